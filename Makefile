@@ -1,0 +1,37 @@
+# The project's commands. Each one sets the project up first when needed.
+#   make setup   Debian packages, virtualenv, catkin workspace (idempotent)
+#   make test    unit tests (pytest), catkin_lint, then the rostests
+#   make demo    the tutorial end to end, headless (TRAJ=step_and_fall|touchdown|touchdown_exhausted)
+#   make bench   the performance benchmark
+SHELL := /bin/bash
+.SHELLFLAGS := -eo pipefail -c
+TRAJ ?= step_and_fall
+IN_ENV := source ./env.sh &&
+
+.PHONY: setup test unit-test lint rostest demo bench clean-workspace
+
+setup:
+	@bash tools/setup.sh
+
+unit-test: setup
+	@$(IN_ENV) python3 -m pytest test/unit -q
+
+lint: setup
+	@$(IN_ENV) catkin_lint -W2 "$$TAC_WS/src"
+
+rostest: setup
+	@$(IN_ENV) bash tools/run_rostests.sh
+
+test: setup
+	@$(IN_ENV) python3 -m pytest test/unit -q
+	@$(IN_ENV) catkin_lint -W2 "$$TAC_WS/src"
+	@$(IN_ENV) bash tools/run_rostests.sh
+
+demo: setup
+	@$(IN_ENV) python3 tools/demo.py "$(TRAJ)"
+
+bench: setup
+	@$(IN_ENV) python3 bench/run_bench.py
+
+clean-workspace:
+	@bash -c 'repo_dir=$$(pwd -P); source tools/paths.sh; rm -rf "$$TAC_HOME"; echo "removed $$TAC_HOME"'

@@ -1,0 +1,26 @@
+# Source this file (`source ./env.sh`) to get the project's whole ROS environment:
+# the catkin workspace sourced, the project's virtualenv first on PATH, and ROS bound to
+# localhost. To open ROS to a network deliberately, export ROS_HOSTNAME (or ROS_IP) and
+# ROS_MASTER_URI with this machine's reachable name *before* sourcing this file.
+if [ -n "${BASH_SOURCE[0]:-}" ]; then
+  repo_dir=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd -P)
+else
+  repo_dir=$(cd "$(dirname "$0")" && pwd -P)
+fi
+. "$repo_dir/tools/paths.sh"
+if [ ! -f "$TAC_WS/devel/setup.sh" ] || [ ! -x "$TAC_VENV/bin/python" ]; then
+  echo "env.sh: the project is not set up yet (no workspace at $TAC_WS); run \`make setup\` first" >&2
+  unset repo_dir
+  return 1 2>/dev/null || exit 1
+fi
+# catkin's setup.sh resets PYTHONPATH/CMAKE_PREFIX_PATH to the workspace chain.
+if [ -n "${BASH_VERSION:-}" ]; then . "$TAC_WS/devel/setup.bash"; else . "$TAC_WS/devel/setup.sh"; fi
+export VIRTUAL_ENV="$TAC_VENV"
+case ":$PATH:" in *":$TAC_VENV/bin:"*) ;; *) export PATH="$TAC_VENV/bin:$PATH" ;; esac
+# Loopback by default: rospy and the master bind to 127.0.0.1 when the host name is localhost.
+export ROS_HOSTNAME="${ROS_HOSTNAME:-localhost}"
+export ROS_MASTER_URI="${ROS_MASTER_URI:-http://localhost:11311}"
+# Offscreen rendering without a GPU or display: software OSMesa unless the user chose otherwise.
+if [ -z "${DISPLAY:-}" ] && [ -z "${MUJOCO_GL:-}" ]; then export MUJOCO_GL=osmesa PYOPENGL_PLATFORM=osmesa; fi
+export TAC_REPO_DIR="$repo_dir"
+unset repo_dir

@@ -1,0 +1,30 @@
+"""The vendored osrf_msgs/JointCommands must be DRCSim's message on the wire."""
+
+import pytest
+
+DRCSIM_MD5 = 'f298c98f3e9c7aae9376ac19f73bfba3'
+FIELDS = ['header', 'name', 'position', 'velocity', 'effort', 'kp_position', 'ki_position',
+          'kd_position', 'kp_velocity', 'i_effort_min', 'i_effort_max']
+
+msg = pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
+
+
+def test_type_and_md5_match_drcsim() -> None:
+    assert msg.JointCommands._type == 'osrf_msgs/JointCommands'
+    assert msg.JointCommands._md5sum == DRCSIM_MD5
+
+
+def test_fields_in_drcsim_order() -> None:
+    assert msg.JointCommands.__slots__ == FIELDS
+    assert msg.JointCommands._slot_types[1:] == ['string[]'] + ['float64[]'] * 9
+
+
+def test_serialization_roundtrip() -> None:
+    from io import BytesIO
+    out = BytesIO()
+    sent = msg.JointCommands(name=['atlas::back_lbz'], position=[0.5], kp_position=[20.0])
+    sent.serialize(out)
+    received = msg.JointCommands().deserialize(out.getvalue())
+    assert received.name == ['atlas::back_lbz']
+    assert list(received.position) == [0.5]
+    assert list(received.kp_position) == [20.0]

@@ -1,0 +1,85 @@
+#!/usr/bin/env bash
+# One-command, idempotent set-up (called by `make setup`):
+#   1. Debian packages (ROS 1 from Debian 12, catkin, software GL) via apt-get;
+#   2. a virtualenv from /usr/bin/python3 with --system-site-packages and the pinned PyPI requirements;
+#   3. a catkin workspace OUTSIDE the repository (a workspace inside the tree makes rosrun loop),
+#      whose src/ holds symlinks to this package and to msg/osrf_msgs.
+# Each step is skipped when its inputs have not changed since the last run.
+set -euo pipefail
+
+repo_dir=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd -P)
+# shellcheck source=tools/paths.sh
+source "$repo_dir/tools/paths.sh"
+
+APT_PACKAGES=(
+  ros-core rosbash rosout python3-rospy python3-rostest python3-rosunit python3-rosbag
+  python3-roslaunch python3-rostopic python3-rosservice python3-rosparam python3-rosmsg
+  catkin catkin-lint python3-catkin-pkg python3-setuptools cmake g++ make
+  ros-message-generation ros-message-runtime python3-genpy python3-gencpp python3-genmsg
+  ros-std-msgs ros-sensor-msgs ros-nav-msgs ros-geometry-msgs ros-std-srvs ros-rosgraph-msgs
+  python3-std-msgs python3-sensor-msgs python3-nav-msgs python3-geometry-msgs python3-std-srvs
+  python3-rosgraph-msgs libstd-msgs-dev libroscpp-dev libsensor-msgs-dev
+  librostest-dev python3-venv python3-yaml python3-numpy
+  libosmesa6 libegl1 libopengl0 libgl1-mesa-dri
+)
+
+log() { printf 'setup: %s\n' "$*"; }
+
+install_debian_packages() {
+  local missing=() pkg
+  for pkg in "${APT_PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q 'install ok installed' || missing+=("$pkg")
+  done
+  [ ${#missing[@]} -eq 0 ] && { log "Debian packages present"; return; }
+  local sudo=()
+  if [ "$(id -u)" -ne 0 ]; then
+    if command -v sudo >/dev/null && sudo -n true 2>/dev/null; then
+      sudo=(sudo -n)
+    else
+      echo "setup: missing Debian packages: ${missing[*]}" >&2
+      echo "setup: run as root or with password-less sudo, or install them with: sudo apt-get install ${missing[*]}" >&2
+      exit 1
+    fi
+  fi
+  log "installing Debian packages: ${missing[*]}"
+  "${sudo[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+}
+
+create_virtualenv() {
+  local stamp="$TAC_VENV/.requirements.sha1" want
+  want=$(sha1sum "$repo_dir/requirements.txt" | cut -d' ' -f1)
+  if [ -x "$TAC_VENV/bin/python" ] && [ "$(cat "$stamp" 2>/dev/null)" = "$want" ]; then
+    log "virtualenv up to date ($TAC_VENV)"; return
+  fi
+  [ -x "$TAC_VENV/bin/python" ] || { log "creating virtualenv $TAC_VENV"; /usr/bin/python3 -m venv --system-site-packages "$TAC_VENV"; }
+  log "installing pinned requirements"
+  "$TAC_VENV/bin/python" -m pip install --disable-pip-version-check -q -r "$repo_dir/requirements.txt"
+  echo "$want" > "$stamp"
+}
+
+build_workspace() {
+  mkdir -p "$TAC_WS/src"
+  ln -sfn "$repo_dir" "$TAC_WS/src/tutorial_atlas_control"
+  ln -sfn "$repo_dir/msg/osrf_msgs" "$TAC_WS/src/osrf_msgs"
+  local stamp="$TAC_WS/.build-inputs.sha1" want
+  want=$( (cd "$repo_dir" && cat CMakeLists.txt package.xml setup.py msg/osrf_msgs/CMakeLists.txt \
+            msg/osrf_msgs/package.xml msg/osrf_msgs/msg/*.msg; ls scripts sim test/rostest 2>/dev/null) | sha1sum | cut -d' ' -f1)
+  if [ -f "$TAC_WS/devel/setup.bash" ] && [ "$(cat "$stamp" 2>/dev/null)" = "$want" ]; then
+    log "catkin workspace up to date ($TAC_WS)"; return
+  fi
+  log "building catkin workspace $TAC_WS"
+  (
+    # catkin must use Debian's Python (where ROS lives), not whatever python3 is first on PATH.
+    unset PYTHONPATH CMAKE_PREFIX_PATH ROS_PACKAGE_PATH
+    cd "$TAC_WS"
+    catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCATKIN_ENABLE_TESTING=ON > "$TAC_WS/build.log" 2>&1 \
+      || { tail -40 "$TAC_WS/build.log" >&2; echo "setup: catkin_make failed; full log: $TAC_WS/build.log" >&2; exit 1; }
+  )
+  echo "$want" > "$stamp"
+}
+
+install_debian_packages
+create_virtualenv
+build_workspace
+log "done; now: source ./env.sh"
