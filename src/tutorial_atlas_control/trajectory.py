@@ -1,0 +1,257 @@
+"""Trajectory files of the DRCSim tutorial: loading, validation and interpolation.
+
+A trajectory file is a YAML mapping from trajectory names to lists of waypoints.
+Each waypoint is a pair ``[duration_s, "p0 p1 ... p27"]``: the time (s) to move
+from where the joints are to the 28 joint positions (rad), given in the order of
+:data:`tutorial_atlas_control.joints.JOINT_NAMES`.  The positions may be a string
+of whitespace-separated numbers, as in the tutorial's ``Traj_data2.yaml``, or a
+YAML list of numbers.
+
+This module is pure (no rospy) so it can be tested without a ROS master; the
+ROS glue is :mod:`tutorial_atlas_control.traj_yaml_node`.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
+from typing import Union
+
+import numpy as np
+import yaml
+
+from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
+
+__all__ = [
+    'PUBLISH_PERIOD_S',
+    'TrajectoryError',
+    'Waypoint',
+    'interpolate',
+    'load_trajectory',
+    'load_trajectory_file',
+    'parse_trajectory',
+    'sample_count',
+]
+
+#: Interval (s) between two published commands: the tutorial's 50 Hz (``dtPublish``).
+PUBLISH_PERIOD_S: float = 0.02
+
+#: Slack (in publish periods) under which ``duration / period`` still counts as a whole
+#: number, so that float artefacts such as 0.14 / 0.02 == 7.000000000000001 give 7
+#: samples rather than 8.
+_SAMPLE_COUNT_SLACK: float = 1e-9
+
+PathLike = Union[str, 'os.PathLike[str]']
+
+
+class TrajectoryError(AtlasControlError):
+    """A trajectory file cannot be read, or a trajectory in it is malformed."""
+
+
+@dataclass(frozen=True)
+class Waypoint:
+    """One row of a trajectory: reach `positions` (rad, tutorial joint order) in `duration_s` (s)."""
+
+    duration_s: float
+    positions: np.ndarray
+
+
+def load_trajectory_file(path: PathLike) -> dict[str, object]:
+    """Read a trajectory file with ``yaml.safe_load`` and check that its root is a mapping.
+
+    Args:
+        path: The YAML file.
+
+    Returns:
+        The mapping of trajectory names to (unvalidated) waypoint lists.
+
+    Raises:
+        TrajectoryError: The file cannot be read, is empty, is not valid YAML, uses a
+            YAML tag that safe loading refuses (``!!python/...``), or its root is not
+            a mapping.  The message is a single line that starts with the path.
+    """
+    try:
+        with open(path, encoding='utf-8') as stream:
+            text = stream.read()
+    except OSError as err:
+        reason = err.strerror or str(err)
+        raise TrajectoryError(f'{path}: cannot read trajectory file: {reason}') from err
+    except UnicodeDecodeError as err:
+        raise TrajectoryError(f'{path}: cannot read trajectory file: not UTF-8 text ({err.reason})') from err
+
+    try:
+        doc = yaml.safe_load(text)
+    except yaml.constructor.ConstructorError as err:
+        raise TrajectoryError(
+            f'{path}: unsupported YAML{_yaml_where(err)}: {err.problem}; '
+            'trajectory files may only hold plain mappings, lists, numbers and strings'
+        ) from err
+    except yaml.YAMLError as err:
+        problem = getattr(err, 'problem', None) or _one_line(str(err))
+        raise TrajectoryError(f'{path}: invalid YAML{_yaml_where(err)}: {problem}') from err
+
+    if doc is None:
+        raise TrajectoryError(f'{path}: the file is empty; expected a mapping of trajectory names to waypoints')
+    if not isinstance(doc, dict):
+        raise TrajectoryError(
+            f'{path}: expected a mapping of trajectory names to waypoints at the top level, '
+            f'got {_kind(doc)}'
+        )
+    return doc
+
+
+def parse_trajectory(doc: Mapping[object, object], name: str, path: PathLike) -> list[Waypoint]:
+    """Validate and convert trajectory `name` of a loaded trajectory file.
+
+    Args:
+        doc: The mapping returned by :func:`load_trajectory_file`.
+        name: The trajectory to extract.
+        path: The file `doc` came from; only used in error messages.
+
+    Returns:
+        The waypoints, in file order (numbered from 0 in messages).
+
+    Raises:
+        TrajectoryError: `name` is not in `doc` (the tutorial's "unable to find
+            trajectory NAME in FILE"), or the trajectory is not a non-empty list of
+            ``[duration_s, positions]`` pairs with a positive finite duration and
+            exactly 28 finite joint positions.  The message names file, trajectory,
+            waypoint index and problem.
+    """
+    if name not in doc:
+        raise TrajectoryError(f'unable to find trajectory {name} in {path}')
+    rows = doc[name]
+    where = f"{path}: trajectory '{name}'"
+    if not isinstance(rows, list):
+        raise TrajectoryError(f'{where}: expected a list of waypoints [duration_s, "positions"], got {_kind(rows)}')
+    if not rows:
+        raise TrajectoryError(f'{where}: has no waypoints')
+    return [_parse_waypoint(row, f'{where}, waypoint {index}') for index, row in enumerate(rows)]
+
+
+def load_trajectory(path: PathLike, name: str) -> list[Waypoint]:
+    """Load trajectory `name` from the file at `path`, fully validated.
+
+    Raises:
+        TrajectoryError: see :func:`load_trajectory_file` and :func:`parse_trajectory`.
+    """
+    return parse_trajectory(load_trajectory_file(path), name, path)
+
+
+def sample_count(duration_s: float) -> int:
+    """Number of commands published for a waypoint lasting `duration_s` (s).
+
+    The tutorial's ``ceil(dt / dtPublish)``, made an ``int`` and at least 1.
+    """
+    if not (math.isfinite(duration_s) and duration_s > 0.0):
+        raise ValueError(f'duration_s must be positive and finite, got {duration_s!r}')
+    return max(1, math.ceil(duration_s / PUBLISH_PERIOD_S - _SAMPLE_COUNT_SLACK))
+
+
+def interpolate(
+    initial: np.ndarray, target: np.ndarray, duration_s: float
+) -> Iterator[tuple[np.ndarray, float]]:
+    """Yield the tutorial's commands from `initial` to `target` over `duration_s`.
+
+    As in the tutorial, ``n = sample_count(duration_s)`` commands
+    ``(1 - ratio) * initial + ratio * target`` for ``ratio in linspace(0, 1, n)``,
+    each followed by a sleep of ``duration_s / n`` (s): the first command is
+    `initial`, the last is `target`, and the whole waypoint lasts `duration_s`.
+    With a single sample (``duration_s <= PUBLISH_PERIOD_S``) the tutorial's
+    ``linspace(0, 1, 1) == [0]`` would only command `initial`; we command `target`.
+
+    The samples are produced lazily, so a long duration costs no memory.
+
+    Yields:
+        ``(positions, sleep_s)``: joint positions (rad) to publish, then the time
+        (s, ROS time) to sleep before the next one.
+    """
+    initial = np.asarray(initial, dtype=float)
+    target = np.asarray(target, dtype=float)
+    if initial.shape != target.shape:
+        raise ValueError(f'initial has shape {initial.shape} but target has shape {target.shape}')
+    count = sample_count(duration_s)
+    sleep_s = duration_s / count
+    if count == 1:
+        yield target.copy(), sleep_s
+        return
+    for index in range(count):
+        ratio = 1.0 if index == count - 1 else index / (count - 1)
+        yield (1.0 - ratio) * initial + ratio * target, sleep_s
+
+
+def _parse_waypoint(row: object, where: str) -> Waypoint:
+    if not isinstance(row, list) or len(row) != 2:
+        raise TrajectoryError(
+            f'{where}: expected a pair [duration_s, "{NUM_JOINTS} joint positions"], got {_kind(row)}'
+        )
+    duration_s = _finite_number(row[0])
+    if duration_s is None:
+        raise TrajectoryError(f'{where}: duration must be a finite number of seconds, got {_show(row[0])}')
+    if duration_s <= 0.0:
+        raise TrajectoryError(f'{where}: duration must be positive, got {_show(row[0])} s')
+    return Waypoint(duration_s=duration_s, positions=_parse_positions(row[1], where))
+
+
+def _parse_positions(value: object, where: str) -> np.ndarray:
+    if isinstance(value, str):
+        items: list[object] = list(value.split())
+    elif isinstance(value, list):
+        items = value
+    else:
+        raise TrajectoryError(
+            f'{where}: joint positions must be a string of {NUM_JOINTS} numbers or a list of them, '
+            f'got {_kind(value)}'
+        )
+    if len(items) != NUM_JOINTS:
+        raise TrajectoryError(f'{where}: expected {NUM_JOINTS} joint positions, got {len(items)}')
+    positions = np.empty(NUM_JOINTS)
+    for index, item in enumerate(items):
+        number = _finite_number(item, allow_text=isinstance(value, str))
+        if number is None:
+            raise TrajectoryError(
+                f'{where}: joint position {index} ({JOINT_NAMES[index]}) must be a finite number, '
+                f'got {_show(item)}'
+            )
+        positions[index] = number
+    return positions
+
+
+def _finite_number(value: object, allow_text: bool = False) -> float | None:
+    """`value` as a finite float, or None if it is not a (finite) number. Booleans are not numbers."""
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, (int, float)) or (allow_text and isinstance(value, str)):
+        try:
+            number = float(value)
+        except (ValueError, OverflowError):
+            return None
+        return number if math.isfinite(number) else None
+    return None
+
+
+def _yaml_where(err: yaml.YAMLError) -> str:
+    mark = getattr(err, 'problem_mark', None) or getattr(err, 'context_mark', None)
+    return f' at line {mark.line + 1}, column {mark.column + 1}' if mark is not None else ''
+
+
+def _one_line(text: str) -> str:
+    return ' '.join(text.split())
+
+
+def _kind(value: object) -> str:
+    if value is None:
+        return 'nothing (null)'
+    if isinstance(value, list):
+        return f'a list of {len(value)} items'
+    if isinstance(value, dict):
+        return 'a mapping'
+    return f'{type(value).__name__} {_show(value)}'
+
+
+def _show(value: object, limit: int = 40) -> str:
+    text = _one_line(repr(value))
+    return text if len(text) <= limit else text[: limit - 3] + '...'
