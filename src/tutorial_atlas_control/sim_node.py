@@ -1,0 +1,306 @@
+"""The simulator node: AtlasSimulator behind DRCSim's ROS interface.
+
+Thin ROS glue. Publishes /clock, /atlas/joint_states, /ground_truth_odom, /atlas/imu and
+the foot contact wrenches in sim time; obeys /atlas/joint_commands and
+/atlas/control_mode; offers gazebo_ros's reset and pause services.
+
+Parameters (private unless noted):
+    ~real_time_factor (float, 1.0): sim time per wall time; 0 runs as fast as possible.
+    ~paused (bool, false): start with physics paused (/gazebo/unpause_physics starts it).
+    ~gui (bool, false): open the MuJoCo viewer (needs a display).
+    ~joint_states_rate, ~imu_rate, ~contact_rate (Hz, 1000): 0 or >= 1000 = every step.
+    ~odom_rate (Hz, 100): /ground_truth_odom rate, as DRCSim.
+    /atlas/time_to_unpin (float, 1.0): seconds the torso stays pinned after start/reset.
+    atlas_controller/gains/<joint>/{p,i,d,i_clamp}: the gains Stand/Freeze/User-hold use.
+"""
+
+from __future__ import annotations
+
+import sys
+import threading
+import time
+from collections.abc import Callable
+
+import genpy
+import mujoco
+import numpy as np
+import rospy
+from geometry_msgs.msg import WrenchStamped
+from nav_msgs.msg import Odometry
+from osrf_msgs.msg import JointCommands
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import Imu, JointState
+from std_msgs.msg import String
+from std_srvs.srv import Empty, EmptyResponse
+
+from tutorial_atlas_control import model as atlas_model
+from tutorial_atlas_control.commands import CommandError
+from tutorial_atlas_control.controller import FIELD_NAMES, gains_from_params
+from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.joints import JOINT_NAMES
+from tutorial_atlas_control.simulator import (
+    DEFAULT_TIME_TO_UNPIN_S, NS_PER_S, AtlasSimulator, ModeError, PhysicsDivergenceError,
+    parse_mode)
+
+NODE_NAME = 'atlas_sim'
+#: Seconds between repeats of the same refusal warning.
+WARN_THROTTLE_S = 2.0
+#: When the loop falls further behind wall time than this, it stops trying to catch up.
+MAX_LAG_S = 0.1
+#: Viewer refresh period (s, wall).
+VIEWER_PERIOD_S = 1.0 / 60.0
+WORLD_FRAME = 'world'
+
+
+def steps_between(rate_hz: float, dt_s: float) -> int:
+    """Publish every N steps for `rate_hz`; 0 or a rate at/above the step rate = every step."""
+    if rate_hz <= 0.0 or rate_hz * dt_s >= 1.0:
+        return 1
+    return max(1, int(round(1.0 / (rate_hz * dt_s))))
+
+
+def stamp(sim_time_ns: int) -> genpy.Time:
+    secs, nsecs = divmod(sim_time_ns, NS_PER_S)
+    return genpy.Time(secs, nsecs)
+
+
+class SimNode:
+    """Owns the simulator, its lock, the publishers and the stepping loop."""
+
+    def __init__(self, sim: AtlasSimulator, real_time_factor: float, paused: bool,
+                 rates_hz: dict[str, float], gui: bool) -> None:
+        self.sim = sim
+        self.lock = threading.Lock()
+        self.real_time_factor = real_time_factor
+        self.paused = paused
+        dt_s = sim.dt_s
+        self.every = {topic: steps_between(rate, dt_s) for topic, rate in rates_hz.items()}
+        self.step_count = 0
+        self.gui = gui
+
+        self.clock_pub = rospy.Publisher('/clock', Clock, queue_size=10)
+        self.joint_state_pub = rospy.Publisher('/atlas/joint_states', JointState, queue_size=100)
+        self.odom_pub = rospy.Publisher('/ground_truth_odom', Odometry, queue_size=100)
+        self.imu_pub = rospy.Publisher('/atlas/imu', Imu, queue_size=100)
+        self.l_contact_pub = rospy.Publisher('/atlas/l_foot_contact', WrenchStamped, queue_size=100)
+        self.r_contact_pub = rospy.Publisher('/atlas/r_foot_contact', WrenchStamped, queue_size=100)
+
+        self.joint_state = JointState(name=list(JOINT_NAMES))
+        self.odom = Odometry()
+        self.odom.header.frame_id = WORLD_FRAME
+        self.odom.child_frame_id = 'pelvis'
+        self.imu = Imu()
+        self.imu.header.frame_id = 'pelvis'
+        self.l_contact = WrenchStamped()
+        self.l_contact.header.frame_id = 'l_foot'
+        self.r_contact = WrenchStamped()
+        self.r_contact.header.frame_id = 'r_foot'
+        data = sim.data
+        self.sensors = {name: data.sensor(name).data for name in (
+            'imu_orientation', 'imu_angular_velocity', 'imu_linear_acceleration',
+            'l_foot_force', 'l_foot_torque', 'r_foot_force', 'r_foot_torque')}
+        self._pelvis_velocity = np.zeros(6)
+
+        rospy.Subscriber('/atlas/joint_commands', JointCommands, self.on_joint_commands,
+                         queue_size=10, tcp_nodelay=True)
+        rospy.Subscriber('/atlas/control_mode', String, self.on_control_mode, queue_size=10)
+        self.services = [
+            rospy.Service('/gazebo/reset_world', Empty, self._service(self.reset_world)),
+            rospy.Service('/gazebo/reset_simulation', Empty, self._service(self.reset_simulation)),
+            rospy.Service('/gazebo/pause_physics', Empty, self._service(self.pause)),
+            rospy.Service('/gazebo/unpause_physics', Empty, self._service(self.unpause)),
+        ]
+
+    # -- subscriptions and services ----------------------------------------------------
+    def on_joint_commands(self, msg: JointCommands) -> None:
+        arrays = {field: getattr(msg, field) for field in FIELD_NAMES}
+        try:
+            with self.lock:
+                self.sim.receive_command(msg.name, arrays)
+        except CommandError as err:
+            rospy.logwarn_throttle(WARN_THROTTLE_S,
+                                   f'refused /atlas/joint_commands: {err}; previous command kept')
+
+    def on_control_mode(self, msg: String) -> None:
+        try:
+            mode = parse_mode(msg.data)
+        except ModeError as err:
+            rospy.logwarn_throttle(WARN_THROTTLE_S, f'refused /atlas/control_mode: {err}')
+            return
+        with self.lock:
+            previous = self.sim.mode
+            self.sim.set_mode(mode)
+        rospy.loginfo(f'control mode: {previous.value} -> {mode.value}')
+
+    def _service(self, action: Callable[[], None]) -> Callable[[object], EmptyResponse]:
+        def handle(_request: object) -> EmptyResponse:
+            action()
+            return EmptyResponse()
+        return handle
+
+    def reset_world(self) -> None:
+        with self.lock:
+            self.sim.reset_world()
+        rospy.loginfo('reset_world: robot back to its initial pose (torso pinned '
+                      f'for {self.sim.time_to_unpin_s} s)')
+
+    def reset_simulation(self) -> None:
+        with self.lock:
+            self.sim.reset_simulation()
+        rospy.loginfo('reset_simulation: robot reset and sim time back to 0')
+
+    def pause(self) -> None:
+        self.paused = True
+        rospy.loginfo('physics paused')
+
+    def unpause(self) -> None:
+        self.paused = False
+        rospy.loginfo('physics unpaused')
+
+    # -- publishing ----------------------------------------------------------------------
+    def publish(self) -> None:
+        """Publish what is due this step (called under the lock, after a step)."""
+        sim = self.sim
+        now = stamp(sim.sim_time_ns)
+        self.clock_pub.publish(Clock(clock=now))
+        count = self.step_count
+        if count % self.every['joint_states'] == 0:
+            msg = self.joint_state
+            msg.header.stamp = now
+            msg.position = sim.joint_positions().tolist()
+            msg.velocity = sim.joint_velocities().tolist()
+            msg.effort = sim.torque_nm.tolist()
+            self.joint_state_pub.publish(msg)
+        if count % self.every['odom'] == 0:
+            self._publish_odom(now)
+        if count % self.every['imu'] == 0:
+            imu = self.imu
+            imu.header.stamp = now
+            w, x, y, z = self.sensors['imu_orientation']
+            imu.orientation.x, imu.orientation.y, imu.orientation.z, imu.orientation.w = x, y, z, w
+            vector_to(imu.angular_velocity, self.sensors['imu_angular_velocity'])
+            vector_to(imu.linear_acceleration, self.sensors['imu_linear_acceleration'])
+            self.imu_pub.publish(imu)
+        if count % self.every['contact'] == 0:
+            for msg, side, pub in ((self.l_contact, 'l', self.l_contact_pub),
+                                   (self.r_contact, 'r', self.r_contact_pub)):
+                msg.header.stamp = now
+                vector_to(msg.wrench.force, self.sensors[f'{side}_foot_force'])
+                vector_to(msg.wrench.torque, self.sensors[f'{side}_foot_torque'])
+                pub.publish(msg)
+
+    def _publish_odom(self, now: genpy.Time) -> None:
+        sim = self.sim
+        odom = self.odom
+        odom.header.stamp = now
+        body = sim.atlas.pelvis_body_id
+        position = sim.data.xpos[body]
+        w, x, y, z = sim.data.xquat[body]
+        pose = odom.pose.pose
+        pose.position.x, pose.position.y, pose.position.z = position
+        pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w = x, y, z, w
+        # World-frame twist of the pelvis frame origin, as Gazebo's p3d plugin reported it.
+        mujoco.mj_objectVelocity(sim.model, sim.data, mujoco.mjtObj.mjOBJ_BODY, body,
+                                 self._pelvis_velocity, 0)
+        vector_to(odom.twist.twist.angular, self._pelvis_velocity[:3])
+        vector_to(odom.twist.twist.linear, self._pelvis_velocity[3:])
+        self.odom_pub.publish(odom)
+
+    # -- the loop ------------------------------------------------------------------------
+    def spin(self) -> None:
+        """Step, publish and pace against wall time until ROS shuts down."""
+        viewer = self._open_viewer() if self.gui else None
+        next_view_s = 0.0
+        wall0 = time.perf_counter()
+        sim0_ns = self.sim.sim_time_ns
+        with self.lock:
+            self.publish()  # /clock and the initial state before the first step
+        while not rospy.is_shutdown():
+            if self.paused:
+                time.sleep(0.01)
+                wall0, sim0_ns = time.perf_counter(), self.sim.sim_time_ns
+                continue
+            with self.lock:
+                try:
+                    self.sim.step()
+                except PhysicsDivergenceError as err:
+                    rospy.logerr(f'{err}; resetting the robot to its initial state')
+                    self.sim.reset_world()
+                self.step_count += 1
+                self.publish()
+                sim_ns = self.sim.sim_time_ns
+            if sim_ns < sim0_ns:  # reset_simulation rewound time
+                wall0, sim0_ns = time.perf_counter(), sim_ns
+            if viewer is not None and time.perf_counter() >= next_view_s:
+                if not viewer.is_running():
+                    rospy.signal_shutdown('viewer closed')
+                    break
+                with self.lock:
+                    viewer.sync()
+                next_view_s = time.perf_counter() + VIEWER_PERIOD_S
+            if self.real_time_factor > 0.0:
+                due_s = wall0 + (sim_ns - sim0_ns) / NS_PER_S / self.real_time_factor
+                ahead_s = due_s - time.perf_counter()
+                if ahead_s > 0.0:
+                    time.sleep(ahead_s)
+                elif ahead_s < -MAX_LAG_S:
+                    wall0, sim0_ns = time.perf_counter(), sim_ns
+        if viewer is not None:
+            viewer.close()
+
+    def _open_viewer(self):  # noqa: ANN202 - mujoco's passive viewer handle
+        try:
+            import mujoco.viewer
+            return mujoco.viewer.launch_passive(self.sim.model, self.sim.data)
+        except Exception as err:  # noqa: BLE001 - no display, no GL: run headless
+            rospy.logwarn(f'cannot open the MuJoCo viewer ({err}); running headless')
+            return None
+
+
+def vector_to(target: object, values: np.ndarray) -> None:
+    """Copy a 3-vector into a geometry_msgs Vector3/Point."""
+    target.x, target.y, target.z = float(values[0]), float(values[1]), float(values[2])
+
+
+def _float_param(name: str, default: float, minimum: float = 0.0) -> float:
+    value = rospy.get_param(name, default)
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) \
+            or value < minimum:
+        raise AtlasControlError(f'parameter {rospy.resolve_name(name)} must be a number '
+                                f'>= {minimum}, got {value!r}')
+    return float(value)
+
+
+def build_node() -> SimNode:
+    """Read parameters, load the model and gains; raise AtlasControlError on bad ones."""
+    gains = gains_from_params(rospy.get_param('atlas_controller/gains', {}))
+    time_to_unpin_s = _float_param('/atlas/time_to_unpin', DEFAULT_TIME_TO_UNPIN_S)
+    rates_hz = {
+        'joint_states': _float_param('~joint_states_rate', 1000.0),
+        'odom': _float_param('~odom_rate', 100.0),
+        'imu': _float_param('~imu_rate', 1000.0),
+        'contact': _float_param('~contact_rate', 1000.0),
+    }
+    sim = AtlasSimulator(atlas_model.load_model(), gains, time_to_unpin_s)
+    return SimNode(sim, _float_param('~real_time_factor', 1.0),
+                   bool(rospy.get_param('~paused', False)), rates_hz,
+                   bool(rospy.get_param('~gui', False)))
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of sim/atlas_sim_node.py."""
+    args = rospy.myargv(argv if argv is not None else sys.argv)
+    if len(args) > 1 and args[1] in ('-h', '--help'):
+        print(__doc__)
+        return 0
+    rospy.init_node(NODE_NAME)
+    try:
+        node = build_node()
+    except AtlasControlError as err:
+        rospy.logfatal(f'{NODE_NAME}: {err}')
+        return 1
+    rospy.loginfo(f'Atlas v1 simulator ready: dt={node.sim.dt_s * 1000:.1f} ms, '
+                  f'real_time_factor={node.real_time_factor}, paused={node.paused}, '
+                  f'torso pinned for {node.sim.time_to_unpin_s} s')
+    node.spin()
+    return 0

@@ -1,0 +1,174 @@
+"""The Atlas simulation without ROS: modes, pinning, the controller law and stepping.
+
+The ROS node (sim_node.py) owns one AtlasSimulator and only translates messages;
+everything that decides what torque a joint gets lives here, so it is unit-tested
+without a master and shared with offline replay.
+"""
+
+from __future__ import annotations
+
+import enum
+from collections.abc import Mapping, Sequence
+
+import mujoco
+import numpy as np
+
+from tutorial_atlas_control import model as atlas_model
+from tutorial_atlas_control.commands import merge_command
+from tutorial_atlas_control.controller import (
+    Gains, JointCommandArrays, PidState, compute_torque, hold_command)
+from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.joints import NUM_JOINTS
+
+#: DRCSim released the pinned torso after this long (s); `/atlas/time_to_unpin` overrides it.
+DEFAULT_TIME_TO_UNPIN_S = 1.0
+#: Simulation time is counted in whole steps to keep stamps exact (ns).
+NS_PER_S = 1_000_000_000
+
+
+class ControlMode(str, enum.Enum):
+    """The strings DRCSim accepted on /atlas/control_mode."""
+
+    STAND = 'Stand'
+    STAND_PREP = 'StandPrep'
+    FREEZE = 'Freeze'
+    RAGDOLL = 'ragdoll'
+    USER = 'User'
+
+
+VALID_MODES: tuple[str, ...] = tuple(mode.value for mode in ControlMode)
+
+
+class ModeError(AtlasControlError):
+    """An unknown control mode string."""
+
+
+class PhysicsDivergenceError(AtlasControlError):
+    """The physics produced NaN/Inf or MuJoCo flagged an unstable step."""
+
+
+def parse_mode(text: str) -> ControlMode:
+    """Return the ControlMode for a /atlas/control_mode string.
+
+    Raises:
+        ModeError: the string is not one of VALID_MODES (the message lists them).
+    """
+    try:
+        return ControlMode(text)
+    except ValueError:
+        shown = text if len(text) <= 40 else text[:40] + '...'
+        raise ModeError(f'unknown control mode {shown!r}; valid modes: '
+                        + ', '.join(VALID_MODES)) from None
+
+
+class AtlasSimulator:
+    """One Atlas in MuJoCo, driven by DRCSim's per-joint controller law.
+
+    Not thread-safe: the ROS node calls every method under its own lock.
+    """
+
+    def __init__(self, atlas: atlas_model.AtlasModel, gains: Gains,
+                 time_to_unpin_s: float = DEFAULT_TIME_TO_UNPIN_S) -> None:
+        self.atlas = atlas
+        self.model = atlas.model
+        self.data = mujoco.MjData(self.model)
+        self.gains = gains
+        self.time_to_unpin_s = time_to_unpin_s
+        self.dt_s = float(self.model.opt.timestep)
+        self.step_ns = int(round(self.dt_s * NS_PER_S))
+        self.mode = ControlMode.STAND
+        self.user_command: JointCommandArrays | None = None
+        self.torque_nm = np.zeros(NUM_JOINTS)
+        self._pid = PidState()
+        self._mode_command = hold_command(gains, np.zeros(NUM_JOINTS))
+        self._ragdoll_command = JointCommandArrays.zeros()
+        self.sim_time_ns = 0
+        self.pinned = False
+        self.reset_world()
+
+    # -- state -------------------------------------------------------------------------
+    def reset_world(self) -> None:
+        """Robot back to its initial state (pinned again), sim time kept, as Gazebo did."""
+        atlas_model.reset_to_initial(self.atlas, self.data)
+        self.data.time = self.sim_time_ns / NS_PER_S
+        self._pid.reset()
+        self.torque_nm[:] = 0.0
+        # A reset robot waits for fresh commands rather than jumping to a stale target.
+        self.user_command = None
+        self._pin_until_ns = self.sim_time_ns + int(round(self.time_to_unpin_s * NS_PER_S))
+        self._set_pinned(self.time_to_unpin_s > 0.0)
+        if self.mode in (ControlMode.FREEZE, ControlMode.USER):
+            self._mode_command = hold_command(self.gains, self.joint_positions())
+
+    def reset_simulation(self) -> None:
+        """reset_world, and sim time back to 0."""
+        self.sim_time_ns = 0
+        self.reset_world()
+
+    def _set_pinned(self, pinned: bool) -> None:
+        atlas_model.set_pelvis_pinned(self.atlas, self.data, pinned)
+        self.pinned = pinned
+
+    def joint_positions(self) -> np.ndarray:
+        return atlas_model.joint_positions(self.atlas, self.data)
+
+    def joint_velocities(self) -> np.ndarray:
+        return atlas_model.joint_velocities(self.atlas, self.data)
+
+    # -- commands ----------------------------------------------------------------------
+    def set_mode(self, mode: ControlMode) -> None:
+        """Switch control mode; Freeze and User start by holding the current pose."""
+        if mode in (ControlMode.STAND, ControlMode.STAND_PREP):
+            self._mode_command = hold_command(self.gains, np.zeros(NUM_JOINTS))
+        elif mode in (ControlMode.FREEZE, ControlMode.USER):
+            self._mode_command = hold_command(self.gains, self.joint_positions())
+        self.mode = mode
+
+    def receive_command(self, names: Sequence[str],
+                        arrays: Mapping[str, Sequence[float]]) -> None:
+        """Merge one JointCommands message into the user command (applied in User mode).
+
+        Joints the message does not name keep their previous command; before the first
+        command that is the current pose with the parameter-server gains.
+
+        Raises:
+            CommandError: the message is refused whole; the previous command stays.
+        """
+        previous = self.user_command
+        if previous is None:
+            previous = hold_command(self.gains, self.joint_positions())
+        self.user_command = merge_command(previous, names, arrays)
+
+    def active_command(self) -> JointCommandArrays:
+        """The command the law applies this step, given the mode."""
+        if self.mode is ControlMode.RAGDOLL:
+            return self._ragdoll_command
+        if self.mode is ControlMode.USER and self.user_command is not None:
+            return self.user_command
+        return self._mode_command
+
+    # -- stepping ----------------------------------------------------------------------
+    def step(self) -> None:
+        """Apply the controller law and advance one physics step.
+
+        Raises:
+            PhysicsDivergenceError: the new state is not finite (the caller resets).
+        """
+        if self.pinned and self.sim_time_ns >= self._pin_until_ns:
+            self._set_pinned(False)
+        data = self.data
+        torque = compute_torque(
+            self.active_command(), self.joint_positions(), self.joint_velocities(),
+            self._pid, self.dt_s, self.atlas.lower_rad, self.atlas.upper_rad,
+            self.atlas.effort_limit_nm)
+        self.torque_nm[:] = torque
+        data.ctrl[:] = torque
+        mujoco.mj_step(self.model, data)
+        self.sim_time_ns += self.step_ns
+        if not (np.isfinite(data.qpos).all() and np.isfinite(data.qvel).all()):
+            raise PhysicsDivergenceError(
+                f'physics diverged at t={self.sim_time_ns / NS_PER_S:.3f} s (non-finite state)')
+        if data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number > 0:
+            data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number = 0
+            raise PhysicsDivergenceError(
+                f'physics diverged at t={self.sim_time_ns / NS_PER_S:.3f} s (bad acceleration)')

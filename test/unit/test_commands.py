@@ -1,0 +1,90 @@
+"""JointCommands mapping and refusal rules (commands.merge_command)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from tutorial_atlas_control.commands import CommandError, joint_indices, merge_command
+from tutorial_atlas_control.controller import FIELD_NAMES, JointCommandArrays
+from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
+
+
+def previous_command() -> JointCommandArrays:
+    command = JointCommandArrays.zeros()
+    command.position[:] = np.arange(NUM_JOINTS) * 0.01
+    command.kp_position[:] = 100.0
+    return command
+
+
+def test_empty_names_read_arrays_in_tutorial_order() -> None:
+    positions = np.linspace(-1.0, 1.0, NUM_JOINTS)
+    merged = merge_command(previous_command(), [], {'position': positions})
+    np.testing.assert_array_equal(merged.position, positions)
+    # Fields sent empty keep their previous values.
+    np.testing.assert_array_equal(merged.kp_position, np.full(NUM_JOINTS, 100.0))
+
+
+@pytest.mark.parametrize('prefix', ['', 'atlas::'])
+def test_named_subset_in_any_order_maps_by_name(prefix: str) -> None:
+    names = [prefix + 'r_arm_elx', prefix + 'back_lbz', prefix + 'l_leg_kny']
+    merged = merge_command(previous_command(), names,
+                           {'position': [0.3, -0.2, 1.1], 'kd_position': [1.0, 2.0, 3.0]})
+    assert merged.position[JOINT_INDEX['r_arm_elx']] == 0.3
+    assert merged.position[JOINT_INDEX['back_lbz']] == -0.2
+    assert merged.position[JOINT_INDEX['l_leg_kny']] == 1.1
+    assert merged.kd_position[JOINT_INDEX['l_leg_kny']] == 3.0
+    untouched = JOINT_INDEX['neck_ay']
+    assert merged.position[untouched] == pytest.approx(untouched * 0.01)
+    assert merged.kd_position[untouched] == 0.0
+
+
+def test_shuffled_full_command_equals_ordered_one() -> None:
+    rng = np.random.default_rng(7)
+    values = rng.normal(size=NUM_JOINTS)
+    order = rng.permutation(NUM_JOINTS)
+    shuffled = merge_command(previous_command(), ['atlas::' + JOINT_NAMES[i] for i in order],
+                             {'position': values[order]})
+    ordered = merge_command(previous_command(), [], {'position': values})
+    np.testing.assert_array_equal(shuffled.position, ordered.position)
+
+
+def test_previous_command_is_not_modified() -> None:
+    previous = previous_command()
+    merge_command(previous, ['neck_ay'], {'position': [0.5]})
+    assert previous.position[JOINT_INDEX['neck_ay']] == pytest.approx(0.03)
+
+
+@pytest.mark.parametrize(('names', 'arrays', 'reason'), [
+    ([], {'position': [0.0] * 27}, 'position has 27 entries for 28 commanded joints'),
+    (['neck_ay', 'back_lbz'], {'effort': [1.0]}, 'effort has 1 entries for 2 commanded joints'),
+    (['neck_ay'], {'position': [math.nan]}, r'position\[0\] is nan'),
+    (['neck_ay'], {'kp_position': [math.inf]}, r'kp_position\[0\] is inf'),
+    (['atlas::nose'], {'position': [0.0]}, "unknown joint name 'atlas::nose'"),
+    (['neck_ay', 'atlas::neck_ay'], {'position': [0.0, 0.0]}, 'named twice'),
+])
+def test_bad_messages_are_refused_with_the_reason(names: list[str], arrays: dict,
+                                                  reason: str) -> None:
+    with pytest.raises(CommandError, match=reason):
+        merge_command(previous_command(), names, arrays)
+
+
+def test_refusal_is_all_or_nothing() -> None:
+    previous = previous_command()
+    arrays = {'position': [9.0] * NUM_JOINTS, 'velocity': [0.0] * (NUM_JOINTS - 1)}
+    with pytest.raises(CommandError):
+        merge_command(previous, [], arrays)
+    assert previous.position[0] == 0.0
+
+
+def test_every_field_is_mergeable() -> None:
+    merged = merge_command(JointCommandArrays.zeros(), ['back_mby'],
+                           {field: [float(k + 1)] for k, field in enumerate(FIELD_NAMES)})
+    for k, field in enumerate(FIELD_NAMES):
+        assert getattr(merged, field)[JOINT_INDEX['back_mby']] == k + 1
+
+
+def test_empty_names_mean_all_joints() -> None:
+    np.testing.assert_array_equal(joint_indices([]), np.arange(NUM_JOINTS))
