@@ -1,0 +1,93 @@
+"""Command line of analyze_bag.py: summarize a recorded run, optionally as JSON/CSV/plot."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import Sequence
+
+from tutorial_atlas_control.bag_analysis import (
+    COMMAND_CHANGE_RAD,
+    EFFORT_LIMIT_TOLERANCE_NM,
+    FALL_HEIGHT_M,
+    MOVED_RANGE_RAD,
+    analyze_bag,
+)
+from tutorial_atlas_control.bag_report import format_summary, plot_run, to_json, write_csv
+from tutorial_atlas_control.errors import AtlasControlError
+
+PROG = 'analyze_bag.py'
+
+DESCRIPTION = """\
+Summarize a run recorded with `rosbag record` (reads the bag with rosbags; no roscore).
+
+Reports the bag's duration, every topic with type, message count and rate; the control
+mode timeline (/atlas/control_mode); whether and when the robot fell (first time the
+pelvis height in /ground_truth_odom drops below {fall} m); for each joint that moved
+(measured range > {moved} rad, or a commanded position that changes by more than
+{change:g} rad) the RMS and max tracking error: at every /atlas/joint_states stamp, the
+latest /atlas/joint_commands position at or before it (zero-order hold, per joint,
+names matched without 'atlas::', empty names = tutorial order) minus the measured
+position; the command rate and the command age (state stamp minus latest command stamp);
+and the joints that reached their effort limit (|effort| >= limit - {tol} N·m) and for
+how long.
+
+Times are header stamps (sim time) where messages have them, bag record time otherwise,
+given in seconds from the bag's start.
+"""
+
+EPILOG = """\
+JSON keys (--json): bag, start_time (s), duration (s), topics {name: {type, count,
+rate (Hz or null)}}, mode_timeline [{time (s), mode}], fell (bool, null without
+odometry), fall_time (s or null), min_pelvis_height (m), joints {name: {rms_error,
+max_error (rad), samples, commanded, measured_range (rad)}} (joints that moved),
+command_rate (Hz), command_count, command_age {mean, max} (s), effort_saturation
+{name: {limit (N·m), duration (s), first_time (s), samples}}, thresholds,
+unavailable {metric: reason}, warnings [text].
+
+Exit status: 0 on success (also when some metrics are unavailable), 1 when the bag
+cannot be read (missing, not a bag, unindexed: run `rosbag reindex BAG`) or an output
+cannot be written, 2 on bad arguments.
+
+Example: rosrun tutorial_atlas_control analyze_bag.py run.bag --plot run.png --csv run_csv
+"""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser (its --help is the documentation)."""
+    parser = argparse.ArgumentParser(
+        prog=PROG, formatter_class=argparse.RawDescriptionHelpFormatter,
+        description=DESCRIPTION.format(fall=FALL_HEIGHT_M, moved=MOVED_RANGE_RAD,
+                                       change=COMMAND_CHANGE_RAD, tol=EFFORT_LIMIT_TOLERANCE_NM),
+        epilog=EPILOG)
+    parser.add_argument('bag', metavar='BAG', help='the ROS 1 .bag file to analyze')
+    parser.add_argument('--json', action='store_true',
+                        help='print the results as one JSON object instead of the text summary')
+    parser.add_argument('--plot', metavar='FILE.png',
+                        help='write commanded vs measured positions of the joints that moved and '
+                             'the pelvis height, with mode changes marked, to this image')
+    parser.add_argument('--csv', metavar='DIR',
+                        help='write joint_states.csv (t, <joint>_position..., _velocity..., '
+                             '_effort...), joint_commands.csv (t, <joint>_position as sent, nan = '
+                             'not sent) and pelvis_pose.csv (t, x y z, qx qy qz qw, vx vy vz, '
+                             'wx wy wz) into this directory (created if needed)')
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; return the exit status."""
+    args = build_parser().parse_args(argv)
+    try:
+        analysis = analyze_bag(args.bag)
+        print(to_json(analysis) if args.json else format_summary(analysis))
+        if args.csv:
+            for path in write_csv(analysis.data, args.csv):
+                print(f'wrote {path}', file=sys.stderr)
+        if args.plot:
+            print(f'wrote {plot_run(analysis, args.plot)}', file=sys.stderr)
+    except AtlasControlError as err:
+        print(f'{PROG}: error: {err}', file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        return 130
+    return 0

@@ -1,0 +1,234 @@
+"""Present a bag :class:`~tutorial_atlas_control.bag_analysis.Analysis`: text, JSON, CSV, plot."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from tutorial_atlas_control.bag_analysis import (
+    EFFORT_LIMIT_TOLERANCE_NM,
+    FALL_HEIGHT_M,
+    JOINT_COMMANDS_TOPIC,
+    MOVED_RANGE_RAD,
+    Analysis,
+    BagAnalysisError,
+    BagData,
+)
+from tutorial_atlas_control.joints import JOINT_NAMES
+
+__all__ = ['format_summary', 'plot_run', 'to_json', 'write_csv']
+
+#: Most points drawn per line; longer series are decimated (plots, not analysis).
+PLOT_MAX_POINTS = 4000
+#: Height of one subplot (inches) and the figure width (inches).
+PLOT_ROW_HEIGHT_IN = 1.6
+PLOT_WIDTH_IN = 11.0
+#: Significant digits written to CSV files.
+CSV_FORMAT = '%.10g'
+
+
+def _fmt(value: float | None, spec: str, unit: str = '') -> str:
+    return 'n/a' if value is None else f'{value:{spec}}{unit}'
+
+
+def format_summary(analysis: Analysis) -> str:
+    """The human-readable report, several lines, no trailing newline."""
+    data = analysis.data
+    lines = [f'Bag:      {data.path}',
+             f'Duration: {data.duration_s:.3f} s (start {data.start_time_s:.3f} s)', 'Topics:']
+    width = max((len(name) for name in data.topics), default=0)
+    type_width = max((len(topic.msgtype) for topic in data.topics.values()), default=0)
+    for name, topic in data.topics.items():
+        lines.append(f'  {name:<{width}}  {topic.msgtype:<{type_width}}  {topic.count:>8} msgs  '
+                     f'{_fmt(topic.rate_hz, "9.2f", " Hz")}')
+    if not data.topics:
+        lines.append('  (none: the bag is empty)')
+
+    lines.append('Control modes:')
+    lines.extend(f'  {t_s:9.3f} s  {mode}' for t_s, mode in data.modes)
+    if not data.modes:
+        lines.append('  (no /atlas/control_mode messages)')
+
+    if analysis.fell is None:
+        lines.append(f'Fall:     unknown ({analysis.unavailable.get("fall", "no pelvis data")})')
+    elif analysis.fell:
+        lines.append(f'Fall:     FELL at {analysis.fall_time_s:.3f} s (pelvis below '
+                     f'{FALL_HEIGHT_M} m; lowest {analysis.min_pelvis_height_m:.3f} m)')
+    else:
+        lines.append(f'Fall:     no (pelvis stayed above {FALL_HEIGHT_M} m; lowest '
+                     f'{analysis.min_pelvis_height_m:.3f} m)')
+
+    count = 0 if data.commands is None else len(data.commands.t_s)
+    if count:
+        age = ('' if analysis.command_age_mean_s is None else
+               f'; command age mean {analysis.command_age_mean_s * 1e3:.1f} ms, '
+               f'max {analysis.command_age_max_s * 1e3:.1f} ms')
+        lines.append(f'Commands: {count} on {JOINT_COMMANDS_TOPIC} at '
+                     f'{_fmt(analysis.command_rate_hz, ".1f", " Hz")}{age}')
+    else:
+        lines.append(f'Commands: none on {JOINT_COMMANDS_TOPIC}')
+
+    if 'joints' in analysis.unavailable:
+        lines.append(f'Tracking: unavailable ({analysis.unavailable["joints"]})')
+    elif not analysis.joints:
+        lines.append(f'Tracking: no joint moved (measured range <= {MOVED_RANGE_RAD} rad, '
+                     'constant commands)')
+    else:
+        lines.append('Tracking (joints that moved; |command - measured| at each joint state, '
+                     'latest command held):')
+        name_width = max(len(name) for name in analysis.joints)
+        lines.append(f'  {"joint":<{name_width}}  {"RMS (rad)":>10}  {"max (rad)":>10}  '
+                     f'{"samples":>8}')
+        for name, joint in analysis.joints.items():
+            lines.append(f'  {name:<{name_width}}  {_fmt(joint.rms_error_rad, "10.5f")}  '
+                         f'{_fmt(joint.max_error_rad, "10.5f")}  {joint.samples:>8}'
+                         + ('' if joint.commanded else '  (never commanded)'))
+
+    if analysis.effort_saturation is None:
+        lines.append(f'Effort:   unavailable ({analysis.unavailable.get("effort_saturation")})')
+    elif not analysis.effort_saturation:
+        lines.append('Effort:   no joint reached its effort limit')
+    else:
+        lines.append(f'Effort limit reached (|effort| >= limit - {EFFORT_LIMIT_TOLERANCE_NM} N·m):')
+        for name, sat in analysis.effort_saturation.items():
+            lines.append(f'  {name:<10} limit {sat.limit_nm:8.3f} N·m  for {sat.duration_s:.3f} s '
+                         f'(first at {sat.first_time_s:.3f} s)')
+    lines.extend(f'Warning:  {warning}' for warning in data.warnings)
+    return '\n'.join(lines)
+
+
+def _json_safe(value: Any) -> Any:
+    """NaN/inf -> None and numpy scalars -> Python, so the output is strict JSON."""
+    if isinstance(value, dict):
+        return {key: _json_safe(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_json_safe(item) for item in value]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def to_json(analysis: Analysis) -> str:
+    """The analysis as one JSON object (strict JSON: no NaN)."""
+    return json.dumps(_json_safe(analysis.to_dict()), indent=2, allow_nan=False)
+
+
+def _save_csv(path: Path, header: list[str], columns: list[np.ndarray]) -> Path:
+    table = np.column_stack(columns) if columns else np.empty((0, len(header)))
+    np.savetxt(path, table, delimiter=',', header=','.join(header), comments='', fmt=CSV_FORMAT)
+    return path
+
+
+def write_csv(data: BagData, directory: Path | str) -> list[Path]:
+    """Write joint_states.csv, joint_commands.csv and pelvis_pose.csv (those available).
+
+    Columns: `t` (s from bag start) then, for joint states, `<joint>_position` for
+    every joint, then `_velocity`, then `_effort`; for commands, `<joint>_position` as
+    sent (nan = not in that message); for the pelvis, x y z (m), qx qy qz qw,
+    vx vy vz (m/s), wx wy wz (rad/s).
+
+    Raises:
+        BagAnalysisError: The directory cannot be created or written.
+    """
+    directory = Path(directory)
+    written = []
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+        states = data.joint_states
+        if states is not None:
+            header = ['t'] + [f'{name}_{quantity}' for quantity in ('position', 'velocity', 'effort')
+                              for name in states.names]
+            written.append(_save_csv(directory / 'joint_states.csv', header,
+                                     [states.t_s, states.position, states.velocity,
+                                      states.effort]))
+        if data.commands is not None:
+            header = ['t'] + [f'{name}_position' for name in JOINT_NAMES]
+            written.append(_save_csv(directory / 'joint_commands.csv', header,
+                                     [data.commands.t_s, data.commands.position]))
+        pelvis = data.pelvis
+        if pelvis is not None:
+            header = ['t', 'x', 'y', 'z', 'qx', 'qy', 'qz', 'qw', 'vx', 'vy', 'vz', 'wx', 'wy',
+                      'wz']
+            written.append(_save_csv(directory / 'pelvis_pose.csv', header,
+                                     [pelvis.t_s, pelvis.position_m, pelvis.orientation_xyzw,
+                                      pelvis.linear_velocity_m_s, pelvis.angular_velocity_rad_s]))
+    except OSError as err:
+        msg = f'Could not write CSV files to {directory}: {err.strerror or err}.'
+        raise BagAnalysisError(msg) from err
+    return written
+
+
+def _decimate(t_s: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    step = max(1, len(t_s) // PLOT_MAX_POINTS)
+    return t_s[::step], values[::step]
+
+
+def plot_run(analysis: Analysis, path: Path | str) -> Path:
+    """Plot commanded vs measured positions of the joints that moved, and pelvis height.
+
+    One subplot per moved joint plus one for the pelvis height, sharing the time axis;
+    control-mode changes are vertical lines labelled with the mode.
+
+    Raises:
+        BagAnalysisError: The image cannot be written.
+    """
+    import matplotlib  # noqa: PLC0415 - only needed with --plot
+
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    data, path = analysis.data, Path(path)
+    names = list(analysis.joints)
+    rows = len(names) + (data.pelvis is not None)
+    fig, axes = plt.subplots(max(rows, 1), 1, sharex=True, squeeze=False,
+                             figsize=(PLOT_WIDTH_IN, PLOT_ROW_HEIGHT_IN * max(rows, 2) + 1.0))
+    axes = list(axes[:, 0])
+    states, commands = data.joint_states, data.commands
+    for ax, name in zip(axes, names):
+        if commands is not None and name in JOINT_NAMES:
+            sent = commands.position[:, JOINT_NAMES.index(name)]
+            finite = np.isfinite(sent)
+            if finite.any():
+                ax.plot(commands.t_s[finite], sent[finite], drawstyle='steps-post',
+                        color='tab:orange', label='commanded')
+        if states is not None:
+            ax.plot(*_decimate(states.t_s, states.position[:, states.names.index(name)]),
+                    color='tab:blue', linewidth=1.0, label='measured')
+        ax.set_ylabel(f'{name}\n(rad)', fontsize=8)
+    if data.pelvis is not None:
+        ax = axes[len(names)]
+        ax.plot(*_decimate(data.pelvis.t_s, data.pelvis.position_m[:, 2]), color='tab:green',
+                label='pelvis z')
+        ax.axhline(FALL_HEIGHT_M, color='tab:red', linestyle=':', label='fall threshold')
+        if analysis.fall_time_s is not None:
+            ax.plot([analysis.fall_time_s], [FALL_HEIGHT_M], 'rx', label='fall')
+        ax.set_ylabel('pelvis\nheight (m)', fontsize=8)
+    if rows == 0:
+        axes[0].text(0.5, 0.5, 'nothing to plot: no joint moved and no pelvis data',
+                     ha='center', va='center', transform=axes[0].transAxes)
+    for ax in axes:
+        for t_s, _ in data.modes:
+            ax.axvline(t_s, color='gray', linestyle='--', linewidth=0.8)
+    for t_s, mode in data.modes:
+        axes[0].annotate(mode, (t_s, 1.0), xycoords=('data', 'axes fraction'),
+                         xytext=(2, 2), textcoords='offset points', fontsize=8, rotation=30)
+    axes[0].legend(loc='upper right', fontsize=7)
+    if data.pelvis is not None and names:
+        axes[-1].legend(loc='upper right', fontsize=7)
+    axes[-1].set_xlabel('time from bag start (s)')
+    fig.suptitle(f'{data.path.name}: commanded vs measured', y=0.995)
+    fig.tight_layout()
+    try:
+        fig.savefig(path, dpi=100)
+    except OSError as err:
+        msg = f'Could not write the plot to {path}: {err.strerror or err}.'
+        raise BagAnalysisError(msg) from err
+    finally:
+        plt.close(fig)
+    return path

@@ -1,0 +1,237 @@
+"""Write small synthetic ROS 1 bags with rosbags, shaped like the simulator's recordings.
+
+Tests describe a run as a list of :class:`Record` (topic, ROS 1 type, bag time, message)
+built with the helpers below and write it with :func:`write_bag`. Times are sim time in
+seconds; bag record time equals the header stamp, as with ``/use_sim_time`` true.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Iterable, Sequence
+
+import numpy as np
+from rosbags.rosbag1 import Writer
+from rosbags.typesys import Stores, get_typestore, get_types_from_msg
+from rosbags.typesys.store import Typestore
+
+from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
+
+#: The repository's definition of osrf_msgs/JointCommands.
+JOINT_COMMANDS_MSG = (
+    Path(__file__).resolve().parents[2] / 'msg' / 'osrf_msgs' / 'msg' / 'JointCommands.msg'
+)
+
+NS_PER_S = 1_000_000_000
+
+#: Topics and ROS 1 types, as the simulator records them.
+TOPIC_TYPES: dict[str, str] = {
+    '/clock': 'rosgraph_msgs/Clock',
+    '/atlas/joint_states': 'sensor_msgs/JointState',
+    '/ground_truth_odom': 'nav_msgs/Odometry',
+    '/atlas/imu': 'sensor_msgs/Imu',
+    '/atlas/l_foot_contact': 'geometry_msgs/WrenchStamped',
+    '/atlas/r_foot_contact': 'geometry_msgs/WrenchStamped',
+    '/atlas/joint_commands': 'osrf_msgs/JointCommands',
+    '/atlas/control_mode': 'std_msgs/String',
+}
+
+
+def make_typestore() -> Typestore:
+    """Return a ROS 1 Noetic typestore with osrf_msgs/JointCommands registered."""
+    typestore = get_typestore(Stores.ROS1_NOETIC)
+    typestore.register(
+        get_types_from_msg(JOINT_COMMANDS_MSG.read_text(), 'osrf_msgs/msg/JointCommands'))
+    return typestore
+
+
+TYPESTORE = make_typestore()
+
+
+def _ros2_name(msgtype: str) -> str:
+    package, name = msgtype.split('/')
+    return f'{package}/msg/{name}'
+
+
+def _type(msgtype: str) -> Any:
+    return TYPESTORE.types[_ros2_name(msgtype)]
+
+
+def _time(t_s: float) -> Any:
+    stamp_ns = round(t_s * NS_PER_S)
+    return _type('builtin_interfaces/Time')(sec=stamp_ns // NS_PER_S, nanosec=stamp_ns % NS_PER_S)
+
+
+def _header(t_s: float, frame_id: str = '', seq: int = 0) -> Any:
+    return _type('std_msgs/Header')(seq=seq, stamp=_time(t_s), frame_id=frame_id)
+
+
+def _f64(values: Sequence[float] | np.ndarray | None) -> np.ndarray:
+    return np.asarray([] if values is None else values, dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class Record:
+    """One message to write: topic, ROS 1 type ('pkg/Name'), bag time (s), message."""
+
+    topic: str
+    msgtype: str
+    t_s: float
+    message: Any
+
+
+def joint_state(t_s: float, position: Sequence[float] | np.ndarray,
+                velocity: Sequence[float] | np.ndarray | None = None,
+                effort: Sequence[float] | np.ndarray | None = None,
+                names: Sequence[str] = JOINT_NAMES, seq: int = 0) -> Record:
+    """A /atlas/joint_states message stamped `t_s`; velocity/effort default to zeros."""
+    count = len(names)
+    msg = _type('sensor_msgs/JointState')(
+        header=_header(t_s, seq=seq), name=list(names), position=_f64(position),
+        velocity=_f64(np.zeros(count) if velocity is None else velocity),
+        effort=_f64(np.zeros(count) if effort is None else effort))
+    return Record('/atlas/joint_states', 'sensor_msgs/JointState', t_s, msg)
+
+
+def joint_commands(t_s: float, position: Sequence[float] | np.ndarray,
+                   names: Sequence[str] = (), stamp_s: float | None = None) -> Record:
+    """A /atlas/joint_commands message; `names` empty means tutorial order.
+
+    `stamp_s` overrides the header stamp (default `t_s`); 0 models an unstamped command.
+    """
+    count = len(position)
+    zeros = np.zeros(count)
+    msg = _type('osrf_msgs/JointCommands')(
+        header=_header(t_s if stamp_s is None else stamp_s), name=list(names),
+        position=_f64(position), velocity=_f64(zeros), effort=_f64(zeros),
+        kp_position=_f64(zeros), ki_position=_f64(zeros), kd_position=_f64(zeros),
+        kp_velocity=_f64(zeros), i_effort_min=_f64(zeros), i_effort_max=_f64(zeros))
+    return Record('/atlas/joint_commands', 'osrf_msgs/JointCommands', t_s, msg)
+
+
+def odometry(t_s: float, z_m: float, x_m: float = 0.0, y_m: float = 0.0,
+             vz_m_s: float = 0.0) -> Record:
+    """A /ground_truth_odom message with the pelvis at (x, y, z), identity orientation."""
+    geo = _type
+    pose = geo('geometry_msgs/PoseWithCovariance')(
+        pose=geo('geometry_msgs/Pose')(
+            position=geo('geometry_msgs/Point')(x=x_m, y=y_m, z=z_m),
+            orientation=geo('geometry_msgs/Quaternion')(x=0.0, y=0.0, z=0.0, w=1.0)),
+        covariance=np.zeros(36))
+    twist = geo('geometry_msgs/TwistWithCovariance')(
+        twist=geo('geometry_msgs/Twist')(
+            linear=geo('geometry_msgs/Vector3')(x=0.0, y=0.0, z=vz_m_s),
+            angular=geo('geometry_msgs/Vector3')(x=0.0, y=0.0, z=0.0)),
+        covariance=np.zeros(36))
+    msg = _type('nav_msgs/Odometry')(
+        header=_header(t_s, frame_id='world'), child_frame_id='pelvis', pose=pose, twist=twist)
+    return Record('/ground_truth_odom', 'nav_msgs/Odometry', t_s, msg)
+
+
+def control_mode(t_s: float, mode: str) -> Record:
+    """A /atlas/control_mode message (std_msgs/String, no header) recorded at `t_s`."""
+    return Record('/atlas/control_mode', 'std_msgs/String', t_s, _type('std_msgs/String')(data=mode))
+
+
+def clock(t_s: float) -> Record:
+    """A /clock message."""
+    return Record('/clock', 'rosgraph_msgs/Clock', t_s, _type('rosgraph_msgs/Clock')(clock=_time(t_s)))
+
+
+def imu(t_s: float) -> Record:
+    """A /atlas/imu message at rest."""
+    geo = _type
+    msg = _type('sensor_msgs/Imu')(
+        header=_header(t_s, frame_id='imu_link'),
+        orientation=geo('geometry_msgs/Quaternion')(x=0.0, y=0.0, z=0.0, w=1.0),
+        orientation_covariance=np.zeros(9),
+        angular_velocity=geo('geometry_msgs/Vector3')(x=0.0, y=0.0, z=0.0),
+        angular_velocity_covariance=np.zeros(9),
+        linear_acceleration=geo('geometry_msgs/Vector3')(x=0.0, y=0.0, z=9.81),
+        linear_acceleration_covariance=np.zeros(9))
+    return Record('/atlas/imu', 'sensor_msgs/Imu', t_s, msg)
+
+
+def foot_contact(t_s: float, side: str, fz_n: float = 450.0) -> Record:
+    """A /atlas/{l,r}_foot_contact message."""
+    geo = _type
+    msg = _type('geometry_msgs/WrenchStamped')(
+        header=_header(t_s, frame_id=f'{side}_foot'),
+        wrench=geo('geometry_msgs/Wrench')(
+            force=geo('geometry_msgs/Vector3')(x=0.0, y=0.0, z=fz_n),
+            torque=geo('geometry_msgs/Vector3')(x=0.0, y=0.0, z=0.0)))
+    topic = f'/atlas/{side}_foot_contact'
+    return Record(topic, TOPIC_TYPES[topic], t_s, msg)
+
+
+def write_bag(path: Path | str, records: Iterable[Record]) -> Path:
+    """Write `records` (any order; sorted by time, stably) to a new ROS 1 bag at `path`."""
+    path = Path(path)
+    ordered = sorted(records, key=lambda record: record.t_s)
+    with Writer(path) as writer:
+        connections: dict[str, Any] = {}
+        for record in ordered:
+            connection = connections.get(record.topic)
+            if connection is None:
+                connection = writer.add_connection(
+                    record.topic, _ros2_name(record.msgtype), typestore=TYPESTORE)
+                connections[record.topic] = connection
+            data = TYPESTORE.serialize_ros1(record.message, _ros2_name(record.msgtype))
+            writer.write(connection, round(record.t_s * NS_PER_S), data)
+    return path
+
+
+#: Pelvis height while standing (m).
+STANDING_HEIGHT_M = 0.93
+
+
+def run_records(duration_s: float = 60.0, *, state_period_s: float = 0.001,
+                odom_period_s: float = 0.01, command_period_s: float = 0.02,
+                fall_time_s: float | None = None, with_imu: bool = True) -> list[Record]:
+    """Records resembling a simulator run: states at 1 kHz, odom 100 Hz, commands 50 Hz.
+
+    The tutorial's arm swing is commanded on l_arm_shx/r_arm_shx (sinusoid, 0.5 rad) and
+    measured with a 10 ms lag; all other joints hold 0. Modes: Stand, then User at 1 s.
+    With `fall_time_s`, the pelvis drops linearly from standing height to 0.2 m over 1 s.
+    """
+    records: list[Record] = [control_mode(0.0, 'Stand'), control_mode(1.0, 'User')]
+    shx = (JOINT_NAMES.index('l_arm_shx'), JOINT_NAMES.index('r_arm_shx'))
+
+    def swing(t_s: float) -> float:
+        return 0.5 * math.sin(2 * math.pi * 0.5 * max(t_s - 1.0, 0.0))
+
+    steps = round(duration_s / state_period_s)
+    for step in range(steps):
+        t_s = step * state_period_s
+        position = np.zeros(NUM_JOINTS)
+        position[list(shx)] = swing(t_s - 0.01)
+        records.append(joint_state(t_s, position, seq=step))
+        records.append(clock(t_s))
+        if with_imu:
+            records.append(imu(t_s))
+    for step in range(round(duration_s / odom_period_s)):
+        t_s = step * odom_period_s
+        z_m = STANDING_HEIGHT_M
+        if fall_time_s is not None and t_s > fall_time_s:
+            z_m = max(0.2, STANDING_HEIGHT_M - (t_s - fall_time_s) * (STANDING_HEIGHT_M - 0.2))
+        records.append(odometry(t_s, z_m))
+        records.append(foot_contact(t_s, 'l'))
+        records.append(foot_contact(t_s, 'r'))
+    for step in range(round(duration_s / command_period_s)):
+        t_s = step * command_period_s + 0.0005
+        position = np.zeros(NUM_JOINTS)
+        position[list(shx)] = swing(t_s)
+        records.append(joint_commands(t_s, position))
+    return records
+
+
+def write_run_bag(path: Path | str, duration_s: float = 60.0, **kwargs: Any) -> Path:
+    """Write :func:`run_records` to `path` (the 60 s default is the speed benchmark)."""
+    return write_bag(path, run_records(duration_s, **kwargs))
+
+
+if __name__ == '__main__':  # pragma: no cover - manual benchmark helper
+    import sys
+    print(write_run_bag(sys.argv[1] if len(sys.argv) > 1 else '/tmp/run60.bag'))
