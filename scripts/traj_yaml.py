@@ -1,0 +1,9 @@
+#!/usr/bin/env python3
+"""Play a trajectory of a YAML file on the simulated Atlas: traj_yaml.py YAML_FILE TRAJECTORY_NAME."""
+
+import sys
+
+from tutorial_atlas_control.traj_yaml_node import main
+
+if __name__ == '__main__':
+    sys.exit(main())

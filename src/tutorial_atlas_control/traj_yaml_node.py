@@ -1,0 +1,340 @@
+"""ROS glue of ``scripts/traj_yaml.py``: the DRCSim tutorial's trajectory player, ported.
+
+Same command line, topics, parameters, message and motion as the tutorial's
+``traj_yaml.py``; each waypoint moves linearly from the measured joint positions to
+the waypoint's positions, published at 50 Hz in ROS time.  Fixed defects: the file is
+validated (``yaml.safe_load``) before anything starts; the first joint state is
+awaited with a timeout; joint states are read by name; the sample count is an integer;
+each command is stamped.  File handling and interpolation live in
+:mod:`tutorial_atlas_control.trajectory`; this module only talks to ROS.
+"""
+
+from __future__ import annotations
+
+import sys
+import threading
+import time
+from collections.abc import Callable, Iterable, Mapping, Sequence
+
+import numpy as np
+import rosgraph
+import rospy
+from sensor_msgs.msg import JointState
+
+from tutorial_atlas_control.controller import GAINS_PARAM, LOAD_HINT, Gains, GainsError, gains_from_params
+from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_INDEX, JOINT_NAMES, NUM_JOINTS, bare_joint_name
+from tutorial_atlas_control.trajectory import TrajectoryError, Waypoint, interpolate, load_trajectory, sample_count
+
+__all__ = [
+    'JointStateCache',
+    'TrajYamlError',
+    'build_command',
+    'main',
+    'positions_by_name',
+    'read_gains',
+    'run_trajectory',
+    'wait_for_joint_state',
+]
+
+USAGE = 'usage: traj_yaml.py YAML_FILE TRAJECTORY_NAME\n where TRAJECTORY is a dictionary defined in YAML_FILE'
+DESCRIPTION = (
+    'Play trajectory TRAJECTORY_NAME of YAML_FILE on the simulated Atlas: for each waypoint\n'
+    '[duration_s, "28 joint positions"], move every joint linearly from its measured position\n'
+    'to the waypoint over duration_s, publishing osrf_msgs/JointCommands on /atlas/joint_commands\n'
+    'at 50 Hz with the gains atlas_controller/gains/<joint>/{p,i,d,i_clamp}.\n'
+    'Start the simulator first:\n'
+    '  roslaunch tutorial_atlas_control atlas.launch\n'
+    'ROS remapping arguments (name:=value) are accepted; ~joint_state_timeout (s) sets how long\n'
+    'to wait for the first joint state.'
+)
+HELP_OPTIONS = ('-h', '--help')
+
+#: The tutorial's node name.
+NODE_NAME = 'tutorial_atlas_control'
+JOINT_STATES_TOPIC = '/atlas/joint_states'
+JOINT_COMMANDS_TOPIC = '/atlas/joint_commands'
+LAUNCH_HINT = 'roslaunch tutorial_atlas_control atlas.launch'
+
+#: Default wait (s, wall clock) for the first message on /atlas/joint_states.
+JOINT_STATE_TIMEOUT_S = 10.0
+#: Private parameter overriding JOINT_STATE_TIMEOUT_S, e.g. `_joint_state_timeout:=30`.
+JOINT_STATE_TIMEOUT_PARAM = '~joint_state_timeout'
+#: How long (s, wall clock) to wait for the simulator to connect to our command publisher
+#: before publishing anyway; rospy drops messages published before a subscriber connects.
+SUBSCRIBER_WAIT_S = 2.0
+#: Polling interval (s, wall clock) of the waits above.
+POLL_PERIOD_S = 0.01
+#: A joint "moves" in a waypoint's log line if its target is this far (rad) from its measured position.
+MOVING_JOINT_THRESHOLD_RAD = 0.01
+
+
+class TrajYamlError(AtlasControlError):
+    """traj_yaml.py cannot run: no workspace, no master, no simulator, bad joint states."""
+
+
+def read_gains(get_param: Callable[..., object] = rospy.get_param) -> Gains:
+    """Read the tutorial's gains, ``atlas_controller/gains/<joint>/{p,i,d,i_clamp}``.
+
+    Args:
+        get_param: ``rospy.get_param`` or a stand-in; called once, with the gains
+            namespace and a default of None (one round trip instead of 112).
+
+    Raises:
+        GainsError: a parameter is missing or not a finite number; the message names
+            it and says how to load the gains.
+    """
+    tree = get_param(GAINS_PARAM, None)
+    if tree is None:
+        raise GainsError(f'parameter {GAINS_PARAM} is not set; {LOAD_HINT}')
+    return gains_from_params(tree)
+
+
+def positions_by_name(names: Sequence[str], positions: Sequence[float]) -> np.ndarray:
+    """Joint positions (rad) of a JointState, reordered into the tutorial's joint order.
+
+    Names may be bare (``back_lbz``) or prefixed (``atlas::back_lbz``); joints that
+    are not Atlas's 28 are ignored.
+
+    Raises:
+        TrajYamlError: the arrays differ in length, a joint is missing or named
+            twice, or a position is not finite.
+    """
+    if len(names) != len(positions):
+        raise TrajYamlError(
+            f'{JOINT_STATES_TOPIC}: the message has {len(names)} names but {len(positions)} positions'
+        )
+    result = np.full(NUM_JOINTS, np.nan)
+    seen = np.zeros(NUM_JOINTS, dtype=bool)
+    for name, position in zip(names, positions):
+        index = JOINT_INDEX.get(bare_joint_name(name))
+        if index is None:
+            continue
+        if seen[index]:
+            raise TrajYamlError(f'{JOINT_STATES_TOPIC}: joint {JOINT_NAMES[index]} is named twice')
+        seen[index] = True
+        result[index] = position
+    if not seen.all():
+        missing = [JOINT_NAMES[index] for index in np.flatnonzero(~seen)]
+        raise TrajYamlError(
+            f'{JOINT_STATES_TOPIC}: the message lacks {len(missing)} Atlas joint(s): {", ".join(missing)}'
+        )
+    if not np.isfinite(result).all():
+        bad = JOINT_NAMES[int(np.flatnonzero(~np.isfinite(result))[0])]
+        raise TrajYamlError(f'{JOINT_STATES_TOPIC}: the position of {bad} is {result[JOINT_INDEX[bad]]}')
+    return result
+
+
+class JointStateCache:
+    """The latest JointState, filled by a subscriber callback (another thread)."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._message: JointState | None = None
+
+    def callback(self, message: JointState) -> None:
+        with self._lock:
+            self._message = message
+
+    def latest(self) -> JointState | None:
+        with self._lock:
+            return self._message
+
+    def positions(self) -> np.ndarray:
+        """The latest joint positions in tutorial order (rad); see :func:`positions_by_name`."""
+        message = self.latest()
+        if message is None:
+            raise TrajYamlError(f'no message received on {JOINT_STATES_TOPIC}')
+        return positions_by_name(message.name, message.position)
+
+
+def wait_for_joint_state(
+    cache: JointStateCache,
+    timeout_s: float = JOINT_STATE_TIMEOUT_S,
+    is_shutdown: Callable[[], bool] = rospy.is_shutdown,
+) -> JointState:
+    """Wait (wall clock) until `cache` holds a joint state, and return it.
+
+    Raises:
+        TrajYamlError: nothing arrived within `timeout_s`; the message says to start the simulator.
+        rospy.ROSInterruptException: the node was shut down while waiting.
+    """
+    deadline = time.monotonic() + timeout_s
+    while True:
+        message = cache.latest()
+        if message is not None:
+            return message
+        if is_shutdown():
+            raise rospy.ROSInterruptException('shut down while waiting for joint states')
+        if time.monotonic() >= deadline:
+            raise TrajYamlError(
+                f'no simulator is publishing {JOINT_STATES_TOPIC}: nothing arrived within {timeout_s:g} s; '
+                f'start it with `{LAUNCH_HINT}`'
+            )
+        time.sleep(POLL_PERIOD_S)
+
+
+def build_command(
+    message_type: Callable[[], object], positions: Iterable[float], gains: Gains, stamp: object
+) -> object:
+    """A JointCommands for all 28 joints as the tutorial sent it, plus a header stamp.
+
+    Names carry the ``atlas::`` prefix; kp/ki/kd_position are the gains p/i/d; velocity,
+    effort and kp_velocity are zero; ``i_effort_min = -i_clamp``, ``i_effort_max = i_clamp``.
+
+    Args:
+        message_type: ``osrf_msgs.msg.JointCommands`` (a parameter so tests need no workspace).
+        positions: the 28 commanded positions (rad), tutorial order.
+        gains: from :func:`read_gains`.
+        stamp: the header stamp, ``rospy.Time.now()``.
+    """
+    command = message_type()
+    command.header.stamp = stamp
+    command.name = [ATLAS_PREFIX + name for name in JOINT_NAMES]
+    command.position = [float(value) for value in positions]
+    zeros = [0.0] * NUM_JOINTS
+    command.velocity = list(zeros)
+    command.effort = list(zeros)
+    command.kp_position = gains.p.tolist()
+    command.ki_position = gains.i.tolist()
+    command.kd_position = gains.d.tolist()
+    command.kp_velocity = list(zeros)
+    command.i_effort_min = (0.0 - gains.i_clamp).tolist()  # 0.0 - x: no -0.0 in the message
+    command.i_effort_max = gains.i_clamp.tolist()
+    return command
+
+
+def run_trajectory(
+    waypoints: Sequence[Waypoint],
+    measure: Callable[[], np.ndarray],
+    send: Callable[[np.ndarray], None],
+    sleep: Callable[[float], None],
+    log: Callable[[str], None],
+) -> int:
+    """Play `waypoints` as the tutorial did; return the number of commands sent.
+
+    For each waypoint: `measure` the joint positions (rad), `log` one line, then
+    `send` each interpolated command followed by ``sleep(duration_s / n)``.
+    """
+    sent = 0
+    for index, waypoint in enumerate(waypoints):
+        initial = measure()
+        log(_waypoint_line(index, len(waypoints), waypoint, initial))
+        for positions, sleep_s in interpolate(initial, waypoint.positions, waypoint.duration_s):
+            send(positions)
+            sent += 1
+            sleep(sleep_s)
+    return sent
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run ``traj_yaml.py YAML_FILE TRAJECTORY_NAME``; return the exit status.
+
+    Args:
+        argv: the arguments after the program name (default ``sys.argv[1:]``);
+            ROS remapping arguments are removed with ``rospy.myargv``.
+    """
+    raw = list(sys.argv[1:] if argv is None else argv)
+    args = rospy.myargv(raw)
+    if any(arg in HELP_OPTIONS for arg in args):
+        print(f'{USAGE}\n\n{DESCRIPTION}')
+        return 0
+    if len(args) != 2:
+        print(USAGE, file=sys.stderr)
+        return 1
+    path, name = args
+    try:
+        waypoints = load_trajectory(path, name)
+        message_type = _joint_commands_type()
+        _require_master()
+    except AtlasControlError as err:
+        print(err, file=sys.stderr)
+        return 1
+
+    try:
+        rospy.init_node(NODE_NAME, argv=[sys.argv[0], *raw])
+    except rospy.ROSInitException as err:
+        print(f'cannot start ROS node {NODE_NAME}: {err}', file=sys.stderr)
+        return 1
+    try:
+        _play(waypoints, message_type, name)
+    except AtlasControlError as err:
+        rospy.logerr(str(err))
+        return 1
+    except rospy.ROSTimeMovedBackwardsException:
+        rospy.logerr('ROS time moved backwards (was the simulation reset?); trajectory aborted')
+        return 1
+    except rospy.ROSInterruptException:
+        rospy.logwarn('shut down before the trajectory finished')
+        return 1
+    return 0
+
+
+def _play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], name: str) -> None:
+    gains = read_gains()
+    cache = JointStateCache()
+    rospy.Subscriber(JOINT_STATES_TOPIC, JointState, cache.callback, queue_size=1)
+    publisher = rospy.Publisher(JOINT_COMMANDS_TOPIC, message_type, queue_size=1)
+    timeout_s = _timeout_param()
+    wait_for_joint_state(cache, timeout_s)
+    _wait_for_subscriber(publisher)
+
+    def send(positions: np.ndarray) -> None:
+        publisher.publish(build_command(message_type, positions, gains, rospy.Time.now()))
+
+    total = sum(sample_count(waypoint.duration_s) for waypoint in waypoints)
+    rospy.loginfo(f"playing trajectory '{name}': {len(waypoints)} waypoints, "
+                  f"{sum(w.duration_s for w in waypoints):g} s, {total} commands")
+    run_trajectory(waypoints, cache.positions, send, rospy.sleep, rospy.loginfo)
+    rospy.loginfo(f"trajectory '{name}' done")
+
+
+def _timeout_param() -> float:
+    value = rospy.get_param(JOINT_STATE_TIMEOUT_PARAM, JOINT_STATE_TIMEOUT_S)
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not (np.isfinite(value) and value > 0):
+        raise TrajYamlError(f'parameter {JOINT_STATE_TIMEOUT_PARAM} must be a positive number of seconds, '
+                            f'got {value!r}')
+    return float(value)
+
+
+def _wait_for_subscriber(publisher: rospy.Publisher) -> None:
+    deadline = time.monotonic() + SUBSCRIBER_WAIT_S
+    while publisher.get_num_connections() == 0:
+        if rospy.is_shutdown():
+            raise rospy.ROSInterruptException('shut down while waiting for a subscriber')
+        if time.monotonic() >= deadline:
+            rospy.logwarn(f'nothing subscribes to {JOINT_COMMANDS_TOPIC} yet; publishing anyway')
+            return
+        time.sleep(POLL_PERIOD_S)
+
+
+def _waypoint_line(index: int, count: int, waypoint: Waypoint, initial: np.ndarray) -> str:
+    moving = np.flatnonzero(np.abs(waypoint.positions - initial) > MOVING_JOINT_THRESHOLD_RAD)
+    if len(moving) == 0:
+        joints = 'no joint moves'
+    elif len(moving) == NUM_JOINTS:
+        joints = 'all joints move'
+    else:
+        joints = 'moving ' + ', '.join(JOINT_NAMES[i] for i in moving)
+    return (f'waypoint {index} ({index + 1} of {count}): {waypoint.duration_s:g} s, '
+            f'{sample_count(waypoint.duration_s)} commands; {joints}')
+
+
+def _joint_commands_type() -> Callable[[], object]:
+    try:
+        from osrf_msgs.msg import JointCommands
+    except ImportError as err:
+        raise TrajYamlError(
+            f'cannot import osrf_msgs.msg.JointCommands ({err}): build the workspace with `make setup` '
+            'and `source ./env.sh`'
+        ) from err
+    return JointCommands
+
+
+def _require_master() -> None:
+    try:
+        uri = rosgraph.get_master_uri()
+    except ValueError as err:
+        raise TrajYamlError(f'bad ROS master setting: {err}') from err
+    if not rosgraph.is_master_online(uri):
+        raise TrajYamlError(f'no ROS master at {uri}: start the simulator with `{LAUNCH_HINT}`')

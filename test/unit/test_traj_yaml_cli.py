@@ -1,0 +1,356 @@
+"""scripts/traj_yaml.py's command line without a ROS master, and the node's pure helpers.
+
+Every CLI error path runs the real script in a subprocess. ROS_MASTER_URI points at a
+listening socket owned by the test, which then checks that nobody connected to it:
+the file is validated before the script goes anywhere near ROS.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+import os
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from tutorial_atlas_control.controller import Gains, GainsError
+from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.trajectory import Waypoint, sample_count
+from tutorial_atlas_control.traj_yaml_node import (
+    JointStateCache,
+    TrajYamlError,
+    build_command,
+    positions_by_name,
+    read_gains,
+    run_trajectory,
+    wait_for_joint_state,
+)
+
+REPO = Path(__file__).resolve().parents[2]
+SCRIPT = REPO / 'scripts' / 'traj_yaml.py'
+TRAJECTORY_FILE = REPO / 'trajectories' / 'Traj_data2.yaml'
+USAGE_LINES = ['usage: traj_yaml.py YAML_FILE TRAJECTORY_NAME', ' where TRAJECTORY is a dictionary defined in YAML_FILE']
+#: Generous bound (s) for a run that must fail before touching ROS (interpreter start-up included).
+QUICK_S = 15.0
+ZEROS = ' '.join(['0'] * NUM_JOINTS)
+HAVE_OSRF_MSGS = importlib.util.find_spec('osrf_msgs') is not None
+
+
+@pytest.fixture()
+def fake_master() -> Iterator[tuple[socket.socket, str]]:
+    """A listening socket standing in for the ROS master; no one should connect to it."""
+    server = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    server.bind(('127.0.0.1', 0))
+    server.listen(8)
+    server.setblocking(False)
+    try:
+        yield server, f'http://127.0.0.1:{server.getsockname()[1]}'
+    finally:
+        server.close()
+
+
+def assert_untouched(server: socket.socket) -> None:
+    with pytest.raises(BlockingIOError):
+        connection, _ = server.accept()
+        connection.close()
+
+
+def run_script(args: list[str], master_uri: str, tmp_path: Path) -> tuple[subprocess.CompletedProcess[str], float]:
+    env = dict(os.environ)
+    env['PYTHONPATH'] = os.pathsep.join(filter(None, [str(REPO / 'src'), env.get('PYTHONPATH')]))
+    env['ROS_MASTER_URI'] = master_uri
+    env['ROS_HOME'] = str(tmp_path / 'ros_home')
+    env['ROS_LOG_DIR'] = str(tmp_path / 'ros_log')
+    start = time.monotonic()
+    result = subprocess.run(
+        [sys.executable, str(SCRIPT), *args], env=env, cwd=tmp_path,
+        capture_output=True, text=True, timeout=60, check=False,
+    )
+    return result, time.monotonic() - start
+
+
+def assert_one_line_error(result: subprocess.CompletedProcess[str], text: str) -> None:
+    assert result.returncode == 1, result
+    assert 'Traceback' not in result.stderr
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1, result.stderr
+    assert text in lines[0]
+
+
+def write(tmp_path: Path, text: str, name: str = 'Traj.yaml') -> Path:
+    path = tmp_path / name
+    path.write_text(text, encoding='utf-8')
+    return path
+
+
+# --- the script -------------------------------------------------------------------------
+
+
+def test_script_is_thin_and_executable() -> None:
+    assert os.access(SCRIPT, os.X_OK)
+    text = SCRIPT.read_text(encoding='utf-8')
+    assert text.startswith('#!/usr/bin/env python3\n')
+    assert 'tutorial_atlas_control.traj_yaml_node' in text
+    assert len(text.splitlines()) <= 12
+
+
+@pytest.mark.parametrize('args', [[], ['Traj.yaml'], ['Traj.yaml', 'step', 'extra'], ['a:=b'], ['Traj.yaml', 'x:=y']])
+def test_wrong_number_of_arguments_prints_usage(args: list[str], fake_master, tmp_path: Path) -> None:
+    server, uri = fake_master
+    result, elapsed = run_script(args, uri, tmp_path)
+    assert result.returncode == 1
+    assert result.stderr.splitlines() == USAGE_LINES
+    assert 'Traceback' not in result.stderr
+    assert elapsed < QUICK_S
+    assert_untouched(server)
+
+
+@pytest.mark.parametrize('flag', ['-h', '--help'])
+def test_help(flag: str, fake_master, tmp_path: Path) -> None:
+    server, uri = fake_master
+    result, _ = run_script([flag], uri, tmp_path)
+    assert result.returncode == 0
+    assert result.stdout.splitlines()[:2] == USAGE_LINES
+    assert '/atlas/joint_commands' in result.stdout and '50 Hz' in result.stdout
+    assert result.stderr == ''
+    assert_untouched(server)
+
+
+def test_missing_file(fake_master, tmp_path: Path) -> None:
+    server, uri = fake_master
+    result, elapsed = run_script(['absent.yaml', 'step_and_fall'], uri, tmp_path)
+    assert_one_line_error(result, 'absent.yaml: cannot read trajectory file: No such file or directory')
+    assert elapsed < QUICK_S
+    assert_untouched(server)
+
+
+@pytest.mark.parametrize(
+    ('text', 'expected'),
+    [
+        ('', 'Traj.yaml: the file is empty'),
+        ('step:\n  - [1.0, "0 0"\n  - [oops\n', 'Traj.yaml: invalid YAML at line 3, column 3:'),
+        ("step: !!python/object/apply:os.system ['touch pwned']\n",
+         "Traj.yaml: unsupported YAML at line 1, column 7: could not determine a constructor for the tag "
+         "'tag:yaml.org,2002:python/object/apply:os.system'"),
+        ('- [1.0, "0"]\n', 'Traj.yaml: expected a mapping of trajectory names to waypoints at the top level'),
+        (f'step_and_fall:\n  - [1.0, "{ZEROS}"]\n  - [1.0, "{ZEROS}"]\n  - [1.0, "{" ".join(["0"] * 27)}"]\n',
+         "Traj.yaml: trajectory 'step_and_fall', waypoint 2: expected 28 joint positions, got 27"),
+        (f'step_and_fall:\n  - [-1, "{ZEROS}"]\n',
+         "Traj.yaml: trajectory 'step_and_fall', waypoint 0: duration must be positive, got -1 s"),
+        ('step_and_fall: []\n', "Traj.yaml: trajectory 'step_and_fall': has no waypoints"),
+    ],
+)
+def test_bad_file_is_one_line_without_ros(text: str, expected: str, fake_master, tmp_path: Path) -> None:
+    server, uri = fake_master
+    write(tmp_path, text)
+    result, elapsed = run_script(['Traj.yaml', 'step_and_fall'], uri, tmp_path)
+    assert_one_line_error(result, expected)
+    assert elapsed < QUICK_S
+    assert_untouched(server)
+    assert not (tmp_path / 'pwned').exists()
+
+
+def test_missing_trajectory_keeps_the_tutorial_message(fake_master, tmp_path: Path) -> None:
+    server, uri = fake_master
+    result, _ = run_script([str(TRAJECTORY_FILE), 'nope'], uri, tmp_path)
+    assert_one_line_error(result, f'unable to find trajectory nope in {TRAJECTORY_FILE}')
+    assert result.stderr == f'unable to find trajectory nope in {TRAJECTORY_FILE}\n'
+    assert_untouched(server)
+
+
+def test_remapping_arguments_are_ignored(fake_master, tmp_path: Path) -> None:
+    server, uri = fake_master
+    result, _ = run_script(['__name:=other', str(TRAJECTORY_FILE), '_joint_state_timeout:=3', 'nope'], uri, tmp_path)
+    assert_one_line_error(result, f'unable to find trajectory nope in {TRAJECTORY_FILE}')
+    assert_untouched(server)
+
+
+def test_valid_file_without_master_fails_with_a_hint(tmp_path: Path) -> None:
+    """Nothing listens on the master port: one line, no hang, no traceback."""
+    with socket.socket() as probe:
+        probe.bind(('127.0.0.1', 0))
+        port = probe.getsockname()[1]
+    result, elapsed = run_script([str(TRAJECTORY_FILE), 'step_and_fall'], f'http://127.0.0.1:{port}', tmp_path)
+    if HAVE_OSRF_MSGS:
+        assert_one_line_error(result, f'no ROS master at http://127.0.0.1:{port}: start the simulator with '
+                                      '`roslaunch tutorial_atlas_control atlas.launch`')
+    else:
+        assert_one_line_error(result, 'cannot import osrf_msgs.msg.JointCommands')
+    assert elapsed < QUICK_S
+
+
+# --- joint states by name ---------------------------------------------------------------
+
+
+def test_positions_by_name_reorders_and_accepts_both_spellings() -> None:
+    expected = np.arange(NUM_JOINTS) * 0.1
+    order = list(reversed(range(NUM_JOINTS)))
+    names = [(ATLAS_PREFIX if i % 2 else '') + JOINT_NAMES[i] for i in order]
+    positions = [expected[i] for i in order]
+    np.testing.assert_array_equal(positions_by_name(names + ['hokuyo_joint'], positions + [9.0]), expected)
+
+
+def test_positions_by_name_missing_joint() -> None:
+    names = [name for name in JOINT_NAMES if name not in ('r_leg_kny', 'neck_ay')]
+    with pytest.raises(TrajYamlError, match=r'/atlas/joint_states: the message lacks 2 Atlas joint\(s\): neck_ay, r_leg_kny'):
+        positions_by_name(names, [0.0] * len(names))
+
+
+def test_positions_by_name_length_mismatch() -> None:
+    with pytest.raises(TrajYamlError, match='28 names but 27 positions'):
+        positions_by_name(list(JOINT_NAMES), [0.0] * 27)
+
+
+def test_positions_by_name_duplicate() -> None:
+    names = list(JOINT_NAMES) + [ATLAS_PREFIX + 'back_lbz']
+    with pytest.raises(TrajYamlError, match='joint back_lbz is named twice'):
+        positions_by_name(names, [0.0] * len(names))
+
+
+def test_positions_by_name_not_finite() -> None:
+    positions = [0.0] * NUM_JOINTS
+    positions[JOINT_INDEX['l_arm_elx']] = math.nan
+    with pytest.raises(TrajYamlError, match='position of l_arm_elx is nan'):
+        positions_by_name(list(JOINT_NAMES), positions)
+
+
+# --- waiting for the simulator ----------------------------------------------------------
+
+
+def test_wait_for_joint_state_times_out_with_a_hint() -> None:
+    start = time.monotonic()
+    with pytest.raises(TrajYamlError, match=r'no simulator is publishing /atlas/joint_states: nothing arrived '
+                                            r'within 0\.05 s; start it with `roslaunch tutorial_atlas_control'):
+        wait_for_joint_state(JointStateCache(), 0.05, is_shutdown=lambda: False)
+    assert time.monotonic() - start < 2.0
+
+
+def test_wait_for_joint_state_returns_the_message() -> None:
+    cache = JointStateCache()
+    message = SimpleNamespace(name=list(JOINT_NAMES), position=[0.5] * NUM_JOINTS)
+    cache.callback(message)
+    assert wait_for_joint_state(cache, 0.05, is_shutdown=lambda: False) is message
+    np.testing.assert_array_equal(cache.positions(), np.full(NUM_JOINTS, 0.5))
+
+
+def test_cache_without_message() -> None:
+    with pytest.raises(TrajYamlError, match='no message received on /atlas/joint_states'):
+        JointStateCache().positions()
+
+
+# --- gains and the command message ------------------------------------------------------
+
+
+def gains_tree() -> dict[str, dict[str, float]]:
+    return {name: {'p': 100.0 + i, 'i': 0.5 * i, 'd': 1.0, 'i_clamp': 2.0 * i} for i, name in enumerate(JOINT_NAMES)}
+
+
+def test_read_gains_reads_the_tutorial_parameters() -> None:
+    calls: list[tuple[object, ...]] = []
+
+    def get_param(*args: object) -> object:
+        calls.append(args)
+        return gains_tree()
+
+    gains = read_gains(get_param)
+    assert calls == [('atlas_controller/gains', None)]
+    assert gains.p[JOINT_INDEX['r_leg_kny']] == 113.0
+    assert gains.i_clamp[JOINT_INDEX['r_arm_mwx']] == 54.0
+
+
+def test_read_gains_missing_namespace() -> None:
+    with pytest.raises(GainsError, match=r'parameter atlas_controller/gains is not set; .*'
+                                         r'roslaunch tutorial_atlas_control atlas\.launch.*'
+                                         r'rosparam load config/atlas_controller\.yaml'):
+        read_gains(lambda *args: None)
+
+
+def test_read_gains_missing_parameter_is_named() -> None:
+    tree = gains_tree()
+    del tree['l_leg_kny']['i_clamp']
+    with pytest.raises(GainsError, match=r'atlas_controller/gains/l_leg_kny/i_clamp is missing;.*rosparam load'):
+        read_gains(lambda *args: tree)
+
+
+class FakeJointCommands(SimpleNamespace):
+    def __init__(self) -> None:
+        super().__init__(header=SimpleNamespace(stamp=None))
+
+
+def check_command(command: object, positions: np.ndarray, gains: Gains, stamp: object) -> None:
+    assert command.header.stamp == stamp
+    assert command.name == [f'atlas::{name}' for name in JOINT_NAMES]
+    assert list(command.position) == positions.tolist()
+    for field in ('velocity', 'effort', 'kp_velocity'):
+        assert list(getattr(command, field)) == [0.0] * NUM_JOINTS
+    assert list(command.kp_position) == gains.p.tolist()
+    assert list(command.ki_position) == gains.i.tolist()
+    assert list(command.kd_position) == gains.d.tolist()
+    assert list(command.i_effort_max) == gains.i_clamp.tolist()
+    assert list(command.i_effort_min) == (-gains.i_clamp).tolist()
+    assert all(math.copysign(1.0, value) == 1.0 for value in command.i_effort_min if value == 0.0)
+
+
+def test_build_command_like_the_tutorial() -> None:
+    gains = read_gains(lambda *args: gains_tree())
+    positions = np.linspace(-1.0, 1.0, NUM_JOINTS)
+    check_command(build_command(FakeJointCommands, positions, gains, 'stamp'), positions, gains, 'stamp')
+
+
+@pytest.mark.skipif(not HAVE_OSRF_MSGS, reason='needs the catkin workspace: source ./env.sh')
+def test_build_command_serializes_as_osrf_msgs() -> None:
+    from io import BytesIO
+
+    import rospy
+    from osrf_msgs.msg import JointCommands
+
+    gains = read_gains(lambda *args: gains_tree())
+    positions = np.linspace(-1.0, 1.0, NUM_JOINTS)
+    stamp = rospy.Time(12, 340_000_000)
+    buffer = BytesIO()
+    build_command(JointCommands, positions, gains, stamp).serialize(buffer)
+    received = JointCommands().deserialize(buffer.getvalue())
+    check_command(received, positions, gains, stamp)
+
+
+# --- the motion -------------------------------------------------------------------------
+
+
+def test_run_trajectory_plays_each_waypoint_from_the_measured_pose() -> None:
+    waypoints = [
+        Waypoint(1.0, np.full(NUM_JOINTS, 1.0)),
+        Waypoint(0.5, np.zeros(NUM_JOINTS)),
+        Waypoint(0.01, np.full(NUM_JOINTS, -1.0)),
+    ]
+    measured = [np.full(NUM_JOINTS, 0.25), np.full(NUM_JOINTS, 0.75), np.full(NUM_JOINTS, 0.1)]
+    sent: list[np.ndarray] = []
+    sleeps: list[float] = []
+    logs: list[str] = []
+    count = run_trajectory(waypoints, lambda: measured[len(logs)], sent.append, sleeps.append, logs.append)
+    assert count == len(sent) == len(sleeps) == 50 + 25 + 1
+    assert len(logs) == 3
+    assert logs[0].startswith('waypoint 0 (1 of 3): 1 s, 50 commands; all joints move')
+    np.testing.assert_array_equal(sent[0], measured[0])
+    np.testing.assert_array_equal(sent[49], waypoints[0].positions)
+    np.testing.assert_array_equal(sent[50], measured[1])
+    np.testing.assert_array_equal(sent[74], waypoints[1].positions)
+    np.testing.assert_array_equal(sent[75], waypoints[2].positions)
+    assert sum(sleeps) == pytest.approx(1.51)
+    assert sleeps[:50] == [pytest.approx(0.02)] * 50
+
+
+def test_waypoint_log_names_the_moving_joints() -> None:
+    target = np.zeros(NUM_JOINTS)
+    target[JOINT_INDEX['r_leg_kny']] = 1.4
+    target[JOINT_INDEX['neck_ay']] = 0.005  # under the threshold
+    logs: list[str] = []
+    run_trajectory([Waypoint(0.1, target)], lambda: np.zeros(NUM_JOINTS), lambda _: None, lambda _: None, logs.append)
+    assert logs == [f'waypoint 0 (1 of 1): 0.1 s, {sample_count(0.1)} commands; moving r_leg_kny']
