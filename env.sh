@@ -16,6 +16,11 @@ fi
 # catkin's setup.sh resets PYTHONPATH/CMAKE_PREFIX_PATH to the workspace chain.
 if [ -n "${BASH_VERSION:-}" ]; then . "$TAC_WS/devel/setup.bash"; else . "$TAC_WS/devel/setup.sh"; fi
 export VIRTUAL_ENV="$TAC_VENV"
+# Nodes started by rosrun/roslaunch run under /usr/bin/python3 (catkin writes that shebang);
+# the virtualenv's packages (mujoco, rosbags, ...) must be importable there too. Same Python.
+_tac_site=$("$TAC_VENV/bin/python" -c 'import sysconfig; print(sysconfig.get_paths()["purelib"])')
+case ":${PYTHONPATH:-}:" in *":$_tac_site:"*) ;; *) export PYTHONPATH="${PYTHONPATH:+$PYTHONPATH:}$_tac_site" ;; esac
+unset _tac_site
 case ":$PATH:" in *":$TAC_VENV/bin:"*) ;; *) export PATH="$TAC_VENV/bin:$PATH" ;; esac
 # Loopback by default: rospy and the master bind to 127.0.0.1 when the host name is localhost.
 export ROS_HOSTNAME="${ROS_HOSTNAME:-localhost}"

@@ -88,6 +88,7 @@ _JOINT_COMMANDS_MSG_RELPATH = Path('msg') / 'osrf_msgs' / 'msg' / 'JointCommands
 _CLOCK_MISMATCH_S = 1.0
 
 _NS_PER_S = 1_000_000_000
+_BAG_MAGIC = b'#ROSBAG V2.0\n'
 _U32 = struct.Struct('<I')
 #: Nav_msgs/Odometry after the two strings: pose (7) + cov (36), twist (6) + cov (36).
 _ODOM_FLOATS = 85
@@ -498,6 +499,15 @@ def _open_reader(path: Path) -> Any:
         raise BagAnalysisError(msg)
     if path.is_dir():
         msg = f'{path} is a directory; expected a ROS 1 .bag file (ROS 2 bags are not supported).'
+        raise BagAnalysisError(msg)
+    try:
+        with path.open('rb') as stream:
+            magic = stream.read(len(_BAG_MAGIC))
+    except OSError as err:
+        msg = f'Could not open {path}: {err.strerror or err}.'
+        raise BagAnalysisError(msg) from err
+    if not magic.startswith(_BAG_MAGIC[:9]):  # '#ROSBAG V', any version
+        msg = f'{path} is not a ROS 1 bag (it does not start with "#ROSBAG V2.0").'
         raise BagAnalysisError(msg)
     reader = Reader(path)
     try:

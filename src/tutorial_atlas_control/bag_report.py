@@ -218,9 +218,8 @@ def plot_run(analysis: Analysis, path: Path | str) -> Path:
     for t_s, mode in data.modes:
         axes[0].annotate(mode, (t_s, 1.0), xycoords=('data', 'axes fraction'),
                          xytext=(2, 2), textcoords='offset points', fontsize=8, rotation=30)
-    axes[0].legend(loc='upper right', fontsize=7)
-    if data.pelvis is not None and names:
-        axes[-1].legend(loc='upper right', fontsize=7)
+    for ax in axes[:1] + axes[-1:] if rows else []:
+        ax.legend(loc='upper right', fontsize=7)
     axes[-1].set_xlabel('time from bag start (s)')
     fig.suptitle(f'{data.path.name}: commanded vs measured', y=0.995)
     fig.tight_layout()

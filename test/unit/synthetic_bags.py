@@ -166,11 +166,18 @@ def foot_contact(t_s: float, side: str, fz_n: float = 450.0) -> Record:
     return Record(topic, TOPIC_TYPES[topic], t_s, msg)
 
 
-def write_bag(path: Path | str, records: Iterable[Record]) -> Path:
-    """Write `records` (any order; sorted by time, stably) to a new ROS 1 bag at `path`."""
+def write_bag(path: Path | str, records: Iterable[Record], *,
+              compression: str | None = None) -> Path:
+    """Write `records` (any order; sorted by time, stably) to a new ROS 1 bag at `path`.
+
+    `compression` is None, 'bz2' or 'lz4' (chunk compression, as `rosbag record -j/--lz4`).
+    """
     path = Path(path)
     ordered = sorted(records, key=lambda record: record.t_s)
-    with Writer(path) as writer:
+    writer = Writer(path)
+    if compression:
+        writer.set_compression(Writer.CompressionFormat[compression.upper()])
+    with writer:
         connections: dict[str, Any] = {}
         for record in ordered:
             connection = connections.get(record.topic)
@@ -230,6 +237,41 @@ def run_records(duration_s: float = 60.0, *, state_period_s: float = 0.001,
 def write_run_bag(path: Path | str, duration_s: float = 60.0, **kwargs: Any) -> Path:
     """Write :func:`run_records` to `path` (the 60 s default is the speed benchmark)."""
     return write_bag(path, run_records(duration_s, **kwargs))
+
+def _with_joint(index: int, value: float) -> np.ndarray:
+    position = np.zeros(NUM_JOINTS)
+    position[index] = value
+    return position
+
+
+def tracking_records(names_style: str) -> list[Record]:
+    """Commands of l_arm_elx: 0.2 at 0.02 s, 0.4 at 0.07 s; measured 0.25 throughout.
+
+    States every 10 ms from 0.00 s: the two before the first command do not count.
+    `names_style`: bare, prefixed (atlas::), empty (tutorial order), subset (one joint).
+    Expected errors (command - measured): -0.05 five times, +0.15 five times.
+    """
+    full = {'bare': list(JOINT_NAMES), 'prefixed': [f'atlas::{n}' for n in JOINT_NAMES],
+            'empty': []}
+    elx = JOINT_NAMES.index('l_arm_elx')
+    records = [clock(0.0)]
+    for t_s, value in ((0.02, 0.2), (0.07, 0.4)):
+        if names_style == 'subset':
+            records.append(joint_commands(t_s, [value], names=['atlas::l_arm_elx']))
+        else:
+            records.append(joint_commands(t_s, _with_joint(elx, value), names=full[names_style]))
+    records += [joint_state(t_s, _with_joint(elx, 0.25))
+                for t_s in np.round(0.02 + np.arange(-2, 10) * 0.01, 6)]
+    return records
+
+
+def unindexed_copy(source: Path, target: Path) -> Path:
+    """What an interrupted `rosbag record` leaves: index_pos=0 in the bag header."""
+    raw = bytearray(source.read_bytes())
+    at = raw.index(b'index_pos=') + len(b'index_pos=')
+    raw[at:at + 8] = bytes(8)
+    target.write_bytes(bytes(raw))
+    return target
 
 
 if __name__ == '__main__':  # pragma: no cover - manual benchmark helper

@@ -1,0 +1,113 @@
+"""A test-side client of the simulator: subscribes to its topics, calls its services.
+
+Shared by the rostest nodes; waits are bounded by wall-clock deadlines so that a
+broken simulator fails a test instead of hanging it.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable, Sequence
+
+import rospy
+from geometry_msgs.msg import WrenchStamped
+from nav_msgs.msg import Odometry
+from osrf_msgs.msg import JointCommands
+from rosgraph_msgs.msg import Clock, Log
+from sensor_msgs.msg import JointState
+from std_msgs.msg import String
+from std_srvs.srv import Empty
+
+#: Longest a single wait may take (s, wall) before the test fails.
+WALL_TIMEOUT_S = 60.0
+
+
+class SimProbe:
+    """Latest messages from the simulator, plus helpers to drive it."""
+
+    def __init__(self, keep_joint_states: bool = False) -> None:
+        self.lock = threading.Lock()
+        self.clock_ns = -1
+        self.joint_state: JointState | None = None
+        self.odom: Odometry | None = None
+        self.contacts: dict[str, WrenchStamped] = {}
+        self.warnings: list[str] = []
+        self.keep_joint_states = keep_joint_states
+        self.joint_states: list[JointState] = []
+        rospy.Subscriber('/clock', Clock, self._on_clock, queue_size=1000)
+        rospy.Subscriber('/atlas/joint_states', JointState, self._on_joint_state, queue_size=2000)
+        rospy.Subscriber('/ground_truth_odom', Odometry, self._on_odom, queue_size=100)
+        for side in ('l', 'r'):
+            rospy.Subscriber(f'/atlas/{side}_foot_contact', WrenchStamped,
+                             self._on_contact, callback_args=side, queue_size=100)
+        rospy.Subscriber('/rosout', Log, self._on_log, queue_size=100)
+        self.mode_pub = rospy.Publisher('/atlas/control_mode', String, queue_size=10, latch=True)
+        self.command_pub = rospy.Publisher('/atlas/joint_commands', JointCommands, queue_size=10)
+
+    # -- callbacks -----------------------------------------------------------------------
+    def _on_clock(self, msg: Clock) -> None:
+        self.clock_ns = msg.clock.to_nsec()
+
+    def _on_joint_state(self, msg: JointState) -> None:
+        with self.lock:
+            self.joint_state = msg
+            if self.keep_joint_states:
+                self.joint_states.append(msg)
+
+    def _on_odom(self, msg: Odometry) -> None:
+        self.odom = msg
+
+    def _on_contact(self, msg: WrenchStamped, side: str) -> None:
+        self.contacts[side] = msg
+
+    def _on_log(self, msg: Log) -> None:
+        if msg.level >= Log.WARN:
+            with self.lock:
+                self.warnings.append(msg.msg)
+
+    # -- waiting -------------------------------------------------------------------------
+    def wait_until(self, predicate: Callable[[], bool], what: str,
+                   timeout_s: float = WALL_TIMEOUT_S) -> None:
+        deadline = time.monotonic() + timeout_s
+        while not predicate():
+            if time.monotonic() > deadline or rospy.is_shutdown():
+                raise AssertionError(f'timed out after {timeout_s} s waiting for {what}')
+            time.sleep(0.005)
+
+    def wait_ready(self) -> None:
+        self.wait_until(lambda: self.joint_state is not None and self.odom is not None,
+                        'the simulator to publish /atlas/joint_states and /ground_truth_odom')
+        self.wait_until(lambda: self.command_pub.get_num_connections() > 0,
+                        'the simulator to subscribe to /atlas/joint_commands')
+
+    def sim_time_s(self) -> float:
+        return self.clock_ns / 1e9
+
+    def wait_sim(self, seconds: float) -> None:
+        """Let `seconds` of sim time pass."""
+        target_ns = self.clock_ns + int(seconds * 1e9)
+        self.wait_until(lambda: self.clock_ns >= target_ns, f'{seconds} s of sim time')
+
+    def pelvis_z(self) -> float:
+        assert self.odom is not None
+        return self.odom.pose.pose.position.z
+
+    def position(self, joint: str) -> float:
+        assert self.joint_state is not None
+        return self.joint_state.position[self.joint_state.name.index(joint)]
+
+    # -- driving -------------------------------------------------------------------------
+    def call(self, service: str) -> None:
+        rospy.wait_for_service(service, timeout=WALL_TIMEOUT_S)
+        rospy.ServiceProxy(service, Empty)()
+
+    def set_mode(self, mode: str) -> None:
+        self.mode_pub.publish(String(data=mode))
+
+    def send(self, names: Sequence[str], **arrays: Sequence[float]) -> None:
+        self.command_pub.publish(JointCommands(name=list(names), **arrays))
+
+    def warnings_containing(self, text: str) -> list[str]:
+        with self.lock:
+            return [w for w in self.warnings if text in w]

@@ -1,0 +1,217 @@
+#!/usr/bin/env python3
+"""rostest: the simulator node speaks DRCSim's ROS interface (topics, commands, modes, services)."""
+
+from __future__ import annotations
+
+import sys
+import time
+import unittest
+from pathlib import Path
+
+import numpy as np
+import rosgraph
+import rospy
+import rostest
+from rosgraph_msgs.msg import Clock
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from sim_probe import SimProbe  # noqa: E402
+
+from tutorial_atlas_control import model as atlas_model  # noqa: E402
+from tutorial_atlas_control.controller import gains_from_params  # noqa: E402
+from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS  # noqa: E402
+from tutorial_atlas_control.simulator import AtlasSimulator, ControlMode  # noqa: E402
+
+PKG = 'tutorial_atlas_control'
+EXPECTED_TYPES = {
+    '/clock': 'rosgraph_msgs/Clock',
+    '/atlas/joint_states': 'sensor_msgs/JointState',
+    '/ground_truth_odom': 'nav_msgs/Odometry',
+    '/atlas/imu': 'sensor_msgs/Imu',
+    '/atlas/l_foot_contact': 'geometry_msgs/WrenchStamped',
+    '/atlas/r_foot_contact': 'geometry_msgs/WrenchStamped',
+    '/atlas/joint_commands': 'osrf_msgs/JointCommands',
+    '/atlas/control_mode': 'std_msgs/String',
+}
+STEP_NS = 1_000_000
+#: A step command on the left elbow, with the tutorial's gains for that joint.
+ELBOW = 'l_arm_elx'
+ELBOW_TARGET_RAD = 0.8
+
+
+class SimInterfaceTest(unittest.TestCase):
+    probe: SimProbe
+
+    @classmethod
+    def setUpClass(cls) -> None:
+        rospy.init_node('test_sim_interface')
+        cls.probe = SimProbe()
+        cls.probe.wait_ready()
+
+    def restart(self, mode: str) -> None:
+        """Sim time 0, robot at its initial pose, in `mode`."""
+        self.probe.call('/gazebo/reset_simulation')
+        self.probe.set_mode(mode)
+        self.probe.wait_sim(0.05)
+
+    def test_01_topics_types_and_joint_names(self) -> None:
+        types = dict(rosgraph.Master('/test').getTopicTypes())
+        for topic, expected in EXPECTED_TYPES.items():
+            self.assertEqual(types.get(topic), expected, topic)
+        self.assertEqual(tuple(self.probe.joint_state.name), JOINT_NAMES)
+
+    def test_02_joint_states_every_step_stamped_with_sim_time(self) -> None:
+        probe = self.probe
+        clocks: list[int] = []
+        with probe.lock:
+            probe.joint_states.clear()
+            probe.keep_joint_states = True
+        start_ns = probe.clock_ns
+        clock_sub = rospy.Subscriber('/clock', Clock, lambda m: clocks.append(m.clock.to_nsec()),
+                                     queue_size=5000)
+        probe.wait_sim(1.0)
+        with probe.lock:
+            probe.keep_joint_states = False
+            states = list(probe.joint_states)
+        clock_sub.unregister()
+        stamps = np.array([s.header.stamp.to_nsec() for s in states if s.header.stamp.to_nsec() > start_ns])
+        self.assertGreater(len(stamps), 950, 'about 1000 joint states per second of sim time')
+        steps = np.diff(stamps)
+        self.assertEqual(int(np.median(steps)), STEP_NS)
+        self.assertTrue(np.all(steps % STEP_NS == 0), 'stamps fall on physics steps')
+        on_clock = np.isin(stamps, np.array(clocks))
+        self.assertGreater(on_clock.mean(), 0.95, 'joint state stamps equal /clock times')
+
+    def test_03_stands_20_s_without_commands(self) -> None:
+        probe = self.probe
+        self.restart('Stand')
+        start_z = probe.pelvis_z()
+        heights = []
+        end_ns = probe.clock_ns + 20 * 10**9
+        while probe.clock_ns < end_ns:
+            heights.append(probe.pelvis_z())
+            probe.wait_sim(0.05)
+        drift = float(np.max(np.abs(np.array(heights) - start_z)))
+        rospy.loginfo(f'standing: max pelvis drift over 20 s = {drift * 100:.2f} cm')
+        self.assertLess(drift, 0.02)
+
+    def test_04_step_command_follows_the_law(self) -> None:
+        """The node's response equals AtlasSimulator's, step for step (one code path)."""
+        probe = self.probe
+        gains = gains_from_params(rospy.get_param('atlas_controller/gains'))
+        index = JOINT_INDEX[ELBOW]
+        command = {'position': [ELBOW_TARGET_RAD], 'kp_position': [float(gains.p[index])],
+                   'kd_position': [float(gains.d[index])]}
+        probe.call('/gazebo/pause_physics')
+        probe.call('/gazebo/reset_simulation')
+        probe.set_mode('User')
+        probe.send(['atlas::' + ELBOW], **command)
+        time.sleep(0.5)  # let both messages arrive while physics is paused
+        with probe.lock:
+            probe.joint_states.clear()
+            probe.keep_joint_states = True
+        probe.call('/gazebo/unpause_physics')
+        probe.wait_sim(1.0)
+        with probe.lock:
+            probe.keep_joint_states = False
+            recorded = {s.header.stamp.to_nsec() // STEP_NS: np.array(s.position)
+                        for s in probe.joint_states}
+
+        offline = AtlasSimulator(atlas_model.load_model(), gains,
+                                 float(rospy.get_param('/atlas/time_to_unpin', 1.0)))
+        offline.set_mode(ControlMode.USER)
+        offline.receive_command(['atlas::' + ELBOW], command)
+        predicted = {}
+        for step in range(1, 1001):
+            offline.step()
+            predicted[step] = offline.joint_positions().copy()
+        common = sorted(set(recorded) & set(predicted))
+        self.assertGreater(len(common), 900)
+        worst = max(float(np.max(np.abs(recorded[s] - predicted[s]))) for s in common)
+        rospy.loginfo(f'step response: largest deviation from the law = {worst:.3g} rad')
+        self.assertLess(worst, 1e-9)
+        self.assertAlmostEqual(recorded[common[-1]][index], ELBOW_TARGET_RAD, delta=0.05)
+
+    def test_05_bad_commands_are_refused_and_previous_command_stays(self) -> None:
+        probe = self.probe
+        self.restart('User')
+        probe.send([ELBOW], position=[ELBOW_TARGET_RAD])
+        probe.wait_sim(1.5)
+        self.assertAlmostEqual(probe.position(ELBOW), ELBOW_TARGET_RAD, delta=0.05)
+        bad = [
+            ([], {'position': [0.0] * (NUM_JOINTS - 1)}, 'position has 27 entries'),
+            ([ELBOW], {'position': [float('nan')]}, 'NaN/Inf'),
+            (['atlas::l_arm_nope'], {'position': [0.0]}, 'unknown joint name'),
+        ]
+        for names, arrays, reason in bad:
+            probe.send(names, **arrays)
+            probe.wait_until(lambda r=reason: probe.warnings_containing(r), f'a warning: {reason}',
+                             timeout_s=10)
+            time.sleep(2.1)  # the refusal warning is throttled
+        probe.wait_sim(0.5)
+        self.assertAlmostEqual(probe.position(ELBOW), ELBOW_TARGET_RAD, delta=0.05)
+
+    def test_06_names_with_prefix_and_shuffled_are_mapped(self) -> None:
+        probe = self.probe
+        self.restart('User')
+        targets = {'r_arm_elx': -0.8, 'l_arm_shx': 0.4, 'r_arm_shx': -0.4}
+        names = ['atlas::r_arm_shx', 'l_arm_shx', 'atlas::r_arm_elx']
+        probe.send(names, position=[targets[n.replace('atlas::', '')] for n in names])
+        probe.wait_sim(2.0)
+        for joint, target in targets.items():
+            self.assertAlmostEqual(probe.position(joint), target, delta=0.05, msg=joint)
+
+    def test_07_modes_freeze_unknown_ragdoll(self) -> None:
+        probe = self.probe
+        self.restart('User')
+        probe.send([ELBOW], position=[ELBOW_TARGET_RAD])
+        probe.wait_sim(1.5)
+        probe.set_mode('Freeze')
+        probe.wait_sim(0.1)
+        frozen_rad = probe.position(ELBOW)
+        probe.send([ELBOW], position=[0.0])  # stored, not applied while frozen
+        probe.set_mode('Dance')
+        probe.wait_until(lambda: probe.warnings_containing('valid modes: Stand, StandPrep, '
+                                                           'Freeze, ragdoll, User'),
+                         'the unknown-mode warning', timeout_s=10)
+        probe.wait_sim(1.0)
+        # Held where it was frozen (sagging under gravity by at most P-gain slack), not sent to 0.
+        self.assertAlmostEqual(probe.position(ELBOW), frozen_rad, delta=0.1)
+        probe.set_mode('ragdoll')
+        probe.wait_sim(3.0)
+        self.assertLess(probe.pelvis_z(), 0.5, 'ragdoll: the robot collapses')
+
+    def test_08_pin_release_reset_and_pause(self) -> None:
+        probe = self.probe
+        unpin_s = float(rospy.get_param('/atlas/time_to_unpin'))
+        probe.set_mode('ragdoll')
+        probe.call('/gazebo/reset_world')
+        reset_ns = probe.clock_ns
+        probe.wait_sim(0.05)  # odometry from after the reset
+        spawn_z = atlas_model.SPAWN_HEIGHT_M
+        while probe.clock_ns < reset_ns + int((unpin_s - 0.1) * 1e9):
+            self.assertAlmostEqual(probe.pelvis_z(), spawn_z, delta=0.002, msg='pinned torso')
+            probe.wait_sim(0.02)
+        probe.wait_sim(3.0)
+        self.assertLess(probe.pelvis_z(), 0.5, 'released after time_to_unpin, ragdoll falls')
+        self.assertGreater(probe.clock_ns, reset_ns, 'reset_world keeps sim time')
+
+        probe.call('/gazebo/reset_simulation')
+        probe.wait_until(lambda: probe.clock_ns < reset_ns, 'the clock to rewind')
+        probe.wait_sim(0.05)
+        self.assertLess(probe.sim_time_s(), 0.5, 'reset_simulation rewinds sim time')
+        self.assertAlmostEqual(probe.pelvis_z(), spawn_z, delta=0.002)
+
+        probe.call('/gazebo/pause_physics')
+        time.sleep(0.2)
+        paused_ns = probe.clock_ns
+        time.sleep(0.5)
+        self.assertEqual(probe.clock_ns, paused_ns, 'paused physics: clock stands still')
+        probe.call('/gazebo/unpause_physics')
+        probe.wait_sim(0.1)
+        self.assertGreater(probe.clock_ns, paused_ns)
+        probe.set_mode('Stand')
+
+
+if __name__ == '__main__':
+    rostest.rosrun(PKG, 'sim_interface', SimInterfaceTest)
