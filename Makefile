@@ -28,7 +28,7 @@ test: setup
 	@$(IN_ENV) bash tools/run_rostests.sh
 
 demo: setup
-	@$(IN_ENV) python3 tools/demo.py "$(TRAJ)"
+	@$(IN_ENV) python3 scripts/run_demo.py "$(TRAJ)"
 
 bench: setup
 	@$(IN_ENV) python3 bench/run_bench.py
