@@ -167,14 +167,17 @@ def foot_contact(t_s: float, side: str, fz_n: float = 450.0) -> Record:
 
 
 def write_bag(path: Path | str, records: Iterable[Record], *,
-              compression: str | None = None) -> Path:
+              compression: str | None = None, chunk_bytes: int | None = None) -> Path:
     """Write `records` (any order; sorted by time, stably) to a new ROS 1 bag at `path`.
 
-    `compression` is None, 'bz2' or 'lz4' (chunk compression, as `rosbag record -j/--lz4`).
+    `compression` is None, 'bz2' or 'lz4' (chunk compression, as `rosbag record -j/--lz4`);
+    `chunk_bytes` overrides the chunk size (default 1 MiB) to get many chunks.
     """
     path = Path(path)
     ordered = sorted(records, key=lambda record: record.t_s)
     writer = Writer(path)
+    if chunk_bytes is not None:
+        writer.chunk_threshold = chunk_bytes
     if compression:
         writer.set_compression(Writer.CompressionFormat[compression.upper()])
     with writer:
