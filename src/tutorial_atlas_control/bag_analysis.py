@@ -415,9 +415,8 @@ def _column_union(name_lists: Sequence[Sequence[str]]) -> list[str]:
 def _read_joint_states(reader: Any, connections: Sequence[Any], typestore: Any,
                        start_ns: int, warnings: list[str]) -> JointStateSeries:
     bag_ns, raws = _read_raw(reader, connections)
-    fast = None
-    if all(connection.digest == JOINT_STATE_MD5 for connection in connections):
-        fast = _joint_states_fast(raws)
+    standard = all(connection.digest == JOINT_STATE_MD5 for connection in connections)
+    fast = _joint_states_fast(raws) if standard else None
     if fast is not None:
         stamps_ns, names, (position, velocity, effort) = fast
         names = [bare_joint_name(name) for name in names]
@@ -426,7 +425,7 @@ def _read_joint_states(reader: Any, connections: Sequence[Any], typestore: Any,
     else:
         parsed = []
         for raw in raws:
-            if all(connection.digest == JOINT_STATE_MD5 for connection in connections):
+            if standard:
                 stamp_ns, msg_names, arrays = _parse_names_arrays(raw, 3)
             else:
                 msg = typestore.deserialize_ros1(raw, 'sensor_msgs/msg/JointState')
@@ -786,7 +785,8 @@ def analyze(data: BagData) -> Analysis:
                 sent = commands.position[:, index]
                 sent = sent[np.isfinite(sent)]
                 commanded = bool(len(sent))
-                moved = moved or bool(commanded and np.any(np.abs(sent - sent[0]) > COMMAND_CHANGE_RAD))
+                changed = commanded and np.any(np.abs(sent - sent[0]) > COMMAND_CHANGE_RAD)
+                moved = moved or bool(changed)
                 rows = latest >= 0
                 target = commands.held[latest[rows], index]
                 errors = target - measured[rows]

@@ -93,7 +93,8 @@ def format_summary(analysis: Analysis) -> str:
     elif not analysis.effort_saturation:
         lines.append('Effort:   no joint reached its effort limit')
     else:
-        lines.append(f'Effort limit reached (|effort| >= limit - {EFFORT_LIMIT_TOLERANCE_NM} N·m):')
+        lines.append('Effort limit reached '
+                     f'(|effort| >= limit - {EFFORT_LIMIT_TOLERANCE_NM} N·m):')
         for name, sat in analysis.effort_saturation.items():
             lines.append(f'  {name:<10} limit {sat.limit_nm:8.3f} N·m  for {sat.duration_s:.3f} s '
                          f'(first at {sat.first_time_s:.3f} s)')
@@ -142,7 +143,8 @@ def write_csv(data: BagData, directory: Path | str) -> list[Path]:
         directory.mkdir(parents=True, exist_ok=True)
         states = data.joint_states
         if states is not None:
-            header = ['t'] + [f'{name}_{quantity}' for quantity in ('position', 'velocity', 'effort')
+            quantities = ('position', 'velocity', 'effort')
+            header = ['t'] + [f'{name}_{quantity}' for quantity in quantities
                               for name in states.names]
             written.append(_save_csv(directory / 'joint_states.csv', header,
                                      [states.t_s, states.position, states.velocity,
@@ -195,8 +197,12 @@ def plot_run(analysis: Analysis, path: Path | str) -> Path:
             sent = commands.position[:, JOINT_NAMES.index(name)]
             finite = np.isfinite(sent)
             if finite.any():
-                ax.plot(commands.t_s[finite], sent[finite], drawstyle='steps-post',
-                        color='tab:orange', label='commanded')
+                t_s, values = commands.t_s[finite], sent[finite]
+                if states is not None and len(states.t_s) and states.t_s[-1] > t_s[-1]:
+                    # The last command is held until the end of the run.
+                    t_s, values = np.append(t_s, states.t_s[-1]), np.append(values, values[-1])
+                ax.plot(t_s, values, drawstyle='steps-post', color='tab:orange',
+                        label='commanded')
         if states is not None:
             ax.plot(*_decimate(states.t_s, states.position[:, states.names.index(name)]),
                     color='tab:blue', linewidth=1.0, label='measured')
@@ -215,9 +221,11 @@ def plot_run(analysis: Analysis, path: Path | str) -> Path:
     for ax in axes:
         for t_s, _ in data.modes:
             ax.axvline(t_s, color='gray', linestyle='--', linewidth=0.8)
-    for t_s, mode in data.modes:
+    for number, (t_s, mode) in enumerate(data.modes):
+        # Alternate label heights so modes that change in quick succession stay legible.
         axes[0].annotate(mode, (t_s, 1.0), xycoords=('data', 'axes fraction'),
-                         xytext=(2, 2), textcoords='offset points', fontsize=8, rotation=30)
+                         xytext=(2, 2 + 10 * (number % 2)), textcoords='offset points',
+                         fontsize=8)
     for ax in axes[:1] + axes[-1:] if rows else []:
         ax.legend(loc='upper right', fontsize=7)
     axes[-1].set_xlabel('time from bag start (s)')

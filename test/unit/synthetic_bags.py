@@ -132,12 +132,14 @@ def odometry(t_s: float, z_m: float, x_m: float = 0.0, y_m: float = 0.0,
 
 def control_mode(t_s: float, mode: str) -> Record:
     """A /atlas/control_mode message (std_msgs/String, no header) recorded at `t_s`."""
-    return Record('/atlas/control_mode', 'std_msgs/String', t_s, _type('std_msgs/String')(data=mode))
+    msg = _type('std_msgs/String')(data=mode)
+    return Record('/atlas/control_mode', 'std_msgs/String', t_s, msg)
 
 
 def clock(t_s: float) -> Record:
     """A /clock message."""
-    return Record('/clock', 'rosgraph_msgs/Clock', t_s, _type('rosgraph_msgs/Clock')(clock=_time(t_s)))
+    msg = _type('rosgraph_msgs/Clock')(clock=_time(t_s))
+    return Record('/clock', 'rosgraph_msgs/Clock', t_s, msg)
 
 
 def imu(t_s: float) -> Record:

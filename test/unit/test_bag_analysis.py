@@ -161,7 +161,8 @@ def test_single_message_topic_has_no_rate(tmp_path: Path) -> None:
 
 def test_mode_timeline_collapses_repeats_and_uses_bag_time(tmp_path: Path) -> None:
     records = [clock(0.5), control_mode(0.5, 'Stand'), control_mode(0.75, 'Stand'),
-               control_mode(1.5, 'User'), control_mode(2.25, 'Freeze'), control_mode(2.5, 'ragdoll')]
+               control_mode(1.5, 'User'), control_mode(2.25, 'Freeze'),
+               control_mode(2.5, 'ragdoll')]
     analysis = analyze_bag(write_bag(tmp_path / 'run.bag', records))
     assert analysis.mode_timeline == [(0.0, 'Stand'), (1.0, 'User'), (1.75, 'Freeze'),
                                       (2.0, 'ragdoll')]
@@ -263,7 +264,8 @@ def test_joint_commands_use_the_bags_own_definition(tmp_path: Path) -> None:
     with Writer(path) as writer:
         connection = writer.add_connection('/atlas/joint_commands', 'osrf_msgs/msg/JointCommands',
                                            msgdef=full_msgdef, md5sum=md5)
-        writer.write(connection, 1, typestore.serialize_ros1(message, 'osrf_msgs/msg/JointCommands'))
+        raw = typestore.serialize_ros1(message, 'osrf_msgs/msg/JointCommands')
+        writer.write(connection, 1, raw)
     data = read_bag(path)
     assert data.commands.position[0, ELX] == 0.7
 
