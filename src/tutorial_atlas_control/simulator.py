@@ -98,7 +98,7 @@ class AtlasSimulator:
         self._pin_until_ns = self.sim_time_ns + int(round(self.time_to_unpin_s * NS_PER_S))
         self._set_pinned(self.time_to_unpin_s > 0.0)
         if self.mode in (ControlMode.FREEZE, ControlMode.USER):
-            self._mode_command = hold_command(self.gains, self.joint_positions())
+            self._mode_command = self._hold_current_pose()
 
     def reset_simulation(self) -> None:
         """reset_world, and sim time back to 0."""
@@ -121,8 +121,22 @@ class AtlasSimulator:
         if mode in (ControlMode.STAND, ControlMode.STAND_PREP):
             self._mode_command = hold_command(self.gains, np.zeros(NUM_JOINTS))
         elif mode in (ControlMode.FREEZE, ControlMode.USER):
-            self._mode_command = hold_command(self.gains, self.joint_positions())
+            self._mode_command = self._hold_current_pose()
+        # The target changed: restart the derivative so the switch gives no kick.
+        self._pid.initialized = False
         self.mode = mode
+
+    def _hold_current_pose(self) -> JointCommandArrays:
+        """Target = the measured pose, feed-forward = the torque applied now.
+
+        A bumpless transfer: holding the measured pose with the PD gains alone would let
+        each joint sag again under the load it already sagged under (the robot leans
+        further and, mid-sway, falls); keeping the present torque as `effort` makes the
+        switch seamless.
+        """
+        command = hold_command(self.gains, self.joint_positions())
+        command.effort[:] = self.torque_nm
+        return command
 
     def receive_command(self, names: Sequence[str],
                         arrays: Mapping[str, Sequence[float]]) -> None:
@@ -136,7 +150,8 @@ class AtlasSimulator:
         """
         previous = self.user_command
         if previous is None:
-            previous = hold_command(self.gains, self.joint_positions())
+            previous = (self._mode_command if self.mode is ControlMode.USER
+                        else self._hold_current_pose())
         self.user_command = merge_command(previous, names, arrays)
 
     def active_command(self) -> JointCommandArrays:

@@ -1,0 +1,197 @@
+#!/usr/bin/env python3
+"""rostest: one tutorial trajectory, run with the real traj_yaml.py, judged by what the robot did.
+
+Private parameters: ~trajectory (step_and_fall | touchdown | touchdown_exhausted | standing).
+The checks are the tutorial's promises (issue 6): step_and_fall lifts the right foot in its
+first waypoint and falls; touchdown tracks the arms and stays up; touchdown_exhausted runs
+to completion and tracks the arms; standing stands 20 s with no command.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import unittest
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import rospy
+import rostest
+from geometry_msgs.msg import WrenchStamped
+from nav_msgs.msg import Odometry
+from osrf_msgs.msg import JointCommands
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from sim_probe import SimProbe  # noqa: E402
+
+from tutorial_atlas_control import model as atlas_model  # noqa: E402
+from tutorial_atlas_control.joints import JOINT_INDEX  # noqa: E402
+from tutorial_atlas_control.trajectory import load_trajectory, sample_count  # noqa: E402
+
+PKG = 'tutorial_atlas_control'
+TRAJECTORY_FILE = Path(__file__).resolve().parents[2] / 'trajectories' / 'Traj_data2.yaml'
+ARM_JOINTS = ('l_arm_shx', 'r_arm_shx', 'l_arm_elx', 'r_arm_elx')
+#: Acceptance thresholds (issue 6).
+ARM_TOLERANCE_RAD = 0.1
+FOOT_LIFT_M = 0.03
+FOOT_UNLOADED_N = 30.0  # the ankle sensor still carries the foot's own weight (16 N)
+FALLEN_BELOW_M = 0.5
+FALL_WINDOW_S = 5.0
+UPRIGHT_ABOVE_M = 0.7
+STANDING_DRIFT_M = 0.02
+STANDING_S = 20.0
+#: Sim time after start before switching to User (the torso is pinned for 1 s).
+UNPIN_WAIT_S = 1.5
+
+
+class Recorder:
+    """Everything the checks need, indexed by sim time (ns)."""
+
+    def __init__(self) -> None:
+        self.commands: list[int] = []
+        self.odom: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self.r_force_n: dict[int, float] = {}
+        rospy.Subscriber('/atlas/joint_commands', JointCommands,
+                         lambda m: self.commands.append(m.header.stamp.to_nsec()), queue_size=500)
+        rospy.Subscriber('/ground_truth_odom', Odometry,
+                         self._on_odom, queue_size=1000)
+        rospy.Subscriber('/atlas/r_foot_contact', WrenchStamped,
+                         self._on_contact, queue_size=5000)
+
+    def _on_odom(self, msg: Odometry) -> None:
+        p, q = msg.pose.pose.position, msg.pose.pose.orientation
+        self.odom[msg.header.stamp.to_nsec()] = (np.array([p.x, p.y, p.z]),
+                                                 np.array([q.w, q.x, q.y, q.z]))
+
+    def _on_contact(self, msg: WrenchStamped) -> None:
+        f = msg.wrench.force
+        self.r_force_n[msg.header.stamp.to_nsec()] = float(np.linalg.norm([f.x, f.y, f.z]))
+
+
+class TutorialRunTest(unittest.TestCase):
+    def setUp(self) -> None:
+        rospy.init_node('test_tutorial_run', anonymous=True)
+        self.trajectory = rospy.get_param('~trajectory')
+        self.probe = SimProbe(keep_joint_states=True)
+        self.recorder = Recorder()
+        self.probe.wait_ready()
+        self.probe.wait_sim(UNPIN_WAIT_S)
+        self.atlas = atlas_model.load_model()
+        self.data = mujoco.MjData(self.atlas.model)
+
+    # -- helpers -------------------------------------------------------------------------
+    def run_port(self) -> None:
+        self.probe.set_mode('User')
+        self.probe.wait_sim(0.1)
+        result = subprocess.run(
+            ['rosrun', PKG, 'traj_yaml.py', str(TRAJECTORY_FILE), self.trajectory],
+            capture_output=True, text=True, timeout=300, check=False)
+        self.assertEqual(result.returncode, 0, f'traj_yaml.py failed:\n{result.stderr}')
+
+    def segment_ends_ns(self) -> list[int]:
+        """Sim time at which each waypoint's last command was sent."""
+        waypoints = load_trajectory(TRAJECTORY_FILE, self.trajectory)
+        counts = np.cumsum([sample_count(w.duration_s) for w in waypoints])
+        stamps = sorted(self.recorder.commands)
+        # The first few may be sent before this test's subscriber connects: count from the end.
+        self.assertGreater(len(stamps), counts[-1] - 10, "the port's commands arrived")
+        return [stamps[len(stamps) - 1 - (counts[-1] - c)] for c in counts]
+
+    def state_at(self, t_ns: int) -> np.ndarray:
+        """Joint positions of the first joint state at or after t_ns."""
+        with self.probe.lock:
+            for msg in self.probe.joint_states:
+                if msg.header.stamp.to_nsec() >= t_ns:
+                    return np.array(msg.position)
+        self.fail(f'no joint state at or after t={t_ns / 1e9:.3f} s')
+
+    def pelvis_heights(self, start_ns: int, end_ns: int) -> np.ndarray:
+        return np.array([pose[0][2] for t, pose in sorted(list(self.recorder.odom.items()))
+                         if start_ns <= t <= end_ns])
+
+    def right_foot_lift_m(self, start_ns: int, end_ns: int) -> float:
+        """Largest height of the right sole above its standing height (forward kinematics)."""
+        foot = self.atlas.model.body('r_foot').id
+        atlas_model.reset_to_initial(self.atlas, self.data)
+        rest_z = self.data.xpos[foot][2]
+        states = {}
+        with self.probe.lock:
+            for msg in self.probe.joint_states:
+                states[msg.header.stamp.to_nsec()] = msg.position
+        lift = -np.inf
+        for t_ns, (position, quat) in list(self.recorder.odom.items()):
+            if not start_ns <= t_ns <= end_ns or t_ns not in states:
+                continue
+            self.data.qpos[:3], self.data.qpos[3:7] = position, quat
+            self.data.qpos[self.atlas.qpos_adr] = states[t_ns]
+            mujoco.mj_kinematics(self.atlas.model, self.data)
+            lift = max(lift, self.data.xpos[foot][2] - rest_z)
+        return float(lift)
+
+    def check_arm_tracking(self) -> None:
+        waypoints = load_trajectory(TRAJECTORY_FILE, self.trajectory)
+        for k, (waypoint, end_ns) in enumerate(zip(waypoints, self.segment_ends_ns())):
+            measured = self.state_at(end_ns)
+            for joint in ARM_JOINTS:
+                index = JOINT_INDEX[joint]
+                error = abs(measured[index] - waypoint.positions[index])
+                rospy.loginfo(f'{self.trajectory} waypoint {k}: {joint} error {error:.3f} rad')
+                self.assertLess(error, ARM_TOLERANCE_RAD, f'waypoint {k}, {joint}')
+
+    # -- the scenario ------------------------------------------------------------------
+    def test_tutorial_scenario(self) -> None:
+        getattr(self, f'scenario_{self.trajectory}')()
+
+    def scenario_standing(self) -> None:
+        start_ns = self.probe.clock_ns
+        start_z = self.probe.pelvis_z()
+        self.probe.wait_sim(STANDING_S)
+        heights = self.pelvis_heights(start_ns, self.probe.clock_ns)
+        drift = float(np.max(np.abs(heights - start_z)))
+        rospy.loginfo(f'standing {STANDING_S} s: largest pelvis drift {drift * 100:.2f} cm')
+        self.assertGreater(len(heights), STANDING_S * 90)
+        self.assertLess(drift, STANDING_DRIFT_M)
+
+    def scenario_step_and_fall(self) -> None:
+        self.run_port()
+        self.probe.wait_sim(FALL_WINDOW_S)
+        ends = self.segment_ends_ns()
+        first_waypoint = load_trajectory(TRAJECTORY_FILE, self.trajectory)[0]
+        first_start = ends[0] - int(first_waypoint.duration_s * 1e9)
+        lift = self.right_foot_lift_m(first_start, ends[0])
+        min_force = min(f for t, f in list(self.recorder.r_force_n.items()) if first_start <= t <= ends[0])
+        rospy.loginfo(f'step_and_fall waypoint 0: right foot up {lift * 100:.1f} cm, '
+                      f'smallest right ankle force {min_force:.1f} N')
+        self.assertTrue(lift > FOOT_LIFT_M or min_force < FOOT_UNLOADED_N,
+                        f'the right foot left the ground in waypoint 0 (lift {lift:.3f} m, '
+                        f'force {min_force:.1f} N)')
+        heights = self.pelvis_heights(ends[-1], ends[-1] + int(FALL_WINDOW_S * 1e9))
+        rospy.loginfo(f'step_and_fall: lowest pelvis {heights.min():.2f} m within '
+                      f'{FALL_WINDOW_S} s of the last waypoint')
+        self.assertLess(heights.min(), FALLEN_BELOW_M, 'the robot fell')
+
+    def scenario_touchdown(self) -> None:
+        start_ns = self.probe.clock_ns
+        self.run_port()
+        self.probe.wait_sim(0.5)
+        self.check_arm_tracking()
+        heights = self.pelvis_heights(start_ns, self.probe.clock_ns)
+        rospy.loginfo(f'touchdown: lowest pelvis {heights.min():.3f} m')
+        self.assertGreater(heights.min(), UPRIGHT_ABOVE_M, 'the robot stays up')
+
+    def scenario_touchdown_exhausted(self) -> None:
+        start_ns = self.probe.clock_ns
+        self.run_port()
+        self.probe.wait_sim(FALL_WINDOW_S)
+        self.check_arm_tracking()
+        lowest = self.pelvis_heights(start_ns, self.probe.clock_ns).min()
+        fell = lowest < FALLEN_BELOW_M
+        report = f'touchdown_exhausted: the robot {"fell" if fell else "stayed up"} ' \
+                 f'(lowest pelvis {lowest:.2f} m)'
+        rospy.loginfo(report)
+        print(report)
+
+
+if __name__ == '__main__':
+    rostest.rosrun(PKG, 'tutorial_run', TutorialRunTest)
