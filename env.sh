@@ -27,5 +27,5 @@ export ROS_HOSTNAME="${ROS_HOSTNAME:-localhost}"
 export ROS_MASTER_URI="${ROS_MASTER_URI:-http://localhost:11311}"
 # Offscreen rendering without a GPU or display: software OSMesa unless the user chose otherwise.
 if [ -z "${DISPLAY:-}" ] && [ -z "${MUJOCO_GL:-}" ]; then export MUJOCO_GL=osmesa PYOPENGL_PLATFORM=osmesa; fi
-export TAC_REPO_DIR="$repo_dir"
+export TAC_REPO_DIR="$repo_dir" TAC_HOME TAC_WS TAC_VENV
 unset repo_dir

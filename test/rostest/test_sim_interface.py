@@ -137,7 +137,9 @@ class SimInterfaceTest(unittest.TestCase):
         self.restart('User')
         probe.send([ELBOW], position=[ELBOW_TARGET_RAD])
         probe.wait_sim(1.5)
-        self.assertAlmostEqual(probe.position(ELBOW), ELBOW_TARGET_RAD, delta=0.05)
+        # P-gain slack: the elbow (p=200) sags a few hundredths of a radian under gravity.
+        self.assertAlmostEqual(probe.position(ELBOW), ELBOW_TARGET_RAD, delta=0.1)
+        held_rad = probe.position(ELBOW)
         bad = [
             ([], {'position': [0.0] * (NUM_JOINTS - 1)}, 'position has 27 entries'),
             ([ELBOW], {'position': [float('nan')]}, 'NaN/Inf'),
@@ -149,7 +151,7 @@ class SimInterfaceTest(unittest.TestCase):
                              timeout_s=10)
             time.sleep(2.1)  # the refusal warning is throttled
         probe.wait_sim(0.5)
-        self.assertAlmostEqual(probe.position(ELBOW), ELBOW_TARGET_RAD, delta=0.05)
+        self.assertAlmostEqual(probe.position(ELBOW), held_rad, delta=0.03)
 
     def test_06_names_with_prefix_and_shuffled_are_mapped(self) -> None:
         probe = self.probe
@@ -166,6 +168,7 @@ class SimInterfaceTest(unittest.TestCase):
         self.restart('User')
         probe.send([ELBOW], position=[ELBOW_TARGET_RAD])
         probe.wait_sim(1.5)
+        self.assertAlmostEqual(probe.position(ELBOW), ELBOW_TARGET_RAD, delta=0.1)
         probe.set_mode('Freeze')
         probe.wait_sim(0.1)
         frozen_rad = probe.position(ELBOW)
@@ -175,7 +178,7 @@ class SimInterfaceTest(unittest.TestCase):
                                                            'Freeze, ragdoll, User'),
                          'the unknown-mode warning', timeout_s=10)
         probe.wait_sim(1.0)
-        # Held where it was frozen (sagging under gravity by at most P-gain slack), not sent to 0.
+        # Held near where it was frozen (the body still sways), not sent to the stored 0.
         self.assertAlmostEqual(probe.position(ELBOW), frozen_rad, delta=0.1)
         probe.set_mode('ragdoll')
         probe.wait_sim(3.0)

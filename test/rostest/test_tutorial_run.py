@@ -90,13 +90,19 @@ class TutorialRunTest(unittest.TestCase):
         self.assertEqual(result.returncode, 0, f'traj_yaml.py failed:\n{result.stderr}')
 
     def segment_ends_ns(self) -> list[int]:
-        """Sim time at which each waypoint's last command was sent."""
+        """Sim time at which each waypoint's segment ends.
+
+        The port publishes a segment's last sample (its target) and then sleeps one
+        publish interval, dt/n, before the next segment starts: that is the segment's end.
+        """
         waypoints = load_trajectory(TRAJECTORY_FILE, self.trajectory)
-        counts = np.cumsum([sample_count(w.duration_s) for w in waypoints])
+        samples = [sample_count(w.duration_s) for w in waypoints]
+        counts = np.cumsum(samples)
         stamps = sorted(self.recorder.commands)
         # The first few may be sent before this test's subscriber connects: count from the end.
         self.assertGreater(len(stamps), counts[-1] - 10, "the port's commands arrived")
-        return [stamps[len(stamps) - 1 - (counts[-1] - c)] for c in counts]
+        return [stamps[len(stamps) - 1 - (counts[-1] - c)] + int(w.duration_s / n * 1e9)
+                for c, n, w in zip(counts, samples, waypoints)]
 
     def state_at(self, t_ns: int) -> np.ndarray:
         """Joint positions of the first joint state at or after t_ns."""
