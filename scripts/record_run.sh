@@ -12,7 +12,7 @@ bag_dir=$1; shift
 mkdir -p "$bag_dir" || { echo "record_run.sh: cannot create bag directory $bag_dir" >&2; exit 1; }
 TOPICS=(
   /clock /atlas/joint_states /ground_truth_odom /atlas/imu /atlas/l_foot_contact
-  /atlas/r_foot_contact /atlas/joint_commands /atlas/control_mode /rosout
+  /atlas/r_foot_contact /atlas/joint_commands /atlas/control_mode /atlas/sim_config /rosout
 )
 echo "record_run.sh: recording to $bag_dir/atlas_<date-time>.bag"
 # exec: roslaunch's SIGINT must reach rosbag itself so that it closes the bag.

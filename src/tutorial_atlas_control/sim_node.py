@@ -1,7 +1,8 @@
 """The simulator node: AtlasSimulator behind DRCSim's ROS interface.
 
 Thin ROS glue. Publishes /clock, /atlas/joint_states, /ground_truth_odom, /atlas/imu and
-the foot contact wrenches in sim time; obeys /atlas/joint_commands and
+the foot contact wrenches in sim time, and a latched /atlas/sim_config (JSON: timestep,
+time_to_unpin, model file and checksum, time of the last reset) for offline replay; obeys /atlas/joint_commands and
 /atlas/control_mode; offers gazebo_ros's reset and pause services.
 
 Parameters (private unless noted):
@@ -16,6 +17,7 @@ Parameters (private unless noted):
 
 from __future__ import annotations
 
+import json
 import sys
 import threading
 import time
@@ -84,6 +86,9 @@ class SimNode:
         self.imu_pub = rospy.Publisher('/atlas/imu', Imu, queue_size=100)
         self.l_contact_pub = rospy.Publisher('/atlas/l_foot_contact', WrenchStamped, queue_size=100)
         self.r_contact_pub = rospy.Publisher('/atlas/r_foot_contact', WrenchStamped, queue_size=100)
+        # Latched, recorded in every bag: what offline replay needs to re-create the run.
+        self.config_pub = rospy.Publisher('/atlas/sim_config', String, queue_size=1, latch=True)
+        self.config_pub.publish(String(data=json.dumps(sim.config())))
 
         self.joint_state = JointState(name=list(JOINT_NAMES))
         self.odom = Odometry()
@@ -141,12 +146,14 @@ class SimNode:
     def reset_world(self) -> None:
         with self.lock:
             self.sim.reset_world()
+        self.config_pub.publish(String(data=json.dumps(self.sim.config())))
         rospy.loginfo('reset_world: robot back to its initial pose (torso pinned '
                       f'for {self.sim.time_to_unpin_s} s)')
 
     def reset_simulation(self) -> None:
         with self.lock:
             self.sim.reset_simulation()
+        self.config_pub.publish(String(data=json.dumps(self.sim.config())))
         rospy.loginfo('reset_simulation: robot reset and sim time back to 0')
 
     def pause(self) -> None:

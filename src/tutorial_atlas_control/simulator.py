@@ -8,7 +8,9 @@ without a master and shared with offline replay.
 from __future__ import annotations
 
 import enum
+import hashlib
 from collections.abc import Mapping, Sequence
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -68,8 +70,11 @@ class AtlasSimulator:
     """
 
     def __init__(self, atlas: atlas_model.AtlasModel, gains: Gains,
-                 time_to_unpin_s: float = DEFAULT_TIME_TO_UNPIN_S) -> None:
+                 time_to_unpin_s: float = DEFAULT_TIME_TO_UNPIN_S,
+                 model_path: Path = atlas_model.MODEL_PATH) -> None:
         self.atlas = atlas
+        self.atlas_path = model_path
+        self.atlas_sha1 = hashlib.sha1(model_path.read_bytes()).hexdigest()
         self.model = atlas.model
         self.data = mujoco.MjData(self.model)
         self.gains = gains
@@ -91,6 +96,7 @@ class AtlasSimulator:
         """Robot back to its initial state (pinned again), sim time kept, as Gazebo did."""
         atlas_model.reset_to_initial(self.atlas, self.data)
         self.data.time = self.sim_time_ns / NS_PER_S
+        self.last_reset_ns = self.sim_time_ns
         self._pid.reset()
         self.torque_nm[:] = 0.0
         # A reset robot waits for fresh commands rather than jumping to a stale target.
@@ -99,6 +105,16 @@ class AtlasSimulator:
         self._set_pinned(self.time_to_unpin_s > 0.0)
         if self.mode in (ControlMode.FREEZE, ControlMode.USER):
             self._mode_command = self._hold_current_pose()
+
+    def config(self) -> dict[str, object]:
+        """What re-creates this run offline: the model, its step, pinning and last reset."""
+        return {
+            'model_file': self.atlas_path.name,
+            'model_sha1': self.atlas_sha1,
+            'timestep': self.dt_s,
+            'time_to_unpin': self.time_to_unpin_s,
+            'last_reset_time': self.last_reset_ns / NS_PER_S,
+        }
 
     def reset_simulation(self) -> None:
         """reset_world, and sim time back to 0."""
