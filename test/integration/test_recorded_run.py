@@ -1,0 +1,92 @@
+"""The main job end to end: `run_demo.py` runs the tutorial and leaves one closed, indexed bag.
+
+Needs the catkin workspace (`source ./env.sh`); runs roslaunch on its own master port.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
+
+from rosbags.highlevel import AnyReader  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[2]
+DRCSIM_MD5 = 'f298c98f3e9c7aae9376ac19f73bfba3'
+RECORDED_TYPES = {
+    '/clock': 'rosgraph_msgs/msg/Clock',
+    '/atlas/joint_states': 'sensor_msgs/msg/JointState',
+    '/ground_truth_odom': 'nav_msgs/msg/Odometry',
+    '/atlas/imu': 'sensor_msgs/msg/Imu',
+    '/atlas/l_foot_contact': 'geometry_msgs/msg/WrenchStamped',
+    '/atlas/r_foot_contact': 'geometry_msgs/msg/WrenchStamped',
+    '/atlas/joint_commands': 'osrf_msgs/msg/JointCommands',
+    '/atlas/control_mode': 'std_msgs/msg/String',
+    '/atlas/sim_config': 'std_msgs/msg/String',
+    '/rosout': 'rosgraph_msgs/msg/Log',
+}
+
+
+@pytest.fixture(scope='module')
+def demo_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[subprocess.CompletedProcess, Path]:
+    bag_dir = tmp_path_factory.mktemp('bags')
+    result = subprocess.run(
+        [sys.executable, str(REPO / 'scripts' / 'run_demo.py'), 'step_and_fall',
+         '--bag-dir', str(bag_dir)],
+        capture_output=True, text=True, timeout=240, check=False)
+    return result, bag_dir
+
+
+def test_demo_exits_0_and_prints_summary_bag_and_plot(demo_run) -> None:  # noqa: ANN001
+    result, bag_dir = demo_run
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert 'the robot fell: pelvis below 0.5 m at t = ' in result.stdout
+    bags = list(bag_dir.glob('atlas_*.bag'))
+    assert len(bags) == 1
+    assert f'bag:  {bags[0]}' in result.stdout
+    plot = bags[0].with_suffix('.png')
+    assert f'plot: {plot}' in result.stdout
+    assert plot.stat().st_size > 10_000
+
+
+def test_bag_is_closed_and_indexed(demo_run) -> None:  # noqa: ANN001
+    _, bag_dir = demo_run
+    assert not list(bag_dir.glob('*.active')), 'rosbag left an unclosed .bag.active'
+    bag = next(bag_dir.glob('atlas_*.bag'))
+    info = subprocess.run(['rosbag', 'info', '--yaml', '--key=indexed', str(bag)],
+                          capture_output=True, text=True, check=True)
+    assert info.stdout.strip() == 'True'
+
+
+def test_bag_holds_the_run(demo_run) -> None:  # noqa: ANN001
+    _, bag_dir = demo_run
+    bag = next(bag_dir.glob('atlas_*.bag'))
+    with AnyReader([bag]) as reader:
+        connections = {c.topic: c for c in reader.connections}
+        for topic, msgtype in RECORDED_TYPES.items():
+            assert topic in connections, topic
+            assert connections[topic].msgtype == msgtype, topic
+        assert connections['/atlas/joint_commands'].digest == DRCSIM_MD5
+
+        commands = []
+        for c, _t, raw in reader.messages(connections=[connections['/atlas/joint_commands']]):
+            stamp = reader.deserialize(raw, c.msgtype).header.stamp
+            commands.append(stamp.sec * 10**9 + stamp.nanosec)
+        modes = [reader.deserialize(raw, c.msgtype).data for c, _t, raw in
+                 reader.messages(connections=[connections['/atlas/control_mode']])]
+        state_stamps = np.array([t for _c, t, _r in reader.messages(
+            connections=[connections['/atlas/joint_states']])])
+
+    # 200 commands (4 waypoints at 50 Hz), about 50 Hz of sim time while the port runs.
+    assert len(commands) >= 195
+    rate_hz = (len(commands) - 1) / ((commands[-1] - commands[0]) / 1e9)
+    assert 45.0 < rate_hz < 51.0, rate_hz
+    assert 'User' in modes
+    # Joint states every 1 ms of sim time (bag time is sim time under /use_sim_time).
+    span_s = (state_stamps[-1] - state_stamps[0]) / 1e9
+    assert len(state_stamps) / span_s == pytest.approx(1000.0, rel=0.02)
