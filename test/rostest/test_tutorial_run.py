@@ -50,14 +50,18 @@ class Recorder:
 
     def __init__(self) -> None:
         self.commands: list[int] = []
+        self.command_msgs: list[JointCommands] = []
         self.odom: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         self.r_force_n: dict[int, float] = {}
-        rospy.Subscriber('/atlas/joint_commands', JointCommands,
-                         lambda m: self.commands.append(m.header.stamp.to_nsec()), queue_size=500)
+        rospy.Subscriber('/atlas/joint_commands', JointCommands, self._on_command, queue_size=500)
         rospy.Subscriber('/ground_truth_odom', Odometry,
                          self._on_odom, queue_size=1000)
         rospy.Subscriber('/atlas/r_foot_contact', WrenchStamped,
                          self._on_contact, queue_size=5000)
+
+    def _on_command(self, msg: JointCommands) -> None:
+        self.command_msgs.append(msg)
+        self.commands.append(msg.header.stamp.to_nsec())
 
     def _on_odom(self, msg: Odometry) -> None:
         p, q = msg.pose.pose.position, msg.pose.pose.orientation
@@ -88,6 +92,7 @@ class TutorialRunTest(unittest.TestCase):
             ['rosrun', PKG, 'traj_yaml.py', str(TRAJECTORY_FILE), self.trajectory],
             capture_output=True, text=True, timeout=300, check=False)
         self.assertEqual(result.returncode, 0, f'traj_yaml.py failed:\n{result.stderr}')
+        self.check_port_commands()
 
     def segment_ends_ns(self) -> list[int]:
         """Sim time at which each waypoint's segment ends.
@@ -144,6 +149,36 @@ class TutorialRunTest(unittest.TestCase):
                 error = abs(measured[index] - waypoint.positions[index])
                 rospy.loginfo(f'{self.trajectory} waypoint {k}: {joint} error {error:.3f} rad')
                 self.assertLess(error, ARM_TOLERANCE_RAD, f'waypoint {k}, {joint}')
+
+    def check_port_commands(self) -> None:
+        """What the port sent: DRCSim's message, the parameter gains, 50 Hz, linear ramps."""
+        msgs = sorted(self.recorder.command_msgs, key=lambda m: m.header.stamp.to_nsec())
+        self.assertEqual(msgs[0]._type, 'osrf_msgs/JointCommands')
+        self.assertEqual(msgs[0]._md5sum, 'f298c98f3e9c7aae9376ac19f73bfba3')
+        gains = rospy.get_param('atlas_controller/gains')
+        for msg in msgs:
+            self.assertEqual([n.replace('atlas::', '') for n in msg.name], list(JOINT_INDEX))
+            for field, key, sign in (('kp_position', 'p', 1), ('ki_position', 'i', 1),
+                                     ('kd_position', 'd', 1), ('i_effort_max', 'i_clamp', 1),
+                                     ('i_effort_min', 'i_clamp', -1)):
+                expected = [sign * gains[joint][key] for joint in JOINT_INDEX]
+                self.assertEqual(list(getattr(msg, field)), expected, field)
+        stamps_s = np.array([m.header.stamp.to_sec() for m in msgs])
+        period_s = np.median(np.diff(stamps_s))
+        rospy.loginfo(f'{self.trajectory}: {len(msgs)} commands, median period '
+                      f'{period_s * 1000:.1f} ms of sim time')
+        self.assertAlmostEqual(period_s, 0.02, delta=0.002, msg='published at 50 Hz')
+        # Each later segment (complete in this recording) is a straight line from its
+        # first sample to the waypoint's positions.
+        waypoints = load_trajectory(TRAJECTORY_FILE, self.trajectory)
+        samples = [sample_count(w.duration_s) for w in waypoints]
+        first = len(msgs) - sum(samples[1:])
+        for waypoint, n in zip(waypoints[1:], samples[1:]):
+            segment = np.array([m.position for m in msgs[first:first + n]])
+            ratios = np.linspace(0.0, 1.0, n)[:, None]
+            line = (1 - ratios) * segment[0] + ratios * waypoint.positions
+            np.testing.assert_allclose(segment, line, atol=1e-9)
+            first += n
 
     # -- the scenario ------------------------------------------------------------------
     def test_tutorial_scenario(self) -> None:
