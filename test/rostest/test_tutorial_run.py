@@ -39,6 +39,8 @@ FOOT_UNLOADED_N = 30.0  # the ankle sensor still carries the foot's own weight (
 FALLEN_BELOW_M = 0.5
 FALL_WINDOW_S = 5.0
 UPRIGHT_ABOVE_M = 0.7
+#: step_and_fall's first waypoint bends the right knee to 1.4 rad; P-gain slack allowed.
+STEP_KNEE_TOLERANCE_RAD = 0.2
 STANDING_DRIFT_M = 0.02
 STANDING_S = 20.0
 #: Sim time after start before switching to User (the torso is pinned for 1 s).
@@ -49,7 +51,6 @@ class Recorder:
     """Everything the checks need, indexed by sim time (ns)."""
 
     def __init__(self) -> None:
-        self.commands: list[int] = []
         self.command_msgs: list[JointCommands] = []
         self.odom: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         self.r_force_n: dict[int, float] = {}
@@ -61,7 +62,6 @@ class Recorder:
 
     def _on_command(self, msg: JointCommands) -> None:
         self.command_msgs.append(msg)
-        self.commands.append(msg.header.stamp.to_nsec())
 
     def _on_odom(self, msg: Odometry) -> None:
         p, q = msg.pose.pose.position, msg.pose.pose.orientation
@@ -94,20 +94,35 @@ class TutorialRunTest(unittest.TestCase):
         self.assertEqual(result.returncode, 0, f'traj_yaml.py failed:\n{result.stderr}')
         self.check_port_commands()
 
+    def sorted_commands(self) -> list[JointCommands]:
+        return sorted(self.recorder.command_msgs, key=lambda m: m.header.stamp.to_nsec())
+
+    def segment_end_indices(self, msgs: list[JointCommands]) -> list[int]:
+        """Index of each waypoint's last sample: the first later one equal to the waypoint.
+
+        Found by value, since the port's first few commands may go out before this
+        test's subscriber is connected.
+        """
+        positions = np.array([m.position for m in msgs])
+        ends: list[int] = []
+        for k, waypoint in enumerate(load_trajectory(TRAJECTORY_FILE, self.trajectory)):
+            hits = np.flatnonzero(np.all(positions == waypoint.positions, axis=1))
+            hits = hits[hits > (ends[-1] if ends else -1)]
+            self.assertTrue(len(hits), f'no command reached waypoint {k} exactly')
+            ends.append(int(hits[0]))
+        return ends
+
     def segment_ends_ns(self) -> list[int]:
         """Sim time at which each waypoint's segment ends.
 
         The port publishes a segment's last sample (its target) and then sleeps one
         publish interval, dt/n, before the next segment starts: that is the segment's end.
         """
+        msgs = self.sorted_commands()
         waypoints = load_trajectory(TRAJECTORY_FILE, self.trajectory)
-        samples = [sample_count(w.duration_s) for w in waypoints]
-        counts = np.cumsum(samples)
-        stamps = sorted(self.recorder.commands)
-        # The first few may be sent before this test's subscriber connects: count from the end.
-        self.assertGreater(len(stamps), counts[-1] - 10, "the port's commands arrived")
-        return [stamps[len(stamps) - 1 - (counts[-1] - c)] + int(w.duration_s / n * 1e9)
-                for c, n, w in zip(counts, samples, waypoints)]
+        return [msgs[end].header.stamp.to_nsec()
+                + int(w.duration_s / sample_count(w.duration_s) * 1e9)
+                for end, w in zip(self.segment_end_indices(msgs), waypoints)]
 
     def state_at(self, t_ns: int) -> np.ndarray:
         """Joint positions of the first joint state at or after t_ns."""
@@ -152,7 +167,7 @@ class TutorialRunTest(unittest.TestCase):
 
     def check_port_commands(self) -> None:
         """What the port sent: DRCSim's message, the parameter gains, 50 Hz, linear ramps."""
-        msgs = sorted(self.recorder.command_msgs, key=lambda m: m.header.stamp.to_nsec())
+        msgs = self.sorted_commands()
         self.assertEqual(msgs[0]._type, 'osrf_msgs/JointCommands')
         self.assertEqual(msgs[0]._md5sum, 'f298c98f3e9c7aae9376ac19f73bfba3')
         gains = rospy.get_param('atlas_controller/gains')
@@ -168,17 +183,18 @@ class TutorialRunTest(unittest.TestCase):
         rospy.loginfo(f'{self.trajectory}: {len(msgs)} commands, median period '
                       f'{period_s * 1000:.1f} ms of sim time')
         self.assertAlmostEqual(period_s, 0.02, delta=0.002, msg='published at 50 Hz')
-        # Each later segment (complete in this recording) is a straight line from its
-        # first sample to the waypoint's positions.
+        # Each later segment (complete in this recording) has n samples on a straight line
+        # to its waypoint.
+        positions = np.array([m.position for m in msgs])
         waypoints = load_trajectory(TRAJECTORY_FILE, self.trajectory)
-        samples = [sample_count(w.duration_s) for w in waypoints]
-        first = len(msgs) - sum(samples[1:])
-        for waypoint, n in zip(waypoints[1:], samples[1:]):
-            segment = np.array([m.position for m in msgs[first:first + n]])
+        ends = self.segment_end_indices(msgs)
+        for k in range(1, len(waypoints)):
+            n = sample_count(waypoints[k].duration_s)
+            self.assertEqual(ends[k] - ends[k - 1], n, f'samples in segment {k}')
+            segment = positions[ends[k - 1] + 1:ends[k] + 1]
             ratios = np.linspace(0.0, 1.0, n)[:, None]
-            line = (1 - ratios) * segment[0] + ratios * waypoint.positions
-            np.testing.assert_allclose(segment, line, atol=1e-9)
-            first += n
+            line = (1 - ratios) * segment[0] + ratios * waypoints[k].positions
+            np.testing.assert_allclose(segment, line, atol=1e-9, err_msg=f'segment {k}')
 
     # -- the scenario ------------------------------------------------------------------
     def test_tutorial_scenario(self) -> None:
@@ -207,6 +223,15 @@ class TutorialRunTest(unittest.TestCase):
         self.assertTrue(lift > FOOT_LIFT_M or min_force < FOOT_UNLOADED_N,
                         f'the right foot left the ground in waypoint 0 (lift {lift:.3f} m, '
                         f'force {min_force:.1f} N)')
+        # It tries a step, then falls: upright on the left leg through the first waypoint,
+        # right knee bent as commanded (a robot that merely collapses fails here).
+        lowest = self.pelvis_heights(first_start, ends[0]).min()
+        knee = self.state_at(ends[0])[JOINT_INDEX['r_leg_kny']]
+        knee_target = first_waypoint.positions[JOINT_INDEX['r_leg_kny']]
+        rospy.loginfo(f'step_and_fall waypoint 0: lowest pelvis {lowest:.2f} m, right knee '
+                      f'{knee:.2f} rad (target {knee_target:.2f})')
+        self.assertGreater(lowest, UPRIGHT_ABOVE_M, 'upright during the step')
+        self.assertLess(abs(knee - knee_target), STEP_KNEE_TOLERANCE_RAD, 'right knee bent')
         heights = self.pelvis_heights(ends[-1], ends[-1] + int(FALL_WINDOW_S * 1e9))
         rospy.loginfo(f'step_and_fall: lowest pelvis {heights.min():.2f} m within '
                       f'{FALL_WINDOW_S} s of the last waypoint')
