@@ -15,6 +15,8 @@ from tutorial_atlas_control.bag_analysis import (
 )
 from tutorial_atlas_control.bag_report import format_summary, plot_run, to_json, write_csv
 from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.render import (
+    DEFAULT_FPS, DEFAULT_SIZE, check_output_path, parse_size, render_bag_video)
 
 PROG = 'analyze_bag.py'
 
@@ -49,7 +51,13 @@ Exit status: 0 on success (also when some metrics are unavailable), 1 when the b
 cannot be read (missing, not a bag, unindexed: run `rosbag reindex BAG`) or an output
 cannot be written, 2 on bad arguments.
 
+Video (--video): each frame poses the model as recorded at the frame's time (pelvis
+from /ground_truth_odom, interpolated; joints from /atlas/joint_states) and draws it
+offscreen through the model's `track` camera (software OSMesa when there is no display);
+the sim time is printed on each frame. Needs both topics.
+
 Example: rosrun tutorial_atlas_control analyze_bag.py run.bag --plot run.png --csv run_csv
+         rosrun tutorial_atlas_control analyze_bag.py run.bag --video run.mp4 --fps 30
 """
 
 
@@ -71,6 +79,12 @@ def build_parser() -> argparse.ArgumentParser:
                              '_effort...), joint_commands.csv (t, <joint>_position as sent, nan = '
                              'not sent) and pelvis_pose.csv (t, x y z, qx qy qz qw, vx vy vz, '
                              'wx wy wz) into this directory (created if needed)')
+    parser.add_argument('--video', metavar='FILE.mp4',
+                        help='render the run offscreen to this video: .mp4 (H.264) or .gif')
+    parser.add_argument('--fps', type=float, default=DEFAULT_FPS,
+                        help='video frames per second of sim time (default: %(default)g)')
+    parser.add_argument('--size', metavar='WxH', default='{}x{}'.format(*DEFAULT_SIZE),
+                        help='video size in pixels (default: %(default)s)')
     return parser
 
 
@@ -78,6 +92,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status."""
     args = build_parser().parse_args(argv)
     try:
+        if args.video:  # fail on a bad output before reading and analyzing the bag
+            size = parse_size(args.size)
+            check_output_path(args.video, *size, args.fps)
         analysis = analyze_bag(args.bag)
         print(to_json(analysis) if args.json else format_summary(analysis))
         if args.csv:
@@ -85,6 +102,10 @@ def main(argv: Sequence[str] | None = None) -> int:
                 print(f'wrote {path}', file=sys.stderr)
         if args.plot:
             print(f'wrote {plot_run(analysis, args.plot)}', file=sys.stderr)
+        if args.video:
+            video = render_bag_video(analysis.data, args.video, args.fps, size)
+            print(f'wrote {video.path} ({video.frames} frames at {video.fps:g} fps)',
+                  file=sys.stderr)
     except AtlasControlError as err:
         print(f'{PROG}: error: {err}', file=sys.stderr)
         return 1
