@@ -1,0 +1,574 @@
+"""Offline replay: re-simulate a recorded run from its bag, without ROS, and compare.
+
+The simulator publishes, after every 1 ms step k, the joint state at sim time k·dt with
+`effort` = the torque applied during that step. Replaying therefore means: start from the
+state the simulator started from, and for each recorded step set `data.ctrl` to the
+recorded effort and call `mj_step`, pinning the torso as `/atlas/sim_config` says
+(`time_to_unpin` after `last_reset_time`). The positions and velocities are float64,
+serialized exactly, so the same MuJoCo build reproduces them bit for bit.
+
+Two details make that exact:
+* The replay starts at the reset the simulator started from (`last_reset_time`), never
+  from a recorded mid-run state: MuJoCo's solver warm-start (and the free joint's
+  velocity) are not in the bag.
+* `rosbag record` usually starts a few hundred steps after the simulator. The steps before
+  the first recorded joint state are re-created with :class:`AtlasSimulator` itself in
+  Stand mode with the gains of config/atlas_controller.yaml (what the simulator does
+  until somebody changes the mode), and checked against the first recorded torque.
+
+Times in the report are sim time (s), as stamped by the simulator.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import math
+import sys
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from tutorial_atlas_control.bag_analysis import BagData, read_bag
+from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
+
+__all__ = [
+    'DEFAULT_TOLERANCE',
+    'Deviation',
+    'Recording',
+    'ReplayError',
+    'ReplayResult',
+    'SimConfig',
+    'format_report',
+    'load_recording',
+    'main',
+    'replay',
+    'replay_bag',
+]
+
+PROG = 'replay_bag.py'
+SIM_CONFIG_TOPIC = '/atlas/sim_config'
+JOINT_STATES_TOPIC = '/atlas/joint_states'
+ODOM_TOPIC = '/ground_truth_odom'
+#: The replay counts as reproducing the run when every deviation is at most this.
+DEFAULT_TOLERANCE = 1e-6
+#: Defaults of the simulator when the bag predates /atlas/sim_config (s).
+DEFAULT_TIME_TO_UNPIN_S = 1.0
+DEFAULT_LAST_RESET_S = 0.0
+GAINS_FILE = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
+#: Exit status when the replay ran but deviates beyond the tolerance.
+EXIT_DEVIATES = 3
+NS_PER_S = 1_000_000_000
+#: A stamp further than this fraction of a step from the step grid is not a simulator stamp.
+_GRID_TOLERANCE_STEPS = 1e-3
+
+
+class ReplayError(AtlasControlError):
+    """The bag cannot be replayed; the message says what is missing or unsupported."""
+
+
+# ---------------------------------------------------------------------------- recording
+
+
+@dataclass(frozen=True)
+class SimConfig:
+    """The simulator's /atlas/sim_config (times in s); `recorded` False = assumed defaults."""
+
+    model_file: str | None
+    model_sha1: str | None
+    timestep_s: float | None
+    time_to_unpin_s: float
+    last_reset_time_s: float
+    recorded: bool
+
+
+@dataclass(frozen=True)
+class Recording:
+    """What replay needs from a bag; stamps are sim time (ns).
+
+    `state_*` rows are /atlas/joint_states in tutorial joint order; `odom_*` rows are
+    /ground_truth_odom (quaternion w x y z, as MuJoCo stores it).
+    """
+
+    path: Path
+    config: SimConfig
+    resets_in_bag: int
+    state_stamp_ns: np.ndarray
+    position_rad: np.ndarray
+    velocity_rad_s: np.ndarray
+    effort_nm: np.ndarray
+    odom_stamp_ns: np.ndarray
+    odom_position_m: np.ndarray
+    odom_quat_wxyz: np.ndarray
+    has_odom: bool
+    warnings: list[str] = field(default_factory=list)
+
+
+def _read_sim_configs(path: Path) -> list[dict[str, Any]]:
+    """Every /atlas/sim_config message in record order, parsed from JSON."""
+    from rosbags.rosbag1 import Reader, ReaderError
+    from rosbags.typesys import Stores, get_typestore
+
+    typestore = get_typestore(Stores.ROS1_NOETIC)
+    configs = []
+    try:
+        with Reader(path) as reader:
+            connections = [c for c in reader.connections if c.topic == SIM_CONFIG_TOPIC]
+            if not connections:
+                return []
+            for _, _, raw in reader.messages(connections=connections):
+                text = typestore.deserialize_ros1(raw, 'std_msgs/msg/String').data
+                try:
+                    configs.append(json.loads(text))
+                except json.JSONDecodeError as err:
+                    raise ReplayError(f'{path}: {SIM_CONFIG_TOPIC} is not JSON ({err}).') from err
+    except ReaderError as err:
+        raise ReplayError(f'Could not read {SIM_CONFIG_TOPIC} from {path}: {err}') from err
+    return configs
+
+
+def _sim_config(path: Path, raw_configs: list[dict[str, Any]],
+                warnings: list[str]) -> tuple[SimConfig, int]:
+    """The config in force for the last segment, and how many resets the bag shows."""
+    if not raw_configs:
+        warnings.append(f'the bag has no {SIM_CONFIG_TOPIC} (recorded before the simulator '
+                        f'published it): assuming time_to_unpin = {DEFAULT_TIME_TO_UNPIN_S} s '
+                        f'and no reset after t = {DEFAULT_LAST_RESET_S} s.')
+        return SimConfig(None, None, None, DEFAULT_TIME_TO_UNPIN_S, DEFAULT_LAST_RESET_S,
+                         False), 0
+    last = raw_configs[-1]
+    try:
+        config = SimConfig(
+            model_file=str(last.get('model_file')) if last.get('model_file') else None,
+            model_sha1=str(last.get('model_sha1')) if last.get('model_sha1') else None,
+            timestep_s=float(last['timestep']),
+            time_to_unpin_s=float(last['time_to_unpin']),
+            last_reset_time_s=float(last['last_reset_time']),
+            recorded=True)
+    except (KeyError, TypeError, ValueError) as err:
+        raise ReplayError(f'{path}: {SIM_CONFIG_TOPIC} lacks a valid {err} (expected JSON with '
+                          'timestep, time_to_unpin, last_reset_time).') from None
+    resets = len({float(c.get('last_reset_time', 0.0)) for c in raw_configs}) - 1
+    return config, resets
+
+
+def _stamps_ns(data: BagData, t_s: np.ndarray) -> np.ndarray:
+    """Absolute sim time stamps (ns) from BagData's seconds-from-bag-start."""
+    return np.round((data.start_time_s + t_s) * NS_PER_S).astype(np.int64)
+
+
+def _to_steps(stamps_ns: np.ndarray, step_ns: int, what: str) -> np.ndarray:
+    """Stamps (ns) as step indices; every simulator stamp lies on the step grid."""
+    steps = (stamps_ns + step_ns // 2) // step_ns
+    off_grid = np.abs(stamps_ns - steps * step_ns) > _GRID_TOLERANCE_STEPS * step_ns
+    if off_grid.any():
+        t_s = int(stamps_ns[np.argmax(off_grid)]) / NS_PER_S
+        raise ReplayError(f'{what} stamp {t_s:.9f} s is not a multiple of the timestep '
+                          f'{step_ns / NS_PER_S} s: not stamped by this simulator.')
+    return steps
+
+
+def load_recording(path: Path | str, data: BagData | None = None) -> Recording:
+    """Read what replay needs from the bag at `path` (`data`: an already read BagData).
+
+    Raises:
+        ReplayError / BagAnalysisError: unreadable bag, missing joint states or joints,
+            a sim_config without the needed keys, stamps off the step grid.
+    """
+    path = Path(path)
+    data = read_bag(path) if data is None else data
+    warnings: list[str] = []
+    states = data.joint_states
+    if states is None or not len(states.t_s):
+        raise ReplayError(f'{path} has no {JOINT_STATES_TOPIC}: the replay needs the recorded '
+                          'torques (effort) of every step.')
+    config, resets = _sim_config(path, _read_sim_configs(path), warnings)
+    columns = []
+    missing = []
+    for name in JOINT_NAMES:
+        if name in states.names:
+            columns.append(states.names.index(name))
+        else:
+            missing.append(name)
+    if missing:
+        raise ReplayError(f'{JOINT_STATES_TOPIC} in {path} lacks joints {", ".join(missing)}; '
+                          'the replay needs the torque of all 28.')
+    state_stamp_ns = _stamps_ns(data, states.t_s)
+    effort = states.effort[:, columns]
+    position = states.position[:, columns]
+    velocity = states.velocity[:, columns]
+    if not (np.isfinite(effort).all() and np.isfinite(position).all()):
+        raise ReplayError(f'{JOINT_STATES_TOPIC} in {path} has missing (NaN) positions or '
+                          'efforts; every message must carry all 28 joints.')
+    pelvis = data.pelvis
+    has_odom = pelvis is not None and len(pelvis.t_s) > 0
+    if has_odom:
+        assert pelvis is not None
+        odom_stamp_ns = _stamps_ns(data, pelvis.t_s)
+        odom_position = pelvis.position_m
+        odom_quat = pelvis.orientation_xyzw[:, [3, 0, 1, 2]]
+    else:
+        warnings.append(f'the bag has no {ODOM_TOPIC}: the pelvis pose is not compared.')
+        odom_stamp_ns = np.empty(0, dtype=np.int64)
+        odom_position, odom_quat = np.empty((0, 3)), np.empty((0, 4))
+    return Recording(path, config, resets, state_stamp_ns, position, velocity, effort,
+                     odom_stamp_ns, odom_position, odom_quat, has_odom, warnings)
+
+
+# ---------------------------------------------------------------------------- replay
+
+
+@dataclass(frozen=True)
+class Deviation:
+    """Largest |replayed - recorded| over `samples`, when (sim time, s) and where (joint)."""
+
+    max_abs: float
+    time_s: float | None
+    joint: str | None
+    samples: int
+
+
+@dataclass(frozen=True)
+class ReplayResult:
+    """The outcome of one replay (units: rad, rad/s, m; times are sim time in s)."""
+
+    bag: Path
+    config: SimConfig
+    resets_in_bag: int
+    model_sha1_matches: bool | None
+    start_time_s: float          # the reset the replay starts from
+    end_time_s: float            # sim time after the last replayed step
+    reconstructed_steps: int     # steps before the recording, re-created in Stand mode
+    recorded_steps: int          # steps driven by the recorded torques
+    joint_position: Deviation
+    joint_velocity: Deviation
+    pelvis_position: Deviation | None
+    pelvis_orientation: Deviation | None
+    tolerance: float
+    warnings: list[str]
+
+    @property
+    def reproduced(self) -> bool:
+        """Every compared deviation is within the tolerance."""
+        compared = [self.joint_position, self.joint_velocity, self.pelvis_position,
+                    self.pelvis_orientation]
+        return all(d.max_abs <= self.tolerance for d in compared if d is not None)
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-ready dict (keys documented in replay_bag.py --help)."""
+        def deviation(value: Deviation | None) -> dict[str, Any] | None:
+            if value is None:
+                return None
+            return {'max': value.max_abs, 'time': value.time_s, 'joint': value.joint,
+                    'samples': value.samples}
+
+        config = self.config
+        return {
+            'bag': str(self.bag),
+            'sim_config': {'recorded': config.recorded, 'model_file': config.model_file,
+                           'model_sha1': config.model_sha1, 'timestep': config.timestep_s,
+                           'time_to_unpin': config.time_to_unpin_s,
+                           'last_reset_time': config.last_reset_time_s},
+            'resets_in_bag': self.resets_in_bag,
+            'model_sha1_matches': self.model_sha1_matches,
+            'start_time': self.start_time_s,
+            'end_time': self.end_time_s,
+            'reconstructed_steps': self.reconstructed_steps,
+            'recorded_steps': self.recorded_steps,
+            'joint_position': deviation(self.joint_position),
+            'joint_velocity': deviation(self.joint_velocity),
+            'pelvis_position': deviation(self.pelvis_position),
+            'pelvis_orientation': deviation(self.pelvis_orientation),
+            'tolerance': self.tolerance,
+            'reproduced': self.reproduced,
+            'warnings': list(self.warnings),
+        }
+
+
+def _quat_angle_rad(a_wxyz: np.ndarray, b_wxyz: np.ndarray) -> np.ndarray:
+    """Rotation angle (rad) between rows of unit quaternions, robust near 0."""
+    a = a_wxyz / np.linalg.norm(a_wxyz, axis=1, keepdims=True)
+    b = b_wxyz / np.linalg.norm(b_wxyz, axis=1, keepdims=True)
+    dot = np.abs(np.sum(a * b, axis=1))
+    # |a - b| or |a + b| (same rotation), whichever is smaller, gives the half-angle chord.
+    chord = np.minimum(np.linalg.norm(a - b, axis=1), np.linalg.norm(a + b, axis=1))
+    return np.where(dot < 0.9, 2.0 * np.arccos(np.clip(dot, 0.0, 1.0)),
+                    4.0 * np.arcsin(np.clip(chord / 2.0, 0.0, 1.0)))
+
+
+def _deviation(replayed: np.ndarray, recorded: np.ndarray, steps: np.ndarray, step_ns: int,
+               names: Sequence[str] | None = None) -> Deviation:
+    """The largest deviation; where and when only if there is one."""
+    if not len(steps):
+        return Deviation(0.0, None, None, 0)
+    error = np.abs(replayed - recorded)
+    if error.ndim == 1:
+        error = error[:, None]
+    row, column = divmod(int(np.argmax(error)), error.shape[1])
+    largest = float(error[row, column])
+    if largest == 0.0:
+        return Deviation(0.0, None, None, len(steps))
+    joint = names[column] if names is not None else None
+    return Deviation(largest, int(steps[row]) * step_ns / NS_PER_S, joint, len(steps))
+
+
+def _segment(recording: Recording, steps: np.ndarray, reset_step: int, dt_s: float,
+             warnings: list[str]) -> np.ndarray:
+    """Row indices of the joint states to replay: after the reset, contiguous steps."""
+    if np.any(np.diff(steps) <= 0):
+        at = int(np.argmax(np.diff(steps) <= 0))
+        raise ReplayError(
+            f'{JOINT_STATES_TOPIC} stamps go backwards or repeat at {steps[at + 1] * dt_s:.3f} s '
+            '(a /gazebo/reset_simulation during the recording?); replay supports runs whose '
+            'sim time only moves forward: cut the bag with `rosbag filter` after the reset.')
+    rows = np.flatnonzero(steps > reset_step)
+    if not len(rows):
+        raise ReplayError(f'{recording.path} has no {JOINT_STATES_TOPIC} after the last reset '
+                          f'at {reset_step * dt_s:.3f} s; nothing to replay.')
+    gaps = np.flatnonzero(np.diff(steps[rows]) != 1)
+    if len(gaps):
+        last = rows[gaps[0]]
+        missing = int(steps[rows[gaps[0] + 1]] - steps[last] - 1)
+        warnings.append(
+            f'{missing} joint state(s) missing after {steps[last] * dt_s:.3f} s (the recorder '
+            'dropped messages; their torques are unknown): replayed only up to there.')
+        rows = rows[:gaps[0] + 1]
+    return rows
+
+
+def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
+           gains_file: Path = GAINS_FILE) -> ReplayResult:
+    """Re-simulate `recording` and measure how far it strays from the recorded run.
+
+    Raises:
+        ReplayError: unsupported recording (timestep differs from the model's; steps before
+            the recording after a mid-run reset; nothing after the last reset).
+    """
+    import mujoco
+
+    from tutorial_atlas_control import model as atlas_model
+    from tutorial_atlas_control.controller import load_gains_yaml
+    from tutorial_atlas_control.simulator import AtlasSimulator
+
+    warnings = list(recording.warnings)
+    config = recording.config
+    atlas = atlas_model.load_model()
+    model = atlas.model
+    dt_s = float(model.opt.timestep)
+    if config.timestep_s is not None and config.timestep_s != dt_s:
+        raise ReplayError(f'the run was simulated with timestep {config.timestep_s} s but '
+                          f'{atlas_model.MODEL_PATH.name} has {dt_s} s; replay with the same model.')
+    sha1_matches = None
+    if config.model_sha1:
+        sha1 = hashlib.sha1(atlas_model.MODEL_PATH.read_bytes()).hexdigest()
+        sha1_matches = sha1 == config.model_sha1
+        if not sha1_matches:
+            warnings.append(f'{atlas_model.MODEL_PATH} differs from the model the run was '
+                            f'recorded with (sha1 {config.model_sha1[:12]}); expect deviations.')
+    step_ns = int(round(dt_s * NS_PER_S))
+    reset_ns = int(round(config.last_reset_time_s * NS_PER_S))
+    if reset_ns % step_ns:
+        raise ReplayError(f'last_reset_time {config.last_reset_time_s} s is not on the step grid.')
+    reset_step = reset_ns // step_ns
+    pin_until_ns = reset_ns + int(round(config.time_to_unpin_s * NS_PER_S))
+    pin_at_reset = config.time_to_unpin_s > 0.0
+    if recording.resets_in_bag:
+        warnings.append(f'the bag holds {recording.resets_in_bag} reset(s); replaying the last '
+                        f'segment, from the reset at {config.last_reset_time_s:.3f} s.')
+
+    all_steps = _to_steps(recording.state_stamp_ns, step_ns, JOINT_STATES_TOPIC)
+    odom_steps_all = _to_steps(recording.odom_stamp_ns, step_ns, ODOM_TOPIC)
+    rows = _segment(recording, all_steps, reset_step, dt_s, warnings)
+    steps = all_steps[rows]
+    effort = recording.effort_nm[rows]
+    first_step = int(steps[0])
+    prefix = first_step - reset_step - 1
+
+    odom_row = {int(step): row for row, step in enumerate(odom_steps_all.tolist())
+                if reset_step < step <= int(steps[-1])}
+    odom_done: list[tuple[int, np.ndarray, np.ndarray]] = []
+
+    def check_odom(data: mujoco.MjData, step: int) -> None:
+        row = odom_row.get(step)
+        if row is not None:
+            # The simulator publishes xpos/xquat as they are after mj_step, so do we.
+            odom_done.append((row, data.xpos[atlas.pelvis_body_id].copy(),
+                              data.xquat[atlas.pelvis_body_id].copy()))
+
+    sim = None
+    if prefix > 0:
+        if reset_step != 0:
+            raise ReplayError(
+                f'the recording starts {prefix} steps after the reset at '
+                f'{config.last_reset_time_s:.3f} s, and the control mode then is unknown; '
+                'only the steps before the recording of a run that starts at t = 0 can be '
+                're-created (Stand mode).')
+        sim = AtlasSimulator(atlas, load_gains_yaml(gains_file), config.time_to_unpin_s)
+        data = sim.data
+        for step in range(1, first_step):
+            sim.step()
+            check_odom(data, step)
+        # The first recorded torque must be what the Stand law gives, or the run had left
+        # Stand mode (or used other gains) before the recorder started.
+        snapshot_spec = mujoco.mjtState.mjSTATE_INTEGRATION
+        snapshot = np.empty(mujoco.mj_stateSize(model, snapshot_spec))
+        mujoco.mj_getState(model, data, snapshot, snapshot_spec)
+        sim.step()
+        predicted = sim.torque_nm.copy()
+        mujoco.mj_setState(model, data, snapshot, snapshot_spec)
+        mismatch = float(np.max(np.abs(predicted - effort[0])))
+        if mismatch > 0.0:
+            warnings.append((
+                f'the first recorded torque differs by up to {mismatch:.3g} N m from the '
+                'Stand-mode law: the mode or the gains changed before the recording began, '
+                f'so the {prefix} steps before it cannot be re-created exactly.'))
+    else:
+        data = mujoco.MjData(model)
+        atlas_model.reset_to_initial(atlas, data)
+        data.time = reset_ns / NS_PER_S
+        atlas_model.set_pelvis_pinned(atlas, data, pin_at_reset)
+    pinned = bool(data.eq_active[atlas.pin_eq_id])
+
+    position = np.empty((len(steps), NUM_JOINTS))
+    velocity = np.empty((len(steps), NUM_JOINTS))
+    qpos_adr, dof_adr = atlas.qpos_adr, atlas.dof_adr
+    ctrl, qpos, qvel = data.ctrl, data.qpos, data.qvel
+    for index, step in enumerate(steps.tolist()):
+        if pinned and (step - 1) * step_ns >= pin_until_ns:
+            atlas_model.set_pelvis_pinned(atlas, data, False)
+            pinned = False
+        ctrl[:] = effort[index]
+        mujoco.mj_step(model, data)
+        position[index] = qpos[qpos_adr]
+        velocity[index] = qvel[dof_adr]
+        check_odom(data, step)
+        if not np.isfinite(qpos).all():
+            raise ReplayError(f'the replay diverged (non-finite state) at {step * dt_s:.3f} s.')
+
+    recorded_position = recording.position_rad[rows]
+    recorded_velocity = recording.velocity_rad_s[rows]
+    pelvis_position = pelvis_orientation = None
+    if recording.has_odom:
+        odom_rows = np.array([row for row, _, _ in odom_done], dtype=np.int64)
+        odom_steps = odom_steps_all[odom_rows]
+        replayed_xpos = np.array([xpos for _, xpos, _ in odom_done]).reshape(-1, 3)
+        replayed_xquat = np.array([xquat for _, _, xquat in odom_done]).reshape(-1, 4)
+        pelvis_position = _deviation(replayed_xpos, recording.odom_position_m[odom_rows],
+                                     odom_steps, step_ns)
+        angles = (_quat_angle_rad(replayed_xquat, recording.odom_quat_wxyz[odom_rows])
+                  if len(odom_rows) else np.empty(0))
+        pelvis_orientation = _deviation(angles, np.zeros(len(angles)), odom_steps, step_ns)
+    return ReplayResult(
+        bag=recording.path, config=config, resets_in_bag=recording.resets_in_bag,
+        model_sha1_matches=sha1_matches, start_time_s=reset_ns / NS_PER_S,
+        end_time_s=int(steps[-1]) * step_ns / NS_PER_S, reconstructed_steps=max(prefix, 0),
+        recorded_steps=len(steps),
+        joint_position=_deviation(position, recorded_position, steps, step_ns, JOINT_NAMES),
+        joint_velocity=_deviation(velocity, recorded_velocity, steps, step_ns, JOINT_NAMES),
+        pelvis_position=pelvis_position, pelvis_orientation=pelvis_orientation,
+        tolerance=tolerance, warnings=warnings)
+
+
+def replay_bag(path: Path | str, tolerance: float = DEFAULT_TOLERANCE) -> ReplayResult:
+    """:func:`load_recording` then :func:`replay`."""
+    return replay(load_recording(path), tolerance)
+
+
+# ---------------------------------------------------------------------------- report
+
+
+def _describe(label: str, value: Deviation | None, unit: str) -> str:
+    if value is None:
+        return f'  {label:<20} not compared'
+    if not value.samples:
+        return f'  {label:<20} no samples'
+    where = f' ({value.joint})' if value.joint else ''
+    at = f' at {value.time_s:.3f} s{where}' if value.max_abs > 0.0 else ''
+    return f'  {label:<20} max |diff| {value.max_abs:.3g} {unit}{at}, {value.samples} samples'
+
+
+def format_report(result: ReplayResult) -> str:
+    """The text report."""
+    config = result.config
+    source = 'from /atlas/sim_config' if config.recorded else 'assumed (no /atlas/sim_config)'
+    model = {True: 'same model file as recorded', False: 'model file DIFFERS from the recording',
+             None: 'model checksum not recorded'}[result.model_sha1_matches]
+    lines = [
+        f'Replay of {result.bag}',
+        f'  reset at {result.start_time_s:.3f} s, torso pinned {config.time_to_unpin_s:g} s '
+        f'({source}); {model}',
+        f'  replayed {result.reconstructed_steps + result.recorded_steps} steps to '
+        f'{result.end_time_s:.3f} s: {result.reconstructed_steps} before the recording '
+        f're-created in Stand mode, {result.recorded_steps} with the recorded torques',
+        _describe('joint positions', result.joint_position, 'rad'),
+        _describe('joint velocities', result.joint_velocity, 'rad/s'),
+        _describe('pelvis position', result.pelvis_position, 'm'),
+        _describe('pelvis orientation', result.pelvis_orientation, 'rad'),
+    ]
+    lines += [f'  warning: {text}' for text in result.warnings]
+    verdict = 'REPRODUCED' if result.reproduced else 'DEVIATES'
+    lines.append(f'{verdict} (tolerance {result.tolerance:g})')
+    return '\n'.join(lines)
+
+
+DESCRIPTION = """\
+Re-simulate a recorded Atlas run without ROS and report how far the replay strays from
+the recording.
+
+Starts from the simulator's reset (/atlas/sim_config last_reset_time; the torso pinned
+for time_to_unpin), applies each step's recorded torque (/atlas/joint_states effort) with
+MuJoCo's mj_step, and compares the joint positions and velocities with every recorded
+joint state and the pelvis pose with /ground_truth_odom. Steps before the recorder
+started are re-created with the simulator's own Stand-mode controller (the gains of
+config/atlas_controller.yaml). With the same model and MuJoCo build the replay is exact
+(all deviations 0).
+"""
+
+EPILOG = """\
+JSON keys (--json): bag, sim_config {recorded, model_file, model_sha1, timestep (s),
+time_to_unpin (s), last_reset_time (s)}, resets_in_bag, model_sha1_matches (bool or null),
+start_time, end_time (s of sim time), reconstructed_steps, recorded_steps,
+joint_position and joint_velocity {max (rad, rad/s), time (s), joint, samples},
+pelvis_position {max (m), time, samples}, pelvis_orientation {max (rad), time, samples}
+(null without /ground_truth_odom), tolerance, reproduced (bool), warnings [text].
+
+Exit status: 0 when every deviation is within --tolerance, 3 when the replay deviates,
+1 when the bag cannot be read or replayed (missing topics, unsupported resets), 2 on bad
+arguments.
+
+Example: rosrun tutorial_atlas_control replay_bag.py ~/.ros/tutorial_atlas_control/bags/atlas_*.bag
+"""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser (its --help is the documentation)."""
+    parser = argparse.ArgumentParser(prog=PROG, description=DESCRIPTION, epilog=EPILOG,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument('bag', metavar='BAG', help='the ROS 1 .bag file of the run')
+    parser.add_argument('--json', action='store_true', help='print one JSON object instead')
+    parser.add_argument('--tolerance', type=float, default=DEFAULT_TOLERANCE,
+                        help='largest deviation (rad, rad/s, m) that still counts as '
+                             'reproduced (default: %(default)g)')
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; return the exit status."""
+    args = build_parser().parse_args(argv)
+    if not (math.isfinite(args.tolerance) and args.tolerance >= 0.0):
+        print(f'{PROG}: error: --tolerance must be a number >= 0.', file=sys.stderr)
+        return 1
+    try:
+        result = replay_bag(args.bag, args.tolerance)
+    except AtlasControlError as err:
+        print(f'{PROG}: error: {err}', file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        return 130
+    print(json.dumps(result.to_dict(), indent=2) if args.json else format_report(result))
+    return 0 if result.reproduced else EXIT_DEVIATES

@@ -1,0 +1,319 @@
+"""Offline replay against recordings made in-process with AtlasSimulator, and its errors."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+import pytest
+
+from synthetic_bags import TYPESTORE, Record, joint_state, write_bag
+from tutorial_atlas_control import model as atlas_model
+from tutorial_atlas_control.bag_analysis import BagAnalysisError
+from tutorial_atlas_control.controller import hold_command, load_gains_yaml
+from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.replay import (
+    EXIT_DEVIATES, GAINS_FILE, ReplayError, format_report, load_recording, main, replay,
+    replay_bag)
+from tutorial_atlas_control.simulator import AtlasSimulator, ControlMode
+
+SCRIPT = Path(__file__).resolve().parents[2] / 'scripts' / 'replay_bag.py'
+#: Short pin so that unpinning happens inside the short synthetic runs (s).
+TIME_TO_UNPIN_S = 0.05
+#: Odometry every this many steps, as the simulator's 100 Hz default.
+ODOM_EVERY = 10
+
+
+def _t(name: str) -> Any:
+    return TYPESTORE.types[name]
+
+
+def odometry_record(t_s: float, position: np.ndarray, quat_wxyz: np.ndarray) -> Record:
+    """A /ground_truth_odom message with the exact pelvis pose (float64)."""
+    w, x, y, z = (float(v) for v in quat_wxyz)
+    stamp_ns = round(t_s * 1e9)
+    header = _t('std_msgs/msg/Header')(
+        seq=0, stamp=_t('builtin_interfaces/msg/Time')(sec=stamp_ns // 10**9,
+                                                       nanosec=stamp_ns % 10**9),
+        frame_id='world')
+    vector = _t('geometry_msgs/msg/Vector3')
+    pose = _t('geometry_msgs/msg/PoseWithCovariance')(
+        pose=_t('geometry_msgs/msg/Pose')(
+            position=_t('geometry_msgs/msg/Point')(x=float(position[0]), y=float(position[1]),
+                                                    z=float(position[2])),
+            orientation=_t('geometry_msgs/msg/Quaternion')(x=x, y=y, z=z, w=w)),
+        covariance=np.zeros(36))
+    twist = _t('geometry_msgs/msg/TwistWithCovariance')(
+        twist=_t('geometry_msgs/msg/Twist')(linear=vector(x=0.0, y=0.0, z=0.0),
+                                            angular=vector(x=0.0, y=0.0, z=0.0)),
+        covariance=np.zeros(36))
+    msg = _t('nav_msgs/msg/Odometry')(header=header, child_frame_id='pelvis', pose=pose,
+                                      twist=twist)
+    return Record('/ground_truth_odom', 'nav_msgs/Odometry', t_s, msg)
+
+
+def sim_config_record(t_s: float, config: dict[str, object]) -> Record:
+    msg = _t('std_msgs/msg/String')(data=json.dumps(config))
+    return Record('/atlas/sim_config', 'std_msgs/String', t_s, msg)
+
+
+@dataclass
+class Run:
+    """Drives an AtlasSimulator like sim_node does and records what it publishes."""
+
+    time_to_unpin_s: float = TIME_TO_UNPIN_S
+    record_from_step: int = 1
+    with_config: bool = True
+    records: list[Record] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.atlas = atlas_model.load_model()
+        self.sim = AtlasSimulator(self.atlas, load_gains_yaml(GAINS_FILE), self.time_to_unpin_s)
+        self.steps = 0
+        self._publish_config()
+
+    def _t_s(self) -> float:
+        return self.sim.sim_time_ns / 1e9
+
+    def _publish_config(self) -> None:
+        # Latched: the recorder gets it when it starts, stamped with the time it arrived.
+        if self.with_config:
+            self.records.append(sim_config_record(
+                max(self._t_s(), self.record_from_step / 1000.0), self.sim.config()))
+
+    def step(self, count: int, before: Callable[[AtlasSimulator, int], None] | None = None) -> None:
+        sim = self.sim
+        for _ in range(count):
+            if before is not None:
+                before(sim, self.steps)
+            sim.step()
+            self.steps += 1
+            if self.steps < self.record_from_step:
+                continue
+            t_s = self._t_s()
+            self.records.append(joint_state(t_s, sim.joint_positions(), sim.joint_velocities(),
+                                            sim.torque_nm.copy(), seq=self.steps))
+            if self.steps % ODOM_EVERY == 0:
+                body = self.atlas.pelvis_body_id
+                self.records.append(odometry_record(t_s, sim.data.xpos[body].copy(),
+                                                    sim.data.xquat[body].copy()))
+
+    def reset_world(self) -> None:
+        self.sim.reset_world()
+        self._publish_config()
+
+    def write(self, path: Path) -> Path:
+        return write_bag(path, self.records)
+
+
+def crouch(sim: AtlasSimulator, step: int, user_step: int = 20, bend_step: int = 40) -> None:
+    """User mode from `user_step`, knees and hips bent from `bend_step`: the robot moves."""
+    if step == user_step:
+        sim.set_mode(ControlMode.USER)
+    if step == bend_step:
+        target = np.zeros(NUM_JOINTS)
+        for side in 'lr':
+            target[JOINT_NAMES.index(f'{side}_leg_lhy')] = -0.6
+            target[JOINT_NAMES.index(f'{side}_leg_kny')] = 1.2
+            target[JOINT_NAMES.index(f'{side}_leg_uay')] = -0.6
+        command = hold_command(sim.gains, target)
+        sim.receive_command(list(JOINT_NAMES), {'position': command.position,
+                                                'kp_position': command.kp_position,
+                                                'kd_position': command.kd_position})
+
+
+@pytest.fixture(scope='module')
+def full_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """200 steps, every one recorded, unpinned at 50 ms, crouching."""
+    run = Run()
+    run.step(200, crouch)
+    return run.write(tmp_path_factory.mktemp('replay') / 'full.bag')
+
+
+def test_full_recording_replays_exactly(full_run: Path) -> None:
+    result = replay_bag(full_run)
+    assert result.reconstructed_steps == 0
+    assert result.recorded_steps == 200
+    assert result.joint_position.max_abs == 0.0
+    assert result.joint_velocity.max_abs == 0.0
+    assert result.pelvis_position is not None and result.pelvis_position.max_abs == 0.0
+    assert result.pelvis_orientation is not None and result.pelvis_orientation.max_abs == 0.0
+    assert result.pelvis_position.samples == 20
+    assert result.model_sha1_matches is True
+    assert result.reproduced and not result.warnings
+    assert result.end_time_s == 0.2
+
+
+def test_late_recording_recreates_the_stand_prefix(tmp_path: Path) -> None:
+    """The recorder starts at step 30, still in Stand and before the torso is released."""
+    run = Run(record_from_step=30)
+    run.step(150, lambda sim, step: crouch(sim, step, user_step=40, bend_step=60))
+    result = replay_bag(run.write(tmp_path / 'late.bag'))
+    assert result.reconstructed_steps == 29 and result.recorded_steps == 121
+    assert result.joint_position.max_abs == 0.0 and result.pelvis_position.max_abs == 0.0
+    assert result.reproduced and not result.warnings
+
+
+def test_leaving_stand_before_the_recording_is_reported(tmp_path: Path) -> None:
+    run = Run(record_from_step=60)
+    run.step(150, crouch)  # User mode at step 20, unseen by the recorder
+    result = replay_bag(run.write(tmp_path / 'mode.bag'))
+    assert any('differs by up to' in text and 'Stand-mode law' in text for text in result.warnings)
+
+
+def test_mid_run_reset_replays_the_last_segment(tmp_path: Path) -> None:
+    run = Run()
+    run.step(120, crouch)
+    run.reset_world()
+    run.step(100)
+    result = replay_bag(run.write(tmp_path / 'reset.bag'))
+    assert result.start_time_s == 0.12 and result.resets_in_bag == 1
+    assert result.recorded_steps == 100 and result.reconstructed_steps == 0
+    assert result.joint_position.max_abs == 0.0 and result.pelvis_position.max_abs == 0.0
+    assert any('1 reset(s); replaying the last segment' in text for text in result.warnings)
+    assert result.reproduced
+
+
+def test_bag_without_sim_config_assumes_the_defaults(tmp_path: Path) -> None:
+    run = Run(time_to_unpin_s=1.0, with_config=False)
+    run.step(60)
+    result = replay_bag(run.write(tmp_path / 'old.bag'))
+    assert not result.config.recorded and result.config.time_to_unpin_s == 1.0
+    assert result.model_sha1_matches is None
+    assert result.joint_position.max_abs == 0.0
+    assert any('no /atlas/sim_config' in text for text in result.warnings)
+
+
+def test_wrong_pin_time_shows_as_a_deviation(tmp_path: Path) -> None:
+    run = Run(with_config=False)  # really 0.05 s, but replay assumes the default 1 s
+    run.step(200, crouch)
+    result = replay_bag(run.write(tmp_path / 'pin.bag'))
+    assert not result.reproduced
+    assert result.pelvis_position.max_abs > 1e-4
+    assert result.joint_position.time_s is not None and result.joint_position.joint in JOINT_NAMES
+
+
+def test_dropped_message_stops_the_replay_there(tmp_path: Path) -> None:
+    run = Run()
+    run.step(100)
+    run.records = [r for r in run.records
+                   if not (r.topic == '/atlas/joint_states' and round(r.t_s * 1000) == 71)]
+    result = replay_bag(run.write(tmp_path / 'gap.bag'))
+    assert result.recorded_steps == 70 and result.end_time_s == 0.07
+    assert any('1 joint state(s) missing after 0.070 s' in text for text in result.warnings)
+    assert result.joint_position.max_abs == 0.0
+
+
+def test_without_odometry_only_joints_are_compared(tmp_path: Path) -> None:
+    run = Run()
+    run.step(30)
+    run.records = [r for r in run.records if r.topic != '/ground_truth_odom']
+    result = replay_bag(run.write(tmp_path / 'noodom.bag'))
+    assert result.pelvis_position is None and result.joint_position.max_abs == 0.0
+    assert 'pelvis position      not compared' in format_report(result)
+
+
+# ---------------------------------------------------------------------------- errors
+
+
+def test_no_joint_states_is_an_error(tmp_path: Path) -> None:
+    bag = write_bag(tmp_path / 'x.bag', [sim_config_record(0.0, {'timestep': 0.001,
+                                                                'time_to_unpin': 1.0,
+                                                                'last_reset_time': 0.0})])
+    with pytest.raises(ReplayError, match=r'has no /atlas/joint_states: the replay needs'):
+        load_recording(bag)
+
+
+def test_missing_joint_is_an_error(tmp_path: Path) -> None:
+    bag = write_bag(tmp_path / 'x.bag', [
+        joint_state(0.001, np.zeros(27), names=JOINT_NAMES[:27])])
+    with pytest.raises(ReplayError, match=r'lacks joints r_arm_mwx; the replay needs'):
+        load_recording(bag)
+
+
+def test_sim_time_going_backwards_is_unsupported(tmp_path: Path) -> None:
+    records = [joint_state(t_s, np.zeros(NUM_JOINTS), seq=i)
+               for i, t_s in enumerate((0.001, 0.002, 0.003))]
+    records.append(joint_state(0.001, np.zeros(NUM_JOINTS)))
+    records[-1] = Record(records[-1].topic, records[-1].msgtype, 0.004, records[-1].message)
+    bag = write_bag(tmp_path / 'x.bag', records)
+    with pytest.raises(ReplayError, match=r'go backwards or repeat at 0.001 s .*reset_simulation'):
+        replay_bag(bag)
+
+
+def test_late_recording_after_a_reset_is_unsupported(tmp_path: Path) -> None:
+    run = Run()
+    run.step(50)
+    run.reset_world()
+    run.step(50)
+    # Drop the first states after the reset: their torques are then unknown.
+    run.records = [r for r in run.records
+                   if not (r.topic == '/atlas/joint_states' and 0.05 < r.t_s < 0.06)]
+    with pytest.raises(ReplayError, match=r'starts 9 steps after the reset at 0.050 s'):
+        replay_bag(run.write(tmp_path / 'x.bag'))
+
+
+def test_off_grid_stamps_are_an_error(tmp_path: Path) -> None:
+    bag = write_bag(tmp_path / 'x.bag', [joint_state(0.0015, np.zeros(NUM_JOINTS))])
+    with pytest.raises(ReplayError, match=r'0.001500000 s is not a multiple of the timestep'):
+        replay_bag(bag)
+
+
+def test_other_timestep_is_an_error(tmp_path: Path) -> None:
+    bag = write_bag(tmp_path / 'x.bag', [
+        sim_config_record(0.0, {'timestep': 0.002, 'time_to_unpin': 1.0, 'last_reset_time': 0.0}),
+        joint_state(0.002, np.zeros(NUM_JOINTS))])
+    with pytest.raises(ReplayError, match=r'simulated with timestep 0.002 s but atlas_v1.xml has'):
+        replay_bag(bag)
+
+
+def test_bad_sim_config_is_an_error(tmp_path: Path) -> None:
+    bag = write_bag(tmp_path / 'x.bag', [
+        sim_config_record(0.0, {'timestep': 0.001}), joint_state(0.001, np.zeros(NUM_JOINTS))])
+    with pytest.raises(ReplayError, match=r"sim_config lacks a valid 'time_to_unpin'"):
+        load_recording(bag)
+
+
+def test_not_a_bag_is_an_error(tmp_path: Path) -> None:
+    (tmp_path / 'x.bag').write_text('hello')
+    with pytest.raises(BagAnalysisError, match=r'is not a ROS 1 bag'):
+        replay_bag(tmp_path / 'x.bag')
+
+
+# ---------------------------------------------------------------------------- command line
+
+
+def test_cli_text_and_json(full_run: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main([str(full_run)]) == 0
+    out = capsys.readouterr().out
+    assert 'joint positions      max |diff| 0 rad, 200 samples' in out
+    assert out.rstrip().endswith('REPRODUCED (tolerance 1e-06)')
+    assert main([str(full_run), '--json']) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result['reproduced'] is True and result['joint_position']['max'] == 0.0
+    assert result['sim_config']['time_to_unpin'] == TIME_TO_UNPIN_S
+    assert result['recorded_steps'] == 200 and result['pelvis_orientation']['samples'] == 20
+
+
+def test_cli_deviation_exit_status(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    run = Run(with_config=False)
+    run.step(200, crouch)
+    assert main([str(run.write(tmp_path / 'pin.bag'))]) == EXIT_DEVIATES
+    assert 'DEVIATES (tolerance 1e-06)' in capsys.readouterr().out
+
+
+def test_script_errors_are_one_line(tmp_path: Path) -> None:
+    env = {key: value for key, value in os.environ.items() if key != 'PYTHONPATH'}
+    done = subprocess.run([sys.executable, str(SCRIPT), str(tmp_path / 'none.bag')],
+                          capture_output=True, text=True, env=env, cwd='/', check=False,
+                          timeout=120)
+    assert done.returncode == 1
+    assert done.stderr.strip().splitlines() == [f'replay_bag.py: error: {tmp_path}/none.bag: '
+                                                'no such file.']
+    assert main(['x.bag', '--tolerance', 'nan']) == 1
