@@ -28,6 +28,14 @@ DEFAULT_TIME_TO_UNPIN_S = 1.0
 NS_PER_S = 1_000_000_000
 
 
+#: MuJoCo's warnings for an unstable step, each with what it means.
+DIVERGENCE_WARNINGS = (
+    (mujoco.mjtWarning.mjWARN_BADQPOS, 'NaN/Inf/huge joint position'),
+    (mujoco.mjtWarning.mjWARN_BADQVEL, 'NaN/Inf/huge joint velocity'),
+    (mujoco.mjtWarning.mjWARN_BADQACC, 'NaN/Inf/huge joint acceleration'),
+)
+
+
 class ControlMode(str, enum.Enum):
     """The strings DRCSim accepted on /atlas/control_mode."""
 
@@ -196,10 +204,13 @@ class AtlasSimulator:
         data.ctrl[:] = torque
         mujoco.mj_step(self.model, data)
         self.sim_time_ns += self.step_ns
+        # MuJoCo resets the state by itself on NaN/Inf/huge values and only warns: catch it
+        # here so that no silently reset (or non-finite) state is ever published.
+        for warning, what in DIVERGENCE_WARNINGS:
+            if data.warning[warning].number > 0:
+                data.warning[warning].number = 0
+                raise PhysicsDivergenceError(
+                    f'physics diverged at t={self.sim_time_ns / NS_PER_S:.3f} s ({what})')
         if not (np.isfinite(data.qpos).all() and np.isfinite(data.qvel).all()):
             raise PhysicsDivergenceError(
                 f'physics diverged at t={self.sim_time_ns / NS_PER_S:.3f} s (non-finite state)')
-        if data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number > 0:
-            data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number = 0
-            raise PhysicsDivergenceError(
-                f'physics diverged at t={self.sim_time_ns / NS_PER_S:.3f} s (bad acceleration)')
