@@ -35,7 +35,7 @@ import numpy as np
 
 from tutorial_atlas_control.bag_analysis import BagData, read_bag
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 
 __all__ = [
     'DEFAULT_TOLERANCE',
@@ -353,7 +353,7 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
 
     from tutorial_atlas_control import model as atlas_model
     from tutorial_atlas_control.controller import load_gains_yaml
-    from tutorial_atlas_control.simulator import AtlasSimulator
+    from tutorial_atlas_control.simulator import DIVERGENCE_WARNINGS, AtlasSimulator
 
     warnings = list(recording.warnings)
     config = recording.config
@@ -362,7 +362,8 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
     dt_s = float(model.opt.timestep)
     if config.timestep_s is not None and config.timestep_s != dt_s:
         raise ReplayError(f'the run was simulated with timestep {config.timestep_s} s but '
-                          f'{atlas_model.MODEL_PATH.name} has {dt_s} s; replay with the same model.')
+                          f'{atlas_model.MODEL_PATH.name} has {dt_s} s; replay with the same '
+                          'model.')
     sha1_matches = None
     if config.model_sha1:
         sha1 = hashlib.sha1(atlas_model.MODEL_PATH.read_bytes()).hexdigest()
@@ -447,8 +448,14 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
         position[index] = qpos[qpos_adr]
         velocity[index] = qvel[dof_adr]
         check_odom(data, step)
-        if not np.isfinite(qpos).all():
-            raise ReplayError(f'the replay diverged (non-finite state) at {step * dt_s:.3f} s.')
+        diverged = [what for warning, what in DIVERGENCE_WARNINGS
+                    if data.warning[warning].number > 0]
+        if diverged or not np.isfinite(qpos).all():
+            raise ReplayError(
+                f'the replay diverged ({", ".join(diverged) or "non-finite state"}) at '
+                f'{step * dt_s:.3f} s; if the recorded run did too, the simulator reset the robot '
+                'there, which the bag does not mark (/atlas/sim_config is not re-published on a '
+                'divergence reset).')
 
     recorded_position = recording.position_rad[rows]
     recorded_velocity = recording.velocity_rad_s[rows]

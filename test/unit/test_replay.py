@@ -19,8 +19,7 @@ from tutorial_atlas_control.bag_analysis import BagAnalysisError
 from tutorial_atlas_control.controller import hold_command, load_gains_yaml
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.replay import (
-    EXIT_DEVIATES, GAINS_FILE, ReplayError, format_report, load_recording, main, replay,
-    replay_bag)
+    EXIT_DEVIATES, GAINS_FILE, ReplayError, format_report, load_recording, main, replay_bag)
 from tutorial_atlas_control.simulator import AtlasSimulator, ControlMode
 
 SCRIPT = Path(__file__).resolve().parents[2] / 'scripts' / 'replay_bag.py'
