@@ -11,6 +11,8 @@ first selected message (`--clock` would make it a second /clock source). So the 
 keep their recorded spacing only while the simulator keeps real time; the test measures
 the sim-time span the played commands arrived over and reports it next to the recorded one.
 
+The same bag must also replay offline (replay_bag) exactly.
+
 Run with `python3 -m pytest test/integration -q -s` after `source env.sh` (needs roslaunch,
 rosbag and the workspace's osrf_msgs; skipped otherwise). Wall time about 60 s.
 """
@@ -216,3 +218,14 @@ def test_played_commands_make_the_robot_fall(
     assert min_z_m < FALLEN_BELOW_M, (
         f'the replayed run did not fall (lowest pelvis {min_z_m:.2f} m); commands arrived over '
         f'{played_span_s:.2f} s of sim time vs {recorded_span_s:.2f} s recorded')
+
+
+def test_offline_replay_of_the_recording_is_exact(recorded_bag: Path) -> None:
+    """The same bag, re-simulated without ROS from its recorded torques: bit for bit."""
+    from tutorial_atlas_control.replay import replay_bag
+
+    result = replay_bag(recorded_bag)
+    assert result.recorded_steps > 1000
+    assert result.joint_position.max_abs == 0.0 and result.joint_velocity.max_abs == 0.0
+    assert result.pelvis_position is not None and result.pelvis_position.max_abs == 0.0
+    assert result.pelvis_orientation is not None and result.pelvis_orientation.max_abs == 0.0
