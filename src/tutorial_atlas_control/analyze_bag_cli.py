@@ -54,7 +54,7 @@ cannot be written, 2 on bad arguments.
 Video (--video): each frame poses the model as recorded at the frame's time (pelvis
 from /ground_truth_odom, interpolated; joints from /atlas/joint_states) and draws it
 offscreen through the model's `track` camera (software OSMesa when there is no display);
-the sim time is printed on each frame. Needs both topics.
+each frame is labelled with its time from the bag's start. Needs both topics.
 
 Example: rosrun tutorial_atlas_control analyze_bag.py run.bag --plot run.png --csv run_csv
          rosrun tutorial_atlas_control analyze_bag.py run.bag --video run.mp4 --fps 30
