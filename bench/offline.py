@@ -1,0 +1,108 @@
+"""The benchmark's measurements that need no ROS master: physics ceiling and bag reading."""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import sys
+import time
+from pathlib import Path
+
+from harness import REPO_DIR, BenchError, log
+
+GAINS_YAML = REPO_DIR / 'config' / 'atlas_controller.yaml'
+SYNTHETIC_BAGS = REPO_DIR / 'test' / 'unit' / 'synthetic_bags.py'
+#: The topics bag_analysis.read_bag deserializes (the baseline reads the same ones).
+ANALYSIS_TOPICS = ('/atlas/joint_states', '/atlas/joint_commands', '/ground_truth_odom',
+                   '/atlas/control_mode')
+
+
+# ---------------------------------------------------------------------------- physics
+def make_simulator():
+    """AtlasSimulator with the DRCSim gains from config/, as the node builds it."""
+    from tutorial_atlas_control import controller, model
+    from tutorial_atlas_control.simulator import AtlasSimulator
+
+    return AtlasSimulator(model.load_model(), controller.load_gains_yaml(GAINS_YAML))
+
+
+def physics_run(warmup_steps: int = 1500, steps: int = 5000) -> float:
+    """Steps per wall second of AtlasSimulator.step() (law + mj_step) in a plain loop.
+
+    A fresh simulator each run; the warm-up passes the 1 s torso pin so the timed
+    steps are the standing robot with its feet in contact, as in a real run.
+    """
+    sim = make_simulator()
+    step = sim.step
+    for _ in range(warmup_steps):
+        step()
+    start = time.perf_counter()
+    for _ in range(steps):
+        step()
+    return steps / (time.perf_counter() - start)
+
+
+def steps_per_sim_second() -> float:
+    from tutorial_atlas_control import model
+
+    return 1.0 / float(model.load_model().model.opt.timestep)
+
+
+# ---------------------------------------------------------------------------- bags
+def run_bag(cache_dir: Path, duration_s: float = 60.0) -> Path:
+    """The 60 s synthetic run bag (test/unit/synthetic_bags.write_run_bag), cached in /tmp.
+
+    Cached under a name that hashes synthetic_bags.py, so a changed generator makes a new
+    bag; written to a temporary name and renamed, so an interrupted run leaves no half bag.
+    """
+    key = hashlib.sha1(SYNTHETIC_BAGS.read_bytes() + str(duration_s).encode()).hexdigest()[:12]
+    path = cache_dir / f'run{duration_s:.0f}s_{key}.bag'
+    if path.is_file():
+        return path
+    cache_dir.mkdir(parents=True, exist_ok=True)
+    sys.path.insert(0, str(SYNTHETIC_BAGS.parent))
+    try:
+        import synthetic_bags
+    except ImportError as err:
+        raise BenchError(f'cannot import {SYNTHETIC_BAGS}: {err}') from err
+    finally:
+        sys.path.remove(str(SYNTHETIC_BAGS.parent))
+    partial = path.with_name(f'{path.stem}.{os.getpid()}.partial.bag')
+    log(f'writing the {duration_s:.0f} s synthetic run bag {path} (once; cached)')
+    start = time.perf_counter()
+    try:
+        synthetic_bags.write_run_bag(partial, duration_s)
+        partial.rename(path)
+    finally:
+        partial.unlink(missing_ok=True)
+    log(f'bag written in {time.perf_counter() - start:.1f} s')
+    return path
+
+
+def analysis_message_count(path: Path) -> int:
+    """Messages on ANALYSIS_TOPICS (what both readers deserialize)."""
+    import rosbag
+
+    with rosbag.Bag(str(path)) as bag:
+        return bag.get_message_count(topic_filters=list(ANALYSIS_TOPICS))
+
+
+def analysis_run(path: Path) -> float:
+    """Wall seconds of bag_analysis.analyze_bag (read_bag + metrics) on `path`."""
+    from tutorial_atlas_control.bag_analysis import analyze_bag
+
+    start = time.perf_counter()
+    analyze_bag(path)
+    return time.perf_counter() - start
+
+
+def rosbag_run(path: Path) -> tuple[float, int]:
+    """Wall seconds (and message count) to deserialize ANALYSIS_TOPICS with Debian's rosbag."""
+    import rosbag
+
+    count = 0
+    start = time.perf_counter()
+    with rosbag.Bag(str(path)) as bag:
+        for _topic, _msg, _t in bag.read_messages(topics=list(ANALYSIS_TOPICS)):
+            count += 1
+    return time.perf_counter() - start, count

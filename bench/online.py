@@ -1,0 +1,244 @@
+"""The benchmark's measurements against the running simulator node (a private master).
+
+fast run:     real_time_factor:=0 with `rosbag record` subscribed; achieved real-time
+              factor = sim time advanced / wall time over a window, both taken from the
+              /clock messages a raw subscriber receives (first and last of the window).
+realtime run: real_time_factor:=1.0; over the window every /clock arrival is kept.
+              lateness of step i = (arrival_i - sim_i) - min_j (arrival_j - sim_j), i.e.
+              how much later than the best-placed step each step arrives against a wall
+              schedule of one sim second per wall second. It includes /clock's transport
+              and our callback jitter, and counts drift: an rtf of 0.999 over 30 s shows
+              as 30 ms of lateness at the end, as it should.
+              Then command latency (User mode): JointCommands for neck_ay only, with all
+              its gains 0 and a unique feed-forward `effort` per message, so the effort the
+              simulator publishes for neck_ay is exactly the commanded one from the step
+              that first applied it. latency = arrival of the first /atlas/joint_states
+              carrying that effort - the publish() call. `net` subtracts the median
+              JointState transport measured by js_transport_probe.py on the same master.
+"""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from harness import READY_TIMEOUT_S, BenchError, Launch, Master, cpu_seconds, wait_until
+from probes import RawRecorder, clock_ns, header_stamp_ns, joint_state_effort
+
+LATENCY_JOINT = 'neck_ay'
+NS_PER_S = 1_000_000_000
+JS_PROBE_TOPIC = '/tac_bench/js_probe'
+
+
+@dataclass
+class Probes:
+    """The benchmark node's subscribers and publishers (created once per master)."""
+
+    clock: RawRecorder
+    joint_states: RawRecorder
+    js_probe: RawRecorder
+    command_pub: object
+    mode_pub: object
+
+
+def make_probes() -> Probes:
+    import warnings
+
+    import rospy
+    from osrf_msgs.msg import JointCommands
+    from std_msgs.msg import String
+
+    # rospy warns about queue_size=None, which is what we want here (synchronous).
+    warnings.filterwarnings('ignore', category=SyntaxWarning, module='rospy')
+    warnings.filterwarnings('ignore', message='The publisher should be created')
+    return Probes(
+        clock=RawRecorder('/clock'),
+        joint_states=RawRecorder('/atlas/joint_states'),
+        js_probe=RawRecorder(JS_PROBE_TOPIC),
+        # Synchronous publishers: the publish() timestamp is then when the bytes leave.
+        command_pub=rospy.Publisher('/atlas/joint_commands', JointCommands, queue_size=None,
+                                    tcp_nodelay=True),
+        mode_pub=rospy.Publisher('/atlas/control_mode', String, queue_size=None),
+    )
+
+
+def _launch(master: Master, launch_file: str, work_dir: Path, name: str,
+            rtf: float) -> Launch:
+    return Launch(master, launch_file,
+                  {'gui': 'false', 'real_time_factor': str(rtf), 'record': 'true',
+                   'bag_dir': str(work_dir / f'{name}_bags')},
+                  work_dir / f'{name}.launch.log')
+
+
+def _drop_bags(launch: Launch) -> None:
+    """Bags at real_time_factor 0 are large (~1 MB per sim second): delete each run's."""
+    shutil.rmtree(launch.args['bag_dir'], ignore_errors=True)
+
+
+def _wait_ready(master: Master, launch: Launch, probes: Probes) -> None:
+    """/clock arriving and the recorder subscribed to the simulator's topics."""
+    start_count = probes.clock.count
+    wait_until(lambda: probes.clock.count > start_count + 10, READY_TIMEOUT_S,
+               'the simulator to publish /clock', alive=launch.check_alive)
+    wait_until(lambda: all(any('recorder' in node for node in master.subscribers(topic))
+                           for topic in ('/clock', '/atlas/joint_states', '/atlas/imu')),
+               READY_TIMEOUT_S, 'rosbag record to subscribe', poll_s=0.2,
+               alive=launch.check_alive)
+
+
+def _clock_series(samples: list[tuple[float, bytes]]) -> tuple[np.ndarray, np.ndarray]:
+    if len(samples) < 2:
+        raise BenchError(f'only {len(samples)} /clock messages in the window')
+    wall = np.array([s[0] for s in samples])
+    sim = np.array([clock_ns(s[1]) for s in samples], dtype=np.int64) / NS_PER_S
+    return wall, sim
+
+
+def fast_run(master: Master, launch_file: str, probes: Probes, work_dir: Path, name: str,
+             warmup_s: float, window_s: float) -> dict[str, float]:
+    with _launch(master, launch_file, work_dir, name, 0.0) as launch:
+        _wait_ready(master, launch, probes)
+        time.sleep(warmup_s)
+        pids = {'node': launch.node_pid('atlas_sim'), 'recorder': launch.node_pid('recorder')}
+        cpu0 = {name: cpu_seconds(pid) if pid else 0.0 for name, pid in pids.items()}
+        probes.clock.start()
+        time.sleep(window_s)
+        samples = probes.clock.stop()
+        cpu1 = {name: cpu_seconds(pid) if pid else 0.0 for name, pid in pids.items()}
+        launch.check_alive()
+    _drop_bags(launch)
+    wall, sim = _clock_series(samples)
+    # Received /clock messages may be a subset; the first and last bound the window.
+    span_s = wall[-1] - wall[0]
+    result = {'fast_rtf': float((sim[-1] - sim[0]) / span_s)}
+    for name, pid in pids.items():
+        if pid:  # CPU (cores) over the window, from /proc (utime + stime)
+            result[f'fast_{name}_cpu'] = (cpu1[name] - cpu0[name]) / window_s
+    return result
+
+
+def _lateness(wall: np.ndarray, sim: np.ndarray) -> np.ndarray:
+    offset = wall - sim
+    return (offset - offset.min()) * 1000.0
+
+
+def _send_commands(probes: Probes, rate_hz: float, duration_s: float,
+                   first_key: int) -> list[tuple[float, float]]:
+    """Publish neck_ay feed-forward commands; return (effort value, publish time) pairs."""
+    from osrf_msgs.msg import JointCommands
+
+    msg = JointCommands(name=[LATENCY_JOINT], kp_position=[0.0], ki_position=[0.0],
+                        kd_position=[0.0], kp_velocity=[0.0])
+    sent = []
+    period = 1.0 / rate_hz
+    count = int(round(rate_hz * duration_s))
+    next_s = time.perf_counter()
+    for index in range(count):
+        key = first_key + index
+        # Unique, small, alternating: the neck barely moves and every value is new.
+        value = (0.5 + key * 1e-4) * (1.0 if key % 2 else -1.0)
+        msg.effort = [value]
+        now = time.perf_counter()
+        probes.command_pub.publish(msg)
+        sent.append((value, now))
+        next_s += period
+        delay = next_s - time.perf_counter()
+        if delay > 0:
+            time.sleep(delay)
+        elif delay < -0.05:  # fell behind (a loaded machine): do not burst to catch up
+            next_s = time.perf_counter()
+    return sent
+
+
+def _match_latencies(sent: list[tuple[float, float]],
+                     states: list[tuple[float, bytes]]) -> tuple[np.ndarray, int]:
+    """(latencies in ms of the commands that were applied, count sent)."""
+    pending = {value: t_pub for value, t_pub in sent}
+    latencies = []
+    for t_recv, raw in states:
+        effort = joint_state_effort(raw, LATENCY_JOINT)
+        t_pub = pending.pop(effort, None)
+        if t_pub is not None:
+            latencies.append((t_recv - t_pub) * 1000.0)
+    return np.array(latencies), len(sent)
+
+
+def js_transport(master: Master, probes: Probes, work_dir: Path, count: int = 2000,
+                 rate_hz: float = 1000.0) -> dict[str, float]:
+    """JointState transport between two rospy processes (ms): p50 and p99."""
+    probes.js_probe.start()
+    probe_log = (work_dir / 'js_probe.log').open('w')
+    try:
+        completed = subprocess.run(
+            [sys.executable, str(Path(__file__).with_name('js_transport_probe.py')),
+             JS_PROBE_TOPIC, str(count), str(rate_hz)],
+            env=master.env(), stdout=probe_log, stderr=subprocess.STDOUT,
+            stdin=subprocess.DEVNULL, timeout=count / rate_hz + 60, check=False)
+    except subprocess.TimeoutExpired as err:
+        raise BenchError('js_transport_probe.py did not finish in time') from err
+    finally:
+        samples = probes.js_probe.stop()
+    if completed.returncode != 0 or len(samples) < count // 2:
+        raise BenchError(f'js_transport_probe.py failed ({completed.returncode}, '
+                         f'{len(samples)} messages); see {probe_log.name}')
+    transport = np.array([t - header_stamp_ns(raw) / NS_PER_S for t, raw in samples]) * 1000.0
+    return {'js_transport_p50_ms': float(np.percentile(transport, 50)),
+            'js_transport_p99_ms': float(np.percentile(transport, 99))}
+
+
+def realtime_run(master: Master, launch_file: str, probes: Probes, work_dir: Path, name: str,
+                 warmup_s: float, window_s: float, latency_s: dict[float, float],
+                 transport_ms: float) -> dict[str, float]:
+    from std_msgs.msg import String
+
+    result: dict[str, float] = {}
+    with _launch(master, launch_file, work_dir, name, 1.0) as launch:
+        _wait_ready(master, launch, probes)
+        time.sleep(warmup_s)
+        probes.clock.start()
+        time.sleep(window_s)
+        samples = probes.clock.stop()
+        launch.check_alive()
+        wall, sim = _clock_series(samples)
+        lateness = _lateness(wall, sim)
+        steps = int(round((sim[-1] - sim[0]) * 1000)) + 1
+        result.update({
+            'realtime_rtf': float((sim[-1] - sim[0]) / (wall[-1] - wall[0])),
+            'lateness_p50_ms': float(np.percentile(lateness, 50)),
+            'lateness_p99_ms': float(np.percentile(lateness, 99)),
+            'lateness_max_ms': float(lateness.max()),
+            'realtime_clock_received': len(samples) / max(steps, 1),
+        })
+
+        if latency_s:
+            wait_until(lambda: probes.command_pub.get_num_connections() > 0
+                       and probes.mode_pub.get_num_connections() > 0, READY_TIMEOUT_S,
+                       'the simulator to subscribe to the commands', alive=launch.check_alive)
+            probes.mode_pub.publish(String(data='User'))
+            time.sleep(0.5)
+        key = 0
+        for rate_hz, duration_s in latency_s.items():
+            label = f'{rate_hz:g}hz' if rate_hz < 1000 else f'{rate_hz / 1000:g}khz'
+            probes.joint_states.start()
+            sent = _send_commands(probes, rate_hz, duration_s, key)
+            key += len(sent) + 1
+            time.sleep(0.2)
+            states = probes.joint_states.stop()
+            launch.check_alive()
+            latencies, count = _match_latencies(sent, states)
+            if len(latencies) < 10:
+                raise BenchError(f'only {len(latencies)} of {count} commands at {label} '
+                                 'showed up in /atlas/joint_states')
+            for pct in (50, 99):
+                raw_ms = float(np.percentile(latencies, pct))
+                result[f'cmd_latency_p{pct}_ms_raw_{label}'] = raw_ms
+                result[f'cmd_latency_p{pct}_ms_{label}'] = raw_ms - transport_ms
+            result[f'cmd_applied_{label}'] = len(latencies) / count
+    _drop_bags(launch)
+    return result

@@ -1,0 +1,244 @@
+#!/usr/bin/env python3
+"""`make bench`: the simulator's performance, each figure as min / median / max over runs.
+
+Prints a table on stdout and, as its last line, one JSON object with the medians. Progress
+goes to stderr. Runs on a private master on a free port (never 11311), under a scratch
+directory in /tmp that is removed afterwards (kept with --keep or on failure).
+
+Sections (see bench/README.md for what each figure means and how it is measured):
+  physics   AtlasSimulator.step() (controller law + mj_step) in a plain loop, no ROS
+  analysis  bag_analysis.analyze_bag vs Debian's rosbag API on a 60 s run bag
+  fast      the node at real_time_factor:=0, `rosbag record` subscribed
+  realtime  the node at real_time_factor:=1.0: achieved factor, step lateness, then the
+            command latency at 50 Hz and 1 kHz (User mode)
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import statistics
+import sys
+import tempfile
+import time
+import traceback
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from harness import BenchError, Master, check_environment, load_average, log  # noqa: E402
+
+SECTIONS = ('physics', 'analysis', 'fast', 'realtime')
+
+#: (key, label, unit, target text, digits) in table order.
+ROWS = (
+    ('physics_limit_steps_per_s', 'physics + law, plain loop', 'steps/s', '', 0),
+    ('fast_rtf', 'node rtf:=0 + rosbag record', 'x real time', '>= 10', 2),
+    ('fast_ratio', 'fast_rtf*1000 / physics limit', '', '>= 0.4', 3),
+    ('fast_node_cpu', 'node CPU at rtf:=0', 'cores', '', 2),
+    ('fast_recorder_cpu', 'rosbag record CPU at rtf:=0', 'cores', '', 2),
+    ('realtime_rtf', 'node rtf:=1, achieved', 'x real time', '1.00 +- 0.01', 4),
+    ('lateness_p50_ms', 'step lateness p50', 'ms', '', 2),
+    ('lateness_p99_ms', 'step lateness p99', 'ms', '< 2', 2),
+    ('lateness_max_ms', 'step lateness max', 'ms', '', 2),
+    ('js_transport_p50_ms', 'JointState transport p50', 'ms', '', 3),
+    ('js_transport_p99_ms', 'JointState transport p99', 'ms', '', 3),
+    ('cmd_latency_p50_ms_50hz', 'command latency p50, 50 Hz (net)', 'ms', '', 2),
+    ('cmd_latency_p99_ms_50hz', 'command latency p99, 50 Hz (net)', 'ms', '< 2', 2),
+    ('cmd_latency_p50_ms_1khz', 'command latency p50, 1 kHz (net)', 'ms', '', 2),
+    ('cmd_latency_p99_ms_1khz', 'command latency p99, 1 kHz (net)', 'ms', '< 2', 2),
+    ('cmd_latency_p50_ms_raw_50hz', 'command latency p50, 50 Hz (raw)', 'ms', '', 2),
+    ('cmd_latency_p99_ms_raw_50hz', 'command latency p99, 50 Hz (raw)', 'ms', '', 2),
+    ('cmd_latency_p50_ms_raw_1khz', 'command latency p50, 1 kHz (raw)', 'ms', '', 2),
+    ('cmd_latency_p99_ms_raw_1khz', 'command latency p99, 1 kHz (raw)', 'ms', '', 2),
+    ('cmd_applied_1khz', 'commands applied, 1 kHz', 'fraction', '', 3),
+    ('analysis_msgs_per_s', 'analyze_bag, 60 s bag', 'msgs/s', '', 0),
+    ('rosbag_msgs_per_s', 'rosbag API, same topics', 'msgs/s', '', 0),
+    ('analysis_speedup', 'analyze_bag / rosbag', 'x', '>= 5', 1),
+)
+
+
+def parse_args(argv: list[str]) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument('--runs', type=int, default=3, help='runs per figure (default 3)')
+    parser.add_argument('--only', default=','.join(SECTIONS),
+                        help=f'comma-separated sections to run (default: {",".join(SECTIONS)})')
+    parser.add_argument('--quick', action='store_true',
+                        help='short windows (a smoke test, not a measurement)')
+    parser.add_argument('--launch-file', default='atlas.launch',
+                        help='launch file to benchmark instead of the package\'s atlas.launch '
+                             '(a path, or a file name in tutorial_atlas_control); it must take '
+                             'the same arguments (gui, real_time_factor, record, bag_dir)')
+    parser.add_argument('--keep', action='store_true', help='keep the scratch directory')
+    args = parser.parse_args(argv)
+    args.sections = [s.strip() for s in args.only.split(',') if s.strip()]
+    unknown = set(args.sections) - set(SECTIONS)
+    if unknown:
+        parser.error(f'unknown section(s) {", ".join(sorted(unknown))}; choose from '
+                     + ', '.join(SECTIONS))
+    if args.runs < 1:
+        parser.error('--runs must be >= 1')
+    if args.launch_file.endswith('.launch') and os.path.sep in args.launch_file:
+        args.launch_file = str(Path(args.launch_file).resolve())
+    return args
+
+
+def add(samples: dict[str, list[float]], values: dict[str, float]) -> None:
+    for key, value in values.items():
+        samples.setdefault(key, []).append(value)
+
+
+def run_offline(args: argparse.Namespace, samples: dict[str, list[float]],
+                loads: dict[str, str]) -> None:
+    import offline
+
+    if 'physics' in args.sections:
+        loads['physics'] = load_average()
+        for run in range(max(args.runs, 5)):
+            rate = offline.physics_run(steps=2000 if args.quick else 5000)
+            log(f'physics run {run + 1}: {rate:.0f} steps/s')
+            add(samples, {'physics_limit_steps_per_s': rate})
+    if 'analysis' in args.sections:
+        path = offline.run_bag(Path(tempfile.gettempdir()) / 'tac_bench_cache',
+                               10.0 if args.quick else 60.0)
+        loads['analysis'] = load_average()
+        count = offline.analysis_message_count(path)
+        offline.analysis_run(path)  # warm the page cache and imports for both readers
+        for run in range(args.runs):
+            analysis_s = offline.analysis_run(path)
+            rosbag_s, read = offline.rosbag_run(path)
+            if read != count:
+                raise BenchError(f'rosbag read {read} messages, expected {count}')
+            log(f'analysis run {run + 1}: analyze_bag {analysis_s:.2f} s, '
+                f'rosbag {rosbag_s:.2f} s for {count} messages')
+            add(samples, {'analysis_s': analysis_s, 'rosbag_s': rosbag_s,
+                          'analysis_msgs_per_s': count / analysis_s,
+                          'rosbag_msgs_per_s': count / rosbag_s,
+                          'analysis_speedup': rosbag_s / analysis_s})
+
+
+def run_online(args: argparse.Namespace, samples: dict[str, list[float]],
+               loads: dict[str, str], work_dir: Path) -> None:
+    if not {'fast', 'realtime'} & set(args.sections):
+        return
+    import online
+
+    master = Master(work_dir)
+    try:
+        log(f'starting a private roscore on port {master.port}')
+        master.start()
+        os.environ.update({'ROS_MASTER_URI': master.uri,
+                           'ROS_LOG_DIR': str(work_dir / 'ros_log')})
+        import rospy
+
+        # Before any launch sets /use_sim_time: our node keeps wall time, no /clock client.
+        rospy.init_node('tac_bench', disable_signals=True)
+        probes = online.make_probes()
+        if 'fast' in args.sections:
+            loads['fast'] = load_average()
+            for run in range(args.runs):
+                values = online.fast_run(master, args.launch_file, probes, work_dir,
+                                         f'fast{run + 1}', warmup_s=2.0,
+                                         window_s=4.0 if args.quick else 10.0)
+                log(f'fast run {run + 1}: rtf {values["fast_rtf"]:.3f}')
+                add(samples, values)
+        if 'realtime' in args.sections:
+            loads['realtime'] = load_average()
+            latency_s = {50.0: 2.0, 1000.0: 1.0} if args.quick else {50.0: 6.0, 1000.0: 3.0}
+            for run in range(args.runs):
+                transport = online.js_transport(master, probes, work_dir)
+                values = online.realtime_run(
+                    master, args.launch_file, probes, work_dir, f'realtime{run + 1}',
+                    warmup_s=2.0, window_s=8.0 if args.quick else 30.0, latency_s=latency_s,
+                    transport_ms=transport['js_transport_p50_ms'])
+                values.update(transport)
+                log(f'realtime run {run + 1}: rtf {values["realtime_rtf"]:.4f}, lateness p99 '
+                    f'{values["lateness_p99_ms"]:.2f} ms, command latency p99 (net) '
+                    f'{values["cmd_latency_p99_ms_50hz"]:.2f} ms at 50 Hz, '
+                    f'{values["cmd_latency_p99_ms_1khz"]:.2f} ms at 1 kHz')
+                add(samples, values)
+        rospy.signal_shutdown('bench done')
+    finally:
+        master.stop()
+
+
+def summarize(samples: dict[str, list[float]]) -> dict[str, float]:
+    medians = {key: statistics.median(values) for key, values in samples.items()}
+    if 'fast_rtf' in samples and 'physics_limit_steps_per_s' in medians:
+        import offline
+
+        per_sim_s = offline.steps_per_sim_second()
+        physics = medians['physics_limit_steps_per_s']
+        samples['fast_ratio'] = [rtf * per_sim_s / physics for rtf in samples['fast_rtf']]
+        medians['fast_ratio'] = medians['fast_rtf'] * per_sim_s / physics
+    for pct in (50, 99):  # the headline: the worse of the two command rates
+        rates = [medians.get(f'cmd_latency_p{pct}_ms_{label}') for label in ('50hz', '1khz')]
+        if all(value is not None for value in rates):
+            medians[f'cmd_latency_p{pct}_ms'] = max(rates)
+    return medians
+
+
+def table(samples: dict[str, list[float]], loads: dict[str, str], runs: int) -> str:
+    lines = [f'tutorial_atlas_control benchmark ({os.cpu_count()} CPUs; load average '
+             f'1/5/15 min at the start of each section: '
+             + ', '.join(f'{section} {load}' for section, load in loads.items()) + ')',
+             f'min / median / max over {runs} runs (physics: over >= 5 runs)', '']
+    header = f'{"figure":<38} {"min":>10} {"median":>10} {"max":>10}  {"unit":<12} target'
+    lines += [header, '-' * len(header)]
+    for key, label, unit, target, digits in ROWS:
+        values = samples.get(key)
+        if not values:
+            continue
+        low, mid, high = min(values), statistics.median(values), max(values)
+        lines.append(f'{label:<38} {low:>10.{digits}f} {mid:>10.{digits}f} {high:>10.{digits}f}'
+                     f'  {unit:<12} {target}')
+    return '\n'.join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parse_args(sys.argv[1:] if argv is None else argv)
+    started = time.monotonic()
+    try:
+        check_environment()
+    except BenchError as err:
+        print(f'run_bench: {err}', file=sys.stderr)
+        return 2
+    work_dir = Path(tempfile.mkdtemp(prefix='tac_bench_'))
+    samples: dict[str, list[float]] = {}
+    loads: dict[str, str] = {}
+    ok = False
+    try:
+        run_offline(args, samples, loads)
+        run_online(args, samples, loads, work_dir)
+        ok = True
+    except BenchError as err:
+        print(f'run_bench: {err}', file=sys.stderr)
+    except KeyboardInterrupt:
+        print('run_bench: interrupted', file=sys.stderr)
+    except Exception:  # noqa: BLE001 - report, clean up, fail
+        traceback.print_exc()
+    finally:
+        if ok and not args.keep:
+            shutil.rmtree(work_dir, ignore_errors=True)
+        else:
+            # Bags are large; keep logs only unless asked to keep everything.
+            if not args.keep:
+                for bag_dir in work_dir.glob('*_bags'):
+                    shutil.rmtree(bag_dir, ignore_errors=True)
+            log(f'scratch directory kept: {work_dir}')
+    if not ok:
+        return 1
+    medians = summarize(samples)
+    print(table(samples, loads, args.runs))
+    result = {key: round(value, 4) for key, value in medians.items()}
+    result.update({'runs': args.runs, 'quick': args.quick, 'cpus': os.cpu_count(),
+                   'load_avg': load_average(), 'wall_s': round(time.monotonic() - started, 1)})
+    print(json.dumps(result, sort_keys=True), flush=True)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
