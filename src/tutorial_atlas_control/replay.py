@@ -397,7 +397,8 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
     def check_odom(data: mujoco.MjData, step: int) -> None:
         row = odom_row.get(step)
         if row is not None:
-            # The simulator publishes xpos/xquat as they are after mj_step, so do we.
+            # After mj_step, xpos/xquat describe the step's start; the simulator stamps its
+            # odometry with that time, so the caller passes the previous step's number.
             odom_done.append((row, data.xpos[atlas.pelvis_body_id].copy(),
                               data.xquat[atlas.pelvis_body_id].copy()))
 
@@ -413,7 +414,7 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
         data = sim.data
         for step in range(1, first_step):
             sim.step()
-            check_odom(data, step)
+            check_odom(data, step - 1)
         # The first recorded torque must be what the Stand law gives, or the run had left
         # Stand mode (or used other gains) before the recorder started.
         snapshot_spec = mujoco.mjtState.mjSTATE_INTEGRATION
@@ -447,7 +448,7 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
         mujoco.mj_step(model, data)
         position[index] = qpos[qpos_adr]
         velocity[index] = qvel[dof_adr]
-        check_odom(data, step)
+        check_odom(data, step - 1)
         diverged = [what for warning, what in DIVERGENCE_WARNINGS
                     if data.warning[warning].number > 0]
         if diverged or not np.isfinite(qpos).all():

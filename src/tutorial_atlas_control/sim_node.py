@@ -52,6 +52,9 @@ MAX_LAG_S = 0.1
 #: Viewer refresh period (s, wall).
 VIEWER_PERIOD_S = 1.0 / 60.0
 WORLD_FRAME = 'world'
+#: Outgoing messages buffered per subscriber: one second of 1 kHz topics, so that a
+#: recorder briefly starved of CPU loses nothing (rospy drops the oldest beyond this).
+PUBLISH_QUEUE_SIZE = 1000
 
 
 def steps_between(rate_hz: float, dt_s: float) -> int:
@@ -80,12 +83,15 @@ class SimNode:
         self.step_count = 0
         self.gui = gui
 
-        self.clock_pub = rospy.Publisher('/clock', Clock, queue_size=10)
-        self.joint_state_pub = rospy.Publisher('/atlas/joint_states', JointState, queue_size=100)
-        self.odom_pub = rospy.Publisher('/ground_truth_odom', Odometry, queue_size=100)
-        self.imu_pub = rospy.Publisher('/atlas/imu', Imu, queue_size=100)
-        self.l_contact_pub = rospy.Publisher('/atlas/l_foot_contact', WrenchStamped, queue_size=100)
-        self.r_contact_pub = rospy.Publisher('/atlas/r_foot_contact', WrenchStamped, queue_size=100)
+        queue = PUBLISH_QUEUE_SIZE
+        self.clock_pub = rospy.Publisher('/clock', Clock, queue_size=queue)
+        self.joint_state_pub = rospy.Publisher('/atlas/joint_states', JointState, queue_size=queue)
+        self.odom_pub = rospy.Publisher('/ground_truth_odom', Odometry, queue_size=queue)
+        self.imu_pub = rospy.Publisher('/atlas/imu', Imu, queue_size=queue)
+        self.l_contact_pub = rospy.Publisher('/atlas/l_foot_contact', WrenchStamped,
+                                             queue_size=queue)
+        self.r_contact_pub = rospy.Publisher('/atlas/r_foot_contact', WrenchStamped,
+                                             queue_size=queue)
         # Latched, recorded in every bag: what offline replay needs to re-create the run.
         self.config_pub = rospy.Publisher('/atlas/sim_config', String, queue_size=1, latch=True)
         self.config_pub.publish(String(data=json.dumps(sim.config())))
@@ -178,11 +184,13 @@ class SimNode:
             msg.velocity = sim.joint_velocities().tolist()
             msg.effort = sim.torque_nm.tolist()
             self.joint_state_pub.publish(msg)
+        # Poses and sensors describe the state at the start of the last step (see step()).
+        sensed = stamp(sim.state_time_ns)
         if count % self.every['odom'] == 0:
-            self._publish_odom(now)
+            self._publish_odom(sensed)
         if count % self.every['imu'] == 0:
             imu = self.imu
-            imu.header.stamp = now
+            imu.header.stamp = sensed
             w, x, y, z = self.sensors['imu_orientation']
             imu.orientation.x, imu.orientation.y, imu.orientation.z, imu.orientation.w = x, y, z, w
             vector_to(imu.angular_velocity, self.sensors['imu_angular_velocity'])
@@ -191,7 +199,7 @@ class SimNode:
         if count % self.every['contact'] == 0:
             for msg, side, pub in ((self.l_contact, 'l', self.l_contact_pub),
                                    (self.r_contact, 'r', self.r_contact_pub)):
-                msg.header.stamp = now
+                msg.header.stamp = sensed
                 vector_to(msg.wrench.force, self.sensors[f'{side}_foot_force'])
                 vector_to(msg.wrench.torque, self.sensors[f'{side}_foot_torque'])
                 pub.publish(msg)
@@ -233,6 +241,7 @@ class SimNode:
                 except PhysicsDivergenceError as err:
                     rospy.logerr(f'{err}; resetting the robot to its initial state')
                     self.sim.reset_world()
+                    self.config_pub.publish(String(data=json.dumps(self.sim.config())))
                 self.step_count += 1
                 self.publish()
                 sim_ns = self.sim.sim_time_ns

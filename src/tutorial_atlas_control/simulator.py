@@ -105,6 +105,7 @@ class AtlasSimulator:
         atlas_model.reset_to_initial(self.atlas, self.data)
         self.data.time = self.sim_time_ns / NS_PER_S
         self.last_reset_ns = self.sim_time_ns
+        self.state_time_ns = self.sim_time_ns
         self._pid.reset()
         self.torque_nm[:] = 0.0
         # A reset robot waits for fresh commands rather than jumping to a stale target.
@@ -203,6 +204,9 @@ class AtlasSimulator:
         self.torque_nm[:] = torque
         data.ctrl[:] = torque
         mujoco.mj_step(self.model, data)
+        # mj_step integrates last: joint positions/velocities are at the new time, while body
+        # poses and sensor readings were computed before integrating, at the step's start.
+        self.state_time_ns = self.sim_time_ns
         self.sim_time_ns += self.step_ns
         # MuJoCo resets the state by itself on NaN/Inf/huge values and only warns: catch it
         # here so that no silently reset (or non-finite) state is ever published.

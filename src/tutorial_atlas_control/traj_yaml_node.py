@@ -297,13 +297,30 @@ def _timeout_param() -> float:
     return float(value)
 
 
+def _registered_subscribers(topic: str) -> int:
+    """How many nodes the master lists as subscribers of `topic` (0 if it cannot tell)."""
+    try:
+        _publishers, subscribers, _services = rosgraph.Master(rospy.get_name()).getSystemState()
+    except Exception:  # noqa: BLE001 - an unreachable master only shortens the wait
+        return 0
+    return next((len(nodes) for name, nodes in subscribers if name == topic), 0)
+
+
 def _wait_for_subscriber(publisher: rospy.Publisher) -> None:
+    """Wait (bounded) until every registered subscriber, the recorder included, is connected.
+
+    Commands published before a subscriber connects never reach it: the simulator would
+    miss the start of the motion and the bag would lack the first commands.
+    """
     deadline = time.monotonic() + SUBSCRIBER_WAIT_S
-    while publisher.get_num_connections() == 0:
+    while (connected := publisher.get_num_connections()) == 0 or \
+            connected < _registered_subscribers(JOINT_COMMANDS_TOPIC):
         if rospy.is_shutdown():
             raise rospy.ROSInterruptException('shut down while waiting for a subscriber')
         if time.monotonic() >= deadline:
-            rospy.logwarn(f'nothing subscribes to {JOINT_COMMANDS_TOPIC} yet; publishing anyway')
+            if connected == 0:
+                rospy.logwarn(f'nothing subscribes to {JOINT_COMMANDS_TOPIC} yet; '
+                              'publishing anyway')
             return
         time.sleep(POLL_PERIOD_S)
 

@@ -6,7 +6,6 @@ Needs the catkin workspace (`source ./env.sh`); runs roslaunch on its own master
 from __future__ import annotations
 
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -32,30 +31,23 @@ RECORDED_TYPES = {
 }
 
 
-@pytest.fixture(scope='module')
-def demo_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[subprocess.CompletedProcess, Path]:
-    bag_dir = tmp_path_factory.mktemp('bags')
-    result = subprocess.run(
-        [sys.executable, str(REPO / 'scripts' / 'run_demo.py'), 'step_and_fall',
-         '--bag-dir', str(bag_dir)],
-        capture_output=True, text=True, timeout=240, check=False)
-    return result, bag_dir
-
-
 def test_demo_exits_0_and_prints_summary_bag_and_plot(demo_run) -> None:  # noqa: ANN001
-    result, bag_dir = demo_run
+    result, bag_dir = demo_run.result, demo_run.bag_dir
     assert result.returncode == 0, result.stdout + result.stderr
     assert 'the robot fell: pelvis below 0.5 m at t = ' in result.stdout
     bags = list(bag_dir.glob('atlas_*.bag'))
     assert len(bags) == 1
-    assert f'bag:  {bags[0]}' in result.stdout
+    assert f'bag:   {bags[0]}' in result.stdout
     plot = bags[0].with_suffix('.png')
-    assert f'plot: {plot}' in result.stdout
+    assert f'plot:  {plot}' in result.stdout
     assert plot.stat().st_size > 10_000
+    video = bags[0].with_suffix('.mp4')
+    assert f'video: {video}' in result.stdout
+    assert video.stat().st_size > 10_000
 
 
 def test_bag_is_closed_and_indexed(demo_run) -> None:  # noqa: ANN001
-    _, bag_dir = demo_run
+    bag_dir = demo_run.bag_dir
     assert not list(bag_dir.glob('*.active')), 'rosbag left an unclosed .bag.active'
     bag = next(bag_dir.glob('atlas_*.bag'))
     info = subprocess.run(['rosbag', 'info', '--yaml', '--key=indexed', str(bag)],
@@ -64,7 +56,7 @@ def test_bag_is_closed_and_indexed(demo_run) -> None:  # noqa: ANN001
 
 
 def test_bag_holds_the_run(demo_run) -> None:  # noqa: ANN001
-    _, bag_dir = demo_run
+    bag_dir = demo_run.bag_dir
     bag = next(bag_dir.glob('atlas_*.bag'))
     with AnyReader([bag]) as reader:
         connections = {c.topic: c for c in reader.connections}

@@ -44,12 +44,10 @@ from rosgraph_msgs.msg import Clock  # noqa: E402
 pytestmark = pytest.mark.filterwarnings('ignore::DeprecationWarning')
 
 REPO = Path(__file__).resolve().parents[2]
-RUN_DEMO = REPO / 'scripts' / 'run_demo.py'
 TRAJECTORY = 'step_and_fall'
 FALLEN_BELOW_M = 0.5
 STANDING_ABOVE_M = 0.8
 #: Wall-clock bounds (s).
-RECORD_TIMEOUT_S = 150.0
 STARTUP_TIMEOUT_S = 60.0
 PLAY_TIMEOUT_S = 60.0
 FALL_TIMEOUT_S = 20.0
@@ -83,20 +81,14 @@ def stop(process: subprocess.Popen) -> None:
 
 
 @pytest.fixture(scope='session')
-def recorded_bag(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """A step_and_fall bag: $TAC_LIVE_REPLAY_BAG, or recorded now with run_demo.py."""
+def recorded_bag(demo_run) -> Path:  # noqa: ANN001 - conftest.DemoRun
+    """A step_and_fall bag: $TAC_LIVE_REPLAY_BAG, or the shared run_demo.py recording."""
     given = os.environ.get('TAC_LIVE_REPLAY_BAG')
     if given:
         return Path(given)
-    bag_dir = tmp_path_factory.mktemp('recorded')
-    env = dict(os.environ, ROS_LOG_DIR=str(bag_dir / 'ros_log'))
-    done = subprocess.run([sys.executable, str(RUN_DEMO), TRAJECTORY, '--bag-dir', str(bag_dir)],
-                          env=env, capture_output=True, text=True, timeout=RECORD_TIMEOUT_S,
-                          check=False)
-    assert done.returncode == 0, f'run_demo.py failed:\n{done.stdout}\n{done.stderr}'
-    bags = sorted(bag_dir.glob('atlas_*.bag'))
-    assert bags, f'run_demo.py left no bag in {bag_dir}'
-    return bags[-1]
+    assert demo_run.result.returncode == 0, \
+        f'run_demo.py failed:\n{demo_run.result.stdout}\n{demo_run.result.stderr}'
+    return demo_run.bag
 
 
 class Probe:

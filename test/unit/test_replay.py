@@ -100,7 +100,9 @@ class Run:
                                             sim.torque_nm.copy(), seq=self.steps))
             if self.steps % ODOM_EVERY == 0:
                 body = self.atlas.pelvis_body_id
-                self.records.append(odometry_record(t_s, sim.data.xpos[body].copy(),
+                # As the simulator node: poses describe the step's start (state_time_ns).
+                self.records.append(odometry_record(sim.state_time_ns / 1e9,
+                                                    sim.data.xpos[body].copy(),
                                                     sim.data.xquat[body].copy()))
 
     def reset_world(self) -> None:
