@@ -20,6 +20,7 @@ realtime run: real_time_factor:=1.0; over the window every /clock arrival is kep
 from __future__ import annotations
 
 import shutil
+import struct
 import subprocess
 import sys
 import time
@@ -76,6 +77,27 @@ def _launch(master: Master, launch_file: str, work_dir: Path, name: str,
                   work_dir / f'{name}.launch.log')
 
 
+def recorded_fraction(bag_dir: Path, topic: str = '/atlas/joint_states') -> float | None:
+    """Share of `topic`'s published messages that reached the bag, from the header seqs.
+
+    The publisher numbers its messages (Header.seq); messages a subscriber queue dropped
+    (rosbag record's, when it cannot keep up) leave gaps. None if there is no closed bag.
+    """
+    from rosbags.rosbag1 import Reader
+
+    bags = sorted(bag_dir.glob('*.bag'))
+    if not bags:
+        return None
+    seqs = []
+    with Reader(bags[-1]) as reader:
+        connections = [c for c in reader.connections if c.topic == topic]
+        for _, _, raw in reader.messages(connections=connections):
+            seqs.append(struct.unpack_from('<I', raw, 0)[0])
+    if len(seqs) < 2:
+        return None
+    return len(seqs) / (max(seqs) - min(seqs) + 1)
+
+
 def _drop_bags(launch: Launch) -> None:
     """Bags at real_time_factor 0 are large (~1 MB per sim second): delete each run's."""
     shutil.rmtree(launch.args['bag_dir'], ignore_errors=True)
@@ -112,11 +134,14 @@ def fast_run(master: Master, launch_file: str, probes: Probes, work_dir: Path, n
         samples = probes.clock.stop()
         cpu1 = {name: cpu_seconds(pid) if pid else 0.0 for name, pid in pids.items()}
         launch.check_alive()
+    recorded = recorded_fraction(Path(launch.args['bag_dir']))
     _drop_bags(launch)
     wall, sim = _clock_series(samples)
     # Received /clock messages may be a subset; the first and last bound the window.
     span_s = wall[-1] - wall[0]
     result = {'fast_rtf': float((sim[-1] - sim[0]) / span_s)}
+    if recorded is not None:
+        result['fast_recorded_fraction'] = recorded
     for name, pid in pids.items():
         if pid:  # CPU (cores) over the window, from /proc (utime + stime)
             result[f'fast_{name}_cpu'] = (cpu1[name] - cpu0[name]) / window_s

@@ -39,6 +39,7 @@ ROWS = (
     ('fast_ratio', 'fast_rtf*1000 / physics limit', '', '>= 0.4', 3),
     ('fast_node_cpu', 'node CPU at rtf:=0', 'cores', '', 2),
     ('fast_recorder_cpu', 'rosbag record CPU at rtf:=0', 'cores', '', 2),
+    ('fast_recorded_fraction', 'joint_states recorded at rtf:=0', 'fraction', '1', 4),
     ('realtime_rtf', 'node rtf:=1, achieved', 'x real time', '1.00 +- 0.01', 4),
     ('lateness_p50_ms', 'step lateness p50', 'ms', '', 2),
     ('lateness_p99_ms', 'step lateness p99', 'ms', '< 2', 2),
