@@ -276,6 +276,26 @@ def load_average() -> str:
         return '?'
 
 
+def cpu_stat() -> list[int]:
+    """The machine's aggregate CPU jiffies from /proc/stat (user ... steal)."""
+    try:
+        return [int(v) for v in Path('/proc/stat').read_text().split('\n', 1)[0].split()[1:9]]
+    except (OSError, ValueError):
+        return [0] * 8
+
+
+def busy_and_steal(before: list[int], after: list[int]) -> tuple[float, float]:
+    """(busy %, steal %) of all CPUs between two cpu_stat() readings.
+
+    Steal is time the hypervisor gave our virtual CPUs to someone else: other tenants'
+    load that `uptime` inside this machine does not show.
+    """
+    delta = [b - a for a, b in zip(before, after)]
+    total = sum(delta) or 1
+    idle = delta[3] + delta[4]
+    return 100.0 * (total - idle - delta[7]) / total, 100.0 * delta[7] / total
+
+
 def wait_until(predicate, timeout_s: float, what: str, poll_s: float = 0.1,
                alive=None) -> None:
     """Poll `predicate` until true; BenchError naming `what` after `timeout_s` (wall)."""

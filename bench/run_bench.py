@@ -28,7 +28,24 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from harness import BenchError, Master, check_environment, load_average, log  # noqa: E402
+from harness import (BenchError, Master, busy_and_steal, check_environment,  # noqa: E402
+                     cpu_stat, load_average, log)
+
+
+class Section:
+    """Records the load average, CPU busy and steal % while a section runs."""
+
+    def __init__(self, name: str, loads: dict[str, str]) -> None:
+        self.name, self.loads = name, loads
+
+    def __enter__(self) -> None:
+        self.load = load_average()
+        self.stat = cpu_stat()
+
+    def __exit__(self, *exc: object) -> None:
+        busy, steal = busy_and_steal(self.stat, cpu_stat())
+        self.loads[self.name] = f'load {self.load}, busy {busy:.0f}%, steal {steal:.0f}%'
+
 
 SECTIONS = ('physics', 'analysis', 'fast', 'realtime')
 
@@ -97,28 +114,28 @@ def run_offline(args: argparse.Namespace, samples: dict[str, list[float]],
     import offline
 
     if 'physics' in args.sections:
-        loads['physics'] = load_average()
-        for run in range(max(args.runs, 5)):
-            rate = offline.physics_run(steps=2000 if args.quick else 5000)
-            log(f'physics run {run + 1}: {rate:.0f} steps/s')
-            add(samples, {'physics_limit_steps_per_s': rate})
+        with Section('physics', loads):
+            for run in range(max(args.runs, 5)):
+                rate = offline.physics_run(steps=2000 if args.quick else 5000)
+                log(f'physics run {run + 1}: {rate:.0f} steps/s')
+                add(samples, {'physics_limit_steps_per_s': rate})
     if 'analysis' in args.sections:
         path = offline.run_bag(Path(tempfile.gettempdir()) / 'tac_bench_cache',
                                10.0 if args.quick else 60.0)
-        loads['analysis'] = load_average()
         count = offline.analysis_message_count(path)
         offline.analysis_run(path)  # warm the page cache and imports for both readers
-        for run in range(args.runs):
-            analysis_s = offline.analysis_run(path)
-            rosbag_s, read = offline.rosbag_run(path)
-            if read != count:
-                raise BenchError(f'rosbag read {read} messages, expected {count}')
-            log(f'analysis run {run + 1}: analyze_bag {analysis_s:.2f} s, '
-                f'rosbag {rosbag_s:.2f} s for {count} messages')
-            add(samples, {'analysis_s': analysis_s, 'rosbag_s': rosbag_s,
-                          'analysis_msgs_per_s': count / analysis_s,
-                          'rosbag_msgs_per_s': count / rosbag_s,
-                          'analysis_speedup': rosbag_s / analysis_s})
+        with Section('analysis', loads):
+            for run in range(args.runs):
+                analysis_s = offline.analysis_run(path)
+                rosbag_s, read = offline.rosbag_run(path)
+                if read != count:
+                    raise BenchError(f'rosbag read {read} messages, expected {count}')
+                log(f'analysis run {run + 1}: analyze_bag {analysis_s:.2f} s, '
+                    f'rosbag {rosbag_s:.2f} s for {count} messages')
+                add(samples, {'analysis_s': analysis_s, 'rosbag_s': rosbag_s,
+                              'analysis_msgs_per_s': count / analysis_s,
+                              'rosbag_msgs_per_s': count / rosbag_s,
+                              'analysis_speedup': rosbag_s / analysis_s})
 
 
 def run_online(args: argparse.Namespace, samples: dict[str, list[float]],
@@ -139,31 +156,42 @@ def run_online(args: argparse.Namespace, samples: dict[str, list[float]],
         rospy.init_node('tac_bench', disable_signals=True)
         probes = online.make_probes()
         if 'fast' in args.sections:
-            loads['fast'] = load_average()
-            for run in range(args.runs):
-                values = online.fast_run(master, args.launch_file, probes, work_dir,
-                                         f'fast{run + 1}', warmup_s=2.0,
-                                         window_s=4.0 if args.quick else 10.0)
-                log(f'fast run {run + 1}: rtf {values["fast_rtf"]:.3f}')
-                add(samples, values)
+            with Section('fast', loads):
+                run_fast(args, samples, master, probes, work_dir)
         if 'realtime' in args.sections:
-            loads['realtime'] = load_average()
-            latency_s = {50.0: 2.0, 1000.0: 1.0} if args.quick else {50.0: 6.0, 1000.0: 3.0}
-            for run in range(args.runs):
-                transport = online.js_transport(master, probes, work_dir)
-                values = online.realtime_run(
-                    master, args.launch_file, probes, work_dir, f'realtime{run + 1}',
-                    warmup_s=2.0, window_s=8.0 if args.quick else 30.0, latency_s=latency_s,
-                    transport_ms=transport['js_transport_p50_ms'])
-                values.update(transport)
-                log(f'realtime run {run + 1}: rtf {values["realtime_rtf"]:.4f}, lateness p99 '
-                    f'{values["lateness_p99_ms"]:.2f} ms, command latency p99 (net) '
-                    f'{values["cmd_latency_p99_ms_50hz"]:.2f} ms at 50 Hz, '
-                    f'{values["cmd_latency_p99_ms_1khz"]:.2f} ms at 1 kHz')
-                add(samples, values)
+            with Section('realtime', loads):
+                run_realtime(args, samples, master, probes, work_dir)
         rospy.signal_shutdown('bench done')
     finally:
         master.stop()
+
+
+def run_fast(args, samples, master, probes, work_dir) -> None:  # noqa: ANN001
+    import online
+
+    for run in range(args.runs):
+        values = online.fast_run(master, args.launch_file, probes, work_dir, f'fast{run + 1}',
+                                 warmup_s=2.0, window_s=4.0 if args.quick else 10.0)
+        log(f'fast run {run + 1}: rtf {values["fast_rtf"]:.3f}')
+        add(samples, values)
+
+
+def run_realtime(args, samples, master, probes, work_dir) -> None:  # noqa: ANN001
+    import online
+
+    latency_s = {50.0: 2.0, 1000.0: 1.0} if args.quick else {50.0: 6.0, 1000.0: 3.0}
+    for run in range(args.runs):
+        transport = online.js_transport(master, probes, work_dir)
+        values = online.realtime_run(
+            master, args.launch_file, probes, work_dir, f'realtime{run + 1}', warmup_s=2.0,
+            window_s=8.0 if args.quick else 30.0, latency_s=latency_s,
+            transport_ms=transport['js_transport_p50_ms'])
+        values.update(transport)
+        log(f'realtime run {run + 1}: rtf {values["realtime_rtf"]:.4f}, lateness p99 '
+            f'{values["lateness_p99_ms"]:.2f} ms, command latency p99 (net) '
+            f'{values["cmd_latency_p99_ms_50hz"]:.2f} ms at 50 Hz, '
+            f'{values["cmd_latency_p99_ms_1khz"]:.2f} ms at 1 kHz')
+        add(samples, values)
 
 
 def summarize(samples: dict[str, list[float]]) -> dict[str, float]:
@@ -183,10 +211,10 @@ def summarize(samples: dict[str, list[float]]) -> dict[str, float]:
 
 
 def table(samples: dict[str, list[float]], loads: dict[str, str], runs: int) -> str:
-    lines = [f'tutorial_atlas_control benchmark ({os.cpu_count()} CPUs; load average '
-             f'1/5/15 min at the start of each section: '
-             + ', '.join(f'{section} {load}' for section, load in loads.items()) + ')',
-             f'min / median / max over {runs} runs (physics: over >= 5 runs)', '']
+    lines = [f'tutorial_atlas_control benchmark, {os.cpu_count()} CPUs; per section: load '
+             'average (1/5/15 min) at its start, CPU busy and hypervisor steal % during it:']
+    lines += [f'  {section:<9} {load}' for section, load in loads.items()]
+    lines += [f'min / median / max over {runs} runs (physics: over >= 5 runs)', '']
     header = f'{"figure":<38} {"min":>10} {"median":>10} {"max":>10}  {"unit":<12} target'
     lines += [header, '-' * len(header)]
     for key, label, unit, target, digits in ROWS:
