@@ -37,22 +37,22 @@ def test_the_pattern_catches_unsafe_calls() -> None:
     assert not UNSAFE_YAML.search('yaml.load(text, Loader=yaml.SafeLoader)')
 
 
-def test_env_sh_binds_ros_to_localhost_by_default() -> None:
-    env = {k: v for k, v in os.environ.items()
-           if k not in ('ROS_HOSTNAME', 'ROS_IP', 'ROS_MASTER_URI')}
+def ros_network_after_sourcing(env: dict[str, str]) -> list[str]:
+    """ROS_HOSTNAME and ROS_MASTER_URI as `source ./env.sh` leaves them, given `env`."""
     result = subprocess.run(
         ['bash', '-c', 'source ./env.sh >/dev/null && echo "$ROS_HOSTNAME $ROS_MASTER_URI"'],
         cwd=REPO, env=env, capture_output=True, text=True, check=False)
     if result.returncode != 0:
         pytest.skip('the project is not set up (make setup)')
-    assert result.stdout.split() == ['localhost', 'http://localhost:11311']
+    return result.stdout.split()
+
+
+def test_env_sh_binds_ros_to_localhost_by_default() -> None:
+    env = {k: v for k, v in os.environ.items()
+           if k not in ('ROS_HOSTNAME', 'ROS_IP', 'ROS_MASTER_URI')}
+    assert ros_network_after_sourcing(env) == ['localhost', 'http://localhost:11311']
 
 
 def test_env_sh_keeps_a_deliberate_network_setting() -> None:
     env = dict(os.environ, ROS_HOSTNAME='robot.lan', ROS_MASTER_URI='http://robot.lan:11311')
-    result = subprocess.run(
-        ['bash', '-c', 'source ./env.sh >/dev/null && echo "$ROS_HOSTNAME $ROS_MASTER_URI"'],
-        cwd=REPO, env=env, capture_output=True, text=True, check=False)
-    if result.returncode != 0:
-        pytest.skip('the project is not set up (make setup)')
-    assert result.stdout.split() == ['robot.lan', 'http://robot.lan:11311']
+    assert ros_network_after_sourcing(env) == ['robot.lan', 'http://robot.lan:11311']
