@@ -21,9 +21,9 @@ import json
 import sys
 import threading
 import time
+import warnings
 from collections.abc import Callable
 
-import genpy
 import mujoco
 import numpy as np
 import rospy
@@ -40,6 +40,8 @@ from tutorial_atlas_control.commands import CommandError
 from tutorial_atlas_control.controller import FIELD_NAMES, gains_from_params
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES
+from tutorial_atlas_control.wire import (
+    ImuWire, JointStateWire, OdometryWire, WireBatch, WrenchStampedWire, clock_bytes)
 from tutorial_atlas_control.simulator import (
     DEFAULT_TIME_TO_UNPIN_S, NS_PER_S, AtlasSimulator, ModeError, PhysicsDivergenceError,
     parse_mode)
@@ -52,9 +54,9 @@ MAX_LAG_S = 0.1
 #: Viewer refresh period (s, wall).
 VIEWER_PERIOD_S = 1.0 / 60.0
 WORLD_FRAME = 'world'
-#: Outgoing messages buffered per subscriber: one second of 1 kHz topics, so that a
-#: recorder briefly starved of CPU loses nothing (rospy drops the oldest beyond this).
-PUBLISH_QUEUE_SIZE = 1000
+#: At real_time_factor 0 the loop sends what it published at most this often (s, wall);
+#: paced runs send after every step.
+FLUSH_PERIOD_S = 0.001
 
 
 def steps_between(rate_hz: float, dt_s: float) -> int:
@@ -62,11 +64,6 @@ def steps_between(rate_hz: float, dt_s: float) -> int:
     if rate_hz <= 0.0 or rate_hz * dt_s >= 1.0:
         return 1
     return max(1, int(round(1.0 / (rate_hz * dt_s))))
-
-
-def stamp(sim_time_ns: int) -> genpy.Time:
-    secs, nsecs = divmod(sim_time_ns, NS_PER_S)
-    return genpy.Time(secs, nsecs)
 
 
 class SimNode:
@@ -83,29 +80,32 @@ class SimNode:
         self.step_count = 0
         self.gui = gui
 
-        queue = PUBLISH_QUEUE_SIZE
-        self.clock_pub = rospy.Publisher('/clock', Clock, queue_size=queue)
-        self.joint_state_pub = rospy.Publisher('/atlas/joint_states', JointState, queue_size=queue)
-        self.odom_pub = rospy.Publisher('/ground_truth_odom', Odometry, queue_size=queue)
-        self.imu_pub = rospy.Publisher('/atlas/imu', Imu, queue_size=queue)
-        self.l_contact_pub = rospy.Publisher('/atlas/l_foot_contact', WrenchStamped,
-                                             queue_size=queue)
-        self.r_contact_pub = rospy.Publisher('/atlas/r_foot_contact', WrenchStamped,
-                                             queue_size=queue)
+        # The loop serializes these itself (wire.py) and writes them to the subscriber
+        # connections in batches. queue_size=None: plain synchronous connections, without
+        # rospy's per-message writer-thread handoff (QueuedConnection.write_data's
+        # time.sleep(0), 5 per step). A subscriber that cannot keep up now slows the loop
+        # (TCP back-pressure) instead of losing messages.
+        with warnings.catch_warnings():
+            warnings.simplefilter('ignore', SyntaxWarning)  # rospy: "explicit queue_size"
+            self.clock_pub = rospy.Publisher('/clock', Clock, queue_size=None)
+            self.joint_state_pub = rospy.Publisher('/atlas/joint_states', JointState,
+                                                   queue_size=None)
+            self.odom_pub = rospy.Publisher('/ground_truth_odom', Odometry, queue_size=None)
+            self.imu_pub = rospy.Publisher('/atlas/imu', Imu, queue_size=None)
+            self.l_contact_pub = rospy.Publisher('/atlas/l_foot_contact', WrenchStamped,
+                                                 queue_size=None)
+            self.r_contact_pub = rospy.Publisher('/atlas/r_foot_contact', WrenchStamped,
+                                                 queue_size=None)
+        self.batch = WireBatch()
         # Latched, recorded in every bag: what offline replay needs to re-create the run.
         self.config_pub = rospy.Publisher('/atlas/sim_config', String, queue_size=1, latch=True)
         self.config_pub.publish(String(data=json.dumps(sim.config())))
 
-        self.joint_state = JointState(name=list(JOINT_NAMES))
-        self.odom = Odometry()
-        self.odom.header.frame_id = WORLD_FRAME
-        self.odom.child_frame_id = 'pelvis'
-        self.imu = Imu()
-        self.imu.header.frame_id = 'pelvis'
-        self.l_contact = WrenchStamped()
-        self.l_contact.header.frame_id = 'l_foot'
-        self.r_contact = WrenchStamped()
-        self.r_contact.header.frame_id = 'r_foot'
+        self.joint_state = JointStateWire(JOINT_NAMES)
+        self.odom = OdometryWire(WORLD_FRAME, 'pelvis')
+        self.imu = ImuWire('pelvis')
+        self.contacts = ((WrenchStampedWire('l_foot'), 'l', self.l_contact_pub),
+                         (WrenchStampedWire('r_foot'), 'r', self.r_contact_pub))
         data = sim.data
         self.sensors = {name: data.sensor(name).data for name in (
             'imu_orientation', 'imu_angular_velocity', 'imu_linear_acceleration',
@@ -172,54 +172,54 @@ class SimNode:
 
     # -- publishing ----------------------------------------------------------------------
     def publish(self) -> None:
-        """Publish what is due this step (called under the lock, after a step)."""
+        """Serialize what is due this step into the batch (called under the lock)."""
         sim = self.sim
-        now = stamp(sim.sim_time_ns)
-        self.clock_pub.publish(Clock(clock=now))
+        now_ns = sim.sim_time_ns
+        batch = self.batch
+        wanted = batch.wanted
+        if wanted(self.clock_pub):
+            # Only the latest time goes out per flush: every step when paced, about one
+            # per FLUSH_PERIOD_S of wall time at real_time_factor 0 (what a sim-time timer
+            # sees at real time); spares the recorder one message in five.
+            batch.replace(self.clock_pub, clock_bytes(now_ns))
         count = self.step_count
-        if count % self.every['joint_states'] == 0:
+        if count % self.every['joint_states'] == 0 and wanted(self.joint_state_pub):
             msg = self.joint_state
-            msg.header.stamp = now
-            msg.position = sim.joint_positions().tolist()
-            msg.velocity = sim.joint_velocities().tolist()
-            msg.effort = sim.torque_nm.tolist()
-            self.joint_state_pub.publish(msg)
+            np.take(sim.data.qpos, sim.atlas.qpos_adr, out=msg.position)
+            np.take(sim.data.qvel, sim.atlas.dof_adr, out=msg.velocity)
+            msg.effort[:] = sim.torque_nm
+            batch.add(self.joint_state_pub, msg.to_bytes(now_ns))
         # Poses and sensors describe the state at the start of the last step (see step()).
-        sensed = stamp(sim.state_time_ns)
-        if count % self.every['odom'] == 0:
-            self._publish_odom(sensed)
-        if count % self.every['imu'] == 0:
+        sensed_ns = sim.state_time_ns
+        if count % self.every['odom'] == 0 and wanted(self.odom_pub):
+            self._publish_odom(sensed_ns)
+        if count % self.every['imu'] == 0 and wanted(self.imu_pub):
             imu = self.imu
-            imu.header.stamp = sensed
             w, x, y, z = self.sensors['imu_orientation']
-            imu.orientation.x, imu.orientation.y, imu.orientation.z, imu.orientation.w = x, y, z, w
-            vector_to(imu.angular_velocity, self.sensors['imu_angular_velocity'])
-            vector_to(imu.linear_acceleration, self.sensors['imu_linear_acceleration'])
-            self.imu_pub.publish(imu)
+            imu.orientation_xyzw[:] = (x, y, z, w)
+            imu.angular_velocity[:] = self.sensors['imu_angular_velocity']
+            imu.linear_acceleration[:] = self.sensors['imu_linear_acceleration']
+            batch.add(self.imu_pub, imu.to_bytes(sensed_ns))
         if count % self.every['contact'] == 0:
-            for msg, side, pub in ((self.l_contact, 'l', self.l_contact_pub),
-                                   (self.r_contact, 'r', self.r_contact_pub)):
-                msg.header.stamp = sensed
-                vector_to(msg.wrench.force, self.sensors[f'{side}_foot_force'])
-                vector_to(msg.wrench.torque, self.sensors[f'{side}_foot_torque'])
-                pub.publish(msg)
+            for msg, side, pub in self.contacts:
+                if wanted(pub):
+                    msg.force[:] = self.sensors[f'{side}_foot_force']
+                    msg.torque[:] = self.sensors[f'{side}_foot_torque']
+                    batch.add(pub, msg.to_bytes(sensed_ns))
 
-    def _publish_odom(self, now: genpy.Time) -> None:
+    def _publish_odom(self, stamp_ns: int) -> None:
         sim = self.sim
         odom = self.odom
-        odom.header.stamp = now
         body = sim.atlas.pelvis_body_id
-        position = sim.data.xpos[body]
+        odom.position[:] = sim.data.xpos[body]
         w, x, y, z = sim.data.xquat[body]
-        pose = odom.pose.pose
-        pose.position.x, pose.position.y, pose.position.z = position
-        pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w = x, y, z, w
+        odom.orientation_xyzw[:] = (x, y, z, w)
         # World-frame twist of the pelvis frame origin, as Gazebo's p3d plugin reported it.
         mujoco.mj_objectVelocity(sim.model, sim.data, mujoco.mjtObj.mjOBJ_BODY, body,
                                  self._pelvis_velocity, 0)
-        vector_to(odom.twist.twist.angular, self._pelvis_velocity[:3])
-        vector_to(odom.twist.twist.linear, self._pelvis_velocity[3:])
-        self.odom_pub.publish(odom)
+        odom.angular[:] = self._pelvis_velocity[:3]
+        odom.linear[:] = self._pelvis_velocity[3:]
+        self.batch.add(self.odom_pub, odom.to_bytes(stamp_ns))
 
     # -- the loop ------------------------------------------------------------------------
     def spin(self) -> None:
@@ -230,8 +230,11 @@ class SimNode:
         sim0_ns = self.sim.sim_time_ns
         with self.lock:
             self.publish()  # /clock and the initial state before the first step
+        self.batch.flush()
+        last_flush_s = time.perf_counter()
         while not rospy.is_shutdown():
             if self.paused:
+                self.batch.flush()
                 time.sleep(0.01)
                 wall0, sim0_ns = time.perf_counter(), self.sim.sim_time_ns
                 continue
@@ -245,6 +248,12 @@ class SimNode:
                 self.step_count += 1
                 self.publish()
                 sim_ns = self.sim.sim_time_ns
+            # Send outside the lock: after every paced step; unpaced, about every
+            # FLUSH_PERIOD_S (TCPROS is a byte stream: one sendall carries many messages).
+            now_s = time.perf_counter()
+            if self.real_time_factor > 0.0 or now_s - last_flush_s >= FLUSH_PERIOD_S:
+                self.batch.flush()
+                last_flush_s = now_s
             if sim_ns < sim0_ns:  # reset_simulation rewound time
                 wall0, sim0_ns = time.perf_counter(), sim_ns
             if viewer is not None and time.perf_counter() >= next_view_s:
@@ -271,11 +280,6 @@ class SimNode:
         except Exception as err:  # noqa: BLE001 - no display, no GL: run headless
             rospy.logwarn(f'cannot open the MuJoCo viewer ({err}); running headless')
             return None
-
-
-def vector_to(target: object, values: np.ndarray) -> None:
-    """Copy a 3-vector into a geometry_msgs Vector3/Point."""
-    target.x, target.y, target.z = float(values[0]), float(values[1]), float(values[2])
 
 
 def _float_param(name: str, default: float, minimum: float = 0.0) -> float:

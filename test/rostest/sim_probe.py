@@ -21,6 +21,8 @@ from std_srvs.srv import Empty
 
 #: Longest a single wait may take (s, wall) before the test fails.
 WALL_TIMEOUT_S = 60.0
+#: How recent (s of sim time) a reading must be: /ground_truth_odom comes at 100 Hz.
+FRESH_S = 0.02
 
 
 class SimProbe:
@@ -89,12 +91,19 @@ class SimProbe:
         target_ns = self.clock_ns + int(seconds * 1e9)
         self.wait_until(lambda: self.clock_ns >= target_ns, f'{seconds} s of sim time')
 
+    def _wait_fresh(self, latest: Callable[[], object], what: str) -> None:
+        """Wait until `latest()` is stamped within FRESH_S of the clock (subscriber queues
+        can lag behind /clock when the simulator runs faster than real time)."""
+        due_ns = self.clock_ns - int(FRESH_S * 1e9)
+        self.wait_until(lambda: latest() is not None and latest().header.stamp.to_nsec() >= due_ns,
+                        f'a {what} from the last {FRESH_S} s of sim time')
+
     def pelvis_z(self) -> float:
-        assert self.odom is not None
+        self._wait_fresh(lambda: self.odom, '/ground_truth_odom')
         return self.odom.pose.pose.position.z
 
     def position(self, joint: str) -> float:
-        assert self.joint_state is not None
+        self._wait_fresh(lambda: self.joint_state, '/atlas/joint_states')
         return self.joint_state.position[self.joint_state.name.index(joint)]
 
     # -- driving -------------------------------------------------------------------------

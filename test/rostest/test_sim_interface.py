@@ -79,8 +79,12 @@ class SimInterfaceTest(unittest.TestCase):
         steps = np.diff(stamps)
         self.assertEqual(int(np.median(steps)), STEP_NS)
         self.assertTrue(np.all(steps % STEP_NS == 0), 'stamps fall on physics steps')
-        on_clock = np.isin(stamps, np.array(clocks))
-        self.assertGreater(on_clock.mean(), 0.95, 'joint state stamps equal /clock times')
+        # /clock carries the latest sim time of each batch the node sends (every step when
+        # paced; thinned at real_time_factor 0): every one of them stamps a joint state.
+        clocks_in_window = np.array([c for c in clocks if stamps[0] <= c <= stamps[-1]])
+        self.assertGreater(len(clocks_in_window), 10)
+        on_states = np.isin(clocks_in_window, stamps)
+        self.assertGreater(on_states.mean(), 0.95, '/clock times stamp joint states')
 
     def test_03_stands_20_s_without_commands(self) -> None:
         probe = self.probe
@@ -139,7 +143,6 @@ class SimInterfaceTest(unittest.TestCase):
         probe.wait_sim(1.5)
         # P-gain slack: the elbow (p=200) sags a few hundredths of a radian under gravity.
         self.assertAlmostEqual(probe.position(ELBOW), ELBOW_TARGET_RAD, delta=0.1)
-        held_rad = probe.position(ELBOW)
         bad = [
             ([], {'position': [0.0] * (NUM_JOINTS - 1)}, 'position has 27 entries'),
             ([ELBOW], {'position': [float('nan')]}, 'NaN/Inf'),
@@ -151,7 +154,8 @@ class SimInterfaceTest(unittest.TestCase):
                              timeout_s=10)
             time.sleep(2.1)  # the refusal warning is throttled
         probe.wait_sim(0.5)
-        self.assertAlmostEqual(probe.position(ELBOW), held_rad, delta=0.03)
+        # Still on the accepted command (the refused 27-entry one would send it to 0).
+        self.assertAlmostEqual(probe.position(ELBOW), ELBOW_TARGET_RAD, delta=0.1)
 
     def test_06_names_with_prefix_and_shuffled_are_mapped(self) -> None:
         probe = self.probe

@@ -1,0 +1,155 @@
+"""Pre-serialized ROS 1 messages for the simulator's 1 kHz topics, and a batching writer.
+
+rospy's generic path costs the simulator most of each step: Publisher.publish() runs
+genpy's serializer into a BytesIO, then hands the bytes to one QueuedConnection per
+subscriber, whose write_data() ends in time.sleep(0) to yield the GIL to that
+connection's writer thread: 5 topics x 1 recorder = 5 thread handoffs per step.
+
+Here each message is a bytearray laid out once (TCPROS length prefix, std_msgs/Header,
+constant strings) whose float fields are numpy views, so a step only copies numbers in
+and stamps the header. WireBatch collects the bytes per publisher and writes each
+publisher's batch to its connections with one sendall (TCPROS is a byte stream: messages
+back to back are valid), on flush(). The layouts are checked against genpy in
+test/unit/test_wire.py.
+"""
+
+from __future__ import annotations
+
+import struct
+from collections.abc import Sequence
+
+import numpy as np
+import rospy
+from rospy.impl.tcpros_base import TransportTerminated
+
+NS_PER_S = 1_000_000_000
+_PREFIX_HEADER = struct.Struct('<IIII')  # TCPROS length, Header.seq, stamp.secs, stamp.nsecs
+_CLOCK = struct.Struct('<III')
+
+
+def _string(text: str) -> bytes:
+    raw = text.encode()
+    return struct.pack('<I', len(raw)) + raw
+
+
+class StampedWire:
+    """A message that starts with std_msgs/Header, then `middle` bytes, then float64s.
+
+    `floats` is a writable float64 view of the trailing block.
+    """
+
+    def __init__(self, frame_id: str, floats: int, middle: bytes = b'') -> None:
+        body = _string(frame_id) + middle
+        self.buf = bytearray(16 + len(body) + 8 * floats)
+        self.buf[16:16 + len(body)] = body
+        self.floats = np.frombuffer(self.buf, dtype='<f8', offset=16 + len(body), count=floats)
+        self.seq = 0
+
+    def to_bytes(self, stamp_ns: int) -> bytes:
+        self.seq += 1
+        secs, nsecs = divmod(stamp_ns, NS_PER_S)
+        _PREFIX_HEADER.pack_into(self.buf, 0, len(self.buf) - 4, self.seq, secs, nsecs)
+        return bytes(self.buf)
+
+
+class JointStateWire(StampedWire):
+    """sensor_msgs/JointState with fixed names; position/velocity/effort are views."""
+
+    def __init__(self, names: Sequence[str]) -> None:
+        count = len(names)
+        names_block = struct.pack('<I', count) + b''.join(_string(name) for name in names)
+        array = struct.pack('<I', count) + bytes(8 * count)
+        super().__init__('', 0, names_block + array * 3)
+        start = len(self.buf) - 3 * len(array)
+        self.position, self.velocity, self.effort = (
+            np.frombuffer(self.buf, dtype='<f8', offset=start + k * len(array) + 4, count=count)
+            for k in range(3))
+
+
+class ImuWire(StampedWire):
+    """sensor_msgs/Imu, covariances 0: orientation (x y z w), angular_velocity,
+    linear_acceleration are views."""
+
+    def __init__(self, frame_id: str) -> None:
+        super().__init__(frame_id, 4 + 9 + 3 + 9 + 3 + 9)
+        self.orientation_xyzw = self.floats[0:4]
+        self.angular_velocity = self.floats[13:16]
+        self.linear_acceleration = self.floats[25:28]
+
+
+class WrenchStampedWire(StampedWire):
+    """geometry_msgs/WrenchStamped: force and torque are views."""
+
+    def __init__(self, frame_id: str) -> None:
+        super().__init__(frame_id, 6)
+        self.force = self.floats[0:3]
+        self.torque = self.floats[3:6]
+
+
+class OdometryWire(StampedWire):
+    """nav_msgs/Odometry, covariances 0: position, orientation (x y z w), linear, angular."""
+
+    def __init__(self, frame_id: str, child_frame_id: str) -> None:
+        super().__init__(frame_id, 7 + 36 + 6 + 36, _string(child_frame_id))
+        self.position = self.floats[0:3]
+        self.orientation_xyzw = self.floats[3:7]
+        self.linear = self.floats[43:46]
+        self.angular = self.floats[46:49]
+
+
+def clock_bytes(stamp_ns: int) -> bytes:
+    """rosgraph_msgs/Clock with its TCPROS length prefix."""
+    secs, nsecs = divmod(stamp_ns, NS_PER_S)
+    return _CLOCK.pack(8, secs, nsecs)
+
+
+#: A subscriber that accepts nothing for this long (s) is dropped rather than left to stall
+#: the simulation: sends are synchronous so that slow subscribers lose nothing.
+SEND_TIMEOUT_S = 2.0
+
+
+def write_to_connections(pub: rospy.Publisher, data: bytes) -> None:
+    """Send already-serialized TCPROS bytes to every subscriber of `pub`.
+
+    The socket is written directly (rospy's write_data mis-handles a send timeout); a
+    subscriber that is gone, or accepts nothing for SEND_TIMEOUT_S, is dropped.
+    """
+    impl = pub.impl
+    for connection in list(impl.connections):
+        sock = getattr(connection, 'socket', None)
+        try:
+            if sock is None or connection.done:
+                raise TransportTerminated('connection closed')
+            if sock.gettimeout() is None:
+                sock.settimeout(SEND_TIMEOUT_S)
+            sock.sendall(data)
+        except (TransportTerminated, OSError) as err:  # socket.timeout is an OSError
+            if not isinstance(err, TransportTerminated):
+                rospy.logwarn(f'{pub.resolved_name}: dropping subscriber '
+                              f'{connection.endpoint_id}: {err}')
+            impl.remove_connection(connection)
+            connection.close()
+
+
+class WireBatch:
+    """Per-publisher byte batches, written on flush() with one sendall per connection."""
+
+    def __init__(self) -> None:
+        self.pending: dict[rospy.Publisher, list[bytes]] = {}
+
+    @staticmethod
+    def wanted(pub: rospy.Publisher) -> bool:
+        """Anyone subscribed? (rospy skips serializing otherwise; so do we)."""
+        return bool(pub.impl.connections)
+
+    def add(self, pub: rospy.Publisher, data: bytes) -> None:
+        self.pending.setdefault(pub, []).append(data)
+
+    def replace(self, pub: rospy.Publisher, data: bytes) -> None:
+        """Queue `data` instead of anything still pending for `pub` (e.g. /clock)."""
+        self.pending[pub] = [data]
+
+    def flush(self) -> None:
+        pending, self.pending = self.pending, {}
+        for pub, chunks in pending.items():
+            write_to_connections(pub, chunks[0] if len(chunks) == 1 else b''.join(chunks))

@@ -1,0 +1,90 @@
+"""wire.py's pre-serialized messages are byte-identical to genpy's serialization."""
+
+import io
+
+import genpy
+import numpy as np
+import pytest
+from geometry_msgs.msg import WrenchStamped
+from nav_msgs.msg import Odometry
+from rosgraph_msgs.msg import Clock
+from rospy.msg import serialize_message
+from sensor_msgs.msg import Imu, JointState
+
+from tutorial_atlas_control import wire
+from tutorial_atlas_control.joints import JOINT_NAMES
+
+STAMP_NS = 12 * wire.NS_PER_S + 345_678
+
+
+def genpy_bytes(msg, seq=1):
+    buffer = io.BytesIO()
+    serialize_message(buffer, seq, msg)
+    return buffer.getvalue()
+
+
+def test_clock():
+    assert wire.clock_bytes(STAMP_NS) == genpy_bytes(Clock(clock=genpy.Time(12, 345_678)))
+
+
+def test_joint_state():
+    rng = np.random.default_rng(1)
+    values = rng.normal(size=(3, len(JOINT_NAMES)))
+    msg = wire.JointStateWire(JOINT_NAMES)
+    msg.position[:], msg.velocity[:], msg.effort[:] = values
+    expected = JointState(name=list(JOINT_NAMES), position=list(values[0]),
+                          velocity=list(values[1]), effort=list(values[2]))
+    expected.header.stamp = genpy.Time(12, 345_678)
+    assert msg.to_bytes(STAMP_NS) == genpy_bytes(expected, seq=1)
+    assert msg.to_bytes(STAMP_NS) == genpy_bytes(expected, seq=2)  # seq counts up
+
+
+def test_imu():
+    msg = wire.ImuWire('pelvis')
+    msg.orientation_xyzw[:] = (0.1, 0.2, 0.3, 0.9)
+    msg.angular_velocity[:] = (1.0, 2.0, 3.0)
+    msg.linear_acceleration[:] = (4.0, 5.0, 9.81)
+    expected = Imu()
+    expected.header.frame_id = 'pelvis'
+    expected.header.stamp = genpy.Time(12, 345_678)
+    o = expected.orientation
+    o.x, o.y, o.z, o.w = 0.1, 0.2, 0.3, 0.9
+    a, l = expected.angular_velocity, expected.linear_acceleration
+    a.x, a.y, a.z = 1.0, 2.0, 3.0
+    l.x, l.y, l.z = 4.0, 5.0, 9.81
+    assert msg.to_bytes(STAMP_NS) == genpy_bytes(expected)
+
+
+def test_wrench_stamped():
+    msg = wire.WrenchStampedWire('l_foot')
+    msg.force[:], msg.torque[:] = (1.0, 2.0, 450.0), (0.1, -0.2, 0.3)
+    expected = WrenchStamped()
+    expected.header.frame_id = 'l_foot'
+    expected.header.stamp = genpy.Time(12, 345_678)
+    f, t = expected.wrench.force, expected.wrench.torque
+    f.x, f.y, f.z = 1.0, 2.0, 450.0
+    t.x, t.y, t.z = 0.1, -0.2, 0.3
+    assert msg.to_bytes(STAMP_NS) == genpy_bytes(expected)
+
+
+def test_odometry():
+    msg = wire.OdometryWire('world', 'pelvis')
+    msg.position[:], msg.orientation_xyzw[:] = (0.1, 0.2, 0.93), (0.0, 0.0, 0.0, 1.0)
+    msg.linear[:], msg.angular[:] = (0.5, 0.0, -0.1), (0.0, 0.2, 0.0)
+    expected = Odometry()
+    expected.header.frame_id, expected.child_frame_id = 'world', 'pelvis'
+    expected.header.stamp = genpy.Time(12, 345_678)
+    p, o = expected.pose.pose.position, expected.pose.pose.orientation
+    p.x, p.y, p.z = 0.1, 0.2, 0.93
+    o.x, o.y, o.z, o.w = 0.0, 0.0, 0.0, 1.0
+    lin, ang = expected.twist.twist.linear, expected.twist.twist.angular
+    lin.x, lin.y, lin.z = 0.5, 0.0, -0.1
+    ang.x, ang.y, ang.z = 0.0, 0.2, 0.0
+    assert msg.to_bytes(STAMP_NS) == genpy_bytes(expected)
+
+
+@pytest.mark.parametrize('stamp_ns', [0, 1, wire.NS_PER_S - 1, 2**32 * wire.NS_PER_S - 1])
+def test_stamp_split(stamp_ns):
+    raw = wire.clock_bytes(stamp_ns)
+    secs, nsecs = divmod(stamp_ns, wire.NS_PER_S)
+    assert raw == genpy_bytes(Clock(clock=genpy.Time(secs, nsecs)))
