@@ -94,9 +94,15 @@ class SimProbe:
     def _wait_fresh(self, latest: Callable[[], object], what: str) -> None:
         """Wait until `latest()` is stamped within FRESH_S of the clock (subscriber queues
         can lag behind /clock when the simulator runs faster than real time)."""
-        due_ns = self.clock_ns - int(FRESH_S * 1e9)
-        self.wait_until(lambda: latest() is not None and latest().header.stamp.to_nsec() >= due_ns,
-                        f'a {what} from the last {FRESH_S} s of sim time')
+        fresh_ns = int(FRESH_S * 1e9)
+
+        def is_fresh() -> bool:
+            # Within FRESH_S of the clock on either side: also rejects a reading from before
+            # a reset_simulation rewound the clock.
+            msg = latest()
+            return msg is not None and abs(msg.header.stamp.to_nsec() - self.clock_ns) <= fresh_ns
+
+        self.wait_until(is_fresh, f'a {what} within {FRESH_S} s of the current sim time')
 
     def pelvis_z(self) -> float:
         self._wait_fresh(lambda: self.odom, '/ground_truth_odom')
