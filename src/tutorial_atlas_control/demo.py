@@ -185,8 +185,12 @@ def main(argv: list[str] | None = None) -> int:
                         help='video size WxH in pixels (default: %(default)s)')
     args = parser.parse_args(argv)
     try:
-        from tutorial_atlas_control.render import parse_size
-        video_size = parse_size(args.video_size)
+        from tutorial_atlas_control.render import RenderError, parse_size
+        try:
+            video_size = parse_size(args.video_size)
+        except RenderError:
+            raise DemoError(f'--video-size {args.video_size!r} is not WIDTHxHEIGHT in pixels, '
+                            'e.g. 480x360') from None
         from tutorial_atlas_control.trajectory import load_trajectory
         load_trajectory(args.file, args.trajectory)  # fail before starting anything
         bag = run_demo(args.trajectory, args.file, args.bag_dir.expanduser().resolve(),
