@@ -2,8 +2,8 @@
 
 Thin ROS glue. Publishes /clock, /atlas/joint_states, /ground_truth_odom, /atlas/imu and
 the foot contact wrenches in sim time, and a latched /atlas/sim_config (JSON: timestep,
-time_to_unpin, model file and checksum, time of the last reset) for offline replay; obeys /atlas/joint_commands and
-/atlas/control_mode; offers gazebo_ros's reset and pause services.
+time_to_unpin, model file and checksum, time of the last reset) for offline replay; obeys
+/atlas/joint_commands and /atlas/control_mode; offers gazebo_ros's reset and pause services.
 
 Parameters (private unless noted):
     ~real_time_factor (float, 1.0): sim time per wall time; 0 runs as fast as possible.
@@ -40,11 +40,11 @@ from tutorial_atlas_control.commands import CommandError
 from tutorial_atlas_control.controller import FIELD_NAMES, gains_from_params
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES
-from tutorial_atlas_control.wire import (
-    ImuWire, JointStateWire, OdometryWire, WireBatch, WrenchStampedWire, clock_bytes)
 from tutorial_atlas_control.simulator import (
     DEFAULT_TIME_TO_UNPIN_S, NS_PER_S, AtlasSimulator, ModeError, PhysicsDivergenceError,
     parse_mode)
+from tutorial_atlas_control.wire import (
+    ImuWire, JointStateWire, OdometryWire, WireBatch, WrenchStampedWire, clock_bytes)
 
 NODE_NAME = 'atlas_sim'
 #: Seconds between repeats of the same refusal warning.
@@ -84,7 +84,8 @@ class SimNode:
         # connections in batches. queue_size=None: plain synchronous connections, without
         # rospy's per-message writer-thread handoff (QueuedConnection.write_data's
         # time.sleep(0), 5 per step). A subscriber that cannot keep up now slows the loop
-        # (TCP back-pressure) instead of losing messages.
+        # (TCP back-pressure) instead of losing messages, until it has accepted nothing for
+        # wire.SEND_TIMEOUT_S and is dropped.
         with warnings.catch_warnings():
             warnings.simplefilter('ignore', SyntaxWarning)  # rospy: "explicit queue_size"
             self.clock_pub = rospy.Publisher('/clock', Clock, queue_size=None)
@@ -99,7 +100,7 @@ class SimNode:
         self.batch = WireBatch()
         # Latched, recorded in every bag: what offline replay needs to re-create the run.
         self.config_pub = rospy.Publisher('/atlas/sim_config', String, queue_size=1, latch=True)
-        self.config_pub.publish(String(data=json.dumps(sim.config())))
+        self._publish_config()
 
         self.joint_state = JointStateWire(JOINT_NAMES)
         self.odom = OdometryWire(WORLD_FRAME, 'pelvis')
@@ -121,6 +122,10 @@ class SimNode:
             rospy.Service('/gazebo/pause_physics', Empty, self._service(self.pause)),
             rospy.Service('/gazebo/unpause_physics', Empty, self._service(self.unpause)),
         ]
+
+    def _publish_config(self) -> None:
+        """(Re-)publish /atlas/sim_config: at start and after every reset."""
+        self.config_pub.publish(String(data=json.dumps(self.sim.config())))
 
     # -- subscriptions and services ----------------------------------------------------
     def on_joint_commands(self, msg: JointCommands) -> None:
@@ -152,14 +157,14 @@ class SimNode:
     def reset_world(self) -> None:
         with self.lock:
             self.sim.reset_world()
-        self.config_pub.publish(String(data=json.dumps(self.sim.config())))
+        self._publish_config()
         rospy.loginfo('reset_world: robot back to its initial pose (torso pinned '
                       f'for {self.sim.time_to_unpin_s} s)')
 
     def reset_simulation(self) -> None:
         with self.lock:
             self.sim.reset_simulation()
-        self.config_pub.publish(String(data=json.dumps(self.sim.config())))
+        self._publish_config()
         rospy.loginfo('reset_simulation: robot reset and sim time back to 0')
 
     def pause(self) -> None:
@@ -244,7 +249,7 @@ class SimNode:
                 except PhysicsDivergenceError as err:
                     rospy.logerr(f'{err}; resetting the robot to its initial state')
                     self.sim.reset_world()
-                    self.config_pub.publish(String(data=json.dumps(self.sim.config())))
+                    self._publish_config()
                 self.step_count += 1
                 self.publish()
                 sim_ns = self.sim.sim_time_ns
