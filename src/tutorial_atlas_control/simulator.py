@@ -93,7 +93,9 @@ class AtlasSimulator:
         self.user_command: JointCommandArrays | None = None
         self.torque_nm = np.zeros(NUM_JOINTS)
         self._pid = PidState()
-        self._mode_command = hold_command(gains, np.zeros(NUM_JOINTS))
+        # Stand/StandPrep hold the initial pose (all joints 0) with the parameter gains.
+        self._stand_command = hold_command(gains, np.zeros(NUM_JOINTS))
+        self._mode_command = self._stand_command
         self._ragdoll_command = JointCommandArrays.zeros()
         self.sim_time_ns = 0
         self.pinned = False
@@ -144,7 +146,7 @@ class AtlasSimulator:
     def set_mode(self, mode: ControlMode) -> None:
         """Switch control mode; Freeze and User start by holding the current pose."""
         if mode in (ControlMode.STAND, ControlMode.STAND_PREP):
-            self._mode_command = hold_command(self.gains, np.zeros(NUM_JOINTS))
+            self._mode_command = self._stand_command
         elif mode in (ControlMode.FREEZE, ControlMode.USER):
             self._mode_command = self._hold_current_pose()
         # The target changed: restart the derivative so the switch gives no kick.
@@ -197,12 +199,11 @@ class AtlasSimulator:
         if self.pinned and self.sim_time_ns >= self._pin_until_ns:
             self._set_pinned(False)
         data = self.data
-        torque = compute_torque(
+        compute_torque(
             self.active_command(), self.joint_positions(), self.joint_velocities(),
             self._pid, self.dt_s, self.atlas.lower_rad, self.atlas.upper_rad,
-            self.atlas.effort_limit_nm)
-        self.torque_nm[:] = torque
-        data.ctrl[:] = torque
+            self.atlas.effort_limit_nm, out=self.torque_nm)
+        data.ctrl[:] = self.torque_nm
         mujoco.mj_step(self.model, data)
         # mj_step integrates last: joint positions/velocities are at the new time, while body
         # poses and sensor readings were computed before integrating, at the step's start.
