@@ -41,23 +41,31 @@ class DemoError(AtlasControlError):
 
 
 def free_local_port() -> int:
+    """A TCP port free on the loopback interface now (for a private ROS master)."""
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
         sock.bind(('127.0.0.1', 0))
         return int(sock.getsockname()[1])
 
 
 def stop(process: subprocess.Popen, name: str) -> None:
-    """SIGINT (what Ctrl-C sends, so rosbag closes its bag), then SIGKILL if it hangs."""
-    if process.poll() is not None:
-        return
-    process.send_signal(signal.SIGINT)
-    try:
-        process.wait(timeout=SHUTDOWN_TIMEOUT_S)
-    except subprocess.TimeoutExpired:
-        print(f'demo: {name} did not stop within {SHUTDOWN_TIMEOUT_S} s; killing it',
-              file=sys.stderr)
-        process.kill()
-        process.wait()
+    """SIGINT (what Ctrl-C sends, so rosbag closes its bag), then SIGKILL if it hangs.
+
+    `process` must have been started with start_new_session=True: whatever is left of
+    its process group afterwards (a node that ignored the SIGINT) is killed too.
+    """
+    if process.poll() is None:
+        process.send_signal(signal.SIGINT)
+        try:
+            process.wait(timeout=SHUTDOWN_TIMEOUT_S)
+        except subprocess.TimeoutExpired:
+            print(f'demo: {name} did not stop within {SHUTDOWN_TIMEOUT_S} s; killing it',
+                  file=sys.stderr)
+            process.kill()
+            process.wait()
+    try:  # leftovers of the group we created, by its id only
+        os.killpg(process.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass
 
 
 def newest_bag(bag_dir: Path, since_s: float) -> Path:

@@ -21,8 +21,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import signal
-import socket
 import subprocess
 import sys
 import threading
@@ -40,6 +38,8 @@ if shutil.which('roslaunch') is None or shutil.which('rosbag') is None:
 from nav_msgs.msg import Odometry  # noqa: E402
 from rosgraph_msgs.msg import Clock  # noqa: E402
 
+from tutorial_atlas_control.demo import free_local_port, stop  # noqa: E402
+
 #: rospy (Debian's 1.15) uses the deprecated Condition.notifyAll on every /clock message.
 pytestmark = pytest.mark.filterwarnings('ignore::DeprecationWarning')
 
@@ -51,33 +51,11 @@ STANDING_ABOVE_M = 0.8
 STARTUP_TIMEOUT_S = 60.0
 PLAY_TIMEOUT_S = 60.0
 FALL_TIMEOUT_S = 20.0
-SHUTDOWN_TIMEOUT_S = 20.0
 #: Start playing this long (sim time) after the torso is released (1 s), so that the
 #: first played message (the switch to User) arrives while the robot stands free.
 PLAY_AFTER_S = 1.2
 #: Sim time to watch for the fall after the last played command.
 FALL_WINDOW_S = 5.0
-
-
-def free_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
-        sock.bind(('127.0.0.1', 0))
-        return int(sock.getsockname()[1])
-
-
-def stop(process: subprocess.Popen) -> None:
-    """SIGINT (roslaunch stops its nodes and master), then SIGKILL our own process group."""
-    if process.poll() is None:
-        process.send_signal(signal.SIGINT)
-        try:
-            process.wait(timeout=SHUTDOWN_TIMEOUT_S)
-        except subprocess.TimeoutExpired:
-            pass
-    try:  # leftovers of the group we created (start_new_session), by its id only
-        os.killpg(process.pid, signal.SIGKILL)
-    except (ProcessLookupError, PermissionError):
-        pass
-    process.wait()
 
 
 @pytest.fixture(scope='session')
@@ -143,7 +121,7 @@ class Probe:
 @pytest.fixture()
 def fresh_simulator(tmp_path: Path) -> Iterator[tuple[dict[str, str], Probe, subprocess.Popen]]:
     """atlas.launch (no recording) on its own master; a probe node in this process."""
-    port = free_port()
+    port = free_local_port()
     env = dict(os.environ, ROS_MASTER_URI=f'http://localhost:{port}',
                ROS_HOSTNAME=os.environ.get('ROS_HOSTNAME', 'localhost'),
                ROS_LOG_DIR=str(tmp_path / 'ros_log'))
@@ -171,7 +149,7 @@ def fresh_simulator(tmp_path: Path) -> Iterator[tuple[dict[str, str], Probe, sub
         if probe is not None:
             probe.close()
         rospy.signal_shutdown('live replay test done')
-        stop(launch)
+        stop(launch, 'roslaunch')
         log.close()
 
 
