@@ -6,6 +6,7 @@ broken simulator fails a test instead of hanging it.
 
 from __future__ import annotations
 
+import json
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -37,6 +38,7 @@ class SimProbe:
         self.warnings: list[str] = []
         self.keep_joint_states = keep_joint_states
         self.joint_states: list[JointState] = []
+        self.configs: list[dict] = []
         rospy.Subscriber('/clock', Clock, self._on_clock, queue_size=1000)
         rospy.Subscriber('/atlas/joint_states', JointState, self._on_joint_state, queue_size=2000)
         rospy.Subscriber('/ground_truth_odom', Odometry, self._on_odom, queue_size=100)
@@ -44,6 +46,7 @@ class SimProbe:
             rospy.Subscriber(f'/atlas/{side}_foot_contact', WrenchStamped,
                              self._on_contact, callback_args=side, queue_size=100)
         rospy.Subscriber('/rosout', Log, self._on_log, queue_size=100)
+        rospy.Subscriber('/atlas/sim_config', String, self._on_config, queue_size=10)
         self.mode_pub = rospy.Publisher('/atlas/control_mode', String, queue_size=10, latch=True)
         self.command_pub = rospy.Publisher('/atlas/joint_commands', JointCommands, queue_size=10)
 
@@ -62,6 +65,10 @@ class SimProbe:
 
     def _on_contact(self, msg: WrenchStamped, side: str) -> None:
         self.contacts[side] = msg
+
+    def _on_config(self, msg: String) -> None:
+        with self.lock:
+            self.configs.append(json.loads(msg.data))
 
     def _on_log(self, msg: Log) -> None:
         if msg.level >= Log.WARN:
@@ -116,6 +123,24 @@ class SimProbe:
     def call(self, service: str) -> None:
         rospy.wait_for_service(service, timeout=WALL_TIMEOUT_S)
         rospy.ServiceProxy(service, Empty)()
+
+    def reset(self, service: str) -> int:
+        """Call a /gazebo/reset_* service; return the sim time (ns) the simulator reset at.
+
+        Taken from the /atlas/sim_config it re-publishes, not from this probe's /clock,
+        which can lag behind the simulator when it runs faster than real time.
+        """
+        with self.lock:
+            seen = len(self.configs)
+        before_ns = self.clock_ns
+        self.call(service)
+        self.wait_until(lambda: len(self.configs) > seen, f'/atlas/sim_config after {service}')
+        with self.lock:
+            reset_ns = round(self.configs[-1]['last_reset_time'] * 1e9)
+        if reset_ns < before_ns:  # reset_simulation: wait for the rewound clock
+            self.wait_until(lambda: self.clock_ns < before_ns, f'/clock to rewind ({service})')
+        self.wait_until(lambda: self.clock_ns >= reset_ns, f'/clock to reach the {service}')
+        return reset_ns
 
     def set_mode(self, mode: str) -> None:
         self.mode_pub.publish(String(data=mode))

@@ -192,8 +192,7 @@ class SimInterfaceTest(unittest.TestCase):
         probe = self.probe
         unpin_s = float(rospy.get_param('/atlas/time_to_unpin'))
         probe.set_mode('ragdoll')
-        probe.call('/gazebo/reset_world')
-        reset_ns = probe.clock_ns
+        reset_ns = probe.reset('/gazebo/reset_world')
         probe.wait_sim(0.05)  # odometry from after the reset
         spawn_z = atlas_model.SPAWN_HEIGHT_M
         while probe.clock_ns < reset_ns + int((unpin_s - 0.1) * 1e9):
@@ -203,8 +202,8 @@ class SimInterfaceTest(unittest.TestCase):
         self.assertLess(probe.pelvis_z(), 0.5, 'released after time_to_unpin, ragdoll falls')
         self.assertGreater(probe.clock_ns, reset_ns, 'reset_world keeps sim time')
 
-        probe.call('/gazebo/reset_simulation')
-        probe.wait_until(lambda: probe.clock_ns < reset_ns, 'the clock to rewind')
+        self.assertEqual(probe.reset('/gazebo/reset_simulation'), 0,
+                         'reset_simulation rewinds sim time to 0')
         probe.wait_sim(0.05)
         self.assertLess(probe.sim_time_s(), 0.5, 'reset_simulation rewinds sim time')
         self.assertAlmostEqual(probe.pelvis_z(), spawn_z, delta=0.002)
