@@ -3,7 +3,8 @@
 DRCSim read the arrays by position and ignored `name`. We keep that for an empty
 `name` (the tutorial's joint order) and map by name otherwise, with or without the
 `atlas::` prefix, in any order, all 28 joints or a subset. A message is applied whole
-or not at all: any inconsistency refuses it and the previous command stays.
+or not at all: any inconsistency, or an absurd magnitude (MAX_MAGNITUDE), refuses it and
+the previous command stays.
 """
 
 from __future__ import annotations
@@ -15,6 +16,23 @@ import numpy as np
 from tutorial_atlas_control.controller import FIELD_NAMES, JointCommandArrays
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_INDEX, NUM_JOINTS, bare_joint_name
+
+
+#: Largest magnitude accepted per field; beyond it a value is a mistake, not a command, and
+#: the message is refused. The bounds sit far above any working value (DRCSim's largest
+#: gains: p 4000, d 20; Atlas v1's velocity limit: 12 rad/s) so they never refuse a real
+#: controller. Within them, the law still clamps the position target to the joint limits
+#: and the torque to the effort limit. Position has no bound: any finite target is clamped.
+MAX_MAGNITUDE: dict[str, float] = {
+    'velocity': 1e3,        # rad/s
+    'effort': 1e5,          # N m
+    'kp_position': 1e6,
+    'ki_position': 1e6,
+    'kd_position': 1e6,
+    'kp_velocity': 1e6,
+    'i_effort_min': 1e5,    # N m
+    'i_effort_max': 1e5,    # N m
+}
 
 
 class CommandError(AtlasControlError):
@@ -55,7 +73,8 @@ def merge_command(previous: JointCommandArrays, names: Sequence[str],
             An empty array leaves that field as it was.
 
     Raises:
-        CommandError: wrong array length, NaN/Inf, unknown or duplicate joint name.
+        CommandError: wrong array length, NaN/Inf, a value beyond MAX_MAGNITUDE,
+            unknown or duplicate joint name.
     """
     indices = joint_indices(names)
     expected = len(indices)
@@ -71,6 +90,11 @@ def merge_command(previous: JointCommandArrays, names: Sequence[str],
         if not np.all(np.isfinite(vector)):
             bad = int(np.flatnonzero(~np.isfinite(vector))[0])
             raise CommandError(f'{field}[{bad}] is {vector[bad]} (NaN/Inf are refused)')
+        bound = MAX_MAGNITUDE.get(field)
+        if bound is not None and np.any(np.abs(vector) > bound):
+            bad = int(np.flatnonzero(np.abs(vector) > bound)[0])
+            raise CommandError(f'{field}[{bad}] is {vector[bad]:g}, beyond the sane bound '
+                               f'of {bound:g} in magnitude')
         getattr(merged, field)[indices] = vector
     return merged
 

@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.commands import CommandError, joint_indices, merge_command
+from tutorial_atlas_control.commands import (
+    MAX_MAGNITUDE, CommandError, joint_indices, merge_command)
 from tutorial_atlas_control.controller import FIELD_NAMES, JointCommandArrays
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
 
@@ -62,6 +63,10 @@ def test_previous_command_is_not_modified() -> None:
     (['neck_ay', 'back_lbz'], {'effort': [1.0]}, 'effort has 1 entries for 2 commanded joints'),
     (['neck_ay'], {'position': [math.nan]}, r'position\[0\] is nan'),
     (['neck_ay'], {'kp_position': [math.inf]}, r'kp_position\[0\] is inf'),
+    (['neck_ay'], {'kp_position': [1e12]}, r'kp_position\[0\] is 1e\+12, beyond the sane bound'),
+    (['neck_ay', 'back_lbz'], {'kd_position': [20.0, -1e7]}, r'kd_position\[1\] is -1e\+07'),
+    (['neck_ay'], {'effort': [1e300]}, r'effort\[0\] is 1e\+300, beyond the sane bound of 100000'),
+    (['neck_ay'], {'velocity': [5e3]}, r'velocity\[0\] is 5000'),
     (['atlas::nose'], {'position': [0.0]}, "unknown joint name 'atlas::nose'"),
     (['neck_ay', 'atlas::neck_ay'], {'position': [0.0, 0.0]}, 'named twice'),
 ])
@@ -88,3 +93,16 @@ def test_every_field_is_mergeable() -> None:
 
 def test_empty_names_mean_all_joints() -> None:
     np.testing.assert_array_equal(joint_indices([]), np.arange(NUM_JOINTS))
+
+
+def test_values_at_the_bounds_are_accepted() -> None:
+    """The bounds refuse absurd values only: a value exactly at each bound is a command."""
+    arrays = {field: [bound] for field, bound in MAX_MAGNITUDE.items()}
+    arrays['position'] = [1e6]  # no bound: the law clamps it to the joint limits
+    merged = merge_command(JointCommandArrays.zeros(), ['back_mby'], arrays)
+    for field, bound in MAX_MAGNITUDE.items():
+        assert getattr(merged, field)[JOINT_INDEX['back_mby']] == bound
+
+
+def test_every_field_but_position_has_a_bound() -> None:
+    assert set(MAX_MAGNITUDE) == set(FIELD_NAMES) - {'position'}
