@@ -23,6 +23,7 @@ import numpy as np
 
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS, bare_joint_name
+from tutorial_atlas_control.ros1_fields import FieldCursor, parse_names_arrays
 
 __all__ = [
     'COMMAND_CHANGE_RAD',
@@ -294,48 +295,6 @@ def _read_raw(reader: Any, connections: Sequence[Any]) -> tuple[np.ndarray, list
     return times_ns, raws
 
 
-class _Cursor:
-    """Sequential reader of ROS 1 serialized fields (little endian, no alignment)."""
-
-    def __init__(self, data: bytes) -> None:
-        self.data = data
-        self.pos = 0
-
-    def u32(self) -> int:
-        (value,) = _U32.unpack_from(self.data, self.pos)
-        self.pos += 4
-        return value
-
-    def string(self) -> str:
-        length = self.u32()
-        self.pos += length
-        return self.data[self.pos - length:self.pos].decode()
-
-    def strings(self) -> list[str]:
-        return [self.string() for _ in range(self.u32())]
-
-    def f64s(self) -> np.ndarray:
-        count = self.u32()
-        values = np.frombuffer(self.data, dtype='<f8', count=count, offset=self.pos)
-        self.pos += 8 * count
-        return values
-
-    def header_stamp_ns(self) -> int:
-        """Read std_msgs/Header; return its stamp (ns)."""
-        self.pos += 4  # seq
-        sec, nsec = self.u32(), self.u32()
-        self.string()  # frame_id
-        return sec * _NS_PER_S + nsec
-
-
-def _parse_names_arrays(raw: bytes, arrays: int) -> tuple[int, list[str], list[np.ndarray]]:
-    """Parse 'Header, string[] name, float64[] x `arrays`' (JointState, JointCommands)."""
-    cursor = _Cursor(raw)
-    stamp_ns = cursor.header_stamp_ns()
-    names = cursor.strings()
-    return stamp_ns, names, [cursor.f64s() for _ in range(arrays)]
-
-
 def _uniform_rows(raws: list[bytes]) -> np.ndarray | None:
     """All messages as one (messages, bytes) uint8 array, or None if lengths differ."""
     lengths = np.fromiter(map(len, raws), dtype=np.int64, count=len(raws))
@@ -362,7 +321,7 @@ def _joint_states_fast(raws: list[bytes]) -> tuple[np.ndarray, list[str], list[n
     rows = _uniform_rows(raws)
     if rows is None:
         return None
-    cursor = _Cursor(raws[0])
+    cursor = FieldCursor(raws[0])
     cursor.header_stamp_ns()
     names = cursor.strings()
     fixed_end = cursor.pos  # frame_id and names must be identical in every message
@@ -387,7 +346,7 @@ def _odometry_fast(raws: list[bytes]) -> tuple[np.ndarray, np.ndarray] | None:
     rows = _uniform_rows(raws)
     if rows is None:
         return None
-    cursor = _Cursor(raws[0])
+    cursor = FieldCursor(raws[0])
     cursor.header_stamp_ns()
     cursor.string()  # child_frame_id
     floats_at = cursor.pos
@@ -426,7 +385,7 @@ def _read_joint_states(reader: Any, connections: Sequence[Any], typestore: Any,
         parsed = []
         for raw in raws:
             if standard:
-                stamp_ns, msg_names, arrays = _parse_names_arrays(raw, 3)
+                stamp_ns, msg_names, arrays = parse_names_arrays(raw, 3)
             else:
                 msg = typestore.deserialize_ros1(raw, 'sensor_msgs/msg/JointState')
                 stamp_ns = msg.header.stamp.sec * _NS_PER_S + msg.header.stamp.nanosec
@@ -465,7 +424,7 @@ def _read_commands(reader: Any, connections: Sequence[Any], typestore: Any, star
     unknown: set[str] = set()
     for row, raw in enumerate(raws):
         if fast:
-            stamp_ns, names, (values,) = _parse_names_arrays(raw, 1)
+            stamp_ns, names, (values,) = parse_names_arrays(raw, 1)
         else:
             msg = typestore.deserialize_ros1(raw, JOINT_COMMANDS_TYPE)
             stamp_ns = msg.header.stamp.sec * _NS_PER_S + msg.header.stamp.nanosec

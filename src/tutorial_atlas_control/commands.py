@@ -9,13 +9,17 @@ the previous command stays.
 
 from __future__ import annotations
 
+import functools
+import struct
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
 from tutorial_atlas_control.controller import FIELD_NAMES, JointCommandArrays
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_INDEX, NUM_JOINTS, bare_joint_name
+from tutorial_atlas_control.ros1_fields import FieldCursor
 
 
 #: Largest magnitude accepted per field; beyond it a value is a mistake, not a command, and
@@ -39,16 +43,28 @@ class CommandError(AtlasControlError):
     """A JointCommands message that cannot be applied; the text says why."""
 
 
+#: MAX_MAGNITUDE per field in FIELD_NAMES order (inf: no bound).
+_BOUNDS = np.array([MAX_MAGNITUDE.get(field, np.inf) for field in FIELD_NAMES])
+_ALL_JOINTS = np.arange(NUM_JOINTS)
+_ALL_JOINTS.setflags(write=False)
+
+
 def joint_indices(names: Sequence[str]) -> np.ndarray:
     """Map message joint names (bare or `atlas::`-prefixed) to tutorial-order indices.
 
     An empty `names` means all 28 joints in the tutorial's order, as DRCSim assumed.
+    Controllers send the same list at every message: the mapping is cached per list.
 
     Raises:
         CommandError: a name is unknown or appears twice.
     """
     if not names:
-        return np.arange(NUM_JOINTS)
+        return _ALL_JOINTS
+    return _indices_of(tuple(names))
+
+
+@functools.lru_cache(maxsize=64)
+def _indices_of(names: tuple[str, ...]) -> np.ndarray:
     indices = np.empty(len(names), dtype=np.intp)
     seen: set[int] = set()
     for slot, name in enumerate(names):
@@ -59,42 +75,117 @@ def joint_indices(names: Sequence[str]) -> np.ndarray:
             raise CommandError(f'joint {name!r} is named twice')
         seen.add(index)
         indices[slot] = index
+    indices.setflags(write=False)  # shared by every message with these names
     return indices
 
 
-def merge_command(previous: JointCommandArrays, names: Sequence[str],
-                  arrays: Mapping[str, Sequence[float]]) -> JointCommandArrays:
-    """Return `previous` updated with one JointCommands message.
+@dataclass(frozen=True)
+class CommandUpdate:
+    """One checked JointCommands message: what it sets, ready to apply to any command.
 
-    Args:
-        previous: the command in force (not modified).
-        names: the message's `name` field.
-        arrays: field name -> the message's array, for the fields in FIELD_NAMES.
-            An empty array leaves that field as it was.
+    `values[k]` holds field FIELD_NAMES[rows[k]] for the joints `indices`; every value is
+    finite and within MAX_MAGNITUDE.
+    """
+
+    indices: np.ndarray
+    rows: tuple[int, ...]
+    values: np.ndarray
+
+    @property
+    def is_complete(self) -> bool:
+        """Sets every field of every joint: nothing of an earlier command survives it."""
+        return len(self.rows) == len(FIELD_NAMES) and len(self.indices) == NUM_JOINTS
+
+    def apply_to(self, command: JointCommandArrays) -> None:
+        """Write this update into `command` (in place)."""
+        for row, values in zip(self.rows, self.values):
+            getattr(command, FIELD_NAMES[row])[self.indices] = values
+
+
+def command_update(names: Sequence[str],
+                   arrays: Mapping[str, Sequence[float]]) -> CommandUpdate:
+    """Check one message's name and array fields; empty arrays leave their field alone.
 
     Raises:
         CommandError: wrong array length, NaN/Inf, a value beyond MAX_MAGNITUDE,
             unknown or duplicate joint name.
     """
-    indices = joint_indices(names)
+    return _checked_update(joint_indices(names), [arrays.get(field, ()) for field in FIELD_NAMES])
+
+
+def _checked_update(indices: np.ndarray, fields: Sequence[Sequence[float]]) -> CommandUpdate:
     expected = len(indices)
-    merged = previous.copy()
-    for field in FIELD_NAMES:
-        values = arrays.get(field, ())
+    rows, given = [], []
+    for row, values in enumerate(fields):
         if len(values) == 0:
             continue
         if len(values) != expected:
-            raise CommandError(
-                f'{field} has {len(values)} entries for {expected} commanded joints')
-        vector = np.asarray(values, dtype=np.float64)
-        if not np.all(np.isfinite(vector)):
-            bad = int(np.flatnonzero(~np.isfinite(vector))[0])
-            raise CommandError(f'{field}[{bad}] is {vector[bad]} (NaN/Inf are refused)')
-        bound = MAX_MAGNITUDE.get(field)
-        if bound is not None and np.any(np.abs(vector) > bound):
-            bad = int(np.flatnonzero(np.abs(vector) > bound)[0])
-            raise CommandError(f'{field}[{bad}] is {vector[bad]:g}, beyond the sane bound '
-                               f'of {bound:g} in magnitude')
-        getattr(merged, field)[indices] = vector
+            raise CommandError(f'{FIELD_NAMES[row]} has {len(values)} entries for {expected} '
+                               'commanded joints')
+        rows.append(row)
+        given.append(values)
+    # One (fields, joints) block: the checks below are a few numpy calls, not 9 x 3.
+    block = np.array(given, dtype=np.float64).reshape(len(rows), expected)
+    bad = ~np.isfinite(block)
+    if bad.any():
+        row, column = np.argwhere(bad)[0]
+        raise CommandError(f'{FIELD_NAMES[rows[row]]}[{column}] is {block[row, column]} '
+                           '(NaN/Inf are refused)')
+    bounds = _BOUNDS[rows]
+    beyond = np.abs(block) > bounds[:, np.newaxis]
+    if beyond.any():
+        row, column = np.argwhere(beyond)[0]
+        raise CommandError(f'{FIELD_NAMES[rows[row]]}[{column}] is {block[row, column]:g}, '
+                           f'beyond the sane bound of {bounds[row]:g} in magnitude')
+    return CommandUpdate(indices, tuple(rows), block)
+
+
+def merge_command(previous: JointCommandArrays, names: Sequence[str],
+                  arrays: Mapping[str, Sequence[float]]) -> JointCommandArrays:
+    """Return `previous` updated with one JointCommands message (`previous` is unchanged).
+
+    Args:
+        previous: the command in force.
+        names: the message's `name` field.
+        arrays: field name -> the message's array, for the fields in FIELD_NAMES.
+            An empty array leaves that field as it was.
+
+    Raises:
+        CommandError: as command_update.
+    """
+    update = command_update(names, arrays)
+    merged = previous.copy()
+    update.apply_to(merged)
     return merged
 
+
+class CommandDecoder:
+    """Serialized osrf_msgs/JointCommands -> CommandUpdate, without genpy.
+
+    A controller sends the same joint names in every message: the decoder remembers the
+    last serialized `name` block and its joint indices, so a message with the same block
+    costs one bytes comparison instead of decoding and looking up 28 strings. Safe to
+    share between rospy's receiving threads (the memo is replaced as one tuple).
+    """
+
+    def __init__(self) -> None:
+        self._memo: tuple[bytes, np.ndarray] = (b'', _ALL_JOINTS)
+
+    def decode(self, raw: bytes) -> CommandUpdate:
+        """Raises CommandError: a malformed message, or one command_update refuses."""
+        try:
+            cursor = FieldCursor(raw)
+            cursor.header_stamp_ns()
+            start = cursor.pos
+            names_block, indices = self._memo
+            if names_block and raw.startswith(names_block, start):
+                cursor.pos = start + len(names_block)
+            else:
+                indices = joint_indices(cursor.strings())
+                self._memo = (raw[start:cursor.pos], indices)
+            fields = [cursor.f64s() for _ in FIELD_NAMES]
+            if cursor.pos != len(raw):
+                raise ValueError(f'{len(raw) - cursor.pos} bytes left after the last field')
+        except (ValueError, struct.error, UnicodeDecodeError) as err:
+            raise CommandError(f'malformed message ({err})') from None
+        return _checked_update(indices, fields)

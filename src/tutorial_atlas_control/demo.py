@@ -47,12 +47,51 @@ def free_local_port() -> int:
         return int(sock.getsockname()[1])
 
 
+def descendants(pid: int) -> list[int]:
+    """Live (non-zombie) processes descended from `pid`, from /proc's parent links.
+
+    roslaunch starts each node in its own session (setsid), so its nodes are not in its
+    process group: following parents is the only way to find them all.
+    """
+    children: dict[int, list[int]] = {}
+    for entry in Path('/proc').iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            stat = (entry / 'stat').read_text()
+        except OSError:
+            continue
+        state, parent = stat[stat.rindex(')') + 2:].split()[:2]
+        if state != 'Z':
+            children.setdefault(int(parent), []).append(int(entry.name))
+    found, todo = [], [pid]
+    while todo:
+        for child in children.get(todo.pop(), []):
+            found.append(child)
+            todo.append(child)
+    return found
+
+
+def alive(pids: list[int]) -> list[int]:
+    """Those of `pids` that still run (zombies count as gone)."""
+    running = []
+    for pid in pids:
+        try:
+            stat = (Path('/proc') / str(pid) / 'stat').read_text()
+        except OSError:
+            continue
+        if stat[stat.rindex(')') + 2:].split()[0] != 'Z':
+            running.append(pid)
+    return running
+
+
 def stop(process: subprocess.Popen, name: str) -> None:
     """SIGINT (what Ctrl-C sends, so rosbag closes its bag), then SIGKILL if it hangs.
 
-    `process` must have been started with start_new_session=True: whatever is left of
-    its process group afterwards (a node that ignored the SIGINT) is killed too.
+    Whatever `process` started and left running afterwards (a node that ignored the
+    SIGINT) is killed too.
     """
+    leftovers = descendants(process.pid)
     if process.poll() is None:
         process.send_signal(signal.SIGINT)
         try:
@@ -60,12 +99,14 @@ def stop(process: subprocess.Popen, name: str) -> None:
         except subprocess.TimeoutExpired:
             print(f'demo: {name} did not stop within {SHUTDOWN_TIMEOUT_S} s; killing it',
                   file=sys.stderr)
+            leftovers = descendants(process.pid) or leftovers
             process.kill()
             process.wait()
-    try:  # leftovers of the group we created, by its id only
-        os.killpg(process.pid, signal.SIGKILL)
-    except (ProcessLookupError, PermissionError):
-        pass
+    for pid in alive(leftovers):
+        try:
+            os.kill(pid, signal.SIGKILL)
+        except (ProcessLookupError, PermissionError):
+            pass
 
 
 def newest_bag(bag_dir: Path, since_s: float) -> Path:

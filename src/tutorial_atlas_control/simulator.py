@@ -16,7 +16,7 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control import model as atlas_model
-from tutorial_atlas_control.commands import merge_command
+from tutorial_atlas_control.commands import CommandUpdate, command_update
 from tutorial_atlas_control.controller import (
     Gains, JointCommandArrays, PidState, compute_torque, hold_command)
 from tutorial_atlas_control.errors import AtlasControlError
@@ -169,17 +169,27 @@ class AtlasSimulator:
                         arrays: Mapping[str, Sequence[float]]) -> None:
         """Merge one JointCommands message into the user command (applied in User mode).
 
-        Joints the message does not name keep their previous command; before the first
-        command that is the current pose with the parameter-server gains.
-
         Raises:
             CommandError: the message is refused whole; the previous command stays.
         """
+        self.receive_updates([command_update(names, arrays)])
+
+    def receive_updates(self, updates: Sequence[CommandUpdate]) -> None:
+        """Apply checked JointCommands messages, in order, to the user command.
+
+        Joints a message does not name keep their previous command; before the first
+        command that is the current pose with the parameter-server gains.
+        """
+        if not updates:
+            return
         previous = self.user_command
         if previous is None:
             previous = (self._mode_command if self.mode is ControlMode.USER
                         else self._hold_current_pose())
-        self.user_command = merge_command(previous, names, arrays)
+        merged = previous.copy()  # the law may hold `previous`; never edit it in place
+        for update in updates:
+            update.apply_to(merged)
+        self.user_command = merged
 
     def active_command(self) -> JointCommandArrays:
         """The command the law applies this step, given the mode."""

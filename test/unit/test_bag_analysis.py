@@ -37,6 +37,7 @@ from tutorial_atlas_control.bag_analysis import (
 )
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.ros1_fields import parse_names_arrays
 
 ELX = JOINT_NAMES.index('l_arm_elx')
 KNY = JOINT_NAMES.index('l_leg_kny')
@@ -124,7 +125,7 @@ def test_odometry_fast_path_matches_generic_deserializer() -> None:
 def test_names_arrays_parser_matches_generic_deserializer(names, values, stamp_s) -> None:
     msg = joint_commands(float(stamp_s), values, names=names).message
     raw = bytes(TYPESTORE.serialize_ros1(msg, 'osrf_msgs/msg/JointCommands'))
-    stamp_ns, parsed_names, (position,) = bag_analysis._parse_names_arrays(raw, 1)
+    stamp_ns, parsed_names, (position,) = parse_names_arrays(raw, 1)
     assert stamp_ns == msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec
     assert parsed_names == list(msg.name)
     np.testing.assert_array_equal(position, msg.position)

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import io
 import math
 
 import numpy as np
 import pytest
 
 from tutorial_atlas_control.commands import (
-    MAX_MAGNITUDE, CommandError, joint_indices, merge_command)
+    MAX_MAGNITUDE, CommandDecoder, CommandError, joint_indices, merge_command)
 from tutorial_atlas_control.controller import FIELD_NAMES, JointCommandArrays
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
 
@@ -106,3 +107,61 @@ def test_values_at_the_bounds_are_accepted() -> None:
 
 def test_every_field_but_position_has_a_bound() -> None:
     assert set(MAX_MAGNITUDE) == set(FIELD_NAMES) - {'position'}
+
+
+# -- CommandDecoder: serialized messages, as the simulator node receives them ------------
+
+def serialized(names: list[str], **arrays: list[float]) -> bytes:
+    """A JointCommands serialized by genpy, the way rospy sends it."""
+    osrf_msgs = pytest.importorskip('osrf_msgs.msg',
+                                    reason='needs the catkin workspace: source ./env.sh')
+    buffer = io.BytesIO()
+    osrf_msgs.JointCommands(name=names, **arrays).serialize(buffer)
+    return buffer.getvalue()
+
+
+def test_decoder_agrees_with_merge_command_and_reuses_the_names() -> None:
+    positions = [0.01 * k for k in range(NUM_JOINTS)]
+    names = ['atlas::' + name for name in JOINT_NAMES]
+    decoder = CommandDecoder()
+    for _ in range(2):  # the second message takes the memoized-names path
+        merged = previous_command()
+        update = decoder.decode(serialized(names, position=positions, kp_position=[5.0] * 28))
+        update.apply_to(merged)
+        expected = merge_command(previous_command(), names,
+                                 {'position': positions, 'kp_position': [5.0] * 28})
+        for field in FIELD_NAMES:
+            np.testing.assert_array_equal(getattr(merged, field), getattr(expected, field))
+    assert not update.is_complete  # 2 of 9 fields
+
+
+def test_decoder_maps_a_new_name_list_after_a_memoized_one() -> None:
+    decoder = CommandDecoder()
+    decoder.decode(serialized(['neck_ay'], position=[0.1]))
+    update = decoder.decode(serialized(['back_lbz', 'neck_ay'], position=[0.2, 0.3]))
+    assert list(update.indices) == [JOINT_INDEX['back_lbz'], JOINT_INDEX['neck_ay']]
+
+
+def test_a_full_command_is_complete() -> None:
+    update = CommandDecoder().decode(serialized(
+        list(JOINT_NAMES), **{field: [0.0] * NUM_JOINTS for field in FIELD_NAMES}))
+    assert update.is_complete
+
+
+@pytest.mark.parametrize(('cut', 'reason'), [
+    (lambda raw: raw[:-3], 'malformed message'),
+    (lambda raw: raw + b'\0', 'malformed message .*1 bytes left'),
+    (lambda raw: raw[:20], 'malformed message'),
+    (lambda raw: b'', 'malformed message'),
+])
+def test_decoder_refuses_malformed_bytes(cut, reason: str) -> None:  # noqa: ANN001
+    raw = serialized(['neck_ay', 'back_lbz'], position=[0.1, 0.2])
+    with pytest.raises(CommandError, match=reason):
+        CommandDecoder().decode(cut(raw))
+
+
+def test_decoder_refuses_what_merge_command_refuses() -> None:
+    with pytest.raises(CommandError, match=r'kd_position\[0\] is 1e\+12'):
+        CommandDecoder().decode(serialized(['neck_ay'], kd_position=[1e12]))
+    with pytest.raises(CommandError, match='unknown joint name'):
+        CommandDecoder().decode(serialized(['nose'], position=[0.0]))
