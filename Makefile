@@ -23,7 +23,7 @@ rostest: setup
 	@$(IN_ENV) bash tools/run_rostests.sh
 
 test: setup
-	@$(IN_ENV) python3 -m pytest test/unit test/integration -q
+	@$(IN_ENV) python3 -m pytest test/unit test/integration test/reliability -q
 	@$(IN_ENV) catkin_lint -W2 "$$TAC_WS/src"
 	@$(IN_ENV) bash tools/run_rostests.sh
 

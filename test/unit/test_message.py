@@ -28,3 +28,14 @@ def test_serialization_roundtrip() -> None:
     assert received.name == ['atlas::back_lbz']
     assert list(received.position) == [0.5]
     assert list(received.kp_position) == [20.0]
+
+
+def test_simulator_subscribes_with_the_real_type_and_md5() -> None:
+    """The node takes commands undecoded, but registers and negotiates the real type."""
+    from tutorial_atlas_control.sim_node import RawJointCommands
+
+    assert RawJointCommands._type == 'osrf_msgs/JointCommands'
+    assert RawJointCommands._md5sum == 'f298c98f3e9c7aae9376ac19f73bfba3'
+    assert RawJointCommands._full_text == msg.JointCommands._full_text
+    raw = b'\x01\x02'
+    assert RawJointCommands().deserialize(raw).raw is raw

@@ -1,0 +1,187 @@
+#!/usr/bin/env python3
+"""Floods /atlas/joint_commands for the reliability tests; prints one JSON line of figures.
+
+    flood_commands.py --kind valid|bad --rate HZ --duration S [--start-sim S] [--subscribers N]
+
+`valid`: one full 28-joint command (the standing pose, left elbow at VALID_ELBOW_RAD, the
+parameter-server gains) over and over: the load test's publishers.
+`bad`: one valid command (the same), then a cycle of every kind of broken message and of
+bad /atlas/control_mode strings: the flooding test. The simulator must refuse them all.
+
+Pacing is by wall clock (not sim time): a flood is an outside load. The JSON line gives
+what was sent and how far sim time advanced meanwhile (the simulator's real-time factor).
+"""
+
+from __future__ import annotations
+
+import argparse
+import io
+import json
+import math
+import sys
+import threading
+import time
+import warnings
+
+import genpy
+import rospy
+from osrf_msgs.msg import JointCommands
+from rosgraph_msgs.msg import Clock
+from std_msgs.msg import String
+
+from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.traj_yaml_node import build_command, read_gains
+
+#: The valid command's left elbow target (rad): the tests check the robot holds it.
+VALID_ELBOW_RAD = 1.2
+ELBOW = JOINT_NAMES.index('l_arm_elx')
+#: Every `BAD_MODE_EVERY`-th bad message is followed by a bad control mode.
+BAD_MODE_EVERY = 50
+BAD_MODES = ('', 'Dance', 'user', 'U' * 100_000, 'User\x00Stand')
+
+
+def valid_command() -> JointCommands:
+    """What traj_yaml.py sends (all 28 joints, parameter-server gains): stand, elbow bent."""
+    position = [0.0] * NUM_JOINTS
+    position[ELBOW] = VALID_ELBOW_RAD
+    return build_command(JointCommands, position, read_gains(), rospy.Time())
+
+
+def bad_commands() -> list[JointCommands]:
+    """One message per way of being wrong; each would move the robot if it were applied."""
+    full = valid_command()
+
+    def variant(**fields: object) -> JointCommands:
+        arrays = {field: list(getattr(full, field)) for field in full.__slots__
+                  if field not in ('header', 'name')}
+        names = fields.pop('name', list(full.name))
+        arrays.update(fields)
+        return JointCommands(name=names, **arrays)
+
+    zeros = [0.0] * NUM_JOINTS
+    with_value = lambda value: [value] + zeros[1:]  # noqa: E731 - a table of cases
+    return [
+        variant(position=zeros[:-1]),                                # 27 entries
+        variant(position=zeros + [0.0]),                             # 29 entries
+        variant(position=with_value(math.nan)),                      # NaN
+        variant(position=with_value(math.inf)),                      # Inf
+        variant(effort=with_value(-math.inf)),
+        variant(kd_position=with_value(math.nan)),
+        variant(name=['atlas::nose'] + list(JOINT_NAMES[1:]), position=zeros),  # unknown
+        variant(name=['l_arm_elx', 'atlas::l_arm_elx'], position=[0.0, 0.0], velocity=[],
+                effort=[], kp_position=[], ki_position=[], kd_position=[], kp_velocity=[],
+                i_effort_min=[], i_effort_max=[]),                   # duplicate name
+        variant(kp_position=[1e12] * NUM_JOINTS, position=zeros),    # absurd gains
+        variant(kd_position=[-1e12] * NUM_JOINTS, position=zeros),
+        variant(effort=[1e12] * NUM_JOINTS, position=zeros),         # absurd efforts
+        variant(effort=[-1e300] * NUM_JOINTS, position=zeros),
+        variant(velocity=[1e9] * NUM_JOINTS, kp_velocity=[1e3] * NUM_JOINTS),
+        variant(name=['l_arm_elx', 'r_arm_elx', 'neck_ay'], position=zeros),  # 3 names, 28
+    ]
+
+
+class Preserialized(genpy.Message):
+    """A message serialized once and sent as is: a flood costs the sender ~10x less.
+
+    Keeps the real type and MD5, so subscribers see an ordinary osrf_msgs/JointCommands
+    (only the header's seq and stamp are frozen).
+    """
+
+    _type = JointCommands._type
+    _md5sum = JointCommands._md5sum
+    _full_text = JointCommands._full_text
+    _has_header = False  # stops rospy from rewriting a header we do not decode
+    __slots__ = ['raw']
+
+    def __init__(self, message: JointCommands) -> None:
+        buffer = io.BytesIO()
+        message.serialize(buffer)
+        self.raw = buffer.getvalue()
+
+    def serialize(self, buff: io.BytesIO) -> None:
+        buff.write(self.raw)
+
+
+class ClockWatch:
+    """The latest /clock, for the real-time factor and for --start-sim."""
+
+    def __init__(self) -> None:
+        self.ns = -1
+        self.lock = threading.Lock()
+        rospy.Subscriber('/clock', Clock, self._on_clock, queue_size=1)
+
+    def _on_clock(self, msg: Clock) -> None:
+        with self.lock:
+            self.ns = msg.clock.to_nsec()
+
+    def now_ns(self) -> int:
+        with self.lock:
+            return self.ns
+
+
+def flood(kind: str, rate_hz: float, duration_s: float, start_sim_s: float,
+          subscribers: int) -> dict:
+    # queue_size=None: synchronous writes, no per-connection writer thread to hand off to.
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', SyntaxWarning)  # rospy: "explicit queue_size"
+        commands = rospy.Publisher('/atlas/joint_commands', Preserialized, queue_size=None,
+                                   tcp_nodelay=True)
+    modes = rospy.Publisher('/atlas/control_mode', String, queue_size=10)
+    clock = ClockWatch()
+    deadline = time.monotonic() + 60.0
+    while clock.now_ns() < start_sim_s * 1e9 or commands.get_num_connections() < subscribers:
+        if time.monotonic() > deadline or rospy.is_shutdown():
+            raise SystemExit(f'flood_commands.py: no /clock, or fewer than {subscribers} '
+                             'subscribers to /atlas/joint_commands')
+        time.sleep(0.01)
+    valid = Preserialized(valid_command())
+    bad = [Preserialized(message) for message in bad_commands()]
+    if kind == 'bad':
+        commands.publish(valid)
+        time.sleep(0.5)  # the one valid command lands before the flood
+    period_s = 1.0 / rate_hz
+    sent = bad_modes = 0
+    sim0_ns, wall0_s = clock.now_ns(), time.monotonic()
+    next_s = wall0_s
+    while not rospy.is_shutdown():
+        now_s = time.monotonic()
+        if now_s - wall0_s >= duration_s:
+            break
+        if kind == 'valid':
+            commands.publish(valid)
+        else:
+            commands.publish(bad[sent % len(bad)])
+            if sent % BAD_MODE_EVERY == 0:
+                modes.publish(String(data=BAD_MODES[bad_modes % len(BAD_MODES)]))
+                bad_modes += 1
+        sent += 1
+        next_s += period_s  # on average exactly `rate_hz`, whatever sleep() overshoots
+        pause_s = next_s - time.monotonic()
+        if pause_s > 0.0:
+            time.sleep(pause_s)
+    wall_s = time.monotonic() - wall0_s
+    sim_s = (clock.now_ns() - sim0_ns) / 1e9
+    return {'kind': kind, 'sent': sent, 'bad_modes': bad_modes, 'wall_s': wall_s,
+            'sim_s': sim_s, 'rate_hz': sent / wall_s, 'real_time_factor': sim_s / wall_s,
+            'sim_start_s': sim0_ns / 1e9}
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--kind', choices=('valid', 'bad'), required=True)
+    parser.add_argument('--rate', type=float, default=1000.0, help='messages per second (wall)')
+    parser.add_argument('--duration', type=float, default=10.0, help='seconds (wall)')
+    parser.add_argument('--start-sim', type=float, default=0.0,
+                        help='start once sim time reaches this (s)')
+    parser.add_argument('--subscribers', type=int, default=2,
+                        help='wait for this many subscribers (default: the simulator and '
+                        'the recorder)')
+    args = parser.parse_args(rospy.myargv()[1:])
+    rospy.init_node('flood_commands', anonymous=True)
+    figures = flood(args.kind, args.rate, args.duration, args.start_sim, args.subscribers)
+    print(json.dumps(figures), flush=True)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
