@@ -42,7 +42,7 @@ from std_srvs.srv import Empty, EmptyResponse
 
 from tutorial_atlas_control import model as atlas_model
 from tutorial_atlas_control.commands import CommandDecoder, CommandError
-from tutorial_atlas_control.controller import FIELD_NAMES, gains_from_params
+from tutorial_atlas_control.controller import gains_from_params
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.simulator import (
@@ -86,8 +86,8 @@ class RawJointCommands(genpy.Message):
     genpy's decoder costs ~60 us per message in the receiving thread, under the GIL the
     stepping loop needs: at thousands of commands a second the simulator fell to 0.1-0.3
     of real time. This class keeps the real type, MD5 and definition, so the subscription
-    is registered, negotiated and shown as osrf_msgs/JointCommands; on_joint_commands
-    decodes `raw` with numpy views (ros1_fields) instead.
+    is registered, negotiated and shown as osrf_msgs/JointCommands; the loop decodes
+    `raw` itself with commands.CommandDecoder (numpy views, names memoized).
     """
 
     _type = JointCommands._type
