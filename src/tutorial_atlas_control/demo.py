@@ -47,6 +47,15 @@ def free_local_port() -> int:
         return int(sock.getsockname()[1])
 
 
+def _stat(pid: int | str) -> list[str] | None:
+    """/proc/PID/stat's fields after the command name (state, parent, ...), None if gone."""
+    try:
+        stat = (Path('/proc') / str(pid) / 'stat').read_text()
+    except OSError:
+        return None
+    return stat[stat.rindex(')') + 2:].split()
+
+
 def descendants(pid: int) -> list[int]:
     """Live (non-zombie) processes descended from `pid`, from /proc's parent links.
 
@@ -55,15 +64,9 @@ def descendants(pid: int) -> list[int]:
     """
     children: dict[int, list[int]] = {}
     for entry in Path('/proc').iterdir():
-        if not entry.name.isdigit():
-            continue
-        try:
-            stat = (entry / 'stat').read_text()
-        except OSError:
-            continue
-        state, parent = stat[stat.rindex(')') + 2:].split()[:2]
-        if state != 'Z':
-            children.setdefault(int(parent), []).append(int(entry.name))
+        fields = _stat(entry.name) if entry.name.isdigit() else None
+        if fields is not None and fields[0] != 'Z':
+            children.setdefault(int(fields[1]), []).append(int(entry.name))
     found, todo = [], [pid]
     while todo:
         for child in children.get(todo.pop(), []):
@@ -74,15 +77,7 @@ def descendants(pid: int) -> list[int]:
 
 def alive(pids: list[int]) -> list[int]:
     """Those of `pids` that still run (zombies count as gone)."""
-    running = []
-    for pid in pids:
-        try:
-            stat = (Path('/proc') / str(pid) / 'stat').read_text()
-        except OSError:
-            continue
-        if stat[stat.rindex(')') + 2:].split()[0] != 'Z':
-            running.append(pid)
-    return running
+    return [pid for pid in pids if (fields := _stat(pid)) is not None and fields[0] != 'Z']
 
 
 def stop(process: subprocess.Popen, name: str) -> None:
