@@ -1,6 +1,6 @@
 """The benchmark's measurements against the running simulator node (a private master).
 
-fast run:     real_time_factor:=0 with `rosbag record` subscribed; achieved real-time
+fast run:     real_time_factor:=0 with the recorder subscribed (`rosbag record` by default); achieved real-time
               factor = sim time advanced / wall time over a window, both taken from the
               /clock messages a raw subscriber receives (first and last of the window).
 realtime run: real_time_factor:=1.0; over the window every /clock arrival is kept.
@@ -70,18 +70,19 @@ def make_probes() -> Probes:
 
 
 def _launch(master: Master, launch_file: str, work_dir: Path, name: str,
-            rtf: float) -> Launch:
-    return Launch(master, launch_file,
-                  {'gui': 'false', 'real_time_factor': str(rtf), 'record': 'true',
-                   'bag_dir': str(work_dir / f'{name}_bags')},
-                  work_dir / f'{name}.launch.log')
+            rtf: float, recorder: str | None = None) -> Launch:
+    args = {'gui': 'false', 'real_time_factor': str(rtf), 'record': 'true',
+            'bag_dir': str(work_dir / f'{name}_bags')}
+    if recorder:
+        args['recorder'] = recorder
+    return Launch(master, launch_file, args, work_dir / f'{name}.launch.log')
 
 
 def recorded_fraction(bag_dir: Path, topic: str = '/atlas/joint_states') -> float | None:
     """Share of `topic`'s published messages that reached the bag, from the header seqs.
 
     The publisher numbers its messages (Header.seq); messages a subscriber queue dropped
-    (rosbag record's, when it cannot keep up) leave gaps. None if there is no closed bag.
+    (the recorder's, when it cannot keep up) leave gaps. None if there is no closed bag.
     """
     from rosbags.rosbag1 import Reader
 
@@ -110,7 +111,7 @@ def _wait_ready(master: Master, launch: Launch, probes: Probes) -> None:
                'the simulator to publish /clock', alive=launch.check_alive)
     wait_until(lambda: all(any('recorder' in node for node in master.subscribers(topic))
                            for topic in ('/clock', '/atlas/joint_states', '/atlas/imu')),
-               READY_TIMEOUT_S, 'rosbag record to subscribe', poll_s=0.2,
+               READY_TIMEOUT_S, 'the recorder to subscribe', poll_s=0.2,
                alive=launch.check_alive)
 
 
@@ -123,8 +124,8 @@ def _clock_series(samples: list[tuple[float, bytes]]) -> tuple[np.ndarray, np.nd
 
 
 def fast_run(master: Master, launch_file: str, probes: Probes, work_dir: Path, name: str,
-             warmup_s: float, window_s: float) -> dict[str, float]:
-    with _launch(master, launch_file, work_dir, name, 0.0) as launch:
+             warmup_s: float, window_s: float, recorder: str) -> dict[str, float]:
+    with _launch(master, launch_file, work_dir, name, 0.0, recorder) as launch:
         _wait_ready(master, launch, probes)
         time.sleep(warmup_s)
         pids = {'node': launch.node_pid('atlas_sim'), 'recorder': launch.node_pid('recorder')}

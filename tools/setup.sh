@@ -19,7 +19,7 @@ APT_PACKAGES=(
   ros-std-msgs ros-sensor-msgs ros-nav-msgs ros-geometry-msgs ros-std-srvs ros-rosgraph-msgs
   python3-std-msgs python3-sensor-msgs python3-nav-msgs python3-geometry-msgs python3-std-srvs
   python3-rosgraph-msgs libstd-msgs-dev libroscpp-dev libsensor-msgs-dev
-  librostest-dev python3-venv python3-yaml python3-numpy
+  librostest-dev librosbag-storage-dev libtopic-tools-dev python3-venv python3-yaml python3-numpy
   libosmesa6 libegl1 libopengl0 libgl1-mesa-dri
 )
 
@@ -64,7 +64,7 @@ build_workspace() {
   ln -sfn "$repo_dir/msg/osrf_msgs" "$TAC_WS/src/osrf_msgs"
   local stamp="$TAC_WS/.build-inputs.sha1" want
   want=$( (cd "$repo_dir" && cat CMakeLists.txt package.xml setup.py msg/osrf_msgs/CMakeLists.txt \
-            msg/osrf_msgs/package.xml msg/osrf_msgs/msg/*.msg; ls scripts sim test/rostest 2>/dev/null) | sha1sum | cut -d' ' -f1)
+            msg/osrf_msgs/package.xml msg/osrf_msgs/msg/*.msg src/*.cpp; ls scripts sim test/rostest 2>/dev/null) | sha1sum | cut -d' ' -f1)
   if [ -f "$TAC_WS/devel/setup.bash" ] && [ "$(cat "$stamp" 2>/dev/null)" = "$want" ]; then
     log "catkin workspace up to date ($TAC_WS)"; return
   fi
@@ -73,7 +73,7 @@ build_workspace() {
     # catkin must use Debian's Python (where ROS lives), not whatever python3 is first on PATH.
     unset PYTHONPATH CMAKE_PREFIX_PATH ROS_PACKAGE_PATH
     cd "$TAC_WS"
-    catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCATKIN_ENABLE_TESTING=ON > "$TAC_WS/build.log" 2>&1 \
+    catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 -DCATKIN_ENABLE_TESTING=ON > "$TAC_WS/build.log" 2>&1 \
       || { tail -40 "$TAC_WS/build.log" >&2; echo "setup: catkin_make failed; full log: $TAC_WS/build.log" >&2; exit 1; }
   )
   echo "$want" > "$stamp"

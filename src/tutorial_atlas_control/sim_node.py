@@ -69,8 +69,12 @@ MAX_PENDING_COMMANDS = 10_000
 VIEWER_PERIOD_S = 1.0 / 60.0
 WORLD_FRAME = 'world'
 #: At real_time_factor 0 the loop sends what it published at most this often (s, wall);
-#: paced runs send after every step.
+#: paced runs send after every step while on schedule.
 FLUSH_PERIOD_S = 0.001
+#: A paced run that has fallen behind sends at most this often (s, wall) until it is back on
+#: schedule: each send to a subscriber is a syscall per topic, and on a loaded 2-core machine
+#: those syscalls are what keeps it behind.
+CATCH_UP_FLUSH_PERIOD_S = 0.004
 
 
 def steps_between(rate_hz: float, dt_s: float) -> int:
@@ -334,9 +338,11 @@ class SimNode:
             # TCPROS is a byte stream, one sendall carries many messages, and the syscalls
             # saved are what lets a loaded simulator catch up.
             now_s = time.perf_counter()
-            on_schedule = self.real_time_factor > 0.0 and (
+            paced = self.real_time_factor > 0.0
+            on_schedule = paced and (
                 wall0 + (sim_ns - sim0_ns) / NS_PER_S / self.real_time_factor >= now_s)
-            if on_schedule or now_s - last_flush_s >= FLUSH_PERIOD_S:
+            flush_period_s = CATCH_UP_FLUSH_PERIOD_S if paced else FLUSH_PERIOD_S
+            if on_schedule or now_s - last_flush_s >= flush_period_s:
                 self.batch.flush()
                 last_flush_s = now_s
             if viewer is not None and time.perf_counter() >= next_view_s:

@@ -1,6 +1,6 @@
 """atlas.launch as the reliability tests drive it: its own master, its own bag directory.
 
-Each test starts the real launch (roscore, the simulator, `rosbag record`), injects a fault from outside (signals, floods, bad files) and judges the outcome
+Each test starts the real launch (roscore, the simulator, the recorder), injects a fault from outside (signals, floods, bad files) and judges the outcome
 from the processes and from the recorded bag, as a user would afterwards.
 """
 
@@ -121,8 +121,8 @@ class AtlasLaunch:
                           '--', mode)
         assert result.returncode == 0, result.stderr
 
-    def start_flood(self, *args: str, niceness: int = 0) -> subprocess.Popen:
-        return subprocess.Popen(['nice', '-n', str(niceness), sys.executable, str(FLOOD), *args],
+    def start_flood(self, *args: str) -> subprocess.Popen:
+        return subprocess.Popen([sys.executable, str(FLOOD), *args],
                                 env=self.env,
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
