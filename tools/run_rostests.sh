@@ -5,7 +5,7 @@ set -euo pipefail
 : "${TAC_WS:?source ./env.sh first}"
 cd "$TAC_WS"
 rm -rf "$TAC_WS/build/test_results/tutorial_atlas_control"
-catkin_make -j1 run_tests_tutorial_atlas_control -DPYTHON_EXECUTABLE=/usr/bin/python3 > "$TAC_WS/run_tests.log" 2>&1 \
+catkin_make -j1 run_tests_tutorial_atlas_control -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 > "$TAC_WS/run_tests.log" 2>&1 \
   || { tail -60 "$TAC_WS/run_tests.log" >&2; echo "rostests: the run failed; full log: $TAC_WS/run_tests.log" >&2; exit 1; }
 status=0
 summary=$(catkin_test_results --verbose "$TAC_WS/build/test_results/tutorial_atlas_control") || status=$?

@@ -14,7 +14,7 @@ from __future__ import annotations
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 import rosgraph
@@ -24,7 +24,7 @@ from sensor_msgs.msg import JointState
 from tutorial_atlas_control.controller import GAINS_PARAM, LOAD_HINT, Gains, GainsError, gains_from_params
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_INDEX, JOINT_NAMES, NUM_JOINTS, bare_joint_name
-from tutorial_atlas_control.trajectory import TrajectoryError, Waypoint, interpolate, load_trajectory, sample_count
+from tutorial_atlas_control.trajectory import Waypoint, interpolate, load_trajectory, sample_count
 
 __all__ = [
     'JointStateCache',

@@ -133,12 +133,21 @@ def parse_trajectory(doc: Mapping[object, object], name: str, path: PathLike) ->
 
 
 def load_trajectory(path: PathLike, name: str) -> list[Waypoint]:
-    """Load trajectory `name` from the file at `path`, fully validated.
+    """Load trajectory `name` from the file at `path`, after validating the whole file.
+
+    Every trajectory is checked, not only `name`: a mistake elsewhere in the file is
+    reported now rather than on the run that needs it.
 
     Raises:
         TrajectoryError: see :func:`load_trajectory_file` and :func:`parse_trajectory`.
     """
-    return parse_trajectory(load_trajectory_file(path), name, path)
+    doc = load_trajectory_file(path)
+    if name not in doc:
+        raise TrajectoryError(f'unable to find trajectory {name} in {path}')
+    for other in doc:
+        if other != name:
+            parse_trajectory(doc, other, path)
+    return parse_trajectory(doc, name, path)
 
 
 def sample_count(duration_s: float) -> int:

@@ -91,11 +91,12 @@ def test_positions_as_yaml_list_and_integer_duration(tmp_path: Path) -> None:
     np.testing.assert_array_equal(waypoint.positions, values)
 
 
-def test_only_the_requested_trajectory_is_validated(tmp_path: Path) -> None:
-    path = write(tmp_path, f'broken: 7\ngood:\n  - [1.0, "{ZEROS}"]\n')
-    assert len(load_trajectory(path, 'good')) == 1
-    with pytest.raises(TrajectoryError, match="trajectory 'broken'"):
-        load_trajectory(path, 'broken')
+def test_every_trajectory_of_the_file_is_validated(tmp_path: Path) -> None:
+    path = write(tmp_path, f'good:\n  - [1.0, "{ZEROS}"]\nbroken:\n  - [0.0, "{ZEROS}"]\n')
+    with pytest.raises(TrajectoryError, match="trajectory 'broken', waypoint 0: .*duration"):
+        load_trajectory(path, 'good')
+    with pytest.raises(TrajectoryError, match='unable to find trajectory absent in'):
+        load_trajectory(path, 'absent')
 
 
 # --- file-level errors ------------------------------------------------------------------
