@@ -42,6 +42,8 @@ UPRIGHT_ABOVE_M = 0.7
 #: step_and_fall's first waypoint bends the right knee to 1.4 rad; P-gain slack allowed.
 STEP_KNEE_TOLERANCE_RAD = 0.2
 STANDING_DRIFT_M = 0.02
+#: Commands of one segment the port may drop (queue_size=1, as the tutorial) under load.
+MAX_DROPPED_PER_SEGMENT = 1
 STANDING_S = 20.0
 #: Sim time after start before switching to User (the torso is pinned for 1 s).
 UNPIN_WAIT_S = 1.5
@@ -183,18 +185,41 @@ class TutorialRunTest(unittest.TestCase):
         rospy.loginfo(f'{self.trajectory}: {len(msgs)} commands, median period '
                       f'{period_s * 1000:.1f} ms of sim time')
         self.assertAlmostEqual(period_s, 0.02, delta=0.002, msg='published at 50 Hz')
-        # Each later segment (complete in this recording) has n samples on a straight line
-        # to its waypoint.
+        # Each later segment (complete in this recording) is n samples on a straight line
+        # from the measured pose (its first sample) to its waypoint. The port publishes with
+        # the tutorial's queue_size=1, so a sample can be dropped when its process is starved
+        # for 20 ms: at most one per segment is allowed.
         positions = np.array([m.position for m in msgs])
         waypoints = load_trajectory(TRAJECTORY_FILE, self.trajectory)
         ends = self.segment_end_indices(msgs)
         for k in range(1, len(waypoints)):
             n = sample_count(waypoints[k].duration_s)
-            self.assertEqual(ends[k] - ends[k - 1], n, f'samples in segment {k}')
             segment = positions[ends[k - 1] + 1:ends[k] + 1]
-            ratios = np.linspace(0.0, 1.0, n)[:, None]
-            line = (1 - ratios) * segment[0] + ratios * waypoints[k].positions
-            np.testing.assert_allclose(segment, line, atol=1e-9, err_msg=f'segment {k}')
+            self.assertGreaterEqual(len(segment), n - MAX_DROPPED_PER_SEGMENT,
+                                    f'samples in segment {k}')
+            self.assertTrue(self.on_the_line(segment, waypoints[k].positions, n),
+                            f'segment {k}: samples not on the straight line to waypoint {k}')
+
+    @staticmethod
+    def on_the_line(segment: np.ndarray, target: np.ndarray, n: int) -> bool:
+        """Are `segment`'s rows, in order, among the n samples from a start to `target`?
+
+        The start is the first row, or, if that sample was dropped, the point the first
+        row's ratio 1/(n-1) places it at.
+        """
+        ratios = np.linspace(0.0, 1.0, n)[:, None]
+        starts = [segment[0]]
+        if len(segment) < n:
+            r = 1.0 / (n - 1)
+            starts.append((segment[0] - r * target) / (1.0 - r))
+        for start in starts:
+            line = (1 - ratios) * start + ratios * target
+            deviation = np.abs(segment[:, None, :] - line[None, :, :]).max(axis=2)
+            sample = deviation.argmin(axis=1)
+            if (deviation.min(axis=1).max() < 1e-7 and np.all(np.diff(sample) > 0)
+                    and sample[-1] == n - 1):
+                return True
+        return False
 
     # -- the scenario ------------------------------------------------------------------
     def test_tutorial_scenario(self) -> None:
