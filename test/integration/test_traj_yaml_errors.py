@@ -76,50 +76,40 @@ def master(tmp_path: Path) -> Iterator[Master]:
         stop(core.process, 'roscore')
 
 
-def error_lines(result: subprocess.CompletedProcess) -> list[str]:
-    return [line for line in result.stderr.splitlines() if line.strip()]
+def refusal(master: Master, *ros_args: str) -> str:
+    """Run the port; assert it exits 1 with one stderr line and publishes nothing; the line."""
+    result, published = master.traj_yaml(*ros_args)
+    lines = [line for line in result.stderr.splitlines() if line.strip()]
+    assert result.returncode == 1, result
+    assert len(lines) == 1, lines
+    assert 'Traceback' not in result.stderr
+    assert published == '', f'published while refusing: {published[:200]}'
+    return lines[0]
 
 
 def test_missing_gains_name_the_parameter_and_how_to_load_it(master: Master) -> None:
-    result, published = master.traj_yaml()
-    assert result.returncode == 1
-    lines = error_lines(result)
-    assert len(lines) == 1, lines
-    assert 'parameter atlas_controller/gains is not set' in lines[0]
-    assert 'roslaunch tutorial_atlas_control atlas.launch' in lines[0]
-    assert 'rosparam load' in lines[0]
-    assert 'Traceback' not in result.stderr
-    assert published == ''
+    line = refusal(master)
+    assert 'parameter atlas_controller/gains is not set' in line
+    assert 'roslaunch tutorial_atlas_control atlas.launch' in line
+    assert 'rosparam load' in line
 
 
 def test_non_numeric_gain_is_named(master: Master) -> None:
     assert master.run('rosparam', 'load', str(GAINS)).returncode == 0
     assert master.run('rosparam', 'set', '/atlas_controller/gains/l_arm_elx/p',
                       'fast').returncode == 0
-    result, published = master.traj_yaml()
-    assert result.returncode == 1
-    lines = error_lines(result)
-    assert len(lines) == 1 and 'atlas_controller/gains/l_arm_elx/p' in lines[0], lines
-    assert published == ''
+    assert 'atlas_controller/gains/l_arm_elx/p' in refusal(master)
 
 
 def test_no_simulator_times_out_with_a_hint(master: Master) -> None:
     assert master.run('rosparam', 'load', str(GAINS)).returncode == 0
-    result, published = master.traj_yaml('_joint_state_timeout:=1.5')
-    assert result.returncode == 1
-    lines = error_lines(result)
-    assert len(lines) == 1, lines
-    assert 'no simulator is publishing /atlas/joint_states' in lines[0]
-    assert 'atlas.launch' in lines[0]
-    assert 'within 1.5 s' in lines[0], 'the ~joint_state_timeout parameter was not used'
-    assert published == ''
+    line = refusal(master, '_joint_state_timeout:=1.5')
+    assert 'no simulator is publishing /atlas/joint_states' in line
+    assert 'atlas.launch' in line
+    assert 'within 1.5 s' in line, 'the ~joint_state_timeout parameter was not used'
 
 
 def test_bad_timeout_parameter_is_named(master: Master) -> None:
     assert master.run('rosparam', 'load', str(GAINS)).returncode == 0
-    result, published = master.traj_yaml('_joint_state_timeout:=-1')
-    assert result.returncode == 1
-    lines = error_lines(result)
-    assert len(lines) == 1 and '~joint_state_timeout' in lines[0], lines
-    assert 'positive number of seconds' in lines[0]
-    assert published == ''
+    line = refusal(master, '_joint_state_timeout:=-1')
+    assert '~joint_state_timeout' in line and 'positive number of seconds' in line
