@@ -35,6 +35,7 @@ __all__ = [
     'read_gains',
     'run_trajectory',
     'wait_for_joint_state',
+    'wait_until_handed_over',
 ]
 
 USAGE = 'usage: traj_yaml.py YAML_FILE TRAJECTORY_NAME\n where TRAJECTORY is a dictionary defined in YAML_FILE'
@@ -65,6 +66,11 @@ JOINT_STATE_TIMEOUT_PARAM = '~joint_state_timeout'
 SUBSCRIBER_WAIT_S = 2.0
 #: Polling interval (s, wall clock) of the waits above.
 POLL_PERIOD_S = 0.01
+#: Longest wait (s, wall clock) for rospy's writer threads to take a command off the
+#: publisher's queue before the next command is published (see wait_until_handed_over).
+HANDOVER_WAIT_S = 0.01
+#: Polling interval (s, wall clock) of that wait.
+HANDOVER_POLL_S = 0.0005
 #: A joint "moves" in a waypoint's log line if its target is this far (rad) from its measured position.
 MOVING_JOINT_THRESHOLD_RAD = 0.01
 
@@ -296,6 +302,7 @@ def _play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], nam
 
     def send(positions: np.ndarray) -> None:
         publisher.publish(build_command(message_type, positions, gains, rospy.Time.now()))
+        wait_until_handed_over(publisher, HANDOVER_WAIT_S)
 
     total = sum(sample_count(waypoint.duration_s) for waypoint in waypoints)
     rospy.loginfo(f"playing trajectory '{name}': {len(waypoints)} waypoints, "
@@ -338,6 +345,26 @@ def _wait_for_subscriber(publisher: rospy.Publisher) -> None:
                               'publishing anyway')
             return
         time.sleep(POLL_PERIOD_S)
+
+
+def wait_until_handed_over(publisher: rospy.Publisher, timeout_s: float) -> bool:
+    """Wait (bounded, wall clock) until rospy has taken the last message off its queues.
+
+    With the tutorial's ``queue_size=1``, rospy 1.15 hands each message to one writer
+    thread per subscriber (``QueuedConnection``) and drops a message still queued when the
+    next is published: on a busy 2-core host a starved writer thread lost 5 of a segment's
+    150 commands. Waiting here keeps every command while the publisher keeps the tutorial's
+    queue size. Returns whether every queue was empty within `timeout_s`.
+    """
+    deadline = time.monotonic() + timeout_s
+    while True:
+        impl = publisher.impl
+        connections = list(impl.connections) if impl is not None else []
+        if not any(getattr(connection, '_queue', None) for connection in connections):
+            return True
+        if time.monotonic() >= deadline:
+            return False
+        time.sleep(HANDOVER_POLL_S)
 
 
 def _waypoint_line(index: int, count: int, waypoint: Waypoint, initial: np.ndarray) -> str:

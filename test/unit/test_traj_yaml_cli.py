@@ -13,6 +13,7 @@ import os
 import socket
 import subprocess
 import sys
+import threading
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -32,6 +33,7 @@ from tutorial_atlas_control.traj_yaml_node import (
     read_gains,
     run_trajectory,
     wait_for_joint_state,
+    wait_until_handed_over,
 )
 
 REPO = Path(__file__).resolve().parents[2]
@@ -401,3 +403,52 @@ def test_waypoint_log_names_the_moving_joints() -> None:
     logs: list[str] = []
     run_trajectory([Waypoint(0.1, target)], lambda: np.zeros(NUM_JOINTS), lambda _: None, lambda _: None, logs.append)
     assert logs == [f'waypoint 0 (1 of 1): 0.1 s, {sample_count(0.1)} commands; moving r_leg_kny']
+
+
+class BlockingTransport:
+    """A subscriber connection whose writes block until `release` is set (a slow socket)."""
+
+    def __init__(self) -> None:
+        self.done = False
+        self.release = threading.Event()
+        self.written: list[bytes] = []
+
+    def set_cleanup_callback(self, _callback: object) -> None:
+        pass
+
+    def write_data(self, data: bytes) -> bool:
+        self.release.wait(5.0)
+        self.written.append(data)
+        return True
+
+
+def test_the_port_waits_until_rospy_has_taken_each_command() -> None:
+    """rospy's own queue_size=1 connection: a command still queued is reported, not lost."""
+    from rospy.impl.tcpros_pubsub import QueuedConnection
+
+    transport = BlockingTransport()
+    connection = QueuedConnection(transport, 1)
+    publisher = SimpleNamespace(impl=SimpleNamespace(connections=[connection]))
+    try:
+        connection.write_data(b'first')
+        assert wait_until_handed_over(publisher, 1.0), 'the writer thread takes the first command'
+        connection.write_data(b'second')  # the writer is still busy with 'first'
+        started = time.monotonic()
+        assert not wait_until_handed_over(publisher, 0.05)
+        assert time.monotonic() - started >= 0.05
+        transport.release.set()
+        assert wait_until_handed_over(publisher, 1.0)
+        deadline = time.monotonic() + 1.0
+        while len(transport.written) < 2 and time.monotonic() < deadline:
+            time.sleep(0.001)
+        assert transport.written == [b'first', b'second']
+    finally:
+        transport.release.set()
+        transport.done = True
+        with connection._lock:
+            connection._cond_data_available.notify()
+
+
+def test_handover_wait_without_connections_returns_at_once() -> None:
+    assert wait_until_handed_over(SimpleNamespace(impl=None), 1.0)
+    assert wait_until_handed_over(SimpleNamespace(impl=SimpleNamespace(connections=[])), 1.0)
