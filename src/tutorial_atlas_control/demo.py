@@ -116,6 +116,7 @@ def newest_bag(bag_dir: Path, since_s: float) -> Path:
 def run_demo(trajectory: str, trajectory_file: Path, bag_dir: Path, real_time_factor: float,
              log_dir: Path) -> Path:
     """Run the tutorial once; return the closed bag's path."""
+    import rosgraph
     import rospy
     from rosgraph_msgs.msg import Clock
     from sensor_msgs.msg import JointState
@@ -135,15 +136,14 @@ def run_demo(trajectory: str, trajectory_file: Path, bag_dir: Path, real_time_fa
         env=env, stdout=launch_log, stderr=subprocess.STDOUT, start_new_session=True)
     try:
         print(f'demo: atlas.launch started (master on port {port}, log {launch_log.name})')
+        # Wait for roslaunch's master first: init_node would print "Unable to register with
+        # master node ... Will keep trying" while it starts.
         deadline = time.monotonic() + STARTUP_TIMEOUT_S
-        while True:
-            try:
-                rospy.init_node('tutorial_demo', anonymous=True, disable_signals=True)
-                break
-            except rospy.exceptions.ROSInitException:
-                if time.monotonic() > deadline or launch.poll() is not None:
-                    raise DemoError(f'the ROS master did not start; see {launch_log.name}') from None
-                time.sleep(0.2)
+        while not rosgraph.is_master_online(env['ROS_MASTER_URI']):
+            if time.monotonic() > deadline or launch.poll() is not None:
+                raise DemoError(f'the ROS master did not start; see {launch_log.name}')
+            time.sleep(0.2)
+        rospy.init_node('tutorial_demo', anonymous=True, disable_signals=True)
         try:
             rospy.wait_for_message('/atlas/joint_states', JointState, timeout=STARTUP_TIMEOUT_S)
         except rospy.ROSException:

@@ -124,7 +124,10 @@ def write_to_connections(pub: rospy.Publisher, data: bytes) -> None:
                 sock.settimeout(SEND_TIMEOUT_S)
             sock.sendall(data)
         except (TransportTerminated, OSError) as err:  # socket.timeout is an OSError
-            if not isinstance(err, TransportTerminated):
+            if isinstance(err, (BrokenPipeError, ConnectionResetError)):
+                # The subscriber exited (traj_yaml.py at its end): routine, as in rospy.
+                rospy.logdebug(f'{pub.resolved_name}: subscriber {connection.endpoint_id} left')
+            elif not isinstance(err, TransportTerminated):
                 rospy.logwarn(f'{pub.resolved_name}: dropping subscriber '
                               f'{connection.endpoint_id}: {err}')
             impl.remove_connection(connection)
