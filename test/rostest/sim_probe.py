@@ -112,8 +112,16 @@ class SimProbe:
         self.wait_until(is_fresh, f'a {what} within {FRESH_S} s of the current sim time')
 
     def pelvis_z(self) -> float:
+        return self.pelvis_z_stamped()[1]
+
+    def pelvis_z_stamped(self) -> tuple[int, float]:
+        """(stamp ns, pelvis height m) of one fresh /ground_truth_odom reading.
+
+        The wait for a fresh reading lets sim time run on: the stamp says when it was measured.
+        """
         self._wait_fresh(lambda: self.odom, '/ground_truth_odom')
-        return self.odom.pose.pose.position.z
+        odom = self.odom
+        return odom.header.stamp.to_nsec(), odom.pose.pose.position.z
 
     def position(self, joint: str) -> float:
         self._wait_fresh(lambda: self.joint_state, '/atlas/joint_states')
