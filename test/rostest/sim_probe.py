@@ -94,9 +94,17 @@ class SimProbe:
         return self.clock_ns / 1e9
 
     def wait_sim(self, seconds: float) -> None:
-        """Let `seconds` of sim time pass."""
+        """Let `seconds` of sim time pass, and the joint states of that time arrive.
+
+        /clock and /atlas/joint_states come on separate connections, each read by its own
+        thread: at real_time_factor 0 on a loaded host the joint states lagged the clock
+        by 210-320 ms of sim time (a fresh-clone run kept 790 of a second's 1000).
+        """
         target_ns = self.clock_ns + int(seconds * 1e9)
         self.wait_until(lambda: self.clock_ns >= target_ns, f'{seconds} s of sim time')
+        self.wait_until(lambda: self.joint_state is not None
+                        and self.joint_state.header.stamp.to_nsec() >= target_ns,
+                        f'/atlas/joint_states to reach the sim time {target_ns / 1e9:.3f} s')
 
     def _wait_fresh(self, latest: Callable[[], object], what: str) -> None:
         """Wait until `latest()` is stamped within FRESH_S of the clock (subscriber queues

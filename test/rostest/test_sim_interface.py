@@ -152,7 +152,8 @@ class SimInterfaceTest(unittest.TestCase):
             probe.send(names, **arrays)
             probe.wait_until(lambda r=reason: probe.warnings_containing(r), f'a warning: {reason}',
                              timeout_s=10)
-            time.sleep(2.1)  # the refusal warning is throttled
+            # The refusal warning is throttled (2 s), in ROS time: wait sim time, not wall time.
+            probe.wait_sim(2.1)
         probe.wait_sim(0.5)
         # Still on the accepted command (the refused 27-entry one would send it to 0).
         self.assertAlmostEqual(probe.position(ELBOW), ELBOW_TARGET_RAD, delta=0.1)
