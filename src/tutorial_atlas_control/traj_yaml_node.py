@@ -66,8 +66,8 @@ JOINT_STATE_TIMEOUT_PARAM = '~joint_state_timeout'
 SUBSCRIBER_WAIT_S = 2.0
 #: Polling interval (s, wall clock) of the waits above.
 POLL_PERIOD_S = 0.01
-#: Longest wait (s, wall clock) for rospy's writer threads to take a command off the
-#: publisher's queue before the next command is published (see wait_until_handed_over).
+#: Longest wait (s, wall clock), before a command is published, for rospy's writer threads to
+#: take the previous one off the publisher's queue (see wait_until_handed_over).
 #: Measured in the touchdown rostest: p99 5-12 ms, worst 29 ms (longer than the 20 ms
 #: between commands, hence the losses); a longer wait only delays the schedule.
 HANDOVER_WAIT_S = 0.05
@@ -303,13 +303,16 @@ def _play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], nam
     _wait_for_subscriber(publisher)
 
     def send(positions: np.ndarray) -> None:
-        publisher.publish(build_command(message_type, positions, gains, rospy.Time.now()))
+        # Waits for the previous command only now: rospy's writer threads had the whole
+        # interval to take it, so the wait delays the schedule only when they were starved.
         wait_until_handed_over(publisher, HANDOVER_WAIT_S)
+        publisher.publish(build_command(message_type, positions, gains, rospy.Time.now()))
 
     total = sum(sample_count(waypoint.duration_s) for waypoint in waypoints)
     rospy.loginfo(f"playing trajectory '{name}': {len(waypoints)} waypoints, "
                   f"{sum(w.duration_s for w in waypoints):g} s, {total} commands")
     run_trajectory(waypoints, cache.positions, send, rospy.sleep, rospy.loginfo, rospy.get_time)
+    wait_until_handed_over(publisher, HANDOVER_WAIT_S)  # the last command, before shutdown
     rospy.loginfo(f"trajectory '{name}' done")
 
 
