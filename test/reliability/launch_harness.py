@@ -33,17 +33,6 @@ def command_line(pid: int) -> str:
         return ''
 
 
-def cpu_times() -> list[int]:
-    """The machine's CPU times (jiffies) from /proc/stat: user nice system idle ... steal."""
-    return [int(field) for field in Path('/proc/stat').read_text().split('\n', 1)[0].split()[1:]]
-
-
-def steal_fraction(before: list[int], after: list[int]) -> float:
-    """Share of the CPU time between two cpu_times() that the hypervisor took (steal)."""
-    delta = [b - a for a, b in zip(before, after)]
-    return delta[7] / max(1, sum(delta[:8]))
-
-
 def rss_kib(pid: int) -> int:
     for line in (Path('/proc') / str(pid) / 'status').read_text().splitlines():
         if line.startswith('VmRSS:'):

