@@ -358,8 +358,21 @@ def _odometry_fast(raws: list[bytes]) -> tuple[np.ndarray, np.ndarray] | None:
 
 
 def _stamps_or_bag_times(stamps_ns: np.ndarray, bag_times_ns: np.ndarray) -> np.ndarray:
-    """Header stamps, with unset (zero) stamps replaced by the bag record time."""
+    """Header stamps, with unset (zero) stamps replaced by the bag record time.
+
+    For commands, which a user may publish unstamped (`rostopic pub`) between stamped ones.
+    """
     return np.where(stamps_ns > 0, stamps_ns, bag_times_ns)
+
+
+def _series_times(stamps_ns: np.ndarray, bag_times_ns: np.ndarray) -> np.ndarray:
+    """Header stamps of a series its publisher stamps (the simulator's), else bag times.
+
+    A zero stamp there is sim time 0, the initial state: atlas_recorder keeps what arrives
+    before the first /clock and writes it at the first valid time (say 12 ms), so taking
+    that bag time for it would put the state at t=0 after the one at t=1 ms.
+    """
+    return stamps_ns if stamps_ns.any() else bag_times_ns
 
 
 def _column_union(name_lists: Sequence[Sequence[str]]) -> list[str]:
@@ -407,7 +420,7 @@ def _read_joint_states(reader: Any, connections: Sequence[Any], typestore: Any,
             warnings.append(f'{JOINT_STATES_TOPIC} header stamps are {offset_s:.3g} s from their '
                             'bag record times (was /use_sim_time false while recording?); '
                             'times relative to bag start may be off.')
-    t_s = (_stamps_or_bag_times(stamps_ns, bag_ns) - start_ns) / _NS_PER_S
+    t_s = (_series_times(stamps_ns, bag_ns) - start_ns) / _NS_PER_S
     return JointStateSeries(t_s, tuple(names), position, velocity, effort)
 
 
@@ -471,7 +484,7 @@ def _read_pelvis(reader: Any, connections: Sequence[Any], typestore: Any,
                                 pose.orientation.w]
             floats[row, 43:49] = [twist.linear.x, twist.linear.y, twist.linear.z,
                                   twist.angular.x, twist.angular.y, twist.angular.z]
-    t_s = (_stamps_or_bag_times(stamps_ns, bag_ns) - start_ns) / _NS_PER_S
+    t_s = (_series_times(stamps_ns, bag_ns) - start_ns) / _NS_PER_S
     return PelvisSeries(t_s, floats[:, 0:3].copy(), floats[:, 3:7].copy(),
                         floats[:, 43:46].copy(), floats[:, 46:49].copy())
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -26,6 +27,7 @@ from synthetic_bags import (
     write_bag,
     write_run_bag,
 )
+from synthetic_bags import STANDING_HEIGHT_M
 from tutorial_atlas_control import bag_analysis
 from tutorial_atlas_control.bag_analysis import (
     EFFORT_LIMITS_NM,
@@ -240,6 +242,18 @@ def test_unstamped_commands_use_bag_time(tmp_path: Path) -> None:
     records = [joint_commands(0.01, np.zeros(NUM_JOINTS), stamp_s=0.0)]
     data = read_bag(write_bag(tmp_path / 'run.bag', [clock(0.0)] + records))
     np.testing.assert_allclose(data.commands.t_s, [0.01])
+
+
+def test_states_stamped_at_sim_time_zero_keep_their_stamp(tmp_path: Path) -> None:
+    """The recorder writes what arrived before the first /clock at the first valid time."""
+    early = [joint_state(k * 0.001, np.zeros(NUM_JOINTS)) for k in range(13)]
+    early = [replace(record, t_s=0.012) for record in early + [odometry(0.0, STANDING_HEIGHT_M)]]
+    later = [joint_state(k * 0.001, np.zeros(NUM_JOINTS)) for k in range(13, 100)]
+    later += [odometry(0.01 * k, STANDING_HEIGHT_M) for k in range(2, 10)]
+    data = read_bag(write_bag(tmp_path / 'run.bag', early + later))
+    states_s = data.start_time_s + data.joint_states.t_s
+    np.testing.assert_allclose(states_s, np.arange(100) * 0.001, atol=1e-9)
+    assert data.start_time_s + data.pelvis.t_s[0] == pytest.approx(0.0, abs=1e-9)
 
 
 def test_unknown_command_names_are_warned_about(tmp_path: Path) -> None:
