@@ -10,7 +10,7 @@ import pytest
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
 from bag_checks import ERROR, WARN, all_finite, count, log_lines, missing_steps
-from host_load import STEAL_LIMIT, cpu_times, steal_fraction
+from host_load import check_real_time, cpu_times, steal_fraction
 from launch_harness import AtlasLaunch, flood_figures, rss_kib
 from flood_commands import VALID_ELBOW_RAD
 from tutorial_atlas_control.bag_analysis import read_bag
@@ -115,7 +115,4 @@ def test_three_publishers_at_2_khz_keep_real_time_and_memory_flat(
         (missing != 0, f'{missing} joint states missing from the bag'),
         (not all(abs(rtf - 1.0) <= RTF_TOLERANCE for rtf in rtfs), f'real-time factor {rtfs}'),
     ) if failed]
-    if shortfalls and steal > STEAL_LIMIT:
-        pytest.xfail(f'{"; ".join(shortfalls)} with {steal:.0%} of the CPU taken by the '
-                     f'hypervisor (limit {STEAL_LIMIT:.0%}): not a 2-core machine')
-    assert not shortfalls, f'{"; ".join(shortfalls)} (hypervisor steal {steal:.1%})'
+    check_real_time(shortfalls, steal)

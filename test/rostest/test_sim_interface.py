@@ -199,7 +199,7 @@ class SimInterfaceTest(unittest.TestCase):
         unpin_ns = reset_ns + int(unpin_s * 1e9)
         pinned_readings = 0
         while probe.clock_ns < unpin_ns - int(0.1 * 1e9):
-            # Judged by when each reading was measured: at real_time_factor 0 the wait for a
+            # Judged by when each reading was measured: when the probe lags, the wait for a
             # fresh one can pass the unpin, after which the limp robot first rises 2-20 mm.
             stamp_ns, z = probe.pelvis_z_stamped()
             if reset_ns <= stamp_ns < unpin_ns:

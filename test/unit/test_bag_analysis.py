@@ -15,6 +15,7 @@ from rosbags.rosbag1 import Reader, Writer
 from rosbags.typesys import get_types_from_msg
 
 from synthetic_bags import (
+    STANDING_HEIGHT_M,
     TYPESTORE,
     clock,
     control_mode,
@@ -27,7 +28,6 @@ from synthetic_bags import (
     write_bag,
     write_run_bag,
 )
-from synthetic_bags import STANDING_HEIGHT_M
 from tutorial_atlas_control import bag_analysis
 from tutorial_atlas_control.bag_analysis import (
     EFFORT_LIMITS_NM,
