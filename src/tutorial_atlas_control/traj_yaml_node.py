@@ -35,6 +35,7 @@ __all__ = [
     'read_gains',
     'run_trajectory',
     'wait_for_joint_state',
+    'wait_for_subscribers',
     'wait_until_handed_over',
 ]
 
@@ -46,8 +47,9 @@ DESCRIPTION = (
     'at 50 Hz with the gains atlas_controller/gains/<joint>/{p,i,d,i_clamp}.\n'
     'Start the simulator first:\n'
     '  roslaunch tutorial_atlas_control atlas.launch\n'
-    'ROS remapping arguments (name:=value) are accepted; ~joint_state_timeout (s) sets how long\n'
-    'to wait for the first joint state.'
+    'ROS remapping arguments (name:=value) are accepted; ~joint_state_timeout (s, default 10)\n'
+    'sets how long to wait for the first joint state, ~subscriber_timeout (s, default 10) how\n'
+    'long to wait for the simulator to subscribe to the commands.'
 )
 HELP_OPTIONS = ('-h', '--help')
 
@@ -61,11 +63,17 @@ LAUNCH_HINT = 'roslaunch tutorial_atlas_control atlas.launch'
 JOINT_STATE_TIMEOUT_S = 10.0
 #: Private parameter overriding JOINT_STATE_TIMEOUT_S, e.g. `_joint_state_timeout:=30`.
 JOINT_STATE_TIMEOUT_PARAM = '~joint_state_timeout'
-#: How long (s, wall clock) to wait for the simulator to connect to our command publisher
-#: before publishing anyway; rospy drops messages published before a subscriber connects.
-SUBSCRIBER_WAIT_S = 2.0
+#: Default wait (s, wall clock) for every subscriber of /atlas/joint_commands (the simulator,
+#: a recorder) to connect before the first command: rospy drops what is published before a
+#: subscriber connects. It was 2 s, without failing: on a starved 2-core host the simulator
+#: connected later than that and missed the first commands (see wait_for_subscribers).
+SUBSCRIBER_TIMEOUT_S = 10.0
+#: Private parameter overriding SUBSCRIBER_TIMEOUT_S, e.g. `_subscriber_timeout:=30`.
+SUBSCRIBER_TIMEOUT_PARAM = '~subscriber_timeout'
 #: Polling interval (s, wall clock) of the waits above.
 POLL_PERIOD_S = 0.01
+#: The master's subscriber list is asked for at most this often (s, wall clock).
+MASTER_POLL_PERIOD_S = 0.1
 #: Longest wait (s, wall clock), before a command is published, for rospy's writer threads to
 #: take the previous one off the publisher's queue (see wait_until_handed_over).
 #: Measured in the touchdown rostest: p99 5-12 ms, worst 29 ms (longer than the 20 ms
@@ -298,9 +306,17 @@ def _play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], nam
     cache = JointStateCache()
     rospy.Subscriber(JOINT_STATES_TOPIC, JointState, cache.callback, queue_size=1)
     publisher = rospy.Publisher(JOINT_COMMANDS_TOPIC, message_type, queue_size=1)
-    timeout_s = _timeout_param()
-    wait_for_joint_state(cache, timeout_s)
-    _wait_for_subscriber(publisher)
+    first_state = wait_for_joint_state(cache, _timeout_param(JOINT_STATE_TIMEOUT_PARAM, JOINT_STATE_TIMEOUT_S))
+    simulator = (getattr(first_state, '_connection_header', None) or {}).get('callerid')
+    started = time.monotonic()
+    missing = wait_for_subscribers(lambda: _connected_subscribers(publisher), _registered_subscribers,
+                                   simulator, _timeout_param(SUBSCRIBER_TIMEOUT_PARAM, SUBSCRIBER_TIMEOUT_S))
+    connected = ', '.join(sorted(_connected_subscribers(publisher)))
+    rospy.loginfo(f'{JOINT_COMMANDS_TOPIC}: subscribers connected after {time.monotonic() - started:.2f} s: '
+                  f'{connected} (simulator: {simulator or "unknown"})')
+    if missing:
+        rospy.logwarn(f'not connected to {JOINT_COMMANDS_TOPIC} in time, so missing the first commands: '
+                      + ', '.join(sorted(missing)))
 
     def send(positions: np.ndarray) -> None:
         # Waits for the previous command only now: rospy's writer threads had the whole
@@ -316,39 +332,81 @@ def _play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], nam
     rospy.loginfo(f"trajectory '{name}' done")
 
 
-def _timeout_param() -> float:
-    value = rospy.get_param(JOINT_STATE_TIMEOUT_PARAM, JOINT_STATE_TIMEOUT_S)
+def _timeout_param(name: str, default: float) -> float:
+    value = rospy.get_param(name, default)
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not (np.isfinite(value) and value > 0):
-        raise TrajYamlError(f'parameter {JOINT_STATE_TIMEOUT_PARAM} must be a positive number of seconds, '
-                            f'got {value!r}')
+        raise TrajYamlError(f'parameter {name} must be a positive number of seconds, got {value!r}')
     return float(value)
 
 
-def _registered_subscribers(topic: str) -> int:
-    """How many nodes the master lists as subscribers of `topic` (0 if it cannot tell)."""
+def _registered_subscribers() -> set[str] | None:
+    """The nodes the master lists as subscribers of /atlas/joint_commands (None: it cannot tell)."""
     try:
         _publishers, subscribers, _services = rosgraph.Master(rospy.get_name()).getSystemState()
-    except Exception:  # noqa: BLE001 - an unreachable master only shortens the wait
-        return 0
-    return next((len(nodes) for name, nodes in subscribers if name == topic), 0)
+    except Exception:  # noqa: BLE001 - an unreachable master is asked again at the next poll
+        return None
+    return next((set(nodes) for name, nodes in subscribers if name == JOINT_COMMANDS_TOPIC), set())
 
 
-def _wait_for_subscriber(publisher: rospy.Publisher) -> None:
-    """Wait (bounded) until every registered subscriber, the recorder included, is connected.
+def _connected_subscribers(publisher: rospy.Publisher) -> set[str]:
+    """The nodes connected to `publisher` (rospy names each connection by its subscriber)."""
+    impl = publisher.impl
+    return {connection.endpoint_id for connection in (list(impl.connections) if impl is not None else [])}
 
-    Commands published before a subscriber connects never reach it: the simulator would
-    miss the start of the motion and the bag would lack the first commands.
+
+def wait_for_subscribers(
+    connected: Callable[[], set[str]],
+    registered: Callable[[], set[str] | None],
+    simulator: str | None,
+    timeout_s: float,
+    is_shutdown: Callable[[], bool] = rospy.is_shutdown,
+) -> set[str]:
+    """Wait (wall clock, bounded) until every subscriber of /atlas/joint_commands is connected.
+
+    A command published before a subscriber connects never reaches it. For the simulator
+    that is no lost sample: it holds its pose, then jumps to the first command that does
+    arrive, and touchdown's robot falls when the first 0.7 s of commands are missed. The
+    port used to publish anyway after 2 s of wall time, which a starved host exceeded.
+
+    Args:
+        connected: the nodes connected to our publisher now.
+        registered: the nodes the master lists as subscribers (None when it cannot tell).
+        simulator: the node that published the first joint state, if known.
+        timeout_s: the bound, s of wall clock.
+
+    Returns:
+        The listed subscribers that had not connected at the timeout (none of them the
+        simulator; the caller warns about them); empty when every one is connected.
+
+    Raises:
+        TrajYamlError: at the timeout nothing is connected, or the simulator subscribes
+            but has not connected: the trajectory would start without it.
+        rospy.ROSInterruptException: the node was shut down while waiting.
     """
-    deadline = time.monotonic() + SUBSCRIBER_WAIT_S
-    while (connected := publisher.get_num_connections()) == 0 or \
-            connected < _registered_subscribers(JOINT_COMMANDS_TOPIC):
-        if rospy.is_shutdown():
-            raise rospy.ROSInterruptException('shut down while waiting for a subscriber')
+    deadline = time.monotonic() + timeout_s
+    listed: set[str] | None = None
+    next_master_poll = 0.0
+    while True:
+        if time.monotonic() >= next_master_poll:
+            answer = registered()
+            if answer is not None:  # else keep the last answer: the master did not reply
+                listed = answer
+            next_master_poll = time.monotonic() + MASTER_POLL_PERIOD_S
+        now_connected = connected()
+        missing = (listed or set()) - now_connected
+        if now_connected and listed is not None and not missing:
+            return set()
+        if is_shutdown():
+            raise rospy.ROSInterruptException('shut down while waiting for subscribers')
         if time.monotonic() >= deadline:
-            if connected == 0:
-                rospy.logwarn(f'nothing subscribes to {JOINT_COMMANDS_TOPIC} yet; '
-                              'publishing anyway')
-            return
+            if not now_connected:
+                raise TrajYamlError(f'nothing subscribed to {JOINT_COMMANDS_TOPIC} within {timeout_s:g} s: '
+                                    f'the commands would reach no simulator; start it with `{LAUNCH_HINT}`')
+            if simulator in missing:
+                raise TrajYamlError(f'the simulator {simulator} subscribes to {JOINT_COMMANDS_TOPIC} but did not '
+                                    f'connect within {timeout_s:g} s; it would miss the start of the trajectory '
+                                    f'(a busy host? raise {SUBSCRIBER_TIMEOUT_PARAM})')
+            return missing
         time.sleep(POLL_PERIOD_S)
 
 

@@ -1,12 +1,14 @@
-"""traj_yaml.py's errors that need a ROS master, run as a user would: exit 1, one clear line,
-nothing published on /atlas/joint_commands.
+"""traj_yaml.py's start-up against a real ROS master, run as a user would: its errors (exit 1,
+one clear line, nothing published on /atlas/joint_commands) and its wait for the simulator.
 
-A private roscore (own port), no simulator: the gains and the timeout come from the
-parameter server, the joint states never come.
+A private roscore (own port); no simulator, or a fake one (fake_simulator.py) that publishes
+joint states and subscribes to the commands late. The gains and timeouts come from the
+parameter server.
 """
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -24,6 +26,7 @@ from tutorial_atlas_control.demo import free_local_port, stop  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
 TRAJ_YAML = REPO / 'scripts' / 'traj_yaml.py'
+FAKE_SIMULATOR = Path(__file__).resolve().parent / 'fake_simulator.py'
 TRAJECTORIES = REPO / 'trajectories' / 'Traj_data2.yaml'
 GAINS = REPO / 'config' / 'atlas_controller.yaml'
 MASTER_TIMEOUT_S = 30.0
@@ -113,3 +116,36 @@ def test_bad_timeout_parameter_is_named(master: Master) -> None:
     assert master.run('rosparam', 'load', str(GAINS)).returncode == 0
     line = refusal(master, '_joint_state_timeout:=-1')
     assert '~joint_state_timeout' in line and 'positive number of seconds' in line
+
+
+def run_with_fake_simulator(master: Master, subscribe_after_s: float,
+                            *ros_args: str) -> tuple[subprocess.CompletedProcess, dict]:
+    """Run the port on step_and_fall (4 s) beside fake_simulator.py; both results."""
+    assert master.run('rosparam', 'load', str(GAINS)).returncode == 0
+    simulator = subprocess.Popen(
+        [sys.executable, str(FAKE_SIMULATOR), '--subscribe-after', str(subscribe_after_s), '--run-for', '12'],
+        env=master.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        port = master.run(sys.executable, str(TRAJ_YAML), str(TRAJECTORIES), 'step_and_fall', *ros_args)
+        out, err = simulator.communicate(timeout=60)
+    finally:
+        stop(simulator, 'fake simulator')
+    assert simulator.returncode == 0, err
+    return port, json.loads(out.strip().splitlines()[-1])
+
+
+def test_a_simulator_that_subscribes_late_gets_every_command(master: Master) -> None:
+    """The port waits for the simulator: it used to publish after 2 s and the robot fell."""
+    port, simulator = run_with_fake_simulator(master, 3.0)
+    assert port.returncode == 0, port.stderr
+    assert simulator['received'] == 200, 'every command of step_and_fall reached the simulator'
+    assert simulator['first_position'] == [0.0] * 28, 'the first command is the measured pose'
+
+
+def test_a_simulator_that_never_subscribes_is_refused(master: Master) -> None:
+    port, simulator = run_with_fake_simulator(master, -1.0, '_subscriber_timeout:=1.5')
+    lines = [line for line in port.stderr.splitlines() if line.strip()]
+    assert port.returncode == 1, port
+    assert 'Traceback' not in port.stderr
+    assert len(lines) == 1 and 'nothing subscribed to /atlas/joint_commands within 1.5 s' in lines[0], lines
+    assert simulator['received'] == 0

@@ -93,6 +93,8 @@ class TutorialRunTest(unittest.TestCase):
         result = subprocess.run(
             ['rosrun', PKG, 'traj_yaml.py', str(TRAJECTORY_FILE), self.trajectory],
             capture_output=True, text=True, timeout=300, check=False)
+        for line in result.stdout.splitlines():  # when its subscribers connected, its waypoints
+            rospy.loginfo(f'traj_yaml.py: {line}')
         self.assertEqual(result.returncode, 0, f'traj_yaml.py failed:\n{result.stderr}')
         self.check_port_commands()
 

@@ -33,6 +33,7 @@ from tutorial_atlas_control.traj_yaml_node import (
     read_gains,
     run_trajectory,
     wait_for_joint_state,
+    wait_for_subscribers,
     wait_until_handed_over,
 )
 
@@ -452,3 +453,73 @@ def test_the_port_waits_until_rospy_has_taken_each_command() -> None:
 def test_handover_wait_without_connections_returns_at_once() -> None:
     assert wait_until_handed_over(SimpleNamespace(impl=None), 1.0)
     assert wait_until_handed_over(SimpleNamespace(impl=SimpleNamespace(connections=[])), 1.0)
+
+
+# --- waiting for the subscribers ------------------------------------------------------------
+
+SIM, RECORDER = '/atlas_sim', '/atlas_recorder'
+
+
+class Connecting:
+    """connected() for wait_for_subscribers: each node connects after its number of polls."""
+
+    def __init__(self, polls_until_connected: dict[str, int]) -> None:
+        self.polls_until_connected = polls_until_connected
+        self.polls = 0
+
+    def __call__(self) -> set[str]:
+        self.polls += 1
+        return {node for node, polls in self.polls_until_connected.items() if self.polls > polls}
+
+
+def never_shut_down() -> bool:
+    return False
+
+
+def test_subscribers_all_connected_return_at_once() -> None:
+    connected = Connecting({SIM: 0, RECORDER: 0})
+    assert wait_for_subscribers(connected, lambda: {SIM, RECORDER}, SIM, 5.0, never_shut_down) == set()
+    assert connected.polls == 1
+
+
+def test_a_simulator_that_connects_late_is_waited_for() -> None:
+    """The CI failure: the simulator connected after the old 2 s and missed the first commands."""
+    connected = Connecting({RECORDER: 0, SIM: 30})  # 30 polls of 10 ms
+    started = time.monotonic()
+    assert wait_for_subscribers(connected, lambda: {SIM, RECORDER}, SIM, 5.0, never_shut_down) == set()
+    assert connected.polls == 31
+    assert time.monotonic() - started >= 0.25
+
+
+def test_a_simulator_that_never_connects_is_an_error_naming_it() -> None:
+    connected = Connecting({RECORDER: 0})
+    with pytest.raises(TrajYamlError) as err:
+        wait_for_subscribers(connected, lambda: {SIM, RECORDER}, SIM, 0.2, never_shut_down)
+    assert f'the simulator {SIM} subscribes to /atlas/joint_commands but did not connect within 0.2 s' \
+        in str(err.value)
+    assert '~subscriber_timeout' in str(err.value)
+
+
+def test_no_subscriber_at_all_is_an_error() -> None:
+    with pytest.raises(TrajYamlError, match='nothing subscribed to /atlas/joint_commands within 0.2 s.*atlas.launch'):
+        wait_for_subscribers(Connecting({}), set, SIM, 0.2, never_shut_down)
+
+
+def test_another_late_subscriber_is_returned_for_a_warning() -> None:
+    missing = wait_for_subscribers(Connecting({SIM: 0}), lambda: {SIM, RECORDER}, SIM, 0.2, never_shut_down)
+    assert missing == {RECORDER}
+
+
+def test_a_master_that_cannot_tell_keeps_the_last_list() -> None:
+    """None from the master is no answer: the recorder it listed before is still waited for."""
+    answers = iter([{SIM, RECORDER}] + [None] * 1000)
+    connected = Connecting({SIM: 0, RECORDER: 15})
+    assert wait_for_subscribers(connected, lambda: next(answers), SIM, 5.0, never_shut_down) == set()
+    assert connected.polls == 16
+
+
+def test_shutdown_while_waiting_for_subscribers() -> None:
+    import rospy
+
+    with pytest.raises(rospy.ROSInterruptException):
+        wait_for_subscribers(Connecting({}), lambda: {SIM}, SIM, 5.0, lambda: True)

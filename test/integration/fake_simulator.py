@@ -1,0 +1,50 @@
+#!/usr/bin/env python3
+"""A stand-in simulator for traj_yaml.py's start-up: joint states now, commands later.
+
+Publishes /atlas/joint_states (all 28 joints at 0 rad, 100 Hz of wall time) from the
+start, and subscribes to /atlas/joint_commands only after --subscribe-after seconds
+(never if negative): the start-up order that made the real simulator miss the first
+commands on a starved host. Prints one JSON line when it exits: how many commands it
+received and the positions of the first.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+
+import rospy
+from osrf_msgs.msg import JointCommands
+from sensor_msgs.msg import JointState
+
+sys.path.insert(0, __file__.rsplit('/test/', 1)[0] + '/src')
+from tutorial_atlas_control.joints import JOINT_NAMES  # noqa: E402
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument('--subscribe-after', type=float, required=True, help='s of wall time; < 0: never')
+    parser.add_argument('--run-for', type=float, required=True, help='s of wall time, then exit')
+    args = parser.parse_args(rospy.myargv()[1:])
+    rospy.init_node('fake_atlas_sim')
+    received: list[JointCommands] = []
+    publisher = rospy.Publisher('/atlas/joint_states', JointState, queue_size=10)
+    state = JointState(name=list(JOINT_NAMES), position=[0.0] * len(JOINT_NAMES))
+    started = time.monotonic()
+    subscribed = False
+    while not rospy.is_shutdown() and time.monotonic() - started < args.run_for:
+        if not subscribed and 0 <= args.subscribe_after <= time.monotonic() - started:
+            rospy.Subscriber('/atlas/joint_commands', JointCommands, received.append, queue_size=1000)
+            subscribed = True
+        state.header.stamp = rospy.Time.now()
+        publisher.publish(state)
+        time.sleep(0.01)
+    first = list(received[0].position) if received else None
+    print(json.dumps({'received': len(received), 'first_position': first}), flush=True)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
