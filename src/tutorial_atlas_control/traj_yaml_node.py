@@ -3,10 +3,11 @@
 Same command line, topics, parameters, message and motion as the tutorial's
 ``traj_yaml.py``; each waypoint moves linearly from the measured joint positions to
 the waypoint's positions, published at 50 Hz in ROS time.  Fixed defects: the file is
-validated (``yaml.safe_load``) before anything starts; the first joint state is
-awaited with a timeout; joint states are read by name; the sample count is an integer;
-each command is stamped.  File handling and interpolation live in
-:mod:`tutorial_atlas_control.trajectory`; this module only talks to ROS.
+validated (``yaml.safe_load``) before anything starts; the first joint state, then the
+simulator's connection to the command topic, are awaited with timeouts; joint states are
+read by name; the sample count is an integer; each command is stamped.  File handling
+and interpolation live in :mod:`tutorial_atlas_control.trajectory`; this module only
+talks to ROS.
 """
 
 from __future__ import annotations
