@@ -213,7 +213,12 @@ class SimNode:
             if update.is_complete:
                 break
         updates.reverse()
+        first = self.sim.user_command is None
         self.sim.receive_updates(updates)
+        if first and updates:
+            # Which command a trajectory started from: a late one makes the robot jump.
+            rospy.loginfo(f'first /atlas/joint_commands since the start or last reset, at '
+                          f't={self.sim.sim_time_ns / NS_PER_S:.3f} s ({self.sim.mode.value} mode)')
 
     def on_control_mode(self, msg: String) -> None:
         try:
