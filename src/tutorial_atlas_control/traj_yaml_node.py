@@ -36,6 +36,7 @@ __all__ = [
     'read_gains',
     'run_trajectory',
     'wait_for_joint_state',
+    'wait_for_ros_time',
     'wait_for_subscribers',
     'wait_until_handed_over',
 ]
@@ -191,6 +192,32 @@ def wait_for_joint_state(
         time.sleep(POLL_PERIOD_S)
 
 
+def wait_for_ros_time(
+    timeout_s: float,
+    ros_time: Callable[[], float] = rospy.get_time,
+    is_shutdown: Callable[[], bool] = rospy.is_shutdown,
+) -> float:
+    """Wait (wall clock) until ROS time has started, and return it (s).
+
+    With ``/use_sim_time`` rospy's time is 0 until the first /clock message, which comes
+    over its own connection, maybe after the joint states: a trajectory started then would
+    stamp its first command 0 and schedule from 0. With wall-clock time it returns at once.
+
+    Raises:
+        TrajYamlError: still 0 after `timeout_s`: /use_sim_time is set but nothing publishes /clock.
+        rospy.ROSInterruptException: the node was shut down while waiting.
+    """
+    deadline = time.monotonic() + timeout_s
+    while (now := ros_time()) == 0.0:
+        if is_shutdown():
+            raise rospy.ROSInterruptException('shut down while waiting for /clock')
+        if time.monotonic() >= deadline:
+            raise TrajYamlError(f'/use_sim_time is set but no /clock arrived within {timeout_s:g} s; '
+                                f'start the simulator with `{LAUNCH_HINT}`')
+        time.sleep(POLL_PERIOD_S)
+    return now
+
+
 def build_command(
     message_type: Callable[[], object], positions: Iterable[float], gains: Gains, stamp: object
 ) -> object:
@@ -307,7 +334,9 @@ def _play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], nam
     cache = JointStateCache()
     rospy.Subscriber(JOINT_STATES_TOPIC, JointState, cache.callback, queue_size=1)
     publisher = rospy.Publisher(JOINT_COMMANDS_TOPIC, message_type, queue_size=1)
-    first_state = wait_for_joint_state(cache, _timeout_param(JOINT_STATE_TIMEOUT_PARAM, JOINT_STATE_TIMEOUT_S))
+    joint_state_timeout_s = _timeout_param(JOINT_STATE_TIMEOUT_PARAM, JOINT_STATE_TIMEOUT_S)
+    first_state = wait_for_joint_state(cache, joint_state_timeout_s)
+    wait_for_ros_time(joint_state_timeout_s)
     simulator = (getattr(first_state, '_connection_header', None) or {}).get('callerid')
     started = time.monotonic()
     missing = wait_for_subscribers(lambda: _connected_subscribers(publisher), _registered_subscribers,

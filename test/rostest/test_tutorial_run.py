@@ -54,6 +54,9 @@ class Recorder:
 
     def __init__(self) -> None:
         self.command_msgs: list[JointCommands] = []
+        #: This node's ROS time when each command arrived minus its stamp (ns): a diagnostic
+        #: of the port's clock (stamps ahead of sim time would misplace every segment window).
+        self.command_age_ns: list[int] = []
         self.odom: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         self.r_force_n: dict[int, float] = {}
         rospy.Subscriber('/atlas/joint_commands', JointCommands, self._on_command, queue_size=500)
@@ -63,6 +66,7 @@ class Recorder:
                          self._on_contact, queue_size=5000)
 
     def _on_command(self, msg: JointCommands) -> None:
+        self.command_age_ns.append(rospy.get_rostime().to_nsec() - msg.header.stamp.to_nsec())
         self.command_msgs.append(msg)
 
     def _on_odom(self, msg: Odometry) -> None:
@@ -184,8 +188,11 @@ class TutorialRunTest(unittest.TestCase):
                 self.assertEqual(list(getattr(msg, field)), expected, field)
         stamps_s = np.array([m.header.stamp.to_sec() for m in msgs])
         period_s = np.median(np.diff(stamps_s))
+        age_ms = np.array(self.recorder.command_age_ns) / 1e6
         rospy.loginfo(f'{self.trajectory}: {len(msgs)} commands, median period '
-                      f'{period_s * 1000:.1f} ms of sim time')
+                      f'{period_s * 1000:.1f} ms of sim time; received {age_ms.min():.1f} / '
+                      f'{np.median(age_ms):.1f} / {age_ms.max():.1f} ms (min / median / max) '
+                      'of sim time after their stamps')
         self.assertAlmostEqual(period_s, 0.02, delta=0.002, msg='published at 50 Hz')
         # Each later segment (complete in this recording) is n samples on a straight line
         # from the measured pose (its first sample) to its waypoint. The port publishes with

@@ -33,6 +33,7 @@ from tutorial_atlas_control.traj_yaml_node import (
     read_gains,
     run_trajectory,
     wait_for_joint_state,
+    wait_for_ros_time,
     wait_for_subscribers,
     wait_until_handed_over,
 )
@@ -523,3 +524,16 @@ def test_shutdown_while_waiting_for_subscribers() -> None:
 
     with pytest.raises(rospy.ROSInterruptException):
         wait_for_subscribers(Connecting({}), lambda: {SIM}, SIM, 5.0, lambda: True)
+
+
+# --- waiting for ROS time -------------------------------------------------------------------
+
+def test_ros_time_is_awaited_until_the_first_clock() -> None:
+    """Sim time is 0 until /clock arrives; the first command must not be stamped 0."""
+    readings = iter([0.0] * 5 + [3.25])
+    assert wait_for_ros_time(5.0, lambda: next(readings), never_shut_down) == 3.25
+
+
+def test_no_clock_is_an_error() -> None:
+    with pytest.raises(TrajYamlError, match='/use_sim_time is set but no /clock arrived within 0.1 s'):
+        wait_for_ros_time(0.1, lambda: 0.0, never_shut_down)
