@@ -337,16 +337,7 @@ def _play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], nam
     joint_state_timeout_s = _timeout_param(JOINT_STATE_TIMEOUT_PARAM, JOINT_STATE_TIMEOUT_S)
     first_state = wait_for_joint_state(cache, joint_state_timeout_s)
     wait_for_ros_time(joint_state_timeout_s)
-    simulator = (getattr(first_state, '_connection_header', None) or {}).get('callerid')
-    started = time.monotonic()
-    missing = wait_for_subscribers(lambda: _connected_subscribers(publisher), _registered_subscribers,
-                                   simulator, _timeout_param(SUBSCRIBER_TIMEOUT_PARAM, SUBSCRIBER_TIMEOUT_S))
-    connected = ', '.join(sorted(_connected_subscribers(publisher)))
-    rospy.loginfo(f'{JOINT_COMMANDS_TOPIC}: subscribers connected after {time.monotonic() - started:.2f} s: '
-                  f'{connected} (simulator: {simulator or "unknown"})')
-    if missing:
-        rospy.logwarn(f'not connected to {JOINT_COMMANDS_TOPIC} in time, so missing the first commands: '
-                      + ', '.join(sorted(missing)))
+    _wait_for_simulator(publisher, first_state)
 
     def send(positions: np.ndarray) -> None:
         # Waits for the previous command only now: rospy's writer threads had the whole
@@ -360,6 +351,20 @@ def _play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], nam
     run_trajectory(waypoints, cache.positions, send, rospy.sleep, rospy.loginfo, rospy.get_time)
     wait_until_handed_over(publisher, HANDOVER_WAIT_S)  # the last command, before shutdown
     rospy.loginfo(f"trajectory '{name}' done")
+
+
+def _wait_for_simulator(publisher: rospy.Publisher, first_state: JointState) -> None:
+    """wait_for_subscribers for our publisher; the simulator is the sender of `first_state`."""
+    simulator = (getattr(first_state, '_connection_header', None) or {}).get('callerid')
+    started = time.monotonic()
+    missing = wait_for_subscribers(lambda: _connected_subscribers(publisher), _registered_subscribers,
+                                   simulator, _timeout_param(SUBSCRIBER_TIMEOUT_PARAM, SUBSCRIBER_TIMEOUT_S))
+    connected = ', '.join(sorted(_connected_subscribers(publisher)))
+    rospy.loginfo(f'{JOINT_COMMANDS_TOPIC}: subscribers connected after {time.monotonic() - started:.2f} s: '
+                  f'{connected} (simulator: {simulator or "unknown"})')
+    if missing:
+        rospy.logwarn(f'not connected to {JOINT_COMMANDS_TOPIC} in time, so missing the first commands: '
+                      + ', '.join(sorted(missing)))
 
 
 def _timeout_param(name: str, default: float) -> float:
