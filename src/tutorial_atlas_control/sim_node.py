@@ -212,10 +212,12 @@ class SimNode:
             updates.append(update)
             if update.is_complete:
                 break
+        if not updates:
+            return
         updates.reverse()
         first = self.sim.user_command is None
         self.sim.receive_updates(updates)
-        if first and updates:
+        if first:
             # Which command a trajectory started from: a late one makes the robot jump.
             rospy.loginfo(f'first /atlas/joint_commands since the start or last reset, at '
                           f't={self.sim.sim_time_ns / NS_PER_S:.3f} s ({self.sim.mode.value} mode)')

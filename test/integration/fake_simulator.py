@@ -14,12 +14,13 @@ import argparse
 import json
 import sys
 import time
+from pathlib import Path
 
 import rospy
 from osrf_msgs.msg import JointCommands
 from sensor_msgs.msg import JointState
 
-sys.path.insert(0, __file__.rsplit('/test/', 1)[0] + '/src')
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / 'src'))
 from tutorial_atlas_control.joints import JOINT_NAMES  # noqa: E402
 
 
