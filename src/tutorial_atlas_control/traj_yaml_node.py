@@ -16,6 +16,7 @@ import sys
 import threading
 import time
 from collections.abc import Callable, Iterable, Sequence
+from typing import TypeVar
 
 import numpy as np
 import rosgraph
@@ -85,6 +86,9 @@ HANDOVER_WAIT_S = 0.05
 HANDOVER_POLL_S = 0.0005
 #: A joint "moves" in a waypoint's log line if its target is this far (rad) from its measured position.
 MOVING_JOINT_THRESHOLD_RAD = 0.01
+
+
+_T = TypeVar('_T')
 
 
 class TrajYamlError(AtlasControlError):
@@ -177,19 +181,9 @@ def wait_for_joint_state(
         TrajYamlError: nothing arrived within `timeout_s`; the message says to start the simulator.
         rospy.ROSInterruptException: the node was shut down while waiting.
     """
-    deadline = time.monotonic() + timeout_s
-    while True:
-        message = cache.latest()
-        if message is not None:
-            return message
-        if is_shutdown():
-            raise rospy.ROSInterruptException('shut down while waiting for joint states')
-        if time.monotonic() >= deadline:
-            raise TrajYamlError(
-                f'no simulator is publishing {JOINT_STATES_TOPIC}: nothing arrived within {timeout_s:g} s; '
-                f'start it with `{LAUNCH_HINT}`'
-            )
-        time.sleep(POLL_PERIOD_S)
+    return _poll(cache.latest, timeout_s, is_shutdown, 'joint states',
+                 f'no simulator is publishing {JOINT_STATES_TOPIC}: nothing arrived within {timeout_s:g} s; '
+                 f'start it with `{LAUNCH_HINT}`')
 
 
 def wait_for_ros_time(
@@ -207,15 +201,27 @@ def wait_for_ros_time(
         TrajYamlError: still 0 after `timeout_s`: /use_sim_time is set but nothing publishes /clock.
         rospy.ROSInterruptException: the node was shut down while waiting.
     """
+    return _poll(lambda: ros_time() or None, timeout_s, is_shutdown, '/clock',
+                 f'/use_sim_time is set but no /clock arrived within {timeout_s:g} s; '
+                 f'start the simulator with `{LAUNCH_HINT}`')
+
+
+def _poll(value: Callable[[], _T | None], timeout_s: float, is_shutdown: Callable[[], bool],
+          what: str, timeout_error: str) -> _T:
+    """Poll `value` (wall clock) until it is not None, and return it.
+
+    Raises:
+        TrajYamlError: `timeout_error`, after `timeout_s`.
+        rospy.ROSInterruptException: the node was shut down while waiting for `what`.
+    """
     deadline = time.monotonic() + timeout_s
-    while (now := ros_time()) == 0.0:
+    while (result := value()) is None:
         if is_shutdown():
-            raise rospy.ROSInterruptException('shut down while waiting for /clock')
+            raise rospy.ROSInterruptException(f'shut down while waiting for {what}')
         if time.monotonic() >= deadline:
-            raise TrajYamlError(f'/use_sim_time is set but no /clock arrived within {timeout_s:g} s; '
-                                f'start the simulator with `{LAUNCH_HINT}`')
+            raise TrajYamlError(timeout_error)
         time.sleep(POLL_PERIOD_S)
-    return now
+    return result
 
 
 def build_command(
@@ -335,9 +341,10 @@ def _play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], nam
     rospy.Subscriber(JOINT_STATES_TOPIC, JointState, cache.callback, queue_size=1)
     publisher = rospy.Publisher(JOINT_COMMANDS_TOPIC, message_type, queue_size=1)
     joint_state_timeout_s = _timeout_param(JOINT_STATE_TIMEOUT_PARAM, JOINT_STATE_TIMEOUT_S)
+    subscriber_timeout_s = _timeout_param(SUBSCRIBER_TIMEOUT_PARAM, SUBSCRIBER_TIMEOUT_S)
     first_state = wait_for_joint_state(cache, joint_state_timeout_s)
     wait_for_ros_time(joint_state_timeout_s)
-    _wait_for_simulator(publisher, first_state)
+    _wait_for_simulator(publisher, first_state, subscriber_timeout_s)
 
     def send(positions: np.ndarray) -> None:
         # Waits for the previous command only now: rospy's writer threads had the whole
@@ -353,12 +360,12 @@ def _play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], nam
     rospy.loginfo(f"trajectory '{name}' done")
 
 
-def _wait_for_simulator(publisher: rospy.Publisher, first_state: JointState) -> None:
+def _wait_for_simulator(publisher: rospy.Publisher, first_state: JointState, timeout_s: float) -> None:
     """wait_for_subscribers for our publisher; the simulator is the sender of `first_state`."""
     simulator = (getattr(first_state, '_connection_header', None) or {}).get('callerid')
     started = time.monotonic()
     missing = wait_for_subscribers(lambda: _connected_subscribers(publisher), _registered_subscribers,
-                                   simulator, _timeout_param(SUBSCRIBER_TIMEOUT_PARAM, SUBSCRIBER_TIMEOUT_S))
+                                   simulator, timeout_s)
     connected = ', '.join(sorted(_connected_subscribers(publisher)))
     rospy.loginfo(f'{JOINT_COMMANDS_TOPIC}: subscribers connected after {time.monotonic() - started:.2f} s: '
                   f'{connected} (simulator: {simulator or "unknown"})')
@@ -383,10 +390,15 @@ def _registered_subscribers() -> set[str] | None:
     return next((set(nodes) for name, nodes in subscribers if name == JOINT_COMMANDS_TOPIC), set())
 
 
+def _connections(publisher: rospy.Publisher) -> list[object]:
+    """A snapshot of `publisher`'s subscriber connections (none once it is closed)."""
+    impl = publisher.impl
+    return list(impl.connections) if impl is not None else []
+
+
 def _connected_subscribers(publisher: rospy.Publisher) -> set[str]:
     """The nodes connected to `publisher` (rospy names each connection by its subscriber)."""
-    impl = publisher.impl
-    return {connection.endpoint_id for connection in (list(impl.connections) if impl is not None else [])}
+    return {connection.endpoint_id for connection in _connections(publisher)}
 
 
 def wait_for_subscribers(
@@ -457,9 +469,7 @@ def wait_until_handed_over(publisher: rospy.Publisher, timeout_s: float) -> bool
     """
     deadline = time.monotonic() + timeout_s
     while True:
-        impl = publisher.impl
-        connections = list(impl.connections) if impl is not None else []
-        if not any(getattr(connection, '_queue', None) for connection in connections):
+        if not any(getattr(connection, '_queue', None) for connection in _connections(publisher)):
             return True
         if time.monotonic() >= deadline:
             return False

@@ -118,6 +118,12 @@ def test_bad_timeout_parameter_is_named(master: Master) -> None:
     assert '~joint_state_timeout' in line and 'positive number of seconds' in line
 
 
+def test_bad_subscriber_timeout_is_named_before_any_wait(master: Master) -> None:
+    assert master.run('rosparam', 'load', str(GAINS)).returncode == 0
+    line = refusal(master, '_subscriber_timeout:=soon')
+    assert '~subscriber_timeout' in line and "got 'soon'" in line
+
+
 def run_with_fake_simulator(master: Master, subscribe_after_s: float,
                             *ros_args: str) -> tuple[subprocess.CompletedProcess, dict]:
     """Run the port on step_and_fall (4 s) beside fake_simulator.py; both results."""
