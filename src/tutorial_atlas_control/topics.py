@@ -1,0 +1,31 @@
+"""The ROS names the simulator, the tutorial script, the recorder and the bag tools share.
+
+DRCSim's names, kept verbatim so that DRCSim-era clients and `rostopic` habits work.
+"""
+
+from __future__ import annotations
+
+CLOCK = '/clock'
+JOINT_STATES = '/atlas/joint_states'
+JOINT_COMMANDS = '/atlas/joint_commands'
+CONTROL_MODE = '/atlas/control_mode'
+GROUND_TRUTH_ODOM = '/ground_truth_odom'
+IMU = '/atlas/imu'
+L_FOOT_CONTACT = '/atlas/l_foot_contact'
+R_FOOT_CONTACT = '/atlas/r_foot_contact'
+#: Latched JSON (timestep, time_to_unpin, model file and sha1, last reset): what replay needs.
+SIM_CONFIG = '/atlas/sim_config'
+ROSOUT = '/rosout'
+
+#: Gazebo's services, as gazebo_ros offered them.
+RESET_WORLD_SERVICE = '/gazebo/reset_world'
+RESET_SIMULATION_SERVICE = '/gazebo/reset_simulation'
+PAUSE_PHYSICS_SERVICE = '/gazebo/pause_physics'
+UNPAUSE_PHYSICS_SERVICE = '/gazebo/unpause_physics'
+
+#: Parameters DRCSim loaded and the tutorial reads.
+GAINS_PARAM = 'atlas_controller/gains'
+TIME_TO_UNPIN_PARAM = '/atlas/time_to_unpin'
+
+WORLD_FRAME = 'world'
+PELVIS_FRAME = 'pelvis'
