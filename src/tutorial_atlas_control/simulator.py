@@ -10,7 +10,6 @@ from __future__ import annotations
 import enum
 import hashlib
 from collections.abc import Mapping, Sequence
-from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -78,11 +77,11 @@ class AtlasSimulator:
     """
 
     def __init__(self, atlas: atlas_model.AtlasModel, gains: Gains,
-                 time_to_unpin_s: float = DEFAULT_TIME_TO_UNPIN_S,
-                 model_path: Path = atlas_model.MODEL_PATH) -> None:
+                 time_to_unpin_s: float = DEFAULT_TIME_TO_UNPIN_S) -> None:
         self.atlas = atlas
-        self.atlas_path = model_path
-        self.atlas_sha1 = hashlib.sha1(model_path.read_bytes()).hexdigest()
+        # The path comes with the compiled model, so the config cannot name another file.
+        self.atlas_path = atlas.path
+        self.atlas_sha1 = hashlib.sha1(atlas.path.read_bytes()).hexdigest()
         self.model = atlas.model
         self.data = mujoco.MjData(self.model)
         self.gains = gains
