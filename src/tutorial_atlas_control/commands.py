@@ -17,7 +17,7 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.joints import JOINT_INDEX, NUM_JOINTS, bare_joint_name
+from tutorial_atlas_control.joints import NUM_JOINTS, joint_index
 from tutorial_atlas_control.ros1_fields import FieldCursor
 
 
@@ -110,7 +110,7 @@ def _indices_of(names: tuple[str, ...]) -> np.ndarray:
     indices = np.empty(len(names), dtype=np.intp)
     seen: set[int] = set()
     for slot, name in enumerate(names):
-        index = JOINT_INDEX.get(bare_joint_name(name))
+        index = joint_index(name)
         if index is None:
             raise CommandError(f'unknown joint name {name!r}')
         if index in seen:
