@@ -24,6 +24,7 @@ import numpy as np
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.units import finite_number
 
 if TYPE_CHECKING:  # pragma: no cover - typing only; mujoco is imported lazily
     from tutorial_atlas_control.bag_analysis import BagData
@@ -97,12 +98,23 @@ def parse_size(text: str) -> tuple[int, int]:
     try:
         width, height = (int(part) for part in parts)
     except ValueError:
-        raise RenderError(f'--size {text!r} is not WIDTHxHEIGHT in pixels, e.g. 640x480.') from None
+        raise RenderError(f'{text!r} is not WIDTHxHEIGHT in pixels, e.g. 640x480.') from None
     for side in (width, height):
         if not MIN_SIDE_PX <= side <= MAX_SIDE_PX:
-            raise RenderError(f'--size {text!r}: each side must be {MIN_SIDE_PX}..{MAX_SIDE_PX} '
-                              'pixels.')
+            raise RenderError(f'{text!r}: each side must be {MIN_SIDE_PX}..{MAX_SIDE_PX} pixels.')
     return width, height
+
+
+def parse_fps(text: str) -> float:
+    """A video frame rate (frames per s of sim time) within MIN_FPS..MAX_FPS.
+
+    Raises:
+        RenderError: not a number, or out of range.
+    """
+    fps = finite_number(text, allow_text=True)
+    if fps is None or not MIN_FPS <= fps <= MAX_FPS:
+        raise RenderError(f'{text!r} is out of range; choose {MIN_FPS:g}..{MAX_FPS:g} frames/s.')
+    return fps
 
 
 def check_output_path(path: Path | str, width: int, height: int, fps: float) -> Path:

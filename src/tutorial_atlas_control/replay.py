@@ -24,8 +24,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
-import sys
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -36,12 +34,13 @@ import numpy as np
 from tutorial_atlas_control import model as atlas_model
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bag_analysis import BagData, read_bag
+from tutorial_atlas_control.cli import argument_type, print_error
 from tutorial_atlas_control.controller import load_gains_yaml
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.simulator import (
     DEFAULT_TIME_TO_UNPIN_S, AtlasSimulator, PhysicsDivergenceError)
-from tutorial_atlas_control.units import NS_PER_S
+from tutorial_atlas_control.units import NS_PER_S, finite_number
 
 __all__ = [
     'DEFAULT_TOLERANCE',
@@ -566,7 +565,7 @@ pelvis_position {max (m), time, samples}, pelvis_orientation {max (rad), time, s
 
 Exit status: 0 when every deviation is within --tolerance, 3 when the replay deviates,
 1 when the bag cannot be read or replayed (missing topics, unsupported resets), 2 on bad
-arguments.
+arguments (e.g. a --tolerance that is not a number >= 0).
 
 Example: rosrun tutorial_atlas_control replay_bag.py ~/.ros/tutorial_atlas_control/bags/atlas_*.bag
 """
@@ -578,22 +577,26 @@ def build_parser() -> argparse.ArgumentParser:
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument('bag', metavar='BAG', help='the ROS 1 .bag file of the run')
     parser.add_argument('--json', action='store_true', help='print one JSON object instead')
-    parser.add_argument('--tolerance', type=float, default=DEFAULT_TOLERANCE,
+    parser.add_argument('--tolerance', type=argument_type(_tolerance), default=DEFAULT_TOLERANCE,
                         help='largest deviation (rad, rad/s, m) that still counts as '
                              'reproduced (default: %(default)g)')
     return parser
 
 
+def _tolerance(text: str) -> float:
+    tolerance = finite_number(text, allow_text=True)
+    if tolerance is None or tolerance < 0.0:
+        raise ReplayError(f'{text!r} is not a number >= 0')
+    return tolerance
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status."""
     args = build_parser().parse_args(argv)
-    if not (math.isfinite(args.tolerance) and args.tolerance >= 0.0):
-        print(f'{PROG}: error: --tolerance must be a number >= 0.', file=sys.stderr)
-        return 1
     try:
         result = replay_bag(args.bag, args.tolerance)
     except AtlasControlError as err:
-        print(f'{PROG}: error: {err}', file=sys.stderr)
+        print_error(PROG, err)
         return 1
     except KeyboardInterrupt:
         return 130

@@ -317,4 +317,13 @@ def test_script_errors_are_one_line(tmp_path: Path) -> None:
     assert done.returncode == 1
     assert done.stderr.strip().splitlines() == [f'replay_bag.py: error: {tmp_path}/none.bag: '
                                                 'no such file.']
-    assert main(['x.bag', '--tolerance', 'nan']) == 1
+
+
+@pytest.mark.parametrize('value', ['nan', '-1', 'abc'])
+def test_bad_tolerance_is_a_usage_error(value: str, capsys: pytest.CaptureFixture[str]) -> None:
+    """Exit 2, as argparse for any bad argument (the epilog says so)."""
+    with pytest.raises(SystemExit) as exit_info:
+        main(['x.bag', '--tolerance', value])
+    assert exit_info.value.code == 2
+    assert capsys.readouterr().err.splitlines()[-1].startswith(
+        'replay_bag.py: error: argument --tolerance: ')
