@@ -12,7 +12,7 @@ from harness import REPO_DIR, BenchError, log
 
 GAINS_YAML = REPO_DIR / 'config' / 'atlas_controller.yaml'
 SYNTHETIC_BAGS = REPO_DIR / 'test' / 'unit' / 'synthetic_bags.py'
-#: The topics bag_analysis.read_bag deserializes (the baseline reads the same ones).
+#: The topics bag_reader.read_bag deserializes (the baseline reads the same ones).
 ANALYSIS_TOPICS = ('/atlas/joint_states', '/atlas/joint_commands', '/ground_truth_odom',
                    '/atlas/control_mode')
 

@@ -9,15 +9,15 @@ from typing import Any
 
 import numpy as np
 
+from tutorial_atlas_control import topics
 from tutorial_atlas_control.bag_analysis import (
     EFFORT_LIMIT_TOLERANCE_NM,
     FALL_HEIGHT_M,
-    JOINT_COMMANDS_TOPIC,
     MOVED_RANGE_RAD,
     Analysis,
-    BagAnalysisError,
-    BagData,
 )
+from tutorial_atlas_control.bag_reader import BagData
+from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_NAMES
 
 __all__ = ['format_summary', 'plot_run', 'to_json', 'write_csv']
@@ -51,7 +51,7 @@ def format_summary(analysis: Analysis) -> str:
     lines.append('Control modes:')
     lines.extend(f'  {t_s:9.3f} s  {mode}' for t_s, mode in data.modes)
     if not data.modes:
-        lines.append('  (no /atlas/control_mode messages)')
+        lines.append(f'  (no {topics.CONTROL_MODE} messages)')
 
     if analysis.fell is None:
         lines.append(f'Fall:     unknown ({analysis.unavailable.get("fall", "no pelvis data")})')
@@ -67,10 +67,10 @@ def format_summary(analysis: Analysis) -> str:
         age = ('' if analysis.command_age_mean_s is None else
                f'; command age mean {analysis.command_age_mean_s * 1e3:.1f} ms, '
                f'max {analysis.command_age_max_s * 1e3:.1f} ms')
-        lines.append(f'Commands: {count} on {JOINT_COMMANDS_TOPIC} at '
+        lines.append(f'Commands: {count} on {topics.JOINT_COMMANDS} at '
                      f'{_fmt(analysis.command_rate_hz, ".1f", " Hz")}{age}')
     else:
-        lines.append(f'Commands: none on {JOINT_COMMANDS_TOPIC}')
+        lines.append(f'Commands: none on {topics.JOINT_COMMANDS}')
 
     if 'joints' in analysis.unavailable:
         lines.append(f'Tracking: unavailable ({analysis.unavailable["joints"]})')

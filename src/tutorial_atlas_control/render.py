@@ -25,7 +25,7 @@ import numpy as np
 from tutorial_atlas_control.errors import AtlasControlError
 
 if TYPE_CHECKING:  # pragma: no cover - typing only; mujoco is imported lazily
-    from tutorial_atlas_control.bag_analysis import BagData
+    from tutorial_atlas_control.bag_reader import BagData
     from tutorial_atlas_control.model import AtlasModel
 
 __all__ = [
@@ -362,7 +362,7 @@ def render_states(states: RunStates, path: Path | str, fps: float = DEFAULT_FPS,
 
 def render_bag_video(data: BagData, path: Path | str, fps: float = DEFAULT_FPS,
                      size: tuple[int, int] = DEFAULT_SIZE, progress: bool = True) -> VideoResult:
-    """Render the run in `data` (from bag_analysis.read_bag) to `path`.
+    """Render the run in `data` (from bag_reader.read_bag) to `path`.
 
     Frame times are seconds from the bag's start (as in the analysis), labelled on the frame.
 

@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from tutorial_atlas_control.bag_analysis import BagData, read_bag
+from tutorial_atlas_control.bag_reader import BagData, read_bag
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 

@@ -15,7 +15,7 @@ import pytest
 
 from synthetic_bags import TYPESTORE, Record, joint_state, write_bag
 from tutorial_atlas_control import model as atlas_model
-from tutorial_atlas_control.bag_analysis import BagAnalysisError
+from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.controller import hold_command, load_gains_yaml
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.replay import (
