@@ -9,15 +9,15 @@ from typing import Any
 
 import numpy as np
 
+from tutorial_atlas_control import topics
 from tutorial_atlas_control.bag_analysis import (
     EFFORT_LIMIT_TOLERANCE_NM,
     FALL_HEIGHT_M,
-    JOINT_COMMANDS_TOPIC,
     MOVED_RANGE_RAD,
     Analysis,
-    BagAnalysisError,
-    BagData,
 )
+from tutorial_atlas_control.bag_reader import BagData
+from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_NAMES
 
 __all__ = ['format_summary', 'plot_run', 'to_json', 'write_csv']
@@ -35,9 +35,7 @@ def _fmt(value: float | None, spec: str, unit: str = '') -> str:
     return 'n/a' if value is None else f'{value:{spec}}{unit}'
 
 
-def format_summary(analysis: Analysis) -> str:
-    """The human-readable report, several lines, no trailing newline."""
-    data = analysis.data
+def _topic_lines(data: BagData) -> list[str]:
     lines = [f'Bag:      {data.path}',
              f'Duration: {data.duration_s:.3f} s (start {data.start_time_s:.3f} s)', 'Topics:']
     width = max((len(name) for name in data.topics), default=0)
@@ -47,58 +45,70 @@ def format_summary(analysis: Analysis) -> str:
                      f'{_fmt(topic.rate_hz, "9.2f", " Hz")}')
     if not data.topics:
         lines.append('  (none: the bag is empty)')
-
     lines.append('Control modes:')
     lines.extend(f'  {t_s:9.3f} s  {mode}' for t_s, mode in data.modes)
     if not data.modes:
-        lines.append('  (no /atlas/control_mode messages)')
+        lines.append(f'  (no {topics.CONTROL_MODE} messages)')
+    return lines
 
+
+def _fall_line(analysis: Analysis) -> str:
     if analysis.fell is None:
-        lines.append(f'Fall:     unknown ({analysis.unavailable.get("fall", "no pelvis data")})')
-    elif analysis.fell:
-        lines.append(f'Fall:     FELL at {analysis.fall_time_s:.3f} s (pelvis below '
-                     f'{FALL_HEIGHT_M} m; lowest {analysis.min_pelvis_height_m:.3f} m)')
-    else:
-        lines.append(f'Fall:     no (pelvis stayed above {FALL_HEIGHT_M} m; lowest '
-                     f'{analysis.min_pelvis_height_m:.3f} m)')
+        return f'Fall:     unknown ({analysis.unavailable.get("fall", "no pelvis data")})'
+    if analysis.fell:
+        return (f'Fall:     FELL at {analysis.fall_time_s:.3f} s (pelvis below '
+                f'{FALL_HEIGHT_M} m; lowest {analysis.min_pelvis_height_m:.3f} m)')
+    return (f'Fall:     no (pelvis stayed above {FALL_HEIGHT_M} m; lowest '
+            f'{analysis.min_pelvis_height_m:.3f} m)')
 
-    count = 0 if data.commands is None else len(data.commands.t_s)
-    if count:
-        age = ('' if analysis.command_age_mean_s is None else
-               f'; command age mean {analysis.command_age_mean_s * 1e3:.1f} ms, '
-               f'max {analysis.command_age_max_s * 1e3:.1f} ms')
-        lines.append(f'Commands: {count} on {JOINT_COMMANDS_TOPIC} at '
-                     f'{_fmt(analysis.command_rate_hz, ".1f", " Hz")}{age}')
-    else:
-        lines.append(f'Commands: none on {JOINT_COMMANDS_TOPIC}')
 
+def _commands_line(analysis: Analysis) -> str:
+    commands = analysis.data.commands
+    count = 0 if commands is None else len(commands.t_s)
+    if not count:
+        return f'Commands: none on {topics.JOINT_COMMANDS}'
+    age = ('' if analysis.command_age_mean_s is None else
+           f'; command age mean {analysis.command_age_mean_s * 1e3:.1f} ms, '
+           f'max {analysis.command_age_max_s * 1e3:.1f} ms')
+    return (f'Commands: {count} on {topics.JOINT_COMMANDS} at '
+            f'{_fmt(analysis.command_rate_hz, ".1f", " Hz")}{age}')
+
+
+def _tracking_lines(analysis: Analysis) -> list[str]:
     if 'joints' in analysis.unavailable:
-        lines.append(f'Tracking: unavailable ({analysis.unavailable["joints"]})')
-    elif not analysis.joints:
-        lines.append(f'Tracking: no joint moved (measured range <= {MOVED_RANGE_RAD} rad, '
-                     'constant commands)')
-    else:
-        lines.append('Tracking (joints that moved; |command - measured| at each joint state, '
-                     'latest command held):')
-        name_width = max(len(name) for name in analysis.joints)
-        lines.append(f'  {"joint":<{name_width}}  {"RMS (rad)":>10}  {"max (rad)":>10}  '
-                     f'{"samples":>8}')
-        for name, joint in analysis.joints.items():
-            lines.append(f'  {name:<{name_width}}  {_fmt(joint.rms_error_rad, "10.5f")}  '
-                         f'{_fmt(joint.max_error_rad, "10.5f")}  {joint.samples:>8}'
-                         + ('' if joint.commanded else '  (never commanded)'))
+        return [f'Tracking: unavailable ({analysis.unavailable["joints"]})']
+    if not analysis.joints:
+        return [f'Tracking: no joint moved (measured range <= {MOVED_RANGE_RAD} rad, '
+                'constant commands)']
+    name_width = max(len(name) for name in analysis.joints)
+    lines = ['Tracking (joints that moved; |command - measured| at each joint state, '
+             'latest command held):',
+             f'  {"joint":<{name_width}}  {"RMS (rad)":>10}  {"max (rad)":>10}  {"samples":>8}']
+    for name, joint in analysis.joints.items():
+        lines.append(f'  {name:<{name_width}}  {_fmt(joint.rms_error_rad, "10.5f")}  '
+                     f'{_fmt(joint.max_error_rad, "10.5f")}  {joint.samples:>8}'
+                     + ('' if joint.commanded else '  (never commanded)'))
+    return lines
 
+
+def _effort_lines(analysis: Analysis) -> list[str]:
     if analysis.effort_saturation is None:
-        lines.append(f'Effort:   unavailable ({analysis.unavailable.get("effort_saturation")})')
-    elif not analysis.effort_saturation:
-        lines.append('Effort:   no joint reached its effort limit')
-    else:
-        lines.append('Effort limit reached '
-                     f'(|effort| >= limit - {EFFORT_LIMIT_TOLERANCE_NM} N·m):')
-        for name, sat in analysis.effort_saturation.items():
-            lines.append(f'  {name:<10} limit {sat.limit_nm:8.3f} N·m  for {sat.duration_s:.3f} s '
-                         f'(first at {sat.first_time_s:.3f} s)')
-    lines.extend(f'Warning:  {warning}' for warning in data.warnings)
+        return [f'Effort:   unavailable ({analysis.unavailable.get("effort_saturation")})']
+    if not analysis.effort_saturation:
+        return ['Effort:   no joint reached its effort limit']
+    lines = [f'Effort limit reached (|effort| >= limit - {EFFORT_LIMIT_TOLERANCE_NM} N·m):']
+    for name, sat in analysis.effort_saturation.items():
+        lines.append(f'  {name:<10} limit {sat.limit_nm:8.3f} N·m  for {sat.duration_s:.3f} s '
+                     f'(first at {sat.first_time_s:.3f} s)')
+    return lines
+
+
+def format_summary(analysis: Analysis) -> str:
+    """The human-readable report, several lines, no trailing newline."""
+    lines = _topic_lines(analysis.data)
+    lines += [_fall_line(analysis), _commands_line(analysis)]
+    lines += _tracking_lines(analysis) + _effort_lines(analysis)
+    lines.extend(f'Warning:  {warning}' for warning in analysis.data.warnings)
     return '\n'.join(lines)
 
 
@@ -171,6 +181,46 @@ def _decimate(t_s: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return t_s[::step], values[::step]
 
 
+def _plot_joint(ax: Any, name: str, data: BagData) -> None:
+    """Commanded (steps, held to the end of the run) and measured position of joint `name`."""
+    states, commands = data.joint_states, data.commands
+    if commands is not None and name in JOINT_NAMES:
+        sent = commands.position[:, JOINT_NAMES.index(name)]
+        finite = np.isfinite(sent)
+        if finite.any():
+            t_s, values = commands.t_s[finite], sent[finite]
+            if states is not None and len(states.t_s) and states.t_s[-1] > t_s[-1]:
+                t_s, values = np.append(t_s, states.t_s[-1]), np.append(values, values[-1])
+            ax.plot(t_s, values, drawstyle='steps-post', color='tab:orange', label='commanded')
+    if states is not None:
+        ax.plot(*_decimate(states.t_s, states.position[:, states.names.index(name)]),
+                color='tab:blue', linewidth=1.0, label='measured')
+    ax.set_ylabel(f'{name}\n(rad)', fontsize=8)
+
+
+def _plot_pelvis(ax: Any, analysis: Analysis) -> None:
+    """Pelvis height, the fall threshold and the fall."""
+    pelvis = analysis.data.pelvis
+    assert pelvis is not None
+    ax.plot(*_decimate(pelvis.t_s, pelvis.position_m[:, 2]), color='tab:green', label='pelvis z')
+    ax.axhline(FALL_HEIGHT_M, color='tab:red', linestyle=':', label='fall threshold')
+    if analysis.fall_time_s is not None:
+        ax.plot([analysis.fall_time_s], [FALL_HEIGHT_M], 'rx', label='fall')
+    ax.set_ylabel('pelvis\nheight (m)', fontsize=8)
+
+
+def _mark_modes(axes: list[Any], modes: list[tuple[float, str]]) -> None:
+    """A vertical line per control-mode change, labelled above the first subplot."""
+    for ax in axes:
+        for t_s, _ in modes:
+            ax.axvline(t_s, color='gray', linestyle='--', linewidth=0.8)
+    for number, (t_s, mode) in enumerate(modes):
+        # Alternate label heights so modes that change in quick succession stay legible.
+        axes[0].annotate(mode, (t_s, 1.0), xycoords=('data', 'axes fraction'),
+                         xytext=(2, 2 + 10 * (number % 2)), textcoords='offset points',
+                         fontsize=8)
+
+
 def plot_run(analysis: Analysis, path: Path | str) -> Path:
     """Plot commanded vs measured positions of the joints that moved, and pelvis height.
 
@@ -191,41 +241,14 @@ def plot_run(analysis: Analysis, path: Path | str) -> Path:
     fig, axes = plt.subplots(max(rows, 1), 1, sharex=True, squeeze=False,
                              figsize=(PLOT_WIDTH_IN, PLOT_ROW_HEIGHT_IN * max(rows, 2) + 1.0))
     axes = list(axes[:, 0])
-    states, commands = data.joint_states, data.commands
     for ax, name in zip(axes, names):
-        if commands is not None and name in JOINT_NAMES:
-            sent = commands.position[:, JOINT_NAMES.index(name)]
-            finite = np.isfinite(sent)
-            if finite.any():
-                t_s, values = commands.t_s[finite], sent[finite]
-                if states is not None and len(states.t_s) and states.t_s[-1] > t_s[-1]:
-                    # The last command is held until the end of the run.
-                    t_s, values = np.append(t_s, states.t_s[-1]), np.append(values, values[-1])
-                ax.plot(t_s, values, drawstyle='steps-post', color='tab:orange',
-                        label='commanded')
-        if states is not None:
-            ax.plot(*_decimate(states.t_s, states.position[:, states.names.index(name)]),
-                    color='tab:blue', linewidth=1.0, label='measured')
-        ax.set_ylabel(f'{name}\n(rad)', fontsize=8)
+        _plot_joint(ax, name, data)
     if data.pelvis is not None:
-        ax = axes[len(names)]
-        ax.plot(*_decimate(data.pelvis.t_s, data.pelvis.position_m[:, 2]), color='tab:green',
-                label='pelvis z')
-        ax.axhline(FALL_HEIGHT_M, color='tab:red', linestyle=':', label='fall threshold')
-        if analysis.fall_time_s is not None:
-            ax.plot([analysis.fall_time_s], [FALL_HEIGHT_M], 'rx', label='fall')
-        ax.set_ylabel('pelvis\nheight (m)', fontsize=8)
+        _plot_pelvis(axes[len(names)], analysis)
     if rows == 0:
         axes[0].text(0.5, 0.5, 'nothing to plot: no joint moved and no pelvis data',
                      ha='center', va='center', transform=axes[0].transAxes)
-    for ax in axes:
-        for t_s, _ in data.modes:
-            ax.axvline(t_s, color='gray', linestyle='--', linewidth=0.8)
-    for number, (t_s, mode) in enumerate(data.modes):
-        # Alternate label heights so modes that change in quick succession stay legible.
-        axes[0].annotate(mode, (t_s, 1.0), xycoords=('data', 'axes fraction'),
-                         xytext=(2, 2 + 10 * (number % 2)), textcoords='offset points',
-                         fontsize=8)
+    _mark_modes(axes, data.modes)
     for ax in axes[:1] + axes[-1:] if rows else []:
         ax.legend(loc='upper right', fontsize=7)
     axes[-1].set_xlabel('time from bag start (s)')

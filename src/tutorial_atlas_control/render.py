@@ -27,7 +27,7 @@ from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.units import finite_number
 
 if TYPE_CHECKING:  # pragma: no cover - typing only; mujoco is imported lazily
-    from tutorial_atlas_control.bag_analysis import BagData
+    from tutorial_atlas_control.bag_reader import BagData
     from tutorial_atlas_control.model import AtlasModel
 
 __all__ = [
@@ -375,7 +375,7 @@ def render_states(states: RunStates, path: Path | str, fps: float = DEFAULT_FPS,
 
 def render_bag_video(data: BagData, path: Path | str, fps: float = DEFAULT_FPS,
                      size: tuple[int, int] = DEFAULT_SIZE, progress: bool = True) -> VideoResult:
-    """Render the run in `data` (from bag_analysis.read_bag) to `path`.
+    """Render the run in `data` (from bag_reader.read_bag) to `path`.
 
     Frame times are seconds from the bag's start (as in the analysis), labelled on the frame.
 

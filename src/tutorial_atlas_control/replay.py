@@ -33,7 +33,7 @@ import numpy as np
 
 from tutorial_atlas_control import model as atlas_model
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.bag_analysis import BagData, read_bag
+from tutorial_atlas_control.bag_reader import BagData, read_bag
 from tutorial_atlas_control.cli import argument_type, print_error
 from tutorial_atlas_control.controller import load_gains_yaml
 from tutorial_atlas_control.errors import AtlasControlError
@@ -112,26 +112,17 @@ class Recording:
     warnings: list[str] = field(default_factory=list)
 
 
-def _read_sim_configs(path: Path) -> list[dict[str, Any]]:
-    """Every /atlas/sim_config message in record order, parsed from JSON."""
-    from rosbags.rosbag1 import Reader, ReaderError
-    from rosbags.typesys import Stores, get_typestore
-
-    typestore = get_typestore(Stores.ROS1_NOETIC)
+def _read_sim_configs(data: BagData) -> list[dict[str, Any]]:
+    """Every /atlas/sim_config message of `data`, in record order, parsed from JSON."""
     configs = []
-    try:
-        with Reader(path) as reader:
-            connections = [c for c in reader.connections if c.topic == SIM_CONFIG_TOPIC]
-            if not connections:
-                return []
-            for _, _, raw in reader.messages(connections=connections):
-                text = typestore.deserialize_ros1(raw, 'std_msgs/msg/String').data
-                try:
-                    configs.append(json.loads(text))
-                except json.JSONDecodeError as err:
-                    raise ReplayError(f'{path}: {SIM_CONFIG_TOPIC} is not JSON ({err}).') from err
-    except ReaderError as err:
-        raise ReplayError(f'Could not read {SIM_CONFIG_TOPIC} from {path}: {err}') from err
+    for _, text in data.sim_configs:
+        try:
+            config = json.loads(text)
+        except json.JSONDecodeError as err:
+            raise ReplayError(f'{data.path}: {SIM_CONFIG_TOPIC} is not JSON ({err}).') from err
+        if not isinstance(config, dict):
+            raise ReplayError(f'{data.path}: {SIM_CONFIG_TOPIC} is not a JSON object: {text!r}.')
+        configs.append(config)
     return configs
 
 
@@ -179,6 +170,8 @@ def _to_steps(stamps_ns: np.ndarray, step_ns: int, what: str) -> np.ndarray:
 def load_recording(path: Path | str, data: BagData | None = None) -> Recording:
     """Read what replay needs from the bag at `path` (`data`: an already read BagData).
 
+    The bag is opened once: /atlas/sim_config comes with the series in `data`.
+
     Raises:
         ReplayError / BagAnalysisError: unreadable bag, missing joint states or joints,
             a sim_config without the needed keys, stamps off the step grid.
@@ -190,7 +183,7 @@ def load_recording(path: Path | str, data: BagData | None = None) -> Recording:
     if states is None or not len(states.t_s):
         raise ReplayError(f'{path} has no {JOINT_STATES_TOPIC}: the replay needs the recorded '
                           'torques (effort) of every step.')
-    config, resets = _sim_config(path, _read_sim_configs(path), warnings)
+    config, resets = _sim_config(path, _read_sim_configs(data), warnings)
     columns = []
     missing = []
     for name in JOINT_NAMES:

@@ -19,7 +19,7 @@ pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source 
 
 from bag_checks import ERROR, FATAL, all_finite, count, log_lines, missing_steps, sim_configs
 from launch_harness import AtlasLaunch
-from tutorial_atlas_control.bag_analysis import read_bag
+from tutorial_atlas_control.bag_reader import read_bag
 from tutorial_atlas_control.joints import JOINT_NAMES
 
 REPO = Path(__file__).resolve().parents[2]

@@ -13,7 +13,7 @@ from bag_checks import ERROR, WARN, all_finite, count, log_lines, missing_steps
 from host_load import check_real_time, cpu_times, steal_fraction
 from launch_harness import AtlasLaunch, flood_figures, rss_kib
 from flood_commands import VALID_ELBOW_RAD
-from tutorial_atlas_control.bag_analysis import read_bag
+from tutorial_atlas_control.bag_reader import read_bag
 
 #: The issue's figures.
 FLOOD_S = 10.0

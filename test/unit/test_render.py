@@ -15,7 +15,7 @@ from PIL import Image
 
 from synthetic_bags import STANDING_HEIGHT_M, joint_state, odometry, write_bag, write_run_bag
 from tutorial_atlas_control.analyze_bag_cli import main as analyze_main
-from tutorial_atlas_control.bag_analysis import read_bag
+from tutorial_atlas_control.bag_reader import read_bag
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.render import (
     RenderError, RunStates, StateRenderer, check_output_path, parse_size, render_states,

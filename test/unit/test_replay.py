@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 from dataclasses import dataclass, field
@@ -15,8 +16,9 @@ import pytest
 
 from synthetic_bags import TYPESTORE, Record, joint_state, write_bag
 from tutorial_atlas_control import model as atlas_model
-from tutorial_atlas_control.bag_analysis import BagAnalysisError
+from tutorial_atlas_control.bag_reader import read_bag
 from tutorial_atlas_control.controller import hold_command, load_gains_yaml
+from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.replay import (
     EXIT_DEVIATES, GAINS_FILE, ReplayError, format_report, load_recording, main, replay_bag)
@@ -290,6 +292,27 @@ def test_bad_sim_config_is_an_error(tmp_path: Path) -> None:
         sim_config_record(0.0, {'timestep': 0.001}), joint_state(0.001, np.zeros(NUM_JOINTS))])
     with pytest.raises(ReplayError, match=r"sim_config lacks a valid 'time_to_unpin'"):
         load_recording(bag)
+
+
+@pytest.mark.parametrize(('text', 'reason'), [('{"timestep": 0.001', 'is not JSON'),
+                                               ('[0.001]', 'is not a JSON object')])
+def test_unparsable_sim_config_is_an_error(tmp_path: Path, text: str, reason: str) -> None:
+    message = _t('std_msgs/msg/String')(data=text)
+    config = Record('/atlas/sim_config', 'std_msgs/String', 0.0, message)
+    bag = write_bag(tmp_path / 'x.bag', [config, joint_state(0.001, np.zeros(NUM_JOINTS))])
+    with pytest.raises(ReplayError, match=rf'x\.bag: /atlas/sim_config {reason}'):
+        load_recording(bag)
+
+
+def test_recording_comes_from_one_reading_of_the_bag(full_run: Path, tmp_path: Path) -> None:
+    """Given the BagData, load_recording does not open the bag again for /atlas/sim_config."""
+    bag = tmp_path / 'once.bag'
+    shutil.copy(full_run, bag)
+    data = read_bag(bag)
+    bag.unlink()
+    recording = load_recording(bag, data)
+    assert recording.config.recorded
+    assert recording.config.time_to_unpin_s == TIME_TO_UNPIN_S
 
 
 def test_not_a_bag_is_an_error(tmp_path: Path) -> None:
