@@ -13,6 +13,8 @@ GROUND_TRUTH_ODOM = '/ground_truth_odom'
 IMU = '/atlas/imu'
 L_FOOT_CONTACT = '/atlas/l_foot_contact'
 R_FOOT_CONTACT = '/atlas/r_foot_contact'
+#: atlas_msgs/ControllerStatistics: the age of the command the robot obeys (DRCSim's).
+CONTROLLER_STATISTICS = '/atlas/controller_statistics'
 #: Latched JSON (timestep, time_to_unpin, model file and sha1, last reset): what replay needs.
 SIM_CONFIG = '/atlas/sim_config'
 ROSOUT = '/rosout'
