@@ -65,9 +65,10 @@ SETTLE_S = 1.0
 #: (0..0.8 rad in 4 s) adds up to ~0.03 rad of lag. An untracked joint is off by up to 0.8 rad.
 TRACKING_TOLERANCE_RAD = 0.1
 #: Ages the client's commands may show (steps): answered before the next step (1) or one
-#: step later (2); most steps must show one of these.
+#: step later (2). The median step must show one of these, and most steps (a loaded host
+#: delays a few answers further: 94% were 1 or 2 steps at a load average of 9 on 2 cores).
 ANSWER_AGES_STEPS = (1, 2)
-ONE_OR_TWO_STEPS_SHARE = 0.9
+ONE_OR_TWO_STEPS_SHARE = 0.8
 #: The client subscribes with queue_size 1, as DRCSim's did: when two states arrive
 #: together (the simulator sends in batches while it catches up) it answers the newer.
 ANSWERED_SHARE = 0.8
@@ -183,6 +184,7 @@ class CommandAgeTest(unittest.TestCase):
         measured = np.array([s.position[index] for s, _c in answered])
         self.assertGreater(measured.max() - measured.min(), 0.6, 'the joint moves with the sine')
         self.assertGreater(len(statistics), TRACKING_S * 900)  # every step by default
+        self.assertIn(int(np.median(ages)), ANSWER_AGES_STEPS)
         self.assertGreaterEqual(share, ONE_OR_TWO_STEPS_SHARE, f'command ages (steps: count) {counts}')
 
 
