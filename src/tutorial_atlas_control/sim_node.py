@@ -45,6 +45,7 @@ from std_msgs.msg import String
 from std_srvs.srv import Empty, EmptyResponse
 
 from tutorial_atlas_control import model as atlas_model
+from tutorial_atlas_control import topics
 from tutorial_atlas_control.commands import CommandDecoder, CommandError
 from tutorial_atlas_control.controller import gains_from_params
 from tutorial_atlas_control.controller_statistics import (
@@ -55,7 +56,6 @@ from tutorial_atlas_control.ros1_fields import FieldCursor
 from tutorial_atlas_control.simulator import (
     DEFAULT_TIME_TO_UNPIN_S, NS_PER_S, AtlasSimulator, ModeError, PhysicsDivergenceError,
     parse_mode)
-from tutorial_atlas_control import topics
 from tutorial_atlas_control.wire import (
     ControllerStatisticsWire, ImuWire, JointStateWire, OdometryWire, WireBatch, WrenchStampedWire,
     clock_bytes)
