@@ -23,8 +23,9 @@ Where this differs from 2.5.2, on purpose:
   DRCSim started from e_prev = 0, which kicks the joints with kd * e / dt on
   the first step after a command arrives (e.g. 10 * 0.1 / 0.001 = 1000 N m on
   a knee, then clamped to the effort limit).
-* 2.5.2 added the BDI AtlasSimInterface's feed-forward torque inside the final clamp
-  when its walking controller was on; there is no BDI controller here, so that term is 0.
+* Not a change of the law, a part left out: 2.5.2 also added the feed-forward torque of
+  the BDI AtlasSimInterface (its walking behaviours) inside the final clamp; there is no
+  BDI library here, so that term is always 0.
 
 The torque clamp here is the only place the effort limits are enforced (the
 MuJoCo motors have no ctrlrange).
