@@ -10,11 +10,13 @@ from pathlib import Path
 
 from harness import REPO_DIR, BenchError, log
 
+from tutorial_atlas_control import topics
+
 GAINS_YAML = REPO_DIR / 'config' / 'atlas_controller.yaml'
 SYNTHETIC_BAGS = REPO_DIR / 'test' / 'unit' / 'synthetic_bags.py'
 #: The topics bag_analysis.read_bag deserializes (the baseline reads the same ones).
-ANALYSIS_TOPICS = ('/atlas/joint_states', '/atlas/joint_commands', '/ground_truth_odom',
-                   '/atlas/control_mode')
+ANALYSIS_TOPICS = (topics.JOINT_STATES, topics.JOINT_COMMANDS, topics.GROUND_TRUTH_ODOM,
+                   topics.CONTROL_MODE)
 
 
 # ---------------------------------------------------------------------------- physics

@@ -32,8 +32,10 @@ import numpy as np
 from harness import READY_TIMEOUT_S, BenchError, Launch, Master, cpu_seconds, wait_until
 from probes import RawRecorder, clock_ns, header_stamp_ns, joint_state_effort
 
+from tutorial_atlas_control import topics
+from tutorial_atlas_control.units import NS_PER_S
+
 LATENCY_JOINT = 'neck_ay'
-NS_PER_S = 1_000_000_000
 JS_PROBE_TOPIC = '/tac_bench/js_probe'
 
 
@@ -59,13 +61,13 @@ def make_probes() -> Probes:
     warnings.filterwarnings('ignore', category=SyntaxWarning, module='rospy')
     warnings.filterwarnings('ignore', message='The publisher should be created')
     return Probes(
-        clock=RawRecorder('/clock'),
-        joint_states=RawRecorder('/atlas/joint_states'),
+        clock=RawRecorder(topics.CLOCK),
+        joint_states=RawRecorder(topics.JOINT_STATES),
         js_probe=RawRecorder(JS_PROBE_TOPIC),
         # Synchronous publishers: the publish() timestamp is then when the bytes leave.
-        command_pub=rospy.Publisher('/atlas/joint_commands', JointCommands, queue_size=None,
+        command_pub=rospy.Publisher(topics.JOINT_COMMANDS, JointCommands, queue_size=None,
                                     tcp_nodelay=True),
-        mode_pub=rospy.Publisher('/atlas/control_mode', String, queue_size=None),
+        mode_pub=rospy.Publisher(topics.CONTROL_MODE, String, queue_size=None),
     )
 
 
@@ -78,7 +80,7 @@ def _launch(master: Master, launch_file: str, work_dir: Path, name: str,
     return Launch(master, launch_file, args, work_dir / f'{name}.launch.log')
 
 
-def recorded_fraction(bag_dir: Path, topic: str = '/atlas/joint_states') -> float | None:
+def recorded_fraction(bag_dir: Path, topic: str = topics.JOINT_STATES) -> float | None:
     """Share of `topic`'s published messages that reached the bag, from the header seqs.
 
     The publisher numbers its messages (Header.seq); messages a subscriber queue dropped
@@ -110,7 +112,7 @@ def _wait_ready(master: Master, launch: Launch, probes: Probes) -> None:
     wait_until(lambda: probes.clock.count > start_count + 10, READY_TIMEOUT_S,
                'the simulator to publish /clock', alive=launch.check_alive)
     wait_until(lambda: all(any('recorder' in node for node in master.subscribers(topic))
-                           for topic in ('/clock', '/atlas/joint_states', '/atlas/imu')),
+                           for topic in (topics.CLOCK, topics.JOINT_STATES, topics.IMU)),
                READY_TIMEOUT_S, 'the recorder to subscribe', poll_s=0.2,
                alive=launch.check_alive)
 

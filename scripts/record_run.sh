@@ -5,30 +5,34 @@
 # BAG_DIR/atlas_<date-time>.bag; SIGINT (Ctrl-C) closes and indexes the bag.
 # atlas_recorder (default): the package's recorder, which never drops a message that arrived;
 # rosbag: Debian's `rosbag record`, which drops the oldest past 100 queued messages per topic.
+# Exit status: 1 when it cannot record, 2 on a bad command line.
 set -euo pipefail
+prog=record_run.sh
+fail() { echo "$prog: error: $1" >&2; exit "${2:-1}"; }
 # roslaunch appends __name:=... and __log:=...; they go to the recorder, not to the arguments.
 args=() ros_args=()
 for arg in "$@"; do
   case $arg in *:=*) ros_args+=("$arg") ;; *) args+=("$arg") ;; esac
 done
 set -- "${args[@]}"
-if [ $# -lt 1 ] || [ $# -gt 2 ] || [ "$1" = "-h" ] || [ "$1" = "--help" ]; then
-  sed -n '2,7p' "$0" | sed 's/^# \{0,1\}//'
-  [ $# -ge 1 ] && [ "$1" = "-h" -o "$1" = "--help" ] && exit 0 || exit 1
+if [ $# -ge 1 ] && { [ "$1" = "-h" ] || [ "$1" = "--help" ]; }; then
+  sed -n '2,8p' "$0" | sed 's/^# \{0,1\}//'
+  exit 0
 fi
+[ $# -ge 1 ] && [ $# -le 2 ] || fail "expected BAG_DIR [atlas_recorder|rosbag], got $# argument(s); see --help" 2
 bag_dir=$1
 recorder=${2:-atlas_recorder}
 case $recorder in
   atlas_recorder|rosbag) ;;
-  *) echo "record_run.sh: unknown recorder '$recorder' (expected atlas_recorder or rosbag)" >&2; exit 1 ;;
+  *) fail "unknown recorder '$recorder' (expected atlas_recorder or rosbag)" 2 ;;
 esac
-mkdir -p "$bag_dir" || { echo "record_run.sh: cannot create bag directory $bag_dir" >&2; exit 1; }
-TOPICS=(
-  /clock /atlas/joint_states /ground_truth_odom /atlas/imu /atlas/l_foot_contact
-  /atlas/r_foot_contact /atlas/joint_commands /atlas/control_mode /atlas/sim_config /rosout
-  /atlas/controller_statistics
-)
-echo "record_run.sh: recording to $bag_dir/atlas_<date-time>.bag with $recorder"
+# The list has one home, tutorial_atlas_control.topics, shared with the analysis and replay
+# that read these bags; a copy here would drift from it.
+topics=$(python3 -c 'from tutorial_atlas_control.topics import RECORDED_TOPICS; print(*RECORDED_TOPICS)' 2>/dev/null) \
+  || fail "cannot import tutorial_atlas_control.topics for the topic list; source ./env.sh (or the workspace's setup.bash) first"
+read -r -a TOPICS <<< "$topics"
+mkdir -p "$bag_dir" || fail "cannot create bag directory $bag_dir"
+echo "$prog: recording to $bag_dir/atlas_<date-time>.bag with $recorder"
 # exec: roslaunch's SIGINT must reach the recorder itself so that it closes the bag.
 case $recorder in
   atlas_recorder)

@@ -2,8 +2,10 @@
 """The tutorial end to end, headless: `run_demo.py [TRAJECTORY]` (see --help)."""
 
 import sys
+from pathlib import Path
 
-from tutorial_atlas_control.demo import main
+sys.path.append(str(Path(__file__).resolve().parent.parent / 'src'))  # a clone without catkin
+from tutorial_atlas_control.demo import main  # noqa: E402
 
 if __name__ == '__main__':
     sys.exit(main())

@@ -2,8 +2,10 @@
 """Play a trajectory of a YAML file on the simulated Atlas: traj_yaml.py YAML_FILE TRAJECTORY_NAME."""
 
 import sys
+from pathlib import Path
 
-from tutorial_atlas_control.traj_yaml_node import main
+sys.path.append(str(Path(__file__).resolve().parent.parent / 'src'))  # a clone without catkin
+from tutorial_atlas_control.traj_yaml_node import main  # noqa: E402
 
 if __name__ == '__main__':
     sys.exit(main())

@@ -14,9 +14,10 @@ from tutorial_atlas_control.bag_analysis import (
     analyze_bag,
 )
 from tutorial_atlas_control.bag_report import format_summary, plot_run, to_json, write_csv
+from tutorial_atlas_control.cli import argument_type, print_error
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.render import (
-    DEFAULT_FPS, DEFAULT_SIZE, check_output_path, parse_size, render_bag_video)
+    DEFAULT_FPS, DEFAULT_SIZE, check_output_path, parse_fps, parse_size, render_bag_video)
 
 PROG = 'analyze_bag.py'
 
@@ -81,9 +82,10 @@ def build_parser() -> argparse.ArgumentParser:
                              'wx wy wz) into this directory (created if needed)')
     parser.add_argument('--video', metavar='FILE.mp4',
                         help='render the run offscreen to this video: .mp4 (H.264) or .gif')
-    parser.add_argument('--fps', type=float, default=DEFAULT_FPS,
+    parser.add_argument('--fps', type=argument_type(parse_fps), default=DEFAULT_FPS,
                         help='video frames per second of sim time (default: %(default)g)')
-    parser.add_argument('--size', metavar='WxH', default='{}x{}'.format(*DEFAULT_SIZE),
+    parser.add_argument('--size', metavar='WxH', type=argument_type(parse_size),
+                        default='{}x{}'.format(*DEFAULT_SIZE),
                         help='video size in pixels (default: %(default)s)')
     return parser
 
@@ -93,8 +95,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         if args.video:  # fail on a bad output before reading and analyzing the bag
-            size = parse_size(args.size)
-            check_output_path(args.video, *size, args.fps)
+            check_output_path(args.video, *args.size, args.fps)
         analysis = analyze_bag(args.bag)
         print(to_json(analysis) if args.json else format_summary(analysis))
         if args.csv:
@@ -103,11 +104,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.plot:
             print(f'wrote {plot_run(analysis, args.plot)}', file=sys.stderr)
         if args.video:
-            video = render_bag_video(analysis.data, args.video, args.fps, size)
+            video = render_bag_video(analysis.data, args.video, args.fps, args.size)
             print(f'wrote {video.path} ({video.frames} frames at {video.fps:g} fps)',
                   file=sys.stderr)
     except AtlasControlError as err:
-        print(f'{PROG}: error: {err}', file=sys.stderr)
+        print_error(PROG, err)
         return 1
     except KeyboardInterrupt:
         return 130

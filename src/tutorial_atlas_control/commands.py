@@ -1,4 +1,4 @@
-"""Validation and merging of osrf_msgs/JointCommands, with DRCSim's semantics made safer.
+"""osrf_msgs/JointCommands: its arrays as numpy, decoding, checking and merging.
 
 DRCSim read the arrays by position and ignored `name`. We keep that for an empty
 `name` (the tutorial's joint order) and map by name otherwise, with or without the
@@ -12,14 +12,56 @@ from __future__ import annotations
 import functools
 import struct
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from tutorial_atlas_control.controller import FIELD_NAMES, JointCommandArrays
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.joints import JOINT_INDEX, NUM_JOINTS, bare_joint_name
+from tutorial_atlas_control.joints import NUM_JOINTS, joint_index
 from tutorial_atlas_control.ros1_fields import FieldCursor
+
+
+#: The array fields of osrf_msgs/JointCommands, in message order.
+FIELD_NAMES: tuple[str, ...] = (
+    'position', 'velocity', 'effort', 'kp_position', 'ki_position', 'kd_position',
+    'kp_velocity', 'i_effort_min', 'i_effort_max',
+)
+
+
+def _zeros() -> np.ndarray:
+    return np.zeros(NUM_JOINTS)
+
+
+@dataclass
+class JointCommandArrays:
+    """One JointCommands message as float64 (28,) arrays in the tutorial's joint order.
+
+    Units: position rad, velocity rad/s, effort N m; kp_position N m/rad,
+    ki_position N m/(rad s), kd_position N m s/rad, kp_velocity N m s/rad;
+    i_effort_min/max N m (bounds of the integral term's torque).
+    """
+
+    position: np.ndarray = field(default_factory=_zeros)
+    velocity: np.ndarray = field(default_factory=_zeros)
+    effort: np.ndarray = field(default_factory=_zeros)
+    kp_position: np.ndarray = field(default_factory=_zeros)
+    ki_position: np.ndarray = field(default_factory=_zeros)
+    kd_position: np.ndarray = field(default_factory=_zeros)
+    kp_velocity: np.ndarray = field(default_factory=_zeros)
+    i_effort_min: np.ndarray = field(default_factory=_zeros)
+    i_effort_max: np.ndarray = field(default_factory=_zeros)
+
+    @classmethod
+    def zeros(cls) -> JointCommandArrays:
+        """All fields 0: no target gains, no feed-forward, i.e. a limp robot."""
+        return cls()
+
+    def copy(self) -> JointCommandArrays:
+        """Deep copy (the arrays are copied, so the copy can be handed to another thread)."""
+        return JointCommandArrays(**{name: getattr(self, name).copy() for name in FIELD_NAMES})
+
+
+assert tuple(f.name for f in fields(JointCommandArrays)) == FIELD_NAMES
 
 
 #: Largest magnitude accepted per field; beyond it a value is a mistake, not a command, and
@@ -44,7 +86,7 @@ class CommandError(AtlasControlError):
 
 
 #: MAX_MAGNITUDE per field in FIELD_NAMES order (inf: no bound).
-_BOUNDS = np.array([MAX_MAGNITUDE.get(field, np.inf) for field in FIELD_NAMES])
+_BOUNDS = np.array([MAX_MAGNITUDE.get(name, np.inf) for name in FIELD_NAMES])
 _ALL_JOINTS = np.arange(NUM_JOINTS)
 _ALL_JOINTS.setflags(write=False)
 
@@ -68,7 +110,7 @@ def _indices_of(names: tuple[str, ...]) -> np.ndarray:
     indices = np.empty(len(names), dtype=np.intp)
     seen: set[int] = set()
     for slot, name in enumerate(names):
-        index = JOINT_INDEX.get(bare_joint_name(name))
+        index = joint_index(name)
         if index is None:
             raise CommandError(f'unknown joint name {name!r}')
         if index in seen:
@@ -110,7 +152,7 @@ def command_update(names: Sequence[str],
         CommandError: wrong array length, NaN/Inf, a value beyond MAX_MAGNITUDE,
             unknown or duplicate joint name.
     """
-    return _checked_update(joint_indices(names), [arrays.get(field, ()) for field in FIELD_NAMES])
+    return _checked_update(joint_indices(names), [arrays.get(name, ()) for name in FIELD_NAMES])
 
 
 def _checked_update(indices: np.ndarray, fields: Sequence[Sequence[float]]) -> CommandUpdate:

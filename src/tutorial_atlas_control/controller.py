@@ -33,25 +33,21 @@ MuJoCo motors have no ctrlrange).
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from tutorial_atlas_control import topics
+from tutorial_atlas_control.commands import JointCommandArrays
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
-
-#: The array fields of osrf_msgs/JointCommands, in message order.
-FIELD_NAMES: tuple[str, ...] = (
-    'position', 'velocity', 'effort', 'kp_position', 'ki_position', 'kd_position',
-    'kp_velocity', 'i_effort_min', 'i_effort_max',
-)
+from tutorial_atlas_control.units import finite_number
 
 #: Where the gains live on the parameter server (and in config/atlas_controller.yaml).
-GAINS_PARAM = 'atlas_controller/gains'
+GAINS_PARAM = topics.GAINS_PARAM
 GAIN_KEYS: tuple[str, ...] = ('p', 'i', 'd', 'i_clamp')
 LOAD_HINT = ('load the gains with `roslaunch tutorial_atlas_control atlas.launch` '
              'or `rosparam load config/atlas_controller.yaml`')
@@ -63,38 +59,6 @@ class GainsError(AtlasControlError):
 
 def _zeros() -> np.ndarray:
     return np.zeros(NUM_JOINTS)
-
-
-@dataclass
-class JointCommandArrays:
-    """One JointCommands message as float64 (28,) arrays in the tutorial's joint order.
-
-    Units: position rad, velocity rad/s, effort N m; kp_position N m/rad,
-    ki_position N m/(rad s), kd_position N m s/rad, kp_velocity N m s/rad;
-    i_effort_min/max N m (bounds of the integral term's torque).
-    """
-
-    position: np.ndarray = field(default_factory=_zeros)
-    velocity: np.ndarray = field(default_factory=_zeros)
-    effort: np.ndarray = field(default_factory=_zeros)
-    kp_position: np.ndarray = field(default_factory=_zeros)
-    ki_position: np.ndarray = field(default_factory=_zeros)
-    kd_position: np.ndarray = field(default_factory=_zeros)
-    kp_velocity: np.ndarray = field(default_factory=_zeros)
-    i_effort_min: np.ndarray = field(default_factory=_zeros)
-    i_effort_max: np.ndarray = field(default_factory=_zeros)
-
-    @classmethod
-    def zeros(cls) -> JointCommandArrays:
-        """All fields 0: no target gains, no feed-forward, i.e. a limp robot."""
-        return cls()
-
-    def copy(self) -> JointCommandArrays:
-        """Deep copy (the arrays are copied, so the copy can be handed to another thread)."""
-        return JointCommandArrays(**{name: getattr(self, name).copy() for name in FIELD_NAMES})
-
-
-assert tuple(f.name for f in fields(JointCommandArrays)) == FIELD_NAMES
 
 
 #: Gazebo's math::equal tolerance: AtlasPlugin ties the integral back only when the torque
@@ -205,11 +169,11 @@ def _gain_value(params: Mapping[str, Any], joint: str, key: str) -> float:
     entry = params.get(joint) if isinstance(params, Mapping) else None
     if not isinstance(entry, Mapping) or key not in entry:
         raise GainsError(f'parameter {name} is missing; {LOAD_HINT}')
-    value = entry[key]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise GainsError(f'parameter {name} is {value!r}, not a finite number; '
+    value = finite_number(entry[key])
+    if value is None:
+        raise GainsError(f'parameter {name} is {entry[key]!r}, not a finite number; '
                          'fix it in config/atlas_controller.yaml and reload it')
-    return float(value)
+    return value
 
 
 def gains_from_params(params: Mapping[str, Any]) -> Gains:

@@ -19,6 +19,8 @@ from pathlib import Path
 
 from tutorial_atlas_control.errors import AtlasControlError
 
+PROG = 'run_demo.py'
+
 PACKAGE_DIR = Path(__file__).resolve().parents[2]
 DEFAULT_TRAJECTORY_FILE = PACKAGE_DIR / 'trajectories' / 'Traj_data2.yaml'
 DEFAULT_BAG_DIR = Path.home() / '.ros' / 'tutorial_atlas_control' / 'bags'
@@ -182,7 +184,7 @@ def wait_sim_time(clock_type: type, seconds: float) -> None:
 
 def summarise(bag: Path, video_fps: float, video_size: tuple[int, int]) -> None:
     """Print the short summary; write the plot and (unless video_fps is 0) the video."""
-    from tutorial_atlas_control.bag_analysis import analyze_bag
+    from tutorial_atlas_control.bag_analysis import FALL_HEIGHT_M, analyze_bag
     from tutorial_atlas_control.bag_report import plot_run
     from tutorial_atlas_control.render import render_bag_video
 
@@ -191,7 +193,7 @@ def summarise(bag: Path, video_fps: float, video_size: tuple[int, int]) -> None:
     if analysis.fell is None:
         print('fall: unknown (no /ground_truth_odom in the bag)')
     elif analysis.fell:
-        print(f'the robot fell: pelvis below 0.5 m at t = {analysis.fall_time_s:.2f} s '
+        print(f'the robot fell: pelvis below {FALL_HEIGHT_M} m at t = {analysis.fall_time_s:.2f} s '
               'from bag start')
     else:
         print(f'the robot did not fall (lowest pelvis height {analysis.min_pelvis_height_m:.2f} m)')
@@ -212,8 +214,11 @@ def summarise(bag: Path, video_fps: float, video_size: tuple[int, int]) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
+    from tutorial_atlas_control.cli import argument_type, print_error
+    from tutorial_atlas_control.render import parse_size
+
     parser = argparse.ArgumentParser(
-        prog='run_demo.py', description=__doc__.split('\n\n')[0])
+        prog=PROG, description=__doc__.split('\n\n')[0])
     parser.add_argument('trajectory', nargs='?', default='step_and_fall',
                         help='trajectory name in the file (default: step_and_fall)')
     parser.add_argument('--file', type=Path, default=DEFAULT_TRAJECTORY_FILE,
@@ -225,25 +230,19 @@ def main(argv: list[str] | None = None) -> int:
                         help='simulator pace; 0 = as fast as possible (default: 1.0)')
     parser.add_argument('--video-fps', type=float, default=DEMO_VIDEO_FPS,
                         help='frame rate of the rendered video; 0 = no video (default: %(default)g)')
-    parser.add_argument('--video-size', default=DEMO_VIDEO_SIZE,
+    parser.add_argument('--video-size', type=argument_type(parse_size), default=DEMO_VIDEO_SIZE,
                         help='video size WxH in pixels (default: %(default)s)')
     args = parser.parse_args(argv)
     try:
-        from tutorial_atlas_control.render import RenderError, parse_size
-        try:
-            video_size = parse_size(args.video_size)
-        except RenderError:
-            raise DemoError(f'--video-size {args.video_size!r} is not WIDTHxHEIGHT in pixels, '
-                            'e.g. 480x360') from None
         from tutorial_atlas_control.trajectory import load_trajectory
         load_trajectory(args.file, args.trajectory)  # fail before starting anything
         bag = run_demo(args.trajectory, args.file, args.bag_dir.expanduser().resolve(),
                        args.real_time_factor, args.bag_dir.expanduser() / 'logs')
-        summarise(bag, args.video_fps, video_size)
+        summarise(bag, args.video_fps, args.video_size)
     except AtlasControlError as err:
-        print(f'demo: {err}', file=sys.stderr)
+        print_error(PROG, err)
         return 1
     except subprocess.TimeoutExpired as err:
-        print(f'demo: {err.cmd[2] if len(err.cmd) > 2 else err.cmd} timed out', file=sys.stderr)
+        print_error(PROG, f'{err.cmd[2] if len(err.cmd) > 2 else err.cmd} timed out')
         return 1
     return 0

@@ -22,3 +22,8 @@ JOINT_INDEX: dict[str, int] = {name: index for index, name in enumerate(JOINT_NA
 def bare_joint_name(name: str) -> str:
     """Return `name` without the Gazebo `atlas::` prefix, if it has one."""
     return name[len(ATLAS_PREFIX):] if name.startswith(ATLAS_PREFIX) else name
+
+
+def joint_index(name: str) -> int | None:
+    """Tutorial-order index of joint `name`, bare or `atlas::`-prefixed; None if not Atlas's."""
+    return JOINT_INDEX.get(bare_joint_name(name))

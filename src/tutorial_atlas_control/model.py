@@ -46,6 +46,7 @@ class AtlasModel:
     """A compiled model plus the index arrays that map it to the tutorial's joints."""
 
     model: mujoco.MjModel
+    path: Path                    # the MJCF it was compiled from: sim_config names and hashes it
     qpos_adr: np.ndarray          # (28,) int, qpos index of each joint in JOINT_NAMES order
     dof_adr: np.ndarray           # (28,) int, qvel/qfrc index
     lower_rad: np.ndarray         # (28,) position limits
@@ -112,6 +113,7 @@ def load_model(path: Path = MODEL_PATH) -> AtlasModel:
 
     return AtlasModel(
         model=model,
+        path=path,
         qpos_adr=frozen(model.jnt_qposadr[joint_ids].astype(np.intp)),
         dof_adr=frozen(model.jnt_dofadr[joint_ids].astype(np.intp)),
         lower_rad=frozen(model.jnt_range[joint_ids, 0].astype(np.float64)),

@@ -22,7 +22,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from tutorial_atlas_control import topics
 from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.units import finite_number
 
 if TYPE_CHECKING:  # pragma: no cover - typing only; mujoco is imported lazily
     from tutorial_atlas_control.bag_analysis import BagData
@@ -96,12 +98,23 @@ def parse_size(text: str) -> tuple[int, int]:
     try:
         width, height = (int(part) for part in parts)
     except ValueError:
-        raise RenderError(f'--size {text!r} is not WIDTHxHEIGHT in pixels, e.g. 640x480.') from None
+        raise RenderError(f'{text!r} is not WIDTHxHEIGHT in pixels, e.g. 640x480.') from None
     for side in (width, height):
         if not MIN_SIDE_PX <= side <= MAX_SIDE_PX:
-            raise RenderError(f'--size {text!r}: each side must be {MIN_SIDE_PX}..{MAX_SIDE_PX} '
-                              'pixels.')
+            raise RenderError(f'{text!r}: each side must be {MIN_SIDE_PX}..{MAX_SIDE_PX} pixels.')
     return width, height
+
+
+def parse_fps(text: str) -> float:
+    """A video frame rate (frames per s of sim time) within MIN_FPS..MAX_FPS.
+
+    Raises:
+        RenderError: not a number, or out of range.
+    """
+    fps = finite_number(text, allow_text=True)
+    if fps is None or not MIN_FPS <= fps <= MAX_FPS:
+        raise RenderError(f'{text!r} is out of range; choose {MIN_FPS:g}..{MAX_FPS:g} frames/s.')
+    return fps
 
 
 def check_output_path(path: Path | str, width: int, height: int, fps: float) -> Path:
@@ -175,11 +188,11 @@ def states_from_bag(data: BagData, fps: float = DEFAULT_FPS) -> RunStates:
     Raises:
         RenderError: the bag lacks /ground_truth_odom or /atlas/joint_states.
     """
-    from tutorial_atlas_control.joints import JOINT_INDEX, NUM_JOINTS
+    from tutorial_atlas_control.joints import NUM_JOINTS, joint_index
 
     pelvis, states = data.pelvis, data.joint_states
-    missing = [topic for topic, series in (('/ground_truth_odom', pelvis),
-                                           ('/atlas/joint_states', states))
+    missing = [topic for topic, series in ((topics.GROUND_TRUTH_ODOM, pelvis),
+                                           (topics.JOINT_STATES, states))
                if series is None or not len(series.t_s)]
     if missing:
         raise RenderError(f'{data.path} has no {" and no ".join(missing)}; the video needs the '
@@ -188,15 +201,15 @@ def states_from_bag(data: BagData, fps: float = DEFAULT_FPS) -> RunStates:
     start_s = max(float(pelvis.t_s[0]), float(states.t_s[0]))
     end_s = min(float(pelvis.t_s[-1]), float(states.t_s[-1]))
     if end_s < start_s:
-        raise RenderError(f'{data.path}: /ground_truth_odom and /atlas/joint_states do not '
-                          'overlap in time; nothing to render.')
+        raise RenderError(f'{data.path}: {topics.GROUND_TRUTH_ODOM} and {topics.JOINT_STATES} '
+                          'do not overlap in time; nothing to render.')
     count = int(np.floor((end_s - start_s) * fps + 1e-9)) + 1
     t_s = start_s + np.arange(count) / fps
     position, quat = _interpolate_pose(t_s, pelvis.t_s, pelvis.position_m, pelvis.orientation_xyzw)
     rows = np.clip(np.searchsorted(states.t_s, t_s, side='right') - 1, 0, len(states.t_s) - 1)
     joints = np.full((count, NUM_JOINTS), np.nan)
     for column, name in enumerate(states.names):
-        index = JOINT_INDEX.get(name)
+        index = joint_index(name)
         if index is not None:
             joints[:, index] = states.position[rows, column]
     return RunStates(t_s, position, quat, joints)

@@ -2,10 +2,11 @@
 
 The simulator publishes, after every 1 ms step k, the joint state at sim time k·dt with
 `effort` = the torque applied during that step. Replaying therefore means: start from the
-state the simulator started from, and for each recorded step set `data.ctrl` to the
-recorded effort and call `mj_step`, pinning the torso as `/atlas/sim_config` says
-(`time_to_unpin` after `last_reset_time`). The positions and velocities are float64,
-serialized exactly, so the same MuJoCo build reproduces them bit for bit.
+state the simulator started from and drive the same :meth:`AtlasSimulator.step` with each
+recorded effort in place of the controller law's torque, so the torso pin
+(`time_to_unpin` after `last_reset_time`, from `/atlas/sim_config`) and the divergence check
+are the node's own code. The positions and velocities are float64, serialized exactly, so
+the same MuJoCo build reproduces them bit for bit.
 
 Two details make that exact:
 * The replay starts at the reset the simulator started from (`last_reset_time`), never
@@ -22,10 +23,7 @@ Times in the report are sim time (s), as stamped by the simulator.
 from __future__ import annotations
 
 import argparse
-import hashlib
 import json
-import math
-import sys
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -33,9 +31,16 @@ from typing import Any
 
 import numpy as np
 
+from tutorial_atlas_control import model as atlas_model
+from tutorial_atlas_control import topics
 from tutorial_atlas_control.bag_analysis import BagData, read_bag
+from tutorial_atlas_control.cli import argument_type, print_error
+from tutorial_atlas_control.controller import load_gains_yaml
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.simulator import (
+    DEFAULT_TIME_TO_UNPIN_S, AtlasSimulator, PhysicsDivergenceError)
+from tutorial_atlas_control.units import NS_PER_S, finite_number
 
 __all__ = [
     'DEFAULT_TOLERANCE',
@@ -52,18 +57,16 @@ __all__ = [
 ]
 
 PROG = 'replay_bag.py'
-SIM_CONFIG_TOPIC = '/atlas/sim_config'
-JOINT_STATES_TOPIC = '/atlas/joint_states'
-ODOM_TOPIC = '/ground_truth_odom'
+SIM_CONFIG_TOPIC = topics.SIM_CONFIG
+JOINT_STATES_TOPIC = topics.JOINT_STATES
+ODOM_TOPIC = topics.GROUND_TRUTH_ODOM
 #: The replay counts as reproducing the run when every deviation is at most this.
 DEFAULT_TOLERANCE = 1e-6
-#: Defaults of the simulator when the bag predates /atlas/sim_config (s).
-DEFAULT_TIME_TO_UNPIN_S = 1.0
+#: When the bag predates /atlas/sim_config: the simulator's defaults, no reset after start (s).
 DEFAULT_LAST_RESET_S = 0.0
 GAINS_FILE = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
 #: Exit status when the replay ran but deviates beyond the tolerance.
 EXIT_DEVIATES = 3
-NS_PER_S = 1_000_000_000
 #: A stamp further than this fraction of a step from the step grid is not a simulator stamp.
 _GRID_TOLERANCE_STEPS = 1e-3
 
@@ -341,143 +344,158 @@ def _segment(recording: Recording, steps: np.ndarray, reset_step: int, dt_s: flo
     return rows
 
 
+class _OdomProbe:
+    """Collects the replayed pelvis pose at the steps /ground_truth_odom was recorded."""
+
+    def __init__(self, odom_steps: np.ndarray, reset_step: int, last_step: int) -> None:
+        self.row_at = {int(step): row for row, step in enumerate(odom_steps.tolist())
+                       if reset_step < step <= last_step}
+        self.rows: list[int] = []
+        self.xpos: list[np.ndarray] = []
+        self.xquat: list[np.ndarray] = []
+
+    def after_step(self, sim: AtlasSimulator, step: int) -> None:
+        """Called after replaying step `step` (the state at sim time step * dt)."""
+        # After mj_step, xpos/xquat describe the step's start; the simulator stamps its
+        # odometry with that time, so the pose belongs to the previous step's number.
+        row = self.row_at.get(step - 1)
+        if row is not None:
+            body = sim.atlas.pelvis_body_id
+            self.rows.append(row)
+            self.xpos.append(sim.data.xpos[body].copy())
+            self.xquat.append(sim.data.xquat[body].copy())
+
+    def deviations(self, recording: Recording, odom_steps: np.ndarray,
+                   step_ns: int) -> tuple[Deviation, Deviation]:
+        """(pelvis position, pelvis orientation) deviations over the collected poses."""
+        rows = np.array(self.rows, dtype=np.int64)
+        steps = odom_steps[rows]
+        xpos = np.array(self.xpos).reshape(-1, 3)
+        xquat = np.array(self.xquat).reshape(-1, 4)
+        position = _deviation(xpos, recording.odom_position_m[rows], steps, step_ns)
+        angles = (_quat_angle_rad(xquat, recording.odom_quat_wxyz[rows])
+                  if len(rows) else np.empty(0))
+        return position, _deviation(angles, np.zeros(len(angles)), steps, step_ns)
+
+
+def _check_model(config: SimConfig, sim: AtlasSimulator, warnings: list[str]) -> bool | None:
+    """Whether the model is the recorded one (None: not recorded); a timestep must match.
+
+    Raises:
+        ReplayError: the run was simulated with another timestep.
+    """
+    if config.timestep_s is not None and config.timestep_s != sim.dt_s:
+        raise ReplayError(f'the run was simulated with timestep {config.timestep_s} s but '
+                          f'{sim.atlas_path.name} has {sim.dt_s} s; replay with the same model.')
+    if not config.model_sha1:
+        return None
+    if sim.atlas_sha1 != config.model_sha1:
+        warnings.append(f'{sim.atlas_path} differs from the model the run was recorded with '
+                        f'(sha1 {config.model_sha1[:12]}); expect deviations.')
+        return False
+    return True
+
+
+def _reset_step(config: SimConfig, step_ns: int) -> int:
+    """The step number of the reset the replay starts from."""
+    reset_ns = int(round(config.last_reset_time_s * NS_PER_S))
+    if reset_ns % step_ns:
+        raise ReplayError(f'last_reset_time {config.last_reset_time_s} s is not on the step grid.')
+    return reset_ns // step_ns
+
+
+def _recreate_prefix(sim: AtlasSimulator, config: SimConfig, reset_step: int, first_step: int,
+                     first_effort_nm: np.ndarray, probe: _OdomProbe,
+                     warnings: list[str]) -> int:
+    """Step the simulator's Stand law up to the first recorded step; return how many steps.
+
+    Raises:
+        ReplayError: steps are missing after a mid-run reset (the mode then is unknown).
+    """
+    prefix = first_step - reset_step - 1
+    if prefix <= 0:
+        return 0
+    if reset_step != 0:
+        raise ReplayError(
+            f'the recording starts {prefix} steps after the reset at '
+            f'{config.last_reset_time_s:.3f} s, and the control mode then is unknown; '
+            'only the steps before the recording of a run that starts at t = 0 can be '
+            're-created (Stand mode).')
+    for step in range(1, first_step):
+        _step(sim)
+        probe.after_step(sim, step)
+    # The first recorded torque must be what the Stand law gives, or the run had left
+    # Stand mode (or used other gains) before the recorder started.
+    mismatch = float(np.max(np.abs(sim.next_law_torque() - first_effort_nm)))
+    if mismatch > 0.0:
+        warnings.append(
+            f'the first recorded torque differs by up to {mismatch:.3g} N m from the '
+            'Stand-mode law: the mode or the gains changed before the recording began, '
+            f'so the {prefix} steps before it cannot be re-created exactly.')
+    return prefix
+
+
+def _step(sim: AtlasSimulator, torque_nm: np.ndarray | None = None) -> None:
+    """One simulator step; a divergence becomes a ReplayError saying what it means here."""
+    try:
+        sim.step(torque_nm)
+    except PhysicsDivergenceError as err:
+        raise ReplayError(
+            f'in the replay, {err}; if the recorded run diverged too, the simulator reset the '
+            f'robot there, which the bag does not mark ({SIM_CONFIG_TOPIC} is not re-published '
+            'on a divergence reset).') from None
+
+
+def _replay_recorded(sim: AtlasSimulator, steps: np.ndarray, effort_nm: np.ndarray,
+                     probe: _OdomProbe) -> tuple[np.ndarray, np.ndarray]:
+    """Apply the recorded torques; the joint positions and velocities after each step."""
+    position = np.empty((len(steps), NUM_JOINTS))
+    velocity = np.empty((len(steps), NUM_JOINTS))
+    for index, step in enumerate(steps.tolist()):
+        _step(sim, effort_nm[index])
+        position[index] = sim.joint_positions()
+        velocity[index] = sim.joint_velocities()
+        probe.after_step(sim, step)
+    return position, velocity
+
+
 def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
            gains_file: Path = GAINS_FILE) -> ReplayResult:
     """Re-simulate `recording` and measure how far it strays from the recorded run.
 
     Raises:
         ReplayError: unsupported recording (timestep differs from the model's; steps before
-            the recording after a mid-run reset; nothing after the last reset).
+            the recording after a mid-run reset; nothing after the last reset; divergence).
     """
-    import mujoco
-
-    from tutorial_atlas_control import model as atlas_model
-    from tutorial_atlas_control.controller import load_gains_yaml
-    from tutorial_atlas_control.simulator import DIVERGENCE_WARNINGS, AtlasSimulator
-
     warnings = list(recording.warnings)
     config = recording.config
-    atlas = atlas_model.load_model()
-    model = atlas.model
-    dt_s = float(model.opt.timestep)
-    if config.timestep_s is not None and config.timestep_s != dt_s:
-        raise ReplayError(f'the run was simulated with timestep {config.timestep_s} s but '
-                          f'{atlas_model.MODEL_PATH.name} has {dt_s} s; replay with the same '
-                          'model.')
-    sha1_matches = None
-    if config.model_sha1:
-        sha1 = hashlib.sha1(atlas_model.MODEL_PATH.read_bytes()).hexdigest()
-        sha1_matches = sha1 == config.model_sha1
-        if not sha1_matches:
-            warnings.append(f'{atlas_model.MODEL_PATH} differs from the model the run was '
-                            f'recorded with (sha1 {config.model_sha1[:12]}); expect deviations.')
-    step_ns = int(round(dt_s * NS_PER_S))
-    reset_ns = int(round(config.last_reset_time_s * NS_PER_S))
-    if reset_ns % step_ns:
-        raise ReplayError(f'last_reset_time {config.last_reset_time_s} s is not on the step grid.')
-    reset_step = reset_ns // step_ns
-    pin_until_ns = reset_ns + int(round(config.time_to_unpin_s * NS_PER_S))
-    pin_at_reset = config.time_to_unpin_s > 0.0
+    sim = AtlasSimulator(atlas_model.load_model(), load_gains_yaml(gains_file),
+                         config.time_to_unpin_s)
+    sha1_matches = _check_model(config, sim, warnings)
+    step_ns = sim.step_ns
+    reset_step = _reset_step(config, step_ns)
+    sim.reset_simulation(reset_step * step_ns)
     if recording.resets_in_bag:
         warnings.append(f'the bag holds {recording.resets_in_bag} reset(s); replaying the last '
                         f'segment, from the reset at {config.last_reset_time_s:.3f} s.')
-
     all_steps = _to_steps(recording.state_stamp_ns, step_ns, JOINT_STATES_TOPIC)
-    odom_steps_all = _to_steps(recording.odom_stamp_ns, step_ns, ODOM_TOPIC)
-    rows = _segment(recording, all_steps, reset_step, dt_s, warnings)
-    steps = all_steps[rows]
-    effort = recording.effort_nm[rows]
-    first_step = int(steps[0])
-    prefix = first_step - reset_step - 1
-
-    odom_row = {int(step): row for row, step in enumerate(odom_steps_all.tolist())
-                if reset_step < step <= int(steps[-1])}
-    odom_done: list[tuple[int, np.ndarray, np.ndarray]] = []
-
-    def check_odom(data: mujoco.MjData, step: int) -> None:
-        row = odom_row.get(step)
-        if row is not None:
-            # After mj_step, xpos/xquat describe the step's start; the simulator stamps its
-            # odometry with that time, so the caller passes the previous step's number.
-            odom_done.append((row, data.xpos[atlas.pelvis_body_id].copy(),
-                              data.xquat[atlas.pelvis_body_id].copy()))
-
-    sim = None
-    if prefix > 0:
-        if reset_step != 0:
-            raise ReplayError(
-                f'the recording starts {prefix} steps after the reset at '
-                f'{config.last_reset_time_s:.3f} s, and the control mode then is unknown; '
-                'only the steps before the recording of a run that starts at t = 0 can be '
-                're-created (Stand mode).')
-        sim = AtlasSimulator(atlas, load_gains_yaml(gains_file), config.time_to_unpin_s)
-        data = sim.data
-        for step in range(1, first_step):
-            sim.step()
-            check_odom(data, step - 1)
-        # The first recorded torque must be what the Stand law gives, or the run had left
-        # Stand mode (or used other gains) before the recorder started.
-        snapshot_spec = mujoco.mjtState.mjSTATE_INTEGRATION
-        snapshot = np.empty(mujoco.mj_stateSize(model, snapshot_spec))
-        mujoco.mj_getState(model, data, snapshot, snapshot_spec)
-        sim.step()
-        predicted = sim.torque_nm.copy()
-        mujoco.mj_setState(model, data, snapshot, snapshot_spec)
-        mismatch = float(np.max(np.abs(predicted - effort[0])))
-        if mismatch > 0.0:
-            warnings.append((
-                f'the first recorded torque differs by up to {mismatch:.3g} N m from the '
-                'Stand-mode law: the mode or the gains changed before the recording began, '
-                f'so the {prefix} steps before it cannot be re-created exactly.'))
-    else:
-        data = mujoco.MjData(model)
-        atlas_model.reset_to_initial(atlas, data)
-        data.time = reset_ns / NS_PER_S
-        atlas_model.set_pelvis_pinned(atlas, data, pin_at_reset)
-    pinned = bool(data.eq_active[atlas.pin_eq_id])
-
-    position = np.empty((len(steps), NUM_JOINTS))
-    velocity = np.empty((len(steps), NUM_JOINTS))
-    qpos_adr, dof_adr = atlas.qpos_adr, atlas.dof_adr
-    ctrl, qpos, qvel = data.ctrl, data.qpos, data.qvel
-    for index, step in enumerate(steps.tolist()):
-        if pinned and (step - 1) * step_ns >= pin_until_ns:
-            atlas_model.set_pelvis_pinned(atlas, data, False)
-            pinned = False
-        ctrl[:] = effort[index]
-        mujoco.mj_step(model, data)
-        position[index] = qpos[qpos_adr]
-        velocity[index] = qvel[dof_adr]
-        check_odom(data, step - 1)
-        diverged = [what for warning, what in DIVERGENCE_WARNINGS
-                    if data.warning[warning].number > 0]
-        if diverged or not np.isfinite(qpos).all():
-            raise ReplayError(
-                f'the replay diverged ({", ".join(diverged) or "non-finite state"}) at '
-                f'{step * dt_s:.3f} s; if the recorded run did too, the simulator reset the robot '
-                'there, which the bag does not mark (/atlas/sim_config is not re-published on a '
-                'divergence reset).')
-
-    recorded_position = recording.position_rad[rows]
-    recorded_velocity = recording.velocity_rad_s[rows]
-    pelvis_position = pelvis_orientation = None
-    if recording.has_odom:
-        odom_rows = np.array([row for row, _, _ in odom_done], dtype=np.int64)
-        odom_steps = odom_steps_all[odom_rows]
-        replayed_xpos = np.array([xpos for _, xpos, _ in odom_done]).reshape(-1, 3)
-        replayed_xquat = np.array([xquat for _, _, xquat in odom_done]).reshape(-1, 4)
-        pelvis_position = _deviation(replayed_xpos, recording.odom_position_m[odom_rows],
-                                     odom_steps, step_ns)
-        angles = (_quat_angle_rad(replayed_xquat, recording.odom_quat_wxyz[odom_rows])
-                  if len(odom_rows) else np.empty(0))
-        pelvis_orientation = _deviation(angles, np.zeros(len(angles)), odom_steps, step_ns)
+    odom_steps = _to_steps(recording.odom_stamp_ns, step_ns, ODOM_TOPIC)
+    rows = _segment(recording, all_steps, reset_step, sim.dt_s, warnings)
+    steps, effort = all_steps[rows], recording.effort_nm[rows]
+    probe = _OdomProbe(odom_steps, reset_step, int(steps[-1]))
+    prefix = _recreate_prefix(sim, config, reset_step, int(steps[0]), effort[0], probe, warnings)
+    position, velocity = _replay_recorded(sim, steps, effort, probe)
+    pelvis_position, pelvis_orientation = (probe.deviations(recording, odom_steps, step_ns)
+                                           if recording.has_odom else (None, None))
     return ReplayResult(
         bag=recording.path, config=config, resets_in_bag=recording.resets_in_bag,
-        model_sha1_matches=sha1_matches, start_time_s=reset_ns / NS_PER_S,
-        end_time_s=int(steps[-1]) * step_ns / NS_PER_S, reconstructed_steps=max(prefix, 0),
+        model_sha1_matches=sha1_matches, start_time_s=reset_step * step_ns / NS_PER_S,
+        end_time_s=int(steps[-1]) * step_ns / NS_PER_S, reconstructed_steps=prefix,
         recorded_steps=len(steps),
-        joint_position=_deviation(position, recorded_position, steps, step_ns, JOINT_NAMES),
-        joint_velocity=_deviation(velocity, recorded_velocity, steps, step_ns, JOINT_NAMES),
+        joint_position=_deviation(position, recording.position_rad[rows], steps, step_ns,
+                                  JOINT_NAMES),
+        joint_velocity=_deviation(velocity, recording.velocity_rad_s[rows], steps, step_ns,
+                                  JOINT_NAMES),
         pelvis_position=pelvis_position, pelvis_orientation=pelvis_orientation,
         tolerance=tolerance, warnings=warnings)
 
@@ -547,7 +565,7 @@ pelvis_position {max (m), time, samples}, pelvis_orientation {max (rad), time, s
 
 Exit status: 0 when every deviation is within --tolerance, 3 when the replay deviates,
 1 when the bag cannot be read or replayed (missing topics, unsupported resets), 2 on bad
-arguments.
+arguments (e.g. a --tolerance that is not a number >= 0).
 
 Example: rosrun tutorial_atlas_control replay_bag.py ~/.ros/tutorial_atlas_control/bags/atlas_*.bag
 """
@@ -559,22 +577,26 @@ def build_parser() -> argparse.ArgumentParser:
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument('bag', metavar='BAG', help='the ROS 1 .bag file of the run')
     parser.add_argument('--json', action='store_true', help='print one JSON object instead')
-    parser.add_argument('--tolerance', type=float, default=DEFAULT_TOLERANCE,
+    parser.add_argument('--tolerance', type=argument_type(_tolerance), default=DEFAULT_TOLERANCE,
                         help='largest deviation (rad, rad/s, m) that still counts as '
                              'reproduced (default: %(default)g)')
     return parser
 
 
+def _tolerance(text: str) -> float:
+    tolerance = finite_number(text, allow_text=True)
+    if tolerance is None or tolerance < 0.0:
+        raise ReplayError(f'{text!r} is not a number >= 0')
+    return tolerance
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status."""
     args = build_parser().parse_args(argv)
-    if not (math.isfinite(args.tolerance) and args.tolerance >= 0.0):
-        print(f'{PROG}: error: --tolerance must be a number >= 0.', file=sys.stderr)
-        return 1
     try:
         result = replay_bag(args.bag, args.tolerance)
     except AtlasControlError as err:
-        print(f'{PROG}: error: {err}', file=sys.stderr)
+        print_error(PROG, err)
         return 1
     except KeyboardInterrupt:
         return 130

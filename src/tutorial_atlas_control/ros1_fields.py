@@ -12,7 +12,8 @@ import struct
 
 import numpy as np
 
-NS_PER_S = 1_000_000_000
+from tutorial_atlas_control.units import NS_PER_S
+
 _U32 = struct.Struct('<I')
 
 

@@ -54,8 +54,8 @@ from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.ros1_fields import FieldCursor
 from tutorial_atlas_control.simulator import (
-    DEFAULT_TIME_TO_UNPIN_S, NS_PER_S, AtlasSimulator, ModeError, PhysicsDivergenceError,
-    parse_mode)
+    DEFAULT_TIME_TO_UNPIN_S, AtlasSimulator, ModeError, PhysicsDivergenceError, parse_mode)
+from tutorial_atlas_control.units import NS_PER_S, finite_number
 from tutorial_atlas_control.wire import (
     ControllerStatisticsWire, ImuWire, JointStateWire, OdometryWire, WireBatch, WrenchStampedWire,
     clock_bytes)
@@ -64,9 +64,8 @@ NODE_NAME = 'atlas_sim'
 #: Seconds between repeats of the same refusal warning.
 WARN_THROTTLE_S = 2.0
 #: When the loop falls further behind wall time than this, it stops trying to catch up.
-#: Below it, the loop runs flat out (sending in batches) until it is back on schedule:
-#: a loaded machine's short stalls then cost no sim time (0.1 s lost ~3% under the
-#: reliability test's load, 1.0 s none).
+#: Below it, the loop runs flat out (sending in batches) until it is back on schedule,
+#: so a loaded machine's short stalls cost no sim time.
 MAX_LAG_S = 1.0
 #: A divergence this soon (s of sim time) after the previous one's reset is "in a row";
 #: that many in a row means the model itself is unstable and the node stops.
@@ -76,14 +75,12 @@ MAX_DIVERGENCES_IN_A_ROW = 3
 MAX_PENDING_COMMANDS = 10_000
 #: Viewer refresh period (s, wall).
 VIEWER_PERIOD_S = 1.0 / 60.0
-WORLD_FRAME = 'world'
 #: At real_time_factor 0 the loop sends what it published at most this often (s, wall);
 #: paced runs send after every step while on schedule.
 FLUSH_PERIOD_S = 0.001
 #: A paced run more than CATCH_UP_LAG_S behind wall time sends at most every
 #: CATCH_UP_FLUSH_PERIOD_S (s, wall) until it has caught up: each send is a syscall per topic
-#: and subscriber, and on a loaded 2-core machine those syscalls are what kept it behind
-#: (3 x 2 kHz of commands: real-time factor 0.77-0.93 when sending every step, 0.97-1.005).
+#: and subscriber, and on a loaded machine those syscalls are what keeps it behind.
 CATCH_UP_LAG_S = 0.005
 CATCH_UP_FLUSH_PERIOD_S = 0.004
 
@@ -98,11 +95,10 @@ def steps_between(rate_hz: float, dt_s: float) -> int:
 class RawJointCommands(genpy.Message):
     """osrf_msgs/JointCommands as it arrives, left undecoded by rospy.
 
-    genpy's decoder costs ~60 us per message in the receiving thread, under the GIL the
-    stepping loop needs: at thousands of commands a second the simulator fell to 0.1-0.3
-    of real time. This class keeps the real type, MD5 and definition, so the subscription
-    is registered, negotiated and shown as osrf_msgs/JointCommands; the loop decodes
-    `raw` itself with commands.CommandDecoder (numpy views, names memoized).
+    genpy's decoder would run in the receiving thread, under the GIL the stepping loop
+    needs, and at thousands of commands a second starve the loop. This class keeps the real
+    type, MD5 and definition, so the subscription is registered, negotiated and shown as
+    osrf_msgs/JointCommands; the loop decodes `raw` itself with commands.CommandDecoder.
     """
 
     _type = JointCommands._type
@@ -136,37 +132,15 @@ class SimNode:
         self._divergences_in_a_row = 0
         self._last_divergence_ns: int | None = None
 
-        # The loop serializes these itself (wire.py) and writes them to the subscriber
-        # connections in batches. queue_size=None: plain synchronous connections, without
-        # rospy's per-message writer-thread handoff (QueuedConnection.write_data's
-        # time.sleep(0), 5 per step). A subscriber that cannot keep up now slows the loop
-        # (TCP back-pressure) instead of losing messages, until it has accepted nothing for
-        # wire.SEND_TIMEOUT_S and is dropped.
-        with warnings.catch_warnings():
-            warnings.simplefilter('ignore', SyntaxWarning)  # rospy: "explicit queue_size"
-            self.clock_pub = rospy.Publisher('/clock', Clock, queue_size=None)
-            self.joint_state_pub = rospy.Publisher('/atlas/joint_states', JointState,
-                                                   queue_size=None)
-            self.odom_pub = rospy.Publisher('/ground_truth_odom', Odometry, queue_size=None)
-            self.imu_pub = rospy.Publisher('/atlas/imu', Imu, queue_size=None)
-            self.l_contact_pub = rospy.Publisher('/atlas/l_foot_contact', WrenchStamped,
-                                                 queue_size=None)
-            self.r_contact_pub = rospy.Publisher('/atlas/r_foot_contact', WrenchStamped,
-                                                 queue_size=None)
+        self._advertise()
         self.batch = WireBatch()
-        # Latched, recorded in every bag: what offline replay needs to re-create the run.
-        self.config_pub = rospy.Publisher('/atlas/sim_config', String, queue_size=1, latch=True)
         self._publish_config()
-
         self.joint_state = JointStateWire(JOINT_NAMES)
-        self.odom = OdometryWire(WORLD_FRAME, 'pelvis')
-        self.imu = ImuWire('pelvis')
+        self.odom = OdometryWire(topics.WORLD_FRAME, topics.PELVIS_FRAME)
+        self.imu = ImuWire(topics.PELVIS_FRAME)
         self.contacts = ((WrenchStampedWire('l_foot'), 'l', self.l_contact_pub),
                          (WrenchStampedWire('r_foot'), 'r', self.r_contact_pub))
-        data = sim.data
-        self.sensors = {name: data.sensor(name).data for name in (
-            'imu_orientation', 'imu_angular_velocity', 'imu_linear_acceleration',
-            'l_foot_force', 'l_foot_torque', 'r_foot_force', 'r_foot_torque')}
+        self.sensors = {name: sim.data.sensor(name).data for name in atlas_model.SENSOR_NAMES}
         self._pelvis_velocity = np.zeros(6)
         self._init_controller_statistics()
 
@@ -175,14 +149,41 @@ class SimNode:
         self.decoder = CommandDecoder()
         self.pending_commands: collections.deque[bytes] = collections.deque(
             maxlen=MAX_PENDING_COMMANDS)
-        rospy.Subscriber('/atlas/joint_commands', RawJointCommands, self.on_joint_commands,
+        self._subscribe()
+
+    def _advertise(self) -> None:
+        """The publishers; the loop serializes their messages itself (wire.py).
+
+        queue_size=None: plain synchronous connections, without rospy's per-message
+        writer-thread handoff. A subscriber that cannot keep up slows the loop (TCP
+        back-pressure) instead of losing messages, until it has accepted nothing for
+        wire.SEND_TIMEOUT_S and is dropped.
+        """
+        with warnings.catch_warnings():
+            warnings.simplefilter('ignore', SyntaxWarning)  # rospy: "explicit queue_size"
+            self.clock_pub = rospy.Publisher(topics.CLOCK, Clock, queue_size=None)
+            self.joint_state_pub = rospy.Publisher(topics.JOINT_STATES, JointState,
+                                                   queue_size=None)
+            self.odom_pub = rospy.Publisher(topics.GROUND_TRUTH_ODOM, Odometry, queue_size=None)
+            self.imu_pub = rospy.Publisher(topics.IMU, Imu, queue_size=None)
+            self.l_contact_pub = rospy.Publisher(topics.L_FOOT_CONTACT, WrenchStamped,
+                                                 queue_size=None)
+            self.r_contact_pub = rospy.Publisher(topics.R_FOOT_CONTACT, WrenchStamped,
+                                                 queue_size=None)
+        # Latched, recorded in every bag: what offline replay needs to re-create the run.
+        self.config_pub = rospy.Publisher(topics.SIM_CONFIG, String, queue_size=1, latch=True)
+
+    def _subscribe(self) -> None:
+        """The command and mode subscriptions and gazebo_ros's services."""
+        rospy.Subscriber(topics.JOINT_COMMANDS, RawJointCommands, self.on_joint_commands,
                          queue_size=10, tcp_nodelay=True)
-        rospy.Subscriber('/atlas/control_mode', String, self.on_control_mode, queue_size=10)
+        rospy.Subscriber(topics.CONTROL_MODE, String, self.on_control_mode, queue_size=10)
         self.services = [
-            rospy.Service('/gazebo/reset_world', Empty, self._service(self.reset_world)),
-            rospy.Service('/gazebo/reset_simulation', Empty, self._service(self.reset_simulation)),
-            rospy.Service('/gazebo/pause_physics', Empty, self._service(self.pause)),
-            rospy.Service('/gazebo/unpause_physics', Empty, self._service(self.unpause)),
+            rospy.Service(topics.RESET_WORLD_SERVICE, Empty, self._service(self.reset_world)),
+            rospy.Service(topics.RESET_SIMULATION_SERVICE, Empty,
+                          self._service(self.reset_simulation)),
+            rospy.Service(topics.PAUSE_PHYSICS_SERVICE, Empty, self._service(self.pause)),
+            rospy.Service(topics.UNPAUSE_PHYSICS_SERVICE, Empty, self._service(self.unpause)),
         ]
 
     def _publish_config(self) -> None:
@@ -193,9 +194,8 @@ class SimNode:
     def on_joint_commands(self, msg: RawJointCommands) -> None:
         """Queue the raw message for the loop, which decodes it before its next step.
 
-        Nothing else happens in rospy's receiving thread: decoding there (~40 us of
-        Python and numpy per message) made three 2 kHz publishers' threads and the loop
-        fight over the GIL, and the simulator fell to a third of real time.
+        Nothing else happens in rospy's receiving thread: decoding there would make several
+        fast publishers' threads and the loop fight over the GIL.
         """
         self.pending_commands.append(msg.raw)
 
@@ -447,17 +447,17 @@ class SimNode:
 
 def _float_param(name: str, default: float, minimum: float = 0.0) -> float:
     value = rospy.get_param(name, default)
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) \
-            or value < minimum:
+    number = finite_number(value)
+    if number is None or number < minimum:
         raise AtlasControlError(f'parameter {rospy.resolve_name(name)} must be a number '
                                 f'>= {minimum}, got {value!r}')
-    return float(value)
+    return number
 
 
 def build_node() -> SimNode:
     """Read parameters, load the model and gains; raise AtlasControlError on bad ones."""
-    gains = gains_from_params(rospy.get_param('atlas_controller/gains', {}))
-    time_to_unpin_s = _float_param('/atlas/time_to_unpin', DEFAULT_TIME_TO_UNPIN_S)
+    gains = gains_from_params(rospy.get_param(topics.GAINS_PARAM, {}))
+    time_to_unpin_s = _float_param(topics.TIME_TO_UNPIN_PARAM, DEFAULT_TIME_TO_UNPIN_S)
     rates_hz = {
         'joint_states': _float_param('~joint_states_rate', 1000.0),
         'odom': _float_param('~odom_rate', 100.0),

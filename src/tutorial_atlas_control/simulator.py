@@ -7,25 +7,23 @@ without a master and shared with offline replay.
 
 from __future__ import annotations
 
+import copy
 import enum
 import hashlib
 from collections.abc import Mapping, Sequence
-from pathlib import Path
 
 import mujoco
 import numpy as np
 
 from tutorial_atlas_control import model as atlas_model
-from tutorial_atlas_control.commands import CommandUpdate, command_update
-from tutorial_atlas_control.controller import (
-    Gains, JointCommandArrays, PidState, compute_torque, hold_command)
+from tutorial_atlas_control.commands import CommandUpdate, JointCommandArrays, command_update
+from tutorial_atlas_control.controller import Gains, PidState, compute_torque, hold_command
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import NUM_JOINTS
+from tutorial_atlas_control.units import NS_PER_S
 
 #: DRCSim released the pinned torso after this long (s); `/atlas/time_to_unpin` overrides it.
 DEFAULT_TIME_TO_UNPIN_S = 1.0
-#: Simulation time is counted in whole steps to keep stamps exact (ns).
-NS_PER_S = 1_000_000_000
 
 
 #: MuJoCo's warnings for an unstable step, each with what it means.
@@ -78,11 +76,11 @@ class AtlasSimulator:
     """
 
     def __init__(self, atlas: atlas_model.AtlasModel, gains: Gains,
-                 time_to_unpin_s: float = DEFAULT_TIME_TO_UNPIN_S,
-                 model_path: Path = atlas_model.MODEL_PATH) -> None:
+                 time_to_unpin_s: float = DEFAULT_TIME_TO_UNPIN_S) -> None:
         self.atlas = atlas
-        self.atlas_path = model_path
-        self.atlas_sha1 = hashlib.sha1(model_path.read_bytes()).hexdigest()
+        # The path comes with the compiled model, so the config cannot name another file.
+        self.atlas_path = atlas.path
+        self.atlas_sha1 = hashlib.sha1(atlas.path.read_bytes()).hexdigest()
         self.model = atlas.model
         self.data = mujoco.MjData(self.model)
         self.gains = gains
@@ -127,9 +125,12 @@ class AtlasSimulator:
             'last_reset_time': self.last_reset_ns / NS_PER_S,
         }
 
-    def reset_simulation(self) -> None:
-        """reset_world, and sim time back to 0."""
-        self.sim_time_ns = 0
+    def reset_simulation(self, sim_time_ns: int = 0) -> None:
+        """reset_world, and sim time back to `sim_time_ns`.
+
+        Gazebo's reset_simulation restarts at 0; replay restarts at a recorded reset.
+        """
+        self.sim_time_ns = sim_time_ns
         self.reset_world()
 
     def _set_pinned(self, pinned: bool) -> None:
@@ -200,27 +201,46 @@ class AtlasSimulator:
         return self._mode_command
 
     # -- stepping ----------------------------------------------------------------------
-    def step(self) -> None:
-        """Apply the controller law and advance one physics step.
+    def step(self, torque_nm: np.ndarray | None = None) -> None:
+        """Advance one physics step with the controller law's torque, or with `torque_nm`.
+
+        Offline replay passes the recorded torque (N m, (28,)): the pin release and the
+        divergence check are then the very code the node runs.
 
         Raises:
             PhysicsDivergenceError: the new state is not finite (the caller resets).
         """
         if self.pinned and self.sim_time_ns >= self._pin_until_ns:
             self._set_pinned(False)
-        data = self.data
-        compute_torque(
-            self.active_command(), self.joint_positions(), self.joint_velocities(),
-            self._pid, self.dt_s, self.atlas.lower_rad, self.atlas.upper_rad,
-            self.atlas.effort_limit_nm, out=self.torque_nm)
-        data.ctrl[:] = self.torque_nm
-        mujoco.mj_step(self.model, data)
+        if torque_nm is None:
+            self._law_torque(self._pid, out=self.torque_nm)
+        else:
+            self.torque_nm[:] = torque_nm
+        self.data.ctrl[:] = self.torque_nm
+        mujoco.mj_step(self.model, self.data)
         # mj_step integrates last: joint positions/velocities are at the new time, while body
         # poses and sensor readings were computed before integrating, at the step's start.
         self.state_time_ns = self.sim_time_ns
         self.sim_time_ns += self.step_ns
-        # MuJoCo resets the state by itself on NaN/Inf/huge values and only warns: catch it
-        # here so that no silently reset (or non-finite) state is ever published.
+        self._check_divergence()
+
+    def next_law_torque(self) -> np.ndarray:
+        """The torque (N m) the law would apply at the next step; the law's memory is kept."""
+        return self._law_torque(copy.deepcopy(self._pid))
+
+    def _law_torque(self, pid: PidState, out: np.ndarray | None = None) -> np.ndarray:
+        return compute_torque(
+            self.active_command(), self.joint_positions(), self.joint_velocities(),
+            pid, self.dt_s, self.atlas.lower_rad, self.atlas.upper_rad,
+            self.atlas.effort_limit_nm, out=out)
+
+    def _check_divergence(self) -> None:
+        """Raise on an unstable step.
+
+        MuJoCo resets the state by itself on NaN/Inf/huge values and only warns: catching
+        it here means no silently reset (or non-finite) state is ever published or replayed.
+        """
+        data = self.data
         for warning, what in DIVERGENCE_WARNINGS:
             if data.warning[warning].number > 0:
                 data.warning[warning].number = 0

@@ -19,6 +19,13 @@ CONTROLLER_STATISTICS = '/atlas/controller_statistics'
 SIM_CONFIG = '/atlas/sim_config'
 ROSOUT = '/rosout'
 
+#: What scripts/record_run.sh records: the simulator's output, the commands and modes that
+#: drove it, the config replay needs, and the log. Analysis and replay read these.
+RECORDED_TOPICS: tuple[str, ...] = (
+    CLOCK, JOINT_STATES, GROUND_TRUTH_ODOM, IMU, L_FOOT_CONTACT, R_FOOT_CONTACT,
+    JOINT_COMMANDS, CONTROL_MODE, SIM_CONFIG, ROSOUT, CONTROLLER_STATISTICS,
+)
+
 #: Gazebo's services, as gazebo_ros offered them.
 RESET_WORLD_SERVICE = '/gazebo/reset_world'
 RESET_SIMULATION_SERVICE = '/gazebo/reset_simulation'

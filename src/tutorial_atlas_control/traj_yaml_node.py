@@ -1,13 +1,11 @@
 """ROS glue of ``scripts/traj_yaml.py``: the DRCSim tutorial's trajectory player, ported.
 
 Same command line, topics, parameters, message and motion as the tutorial's
-``traj_yaml.py``; each waypoint moves linearly from the measured joint positions to
-the waypoint's positions, published at 50 Hz in ROS time.  Fixed defects: the file is
-validated (``yaml.safe_load``) before anything starts; the first joint state, then the
-simulator's connection to the command topic, are awaited with timeouts; joint states are
-read by name; the sample count is an integer; each command is stamped.  File handling
-and interpolation live in :mod:`tutorial_atlas_control.trajectory`; this module only
-talks to ROS.
+``traj_yaml.py``: each waypoint moves linearly from the measured joint positions to the
+waypoint's, published at 50 Hz in ROS time. Unlike the tutorial, it validates the file
+before anything starts, waits (bounded) for the simulator before the first command, reads
+joint states by name and stamps each command. File handling and interpolation live in
+:mod:`tutorial_atlas_control.trajectory`; this module only talks to ROS.
 """
 
 from __future__ import annotations
@@ -23,10 +21,12 @@ import rosgraph
 import rospy
 from sensor_msgs.msg import JointState
 
-from tutorial_atlas_control.controller import GAINS_PARAM, LOAD_HINT, Gains, GainsError, gains_from_params
+from tutorial_atlas_control import topics
+from tutorial_atlas_control.controller import LOAD_HINT, Gains, GainsError, gains_from_params
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_INDEX, JOINT_NAMES, NUM_JOINTS, bare_joint_name
+from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES, NUM_JOINTS, joint_index
 from tutorial_atlas_control.trajectory import Waypoint, interpolate, load_trajectory, sample_count
+from tutorial_atlas_control.units import finite_number
 
 __all__ = [
     'JointStateCache',
@@ -58,8 +58,8 @@ HELP_OPTIONS = ('-h', '--help')
 
 #: The tutorial's node name.
 NODE_NAME = 'tutorial_atlas_control'
-JOINT_STATES_TOPIC = '/atlas/joint_states'
-JOINT_COMMANDS_TOPIC = '/atlas/joint_commands'
+JOINT_STATES_TOPIC = topics.JOINT_STATES
+JOINT_COMMANDS_TOPIC = topics.JOINT_COMMANDS
 LAUNCH_HINT = 'roslaunch tutorial_atlas_control atlas.launch'
 
 #: Default wait (s, wall clock) for the first message on /atlas/joint_states.
@@ -68,8 +68,7 @@ JOINT_STATE_TIMEOUT_S = 10.0
 JOINT_STATE_TIMEOUT_PARAM = '~joint_state_timeout'
 #: Default wait (s, wall clock) for every subscriber of /atlas/joint_commands (the simulator,
 #: a recorder) to connect before the first command: rospy drops what is published before a
-#: subscriber connects. It was 2 s, without failing: on a starved 2-core host the simulator
-#: connected later than that and missed the first commands (see wait_for_subscribers).
+#: subscriber connects, and a busy host can take seconds to connect (see wait_for_subscribers).
 SUBSCRIBER_TIMEOUT_S = 10.0
 #: Private parameter overriding SUBSCRIBER_TIMEOUT_S, e.g. `_subscriber_timeout:=30`.
 SUBSCRIBER_TIMEOUT_PARAM = '~subscriber_timeout'
@@ -78,9 +77,8 @@ POLL_PERIOD_S = 0.01
 #: The master's subscriber list is asked for at most this often (s, wall clock).
 MASTER_POLL_PERIOD_S = 0.1
 #: Longest wait (s, wall clock), before a command is published, for rospy's writer threads to
-#: take the previous one off the publisher's queue (see wait_until_handed_over).
-#: Measured in the touchdown rostest: p99 5-12 ms, worst 29 ms (longer than the 20 ms
-#: between commands, hence the losses); a longer wait only delays the schedule.
+#: take the previous one off the publisher's queue (see wait_until_handed_over). Above the
+#: worst starvation seen on a loaded host; a longer wait would only delay the schedule.
 HANDOVER_WAIT_S = 0.05
 #: Polling interval (s, wall clock) of that wait.
 HANDOVER_POLL_S = 0.0005
@@ -106,9 +104,9 @@ def read_gains(get_param: Callable[..., object] = rospy.get_param) -> Gains:
         GainsError: a parameter is missing or not a finite number; the message names
             it and says how to load the gains.
     """
-    tree = get_param(GAINS_PARAM, None)
+    tree = get_param(topics.GAINS_PARAM, None)
     if tree is None:
-        raise GainsError(f'parameter {GAINS_PARAM} is not set; {LOAD_HINT}')
+        raise GainsError(f'parameter {topics.GAINS_PARAM} is not set; {LOAD_HINT}')
     return gains_from_params(tree)
 
 
@@ -129,7 +127,7 @@ def positions_by_name(names: Sequence[str], positions: Sequence[float]) -> np.nd
     result = np.full(NUM_JOINTS, np.nan)
     seen = np.zeros(NUM_JOINTS, dtype=bool)
     for name, position in zip(names, positions):
-        index = JOINT_INDEX.get(bare_joint_name(name))
+        index = joint_index(name)
         if index is None:
             continue
         if seen[index]:
@@ -142,8 +140,8 @@ def positions_by_name(names: Sequence[str], positions: Sequence[float]) -> np.nd
             f'{JOINT_STATES_TOPIC}: the message lacks {len(missing)} Atlas joint(s): {", ".join(missing)}'
         )
     if not np.isfinite(result).all():
-        bad = JOINT_NAMES[int(np.flatnonzero(~np.isfinite(result))[0])]
-        raise TrajYamlError(f'{JOINT_STATES_TOPIC}: the position of {bad} is {result[JOINT_INDEX[bad]]}')
+        bad = int(np.flatnonzero(~np.isfinite(result))[0])
+        raise TrajYamlError(f'{JOINT_STATES_TOPIC}: the position of {JOINT_NAMES[bad]} is {result[bad]}')
     return result
 
 
@@ -201,7 +199,7 @@ def wait_for_ros_time(
         TrajYamlError: still 0 after `timeout_s`: /use_sim_time is set but nothing publishes /clock.
         rospy.ROSInterruptException: the node was shut down while waiting.
     """
-    return _poll(lambda: ros_time() or None, timeout_s, is_shutdown, '/clock',
+    return _poll(lambda: ros_time() or None, timeout_s, is_shutdown, topics.CLOCK,
                  f'/use_sim_time is set but no /clock arrived within {timeout_s:g} s; '
                  f'start the simulator with `{LAUNCH_HINT}`')
 
@@ -376,9 +374,10 @@ def _wait_for_simulator(publisher: rospy.Publisher, first_state: JointState, tim
 
 def _timeout_param(name: str, default: float) -> float:
     value = rospy.get_param(name, default)
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not (np.isfinite(value) and value > 0):
+    seconds = finite_number(value)
+    if seconds is None or seconds <= 0.0:
         raise TrajYamlError(f'parameter {name} must be a positive number of seconds, got {value!r}')
-    return float(value)
+    return seconds
 
 
 def _registered_subscribers() -> set[str] | None:
@@ -412,8 +411,7 @@ def wait_for_subscribers(
 
     A command published before a subscriber connects never reaches it. For the simulator
     that is no lost sample: it holds its pose, then jumps to the first command that does
-    arrive, and touchdown's robot falls when the first 0.7 s of commands are missed. The
-    port used to publish anyway after 2 s of wall time, which a starved host exceeded.
+    arrive, and the robot can fall.
 
     Args:
         connected: the nodes connected to our publisher now.
@@ -462,9 +460,9 @@ def wait_until_handed_over(publisher: rospy.Publisher, timeout_s: float) -> bool
 
     With the tutorial's ``queue_size=1``, rospy 1.15 hands each message to one writer
     thread per subscriber (``QueuedConnection``) and drops a message still queued when the
-    next is published: on a busy 2-core host the writer thread was starved for up to 29 ms,
-    more than the 20 ms between commands, and a fresh-clone run lost 5 of a segment's 150.
-    Waiting here keeps every command while the publisher keeps the tutorial's queue size.
+    next is published; on a busy host the writer thread can be starved for longer than the
+    20 ms between commands. Waiting here keeps every command while the publisher keeps the
+    tutorial's queue size.
     Returns whether every queue was empty within `timeout_s`.
     """
     deadline = time.monotonic() + timeout_s

@@ -24,6 +24,7 @@ import yaml
 
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.units import finite_number
 
 __all__ = [
     'PUBLISH_PERIOD_S',
@@ -197,7 +198,7 @@ def _parse_waypoint(row: object, where: str) -> Waypoint:
         raise TrajectoryError(
             f'{where}: expected a pair [duration_s, "{NUM_JOINTS} joint positions"], got {_kind(row)}'
         )
-    duration_s = _finite_number(row[0])
+    duration_s = finite_number(row[0])
     if duration_s is None:
         raise TrajectoryError(f'{where}: duration must be a finite number of seconds, got {_show(row[0])}')
     if duration_s <= 0.0:
@@ -219,7 +220,7 @@ def _parse_positions(value: object, where: str) -> np.ndarray:
         raise TrajectoryError(f'{where}: expected {NUM_JOINTS} joint positions, got {len(items)}')
     positions = np.empty(NUM_JOINTS)
     for index, item in enumerate(items):
-        number = _finite_number(item, allow_text=isinstance(value, str))
+        number = finite_number(item, allow_text=isinstance(value, str))
         if number is None:
             raise TrajectoryError(
                 f'{where}: joint position {index} ({JOINT_NAMES[index]}) must be a finite number, '
@@ -227,19 +228,6 @@ def _parse_positions(value: object, where: str) -> np.ndarray:
             )
         positions[index] = number
     return positions
-
-
-def _finite_number(value: object, allow_text: bool = False) -> float | None:
-    """`value` as a finite float, or None if it is not a (finite) number. Booleans are not numbers."""
-    if isinstance(value, bool):
-        return None
-    if isinstance(value, (int, float)) or (allow_text and isinstance(value, str)):
-        try:
-            number = float(value)
-        except (ValueError, OverflowError):
-            return None
-        return number if math.isfinite(number) else None
-    return None
 
 
 def _yaml_where(err: yaml.YAMLError) -> str:

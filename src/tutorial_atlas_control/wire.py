@@ -22,7 +22,8 @@ import numpy as np
 import rospy
 from rospy.impl.tcpros_base import TransportTerminated
 
-NS_PER_S = 1_000_000_000
+from tutorial_atlas_control.units import NS_PER_S
+
 _PREFIX_HEADER = struct.Struct('<IIII')  # TCPROS length, Header.seq, stamp.secs, stamp.nsecs
 _CLOCK = struct.Struct('<III')
 

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from tutorial_atlas_control.commands import (
-    MAX_MAGNITUDE, CommandDecoder, CommandError, joint_indices, merge_command)
-from tutorial_atlas_control.controller import FIELD_NAMES, JointCommandArrays
+    FIELD_NAMES, MAX_MAGNITUDE, CommandDecoder, CommandError, JointCommandArrays, joint_indices,
+    merge_command)
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
 
 

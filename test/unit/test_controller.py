@@ -11,9 +11,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
+from tutorial_atlas_control.commands import FIELD_NAMES, JointCommandArrays
 from tutorial_atlas_control.controller import (
-    FIELD_NAMES, Gains, GainsError, JointCommandArrays, PidState, compute_torque, gains_from_params,
-    hold_command, load_gains_yaml)
+    Gains, GainsError, PidState, compute_torque, gains_from_params, hold_command, load_gains_yaml)
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
 

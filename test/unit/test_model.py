@@ -11,7 +11,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from tutorial_atlas_control import controller, model
+from tutorial_atlas_control import commands, controller, model
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 
 REPO = Path(__file__).resolve().parents[2]
@@ -194,7 +194,7 @@ def test_pin_holds_the_spawn_pose_without_a_jump(atlas: model.AtlasModel) -> Non
 
 # --- physics -----------------------------------------------------------------------------------
 
-def simulate(atlas: model.AtlasModel, command: controller.JointCommandArrays, seconds: float,
+def simulate(atlas: model.AtlasModel, command: commands.JointCommandArrays, seconds: float,
              pin_seconds: float) -> dict[str, float]:
     """Run the controller law at 1 kHz; return drift figures and the first time z < 0.5 m."""
     m = atlas.model
@@ -238,7 +238,7 @@ def test_stands_30s_on_the_pd_law_alone(atlas: model.AtlasModel, pin_seconds: fl
 
 
 def test_falls_without_gains(atlas: model.AtlasModel) -> None:
-    result = simulate(atlas, controller.JointCommandArrays.zeros(), 3.0, 0.0)
+    result = simulate(atlas, commands.JointCommandArrays.zeros(), 3.0, 0.0)
     assert result['fall_time'] < 3.0
 
 

@@ -198,7 +198,6 @@ def run_script(*args: str) -> subprocess.CompletedProcess[str]:
 @pytest.mark.parametrize(('args', 'message'), [
     (['--video', 'OUT/run.avi'], "unknown video format '.avi'"),
     (['--video', 'OUT/missing/run.mp4'], 'does not exist'),
-    (['--video', 'OUT/run.mp4', '--size', '10'], "--size '10' is not WIDTHxHEIGHT"),
 ])
 def test_analyze_bag_video_errors_are_one_line(fall_bag: Path, tmp_path: Path, args: list[str],
                                                message: str) -> None:
@@ -209,3 +208,17 @@ def test_analyze_bag_video_errors_are_one_line(fall_bag: Path, tmp_path: Path, a
     assert len(lines) == 1 and lines[0].startswith('analyze_bag.py: error: ')
     assert message in lines[0]
     assert done.stdout == ''  # checked before the analysis is printed
+
+
+@pytest.mark.parametrize(('args', 'message'), [
+    (['--size', '10'], "argument --size: '10' is not WIDTHxHEIGHT"),
+    (['--fps', '0'], "argument --fps: '0' is out of range"),
+])
+def test_analyze_bag_bad_option_values_are_usage_errors(fall_bag: Path, args: list[str],
+                                                        message: str) -> None:
+    """Exit 2 and argparse's usage, as for any bad argument."""
+    done = run_script(str(fall_bag), '--video', 'run.mp4', *args)
+    assert done.returncode == 2
+    last = done.stderr.strip().splitlines()[-1]
+    assert last.startswith('analyze_bag.py: error: ') and message in last
+    assert done.stdout == ''

@@ -223,6 +223,17 @@ def test_without_odometry_only_joints_are_compared(tmp_path: Path) -> None:
 # ---------------------------------------------------------------------------- errors
 
 
+def test_divergence_in_the_replay_is_an_error(tmp_path: Path) -> None:
+    """The simulator's own divergence check runs in the replay and names what happened."""
+    run = Run()
+    run.step(60)
+    state = next(record for record in run.records[::-1] if record.topic == '/atlas/joint_states')
+    state.message.effort[:] = 1e9  # a torque no step survives
+    with pytest.raises(ReplayError, match=r'in the replay, physics diverged at t=0\.060 s .*'
+                                          r'the bag does not mark'):
+        replay_bag(run.write(tmp_path / 'diverging.bag'))
+
+
 def test_no_joint_states_is_an_error(tmp_path: Path) -> None:
     bag = write_bag(tmp_path / 'x.bag', [sim_config_record(0.0, {'timestep': 0.001,
                                                                 'time_to_unpin': 1.0,
@@ -317,4 +328,13 @@ def test_script_errors_are_one_line(tmp_path: Path) -> None:
     assert done.returncode == 1
     assert done.stderr.strip().splitlines() == [f'replay_bag.py: error: {tmp_path}/none.bag: '
                                                 'no such file.']
-    assert main(['x.bag', '--tolerance', 'nan']) == 1
+
+
+@pytest.mark.parametrize('value', ['nan', '-1', 'abc'])
+def test_bad_tolerance_is_a_usage_error(value: str, capsys: pytest.CaptureFixture[str]) -> None:
+    """Exit 2, as argparse for any bad argument (the epilog says so)."""
+    with pytest.raises(SystemExit) as exit_info:
+        main(['x.bag', '--tolerance', value])
+    assert exit_info.value.code == 2
+    assert capsys.readouterr().err.splitlines()[-1].startswith(
+        'replay_bag.py: error: argument --tolerance: ')

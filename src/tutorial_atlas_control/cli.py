@@ -1,0 +1,38 @@
+"""The command-line convention every script of the package follows.
+
+One line on stderr per error, `<script>: error: <message>` as argparse prints it, and no
+traceback. Exit status 0 on success, 1 when the input or the environment is refused (a
+bag, a file, no ROS master), 2 when the command line is (argparse, including option values
+out of range), 3 when replay_bag.py's replay deviates, 130 on Ctrl-C. traj_yaml.py keeps
+the DRCSim tutorial's command line instead: its usage and exit status 1.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Callable
+from typing import TypeVar
+
+from tutorial_atlas_control.errors import AtlasControlError
+
+_T = TypeVar('_T')
+
+
+def argument_type(convert: Callable[[str], _T]) -> Callable[[str], _T]:
+    """An argparse `type=` from a converter that raises AtlasControlError on a bad value.
+
+    argparse then reports the converter's message and exits 2, as for any bad argument.
+    """
+    def checked(text: str) -> _T:
+        try:
+            return convert(text)
+        except AtlasControlError as err:
+            raise argparse.ArgumentTypeError(str(err)) from None
+    checked.__name__ = convert.__name__
+    return checked
+
+
+def print_error(prog: str, message: object) -> None:
+    """The one stderr line of a refused run."""
+    print(f'{prog}: error: {message}', file=sys.stderr)

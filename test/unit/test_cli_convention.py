@@ -1,0 +1,63 @@
+"""Every script follows tutorial_atlas_control.cli's convention, run from a clone, anywhere."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+SCRIPTS = Path(__file__).resolve().parents[2] / 'scripts'
+PYTHON_SCRIPTS = ('analyze_bag.py', 'replay_bag.py', 'run_demo.py', 'traj_yaml.py')
+
+
+def run(script: str, *args: str) -> subprocess.CompletedProcess[str]:
+    """The script as a user runs it: by path, without rosrun, from an unrelated directory."""
+    command = [str(SCRIPTS / script), *args]
+    if script.endswith('.py'):
+        command.insert(0, sys.executable)
+    return subprocess.run(command, capture_output=True, text=True, cwd='/', env=dict(os.environ),
+                          check=False, timeout=120)
+
+
+@pytest.mark.parametrize('script', [*PYTHON_SCRIPTS, 'record_run.sh'])
+def test_help_works_from_anywhere(script: str) -> None:
+    result = run(script, '--help')
+    assert result.returncode == 0, result.stderr
+    assert 'usage' in result.stdout.lower()
+
+
+@pytest.mark.parametrize(('script', 'args', 'message'), [
+    ('analyze_bag.py', [], 'the following arguments are required: BAG'),
+    ('replay_bag.py', ['run.bag', '--tolerance', '-1'], "argument --tolerance: '-1' is not"),
+    ('run_demo.py', ['--video-size', 'big'], "argument --video-size: 'big' is not WIDTHxHEIGHT"),
+    ('record_run.sh', [], 'expected BAG_DIR [atlas_recorder|rosbag], got 0 argument(s)'),
+    ('record_run.sh', ['/tmp', 'rosbag2'], "unknown recorder 'rosbag2'"),
+])
+def test_bad_command_line_exits_2(script: str, args: list[str], message: str) -> None:
+    result = run(script, *args)
+    assert result.returncode == 2, result
+    last = result.stderr.strip().splitlines()[-1]
+    assert last.startswith(f'{script}: error: ') and message in last, result.stderr
+    assert 'Traceback' not in result.stderr
+
+
+@pytest.mark.parametrize(('script', 'args', 'message'), [
+    ('analyze_bag.py', ['/nonexistent/run.bag'], 'no such file'),
+    ('replay_bag.py', ['/nonexistent/run.bag'], 'no such file'),
+    ('run_demo.py', ['--file', '/nonexistent/Traj.yaml'], '/nonexistent/Traj.yaml: cannot read'),
+])
+def test_refused_input_exits_1_with_one_line(script: str, args: list[str], message: str) -> None:
+    result = run(script, *args)
+    assert result.returncode == 1, result
+    assert result.stderr.splitlines() == [result.stderr.strip()], 'one line'
+    assert result.stderr.startswith(f'{script}: error: ') and message in result.stderr
+
+
+def test_traj_yaml_keeps_the_tutorial_command_line() -> None:
+    """The exception: DRCSim's usage text and exit status 1."""
+    result = run('traj_yaml.py')
+    assert result.returncode == 1
+    assert result.stderr.startswith('usage: traj_yaml.py YAML_FILE TRAJECTORY_NAME')
