@@ -3,7 +3,7 @@
 #   1. Debian packages (ROS 1 from Debian 12, catkin, software GL) via apt-get;
 #   2. a virtualenv from /usr/bin/python3 with --system-site-packages and the pinned PyPI requirements;
 #   3. a catkin workspace OUTSIDE the repository (a workspace inside the tree makes rosrun loop),
-#      whose src/ holds symlinks to this package and to msg/osrf_msgs.
+#      whose src/ holds symlinks to this package and to the vendored message packages under msg/.
 # Each step is skipped when its inputs have not changed since the last run.
 set -euo pipefail
 
@@ -62,9 +62,10 @@ build_workspace() {
   mkdir -p "$TAC_WS/src"
   ln -sfn "$repo_dir" "$TAC_WS/src/tutorial_atlas_control"
   ln -sfn "$repo_dir/msg/osrf_msgs" "$TAC_WS/src/osrf_msgs"
+  ln -sfn "$repo_dir/msg/atlas_msgs" "$TAC_WS/src/atlas_msgs"
   local stamp="$TAC_WS/.build-inputs.sha1" want
-  want=$( (cd "$repo_dir" && cat CMakeLists.txt package.xml setup.py msg/osrf_msgs/CMakeLists.txt \
-            msg/osrf_msgs/package.xml msg/osrf_msgs/msg/*.msg src/*.cpp; ls scripts sim test/rostest 2>/dev/null) | sha1sum | cut -d' ' -f1)
+  want=$( (cd "$repo_dir" && cat CMakeLists.txt package.xml setup.py msg/*/CMakeLists.txt \
+            msg/*/package.xml msg/*/msg/*.msg src/*.cpp test/rostest/*.cpp; ls scripts sim test/rostest 2>/dev/null) | sha1sum | cut -d' ' -f1)
   if [ -f "$TAC_WS/devel/setup.bash" ] && [ "$(cat "$stamp" 2>/dev/null)" = "$want" ]; then
     log "catkin workspace up to date ($TAC_WS)"; return
   fi

@@ -1,23 +1,31 @@
-"""DRCSim AtlasPlugin's joint controller law, vectorized over the 28 joints.
+"""DRCSim 2.5.2 AtlasPlugin's joint controller law, vectorized over the 28 joints.
 
-Per joint, each 1 ms step (DRCSim 2.x AtlasPlugin::UpdateStates):
+Per joint, each 1 ms step (AtlasPlugin::UpdateStates in DRCSim 2.5.2):
 
     q_target = clamp(position, lower, upper)
     e        = q_target - q
-    de/dt    = (e - e_prev) / dt
-    i        = clamp(i + dt * e, i_effort_min / ki, i_effort_max / ki)
-    torque   = kp_position * e + ki_position * i + kd_position * de/dt
-               + kp_velocity * (velocity - v) + effort
-    torque   = clamp(torque, -effort_limit, +effort_limit)
+    de/dt    = (e - e_prev) / dt ;  e_prev = e
+    qd_p     = velocity - v
+    I        = clamp(I + dt * ki_position * e, i_effort_min, i_effort_max)   # a torque (N m)
+    u        = kp_position * e + I + kd_position * de/dt + kp_velocity * qd_p + effort
+    tau      = clamp(u, -effort_limit, effort_limit)
+    if |tau - u| > 1e-6 and |ki_position| > 1e-6:                         # tie-back
+        I = clamp(I + (tau - u), i_effort_min, i_effort_max)
+    applied torque = joint_states effort = tau
 
-Two choices differ from DRCSim, on purpose:
+with Gazebo's clamp(x, lo, hi) = max(min(x, hi), lo) (so lo wins when lo > hi) and
+Gazebo's math::equal tolerance (1e-6) deciding "saturated" and "ki is on". The integral
+holds a torque, so a change of ki between commands keeps what was accumulated, and while
+the torque saturates the integral is pulled back by the excess (anti-windup).
+
+Where this differs from 2.5.2, on purpose:
 * First step after a reset: e_prev := e, so the derivative term starts at 0.
   DRCSim started from e_prev = 0, which kicks the joints with kd * e / dt on
   the first step after a command arrives (e.g. 10 * 0.1 / 0.001 = 1000 N m on
   a knee, then clamped to the effort limit).
-* ki == 0: the integral is held at 0 (DRCSim divided by ki, giving NaN or
-  inf bounds). Nothing winds up while the integral gain is off, so turning
-  it on later starts from a clean integral.
+* Not a change of the law, a part left out: 2.5.2 also added the feed-forward torque of
+  the BDI AtlasSimInterface (its walking behaviours) inside the final clamp; there is no
+  BDI library here, so that term is always 0.
 
 The torque clamp here is the only place the effort limits are enforced (the
 MuJoCo motors have no ctrlrange).
@@ -53,18 +61,22 @@ def _zeros() -> np.ndarray:
     return np.zeros(NUM_JOINTS)
 
 
+#: Gazebo's math::equal tolerance: AtlasPlugin ties the integral back only when the torque
+#: was clipped by more than this (N m) and ki_position is further than this from 0.
+TIE_BACK_EPSILON = 1e-6
+
+
 @dataclass
 class PidState:
-    """Per-joint memory of the law: integral of the error and the previous error."""
+    """Per-joint memory of the law: the integral term (a torque) and the previous error."""
 
-    integral: np.ndarray = field(default_factory=_zeros)        # rad s
+    integral: np.ndarray = field(default_factory=_zeros)        # N m
     previous_error: np.ndarray = field(default_factory=_zeros)  # rad
     initialized: bool = False
-    # Scratch buffers so that compute_torque allocates nothing per step.
+    # Scratch buffers so that compute_torque allocates nothing per step while every ki is 0.
     _error: np.ndarray = field(default_factory=_zeros, repr=False)
     _term: np.ndarray = field(default_factory=_zeros, repr=False)
-    _low: np.ndarray = field(default_factory=_zeros, repr=False)
-    _high: np.ndarray = field(default_factory=_zeros, repr=False)
+    _unclamped: np.ndarray = field(default_factory=_zeros, repr=False)
 
     def reset(self) -> None:
         """Forget the integral and the previous error (e.g. after a simulation reset)."""
@@ -73,10 +85,19 @@ class PidState:
         self.initialized = False
 
 
+def _clamp(value: np.ndarray, low: np.ndarray, high: np.ndarray, out: np.ndarray) -> np.ndarray:
+    """Gazebo's math::clamp, elementwise: max(min(value, high), low)."""
+    np.minimum(value, high, out=out)
+    return np.maximum(out, low, out=out)
+
+
 def compute_torque(command: JointCommandArrays, q: np.ndarray, v: np.ndarray, state: PidState,
                    dt_s: float, lower: np.ndarray, upper: np.ndarray, effort_limit: np.ndarray,
                    out: np.ndarray | None = None) -> np.ndarray:
     """Joint torques (N m, (28,)) for one control step; updates `state` in place.
+
+    The operations run in the order of the scalar law in the module docstring, so each
+    joint's result is bit for bit what a per-joint loop of it gives.
 
     Args:
         command: targets and gains, tutorial joint order.
@@ -84,56 +105,52 @@ def compute_torque(command: JointCommandArrays, q: np.ndarray, v: np.ndarray, st
         state: the law's memory, advanced by this call.
         dt_s: step length (s), > 0.
         lower, upper: position limits (rad) the target is clamped to.
-        effort_limit: |torque| bound (N m).
+        effort_limit: |torque| bound (N m), >= 0.
         out: optional (28,) buffer for the result.
     """
-    error, term, low, high = state._error, state._term, state._low, state._high
+    error, term, unclamped = state._error, state._term, state._unclamped
     torque = np.empty(NUM_JOINTS) if out is None else out
+    integral = state.integral
+    ki = command.ki_position
 
-    # target clamped to the joint limits (minimum/maximum: cheaper than clip)
-    np.minimum(command.position, upper, out=error)
-    np.maximum(error, lower, out=error)
+    _clamp(command.position, lower, upper, out=error)
     error -= q
     if not state.initialized:
         state.previous_error[:] = error
         state.initialized = True
 
-    # proportional + derivative of the error
-    np.multiply(command.kp_position, error, out=torque)
+    # integral: a torque, accumulating dt * ki * e within [i_effort_min, i_effort_max]
+    np.multiply(ki, dt_s, out=term)
+    term *= error
+    integral += term
+    _clamp(integral, command.i_effort_min, command.i_effort_max, out=integral)
+
+    # u = kp * e + I + kd * de/dt + kp_velocity * (velocity - v) + effort, summed in that order
+    np.multiply(command.kp_position, error, out=unclamped)
+    unclamped += integral
     np.subtract(error, state.previous_error, out=term)
+    term /= dt_s
     term *= command.kd_position
-    term *= 1.0 / dt_s
-    torque += term
+    unclamped += term
     state.previous_error[:] = error
-
-    # integral, clamped so that ki * integral stays in [i_effort_min, i_effort_max]
-    ki = command.ki_position
-    integral = state.integral
-    if ki.any():
-        error *= dt_s
-        integral += error
-        integral_on = ki != 0.0
-        np.divide(command.i_effort_min, ki, out=low, where=integral_on)
-        np.divide(command.i_effort_max, ki, out=high, where=integral_on)
-        np.minimum(low, high, out=term)   # a negative ki swaps the bounds
-        np.maximum(low, high, out=high)
-        np.maximum(integral, term, out=integral)
-        np.minimum(integral, high, out=integral)
-        np.copyto(integral, 0.0, where=~integral_on)
-        np.multiply(ki, integral, out=term)
-        torque += term
-    else:
-        integral.fill(0.0)
-
-    # velocity feedback and feed-forward effort
     np.subtract(command.velocity, v, out=term)
     term *= command.kp_velocity
-    torque += term
-    torque += command.effort
+    unclamped += term
+    unclamped += command.effort
 
     np.negative(effort_limit, out=term)
-    np.maximum(torque, term, out=torque)
-    np.minimum(torque, effort_limit, out=torque)
+    _clamp(unclamped, term, effort_limit, out=torque)
+
+    # tie-back: while saturated, pull the integral back by the torque that was cut off
+    # (with every ki 0, the tutorial's gains, there is nothing to tie back)
+    if ki.any():
+        np.subtract(torque, unclamped, out=term)
+        tie_back = np.abs(term) > TIE_BACK_EPSILON
+        tie_back &= np.abs(ki) > TIE_BACK_EPSILON
+        if tie_back.any():
+            term += integral
+            _clamp(term, command.i_effort_min, command.i_effort_max, out=term)
+            np.copyto(integral, term, where=tie_back)
     return torque
 
 

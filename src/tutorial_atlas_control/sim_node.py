@@ -1,8 +1,9 @@
 """The simulator node: AtlasSimulator behind DRCSim's ROS interface.
 
 Thin ROS glue. Publishes /clock, /atlas/joint_states, /ground_truth_odom, /atlas/imu and
-the foot contact wrenches in sim time, and a latched /atlas/sim_config (JSON: timestep,
-time_to_unpin, model file and checksum, time of the last reset) for offline replay; obeys
+the foot contact wrenches in sim time, /atlas/controller_statistics (command age, while
+subscribed), and a latched /atlas/sim_config (JSON: timestep, time_to_unpin, model file and
+checksum, time of the last reset) for offline replay; obeys
 /atlas/joint_commands and /atlas/control_mode; offers gazebo_ros's reset and pause services.
 
 Parameters (private unless noted):
@@ -15,6 +16,8 @@ Parameters (private unless noted):
         Atlas v1's joints, actuators and sensors (a variant of the package's model).
     /atlas/time_to_unpin (float, 1.0): seconds the torso stays pinned after start/reset.
     atlas_controller/gains/<joint>/{p,i,d,i_clamp}: the gains Stand/Freeze/User-hold use.
+    atlas_controller/statistics_time_window_size (s, 1.0): window of the command age statistics.
+    /atlas/controller_statistics/update_rate (Hz, unset = every step): clamped to 1..10000.
 """
 
 from __future__ import annotations
@@ -32,6 +35,7 @@ import genpy
 import mujoco
 import numpy as np
 import rospy
+from atlas_msgs.msg import ControllerStatistics
 from geometry_msgs.msg import WrenchStamped
 from nav_msgs.msg import Odometry
 from osrf_msgs.msg import JointCommands
@@ -44,13 +48,17 @@ from tutorial_atlas_control import model as atlas_model
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.commands import CommandDecoder, CommandError
 from tutorial_atlas_control.controller import gains_from_params
+from tutorial_atlas_control.controller_statistics import (
+    DEFAULT_WINDOW_S, UPDATE_RATE_PARAM, WINDOW_PARAM, CommandAgeStatistics)
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES
+from tutorial_atlas_control.ros1_fields import FieldCursor
 from tutorial_atlas_control.simulator import (
     DEFAULT_TIME_TO_UNPIN_S, AtlasSimulator, ModeError, PhysicsDivergenceError, parse_mode)
 from tutorial_atlas_control.units import NS_PER_S, finite_number
 from tutorial_atlas_control.wire import (
-    ImuWire, JointStateWire, OdometryWire, WireBatch, WrenchStampedWire, clock_bytes)
+    ControllerStatisticsWire, ImuWire, JointStateWire, OdometryWire, WireBatch, WrenchStampedWire,
+    clock_bytes)
 
 NODE_NAME = 'atlas_sim'
 #: Seconds between repeats of the same refusal warning.
@@ -134,6 +142,7 @@ class SimNode:
                          (WrenchStampedWire('r_foot'), 'r', self.r_contact_pub))
         self.sensors = {name: sim.data.sensor(name).data for name in atlas_model.SENSOR_NAMES}
         self._pelvis_velocity = np.zeros(6)
+        self._init_controller_statistics()
 
         # Commands wait here, undecoded, for the loop (see on_joint_commands). Bounded, so
         # that a stalled loop cannot make it grow without limit; emptied every step.
@@ -210,6 +219,8 @@ class SimNode:
                 rospy.logwarn_throttle(
                     WARN_THROTTLE_S, f'refused /atlas/joint_commands: {err}; previous command kept')
                 continue
+            if not updates:
+                self._note_command_stamp(raw)  # the newest applied command
             updates.append(update)
             if update.is_complete:
                 break
@@ -250,6 +261,7 @@ class SimNode:
     def reset_simulation(self) -> None:
         with self.lock:
             self.sim.reset_simulation()
+            self.statistics.forget_command()  # its stamp lies in the rewound future
         self._publish_config()
         rospy.loginfo('reset_simulation: robot reset and sim time back to 0')
 
@@ -298,6 +310,34 @@ class SimNode:
                     msg.torque[:] = self.sensors[f'{side}_foot_torque']
                     batch.add(pub, msg.to_bytes(sensed_ns))
 
+    # -- /atlas/controller_statistics ----------------------------------------------------
+    def _init_controller_statistics(self) -> None:
+        """DRCSim's command age statistics, fed and published only while subscribed."""
+        rate_hz = rospy.get_param(UPDATE_RATE_PARAM) if rospy.has_param(UPDATE_RATE_PARAM) else None
+        self.statistics = CommandAgeStatistics(
+            self.sim.dt_s, rospy.get_param(WINDOW_PARAM, DEFAULT_WINDOW_S), rate_hz)
+        self.statistics_msg = ControllerStatisticsWire()
+        with warnings.catch_warnings():
+            warnings.simplefilter('ignore', SyntaxWarning)  # rospy: "explicit queue_size"
+            self.statistics_pub = rospy.Publisher(topics.CONTROLLER_STATISTICS,
+                                                  ControllerStatistics, queue_size=None)
+
+    def _note_command_stamp(self, raw: bytes) -> None:
+        """The command in `raw` is applied from the coming step on: remember its stamp."""
+        self.statistics.command_applied(FieldCursor(raw).header_stamp_ns(),
+                                        self.sim.sim_time_ns + self.sim.step_ns)
+
+    def _publish_controller_statistics(self, now_ns: int) -> None:
+        """After each step: the command age at `now_ns`, into the window and, when due, out."""
+        if not self.batch.wanted(self.statistics_pub):
+            return
+        stats = self.statistics
+        stats.update(now_ns)
+        if stats.publication_due(now_ns):
+            self.statistics_msg.values[:] = (stats.age_s, stats.mean_s, stats.variance_s2,
+                                             stats.window_s)
+            self.batch.add(self.statistics_pub, self.statistics_msg.to_bytes(now_ns))
+
     def _publish_odom(self, stamp_ns: int) -> None:
         sim = self.sim
         odom = self.odom
@@ -340,6 +380,7 @@ class SimNode:
                         break
                 self.step_count += 1
                 self.publish()
+                self._publish_controller_statistics(self.sim.sim_time_ns)
                 sim_ns = self.sim.sim_time_ns
             if sim_ns < sim0_ns:  # reset_simulation rewound time
                 wall0, sim0_ns = time.perf_counter(), sim_ns

@@ -13,6 +13,8 @@ GROUND_TRUTH_ODOM = '/ground_truth_odom'
 IMU = '/atlas/imu'
 L_FOOT_CONTACT = '/atlas/l_foot_contact'
 R_FOOT_CONTACT = '/atlas/r_foot_contact'
+#: atlas_msgs/ControllerStatistics: the age of the command the robot obeys (DRCSim's).
+CONTROLLER_STATISTICS = '/atlas/controller_statistics'
 #: Latched JSON (timestep, time_to_unpin, model file and sha1, last reset): what replay needs.
 SIM_CONFIG = '/atlas/sim_config'
 ROSOUT = '/rosout'
@@ -21,7 +23,7 @@ ROSOUT = '/rosout'
 #: drove it, the config replay needs, and the log. Analysis and replay read these.
 RECORDED_TOPICS: tuple[str, ...] = (
     CLOCK, JOINT_STATES, GROUND_TRUTH_ODOM, IMU, L_FOOT_CONTACT, R_FOOT_CONTACT,
-    JOINT_COMMANDS, CONTROL_MODE, SIM_CONFIG, ROSOUT,
+    JOINT_COMMANDS, CONTROL_MODE, SIM_CONFIG, ROSOUT, CONTROLLER_STATISTICS,
 )
 
 #: Gazebo's services, as gazebo_ros offered them.

@@ -98,6 +98,15 @@ class OdometryWire(StampedWire):
         self.angular = self.floats[46:49]
 
 
+class ControllerStatisticsWire(StampedWire):
+    """atlas_msgs/ControllerStatistics: `values` = command_age, command_age_mean,
+    command_age_variance, command_age_window_size (a view)."""
+
+    def __init__(self) -> None:
+        super().__init__('', 4)
+        self.values = self.floats
+
+
 def clock_bytes(stamp_ns: int) -> bytes:
     """rosgraph_msgs/Clock with its TCPROS length prefix."""
     secs, nsecs = divmod(stamp_ns, NS_PER_S)

@@ -29,7 +29,9 @@ RECORDED_TYPES = {
     '/atlas/control_mode': 'std_msgs/msg/String',
     '/atlas/sim_config': 'std_msgs/msg/String',
     '/rosout': 'rosgraph_msgs/msg/Log',
+    '/atlas/controller_statistics': 'atlas_msgs/msg/ControllerStatistics',
 }
+CONTROLLER_STATISTICS_MD5 = '628a0c6643f9fd5708402f085735e478'
 
 
 def test_demo_exits_0_and_prints_summary_bag_and_plot(demo_run) -> None:  # noqa: ANN001
@@ -65,6 +67,7 @@ def test_bag_holds_the_run(demo_run) -> None:  # noqa: ANN001
             assert topic in connections, topic
             assert connections[topic].msgtype == msgtype, topic
         assert connections['/atlas/joint_commands'].digest == DRCSIM_MD5
+        assert connections['/atlas/controller_statistics'].digest == CONTROLLER_STATISTICS_MD5
 
         commands = []
         for c, _t, raw in reader.messages(connections=[connections['/atlas/joint_commands']]):

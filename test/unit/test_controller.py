@@ -91,36 +91,74 @@ def test_velocity_term_and_feed_forward() -> None:
     assert torque(command, q=0.0, v=0.5) == pytest.approx(4.0 * (1.5 - 0.5) - 7.0)
 
 
-def test_integral_term_accumulates_dt_times_error() -> None:
+def test_integral_accumulates_dt_times_ki_times_error_as_a_torque() -> None:
     command = one_joint(position=0.5, ki_position=100.0, i_effort_min=-50.0, i_effort_max=50.0)
     state = PidState()
-    expected = [100.0 * 0.5 * DT_S * k for k in (1, 2, 3)]
+    expected = [DT_S * 100.0 * 0.5 * k for k in (1, 2, 3)]
     assert [torque(command, q=0.0, state=state) for _ in range(3)] == pytest.approx(expected)
-    np.testing.assert_allclose(state.integral, 3 * 0.5 * DT_S)
+    np.testing.assert_allclose(state.integral, 3 * DT_S * 100.0 * 0.5)  # N m
 
 
-def test_integral_is_clamped_so_its_torque_stays_in_bounds() -> None:
+def test_a_change_of_ki_keeps_the_accumulated_torque() -> None:
+    command = one_joint(position=0.5, ki_position=100.0, i_effort_min=-50.0, i_effort_max=50.0)
+    state = PidState()
+    for _ in range(10):
+        torque(command, q=0.0, state=state)
+    command.ki_position[:] = 400.0  # the old law (ki * integral of e) jumped 4x here
+    assert torque(command, q=0.0, state=state) == pytest.approx(10 * DT_S * 100.0 * 0.5
+                                                                + DT_S * 400.0 * 0.5)
+    command.ki_position[:] = 0.0  # ki off: the integral holds its torque
+    held = torque(command, q=0.0, state=state)
+    assert held == pytest.approx(10 * DT_S * 100.0 * 0.5 + DT_S * 400.0 * 0.5)
+    assert torque(command, q=0.3, state=state) == held
+
+
+def test_integral_is_clamped_to_the_effort_bounds() -> None:
     command = one_joint(position=1.0, ki_position=200.0, i_effort_min=-0.3, i_effort_max=0.5)
     state = PidState()
     for _ in range(50):  # unclamped: 200 * 50 * 1e-3 = 10 N m
         last = torque(command, q=0.0, state=state)
     assert last == pytest.approx(0.5)
-    np.testing.assert_allclose(state.integral, 0.5 / 200.0)
+    np.testing.assert_allclose(state.integral, 0.5)
     command.position[:] = -1.0
     for _ in range(100):
         last = torque(command, q=0.0, state=state)
     assert last == pytest.approx(-0.3)
 
 
-def test_negative_ki_swaps_the_integral_bounds() -> None:
+def test_negative_ki_drives_the_integral_down() -> None:
     command = one_joint(position=1.0, ki_position=-100.0, i_effort_min=-0.2, i_effort_max=0.4)
     state = PidState()
     for _ in range(100):
         last = torque(command, q=0.0, state=state)
-    assert last == pytest.approx(-0.2)  # integral grows, ki < 0: torque falls to the lower bound
+    assert last == pytest.approx(-0.2)  # ki < 0, e > 0: the integral torque falls to its lower bound
 
 
-def test_zero_ki_keeps_the_integral_at_zero() -> None:
+def test_inverted_integral_bounds_clamp_as_gazebo_did() -> None:
+    # Gazebo's clamp(x, lo, hi) = max(min(x, hi), lo): with lo > hi the integral sits at lo.
+    command = one_joint(position=1.0, ki_position=100.0, i_effort_min=0.7, i_effort_max=-0.2)
+    state = PidState()
+    assert torque(command, q=0.0, state=state) == 0.7
+    command.position[:] = -1.0
+    assert torque(command, q=0.0, state=state) == 0.7
+
+
+def test_tie_back_pulls_the_integral_back_under_saturation() -> None:
+    # kp e = 150 N m against a 100 N m limit: the 50 N m cut off comes out of the integral.
+    command = one_joint(position=1.0, kp_position=150.0, ki_position=1000.0,
+                        i_effort_min=-80.0, i_effort_max=80.0)
+    state = PidState()
+    assert torque(command, q=0.0, state=state) == LIMIT[0]
+    # I = 1000 * 1e-3 * 1 = 1; u = 151; tie-back: I = 1 + (100 - 151) = -50
+    assert state.integral[0] == pytest.approx(-50.0)
+    assert torque(command, q=0.0, state=state) == LIMIT[0]
+    assert state.integral[0] == pytest.approx(-50.0)  # (-50 + 1) + 150 = 101 -> -49 - 1
+    command.ki_position[:] = 0.0  # no integral gain: no tie-back, the integral is left alone
+    torque(command, q=0.0, state=state)
+    assert state.integral[0] == pytest.approx(-50.0)
+
+
+def test_zero_ki_adds_nothing_to_a_zero_integral() -> None:
     command = one_joint(position=1.0, ki_position=0.0, i_effort_min=-5.0, i_effort_max=5.0)
     state = PidState()
     for _ in range(10):
@@ -131,7 +169,7 @@ def test_zero_ki_keeps_the_integral_at_zero() -> None:
     command.i_effort_max[3] = 100.0
     result = compute_torque(command, np.zeros(NUM_JOINTS), np.zeros(NUM_JOINTS), state, DT_S,
                             LOWER, UPPER, LIMIT)
-    assert result[3] == pytest.approx(1000.0 * DT_S * 1.0)
+    assert result[3] == pytest.approx(DT_S * 1000.0 * 1.0)
     assert np.count_nonzero(result) == 1
 
 
@@ -145,28 +183,95 @@ def test_torque_is_clamped_to_the_effort_limit() -> None:
     assert torque(one_joint(effort=-1e3), q=0.0) == -LIMIT[0]
 
 
-def test_all_terms_together_per_joint() -> None:
-    rng = np.random.default_rng(7)
-    command = JointCommandArrays(**{name: rng.uniform(-1, 1, NUM_JOINTS) for name in FIELD_NAMES})
-    command.i_effort_min[:] = -np.abs(command.i_effort_min)
-    command.i_effort_max[:] = np.abs(command.i_effort_max)
-    q0, q1 = rng.uniform(-0.5, 0.5, (2, NUM_JOINTS))
-    v1 = rng.uniform(-1, 1, NUM_JOINTS)
-    lower, upper, limit = np.full(NUM_JOINTS, -0.4), np.full(NUM_JOINTS, 0.4), np.full(NUM_JOINTS, 1.5)
-    state = PidState()
-    compute_torque(command, q0, v1, state, DT_S, lower, upper, limit)
-    out = np.empty(NUM_JOINTS)
-    result = compute_torque(command, q1, v1, state, DT_S, lower, upper, limit, out=out)
-    assert result is out
-    for j in range(NUM_JOINTS):  # scalar reference, written out as in AtlasPlugin
-        target = min(max(command.position[j], lower[j]), upper[j])
-        e0, e1 = target - q0[j], target - q1[j]
-        ki = command.ki_position[j]
-        bounds = sorted((command.i_effort_min[j] / ki, command.i_effort_max[j] / ki))
-        i = min(max(min(max(DT_S * e0, bounds[0]), bounds[1]) + DT_S * e1, bounds[0]), bounds[1])
-        tau = (command.kp_position[j] * e1 + ki * i + command.kd_position[j] * (e1 - e0) / DT_S
-               + command.kp_velocity[j] * (command.velocity[j] - v1[j]) + command.effort[j])
-        assert result[j] == pytest.approx(min(max(tau, -limit[j]), limit[j]), abs=1e-12), JOINT_NAMES[j]
+def gazebo_clamp(value: float, low: float, high: float) -> float:
+    """Gazebo's math::clamp: max(min(value, high), low)."""
+    return max(min(value, high), low)
+
+
+class ScalarJoint:
+    """One joint of DRCSim 2.5.2's law, transcribed line by line with Python floats."""
+
+    def __init__(self) -> None:
+        self.reset()
+
+    def reset(self) -> None:
+        self.integral = 0.0
+        self.previous_error = 0.0
+        self.initialized = False
+        self.tied_back = False
+
+    def step(self, c: dict[str, float], q: float, v: float, dt: float, lower: float, upper: float,
+             limit: float) -> float:
+        e = gazebo_clamp(c['position'], lower, upper) - q
+        if not self.initialized:  # the project's deviation: no derivative kick after a reset
+            self.previous_error, self.initialized = e, True
+        de = (e - self.previous_error) / dt
+        self.previous_error = e
+        qd_p = c['velocity'] - v
+        self.integral = gazebo_clamp(self.integral + dt * c['ki_position'] * e,
+                                     c['i_effort_min'], c['i_effort_max'])
+        u = (c['kp_position'] * e + self.integral + c['kd_position'] * de
+             + c['kp_velocity'] * qd_p + c['effort'])
+        tau = gazebo_clamp(u, -limit, limit)
+        self.tied_back = math.fabs(tau - u) > 1e-6 and math.fabs(c['ki_position']) > 1e-6
+        if self.tied_back:  # !math::equal(tau, u) && !math::equal(ki, 0)
+            self.integral = gazebo_clamp(self.integral + (tau - u),
+                                         c['i_effort_min'], c['i_effort_max'])
+        return tau
+
+
+def random_command(rng: np.random.Generator) -> JointCommandArrays:
+    """Targets and gains that saturate often, with negative and tiny ki and inverted bounds."""
+    command = JointCommandArrays(
+        position=rng.uniform(-2.0, 2.0, NUM_JOINTS),
+        velocity=rng.uniform(-3.0, 3.0, NUM_JOINTS),
+        effort=rng.uniform(-60.0, 60.0, NUM_JOINTS),
+        kp_position=rng.choice([0.0, 10.0, 300.0, 4000.0], NUM_JOINTS) * rng.uniform(0, 1, NUM_JOINTS),
+        ki_position=rng.choice([0.0, 1e-7, -5e-7, 50.0, -50.0, 3000.0, -3000.0], NUM_JOINTS)
+        * rng.uniform(0.5, 1.5, NUM_JOINTS),
+        kd_position=rng.uniform(0.0, 20.0, NUM_JOINTS),
+        kp_velocity=rng.uniform(-5.0, 20.0, NUM_JOINTS),
+        i_effort_min=rng.uniform(-80.0, 20.0, NUM_JOINTS),
+        i_effort_max=rng.uniform(-20.0, 80.0, NUM_JOINTS),
+    )
+    return command
+
+
+def test_vectorized_law_equals_the_scalar_transcription() -> None:
+    """200 runs of 60 steps: ki changes and flips sign, bounds inverted, torques saturated."""
+    rng = np.random.default_rng(2025)
+    largest = 0.0
+    counts = {'tie_backs': 0, 'inverted_bounds': 0, 'negative_ki': 0}
+    for _run in range(200):
+        lower = rng.uniform(-2.5, 0.0, NUM_JOINTS)
+        upper = lower + rng.uniform(0.0, 3.0, NUM_JOINTS)
+        limit = rng.uniform(0.0, 200.0, NUM_JOINTS)
+        state, joints = PidState(), [ScalarJoint() for _ in range(NUM_JOINTS)]
+        command = random_command(rng)
+        q = rng.uniform(-2.0, 2.0, NUM_JOINTS)
+        v = rng.uniform(-5.0, 5.0, NUM_JOINTS)
+        for step in range(60):
+            if rng.random() < 0.2:  # a new command: ki and bounds change between steps
+                command = random_command(rng)
+            if step == 30 and rng.random() < 0.5:  # a reset mid-run
+                state.reset()
+                for joint in joints:
+                    joint.reset()
+            q = q + rng.normal(0.0, 0.05, NUM_JOINTS)
+            v = v + rng.normal(0.0, 0.5, NUM_JOINTS)
+            result = compute_torque(command, q, v, state, DT_S, lower, upper, limit)
+            fields = {name: getattr(command, name) for name in FIELD_NAMES}
+            for j, joint in enumerate(joints):
+                expected = joint.step({name: float(values[j]) for name, values in fields.items()},
+                                      float(q[j]), float(v[j]), DT_S, float(lower[j]),
+                                      float(upper[j]), float(limit[j]))
+                largest = max(largest, abs(result[j] - expected),
+                              abs(state.integral[j] - joint.integral))
+            counts['tie_backs'] += sum(joint.tied_back for joint in joints)
+            counts['inverted_bounds'] += int(np.count_nonzero(command.i_effort_min > command.i_effort_max))
+            counts['negative_ki'] += int(np.count_nonzero(command.ki_position < -1e-6))
+    assert largest == 0.0
+    assert min(counts.values()) > 1000, counts  # every case the law distinguishes was exercised
 
 
 @settings(max_examples=200, deadline=None)

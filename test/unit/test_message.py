@@ -39,3 +39,12 @@ def test_simulator_subscribes_with_the_real_type_and_md5() -> None:
     assert RawJointCommands._full_text == msg.JointCommands._full_text
     raw = b'\x01\x02'
     assert RawJointCommands().deserialize(raw).raw is raw
+
+
+def test_controller_statistics_is_drcsim_atlas_msgs() -> None:
+    atlas = pytest.importorskip('atlas_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
+    assert atlas.ControllerStatistics._type == 'atlas_msgs/ControllerStatistics'
+    assert atlas.ControllerStatistics._md5sum == '628a0c6643f9fd5708402f085735e478'
+    assert atlas.ControllerStatistics.__slots__ == [
+        'header', 'command_age', 'command_age_mean', 'command_age_variance',
+        'command_age_window_size']

@@ -139,3 +139,14 @@ def test_a_subscriber_that_left_is_dropped_quietly_a_stalled_one_with_a_warning(
     assert pub.connections == [healthy]
     assert left.closed and stalled.closed
     assert len(warnings) == 1 and '/slow' in warnings[0], warnings
+
+
+def test_controller_statistics():
+    from atlas_msgs.msg import ControllerStatistics
+
+    msg = wire.ControllerStatisticsWire()
+    msg.values[:] = (0.001, 0.0105, 33.28e-6, 1.0)
+    expected = ControllerStatistics(command_age=0.001, command_age_mean=0.0105,
+                                    command_age_variance=33.28e-6, command_age_window_size=1.0)
+    expected.header.stamp = genpy.Time(12, 345_678)
+    assert msg.to_bytes(STAMP_NS) == genpy_bytes(expected)
