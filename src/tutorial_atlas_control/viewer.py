@@ -98,9 +98,9 @@ class ViewerLink:
 
     def __init__(self, model: mujoco.MjModel, launch: Launcher | None = None,
                  modifiers: Modifiers = _glfw_modifiers) -> None:
-        if launch is None:
-            import mujoco.viewer
-            launch = mujoco.viewer.launch_passive
+        if launch is None:  # imported late: it needs GLFW, hence a display library
+            from mujoco import viewer as mujoco_viewer
+            launch = mujoco_viewer.launch_passive
         self.model = model
         self.shadow = mujoco.MjData(model)
         self._modifiers = modifiers
