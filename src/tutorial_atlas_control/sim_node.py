@@ -329,8 +329,10 @@ class SimNode:
                 with self.lock:
                     self._apply_pending_commands()
                 self.batch.flush()
-                if viewer is not None and not self._update_viewer(viewer):
-                    break
+                if viewer is not None and time.perf_counter() >= next_view_s:
+                    if not self._update_viewer(viewer):
+                        break
+                    next_view_s = time.perf_counter() + VIEWER_PERIOD_S
                 time.sleep(0.01)
                 wall0, sim0_ns = time.perf_counter(), self.sim.sim_time_ns
                 continue

@@ -28,7 +28,7 @@ from collections.abc import Callable
 import mujoco
 import numpy as np
 
-__all__ = ['KEY_R', 'KEY_SPACE', 'ViewerLink', 'ViewerRequest']
+__all__ = ['KEY_R', 'KEY_SPACE', 'ViewerLink', 'ViewerRequest', 'request_for_key']
 
 
 class ViewerRequest(enum.Enum):

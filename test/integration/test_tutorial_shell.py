@@ -144,3 +144,16 @@ def test_tutorial_step_and_fall_from_the_package_directory(simulator: dict[str, 
             if heights[-1] < FALLEN_BELOW_M:
                 break
     assert heights and heights[-1] < FALLEN_BELOW_M, f'the robot did not fall: pelvis {heights}'
+
+
+def test_posix_sh_says_what_it_misses(home: Path) -> None:
+    """In a shell other than bash env.sh sets ROS up and says, in one line, what it cannot give."""
+    env = fresh_env(home, 'http://localhost:11311')
+    result = subprocess.run(
+        ['sh', '-c', '. ./env.sh; echo "env.sh status $?"; rospack find tutorial_atlas_control'],
+        cwd=REPO, env=env, capture_output=True, text=True, timeout=SHELL_TIMEOUT_S, check=False)
+    assert result.stdout.splitlines()[0] == 'env.sh status 0'
+    assert Path(result.stdout.splitlines()[1]).resolve() == REPO
+    assert result.stderr.splitlines() == [
+        "env.sh: no roscd/rosls/rosed/roscp or ROS tab completion in this shell: they are bash "
+        "functions (Debian's rosbash); ROS itself is set up"]
