@@ -41,6 +41,7 @@ SPAWN_TOLERANCE_M = 0.001
 #: The probe's pinned-height window holds ~78 odometry samples at 100 Hz; far fewer means
 #: the height was not watched over the window.
 MIN_PINNED_SAMPLES = 30
+PINNED_WINDOW_TEXT = 'the 0.02-0.8 s after it (torso pinned 1 s)'
 #: Wall-clock bounds (s).
 PROBE_TIMEOUT_S = 180.0
 UI_DRAWN_TIMEOUT_S = 30.0
@@ -93,6 +94,10 @@ def assert_reset_world(report: dict[str, object]) -> None:
     heights = report['pinned_heights_m']
     assert len(heights) >= MIN_PINNED_SAMPLES, heights
     worst = max(abs(z - SPAWN_HEIGHT_M) for z in heights)
+    print(f'\nreset at {report["reset_after_s"]:.3f} s (gesture at {report["gesture_clock_s"]:.3f} s, '
+          f'pelvis was at {report["collapsed_z_m"]:.3f} m): {len(heights)} heights over '
+          f'{PINNED_WINDOW_TEXT}, at most {worst * 1000:.3f} mm from the spawn height; '
+          f'{report["clock_count"]} /clock messages, {report["clock_backwards"]} backwards')
     assert worst <= SPAWN_TOLERANCE_M, (
         f'pelvis {min(heights):.4f}..{max(heights):.4f} m after the reset, spawn '
         f'{SPAWN_HEIGHT_M:.4f} m')
