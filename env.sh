@@ -2,10 +2,20 @@
 # the catkin workspace sourced, the project's virtualenv first on PATH, and ROS bound to
 # localhost. To open ROS to a network deliberately, export ROS_HOSTNAME (or ROS_IP) and
 # ROS_MASTER_URI with this machine's reachable name *before* sourcing this file.
-if [ -n "${BASH_SOURCE[0]:-}" ]; then
-  repo_dir=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd -P)
+# bash names the sourced file in BASH_SOURCE (eval: other shells refuse the syntax), zsh in
+# $0; a POSIX sh names only itself, so there the current directory must be the repository.
+if [ -n "${BASH_VERSION:-}" ]; then
+  eval 'repo_dir=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd -P)'
 else
-  repo_dir=$(cd "$(dirname "$0")" && pwd -P)
+  repo_dir=$(cd "$(dirname "$0")" 2>/dev/null && pwd -P)
+fi
+if [ ! -f "$repo_dir/tools/paths.sh" ]; then
+  repo_dir=$(pwd -P)
+  if [ ! -f "$repo_dir/tools/paths.sh" ]; then
+    echo "env.sh: this shell does not say where env.sh is; source it from the repository's directory (. ./env.sh)" >&2
+    unset repo_dir
+    return 1 2>/dev/null || exit 1
+  fi
 fi
 . "$repo_dir/tools/paths.sh"
 if [ ! -f "$TAC_WS/devel/setup.sh" ] || [ ! -x "$TAC_VENV/bin/python" ]; then
@@ -29,3 +39,14 @@ export ROS_MASTER_URI="${ROS_MASTER_URI:-http://localhost:11311}"
 if [ -z "${DISPLAY:-}" ] && [ -z "${MUJOCO_GL:-}" ]; then export MUJOCO_GL=osmesa PYOPENGL_PLATFORM=osmesa; fi
 export TAC_REPO_DIR="$repo_dir" TAC_HOME TAC_WS TAC_VENV
 unset repo_dir
+# The tutorial's roscd, rosls, rosed, roscp and the ROS commands' tab completion: shell
+# functions from Debian's rosbash package, for bash only (nothing else sources them).
+_tac_rosbash=/usr/share/bash-completion/completions/rosbash
+if [ -n "${BASH_VERSION:-}" ] && [ -f "$_tac_rosbash" ]; then
+  . "$_tac_rosbash"
+elif [ -n "${BASH_VERSION:-}" ]; then
+  echo "env.sh: no roscd/rosls/rosed/roscp or ROS tab completion: $_tac_rosbash is missing (install Debian's rosbash: make setup)" >&2
+else
+  echo "env.sh: no roscd/rosls/rosed/roscp or ROS tab completion in this shell: they are bash functions (Debian's rosbash); ROS itself is set up" >&2
+fi
+unset _tac_rosbash

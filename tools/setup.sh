@@ -21,6 +21,7 @@ APT_PACKAGES=(
   python3-rosgraph-msgs libstd-msgs-dev libroscpp-dev libsensor-msgs-dev
   librostest-dev librosbag-storage-dev libtopic-tools-dev python3-venv python3-yaml python3-numpy
   libosmesa6 libegl1 libopengl0 libgl1-mesa-dri
+  xvfb xdotool x11-apps imagemagick
 )
 
 log() { printf 'setup: %s\n' "$*"; }

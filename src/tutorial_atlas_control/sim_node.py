@@ -9,7 +9,8 @@ checksum, time of the last reset) for offline replay; obeys
 Parameters (private unless noted):
     ~real_time_factor (float, 1.0): sim time per wall time; 0 runs as fast as possible.
     ~paused (bool, false): start with physics paused (/gazebo/unpause_physics starts it).
-    ~gui (bool, false): open the MuJoCo viewer (needs a display).
+    ~gui (bool, false): open the MuJoCo viewer (needs a display); its Reset button and key
+        (Backspace) and Shift+Ctrl+R do reset_world, Space pauses/unpauses (viewer.py).
     ~joint_states_rate, ~imu_rate, ~contact_rate (Hz, 1000): 0 or >= 1000 = every step.
     ~odom_rate (Hz, 100): /ground_truth_odom rate, as DRCSim.
     ~model_file (str, the package's sim/atlas_v1.xml): the MJCF to simulate; it must have
@@ -56,6 +57,7 @@ from tutorial_atlas_control.ros1_fields import FieldCursor
 from tutorial_atlas_control.simulator import (
     DEFAULT_TIME_TO_UNPIN_S, AtlasSimulator, ModeError, PhysicsDivergenceError, parse_mode)
 from tutorial_atlas_control.units import NS_PER_S, finite_number
+from tutorial_atlas_control.viewer import ViewerLink, ViewerRequest
 from tutorial_atlas_control.wire import (
     ControllerStatisticsWire, ImuWire, JointStateWire, OdometryWire, WireBatch, WrenchStampedWire,
     clock_bytes)
@@ -368,6 +370,10 @@ class SimNode:
                 with self.lock:
                     self._apply_pending_commands()
                 self.batch.flush()
+                if viewer is not None and time.perf_counter() >= next_view_s:
+                    if not self._update_viewer(viewer):
+                        break
+                    next_view_s = time.perf_counter() + VIEWER_PERIOD_S
                 time.sleep(0.01)
                 wall0, sim0_ns = time.perf_counter(), self.sim.sim_time_ns
                 continue
@@ -399,11 +405,8 @@ class SimNode:
                 self.batch.flush()
                 last_flush_s = now_s
             if viewer is not None and time.perf_counter() >= next_view_s:
-                if not viewer.is_running():
-                    rospy.signal_shutdown('viewer closed')
+                if not self._update_viewer(viewer):
                     break
-                with self.lock:
-                    viewer.sync()
                 next_view_s = time.perf_counter() + VIEWER_PERIOD_S
             if self.real_time_factor > 0.0:
                 due_s = wall0 + (sim_ns - sim0_ns) / NS_PER_S / self.real_time_factor
@@ -436,13 +439,37 @@ class SimNode:
         self._publish_config()
         return True
 
-    def _open_viewer(self):  # noqa: ANN202 - mujoco's passive viewer handle
+    def _open_viewer(self) -> ViewerLink | None:
         try:
-            import mujoco.viewer
-            return mujoco.viewer.launch_passive(self.sim.model, self.sim.data)
+            return ViewerLink(self.sim.model)
         except Exception as err:  # noqa: BLE001 - no display, no GL: run headless
             rospy.logwarn(f'cannot open the MuJoCo viewer ({err}); running headless')
             return None
+
+    def _update_viewer(self, viewer: ViewerLink) -> bool:
+        """Refresh the window and carry out what was asked in it; False once it is closed.
+
+        The lock is held only to copy the state in and the mouse forces out: the sync
+        itself waits for the viewer's thread, which must not stall services and commands.
+        """
+        if not viewer.is_running():
+            rospy.signal_shutdown('viewer closed')
+            return False
+        with self.lock:
+            viewer.copy_in(self.sim.data)
+        viewer.sync()
+        with self.lock:
+            viewer.copy_out(self.sim.data)
+        for request in viewer.take_requests():
+            if request is ViewerRequest.RESET_WORLD:
+                rospy.loginfo('viewer: Reset -> reset_world')
+                self.reset_world()
+            elif self.paused:  # ViewerRequest.TOGGLE_PAUSE
+                self.unpause()
+            else:
+                self.pause()
+        viewer.show_paused(self.paused)
+        return True
 
 
 def _float_param(name: str, default: float, minimum: float = 0.0) -> float:

@@ -25,7 +25,8 @@ from tutorial_atlas_control import topics
 from tutorial_atlas_control.controller import LOAD_HINT, Gains, GainsError, gains_from_params
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES, NUM_JOINTS, joint_index
-from tutorial_atlas_control.trajectory import Waypoint, interpolate, load_trajectory, sample_count
+from tutorial_atlas_control.trajectory import (
+    Waypoint, interpolate, load_trajectory, resolve_trajectory_file, sample_count)
 from tutorial_atlas_control.units import finite_number
 
 __all__ = [
@@ -48,6 +49,8 @@ DESCRIPTION = (
     '[duration_s, "28 joint positions"], move every joint linearly from its measured position\n'
     'to the waypoint over duration_s, publishing osrf_msgs/JointCommands on /atlas/joint_commands\n'
     'at 50 Hz with the gains atlas_controller/gains/<joint>/{p,i,d,i_clamp}.\n'
+    'A YAML_FILE name not found from the current directory is taken from the package\'s\n'
+    'trajectories/ folder (as the tutorial, run from the folder holding Traj_data2.yaml).\n'
     'Start the simulator first:\n'
     '  roslaunch tutorial_atlas_control atlas.launch\n'
     'ROS remapping arguments (name:=value) are accepted; ~joint_state_timeout (s, default 10)\n'
@@ -307,7 +310,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 1
     path, name = args
     try:
-        waypoints = load_trajectory(path, name)
+        waypoints = load_trajectory(_trajectory_file(path), name)
         message_type = _joint_commands_type()
         _require_master()
     except AtlasControlError as err:
@@ -331,6 +334,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         rospy.logwarn('shut down before the trajectory finished')
         return 1
     return 0
+
+
+def _trajectory_file(path: str) -> str:
+    """YAML_FILE as the tutorial uses it: a bare name also finds the package's trajectories/ copy.
+
+    Says which file it took when it was not the one in the current directory.
+    """
+    found, from_package = resolve_trajectory_file(path)
+    if from_package:
+        print(f'{path} is not in the current directory; using {found}')
+    return found
 
 
 def _play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], name: str) -> None:

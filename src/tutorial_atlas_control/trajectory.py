@@ -17,6 +17,7 @@ import math
 import os
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Union
 
 import numpy as np
@@ -34,6 +35,7 @@ __all__ = [
     'load_trajectory',
     'load_trajectory_file',
     'parse_trajectory',
+    'resolve_trajectory_file',
     'sample_count',
 ]
 
@@ -46,6 +48,11 @@ PUBLISH_PERIOD_S: float = 0.02
 _SAMPLE_COUNT_SLACK: float = 1e-9
 
 PathLike = Union[str, 'os.PathLike[str]']
+
+#: The package's trajectory files. The tutorial runs ``traj_yaml.py Traj_data2.yaml ...``
+#: from the folder that holds the file; a bare or relative name that does not exist from
+#: the current directory is looked up here (see :func:`resolve_trajectory_file`).
+TRAJECTORIES_DIR: Path = Path(__file__).resolve().parents[2] / 'trajectories'
 
 
 class TrajectoryError(AtlasControlError):
@@ -131,6 +138,33 @@ def parse_trajectory(doc: Mapping[object, object], name: str, path: PathLike) ->
     if not rows:
         raise TrajectoryError(f'{where}: has no waypoints')
     return [_parse_waypoint(row, f'{where}, waypoint {index}') for index, row in enumerate(rows)]
+
+
+def is_explicit_path(path: PathLike) -> bool:
+    """Absolute, or anchored at the current directory (``./x.yaml``, ``../x.yaml``)."""
+    text = os.fspath(path)
+    return os.path.isabs(text) or text.split(os.sep, 1)[0] in ('.', '..')
+
+
+def resolve_trajectory_file(path: PathLike, search_dir: Path = TRAJECTORIES_DIR) -> tuple[str, bool]:
+    """The file a YAML_FILE argument names, and whether it was found in `search_dir`.
+
+    The argument as given when it exists from the current directory, or when it is an
+    explicit path (:func:`is_explicit_path`: the user said where it is, so a missing file
+    is their mistake, reported by :func:`load_trajectory_file`). Otherwise a bare or
+    relative name is looked up in `search_dir`, the package's ``trajectories/``.
+
+    Raises:
+        TrajectoryError: a bare or relative name found in neither place (one line).
+    """
+    text = os.fspath(path)
+    if os.path.exists(text) or is_explicit_path(text):
+        return text, False
+    candidate = search_dir / text
+    if candidate.is_file():
+        return str(candidate), True
+    raise TrajectoryError(f'{text}: cannot read trajectory file: No such file or directory '
+                          f'(not in the current directory, nor in {search_dir})')
 
 
 def load_trajectory(path: PathLike, name: str) -> list[Waypoint]:

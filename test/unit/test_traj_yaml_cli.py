@@ -537,3 +537,22 @@ def test_ros_time_is_awaited_until_the_first_clock() -> None:
 def test_no_clock_is_an_error() -> None:
     with pytest.raises(TrajYamlError, match='/use_sim_time is set but no /clock arrived within 0.1 s'):
         wait_for_ros_time(0.1, lambda: 0.0, never_shut_down)
+
+
+def test_bare_name_is_taken_from_the_package_trajectories_folder(fake_master, tmp_path: Path) -> None:
+    """The tutorial's `traj_yaml.py Traj_data2.yaml ...` from anywhere: one info line names the file."""
+    server, uri = fake_master
+    result, elapsed = run_script(['Traj_data2.yaml', 'no_such_trajectory'], uri, tmp_path)
+    assert result.stdout.splitlines() == [
+        f'Traj_data2.yaml is not in the current directory; using {TRAJECTORY_FILE}']
+    assert_one_line_error(result, f'unable to find trajectory no_such_trajectory in {TRAJECTORY_FILE}')
+    assert elapsed < QUICK_S
+    assert_untouched(server)
+
+
+def test_explicit_missing_path_is_not_redirected(fake_master, tmp_path: Path) -> None:
+    server, uri = fake_master
+    result, _ = run_script(['./Traj_data2.yaml', 'step_and_fall'], uri, tmp_path)
+    assert result.stdout == ''
+    assert_one_line_error(result, './Traj_data2.yaml: cannot read trajectory file: No such file or directory')
+    assert_untouched(server)

@@ -1,0 +1,159 @@
+"""The MuJoCo viewer window as a view of the simulator node, never a second simulator.
+
+MuJoCo's passive viewer acts on the MjData it is given: its "Reset" button and key
+(Backspace) make the next ``sync()`` call ``mj_resetData`` on it, which would put the robot
+at the model's qpos0 unpinned, rewind ``data.time`` to 0 and leave the controller's memory
+and ``/atlas/sim_config`` stale. So the viewer never gets the physics data: it shows a
+shadow copy, refreshed before each sync, and a reset it performs on the shadow is turned
+into a request for the node's own ``reset_world`` (DRCSim's "Reset Model Poses"). Keys
+the node adds, as Gazebo had them:
+
+    Backspace, or the "Reset" button   reset_world (what /gazebo/reset_world does)
+    Shift+Ctrl+R                       reset_world (Gazebo's "Reset Model Poses")
+    Space                              pause / unpause physics and /clock
+                                       (/gazebo/pause_physics, /gazebo/unpause_physics)
+
+The viewer's own Pause/Run switch is greyed out for a passive viewer (MuJoCo's choice); a
+"PAUSED" overlay shows the node's state instead. Mouse perturbations (Ctrl+drag) still push
+the robot: their forces are copied back to the physics data. Joint and control sliders only
+display values: the next refresh overwrites an edit (the controller owns the joints).
+"""
+
+from __future__ import annotations
+
+import enum
+import threading
+from collections.abc import Callable
+
+import mujoco
+import numpy as np
+
+__all__ = ['KEY_R', 'KEY_SPACE', 'ViewerLink', 'ViewerRequest', 'request_for_key']
+
+
+class ViewerRequest(enum.Enum):
+    """What the user asked for in the window; the node's loop carries it out."""
+
+    RESET_WORLD = 'reset_world'
+    TOGGLE_PAUSE = 'toggle_pause'
+
+
+#: GLFW key codes (glfw.KEY_SPACE, glfw.KEY_R), named here so that the mapping can be
+#: tested without a display.
+KEY_SPACE = 32
+KEY_R = 82
+#: Modifier sets, as _glfw_modifiers() reports them.
+SHIFT = 'shift'
+CONTROL = 'control'
+ALT = 'alt'
+RESET_MODIFIERS = frozenset({SHIFT, CONTROL})
+#: Written into the shadow's qacc_warmstart before each sync: mj_resetData (the viewer's
+#: reset) zeroes that field, and nothing else on the shadow writes it (the shadow is never
+#: stepped; mj_forward reads it only). Unlike data.time, it also tells a reset at t = 0.
+RESET_CANARY = 1.0
+#: The overlay shown while physics is paused (left and right column).
+PAUSED_TEXT = ('PAUSED', 'physics and /clock stopped; Space runs')
+
+Modifiers = Callable[[], frozenset[str]]
+Launcher = Callable[..., object]
+
+
+def _glfw_modifiers() -> frozenset[str]:
+    """Modifier keys held now in the viewer's window (call from the viewer's thread).
+
+    The passive viewer's key callback receives only the key code; its thread has the
+    window's GL context current, so GLFW can be asked for the modifiers' state.
+    """
+    import glfw  # the viewer's own GLFW binding; imported late: it needs a display library
+
+    window = glfw.get_current_context()
+    if not window:
+        return frozenset()
+    held = set()
+    for name, keys in ((SHIFT, (glfw.KEY_LEFT_SHIFT, glfw.KEY_RIGHT_SHIFT)),
+                       (CONTROL, (glfw.KEY_LEFT_CONTROL, glfw.KEY_RIGHT_CONTROL)),
+                       (ALT, (glfw.KEY_LEFT_ALT, glfw.KEY_RIGHT_ALT))):
+        if any(glfw.get_key(window, key) == glfw.PRESS for key in keys):
+            held.add(name)
+    return frozenset(held)
+
+
+def request_for_key(key: int, modifiers: frozenset[str]) -> ViewerRequest | None:
+    """The node's action for a key pressed in the window, if any."""
+    if key == KEY_SPACE and not modifiers:
+        return ViewerRequest.TOGGLE_PAUSE
+    if key == KEY_R and modifiers == RESET_MODIFIERS:
+        return ViewerRequest.RESET_WORLD
+    return None
+
+
+class ViewerLink:
+    """A passive MuJoCo viewer on a shadow of the physics data, and the requests made in it.
+
+    Threads: ``on_key`` runs in the viewer's thread and only queues a request; everything
+    else is called by the node's loop. ``copy_in``/``copy_out`` read/write the physics data
+    and belong under the node's lock; ``sync`` does not (it waits for the viewer's own
+    mutex, which the viewer's thread holds while it handles window events).
+    """
+
+    def __init__(self, model: mujoco.MjModel, launch: Launcher | None = None,
+                 modifiers: Modifiers = _glfw_modifiers) -> None:
+        if launch is None:  # imported late: it needs GLFW, hence a display library
+            from mujoco import viewer as mujoco_viewer
+            launch = mujoco_viewer.launch_passive
+        self.model = model
+        self.shadow = mujoco.MjData(model)
+        self._modifiers = modifiers
+        self._requests: list[ViewerRequest] = []
+        self._requests_lock = threading.Lock()
+        self._paused_shown = False
+        self.handle = launch(model, self.shadow, key_callback=self.on_key)
+
+    # -- the viewer's thread -------------------------------------------------------------
+    def on_key(self, key: int) -> None:
+        request = request_for_key(key, self._modifiers())
+        if request is not None:
+            self._push(request)
+
+    def _push(self, request: ViewerRequest) -> None:
+        with self._requests_lock:
+            self._requests.append(request)
+
+    # -- the node's loop ----------------------------------------------------------------
+    def is_running(self) -> bool:
+        return bool(self.handle.is_running())
+
+    def copy_in(self, data: mujoco.MjData) -> None:
+        """Refresh the shadow from the physics data (under the node's lock; ~10 us)."""
+        mujoco.mj_copyData(self.shadow, self.model, data)
+        self.shadow.qacc_warmstart[:] = RESET_CANARY
+
+    def sync(self) -> None:
+        """Hand the shadow to the window; a reset the viewer did on it becomes a request."""
+        self.handle.sync()
+        if self.model.nv and self.shadow.qacc_warmstart[0] != RESET_CANARY:
+            self._push(ViewerRequest.RESET_WORLD)
+
+    def copy_out(self, data: mujoco.MjData) -> None:
+        """Apply the window's mouse perturbation forces to the physics (under the lock)."""
+        np.copyto(data.xfrc_applied, self.shadow.xfrc_applied)
+
+    def take_requests(self) -> list[ViewerRequest]:
+        with self._requests_lock:
+            requests, self._requests = self._requests, []
+        return requests
+
+    def show_paused(self, paused: bool) -> None:
+        """Overlay "PAUSED" while physics is paused (MuJoCo's own label needs its Pause)."""
+        if paused == self._paused_shown:
+            return
+        if paused:
+            left, right = PAUSED_TEXT
+            self.handle.set_texts((mujoco.mjtFontScale.mjFONTSCALE_150,
+                                   mujoco.mjtGridPos.mjGRID_TOP, left, right))
+        else:
+            self.handle.clear_texts()
+        self._paused_shown = paused
+
+    def close(self) -> None:
+        self.handle.close()

@@ -1,0 +1,149 @@
+"""viewer.ViewerLink without a display: a fake passive viewer doing what MuJoCo's does on sync."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+
+from tutorial_atlas_control.viewer import (
+    CONTROL, KEY_R, KEY_SPACE, SHIFT, ViewerLink, ViewerRequest, request_for_key)
+
+MJCF = """
+<mujoco>
+  <worldbody>
+    <body name="ball" pos="0 0 1"><freejoint/><geom size="0.1" mass="1"/></body>
+  </worldbody>
+</mujoco>
+"""
+KEY_BACKSPACE = 259
+
+
+class FakeViewer:
+    """Stands in for mujoco.viewer.Handle; `press_reset` does what the Reset button does."""
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, key_callback) -> None:  # noqa: ANN001
+        self.model, self.data, self.key_callback = model, data, key_callback
+        self.reset_pending = False
+        self.force = np.zeros(6)
+        self.texts: list[object] = []
+        self.running = True
+
+    def sync(self) -> None:
+        if self.reset_pending:  # simulate.cc: mj_resetData + mj_forward on the user's data
+            mujoco.mj_resetData(self.model, self.data)
+            mujoco.mj_forward(self.model, self.data)
+            self.reset_pending = False
+        self.data.xfrc_applied[:] = 0.0  # then the perturbation of the mouse, if any
+        self.data.xfrc_applied[1] = self.force
+
+    def set_texts(self, texts: object) -> None:
+        self.texts = [texts]
+
+    def clear_texts(self) -> None:
+        self.texts = []
+
+    def is_running(self) -> bool:
+        return self.running
+
+    def close(self) -> None:
+        self.running = False
+
+
+@pytest.fixture()
+def physics() -> tuple[mujoco.MjModel, mujoco.MjData]:
+    model = mujoco.MjModel.from_xml_string(MJCF)
+    data = mujoco.MjData(model)
+    for _ in range(200):
+        mujoco.mj_step(model, data)
+    return model, data
+
+
+def make_link(model: mujoco.MjModel, held: frozenset[str] = frozenset()) -> tuple[ViewerLink, FakeViewer]:
+    viewers = []
+
+    def launch(m: mujoco.MjModel, d: mujoco.MjData, key_callback) -> FakeViewer:  # noqa: ANN001
+        viewers.append(FakeViewer(m, d, key_callback))
+        return viewers[-1]
+
+    link = ViewerLink(model, launch=launch, modifiers=lambda: held)
+    return link, viewers[0]
+
+
+def refresh(link: ViewerLink, data: mujoco.MjData) -> list[ViewerRequest]:
+    link.copy_in(data)
+    link.sync()
+    link.copy_out(data)
+    return link.take_requests()
+
+
+def test_the_viewer_never_gets_the_physics_data(physics) -> None:  # noqa: ANN001
+    model, data = physics
+    link, viewer = make_link(model)
+    assert viewer.data is not data
+    refresh(link, data)
+    np.testing.assert_array_equal(viewer.data.qpos, data.qpos)
+    assert viewer.data.time == data.time
+
+
+def test_reset_button_becomes_a_request_and_leaves_physics_alone(physics) -> None:  # noqa: ANN001
+    model, data = physics
+    link, viewer = make_link(model)
+    qpos, time_s = data.qpos.copy(), data.time
+    viewer.reset_pending = True
+    assert refresh(link, data) == [ViewerRequest.RESET_WORLD]
+    np.testing.assert_array_equal(data.qpos, qpos)  # no raw mj_resetData on the physics
+    assert data.time == time_s  # nor a rewound clock
+    assert refresh(link, data) == []  # one reset, one request
+
+
+def test_reset_is_seen_at_time_zero(physics) -> None:  # noqa: ANN001
+    model, _ = physics
+    link, viewer = make_link(model)
+    fresh = mujoco.MjData(model)
+    mujoco.mj_forward(model, fresh)
+    assert fresh.time == 0.0
+    assert refresh(link, fresh) == []
+    viewer.reset_pending = True
+    assert refresh(link, fresh) == [ViewerRequest.RESET_WORLD]
+
+
+def test_mouse_forces_reach_the_physics(physics) -> None:  # noqa: ANN001
+    model, data = physics
+    link, viewer = make_link(model)
+    viewer.force = np.array([0.0, 0.0, 50.0, 0.0, 0.0, 0.0])
+    refresh(link, data)
+    np.testing.assert_array_equal(data.xfrc_applied[1], viewer.force)
+    viewer.force = np.zeros(6)
+    refresh(link, data)
+    assert not data.xfrc_applied.any()
+
+
+@pytest.mark.parametrize(('key', 'held', 'expected'), [
+    (KEY_SPACE, frozenset(), ViewerRequest.TOGGLE_PAUSE),
+    (KEY_R, frozenset({SHIFT, CONTROL}), ViewerRequest.RESET_WORLD),
+    (KEY_R, frozenset(), None),  # MuJoCo's own reflection toggle
+    (KEY_R, frozenset({CONTROL}), None),
+    (KEY_SPACE, frozenset({CONTROL}), None),
+    (KEY_BACKSPACE, frozenset(), None),  # MuJoCo's Reset: seen at sync, not here
+])
+def test_keys(key: int, held: frozenset[str], expected: ViewerRequest | None) -> None:
+    assert request_for_key(key, held) is expected
+
+
+def test_key_callback_queues_until_taken(physics) -> None:  # noqa: ANN001
+    model, data = physics
+    link, viewer = make_link(model, frozenset({SHIFT, CONTROL}))
+    viewer.key_callback(KEY_R)
+    viewer.key_callback(KEY_R)
+    assert refresh(link, data) == [ViewerRequest.RESET_WORLD, ViewerRequest.RESET_WORLD]
+    assert link.take_requests() == []
+
+
+def test_paused_overlay_follows_the_node(physics) -> None:  # noqa: ANN001
+    model, _ = physics
+    link, viewer = make_link(model)
+    link.show_paused(True)
+    assert len(viewer.texts) == 1 and 'PAUSED' in viewer.texts[0]
+    link.show_paused(False)
+    assert viewer.texts == []
