@@ -16,8 +16,12 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from tutorial_atlas_control.errors import AtlasControlError
+
+if TYPE_CHECKING:
+    from tutorial_atlas_control.bag_analysis import Analysis
 
 PACKAGE_DIR = Path(__file__).resolve().parents[2]
 DEFAULT_TRAJECTORY_FILE = PACKAGE_DIR / 'trajectories' / 'Traj_data2.yaml'
@@ -180,6 +184,25 @@ def wait_sim_time(clock_type: type, seconds: float) -> None:
         time.sleep(0.05)
 
 
+def summary_text(analysis: Analysis) -> str:
+    """The demo's summary of a run: fall, then tracking of the joints that moved (lines)."""
+    lines = ['=== summary ===']
+    if analysis.fell is None:
+        lines.append('fall: unknown (no /ground_truth_odom in the bag)')
+    elif analysis.fell:
+        lines.append(f'the robot fell: pelvis below 0.5 m at t = {analysis.fall_time_s:.2f} s '
+                     'from bag start')
+    else:
+        lines.append('the robot did not fall (lowest pelvis height '
+                     f'{analysis.min_pelvis_height_m:.2f} m)')
+    lines.append('tracking error of the joints that moved (commanded vs measured):')
+    for name, tracking in analysis.joints.items():
+        if tracking.rms_error_rad is not None:
+            lines.append(f'  {name:10s} RMS {tracking.rms_error_rad:.4f} rad, '
+                         f'max {tracking.max_error_rad:.4f} rad')
+    return '\n'.join(lines)
+
+
 def summarise(bag: Path, video_fps: float, video_size: tuple[int, int]) -> None:
     """Print the short summary; write the plot and (unless video_fps is 0) the video."""
     from tutorial_atlas_control.bag_analysis import analyze_bag
@@ -187,19 +210,7 @@ def summarise(bag: Path, video_fps: float, video_size: tuple[int, int]) -> None:
     from tutorial_atlas_control.render import render_bag_video
 
     analysis = analyze_bag(bag)
-    print('\n=== summary ===')
-    if analysis.fell is None:
-        print('fall: unknown (no /ground_truth_odom in the bag)')
-    elif analysis.fell:
-        print(f'the robot fell: pelvis below 0.5 m at t = {analysis.fall_time_s:.2f} s '
-              'from bag start')
-    else:
-        print(f'the robot did not fall (lowest pelvis height {analysis.min_pelvis_height_m:.2f} m)')
-    print('tracking error of the joints that moved (commanded vs measured):')
-    for name, tracking in analysis.joints.items():
-        if tracking.rms_error_rad is not None:
-            print(f'  {name:10s} RMS {tracking.rms_error_rad:.4f} rad, '
-                  f'max {tracking.max_error_rad:.4f} rad')
+    print('\n' + summary_text(analysis))
     plot = plot_run(analysis, bag.with_suffix('.png'))
     video = None
     if video_fps > 0:

@@ -33,6 +33,7 @@ __all__ = [
     'load_trajectory',
     'load_trajectory_file',
     'parse_trajectory',
+    'resolve_trajectory_file',
     'sample_count',
 ]
 
@@ -148,6 +149,15 @@ def load_trajectory(path: PathLike, name: str) -> list[Waypoint]:
         if other != name:
             parse_trajectory(doc, other, path)
     return parse_trajectory(doc, name, path)
+
+
+def resolve_trajectory_file(path: PathLike) -> str:
+    """The trajectory file a command line argument names (traj_yaml.py, run_offline.py).
+
+    One function for every script that takes a YAML_FILE, so they find the same file;
+    today the path as given (relative to the working directory).
+    """
+    return os.fspath(path)
 
 
 def sample_count(duration_s: float) -> int:
