@@ -35,11 +35,17 @@ def _fmt(value: float | None, spec: str, unit: str = '') -> str:
     return 'n/a' if value is None else f'{value:{spec}}{unit}'
 
 
-def format_summary(analysis: Analysis) -> str:
-    """The human-readable report, several lines, no trailing newline."""
+def format_summary(analysis: Analysis, trajectory: str | None = None) -> str:
+    """The human-readable report, several lines, no trailing newline.
+
+    `trajectory`: what the bag's /rosout says was played (run_log), shown when given.
+    """
     data = analysis.data
     lines = [f'Bag:      {data.path}',
-             f'Duration: {data.duration_s:.3f} s (start {data.start_time_s:.3f} s)', 'Topics:']
+             f'Duration: {data.duration_s:.3f} s (start {data.start_time_s:.3f} s)']
+    if trajectory is not None:
+        lines.append(f'Trajectory: {trajectory}')
+    lines.append('Topics:')
     width = max((len(name) for name in data.topics), default=0)
     type_width = max((len(topic.msgtype) for topic in data.topics.values()), default=0)
     for name, topic in data.topics.items():
@@ -115,9 +121,10 @@ def _json_safe(value: Any) -> Any:
     return value
 
 
-def to_json(analysis: Analysis) -> str:
-    """The analysis as one JSON object (strict JSON: no NaN)."""
-    return json.dumps(_json_safe(analysis.to_dict()), indent=2, allow_nan=False)
+def to_json(analysis: Analysis, extra: dict[str, Any] | None = None) -> str:
+    """The analysis as one JSON object (strict JSON: no NaN), plus the keys of `extra`."""
+    return json.dumps(_json_safe({**analysis.to_dict(), **(extra or {})}), indent=2,
+                      allow_nan=False)
 
 
 def _save_csv(path: Path, header: list[str], columns: list[np.ndarray]) -> Path:
