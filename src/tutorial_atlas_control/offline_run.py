@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import struct
 import sys
 import tempfile
 import time
@@ -40,7 +41,7 @@ from tutorial_atlas_control.simulator import (
 from tutorial_atlas_control.trajectory import (
     Waypoint, load_trajectory, resolve_trajectory_file, sample_count)
 from tutorial_atlas_control.units import NS_PER_S
-from tutorial_atlas_control.wire import JointCommandsWire, clock_bytes
+from tutorial_atlas_control.wire import JointCommandsWire, StampedWire, clock_bytes
 
 __all__ = ['OfflineRunError', 'OfflineRun', 'main', 'run_offline', 'write_offline_bag']
 
@@ -99,19 +100,85 @@ class OfflineRun:
         return self.sim_time_s / self.wall_s if self.wall_s > 0 else float('inf')
 
 
-class _BagSink:
-    """A rosbags Writer with one connection per topic and a cheap write of raw bytes.
+#: Steps whose 1 kHz messages are buffered, then stamped and written to the bag in one go.
+BLOCK_STEPS = 500
 
-    rosbags' Writer.write builds each record header field by field (a dict, an f-string
-    and a struct per field, ~6 us): four times a step, more than the serializing. Here
-    the header of a topic's records is laid out once; a write packs the time into it and
-    appends to the writer's open chunk, keeping the writer's own chunk index, so the
-    writer closes, indexes and compresses the bag as its own.
+
+def _put_times(rows: np.ndarray, at: int, times_ns: np.ndarray) -> None:
+    """Write ROS times (secs, nsecs as two uint32) at byte `at` of every row."""
+    column = rows[:, at:at + 8].view('<u4')
+    column[:, 0] = times_ns // NS_PER_S
+    column[:, 1] = times_ns % NS_PER_S
+
+
+class _RecordBlock:
+    """Bag records of one topic whose messages all have the layout of one wire.py message.
+
+    Rows are laid out once as whole bag records (record header, length, the message as
+    the wire message holds it); the numbers of many steps are then written into them by
+    numpy (float_view, or add() copying the wire message) and take() stamps the record
+    times, Header.seq and Header.stamp of all rows at once.
+    """
+
+    def __init__(self, record_prefix: bytes, message: StampedWire, capacity: int) -> None:
+        self.source = np.frombuffer(message.buf, dtype=np.uint8)[TCPROS_PREFIX_BYTES:]
+        self.time_at = len(record_prefix)
+        self.data_at = self.time_at + 8 + 4
+        self.rows = np.zeros((capacity, self.data_at + len(self.source)), dtype=np.uint8)
+        self.rows[:, :self.time_at] = np.frombuffer(record_prefix, dtype=np.uint8)
+        self.rows[:, self.time_at + 8:self.data_at] = np.frombuffer(
+            _U32.pack(len(self.source)), dtype=np.uint8)
+        self.rows[:, self.data_at:] = self.source
+        self.times_ns = np.empty(capacity, dtype=np.int64)
+        self.stamps_ns = np.empty(capacity, dtype=np.int64)
+        self.count = 0
+        self.seq = 0
+
+    def float_view(self, offset: int, count: int) -> np.ndarray:
+        """The `count` float64s at byte `offset` of the message, every row: (rows, count)."""
+        at = self.data_at + offset
+        return self.rows[:, at:at + 8 * count].view('<f8')
+
+    def add(self, time_ns: int, stamp_ns: int) -> None:
+        """Queue the wire message as it is now, recorded at `time_ns`, stamped `stamp_ns`."""
+        k = self.count
+        self.rows[k, self.data_at:] = self.source
+        self.times_ns[k] = time_ns
+        self.stamps_ns[k] = stamp_ns
+        self.count = k + 1
+
+    def take(self, times_ns: np.ndarray | None = None,
+             stamps_ns: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Stamp and return the first rows: those add()ed, or len(times_ns) filled in place."""
+        if times_ns is None or stamps_ns is None:
+            times_ns, stamps_ns = self.times_ns[:self.count], self.stamps_ns[:self.count]
+        count = len(times_ns)
+        rows = self.rows[:count]
+        _put_times(rows, self.time_at, times_ns)
+        rows[:, self.data_at:self.data_at + 4].view('<u4')[:, 0] = (
+            self.seq + 1 + np.arange(count, dtype=np.uint32))
+        _put_times(rows, self.data_at + 4, stamps_ns)
+        self.seq += count
+        self.count = 0
+        return times_ns.copy(), rows
+
+
+_U32 = struct.Struct('<I')
+_TIME = struct.Struct('<II')
+
+
+class _BagSink:
+    """A rosbags Writer with one connection per topic, written a block of steps at a time.
+
+    rosbags' Writer.write builds each record header field by field (~6 us a message, four
+    1 kHz topics: as much as a third of a physics step). Here a topic's record header is
+    laid out once, the 1 kHz topics are stamped and appended by numpy a block at a time
+    (_RecordBlock), and the rest are appended as they come; all go into the writer's open
+    chunk with its own index, so the writer closes and indexes the bag as its own.
+    Within a chunk, records are grouped by topic (readers go by the index, in time order).
     """
 
     def __init__(self, path: Path) -> None:
-        import struct
-
         from rosbags.rosbag1 import Writer
 
         from tutorial_atlas_control.bag_analysis import load_typestore
@@ -123,58 +190,99 @@ class _BagSink:
         self.writer = Writer(path)
         self.writer.chunk_threshold = CHUNK_BYTES
         self.writer.open()
-        self.connections: dict[str, Any] = {}
-        self._headers: dict[str, tuple[bytes, bytes]] = {}
-        self._time = struct.Struct('<II')
-        self._u32 = struct.Struct('<I')
+        self.connection_ids: dict[str, int] = {}
+        self.prefixes: dict[str, bytes] = {}
         for topic, (msgtype, caller, latched) in TOPIC_TYPES.items():
             connection = self.writer.add_connection(
                 topic, msgtype, typestore=self.typestore, callerid=caller,
                 latching=1 if latched else None)
-            self.connections[topic] = connection
+            self.connection_ids[topic] = connection.id
             # The record header as rosbags writes it: op=MSGDATA, conn=<id>, time=<8 bytes>.
-            fields = [b'op=\x02', b'conn=' + self._u32.pack(connection.id)]
-            head = b''.join(self._u32.pack(len(f)) + f for f in fields)
+            fields = [b'op=\x02', b'conn=' + _U32.pack(connection.id)]
+            head = b''.join(_U32.pack(len(field)) + field for field in fields)
             size = len(head) + 4 + len(b'time=') + 8
-            self._headers[topic] = (self._u32.pack(size) + head
-                                    + self._u32.pack(len(b'time=') + 8) + b'time=',
-                                    connection.id)
+            self.prefixes[topic] = (_U32.pack(size) + head + _U32.pack(len(b'time=') + 8)
+                                    + b'time=')
+        self._pending: list[tuple[str, int, bytes]] = []
+        self._blocks: list[tuple[str, np.ndarray, bytes, int]] = []
 
-    def write(self, topic: str, stamp_ns: int, data: bytes | memoryview) -> None:
-        """Append one message (its ROS 1 serialization, no length prefix) at bag time `stamp_ns`."""
-        prefix, connection_id = self._headers[topic]
+    def block(self, topic: str, message: StampedWire) -> _RecordBlock:
+        """Rows for BLOCK_STEPS records of `topic`, laid out like `message`."""
+        return _RecordBlock(self.prefixes[topic], message, BLOCK_STEPS)
+
+    def write_rows(self, topic: str, times_ns: np.ndarray, rows: np.ndarray) -> None:
+        """Queue whole records (a _RecordBlock's take()) of `topic`."""
+        if len(rows):
+            self._blocks.append((topic, times_ns, rows.tobytes(), rows.shape[1]))
+
+    def write(self, topic: str, time_ns: int, data: bytes) -> None:
+        """Queue one message (its ROS 1 serialization, no length prefix) at bag time `time_ns`."""
+        self._pending.append((topic, time_ns, data))
+
+    def write_message(self, topic: str, time_ns: int, message: Any) -> None:
+        """Serialize a rosbags message of the topic's type and queue it."""
+        msgtype = TOPIC_TYPES[topic][0]
+        self.write(topic, time_ns, bytes(self.typestore.serialize_ros1(message, msgtype)))
+
+    def flush(self) -> None:
+        """Append everything queued to the writer's open chunk; close the chunk when full."""
         writer = self.writer
         chunk = writer.chunks[-1]
         bio = chunk.data
-        chunk.connections[connection_id].append((stamp_ns, bio.tell()))
-        if stamp_ns < chunk.start:
-            chunk.start = stamp_ns
-        if stamp_ns > chunk.end:
-            chunk.end = stamp_ns
-        secs, nsecs = divmod(stamp_ns, NS_PER_S)
-        bio.write(prefix)
-        bio.write(self._time.pack(secs, nsecs))
-        bio.write(self._u32.pack(len(data)))
-        bio.write(data)
+        first_ns, last_ns = chunk.start, chunk.end
+        for topic, time_ns, data in self._pending:
+            chunk.connections[self.connection_ids[topic]].append((time_ns, bio.tell()))
+            bio.write(self.prefixes[topic] + _TIME.pack(*divmod(time_ns, NS_PER_S))
+                      + _U32.pack(len(data)) + data)
+            first_ns, last_ns = min(first_ns, time_ns), max(last_ns, time_ns)
+        self._pending.clear()
+        for topic, times_ns, records, width in self._blocks:
+            start = bio.tell()
+            bio.write(records)
+            offsets = start + np.arange(len(times_ns), dtype=np.int64) * width
+            chunk.connections[self.connection_ids[topic]].extend(
+                zip(times_ns.tolist(), offsets.tolist()))
+            first_ns, last_ns = min(first_ns, int(times_ns[0])), max(last_ns, int(times_ns[-1]))
+        self._blocks.clear()
+        chunk.start, chunk.end = first_ns, last_ns
         if bio.tell() > writer.chunk_threshold:
             writer.write_chunk(chunk)
 
-    def write_message(self, topic: str, stamp_ns: int, message: Any) -> None:
-        """Serialize a rosbags message of the topic's type and write it."""
-        msgtype = TOPIC_TYPES[topic][0]
-        self.write(topic, stamp_ns, self.typestore.serialize_ros1(message, msgtype))
-
     def close(self) -> None:
+        self.flush()
         self.writer.close()
 
 
 class _OfflinePlayer:
-    """The simulator, traj_yaml's commands and the recorder, on one sim clock."""
+    """The simulator, traj_yaml's commands and the recorder, on one sim clock.
+
+    After each step it keeps what the simulator node would publish as rows of numbers
+    (qpos, qvel, torque, sensordata, stamps); every BLOCK_STEPS steps SimMessages' maps
+    turn them into messages, all at once (write_steps).
+    """
 
     def __init__(self, sim: AtlasSimulator, sink: _BagSink) -> None:
         self.sim = sim
         self.sink = sink
-        self.messages = SimMessages(sim)
+        self.messages = messages = SimMessages(sim)
+        self.joint_states = sink.block(topics.JOINT_STATES, messages.joint_state_wire)
+        self.odometry = sink.block(topics.GROUND_TRUTH_ODOM, messages.odometry_wire)
+        self.sensor_blocks = {
+            topics.IMU: (sink.block(topics.IMU, messages.imu_wire), 'imu', messages.imu_map),
+            **{topic: (sink.block(topic, messages.contact_wires[side]), side,
+                       messages.contact_maps[side])
+               for topic, side in ((topics.L_FOOT_CONTACT, 'l'), (topics.R_FOOT_CONTACT, 'r'))}}
+        wire = messages.joint_state_wire
+        self.joint_views = [self.joint_states.float_view(_offset_in(wire, view), len(view))
+                            for view in (wire.position, wire.velocity, wire.effort)]
+        data = sim.data
+        self.qpos = np.empty((BLOCK_STEPS, len(data.qpos)))
+        self.qvel = np.empty((BLOCK_STEPS, len(data.qvel)))
+        self.torque = np.empty((BLOCK_STEPS, len(sim.torque_nm)))
+        self.sensordata = np.empty((BLOCK_STEPS, len(data.sensordata)))
+        self.now_ns = np.empty(BLOCK_STEPS, dtype=np.int64)
+        self.sensed_ns = np.empty(BLOCK_STEPS, dtype=np.int64)
+        self.count = 0
         self.odom_every = max(1, int(round(1.0 / (ODOM_RATE_HZ * sim.dt_s))))
         self.steps = 0
         self.next_clock_ns = 0
@@ -190,20 +298,46 @@ class _OfflinePlayer:
 
     # -- what the simulator publishes ---------------------------------------------------
     def publish(self) -> None:
-        """What the simulator node sends after a step, written at the sim time it sends it."""
-        sim, write, messages = self.sim, self.sink.write, self.messages
+        """Keep what the simulator node sends after a step, recorded at the time it sends it."""
+        sim = self.sim
+        data = sim.data
         now_ns = sim.sim_time_ns
-        sensed_ns = sim.state_time_ns
-        skip = TCPROS_PREFIX_BYTES
         if now_ns >= self.next_clock_ns:
-            write(topics.CLOCK, now_ns, clock_bytes(now_ns)[skip:])
+            self.sink.write(topics.CLOCK, now_ns, clock_bytes(now_ns)[TCPROS_PREFIX_BYTES:])
             self.next_clock_ns = now_ns + CLOCK_PERIOD_NS
-        write(topics.JOINT_STATES, now_ns, memoryview(messages.joint_state(now_ns))[skip:])
+        k = self.count
+        self.now_ns[k] = now_ns
+        self.sensed_ns[k] = sim.state_time_ns  # poses and sensors: the step's start
+        self.qpos[k] = data.qpos
+        self.qvel[k] = data.qvel
+        self.torque[k] = sim.torque_nm
+        self.sensordata[k] = data.sensordata
         if self.steps % self.odom_every == 0:
-            write(topics.GROUND_TRUTH_ODOM, now_ns, memoryview(messages.odometry(sensed_ns))[skip:])
-        write(topics.IMU, now_ns, memoryview(messages.imu(sensed_ns))[skip:])
-        write(topics.L_FOOT_CONTACT, now_ns, memoryview(messages.foot_contact('l', sensed_ns))[skip:])
-        write(topics.R_FOOT_CONTACT, now_ns, memoryview(messages.foot_contact('r', sensed_ns))[skip:])
+            self.messages.fill_odometry()
+            self.odometry.add(now_ns, sim.state_time_ns)
+        self.count = k + 1
+        if self.count == BLOCK_STEPS:
+            self.write_steps()
+
+    def write_steps(self) -> None:
+        """Turn the kept steps into messages (SimMessages' selection) and queue them."""
+        count, sink = self.count, self.sink
+        if count:
+            atlas = self.sim.atlas
+            position, velocity, effort = (view[:count] for view in self.joint_views)
+            position[:] = self.qpos[:count, atlas.qpos_adr]
+            velocity[:] = self.qvel[:count, atlas.dof_adr]
+            effort[:] = self.torque[:count]
+            now_ns, sensed_ns = self.now_ns[:count], self.sensed_ns[:count]
+            sink.write_rows(topics.JOINT_STATES, *self.joint_states.take(now_ns, now_ns))
+            sensors = self.sensordata[:count]
+            for topic, (block, name, (to, source)) in self.sensor_blocks.items():
+                floats = block.float_view(self.messages.float_offsets[name], max(to) + 1)
+                floats[:count, to] = sensors[:, source]
+                sink.write_rows(topic, *block.take(now_ns, sensed_ns))
+        sink.write_rows(topics.GROUND_TRUTH_ODOM, *self.odometry.take())
+        self.count = 0
+        sink.flush()
 
     def advance(self, duration_s: float) -> None:
         """Step and publish for `duration_s` of sim time (whole steps, rounded up)."""
@@ -259,6 +393,12 @@ class _OfflinePlayer:
         self.sink.write_message(topics.ROSOUT, stamp_ns, message)
 
 
+def _offset_in(message: StampedWire, view: np.ndarray) -> int:
+    """Byte offset of `view` (a wire.py field) in `message`'s serialization (no TCPROS prefix)."""
+    base = np.frombuffer(message.buf, dtype=np.uint8).ctypes.data
+    return view.ctypes.data - base - TCPROS_PREFIX_BYTES
+
+
 def _command_wire(gains: Gains) -> JointCommandsWire:
     """traj_yaml's JointCommands (traj_yaml_node.build_command), laid out once."""
     command = JointCommandsWire([ATLAS_PREFIX + name for name in JOINT_NAMES])
@@ -275,9 +415,10 @@ def write_offline_bag(bag: Path, trajectory_file: str, name: str, waypoints: Seq
                       gains: Gains, settle_s: float, start_after_s: float,
                       model_path: Path = atlas_model.MODEL_PATH) -> OfflineRun:
     """Simulate the run and write it to `bag` (a new file; see run_offline for the checks)."""
-    started_s = time.perf_counter()
     sim = AtlasSimulator(atlas_model.load_model(model_path), gains, model_path=model_path)
     sink = _BagSink(bag)
+    # The run's time, without loading the model and the message types (fixed costs).
+    started_s = time.perf_counter()
     try:
         player = _OfflinePlayer(sim, sink)
         player.write_config()
@@ -292,6 +433,7 @@ def write_offline_bag(bag: Path, trajectory_file: str, name: str, waypoints: Seq
                        player.now_s)
         player.log(f"trajectory '{name}' done")
         player.advance(settle_s)
+        player.write_steps()
     finally:
         sink.close()
     return OfflineRun(bag, player.commands_sent, sim.sim_time_ns / NS_PER_S, player.steps,
