@@ -44,12 +44,11 @@ from tutorial_atlas_control import model as atlas_model
 from tutorial_atlas_control.commands import CommandDecoder, CommandError
 from tutorial_atlas_control.controller import gains_from_params
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.simulator import (
     DEFAULT_TIME_TO_UNPIN_S, NS_PER_S, AtlasSimulator, ModeError, PhysicsDivergenceError,
     parse_mode)
-from tutorial_atlas_control.wire import (
-    ImuWire, JointStateWire, OdometryWire, WireBatch, WrenchStampedWire, clock_bytes)
+from tutorial_atlas_control.sim_messages import SimMessages
+from tutorial_atlas_control.wire import WireBatch, clock_bytes
 
 NODE_NAME = 'atlas_sim'
 #: Seconds between repeats of the same refusal warning.
@@ -67,7 +66,6 @@ MAX_DIVERGENCES_IN_A_ROW = 3
 MAX_PENDING_COMMANDS = 10_000
 #: Viewer refresh period (s, wall).
 VIEWER_PERIOD_S = 1.0 / 60.0
-WORLD_FRAME = 'world'
 #: At real_time_factor 0 the loop sends what it published at most this often (s, wall);
 #: paced runs send after every step while on schedule.
 FLUSH_PERIOD_S = 0.001
@@ -149,16 +147,9 @@ class SimNode:
         self.config_pub = rospy.Publisher('/atlas/sim_config', String, queue_size=1, latch=True)
         self._publish_config()
 
-        self.joint_state = JointStateWire(JOINT_NAMES)
-        self.odom = OdometryWire(WORLD_FRAME, 'pelvis')
-        self.imu = ImuWire('pelvis')
-        self.contacts = ((WrenchStampedWire('l_foot'), 'l', self.l_contact_pub),
-                         (WrenchStampedWire('r_foot'), 'r', self.r_contact_pub))
-        data = sim.data
-        self.sensors = {name: data.sensor(name).data for name in (
-            'imu_orientation', 'imu_angular_velocity', 'imu_linear_acceleration',
-            'l_foot_force', 'l_foot_torque', 'r_foot_force', 'r_foot_torque')}
-        self._pelvis_velocity = np.zeros(6)
+        # What each message holds is sim_messages' (shared with offline runs).
+        self.messages = SimMessages(sim)
+        self.contacts = (('l', self.l_contact_pub), ('r', self.r_contact_pub))
 
         # Commands wait here, undecoded, for the loop (see on_joint_commands). Bounded, so
         # that a stalled loop cannot make it grow without limit; emptied every step.
@@ -273,43 +264,19 @@ class SimNode:
             # sees at real time); spares the recorder one message in five.
             batch.replace(self.clock_pub, clock_bytes(now_ns))
         count = self.step_count
+        messages = self.messages
         if count % self.every['joint_states'] == 0 and wanted(self.joint_state_pub):
-            msg = self.joint_state
-            np.take(sim.data.qpos, sim.atlas.qpos_adr, out=msg.position)
-            np.take(sim.data.qvel, sim.atlas.dof_adr, out=msg.velocity)
-            msg.effort[:] = sim.torque_nm
-            batch.add(self.joint_state_pub, msg.to_bytes(now_ns))
+            batch.add(self.joint_state_pub, messages.joint_state(now_ns))
         # Poses and sensors describe the state at the start of the last step (see step()).
         sensed_ns = sim.state_time_ns
         if count % self.every['odom'] == 0 and wanted(self.odom_pub):
-            self._publish_odom(sensed_ns)
+            batch.add(self.odom_pub, messages.odometry(sensed_ns))
         if count % self.every['imu'] == 0 and wanted(self.imu_pub):
-            imu = self.imu
-            w, x, y, z = self.sensors['imu_orientation']
-            imu.orientation_xyzw[:] = (x, y, z, w)
-            imu.angular_velocity[:] = self.sensors['imu_angular_velocity']
-            imu.linear_acceleration[:] = self.sensors['imu_linear_acceleration']
-            batch.add(self.imu_pub, imu.to_bytes(sensed_ns))
+            batch.add(self.imu_pub, messages.imu(sensed_ns))
         if count % self.every['contact'] == 0:
-            for msg, side, pub in self.contacts:
+            for side, pub in self.contacts:
                 if wanted(pub):
-                    msg.force[:] = self.sensors[f'{side}_foot_force']
-                    msg.torque[:] = self.sensors[f'{side}_foot_torque']
-                    batch.add(pub, msg.to_bytes(sensed_ns))
-
-    def _publish_odom(self, stamp_ns: int) -> None:
-        sim = self.sim
-        odom = self.odom
-        body = sim.atlas.pelvis_body_id
-        odom.position[:] = sim.data.xpos[body]
-        w, x, y, z = sim.data.xquat[body]
-        odom.orientation_xyzw[:] = (x, y, z, w)
-        # World-frame twist of the pelvis frame origin, as Gazebo's p3d plugin reported it.
-        mujoco.mj_objectVelocity(sim.model, sim.data, mujoco.mjtObj.mjOBJ_BODY, body,
-                                 self._pelvis_velocity, 0)
-        odom.angular[:] = self._pelvis_velocity[:3]
-        odom.linear[:] = self._pelvis_velocity[3:]
-        self.batch.add(self.odom_pub, odom.to_bytes(stamp_ns))
+                    batch.add(pub, messages.foot_contact(side, sensed_ns))
 
     # -- the loop ------------------------------------------------------------------------
     def spin(self) -> None:
