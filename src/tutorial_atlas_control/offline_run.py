@@ -16,6 +16,7 @@ CLOCK_PERIOD_NS), so every bag tool reads it as one.
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import struct
 import sys
@@ -30,8 +31,10 @@ import numpy as np
 
 from tutorial_atlas_control import model as atlas_model
 from tutorial_atlas_control import topics
+from tutorial_atlas_control.bag_analysis import analyze_bag, load_typestore
 from tutorial_atlas_control.commands import CommandDecoder, CommandError
 from tutorial_atlas_control.controller import Gains, load_gains_yaml
+from tutorial_atlas_control.demo import summary_text
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES
 from tutorial_atlas_control.schedule import run_trajectory, trajectory_log_line
@@ -104,6 +107,10 @@ class OfflineRun:
 BLOCK_STEPS = 500
 
 
+_U32 = struct.Struct('<I')
+_TIME = struct.Struct('<II')
+
+
 def _put_times(rows: np.ndarray, at: int, times_ns: np.ndarray) -> None:
     """Write ROS times (secs, nsecs as two uint32) at byte `at` of every row."""
     column = rows[:, at:at + 8].view('<u4')
@@ -163,10 +170,6 @@ class _RecordBlock:
         return times_ns.copy(), rows
 
 
-_U32 = struct.Struct('<I')
-_TIME = struct.Struct('<II')
-
-
 class _BagSink:
     """A rosbags Writer with one connection per topic, written a block of steps at a time.
 
@@ -180,8 +183,6 @@ class _BagSink:
 
     def __init__(self, path: Path) -> None:
         from rosbags.rosbag1 import Writer
-
-        from tutorial_atlas_control.bag_analysis import load_typestore
 
         self.typestore = load_typestore()
         if JOINT_COMMANDS_TYPE not in self.typestore.fielddefs:
@@ -358,7 +359,6 @@ class _OfflinePlayer:
 
     # -- what the user and traj_yaml do ------------------------------------------------
     def write_config(self) -> None:
-        import json
         self.sink.write_message(topics.SIM_CONFIG, self.sim.sim_time_ns,
                                 self._string(data=json.dumps(self.sim.config())))
 
@@ -440,12 +440,12 @@ def write_offline_bag(bag: Path, trajectory_file: str, name: str, waypoints: Seq
                       time.perf_counter() - started_s)
 
 
-def run_offline(trajectory_file: str, name: str, bag: Path | None,
+def run_offline(trajectory_file: str, name: str, bag: Path | str,
                 settle_s: float = DEFAULT_SETTLE_S,
                 start_after_s: float = DEFAULT_START_AFTER_S,
                 gains_file: Path = GAINS_FILE,
                 model_path: Path = atlas_model.MODEL_PATH) -> OfflineRun:
-    """Run trajectory `name` of `trajectory_file` offline into `bag` (None: a temporary bag).
+    """Run trajectory `name` of `trajectory_file` offline into the bag `bag`.
 
     The bag is written under a temporary name beside `bag` and renamed when complete
     (replacing an existing file): a failed run leaves nothing.
@@ -457,17 +457,12 @@ def run_offline(trajectory_file: str, name: str, bag: Path | None,
     path = resolve_trajectory_file(trajectory_file)
     waypoints = load_trajectory(path, name)
     gains = load_gains_yaml(gains_file)
-    if bag is None:
-        directory = Path(tempfile.mkdtemp(prefix='tac_offline_'))
-        target = directory / f'{name}.bag'
-    else:
-        target = Path(bag)
-        directory = target.parent
-        if not directory.is_dir():
-            raise OfflineRunError(f'{target}: directory {directory} does not exist')
-        if target.is_dir():
-            raise OfflineRunError(f'{target} is a directory; give a .bag file name')
-    partial = directory / f'.{target.name}.{os.getpid()}.partial'
+    target = Path(bag)
+    if not target.parent.is_dir():
+        raise OfflineRunError(f'{target}: directory {target.parent} does not exist')
+    if target.is_dir():
+        raise OfflineRunError(f'{target} is a directory; give a .bag file name')
+    partial = target.parent / f'.{target.name}.{os.getpid()}.partial'
     try:
         run = write_offline_bag(partial, os.path.abspath(path), name, waypoints, gains,
                                 settle_s, start_after_s, model_path)
@@ -476,8 +471,6 @@ def run_offline(trajectory_file: str, name: str, bag: Path | None,
         raise OfflineRunError(f'cannot write {target}: {err.strerror or err}') from err
     finally:
         partial.unlink(missing_ok=True)
-        if bag is None and not target.exists():
-            directory.rmdir()
     return OfflineRun(target, run.commands, run.sim_time_s, run.steps, run.wall_s)
 
 
@@ -517,22 +510,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     """The command line; returns the exit status (1: bad input or failed run, nothing written)."""
     args = build_parser().parse_args(argv)
     try:
-        run = run_offline(args.trajectory_file, args.name, args.bag, args.settle,
-                          args.start_after, args.gains)
-        from tutorial_atlas_control.bag_analysis import analyze_bag
-        from tutorial_atlas_control.demo import summary_text
-
-        analysis = analyze_bag(run.bag)
-        print(f'offline: {args.name}: {run.commands} commands, {run.sim_time_s:.3f} s of sim '
-              f'time in {run.wall_s:.2f} s ({run.real_time_factor:.1f}x real time)')
-        print(summary_text(analysis))
-        if args.bag is not None:
-            print(f'bag:   {run.bag}')
+        with tempfile.TemporaryDirectory(prefix='tac_offline_') as scratch:
+            # Without --bag the summary is read from a bag that is deleted afterwards.
+            bag = args.bag if args.bag is not None else Path(scratch) / f'{args.name}.bag'
+            run = run_offline(args.trajectory_file, args.name, bag, args.settle,
+                              args.start_after, args.gains)
+            analysis = analyze_bag(run.bag)
     except AtlasControlError as err:
         print(err, file=sys.stderr)  # one line, as traj_yaml.py
         return 1
-    finally:
-        if args.bag is None and 'run' in locals():
-            import shutil
-            shutil.rmtree(run.bag.parent, ignore_errors=True)
+    print(f'offline: {args.name}: {run.commands} commands, {run.sim_time_s:.3f} s of sim time '
+          f'in {run.wall_s:.2f} s ({run.real_time_factor:.1f}x real time)')
+    print(summary_text(analysis))
+    if args.bag is not None:
+        print(f'bag:   {run.bag}')
     return 0
