@@ -37,12 +37,13 @@ from tutorial_atlas_control.controller import Gains, load_gains_yaml
 from tutorial_atlas_control.demo import summary_text
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES
-from tutorial_atlas_control.schedule import run_trajectory, trajectory_log_line
+from tutorial_atlas_control.schedule import (
+    done_line, playing_line, run_trajectory, trajectory_log_line)
 from tutorial_atlas_control.sim_messages import TCPROS_PREFIX_BYTES, SimMessages
 from tutorial_atlas_control.simulator import (
     AtlasSimulator, ControlMode, PhysicsDivergenceError)
 from tutorial_atlas_control.trajectory import (
-    Waypoint, load_trajectory, resolve_trajectory_file, sample_count)
+    Waypoint, load_trajectory, resolve_trajectory_file)
 from tutorial_atlas_control.units import NS_PER_S
 from tutorial_atlas_control.wire import JointCommandsWire, StampedWire, clock_bytes
 
@@ -493,13 +494,11 @@ def write_offline_bag(bag: Path, trajectory_file: str, name: str, waypoints: Seq
         player.publish()  # the initial state, before the first step, as the node does
         player.advance(start_after_s)
         player.switch_mode(ControlMode.USER)
-        total = sum(sample_count(waypoint.duration_s) for waypoint in waypoints)
         player.log(trajectory_log_line(trajectory_file, name))
-        player.log(f"playing trajectory '{name}': {len(waypoints)} waypoints, "
-                   f"{sum(w.duration_s for w in waypoints):g} s, {total} commands")
+        player.log(playing_line(name, waypoints))
         run_trajectory(waypoints, sim.joint_positions, player.send, player.advance, player.log,
                        player.now_s)
-        player.log(f"trajectory '{name}' done")
+        player.log(done_line(name))
         player.advance(settle_s)
         player.write_steps()
     finally:

@@ -17,7 +17,9 @@ from tutorial_atlas_control.trajectory import Waypoint, interpolate, sample_coun
 __all__ = [
     'MOVING_JOINT_THRESHOLD_RAD',
     'TRAJECTORY_LOG_PREFIX',
+    'done_line',
     'parse_trajectory_log_line',
+    'playing_line',
     'run_trajectory',
     'trajectory_log_line',
 ]
@@ -46,6 +48,18 @@ def parse_trajectory_log_line(text: str) -> dict[str, str] | None:
                                                for key in ('file', 'name')):
         return None
     return {'file': fields['file'], 'name': fields['name']}
+
+
+def playing_line(name: str, waypoints: Sequence[Waypoint]) -> str:
+    """The log line before the first command: waypoints, duration and commands."""
+    total = sum(sample_count(waypoint.duration_s) for waypoint in waypoints)
+    return (f"playing trajectory '{name}': {len(waypoints)} waypoints, "
+            f"{sum(w.duration_s for w in waypoints):g} s, {total} commands")
+
+
+def done_line(name: str) -> str:
+    """The log line after the last command."""
+    return f"trajectory '{name}' done"
 
 
 def run_trajectory(

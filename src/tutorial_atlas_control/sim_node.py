@@ -29,7 +29,6 @@ from collections.abc import Callable
 from pathlib import Path
 
 import genpy
-import mujoco
 import numpy as np
 import rospy
 from geometry_msgs.msg import WrenchStamped

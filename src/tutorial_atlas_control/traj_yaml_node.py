@@ -27,8 +27,8 @@ from sensor_msgs.msg import JointState
 from tutorial_atlas_control.controller import GAINS_PARAM, LOAD_HINT, Gains, GainsError, gains_from_params
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_INDEX, JOINT_NAMES, NUM_JOINTS, bare_joint_name
-from tutorial_atlas_control.schedule import run_trajectory, trajectory_log_line
-from tutorial_atlas_control.trajectory import Waypoint, load_trajectory, resolve_trajectory_file, sample_count
+from tutorial_atlas_control.schedule import done_line, playing_line, run_trajectory, trajectory_log_line
+from tutorial_atlas_control.trajectory import Waypoint, load_trajectory, resolve_trajectory_file
 
 __all__ = [
     'JointStateCache',
@@ -316,15 +316,13 @@ def _play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], pat
         wait_until_handed_over(publisher, HANDOVER_WAIT_S)
         publisher.publish(build_command(message_type, positions, gains, rospy.Time.now()))
 
-    total = sum(sample_count(waypoint.duration_s) for waypoint in waypoints)
     # Logged once the recorder is connected (rospy's /rosout is latched, one message deep):
     # how analyze_bag.py tells which trajectory a bag played.
     rospy.loginfo(trajectory_log_line(os.path.abspath(path), name))
-    rospy.loginfo(f"playing trajectory '{name}': {len(waypoints)} waypoints, "
-                  f"{sum(w.duration_s for w in waypoints):g} s, {total} commands")
+    rospy.loginfo(playing_line(name, waypoints))
     run_trajectory(waypoints, cache.positions, send, rospy.sleep, rospy.loginfo, rospy.get_time)
     wait_until_handed_over(publisher, HANDOVER_WAIT_S)  # the last command, before shutdown
-    rospy.loginfo(f"trajectory '{name}' done")
+    rospy.loginfo(done_line(name))
 
 
 def _wait_for_simulator(publisher: rospy.Publisher, first_state: JointState, timeout_s: float) -> None:
