@@ -247,8 +247,8 @@ class _BagSink:
     rosbags' Writer.write builds each record header field by field (~6 us a message, four
     1 kHz topics: as much as a third of a physics step). Here a topic's record header is
     laid out once, the 1 kHz topics are stamped and appended by numpy a block at a time
-    (_RecordBlock), and the rest are appended as they come; all go into the writer's open
-    chunk with its own index, so the writer closes and indexes the bag as its own.
+    (_RecordBlock), and the rest as they come; all go into the writer's open chunk and its
+    index (kept by numpy, _writer_class), so the writer closes and indexes the bag as its own.
     Within a chunk, records are grouped by topic (readers go by the index, in time order).
     """
 
