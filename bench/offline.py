@@ -108,3 +108,19 @@ def rosbag_run(path: Path) -> tuple[float, int]:
         for _topic, _msg, _t in bag.read_messages(topics=list(ANALYSIS_TOPICS)):
             count += 1
     return time.perf_counter() - start, count
+
+
+# ---------------------------------------------------------------------------- offline runs
+#: The trajectory of the offline-run figure: the longest that stays up (10.5 s of sim time).
+OFFLINE_TRAJECTORY = 'touchdown'
+
+
+def offline_run(work_dir: Path) -> float:
+    """Real-time factor of run_offline (simulate + write the bag) on OFFLINE_TRAJECTORY."""
+    from tutorial_atlas_control.offline_run import run_offline
+
+    bag = work_dir / 'offline_bench.bag'
+    run = run_offline(str(REPO_DIR / 'trajectories' / 'Traj_data2.yaml'), OFFLINE_TRAJECTORY,
+                      bag, gains_file=GAINS_YAML)
+    bag.unlink()
+    return run.real_time_factor

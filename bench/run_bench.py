@@ -7,6 +7,7 @@ directory in /tmp that is removed afterwards (kept with --keep or on failure).
 
 Sections (see bench/README.md for what each figure means and how it is measured):
   physics   AtlasSimulator.step() (controller law + mj_step) in a plain loop, no ROS
+  offline   run_offline.py's run of touchdown to a bag, against the plain loop
   analysis  bag_analysis.analyze_bag vs Debian's rosbag API on a 60 s run bag
   fast      the node at real_time_factor:=0, the recorder (--recorder) subscribed
   realtime  the node at real_time_factor:=1.0: achieved factor, step lateness, then the
@@ -47,11 +48,13 @@ class Section:
         self.loads[self.name] = f'load {self.load}, busy {busy:.0f}%, steal {steal:.0f}%'
 
 
-SECTIONS = ('physics', 'analysis', 'fast', 'realtime')
+SECTIONS = ('physics', 'offline', 'analysis', 'fast', 'realtime')
 
 #: (key, label, unit, target text, digits) in table order.
 ROWS = (
     ('physics_limit_steps_per_s', 'physics + law, plain loop', 'steps/s', '', 0),
+    ('offline_rtf', 'run_offline.py to a bag', 'x real time', '', 2),
+    ('offline_ratio', 'offline_rtf*1000 / physics limit', '', '>= 0.8', 3),
     ('fast_rtf', 'node rtf:=0 + recorder', 'x real time', '>= 10', 2),
     ('fast_ratio', 'fast_rtf*1000 / physics limit', '', '>= 0.4', 3),
     ('fast_node_cpu', 'node CPU at rtf:=0', 'cores', '', 2),
@@ -122,6 +125,17 @@ def run_offline(args: argparse.Namespace, samples: dict[str, list[float]],
                 rate = offline.physics_run(steps=2000 if args.quick else 5000)
                 log(f'physics run {run + 1}: {rate:.0f} steps/s')
                 add(samples, {'physics_limit_steps_per_s': rate})
+    if 'offline' in args.sections:
+        steps_per_s = offline.steps_per_sim_second()
+        with Section('offline', loads), tempfile.TemporaryDirectory(prefix='tac_bench_') as tmp:
+            for run in range(max(args.runs, 5)):
+                # Interleaved with the plain loop: both see the same load.
+                physics = offline.physics_run(steps=2000 if args.quick else 5000)
+                rtf = offline.offline_run(Path(tmp))
+                log(f'offline run {run + 1}: {rtf:.2f}x real time; plain loop {physics:.0f} '
+                    'steps/s')
+                add(samples, {'offline_rtf': rtf,
+                              'offline_ratio': rtf * steps_per_s / physics})
     if 'analysis' in args.sections:
         path = offline.run_bag(Path(tempfile.gettempdir()) / 'tac_bench_cache',
                                10.0 if args.quick else 60.0)

@@ -13,11 +13,14 @@ from tutorial_atlas_control.bag_analysis import (
     MOVED_RANGE_RAD,
     analyze_bag,
 )
+from tutorial_atlas_control.bag_compare import compare_bags, format_comparison, plot_comparison
+from tutorial_atlas_control.bag_compare import to_json as comparison_json
 from tutorial_atlas_control.bag_report import format_summary, plot_run, to_json, write_csv
 from tutorial_atlas_control.cli import argument_type, print_error
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.render import (
     DEFAULT_FPS, DEFAULT_SIZE, check_output_path, parse_fps, parse_size, render_bag_video)
+from tutorial_atlas_control.run_log import PlayedTrajectory, played_trajectories
 
 PROG = 'analyze_bag.py'
 
@@ -48,6 +51,16 @@ command_rate (Hz), command_count, command_age {mean, max} (s), effort_saturation
 {name: {limit (N·m), duration (s), first_time (s), samples}}, thresholds,
 unavailable {metric: reason}, warnings [text].
 
+With a player's start line on /rosout (traj_yaml.py, run_offline.py), the summary names the
+trajectory played (JSON: trajectory {file, name} or null).
+
+--compare B.bag (JSON keys): a, b {bag, trajectory}, aligned_on {event, time_a, time_b (s
+from each bag's start), window [s, s]}, joints {name: {rms_diff, max_diff, command_rms_diff
+(rad, A - B)}}, pelvis_height_rms_diff (m), fall_time_a, fall_time_b (s from the first
+applied command, null: did not fall). The runs are aligned on their first applied joint
+command (the first /atlas/joint_commands at or after the switch to User mode) and compared
+at A's joint states over the time both cover after it.
+
 Exit status: 0 on success (also when some metrics are unavailable), 1 when the bag
 cannot be read (missing, not a bag, unindexed: run `rosbag reindex BAG`) or an output
 cannot be written, 2 on bad arguments.
@@ -70,6 +83,11 @@ def build_parser() -> argparse.ArgumentParser:
                                        change=COMMAND_CHANGE_RAD, tol=EFFORT_LIMIT_TOLERANCE_NM),
         epilog=EPILOG)
     parser.add_argument('bag', metavar='BAG', help='the ROS 1 .bag file to analyze')
+    parser.add_argument('--compare', metavar='B.bag',
+                        help='compare BAG (A) with this run (B), aligned on their first applied '
+                             'joint command: per joint RMS/max difference of measured and '
+                             'commanded positions, pelvis height, fall times; --json and --plot '
+                             'then apply to the comparison')
     parser.add_argument('--json', action='store_true',
                         help='print the results as one JSON object instead of the text summary')
     parser.add_argument('--plot', metavar='FILE.png',
@@ -92,12 +110,19 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status."""
-    args = build_parser().parse_args(argv)
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.compare:
+        if args.csv or args.video:
+            parser.error('--csv and --video describe one run; leave them out with --compare')
+        return _compare(args)
     try:
         if args.video:  # fail on a bad output before reading and analyzing the bag
             check_output_path(args.video, *args.size, args.fps)
         analysis = analyze_bag(args.bag)
-        print(to_json(analysis) if args.json else format_summary(analysis))
+        played = played_trajectories(args.bag)
+        print(to_json(analysis, {'trajectory': _played_dict(played)}) if args.json
+              else format_summary(analysis, trajectory=_played_text(played)))
         if args.csv:
             for path in write_csv(analysis.data, args.csv):
                 print(f'wrote {path}', file=sys.stderr)
@@ -112,4 +137,25 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 1
     except KeyboardInterrupt:
         return 130
+    return 0
+
+
+def _played_dict(played: list[PlayedTrajectory]) -> dict[str, str] | None:
+    return {'file': played[0].file, 'name': played[0].name} if played else None
+
+
+def _played_text(played: list[PlayedTrajectory]) -> str | None:
+    return ', then '.join(p.describe() for p in played) if played else None
+
+
+def _compare(args: argparse.Namespace) -> int:
+    """`BAG --compare B.bag`: bag_compare's report, JSON or plot."""
+    try:
+        comparison = compare_bags(args.bag, args.compare)
+        print(comparison_json(comparison) if args.json else format_comparison(comparison))
+        if args.plot:
+            print(f'wrote {plot_comparison(comparison, args.plot)}', file=sys.stderr)
+    except AtlasControlError as err:
+        print(f'{PROG}: error: {err}', file=sys.stderr)
+        return 1
     return 0

@@ -35,9 +35,12 @@ def _fmt(value: float | None, spec: str, unit: str = '') -> str:
     return 'n/a' if value is None else f'{value:{spec}}{unit}'
 
 
-def _topic_lines(data: BagData) -> list[str]:
+def _topic_lines(data: BagData, trajectory: str | None = None) -> list[str]:
     lines = [f'Bag:      {data.path}',
-             f'Duration: {data.duration_s:.3f} s (start {data.start_time_s:.3f} s)', 'Topics:']
+             f'Duration: {data.duration_s:.3f} s (start {data.start_time_s:.3f} s)']
+    if trajectory is not None:
+        lines.append(f'Trajectory: {trajectory}')
+    lines.append('Topics:')
     width = max((len(name) for name in data.topics), default=0)
     type_width = max((len(topic.msgtype) for topic in data.topics.values()), default=0)
     for name, topic in data.topics.items():
@@ -103,12 +106,35 @@ def _effort_lines(analysis: Analysis) -> list[str]:
     return lines
 
 
-def format_summary(analysis: Analysis) -> str:
-    """The human-readable report, several lines, no trailing newline."""
-    lines = _topic_lines(analysis.data)
+def format_summary(analysis: Analysis, trajectory: str | None = None) -> str:
+    """The human-readable report, several lines, no trailing newline.
+
+    `trajectory`: what the bag's /rosout says was played (run_log), shown when given.
+    """
+    lines = _topic_lines(analysis.data, trajectory)
     lines += [_fall_line(analysis), _commands_line(analysis)]
     lines += _tracking_lines(analysis) + _effort_lines(analysis)
     lines.extend(f'Warning:  {warning}' for warning in analysis.data.warnings)
+    return '\n'.join(lines)
+
+
+def short_summary(analysis: Analysis) -> str:
+    """The demo's summary of a run (make demo, run_offline.py): fall, then tracking of the
+    joints that moved."""
+    lines = ['=== summary ===']
+    if analysis.fell is None:
+        lines.append(f'fall: unknown (no {topics.GROUND_TRUTH_ODOM} in the bag)')
+    elif analysis.fell:
+        lines.append(f'the robot fell: pelvis below {FALL_HEIGHT_M} m at '
+                     f't = {analysis.fall_time_s:.2f} s from bag start')
+    else:
+        lines.append('the robot did not fall (lowest pelvis height '
+                     f'{analysis.min_pelvis_height_m:.2f} m)')
+    lines.append('tracking error of the joints that moved (commanded vs measured):')
+    for name, tracking in analysis.joints.items():
+        if tracking.rms_error_rad is not None:
+            lines.append(f'  {name:10s} RMS {tracking.rms_error_rad:.4f} rad, '
+                         f'max {tracking.max_error_rad:.4f} rad')
     return '\n'.join(lines)
 
 
@@ -125,9 +151,10 @@ def _json_safe(value: Any) -> Any:
     return value
 
 
-def to_json(analysis: Analysis) -> str:
-    """The analysis as one JSON object (strict JSON: no NaN)."""
-    return json.dumps(_json_safe(analysis.to_dict()), indent=2, allow_nan=False)
+def to_json(analysis: Analysis, extra: dict[str, Any] | None = None) -> str:
+    """The analysis as one JSON object (strict JSON: no NaN), plus the keys of `extra`."""
+    return json.dumps(_json_safe({**analysis.to_dict(), **(extra or {})}), indent=2,
+                      allow_nan=False)
 
 
 def _save_csv(path: Path, header: list[str], columns: list[np.ndarray]) -> Path:

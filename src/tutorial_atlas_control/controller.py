@@ -49,6 +49,8 @@ from tutorial_atlas_control.units import finite_number
 #: Where the gains live on the parameter server (and in config/atlas_controller.yaml).
 GAINS_PARAM = topics.GAINS_PARAM
 GAIN_KEYS: tuple[str, ...] = ('p', 'i', 'd', 'i_clamp')
+#: DRCSim's gains as the package ships them (what atlas.launch loads by default).
+DEFAULT_GAINS_FILE: Path = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
 LOAD_HINT = ('load the gains with `roslaunch tutorial_atlas_control atlas.launch` '
              'or `rosparam load config/atlas_controller.yaml`')
 

@@ -184,24 +184,12 @@ def wait_sim_time(clock_type: type, seconds: float) -> None:
 
 def summarise(bag: Path, video_fps: float, video_size: tuple[int, int]) -> None:
     """Print the short summary; write the plot and (unless video_fps is 0) the video."""
-    from tutorial_atlas_control.bag_analysis import FALL_HEIGHT_M, analyze_bag
-    from tutorial_atlas_control.bag_report import plot_run
+    from tutorial_atlas_control.bag_analysis import analyze_bag
+    from tutorial_atlas_control.bag_report import plot_run, short_summary
     from tutorial_atlas_control.render import render_bag_video
 
     analysis = analyze_bag(bag)
-    print('\n=== summary ===')
-    if analysis.fell is None:
-        print('fall: unknown (no /ground_truth_odom in the bag)')
-    elif analysis.fell:
-        print(f'the robot fell: pelvis below {FALL_HEIGHT_M} m at t = {analysis.fall_time_s:.2f} s '
-              'from bag start')
-    else:
-        print(f'the robot did not fall (lowest pelvis height {analysis.min_pelvis_height_m:.2f} m)')
-    print('tracking error of the joints that moved (commanded vs measured):')
-    for name, tracking in analysis.joints.items():
-        if tracking.rms_error_rad is not None:
-            print(f'  {name:10s} RMS {tracking.rms_error_rad:.4f} rad, '
-                  f'max {tracking.max_error_rad:.4f} rad')
+    print('\n' + short_summary(analysis))
     plot = plot_run(analysis, bag.with_suffix('.png'))
     video = None
     if video_fps > 0:

@@ -35,7 +35,7 @@ from tutorial_atlas_control import model as atlas_model
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bag_reader import BagData, read_bag
 from tutorial_atlas_control.cli import argument_type, print_error
-from tutorial_atlas_control.controller import load_gains_yaml
+from tutorial_atlas_control.controller import DEFAULT_GAINS_FILE, load_gains_yaml
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.simulator import (
@@ -64,7 +64,6 @@ ODOM_TOPIC = topics.GROUND_TRUTH_ODOM
 DEFAULT_TOLERANCE = 1e-6
 #: When the bag predates /atlas/sim_config: the simulator's defaults, no reset after start (s).
 DEFAULT_LAST_RESET_S = 0.0
-GAINS_FILE = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
 #: Exit status when the replay ran but deviates beyond the tolerance.
 EXIT_DEVIATES = 3
 #: A stamp further than this fraction of a step from the step grid is not a simulator stamp.
@@ -453,7 +452,7 @@ def _replay_recorded(sim: AtlasSimulator, steps: np.ndarray, effort_nm: np.ndarr
 
 
 def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
-           gains_file: Path = GAINS_FILE) -> ReplayResult:
+           gains_file: Path = DEFAULT_GAINS_FILE) -> ReplayResult:
     """Re-simulate `recording` and measure how far it strays from the recorded run.
 
     Raises:

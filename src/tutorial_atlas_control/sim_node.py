@@ -33,7 +33,6 @@ from collections.abc import Callable
 from pathlib import Path
 
 import genpy
-import mujoco
 import numpy as np
 import rospy
 from atlas_msgs.msg import ControllerStatistics
@@ -52,15 +51,13 @@ from tutorial_atlas_control.controller import gains_from_params
 from tutorial_atlas_control.controller_statistics import (
     DEFAULT_WINDOW_S, UPDATE_RATE_PARAM, WINDOW_PARAM, CommandAgeStatistics)
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.ros1_fields import FieldCursor
+from tutorial_atlas_control.sim_messages import SimMessages
 from tutorial_atlas_control.simulator import (
     DEFAULT_TIME_TO_UNPIN_S, AtlasSimulator, ModeError, PhysicsDivergenceError, parse_mode)
 from tutorial_atlas_control.units import NS_PER_S, finite_number
 from tutorial_atlas_control.viewer import ViewerLink, ViewerRequest
-from tutorial_atlas_control.wire import (
-    ControllerStatisticsWire, ImuWire, JointStateWire, OdometryWire, WireBatch, WrenchStampedWire,
-    clock_bytes)
+from tutorial_atlas_control.wire import ControllerStatisticsWire, WireBatch, clock_bytes
 
 NODE_NAME = 'atlas_sim'
 #: Seconds between repeats of the same refusal warning.
@@ -137,13 +134,10 @@ class SimNode:
         self._advertise()
         self.batch = WireBatch()
         self._publish_config()
-        self.joint_state = JointStateWire(JOINT_NAMES)
-        self.odom = OdometryWire(topics.WORLD_FRAME, topics.PELVIS_FRAME)
-        self.imu = ImuWire(topics.PELVIS_FRAME)
-        self.contacts = ((WrenchStampedWire('l_foot'), 'l', self.l_contact_pub),
-                         (WrenchStampedWire('r_foot'), 'r', self.r_contact_pub))
-        self.sensors = {name: sim.data.sensor(name).data for name in atlas_model.SENSOR_NAMES}
-        self._pelvis_velocity = np.zeros(6)
+
+        # What each message holds is sim_messages' (shared with offline runs).
+        self.messages = SimMessages(sim)
+        self.contacts = (('l', self.l_contact_pub), ('r', self.r_contact_pub))
         self._init_controller_statistics()
 
         # Commands wait here, undecoded, for the loop (see on_joint_commands). Bounded, so
@@ -288,29 +282,19 @@ class SimNode:
             # sees at real time); spares the recorder one message in five.
             batch.replace(self.clock_pub, clock_bytes(now_ns))
         count = self.step_count
+        messages = self.messages
         if count % self.every['joint_states'] == 0 and wanted(self.joint_state_pub):
-            msg = self.joint_state
-            np.take(sim.data.qpos, sim.atlas.qpos_adr, out=msg.position)
-            np.take(sim.data.qvel, sim.atlas.dof_adr, out=msg.velocity)
-            msg.effort[:] = sim.torque_nm
-            batch.add(self.joint_state_pub, msg.to_bytes(now_ns))
+            batch.add(self.joint_state_pub, messages.joint_state(now_ns))
         # Poses and sensors describe the state at the start of the last step (see step()).
         sensed_ns = sim.state_time_ns
         if count % self.every['odom'] == 0 and wanted(self.odom_pub):
-            self._publish_odom(sensed_ns)
+            batch.add(self.odom_pub, messages.odometry(sensed_ns))
         if count % self.every['imu'] == 0 and wanted(self.imu_pub):
-            imu = self.imu
-            w, x, y, z = self.sensors['imu_orientation']
-            imu.orientation_xyzw[:] = (x, y, z, w)
-            imu.angular_velocity[:] = self.sensors['imu_angular_velocity']
-            imu.linear_acceleration[:] = self.sensors['imu_linear_acceleration']
-            batch.add(self.imu_pub, imu.to_bytes(sensed_ns))
+            batch.add(self.imu_pub, messages.imu(sensed_ns))
         if count % self.every['contact'] == 0:
-            for msg, side, pub in self.contacts:
+            for side, pub in self.contacts:
                 if wanted(pub):
-                    msg.force[:] = self.sensors[f'{side}_foot_force']
-                    msg.torque[:] = self.sensors[f'{side}_foot_torque']
-                    batch.add(pub, msg.to_bytes(sensed_ns))
+                    batch.add(pub, messages.foot_contact(side, sensed_ns))
 
     # -- /atlas/controller_statistics ----------------------------------------------------
     def _init_controller_statistics(self) -> None:
@@ -339,20 +323,6 @@ class SimNode:
             self.statistics_msg.values[:] = (stats.age_s, stats.mean_s, stats.variance_s2,
                                              stats.window_s)
             self.batch.add(self.statistics_pub, self.statistics_msg.to_bytes(now_ns))
-
-    def _publish_odom(self, stamp_ns: int) -> None:
-        sim = self.sim
-        odom = self.odom
-        body = sim.atlas.pelvis_body_id
-        odom.position[:] = sim.data.xpos[body]
-        w, x, y, z = sim.data.xquat[body]
-        odom.orientation_xyzw[:] = (x, y, z, w)
-        # World-frame twist of the pelvis frame origin, as Gazebo's p3d plugin reported it.
-        mujoco.mj_objectVelocity(sim.model, sim.data, mujoco.mjtObj.mjOBJ_BODY, body,
-                                 self._pelvis_velocity, 0)
-        odom.angular[:] = self._pelvis_velocity[:3]
-        odom.linear[:] = self._pelvis_velocity[3:]
-        self.batch.add(self.odom_pub, odom.to_bytes(stamp_ns))
 
     # -- the loop ------------------------------------------------------------------------
     def spin(self) -> None:

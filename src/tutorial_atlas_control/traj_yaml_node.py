@@ -10,6 +10,7 @@ joint states by name and stamps each command. File handling and interpolation li
 
 from __future__ import annotations
 
+import os
 import sys
 import threading
 import time
@@ -25,8 +26,8 @@ from tutorial_atlas_control import topics
 from tutorial_atlas_control.controller import LOAD_HINT, Gains, GainsError, gains_from_params
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES, NUM_JOINTS, joint_index
-from tutorial_atlas_control.trajectory import (
-    Waypoint, interpolate, load_trajectory, resolve_trajectory_file, sample_count)
+from tutorial_atlas_control.schedule import done_line, playing_line, run_trajectory, trajectory_log_line
+from tutorial_atlas_control.trajectory import Waypoint, load_trajectory, locate_trajectory_file
 from tutorial_atlas_control.units import finite_number
 
 __all__ = [
@@ -85,8 +86,6 @@ MASTER_POLL_PERIOD_S = 0.1
 HANDOVER_WAIT_S = 0.05
 #: Polling interval (s, wall clock) of that wait.
 HANDOVER_POLL_S = 0.0005
-#: A joint "moves" in a waypoint's log line if its target is this far (rad) from its measured position.
-MOVING_JOINT_THRESHOLD_RAD = 0.01
 
 
 _T = TypeVar('_T')
@@ -255,44 +254,6 @@ def build_command(
     return command
 
 
-def run_trajectory(
-    waypoints: Sequence[Waypoint],
-    measure: Callable[[], np.ndarray],
-    send: Callable[[np.ndarray], None],
-    sleep: Callable[[float], None],
-    log: Callable[[str], None],
-    now: Callable[[], float] | None = None,
-) -> int:
-    """Play `waypoints` as the tutorial did; return the number of commands sent.
-
-    For each waypoint: `measure` the joint positions (rad), `log` one line, then `send`
-    each interpolated command, one every ``duration_s / n`` (s). The tutorial slept that
-    long after each send, so every late wake-up (a busy machine) stretched the motion; with
-    a clock (`now`, s) each send is instead due a fixed interval after the previous one's
-    due time, so the trajectory keeps its 50 Hz and its durations. Falling more than one
-    interval behind restarts the schedule rather than sending a burst (the publisher keeps
-    the tutorial's queue_size=1). Without `now`, ``sleep(duration_s / n)`` as the tutorial.
-    """
-    sent = 0
-    due_s = now() if now is not None else 0.0
-    for index, waypoint in enumerate(waypoints):
-        initial = measure()
-        log(_waypoint_line(index, len(waypoints), waypoint, initial))
-        for positions, sleep_s in interpolate(initial, waypoint.positions, waypoint.duration_s):
-            send(positions)
-            sent += 1
-            if now is None:
-                sleep(sleep_s)
-                continue
-            due_s += sleep_s
-            remaining_s = due_s - now()
-            if remaining_s > 0.0:
-                sleep(remaining_s)
-            elif remaining_s < -sleep_s:
-                due_s = now()
-    return sent
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """Run ``traj_yaml.py YAML_FILE TRAJECTORY_NAME``; return the exit status.
 
@@ -310,7 +271,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 1
     path, name = args
     try:
-        waypoints = load_trajectory(_trajectory_file(path), name)
+        path = locate_trajectory_file(path)
+        waypoints = load_trajectory(path, name)
         message_type = _joint_commands_type()
         _require_master()
     except AtlasControlError as err:
@@ -323,7 +285,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f'cannot start ROS node {NODE_NAME}: {err}', file=sys.stderr)
         return 1
     try:
-        _play(waypoints, message_type, name)
+        _play(waypoints, message_type, path, name)
     except AtlasControlError as err:
         rospy.logerr(str(err))
         return 1
@@ -336,18 +298,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     return 0
 
 
-def _trajectory_file(path: str) -> str:
-    """YAML_FILE as the tutorial uses it: a bare name also finds the package's trajectories/ copy.
-
-    Says which file it took when it was not the one in the current directory.
-    """
-    found, from_package = resolve_trajectory_file(path)
-    if from_package:
-        print(f'{path} is not in the current directory; using {found}')
-    return found
-
-
-def _play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], name: str) -> None:
+def _play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], path: str,
+          name: str) -> None:
     gains = read_gains()
     cache = JointStateCache()
     rospy.Subscriber(JOINT_STATES_TOPIC, JointState, cache.callback, queue_size=1)
@@ -364,12 +316,13 @@ def _play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], nam
         wait_until_handed_over(publisher, HANDOVER_WAIT_S)
         publisher.publish(build_command(message_type, positions, gains, rospy.Time.now()))
 
-    total = sum(sample_count(waypoint.duration_s) for waypoint in waypoints)
-    rospy.loginfo(f"playing trajectory '{name}': {len(waypoints)} waypoints, "
-                  f"{sum(w.duration_s for w in waypoints):g} s, {total} commands")
+    # Logged once the recorder is connected (rospy's /rosout is latched, one message deep):
+    # how analyze_bag.py tells which trajectory a bag played.
+    rospy.loginfo(trajectory_log_line(os.path.abspath(path), name))
+    rospy.loginfo(playing_line(name, waypoints))
     run_trajectory(waypoints, cache.positions, send, rospy.sleep, rospy.loginfo, rospy.get_time)
     wait_until_handed_over(publisher, HANDOVER_WAIT_S)  # the last command, before shutdown
-    rospy.loginfo(f"trajectory '{name}' done")
+    rospy.loginfo(done_line(name))
 
 
 def _wait_for_simulator(publisher: rospy.Publisher, first_state: JointState, timeout_s: float) -> None:
@@ -486,18 +439,6 @@ def wait_until_handed_over(publisher: rospy.Publisher, timeout_s: float) -> bool
         if time.monotonic() >= deadline:
             return False
         time.sleep(HANDOVER_POLL_S)
-
-
-def _waypoint_line(index: int, count: int, waypoint: Waypoint, initial: np.ndarray) -> str:
-    moving = np.flatnonzero(np.abs(waypoint.positions - initial) > MOVING_JOINT_THRESHOLD_RAD)
-    if len(moving) == 0:
-        joints = 'no joint moves'
-    elif len(moving) == NUM_JOINTS:
-        joints = 'all joints move'
-    else:
-        joints = 'moving ' + ', '.join(JOINT_NAMES[i] for i in moving)
-    return (f'waypoint {index} ({index + 1} of {count}): {waypoint.duration_s:g} s, '
-            f'{sample_count(waypoint.duration_s)} commands; {joints}')
 
 
 def _joint_commands_type() -> Callable[[], object]:

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Union
@@ -165,6 +165,19 @@ def resolve_trajectory_file(path: PathLike, search_dir: Path = TRAJECTORIES_DIR)
         return str(candidate), True
     raise TrajectoryError(f'{text}: cannot read trajectory file: No such file or directory '
                           f'(not in the current directory, nor in {search_dir})')
+
+
+def locate_trajectory_file(path: PathLike, announce: Callable[[str], None] = print) -> str:
+    """YAML_FILE as the tutorial uses it (traj_yaml.py, run_offline.py): a bare name also finds
+    the package's trajectories/ copy, and `announce` says so in one line.
+
+    Raises:
+        TrajectoryError: as :func:`resolve_trajectory_file`.
+    """
+    found, from_package = resolve_trajectory_file(path)
+    if from_package:
+        announce(f'{os.fspath(path)} is not in the current directory; using {found}')
+    return found
 
 
 def load_trajectory(path: PathLike, name: str) -> list[Waypoint]:

@@ -107,6 +107,27 @@ class ControllerStatisticsWire(StampedWire):
         self.values = self.floats
 
 
+class JointCommandsWire(StampedWire):
+    """osrf_msgs/JointCommands with fixed names; each of its nine arrays is a view in `arrays`.
+
+    For writers of many commands to the same joints (offline runs write traj_yaml's 50 Hz).
+    """
+
+    FIELDS = ('position', 'velocity', 'effort', 'kp_position', 'ki_position', 'kd_position',
+              'kp_velocity', 'i_effort_min', 'i_effort_max')
+
+    def __init__(self, names: Sequence[str]) -> None:
+        count = len(names)
+        names_block = struct.pack('<I', count) + b''.join(_string(name) for name in names)
+        array = struct.pack('<I', count) + bytes(8 * count)
+        super().__init__('', 0, names_block + array * len(self.FIELDS))
+        start = len(self.buf) - len(self.FIELDS) * len(array)
+        self.arrays = {
+            field: np.frombuffer(self.buf, dtype='<f8', offset=start + k * len(array) + 4,
+                                 count=count)
+            for k, field in enumerate(self.FIELDS)}
+
+
 def clock_bytes(stamp_ns: int) -> bytes:
     """rosgraph_msgs/Clock with its TCPROS length prefix."""
     secs, nsecs = divmod(stamp_ns, NS_PER_S)

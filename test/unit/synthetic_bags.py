@@ -36,6 +36,7 @@ TOPIC_TYPES: dict[str, str] = {
     '/atlas/r_foot_contact': 'geometry_msgs/WrenchStamped',
     '/atlas/joint_commands': 'osrf_msgs/JointCommands',
     '/atlas/control_mode': 'std_msgs/String',
+    '/rosout': 'rosgraph_msgs/Log',
 }
 
 
@@ -134,6 +135,13 @@ def control_mode(t_s: float, mode: str) -> Record:
     """A /atlas/control_mode message (std_msgs/String, no header) recorded at `t_s`."""
     msg = _type('std_msgs/String')(data=mode)
     return Record('/atlas/control_mode', 'std_msgs/String', t_s, msg)
+
+
+def rosout(t_s: float, text: str, node: str = '/tutorial_atlas_control') -> Record:
+    """An INFO line on /rosout (rosgraph_msgs/Log) from `node`."""
+    msg = _type('rosgraph_msgs/Log')(header=_header(t_s), level=2, name=node, msg=text,
+                                     file='test.py', function='test', line=1, topics=[])
+    return Record('/rosout', 'rosgraph_msgs/Log', t_s, msg)
 
 
 def clock(t_s: float) -> Record:

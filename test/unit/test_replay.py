@@ -17,11 +17,11 @@ import pytest
 from synthetic_bags import TYPESTORE, Record, joint_state, write_bag
 from tutorial_atlas_control import model as atlas_model
 from tutorial_atlas_control.bag_reader import read_bag
-from tutorial_atlas_control.controller import hold_command, load_gains_yaml
+from tutorial_atlas_control.controller import DEFAULT_GAINS_FILE, hold_command, load_gains_yaml
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.replay import (
-    EXIT_DEVIATES, GAINS_FILE, ReplayError, format_report, load_recording, main, replay_bag)
+    EXIT_DEVIATES, ReplayError, format_report, load_recording, main, replay_bag)
 from tutorial_atlas_control.simulator import AtlasSimulator, ControlMode
 
 SCRIPT = Path(__file__).resolve().parents[2] / 'scripts' / 'replay_bag.py'
@@ -75,7 +75,7 @@ class Run:
 
     def __post_init__(self) -> None:
         self.atlas = atlas_model.load_model()
-        self.sim = AtlasSimulator(self.atlas, load_gains_yaml(GAINS_FILE), self.time_to_unpin_s)
+        self.sim = AtlasSimulator(self.atlas, load_gains_yaml(DEFAULT_GAINS_FILE), self.time_to_unpin_s)
         self.steps = 0
         self._publish_config()
 

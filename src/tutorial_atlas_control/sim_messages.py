@@ -1,0 +1,120 @@
+"""The simulator's sensor messages, serialized from an AtlasSimulator's state.
+
+What each 1 kHz message holds (which array, which time, which quaternion order) is
+decided once, here, for both writers of those messages: the ROS node (sim_node.py),
+which sends the bytes over TCPROS, and offline runs (offline_run.py), which write them
+to a bag. The bytes come from wire.py's pre-laid-out messages: a step copies numbers in
+and stamps the header; nothing is serialized field by field.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from tutorial_atlas_control.joints import JOINT_NAMES
+from tutorial_atlas_control.simulator import AtlasSimulator
+from tutorial_atlas_control.topics import PELVIS_FRAME, WORLD_FRAME
+from tutorial_atlas_control.wire import (
+    ImuWire, JointStateWire, OdometryWire, StampedWire, WrenchStampedWire)
+
+__all__ = ['TCPROS_PREFIX_BYTES', 'SimMessages']
+
+#: wire.py's messages start with TCPROS's 4-byte length; a bag record holds what follows.
+TCPROS_PREFIX_BYTES = 4
+
+#: The MuJoCo sensors the messages read, by name in the model.
+SENSOR_NAMES = ('imu_orientation', 'imu_angular_velocity', 'imu_linear_acceleration',
+                'l_foot_force', 'l_foot_torque', 'r_foot_force', 'r_foot_torque')
+
+
+def _float_offset(message: StampedWire) -> int:
+    """Byte offset of `message`'s float block in its serialization (without TCPROS prefix)."""
+    base = np.frombuffer(message.buf, dtype=np.uint8).ctypes.data
+    return message.floats.ctypes.data - base - TCPROS_PREFIX_BYTES
+
+
+class SimMessages:
+    """One simulator's /atlas/joint_states, /ground_truth_odom, /atlas/imu and foot contacts.
+
+    Each fill_* writes the simulator's current state into its wire message; the methods
+    without the prefix also stamp it and return it with the TCPROS length prefix. The IMU
+    and contact messages are a fixed selection of `data.sensordata`
+    (`imu_map`, `contact_maps`: float index in the message <- index in sensordata), so a
+    writer that keeps sensordata per step can build many messages at once (offline_run.py).
+    """
+
+    def __init__(self, sim: AtlasSimulator) -> None:
+        self.sim = sim
+        self.joint_state_wire = JointStateWire(JOINT_NAMES)
+        self.odometry_wire = OdometryWire(WORLD_FRAME, PELVIS_FRAME)
+        self.imu_wire = ImuWire(PELVIS_FRAME)
+        self.contact_wires = {side: WrenchStampedWire(f'{side}_foot') for side in 'lr'}
+        model = sim.model
+        adr = {name: int(model.sensor_adr[model.sensor(name).id]) for name in SENSOR_NAMES}
+        orientation = adr['imu_orientation']
+        # Orientation as ROS orders it (x y z w) from MuJoCo's (w x y z); covariances stay 0.
+        self.imu_map = (
+            np.r_[0:4, 13:16, 25:28],
+            np.r_[orientation + 1:orientation + 4, orientation,
+                  adr['imu_angular_velocity'] + np.arange(3),
+                  adr['imu_linear_acceleration'] + np.arange(3)])
+        self.contact_maps = {
+            side: (np.arange(6), np.r_[adr[f'{side}_foot_force'] + np.arange(3),
+                                       adr[f'{side}_foot_torque'] + np.arange(3)])
+            for side in 'lr'}
+        self.float_offsets = {name: _float_offset(wire) for name, wire in (
+            ('imu', self.imu_wire), ('odometry', self.odometry_wire),
+            ('l', self.contact_wires['l']), ('r', self.contact_wires['r']))}
+        self._pelvis_velocity = np.zeros(6)
+
+    def fill_joint_state(self) -> None:
+        """Joint positions and velocities after the last step; effort = the torque it applied.
+
+        Stamp it with the sim time after the step (`sim.sim_time_ns`).
+        """
+        sim, msg = self.sim, self.joint_state_wire
+        sim.data.qpos.take(sim.atlas.qpos_adr, out=msg.position)
+        sim.data.qvel.take(sim.atlas.dof_adr, out=msg.velocity)
+        msg.effort[:] = sim.torque_nm
+
+    def fill_odometry(self) -> None:
+        """Pelvis pose and world-frame twist, as Gazebo's p3d plugin reported them.
+
+        Body poses are computed before mj_step integrates: stamp with `sim.state_time_ns`.
+        """
+        sim, odom = self.sim, self.odometry_wire
+        body = sim.atlas.pelvis_body_id
+        odom.position[:] = sim.data.xpos[body]
+        odom.orientation_xyzw[:3] = sim.data.xquat[body, 1:]
+        odom.orientation_xyzw[3] = sim.data.xquat[body, 0]
+        mujoco.mj_objectVelocity(sim.model, sim.data, mujoco.mjtObj.mjOBJ_BODY, body,
+                                 self._pelvis_velocity, 0)
+        odom.angular[:] = self._pelvis_velocity[:3]
+        odom.linear[:] = self._pelvis_velocity[3:]
+
+    def fill_imu(self) -> None:
+        """The pelvis IMU (sensor readings: stamp with `sim.state_time_ns`)."""
+        to, source = self.imu_map
+        self.imu_wire.floats[to] = self.sim.data.sensordata[source]
+
+    def fill_foot_contact(self, side: str) -> None:
+        """The `side` ('l' or 'r') foot's force/torque sensor (stamp with `sim.state_time_ns`)."""
+        to, source = self.contact_maps[side]
+        self.contact_wires[side].floats[to] = self.sim.data.sensordata[source]
+
+    def joint_state(self, stamp_ns: int) -> bytes:
+        self.fill_joint_state()
+        return self.joint_state_wire.to_bytes(stamp_ns)
+
+    def odometry(self, stamp_ns: int) -> bytes:
+        self.fill_odometry()
+        return self.odometry_wire.to_bytes(stamp_ns)
+
+    def imu(self, stamp_ns: int) -> bytes:
+        self.fill_imu()
+        return self.imu_wire.to_bytes(stamp_ns)
+
+    def foot_contact(self, side: str, stamp_ns: int) -> bytes:
+        self.fill_foot_contact(side)
+        return self.contact_wires[side].to_bytes(stamp_ns)

@@ -1,0 +1,64 @@
+"""An offline run (run_offline.py) reaches the outcome of the live run (`make demo`) it stands for.
+
+The live runs are run_demo.py's (step_and_fall: the shared demo_run fixture; touchdown: its
+own); each is compared with the offline run of the same trajectory, aligned on the first
+applied command (bag_compare). Transport and scheduling move a live run a little (the
+trajectory starts from a pose the robot held longer, commands arrive 1-2 ms late), so only
+the outcome must agree: the robot falls in both or in neither, within FALL_TOLERANCE_S.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
+
+from tutorial_atlas_control.bag_compare import compare_bags, format_comparison  # noqa: E402
+from tutorial_atlas_control.offline_run import run_offline  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[2]
+TRAJECTORIES = REPO / 'trajectories' / 'Traj_data2.yaml'
+RUN_DEMO = REPO / 'scripts' / 'run_demo.py'
+#: Wall-clock bound of a live run (s), as the demo_run fixture's.
+DEMO_TIMEOUT_S = 300
+#: Largest difference (s) between the live and the offline fall time, from the first command.
+FALL_TOLERANCE_S = 0.3
+
+
+@dataclass(frozen=True)
+class LiveRun:
+    result: subprocess.CompletedProcess
+    bag: Path
+
+
+@pytest.fixture(scope='module')
+def touchdown_run(tmp_path_factory: pytest.TempPathFactory) -> LiveRun:
+    bag_dir = tmp_path_factory.mktemp('touchdown')
+    env = dict(os.environ, ROS_LOG_DIR=str(bag_dir / 'ros_log'))
+    result = subprocess.run(
+        [sys.executable, str(RUN_DEMO), 'touchdown', '--bag-dir', str(bag_dir), '--video-fps', '0'],
+        env=env, capture_output=True, text=True, timeout=DEMO_TIMEOUT_S, check=False)
+    bags = sorted(bag_dir.glob('atlas_*.bag'))
+    assert bags, f'run_demo.py left no bag in {bag_dir}:\n{result.stderr}'
+    return LiveRun(result, bags[-1])
+
+
+@pytest.mark.parametrize(('trajectory', 'falls'), [('step_and_fall', True), ('touchdown', False)])
+def test_offline_run_reaches_the_live_outcome(trajectory: str, falls: bool, request: pytest.FixtureRequest,
+                                              tmp_path: Path) -> None:
+    live = request.getfixturevalue('demo_run' if trajectory == 'step_and_fall' else 'touchdown_run')
+    assert live.result.returncode == 0, live.result.stdout + live.result.stderr
+    offline = run_offline(str(TRAJECTORIES), trajectory, tmp_path / f'{trajectory}.bag')
+    comparison = compare_bags(live.bag, offline.bag)
+    print(format_comparison(comparison))  # the figures, with pytest -s
+    assert comparison.trajectory_a is not None and comparison.trajectory_a.name == trajectory
+    assert comparison.trajectory_b is not None and comparison.trajectory_b.name == trajectory
+    assert comparison.a.fell is falls and comparison.b.fell is falls
+    if falls:
+        assert abs(comparison.fall_time_diff_s) <= FALL_TOLERANCE_S
