@@ -4,12 +4,8 @@
 import sys
 from pathlib import Path
 
-try:
-    import tutorial_atlas_control  # noqa: F401
-except ImportError:  # running from a source checkout without catkin
-    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / 'src'))
-
-from tutorial_atlas_control.offline_run import main
+sys.path.append(str(Path(__file__).resolve().parent.parent / 'src'))  # a clone without catkin
+from tutorial_atlas_control.offline_run import main  # noqa: E402
 
 if __name__ == '__main__':
     sys.exit(main())

@@ -34,6 +34,7 @@ from tutorial_atlas_control import topics
 from tutorial_atlas_control.bag_analysis import analyze_bag
 from tutorial_atlas_control.bag_reader import load_typestore
 from tutorial_atlas_control.bag_report import short_summary
+from tutorial_atlas_control.cli import print_error
 from tutorial_atlas_control.commands import CommandDecoder, CommandError
 from tutorial_atlas_control.controller import DEFAULT_GAINS_FILE, Gains, load_gains_yaml
 from tutorial_atlas_control.errors import AtlasControlError
@@ -583,7 +584,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                               args.start_after, args.gains)
             analysis = analyze_bag(run.bag)
     except AtlasControlError as err:
-        print(err, file=sys.stderr)  # one line, as traj_yaml.py
+        print_error(PROG, err)
         return 1
     print(f'offline: {args.name}: {run.commands} commands, {run.sim_time_s:.3f} s of sim time '
           f'in {run.wall_s:.2f} s ({run.real_time_factor:.1f}x real time)')

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 SCRIPTS = Path(__file__).resolve().parents[2] / 'scripts'
-PYTHON_SCRIPTS = ('analyze_bag.py', 'replay_bag.py', 'run_demo.py', 'traj_yaml.py')
+PYTHON_SCRIPTS = ('analyze_bag.py', 'replay_bag.py', 'run_demo.py', 'run_offline.py', 'traj_yaml.py')
 
 
 def run(script: str, *args: str) -> subprocess.CompletedProcess[str]:
@@ -33,6 +33,8 @@ def test_help_works_from_anywhere(script: str) -> None:
     ('analyze_bag.py', [], 'the following arguments are required: BAG'),
     ('replay_bag.py', ['run.bag', '--tolerance', '-1'], "argument --tolerance: '-1' is not"),
     ('run_demo.py', ['--video-size', 'big'], "argument --video-size: 'big' is not WIDTHxHEIGHT"),
+    ('run_offline.py', ['Traj_data2.yaml', 'touchdown', '--settle', '-1'],
+     "argument --settle: '-1' must be a finite number of seconds >= 0"),
     ('record_run.sh', [], 'expected BAG_DIR [atlas_recorder|rosbag], got 0 argument(s)'),
     ('record_run.sh', ['/tmp', 'rosbag2'], "unknown recorder 'rosbag2'"),
 ])
@@ -48,6 +50,7 @@ def test_bad_command_line_exits_2(script: str, args: list[str], message: str) ->
     ('analyze_bag.py', ['/nonexistent/run.bag'], 'no such file'),
     ('replay_bag.py', ['/nonexistent/run.bag'], 'no such file'),
     ('run_demo.py', ['--file', '/nonexistent/Traj.yaml'], '/nonexistent/Traj.yaml: cannot read'),
+    ('run_offline.py', ['/nonexistent/Traj.yaml', 'touchdown'], '/nonexistent/Traj.yaml: cannot read'),
 ])
 def test_refused_input_exits_1_with_one_line(script: str, args: list[str], message: str) -> None:
     result = run(script, *args)
