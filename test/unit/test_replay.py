@@ -13,7 +13,7 @@ from typing import Any, Callable
 import numpy as np
 import pytest
 
-from synthetic_bags import TYPESTORE, Record, joint_state, write_bag
+from tutorial_atlas_control.synthetic_bags import TYPESTORE, Record, joint_state, write_bag
 from tutorial_atlas_control import model as atlas_model
 from tutorial_atlas_control.bag_analysis import BagAnalysisError
 from tutorial_atlas_control.controller import hold_command, load_gains_yaml
