@@ -243,7 +243,9 @@ class _RosProcess:
         return alive([self.process.pid, *tree])
 
     def output(self) -> str:
-        self._log.flush()
+        """Everything the process has written so far (also after close())."""
+        if not self._log.closed:
+            self._log.flush()
         return self.log_path.read_text(errors='replace')
 
     def tail(self, lines: int = 15) -> str:
