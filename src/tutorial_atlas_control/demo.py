@@ -41,6 +41,7 @@ class DemoError(AtlasControlError):
 
 
 def newest_bag(bag_dir: Path, since_s: float) -> Path:
+    """The bag this run closed in `bag_dir` (modified since `since_s`, wall time)."""
     bags = [p for p in bag_dir.glob('atlas_*.bag') if p.stat().st_mtime >= since_s]
     if not bags:
         active = list(bag_dir.glob('atlas_*.bag.active'))
