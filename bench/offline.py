@@ -4,16 +4,14 @@ from __future__ import annotations
 
 import hashlib
 import os
-import sys
 import time
 from pathlib import Path
 
-from harness import REPO_DIR, BenchError, log
+from harness import REPO_DIR, log
 
 from tutorial_atlas_control import topics
 
 GAINS_YAML = REPO_DIR / 'config' / 'atlas_controller.yaml'
-SYNTHETIC_BAGS = REPO_DIR / 'test' / 'unit' / 'synthetic_bags.py'
 #: The topics bag_reader.read_bag deserializes (the baseline reads the same ones).
 ANALYSIS_TOPICS = (topics.JOINT_STATES, topics.JOINT_COMMANDS, topics.GROUND_TRUTH_ODOM,
                    topics.CONTROL_MODE)
@@ -52,23 +50,19 @@ def steps_per_sim_second() -> float:
 
 # ---------------------------------------------------------------------------- bags
 def run_bag(cache_dir: Path, duration_s: float = 60.0) -> Path:
-    """The 60 s synthetic run bag (test/unit/synthetic_bags.write_run_bag), cached in /tmp.
+    """The 60 s synthetic run bag (synthetic_bags.write_run_bag), cached in /tmp.
 
     Cached under a name that hashes synthetic_bags.py, so a changed generator makes a new
     bag; written to a temporary name and renamed, so an interrupted run leaves no half bag.
     """
-    key = hashlib.sha1(SYNTHETIC_BAGS.read_bytes() + str(duration_s).encode()).hexdigest()[:12]
+    from tutorial_atlas_control import synthetic_bags
+
+    source = Path(synthetic_bags.__file__).read_bytes()
+    key = hashlib.sha1(source + str(duration_s).encode()).hexdigest()[:12]
     path = cache_dir / f'run{duration_s:.0f}s_{key}.bag'
     if path.is_file():
         return path
     cache_dir.mkdir(parents=True, exist_ok=True)
-    sys.path.insert(0, str(SYNTHETIC_BAGS.parent))
-    try:
-        import synthetic_bags
-    except ImportError as err:
-        raise BenchError(f'cannot import {SYNTHETIC_BAGS}: {err}') from err
-    finally:
-        sys.path.remove(str(SYNTHETIC_BAGS.parent))
     partial = path.with_name(f'{path.stem}.{os.getpid()}.partial.bag')
     log(f'writing the {duration_s:.0f} s synthetic run bag {path} (once; cached)')
     start = time.perf_counter()

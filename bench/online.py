@@ -29,7 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from harness import READY_TIMEOUT_S, BenchError, Launch, Master, cpu_seconds, wait_until
+from harness import READY_TIMEOUT_S, BenchError, Launch, Master
+from tutorial_atlas_control.processes import cpu_seconds, wait_until
 from probes import RawRecorder, clock_ns, header_stamp_ns, joint_state_effort
 
 from tutorial_atlas_control import topics
@@ -110,11 +111,10 @@ def _wait_ready(master: Master, launch: Launch, probes: Probes) -> None:
     """/clock arriving and the recorder subscribed to the simulator's topics."""
     start_count = probes.clock.count
     wait_until(lambda: probes.clock.count > start_count + 10, READY_TIMEOUT_S,
-               'the simulator to publish /clock', alive=launch.check_alive)
+               'the simulator did not publish /clock', launch.check_running)
     wait_until(lambda: all(any('recorder' in node for node in master.subscribers(topic))
                            for topic in (topics.CLOCK, topics.JOINT_STATES, topics.IMU)),
-               READY_TIMEOUT_S, 'the recorder to subscribe', poll_s=0.2,
-               alive=launch.check_alive)
+               READY_TIMEOUT_S, 'the recorder did not subscribe', launch.check_running)
 
 
 def _clock_series(samples: list[tuple[float, bytes]]) -> tuple[np.ndarray, np.ndarray]:
@@ -136,7 +136,7 @@ def fast_run(master: Master, launch_file: str, probes: Probes, work_dir: Path, n
         time.sleep(window_s)
         samples = probes.clock.stop()
         cpu1 = {name: cpu_seconds(pid) if pid else 0.0 for name, pid in pids.items()}
-        launch.check_alive()
+        launch.check_running()
     recorded = recorded_fraction(Path(launch.args['bag_dir']))
     _drop_bags(launch)
     wall, sim = _clock_series(samples)
@@ -206,7 +206,7 @@ def js_transport(master: Master, probes: Probes, work_dir: Path, count: int = 20
         completed = subprocess.run(
             [sys.executable, str(Path(__file__).with_name('js_transport_probe.py')),
              JS_PROBE_TOPIC, str(count), str(rate_hz)],
-            env=master.env(), stdout=probe_log, stderr=subprocess.STDOUT,
+            env=master.env, stdout=probe_log, stderr=subprocess.STDOUT,
             stdin=subprocess.DEVNULL, timeout=count / rate_hz + 60, check=False)
     except subprocess.TimeoutExpired as err:
         raise BenchError('js_transport_probe.py did not finish in time') from err
@@ -232,7 +232,7 @@ def realtime_run(master: Master, launch_file: str, probes: Probes, work_dir: Pat
         probes.clock.start()
         time.sleep(window_s)
         samples = probes.clock.stop()
-        launch.check_alive()
+        launch.check_running()
         wall, sim = _clock_series(samples)
         lateness = _lateness(wall, sim)
         steps = int(round((sim[-1] - sim[0]) * 1000)) + 1
@@ -247,7 +247,7 @@ def realtime_run(master: Master, launch_file: str, probes: Probes, work_dir: Pat
         if latency_s:
             wait_until(lambda: probes.command_pub.get_num_connections() > 0
                        and probes.mode_pub.get_num_connections() > 0, READY_TIMEOUT_S,
-                       'the simulator to subscribe to the commands', alive=launch.check_alive)
+                       'the simulator did not subscribe to the commands', launch.check_running)
             probes.mode_pub.publish(String(data='User'))
             time.sleep(0.5)
         key = 0
@@ -258,7 +258,7 @@ def realtime_run(master: Master, launch_file: str, probes: Probes, work_dir: Pat
             key += len(sent) + 1
             time.sleep(0.2)
             states = probes.joint_states.stop()
-            launch.check_alive()
+            launch.check_running()
             latencies, count = _match_latencies(sent, states)
             if len(latencies) < 10:
                 raise BenchError(f'only {len(latencies)} of {count} commands at {label} '

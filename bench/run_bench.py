@@ -12,6 +12,10 @@ Sections (see bench/README.md for what each figure means and how it is measured)
   fast      the node at real_time_factor:=0, the recorder (--recorder) subscribed
   realtime  the node at real_time_factor:=1.0: achieved factor, step lateness, then the
             command latency at 50 Hz and 1 kHz (User mode)
+  load      the node at real_time_factor:=1.0 under 3 x 2 kHz of valid commands for 30 s:
+            achieved factor, commands lost by the recorder, simulator memory growth,
+            then the time SIGINT takes to stop the launch
+  tutorial  run_demo.py step_and_fall: the port's command rate in sim time
 """
 
 from __future__ import annotations
@@ -27,10 +31,13 @@ import time
 import traceback
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-
-from harness import (BenchError, Master, busy_and_steal, check_environment,  # noqa: E402
-                     cpu_stat, load_average, log)
+try:
+    from harness import (BenchError, Master, busy_and_steal, check_environment,
+                         cpu_stat, load_average, log)
+    from tutorial_atlas_control.errors import AtlasControlError
+except ImportError as import_error:
+    sys.exit(f'run_bench: cannot import {import_error.name}; run `make bench`, or '
+             '`make setup` and `source ./env.sh` first')
 
 
 class Section:
@@ -48,7 +55,7 @@ class Section:
         self.loads[self.name] = f'load {self.load}, busy {busy:.0f}%, steal {steal:.0f}%'
 
 
-SECTIONS = ('physics', 'offline', 'analysis', 'fast', 'realtime')
+SECTIONS = ('physics', 'offline', 'analysis', 'fast', 'realtime', 'load', 'tutorial')
 
 #: (key, label, unit, target text, digits) in table order.
 ROWS = (
@@ -75,6 +82,14 @@ ROWS = (
     ('cmd_latency_p50_ms_raw_1khz', 'command latency p50, 1 kHz (raw)', 'ms', '', 2),
     ('cmd_latency_p99_ms_raw_1khz', 'command latency p99, 1 kHz (raw)', 'ms', '', 2),
     ('cmd_applied_1khz', 'commands applied, 1 kHz', 'fraction', '', 3),
+    ('load_rtf', 'node rtf:=1 under 3 x 2 kHz commands', 'x real time', '1.00 +- 0.05', 4),
+    ('load_publish_rate_hz', 'commands published under load', 'msgs/s', '6000', 0),
+    ('load_commands_lost', 'commands lost by the recorder', 'count', '0', 0),
+    ('load_recorded_fraction', 'joint_states recorded under load', 'fraction', '1', 4),
+    ('load_rss_growth_mib', 'simulator RSS growth under load', 'MiB', '<= 4', 2),
+    ('shutdown_s', 'SIGINT until every process is gone', 's', '<= 5', 2),
+    ('tutorial_command_rate_hz', 'step_and_fall commands (sim time)', 'Hz', '50 (45-51)', 2),
+    ('analysis_s', 'analyze_bag, 60 s bag', 's', '< 2', 2),
     ('analysis_msgs_per_s', 'analyze_bag, 60 s bag', 'msgs/s', '', 0),
     ('rosbag_msgs_per_s', 'rosbag API, same topics', 'msgs/s', '', 0),
     ('analysis_speedup', 'analyze_bag / rosbag', 'x', '>= 5', 1),
@@ -157,14 +172,14 @@ def run_offline(args: argparse.Namespace, samples: dict[str, list[float]],
 
 def run_online(args: argparse.Namespace, samples: dict[str, list[float]],
                loads: dict[str, str], work_dir: Path) -> None:
-    if not {'fast', 'realtime'} & set(args.sections):
+    if not {'fast', 'realtime', 'load'} & set(args.sections):
         return
     import online
 
     master = Master(work_dir)
     try:
-        log(f'starting a private roscore on port {master.port}')
-        master.start()
+        log(f'started a private roscore on port {master.port}')
+        master.wait_online()
         os.environ.update({'ROS_MASTER_URI': master.uri,
                            'ROS_LOG_DIR': str(work_dir / 'ros_log')})
         import rospy
@@ -178,9 +193,38 @@ def run_online(args: argparse.Namespace, samples: dict[str, list[float]],
         if 'realtime' in args.sections:
             with Section('realtime', loads):
                 run_realtime(args, samples, master, probes, work_dir)
+        if 'load' in args.sections:
+            with Section('load', loads):
+                run_load(args, samples, master, probes, work_dir)
         rospy.signal_shutdown('bench done')
     finally:
-        master.stop()
+        master.close()
+
+
+def run_load(args, samples, master, probes, work_dir) -> None:  # noqa: ANN001
+    import load
+
+    for run in range(args.runs):
+        values = load.load_run(master, args.launch_file, probes, work_dir, f'load{run + 1}',
+                               duration_s=8.0 if args.quick else 30.0)
+        log(f'load run {run + 1}: rtf {values["load_rtf"]:.4f}, '
+            f'{values["load_commands_lost"]:.0f} commands lost, RSS growth '
+            f'{values["load_rss_growth_mib"]:.2f} MiB, shutdown {values["shutdown_s"]:.2f} s')
+        add(samples, values)
+
+
+def run_tutorial(args: argparse.Namespace, samples: dict[str, list[float]],
+                 loads: dict[str, str], work_dir: Path) -> None:
+    if 'tutorial' not in args.sections:
+        return
+    import load
+
+    with Section('tutorial', loads):
+        for run in range(args.runs):
+            values = load.tutorial_run(work_dir, f'tutorial{run + 1}')
+            log(f'tutorial run {run + 1}: commands at '
+                f'{values["tutorial_command_rate_hz"]:.2f} Hz of sim time')
+            add(samples, values)
 
 
 def run_fast(args, samples, master, probes, work_dir) -> None:  # noqa: ANN001
@@ -260,8 +304,9 @@ def main(argv: list[str] | None = None) -> int:
     try:
         run_offline(args, samples, loads)
         run_online(args, samples, loads, work_dir)
+        run_tutorial(args, samples, loads, work_dir)
         ok = True
-    except BenchError as err:
+    except AtlasControlError as err:
         print(f'run_bench: {err}', file=sys.stderr)
     except KeyboardInterrupt:
         print('run_bench: interrupted', file=sys.stderr)

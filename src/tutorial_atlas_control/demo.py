@@ -3,21 +3,21 @@
 Does what the tutorial asks a user to do in three terminals: start the simulator
 (atlas.launch), switch to User mode, run traj_yaml.py on a trajectory; then lets the
 robot settle, shuts everything down cleanly and summarises the recorded bag.
-It uses its own ROS master on a free localhost port, so it never disturbs a running one.
+It uses its own ROS master on a free localhost port (see processes), so it never disturbs
+a running one.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
-import signal
-import socket
 import subprocess
 import sys
 import time
 from pathlib import Path
 
 from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.processes import AtlasLaunch
 
 PROG = 'run_demo.py'
 
@@ -42,71 +42,8 @@ class DemoError(AtlasControlError):
     """A phase of the demo failed; the message says which and where to look."""
 
 
-def free_local_port() -> int:
-    """A TCP port free on the loopback interface now (for a private ROS master)."""
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
-        sock.bind(('127.0.0.1', 0))
-        return int(sock.getsockname()[1])
-
-
-def _stat(pid: int | str) -> list[str] | None:
-    """/proc/PID/stat's fields after the command name (state, parent, ...), None if gone."""
-    try:
-        stat = (Path('/proc') / str(pid) / 'stat').read_text()
-    except OSError:
-        return None
-    return stat[stat.rindex(')') + 2:].split()
-
-
-def descendants(pid: int) -> list[int]:
-    """Live (non-zombie) processes descended from `pid`, from /proc's parent links.
-
-    roslaunch starts each node in its own session (setsid), so its nodes are not in its
-    process group: following parents is the only way to find them all.
-    """
-    children: dict[int, list[int]] = {}
-    for entry in Path('/proc').iterdir():
-        fields = _stat(entry.name) if entry.name.isdigit() else None
-        if fields is not None and fields[0] != 'Z':
-            children.setdefault(int(fields[1]), []).append(int(entry.name))
-    found, todo = [], [pid]
-    while todo:
-        for child in children.get(todo.pop(), []):
-            found.append(child)
-            todo.append(child)
-    return found
-
-
-def alive(pids: list[int]) -> list[int]:
-    """Those of `pids` that still run (zombies count as gone)."""
-    return [pid for pid in pids if (fields := _stat(pid)) is not None and fields[0] != 'Z']
-
-
-def stop(process: subprocess.Popen, name: str) -> None:
-    """SIGINT (what Ctrl-C sends, so rosbag closes its bag), then SIGKILL if it hangs.
-
-    Whatever `process` started and left running afterwards (a node that ignored the
-    SIGINT) is killed too.
-    """
-    leftovers = descendants(process.pid)
-    if process.poll() is None:
-        process.send_signal(signal.SIGINT)
-        try:
-            process.wait(timeout=SHUTDOWN_TIMEOUT_S)
-        except subprocess.TimeoutExpired:
-            print(f'demo: {name} did not stop within {SHUTDOWN_TIMEOUT_S} s; killing it',
-                  file=sys.stderr)
-            leftovers = descendants(process.pid) or leftovers
-            process.kill()
-            process.wait()
-    for pid in alive(leftovers):
-        try:
-            os.kill(pid, signal.SIGKILL)
-        except (ProcessLookupError, PermissionError):
-            pass
-
-
 def newest_bag(bag_dir: Path, since_s: float) -> Path:
+    """The bag this run closed in `bag_dir` (modified since `since_s`, wall time)."""
     bags = [p for p in bag_dir.glob('atlas_*.bag') if p.stat().st_mtime >= since_s]
     if not bags:
         active = list(bag_dir.glob('atlas_*.bag.active'))
@@ -118,54 +55,48 @@ def newest_bag(bag_dir: Path, since_s: float) -> Path:
 def run_demo(trajectory: str, trajectory_file: Path, bag_dir: Path, real_time_factor: float,
              log_dir: Path) -> Path:
     """Run the tutorial once; return the closed bag's path."""
-    import rosgraph
+    started_s = time.time()
+    gui = 'true' if os.environ.get('DISPLAY') else 'false'
+    launch = AtlasLaunch(log_dir / 'atlas_launch.log',
+                         {'gui': gui, 'bag_dir': bag_dir, 'real_time_factor': real_time_factor})
+    try:
+        print(f'demo: atlas.launch started (master on port {launch.port}, log {launch.log_path})')
+        drive(launch, trajectory, trajectory_file)
+    finally:
+        if not launch.close(SHUTDOWN_TIMEOUT_S):
+            print(f'demo: roslaunch did not stop within {SHUTDOWN_TIMEOUT_S:.0f} s; killed it',
+                  file=sys.stderr)
+    return newest_bag(bag_dir, started_s)
+
+
+def drive(launch: AtlasLaunch, trajectory: str, trajectory_file: Path) -> None:
+    """What the tutorial's user does in the other terminals: User mode, then traj_yaml.py."""
     import rospy
     from rosgraph_msgs.msg import Clock
     from sensor_msgs.msg import JointState
     from std_msgs.msg import String
 
-    port = free_local_port()
-    env = dict(os.environ, ROS_MASTER_URI=f'http://localhost:{port}',
-               ROS_HOSTNAME=os.environ.get('ROS_HOSTNAME', 'localhost'))
-    os.environ.update(ROS_MASTER_URI=env['ROS_MASTER_URI'], ROS_HOSTNAME=env['ROS_HOSTNAME'])
-    log_dir.mkdir(parents=True, exist_ok=True)
-    started_s = time.time()
-    gui = 'true' if os.environ.get('DISPLAY') else 'false'
-    launch_log = open(log_dir / 'atlas_launch.log', 'w')  # noqa: SIM115 - closed below
-    launch = subprocess.Popen(
-        ['roslaunch', '-p', str(port), 'tutorial_atlas_control', 'atlas.launch', f'gui:={gui}',
-         f'bag_dir:={bag_dir}', f'real_time_factor:={real_time_factor}'],
-        env=env, stdout=launch_log, stderr=subprocess.STDOUT, start_new_session=True)
+    os.environ.update(ROS_MASTER_URI=launch.uri, ROS_HOSTNAME=launch.env['ROS_HOSTNAME'])
+    # The master first: init_node would print "Unable to register with master node ... Will
+    # keep trying" while it starts.
+    launch.wait_master(STARTUP_TIMEOUT_S)
+    rospy.init_node('tutorial_demo', anonymous=True, disable_signals=True)
     try:
-        print(f'demo: atlas.launch started (master on port {port}, log {launch_log.name})')
-        # Wait for roslaunch's master first: init_node would print "Unable to register with
-        # master node ... Will keep trying" while it starts.
-        deadline = time.monotonic() + STARTUP_TIMEOUT_S
-        while not rosgraph.is_master_online(env['ROS_MASTER_URI']):
-            if time.monotonic() > deadline or launch.poll() is not None:
-                raise DemoError(f'the ROS master did not start; see {launch_log.name}')
-            time.sleep(0.2)
-        rospy.init_node('tutorial_demo', anonymous=True, disable_signals=True)
-        try:
-            rospy.wait_for_message('/atlas/joint_states', JointState, timeout=STARTUP_TIMEOUT_S)
-        except rospy.ROSException:
-            raise DemoError('the simulator did not publish /atlas/joint_states within '
-                            f'{STARTUP_TIMEOUT_S:.0f} s; see {launch_log.name}') from None
-        wait_sim_time(Clock, START_SETTLE_S)
-        mode_pub = rospy.Publisher('/atlas/control_mode', String, queue_size=1, latch=True)
-        mode_pub.publish(String(data='User'))
-        print('demo: /atlas/control_mode <- "User"')
-        command = ['rosrun', 'tutorial_atlas_control', 'traj_yaml.py', str(trajectory_file),
-                   trajectory]
-        print('demo: ' + ' '.join(command))
-        result = subprocess.run(command, env=env, timeout=TRAJECTORY_TIMEOUT_S, check=False)
-        if result.returncode != 0:
-            raise DemoError(f'traj_yaml.py exited with status {result.returncode}')
-        wait_sim_time(Clock, END_SETTLE_S)
-    finally:
-        stop(launch, 'roslaunch')
-        launch_log.close()
-    return newest_bag(bag_dir, started_s)
+        rospy.wait_for_message('/atlas/joint_states', JointState, timeout=STARTUP_TIMEOUT_S)
+    except rospy.ROSException:
+        raise DemoError('the simulator did not publish /atlas/joint_states within '
+                        f'{STARTUP_TIMEOUT_S:.0f} s; see {launch.log_path}') from None
+    wait_sim_time(Clock, START_SETTLE_S)
+    mode_pub = rospy.Publisher('/atlas/control_mode', String, queue_size=1, latch=True)
+    mode_pub.publish(String(data='User'))
+    print('demo: /atlas/control_mode <- "User"')
+    command = ['rosrun', 'tutorial_atlas_control', 'traj_yaml.py', str(trajectory_file),
+               trajectory]
+    print('demo: ' + ' '.join(command))
+    result = subprocess.run(command, env=launch.env, timeout=TRAJECTORY_TIMEOUT_S, check=False)
+    if result.returncode != 0:
+        raise DemoError(f'traj_yaml.py exited with status {result.returncode}')
+    wait_sim_time(Clock, END_SETTLE_S)
 
 
 def wait_sim_time(clock_type: type, seconds: float) -> None:

@@ -19,7 +19,6 @@ import argparse
 import json
 import os
 import struct
-import sys
 import tempfile
 import time
 from collections.abc import Sequence

@@ -33,7 +33,6 @@ from collections.abc import Callable
 from pathlib import Path
 
 import genpy
-import numpy as np
 import rospy
 from atlas_msgs.msg import ControllerStatistics
 from geometry_msgs.msg import WrenchStamped

@@ -10,12 +10,11 @@ from pathlib import Path
 
 import pytest
 
-from host_load import cpu_times, steal_fraction
-
 REPO = Path(__file__).resolve().parents[2]
 RUN_DEMO = REPO / 'scripts' / 'run_demo.py'
-#: Wall-clock bound of the recording (s).
-DEMO_TIMEOUT_S = 300
+#: Wall-clock guard against a hung recording (s): far beyond the ~30 s it takes, as the
+#: tests run niced beside other work (a niced process gets ~1/10 of a busy core's share).
+DEMO_TIMEOUT_S = 900
 
 
 @dataclass(frozen=True)
@@ -24,8 +23,6 @@ class DemoRun:
 
     result: subprocess.CompletedProcess
     bag_dir: Path
-    #: Share of the CPU the hypervisor took during the run (see host_load).
-    steal: float
 
     @property
     def bag(self) -> Path:
@@ -39,8 +36,7 @@ def demo_run(tmp_path_factory: pytest.TempPathFactory) -> DemoRun:
     pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
     bag_dir = tmp_path_factory.mktemp('demo')
     env = dict(os.environ, ROS_LOG_DIR=str(bag_dir / 'ros_log'))
-    cpu_before = cpu_times()
     result = subprocess.run(
         [sys.executable, str(RUN_DEMO), 'step_and_fall', '--bag-dir', str(bag_dir)],
         env=env, capture_output=True, text=True, timeout=DEMO_TIMEOUT_S, check=False)
-    return DemoRun(result, bag_dir, steal_fraction(cpu_before, cpu_times()))
+    return DemoRun(result, bag_dir)

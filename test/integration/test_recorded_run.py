@@ -13,7 +13,6 @@ import pytest
 
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
-from host_load import check_real_time  # noqa: E402
 from rosbags.highlevel import AnyReader  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
@@ -78,14 +77,10 @@ def test_bag_holds_the_run(demo_run) -> None:  # noqa: ANN001
         state_stamps = np.array([t for _c, t, _r in reader.messages(
             connections=[connections['/atlas/joint_states']])])
 
-    # 200 commands (4 waypoints at 50 Hz).
+    # 200 commands (4 waypoints at 50 Hz). Their rate in sim time depends on the machine's
+    # speed: `make bench` measures it (tutorial_command_rate_hz).
     assert len(commands) >= 195
     assert 'User' in modes
     # Joint states every 1 ms of sim time (bag time is sim time under /use_sim_time).
     span_s = (state_stamps[-1] - state_stamps[0]) / 1e9
     assert len(state_stamps) / span_s == pytest.approx(1000.0, rel=0.02)
-    # About 50 Hz of sim time while the port runs; last, as it needs the 2 cores: with 80 %
-    # of the CPU taken by the hypervisor the port fell behind and restarted its schedule.
-    rate_hz = (len(commands) - 1) / ((commands[-1] - commands[0]) / 1e9)
-    check_real_time([] if 45.0 < rate_hz < 51.0 else [f'commands at {rate_hz:.1f} Hz of sim time'],
-                    demo_run.steal)

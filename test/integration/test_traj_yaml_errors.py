@@ -9,7 +9,7 @@ parameter server.
 from __future__ import annotations
 
 import json
-import os
+import signal
 import subprocess
 import sys
 import time
@@ -20,37 +20,25 @@ import pytest
 
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
-import rosgraph  # noqa: E402
-
-from tutorial_atlas_control.demo import free_local_port, stop  # noqa: E402
+from tutorial_atlas_control.processes import RosMaster, stop_tree  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
 TRAJ_YAML = REPO / 'scripts' / 'traj_yaml.py'
 FAKE_SIMULATOR = Path(__file__).resolve().parent / 'fake_simulator.py'
 TRAJECTORIES = REPO / 'trajectories' / 'Traj_data2.yaml'
 GAINS = REPO / 'config' / 'atlas_controller.yaml'
-MASTER_TIMEOUT_S = 30.0
+MASTER_TIMEOUT_S = 60.0
+#: step_and_fall: 4 waypoints of 1 s at 50 Hz.
+STEP_AND_FALL_COMMANDS = 200
+#: Wall-clock guard (s): how long the fake simulator runs at most.
+FAKE_SIMULATOR_GUARD_S = 90.0
 
 
-class Master:
+class Master(RosMaster):
     """A roscore of our own, and commands run against it."""
 
     def __init__(self, tmp_path: Path) -> None:
-        port = free_local_port()
-        self.env = dict(os.environ, ROS_MASTER_URI=f'http://localhost:{port}',
-                        ROS_HOSTNAME='localhost', ROS_LOG_DIR=str(tmp_path / 'ros_log'))
-        self.process = subprocess.Popen(['roscore', '-p', str(port)], env=self.env,
-                                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                                        start_new_session=True)
-        master = rosgraph.Master('/traj_yaml_errors_test', master_uri=self.env['ROS_MASTER_URI'])
-        deadline = time.monotonic() + MASTER_TIMEOUT_S
-        while True:
-            try:
-                master.getSystemState()
-                return
-            except OSError:
-                assert time.monotonic() < deadline, 'roscore did not start'
-                time.sleep(0.2)
+        super().__init__(tmp_path / 'roscore.log', ros_log_dir=tmp_path / 'ros_log')
 
     def run(self, *command: str, timeout_s: float = 60.0) -> subprocess.CompletedProcess:
         return subprocess.run(command, env=self.env, capture_output=True, text=True,
@@ -66,17 +54,15 @@ class Master:
             result = self.run(sys.executable, str(TRAJ_YAML), str(TRAJECTORIES),
                               'step_and_fall', *ros_args)
         finally:
-            stop(echo, 'rostopic echo')
+            stop_tree(echo)
         return result, echo.stdout.read() if echo.stdout else ''
 
 
 @pytest.fixture()
 def master(tmp_path: Path) -> Iterator[Master]:
-    core = Master(tmp_path)
-    try:
+    with Master(tmp_path) as core:
+        core.wait_online(MASTER_TIMEOUT_S)
         yield core
-    finally:
-        stop(core.process, 'roscore')
 
 
 def refusal(master: Master, *ros_args: str) -> str:
@@ -126,16 +112,23 @@ def test_bad_subscriber_timeout_is_named_before_any_wait(master: Master) -> None
 
 def run_with_fake_simulator(master: Master, subscribe_after_s: float,
                             *ros_args: str) -> tuple[subprocess.CompletedProcess, dict]:
-    """Run the port on step_and_fall (4 s) beside fake_simulator.py; both results."""
+    """Run the port on step_and_fall (4 s) beside fake_simulator.py; both results.
+
+    The fake simulator stops on its own once it has all 200 commands; otherwise when the
+    port has exited (SIGINT), so that a slow machine only makes the test slower.
+    """
     assert master.run('rosparam', 'load', str(GAINS)).returncode == 0
     simulator = subprocess.Popen(
-        [sys.executable, str(FAKE_SIMULATOR), '--subscribe-after', str(subscribe_after_s), '--run-for', '12'],
+        [sys.executable, str(FAKE_SIMULATOR), '--subscribe-after', str(subscribe_after_s),
+         '--until-received', str(STEP_AND_FALL_COMMANDS), '--run-for', str(FAKE_SIMULATOR_GUARD_S)],
         env=master.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
     try:
         port = master.run(sys.executable, str(TRAJ_YAML), str(TRAJECTORIES), 'step_and_fall', *ros_args)
-        out, err = simulator.communicate(timeout=60)
+        if port.returncode != 0:
+            simulator.send_signal(signal.SIGINT)
+        out, err = simulator.communicate(timeout=FAKE_SIMULATOR_GUARD_S + 30)
     finally:
-        stop(simulator, 'fake simulator')
+        stop_tree(simulator)
     assert simulator.returncode == 0, err
     return port, json.loads(out.strip().splitlines()[-1])
 
@@ -144,7 +137,7 @@ def test_a_simulator_that_subscribes_late_gets_every_command(master: Master) -> 
     """The port waits for the simulator: it used to publish after 2 s and the robot fell."""
     port, simulator = run_with_fake_simulator(master, 3.0)
     assert port.returncode == 0, port.stderr
-    assert simulator['received'] == 200, 'every command of step_and_fall reached the simulator'
+    assert simulator['received'] == STEP_AND_FALL_COMMANDS, 'every command of step_and_fall reached the simulator'
     assert simulator['first_position'] == [0.0] * 28, 'the first command is the measured pose'
 
 

@@ -25,7 +25,7 @@ from pathlib import Path
 import pytest
 
 import xvfb_window
-from tutorial_atlas_control.demo import free_local_port, stop
+from tutorial_atlas_control.processes import free_local_port, stop_tree
 from tutorial_atlas_control.model import SPAWN_HEIGHT_M
 
 if xvfb_window.missing_tools():
@@ -71,7 +71,7 @@ def viewer(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Viewer]:
         yield Viewer(env, xvfb.display, window, log_dir)
         assert launch.poll() is None, f'atlas.launch exited; see {log.name}'
     finally:
-        stop(launch, 'roslaunch')
+        stop_tree(launch)
         log.close()
         xvfb.close()
 

@@ -1,4 +1,4 @@
-"""The reliability tests' fixture: one atlas.launch per test (see launch_harness)."""
+"""The reliability tests' fixture: one atlas.launch per test (see support.launch)."""
 
 from __future__ import annotations
 
@@ -7,19 +7,16 @@ from pathlib import Path
 
 import pytest
 
-from launch_harness import AtlasLaunch
+from support.launch import TestLaunch
 
 
 @pytest.fixture()
-def atlas_launch(tmp_path: Path, request: pytest.FixtureRequest) -> Iterator[AtlasLaunch]:
+def atlas_launch(tmp_path: Path, request: pytest.FixtureRequest) -> Iterator[TestLaunch]:
     """Start atlas.launch with the test's launch args (`@pytest.mark.launch_args(...)`)."""
     pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
     marker = request.node.get_closest_marker('launch_args')
-    launch = AtlasLaunch(tmp_path, *(marker.args if marker else ()))
-    try:
+    with TestLaunch(tmp_path, *(marker.args if marker else ())) as launch:
         yield launch
-    finally:
-        launch.close()
 
 
 def pytest_configure(config: pytest.Config) -> None:

@@ -1,4 +1,8 @@
-"""Floods of bad commands and a heavy load of good ones against a real-time simulator."""
+"""Floods of bad commands and a heavy load of good ones against a real-time simulator.
+
+What must hold at any speed of the machine is asserted here; how fast the simulator stays
+under the load (its real-time factor) is `make bench`'s `load` section.
+"""
 
 from __future__ import annotations
 
@@ -9,18 +13,18 @@ import pytest
 
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
-from bag_checks import ERROR, WARN, all_finite, count, log_lines, missing_steps
-from host_load import check_real_time, cpu_times, steal_fraction
-from launch_harness import AtlasLaunch, flood_figures, rss_kib
-from flood_commands import VALID_ELBOW_RAD
-from tutorial_atlas_control.bag_reader import read_bag
+from support.bag_checks import ERROR, WARN, all_finite, count, log_lines, missing_steps  # noqa: E402
+from support.launch import TestLaunch, flood_figures  # noqa: E402
+from tutorial_atlas_control.bag_reader import read_bag  # noqa: E402
+from tutorial_atlas_control.processes import rss_kib  # noqa: E402
 
 #: The issue's figures.
 FLOOD_S = 10.0
 LOAD_PUBLISHERS = 3
 LOAD_RATE_HZ = 2000.0
 LOAD_S = 30.0
-RTF_TOLERANCE = 0.05
+#: The valid command's left elbow target (rad): the robot must hold it.
+VALID_ELBOW_RAD = 1.2
 #: How far the held elbow may be from its target (rad): P-gain slack plus the standing
 #: robot's slow sway (1.17 typical; 1.14 in the last second of a long run), as in the
 #: sim_interface rostest. A refused command would send it to 0.
@@ -30,13 +34,17 @@ ELBOW_TOLERANCE_RAD = 0.1
 RSS_GROWTH_BOUND_KIB = 4096
 #: Sim time (s) the floods start at: after the torso is released (time_to_unpin 1 s).
 START_SIM_S = 2.0
+#: Sim time (s) of the first memory reading: the floods have run and the simulator has
+#: warmed up.
+RSS_START_SIM_S = START_SIM_S + 3.0
 
 
-def test_flood_of_bad_commands_and_modes_is_refused(atlas_launch: AtlasLaunch) -> None:
+def test_flood_of_bad_commands_and_modes_is_refused(atlas_launch: TestLaunch) -> None:
     atlas_launch.wait_ready()
     atlas_launch.set_mode('User')
-    flood = atlas_launch.start_flood('--kind', 'bad', '--rate', '1000',
-                                     '--duration', str(FLOOD_S), '--start-sim', str(START_SIM_S))
+    flood = atlas_launch.start_flood('--kind', 'bad', '--rate', '1000', '--elbow',
+                                     str(VALID_ELBOW_RAD), '--duration', str(FLOOD_S),
+                                     '--start-sim', str(START_SIM_S))
     figures = flood_figures(flood, timeout_s=FLOOD_S + 90.0)
     time.sleep(1.0)
     atlas_launch.interrupt()
@@ -68,36 +76,37 @@ def test_flood_of_bad_commands_and_modes_is_refused(atlas_launch: AtlasLaunch) -
           f'{recorded} commands recorded, 0 lost; elbow held at {elbow[-1]:.3f} rad')
 
 
-def test_three_publishers_at_2_khz_keep_real_time_and_memory_flat(
-        atlas_launch: AtlasLaunch) -> None:
+def test_three_publishers_at_2_khz_lose_nothing_and_keep_memory_flat(
+        atlas_launch: TestLaunch) -> None:
     atlas_launch.wait_ready()
     atlas_launch.set_mode('User')
     sim_pid = atlas_launch.pid_of('atlas_sim_node.py')
-    cpu_before = cpu_times()
     floods = [atlas_launch.start_flood('--kind', 'valid', '--rate', str(LOAD_RATE_HZ),
+                                       '--elbow', str(VALID_ELBOW_RAD),
                                        '--duration', str(LOAD_S), '--start-sim', str(START_SIM_S))
               for _ in range(LOAD_PUBLISHERS)]
-    time.sleep(5.0)  # the floods have started and the simulator has warmed up
+    atlas_launch.wait_sim_until(RSS_START_SIM_S)
     rss_start_kib = rss_kib(sim_pid)
     rss_kib_samples = []
     while any(flood.poll() is None for flood in floods):
         rss_kib_samples.append(rss_kib(sim_pid))
         time.sleep(1.0)
     rss_end_kib = rss_kib(sim_pid)
-    steal = steal_fraction(cpu_before, cpu_times())
     figures = [flood_figures(flood, timeout_s=30.0) for flood in floods]
     atlas_launch.interrupt()
     bag = atlas_launch.bag()
     data = read_bag(bag)
 
     sent = sum(f['sent'] for f in figures)
-    rates = [f['rate_hz'] for f in figures]
-    rtfs = [f['real_time_factor'] for f in figures]
-    print(f'figures: load: {LOAD_PUBLISHERS} publishers at {[round(r) for r in rates]} msg/s '
-          f'for {LOAD_S:.0f} s ({sent} commands); real-time factor {[round(r, 4) for r in rtfs]}; '
+    recorded = count(bag, '/atlas/joint_commands')
+    missing = missing_steps(data.joint_states)
+    print(f'figures: load: {LOAD_PUBLISHERS} publishers at '
+          f'{[round(f["rate_hz"]) for f in figures]} msg/s for {LOAD_S:.0f} s ({sent} commands); '
+          f'real-time factor {[round(f["real_time_factor"], 4) for f in figures]}; '
           f'simulator RSS {rss_start_kib / 1024:.1f} -> {rss_end_kib / 1024:.1f} MiB '
-          f'(max {max(rss_kib_samples) / 1024:.1f}); hypervisor steal {steal:.1%}')
-    assert all(rate >= 0.9 * LOAD_RATE_HZ for rate in rates), f'the load was not applied: {rates}'
+          f'(max {max(rss_kib_samples) / 1024:.1f}); the recorder kept {recorded} of {sent} '
+          f'commands; {missing} joint states missing')
+    assert all(f['sent'] > 0 for f in figures), f'a publisher sent nothing: {figures}'
     assert rss_end_kib - rss_start_kib <= RSS_GROWTH_BOUND_KIB
     assert max(rss_kib_samples) - rss_start_kib <= RSS_GROWTH_BOUND_KIB
     assert all_finite(data.joint_states)
@@ -105,14 +114,5 @@ def test_three_publishers_at_2_khz_keep_real_time_and_memory_flat(
     assert abs(elbow - VALID_ELBOW_RAD) < ELBOW_TOLERANCE_RAD, 'the commands were applied'
     # Nothing lost: atlas_recorder queues what it has not written yet (`rosbag record`, with
     # its 100-message queue, dropped 6-25 % of these commands; recorder:=rosbag).
-    recorded = count(bag, '/atlas/joint_commands')
-    missing = missing_steps(data.joint_states)
-    print(f'figures: load: the recorder kept {recorded} of {sent} commands; '
-          f'{missing} joint states missing')
-    # Last, so that every check above has run: what needs the 2 cores in real time.
-    shortfalls = [text for failed, text in (
-        (recorded != sent, f'the recorder lost {sent - recorded} of {sent} commands'),
-        (missing != 0, f'{missing} joint states missing from the bag'),
-        (not all(abs(rtf - 1.0) <= RTF_TOLERANCE for rtf in rtfs), f'real-time factor {rtfs}'),
-    ) if failed]
-    check_real_time(shortfalls, steal)
+    assert recorded == sent, f'the recorder lost {sent - recorded} of {sent} commands'
+    assert missing == 0, f'{missing} joint states missing from the bag'

@@ -15,7 +15,6 @@ Private parameter ~client:
 from __future__ import annotations
 
 import subprocess
-import sys
 import threading
 import unittest
 from pathlib import Path
@@ -27,7 +26,6 @@ import rostest
 from atlas_msgs.msg import ControllerStatistics
 from osrf_msgs.msg import JointCommands
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
 from sim_probe import SimProbe  # noqa: E402
 
 PKG = 'tutorial_atlas_control'

@@ -3,10 +3,8 @@
 
 from __future__ import annotations
 
-import sys
 import time
 import unittest
-from pathlib import Path
 
 import numpy as np
 import rosgraph
@@ -14,13 +12,12 @@ import rospy
 import rostest
 from rosgraph_msgs.msg import Clock
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from sim_probe import SimProbe  # noqa: E402
+from sim_probe import SimProbe  # beside this script, on its sys.path
 
-from tutorial_atlas_control import model as atlas_model  # noqa: E402
-from tutorial_atlas_control.controller import gains_from_params  # noqa: E402
-from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS  # noqa: E402
-from tutorial_atlas_control.simulator import AtlasSimulator, ControlMode  # noqa: E402
+from tutorial_atlas_control import model as atlas_model
+from tutorial_atlas_control.controller import gains_from_params
+from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.simulator import AtlasSimulator, ControlMode
 
 PKG = 'tutorial_atlas_control'
 EXPECTED_TYPES = {
@@ -150,8 +147,7 @@ class SimInterfaceTest(unittest.TestCase):
         ]
         for names, arrays, reason in bad:
             probe.send(names, **arrays)
-            probe.wait_until(lambda r=reason: probe.warnings_containing(r), f'a warning: {reason}',
-                             timeout_s=10)
+            probe.wait_until(lambda r=reason: probe.warnings_containing(r), f'a warning: {reason}')
             # The refusal warning is throttled (2 s), in ROS time: wait sim time, not wall time.
             probe.wait_sim(2.1)
         probe.wait_sim(0.5)
@@ -181,7 +177,7 @@ class SimInterfaceTest(unittest.TestCase):
         probe.set_mode('Dance')
         probe.wait_until(lambda: probe.warnings_containing('valid modes: Stand, StandPrep, '
                                                            'Freeze, ragdoll, User'),
-                         'the unknown-mode warning', timeout_s=10)
+                         'the unknown-mode warning')
         probe.wait_sim(1.0)
         # Held near where it was frozen (the body still sways), not sent to the stored 0.
         self.assertAlmostEqual(probe.position(ELBOW), frozen_rad, delta=0.1)

@@ -10,7 +10,6 @@ to completion and tracks the arms; standing stands 20 s with no command.
 from __future__ import annotations
 
 import subprocess
-import sys
 import unittest
 from pathlib import Path
 
@@ -22,12 +21,11 @@ from geometry_msgs.msg import WrenchStamped
 from nav_msgs.msg import Odometry
 from osrf_msgs.msg import JointCommands
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from sim_probe import SimProbe  # noqa: E402
+from sim_probe import SimProbe  # beside this script, on its sys.path
 
-from tutorial_atlas_control import model as atlas_model  # noqa: E402
-from tutorial_atlas_control.joints import JOINT_INDEX  # noqa: E402
-from tutorial_atlas_control.trajectory import load_trajectory, sample_count  # noqa: E402
+from tutorial_atlas_control import model as atlas_model
+from tutorial_atlas_control.joints import JOINT_INDEX
+from tutorial_atlas_control.trajectory import load_trajectory, sample_count
 
 PKG = 'tutorial_atlas_control'
 TRAJECTORY_FILE = Path(__file__).resolve().parents[2] / 'trajectories' / 'Traj_data2.yaml'
@@ -174,7 +172,11 @@ class TutorialRunTest(unittest.TestCase):
                 self.assertLess(error, ARM_TOLERANCE_RAD, f'waypoint {k}, {joint}')
 
     def check_port_commands(self) -> None:
-        """What the port sent: DRCSim's message, the parameter gains, 50 Hz, linear ramps."""
+        """What the port sent: DRCSim's message, the parameter gains, linear ramps.
+
+        Its rate in sim time (50 Hz) depends on the machine's speed: `make bench` measures
+        it (tutorial_command_rate_hz); here it is logged.
+        """
         msgs = self.sorted_commands()
         self.assertEqual(msgs[0]._type, 'osrf_msgs/JointCommands')
         self.assertEqual(msgs[0]._md5sum, 'f298c98f3e9c7aae9376ac19f73bfba3')
@@ -193,7 +195,6 @@ class TutorialRunTest(unittest.TestCase):
                       f'{period_s * 1000:.1f} ms of sim time; received {age_ms.min():.1f} / '
                       f'{np.median(age_ms):.1f} / {age_ms.max():.1f} ms (min / median / max) '
                       'of sim time after their stamps')
-        self.assertAlmostEqual(period_s, 0.02, delta=0.002, msg='published at 50 Hz')
         # Each later segment (complete in this recording) is n samples on a straight line
         # from the measured pose (its first sample) to its waypoint. The port publishes with
         # the tutorial's queue_size=1, so a sample can be dropped when its process is starved

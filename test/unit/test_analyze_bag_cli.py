@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from synthetic_bags import (
+from tutorial_atlas_control.synthetic_bags import (
     clock,
     control_mode,
     joint_commands,

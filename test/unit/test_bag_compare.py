@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from synthetic_bags import (clock, control_mode, joint_commands, joint_state, odometry, rosout,
+from tutorial_atlas_control.synthetic_bags import (clock, control_mode, joint_commands, joint_state, odometry, rosout,
                             write_bag)
 from tutorial_atlas_control.analyze_bag_cli import main
 from tutorial_atlas_control.bag_analysis import analyze_bag

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from rosbags.rosbag1 import Reader, Writer
 from rosbags.typesys import get_types_from_msg
 
-from synthetic_bags import (
+from tutorial_atlas_control.synthetic_bags import (
     STANDING_HEIGHT_M,
     TYPESTORE,
     Record,

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from synthetic_bags import STANDING_HEIGHT_M, joint_state, odometry, write_bag, write_run_bag
+from tutorial_atlas_control.synthetic_bags import STANDING_HEIGHT_M, joint_state, odometry, write_bag, write_run_bag
 from tutorial_atlas_control.analyze_bag_cli import main as analyze_main
 from tutorial_atlas_control.bag_reader import read_bag
 from tutorial_atlas_control.joints import NUM_JOINTS

@@ -14,7 +14,7 @@ from typing import Any, Callable
 import numpy as np
 import pytest
 
-from synthetic_bags import TYPESTORE, Record, joint_state, write_bag
+from tutorial_atlas_control.synthetic_bags import TYPESTORE, Record, joint_state, write_bag
 from tutorial_atlas_control import model as atlas_model
 from tutorial_atlas_control.bag_reader import read_bag
 from tutorial_atlas_control.controller import DEFAULT_GAINS_FILE, hold_command, load_gains_yaml

@@ -42,8 +42,11 @@ REPO = Path(__file__).resolve().parents[2]
 SCRIPT = REPO / 'scripts' / 'traj_yaml.py'
 TRAJECTORY_FILE = REPO / 'trajectories' / 'Traj_data2.yaml'
 USAGE_LINES = ['usage: traj_yaml.py YAML_FILE TRAJECTORY_NAME', ' where TRAJECTORY is a dictionary defined in YAML_FILE']
-#: Generous bound (s) for a run that must fail before touching ROS (interpreter start-up included).
-QUICK_S = 15.0
+#: Guard (s) against a run that hangs; that a run did not touch ROS is what
+#: assert_untouched checks, not how fast it was.
+HANG_GUARD_S = 120.0
+#: Guard (s) for another thread to do what it must, however busy the machine is.
+THREAD_GUARD_S = 30.0
 ZEROS = ' '.join(['0'] * NUM_JOINTS)
 HAVE_OSRF_MSGS = importlib.util.find_spec('osrf_msgs') is not None
 
@@ -67,18 +70,16 @@ def assert_untouched(server: socket.socket) -> None:
         connection.close()
 
 
-def run_script(args: list[str], master_uri: str, tmp_path: Path) -> tuple[subprocess.CompletedProcess[str], float]:
+def run_script(args: list[str], master_uri: str, tmp_path: Path) -> subprocess.CompletedProcess[str]:
     env = dict(os.environ)
     env['PYTHONPATH'] = os.pathsep.join(filter(None, [str(REPO / 'src'), env.get('PYTHONPATH')]))
     env['ROS_MASTER_URI'] = master_uri
     env['ROS_HOME'] = str(tmp_path / 'ros_home')
     env['ROS_LOG_DIR'] = str(tmp_path / 'ros_log')
-    start = time.monotonic()
-    result = subprocess.run(
+    return subprocess.run(
         [sys.executable, str(SCRIPT), *args], env=env, cwd=tmp_path,
-        capture_output=True, text=True, timeout=60, check=False,
+        capture_output=True, text=True, timeout=HANG_GUARD_S, check=False,
     )
-    return result, time.monotonic() - start
 
 
 def assert_one_line_error(result: subprocess.CompletedProcess[str], text: str) -> None:
@@ -109,18 +110,17 @@ def test_script_is_thin_and_executable() -> None:
 @pytest.mark.parametrize('args', [[], ['Traj.yaml'], ['Traj.yaml', 'step', 'extra'], ['a:=b'], ['Traj.yaml', 'x:=y']])
 def test_wrong_number_of_arguments_prints_usage(args: list[str], fake_master, tmp_path: Path) -> None:
     server, uri = fake_master
-    result, elapsed = run_script(args, uri, tmp_path)
+    result = run_script(args, uri, tmp_path)
     assert result.returncode == 1
     assert result.stderr.splitlines() == USAGE_LINES
     assert 'Traceback' not in result.stderr
-    assert elapsed < QUICK_S
     assert_untouched(server)
 
 
 @pytest.mark.parametrize('flag', ['-h', '--help'])
 def test_help(flag: str, fake_master, tmp_path: Path) -> None:
     server, uri = fake_master
-    result, _ = run_script([flag], uri, tmp_path)
+    result = run_script([flag], uri, tmp_path)
     assert result.returncode == 0
     assert result.stdout.splitlines()[:2] == USAGE_LINES
     assert '/atlas/joint_commands' in result.stdout and '50 Hz' in result.stdout
@@ -130,9 +130,8 @@ def test_help(flag: str, fake_master, tmp_path: Path) -> None:
 
 def test_missing_file(fake_master, tmp_path: Path) -> None:
     server, uri = fake_master
-    result, elapsed = run_script(['absent.yaml', 'step_and_fall'], uri, tmp_path)
+    result = run_script(['absent.yaml', 'step_and_fall'], uri, tmp_path)
     assert_one_line_error(result, 'absent.yaml: cannot read trajectory file: No such file or directory')
-    assert elapsed < QUICK_S
     assert_untouched(server)
 
 
@@ -155,16 +154,15 @@ def test_missing_file(fake_master, tmp_path: Path) -> None:
 def test_bad_file_is_one_line_without_ros(text: str, expected: str, fake_master, tmp_path: Path) -> None:
     server, uri = fake_master
     write(tmp_path, text)
-    result, elapsed = run_script(['Traj.yaml', 'step_and_fall'], uri, tmp_path)
+    result = run_script(['Traj.yaml', 'step_and_fall'], uri, tmp_path)
     assert_one_line_error(result, expected)
-    assert elapsed < QUICK_S
     assert_untouched(server)
     assert not (tmp_path / 'pwned').exists()
 
 
 def test_missing_trajectory_keeps_the_tutorial_message(fake_master, tmp_path: Path) -> None:
     server, uri = fake_master
-    result, _ = run_script([str(TRAJECTORY_FILE), 'nope'], uri, tmp_path)
+    result = run_script([str(TRAJECTORY_FILE), 'nope'], uri, tmp_path)
     assert_one_line_error(result, f'unable to find trajectory nope in {TRAJECTORY_FILE}')
     assert result.stderr == f'unable to find trajectory nope in {TRAJECTORY_FILE}\n'
     assert_untouched(server)
@@ -172,7 +170,7 @@ def test_missing_trajectory_keeps_the_tutorial_message(fake_master, tmp_path: Pa
 
 def test_remapping_arguments_are_ignored(fake_master, tmp_path: Path) -> None:
     server, uri = fake_master
-    result, _ = run_script(['__name:=other', str(TRAJECTORY_FILE), '_joint_state_timeout:=3', 'nope'], uri, tmp_path)
+    result = run_script(['__name:=other', str(TRAJECTORY_FILE), '_joint_state_timeout:=3', 'nope'], uri, tmp_path)
     assert_one_line_error(result, f'unable to find trajectory nope in {TRAJECTORY_FILE}')
     assert_untouched(server)
 
@@ -182,13 +180,12 @@ def test_valid_file_without_master_fails_with_a_hint(tmp_path: Path) -> None:
     with socket.socket() as probe:
         probe.bind(('127.0.0.1', 0))
         port = probe.getsockname()[1]
-    result, elapsed = run_script([str(TRAJECTORY_FILE), 'step_and_fall'], f'http://127.0.0.1:{port}', tmp_path)
+    result = run_script([str(TRAJECTORY_FILE), 'step_and_fall'], f'http://127.0.0.1:{port}', tmp_path)
     if HAVE_OSRF_MSGS:
         assert_one_line_error(result, f'no ROS master at http://127.0.0.1:{port}: start the simulator with '
                                       '`roslaunch tutorial_atlas_control atlas.launch`')
     else:
         assert_one_line_error(result, 'cannot import osrf_msgs.msg.JointCommands')
-    assert elapsed < QUICK_S
 
 
 # --- joint states by name ---------------------------------------------------------------
@@ -230,11 +227,9 @@ def test_positions_by_name_not_finite() -> None:
 
 
 def test_wait_for_joint_state_times_out_with_a_hint() -> None:
-    start = time.monotonic()
     with pytest.raises(TrajYamlError, match=r'no simulator is publishing /atlas/joint_states: nothing arrived '
                                             r'within 0\.05 s; start it with `roslaunch tutorial_atlas_control'):
         wait_for_joint_state(JointStateCache(), 0.05, is_shutdown=lambda: False)
-    assert time.monotonic() - start < 2.0
 
 
 def test_wait_for_joint_state_returns_the_message() -> None:
@@ -433,14 +428,14 @@ def test_the_port_waits_until_rospy_has_taken_each_command() -> None:
     publisher = SimpleNamespace(impl=SimpleNamespace(connections=[connection]))
     try:
         connection.write_data(b'first')
-        assert wait_until_handed_over(publisher, 1.0), 'the writer thread takes the first command'
+        assert wait_until_handed_over(publisher, THREAD_GUARD_S), 'the writer thread takes the first command'
         connection.write_data(b'second')  # the writer is still busy with 'first'
         started = time.monotonic()
         assert not wait_until_handed_over(publisher, 0.05)
         assert time.monotonic() - started >= 0.05
         transport.release.set()
-        assert wait_until_handed_over(publisher, 1.0)
-        deadline = time.monotonic() + 1.0
+        assert wait_until_handed_over(publisher, THREAD_GUARD_S)
+        deadline = time.monotonic() + THREAD_GUARD_S
         while len(transport.written) < 2 and time.monotonic() < deadline:
             time.sleep(0.001)
         assert transport.written == [b'first', b'second']
@@ -542,17 +537,16 @@ def test_no_clock_is_an_error() -> None:
 def test_bare_name_is_taken_from_the_package_trajectories_folder(fake_master, tmp_path: Path) -> None:
     """The tutorial's `traj_yaml.py Traj_data2.yaml ...` from anywhere: one info line names the file."""
     server, uri = fake_master
-    result, elapsed = run_script(['Traj_data2.yaml', 'no_such_trajectory'], uri, tmp_path)
+    result = run_script(['Traj_data2.yaml', 'no_such_trajectory'], uri, tmp_path)
     assert result.stdout.splitlines() == [
         f'Traj_data2.yaml is not in the current directory; using {TRAJECTORY_FILE}']
     assert_one_line_error(result, f'unable to find trajectory no_such_trajectory in {TRAJECTORY_FILE}')
-    assert elapsed < QUICK_S
     assert_untouched(server)
 
 
 def test_explicit_missing_path_is_not_redirected(fake_master, tmp_path: Path) -> None:
     server, uri = fake_master
-    result, _ = run_script(['./Traj_data2.yaml', 'step_and_fall'], uri, tmp_path)
+    result = run_script(['./Traj_data2.yaml', 'step_and_fall'], uri, tmp_path)
     assert result.stdout == ''
     assert_one_line_error(result, './Traj_data2.yaml: cannot read trajectory file: No such file or directory')
     assert_untouched(server)

@@ -1,4 +1,7 @@
-"""Write small synthetic ROS 1 bags with rosbags, shaped like the simulator's recordings.
+"""Write synthetic ROS 1 bags with rosbags, shaped like the simulator's recordings.
+
+The unit tests' bags and the benchmark's 60 s run bag (bench/offline.py), with no
+simulator and no ROS installation: both need them, so they live in the package.
 
 Tests describe a run as a list of :class:`Record` (topic, ROS 1 type, bag time, message)
 built with the helpers below and write it with :func:`write_bag`. Times are sim time in
@@ -286,7 +289,3 @@ def unindexed_copy(source: Path, target: Path) -> Path:
     target.write_bytes(bytes(raw))
     return target
 
-
-if __name__ == '__main__':  # pragma: no cover - manual benchmark helper
-    import sys
-    print(write_run_bag(sys.argv[1] if len(sys.argv) > 1 else '/tmp/run60.bag'))

@@ -1,10 +1,13 @@
 #!/usr/bin/env python3
-"""Floods /atlas/joint_commands for the reliability tests; prints one JSON line of figures.
+"""Floods /atlas/joint_commands from outside; prints one JSON line of figures.
 
-    flood_commands.py --kind valid|bad --rate HZ --duration S [--start-sim S] [--subscribers N]
+    flood_commands.py --kind valid|bad --rate HZ --duration S [--start-sim S]
+                      [--subscribers N] [--elbow RAD]
 
-`valid`: one full 28-joint command (the standing pose, left elbow at VALID_ELBOW_RAD, the
-parameter-server gains) over and over: the load test's publishers.
+The reliability tests (test/reliability) and the benchmark's `load` section run it against
+a running atlas.launch, as a separate process.
+`valid`: one full 28-joint command (the standing pose, left elbow at --elbow, the
+parameter-server gains) over and over: the load's publishers.
 `bad`: one valid command (the same), then a cycle of every kind of broken message and of
 bad /atlas/control_mode strings: the flooding test. The simulator must refuse them all.
 
@@ -32,24 +35,24 @@ from std_msgs.msg import String
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.traj_yaml_node import build_command, read_gains
 
-#: The valid command's left elbow target (rad): the tests check the robot holds it.
-VALID_ELBOW_RAD = 1.2
+#: The valid command's default left elbow target (rad).
+DEFAULT_ELBOW_RAD = 1.2
 ELBOW = JOINT_NAMES.index('l_arm_elx')
 #: Every `BAD_MODE_EVERY`-th bad message is followed by a bad control mode.
 BAD_MODE_EVERY = 50
 BAD_MODES = ('', 'Dance', 'user', 'U' * 100_000, 'User\x00Stand')
 
 
-def valid_command() -> JointCommands:
+def valid_command(elbow_rad: float) -> JointCommands:
     """What traj_yaml.py sends (all 28 joints, parameter-server gains): stand, elbow bent."""
     position = [0.0] * NUM_JOINTS
-    position[ELBOW] = VALID_ELBOW_RAD
+    position[ELBOW] = elbow_rad
     return build_command(JointCommands, position, read_gains(), rospy.Time())
 
 
 def bad_commands() -> list[JointCommands]:
     """One message per way of being wrong; each would move the robot if it were applied."""
-    full = valid_command()
+    full = valid_command(DEFAULT_ELBOW_RAD)
 
     def variant(**fields: object) -> JointCommands:
         arrays = {field: list(getattr(full, field)) for field in full.__slots__
@@ -120,7 +123,7 @@ class ClockWatch:
 
 
 def flood(kind: str, rate_hz: float, duration_s: float, start_sim_s: float,
-          subscribers: int) -> dict:
+          subscribers: int, elbow_rad: float) -> dict:
     # queue_size=None: synchronous writes, no per-connection writer thread to hand off to.
     with warnings.catch_warnings():
         warnings.simplefilter('ignore', SyntaxWarning)  # rospy: "explicit queue_size"
@@ -134,7 +137,7 @@ def flood(kind: str, rate_hz: float, duration_s: float, start_sim_s: float,
             raise SystemExit(f'flood_commands.py: no /clock, or fewer than {subscribers} '
                              'subscribers to /atlas/joint_commands')
         time.sleep(0.01)
-    valid = Preserialized(valid_command())
+    valid = Preserialized(valid_command(elbow_rad))
     bad = [Preserialized(message) for message in bad_commands()]
     if kind == 'bad':
         commands.publish(valid)
@@ -176,9 +179,12 @@ def main() -> int:
     parser.add_argument('--subscribers', type=int, default=2,
                         help='wait for this many subscribers (default: the simulator and '
                         'the recorder)')
+    parser.add_argument('--elbow', type=float, default=DEFAULT_ELBOW_RAD,
+                        help='left elbow target of the valid command (rad, default %(default)g)')
     args = parser.parse_args(rospy.myargv()[1:])
     rospy.init_node('flood_commands', anonymous=True)
-    figures = flood(args.kind, args.rate, args.duration, args.start_sim, args.subscribers)
+    figures = flood(args.kind, args.rate, args.duration, args.start_sim, args.subscribers,
+                    args.elbow)
     print(json.dumps(figures), flush=True)
     return 0
 

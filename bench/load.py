@@ -1,0 +1,141 @@
+"""The benchmark's runs that time whole scenarios: the node under a load of commands, and
+the tutorial itself.
+
+load run:     the node at real_time_factor:=1.0 with the launch's default recorder
+              (atlas_recorder), in User mode, while 3 tools/flood_commands.py publishers
+              each send 2 kHz of valid 28-joint commands for 30 s (what the reliability
+              test test_flood_and_load.py applies, where only speed-independent outcomes
+              are asserted). Each publisher reports sim time advanced / wall time over its
+              own window; the simulator's resident memory is read every second.
+tutorial run: `run_demo.py step_and_fall --video-fps 0` (its own master), then the rate of
+              the port's commands in sim time, from the recorded bag.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from harness import READY_TIMEOUT_S, REPO_DIR, BenchError, Launch, Master
+from online import Probes, recorded_fraction
+from tutorial_atlas_control.processes import STOP_TIMEOUT_S, rss_kib, wait_until
+
+FLOOD = REPO_DIR / 'tools' / 'flood_commands.py'
+RUN_DEMO = REPO_DIR / 'scripts' / 'run_demo.py'
+LOAD_PUBLISHERS = 3
+LOAD_RATE_HZ = 2000.0
+#: Sim time (s) the floods start at: after the torso is released (time_to_unpin 1 s).
+LOAD_START_SIM_S = 2.0
+#: Wall time (s) after starting the floods before the first memory reading: they have
+#: begun and the simulator has warmed up.
+LOAD_WARMUP_S = 5.0
+KIB_PER_MIB = 1024.0
+#: Wall-clock guards (s).
+FLOOD_EXTRA_S = 90.0
+DEMO_TIMEOUT_S = 300.0
+
+
+def _start_floods(master: Master, duration_s: float) -> list[subprocess.Popen]:
+    command = [sys.executable, str(FLOOD), '--kind', 'valid', '--rate', str(LOAD_RATE_HZ),
+               '--duration', str(duration_s), '--start-sim', str(LOAD_START_SIM_S)]
+    return [subprocess.Popen(command, env=master.env, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)
+            for _ in range(LOAD_PUBLISHERS)]
+
+
+def _flood_figures(floods: list[subprocess.Popen], duration_s: float) -> list[dict]:
+    figures = []
+    for flood in floods:
+        try:
+            stdout, stderr = flood.communicate(timeout=duration_s + FLOOD_EXTRA_S)
+        except subprocess.TimeoutExpired as err:
+            flood.kill()
+            raise BenchError('flood_commands.py did not finish in time') from err
+        if flood.returncode != 0:
+            raise BenchError(f'flood_commands.py failed ({flood.returncode}): {stderr.strip()}')
+        figures.append(json.loads(stdout.strip().splitlines()[-1]))
+    return figures
+
+
+def _recorded_commands(bag_dir: Path) -> int:
+    from rosbags.rosbag1 import Reader
+
+    bags = sorted(bag_dir.glob('*.bag'))
+    if not bags:
+        raise BenchError(f'the load run left no closed bag in {bag_dir}')
+    with Reader(bags[-1]) as reader:
+        return sum(c.msgcount for c in reader.connections if c.topic == '/atlas/joint_commands')
+
+
+def _watch_memory(launch: Launch, floods: list[subprocess.Popen]) -> tuple[int, int]:
+    """(first, highest) resident memory (KiB) of the simulator while the floods run."""
+    sim_pid = launch.node_pid('atlas_sim')
+    if sim_pid is None:
+        raise BenchError(f'no atlas_sim node in the launch; see {launch.log_path}')
+    time.sleep(LOAD_WARMUP_S)
+    samples_kib = [rss_kib(sim_pid) or 0]
+    while any(flood.poll() is None for flood in floods):
+        launch.check_running()
+        samples_kib.append(rss_kib(sim_pid) or 0)
+        time.sleep(1.0)
+    samples_kib.append(rss_kib(sim_pid) or 0)
+    return samples_kib[0], max(samples_kib)
+
+
+def load_run(master: Master, launch_file: str, probes: Probes, work_dir: Path, name: str,
+             duration_s: float) -> dict[str, float]:
+    from std_msgs.msg import String
+
+    bag_dir = work_dir / f'{name}_bags'
+    args = {'gui': 'false', 'real_time_factor': '1.0', 'record': 'true', 'bag_dir': str(bag_dir)}
+    with Launch(master, launch_file, args, work_dir / f'{name}.launch.log') as launch:
+        wait_until(lambda: {'/atlas_sim', '/recorder'} <= set(
+            master.subscribers('/atlas/joint_commands')), READY_TIMEOUT_S,
+            'the simulator and the recorder did not subscribe', launch.check_running)
+        wait_until(lambda: probes.mode_pub.get_num_connections() >= 2, READY_TIMEOUT_S,
+                   'the simulator did not subscribe to the mode', launch.check_running)
+        probes.mode_pub.publish(String(data='User'))
+        floods = _start_floods(master, duration_s)
+        rss_start_kib, rss_max_kib = _watch_memory(launch, floods)
+        figures = _flood_figures(floods, duration_s)
+        shutdown_s = launch.interrupt(STOP_TIMEOUT_S)
+    sent = sum(f['sent'] for f in figures)
+    result = {
+        'load_rtf': sum(f['real_time_factor'] for f in figures) / len(figures),
+        'load_publish_rate_hz': sum(f['rate_hz'] for f in figures),
+        'load_commands_lost': float(sent - _recorded_commands(bag_dir)),
+        'load_rss_growth_mib': (rss_max_kib - rss_start_kib) / KIB_PER_MIB,
+        'shutdown_s': shutdown_s,
+    }
+    fraction = recorded_fraction(bag_dir)
+    if fraction is not None:
+        result['load_recorded_fraction'] = fraction
+    shutil.rmtree(bag_dir, ignore_errors=True)  # ~2.5 kB per command: hundreds of MB
+    return result
+
+
+def tutorial_run(work_dir: Path, name: str) -> dict[str, float]:
+    from tutorial_atlas_control.bag_analysis import analyze_bag
+
+    bag_dir = work_dir / f'{name}_bags'
+    log_path = work_dir / f'{name}.log'
+    with log_path.open('w') as log_file:
+        try:
+            completed = subprocess.run(
+                [sys.executable, str(RUN_DEMO), 'step_and_fall', '--video-fps', '0',
+                 '--bag-dir', str(bag_dir)], stdout=log_file, stderr=subprocess.STDOUT,
+                stdin=subprocess.DEVNULL, timeout=DEMO_TIMEOUT_S, check=False)
+        except subprocess.TimeoutExpired as err:
+            raise BenchError(f'run_demo.py did not finish in time; see {log_path}') from err
+    bags = sorted(bag_dir.glob('atlas_*.bag'))
+    if completed.returncode != 0 or not bags:
+        raise BenchError(f'run_demo.py failed ({completed.returncode}); see {log_path}')
+    rate_hz = analyze_bag(bags[-1]).command_rate_hz
+    shutil.rmtree(bag_dir, ignore_errors=True)
+    if rate_hz is None:
+        raise BenchError(f'the tutorial run recorded no commands; see {log_path}')
+    return {'tutorial_command_rate_hz': rate_hz}

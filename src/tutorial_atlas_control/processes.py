@@ -1,0 +1,343 @@
+"""The ROS processes the demo, the tests and the benchmark start: a private master,
+`atlas.launch`, and stopping everything they started.
+
+Each master runs on a free localhost port, never 11311, so a user's running ROS session is
+never touched. roslaunch starts each node in a session of its own (setsid), so neither its
+process group nor its session holds its nodes: the process tree is read from /proc's
+parent links, remembered while it runs, and whatever outlives roslaunch is killed by pid,
+only while that pid still runs the command line it had (a reused pid is someone else's).
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import socket
+import subprocess
+import time
+import xmlrpc.client
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import IO, Self
+
+from tutorial_atlas_control.errors import AtlasControlError
+
+PACKAGE = 'tutorial_atlas_control'
+#: Longest wait for a master to answer (s, wall).
+MASTER_TIMEOUT_S = 60.0
+#: How long roslaunch gets after SIGINT (the recorder closes and indexes its bag) before
+#: it and everything it started are killed (s, wall).
+STOP_TIMEOUT_S = 20.0
+#: A master that accepts a connection but does not answer is not up (s).
+XMLRPC_TIMEOUT_S = 5.0
+POLL_PERIOD_S = 0.1
+
+
+class ProcessError(AtlasControlError):
+    """A process did not start or answer in time; the message names it and its log."""
+
+
+# ------------------------------------------------------------------------- /proc
+def _stat(pid: int | str) -> list[str] | None:
+    """/proc/PID/stat's fields after the command name (state, parent, ...), None if gone."""
+    try:
+        stat = (Path('/proc') / str(pid) / 'stat').read_text()
+    except OSError:
+        return None
+    return stat[stat.rindex(')') + 2:].split()
+
+
+def descendants(pid: int) -> list[int]:
+    """Live (non-zombie) processes descended from `pid`, following /proc's parent links."""
+    children: dict[int, list[int]] = {}
+    for entry in Path('/proc').iterdir():
+        fields = _stat(entry.name) if entry.name.isdigit() else None
+        if fields is not None and fields[0] != 'Z':
+            children.setdefault(int(fields[1]), []).append(int(entry.name))
+    found, todo = [], [pid]
+    while todo:
+        for child in children.get(todo.pop(), []):
+            found.append(child)
+            todo.append(child)
+    return found
+
+
+def alive(pids: Sequence[int]) -> list[int]:
+    """Those of `pids` that still run (zombies count as gone)."""
+    return [pid for pid in pids if (fields := _stat(pid)) is not None and fields[0] != 'Z']
+
+
+def command_line(pid: int) -> str:
+    """`pid`'s command line, arguments joined by spaces; '' if it is gone."""
+    try:
+        raw = (Path('/proc') / str(pid) / 'cmdline').read_bytes()
+    except OSError:
+        return ''
+    return raw.replace(b'\0', b' ').decode(errors='replace').strip()
+
+
+def rss_kib(pid: int) -> int | None:
+    """Resident memory of `pid` (KiB), None if it is gone."""
+    try:
+        status = (Path('/proc') / str(pid) / 'status').read_text()
+    except OSError:
+        return None
+    for line in status.splitlines():
+        if line.startswith('VmRSS:'):
+            return int(line.split()[1])
+    return None
+
+
+def cpu_seconds(pid: int) -> float:
+    """CPU time `pid` has used (user + system, s), 0.0 if it is gone."""
+    fields = _stat(pid)
+    if fields is None:
+        return 0.0
+    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+
+
+def kill_if_unchanged(pids: Mapping[int, str]) -> None:
+    """SIGKILL each pid that still runs the command line recorded for it."""
+    for pid, command in pids.items():
+        if command and command_line(pid) == command and alive([pid]):
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except (ProcessLookupError, PermissionError):
+                pass
+
+
+def stop_tree(process: subprocess.Popen, timeout_s: float = STOP_TIMEOUT_S,
+              known: Mapping[int, str] | None = None) -> bool:
+    """SIGINT `process`'s group, as Ctrl-C in a terminal; SIGKILL it after `timeout_s`.
+
+    Then SIGKILL whatever it started that still runs (its tree now, plus `known`: pid ->
+    command line of processes seen under it earlier). Returns False if it had to be killed.
+    """
+    tree = dict(known or {})
+    tree.update({pid: command_line(pid) for pid in descendants(process.pid)})
+    clean = True
+    if process.poll() is None:
+        _signal_group(process, signal.SIGINT)
+        try:
+            process.wait(timeout=timeout_s)
+        except subprocess.TimeoutExpired:
+            clean = False
+            tree.update({pid: command_line(pid) for pid in descendants(process.pid)})
+            _signal_group(process, signal.SIGKILL)
+            process.wait()
+    kill_if_unchanged(tree)
+    return clean
+
+
+def _signal_group(process: subprocess.Popen, sig: int) -> None:
+    """`sig` to the process group `process` leads (started with start_new_session)."""
+    try:
+        os.killpg(process.pid, sig)
+    except ProcessLookupError:
+        pass
+    except PermissionError:  # not a group leader after all: the process alone
+        process.send_signal(sig)
+
+
+# ------------------------------------------------------------------------- a master
+def free_local_port() -> int:
+    """A TCP port free on the loopback interface now (the kernel's pick)."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
+        sock.bind(('127.0.0.1', 0))
+        return int(sock.getsockname()[1])
+
+
+def ros_environment(port: int, ros_log_dir: Path | None = None,
+                    base: Mapping[str, str] | None = None) -> dict[str, str]:
+    """The environment of a ROS client of the master on localhost:`port`."""
+    env = dict(os.environ if base is None else base)
+    env['ROS_MASTER_URI'] = f'http://localhost:{port}'
+    env.setdefault('ROS_HOSTNAME', 'localhost')
+    if ros_log_dir is not None:
+        env['ROS_LOG_DIR'] = str(ros_log_dir)
+    return env
+
+
+class _TimeoutTransport(xmlrpc.client.Transport):
+    def make_connection(self, host: object) -> object:
+        connection = super().make_connection(host)
+        connection.timeout = XMLRPC_TIMEOUT_S
+        return connection
+
+
+def system_state(master_uri: str) -> tuple[dict[str, list[str]], dict[str, list[str]]]:
+    """(publishers, subscribers) of each topic: the master's getSystemState.
+
+    Raises OSError while the master does not answer.
+    """
+    proxy = xmlrpc.client.ServerProxy(master_uri, transport=_TimeoutTransport())
+    code, message, state = proxy.getSystemState('/tutorial_atlas_control_processes')
+    if code != 1:
+        raise OSError(f'{master_uri}: {message}')
+    return dict(state[0]), dict(state[1])
+
+
+def wait_until(condition: Callable[[], bool], timeout_s: float, failure: str,
+               check: Callable[[], None] | None = None) -> None:
+    """Poll `condition` until true, for at most `timeout_s` (wall).
+
+    Raises ProcessError(f'{failure} within {timeout_s} s'); `check` runs before each poll
+    and raises if waiting is pointless (a process died).
+    """
+    deadline = time.monotonic() + timeout_s
+    while True:
+        if check is not None:
+            check()
+        if condition():
+            return
+        if time.monotonic() > deadline:
+            raise ProcessError(f'{failure} within {timeout_s:.0f} s')
+        time.sleep(POLL_PERIOD_S)
+
+
+def master_online(master_uri: str) -> bool:
+    try:
+        system_state(master_uri)
+    except OSError:
+        return False
+    return True
+
+
+class _RosProcess:
+    """A ROS process (`env` names its master) whose output goes to a log file; stopped
+    with its whole tree."""
+
+    name = 'process'
+
+    def __init__(self, command: Sequence[str], env: Mapping[str, str], log_path: Path) -> None:
+        self.env = dict(env)
+        self.log_path = log_path
+        log_path.parent.mkdir(parents=True, exist_ok=True)
+        self._log: IO[str] = log_path.open('w')
+        #: pid -> command line of every process seen under this one (see stop_tree).
+        self.known: dict[int, str] = {}
+        try:
+            self.process = subprocess.Popen(
+                list(command), env=self.env, stdout=self._log, stderr=subprocess.STDOUT,
+                stdin=subprocess.DEVNULL, start_new_session=True)
+        except FileNotFoundError:
+            self._log.close()
+            raise ProcessError(f'{command[0]} is not on PATH; run `make setup` and '
+                               '`source ./env.sh`') from None
+
+    @property
+    def uri(self) -> str:
+        return self.env['ROS_MASTER_URI']
+
+    def subscribers(self, topic: str) -> list[str]:
+        """Nodes subscribed to `topic` now; [] while the master is not up."""
+        try:
+            return system_state(self.uri)[1].get(topic, [])
+        except OSError:
+            return []
+
+    def pids(self) -> list[int]:
+        """This process and everything it started that still runs."""
+        tree = descendants(self.process.pid)
+        self.known.update({pid: command_line(pid) for pid in tree})
+        return alive([self.process.pid, *tree])
+
+    def output(self) -> str:
+        """Everything the process has written so far (also after close())."""
+        if not self._log.closed:
+            self._log.flush()
+        return self.log_path.read_text(errors='replace')
+
+    def tail(self, lines: int = 15) -> str:
+        return '\n'.join(self.output().splitlines()[-lines:])
+
+    def check_running(self) -> None:
+        """ProcessError naming the log if the process has exited."""
+        status = self.process.poll()
+        if status is not None:
+            raise ProcessError(f'{self.name} exited with status {status}; see {self.log_path}')
+
+    def interrupt(self, timeout_s: float = STOP_TIMEOUT_S) -> float:
+        """SIGINT, as Ctrl-C; the seconds until every process of the tree was gone
+        (`timeout_s` if some were not: close() kills them)."""
+        pids = self.pids()  # before: once the leader is gone, its orphans have no parent link
+        started_s = time.monotonic()
+        _signal_group(self.process, signal.SIGINT)
+        while alive(pids) and time.monotonic() - started_s < timeout_s:
+            time.sleep(0.02)
+        gone_s = time.monotonic() - started_s
+        try:
+            self.process.wait(timeout=max(0.0, timeout_s - gone_s))
+        except subprocess.TimeoutExpired:
+            pass
+        return gone_s
+
+    def close(self, timeout_s: float = STOP_TIMEOUT_S) -> bool:
+        """Stop the tree (see stop_tree); False if it had to be killed. Idempotent."""
+        self.pids()
+        clean = stop_tree(self.process, timeout_s, self.known)
+        self._log.close()
+        return clean
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+class RosMaster(_RosProcess):
+    """`roscore` on a free localhost port; `env` is what its clients need."""
+
+    name = 'roscore'
+
+    def __init__(self, log_path: Path, ros_log_dir: Path | None = None,
+                 extra_env: Mapping[str, str] | None = None) -> None:
+        self.port = free_local_port()
+        env = ros_environment(self.port, ros_log_dir)
+        env.update(extra_env or {})
+        super().__init__(['roscore', '-p', str(self.port)], env, log_path)
+
+    def wait_online(self, timeout_s: float = MASTER_TIMEOUT_S) -> None:
+        wait_until(lambda: master_online(self.uri), timeout_s,
+                   f'roscore -p {self.port} did not answer (see {self.log_path})',
+                   self.check_running)
+
+
+class AtlasLaunch(_RosProcess):
+    """`roslaunch tutorial_atlas_control atlas.launch ARG:=VALUE ...`.
+
+    Without `master` roslaunch starts a master of its own on a free port; with one, it
+    waits for that master (several launches may then run on it in turn).
+    """
+
+    name = 'roslaunch'
+
+    def __init__(self, log_path: Path, args: Mapping[str, object], *,
+                 master: RosMaster | None = None, ros_log_dir: Path | None = None,
+                 launch_file: str = 'atlas.launch') -> None:
+        if master is None:
+            self.port = free_local_port()
+            env, wait = ros_environment(self.port), []
+        else:
+            self.port, env, wait = master.port, dict(master.env), ['--wait']
+        if ros_log_dir is not None:
+            env['ROS_LOG_DIR'] = str(ros_log_dir)
+        self.args = {key: str(value) for key, value in args.items()}
+        target = [launch_file] if os.path.sep in launch_file else [PACKAGE, launch_file]
+        super().__init__(['roslaunch', '-p', str(self.port), *wait, *target,
+                          *(f'{key}:={value}' for key, value in self.args.items())],
+                         env, log_path)
+
+    def wait_master(self, timeout_s: float = MASTER_TIMEOUT_S) -> None:
+        """Until the launch's master answers (roslaunch starts it first)."""
+        wait_until(lambda: master_online(self.uri), timeout_s,
+                   f'the ROS master of roslaunch -p {self.port} did not answer '
+                   f'(see {self.log_path})', self.check_running)
+
+    def pid_of(self, fragment: str) -> int | None:
+        """The launch's process whose command line contains `fragment`."""
+        for pid in self.pids():
+            if fragment in self.known.get(pid, ''):
+                return pid
+        return None

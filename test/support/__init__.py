@@ -1,0 +1,3 @@
+"""Helpers shared by the test directories: imported as `support` (pytest.ini puts test/ on
+the path). What the benchmark needs too lives in the package (processes, synthetic_bags)
+or in tools/ (flood_commands.py), never here."""

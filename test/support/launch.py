@@ -1,0 +1,123 @@
+"""atlas.launch as the integration and reliability tests drive it: its own master, bag
+directory and ROS log directory under the test's tmp_path.
+
+Each test starts the real launch (roscore, the simulator, the recorder), injects a fault
+or a load from outside (signals, floods, bad files) and judges the outcome from the
+processes and from the recorded bag, as a user would afterwards. Waits fail the test
+with the launch's output; they are bounded in wall time only as guards against hangs.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from tutorial_atlas_control import processes
+
+REPO = Path(__file__).resolve().parents[2]
+FLOOD = REPO / 'tools' / 'flood_commands.py'
+#: Wall-clock guards (s): far beyond what any step takes on a loaded machine.
+STARTUP_TIMEOUT_S = 120.0
+EXIT_TIMEOUT_S = 60.0
+SIM_TIME_TIMEOUT_S = 120.0
+
+
+class TestLaunch(processes.AtlasLaunch):
+    """One `roslaunch tutorial_atlas_control atlas.launch` run, and what it left behind."""
+
+    __test__ = False  # not a test class, whatever pytest's name rules say
+
+    def __init__(self, tmp_path: Path, *args: str) -> None:
+        self.bag_dir = tmp_path / 'bags'
+        launch_args = {'gui': 'false', 'bag_dir': str(self.bag_dir)}
+        launch_args.update(arg.split(':=', 1) for arg in args)
+        super().__init__(tmp_path / 'atlas_launch.log', launch_args,
+                         ros_log_dir=tmp_path / 'ros_log')
+
+    # -- processes ------------------------------------------------------------------------
+    def pid_of(self, fragment: str) -> int:
+        """The launch's process whose command line contains `fragment`."""
+        pid = super().pid_of(fragment)
+        assert pid is not None, f'no process running {fragment!r}; see {self.log_path}'
+        return pid
+
+    def wait(self, condition: object, timeout_s: float, failure: str) -> None:
+        """processes.wait_until, failing the test with the launch's output."""
+        try:
+            processes.wait_until(condition, timeout_s, failure, self.check_running)
+        except processes.ProcessError as err:
+            pytest.fail(f'{err}:\n{self.output()}')
+
+    def wait_ready(self) -> None:
+        """Until the simulator and the recorder are both subscribed to the commands."""
+        self.wait(lambda: {'/atlas_sim', '/recorder'} <= set(
+            self.subscribers('/atlas/joint_commands')), STARTUP_TIMEOUT_S,
+            'atlas.launch was not ready')
+
+    def wait_exit(self, timeout_s: float = EXIT_TIMEOUT_S) -> int:
+        try:
+            return self.process.wait(timeout=timeout_s)
+        except subprocess.TimeoutExpired:
+            pytest.fail(f'atlas.launch did not exit within {timeout_s} s:\n{self.output()}')
+
+    # -- helpers run against this launch's master ----------------------------------------
+    def run(self, *command: str, timeout_s: float = 60.0) -> subprocess.CompletedProcess:
+        return subprocess.run(command, env=self.env, capture_output=True, text=True,
+                              timeout=timeout_s, check=False)
+
+    def set_mode(self, mode: str) -> None:
+        """The tutorial's `rostopic pub /atlas/control_mode std_msgs/String -- User`."""
+        result = self.run('rostopic', 'pub', '-1', '/atlas/control_mode', 'std_msgs/String',
+                          '--', mode)
+        assert result.returncode == 0, result.stderr
+
+    def sim_time_s(self) -> float:
+        """The simulator's clock now (s), from one /clock message."""
+        result = self.run('rostopic', 'echo', '-n', '1', '/clock')
+        fields = dict(line.strip().split(': ') for line in result.stdout.splitlines()
+                      if line.strip().startswith(('secs:', 'nsecs:')))
+        assert result.returncode == 0 and fields, f'no /clock: {result.stderr}'
+        return int(fields['secs']) + int(fields['nsecs']) * 1e-9
+
+    def wait_sim_until(self, until_s: float) -> None:
+        """Until the simulator's clock reaches `until_s`: at any speed of the machine.
+
+        Sleeps the sim time still to go between readings (each is a `rostopic echo`):
+        at real_time_factor <= 1 a sim second takes at least a wall second.
+        """
+        deadline = time.monotonic() + SIM_TIME_TIMEOUT_S
+        while (now_s := self.sim_time_s()) < until_s:
+            self.check_running()
+            if time.monotonic() > deadline:
+                pytest.fail(f'sim time {now_s:.1f} s did not reach {until_s:.1f} s within '
+                            f'{SIM_TIME_TIMEOUT_S:.0f} s:\n{self.output()}')
+            time.sleep(max(0.2, until_s - now_s))
+
+    def wait_sim_s(self, seconds: float) -> None:
+        """Until `seconds` of sim time have passed."""
+        self.wait_sim_until(self.sim_time_s() + seconds)
+
+    def start_flood(self, *args: str) -> subprocess.Popen:
+        return subprocess.Popen([sys.executable, str(FLOOD), *args], env=self.env,
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+    # -- the recording -------------------------------------------------------------------
+    def bag(self) -> Path:
+        """The run's one bag: closed (no .active left) and alone in its directory."""
+        active = sorted(self.bag_dir.glob('*.active'))
+        assert not active, f'the recorder left {[p.name for p in active]} unclosed'
+        bags = sorted(self.bag_dir.glob('atlas_*.bag'))
+        assert len(bags) == 1, f'expected one bag in {self.bag_dir}, found {bags}'
+        return bags[0]
+
+
+def flood_figures(process: subprocess.Popen, timeout_s: float) -> dict:
+    """Wait for a flood_commands.py and return its JSON figures."""
+    stdout, stderr = process.communicate(timeout=timeout_s)
+    assert process.returncode == 0, f'flood_commands.py failed:\n{stderr}'
+    return json.loads(stdout.strip().splitlines()[-1])

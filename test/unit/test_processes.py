@@ -1,0 +1,118 @@
+"""processes: finding and stopping a launch's process tree (roslaunch setsid()s its nodes)."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.processes import (AtlasLaunch, ProcessError, alive, command_line,
+                                              descendants, free_local_port, rss_kib, stop_tree,
+                                              wait_until)
+
+#: Guard (s) for child processes to start or be reaped, however busy the machine is.
+GUARD_S = 30.0
+#: A parent that ignores SIGINT, with a child in a session of its own that ignores it too
+#: (as a roslaunch node that hangs on shutdown) and an ordinary child.
+STUBBORN_TREE = "trap '' INT; setsid bash -c \"trap '' INT; sleep 300\" & sleep 300 & wait"
+
+
+def session(pid: int) -> int:
+    return int((Path('/proc') / str(pid) / 'stat').read_text().rsplit(')', 1)[1].split()[3])
+
+
+def wait_for_children(parent: subprocess.Popen, count: int) -> list[int]:
+    wait_until(lambda: len(descendants(parent.pid)) >= count, GUARD_S, 'children did not start')
+    return descendants(parent.pid)
+
+
+def test_descendants_follow_parents_across_sessions_and_alive_drops_the_dead() -> None:
+    parent = subprocess.Popen(['bash', '-c', 'setsid sleep 30 & sleep 30 & wait'])
+    try:
+        wait_until(lambda: len({session(pid) for pid in descendants(parent.pid)}) == 2,
+                   GUARD_S, 'one child did not move to a session of its own')
+        found = descendants(parent.pid)
+        assert len(found) == 2, found
+        assert alive(found) == found
+    finally:
+        for pid in [parent.pid, *descendants(parent.pid)]:
+            subprocess.run(['kill', '-9', str(pid)], check=False)
+        parent.wait()
+    wait_until(lambda: alive(found) == [], GUARD_S, 'init did not reap the orphans')
+
+
+def test_stop_tree_kills_what_ignores_sigint_including_other_sessions() -> None:
+    parent = subprocess.Popen(['bash', '-c', STUBBORN_TREE], start_new_session=True)
+    children = wait_for_children(parent, 2)
+    assert stop_tree(parent, timeout_s=0.5) is False, 'it had to be killed'
+    assert parent.poll() == -signal.SIGKILL
+    wait_until(lambda: alive(children) == [], GUARD_S, 'children survived')
+
+
+def test_stop_tree_is_clean_when_sigint_stops_the_tree() -> None:
+    parent = subprocess.Popen(['bash', '-c', 'sleep 300 & wait'], start_new_session=True)
+    children = wait_for_children(parent, 1)
+    assert stop_tree(parent, timeout_s=GUARD_S) is True
+    wait_until(lambda: alive(children) == [], GUARD_S, 'children survived')
+
+
+def test_a_reused_pid_is_left_alone() -> None:
+    """Only pids still running their recorded command line are killed."""
+    bystander = subprocess.Popen(['sleep', '300'])
+    finished = subprocess.Popen(['true'])
+    finished.wait()
+    try:
+        stop_tree(finished, known={bystander.pid: 'something else'})
+        assert alive([bystander.pid]) == [bystander.pid]
+    finally:
+        bystander.kill()
+        bystander.wait()
+
+
+def test_command_line_and_memory_of_a_process() -> None:
+    child = subprocess.Popen(['sleep', '300'])
+    try:
+        wait_until(lambda: command_line(child.pid) == 'sleep 300', GUARD_S, 'no command line')
+        assert rss_kib(child.pid) > 0
+    finally:
+        child.kill()
+        child.wait()
+    assert command_line(child.pid) == '' and rss_kib(child.pid) is None
+
+
+def test_free_local_port_can_be_bound() -> None:
+    import socket
+
+    with socket.socket() as sock:
+        sock.bind(('127.0.0.1', free_local_port()))
+
+
+def test_wait_until_names_what_did_not_happen() -> None:
+    with pytest.raises(ProcessError, match=r'^the robot did not stand within 0 s$'):
+        wait_until(lambda: False, 0.0, 'the robot did not stand')
+    assert issubclass(ProcessError, AtlasControlError)
+
+
+def test_a_launch_that_exits_is_reported_with_its_log(tmp_path: Path,
+                                                      monkeypatch: pytest.MonkeyPatch) -> None:
+    """A stand-in `roslaunch` on PATH that fails at once: one line naming the log."""
+    fake = tmp_path / 'bin' / 'roslaunch'
+    fake.parent.mkdir()
+    fake.write_text('#!/bin/sh\necho "RLException: $*"\nexit 1\n')
+    fake.chmod(0o755)
+    monkeypatch.setenv('PATH', f'{fake.parent}{os.pathsep}{os.environ["PATH"]}')
+    with AtlasLaunch(tmp_path / 'launch.log', {'gui': 'false'}) as launch:
+        with pytest.raises(ProcessError) as err:
+            launch.wait_master(GUARD_S)
+        assert str(err.value) == f'roslaunch exited with status 1; see {tmp_path / "launch.log"}'
+        assert f'-p {launch.port} tutorial_atlas_control atlas.launch gui:=false' in launch.output()
+
+
+def test_a_missing_roslaunch_is_one_line(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv('PATH', str(tmp_path))
+    with pytest.raises(ProcessError, match=r'^roslaunch is not on PATH; run `make setup`'):
+        AtlasLaunch(tmp_path / 'launch.log', {})
