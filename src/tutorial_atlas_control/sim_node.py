@@ -11,6 +11,9 @@ Parameters (private unless noted):
     ~gui (bool, false): open the MuJoCo viewer (needs a display).
     ~joint_states_rate, ~imu_rate, ~contact_rate (Hz, 1000): 0 or >= 1000 = every step.
     ~odom_rate (Hz, 100): /ground_truth_odom rate, as DRCSim.
+    ~tf (bool, true): broadcast world -> pelvis on /tf from the ground truth, if the model
+        has a matching URDF (urdf.matching_urdf); else one warning and no /tf.
+    ~tf_rate (Hz, 100): /tf rate.
     ~model_file (str, the package's sim/atlas_v1.xml): the MJCF to simulate; it must have
         Atlas v1's joints, actuators and sensors (a variant of the package's model).
     /atlas/time_to_unpin (float, 1.0): seconds the torso stays pinned after start/reset.
@@ -39,17 +42,22 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import String
 from std_srvs.srv import Empty, EmptyResponse
+from tf2_msgs.msg import TFMessage
 
 from tutorial_atlas_control import model as atlas_model
 from tutorial_atlas_control.commands import CommandDecoder, CommandError
 from tutorial_atlas_control.controller import gains_from_params
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES
+from tutorial_atlas_control.render import configure_viewer_camera
 from tutorial_atlas_control.simulator import (
     DEFAULT_TIME_TO_UNPIN_S, NS_PER_S, AtlasSimulator, ModeError, PhysicsDivergenceError,
     parse_mode)
+from tutorial_atlas_control.topics import PELVIS_FRAME, TF
+from tutorial_atlas_control.urdf import UrdfError, matching_urdf
 from tutorial_atlas_control.wire import (
-    ImuWire, JointStateWire, OdometryWire, WireBatch, WrenchStampedWire, clock_bytes)
+    ImuWire, JointStateWire, OdometryWire, TransformWire, WireBatch, WrenchStampedWire,
+    clock_bytes)
 
 NODE_NAME = 'atlas_sim'
 #: Seconds between repeats of the same refusal warning.
@@ -114,7 +122,7 @@ class SimNode:
     """Owns the simulator, its lock, the publishers and the stepping loop."""
 
     def __init__(self, sim: AtlasSimulator, real_time_factor: float, paused: bool,
-                 rates_hz: dict[str, float], gui: bool) -> None:
+                 rates_hz: dict[str, float], gui: bool, tf: bool = False) -> None:
         self.sim = sim
         self.lock = threading.Lock()
         self.real_time_factor = real_time_factor
@@ -144,6 +152,8 @@ class SimNode:
                                                  queue_size=None)
             self.r_contact_pub = rospy.Publisher('/atlas/r_foot_contact', WrenchStamped,
                                                  queue_size=None)
+            # world -> pelvis; robot_state_publisher adds the links from the joint states.
+            self.tf_pub = rospy.Publisher(TF, TFMessage, queue_size=None) if tf else None
         self.batch = WireBatch()
         # Latched, recorded in every bag: what offline replay needs to re-create the run.
         self.config_pub = rospy.Publisher('/atlas/sim_config', String, queue_size=1, latch=True)
@@ -152,6 +162,7 @@ class SimNode:
         self.joint_state = JointStateWire(JOINT_NAMES)
         self.odom = OdometryWire(WORLD_FRAME, 'pelvis')
         self.imu = ImuWire('pelvis')
+        self.pelvis_tf = TransformWire(WORLD_FRAME, PELVIS_FRAME)
         self.contacts = ((WrenchStampedWire('l_foot'), 'l', self.l_contact_pub),
                          (WrenchStampedWire('r_foot'), 'r', self.r_contact_pub))
         data = sim.data
@@ -283,6 +294,8 @@ class SimNode:
         sensed_ns = sim.state_time_ns
         if count % self.every['odom'] == 0 and wanted(self.odom_pub):
             self._publish_odom(sensed_ns)
+        if self.tf_pub is not None and count % self.every['tf'] == 0 and wanted(self.tf_pub):
+            self._publish_tf(sensed_ns)
         if count % self.every['imu'] == 0 and wanted(self.imu_pub):
             imu = self.imu
             w, x, y, z = self.sensors['imu_orientation']
@@ -310,6 +323,15 @@ class SimNode:
         odom.angular[:] = self._pelvis_velocity[:3]
         odom.linear[:] = self._pelvis_velocity[3:]
         self.batch.add(self.odom_pub, odom.to_bytes(stamp_ns))
+
+    def _publish_tf(self, stamp_ns: int) -> None:
+        """world -> pelvis from the ground truth, the pose /ground_truth_odom has at this stamp."""
+        sim = self.sim
+        body = sim.atlas.pelvis_body_id
+        self.pelvis_tf.translation[:] = sim.data.xpos[body]
+        w, x, y, z = sim.data.xquat[body]
+        self.pelvis_tf.rotation_xyzw[:] = (x, y, z, w)
+        self.batch.add(self.tf_pub, self.pelvis_tf.to_bytes(stamp_ns))
 
     # -- the loop ------------------------------------------------------------------------
     def spin(self) -> None:
@@ -360,8 +382,7 @@ class SimNode:
                 if not viewer.is_running():
                     rospy.signal_shutdown('viewer closed')
                     break
-                with self.lock:
-                    viewer.sync()
+                self._sync_viewer(viewer)
                 next_view_s = time.perf_counter() + VIEWER_PERIOD_S
             if self.real_time_factor > 0.0:
                 due_s = wall0 + (sim_ns - sim0_ns) / NS_PER_S / self.real_time_factor
@@ -395,12 +416,34 @@ class SimNode:
         return True
 
     def _open_viewer(self):  # noqa: ANN202 - mujoco's passive viewer handle
+        """The passive viewer on a mirror of the simulator's data (see _sync_viewer),
+        its camera framing the whole robot and following the pelvis."""
         try:
             import mujoco.viewer
-            return mujoco.viewer.launch_passive(self.sim.model, self.sim.data)
+            self._view_data = mujoco.MjData(self.sim.model)
+            with self.lock:
+                mujoco.mj_copyData(self._view_data, self.sim.model, self.sim.data)
+            viewer = mujoco.viewer.launch_passive(self.sim.model, self._view_data)
         except Exception as err:  # noqa: BLE001 - no display, no GL: run headless
             rospy.logwarn(f'cannot open the MuJoCo viewer ({err}); running headless')
             return None
+        with viewer.lock():
+            configure_viewer_camera(viewer.cam, self.sim.model, self._view_data)
+        return viewer
+
+    def _sync_viewer(self, viewer) -> None:  # noqa: ANN001 - mujoco's passive viewer handle
+        """Hand the viewer the current state without making the loop wait for it.
+
+        Only the copy into the viewer's mirror happens under the simulator's lock; sync()
+        waits for the viewer's own mutex (held while it polls events and builds its scene),
+        so it runs outside. Forces the user applies with the mouse (Ctrl + drag) land in
+        the mirror and are carried over to the simulation here.
+        """
+        view_data = self._view_data
+        with self.lock:
+            self.sim.data.xfrc_applied[:] = view_data.xfrc_applied
+            mujoco.mj_copyData(view_data, self.sim.model, self.sim.data)
+        viewer.sync()
 
 
 def _float_param(name: str, default: float, minimum: float = 0.0) -> float:
@@ -421,6 +464,7 @@ def build_node() -> SimNode:
         'odom': _float_param('~odom_rate', 100.0),
         'imu': _float_param('~imu_rate', 1000.0),
         'contact': _float_param('~contact_rate', 1000.0),
+        'tf': _float_param('~tf_rate', 100.0),
     }
     model_file = rospy.get_param('~model_file', str(atlas_model.MODEL_PATH))
     if not isinstance(model_file, str) or not model_file:
@@ -429,7 +473,20 @@ def build_node() -> SimNode:
     sim = AtlasSimulator(atlas_model.load_model(Path(model_file)), gains, time_to_unpin_s)
     return SimNode(sim, _float_param('~real_time_factor', 1.0),
                    bool(rospy.get_param('~paused', False)), rates_hz,
-                   bool(rospy.get_param('~gui', False)))
+                   bool(rospy.get_param('~gui', False)), _tf_wanted(Path(model_file), sim))
+
+
+def _tf_wanted(model_file: Path, sim: AtlasSimulator) -> bool:
+    """~tf, unless the model has no matching URDF: then one warning saying why."""
+    if not rospy.get_param('~tf', True):
+        return False
+    try:
+        matching_urdf(model_file, sim.model)
+    except UrdfError as err:
+        rospy.logwarn(f'TF is off: {err}; rviz cannot show this model '
+                      '(write a matching URDF beside it to get TF)')
+        return False
+    return True
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -16,6 +16,10 @@ R_FOOT_CONTACT = '/atlas/r_foot_contact'
 #: Latched JSON (timestep, time_to_unpin, model file and sha1, last reset): what replay needs.
 SIM_CONFIG = '/atlas/sim_config'
 ROSOUT = '/rosout'
+#: world -> pelvis from the simulator; robot_state_publisher adds the links.
+TF = '/tf'
+#: The URDF of the simulated model (set by atlas.launch's state_publisher.py).
+ROBOT_DESCRIPTION_PARAM = '/robot_description'
 
 #: Gazebo's services, as gazebo_ros offered them.
 RESET_WORLD_SERVICE = '/gazebo/reset_world'
