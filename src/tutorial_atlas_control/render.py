@@ -39,6 +39,7 @@ __all__ = [
     'VideoResult',
     'check_output_path',
     'configure_viewer_camera',
+    'configure_viewer_scene',
     'parse_size',
     'prepare_gl',
     'render_bag_video',
@@ -323,6 +324,19 @@ def configure_viewer_camera(cam: object, model: object, data: object, camera: st
     cam.azimuth = view.azimuth_deg
     cam.elevation = view.elevation_deg
     cam.lookat[:] = data.subtree_com[body]
+
+
+def configure_viewer_scene(scene: object) -> None:
+    """The video's look in the viewer: no shadows, no reflections.
+
+    With software OpenGL (no GPU, Xvfb) they cost most of each frame, and the viewer's
+    render thread competes with the simulation for the CPU. The Rendering panel turns them
+    back on.
+    """
+    import mujoco
+
+    scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = False
+    scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = False
 
 
 def _frames(states: RunStates, width: int, height: int, progress: bool,

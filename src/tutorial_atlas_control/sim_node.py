@@ -49,7 +49,7 @@ from tutorial_atlas_control.commands import CommandDecoder, CommandError
 from tutorial_atlas_control.controller import gains_from_params
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES
-from tutorial_atlas_control.render import configure_viewer_camera
+from tutorial_atlas_control.render import configure_viewer_camera, configure_viewer_scene
 from tutorial_atlas_control.simulator import (
     DEFAULT_TIME_TO_UNPIN_S, NS_PER_S, AtlasSimulator, ModeError, PhysicsDivergenceError,
     parse_mode)
@@ -75,6 +75,12 @@ MAX_DIVERGENCES_IN_A_ROW = 3
 MAX_PENDING_COMMANDS = 10_000
 #: Viewer refresh period (s, wall).
 VIEWER_PERIOD_S = 1.0 / 60.0
+#: The viewer draws at most one frame per VIEWER_FRAME_PERIOD_S (s, wall): left alone, its
+#: render thread draws as fast as it can, and with software OpenGL (no GPU, Xvfb) that took
+#: the CPU the simulation needs. The pause is VIEWER_HOLD_S of it; the rest is its turn.
+VIEWER_FRAME_PERIOD_S = 1.0 / 30.0
+VIEWER_TURN_S = 0.005
+VIEWER_HOLD_S = VIEWER_FRAME_PERIOD_S - VIEWER_TURN_S
 WORLD_FRAME = 'world'
 #: At real_time_factor 0 the loop sends what it published at most this often (s, wall);
 #: paced runs send after every step while on schedule.
@@ -382,7 +388,6 @@ class SimNode:
                 if not viewer.is_running():
                     rospy.signal_shutdown('viewer closed')
                     break
-                self._sync_viewer(viewer)
                 next_view_s = time.perf_counter() + VIEWER_PERIOD_S
             if self.real_time_factor > 0.0:
                 due_s = wall0 + (sim_ns - sim0_ns) / NS_PER_S / self.real_time_factor
@@ -416,8 +421,9 @@ class SimNode:
         return True
 
     def _open_viewer(self):  # noqa: ANN202 - mujoco's passive viewer handle
-        """The passive viewer on a mirror of the simulator's data (see _sync_viewer),
-        its camera framing the whole robot and following the pelvis."""
+        """The passive viewer on a mirror of the simulator's data, its camera framing the
+        whole robot and following the pelvis; a thread of its own keeps it up to date
+        (_viewer_loop)."""
         try:
             import mujoco.viewer
             self._view_data = mujoco.MjData(self.sim.model)
@@ -429,21 +435,28 @@ class SimNode:
             return None
         with viewer.lock():
             configure_viewer_camera(viewer.cam, self.sim.model, self._view_data)
+            configure_viewer_scene(viewer.user_scn)
+        threading.Thread(target=self._viewer_loop, args=(viewer,), name='viewer',
+                         daemon=True).start()
         return viewer
 
-    def _sync_viewer(self, viewer) -> None:  # noqa: ANN001 - mujoco's passive viewer handle
-        """Hand the viewer the current state without making the loop wait for it.
+    def _viewer_loop(self, viewer) -> None:  # noqa: ANN001 - mujoco's passive viewer handle
+        """Hand the viewer the state, and pace its drawing, outside the stepping loop.
 
-        Only the copy into the viewer's mirror happens under the simulator's lock; sync()
-        waits for the viewer's own mutex (held while it polls events and builds its scene),
-        so it runs outside. Forces the user applies with the mouse (Ctrl + drag) land in
-        the mirror and are carried over to the simulation here.
+        Only the copy into the viewer's mirror happens under the simulator's lock (~10 us);
+        sync() and the pacing wait for the viewer's own mutex, never with the simulator's
+        lock held. Forces the user applies with the mouse (Ctrl + right drag) land in the
+        mirror and are carried over to the simulation here.
         """
-        view_data = self._view_data
-        with self.lock:
-            self.sim.data.xfrc_applied[:] = view_data.xfrc_applied
-            mujoco.mj_copyData(view_data, self.sim.model, self.sim.data)
-        viewer.sync()
+        view_data, model = self._view_data, self.sim.model
+        while viewer.is_running() and not rospy.is_shutdown():
+            with self.lock:
+                self.sim.data.xfrc_applied[:] = view_data.xfrc_applied
+                mujoco.mj_copyData(view_data, model, self.sim.data)
+            viewer.sync()
+            with viewer.lock():  # its render thread waits at the top of its next frame
+                time.sleep(VIEWER_HOLD_S)
+            time.sleep(VIEWER_TURN_S)
 
 
 def _float_param(name: str, default: float, minimum: float = 0.0) -> float:
