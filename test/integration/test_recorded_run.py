@@ -29,6 +29,7 @@ RECORDED_TYPES = {
     '/atlas/control_mode': 'std_msgs/msg/String',
     '/atlas/sim_config': 'std_msgs/msg/String',
     '/rosout': 'rosgraph_msgs/msg/Log',
+    '/tf': 'tf2_msgs/msg/TFMessage',
 }
 
 
