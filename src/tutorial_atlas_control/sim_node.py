@@ -73,7 +73,7 @@ DIVERGENCE_REPEAT_S = 1.0
 MAX_DIVERGENCES_IN_A_ROW = 3
 #: Commands waiting for the next step, at most (a second of 10 kHz of them).
 MAX_PENDING_COMMANDS = 10_000
-#: Viewer refresh period (s, wall).
+#: How often (s, wall) the loop checks whether the user closed the viewer.
 VIEWER_PERIOD_S = 1.0 / 60.0
 #: The viewer draws at most one frame per VIEWER_FRAME_PERIOD_S (s, wall): left alone, its
 #: render thread draws as fast as it can, and with software OpenGL (no GPU, Xvfb) that took
