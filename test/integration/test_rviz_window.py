@@ -59,7 +59,10 @@ def robot_pixels(image: np.ndarray) -> tuple[int, int]:
                                    MIN_BRIGHTNESS).sum()) for name in ('orange', 'blue'))
 
 
-def test_rviz_shows_the_robot(tmp_path: Path) -> None:
+@pytest.mark.parametrize('tf', [True, False], ids=['tf', 'no_tf'])
+def test_rviz_shows_the_robot(tmp_path: Path, tf: bool) -> None:
+    """With atlas.launch's TF, the robot in the 3D view; with tf:=false (no robot_description,
+    no TF: the check's bad frame), none of its colours."""
     with xvfb() as display:
         port = free_local_port()
         env = _launch_env(display, tmp_path, port)
@@ -67,8 +70,8 @@ def test_rviz_shows_the_robot(tmp_path: Path) -> None:
         rviz_log = open(tmp_path / 'rviz.log', 'w')  # noqa: SIM115 - closed below
         atlas = subprocess.Popen(
             ['roslaunch', '-p', str(port), 'tutorial_atlas_control', 'atlas.launch', 'gui:=false',
-             'record:=false'], env=env, stdout=atlas_log, stderr=subprocess.STDOUT,
-            start_new_session=True)
+             'record:=false', f'tf:={str(tf).lower()}'], env=env, stdout=atlas_log,
+            stderr=subprocess.STDOUT, start_new_session=True)
         rviz = None
         try:
             wait_sim_time(env, 1.0)
@@ -86,8 +89,11 @@ def test_rviz_shows_the_robot(tmp_path: Path) -> None:
             rviz_log.close()
     head, legs = robot_pixels(image)
     output = (tmp_path / 'rviz.log').read_text(errors='replace')
-    print(f'rviz: {head} orange and {legs} blue pixels in the 3D view; '
+    print(f'rviz (tf:={tf}): {head} orange and {legs} blue pixels in the 3D view; '
           f'screenshot {tmp_path / "rviz.png"}')
+    if not tf:
+        assert head < MIN_HEAD_PIXELS and legs < MIN_LEG_PIXELS
+        return
     assert head >= MIN_HEAD_PIXELS
     assert legs >= MIN_LEG_PIXELS
     bad = [line for line in output.splitlines()
