@@ -25,9 +25,9 @@ import rosgraph  # noqa: E402
 from tutorial_atlas_control import model as atlas_model  # noqa: E402
 from tutorial_atlas_control.demo import free_local_port  # noqa: E402
 
-from test_viewer_window import (  # noqa: E402
-    CHROMA_TOLERANCE, MIN_BRIGHTNESS, WALL_TIMEOUT_S, stop_launch, wait_sim_time, _launch_env)
-from xdisplay import find_window, material_mask, screenshot, xvfb  # noqa: E402
+from test_viewer_window import CHROMA_TOLERANCE, MIN_BRIGHTNESS  # noqa: E402
+from xdisplay import (  # noqa: E402
+    find_window, launch_env, material_mask, screenshot, stop_launch, wait_sim_time, xvfb)
 
 #: rviz/atlas.rviz's background colour: the 3D view is where it shows.
 BACKGROUND_RGB = (48, 48, 48)
@@ -65,7 +65,7 @@ def test_rviz_shows_the_robot(tmp_path: Path, tf: bool) -> None:
     no TF: the check's bad frame), none of its colours."""
     with xvfb() as display:
         port = free_local_port()
-        env = _launch_env(display, tmp_path, port)
+        env = launch_env(display, tmp_path, port)
         atlas_log = open(tmp_path / 'atlas.log', 'w')  # noqa: SIM115 - closed below
         rviz_log = open(tmp_path / 'rviz.log', 'w')  # noqa: SIM115 - closed below
         atlas = subprocess.Popen(
@@ -78,7 +78,7 @@ def test_rviz_shows_the_robot(tmp_path: Path, tf: bool) -> None:
             rviz = subprocess.Popen(['roslaunch', 'tutorial_atlas_control', 'rviz.launch'], env=env,
                                     stdout=rviz_log, stderr=subprocess.STDOUT,
                                     start_new_session=True)
-            find_window(display, 'RViz', WALL_TIMEOUT_S)
+            find_window(display, 'RViz')
             time.sleep(RVIZ_SETTLE_S)
             image = screenshot(display, 'root', tmp_path / 'rviz.png')
         finally:

@@ -11,11 +11,7 @@ from the model's ankle height and the robot's height on screen) above the window
 
 from __future__ import annotations
 
-import os
-import signal
 import subprocess
-import sys
-import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -29,7 +25,8 @@ from tutorial_atlas_control import model as atlas_model  # noqa: E402
 from tutorial_atlas_control.demo import free_local_port  # noqa: E402
 from tutorial_atlas_control.render import configure_viewer_camera  # noqa: E402
 
-from xdisplay import find_window, material_mask, screenshot, xvfb  # noqa: E402
+from xdisplay import (  # noqa: E402
+    find_window, launch_env, material_mask, screenshot, stop_launch, wait_sim_time, xvfb)
 
 #: A pixel is the material's colour when its r : g : b is this close (chromaticity distance).
 #: The blue (0.2, 0.3, 0.55) and the sky near the horizon (about 0.33, 0.43, 0.58) are 0.11
@@ -45,7 +42,6 @@ MIN_LEG_PIXELS = 1000
 MIN_SPAN_FRACTION = 1.0 / 3.0
 #: Sim time (s) at which the screenshot is taken: standing, after the 1 s pin.
 SCREENSHOT_AT_S = 3.0
-WALL_TIMEOUT_S = 180.0
 REPO = Path(__file__).resolve().parents[2]
 
 
@@ -94,53 +90,17 @@ def _ankle_share() -> float:
     return float(data.body('l_talus').xpos[2] / data.body('head').xpos[2])
 
 
-def _launch_env(display: str, tmp_path: Path, port: int) -> dict[str, str]:
-    env = dict(os.environ, DISPLAY=display, LIBGL_ALWAYS_SOFTWARE='1',
-               ROS_MASTER_URI=f'http://localhost:{port}', ROS_HOSTNAME='localhost',
-               ROS_LOG_DIR=str(tmp_path / 'ros_log'))
-    for name in ('MUJOCO_GL', 'PYOPENGL_PLATFORM'):  # env.sh's headless choice: not here
-        env.pop(name, None)
-    return env
-
-
-WAIT_SIM_TIME = '''
-import sys, rospy
-from rosgraph_msgs.msg import Clock
-rospy.init_node('wait_sim_time', anonymous=True, disable_signals=True)
-target = float(sys.argv[1])
-while rospy.wait_for_message('/clock', Clock, timeout=120).clock.to_sec() < target:
-    pass
-'''
-
-
-def wait_sim_time(env: dict[str, str], seconds: float) -> None:
-    subprocess.run([sys.executable, '-c', WAIT_SIM_TIME, str(seconds)], env=env, check=True,
-                   timeout=WALL_TIMEOUT_S, capture_output=True)
-
-
-def stop_launch(process: subprocess.Popen) -> float:
-    """SIGINT the launch as Ctrl-C would; return how long it took to exit (s)."""
-    start = time.monotonic()
-    os.killpg(process.pid, signal.SIGINT)
-    try:
-        process.wait(timeout=60)
-    except subprocess.TimeoutExpired:
-        os.killpg(process.pid, signal.SIGKILL)
-        process.wait()
-    return time.monotonic() - start
-
-
 def test_viewer_window_shows_the_whole_robot(tmp_path: Path) -> None:
     m = atlas_model.load_model().model
     with xvfb() as display:
         port = free_local_port()
-        env = _launch_env(display, tmp_path, port)
+        env = launch_env(display, tmp_path, port)
         log = open(tmp_path / 'launch.log', 'w')  # noqa: SIM115 - closed below
         process = subprocess.Popen(
             ['roslaunch', '-p', str(port), 'tutorial_atlas_control', 'atlas.launch', 'gui:=true',
              'record:=false'], env=env, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
         try:
-            window = find_window(display, 'MuJoCo', WALL_TIMEOUT_S)
+            window = find_window(display, 'MuJoCo')
             wait_sim_time(env, SCREENSHOT_AT_S)
             image = screenshot(display, window, tmp_path / 'viewer.png')
         finally:

@@ -1,4 +1,5 @@
-"""A private X server (Xvfb) for tests that open windows, and screenshots of it.
+"""A private X server (Xvfb) for tests that open windows, screenshots of it, and the
+roslaunch helpers those tests share.
 
 Each test starts its own Xvfb on a free display number and stops it; windows are found with
 xdotool and captured with ImageMagick's `import` (Debian packages xvfb, xdotool, imagemagick).
@@ -8,7 +9,9 @@ from __future__ import annotations
 
 import os
 import shutil
+import signal
 import subprocess
+import sys
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -22,6 +25,8 @@ SCREEN = '1280x800x24'
 #: Display numbers tried, and how long Xvfb may take to come up (s).
 DISPLAYS = range(70, 200)
 START_TIMEOUT_S = 20.0
+#: Longest wait (s, wall) for a window or for sim time.
+WALL_TIMEOUT_S = 180.0
 
 
 def _free_display() -> int:
@@ -57,7 +62,7 @@ def xvfb() -> Iterator[str]:
             process.wait()
 
 
-def find_window(display: str, name: str, timeout_s: float = 60.0) -> str:
+def find_window(display: str, name: str, timeout_s: float = WALL_TIMEOUT_S) -> str:
     """The id of the first window whose title contains `name`."""
     env = dict(os.environ, DISPLAY=display)
     deadline = time.monotonic() + timeout_s
@@ -96,3 +101,41 @@ def material_mask(image: np.ndarray, rgba: np.ndarray, chroma_tolerance: float,
     target = np.asarray(rgba[:3], dtype=float) / float(np.sum(rgba[:3]))
     close = np.linalg.norm(chroma - target, axis=2) < chroma_tolerance
     return close & (total / 3.0 > min_brightness)
+
+
+def launch_env(display: str, tmp_path: Path, port: int) -> dict[str, str]:
+    """The environment of a launch on `display` with software OpenGL and its own master."""
+    env = dict(os.environ, DISPLAY=display, LIBGL_ALWAYS_SOFTWARE='1',
+               ROS_MASTER_URI=f'http://localhost:{port}', ROS_HOSTNAME='localhost',
+               ROS_LOG_DIR=str(tmp_path / 'ros_log'))
+    for name in ('MUJOCO_GL', 'PYOPENGL_PLATFORM'):  # env.sh's headless choice: not here
+        env.pop(name, None)
+    return env
+
+
+WAIT_SIM_TIME = '''
+import sys, rospy
+from rosgraph_msgs.msg import Clock
+rospy.init_node('wait_sim_time', anonymous=True, disable_signals=True)
+target = float(sys.argv[1])
+while rospy.wait_for_message('/clock', Clock, timeout=120).clock.to_sec() < target:
+    pass
+'''
+
+
+def wait_sim_time(env: dict[str, str], seconds: float) -> None:
+    """Until the launch's /clock reaches `seconds` of sim time."""
+    subprocess.run([sys.executable, '-c', WAIT_SIM_TIME, str(seconds)], env=env, check=True,
+                   timeout=WALL_TIMEOUT_S, capture_output=True)
+
+
+def stop_launch(process: subprocess.Popen) -> float:
+    """SIGINT the launch as Ctrl-C would; return how long it took to exit (s)."""
+    start = time.monotonic()
+    os.killpg(process.pid, signal.SIGINT)
+    try:
+        process.wait(timeout=60)
+    except subprocess.TimeoutExpired:
+        os.killpg(process.pid, signal.SIGKILL)
+        process.wait()
+    return time.monotonic() - start
