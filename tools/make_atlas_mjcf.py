@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Generate sim/atlas_v1.xml (MJCF) from a table of Atlas v1 figures.
+"""Generate sim/atlas_v1.xml (MJCF) and sim/atlas_v1.urdf from one table of Atlas v1 figures.
 
 The figures below are typed in from DRCSim 2.5.2's Atlas v1 description
 (atlas.urdf for joints, masses and inertias; the simple-shapes URDF for the
@@ -7,7 +7,11 @@ primitive collision shapes; multisense_sl.urdf for the `head` link that
 neck_ay moves). Keeping them in one table lets the unit tests compare the
 compiled MuJoCo model against the same numbers without the reference files.
 
-Usage: python3 tools/make_atlas_mjcf.py [OUTPUT]   (default: sim/atlas_v1.xml)
+The URDF (for robot_state_publisher and rviz) has the same links, joints, limits, masses,
+inertias, shapes and colours; test/unit/test_urdf.py compares the two, kinematics included.
+
+Usage: python3 tools/make_atlas_mjcf.py [OUTPUT]   (default: sim/atlas_v1.xml; the URDF
+       is written beside it, same name, suffix .urdf)
 """
 
 from __future__ import annotations
@@ -256,7 +260,14 @@ def fmt(values) -> str:
     return ' '.join(repr(float(v)) if float(v) != int(v) else str(int(v)) for v in values)
 
 
-# Colours: DRCSim's Atlas was dark grey with orange accents.
+# Colours: DRCSim's Atlas was dark grey with orange accents. Name -> (rgba, specular);
+# the MJCF's materials and the URDF's <material> colours both come from here.
+MATERIALS: dict[str, tuple[tuple[float, float, float, float], float]] = {
+    'grey': ((0.45, 0.46, 0.48, 1), 0.3),
+    'dark': ((0.18, 0.18, 0.2, 1), 0.2),
+    'blue': ((0.2, 0.3, 0.55, 1), 0.3),
+    'orange': ((0.91, 0.44, 0.03, 1), 0.3),
+}
 LINK_MATERIAL = {
     'pelvis': 'grey', 'ltorso': 'dark', 'mtorso': 'dark', 'utorso': 'grey', 'head': 'orange',
 }
@@ -271,38 +282,55 @@ def children_of(link: str) -> list[tuple[str, Joint]]:
     return [(name, JOINTS[name]) for name in JOINT_NAMES if JOINTS[name].parent == link]
 
 
-def visual_geoms(link: str, indent: str) -> list[str]:
+@dataclass(frozen=True)
+class VisualShape:
+    """A visual-only shape in MJCF terms (box half sizes; capsule radius and fromto).
+
+    The figures are kept as the MJCF text they are written as; the URDF writer parses them.
+    """
+
+    kind: str        # 'box' or 'capsule'
+    material: str
+    size: str
+    pos: str = ''
+    fromto: str = ''
+
+    def mjcf_attributes(self) -> str:
+        place = f'pos="{self.pos}"' if self.pos else f'fromto="{self.fromto}"'
+        return f'type="{self.kind}" size="{self.size}" {place}'
+
+
+def visual_shapes(link: str) -> list[VisualShape]:
     """Extra visual-only shapes so the primitive robot reads as a humanoid."""
-    side = link[0]
-    sign = 1.0 if side == 'l' else -1.0
+    sign = 1.0 if link[0] == 'l' else -1.0
     mat = LINK_MATERIAL[link]
-    lines: list[str] = []
-
-    def add(text: str) -> None:
-        lines.append(f'{indent}<geom class="visual" material="{mat}" {text}/>')
-
     if link == 'pelvis':
-        add('type="box" size="0.09 0.13 0.06" pos="0.0 0 0.02"')
-    elif link == 'utorso':
-        add('type="box" size="0.13 0.17 0.14" pos="0.02 0 0.22"')
-        add('type="capsule" size="0.05" fromto="0.02 -0.12 0.32 0.02 0.12 0.32"')
-        add('type="capsule" size="0.035" fromto="0.07 0 0.34 0.15 0 0.49"')  # neck
-    elif link == 'ltorso':
-        add('type="capsule" size="0.06" fromto="0 0 0.04 0 0 0.14"')  # waist
-    elif link == 'head':
-        lines.append(f'{indent}<geom class="visual" material="dark" type="box" '
-                     'size="0.02 0.055 0.035" pos="0.01 0 0.0"/>')
-    elif link.endswith('uleg'):
-        add('type="capsule" size="0.065" fromto="0 0 -0.06 -0.05 0 -0.374"')
-    elif link.endswith('lleg'):
-        add('type="capsule" size="0.05" fromto="0 0 0 0 0 -0.40"')
-    elif link.endswith('uarm'):
-        add(f'type="capsule" size="0.042" fromto="0 0 0 0 {sign * 0.121:.3f} 0.013"')
-    elif link.endswith('hand'):
-        add(f'type="box" size="0.035 0.05 0.015" pos="0 {sign * 0.12:.3f} 0"')
-    elif link.endswith('foot'):
-        add('type="box" size="0.1 0.05 0.03" pos="0.04 0 -0.045"')
-    return lines
+        return [VisualShape('box', mat, '0.09 0.13 0.06', pos='0.0 0 0.02')]
+    if link == 'utorso':
+        return [VisualShape('box', mat, '0.13 0.17 0.14', pos='0.02 0 0.22'),
+                VisualShape('capsule', mat, '0.05', fromto='0.02 -0.12 0.32 0.02 0.12 0.32'),
+                VisualShape('capsule', mat, '0.035', fromto='0.07 0 0.34 0.15 0 0.49')]  # neck
+    if link == 'ltorso':
+        return [VisualShape('capsule', mat, '0.06', fromto='0 0 0.04 0 0 0.14')]  # waist
+    if link == 'head':
+        return [VisualShape('box', 'dark', '0.02 0.055 0.035', pos='0.01 0 0.0')]
+    if link.endswith('uleg'):
+        return [VisualShape('capsule', mat, '0.065', fromto='0 0 -0.06 -0.05 0 -0.374')]
+    if link.endswith('lleg'):
+        return [VisualShape('capsule', mat, '0.05', fromto='0 0 0 0 0 -0.40')]
+    if link.endswith('uarm'):
+        return [VisualShape('capsule', mat, '0.042', fromto=f'0 0 0 0 {sign * 0.121:.3f} 0.013')]
+    if link.endswith('hand'):
+        return [VisualShape('box', mat, '0.035 0.05 0.015', pos=f'0 {sign * 0.12:.3f} 0')]
+    if link.endswith('foot'):
+        return [VisualShape('box', mat, '0.1 0.05 0.03', pos='0.04 0 -0.045')]
+    return []
+
+
+def visual_geoms(link: str, indent: str) -> list[str]:
+    """MJCF <geom> lines of the link's visual shapes."""
+    return [f'{indent}<geom class="visual" material="{shape.material}" {shape.mjcf_attributes()}/>'
+            for shape in visual_shapes(link)]
 
 
 def body_xml(name: str, joint_name: str | None, depth: int) -> list[str]:
@@ -367,6 +395,8 @@ def build() -> str:
     """Return the complete MJCF text."""
     body_lines = body_xml(ROOT_LINK, None, 2)
     actuator_lines = [f'    <motor name="{n}" joint="{n}" gear="1"/>' for n in JOINT_NAMES]
+    material_lines = [f'    <material name="{name}" rgba="{fmt(rgba)}" specular="{specular}"/>'
+                      for name, (rgba, specular) in MATERIALS.items()]
     return f'''<!--
   Atlas v1 (DRCSim 2.5.2) for MuJoCo. GENERATED by tools/make_atlas_mjcf.py from
   its table of figures; edit the table, then run:  python3 tools/make_atlas_mjcf.py
@@ -417,10 +447,7 @@ def build() -> str:
     <texture name="checker" type="2d" builtin="checker" rgb1="0.32 0.34 0.36" rgb2="0.22 0.24 0.26"
              width="512" height="512" mark="edge" markrgb="0.5 0.5 0.5"/>
     <material name="floor" texture="checker" texrepeat="1 1" texuniform="true" reflectance="0.1"/>
-    <material name="grey" rgba="0.45 0.46 0.48 1" specular="0.3"/>
-    <material name="dark" rgba="0.18 0.18 0.2 1" specular="0.2"/>
-    <material name="blue" rgba="0.2 0.3 0.55 1" specular="0.3"/>
-    <material name="orange" rgba="0.91 0.44 0.03 1" specular="0.3"/>
+{chr(10).join(material_lines)}
   </asset>
 
   <default>
@@ -489,12 +516,133 @@ def build() -> str:
 '''
 
 
+# ---------------------------------------------------------------------------
+# URDF: the same links, joints, inertias and shapes, for robot_state_publisher and rviz.
+# ---------------------------------------------------------------------------
+
+
+def _floats(text: str) -> np.ndarray:
+    return np.array([float(v) for v in text.split()])
+
+
+def _z_to_direction_rpy(direction: np.ndarray) -> tuple[float, float, float]:
+    """URDF rpy turning a shape's local z axis (cylinders) onto `direction`."""
+    dx, dy, dz = direction / np.linalg.norm(direction)
+    return 0.0, float(np.arctan2(np.hypot(dx, dy), dz)), float(np.arctan2(dy, dx))
+
+
+def _urdf_visual(geometry: str, xyz, rpy, material: str) -> list[str]:
+    return ['    <visual>',
+            f'      <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>',
+            f'      <geometry>{geometry}</geometry>',
+            f'      <material name="{material}"/>',
+            '    </visual>']
+
+
+def _urdf_shape_visuals(shape: VisualShape) -> list[str]:
+    """A visual shape as URDF visuals; a capsule (no URDF primitive) is a cylinder and two spheres."""
+    if shape.kind == 'box':
+        size = fmt(2 * _floats(shape.size))
+        return _urdf_visual(f'<box size="{size}"/>', _floats(shape.pos), (0, 0, 0), shape.material)
+    radius = float(shape.size)
+    ends = _floats(shape.fromto).reshape(2, 3)
+    axis = ends[1] - ends[0]
+    length = np.round(np.linalg.norm(axis), 9)
+    lines = _urdf_visual(f'<cylinder radius="{fmt([radius])}" length="{fmt([length])}"/>',
+                         np.round(ends.mean(axis=0), 9), np.round(_z_to_direction_rpy(axis), 9),
+                         shape.material)
+    for end in ends:
+        lines += _urdf_visual(f'<sphere radius="{fmt([radius])}"/>', end, (0, 0, 0), shape.material)
+    return lines
+
+
+def _urdf_collision_geometry(kind: str, size: tuple) -> str:
+    if kind == 'box':
+        return f'<box size="{fmt(size)}"/>'
+    return f'<cylinder radius="{fmt(size[:1])}" length="{fmt(size[1:])}"/>'
+
+
+def link_urdf(name: str) -> list[str]:
+    """One <link>: inertial (as the MJCF's, corrected where the reference is not physical),
+    the collision shapes drawn and colliding, and the visual-only shapes drawn."""
+    link = LINKS[name]
+    inertia, changed = corrected_inertia(link.inertia)
+    ixx, iyy, izz, ixy, ixz, iyz = inertia
+    lines = [f'  <link name="{name}">', '    <inertial>']
+    if changed:
+        lines.append(f'      <!-- reference inertia {fmt(link.inertia)} is not physical (A + B < C); '
+                     'largest principal moment lowered to A + B, as in the MJCF -->')
+    lines += [f'      <origin xyz="{fmt(link.com_m)}" rpy="0 0 0"/>',
+              f'      <mass value="{link.mass_kg!r}"/>',
+              f'      <inertia ixx="{ixx!r}" ixy="{ixy!r}" ixz="{ixz!r}" iyy="{iyy!r}" iyz="{iyz!r}" '
+              f'izz="{izz!r}"/>',
+              '    </inertial>']
+    for kind, size, pos, rpy in COLLISION_SHAPES.get(name, []):
+        lines += _urdf_visual(_urdf_collision_geometry(kind, size), pos, rpy, LINK_MATERIAL[name])
+    for shape in visual_shapes(name):
+        lines += _urdf_shape_visuals(shape)
+    for kind, size, pos, rpy in COLLISION_SHAPES.get(name, []):
+        lines += ['    <collision>',
+                  f'      <origin xyz="{fmt(pos)}" rpy="{fmt(rpy)}"/>',
+                  f'      <geometry>{_urdf_collision_geometry(kind, size)}</geometry>',
+                  '    </collision>']
+    lines.append('  </link>')
+    return lines
+
+
+def joint_urdf(name: str) -> list[str]:
+    joint = JOINTS[name]
+    return [f'  <joint name="{name}" type="revolute">',
+            f'    <parent link="{joint.parent}"/>',
+            f'    <child link="{joint.child}"/>',
+            f'    <origin xyz="{fmt(joint.origin_m)}" rpy="0 0 0"/>',
+            f'    <axis xyz="{fmt(joint.axis)}"/>',
+            f'    <limit lower="{joint.lower_rad!r}" upper="{joint.upper_rad!r}" '
+            f'effort="{joint.effort_nm!r}" velocity="{joint.velocity_rad_s!r}"/>',
+            f'    <dynamics damping="{joint.damping_nms!r}"/>',
+            '  </joint>']
+
+
+def _tree_order(link: str) -> list[tuple[str, str | None]]:
+    """(link, joint into it) depth first, the order of the MJCF's nested bodies."""
+    order: list[tuple[str, str | None]] = [(link, None)] if link == ROOT_LINK else []
+    for joint_name, joint in children_of(link):
+        order.append((joint.child, joint_name))
+        order.extend(_tree_order(joint.child))
+    return order
+
+
+def build_urdf() -> str:
+    """Return the URDF text: the MJCF's robot, for robot_state_publisher and rviz."""
+    lines = ['<?xml version="1.0"?>',
+             '<!--',
+             '  Atlas v1 (DRCSim 2.5.2) as URDF. GENERATED by tools/make_atlas_mjcf.py from the same',
+             '  table as sim/atlas_v1.xml (links, joints, limits, masses, inertias, shapes, colours);',
+             '  edit the table, then run:  python3 tools/make_atlas_mjcf.py',
+             '  The root link is pelvis; the simulator broadcasts world -> pelvis on /tf.',
+             '  Capsules (no URDF primitive) are drawn as a cylinder with a sphere at each end.',
+             '-->',
+             '<robot name="atlas">']
+    for name, (rgba, _specular) in MATERIALS.items():
+        lines.append(f'  <material name="{name}"><color rgba="{fmt(rgba)}"/></material>')
+    for link, joint_name in _tree_order(ROOT_LINK):
+        if joint_name is not None:
+            lines += joint_urdf(joint_name)
+        lines += link_urdf(link)
+    lines.append('</robot>')
+    return '\n'.join(lines) + '\n'
+
+
 def main() -> int:
-    """Write the MJCF file; argv[1] overrides the output path."""
+    """Write the MJCF file and the URDF beside it; argv[1] overrides the MJCF path
+    (the URDF gets the same name with the suffix .urdf)."""
     output = Path(sys.argv[1]) if len(sys.argv) > 1 else DEFAULT_OUTPUT
     output.parent.mkdir(parents=True, exist_ok=True)
     output.write_text(build())
     print(f'wrote {output}')
+    urdf_output = output.with_suffix('.urdf')
+    urdf_output.write_text(build_urdf())
+    print(f'wrote {urdf_output}')
     return 0
 
 

@@ -21,6 +21,7 @@ APT_PACKAGES=(
   python3-rosgraph-msgs libstd-msgs-dev libroscpp-dev libsensor-msgs-dev
   librostest-dev librosbag-storage-dev libtopic-tools-dev python3-venv python3-yaml python3-numpy
   libosmesa6 libegl1 libopengl0 libgl1-mesa-dri
+  ros-robot-state-publisher ros-tf2-msgs python3-tf2-msgs python3-tf2-ros rviz
   xvfb xdotool x11-apps imagemagick
 )
 
@@ -66,7 +67,7 @@ build_workspace() {
   ln -sfn "$repo_dir/msg/atlas_msgs" "$TAC_WS/src/atlas_msgs"
   local stamp="$TAC_WS/.build-inputs.sha1" want
   want=$( (cd "$repo_dir" && cat CMakeLists.txt package.xml setup.py msg/*/CMakeLists.txt \
-            msg/*/package.xml msg/*/msg/*.msg src/*.cpp test/rostest/*.cpp; ls scripts sim test/rostest 2>/dev/null) | sha1sum | cut -d' ' -f1)
+            msg/*/package.xml msg/*/msg/*.msg src/*.cpp test/rostest/*.cpp; ls scripts sim rviz test/rostest 2>/dev/null) | sha1sum | cut -d' ' -f1)
   if [ -f "$TAC_WS/devel/setup.bash" ] && [ "$(cat "$stamp" 2>/dev/null)" = "$want" ]; then
     log "catkin workspace up to date ($TAC_WS)"; return
   fi

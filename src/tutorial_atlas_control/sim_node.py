@@ -13,6 +13,9 @@ Parameters (private unless noted):
         (Backspace) and Shift+Ctrl+R do reset_world, Space pauses/unpauses (viewer.py).
     ~joint_states_rate, ~imu_rate, ~contact_rate (Hz, 1000): 0 or >= 1000 = every step.
     ~odom_rate (Hz, 100): /ground_truth_odom rate, as DRCSim.
+    ~tf (bool, true): broadcast world -> pelvis on /tf from the ground truth, if the model
+        has a matching URDF (urdf.matching_urdf); else one warning and no /tf.
+    ~tf_rate (Hz, 100): /tf rate.
     ~model_file (str, the package's sim/atlas_v1.xml): the MJCF to simulate; it must have
         Atlas v1's joints, actuators and sensors (a variant of the package's model).
     /atlas/time_to_unpin (float, 1.0): seconds the torso stays pinned after start/reset.
@@ -42,6 +45,7 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import String
 from std_srvs.srv import Empty, EmptyResponse
+from tf2_msgs.msg import TFMessage
 
 from tutorial_atlas_control import model as atlas_model
 from tutorial_atlas_control import topics
@@ -50,13 +54,16 @@ from tutorial_atlas_control.controller import gains_from_params
 from tutorial_atlas_control.controller_statistics import (
     DEFAULT_WINDOW_S, UPDATE_RATE_PARAM, WINDOW_PARAM, CommandAgeStatistics)
 from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.render import configure_viewer_camera, configure_viewer_scene
 from tutorial_atlas_control.ros1_fields import FieldCursor
 from tutorial_atlas_control.sim_messages import SimMessages
 from tutorial_atlas_control.simulator import (
     DEFAULT_TIME_TO_UNPIN_S, AtlasSimulator, ModeError, PhysicsDivergenceError, parse_mode)
 from tutorial_atlas_control.units import NS_PER_S, finite_number
+from tutorial_atlas_control.urdf import UrdfError, matching_urdf
 from tutorial_atlas_control.viewer import ViewerLink, ViewerRequest
-from tutorial_atlas_control.wire import ControllerStatisticsWire, WireBatch, clock_bytes
+from tutorial_atlas_control.wire import (
+    ControllerStatisticsWire, TransformWire, WireBatch, clock_bytes)
 
 NODE_NAME = 'atlas_sim'
 #: Seconds between repeats of the same refusal warning.
@@ -71,8 +78,12 @@ DIVERGENCE_REPEAT_S = 1.0
 MAX_DIVERGENCES_IN_A_ROW = 3
 #: Commands waiting for the next step, at most (a second of 10 kHz of them).
 MAX_PENDING_COMMANDS = 10_000
-#: Viewer refresh period (s, wall).
-VIEWER_PERIOD_S = 1.0 / 60.0
+#: The viewer draws at most one frame per VIEWER_FRAME_PERIOD_S (s, wall): left alone, its
+#: render thread draws as fast as it can, and with software OpenGL (no GPU, Xvfb) that took
+#: the CPU the simulation needs. The pause is VIEWER_HOLD_S of it; the rest is its turn.
+VIEWER_FRAME_PERIOD_S = 1.0 / 30.0
+VIEWER_TURN_S = 0.005
+VIEWER_HOLD_S = VIEWER_FRAME_PERIOD_S - VIEWER_TURN_S
 #: At real_time_factor 0 the loop sends what it published at most this often (s, wall);
 #: paced runs send after every step while on schedule.
 FLUSH_PERIOD_S = 0.001
@@ -117,7 +128,7 @@ class SimNode:
     """Owns the simulator, its lock, the publishers and the stepping loop."""
 
     def __init__(self, sim: AtlasSimulator, real_time_factor: float, paused: bool,
-                 rates_hz: dict[str, float], gui: bool) -> None:
+                 rates_hz: dict[str, float], gui: bool, tf: bool = False) -> None:
         self.sim = sim
         self.lock = threading.Lock()
         self.real_time_factor = real_time_factor
@@ -130,13 +141,14 @@ class SimNode:
         self._divergences_in_a_row = 0
         self._last_divergence_ns: int | None = None
 
-        self._advertise()
+        self._advertise(tf)
         self.batch = WireBatch()
         self._publish_config()
 
         # What each message holds is sim_messages' (shared with offline runs).
         self.messages = SimMessages(sim)
         self.contacts = (('l', self.l_contact_pub), ('r', self.r_contact_pub))
+        self.pelvis_tf = TransformWire(topics.WORLD_FRAME, topics.PELVIS_FRAME)
         self._init_controller_statistics()
 
         # Commands wait here, undecoded, for the loop (see on_joint_commands). Bounded, so
@@ -146,7 +158,7 @@ class SimNode:
             maxlen=MAX_PENDING_COMMANDS)
         self._subscribe()
 
-    def _advertise(self) -> None:
+    def _advertise(self, tf: bool) -> None:
         """The publishers; the loop serializes their messages itself (wire.py).
 
         queue_size=None: plain synchronous connections, without rospy's per-message
@@ -165,6 +177,8 @@ class SimNode:
                                                  queue_size=None)
             self.r_contact_pub = rospy.Publisher(topics.R_FOOT_CONTACT, WrenchStamped,
                                                  queue_size=None)
+            # world -> pelvis; robot_state_publisher adds the links from the joint states.
+            self.tf_pub = rospy.Publisher(topics.TF, TFMessage, queue_size=None) if tf else None
         # Latched, recorded in every bag: what offline replay needs to re-create the run.
         self.config_pub = rospy.Publisher(topics.SIM_CONFIG, String, queue_size=1, latch=True)
 
@@ -288,6 +302,8 @@ class SimNode:
         sensed_ns = sim.state_time_ns
         if count % self.every['odom'] == 0 and wanted(self.odom_pub):
             batch.add(self.odom_pub, messages.odometry(sensed_ns))
+        if self.tf_pub is not None and count % self.every['tf'] == 0 and wanted(self.tf_pub):
+            self._publish_tf(sensed_ns)
         if count % self.every['imu'] == 0 and wanted(self.imu_pub):
             batch.add(self.imu_pub, messages.imu(sensed_ns))
         if count % self.every['contact'] == 0:
@@ -323,11 +339,19 @@ class SimNode:
                                              stats.window_s)
             self.batch.add(self.statistics_pub, self.statistics_msg.to_bytes(now_ns))
 
+    def _publish_tf(self, stamp_ns: int) -> None:
+        """world -> pelvis from the ground truth, the pose /ground_truth_odom has at this stamp."""
+        sim = self.sim
+        body = sim.atlas.pelvis_body_id
+        self.pelvis_tf.translation[:] = sim.data.xpos[body]
+        w, x, y, z = sim.data.xquat[body]
+        self.pelvis_tf.rotation_xyzw[:] = (x, y, z, w)
+        self.batch.add(self.tf_pub, self.pelvis_tf.to_bytes(stamp_ns))
+
     # -- the loop ------------------------------------------------------------------------
     def spin(self) -> None:
         """Step, publish and pace against wall time until ROS shuts down."""
         viewer = self._open_viewer() if self.gui else None
-        next_view_s = 0.0
         wall0 = time.perf_counter()
         sim0_ns = self.sim.sim_time_ns
         with self.lock:
@@ -339,10 +363,6 @@ class SimNode:
                 with self.lock:
                     self._apply_pending_commands()
                 self.batch.flush()
-                if viewer is not None and time.perf_counter() >= next_view_s:
-                    if not self._update_viewer(viewer):
-                        break
-                    next_view_s = time.perf_counter() + VIEWER_PERIOD_S
                 time.sleep(0.01)
                 wall0, sim0_ns = time.perf_counter(), self.sim.sim_time_ns
                 continue
@@ -373,10 +393,6 @@ class SimNode:
             if flush:
                 self.batch.flush()
                 last_flush_s = now_s
-            if viewer is not None and time.perf_counter() >= next_view_s:
-                if not self._update_viewer(viewer):
-                    break
-                next_view_s = time.perf_counter() + VIEWER_PERIOD_S
             if self.real_time_factor > 0.0:
                 due_s = wall0 + (sim_ns - sim0_ns) / NS_PER_S / self.real_time_factor
                 ahead_s = due_s - time.perf_counter()
@@ -409,11 +425,28 @@ class SimNode:
         return True
 
     def _open_viewer(self) -> ViewerLink | None:
+        """The viewer window, framing the whole robot and following the pelvis, kept up to
+        date by a thread of its own (_viewer_loop)."""
         try:
-            return ViewerLink(self.sim.model)
+            link = ViewerLink(self.sim.model)
         except Exception as err:  # noqa: BLE001 - no display, no GL: run headless
             rospy.logwarn(f'cannot open the MuJoCo viewer ({err}); running headless')
             return None
+        with self.lock:
+            link.copy_in(self.sim.data)
+        with link.handle.lock():
+            configure_viewer_camera(link.handle.cam, self.sim.model, link.shadow)
+            configure_viewer_scene(link.handle.user_scn)
+        threading.Thread(target=self._viewer_loop, args=(link,), name='viewer',
+                         daemon=True).start()
+        return link
+
+    def _viewer_loop(self, viewer: ViewerLink) -> None:
+        """Refresh the window and pace its drawing, outside the stepping loop."""
+        while not rospy.is_shutdown() and self._update_viewer(viewer):
+            with viewer.handle.lock():  # its render thread waits at the top of its next frame
+                time.sleep(VIEWER_HOLD_S)
+            time.sleep(VIEWER_TURN_S)
 
     def _update_viewer(self, viewer: ViewerLink) -> bool:
         """Refresh the window and carry out what was asked in it; False once it is closed.
@@ -459,6 +492,7 @@ def build_node() -> SimNode:
         'odom': _float_param('~odom_rate', 100.0),
         'imu': _float_param('~imu_rate', 1000.0),
         'contact': _float_param('~contact_rate', 1000.0),
+        'tf': _float_param('~tf_rate', 100.0),
     }
     model_file = rospy.get_param('~model_file', str(atlas_model.MODEL_PATH))
     if not isinstance(model_file, str) or not model_file:
@@ -467,7 +501,20 @@ def build_node() -> SimNode:
     sim = AtlasSimulator(atlas_model.load_model(Path(model_file)), gains, time_to_unpin_s)
     return SimNode(sim, _float_param('~real_time_factor', 1.0),
                    bool(rospy.get_param('~paused', False)), rates_hz,
-                   bool(rospy.get_param('~gui', False)))
+                   bool(rospy.get_param('~gui', False)), _tf_wanted(Path(model_file), sim))
+
+
+def _tf_wanted(model_file: Path, sim: AtlasSimulator) -> bool:
+    """~tf, unless the model has no matching URDF: then one warning saying why."""
+    if not rospy.get_param('~tf', True):
+        return False
+    try:
+        matching_urdf(model_file, sim.model)
+    except UrdfError as err:
+        rospy.logwarn(f'TF is off: {err}; rviz cannot show this model '
+                      '(write a matching URDF beside it to get TF)')
+        return False
+    return True
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -18,12 +18,16 @@ CONTROLLER_STATISTICS = '/atlas/controller_statistics'
 #: Latched JSON (timestep, time_to_unpin, model file and sha1, last reset): what replay needs.
 SIM_CONFIG = '/atlas/sim_config'
 ROSOUT = '/rosout'
+#: world -> pelvis from the simulator; robot_state_publisher adds the links.
+TF = '/tf'
+#: The URDF of the simulated model (set by atlas.launch's state_publisher.py).
+ROBOT_DESCRIPTION_PARAM = '/robot_description'
 
 #: What scripts/record_run.sh records: the simulator's output, the commands and modes that
 #: drove it, the config replay needs, and the log. Analysis and replay read these.
 RECORDED_TOPICS: tuple[str, ...] = (
     CLOCK, JOINT_STATES, GROUND_TRUTH_ODOM, IMU, L_FOOT_CONTACT, R_FOOT_CONTACT,
-    JOINT_COMMANDS, CONTROL_MODE, SIM_CONFIG, ROSOUT, CONTROLLER_STATISTICS,
+    JOINT_COMMANDS, CONTROL_MODE, SIM_CONFIG, ROSOUT, CONTROLLER_STATISTICS, TF,
 )
 
 #: Gazebo's services, as gazebo_ros offered them.

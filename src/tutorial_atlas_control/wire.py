@@ -128,6 +128,32 @@ class JointCommandsWire(StampedWire):
             for k, field in enumerate(self.FIELDS)}
 
 
+class TransformWire:
+    """tf2_msgs/TFMessage holding one geometry_msgs/TransformStamped (parent -> child);
+    translation and rotation (x y z w) are views.
+
+    TFMessage starts with the array length, not a Header, so it has its own layout.
+    """
+
+    def __init__(self, frame_id: str, child_frame_id: str) -> None:
+        names = _string(frame_id) + _string(child_frame_id)
+        self.buf = bytearray(8 + 12 + len(names) + 8 * 7)
+        struct.pack_into('<I', self.buf, 4, 1)  # one transform
+        self.buf[20:20 + len(names)] = names
+        floats = np.frombuffer(self.buf, dtype='<f8', offset=20 + len(names), count=7)
+        self.translation = floats[0:3]
+        self.rotation_xyzw = floats[3:7]
+        self.rotation_xyzw[3] = 1.0
+        self.seq = 0
+
+    def to_bytes(self, stamp_ns: int) -> bytes:
+        self.seq += 1
+        secs, nsecs = divmod(stamp_ns, NS_PER_S)
+        struct.pack_into('<I', self.buf, 0, len(self.buf) - 4)
+        struct.pack_into('<III', self.buf, 8, self.seq, secs, nsecs)
+        return bytes(self.buf)
+
+
 def clock_bytes(stamp_ns: int) -> bytes:
     """rosgraph_msgs/Clock with its TCPROS length prefix."""
     secs, nsecs = divmod(stamp_ns, NS_PER_S)

@@ -29,6 +29,7 @@ RECORDED_TYPES = {
     '/atlas/sim_config': 'std_msgs/msg/String',
     '/rosout': 'rosgraph_msgs/msg/Log',
     '/atlas/controller_statistics': 'atlas_msgs/msg/ControllerStatistics',
+    '/tf': 'tf2_msgs/msg/TFMessage',
 }
 CONTROLLER_STATISTICS_MD5 = '628a0c6643f9fd5708402f085735e478'
 

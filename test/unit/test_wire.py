@@ -10,6 +10,8 @@ from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from rospy.msg import serialize_message
 from sensor_msgs.msg import Imu, JointState
+from geometry_msgs.msg import TransformStamped
+from tf2_msgs.msg import TFMessage
 
 from tutorial_atlas_control import wire
 from tutorial_atlas_control.joints import JOINT_NAMES
@@ -150,3 +152,21 @@ def test_controller_statistics():
                                     command_age_variance=33.28e-6, command_age_window_size=1.0)
     expected.header.stamp = genpy.Time(12, 345_678)
     assert msg.to_bytes(STAMP_NS) == genpy_bytes(expected)
+
+
+def test_transform():
+    msg = wire.TransformWire('world', 'pelvis')
+    msg.translation[:] = (0.1, -0.2, 0.92)
+    msg.rotation_xyzw[:] = (0.0, 0.1, 0.0, 0.995)
+    expected = TransformStamped()
+    expected.header.frame_id = 'world'
+    expected.header.stamp = genpy.Time(12, 345_678)
+    expected.header.seq = 1
+    expected.child_frame_id = 'pelvis'
+    t, r = expected.transform.translation, expected.transform.rotation
+    t.x, t.y, t.z = 0.1, -0.2, 0.92
+    r.x, r.y, r.z, r.w = 0.0, 0.1, 0.0, 0.995
+    # TFMessage has no header of its own: the transform's seq is set by the writer.
+    assert msg.to_bytes(STAMP_NS) == genpy_bytes(TFMessage(transforms=[expected]))
+    expected.header.seq = 2
+    assert msg.to_bytes(STAMP_NS) == genpy_bytes(TFMessage(transforms=[expected]))

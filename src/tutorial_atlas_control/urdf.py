@@ -1,0 +1,126 @@
+"""The URDF that goes with a MuJoCo model, for robot_state_publisher and rviz.
+
+tools/make_atlas_mjcf.py writes sim/atlas_v1.urdf beside sim/atlas_v1.xml from one table.
+A model variant (launch argument model:=...) has a URDF only if someone wrote one beside
+it with the same name; when it is missing or describes other kinematics, TF would draw a
+robot that is not the one simulated, so the simulator turns TF off and says why.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from tutorial_atlas_control.errors import AtlasControlError
+
+__all__ = ['UrdfError', 'UrdfJoint', 'matching_urdf', 'read_joints', 'urdf_path_for']
+
+#: Joint origins and axes of the URDF and the MJCF agree to this (m, unit vector).
+KINEMATICS_TOLERANCE = 1e-6
+
+
+class UrdfError(AtlasControlError):
+    """There is no URDF that describes the simulated model; the message says why."""
+
+
+@dataclass(frozen=True)
+class UrdfJoint:
+    """One URDF joint, as robot_state_publisher reads it."""
+
+    name: str
+    kind: str
+    parent: str
+    child: str
+    origin_m: np.ndarray
+    rpy_rad: np.ndarray
+    axis: np.ndarray
+    lower_rad: float
+    upper_rad: float
+
+
+def urdf_path_for(model_path: Path | str) -> Path:
+    """Where a model's URDF must be: beside it, same name, suffix .urdf."""
+    return Path(model_path).with_suffix('.urdf')
+
+
+def _vector(element: ET.Element | None, attribute: str, default: str) -> np.ndarray:
+    text = default if element is None else element.get(attribute, default)
+    return np.array([float(value) for value in text.split()])
+
+
+def read_joints(text: str, source: str = 'URDF') -> tuple[list[str], list[UrdfJoint]]:
+    """(link names, joints) of a URDF text, in file order.
+
+    Raises:
+        UrdfError: the text is not a URDF robot.
+    """
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as err:
+        raise UrdfError(f'{source} is not valid XML: {err}') from err
+    if root.tag != 'robot':
+        raise UrdfError(f'{source} is not a URDF: its root element is <{root.tag}>, not <robot>')
+    links = [link.get('name', '') for link in root.findall('link')]
+    joints = []
+    try:
+        for joint in root.findall('joint'):
+            origin, limit = joint.find('origin'), joint.find('limit')
+            joints.append(UrdfJoint(
+                name=joint.get('name', ''), kind=joint.get('type', ''),
+                parent=joint.find('parent').get('link', ''),
+                child=joint.find('child').get('link', ''),
+                origin_m=_vector(origin, 'xyz', '0 0 0'), rpy_rad=_vector(origin, 'rpy', '0 0 0'),
+                axis=_vector(joint.find('axis'), 'xyz', '1 0 0'),
+                lower_rad=float(limit.get('lower', 0.0)) if limit is not None else 0.0,
+                upper_rad=float(limit.get('upper', 0.0)) if limit is not None else 0.0))
+    except (AttributeError, ValueError) as err:
+        raise UrdfError(f'{source}: a <joint> lacks its parent, child or a number ({err})') from err
+    return links, joints
+
+
+def matching_urdf(model_path: Path | str, model: mujoco.MjModel) -> tuple[Path, str]:
+    """The URDF beside `model_path` and its text, if it describes `model`'s kinematics.
+
+    Every hinge joint of the model must be a URDF revolute joint of the same name between
+    the same two links, with the same origin and axis; the URDF's links are the model's
+    bodies.
+
+    Raises:
+        UrdfError: no such file, or it describes a different robot (the message says what).
+    """
+    path = urdf_path_for(model_path)
+    if not path.is_file():
+        raise UrdfError(f'the model {model_path} has no URDF beside it ({path} does not exist)')
+    text = path.read_text()
+    links, joints = read_joints(text, str(path))
+    by_name = {joint.name: joint for joint in joints}
+    bodies = {mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) for b in range(1, model.nbody)}
+    if set(links) != bodies:
+        differ = sorted(set(links) ^ bodies)
+        raise UrdfError(f'{path} does not match the model {model_path}: links and bodies differ '
+                        f'({", ".join(differ[:5])})')
+    for joint_id in range(model.njnt):
+        if model.jnt_type[joint_id] != mujoco.mjtJoint.mjJNT_HINGE:
+            continue
+        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, joint_id)
+        joint = by_name.get(name)
+        body = int(model.jnt_bodyid[joint_id])
+        child = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, body)
+        parent = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, int(model.body_parentid[body]))
+        if joint is None or joint.kind not in ('revolute', 'continuous'):
+            raise UrdfError(f'{path} does not match the model {model_path}: no revolute joint '
+                            f'{name!r}')
+        quat = np.zeros(4)
+        mujoco.mju_euler2Quat(quat, joint.rpy_rad, 'XYZ')
+        axis = joint.axis / np.linalg.norm(joint.axis)
+        if ((joint.parent, joint.child) != (parent, child)
+                or not np.allclose(joint.origin_m, model.body_pos[body], atol=KINEMATICS_TOLERANCE)
+                or not np.allclose(np.abs(quat @ model.body_quat[body]), 1.0, atol=KINEMATICS_TOLERANCE)
+                or not np.allclose(axis, model.jnt_axis[joint_id], atol=KINEMATICS_TOLERANCE)):
+            raise UrdfError(f'{path} does not match the model {model_path}: joint {name!r} '
+                            'connects other links or has another origin or axis')
+    return path, text

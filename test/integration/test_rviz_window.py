@@ -1,0 +1,144 @@
+"""rviz.launch beside atlas.launch, under a real X server (Xvfb) with software OpenGL: the
+robot model is drawn in the 3D view, and rviz reports no missing frame or robot_description.
+Also the bad inputs of issue 15: rviz without a display, and a model variant without a URDF.
+
+Robot pixels are found from the model's material colours (xdisplay.material_mask) inside
+rviz's 3D view (the area of its background colour); rviz draws the URDF's colours, which
+are the MJCF's.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
+
+import rosgraph  # noqa: E402
+
+from tutorial_atlas_control import model as atlas_model  # noqa: E402
+from tutorial_atlas_control.demo import free_local_port  # noqa: E402
+
+from test_viewer_window import CHROMA_TOLERANCE, MIN_BRIGHTNESS  # noqa: E402
+from xdisplay import (  # noqa: E402
+    find_window, launch_env, material_mask, screenshot, stop_launch, wait_sim_time, xvfb)
+
+#: rviz/atlas.rviz's background colour: the 3D view is where it shows.
+BACKGROUND_RGB = (48, 48, 48)
+#: The 3D view's rows and columns hold more background pixels than this.
+MIN_VIEW_SIDE_PX = 100
+#: Robot-coloured pixels in the 3D view at least. Measured on the 1280 x 800 screen: the head
+#: about 1000 orange pixels, the legs and arms about 12000 blue; with tf:=false (no
+#: robot_description, no TF) none of either. A quarter of the measured figures: a robot drawn
+#: at half the size still passes, an empty view never does.
+MIN_HEAD_PIXELS = 250
+MIN_LEG_PIXELS = 3000
+#: rviz has drawn its first frames of the robot after this long (s, wall; software GL).
+RVIZ_SETTLE_S = 20.0
+#: rviz messages that would mean it cannot place or build the robot.
+BAD_MESSAGES = ('robot_description', 'does not exist', 'No transform', 'Could not transform',
+                'Fixed Frame', 'URDF')
+
+
+def robot_pixels(image: np.ndarray) -> tuple[int, int]:
+    """(orange, blue) pixels inside the 3D view."""
+    background = np.all(image == BACKGROUND_RGB, axis=2)
+    # Rows and columns mostly of background: the view, not the colour swatch in the panel.
+    rows = np.nonzero(background.sum(axis=1) > MIN_VIEW_SIDE_PX)[0]
+    cols = np.nonzero(background.sum(axis=0) > MIN_VIEW_SIDE_PX)[0]
+    assert len(rows) and len(cols), 'no rviz 3D view (background colour) on screen'
+    view = image[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1]
+    m = atlas_model.load_model().model
+    return tuple(int(material_mask(view, m.material(name).rgba, CHROMA_TOLERANCE,
+                                   MIN_BRIGHTNESS).sum()) for name in ('orange', 'blue'))
+
+
+@pytest.mark.parametrize('tf', [True, False], ids=['tf', 'no_tf'])
+def test_rviz_shows_the_robot(tmp_path: Path, tf: bool) -> None:
+    """With atlas.launch's TF, the robot in the 3D view; with tf:=false (no robot_description,
+    no TF: the check's bad frame), none of its colours."""
+    with xvfb() as display:
+        port = free_local_port()
+        env = launch_env(display, tmp_path, port)
+        atlas_log = open(tmp_path / 'atlas.log', 'w')  # noqa: SIM115 - closed below
+        rviz_log = open(tmp_path / 'rviz.log', 'w')  # noqa: SIM115 - closed below
+        atlas = subprocess.Popen(
+            ['roslaunch', '-p', str(port), 'tutorial_atlas_control', 'atlas.launch', 'gui:=false',
+             'record:=false', f'tf:={str(tf).lower()}'], env=env, stdout=atlas_log,
+            stderr=subprocess.STDOUT, start_new_session=True)
+        rviz = None
+        try:
+            wait_sim_time(env, 1.0)
+            rviz = subprocess.Popen(['roslaunch', 'tutorial_atlas_control', 'rviz.launch'], env=env,
+                                    stdout=rviz_log, stderr=subprocess.STDOUT,
+                                    start_new_session=True)
+            find_window(display, 'RViz')
+            time.sleep(RVIZ_SETTLE_S)
+            image = screenshot(display, 'root', tmp_path / 'rviz.png')
+        finally:
+            if rviz is not None:
+                stop_launch(rviz)
+            stop_launch(atlas)
+            atlas_log.close()
+            rviz_log.close()
+    head, legs = robot_pixels(image)
+    output = (tmp_path / 'rviz.log').read_text(errors='replace')
+    print(f'rviz (tf:={tf}): {head} orange and {legs} blue pixels in the 3D view; '
+          f'screenshot {tmp_path / "rviz.png"}')
+    if not tf:
+        assert head < MIN_HEAD_PIXELS and legs < MIN_LEG_PIXELS
+        return
+    assert head >= MIN_HEAD_PIXELS
+    assert legs >= MIN_LEG_PIXELS
+    bad = [line for line in output.splitlines()
+           if any(text in line for text in BAD_MESSAGES) and ('ERROR' in line or 'WARN' in line)]
+    assert bad == []
+
+
+def test_rviz_without_a_display_says_so_in_one_line(tmp_path: Path) -> None:
+    env = dict(os.environ, ROS_LOG_DIR=str(tmp_path / 'ros_log'),
+               ROS_MASTER_URI=f'http://localhost:{free_local_port()}')
+    env.pop('DISPLAY', None)
+    result = subprocess.run(['roslaunch', 'tutorial_atlas_control', 'rviz.launch'], env=env,
+                            capture_output=True, text=True, timeout=120, check=False)
+    assert result.returncode == 1
+    errors = [line for line in result.stderr.splitlines() if line.strip()]
+    # roslaunch's own fixed second line follows ours: "The traceback ... written to the log file".
+    assert "environment variable 'DISPLAY' is not set" in errors[0]
+    assert len(errors) == 2 and 'log file' in errors[1]
+    assert 'Traceback' not in result.stderr
+
+
+def test_model_variant_without_urdf_runs_without_tf(tmp_path: Path) -> None:
+    variant = tmp_path / 'variant.xml'
+    shutil.copy(atlas_model.MODEL_PATH, variant)
+    port = free_local_port()
+    env = dict(os.environ, ROS_MASTER_URI=f'http://localhost:{port}', ROS_HOSTNAME='localhost',
+               ROS_LOG_DIR=str(tmp_path / 'ros_log'))
+    log = open(tmp_path / 'atlas.log', 'w')  # noqa: SIM115 - closed below
+    process = subprocess.Popen(
+        ['roslaunch', '-p', str(port), 'tutorial_atlas_control', 'atlas.launch', 'gui:=false',
+         'record:=false', f'model:={variant}'], env=env, stdout=log, stderr=subprocess.STDOUT,
+        start_new_session=True)
+    try:
+        wait_sim_time(env, 1.0)  # the simulator runs
+        master = rosgraph.Master('/test_variant', master_uri=env['ROS_MASTER_URI'])
+        publishers = dict(master.getSystemState()[0])
+        has_description = master.hasParam('/robot_description')
+    finally:
+        stop_launch(process)
+        log.close()
+    output = (tmp_path / 'atlas.log').read_text(errors='replace')
+    warnings = [line for line in output.splitlines() if 'TF is off' in line]
+    assert len(warnings) == 1, output
+    assert f'the model {variant} has no URDF beside it ({tmp_path / "variant.urdf"} does not exist)' \
+        in warnings[0]
+    assert '/tf' not in publishers
+    assert not has_description
+    assert '/clock' in publishers

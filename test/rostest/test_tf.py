@@ -1,0 +1,143 @@
+#!/usr/bin/env python3
+"""rostest: atlas.launch publishes the robot to TF (robot_description, robot_state_publisher,
+world -> pelvis from the simulator), as rviz needs it.
+
+The launch starts paused; the test subscribes to /tf and /ground_truth_odom, waits for both
+/tf publishers (the simulator and robot_state_publisher), then unpauses: it sees /tf from
+sim time 0.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+import unittest
+import xml.etree.ElementTree as ET
+
+import mujoco
+import numpy as np
+import rospy
+import rostest
+import tf2_ros
+from nav_msgs.msg import Odometry
+from rosgraph_msgs.msg import Clock
+from std_srvs.srv import Empty
+from tf2_msgs.msg import TFMessage
+
+from tutorial_atlas_control import model as atlas_model
+
+PKG = 'tutorial_atlas_control'
+#: Every link of robot_description must be on /tf within this much sim time (s).
+ALL_LINKS_WITHIN_S = 2.0
+#: world -> pelvis and /ground_truth_odom at the same stamp agree within this (m).
+POSE_TOLERANCE_M = 1e-3
+#: Standing, the feet's TF heights are within this of the model's (m).
+FOOT_HEIGHT_TOLERANCE_M = 0.03
+#: When the feet are compared (s of sim time): standing, after the 1 s pin.
+STANDING_AT_S = 3.0
+#: Sim time (s) the test watches /tf and /ground_truth_odom for.
+WATCH_S = 3.5
+#: Longest wall-clock wait (s).
+WALL_TIMEOUT_S = 120.0
+
+
+class TfTest(unittest.TestCase):
+    """What rviz relies on, from the start of the simulation."""
+
+    first_stamp_s: dict[str, float]
+    pelvis_tf: dict[int, np.ndarray]
+    pelvis_odom: dict[int, np.ndarray]
+
+    @classmethod
+    def setUpClass(cls) -> None:
+        rospy.init_node('test_tf')
+        cls.lock = threading.Lock()
+        cls.first_stamp_s, cls.pelvis_tf, cls.pelvis_odom = {}, {}, {}
+        cls.clock_s = 0.0
+        cls.buffer = tf2_ros.Buffer(cache_time=rospy.Duration(60))
+        cls.listener = tf2_ros.TransformListener(cls.buffer)
+        tf_sub = rospy.Subscriber('/tf', TFMessage, cls._on_tf, queue_size=1000)
+        rospy.Subscriber('/ground_truth_odom', Odometry, cls._on_odom, queue_size=1000)
+        rospy.Subscriber('/clock', Clock, cls._on_clock, queue_size=10)
+        cls._wait(lambda: tf_sub.get_num_connections() >= 2 and cls.listener is not None
+                  and rospy.has_param('/robot_description'),
+                  'the simulator and robot_state_publisher to publish /tf')
+        time.sleep(1.0)  # the listener's own /tf subscription connects too
+        rospy.wait_for_service('/gazebo/unpause_physics', timeout=WALL_TIMEOUT_S)
+        rospy.ServiceProxy('/gazebo/unpause_physics', Empty)()
+        cls._wait(lambda: cls.clock_s >= WATCH_S, f'{WATCH_S} s of sim time')
+        time.sleep(0.5)  # the messages stamped before it arrive
+
+    @classmethod
+    def _wait(cls, predicate, what: str) -> None:  # noqa: ANN001
+        deadline = time.monotonic() + WALL_TIMEOUT_S
+        while not predicate():
+            if time.monotonic() > deadline or rospy.is_shutdown():
+                raise AssertionError(f'timed out after {WALL_TIMEOUT_S} s waiting for {what}')
+            time.sleep(0.01)
+
+    @classmethod
+    def _on_clock(cls, msg: Clock) -> None:
+        cls.clock_s = msg.clock.to_sec()
+
+    @classmethod
+    def _on_tf(cls, msg: TFMessage) -> None:
+        with cls.lock:
+            for transform in msg.transforms:
+                stamp_s = transform.header.stamp.to_sec()
+                child = transform.child_frame_id
+                cls.first_stamp_s[child] = min(stamp_s, cls.first_stamp_s.get(child, np.inf))
+                if (transform.header.frame_id, child) == ('world', 'pelvis'):
+                    t, r = transform.transform.translation, transform.transform.rotation
+                    cls.pelvis_tf[transform.header.stamp.to_nsec()] = np.array(
+                        [t.x, t.y, t.z, r.x, r.y, r.z, r.w])
+
+    @classmethod
+    def _on_odom(cls, msg: Odometry) -> None:
+        p, q = msg.pose.pose.position, msg.pose.pose.orientation
+        with cls.lock:
+            cls.pelvis_odom[msg.header.stamp.to_nsec()] = np.array([p.x, p.y, p.z, q.x, q.y, q.z, q.w])
+
+    def test_every_link_of_robot_description_is_on_tf_within_2_s(self) -> None:
+        root = ET.fromstring(rospy.get_param('/robot_description'))
+        links = {link.get('name') for link in root.findall('link')}
+        self.assertEqual(len(links), 29)
+        with self.lock:
+            first = dict(self.first_stamp_s)
+        missing = sorted(links - set(first))
+        self.assertEqual(missing, [], 'links never seen on /tf')
+        late = {link: first[link] for link in links if first[link] > ALL_LINKS_WITHIN_S}
+        self.assertEqual(late, {}, f'links first on /tf after {ALL_LINKS_WITHIN_S} s of sim time')
+        rospy.loginfo(f'every link on /tf by {max(first[link] for link in links):.3f} s of sim time')
+
+    def test_world_to_pelvis_is_the_ground_truth(self) -> None:
+        with self.lock:
+            common = sorted(set(self.pelvis_tf) & set(self.pelvis_odom))
+            pairs = [(self.pelvis_tf[s], self.pelvis_odom[s]) for s in common]
+        # 100 Hz each over WATCH_S: nearly every stamp pairs up.
+        self.assertGreater(len(pairs), 0.9 * 100 * WATCH_S)
+        position_error_m = max(np.linalg.norm(tf[:3] - odom[:3]) for tf, odom in pairs)
+        self.assertLessEqual(position_error_m, POSE_TOLERANCE_M)
+        rotation_error = max(1.0 - abs(float(tf[3:] @ odom[3:])) for tf, odom in pairs)
+        self.assertLess(rotation_error, 1e-9)
+        # The pelvis moved (it settles after the pin): the comparison is not of constants.
+        heights = [odom[2] for _tf, odom in pairs]
+        self.assertGreater(max(heights) - min(heights), 1e-5)
+
+    def test_standing_feet_heights_match_the_model(self) -> None:
+        atlas = atlas_model.load_model()
+        data = mujoco.MjData(atlas.model)
+        atlas_model.reset_to_initial(atlas, data)
+        for side in ('l', 'r'):
+            expected_m = float(data.body(f'{side}_foot').xpos[2])
+            stamp = rospy.Time.from_sec(STANDING_AT_S)
+            transform = self.buffer.lookup_transform('world', f'{side}_foot', stamp,
+                                                     rospy.Duration(5.0))
+            height_m = transform.transform.translation.z
+            rospy.loginfo(f'{side}_foot at {STANDING_AT_S} s: TF height {height_m:.4f} m, '
+                          f'model {expected_m:.4f} m')
+            self.assertAlmostEqual(height_m, expected_m, delta=FOOT_HEIGHT_TOLERANCE_M)
+
+
+if __name__ == '__main__':
+    rostest.rosrun(PKG, 'tf', TfTest)

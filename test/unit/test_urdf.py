@@ -1,0 +1,180 @@
+"""sim/atlas_v1.urdf against sim/atlas_v1.xml: one robot, described twice from one table."""
+
+from __future__ import annotations
+
+import importlib.util
+import re
+import shutil
+import sys
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+
+from tutorial_atlas_control import model, urdf
+from tutorial_atlas_control.joints import JOINT_NAMES
+
+REPO = Path(__file__).resolve().parents[2]
+#: The left knee's joint origin in the URDF, and the same 1 cm lower.
+KNEE_ORIGIN = '<child link="l_lleg"/>\n    <origin xyz="-0.05 0 -0.374"'
+KNEE_ORIGIN_MOVED = '<child link="l_lleg"/>\n    <origin xyz="-0.05 0 -0.384"'
+URDF_PATH = REPO / 'sim' / 'atlas_v1.urdf'
+#: Random joint configurations whose forward kinematics are compared.
+FK_SAMPLES = 50
+#: Every link origin of the two models within this (m) in every sample.
+FK_TOLERANCE_M = 1e-3
+#: Link orientations within this (rad).
+FK_TOLERANCE_RAD = 1e-6
+
+
+def _load_table():
+    spec = importlib.util.spec_from_file_location('make_atlas_mjcf_urdf', REPO / 'tools' / 'make_atlas_mjcf.py')
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+TABLE = _load_table()
+
+
+@pytest.fixture(scope='module')
+def mjcf() -> mujoco.MjModel:
+    return model.load_model().model
+
+
+@pytest.fixture(scope='module')
+def urdf_model() -> mujoco.MjModel:
+    """The URDF compiled by MuJoCo, the root link kept as a body (MuJoCo would fuse it into
+    the world) and its visuals kept, so that bodies, masses and shapes can be compared."""
+    text = URDF_PATH.read_text().replace(
+        '<robot name="atlas">',
+        '<robot name="atlas"><mujoco><compiler fusestatic="false" discardvisual="false"/></mujoco>')
+    return mujoco.MjModel.from_xml_string(text)
+
+
+def body_names(m: mujoco.MjModel) -> list[str]:
+    return [m.body(b).name for b in range(1, m.nbody)]
+
+
+def test_urdf_file_is_what_the_generator_writes() -> None:
+    assert URDF_PATH.read_text() == TABLE.build_urdf(), \
+        'sim/atlas_v1.urdf is stale: run `python3 tools/make_atlas_mjcf.py`'
+
+
+def test_same_joints_in_the_same_order_with_the_same_limits(mjcf: mujoco.MjModel) -> None:
+    _links, joints = urdf.read_joints(URDF_PATH.read_text())
+    mjcf_hinges = [mjcf.joint(j).name for j in range(mjcf.njnt)
+                   if mjcf.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE]
+    assert [joint.name for joint in joints] == mjcf_hinges
+    assert set(mjcf_hinges) == set(JOINT_NAMES)  # bare names, no atlas:: prefix
+    for joint in joints:
+        assert joint.kind == 'revolute', joint.name
+        np.testing.assert_array_equal([joint.lower_rad, joint.upper_rad], mjcf.joint(joint.name).range)
+
+
+def test_same_links_masses_and_inertias(mjcf: mujoco.MjModel, urdf_model: mujoco.MjModel) -> None:
+    assert sorted(body_names(urdf_model)) == sorted(body_names(mjcf))
+    for name in body_names(mjcf):
+        assert urdf_model.body(name).mass[0] == mjcf.body(name).mass[0], name
+        np.testing.assert_allclose(urdf_model.body(name).ipos, mjcf.body(name).ipos, atol=1e-12)
+        np.testing.assert_allclose(urdf_model.body(name).inertia, mjcf.body(name).inertia,
+                                   rtol=1e-9, err_msg=name)
+
+
+def test_forward_kinematics_agree_in_random_configurations(
+        mjcf: mujoco.MjModel, urdf_model: mujoco.MjModel) -> None:
+    """Both models with the pelvis at the origin, the same random joint angles within the
+    limits: every link origin (and orientation) agrees. Prints the largest difference."""
+    rng = np.random.default_rng(15)
+    data_mjcf, data_urdf = mujoco.MjData(mjcf), mujoco.MjData(urdf_model)
+    names = body_names(mjcf)
+    worst_m = worst_rad = 0.0
+    for _ in range(FK_SAMPLES):
+        data_mjcf.qpos[:7] = (0, 0, 0, 1, 0, 0, 0)
+        for name in JOINT_NAMES:
+            angle = rng.uniform(*mjcf.joint(name).range)
+            data_mjcf.qpos[mjcf.joint(name).qposadr[0]] = angle
+            data_urdf.qpos[urdf_model.joint(name).qposadr[0]] = angle
+        mujoco.mj_kinematics(mjcf, data_mjcf)
+        mujoco.mj_kinematics(urdf_model, data_urdf)
+        for name in names:
+            worst_m = max(worst_m, float(np.linalg.norm(
+                data_mjcf.body(name).xpos - data_urdf.body(name).xpos)))
+            dot = abs(float(data_mjcf.body(name).xquat @ data_urdf.body(name).xquat))
+            worst_rad = max(worst_rad, 2.0 * float(np.arccos(min(1.0, dot))))
+    print(f'largest URDF-MJCF difference over {FK_SAMPLES} configurations: link origin '
+          f'{worst_m:.3g} m, orientation {worst_rad:.3g} rad')
+    assert worst_m <= FK_TOLERANCE_M
+    assert worst_rad <= FK_TOLERANCE_RAD
+
+
+def test_a_moved_joint_is_seen_by_the_comparison(mjcf: mujoco.MjModel) -> None:
+    """The FK comparison can fail: a URDF with the knee 1 cm lower puts the foot 1 cm off."""
+    text = URDF_PATH.read_text().replace(KNEE_ORIGIN, KNEE_ORIGIN_MOVED)
+    moved = mujoco.MjModel.from_xml_string(text)
+    data_mjcf, data_moved = mujoco.MjData(mjcf), mujoco.MjData(moved)
+    data_mjcf.qpos[:7] = (0, 0, 0, 1, 0, 0, 0)
+    mujoco.mj_kinematics(mjcf, data_mjcf)
+    mujoco.mj_kinematics(moved, data_moved)
+    offset = data_mjcf.body('l_foot').xpos - data_moved.body('l_foot').xpos
+    assert np.linalg.norm(offset) == pytest.approx(0.01, abs=1e-9)
+
+
+def _visual_colours(m: mujoco.MjModel, body: str) -> set[tuple[float, ...]]:
+    """Colours drawn on a body: its geoms' material (MJCF) or rgba (URDF import) colours."""
+    colours = set()
+    for geom in range(m.ngeom):
+        if m.geom_bodyid[geom] == m.body(body).id:
+            material = m.geom_matid[geom]
+            rgba = m.mat_rgba[material] if material >= 0 else m.geom_rgba[geom]
+            colours.add(tuple(round(float(v), 6) for v in rgba))
+    return colours
+
+
+def test_same_shapes_and_colours(mjcf: mujoco.MjModel) -> None:
+    """Each link draws the MJCF's shapes in the MJCF's colours (a capsule as a cylinder
+    and two spheres)."""
+    root = ET.fromstring(URDF_PATH.read_text())
+    for link in root.findall('link'):
+        name = link.get('name')
+        visuals = link.findall('visual')
+        body = mjcf.body(name).id
+        geoms = [g for g in range(mjcf.ngeom) if mjcf.geom_bodyid[g] == body]
+        capsules = sum(mjcf.geom_type[g] == mujoco.mjtGeom.mjGEOM_CAPSULE for g in geoms)
+        assert len(visuals) == len(geoms) + 2 * capsules, name
+        colours = {tuple(float(v) for v in root.find(f"material[@name='{v.find('material').get('name')}']")
+                         .find('color').get('rgba').split()) for v in visuals}
+        assert colours == _visual_colours(mjcf, name), name
+
+
+def test_the_shipped_urdf_matches_the_shipped_model(mjcf: mujoco.MjModel) -> None:
+    path, text = urdf.matching_urdf(model.MODEL_PATH, mjcf)
+    assert path == URDF_PATH
+    assert text == URDF_PATH.read_text()
+
+
+def test_a_variant_without_urdf_has_none(tmp_path: Path, mjcf: mujoco.MjModel) -> None:
+    variant = tmp_path / 'variant.xml'
+    shutil.copy(model.MODEL_PATH, variant)
+    with pytest.raises(urdf.UrdfError, match=re.escape(f'({tmp_path / "variant.urdf"} does not exist)')):
+        urdf.matching_urdf(variant, mjcf)
+
+
+def test_a_urdf_of_another_robot_does_not_match(tmp_path: Path, mjcf: mujoco.MjModel) -> None:
+    variant = tmp_path / 'variant.xml'
+    shutil.copy(model.MODEL_PATH, variant)
+    (tmp_path / 'variant.urdf').write_text(
+        URDF_PATH.read_text().replace(KNEE_ORIGIN, KNEE_ORIGIN_MOVED))
+    with pytest.raises(urdf.UrdfError, match="joint 'l_leg_kny' connects other links or has "
+                                             'another origin or axis'):
+        urdf.matching_urdf(variant, mjcf)
+    (tmp_path / 'variant.urdf').write_text('<mujoco/>')
+    with pytest.raises(urdf.UrdfError, match='root element is <mujoco>, not <robot>'):
+        urdf.matching_urdf(variant, mjcf)
+    (tmp_path / 'variant.urdf').write_text(
+        URDF_PATH.read_text().replace('name="l_leg_kny"', 'name="l_knee"'))
+    with pytest.raises(urdf.UrdfError, match="no revolute joint 'l_leg_kny'"):
+        urdf.matching_urdf(variant, mjcf)
