@@ -23,7 +23,7 @@ pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source 
 import rosgraph  # noqa: E402
 
 from tutorial_atlas_control import model as atlas_model  # noqa: E402
-from tutorial_atlas_control.demo import free_local_port  # noqa: E402
+from tutorial_atlas_control.processes import free_local_port  # noqa: E402
 
 from test_viewer_window import CHROMA_TOLERANCE, MIN_BRIGHTNESS  # noqa: E402
 from xdisplay import (  # noqa: E402

@@ -22,7 +22,7 @@ import pytest
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
 from tutorial_atlas_control import model as atlas_model  # noqa: E402
-from tutorial_atlas_control.demo import free_local_port  # noqa: E402
+from tutorial_atlas_control.processes import free_local_port  # noqa: E402
 from tutorial_atlas_control.render import configure_viewer_camera  # noqa: E402
 
 from xdisplay import (  # noqa: E402
