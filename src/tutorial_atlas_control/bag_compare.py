@@ -23,6 +23,7 @@ import numpy as np
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bag_analysis import FALL_HEIGHT_M, Analysis, analyze_bag
+from tutorial_atlas_control.bag_report import save_figure
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_INDEX
 from tutorial_atlas_control.run_log import PlayedTrajectory, played_trajectories
@@ -294,12 +295,4 @@ def plot_comparison(comparison: Comparison, path: Path | str) -> Path:
     axes[-1].legend(loc='upper right', fontsize=7)
     axes[-1].set_xlabel(f'time from the {ALIGNED_ON} (s)')
     fig.suptitle(f'A: {c.a.data.path.name} vs B: {c.b.data.path.name}', y=0.995)
-    fig.tight_layout()
-    try:
-        fig.savefig(path, dpi=100)
-    except OSError as err:
-        msg = f'Could not write the plot to {path}: {err.strerror or err}.'
-        raise BagAnalysisError(msg) from err
-    finally:
-        plt.close(fig)
-    return path
+    return save_figure(fig, path)

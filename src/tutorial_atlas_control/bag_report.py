@@ -248,6 +248,25 @@ def _mark_modes(axes: list[Any], modes: list[tuple[float, str]]) -> None:
                          fontsize=8)
 
 
+def save_figure(fig: Any, path: Path | str) -> Path:
+    """Lay out, write and close a matplotlib figure.
+
+    Raises:
+        BagAnalysisError: The image cannot be written.
+    """
+    import matplotlib.pyplot as plt
+
+    fig.tight_layout()
+    try:
+        fig.savefig(path, dpi=100)
+    except OSError as err:
+        msg = f'Could not write the plot to {path}: {err.strerror or err}.'
+        raise BagAnalysisError(msg) from err
+    finally:
+        plt.close(fig)
+    return Path(path)
+
+
 def plot_run(analysis: Analysis, path: Path | str) -> Path:
     """Plot commanded vs measured positions of the joints that moved, and pelvis height.
 
@@ -280,12 +299,4 @@ def plot_run(analysis: Analysis, path: Path | str) -> Path:
         ax.legend(loc='upper right', fontsize=7)
     axes[-1].set_xlabel('time from bag start (s)')
     fig.suptitle(f'{data.path.name}: commanded vs measured', y=0.995)
-    fig.tight_layout()
-    try:
-        fig.savefig(path, dpi=100)
-    except OSError as err:
-        msg = f'Could not write the plot to {path}: {err.strerror or err}.'
-        raise BagAnalysisError(msg) from err
-    finally:
-        plt.close(fig)
-    return path
+    return save_figure(fig, path)

@@ -20,27 +20,16 @@ from rosbags.rosbag1 import Writer
 from rosbags.typesys import Stores, get_typestore, get_types_from_msg
 from rosbags.typesys.store import Typestore
 
+from tutorial_atlas_control import topics
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.units import NS_PER_S
 
 #: The repository's definition of osrf_msgs/JointCommands.
 JOINT_COMMANDS_MSG = (
     Path(__file__).resolve().parents[2] / 'msg' / 'osrf_msgs' / 'msg' / 'JointCommands.msg'
 )
 
-NS_PER_S = 1_000_000_000
 
-#: Topics and ROS 1 types, as the simulator records them.
-TOPIC_TYPES: dict[str, str] = {
-    '/clock': 'rosgraph_msgs/Clock',
-    '/atlas/joint_states': 'sensor_msgs/JointState',
-    '/ground_truth_odom': 'nav_msgs/Odometry',
-    '/atlas/imu': 'sensor_msgs/Imu',
-    '/atlas/l_foot_contact': 'geometry_msgs/WrenchStamped',
-    '/atlas/r_foot_contact': 'geometry_msgs/WrenchStamped',
-    '/atlas/joint_commands': 'osrf_msgs/JointCommands',
-    '/atlas/control_mode': 'std_msgs/String',
-    '/rosout': 'rosgraph_msgs/Log',
-}
 
 
 def make_typestore() -> Typestore:
@@ -176,7 +165,7 @@ def foot_contact(t_s: float, side: str, fz_n: float = 450.0) -> Record:
             force=geo('geometry_msgs/Vector3')(x=0.0, y=0.0, z=fz_n),
             torque=geo('geometry_msgs/Vector3')(x=0.0, y=0.0, z=0.0)))
     topic = f'/atlas/{side}_foot_contact'
-    return Record(topic, TOPIC_TYPES[topic], t_s, msg)
+    return Record(topic, topics.MSG_TYPES[topic], t_s, msg)
 
 
 def write_bag(path: Path | str, records: Iterable[Record], *,

@@ -30,6 +30,22 @@ RECORDED_TOPICS: tuple[str, ...] = (
     JOINT_COMMANDS, CONTROL_MODE, SIM_CONFIG, ROSOUT, CONTROLLER_STATISTICS, TF,
 )
 
+#: The ROS 1 message type of each recorded topic.
+MSG_TYPES: dict[str, str] = {
+    CLOCK: 'rosgraph_msgs/Clock',
+    JOINT_STATES: 'sensor_msgs/JointState',
+    GROUND_TRUTH_ODOM: 'nav_msgs/Odometry',
+    IMU: 'sensor_msgs/Imu',
+    L_FOOT_CONTACT: 'geometry_msgs/WrenchStamped',
+    R_FOOT_CONTACT: 'geometry_msgs/WrenchStamped',
+    JOINT_COMMANDS: 'osrf_msgs/JointCommands',
+    CONTROL_MODE: 'std_msgs/String',
+    SIM_CONFIG: 'std_msgs/String',
+    ROSOUT: 'rosgraph_msgs/Log',
+    CONTROLLER_STATISTICS: 'atlas_msgs/ControllerStatistics',
+    TF: 'tf2_msgs/TFMessage',
+}
+
 #: Gazebo's services, as gazebo_ros offered them.
 RESET_WORLD_SERVICE = '/gazebo/reset_world'
 RESET_SIMULATION_SERVICE = '/gazebo/reset_simulation'

@@ -15,21 +15,15 @@ from rosgraph_msgs.msg import Clock
 from sim_probe import SimProbe  # beside this script, on its sys.path
 
 from tutorial_atlas_control import model as atlas_model
+from tutorial_atlas_control import topics
 from tutorial_atlas_control.controller import gains_from_params
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.simulator import AtlasSimulator, ControlMode
 
 PKG = 'tutorial_atlas_control'
-EXPECTED_TYPES = {
-    '/clock': 'rosgraph_msgs/Clock',
-    '/atlas/joint_states': 'sensor_msgs/JointState',
-    '/ground_truth_odom': 'nav_msgs/Odometry',
-    '/atlas/imu': 'sensor_msgs/Imu',
-    '/atlas/l_foot_contact': 'geometry_msgs/WrenchStamped',
-    '/atlas/r_foot_contact': 'geometry_msgs/WrenchStamped',
-    '/atlas/joint_commands': 'osrf_msgs/JointCommands',
-    '/atlas/control_mode': 'std_msgs/String',
-}
+EXPECTED_TYPES = {topic: topics.MSG_TYPES[topic] for topic in (
+    topics.CLOCK, topics.JOINT_STATES, topics.GROUND_TRUTH_ODOM, topics.IMU,
+    topics.L_FOOT_CONTACT, topics.R_FOOT_CONTACT, topics.JOINT_COMMANDS, topics.CONTROL_MODE)}
 STEP_NS = 1_000_000
 #: A step command on the left elbow, with the tutorial's gains for that joint.
 ELBOW = 'l_arm_elx'
