@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from rosbags.typesys import get_types_from_msg
 
 from tutorial_atlas_control import model as atlas_model
 from tutorial_atlas_control import topics
@@ -69,6 +70,9 @@ LOG_INFO = 2
 CHUNK_BYTES = 768 * 1024
 
 JOINT_COMMANDS_TYPE = 'osrf_msgs/msg/JointCommands'
+#: tf2_msgs/TFMessage, field for field (its definition as Debian's ros-tf2-msgs ships it).
+TF_TYPE = 'tf2_msgs/msg/TFMessage'
+TF_MSG_DEFINITION = 'geometry_msgs/TransformStamped[] transforms'
 #: Topic -> (type, publishing node, latched), as in a live run.
 TOPIC_TYPES: dict[str, tuple[str, str, bool]] = {
     topics.SIM_CONFIG: ('std_msgs/msg/String', SIMULATOR_NODE, True),
@@ -81,6 +85,7 @@ TOPIC_TYPES: dict[str, tuple[str, str, bool]] = {
     topics.CONTROL_MODE: ('std_msgs/msg/String', PLAYER_NODE, True),
     topics.JOINT_COMMANDS: (JOINT_COMMANDS_TYPE, PLAYER_NODE, False),
     topics.ROSOUT: ('rosgraph_msgs/msg/Log', PLAYER_NODE, True),
+    topics.TF: (TF_TYPE, SIMULATOR_NODE, False),
 }
 
 
@@ -256,6 +261,8 @@ class _BagSink:
         if JOINT_COMMANDS_TYPE not in self.typestore.fielddefs:
             raise OfflineRunError('cannot find osrf_msgs/JointCommands.msg (msg/osrf_msgs in '
                                   'the package): the commands could not be written')
+        if TF_TYPE not in self.typestore.fielddefs:  # not in rosbags' Noetic store
+            self.typestore.register(get_types_from_msg(TF_MSG_DEFINITION, TF_TYPE))
         self.writer = _writer_class()(path)
         self.writer.chunk_threshold = CHUNK_BYTES
         self.writer.open()
@@ -384,6 +391,8 @@ class _OfflinePlayer:
         if self.steps % self.odom_every == 0:
             self.messages.fill_odometry()
             self.odometry.add(now_ns, sim.state_time_ns)
+            self.sink.write(topics.TF, now_ns,
+                            self.messages.pelvis_tf(sim.state_time_ns)[TCPROS_PREFIX_BYTES:])
         self.count = k + 1
         if self.count == BLOCK_STEPS:
             self.write_steps()

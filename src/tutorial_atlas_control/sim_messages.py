@@ -16,7 +16,7 @@ from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.simulator import AtlasSimulator
 from tutorial_atlas_control.topics import PELVIS_FRAME, WORLD_FRAME
 from tutorial_atlas_control.wire import (
-    ImuWire, JointStateWire, OdometryWire, StampedWire, WrenchStampedWire)
+    ImuWire, JointStateWire, OdometryWire, StampedWire, TransformWire, WrenchStampedWire)
 
 __all__ = ['TCPROS_PREFIX_BYTES', 'SimMessages']
 
@@ -50,6 +50,7 @@ class SimMessages:
         self.odometry_wire = OdometryWire(WORLD_FRAME, PELVIS_FRAME)
         self.imu_wire = ImuWire(PELVIS_FRAME)
         self.contact_wires = {side: WrenchStampedWire(f'{side}_foot') for side in 'lr'}
+        self.pelvis_tf_wire = TransformWire(WORLD_FRAME, PELVIS_FRAME)
         model = sim.model
         adr = {name: int(model.sensor_adr[model.sensor(name).id]) for name in SENSOR_NAMES}
         orientation = adr['imu_orientation']
@@ -93,6 +94,14 @@ class SimMessages:
         odom.angular[:] = self._pelvis_velocity[:3]
         odom.linear[:] = self._pelvis_velocity[3:]
 
+    def fill_pelvis_tf(self) -> None:
+        """world -> pelvis, the pose /ground_truth_odom has (stamp with `sim.state_time_ns`)."""
+        sim, tf = self.sim, self.pelvis_tf_wire
+        body = sim.atlas.pelvis_body_id
+        tf.translation[:] = sim.data.xpos[body]
+        tf.rotation_xyzw[:3] = sim.data.xquat[body, 1:]
+        tf.rotation_xyzw[3] = sim.data.xquat[body, 0]
+
     def fill_imu(self) -> None:
         """The pelvis IMU (sensor readings: stamp with `sim.state_time_ns`)."""
         to, source = self.imu_map
@@ -110,6 +119,10 @@ class SimMessages:
     def odometry(self, stamp_ns: int) -> bytes:
         self.fill_odometry()
         return self.odometry_wire.to_bytes(stamp_ns)
+
+    def pelvis_tf(self, stamp_ns: int) -> bytes:
+        self.fill_pelvis_tf()
+        return self.pelvis_tf_wire.to_bytes(stamp_ns)
 
     def imu(self, stamp_ns: int) -> bytes:
         self.fill_imu()

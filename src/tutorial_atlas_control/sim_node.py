@@ -63,7 +63,7 @@ from tutorial_atlas_control.units import NS_PER_S, finite_number
 from tutorial_atlas_control.urdf import UrdfError, matching_urdf
 from tutorial_atlas_control.viewer import ViewerLink, ViewerRequest
 from tutorial_atlas_control.wire import (
-    ControllerStatisticsWire, TransformWire, WireBatch, clock_bytes)
+    ControllerStatisticsWire, WireBatch, clock_bytes)
 
 NODE_NAME = 'atlas_sim'
 #: Seconds between repeats of the same refusal warning.
@@ -148,7 +148,6 @@ class SimNode:
         # What each message holds is sim_messages' (shared with offline runs).
         self.messages = SimMessages(sim)
         self.contacts = (('l', self.l_contact_pub), ('r', self.r_contact_pub))
-        self.pelvis_tf = TransformWire(topics.WORLD_FRAME, topics.PELVIS_FRAME)
         self._init_controller_statistics()
 
         # Commands wait here, undecoded, for the loop (see on_joint_commands). Bounded, so
@@ -303,7 +302,7 @@ class SimNode:
         if count % self.every['odom'] == 0 and wanted(self.odom_pub):
             batch.add(self.odom_pub, messages.odometry(sensed_ns))
         if self.tf_pub is not None and count % self.every['tf'] == 0 and wanted(self.tf_pub):
-            self._publish_tf(sensed_ns)
+            batch.add(self.tf_pub, messages.pelvis_tf(sensed_ns))
         if count % self.every['imu'] == 0 and wanted(self.imu_pub):
             batch.add(self.imu_pub, messages.imu(sensed_ns))
         if count % self.every['contact'] == 0:
@@ -338,15 +337,6 @@ class SimNode:
             self.statistics_msg.values[:] = (stats.age_s, stats.mean_s, stats.variance_s2,
                                              stats.window_s)
             self.batch.add(self.statistics_pub, self.statistics_msg.to_bytes(now_ns))
-
-    def _publish_tf(self, stamp_ns: int) -> None:
-        """world -> pelvis from the ground truth, the pose /ground_truth_odom has at this stamp."""
-        sim = self.sim
-        body = sim.atlas.pelvis_body_id
-        self.pelvis_tf.translation[:] = sim.data.xpos[body]
-        w, x, y, z = sim.data.xquat[body]
-        self.pelvis_tf.rotation_xyzw[:] = (x, y, z, w)
-        self.batch.add(self.tf_pub, self.pelvis_tf.to_bytes(stamp_ns))
 
     # -- the loop ------------------------------------------------------------------------
     def spin(self) -> None:

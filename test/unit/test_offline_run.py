@@ -37,6 +37,7 @@ RECORDED = {
     '/atlas/control_mode': ('std_msgs/String', '992ce8a1687cec8c8bd883ec73ca41d1'),
     '/atlas/sim_config': ('std_msgs/String', '992ce8a1687cec8c8bd883ec73ca41d1'),
     '/rosout': ('rosgraph_msgs/Log', 'acffd30cd6b6de30f120938c17c593fb'),
+    '/tf': ('tf2_msgs/TFMessage', '94810edda583a504dfda3829e70d7eec'),
 }
 START_AFTER_S = 1.1
 SETTLE_S = 0.2
