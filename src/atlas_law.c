@@ -37,6 +37,7 @@ typedef struct {
   double dt_s;
   long n;
   long initialized;                  /* PidState.initialized; set to 1 */
+  long nq, nv;                       /* lengths of qpos and qvel (atlas_state_is_finite) */
 } AtlasLawStep;
 
 /* numpy.minimum / numpy.maximum for one pair: a NaN wins, and of two equal values (0.0 and
@@ -80,4 +81,16 @@ void atlas_law_step(AtlasLawStep *s) {
     if (s->ctrl != NULL) s->ctrl[j] = torque;
   }
   s->initialized = 1;
+}
+
+/* 1 if every qpos and qvel is finite, else 0: the simulator's divergence check after each
+ * step, in one call instead of four numpy ones. */
+int atlas_state_is_finite(const AtlasLawStep *s) {
+  for (long i = 0; i < s->nq; ++i) {
+    if (!isfinite(s->qpos[i])) return 0;
+  }
+  for (long i = 0; i < s->nv; ++i) {
+    if (!isfinite(s->qvel[i])) return 0;
+  }
+  return 1;
 }

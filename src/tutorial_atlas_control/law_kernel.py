@@ -37,6 +37,7 @@ class _Step(ctypes.Structure):
         ('integral', ctypes.c_void_p), ('previous_error', ctypes.c_void_p),
         ('torque', ctypes.c_void_p), ('ctrl', ctypes.c_void_p),
         ('dt_s', ctypes.c_double), ('n', ctypes.c_long), ('initialized', ctypes.c_long),
+        ('nq', ctypes.c_long), ('nv', ctypes.c_long),
     ]
 
 
@@ -76,6 +77,8 @@ def load_library() -> ctypes.CDLL | None:
             library = ctypes.CDLL(str(path))
             library.atlas_law_step.argtypes = [ctypes.POINTER(_Step)]
             library.atlas_law_step.restype = None
+            library.atlas_state_is_finite.argtypes = [ctypes.POINTER(_Step)]
+            library.atlas_state_is_finite.restype = ctypes.c_int
             _library = library
             return library
         except (OSError, AttributeError) as err:
@@ -132,7 +135,9 @@ class CompiledLaw:
         step.ctrl = None if ctrl is None else _address(ctrl, np.float64)
         step.dt_s = dt_s
         step.n = count
+        step.nq, step.nv = qpos.size, qvel.size
         self._call = library.atlas_law_step
+        self._finite = library.atlas_state_is_finite
         self._pointer = ctypes.byref(step)
         self._command: JointCommandArrays | None = None
         self._command_arrays: tuple[np.ndarray, ...] = ()
@@ -146,6 +151,10 @@ class CompiledLaw:
         step.initialized = state.initialized
         self._call(self._pointer)
         state.initialized = True
+
+    def state_is_finite(self) -> bool:
+        """Every entry of qpos and qvel (the MjData arrays given) finite?"""
+        return bool(self._finite(self._pointer))
 
     def _bind(self, command: JointCommandArrays) -> None:
         """Point the kernel at another command's arrays (a new command arrived)."""

@@ -96,6 +96,7 @@ class AtlasSimulator:
         self.torque_nm = np.zeros(NUM_JOINTS)
         self._pid = PidState()
         self._compiled_law = self._make_compiled_law() if compiled_law else None
+        self._warning_counts = self.data.warning.number  # a view: MuJoCo's counters
         # Stand/StandPrep hold the initial pose (all joints 0) with the parameter gains.
         self._stand_command = hold_command(gains, np.zeros(NUM_JOINTS))
         self._mode_command = self._stand_command
@@ -262,12 +263,17 @@ class AtlasSimulator:
         MuJoCo resets the state by itself on NaN/Inf/huge values and only warns: catching
         it here means no silently reset (or non-finite) state is ever published or replayed.
         """
-        data = self.data
+        counts = self._warning_counts
         for warning, what in DIVERGENCE_WARNINGS:
-            if data.warning[warning].number > 0:
-                data.warning[warning].number = 0
+            if counts[warning] > 0:
+                counts[warning] = 0
                 raise PhysicsDivergenceError(
                     f'physics diverged at t={self.sim_time_ns / NS_PER_S:.3f} s ({what})')
-        if not (np.isfinite(data.qpos).all() and np.isfinite(data.qvel).all()):
+        compiled = self._compiled_law
+        if compiled is not None:
+            finite = compiled.state_is_finite()
+        else:
+            finite = bool(np.isfinite(self.data.qpos).all() and np.isfinite(self.data.qvel).all())
+        if not finite:
             raise PhysicsDivergenceError(
                 f'physics diverged at t={self.sim_time_ns / NS_PER_S:.3f} s (non-finite state)')
