@@ -10,6 +10,7 @@
  */
 #include <math.h>
 #include <stddef.h>
+#include <string.h>
 
 /* Gazebo's math::equal tolerance (controller.TIE_BACK_EPSILON). */
 #define TIE_BACK_EPSILON 1e-6
@@ -81,6 +82,18 @@ void atlas_law_step(AtlasLawStep *s) {
     if (s->ctrl != NULL) s->ctrl[j] = torque;
   }
   s->initialized = 1;
+}
+
+/* A list of single doubles to copy, each from anywhere to anywhere: what refreshes the
+ * simulator's pre-laid-out messages (wire.py) from MjData after a step, in one call. */
+typedef struct {
+  const void *const *source;
+  void *const *destination; /* may be unaligned: inside a serialized message */
+  long n;
+} AtlasGather;
+
+void atlas_gather(const AtlasGather *g) {
+  for (long i = 0; i < g->n; ++i) memcpy(g->destination[i], g->source[i], sizeof(double));
 }
 
 /* 1 if every qpos and qvel is finite, else 0: the simulator's divergence check after each

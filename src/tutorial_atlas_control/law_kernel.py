@@ -1,5 +1,9 @@
 """The controller law as one compiled call per step (src/atlas_law.c through ctypes).
 
+Also compiled there, for the same reason (a numpy call costs about a microsecond, the
+work a few nanoseconds): the divergence check's finiteness test and the gather that
+copies a step's numbers into the node's messages.
+
 controller.compute_torque spends ~25 numpy calls per step, as much time as half a physics
 step; the C twin does the same arithmetic in one call, reading q and v straight from
 MjData and writing MjData.ctrl. It is built by catkin into the workspace's lib directory
@@ -79,6 +83,8 @@ def load_library() -> ctypes.CDLL | None:
             library.atlas_law_step.restype = None
             library.atlas_state_is_finite.argtypes = [ctypes.POINTER(_Step)]
             library.atlas_state_is_finite.restype = ctypes.c_int
+            library.atlas_gather.argtypes = [ctypes.POINTER(_Gather)]
+            library.atlas_gather.restype = None
             _library = library
             return library
         except (OSError, AttributeError) as err:
@@ -88,6 +94,47 @@ def load_library() -> ctypes.CDLL | None:
                       RuntimeWarning, stacklevel=2)
         _warned = True
     return None
+
+
+class _Gather(ctypes.Structure):
+    """AtlasGather in src/atlas_law.c."""
+
+    _fields_ = [('source', ctypes.c_void_p), ('destination', ctypes.c_void_p),
+                ('n', ctypes.c_long)]
+
+
+class Gather:
+    """Copies float64 elements, each from (array, index) to (array, index), in one C call.
+
+    Built once from (destination, source, source indices) triples: destination[i] =
+    source[indices[i]] for every i of each triple. Pointers are taken here, so the arrays
+    must never be reallocated (MjData's and wire.py's never are); references are kept.
+    """
+
+    def __init__(self, library: ctypes.CDLL,
+                 copies: list[tuple[np.ndarray, np.ndarray, np.ndarray]]) -> None:
+        sources: list[int] = []
+        destinations: list[int] = []
+        for destination, source, indices in copies:
+            if destination.shape != indices.shape or destination.ndim != 1:
+                raise ValueError(f'{len(indices)} indices for a destination of shape '
+                                 f'{destination.shape}')
+            if len(indices) and not 0 <= int(indices.min()) <= int(indices.max()) < source.size:
+                raise ValueError(f'index out of range for a source of {source.size} elements')
+            base, step = _address(destination, np.float64), destination.strides[0]
+            destinations += [base + step * i for i in range(len(destination))]
+            source_base = _address(source, np.float64)
+            sources += [source_base + 8 * int(i) for i in indices]
+        self._keep = copies
+        self._sources = (ctypes.c_void_p * len(sources))(*sources)
+        self._destinations = (ctypes.c_void_p * len(destinations))(*destinations)
+        self._gather = _Gather(ctypes.addressof(self._sources),
+                               ctypes.addressof(self._destinations), len(sources))
+        self._call = library.atlas_gather
+        self._pointer = ctypes.byref(self._gather)
+
+    def __call__(self) -> None:
+        self._call(self._pointer)
 
 
 def _address(array: np.ndarray, dtype: type) -> int:

@@ -45,6 +45,7 @@ from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import String
 from std_srvs.srv import Empty, EmptyResponse
 
+from tutorial_atlas_control import law_kernel
 from tutorial_atlas_control import model as atlas_model
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.commands import CommandDecoder, CommandError
@@ -300,6 +301,17 @@ class SimNode:
         self._contact_sources = tuple(
             (msg, pub, indices(f'{side}_foot_force', f'{side}_foot_torque'))
             for msg, side, pub in self.contacts)
+        # With the compiled kernels built: all of the above in one call per step.
+        library = law_kernel.load_library()
+        self._gather = None if library is None else law_kernel.Gather(library, [
+            (self.joint_state.position, self._qpos, atlas.qpos_adr),
+            (self.joint_state.velocity, self._qvel, atlas.dof_adr),
+            (self.joint_state.effort, self._torque_nm, np.arange(len(self._torque_nm))),
+            (self.imu.orientation_xyzw, self._sensordata, self._imu_orientation_index),
+            (self.imu.angular_velocity, self._sensordata, indices('imu_angular_velocity')),
+            (self.imu.linear_acceleration, self._sensordata, indices('imu_linear_acceleration')),
+            *((msg.floats, self._sensordata, index) for msg, _pub, index in self._contact_sources),
+        ])
 
     def publish(self) -> None:
         """Serialize what is due this step into the batch (called under the lock)."""
@@ -312,11 +324,15 @@ class SimNode:
             batch.replace(self.clock_pub, clock_bytes(now_ns))
         count = self.step_count
         every = self.every
+        gather = self._gather
+        if gather is not None:
+            gather()  # the joint state's, IMU's and contacts' numbers, due or not
         if count % every['joint_states'] == 0 and self.joint_state_pub.impl.connections:
             msg = self.joint_state
-            self._qpos.take(self.sim.atlas.qpos_adr, out=msg.position)
-            self._qvel.take(self.sim.atlas.dof_adr, out=msg.velocity)
-            msg.effort[:] = self._torque_nm
+            if gather is None:
+                self._qpos.take(self.sim.atlas.qpos_adr, out=msg.position)
+                self._qvel.take(self.sim.atlas.dof_adr, out=msg.velocity)
+                msg.effort[:] = self._torque_nm
             batch.add(self.joint_state_pub, msg.to_bytes(now_ns))
         # Poses and sensors describe the state at the start of the last step (see step()).
         sensed_ns = self.sim.state_time_ns
@@ -325,14 +341,16 @@ class SimNode:
         sensordata = self._sensordata
         if count % every['imu'] == 0 and self.imu_pub.impl.connections:
             imu = self.imu
-            sensordata.take(self._imu_orientation_index, out=imu.orientation_xyzw)
-            imu.angular_velocity[:] = self._imu_angular_velocity
-            imu.linear_acceleration[:] = self._imu_linear_acceleration
+            if gather is None:
+                sensordata.take(self._imu_orientation_index, out=imu.orientation_xyzw)
+                imu.angular_velocity[:] = self._imu_angular_velocity
+                imu.linear_acceleration[:] = self._imu_linear_acceleration
             batch.add(self.imu_pub, imu.to_bytes(sensed_ns))
         if count % every['contact'] == 0:
             for msg, pub, index in self._contact_sources:
                 if pub.impl.connections:
-                    sensordata.take(index, out=msg.floats)
+                    if gather is None:
+                        sensordata.take(index, out=msg.floats)
                     batch.add(pub, msg.to_bytes(sensed_ns))
 
     # -- /atlas/controller_statistics ----------------------------------------------------

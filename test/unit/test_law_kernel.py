@@ -167,3 +167,24 @@ def test_ragdoll_command_gives_zero_torque(library) -> None:  # noqa: ANN001
     sim.step()
     assert not sim.torque_nm.any() and not sim.data.ctrl.any()
     assert JointCommandArrays.zeros().position.shape == (NUM_JOINTS,)
+
+
+def test_gather_copies_every_bit_into_unaligned_message_buffers(library) -> None:  # noqa: ANN001
+    buffer = bytearray(3 + 8 * 5)
+    destination = np.frombuffer(buffer, dtype='<f8', offset=3, count=5)  # as in wire.py
+    other = np.zeros(2)
+    source = np.array([1.5, -0.0, np.nan, np.inf, 2.0 ** -1074, 7.0])
+    gather = law_kernel.Gather(library, [
+        (destination, source, np.array([5, 0, 1, 2, 4], dtype=np.intp)),
+        (other, source, np.array([3, 3], dtype=np.intp)),
+    ])
+    gather()
+    assert destination.tobytes() == source[[5, 0, 1, 2, 4]].tobytes()
+    assert other.tolist() == [np.inf, np.inf]
+    source[5] = -3.0
+    gather()
+    assert destination[0] == -3.0 and buffer[:3] == b'\0\0\0'
+    with pytest.raises(ValueError, match='index out of range for a source of 6 elements'):
+        law_kernel.Gather(library, [(other, source, np.array([0, 6], dtype=np.intp))])
+    with pytest.raises(ValueError, match=r'3 indices for a destination of shape \(2,\)'):
+        law_kernel.Gather(library, [(other, source, np.arange(3))])
