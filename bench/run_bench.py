@@ -6,7 +6,8 @@ goes to stderr. Runs on a private master on a free port (never 11311), under a s
 directory in /tmp that is removed afterwards (kept with --keep or on failure).
 
 Sections (see bench/README.md for what each figure means and how it is measured):
-  physics   AtlasSimulator.step() (controller law + mj_step) in a plain loop, no ROS
+  physics   bare mj_step, and AtlasSimulator.step() (law + mj_step; C and numpy law) in a
+            plain loop, no ROS
   analysis  bag_analysis.analyze_bag vs Debian's rosbag API on a 60 s run bag
   fast      the node at real_time_factor:=0, the recorder (--recorder) subscribed
   realtime  the node at real_time_factor:=1.0: achieved factor, step lateness, then the
