@@ -6,7 +6,8 @@ goes to stderr. Runs on a private master on a free port (never 11311), under a s
 directory in /tmp that is removed afterwards (kept with --keep or on failure).
 
 Sections (see bench/README.md for what each figure means and how it is measured):
-  physics   AtlasSimulator.step() (controller law + mj_step) in a plain loop, no ROS
+  physics   bare mj_step, and AtlasSimulator.step() (law + mj_step; C and numpy law) in a
+            plain loop, no ROS
   offline   run_offline.py's run of touchdown to a bag, against the plain loop
   analysis  bag_analysis.analyze_bag vs Debian's rosbag API on a 60 s run bag
   fast      the node at real_time_factor:=0, the recorder (--recorder) subscribed
@@ -59,12 +60,17 @@ SECTIONS = ('physics', 'offline', 'analysis', 'fast', 'realtime', 'load', 'tutor
 
 #: (key, label, unit, target text, digits) in table order.
 ROWS = (
+    ('bare_physics_steps_per_s', 'bare mj_step, plain loop', 'steps/s', '', 0),
     ('physics_limit_steps_per_s', 'physics + law, plain loop', 'steps/s', '', 0),
+    ('physics_numpy_law_steps_per_s', 'physics + numpy law, plain loop', 'steps/s', '', 0),
     ('offline_rtf', 'run_offline.py to a bag', 'x real time', '', 2),
     ('offline_ratio', 'offline_rtf*1000 / physics limit', '', '>= 0.8', 3),
-    ('fast_rtf', 'node rtf:=0 + recorder', 'x real time', '>= 10', 2),
-    ('fast_ratio', 'fast_rtf*1000 / physics limit', '', '>= 0.4', 3),
+    ('fast_rtf', 'node rtf:=0 + recorder', 'x real time', '>= 0.6 x bare/1000', 2),
+    ('fast_bare_ratio', 'fast_rtf*1000 / bare mj_step', '', '>= 0.6', 3),
+    ('fast_ratio', 'fast_rtf*1000 / physics limit', '', '', 3),
     ('fast_node_cpu', 'node CPU at rtf:=0', 'cores', '', 2),
+    ('node_us_per_step', 'node CPU per step at rtf:=0', 'us', '<= 1.5 x bare', 1),
+    ('node_bare_ratio', 'node_us_per_step / bare mj_step', '', '<= 1.5', 2),
     ('fast_recorder_cpu', 'recorder CPU at rtf:=0', 'cores', '', 2),
     ('fast_recorded_fraction', 'joint_states recorded at rtf:=0', 'fraction', '1', 4),
     ('realtime_rtf', 'node rtf:=1, achieved', 'x real time', '1.00 +- 0.01', 4),
@@ -135,11 +141,18 @@ def run_offline(args: argparse.Namespace, samples: dict[str, list[float]],
     import offline
 
     if 'physics' in args.sections:
+        import node_loop
+
         with Section('physics', loads):
             for run in range(max(args.runs, 5)):
-                rate = offline.physics_run(steps=2000 if args.quick else 5000)
-                log(f'physics run {run + 1}: {rate:.0f} steps/s')
-                add(samples, {'physics_limit_steps_per_s': rate})
+                steps = 2000 if args.quick else 5000
+                rates = {'bare_physics_steps_per_s': node_loop.bare_physics_run(steps),
+                         'physics_limit_steps_per_s': offline.physics_run(steps=steps),
+                         'physics_numpy_law_steps_per_s':
+                             node_loop.law_physics_run(False, steps=steps)}
+                log(f'physics run {run + 1}: ' + ', '.join(
+                    f'{key} {rate:.0f}' for key, rate in rates.items()))
+                add(samples, rates)
     if 'offline' in args.sections:
         steps_per_s = offline.steps_per_sim_second()
         with Section('offline', loads), tempfile.TemporaryDirectory(prefix='tac_bench_') as tmp:
@@ -265,6 +278,24 @@ def summarize(samples: dict[str, list[float]]) -> dict[str, float]:
         physics = medians['physics_limit_steps_per_s']
         samples['fast_ratio'] = [rtf * per_sim_s / physics for rtf in samples['fast_rtf']]
         medians['fast_ratio'] = medians['fast_rtf'] * per_sim_s / physics
+    if 'fast_node_cpu' in samples:  # node CPU (µs) per simulated step
+        import offline
+
+        per_sim_s = offline.steps_per_sim_second()
+        samples['node_us_per_step'] = [cpu * 1e6 / (rtf * per_sim_s) for cpu, rtf
+                                       in zip(samples['fast_node_cpu'], samples['fast_rtf'])]
+        medians['node_us_per_step'] = statistics.median(samples['node_us_per_step'])
+    if 'bare_physics_steps_per_s' in medians:  # issue 18's targets: ratios to bare mj_step
+        import offline
+
+        bare = medians['bare_physics_steps_per_s']
+        per_sim_s = offline.steps_per_sim_second()
+        for key, ratio in (('fast_rtf', lambda rtf: rtf * per_sim_s / bare),
+                           ('node_us_per_step', lambda us: us * bare / 1e6)):
+            if key in samples:
+                name = 'fast_bare_ratio' if key == 'fast_rtf' else 'node_bare_ratio'
+                samples[name] = [ratio(value) for value in samples[key]]
+                medians[name] = ratio(medians[key])
     for pct in (50, 99):  # the headline: the worse of the two command rates
         rates = [medians.get(f'cmd_latency_p{pct}_ms_{label}') for label in ('50hz', '1khz')]
         if all(value is not None for value in rates):

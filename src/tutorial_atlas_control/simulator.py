@@ -15,6 +15,7 @@ from collections.abc import Mapping, Sequence
 import mujoco
 import numpy as np
 
+from tutorial_atlas_control import law_kernel
 from tutorial_atlas_control import model as atlas_model
 from tutorial_atlas_control.commands import CommandUpdate, JointCommandArrays, command_update
 from tutorial_atlas_control.controller import Gains, PidState, compute_torque, hold_command
@@ -76,7 +77,10 @@ class AtlasSimulator:
     """
 
     def __init__(self, atlas: atlas_model.AtlasModel, gains: Gains,
-                 time_to_unpin_s: float = DEFAULT_TIME_TO_UNPIN_S) -> None:
+                 time_to_unpin_s: float = DEFAULT_TIME_TO_UNPIN_S,
+                 compiled_law: bool = True) -> None:
+        """`compiled_law`: run the law through law_kernel's C kernel when it is built
+        (the same torques bit for bit, faster); False: always controller.compute_torque."""
         self.atlas = atlas
         # The path comes with the compiled model, so the config cannot name another file.
         self.atlas_path = atlas.path
@@ -91,6 +95,8 @@ class AtlasSimulator:
         self.user_command: JointCommandArrays | None = None
         self.torque_nm = np.zeros(NUM_JOINTS)
         self._pid = PidState()
+        self._compiled_law = self._make_compiled_law() if compiled_law else None
+        self._warning_counts = self.data.warning.number  # a view: MuJoCo's counters
         # Stand/StandPrep hold the initial pose (all joints 0) with the parameter gains.
         self._stand_command = hold_command(gains, np.zeros(NUM_JOINTS))
         self._mode_command = self._stand_command
@@ -98,6 +104,20 @@ class AtlasSimulator:
         self.sim_time_ns = 0
         self.pinned = False
         self.reset_world()
+
+    def _make_compiled_law(self) -> law_kernel.CompiledLaw | None:
+        """The C law writing torque_nm and MjData.ctrl; None (numpy law) if it is not built."""
+        library = law_kernel.load_library()
+        if library is None or self.data.ctrl.shape != self.torque_nm.shape:
+            return None
+        return law_kernel.CompiledLaw(
+            library, self.data.qpos, self.atlas.qpos_adr, self.data.qvel, self.atlas.dof_adr,
+            self.atlas.lower_rad, self.atlas.upper_rad, self.atlas.effort_limit_nm, self.dt_s,
+            self._pid, self.torque_nm, self.data.ctrl)
+
+    @property
+    def uses_compiled_law(self) -> bool:
+        return self._compiled_law is not None
 
     # -- state -------------------------------------------------------------------------
     def reset_world(self) -> None:
@@ -212,11 +232,14 @@ class AtlasSimulator:
         """
         if self.pinned and self.sim_time_ns >= self._pin_until_ns:
             self._set_pinned(False)
-        if torque_nm is None:
-            self._law_torque(self._pid, out=self.torque_nm)
-        else:
+        if torque_nm is not None:
             self.torque_nm[:] = torque_nm
-        self.data.ctrl[:] = self.torque_nm
+            self.data.ctrl[:] = self.torque_nm
+        elif self._compiled_law is not None:
+            self._compiled_law(self.active_command())  # sets torque_nm and data.ctrl
+        else:
+            self._law_torque(self._pid, out=self.torque_nm)
+            self.data.ctrl[:] = self.torque_nm
         mujoco.mj_step(self.model, self.data)
         # mj_step integrates last: joint positions/velocities are at the new time, while body
         # poses and sensor readings were computed before integrating, at the step's start.
@@ -240,12 +263,17 @@ class AtlasSimulator:
         MuJoCo resets the state by itself on NaN/Inf/huge values and only warns: catching
         it here means no silently reset (or non-finite) state is ever published or replayed.
         """
-        data = self.data
+        counts = self._warning_counts
         for warning, what in DIVERGENCE_WARNINGS:
-            if data.warning[warning].number > 0:
-                data.warning[warning].number = 0
+            if counts[warning] > 0:
+                counts[warning] = 0
                 raise PhysicsDivergenceError(
                     f'physics diverged at t={self.sim_time_ns / NS_PER_S:.3f} s ({what})')
-        if not (np.isfinite(data.qpos).all() and np.isfinite(data.qvel).all()):
+        compiled = self._compiled_law
+        if compiled is not None:
+            finite = compiled.state_is_finite()
+        else:
+            finite = bool(np.isfinite(self.data.qpos).all() and np.isfinite(self.data.qvel).all())
+        if not finite:
             raise PhysicsDivergenceError(
                 f'physics diverged at t={self.sim_time_ns / NS_PER_S:.3f} s (non-finite state)')

@@ -1,0 +1,96 @@
+/*
+ * DRCSim 2.5.2's joint controller law for all joints in one call: the compiled twin of
+ * compute_torque() in src/tutorial_atlas_control/controller.py (whose docstring gives the
+ * law). Called once per step through ctypes (law_kernel.py) instead of ~25 numpy calls.
+ *
+ * It must give the numpy law's results bit for bit (offline replay depends on it), so:
+ * every operation is the numpy code's, in the same order, in double precision; the build
+ * forbids contracting a*b+c into an FMA (-ffp-contract=off, see CMakeLists.txt) and uses
+ * no -ffast-math; min/max are numpy's (see np_minimum).
+ */
+#include <math.h>
+#include <stddef.h>
+
+/* Gazebo's math::equal tolerance (controller.TIE_BACK_EPSILON). */
+#define TIE_BACK_EPSILON 1e-6
+
+/* The fields of osrf_msgs/JointCommands, in message order (commands.FIELD_NAMES). */
+enum {
+  POSITION, VELOCITY, EFFORT, KP_POSITION, KI_POSITION, KD_POSITION, KP_VELOCITY,
+  I_EFFORT_MIN, I_EFFORT_MAX, NUM_FIELDS
+};
+
+/* Everything one step reads and writes; laid out once by law_kernel.py (same order). */
+typedef struct {
+  const double *command[NUM_FIELDS]; /* (n,) each, joint order */
+  const double *qpos;                /* MjData.qpos */
+  const ptrdiff_t *qpos_adr;         /* (n,) qpos index of each joint */
+  const double *qvel;                /* MjData.qvel */
+  const ptrdiff_t *dof_adr;          /* (n,) qvel index of each joint */
+  const double *lower;               /* (n,) position limits (rad) */
+  const double *upper;
+  const double *effort_limit;        /* (n,) |torque| bound (N m) */
+  double *integral;                  /* (n,) PidState.integral (N m), updated */
+  double *previous_error;            /* (n,) PidState.previous_error (rad), updated */
+  double *torque;                    /* (n,) result (N m) */
+  double *ctrl;                      /* (n,) MjData.ctrl, also set to the result; or NULL */
+  double dt_s;
+  long n;
+  long initialized;                  /* PidState.initialized; set to 1 */
+  long nq, nv;                       /* lengths of qpos and qvel (atlas_state_is_finite) */
+} AtlasLawStep;
+
+/* numpy.minimum / numpy.maximum for one pair: a NaN wins, and of two equal values (0.0 and
+ * -0.0) the second is returned, like the SIMD minpd/maxpd numpy's loops use. */
+static inline double np_minimum(double a, double b) { return (isnan(a) || a < b) ? a : b; }
+static inline double np_maximum(double a, double b) { return (isnan(a) || a > b) ? a : b; }
+
+/* Gazebo's math::clamp as controller._clamp computes it: max(min(value, high), low). */
+static inline double clamp(double value, double low, double high) {
+  return np_maximum(np_minimum(value, high), low);
+}
+
+void atlas_law_step(AtlasLawStep *s) {
+  const double *const *c = s->command;
+  const double dt_s = s->dt_s;
+  const int initialized = s->initialized != 0;
+  for (long j = 0; j < s->n; ++j) {
+    const double error = clamp(c[POSITION][j], s->lower[j], s->upper[j]) - s->qpos[s->qpos_adr[j]];
+    const double previous = initialized ? s->previous_error[j] : error;
+    const double ki = c[KI_POSITION][j];
+
+    double integral = s->integral[j] + (ki * dt_s) * error;
+    integral = clamp(integral, c[I_EFFORT_MIN][j], c[I_EFFORT_MAX][j]);
+
+    double u = c[KP_POSITION][j] * error;
+    u += integral;
+    u += ((error - previous) / dt_s) * c[KD_POSITION][j];
+    u += (c[VELOCITY][j] - s->qvel[s->dof_adr[j]]) * c[KP_VELOCITY][j];
+    u += c[EFFORT][j];
+    s->previous_error[j] = error;
+
+    const double limit = s->effort_limit[j];
+    const double torque = clamp(u, -limit, limit);
+
+    /* tie-back: while saturated, pull the integral back by the torque that was cut off */
+    if (fabs(torque - u) > TIE_BACK_EPSILON && fabs(ki) > TIE_BACK_EPSILON) {
+      integral = clamp((torque - u) + integral, c[I_EFFORT_MIN][j], c[I_EFFORT_MAX][j]);
+    }
+    s->integral[j] = integral;
+    s->torque[j] = torque;
+    if (s->ctrl != NULL) s->ctrl[j] = torque;
+  }
+  s->initialized = 1;
+}
+
+/* 1 if every qpos and qvel is finite, else 0: the simulator's divergence check after each
+ * step, in one call instead of four numpy ones. */
+int atlas_state_is_finite(const AtlasLawStep *s) {
+  for (long i = 0; i < s->nq; ++i) {
+    if (!isfinite(s->qpos[i])) return 0;
+  }
+  for (long i = 0; i < s->nv; ++i) {
+    if (!isfinite(s->qvel[i])) return 0;
+  }
+  return 1;
+}

@@ -1,0 +1,171 @@
+"""The compiled controller law (src/atlas_law.c) equals the numpy law bit for bit."""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+from test_controller import random_command
+
+from tutorial_atlas_control import law_kernel
+from tutorial_atlas_control import model as atlas_model
+from tutorial_atlas_control.commands import FIELD_NAMES, JointCommandArrays
+from tutorial_atlas_control.controller import PidState, compute_torque, load_gains_yaml
+from tutorial_atlas_control.joints import NUM_JOINTS
+from tutorial_atlas_control.simulator import AtlasSimulator, ControlMode
+
+CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
+DT_S = 0.001
+
+
+@pytest.fixture(scope='module')
+def library():
+    library = law_kernel.load_library()
+    assert library is not None, (f'{law_kernel.LIBRARY_NAME} is not in the catkin workspace: '
+                                 'run `make setup` and `source ./env.sh`')
+    return library
+
+
+def same_bits(a: np.ndarray, b: np.ndarray) -> bool:
+    return a.tobytes() == b.tobytes()
+
+
+class Joints:
+    """q and v laid out like MjData: scattered through longer arrays, in another order."""
+
+    def __init__(self, rng: np.random.Generator) -> None:
+        self.qpos = np.zeros(NUM_JOINTS + 7)
+        self.qvel = np.zeros(NUM_JOINTS + 6)
+        self.qpos_adr = (rng.permutation(NUM_JOINTS) + 7).astype(np.intp)
+        self.dof_adr = (rng.permutation(NUM_JOINTS) + 6).astype(np.intp)
+
+    def set(self, q: np.ndarray, v: np.ndarray) -> None:
+        self.qpos[self.qpos_adr] = q
+        self.qvel[self.dof_adr] = v
+
+
+def test_compiled_law_equals_the_numpy_law_on_random_inputs(library) -> None:  # noqa: ANN001
+    """300 runs of 60 steps: saturation, tie-back, ki changes and sign flips, inverted
+    integral bounds, targets beyond the limits, resets mid-run; torque and memory compared."""
+    rng = np.random.default_rng(18)
+    counts = {'tie_backs': 0, 'inverted_bounds': 0, 'negative_ki': 0, 'saturated': 0}
+    for _run in range(300):
+        lower = rng.uniform(-2.5, 0.0, NUM_JOINTS)
+        upper = lower + rng.uniform(0.0, 3.0, NUM_JOINTS)
+        upper[:3] = lower[:3]  # a joint without range
+        limit = rng.uniform(0.0, 200.0, NUM_JOINTS)
+        limit[3] = 0.0
+        joints = Joints(rng)
+        numpy_state, c_state = PidState(), PidState()
+        torque, ctrl = np.zeros(NUM_JOINTS), np.full(NUM_JOINTS, np.nan)
+        law = law_kernel.CompiledLaw(library, joints.qpos, joints.qpos_adr, joints.qvel,
+                                     joints.dof_adr, lower, upper, limit, DT_S, c_state, torque,
+                                     ctrl)
+        command = random_command(rng)
+        q = rng.uniform(-2.0, 2.0, NUM_JOINTS)
+        v = rng.uniform(-5.0, 5.0, NUM_JOINTS)
+        for step in range(60):
+            if rng.random() < 0.2:  # a new command object: ki and bounds change
+                command = random_command(rng)
+            elif rng.random() < 0.1:  # the same object, edited in place
+                command.ki_position[:] = -command.ki_position
+            if step == 30 and rng.random() < 0.5:
+                numpy_state.reset()
+                c_state.reset()
+            q = q + rng.normal(0.0, 0.05, NUM_JOINTS)
+            v = v + rng.normal(0.0, 0.5, NUM_JOINTS)
+            if step % 7 == 0:
+                q[5] = upper[5]  # exactly at a limit
+                q[6] = -0.0
+            joints.set(q, v)
+            expected = compute_torque(command, q, v, numpy_state, DT_S, lower, upper, limit)
+            law(command)
+            assert same_bits(torque, expected), (step, torque - expected)
+            assert same_bits(ctrl, expected)
+            assert same_bits(c_state.integral, numpy_state.integral), step
+            assert same_bits(c_state.previous_error, numpy_state.previous_error), step
+            assert c_state.initialized
+            counts['saturated'] += int(np.count_nonzero(np.abs(expected) == limit))
+            counts['inverted_bounds'] += int(np.count_nonzero(
+                command.i_effort_min > command.i_effort_max))
+            counts['negative_ki'] += int(np.count_nonzero(command.ki_position < -1e-6))
+            counts['tie_backs'] += int(np.count_nonzero(  # saturated with ki on
+                (np.abs(command.ki_position) > 1e-6) & (np.abs(torque) == limit)))
+    assert min(counts.values()) > 1000, counts  # every case the law distinguishes was exercised
+
+
+def test_compiled_law_refuses_misshapen_arrays(library) -> None:  # noqa: ANN001
+    state = PidState()
+    good = np.zeros(NUM_JOINTS)
+    adr = np.arange(NUM_JOINTS, dtype=np.intp)
+    with pytest.raises(ValueError, match=r'qpos_adr has shape \(3,\), expected \(28,\)'):
+        law_kernel.CompiledLaw(library, good, adr[:3], good, adr, good, good, good, DT_S, state,
+                               np.zeros(NUM_JOINTS))
+    with pytest.raises(ValueError, match='C-contiguous int64 arrays, got int32'):
+        law_kernel.CompiledLaw(library, good, adr.astype(np.int32), good, adr, good, good, good,
+                               DT_S, state, np.zeros(NUM_JOINTS))
+
+
+def run_simulator(compiled_law: bool) -> tuple[AtlasSimulator, list[bytes]]:
+    """Stand past the pin, then User commands with integral gains that saturate, ragdoll,
+    a reset: the qpos bytes after every step."""
+    sim = AtlasSimulator(atlas_model.load_model(), load_gains_yaml(CONFIG), time_to_unpin_s=0.3,
+                         compiled_law=compiled_law)
+    assert sim.uses_compiled_law is compiled_law
+    rng = np.random.default_rng(7)
+    states = []
+    commands = [random_command(rng) for _ in range(4)]
+    for step in range(2500):
+        if step == 600:
+            sim.set_mode(ControlMode.USER)
+        if step in (700, 900, 1100, 1300):
+            command = commands[(step - 700) // 200]
+            sim.receive_command([], {name: getattr(command, name) for name in FIELD_NAMES})
+        if step == 1500:
+            sim.set_mode(ControlMode.RAGDOLL)
+        if step == 1800:
+            sim.reset_world()
+            sim.set_mode(ControlMode.FREEZE)
+        sim.step()
+        states.append(sim.data.qpos.tobytes() + sim.torque_nm.tobytes()
+                      + sim._pid.integral.tobytes())
+    return sim, states
+
+
+def test_simulator_runs_identically_with_either_law(library) -> None:  # noqa: ANN001
+    _, with_c = run_simulator(True)
+    _, with_numpy = run_simulator(False)
+    first_difference = next((i for i, (a, b) in enumerate(zip(with_c, with_numpy)) if a != b),
+                            None)
+    assert first_difference is None
+    integral_at_1500 = np.frombuffer(with_numpy[1499][-8 * NUM_JOINTS:])
+    assert np.count_nonzero(integral_at_1500) > 5  # the User commands' integral was in play
+
+
+def test_missing_library_falls_back_to_numpy_with_one_warning(
+        monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    monkeypatch.setenv(law_kernel.LIBRARY_ENV, str(tmp_path / 'missing.so'))
+    monkeypatch.setattr(law_kernel, '_library', None)
+    monkeypatch.setattr(law_kernel, '_warned', False)
+    with pytest.warns(RuntimeWarning, match=r'^TAC_LAW_LIBRARY=.*missing\.so does not exist; '
+                                            r'using the numpy controller law'):
+        first = AtlasSimulator(atlas_model.load_model(), load_gains_yaml(CONFIG))
+    assert not first.uses_compiled_law
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        second = AtlasSimulator(atlas_model.load_model(), load_gains_yaml(CONFIG))
+    assert not second.uses_compiled_law
+    second.step()
+    assert np.isfinite(second.torque_nm).all()
+
+
+def test_ragdoll_command_gives_zero_torque(library) -> None:  # noqa: ANN001
+    sim = AtlasSimulator(atlas_model.load_model(), load_gains_yaml(CONFIG))
+    sim.set_mode(ControlMode.RAGDOLL)
+    sim.step()
+    assert not sim.torque_nm.any() and not sim.data.ctrl.any()
+    assert JointCommandArrays.zeros().position.shape == (NUM_JOINTS,)
+
+
