@@ -18,6 +18,7 @@ from unittest import mock
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+import offline  # noqa: E402
 from offline import make_simulator  # noqa: E402
 
 #: The node's law runs this long (s of sim time) before the bare physics is timed: past
@@ -59,23 +60,6 @@ def bare_physics_run(steps: int = 5000) -> float:
         elapsed_s += time.perf_counter() - start
         done += block
     return steps / elapsed_s
-
-
-def law_physics_run(compiled_law: bool, warmup_steps: int = 1500, steps: int = 5000) -> float:
-    """Steps per wall second of AtlasSimulator.step() (law + mj_step), either law."""
-    from tutorial_atlas_control import controller, model
-    from tutorial_atlas_control.simulator import AtlasSimulator
-    from offline import GAINS_YAML
-
-    sim = AtlasSimulator(model.load_model(), controller.load_gains_yaml(GAINS_YAML),
-                         compiled_law=compiled_law)
-    step = sim.step
-    for _ in range(warmup_steps):
-        step()
-    start = time.perf_counter()
-    for _ in range(steps):
-        step()
-    return steps / (time.perf_counter() - start)
 
 
 class _NullSocket:
@@ -212,8 +196,8 @@ def main() -> int:
     for _ in range(rounds):
         figures = {
             'bare mj_step': 1e6 / bare_physics_run(),
-            'law (C) + mj_step': 1e6 / law_physics_run(True),
-            'law (numpy) + mj_step': 1e6 / law_physics_run(False),
+            'law (C) + mj_step': 1e6 / offline.physics_run(compiled_law=True),
+            'law (numpy) + mj_step': 1e6 / offline.physics_run(compiled_law=False),
             'node spin, C law': node_spin_run(),
             'node spin, numpy law': node_spin_run(compiled_law=False),
             'node spin, C law, TCP': node_spin_run(tcp=True),

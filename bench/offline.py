@@ -18,21 +18,22 @@ ANALYSIS_TOPICS = (topics.JOINT_STATES, topics.JOINT_COMMANDS, topics.GROUND_TRU
 
 
 # ---------------------------------------------------------------------------- physics
-def make_simulator():
+def make_simulator(compiled_law: bool = True):
     """AtlasSimulator with the DRCSim gains from config/, as the node builds it."""
     from tutorial_atlas_control import controller, model
     from tutorial_atlas_control.simulator import AtlasSimulator
 
-    return AtlasSimulator(model.load_model(), controller.load_gains_yaml(GAINS_YAML))
+    return AtlasSimulator(model.load_model(), controller.load_gains_yaml(GAINS_YAML),
+                          compiled_law=compiled_law)
 
 
-def physics_run(warmup_steps: int = 1500, steps: int = 5000) -> float:
+def physics_run(warmup_steps: int = 1500, steps: int = 5000, compiled_law: bool = True) -> float:
     """Steps per wall second of AtlasSimulator.step() (law + mj_step) in a plain loop.
 
     A fresh simulator each run; the warm-up passes the 1 s torso pin so the timed
     steps are the standing robot with its feet in contact, as in a real run.
     """
-    sim = make_simulator()
+    sim = make_simulator(compiled_law)
     step = sim.step
     for _ in range(warmup_steps):
         step()

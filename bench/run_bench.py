@@ -149,7 +149,7 @@ def run_offline(args: argparse.Namespace, samples: dict[str, list[float]],
                 rates = {'bare_physics_steps_per_s': node_loop.bare_physics_run(steps),
                          'physics_limit_steps_per_s': offline.physics_run(steps=steps),
                          'physics_numpy_law_steps_per_s':
-                             node_loop.law_physics_run(False, steps=steps)}
+                             offline.physics_run(steps=steps, compiled_law=False)}
                 log(f'physics run {run + 1}: ' + ', '.join(
                     f'{key} {rate:.0f}' for key, rate in rates.items()))
                 add(samples, rates)

@@ -14,7 +14,6 @@ run's (bag_analysis's definition), from its first applied command.
 from __future__ import annotations
 
 import json
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -23,7 +22,7 @@ import numpy as np
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bag_analysis import FALL_HEIGHT_M, Analysis, analyze_bag
-from tutorial_atlas_control.bag_report import save_figure
+from tutorial_atlas_control.bag_report import json_safe, save_figure
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_INDEX
 from tutorial_atlas_control.run_log import PlayedTrajectory, played_trajectories
@@ -237,19 +236,9 @@ def format_comparison(comparison: Comparison) -> str:
     return '\n'.join(lines)
 
 
-def _json_safe(value: Any) -> Any:
-    if isinstance(value, dict):
-        return {key: _json_safe(item) for key, item in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_safe(item) for item in value]
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
-
-
 def to_json(comparison: Comparison) -> str:
     """The comparison as one strict JSON document."""
-    return json.dumps(_json_safe(comparison.to_dict()), indent=2, allow_nan=False)
+    return json.dumps(json_safe(comparison.to_dict()), indent=2, allow_nan=False)
 
 
 def _decimate(t_s: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -138,12 +138,12 @@ def short_summary(analysis: Analysis) -> str:
     return '\n'.join(lines)
 
 
-def _json_safe(value: Any) -> Any:
+def json_safe(value: Any) -> Any:
     """NaN/inf -> None and numpy scalars -> Python, so the output is strict JSON."""
     if isinstance(value, dict):
-        return {key: _json_safe(item) for key, item in value.items()}
+        return {key: json_safe(item) for key, item in value.items()}
     if isinstance(value, (list, tuple)):
-        return [_json_safe(item) for item in value]
+        return [json_safe(item) for item in value]
     if isinstance(value, np.generic):
         value = value.item()
     if isinstance(value, float) and not math.isfinite(value):
@@ -153,7 +153,7 @@ def _json_safe(value: Any) -> Any:
 
 def to_json(analysis: Analysis, extra: dict[str, Any] | None = None) -> str:
     """The analysis as one JSON object (strict JSON: no NaN), plus the keys of `extra`."""
-    return json.dumps(_json_safe({**analysis.to_dict(), **(extra or {})}), indent=2,
+    return json.dumps(json_safe({**analysis.to_dict(), **(extra or {})}), indent=2,
                       allow_nan=False)
 
 

@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import importlib.util
-import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import mujoco
 import numpy as np
 import pytest
+from support.model_table import load_table
 
 from tutorial_atlas_control import commands, controller, model
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
@@ -19,16 +18,7 @@ REFERENCE = REPO.parent / 'shared' / 'reference'
 GAINS_YAML = REPO / 'config' / 'atlas_controller.yaml'
 
 
-def _load_table():
-    """tools/make_atlas_mjcf.py: the table of figures the model is generated from."""
-    spec = importlib.util.spec_from_file_location('make_atlas_mjcf', REPO / 'tools' / 'make_atlas_mjcf.py')
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-TABLE = _load_table()
+TABLE = load_table()
 
 
 @pytest.fixture(scope='module')

@@ -2,16 +2,15 @@
 
 from __future__ import annotations
 
-import importlib.util
 import re
 import shutil
-import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import mujoco
 import numpy as np
 import pytest
+from support.model_table import load_table
 
 from tutorial_atlas_control import model, urdf
 from tutorial_atlas_control.joints import JOINT_NAMES
@@ -29,15 +28,7 @@ FK_TOLERANCE_M = 1e-3
 FK_TOLERANCE_RAD = 1e-6
 
 
-def _load_table():
-    spec = importlib.util.spec_from_file_location('make_atlas_mjcf_urdf', REPO / 'tools' / 'make_atlas_mjcf.py')
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-TABLE = _load_table()
+TABLE = load_table()
 
 
 @pytest.fixture(scope='module')
