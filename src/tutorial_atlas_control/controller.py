@@ -143,17 +143,23 @@ def compute_torque(command: JointCommandArrays, q: np.ndarray, v: np.ndarray, st
     np.negative(effort_limit, out=term)
     _clamp(unclamped, term, effort_limit, out=torque)
 
-    # tie-back: while saturated, pull the integral back by the torque that was cut off
-    # (with every ki 0, the tutorial's gains, there is nothing to tie back)
+    # with every ki 0 (the tutorial's gains) there is nothing to tie back
     if ki.any():
-        np.subtract(torque, unclamped, out=term)
-        tie_back = np.abs(term) > TIE_BACK_EPSILON
-        tie_back &= np.abs(ki) > TIE_BACK_EPSILON
-        if tie_back.any():
-            term += integral
-            _clamp(term, command.i_effort_min, command.i_effort_max, out=term)
-            np.copyto(integral, term, where=tie_back)
+        _tie_back(command, torque, unclamped, integral, term)
     return torque
+
+
+def _tie_back(command: JointCommandArrays, torque: np.ndarray, unclamped: np.ndarray,
+              integral: np.ndarray, scratch: np.ndarray) -> None:
+    """While saturated, pull the integral back by the torque the clamp cut off (2.5.2's
+    anti-windup), on joints whose ki and cut both exceed Gazebo's equality tolerance."""
+    np.subtract(torque, unclamped, out=scratch)
+    tie_back = np.abs(scratch) > TIE_BACK_EPSILON
+    tie_back &= np.abs(command.ki_position) > TIE_BACK_EPSILON
+    if tie_back.any():
+        scratch += integral
+        _clamp(scratch, command.i_effort_min, command.i_effort_max, out=scratch)
+        np.copyto(integral, scratch, where=tie_back)
 
 
 @dataclass(frozen=True)
