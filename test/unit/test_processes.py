@@ -47,7 +47,11 @@ def test_descendants_follow_parents_across_sessions_and_alive_drops_the_dead() -
 
 def test_stop_tree_kills_what_ignores_sigint_including_other_sessions() -> None:
     parent = subprocess.Popen(['bash', '-c', STUBBORN_TREE], start_new_session=True)
-    children = wait_for_children(parent, 2)
+    # Both sleeps running: before that, a forked child still shows its parent's command line
+    # and has not set its trap yet.
+    wait_until(lambda: [command_line(pid) for pid in descendants(parent.pid)].count('sleep 300') == 2,
+               GUARD_S, 'children did not start')
+    children = descendants(parent.pid)
     assert stop_tree(parent, timeout_s=0.5) is False, 'it had to be killed'
     assert parent.poll() == -signal.SIGKILL
     wait_until(lambda: alive(children) == [], GUARD_S, 'children survived')
