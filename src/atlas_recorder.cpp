@@ -32,11 +32,13 @@ namespace
 {
 using RecordedEvent = ros::MessageEvent<topic_tools::ShapeShifter const>;
 
-// Messages each topic may have waiting to be written: 50 s of 1 kHz joint states, 8 s of a
-// 6 kHz command flood, up to ~100 MB of memory per topic. Beyond it roscpp drops the oldest,
-// as rosbag record does past 100: a recorder slower than the simulator for good (real_time_factor
-// 0 on a small machine) must not grow without bound.
-constexpr uint32_t kQueueDepth = 50000;
+// Messages each topic may have waiting to be written: 200 s of 1 kHz joint states, 33 s of a
+// 6 kHz command flood (up to ~500 MB of commands). The recorder runs at niceness 10, so a
+// machine kept busy by other work starves it for as long as the load lasts; it catches up
+// afterwards. Beyond the bound roscpp drops the oldest, as rosbag record does past 100: a
+// recorder slower than the simulator for good (real_time_factor 0 on a small machine) must
+// not grow without bound.
+constexpr uint32_t kQueueDepth = 200000;
 
 std::atomic<bool> g_stop_requested(false);
 

@@ -25,11 +25,6 @@ def session(pid: int) -> int:
     return int((Path('/proc') / str(pid) / 'stat').read_text().rsplit(')', 1)[1].split()[3])
 
 
-def wait_for_children(parent: subprocess.Popen, count: int) -> list[int]:
-    wait_until(lambda: len(descendants(parent.pid)) >= count, GUARD_S, 'children did not start')
-    return descendants(parent.pid)
-
-
 def test_descendants_follow_parents_across_sessions_and_alive_drops_the_dead() -> None:
     parent = subprocess.Popen(['bash', '-c', 'setsid sleep 30 & sleep 30 & wait'])
     try:
@@ -58,8 +53,13 @@ def test_stop_tree_kills_what_ignores_sigint_including_other_sessions() -> None:
 
 
 def test_stop_tree_is_clean_when_sigint_stops_the_tree() -> None:
-    parent = subprocess.Popen(['bash', '-c', 'sleep 300 & wait'], start_new_session=True)
-    children = wait_for_children(parent, 1)
+    # As roslaunch does: SIGINT handled by stopping the children, then exiting. The trap is
+    # set before the child starts, and the child has exec'd before the signal is sent.
+    parent = subprocess.Popen(['bash', '-c', "trap 'kill $!; exit 130' INT; sleep 300 & wait"],
+                              start_new_session=True)
+    wait_until(lambda: [command_line(pid) for pid in descendants(parent.pid)] == ['sleep 300'],
+               GUARD_S, 'the child did not start')
+    children = descendants(parent.pid)
     assert stop_tree(parent, timeout_s=GUARD_S) is True
     wait_until(lambda: alive(children) == [], GUARD_S, 'children survived')
 
