@@ -129,6 +129,15 @@ def stop_tree(process: subprocess.Popen, timeout_s: float = STOP_TIMEOUT_S,
     return clean
 
 
+def default_sigint() -> None:
+    """`preexec_fn` for a child stopped with SIGINT: SIGINT back to its default action.
+
+    A child inherits an ignored SIGINT (e.g. from a shell's background job), and a shell
+    cannot even trap a signal ignored at its start; stop_tree's Ctrl-C must reach it.
+    """
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _signal_group(process: subprocess.Popen, sig: int) -> None:
     """`sig` to the process group `process` leads (started with start_new_session)."""
     try:
@@ -219,7 +228,7 @@ class _RosProcess:
         try:
             self.process = subprocess.Popen(
                 list(command), env=self.env, stdout=self._log, stderr=subprocess.STDOUT,
-                stdin=subprocess.DEVNULL, start_new_session=True)
+                stdin=subprocess.DEVNULL, start_new_session=True, preexec_fn=default_sigint)
         except FileNotFoundError:
             self._log.close()
             raise ProcessError(f'{command[0]} is not on PATH; run `make setup` and '

@@ -11,8 +11,8 @@ import pytest
 
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.processes import (AtlasLaunch, ProcessError, alive, command_line,
-                                              descendants, free_local_port, rss_kib, stop_tree,
-                                              wait_until)
+                                              default_sigint, descendants, free_local_port,
+                                              rss_kib, stop_tree, wait_until)
 
 #: Guard (s) for child processes to start or be reaped, however busy the machine is.
 GUARD_S = 30.0
@@ -56,7 +56,7 @@ def test_stop_tree_is_clean_when_sigint_stops_the_tree() -> None:
     # As roslaunch does: SIGINT handled by stopping the children, then exiting. The trap is
     # set before the child starts, and the child has exec'd before the signal is sent.
     parent = subprocess.Popen(['bash', '-c', "trap 'kill $!; exit 130' INT; sleep 300 & wait"],
-                              start_new_session=True)
+                              start_new_session=True, preexec_fn=default_sigint)
     wait_until(lambda: [command_line(pid) for pid in descendants(parent.pid)] == ['sleep 300'],
                GUARD_S, 'the child did not start')
     children = descendants(parent.pid)
