@@ -490,7 +490,8 @@ def _command_wire(gains: Gains) -> JointCommandsWire:
 
 def write_offline_bag(bag: Path, trajectory_file: str, name: str, waypoints: Sequence[Waypoint],
                       gains: Gains, settle_s: float, start_after_s: float,
-                      model_path: Path = atlas_model.MODEL_PATH) -> OfflineRun:
+                      model_path: Path = atlas_model.MODEL_PATH,
+                      play_after_s: float = 0.0) -> OfflineRun:
     """Simulate the run and write it to `bag` (a new file; see run_offline for the checks)."""
     sim = AtlasSimulator(atlas_model.load_model(model_path), gains)
     sink = _BagSink(bag)
@@ -502,6 +503,7 @@ def write_offline_bag(bag: Path, trajectory_file: str, name: str, waypoints: Seq
         player.publish()  # the initial state, before the first step, as the node does
         player.advance(start_after_s)
         player.switch_mode(ControlMode.USER)
+        player.advance(play_after_s)
         player.log(trajectory_log_line(trajectory_file, name))
         player.log(playing_line(name, waypoints))
         run_trajectory(waypoints, sim.joint_positions, player.send, player.advance, player.log,
@@ -519,8 +521,13 @@ def run_offline(trajectory_file: str, name: str, bag: Path | str,
                 settle_s: float = DEFAULT_SETTLE_S,
                 start_after_s: float = DEFAULT_START_AFTER_S,
                 gains_file: Path = DEFAULT_GAINS_FILE,
-                model_path: Path = atlas_model.MODEL_PATH) -> OfflineRun:
+                model_path: Path = atlas_model.MODEL_PATH,
+                play_after_s: float = 0.0) -> OfflineRun:
     """Run trajectory `name` of `trajectory_file` offline into the bag `bag`.
+
+    User mode starts `start_after_s` after spawn and the trajectory `play_after_s` later (a
+    live traj_yaml.py starts a few seconds after the switch: to re-create a live run, give
+    both from its bag).
 
     The bag is written under a temporary name beside `bag` and renamed when complete
     (replacing an existing file): a failed run leaves nothing.
@@ -540,7 +547,7 @@ def run_offline(trajectory_file: str, name: str, bag: Path | str,
     partial = target.parent / f'.{target.name}.{os.getpid()}.partial'
     try:
         run = write_offline_bag(partial, os.path.abspath(path), name, waypoints, gains,
-                                settle_s, start_after_s, model_path)
+                                settle_s, start_after_s, model_path, play_after_s)
         os.replace(partial, target)
     except OSError as err:
         raise OfflineRunError(f'cannot write {target}: {err.strerror or err}') from err
@@ -573,6 +580,9 @@ def build_parser() -> argparse.ArgumentParser:
                         help='write the run to this bag (replaced if it exists)')
     parser.add_argument('--settle', type=_seconds, default=DEFAULT_SETTLE_S, metavar='S',
                         help='sim time after the last command (default: %(default)g)')
+    parser.add_argument('--play-after', type=_seconds, default=0.0, metavar='S',
+                        help='sim time between the switch to User and the first command '
+                             '(default: 0; a live traj_yaml.py starts a few seconds after)')
     parser.add_argument('--start-after', type=_seconds, default=DEFAULT_START_AFTER_S,
                         metavar='S', help='sim time from spawn to User mode and the first '
                         'command (default: %(default)g; the torso is pinned for 1 s)')
@@ -589,7 +599,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             # Without --bag the summary is read from a bag that is deleted afterwards.
             bag = args.bag if args.bag is not None else Path(scratch) / f'{args.name}.bag'
             run = run_offline(args.trajectory_file, args.name, bag, args.settle,
-                              args.start_after, args.gains)
+                              args.start_after, args.gains, play_after_s=args.play_after)
             analysis = analyze_bag(run.bag)
     except AtlasControlError as err:
         print_error(PROG, err)

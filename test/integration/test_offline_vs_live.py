@@ -19,7 +19,9 @@ import pytest
 
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
-from tutorial_atlas_control.bag_compare import compare_bags, format_comparison  # noqa: E402
+from tutorial_atlas_control.bag_analysis import analyze_bag  # noqa: E402
+from tutorial_atlas_control.bag_compare import (  # noqa: E402
+    compare_bags, first_applied_command_s, format_comparison)
 from tutorial_atlas_control.offline_run import run_offline  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
@@ -54,7 +56,14 @@ def test_offline_run_reaches_the_live_outcome(trajectory: str, falls: bool, requ
                                               tmp_path: Path) -> None:
     live = request.getfixturevalue('demo_run' if trajectory == 'step_and_fall' else 'touchdown_run')
     assert live.result.returncode == 0, live.result.stdout + live.result.stderr
-    offline = run_offline(str(TRAJECTORIES), trajectory, tmp_path / f'{trajectory}.bag')
+    # The offline run on the live run's schedule: User and the first command at the same sim
+    # times (traj_yaml.py's start-up after the switch depends on how busy the machine is).
+    live_analysis = analyze_bag(live.bag)
+    user_s = next(t_s for t_s, mode in live_analysis.data.modes if mode == 'User')
+    start_s = live_analysis.data.start_time_s
+    offline = run_offline(str(TRAJECTORIES), trajectory, tmp_path / f'{trajectory}.bag',
+                          start_after_s=start_s + user_s,
+                          play_after_s=first_applied_command_s(live_analysis) - user_s)
     comparison = compare_bags(live.bag, offline.bag)
     print(format_comparison(comparison))  # the figures, with pytest -s
     assert comparison.trajectory_a is not None and comparison.trajectory_a.name == trajectory
