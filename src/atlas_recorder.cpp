@@ -39,8 +39,10 @@ using RecordedEvent = ros::MessageEvent<topic_tools::ShapeShifter const>;
 // recorder slower than the simulator for good (real_time_factor 0 on a small machine) must
 // not grow without bound.
 constexpr uint32_t kQueueDepth = 200000;
-// After SIGINT: stop once this long (s, wall) passes without a message, or after kDrainMaxS.
-constexpr double kDrainQuietS = 0.5;
+// After SIGINT: stop after kQuietWaits empty waits of kDrainWaitS (s) in a row (1 s when the
+// recorder gets the CPU), or after kDrainMaxS (s, wall).
+constexpr double kDrainWaitS = 0.05;
+constexpr int kQuietWaits = 20;
 constexpr double kDrainMaxS = 10.0;
 
 std::atomic<bool> g_stop_requested(false);
@@ -165,24 +167,23 @@ int main(int argc, char** argv)
 
   // Write what has already arrived, and what is still arriving: a recorder starved of CPU is
   // behind, and what the publishers sent before they stopped may still be in its sockets. Drain
-  // until kDrainQuietS pass without a message (roslaunch stops the other nodes at the same
-  // time), kDrainMaxS at most (roslaunch escalates to SIGTERM after 15 s). Then stop receiving
-  // (shutting a subscriber down first would discard its queued messages).
+  // until kQuietWaits waits of kDrainWaitS in a row bring nothing (counted in waits, not wall
+  // time, so that a starved recorder is not cut short), kDrainMaxS at most (roslaunch
+  // escalates to SIGTERM after 15 s). Then stop receiving (shutting a subscriber down first
+  // would discard its queued messages).
   const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(kDrainMaxS);
-  ros::WallTime last_message = ros::WallTime::now();
   unsigned long seen = writer.written();
-  while (ros::WallTime::now() < give_up && !writer.failed())
+  for (int quiet = 0; quiet < kQuietWaits && ros::WallTime::now() < give_up && !writer.failed();)
   {
-    callbacks->callAvailable(ros::WallDuration(0.05));
-    const ros::WallTime now = ros::WallTime::now();
+    callbacks->callAvailable(ros::WallDuration(kDrainWaitS));
     if (writer.written() != seen)
     {
       seen = writer.written();
-      last_message = now;
+      quiet = 0;
     }
-    else if ((now - last_message).toSec() >= kDrainQuietS)
+    else
     {
-      break;
+      ++quiet;
     }
   }
   for (ros::Subscriber& subscriber : subscribers)
