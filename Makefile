@@ -1,6 +1,6 @@
 # The project's commands. Each one sets the project up first when needed.
 #   make setup   Debian packages, virtualenv, catkin workspace (idempotent)
-#   make test    unit and integration tests (pytest), catkin_lint, then the rostests
+#   make test    unit, integration and reliability tests (pytest), catkin_lint, then the rostests
 #   make demo    the tutorial end to end, headless (TRAJ=step_and_fall|touchdown|touchdown_exhausted)
 #   make bench   the performance benchmark
 SHELL := /bin/bash
