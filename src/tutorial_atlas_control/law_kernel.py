@@ -1,7 +1,8 @@
 """The controller law as one compiled call per step (src/atlas_law.c through ctypes).
 
-Also compiled there, for the same reason (a numpy call costs about a microsecond, the
-work a few nanoseconds): the divergence check's finiteness test.
+Also compiled in that library, for the same reason (a numpy call costs about a
+microsecond, the work a few nanoseconds): the divergence check's finiteness test, and the
+indexed copies that fill the simulator's messages from MjData (CopyPlan, src/atlas_gather.c).
 
 controller.compute_torque spends ~25 numpy calls per step, as much time as half a physics
 step; the C twin does the same arithmetic in one call, reading q and v straight from
@@ -16,6 +17,7 @@ from __future__ import annotations
 import ctypes
 import os
 import warnings
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -42,6 +44,14 @@ class _Step(ctypes.Structure):
         ('dt_s', ctypes.c_double), ('n', ctypes.c_long), ('initialized', ctypes.c_long),
         ('nq', ctypes.c_long), ('nv', ctypes.c_long),
     ]
+
+
+class _Copy(ctypes.Structure):
+    """AtlasCopy in src/atlas_gather.c (same fields, same order)."""
+
+    _fields_ = [('dst', ctypes.c_void_p), ('dst_index', ctypes.c_void_p),
+                ('src', ctypes.c_void_p), ('src_index', ctypes.c_void_p),
+                ('count', ctypes.c_long)]
 
 
 def find_library() -> Path | None:
@@ -82,6 +92,8 @@ def load_library() -> ctypes.CDLL | None:
             library.atlas_law_step.restype = None
             library.atlas_state_is_finite.argtypes = [ctypes.POINTER(_Step)]
             library.atlas_state_is_finite.restype = ctypes.c_int
+            library.atlas_copy_all.argtypes = [ctypes.POINTER(_Copy), ctypes.c_long]
+            library.atlas_copy_all.restype = None
             _library = library
             return library
         except (OSError, AttributeError) as err:
@@ -168,3 +180,48 @@ class CompiledLaw:
                 raise ValueError(f'command.{name} has shape {array.shape}, expected ({count},)')
             self._step.command[FIELD_NAMES.index(name)] = _address(array, np.float64)
         self._command, self._command_arrays = command, arrays
+
+
+#: One copy of a CopyPlan: (dst, dst_index, src, src_index), meaning dst[dst_index] = src[src_index].
+Copy = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+class CopyPlan:
+    """A fixed list of indexed float64 copies, run together by one call.
+
+    Compiled (one ctypes call) when the library is built, else numpy, one call per copy;
+    the values copied are the same. Holds pointers into the arrays given and references to
+    them: they must never be reallocated (MjData's arrays and wire.py's views are not).
+    """
+
+    def __init__(self, copies: Sequence[Copy], compiled: bool = True) -> None:
+        """`compiled`: False always copies with numpy (the reference the C copies equal)."""
+        self.copies = [(dst, np.ascontiguousarray(to, dtype=np.intp), src,
+                        np.ascontiguousarray(source, dtype=np.intp))
+                       for dst, to, src, source in copies]
+        for dst, to, src, source in self.copies:
+            if len(to) != len(source):
+                raise ValueError(f'a copy of {len(source)} values to {len(to)} places')
+            for name, array, index in (('dst', dst, to), ('src', src, source)):
+                if len(index) and not 0 <= index.min() <= index.max() < array.size:
+                    raise ValueError(f'{name} index outside 0..{array.size - 1}')
+        library = load_library() if compiled else None
+        self._call = None
+        if library is not None:
+            table = (_Copy * len(self.copies))()
+            for entry, (dst, to, src, source) in zip(table, self.copies):
+                entry.dst = _address(dst, np.float64)
+                entry.dst_index = _address(to, np.intp)
+                entry.src = _address(src, np.float64)
+                entry.src_index = _address(source, np.intp)
+                entry.count = len(to)
+            self._table = table
+            self._call = library.atlas_copy_all
+            self._arguments = (table, len(table))
+
+    def __call__(self) -> None:
+        if self._call is not None:
+            self._call(*self._arguments)
+            return
+        for dst, to, src, source in self.copies:
+            dst[to] = src[source]

@@ -13,6 +13,7 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control.joints import JOINT_NAMES
+from tutorial_atlas_control.law_kernel import CopyPlan
 from tutorial_atlas_control.simulator import AtlasSimulator
 from tutorial_atlas_control.topics import PELVIS_FRAME, WORLD_FRAME
 from tutorial_atlas_control.wire import (
@@ -68,16 +69,26 @@ class SimMessages:
             ('imu', self.imu_wire), ('odometry', self.odometry_wire),
             ('l', self.contact_wires['l']), ('r', self.contact_wires['r']))}
         self._pelvis_velocity = np.zeros(6)
+        # The 1 kHz messages' numbers, one CopyPlan call each per step.
+        data, joints = sim.data, np.arange(len(JOINT_NAMES))
+        wire = self.joint_state_wire
+        self._joint_state_copies = CopyPlan([
+            (wire.position, joints, data.qpos, sim.atlas.qpos_adr),
+            (wire.velocity, joints, data.qvel, sim.atlas.dof_adr),
+            (wire.effort, joints, sim.torque_nm, joints)])
+        to, source = self.imu_map
+        self._imu_copies = CopyPlan([(self.imu_wire.floats, to, data.sensordata, source)])
+        self._contact_copies = {}
+        for side, (to, source) in self.contact_maps.items():
+            self._contact_copies[side] = CopyPlan(
+                [(self.contact_wires[side].floats, to, data.sensordata, source)])
 
     def fill_joint_state(self) -> None:
         """Joint positions and velocities after the last step; effort = the torque it applied.
 
         Stamp it with the sim time after the step (`sim.sim_time_ns`).
         """
-        sim, msg = self.sim, self.joint_state_wire
-        sim.data.qpos.take(sim.atlas.qpos_adr, out=msg.position)
-        sim.data.qvel.take(sim.atlas.dof_adr, out=msg.velocity)
-        msg.effort[:] = sim.torque_nm
+        self._joint_state_copies()
 
     def fill_odometry(self) -> None:
         """Pelvis pose and world-frame twist, as Gazebo's p3d plugin reported them.
@@ -104,13 +115,11 @@ class SimMessages:
 
     def fill_imu(self) -> None:
         """The pelvis IMU (sensor readings: stamp with `sim.state_time_ns`)."""
-        to, source = self.imu_map
-        self.imu_wire.floats[to] = self.sim.data.sensordata[source]
+        self._imu_copies()
 
     def fill_foot_contact(self, side: str) -> None:
         """The `side` ('l' or 'r') foot's force/torque sensor (stamp with `sim.state_time_ns`)."""
-        to, source = self.contact_maps[side]
-        self.contact_wires[side].floats[to] = self.sim.data.sensordata[source]
+        self._contact_copies[side]()
 
     def joint_state(self, stamp_ns: int) -> bytes:
         self.fill_joint_state()

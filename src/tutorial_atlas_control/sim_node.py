@@ -336,8 +336,8 @@ class SimNode:
         stats = self.statistics
         stats.update(now_ns)
         if stats.publication_due(now_ns):
-            self.statistics_msg.values[:] = (stats.age_s, stats.mean_s, stats.variance_s2,
-                                             stats.window_s)
+            self.statistics_msg.set_values(stats.age_s, stats.mean_s, stats.variance_s2,
+                                           stats.window_s)
             self.batch.add(self.statistics_pub, self.statistics_msg.to_bytes(now_ns))
 
     # -- the loop ------------------------------------------------------------------------

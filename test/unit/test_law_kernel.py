@@ -169,3 +169,35 @@ def test_ragdoll_command_gives_zero_torque(library) -> None:  # noqa: ANN001
     assert JointCommandArrays.zeros().position.shape == (NUM_JOINTS,)
 
 
+
+
+def test_copy_plan_equals_numpy_copies_into_unaligned_bytes(library) -> None:  # noqa: ANN001
+    """The compiled copies write what numpy's `dst[to] = src[from]` writes, bit for bit,
+    into float blocks at odd byte offsets (as in a serialized message)."""
+    rng = np.random.default_rng(7)
+    src = rng.standard_normal(40)
+    src[[3, 5]] = (np.nan, -0.0)
+    to, source = np.array([4, 0, 2, 9]), np.array([3, 5, 39, 0])
+    results = []
+    for compiled in (True, False):
+        buf = bytearray(3 + 8 * 10)
+        dst = np.frombuffer(buf, dtype='<f8', offset=3, count=10)
+        plan = law_kernel.CopyPlan([(dst, to, src, source), (dst[5:8], [0, 1, 2], src, [6, 7, 8])],
+                                   compiled=compiled)
+        assert (plan._call is not None) == compiled
+        plan()
+        results.append(bytes(buf))
+    assert results[0] == results[1]
+    copied = np.frombuffer(results[0], dtype='<f8', offset=3, count=10)
+    assert copied[0] == 0.0 and np.signbit(copied[0]) and np.isnan(copied[4])
+    assert copied[9] == src[0] and list(copied[5:8]) == list(src[6:9])
+
+
+@pytest.mark.parametrize('copy, problem', [
+    ((np.zeros(3), [0, 1], np.zeros(3), [0]), 'a copy of 1 values to 2 places'),
+    ((np.zeros(3), [0, 3], np.zeros(3), [0, 1]), 'dst index outside 0..2'),
+    ((np.zeros(3), [0, 1], np.zeros(2), [0, -1]), 'src index outside 0..1'),
+])
+def test_copy_plan_refuses_bad_indices(copy, problem) -> None:  # noqa: ANN001
+    with pytest.raises(ValueError, match=problem):
+        law_kernel.CopyPlan([copy])

@@ -147,7 +147,7 @@ def test_controller_statistics():
     from atlas_msgs.msg import ControllerStatistics
 
     msg = wire.ControllerStatisticsWire()
-    msg.values[:] = (0.001, 0.0105, 33.28e-6, 1.0)
+    msg.set_values(0.001, 0.0105, 33.28e-6, 1.0)
     expected = ControllerStatistics(command_age=0.001, command_age_mean=0.0105,
                                     command_age_variance=33.28e-6, command_age_window_size=1.0)
     expected.header.stamp = genpy.Time(12, 345_678)
