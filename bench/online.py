@@ -1,6 +1,6 @@
 """The benchmark's measurements against the running simulator node (a private master).
 
-fast run:     real_time_factor:=0 with the recorder subscribed (`rosbag record` by default); achieved real-time
+fast run:     real_time_factor:=0 with the recorder subscribed (atlas_recorder, then `rosbag record`); achieved real-time
               factor = sim time advanced / wall time over a window, both taken from the
               /clock messages a raw subscriber receives (first and last of the window).
 realtime run: real_time_factor:=1.0; over the window every /clock arrival is kept.
@@ -126,11 +126,16 @@ def _clock_series(samples: list[tuple[float, bytes]]) -> tuple[np.ndarray, np.nd
 
 
 def fast_run(master: Master, launch_file: str, probes: Probes, work_dir: Path, name: str,
-             warmup_s: float, window_s: float, recorder: str) -> dict[str, float]:
+             warmup_s: float, window_s: float, recorder: str,
+             prefix: str = 'fast') -> dict[str, float]:
+    """One run at real_time_factor:=0: `<prefix>_rtf`, `<prefix>_recorded_fraction`, and the
+    CPU (cores) of each process that shares the machine's cores at that pace."""
     with _launch(master, launch_file, work_dir, name, 0.0, recorder) as launch:
         _wait_ready(master, launch, probes)
         time.sleep(warmup_s)
-        pids = {'node': launch.node_pid('atlas_sim'), 'recorder': launch.node_pid('recorder')}
+        pids = {'node': launch.node_pid('atlas_sim'), 'recorder': launch.node_pid('recorder'),
+                'state_publisher': launch.node_pid('robot_state_publisher'),
+                'master': master.pid_of('rosmaster')}
         cpu0 = {name: cpu_seconds(pid) if pid else 0.0 for name, pid in pids.items()}
         probes.clock.start()
         time.sleep(window_s)
@@ -142,12 +147,12 @@ def fast_run(master: Master, launch_file: str, probes: Probes, work_dir: Path, n
     wall, sim = _clock_series(samples)
     # Received /clock messages may be a subset; the first and last bound the window.
     span_s = wall[-1] - wall[0]
-    result = {'fast_rtf': float((sim[-1] - sim[0]) / span_s)}
+    result = {f'{prefix}_rtf': float((sim[-1] - sim[0]) / span_s)}
     if recorded is not None:
-        result['fast_recorded_fraction'] = recorded
+        result[f'{prefix}_recorded_fraction'] = recorded
     for name, pid in pids.items():
         if pid:  # CPU (cores) over the window, from /proc (utime + stime)
-            result[f'fast_{name}_cpu'] = (cpu1[name] - cpu0[name]) / window_s
+            result[f'{prefix}_{name}_cpu'] = (cpu1[name] - cpu0[name]) / window_s
     return result
 
 

@@ -10,7 +10,8 @@ Sections (see bench/README.md for what each figure means and how it is measured)
             plain loop, no ROS
   offline   run_offline.py's run of touchdown to a bag, against the plain loop
   analysis  bag_analysis.analyze_bag vs Debian's rosbag API on a 60 s run bag
-  fast      the node at real_time_factor:=0, the recorder (--recorder) subscribed
+  fast      the node at real_time_factor:=0 with atlas_recorder (the launch's default; the
+            fast_* keys), then with `rosbag record` (fast_rosbag_*); the CPU of every process
   realtime  the node at real_time_factor:=1.0: achieved factor, step lateness, then the
             command latency at 50 Hz and 1 kHz (User mode)
   load      the node at real_time_factor:=1.0 under 3 x 2 kHz of valid commands for 30 s:
@@ -72,7 +73,12 @@ ROWS = (
     ('node_us_per_step', 'node CPU per step at rtf:=0', 'us', '<= 1.5 x bare', 1),
     ('node_bare_ratio', 'node_us_per_step / bare mj_step', '', '<= 1.5', 2),
     ('fast_recorder_cpu', 'recorder CPU at rtf:=0', 'cores', '', 2),
+    ('fast_state_publisher_cpu', 'robot_state_publisher CPU at rtf:=0', 'cores', '', 2),
+    ('fast_master_cpu', 'rosmaster CPU at rtf:=0', 'cores', '', 2),
+    ('fast_cpu_us_per_step', 'all four: CPU per step at rtf:=0', 'us', '', 1),
     ('fast_recorded_fraction', 'joint_states recorded at rtf:=0', 'fraction', '1', 4),
+    ('fast_rosbag_rtf', 'same, `rosbag record` recording', 'x real time', '', 2),
+    ('fast_rosbag_recorded_fraction', 'joint_states recorded (rosbag)', 'fraction', '', 4),
     ('realtime_rtf', 'node rtf:=1, achieved', 'x real time', '1.00 +- 0.01', 4),
     ('lateness_p50_ms', 'step lateness p50', 'ms', '', 2),
     ('lateness_p99_ms', 'step lateness p99', 'ms', '< 2', 2),
@@ -115,9 +121,6 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
                              '(a path, or a file name in tutorial_atlas_control); it must take '
                              'the same arguments (gui, real_time_factor, record, bag_dir)')
     parser.add_argument('--keep', action='store_true', help='keep the scratch directory')
-    parser.add_argument('--recorder', choices=('rosbag', 'atlas_recorder'), default='rosbag',
-                        help='recorder of the fast run (default rosbag: `rosbag record`, as the '
-                             'issue defines fast_rtf; atlas_recorder: the launch\'s default)')
     args = parser.parse_args(argv)
     args.sections = [s.strip() for s in args.only.split(',') if s.strip()]
     unknown = set(args.sections) - set(SECTIONS)
@@ -241,13 +244,19 @@ def run_tutorial(args: argparse.Namespace, samples: dict[str, list[float]],
 
 
 def run_fast(args, samples, master, probes, work_dir) -> None:  # noqa: ANN001
+    """Each run: the launch's default recorder (atlas_recorder, the headline fast_* keys),
+    then `rosbag record` (fast_rosbag_*)."""
     import online
 
     for run in range(args.runs):
-        values = online.fast_run(master, args.launch_file, probes, work_dir, f'fast{run + 1}',
-                                 warmup_s=2.0, window_s=4.0 if args.quick else 10.0,
-                                 recorder=args.recorder)
-        log(f'fast run {run + 1}: rtf {values["fast_rtf"]:.3f}')
+        values = {}
+        for recorder, prefix in (('atlas_recorder', 'fast'), ('rosbag', 'fast_rosbag')):
+            values.update(online.fast_run(
+                master, args.launch_file, probes, work_dir, f'{prefix}{run + 1}',
+                warmup_s=2.0, window_s=4.0 if args.quick else 10.0, recorder=recorder,
+                prefix=prefix))
+        log(f'fast run {run + 1}: rtf {values["fast_rtf"]:.3f} (atlas_recorder), '
+            f'{values["fast_rosbag_rtf"]:.3f} (rosbag record)')
         add(samples, values)
 
 
@@ -285,6 +294,15 @@ def summarize(samples: dict[str, list[float]]) -> dict[str, float]:
         samples['node_us_per_step'] = [cpu * 1e6 / (rtf * per_sim_s) for cpu, rtf
                                        in zip(samples['fast_node_cpu'], samples['fast_rtf'])]
         medians['node_us_per_step'] = statistics.median(samples['node_us_per_step'])
+    cpu_keys = [f'fast_{name}_cpu' for name in ('node', 'recorder', 'state_publisher', 'master')]
+    if all(key in samples for key in cpu_keys):  # what one sim step costs the machine
+        import offline
+
+        per_sim_s = offline.steps_per_sim_second()
+        samples['fast_cpu_us_per_step'] = [
+            sum(cpus) * 1e6 / (rtf * per_sim_s)
+            for rtf, *cpus in zip(samples['fast_rtf'], *(samples[key] for key in cpu_keys))]
+        medians['fast_cpu_us_per_step'] = statistics.median(samples['fast_cpu_us_per_step'])
     if 'bare_physics_steps_per_s' in medians:  # issue 18's targets: ratios to bare mj_step
         import offline
 
@@ -358,7 +376,6 @@ def main(argv: list[str] | None = None) -> int:
     print(table(samples, loads, args.runs))
     result = {key: round(value, 4) for key, value in medians.items()}
     result.update({'runs': args.runs, 'quick': args.quick, 'cpus': os.cpu_count(),
-                   'fast_recorder': args.recorder,
                    'load_avg': load_average(), 'wall_s': round(time.monotonic() - started, 1)})
     print(json.dumps(result, sort_keys=True), flush=True)
     return 0

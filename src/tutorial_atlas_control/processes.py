@@ -251,6 +251,13 @@ class _RosProcess:
         self.known.update({pid: command_line(pid) for pid in tree})
         return alive([self.process.pid, *tree])
 
+    def pid_of(self, fragment: str) -> int | None:
+        """The process, or one it started, whose command line contains `fragment`."""
+        for pid in self.pids():
+            if fragment in self.known.get(pid, ''):
+                return pid
+        return None
+
     def output(self) -> str:
         """Everything the process has written so far (also after close())."""
         if not self._log.closed:
@@ -344,9 +351,3 @@ class AtlasLaunch(_RosProcess):
                    f'the ROS master of roslaunch -p {self.port} did not answer '
                    f'(see {self.log_path})', self.check_running)
 
-    def pid_of(self, fragment: str) -> int | None:
-        """The launch's process whose command line contains `fragment`."""
-        for pid in self.pids():
-            if fragment in self.known.get(pid, ''):
-                return pid
-        return None
