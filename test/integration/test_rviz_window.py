@@ -2,9 +2,9 @@
 robot model is drawn in the 3D view, and rviz reports no missing frame or robot_description.
 Also the bad inputs of issue 15: rviz without a display, and a model variant without a URDF.
 
-Robot pixels are found from the model's material colours (xdisplay.material_mask) inside
-rviz's 3D view (the area of its background colour); rviz draws the URDF's colours, which
-are the MJCF's.
+Robot pixels are found from the model's material colours (support.xdisplay.material_mask)
+inside rviz's 3D view (the area of its background colour); rviz draws the URDF's colours,
+which are the MJCF's.
 """
 
 from __future__ import annotations
@@ -22,12 +22,13 @@ pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source 
 
 import rosgraph  # noqa: E402
 
+from support.launch import wait_sim_time  # noqa: E402
+from support.xdisplay import display_env, find_window, material_mask, screenshot, xvfb  # noqa: E402
 from tutorial_atlas_control import model as atlas_model  # noqa: E402
-from tutorial_atlas_control.processes import free_local_port  # noqa: E402
+from tutorial_atlas_control.processes import (  # noqa: E402
+    free_local_port, ros_environment, stop_tree)
 
 from test_viewer_window import CHROMA_TOLERANCE, MIN_BRIGHTNESS  # noqa: E402
-from xdisplay import (  # noqa: E402
-    find_window, launch_env, material_mask, screenshot, stop_launch, wait_sim_time, xvfb)
 
 #: rviz/atlas.rviz's background colour: the 3D view is where it shows.
 BACKGROUND_RGB = (48, 48, 48)
@@ -63,9 +64,9 @@ def robot_pixels(image: np.ndarray) -> tuple[int, int]:
 def test_rviz_shows_the_robot(tmp_path: Path, tf: bool) -> None:
     """With atlas.launch's TF, the robot in the 3D view; with tf:=false (no robot_description,
     no TF: the check's bad frame), none of its colours."""
-    with xvfb() as display:
+    with xvfb(tmp_path / 'xvfb.log') as display:
         port = free_local_port()
-        env = launch_env(display, tmp_path, port)
+        env = ros_environment(port, tmp_path / 'ros_log', base=display_env(display))
         atlas_log = open(tmp_path / 'atlas.log', 'w')  # noqa: SIM115 - closed below
         rviz_log = open(tmp_path / 'rviz.log', 'w')  # noqa: SIM115 - closed below
         atlas = subprocess.Popen(
@@ -83,8 +84,8 @@ def test_rviz_shows_the_robot(tmp_path: Path, tf: bool) -> None:
             image = screenshot(display, 'root', tmp_path / 'rviz.png')
         finally:
             if rviz is not None:
-                stop_launch(rviz)
-            stop_launch(atlas)
+                stop_tree(rviz)
+            stop_tree(atlas)
             atlas_log.close()
             rviz_log.close()
     head, legs = robot_pixels(image)
@@ -132,7 +133,7 @@ def test_model_variant_without_urdf_runs_without_tf(tmp_path: Path) -> None:
         publishers = dict(master.getSystemState()[0])
         has_description = master.hasParam('/robot_description')
     finally:
-        stop_launch(process)
+        stop_tree(process)
         log.close()
     output = (tmp_path / 'atlas.log').read_text(errors='replace')
     warnings = [line for line in output.splitlines() if 'TF is off' in line]

@@ -2,10 +2,11 @@
 
 `atlas.launch gui:=true` runs on a private X server and ROS master; xdotool presses keys in
 the viewer's window and clicks its Reset button (found from the window's pixels, see
-xvfb_window.py); viewer_probe.py, a ROS node in its own process, ragdolls the robot until it
-lies down and reports what the gesture did. A reset must be the node's reset_world: the
-pelvis back at the spawn height and held there (pinned) for the watch window, /clock never
-going backwards, /atlas/sim_config carrying the new reset time (in sim time, not 0).
+support.xdisplay.find_reset_button); viewer_probe.py, a ROS node in its own process,
+ragdolls the robot until it lies down and reports what the gesture did. A reset must be the
+node's reset_world: the pelvis back at the spawn height and held there (pinned) for the
+watch window, /clock never going backwards, /atlas/sim_config carrying the new reset time
+(in sim time, not 0).
 
 Needs Xvfb, xdotool and ImageMagick (tools/setup.sh installs them) and `source ./env.sh`.
 Wall time about 90 s for the module (one simulator for all gestures).
@@ -24,12 +25,12 @@ from pathlib import Path
 
 import pytest
 
-import xvfb_window
-from tutorial_atlas_control.processes import free_local_port, stop_tree
+from support import xdisplay
 from tutorial_atlas_control.model import SPAWN_HEIGHT_M
+from tutorial_atlas_control.processes import free_local_port, ros_environment, stop_tree
 
-if xvfb_window.missing_tools():
-    pytest.skip(f'needs {", ".join(xvfb_window.missing_tools())} (tools/setup.sh installs '
+if xdisplay.missing_tools():
+    pytest.skip(f'needs {", ".join(xdisplay.missing_tools())} (tools/setup.sh installs '
                 'xvfb, xdotool and imagemagick)', allow_module_level=True)
 if shutil.which('roslaunch') is None:
     pytest.skip('roslaunch is not on PATH (source env.sh)', allow_module_level=True)
@@ -37,6 +38,8 @@ pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source 
 
 PROBE = Path(__file__).resolve().parent / 'viewer_probe.py'
 WINDOW_NAME = 'MuJoCo'
+#: The screen the Reset button's layout (xdisplay.find_reset_button) is read on.
+SCREEN = '1280x1024x24'
 SPAWN_TOLERANCE_M = 0.001
 #: The probe's pinned-height window holds ~78 odometry samples at 100 Hz; far fewer means
 #: the height was not watched over the window.
@@ -58,22 +61,21 @@ class Viewer:
 @pytest.fixture(scope='module')
 def viewer(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Viewer]:
     log_dir = tmp_path_factory.mktemp('viewer')
-    xvfb = xvfb_window.Xvfb(log_dir / 'xvfb.log')
-    port = free_local_port()
-    env = dict(xvfb.env(), ROS_MASTER_URI=f'http://localhost:{port}', ROS_HOSTNAME='localhost',
-               ROS_LOG_DIR=str(log_dir / 'ros_log'))
-    log = open(log_dir / 'atlas_launch.log', 'w')  # noqa: SIM115 - closed below
-    launch = subprocess.Popen(
-        ['roslaunch', '-p', str(port), 'tutorial_atlas_control', 'atlas.launch', 'gui:=true',
-         'record:=false'], env=env, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
-    try:
-        window = xvfb_window.wait_for_window(xvfb.display, WINDOW_NAME)
-        yield Viewer(env, xvfb.display, window, log_dir)
-        assert launch.poll() is None, f'atlas.launch exited; see {log.name}'
-    finally:
-        stop_tree(launch)
-        log.close()
-        xvfb.close()
+    with xdisplay.xvfb(log_dir / 'xvfb.log', SCREEN) as display:
+        port = free_local_port()
+        env = ros_environment(port, log_dir / 'ros_log', base=xdisplay.display_env(display))
+        log = open(log_dir / 'atlas_launch.log', 'w')  # noqa: SIM115 - closed below
+        launch = subprocess.Popen(
+            ['roslaunch', '-p', str(port), 'tutorial_atlas_control', 'atlas.launch',
+             'gui:=true', 'record:=false'], env=env, stdout=log, stderr=subprocess.STDOUT,
+            start_new_session=True)
+        try:
+            window = xdisplay.find_window(display, WINDOW_NAME)
+            yield Viewer(env, display, window, log_dir)
+            assert launch.poll() is None, f'atlas.launch exited; see {log.name}'
+        finally:
+            stop_tree(launch)
+            log.close()
 
 
 def run_probe(viewer: Viewer, scenario: str, gesture: list[str]) -> dict[str, object]:
@@ -118,16 +120,16 @@ def test_shift_ctrl_r_is_reset_world(viewer: Viewer) -> None:
 def test_reset_button_is_reset_world(viewer: Viewer) -> None:
     deadline = time.monotonic() + UI_DRAWN_TIMEOUT_S
     while True:
-        pixels = xvfb_window.capture(viewer.display, viewer.window)
+        pixels = xdisplay.screenshot(viewer.display, viewer.window)
         try:
-            x, y = xvfb_window.find_reset_button(pixels)
+            x, y = xdisplay.find_reset_button(pixels)
             break
         except LookupError:
             if time.monotonic() > deadline:
-                xvfb_window.save_png(pixels, viewer.log_dir / 'no_reset_button.png')
+                xdisplay.save_png(pixels, viewer.log_dir / 'no_reset_button.png')
                 raise
             time.sleep(1.0)
-    xvfb_window.save_png(pixels, viewer.log_dir / 'reset_button.png', (x, y))
+    xdisplay.save_png(pixels, viewer.log_dir / 'reset_button.png', (x, y))
     print(f'\nReset button at ({x}, {y}); screenshot {viewer.log_dir / "reset_button.png"}')
     report = run_probe(viewer, 'reset', ['xdotool', 'mousemove', '--window', viewer.window,
                                          str(x), str(y), 'click', '1'])

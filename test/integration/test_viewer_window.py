@@ -3,15 +3,17 @@ server (Xvfb, software OpenGL), as a user opening it sees it.
 
 How the robot's pixels are found: from the model's own material colours. The head is the
 only orange thing in the scene, the legs and upper arms are blue; light changes their
-brightness, not their proportions r : g : b (xdisplay.material_mask). The grey and dark
-parts cannot be told from the grey floor, so the feet are judged from the blue shins
-above them: the shins' lowest pixel must leave room for the feet (their height on screen,
-from the model's ankle height and the robot's height on screen) above the window's edge.
+brightness, not their proportions r : g : b (support.xdisplay.material_mask). The grey
+and dark parts cannot be told from the grey floor, so the feet are judged from the blue
+shins above them: the shins' lowest pixel must leave room for the feet (their height on
+screen, from the model's ankle height and the robot's height on screen) above the window's
+edge.
 """
 
 from __future__ import annotations
 
 import subprocess
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -21,12 +23,12 @@ import pytest
 
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
+from support.launch import wait_sim_time  # noqa: E402
+from support.xdisplay import display_env, find_window, material_mask, screenshot, xvfb  # noqa: E402
 from tutorial_atlas_control import model as atlas_model  # noqa: E402
-from tutorial_atlas_control.processes import free_local_port  # noqa: E402
+from tutorial_atlas_control.processes import (  # noqa: E402
+    free_local_port, ros_environment, stop_tree)
 from tutorial_atlas_control.render import configure_viewer_camera  # noqa: E402
-
-from xdisplay import (  # noqa: E402
-    find_window, launch_env, material_mask, screenshot, stop_launch, wait_sim_time, xvfb)
 
 #: A pixel is the material's colour when its r : g : b is this close (chromaticity distance).
 #: The blue (0.2, 0.3, 0.55) and the sky near the horizon (about 0.33, 0.43, 0.58) are 0.11
@@ -92,9 +94,9 @@ def _ankle_share() -> float:
 
 def test_viewer_window_shows_the_whole_robot(tmp_path: Path) -> None:
     m = atlas_model.load_model().model
-    with xvfb() as display:
+    with xvfb(tmp_path / 'xvfb.log') as display:
         port = free_local_port()
-        env = launch_env(display, tmp_path, port)
+        env = ros_environment(port, tmp_path / 'ros_log', base=display_env(display))
         log = open(tmp_path / 'launch.log', 'w')  # noqa: SIM115 - closed below
         process = subprocess.Popen(
             ['roslaunch', '-p', str(port), 'tutorial_atlas_control', 'atlas.launch', 'gui:=true',
@@ -104,7 +106,9 @@ def test_viewer_window_shows_the_whole_robot(tmp_path: Path) -> None:
             wait_sim_time(env, SCREENSHOT_AT_S)
             image = screenshot(display, window, tmp_path / 'viewer.png')
         finally:
-            exit_s = stop_launch(process)
+            stop_start_s = time.monotonic()
+            stop_tree(process)
+            exit_s = time.monotonic() - stop_start_s
             log.close()
     seen = robot_on_screen(image, m)
     print(f'viewer {image.shape[1]}x{image.shape[0]}: {seen}, span {seen.span_fraction:.2f} of '

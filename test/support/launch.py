@@ -25,6 +25,8 @@ FLOOD = REPO / 'tools' / 'flood_commands.py'
 STARTUP_TIMEOUT_S = 120.0
 EXIT_TIMEOUT_S = 60.0
 SIM_TIME_TIMEOUT_S = 120.0
+#: wait_sim_time's guard (s): it also waits for the master and the simulator to start.
+WAIT_SIM_TIME_TIMEOUT_S = 180.0
 
 
 class TestLaunch(processes.AtlasLaunch):
@@ -114,6 +116,23 @@ class TestLaunch(processes.AtlasLaunch):
         bags = sorted(self.bag_dir.glob('atlas_*.bag'))
         assert len(bags) == 1, f'expected one bag in {self.bag_dir}, found {bags}'
         return bags[0]
+
+
+WAIT_SIM_TIME = '''
+import sys, rospy
+from rosgraph_msgs.msg import Clock
+rospy.init_node('wait_sim_time', anonymous=True, disable_signals=True)
+target = float(sys.argv[1])
+while rospy.wait_for_message('/clock', Clock, timeout=120).clock.to_sec() < target:
+    pass
+'''
+
+
+def wait_sim_time(env: dict[str, str], seconds: float) -> None:
+    """Until the /clock of the master in `env` reaches `seconds` of sim time: for a launch
+    started by hand (a GUI one, with its own environment) rather than as a TestLaunch."""
+    subprocess.run([sys.executable, '-c', WAIT_SIM_TIME, str(seconds)], env=env, check=True,
+                   timeout=WAIT_SIM_TIME_TIMEOUT_S, capture_output=True)
 
 
 def flood_figures(process: subprocess.Popen, timeout_s: float) -> dict:
