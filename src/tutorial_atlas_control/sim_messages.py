@@ -13,7 +13,7 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control.joints import JOINT_NAMES
-from tutorial_atlas_control.law_kernel import CopyPlan
+from tutorial_atlas_control.law_kernel import Copy, CopyPlan
 from tutorial_atlas_control.simulator import AtlasSimulator
 from tutorial_atlas_control.topics import PELVIS_FRAME, WORLD_FRAME
 from tutorial_atlas_control.wire import (
@@ -69,26 +69,31 @@ class SimMessages:
             ('imu', self.imu_wire), ('odometry', self.odometry_wire),
             ('l', self.contact_wires['l']), ('r', self.contact_wires['r']))}
         self._pelvis_velocity = np.zeros(6)
-        # The 1 kHz messages' numbers, one CopyPlan call each per step.
+        # Where the 1 kHz messages' numbers come from, as CopyPlan copies: a writer that
+        # fills several of them at the same steps joins their lists into one plan (one call).
         data, joints = sim.data, np.arange(len(JOINT_NAMES))
         wire = self.joint_state_wire
-        self._joint_state_copies = CopyPlan([
-            (wire.position, joints, data.qpos, sim.atlas.qpos_adr),
-            (wire.velocity, joints, data.qvel, sim.atlas.dof_adr),
-            (wire.effort, joints, sim.torque_nm, joints)])
-        to, source = self.imu_map
-        self._imu_copies = CopyPlan([(self.imu_wire.floats, to, data.sensordata, source)])
-        self._contact_copies = {}
-        for side, (to, source) in self.contact_maps.items():
-            self._contact_copies[side] = CopyPlan(
-                [(self.contact_wires[side].floats, to, data.sensordata, source)])
+        self.copies: dict[str, list[Copy]] = {
+            'joint_state': [(wire.position, joints, data.qpos, sim.atlas.qpos_adr),
+                            (wire.velocity, joints, data.qvel, sim.atlas.dof_adr),
+                            (wire.effort, joints, sim.torque_nm, joints)],
+            'imu': [(self.imu_wire.floats, self.imu_map[0], data.sensordata, self.imu_map[1])],
+            **{side: [(self.contact_wires[side].floats, to, data.sensordata, source)]
+               for side, (to, source) in self.contact_maps.items()}}
+        self._plans = {name: CopyPlan(copies) for name, copies in self.copies.items()}
+
+    def wire(self, name: str) -> StampedWire:
+        """The wire message of `name` ('joint_state', 'imu', 'l' or 'r', as in `copies`)."""
+        if name in ('l', 'r'):
+            return self.contact_wires[name]
+        return {'joint_state': self.joint_state_wire, 'imu': self.imu_wire}[name]
 
     def fill_joint_state(self) -> None:
         """Joint positions and velocities after the last step; effort = the torque it applied.
 
         Stamp it with the sim time after the step (`sim.sim_time_ns`).
         """
-        self._joint_state_copies()
+        self._plans['joint_state']()
 
     def fill_odometry(self) -> None:
         """Pelvis pose and world-frame twist, as Gazebo's p3d plugin reported them.
@@ -115,11 +120,11 @@ class SimMessages:
 
     def fill_imu(self) -> None:
         """The pelvis IMU (sensor readings: stamp with `sim.state_time_ns`)."""
-        self._imu_copies()
+        self._plans['imu']()
 
     def fill_foot_contact(self, side: str) -> None:
         """The `side` ('l' or 'r') foot's force/torque sensor (stamp with `sim.state_time_ns`)."""
-        self._contact_copies[side]()
+        self._plans[side]()
 
     def joint_state(self, stamp_ns: int) -> bytes:
         self.fill_joint_state()

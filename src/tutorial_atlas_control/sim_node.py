@@ -54,6 +54,7 @@ from tutorial_atlas_control.controller import gains_from_params
 from tutorial_atlas_control.controller_statistics import (
     DEFAULT_WINDOW_S, UPDATE_RATE_PARAM, WINDOW_PARAM, CommandAgeStatistics)
 from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.law_kernel import CopyPlan
 from tutorial_atlas_control.render import configure_viewer_camera, configure_viewer_scene
 from tutorial_atlas_control.ros1_fields import FieldCursor
 from tutorial_atlas_control.sim_messages import SimMessages
@@ -148,8 +149,22 @@ class SimNode:
         self._publish_config()
 
         # What each message holds is sim_messages' (shared with offline runs).
-        self.messages = SimMessages(sim)
-        self.contacts = (('l', self.l_contact_pub), ('r', self.r_contact_pub))
+        self.messages = messages = SimMessages(sim)
+        #: The per-step messages: (every how many steps, its name in SimMessages, publisher,
+        #: stamped at the step's end (True) or, as poses and sensors, at its start).
+        self.step_messages = (
+            (self.every['joint_states'], 'joint_state', self.joint_state_pub, True),
+            (self.every['imu'], 'imu', self.imu_pub, False),
+            (self.every['contact'], 'l', self.l_contact_pub, False),
+            (self.every['contact'], 'r', self.r_contact_pub, False))
+        # Messages due at the same steps are filled by one CopyPlan call (one C call a step
+        # at the launch's rates, where each message's own would be four).
+        copies: dict[int, list] = {}
+        for every, name, _, _ in self.step_messages:
+            copies.setdefault(every, []).extend(messages.copies[name])
+        self.fill_plans = tuple((every, CopyPlan(plan)) for every, plan in copies.items())
+        self.step_wires = tuple((every, messages.wire(name), pub, at_end)
+                                for every, name, pub, at_end in self.step_messages)
         self._init_controller_statistics()
 
         # Commands wait here, undecoded, for the loop (see on_joint_commands). Bounded, so
@@ -296,21 +311,19 @@ class SimNode:
             # sees at real time); spares the recorder one message in five.
             batch.replace(self.clock_pub, clock_bytes(now_ns))
         count = self.step_count
-        messages = self.messages
-        if count % self.every['joint_states'] == 0 and wanted(self.joint_state_pub):
-            batch.add(self.joint_state_pub, messages.joint_state(now_ns))
+        for every, plan in self.fill_plans:
+            if count % every == 0:
+                plan()
         # Poses and sensors describe the state at the start of the last step (see step()).
         sensed_ns = sim.state_time_ns
+        for every, message, pub, at_end in self.step_wires:
+            if count % every == 0 and wanted(pub):
+                batch.add(pub, message.stamped(now_ns if at_end else sensed_ns))
+        messages = self.messages
         if count % self.every['odom'] == 0 and wanted(self.odom_pub):
             batch.add(self.odom_pub, messages.odometry(sensed_ns))
         if self.tf_pub is not None and count % self.every['tf'] == 0 and wanted(self.tf_pub):
             batch.add(self.tf_pub, messages.pelvis_tf(sensed_ns))
-        if count % self.every['imu'] == 0 and wanted(self.imu_pub):
-            batch.add(self.imu_pub, messages.imu(sensed_ns))
-        if count % self.every['contact'] == 0:
-            for side, pub in self.contacts:
-                if wanted(pub):
-                    batch.add(pub, messages.foot_contact(side, sensed_ns))
 
     # -- /atlas/controller_statistics ----------------------------------------------------
     def _init_controller_statistics(self) -> None:
@@ -338,7 +351,7 @@ class SimNode:
         if stats.publication_due(now_ns):
             self.statistics_msg.set_values(stats.age_s, stats.mean_s, stats.variance_s2,
                                            stats.window_s)
-            self.batch.add(self.statistics_pub, self.statistics_msg.to_bytes(now_ns))
+            self.batch.add(self.statistics_pub, self.statistics_msg.stamped(now_ns))
 
     # -- the loop ------------------------------------------------------------------------
     def spin(self) -> None:

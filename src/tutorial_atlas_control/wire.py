@@ -46,11 +46,16 @@ class StampedWire:
         self.floats = np.frombuffer(self.buf, dtype='<f8', offset=16 + len(body), count=floats)
         self.seq = 0
 
-    def to_bytes(self, stamp_ns: int) -> bytes:
+    def stamped(self, stamp_ns: int) -> bytearray:
+        """The next message, stamped `stamp_ns`: the buffer itself, valid until the next
+        call (WireBatch.add copies it; a copy of 1 kB costs less than a new bytes object)."""
         self.seq += 1
         secs, nsecs = divmod(stamp_ns, NS_PER_S)
         _PREFIX_HEADER.pack_into(self.buf, 0, len(self.buf) - 4, self.seq, secs, nsecs)
-        return bytes(self.buf)
+        return self.buf
+
+    def to_bytes(self, stamp_ns: int) -> bytes:
+        return bytes(self.stamped(stamp_ns))
 
 
 class JointStateWire(StampedWire):
@@ -172,7 +177,7 @@ def clock_bytes(stamp_ns: int) -> bytes:
 SEND_TIMEOUT_S = 2.0
 
 
-def write_to_connections(pub: rospy.Publisher, data: bytes) -> None:
+def write_to_connections(pub: rospy.Publisher, data: bytes | bytearray) -> None:
     """Send already-serialized TCPROS bytes to every subscriber of `pub`.
 
     The socket is written directly (rospy's write_data mis-handles a send timeout); a
@@ -202,21 +207,26 @@ class WireBatch:
     """Per-publisher byte batches, written on flush() with one sendall per connection."""
 
     def __init__(self) -> None:
-        self.pending: dict[rospy.Publisher, list[bytes]] = {}
+        self.pending: dict[rospy.Publisher, bytearray] = {}
 
     @staticmethod
     def wanted(pub: rospy.Publisher) -> bool:
         """Anyone subscribed? (rospy skips serializing otherwise; so do we)."""
         return bool(pub.impl.connections)
 
-    def add(self, pub: rospy.Publisher, data: bytes) -> None:
-        self.pending.setdefault(pub, []).append(data)
+    def add(self, pub: rospy.Publisher, data: bytes | bytearray) -> None:
+        """Append a copy of `data` (TCPROS-framed messages) to `pub`'s batch."""
+        batch = self.pending.get(pub)
+        if batch is None:
+            self.pending[pub] = bytearray(data)
+        else:
+            batch += data
 
-    def replace(self, pub: rospy.Publisher, data: bytes) -> None:
+    def replace(self, pub: rospy.Publisher, data: bytes | bytearray) -> None:
         """Queue `data` instead of anything still pending for `pub` (e.g. /clock)."""
-        self.pending[pub] = [data]
+        self.pending[pub] = bytearray(data)
 
     def flush(self) -> None:
         pending, self.pending = self.pending, {}
-        for pub, chunks in pending.items():
-            write_to_connections(pub, chunks[0] if len(chunks) == 1 else b''.join(chunks))
+        for pub, data in pending.items():
+            write_to_connections(pub, data)
