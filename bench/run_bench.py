@@ -298,7 +298,7 @@ def summarize(samples: dict[str, list[float]]) -> dict[str, float]:
     cpu_keys = [key for key in (f'fast_{name}_cpu' for name in
                                 ('node', 'recorder', 'state_publisher', 'master'))
                 if len(samples.get(key, ())) == len(samples.get('fast_rtf', ()))]
-    if 'fast_node_cpu' in cpu_keys:
+    if 'fast_rtf' in samples and 'fast_node_cpu' in cpu_keys:
         import offline
 
         per_sim_s = offline.steps_per_sim_second()
