@@ -114,7 +114,10 @@ def load_run(master: Master, launch_file: str, probes: Probes, work_dir: Path, n
     fraction = recorded_fraction(bag_dir)
     if fraction is not None:
         result['load_recorded_fraction'] = fraction
-    shutil.rmtree(bag_dir, ignore_errors=True)  # ~2.5 kB per command: hundreds of MB
+    if result['load_commands_lost'] == 0:
+        shutil.rmtree(bag_dir, ignore_errors=True)  # ~2.5 kB per command: hundreds of MB
+    # else kept with the launch log: which commands are missing says why (run_bench keeps
+    # the scratch directory then).
     return result
 
 

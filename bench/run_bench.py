@@ -227,6 +227,9 @@ def run_load(args, samples, master, probes, work_dir) -> None:  # noqa: ANN001
             f'{values["load_commands_lost"]:.0f} commands lost, RSS growth '
             f'{values["load_rss_growth_mib"]:.2f} MiB, shutdown {values["shutdown_s"]:.2f} s')
         add(samples, values)
+        if values['load_commands_lost']:
+            args.keep = True
+            log(f'load run {run + 1} lost commands: its bag and launch log stay in {work_dir}')
 
 
 def run_tutorial(args: argparse.Namespace, samples: dict[str, list[float]],
