@@ -9,6 +9,8 @@ and stamps the header; nothing is serialized field by field.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import mujoco
 import numpy as np
 
@@ -38,8 +40,9 @@ def _float_offset(message: StampedWire) -> int:
 class SimMessages:
     """One simulator's /atlas/joint_states, /ground_truth_odom, /atlas/imu and foot contacts.
 
-    Each fill_* writes the simulator's current state into its wire message; the methods
-    without the prefix also stamp it and return it with the TCPROS length prefix. The IMU
+    The per-step messages (joint state, IMU, feet) are filled through fill_plan; odometry
+    and the pelvis transform by their fill_* methods, which odometry() and pelvis_tf() also
+    stamp and return with the TCPROS length prefix. The IMU
     and contact messages are a fixed selection of `data.sensordata`
     (`imu_map`, `contact_maps`: float index in the message <- index in sensordata), so a
     writer that keeps sensordata per step can build many messages at once (offline_run.py).
@@ -69,31 +72,30 @@ class SimMessages:
             ('imu', self.imu_wire), ('odometry', self.odometry_wire),
             ('l', self.contact_wires['l']), ('r', self.contact_wires['r']))}
         self._pelvis_velocity = np.zeros(6)
-        # Where the 1 kHz messages' numbers come from, as CopyPlan copies: a writer that
-        # fills several of them at the same steps joins their lists into one plan (one call).
+        # The per-step messages' numbers as CopyPlan copies (dst, to, src, from), by name.
+        # joint_state: positions and velocities after the step, effort = the torque it
+        # applied (stamp with `sim.sim_time_ns`); imu, l and r (the feet): sensor readings,
+        # computed before mj_step integrates (stamp with `sim.state_time_ns`).
         data, joints = sim.data, np.arange(len(JOINT_NAMES))
         wire = self.joint_state_wire
-        self.copies: dict[str, list[Copy]] = {
+        self._copies: dict[str, list[Copy]] = {
             'joint_state': [(wire.position, joints, data.qpos, sim.atlas.qpos_adr),
                             (wire.velocity, joints, data.qvel, sim.atlas.dof_adr),
                             (wire.effort, joints, sim.torque_nm, joints)],
             'imu': [(self.imu_wire.floats, self.imu_map[0], data.sensordata, self.imu_map[1])],
             **{side: [(self.contact_wires[side].floats, to, data.sensordata, source)]
                for side, (to, source) in self.contact_maps.items()}}
-        self._plans = {name: CopyPlan(copies) for name, copies in self.copies.items()}
+        #: The wire message of each per-step message, by the same names.
+        self.step_wires: dict[str, StampedWire] = {
+            'joint_state': self.joint_state_wire, 'imu': self.imu_wire, **self.contact_wires}
 
-    def wire(self, name: str) -> StampedWire:
-        """The wire message of `name` ('joint_state', 'imu', 'l' or 'r', as in `copies`)."""
-        if name in ('l', 'r'):
-            return self.contact_wires[name]
-        return {'joint_state': self.joint_state_wire, 'imu': self.imu_wire}[name]
+    def fill_plan(self, names: Sequence[str]) -> CopyPlan:
+        """One call that writes the current state into the named per-step messages.
 
-    def fill_joint_state(self) -> None:
-        """Joint positions and velocities after the last step; effort = the torque it applied.
-
-        Stamp it with the sim time after the step (`sim.sim_time_ns`).
+        A writer that fills several of them at the same steps joins them in one plan: one
+        C call a step instead of one per message.
         """
-        self._plans['joint_state']()
+        return CopyPlan([copy for name in names for copy in self._copies[name]])
 
     def fill_odometry(self) -> None:
         """Pelvis pose and world-frame twist, as Gazebo's p3d plugin reported them.
@@ -118,18 +120,6 @@ class SimMessages:
         tf.rotation_xyzw[:3] = sim.data.xquat[body, 1:]
         tf.rotation_xyzw[3] = sim.data.xquat[body, 0]
 
-    def fill_imu(self) -> None:
-        """The pelvis IMU (sensor readings: stamp with `sim.state_time_ns`)."""
-        self._plans['imu']()
-
-    def fill_foot_contact(self, side: str) -> None:
-        """The `side` ('l' or 'r') foot's force/torque sensor (stamp with `sim.state_time_ns`)."""
-        self._plans[side]()
-
-    def joint_state(self, stamp_ns: int) -> bytes:
-        self.fill_joint_state()
-        return self.joint_state_wire.to_bytes(stamp_ns)
-
     def odometry(self, stamp_ns: int) -> bytes:
         self.fill_odometry()
         return self.odometry_wire.to_bytes(stamp_ns)
@@ -137,11 +127,3 @@ class SimMessages:
     def pelvis_tf(self, stamp_ns: int) -> bytes:
         self.fill_pelvis_tf()
         return self.pelvis_tf_wire.to_bytes(stamp_ns)
-
-    def imu(self, stamp_ns: int) -> bytes:
-        self.fill_imu()
-        return self.imu_wire.to_bytes(stamp_ns)
-
-    def foot_contact(self, side: str, stamp_ns: int) -> bytes:
-        self.fill_foot_contact(side)
-        return self.contact_wires[side].to_bytes(stamp_ns)

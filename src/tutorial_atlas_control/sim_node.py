@@ -54,7 +54,6 @@ from tutorial_atlas_control.controller import gains_from_params
 from tutorial_atlas_control.controller_statistics import (
     DEFAULT_WINDOW_S, UPDATE_RATE_PARAM, WINDOW_PARAM, CommandAgeStatistics)
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.law_kernel import CopyPlan
 from tutorial_atlas_control.render import configure_viewer_camera, configure_viewer_scene
 from tutorial_atlas_control.ros1_fields import FieldCursor
 from tutorial_atlas_control.sim_messages import SimMessages
@@ -150,21 +149,21 @@ class SimNode:
 
         # What each message holds is sim_messages' (shared with offline runs).
         self.messages = messages = SimMessages(sim)
-        #: The per-step messages: (every how many steps, its name in SimMessages, publisher,
-        #: stamped at the step's end (True) or, as poses and sensors, at its start).
-        self.step_messages = (
+        # The per-step messages: (every how many steps, name in SimMessages.step_wires,
+        # publisher, stamped at the step's end (True) or, as poses and sensors, at its start).
+        step_messages = (
             (self.every['joint_states'], 'joint_state', self.joint_state_pub, True),
             (self.every['imu'], 'imu', self.imu_pub, False),
             (self.every['contact'], 'l', self.l_contact_pub, False),
             (self.every['contact'], 'r', self.r_contact_pub, False))
-        # Messages due at the same steps are filled by one CopyPlan call (one C call a step
-        # at the launch's rates, where each message's own would be four).
-        copies: dict[int, list] = {}
-        for every, name, _, _ in self.step_messages:
-            copies.setdefault(every, []).extend(messages.copies[name])
-        self.fill_plans = tuple((every, CopyPlan(plan)) for every, plan in copies.items())
-        self.step_wires = tuple((every, messages.wire(name), pub, at_end)
-                                for every, name, pub, at_end in self.step_messages)
+        # Those due at the same steps are filled by one plan (at the launch's rates, all).
+        due_together: dict[int, list[str]] = {}
+        for every, name, _, _ in step_messages:
+            due_together.setdefault(every, []).append(name)
+        self.fill_plans = tuple((every, messages.fill_plan(names))
+                                for every, names in due_together.items())
+        self.step_wires = tuple((every, messages.step_wires[name], pub, at_end)
+                                for every, name, pub, at_end in step_messages)
         self._init_controller_statistics()
 
         # Commands wait here, undecoded, for the loop (see on_joint_commands). Bounded, so

@@ -27,15 +27,13 @@ from tutorial_atlas_control.units import NS_PER_S
 DEFAULT_TIME_TO_UNPIN_S = 1.0
 
 
-#: MuJoCo's warnings for an unstable step, each with what it means.
+#: MuJoCo's warnings for an unstable step (plain ints: indexing MjData's counters with the
+#: enums costs a microsecond a step), each with what it means.
 DIVERGENCE_WARNINGS = (
-    (mujoco.mjtWarning.mjWARN_BADQPOS, 'NaN/Inf/huge joint position'),
-    (mujoco.mjtWarning.mjWARN_BADQVEL, 'NaN/Inf/huge joint velocity'),
-    (mujoco.mjtWarning.mjWARN_BADQACC, 'NaN/Inf/huge joint acceleration'),
+    (int(mujoco.mjtWarning.mjWARN_BADQPOS), 'NaN/Inf/huge joint position'),
+    (int(mujoco.mjtWarning.mjWARN_BADQVEL), 'NaN/Inf/huge joint velocity'),
+    (int(mujoco.mjtWarning.mjWARN_BADQACC), 'NaN/Inf/huge joint acceleration'),
 )
-# The same as plain ints: indexing MjData's counters with the enums costs a microsecond a step.
-_BADQPOS, _BADQVEL, _BADQACC = (int(warning) for warning, _ in DIVERGENCE_WARNINGS)
-
 
 class ControlMode(str, enum.Enum):
     """The strings DRCSim accepted on /atlas/control_mode."""
@@ -266,12 +264,11 @@ class AtlasSimulator:
         it here means no silently reset (or non-finite) state is ever published or replayed.
         """
         counts = self._warning_counts
-        if counts[_BADQPOS] or counts[_BADQVEL] or counts[_BADQACC]:
-            for warning, what in DIVERGENCE_WARNINGS:
-                if counts[warning] > 0:
-                    counts[warning] = 0
-                    raise PhysicsDivergenceError(
-                        f'physics diverged at t={self.sim_time_ns / NS_PER_S:.3f} s ({what})')
+        for warning, what in DIVERGENCE_WARNINGS:
+            if counts[warning] > 0:
+                counts[warning] = 0
+                raise PhysicsDivergenceError(
+                    f'physics diverged at t={self.sim_time_ns / NS_PER_S:.3f} s ({what})')
         compiled = self._compiled_law
         if compiled is not None:
             finite = compiled.state_is_finite()

@@ -25,9 +25,7 @@ def stepped() -> AtlasSimulator:
 
 def test_imu_and_contacts_are_the_named_sensors(stepped: AtlasSimulator) -> None:
     messages = SimMessages(stepped)
-    messages.fill_imu()
-    messages.fill_foot_contact('l')
-    messages.fill_foot_contact('r')
+    messages.fill_plan(('imu', 'l', 'r'))()
     sensor = {name: stepped.data.sensor(name).data.copy() for name in (
         'imu_orientation', 'imu_angular_velocity', 'imu_linear_acceleration',
         'l_foot_force', 'l_foot_torque', 'r_foot_force', 'r_foot_torque')}
@@ -46,7 +44,7 @@ def test_imu_and_contacts_are_the_named_sensors(stepped: AtlasSimulator) -> None
 
 def test_joint_state_and_odometry(stepped: AtlasSimulator) -> None:
     messages = SimMessages(stepped)
-    messages.fill_joint_state()
+    messages.fill_plan(('joint_state',))()
     messages.fill_odometry()
     state = messages.joint_state_wire
     assert np.array_equal(state.position, stepped.joint_positions())
