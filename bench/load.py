@@ -23,6 +23,7 @@ from pathlib import Path
 from harness import READY_TIMEOUT_S, REPO_DIR, BenchError, Launch, Master
 from online import Probes, recorded_fraction
 from tutorial_atlas_control.processes import STOP_TIMEOUT_S, rss_kib, wait_until
+from tutorial_atlas_control.wire import subscriber_names
 
 FLOOD = REPO_DIR / 'tools' / 'flood_commands.py'
 RUN_DEMO = REPO_DIR / 'scripts' / 'run_demo.py'
@@ -96,7 +97,7 @@ def load_run(master: Master, launch_file: str, probes: Probes, work_dir: Path, n
         wait_until(lambda: {'/atlas_sim', '/recorder'} <= set(
             master.subscribers('/atlas/joint_commands')), READY_TIMEOUT_S,
             'the simulator and the recorder did not subscribe', launch.check_running)
-        wait_until(lambda: probes.mode_pub.get_num_connections() >= 2, READY_TIMEOUT_S,
+        wait_until(lambda: len(subscriber_names(probes.mode_pub)) >= 2, READY_TIMEOUT_S,
                    'the simulator did not subscribe to the mode', launch.check_running)
         probes.mode_pub.publish(String(data='User'))
         floods = _start_floods(master, duration_s)

@@ -34,6 +34,7 @@ from std_msgs.msg import String
 
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.traj_yaml_node import build_command, read_gains
+from tutorial_atlas_control.wire import subscriber_names
 
 #: The valid command's default left elbow target (rad).
 DEFAULT_ELBOW_RAD = 1.2
@@ -132,7 +133,7 @@ def flood(kind: str, rate_hz: float, duration_s: float, start_sim_s: float,
     modes = rospy.Publisher('/atlas/control_mode', String, queue_size=10)
     clock = ClockWatch()
     deadline = time.monotonic() + 60.0
-    while clock.now_ns() < start_sim_s * 1e9 or commands.get_num_connections() < subscribers:
+    while clock.now_ns() < start_sim_s * 1e9 or len(subscriber_names(commands)) < subscribers:
         if time.monotonic() > deadline or rospy.is_shutdown():
             raise SystemExit(f'flood_commands.py: no /clock, or fewer than {subscribers} '
                              'subscribers to /atlas/joint_commands')
@@ -177,7 +178,7 @@ def main() -> int:
     parser.add_argument('--start-sim', type=float, default=0.0,
                         help='start once sim time reaches this (s)')
     parser.add_argument('--subscribers', type=int, default=2,
-                        help='wait for this many subscribers (default: the simulator and '
+                        help='wait until this many nodes are connected (default: the simulator and '
                         'the recorder)')
     parser.add_argument('--elbow', type=float, default=DEFAULT_ELBOW_RAD,
                         help='left elbow target of the valid command (rad, default %(default)g)')

@@ -203,6 +203,17 @@ def write_to_connections(pub: rospy.Publisher, data: bytes | bytearray) -> None:
             connection.close()
 
 
+def subscriber_names(pub: rospy.Publisher) -> set[str]:
+    """The nodes connected to `pub` now.
+
+    Count these, not get_num_connections(): when a subscriber connects twice at once
+    (rospy does, on two quick publisher updates), the publisher holds both connections for a
+    moment before dropping one, so a node counts twice and "the simulator and the recorder
+    are connected" can be true with only the simulator.
+    """
+    return {connection.endpoint_id for connection in list(pub.impl.connections)}
+
+
 class WireBatch:
     """Per-publisher byte batches, written on flush() with one sendall per connection."""
 

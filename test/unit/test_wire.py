@@ -128,6 +128,15 @@ class FakePublisher:
         self.connections.remove(connection)
 
 
+def test_a_subscriber_connected_twice_counts_once():
+    """rospy may hold two connections from one node for a moment (seen: a flood started
+    with only the simulator connected, and the recorder missed 114 of its commands)."""
+    pub = FakePublisher([FakeConnection('/atlas_sim'), FakeConnection('/atlas_sim')])
+    assert wire.subscriber_names(pub) == {'/atlas_sim'}
+    pub.connections.append(FakeConnection('/recorder'))
+    assert wire.subscriber_names(pub) == {'/atlas_sim', '/recorder'}
+
+
 def test_a_subscriber_that_left_is_dropped_quietly_a_stalled_one_with_a_warning(monkeypatch):
     warnings = []
     monkeypatch.setattr(wire.rospy, 'logwarn', warnings.append)
