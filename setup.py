@@ -4,6 +4,15 @@ from catkin_pkg.python_setup import generate_distutils_setup
 from setuptools import setup
 
 setup(**generate_distutils_setup(
-    packages=['tutorial_atlas_control'],
+    packages=[
+        'tutorial_atlas_control',
+        'tutorial_atlas_control.bags',
+        'tutorial_atlas_control.cli',
+        'tutorial_atlas_control.msgs',
+        'tutorial_atlas_control.node',
+        'tutorial_atlas_control.offline',
+        'tutorial_atlas_control.sim',
+        'tutorial_atlas_control.trajectories',
+    ],
     package_dir={'': 'src'},
 ))

@@ -23,7 +23,7 @@ from pathlib import Path
 from harness import READY_TIMEOUT_S, REPO_DIR, BenchError, Launch, Master
 from online import Probes, recorded_fraction
 from tutorial_atlas_control.processes import STOP_TIMEOUT_S, rss_kib, wait_until
-from tutorial_atlas_control.wire import subscriber_names
+from tutorial_atlas_control.msgs.wire import subscriber_names
 
 FLOOD = REPO_DIR / 'tools' / 'flood_commands.py'
 RUN_DEMO = REPO_DIR / 'scripts' / 'run_demo.py'
@@ -123,7 +123,7 @@ def load_run(master: Master, launch_file: str, probes: Probes, work_dir: Path, n
 
 
 def tutorial_run(work_dir: Path, name: str) -> dict[str, float]:
-    from tutorial_atlas_control.bag_analysis import analyze_bag
+    from tutorial_atlas_control.bags.analysis import analyze_bag
 
     bag_dir = work_dir / f'{name}_bags'
     log_path = work_dir / f'{name}.log'

@@ -149,7 +149,7 @@ def fake_ros_node(steps: int, warmup_steps: int = 1500, compiled_law: bool = Tru
     Each publisher has one subscriber (see _Sinks); rospy.is_shutdown() ends spin() after
     `steps` steps.
     """
-    from tutorial_atlas_control import sim_node
+    from tutorial_atlas_control.node import sim_node
 
     sinks = _Sinks(tcp)
     sim = make_simulator()

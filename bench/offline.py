@@ -20,8 +20,8 @@ ANALYSIS_TOPICS = (topics.JOINT_STATES, topics.JOINT_COMMANDS, topics.GROUND_TRU
 # ---------------------------------------------------------------------------- physics
 def make_simulator(compiled_law: bool = True):
     """AtlasSimulator with the DRCSim gains from config/, as the node builds it."""
-    from tutorial_atlas_control import controller, model
-    from tutorial_atlas_control.simulator import AtlasSimulator
+    from tutorial_atlas_control.sim import controller, model
+    from tutorial_atlas_control.sim.simulator import AtlasSimulator
 
     return AtlasSimulator(model.load_model(), controller.load_gains_yaml(GAINS_YAML),
                           compiled_law=compiled_law)
@@ -44,7 +44,7 @@ def physics_run(warmup_steps: int = 1500, steps: int = 5000, compiled_law: bool 
 
 
 def steps_per_sim_second() -> float:
-    from tutorial_atlas_control import model
+    from tutorial_atlas_control.sim import model
 
     return 1.0 / float(model.load_model().model.opt.timestep)
 
@@ -56,7 +56,7 @@ def run_bag(cache_dir: Path, duration_s: float = 60.0) -> Path:
     Cached under a name that hashes synthetic_bags.py, so a changed generator makes a new
     bag; written to a temporary name and renamed, so an interrupted run leaves no half bag.
     """
-    from tutorial_atlas_control import synthetic_bags
+    from tutorial_atlas_control.bags import synthetic as synthetic_bags
 
     source = Path(synthetic_bags.__file__).read_bytes()
     key = hashlib.sha1(source + str(duration_s).encode()).hexdigest()[:12]
@@ -86,7 +86,7 @@ def analysis_message_count(path: Path) -> int:
 
 def analysis_run(path: Path) -> float:
     """Wall seconds of bag_analysis.analyze_bag (read_bag + metrics) on `path`."""
-    from tutorial_atlas_control.bag_analysis import analyze_bag
+    from tutorial_atlas_control.bags.analysis import analyze_bag
 
     start = time.perf_counter()
     analyze_bag(path)
@@ -112,7 +112,7 @@ OFFLINE_TRAJECTORY = 'touchdown'
 
 def offline_run(work_dir: Path) -> float:
     """Real-time factor of run_offline (simulate + write the bag) on OFFLINE_TRAJECTORY."""
-    from tutorial_atlas_control.offline_run import run_offline
+    from tutorial_atlas_control.offline.player import run_offline
 
     bag = work_dir / 'offline_bench.bag'
     run = run_offline(str(REPO_DIR / 'trajectories' / 'Traj_data2.yaml'), OFFLINE_TRAJECTORY,

@@ -138,7 +138,7 @@ def fresh_simulator(tmp_path: Path) -> Iterator[tuple[dict[str, str], Probe, sub
 def test_played_commands_make_the_robot_fall(
         recorded_bag: Path,
         fresh_simulator: tuple[dict[str, str], Probe, subprocess.Popen]) -> None:
-    from tutorial_atlas_control.bag_analysis import analyze_bag
+    from tutorial_atlas_control.bags.analysis import analyze_bag
 
     recorded = analyze_bag(recorded_bag)
     assert recorded.fell, f'the recorded run did not fall: {recorded_bag}'
@@ -174,7 +174,7 @@ def test_played_commands_make_the_robot_fall(
 
 def test_offline_replay_of_the_recording_is_exact(recorded_bag: Path) -> None:
     """The same bag, re-simulated without ROS from its recorded torques: bit for bit."""
-    from tutorial_atlas_control.replay import replay_bag
+    from tutorial_atlas_control.offline.replay import replay_bag
 
     result = replay_bag(recorded_bag)
     assert result.recorded_steps > 1000

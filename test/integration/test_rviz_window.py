@@ -24,7 +24,7 @@ import rosgraph  # noqa: E402
 
 from support.launch import wait_sim_time  # noqa: E402
 from support.xdisplay import display_env, find_window, material_mask, screenshot, xvfb  # noqa: E402
-from tutorial_atlas_control import model as atlas_model  # noqa: E402
+from tutorial_atlas_control.sim import model as atlas_model  # noqa: E402
 from tutorial_atlas_control.processes import (  # noqa: E402
     free_local_port, ros_environment, stop_tree)
 

@@ -26,7 +26,7 @@ from pathlib import Path
 import pytest
 
 from support import xdisplay
-from tutorial_atlas_control.model import SPAWN_HEIGHT_M
+from tutorial_atlas_control.sim.model import SPAWN_HEIGHT_M
 from tutorial_atlas_control.processes import free_local_port, ros_environment, stop_tree
 
 if xdisplay.missing_tools():

@@ -15,7 +15,7 @@ pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source 
 
 from support.bag_checks import ERROR, WARN, all_finite, count, log_lines, missing_steps  # noqa: E402
 from support.launch import TestLaunch, flood_figures  # noqa: E402
-from tutorial_atlas_control.bag_reader import read_bag  # noqa: E402
+from tutorial_atlas_control.bags.reader import read_bag  # noqa: E402
 from tutorial_atlas_control.processes import rss_kib  # noqa: E402
 
 #: The issue's figures.

@@ -24,7 +24,7 @@ from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Empty
 from tf2_msgs.msg import TFMessage
 
-from tutorial_atlas_control import model as atlas_model
+from tutorial_atlas_control.sim import model as atlas_model
 
 PKG = 'tutorial_atlas_control'
 #: Every link of robot_description must be on /tf within this much sim time (s).

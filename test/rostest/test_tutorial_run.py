@@ -23,9 +23,9 @@ from osrf_msgs.msg import JointCommands
 
 from sim_probe import SimProbe  # beside this script, on its sys.path
 
-from tutorial_atlas_control import model as atlas_model
+from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.joints import JOINT_INDEX
-from tutorial_atlas_control.trajectory import load_trajectory, sample_count
+from tutorial_atlas_control.trajectories.trajectory import load_trajectory, sample_count
 
 PKG = 'tutorial_atlas_control'
 TRAJECTORY_FILE = Path(__file__).resolve().parents[2] / 'trajectories' / 'Traj_data2.yaml'

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from tutorial_atlas_control.bag_reader import JointStateSeries, load_typestore
+from tutorial_atlas_control.bags.reader import JointStateSeries, load_typestore
 
 #: rosgraph_msgs/Log levels.
 WARN, ERROR, FATAL = 4, 8, 16

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.synthetic_bags import (
+from tutorial_atlas_control.bags.synthetic import (
     clock,
     control_mode,
     joint_commands,
@@ -23,7 +23,7 @@ from tutorial_atlas_control.synthetic_bags import (
     write_bag,
     write_run_bag,
 )
-from tutorial_atlas_control.analyze_bag_cli import main
+from tutorial_atlas_control.cli.analyze_bag import main
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 
 SCRIPT = Path(__file__).resolve().parents[2] / 'scripts' / 'analyze_bag.py'

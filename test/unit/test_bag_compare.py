@@ -11,14 +11,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.synthetic_bags import (clock, control_mode, joint_commands, joint_state, odometry, rosout,
+from tutorial_atlas_control.bags.synthetic import (clock, control_mode, joint_commands, joint_state, odometry, rosout,
                             write_bag)
-from tutorial_atlas_control.analyze_bag_cli import main
-from tutorial_atlas_control.bag_analysis import analyze_bag
+from tutorial_atlas_control.cli.analyze_bag import main
+from tutorial_atlas_control.bags.analysis import analyze_bag
 from tutorial_atlas_control.errors import BagAnalysisError
-from tutorial_atlas_control.bag_compare import compare, compare_bags, first_applied_command_s
+from tutorial_atlas_control.bags.compare import compare, compare_bags, first_applied_command_s
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.schedule import trajectory_log_line
+from tutorial_atlas_control.trajectories.schedule import trajectory_log_line
 
 REPO = Path(__file__).resolve().parents[2]
 ELX = JOINT_NAMES.index('l_arm_elx')

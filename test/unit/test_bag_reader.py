@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from rosbags.rosbag1 import Reader, Writer
 from rosbags.typesys import get_types_from_msg
 
-from tutorial_atlas_control.synthetic_bags import (
+from tutorial_atlas_control.bags.synthetic import (
     STANDING_HEIGHT_M,
     TYPESTORE,
     Record,
@@ -27,12 +27,12 @@ from tutorial_atlas_control.synthetic_bags import (
     unindexed_copy,
     write_bag,
 )
-from tutorial_atlas_control import bag_reader
-from tutorial_atlas_control.bag_reader import BagData, load_typestore, read_bag
-from tutorial_atlas_control.bag_records import IndexedBag, PublicBag, open_bag
+from tutorial_atlas_control.bags import reader as bag_reader
+from tutorial_atlas_control.bags.reader import BagData, load_typestore, read_bag
+from tutorial_atlas_control.bags.records import IndexedBag, PublicBag, open_bag
 from tutorial_atlas_control.errors import AtlasControlError, BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.ros1_fields import parse_names_arrays
+from tutorial_atlas_control.msgs.ros1_fields import parse_names_arrays
 
 ELX = JOINT_NAMES.index('l_arm_elx')
 

@@ -1,4 +1,4 @@
-"""Every script follows tutorial_atlas_control.cli's convention, run from a clone, anywhere."""
+"""Every script follows tutorial_atlas_control.cli.convention's convention, run from a clone, anywhere."""
 
 from __future__ import annotations
 

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.commands import (
+from tutorial_atlas_control.msgs.commands import (
     FIELD_NAMES, MAX_MAGNITUDE, CommandDecoder, CommandError, JointCommandArrays, joint_indices,
     merge_command)
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS

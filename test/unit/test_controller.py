@@ -11,8 +11,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
-from tutorial_atlas_control.commands import FIELD_NAMES, JointCommandArrays
-from tutorial_atlas_control.controller import (
+from tutorial_atlas_control.msgs.commands import FIELD_NAMES, JointCommandArrays
+from tutorial_atlas_control.sim.controller import (
     Gains, GainsError, PidState, compute_torque, gains_from_params, hold_command, load_gains_yaml)
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS

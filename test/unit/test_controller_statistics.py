@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.controller_statistics import (
+from tutorial_atlas_control.sim.controller_statistics import (
     CommandAgeStatistics, StatisticsConfigError, update_period_ns, window_steps)
 from tutorial_atlas_control.errors import AtlasControlError
 

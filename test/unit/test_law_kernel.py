@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 from test_controller import random_command
 
-from tutorial_atlas_control import law_kernel
-from tutorial_atlas_control import model as atlas_model
-from tutorial_atlas_control.commands import FIELD_NAMES, JointCommandArrays
-from tutorial_atlas_control.controller import PidState, compute_torque, load_gains_yaml
+from tutorial_atlas_control.sim import law_kernel
+from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.msgs.commands import FIELD_NAMES, JointCommandArrays
+from tutorial_atlas_control.sim.controller import PidState, compute_torque, load_gains_yaml
 from tutorial_atlas_control.joints import NUM_JOINTS
-from tutorial_atlas_control.simulator import AtlasSimulator, ControlMode
+from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode
 
 CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
 DT_S = 0.001

@@ -32,7 +32,7 @@ def test_serialization_roundtrip() -> None:
 
 def test_simulator_subscribes_with_the_real_type_and_md5() -> None:
     """The node takes commands undecoded, but registers and negotiates the real type."""
-    from tutorial_atlas_control.sim_node import RawJointCommands
+    from tutorial_atlas_control.node.sim_node import RawJointCommands
 
     assert RawJointCommands._type == 'osrf_msgs/JointCommands'
     assert RawJointCommands._md5sum == 'f298c98f3e9c7aae9376ac19f73bfba3'

@@ -10,7 +10,9 @@ import numpy as np
 import pytest
 from support.model_table import load_table
 
-from tutorial_atlas_control import commands, controller, model
+from tutorial_atlas_control.msgs import commands
+
+from tutorial_atlas_control.sim import controller, model
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 
 REPO = Path(__file__).resolve().parents[2]

@@ -16,10 +16,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.controller import load_gains_yaml
+from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.offline_run import main, run_offline
-from tutorial_atlas_control.trajectory import TrajectoryError
+from tutorial_atlas_control.offline.player import main, run_offline
+from tutorial_atlas_control.trajectories.trajectory import TrajectoryError
 
 REPO = Path(__file__).resolve().parents[2]
 SCRIPT = REPO / 'scripts' / 'run_offline.py'
@@ -119,7 +119,7 @@ def test_commands_are_the_bytes_traj_yaml_publishes(trajectory_file: Path, tmp_p
     from osrf_msgs.msg import JointCommands
     from rospy.msg import serialize_message
 
-    from tutorial_atlas_control.traj_yaml_node import build_command
+    from tutorial_atlas_control.node.traj_yaml import build_command
 
     bag = tmp_path / 'run.bag'
     short_run(trajectory_file, bag)

@@ -13,11 +13,11 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from tutorial_atlas_control.synthetic_bags import STANDING_HEIGHT_M, joint_state, odometry, write_bag, write_run_bag
-from tutorial_atlas_control.analyze_bag_cli import main as analyze_main
-from tutorial_atlas_control.bag_reader import read_bag
+from tutorial_atlas_control.bags.synthetic import STANDING_HEIGHT_M, joint_state, odometry, write_bag, write_run_bag
+from tutorial_atlas_control.cli.analyze_bag import main as analyze_main
+from tutorial_atlas_control.bags.reader import read_bag
 from tutorial_atlas_control.joints import NUM_JOINTS
-from tutorial_atlas_control.render import (
+from tutorial_atlas_control.bags.render import (
     RenderError, RunStates, StateRenderer, check_output_path, parse_size, render_states,
     states_from_bag)
 

@@ -14,15 +14,15 @@ from typing import Any, Callable
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.synthetic_bags import TYPESTORE, Record, joint_state, write_bag
-from tutorial_atlas_control import model as atlas_model
-from tutorial_atlas_control.bag_reader import read_bag
-from tutorial_atlas_control.controller import DEFAULT_GAINS_FILE, hold_command, load_gains_yaml
+from tutorial_atlas_control.bags.synthetic import TYPESTORE, Record, joint_state, write_bag
+from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.bags.reader import read_bag
+from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, hold_command, load_gains_yaml
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.replay import (
+from tutorial_atlas_control.offline.replay import (
     EXIT_DEVIATES, ReplayError, format_report, load_recording, main, replay_bag)
-from tutorial_atlas_control.simulator import AtlasSimulator, ControlMode
+from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode
 
 SCRIPT = Path(__file__).resolve().parents[2] / 'scripts' / 'replay_bag.py'
 #: Short pin so that unpinning happens inside the short synthetic runs (s).

@@ -10,9 +10,9 @@ from typing import Any
 import pytest
 import yaml
 
-from tutorial_atlas_control import model as atlas_model
+from tutorial_atlas_control.sim import model as atlas_model
 
-sim_node = pytest.importorskip('tutorial_atlas_control.sim_node',
+sim_node = pytest.importorskip('tutorial_atlas_control.node.sim_node',
                                reason='needs the catkin workspace: source ./env.sh')
 
 CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'

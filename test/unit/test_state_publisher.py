@@ -8,7 +8,9 @@ from pathlib import Path
 
 import pytest
 
-from tutorial_atlas_control import model, state_publisher
+from tutorial_atlas_control.sim import model
+
+from tutorial_atlas_control.node import state_publisher
 
 
 def test_usage_without_a_model_file(capsys: pytest.CaptureFixture[str]) -> None:

@@ -22,10 +22,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.controller import Gains, GainsError
+from tutorial_atlas_control.sim.controller import Gains, GainsError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.trajectory import Waypoint, sample_count
-from tutorial_atlas_control.traj_yaml_node import (
+from tutorial_atlas_control.trajectories.trajectory import Waypoint, sample_count
+from tutorial_atlas_control.node.traj_yaml import (
     JointStateCache,
     TrajYamlError,
     build_command,
@@ -103,7 +103,7 @@ def test_script_is_thin_and_executable() -> None:
     assert os.access(SCRIPT, os.X_OK)
     text = SCRIPT.read_text(encoding='utf-8')
     assert text.startswith('#!/usr/bin/env python3\n')
-    assert 'tutorial_atlas_control.traj_yaml_node' in text
+    assert 'tutorial_atlas_control.node.traj_yaml' in text
     assert len(text.splitlines()) <= 12
 
 

@@ -1,4 +1,4 @@
-"""Unit tests for tutorial_atlas_control.trajectory: file validation, the tutorial's file, interpolation."""
+"""Unit tests for tutorial_atlas_control.trajectories.trajectory: file validation, the tutorial's file, interpolation."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tutorial_atlas_control.joints import JOINT_INDEX, NUM_JOINTS
-from tutorial_atlas_control.trajectory import (
+from tutorial_atlas_control.trajectories.trajectory import (
     PUBLISH_PERIOD_S,
     TrajectoryError,
     Waypoint,

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from tutorial_atlas_control.trajectory import (
+from tutorial_atlas_control.trajectories.trajectory import (
     TRAJECTORIES_DIR, TrajectoryError, is_explicit_path, load_trajectory, resolve_trajectory_file)
 
 

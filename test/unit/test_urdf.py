@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from support.model_table import load_table
 
-from tutorial_atlas_control import model, urdf
+from tutorial_atlas_control.sim import model, urdf
 from tutorial_atlas_control.joints import JOINT_NAMES
 
 REPO = Path(__file__).resolve().parents[2]

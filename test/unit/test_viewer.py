@@ -6,7 +6,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.viewer import (
+from tutorial_atlas_control.node.viewer import (
     CONTROL, KEY_R, KEY_SPACE, SHIFT, ViewerLink, ViewerRequest, request_for_key)
 
 MJCF = """

@@ -13,7 +13,7 @@ from sensor_msgs.msg import Imu, JointState
 from geometry_msgs.msg import TransformStamped
 from tf2_msgs.msg import TFMessage
 
-from tutorial_atlas_control import wire
+from tutorial_atlas_control.msgs import wire
 from tutorial_atlas_control.joints import JOINT_NAMES
 
 STAMP_NS = 12 * wire.NS_PER_S + 345_678

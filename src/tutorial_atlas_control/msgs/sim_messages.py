@@ -15,10 +15,10 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control.joints import JOINT_NAMES
-from tutorial_atlas_control.law_kernel import Copy, CopyPlan
-from tutorial_atlas_control.simulator import AtlasSimulator
+from tutorial_atlas_control.sim.law_kernel import Copy, CopyPlan
+from tutorial_atlas_control.sim.simulator import AtlasSimulator
 from tutorial_atlas_control.topics import PELVIS_FRAME, WORLD_FRAME
-from tutorial_atlas_control.wire import (
+from tutorial_atlas_control.msgs.wire import (
     ImuWire, JointStateWire, OdometryWire, StampedWire, TransformWire, WrenchStampedWire)
 
 __all__ = ['TCPROS_PREFIX_BYTES', 'SimMessages']

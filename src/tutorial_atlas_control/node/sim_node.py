@@ -47,22 +47,22 @@ from std_msgs.msg import String
 from std_srvs.srv import Empty, EmptyResponse
 from tf2_msgs.msg import TFMessage
 
-from tutorial_atlas_control import model as atlas_model
+from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.commands import CommandDecoder, CommandError
-from tutorial_atlas_control.controller import gains_from_params
-from tutorial_atlas_control.controller_statistics import (
+from tutorial_atlas_control.msgs.commands import CommandDecoder, CommandError
+from tutorial_atlas_control.sim.controller import gains_from_params
+from tutorial_atlas_control.sim.controller_statistics import (
     DEFAULT_WINDOW_S, UPDATE_RATE_PARAM, WINDOW_PARAM, CommandAgeStatistics)
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.render import configure_viewer_camera, configure_viewer_scene
-from tutorial_atlas_control.ros1_fields import FieldCursor
-from tutorial_atlas_control.sim_messages import SimMessages
-from tutorial_atlas_control.simulator import (
+from tutorial_atlas_control.bags.render import configure_viewer_camera, configure_viewer_scene
+from tutorial_atlas_control.msgs.ros1_fields import FieldCursor
+from tutorial_atlas_control.msgs.sim_messages import SimMessages
+from tutorial_atlas_control.sim.simulator import (
     DEFAULT_TIME_TO_UNPIN_S, AtlasSimulator, ModeError, PhysicsDivergenceError, parse_mode)
 from tutorial_atlas_control.units import NS_PER_S, finite_number
-from tutorial_atlas_control.urdf import UrdfError, matching_urdf
-from tutorial_atlas_control.viewer import ViewerLink, ViewerRequest
-from tutorial_atlas_control.wire import (
+from tutorial_atlas_control.sim.urdf import UrdfError, matching_urdf
+from tutorial_atlas_control.node.viewer import ViewerLink, ViewerRequest
+from tutorial_atlas_control.msgs.wire import (
     ControllerStatisticsWire, WireBatch, clock_bytes)
 
 NODE_NAME = 'atlas_sim'

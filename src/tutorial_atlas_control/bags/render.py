@@ -27,8 +27,8 @@ from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.units import finite_number
 
 if TYPE_CHECKING:  # pragma: no cover - typing only; mujoco is imported lazily
-    from tutorial_atlas_control.bag_reader import BagData
-    from tutorial_atlas_control.model import AtlasModel
+    from tutorial_atlas_control.bags.reader import BagData
+    from tutorial_atlas_control.sim.model import AtlasModel
 
 __all__ = [
     'CAMERA',
@@ -232,7 +232,7 @@ class StateRenderer:
         prepare_gl()
         import mujoco
 
-        from tutorial_atlas_control.model import load_model
+        from tutorial_atlas_control.sim.model import load_model
 
         self._mujoco = mujoco
         self.atlas = atlas if atlas is not None else load_model()

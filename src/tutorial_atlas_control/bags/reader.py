@@ -25,10 +25,10 @@ from rosbags.interfaces import Connection
 from rosbags.rosbag1 import ReaderError
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.bag_records import BagRecords, open_bag
+from tutorial_atlas_control.bags.records import BagRecords, open_bag
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS, bare_joint_name
-from tutorial_atlas_control.ros1_fields import FieldCursor, parse_names_arrays
+from tutorial_atlas_control.msgs.ros1_fields import FieldCursor, parse_names_arrays
 from tutorial_atlas_control.units import NS_PER_S
 
 __all__ = [

@@ -15,8 +15,9 @@ import numpy as np
 
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES
+from tutorial_atlas_control.resources import package_path
 
-MODEL_PATH: Path = Path(__file__).resolve().parents[2] / 'sim' / 'atlas_v1.xml'
+MODEL_PATH: Path = package_path('sim', 'atlas_v1.xml')
 
 #: Pelvis z (m) at which both sole boxes touch z = 0 with every joint at 0:
 #: hip-pitch origin 0.05 + knee 0.374 + ankle 0.422 + sole centre 0.076119 +

@@ -31,14 +31,14 @@ from typing import Any
 
 import numpy as np
 
-from tutorial_atlas_control import model as atlas_model
+from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.bag_reader import BagData, read_bag
-from tutorial_atlas_control.cli import argument_type, print_error
-from tutorial_atlas_control.controller import DEFAULT_GAINS_FILE, load_gains_yaml
+from tutorial_atlas_control.bags.reader import BagData, read_bag
+from tutorial_atlas_control.cli.convention import argument_type, print_error
+from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, load_gains_yaml
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.simulator import (
+from tutorial_atlas_control.sim.simulator import (
     DEFAULT_TIME_TO_UNPIN_S, AtlasSimulator, PhysicsDivergenceError)
 from tutorial_atlas_control.units import NS_PER_S, finite_number
 

@@ -18,11 +18,11 @@ from pathlib import Path
 
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.processes import AtlasLaunch
+from tutorial_atlas_control.resources import package_path
 
 PROG = 'run_demo.py'
 
-PACKAGE_DIR = Path(__file__).resolve().parents[2]
-DEFAULT_TRAJECTORY_FILE = PACKAGE_DIR / 'trajectories' / 'Traj_data2.yaml'
+DEFAULT_TRAJECTORY_FILE = package_path('trajectories', 'Traj_data2.yaml')
 DEFAULT_BAG_DIR = Path.home() / '.ros' / 'tutorial_atlas_control' / 'bags'
 #: Sim time to wait before switching to User: the torso is pinned for 1 s after start.
 START_SETTLE_S = 1.5
@@ -115,9 +115,9 @@ def wait_sim_time(clock_type: type, seconds: float) -> None:
 
 def summarise(bag: Path, video_fps: float, video_size: tuple[int, int]) -> None:
     """Print the short summary; write the plot and (unless video_fps is 0) the video."""
-    from tutorial_atlas_control.bag_analysis import analyze_bag
-    from tutorial_atlas_control.bag_report import plot_run, short_summary
-    from tutorial_atlas_control.render import render_bag_video
+    from tutorial_atlas_control.bags.analysis import analyze_bag
+    from tutorial_atlas_control.bags.report import plot_run, short_summary
+    from tutorial_atlas_control.bags.render import render_bag_video
 
     analysis = analyze_bag(bag)
     print('\n' + short_summary(analysis))
@@ -133,8 +133,8 @@ def summarise(bag: Path, video_fps: float, video_size: tuple[int, int]) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from tutorial_atlas_control.cli import argument_type, print_error
-    from tutorial_atlas_control.render import parse_size
+    from tutorial_atlas_control.cli.convention import argument_type, print_error
+    from tutorial_atlas_control.bags.render import parse_size
 
     parser = argparse.ArgumentParser(
         prog=PROG, description=__doc__.split('\n\n')[0])
@@ -153,7 +153,7 @@ def main(argv: list[str] | None = None) -> int:
                         help='video size WxH in pixels (default: %(default)s)')
     args = parser.parse_args(argv)
     try:
-        from tutorial_atlas_control.trajectory import load_trajectory
+        from tutorial_atlas_control.trajectories.trajectory import load_trajectory
         load_trajectory(args.file, args.trajectory)  # fail before starting anything
         bag = run_demo(args.trajectory, args.file, args.bag_dir.expanduser().resolve(),
                        args.real_time_factor, args.bag_dir.expanduser() / 'logs')

@@ -12,7 +12,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.trajectory import Waypoint, interpolate, sample_count
+from tutorial_atlas_control.trajectories.trajectory import Waypoint, interpolate, sample_count
 
 __all__ = [
     'MOVING_JOINT_THRESHOLD_RAD',

@@ -8,7 +8,7 @@ of whitespace-separated numbers, as in the tutorial's ``Traj_data2.yaml``, or a
 YAML list of numbers.
 
 This module is pure (no rospy) so it can be tested without a ROS master; the
-ROS glue is :mod:`tutorial_atlas_control.traj_yaml_node`.
+ROS glue is :mod:`tutorial_atlas_control.node.traj_yaml`.
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ import yaml
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.units import finite_number
+from tutorial_atlas_control.resources import package_path
 
 __all__ = [
     'PUBLISH_PERIOD_S',
@@ -52,7 +53,7 @@ PathLike = Union[str, 'os.PathLike[str]']
 #: The package's trajectory files. The tutorial runs ``traj_yaml.py Traj_data2.yaml ...``
 #: from the folder that holds the file; a bare or relative name that does not exist from
 #: the current directory is looked up here (see :func:`resolve_trajectory_file`).
-TRAJECTORIES_DIR: Path = Path(__file__).resolve().parents[2] / 'trajectories'
+TRAJECTORIES_DIR: Path = package_path('trajectories')
 
 
 class TrajectoryError(AtlasControlError):

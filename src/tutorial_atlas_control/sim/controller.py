@@ -41,16 +41,17 @@ from typing import Any
 import numpy as np
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.commands import JointCommandArrays
+from tutorial_atlas_control.msgs.commands import JointCommandArrays
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.units import finite_number
+from tutorial_atlas_control.resources import package_path
 
 #: Where the gains live on the parameter server (and in config/atlas_controller.yaml).
 GAINS_PARAM = topics.GAINS_PARAM
 GAIN_KEYS: tuple[str, ...] = ('p', 'i', 'd', 'i_clamp')
 #: DRCSim's gains as the package ships them (what atlas.launch loads by default).
-DEFAULT_GAINS_FILE: Path = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
+DEFAULT_GAINS_FILE: Path = package_path('config', 'atlas_controller.yaml')
 LOAD_HINT = ('load the gains with `roslaunch tutorial_atlas_control atlas.launch` '
              'or `rosparam load config/atlas_controller.yaml`')
 

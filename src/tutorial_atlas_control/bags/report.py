@@ -1,4 +1,4 @@
-"""Present a bag :class:`~tutorial_atlas_control.bag_analysis.Analysis`: text, JSON, CSV, plot."""
+"""Present a bag :class:`~tutorial_atlas_control.bags.analysis.Analysis`: text, JSON, CSV, plot."""
 
 from __future__ import annotations
 
@@ -10,13 +10,13 @@ from typing import Any
 import numpy as np
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.bag_analysis import (
+from tutorial_atlas_control.bags.analysis import (
     EFFORT_LIMIT_TOLERANCE_NM,
     FALL_HEIGHT_M,
     MOVED_RANGE_RAD,
     Analysis,
 )
-from tutorial_atlas_control.bag_reader import BagData
+from tutorial_atlas_control.bags.reader import BagData
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_NAMES
 

@@ -55,7 +55,7 @@ def main(argv: list[str] | None = None) -> int:
     import mujoco
     import rosgraph
 
-    from tutorial_atlas_control.urdf import UrdfError, matching_urdf
+    from tutorial_atlas_control.sim.urdf import UrdfError, matching_urdf
     model_file = Path(plain[0])
     try:
         model = mujoco.MjModel.from_xml_path(str(model_file))

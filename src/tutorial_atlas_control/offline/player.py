@@ -29,25 +29,25 @@ from typing import Any
 import numpy as np
 from rosbags.typesys import get_types_from_msg
 
-from tutorial_atlas_control import model as atlas_model
+from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.bag_analysis import analyze_bag
-from tutorial_atlas_control.bag_reader import load_typestore
-from tutorial_atlas_control.bag_report import short_summary
-from tutorial_atlas_control.cli import print_error
-from tutorial_atlas_control.commands import CommandDecoder, CommandError
-from tutorial_atlas_control.controller import DEFAULT_GAINS_FILE, Gains, load_gains_yaml
+from tutorial_atlas_control.bags.analysis import analyze_bag
+from tutorial_atlas_control.bags.reader import load_typestore
+from tutorial_atlas_control.bags.report import short_summary
+from tutorial_atlas_control.cli.convention import print_error
+from tutorial_atlas_control.msgs.commands import CommandDecoder, CommandError
+from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, Gains, load_gains_yaml
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES
-from tutorial_atlas_control.schedule import (
+from tutorial_atlas_control.trajectories.schedule import (
     done_line, playing_line, run_trajectory, trajectory_log_line)
-from tutorial_atlas_control.sim_messages import TCPROS_PREFIX_BYTES, SimMessages
-from tutorial_atlas_control.simulator import (
+from tutorial_atlas_control.msgs.sim_messages import TCPROS_PREFIX_BYTES, SimMessages
+from tutorial_atlas_control.sim.simulator import (
     AtlasSimulator, ControlMode, PhysicsDivergenceError)
-from tutorial_atlas_control.trajectory import (
+from tutorial_atlas_control.trajectories.trajectory import (
     Waypoint, load_trajectory, locate_trajectory_file)
 from tutorial_atlas_control.units import NS_PER_S
-from tutorial_atlas_control.wire import JointCommandsWire, StampedWire, clock_bytes
+from tutorial_atlas_control.msgs.wire import JointCommandsWire, StampedWire, clock_bytes
 
 __all__ = ['OfflineRunError', 'OfflineRun', 'main', 'run_offline', 'write_offline_bag']
 

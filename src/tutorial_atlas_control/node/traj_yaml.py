@@ -5,7 +5,7 @@ Same command line, topics, parameters, message and motion as the tutorial's
 waypoint's, published at 50 Hz in ROS time. Unlike the tutorial, it validates the file
 before anything starts, waits (bounded) for the simulator before the first command, reads
 joint states by name and stamps each command. File handling and interpolation live in
-:mod:`tutorial_atlas_control.trajectory`; this module only talks to ROS.
+:mod:`tutorial_atlas_control.trajectories.trajectory`; this module only talks to ROS.
 """
 
 from __future__ import annotations
@@ -23,11 +23,11 @@ import rospy
 from sensor_msgs.msg import JointState
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.controller import LOAD_HINT, Gains, GainsError, gains_from_params
+from tutorial_atlas_control.sim.controller import LOAD_HINT, Gains, GainsError, gains_from_params
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES, NUM_JOINTS, joint_index
-from tutorial_atlas_control.schedule import done_line, playing_line, run_trajectory, trajectory_log_line
-from tutorial_atlas_control.trajectory import Waypoint, load_trajectory, locate_trajectory_file
+from tutorial_atlas_control.trajectories.schedule import done_line, playing_line, run_trajectory, trajectory_log_line
+from tutorial_atlas_control.trajectories.trajectory import Waypoint, load_trajectory, locate_trajectory_file
 from tutorial_atlas_control.units import finite_number
 
 __all__ = [

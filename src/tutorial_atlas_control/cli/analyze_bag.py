@@ -6,21 +6,21 @@ import argparse
 import sys
 from typing import Sequence
 
-from tutorial_atlas_control.bag_analysis import (
+from tutorial_atlas_control.bags.analysis import (
     COMMAND_CHANGE_RAD,
     EFFORT_LIMIT_TOLERANCE_NM,
     FALL_HEIGHT_M,
     MOVED_RANGE_RAD,
     analyze_bag,
 )
-from tutorial_atlas_control.bag_compare import compare_bags, format_comparison, plot_comparison
-from tutorial_atlas_control.bag_compare import to_json as comparison_json
-from tutorial_atlas_control.bag_report import format_summary, plot_run, to_json, write_csv
-from tutorial_atlas_control.cli import argument_type, print_error
+from tutorial_atlas_control.bags.compare import compare_bags, format_comparison, plot_comparison
+from tutorial_atlas_control.bags.compare import to_json as comparison_json
+from tutorial_atlas_control.bags.report import format_summary, plot_run, to_json, write_csv
+from tutorial_atlas_control.cli.convention import argument_type, print_error
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.render import (
+from tutorial_atlas_control.bags.render import (
     DEFAULT_FPS, DEFAULT_SIZE, check_output_path, parse_fps, parse_size, render_bag_video)
-from tutorial_atlas_control.run_log import PlayedTrajectory, played_trajectories
+from tutorial_atlas_control.bags.run_log import PlayedTrajectory, played_trajectories
 
 PROG = 'analyze_bag.py'
 

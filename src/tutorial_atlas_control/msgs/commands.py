@@ -18,7 +18,7 @@ import numpy as np
 
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import NUM_JOINTS, joint_index
-from tutorial_atlas_control.ros1_fields import FieldCursor
+from tutorial_atlas_control.msgs.ros1_fields import FieldCursor
 
 
 #: The array fields of osrf_msgs/JointCommands, in message order.

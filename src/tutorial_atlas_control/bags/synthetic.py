@@ -26,7 +26,7 @@ from tutorial_atlas_control.units import NS_PER_S
 
 #: The repository's definition of osrf_msgs/JointCommands.
 JOINT_COMMANDS_MSG = (
-    Path(__file__).resolve().parents[2] / 'msg' / 'osrf_msgs' / 'msg' / 'JointCommands.msg'
+    Path(__file__).resolve().parents[3] / 'msg' / 'osrf_msgs' / 'msg' / 'JointCommands.msg'
 )
 
 

@@ -1,6 +1,6 @@
 """The tutorial's metrics of a recorded run: fall, tracking, command timing, effort limits.
 
-Works on the :class:`~tutorial_atlas_control.bag_reader.BagData` that bag_reader extracts;
+Works on the :class:`~tutorial_atlas_control.bags.reader.BagData` that bag_reader extracts;
 all times are seconds from the bag's start.
 """
 
@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.bag_reader import (
+from tutorial_atlas_control.bags.reader import (
     BagData,
     JointCommandSeries,
     JointStateSeries,
@@ -259,5 +259,5 @@ def analyze(data: BagData) -> Analysis:
 
 
 def analyze_bag(path: Path | str) -> Analysis:
-    """:func:`~tutorial_atlas_control.bag_reader.read_bag` then :func:`analyze`."""
+    """:func:`~tutorial_atlas_control.bags.reader.read_bag` then :func:`analyze`."""
     return analyze(read_bag(path))

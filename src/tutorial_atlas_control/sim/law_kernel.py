@@ -22,8 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from tutorial_atlas_control.commands import FIELD_NAMES, JointCommandArrays
-from tutorial_atlas_control.controller import PidState
+from tutorial_atlas_control.msgs.commands import FIELD_NAMES, JointCommandArrays
+from tutorial_atlas_control.sim.controller import PidState
 
 #: The shared library CMakeLists.txt builds (devel/lib, installed to the package lib dir).
 LIBRARY_NAME = 'libtutorial_atlas_control_law.so'

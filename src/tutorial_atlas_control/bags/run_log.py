@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from tutorial_atlas_control.schedule import TRAJECTORY_LOG_PREFIX, parse_trajectory_log_line
+from tutorial_atlas_control.trajectories.schedule import TRAJECTORY_LOG_PREFIX, parse_trajectory_log_line
 from tutorial_atlas_control.topics import ROSOUT
 
 __all__ = ['PlayedTrajectory', 'played_trajectories']

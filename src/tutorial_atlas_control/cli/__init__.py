@@ -1,0 +1,1 @@
+"""The scripts' command lines: argument parsing, the error convention and exit codes."""

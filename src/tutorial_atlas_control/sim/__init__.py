@@ -1,0 +1,1 @@
+"""The simulation: the MuJoCo model and its URDF, the controller law (numpy and compiled), the simulator. No ROS."""

@@ -1,0 +1,1 @@
+"""Trajectory files (lookup, validation, interpolation) and the 50 Hz schedule. No ROS."""
