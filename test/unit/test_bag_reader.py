@@ -28,8 +28,9 @@ from tutorial_atlas_control.bags.synthetic import (
     write_bag,
 )
 from tutorial_atlas_control.bags import reader as bag_reader
-from tutorial_atlas_control.bags.reader import BagData, load_typestore, read_bag
+from tutorial_atlas_control.bags.reader import BagData, read_bag
 from tutorial_atlas_control.bags.records import IndexedBag, PublicBag, open_bag
+from tutorial_atlas_control.bags.typestore import load_typestore
 from tutorial_atlas_control.errors import AtlasControlError, BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.msgs.ros1_fields import parse_names_arrays
@@ -200,6 +201,12 @@ def test_joint_commands_definition_has_the_expected_md5() -> None:
     typestore = load_typestore()
     assert typestore.generate_msgdef('osrf_msgs/msg/JointCommands')[1] == (
         bag_reader.JOINT_COMMANDS_MD5)
+
+
+def test_typestore_has_tf_messages_with_the_debian_md5() -> None:
+    """rosbags' Noetic store lacks tf2_msgs/TFMessage; load_typestore adds it, as ROS has it."""
+    assert load_typestore().generate_msgdef('tf2_msgs/msg/TFMessage')[1] == (
+        '94810edda583a504dfda3829e70d7eec')
 
 
 # ---------------------------------------------------------------- topics and series

@@ -27,12 +27,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from rosbags.typesys import get_types_from_msg
 
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags.analysis import analyze_bag
-from tutorial_atlas_control.bags.reader import load_typestore
+from tutorial_atlas_control.bags.typestore import JOINT_COMMANDS_TYPE, load_typestore
 from tutorial_atlas_control.bags.report import short_summary
 from tutorial_atlas_control.cli.convention import print_error
 from tutorial_atlas_control.msgs.commands import CommandDecoder, CommandError
@@ -69,10 +68,6 @@ LOG_INFO = 2
 #: Bag chunk size (bytes): rosbag record's default.
 CHUNK_BYTES = 768 * 1024
 
-JOINT_COMMANDS_TYPE = 'osrf_msgs/msg/JointCommands'
-#: tf2_msgs/TFMessage, field for field (its definition as Debian's ros-tf2-msgs ships it).
-TF_TYPE = 'tf2_msgs/msg/TFMessage'
-TF_MSG_DEFINITION = 'geometry_msgs/TransformStamped[] transforms'
 #: Topic -> (type, publishing node, latched), as in a live run.
 TOPIC_TYPES: dict[str, tuple[str, str, bool]] = {
     topics.SIM_CONFIG: ('std_msgs/msg/String', SIMULATOR_NODE, True),
@@ -85,7 +80,7 @@ TOPIC_TYPES: dict[str, tuple[str, str, bool]] = {
     topics.CONTROL_MODE: ('std_msgs/msg/String', PLAYER_NODE, True),
     topics.JOINT_COMMANDS: (JOINT_COMMANDS_TYPE, PLAYER_NODE, False),
     topics.ROSOUT: ('rosgraph_msgs/msg/Log', PLAYER_NODE, True),
-    topics.TF: (TF_TYPE, SIMULATOR_NODE, False),
+    topics.TF: ('tf2_msgs/msg/TFMessage', SIMULATOR_NODE, False),
 }
 
 
@@ -261,8 +256,6 @@ class _BagSink:
         if JOINT_COMMANDS_TYPE not in self.typestore.fielddefs:
             raise OfflineRunError('cannot find osrf_msgs/JointCommands.msg (msg/osrf_msgs in '
                                   'the package): the commands could not be written')
-        if TF_TYPE not in self.typestore.fielddefs:  # not in rosbags' Noetic store
-            self.typestore.register(get_types_from_msg(TF_MSG_DEFINITION, TF_TYPE))
         self.writer = _writer_class()(path)
         self.writer.chunk_threshold = CHUNK_BYTES
         self.writer.open()
