@@ -31,7 +31,8 @@ import numpy as np
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags.analysis import analyze_bag
-from tutorial_atlas_control.bags.typestore import JOINT_COMMANDS_TYPE, load_typestore
+from tutorial_atlas_control.bags.typestore import (
+    JOINT_COMMANDS_TYPE, load_typestore, rosbags_msgtype)
 from tutorial_atlas_control.bags.report import short_summary
 from tutorial_atlas_control.cli.convention import print_error
 from tutorial_atlas_control.msgs.commands import CommandDecoder, CommandError
@@ -68,20 +69,25 @@ LOG_INFO = 2
 #: Bag chunk size (bytes): rosbag record's default.
 CHUNK_BYTES = 768 * 1024
 
-#: Topic -> (type, publishing node, latched), as in a live run.
-TOPIC_TYPES: dict[str, tuple[str, str, bool]] = {
-    topics.SIM_CONFIG: ('std_msgs/msg/String', SIMULATOR_NODE, True),
-    topics.CLOCK: ('rosgraph_msgs/msg/Clock', SIMULATOR_NODE, False),
-    topics.JOINT_STATES: ('sensor_msgs/msg/JointState', SIMULATOR_NODE, False),
-    topics.GROUND_TRUTH_ODOM: ('nav_msgs/msg/Odometry', SIMULATOR_NODE, False),
-    topics.IMU: ('sensor_msgs/msg/Imu', SIMULATOR_NODE, False),
-    topics.L_FOOT_CONTACT: ('geometry_msgs/msg/WrenchStamped', SIMULATOR_NODE, False),
-    topics.R_FOOT_CONTACT: ('geometry_msgs/msg/WrenchStamped', SIMULATOR_NODE, False),
-    topics.CONTROL_MODE: ('std_msgs/msg/String', PLAYER_NODE, True),
-    topics.JOINT_COMMANDS: (JOINT_COMMANDS_TYPE, PLAYER_NODE, False),
-    topics.ROSOUT: ('rosgraph_msgs/msg/Log', PLAYER_NODE, True),
-    topics.TF: ('tf2_msgs/msg/TFMessage', SIMULATOR_NODE, False),
+#: Topic -> (publishing node, latched), as in a live run; this order is the bag's
+#: connections' order (their ids).
+PUBLISHERS: dict[str, tuple[str, bool]] = {
+    topics.SIM_CONFIG: (SIMULATOR_NODE, True),
+    topics.CLOCK: (SIMULATOR_NODE, False),
+    topics.JOINT_STATES: (SIMULATOR_NODE, False),
+    topics.GROUND_TRUTH_ODOM: (SIMULATOR_NODE, False),
+    topics.IMU: (SIMULATOR_NODE, False),
+    topics.L_FOOT_CONTACT: (SIMULATOR_NODE, False),
+    topics.R_FOOT_CONTACT: (SIMULATOR_NODE, False),
+    topics.CONTROL_MODE: (PLAYER_NODE, True),
+    topics.JOINT_COMMANDS: (PLAYER_NODE, False),
+    topics.ROSOUT: (PLAYER_NODE, True),
+    topics.TF: (SIMULATOR_NODE, False),
 }
+#: Topic -> (type (topics.MSG_TYPES), publishing node, latched): the bag's connections.
+TOPIC_TYPES: dict[str, tuple[str, str, bool]] = {
+    topic: (rosbags_msgtype(topics.MSG_TYPES[topic]), node, latched)
+    for topic, (node, latched) in PUBLISHERS.items()}
 
 
 class OfflineRunError(AtlasControlError):
