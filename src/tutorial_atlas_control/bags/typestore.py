@@ -8,12 +8,15 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from rosbags.interfaces import Connection
 from rosbags.typesys import Stores, TypesysError, get_types_from_msg, get_typestore
-from rosbags.typesys.store import Typestore
 
 from tutorial_atlas_control.errors import BagAnalysisError
+
+if TYPE_CHECKING:  # get_typestore's return type; rosbags.typesys does not re-export it
+    from rosbags.typesys.store import Typestore
 
 __all__ = [
     'JOINT_COMMANDS_MSG_RELPATH',
