@@ -8,7 +8,8 @@ from typing import Any
 
 import numpy as np
 
-from tutorial_atlas_control.bags.reader import JointStateSeries, load_typestore
+from tutorial_atlas_control.bags.reader import JointStateSeries
+from tutorial_atlas_control.bags.typestore import load_typestore
 
 #: rosgraph_msgs/Log levels.
 WARN, ERROR, FATAL = 4, 8, 16
