@@ -15,6 +15,7 @@ from collections.abc import Mapping, Sequence
 import mujoco
 import numpy as np
 
+from tutorial_atlas_control import native
 from tutorial_atlas_control.sim import law_kernel
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.msgs.commands import CommandUpdate, JointCommandArrays, command_update
@@ -107,7 +108,7 @@ class AtlasSimulator:
 
     def _make_compiled_law(self) -> law_kernel.CompiledLaw | None:
         """The C law writing torque_nm and MjData.ctrl; None (numpy law) if it is not built."""
-        library = law_kernel.load_library()
+        library = native.load_library()
         if library is None or self.data.ctrl.shape != self.torque_nm.shape:
             return None
         return law_kernel.CompiledLaw(
