@@ -16,7 +16,6 @@ CLOCK_PERIOD_NS), so every bag tool reads it as one.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import struct
 import tempfile
@@ -437,7 +436,7 @@ class _OfflinePlayer:
     # -- what the user and traj_yaml do ------------------------------------------------
     def write_config(self) -> None:
         self.sink.write_message(topics.SIM_CONFIG, self.sim.sim_time_ns,
-                                self._string(data=json.dumps(self.sim.config())))
+                                self._string(data=self.sim.config().to_json()))
 
     def switch_mode(self, mode: ControlMode) -> None:
         self.sink.write_message(topics.CONTROL_MODE, self.sim.sim_time_ns,

@@ -38,6 +38,7 @@ from tutorial_atlas_control.cli.convention import argument_type, print_error
 from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, load_gains_yaml
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.sim.sim_config import SimConfig, SimConfigError, parse_sim_config
 from tutorial_atlas_control.sim.simulator import (
     DEFAULT_TIME_TO_UNPIN_S, AtlasSimulator, PhysicsDivergenceError)
 from tutorial_atlas_control.units import NS_PER_S, finite_number
@@ -48,7 +49,6 @@ __all__ = [
     'Recording',
     'ReplayError',
     'ReplayResult',
-    'SimConfig',
     'format_report',
     'load_recording',
     'main',
@@ -78,18 +78,6 @@ class ReplayError(AtlasControlError):
 
 
 @dataclass(frozen=True)
-class SimConfig:
-    """The simulator's /atlas/sim_config (times in s); `recorded` False = assumed defaults."""
-
-    model_file: str | None
-    model_sha1: str | None
-    timestep_s: float | None
-    time_to_unpin_s: float
-    last_reset_time_s: float
-    recorded: bool
-
-
-@dataclass(frozen=True)
 class Recording:
     """What replay needs from a bag; stamps are sim time (ns).
 
@@ -112,17 +100,11 @@ class Recording:
 
 
 def _read_sim_configs(data: BagData) -> list[dict[str, Any]]:
-    """Every /atlas/sim_config message of `data`, in record order, parsed from JSON."""
-    configs = []
-    for _, text in data.sim_configs:
-        try:
-            config = json.loads(text)
-        except json.JSONDecodeError as err:
-            raise ReplayError(f'{data.path}: {SIM_CONFIG_TOPIC} is not JSON ({err}).') from err
-        if not isinstance(config, dict):
-            raise ReplayError(f'{data.path}: {SIM_CONFIG_TOPIC} is not a JSON object: {text!r}.')
-        configs.append(config)
-    return configs
+    """Every /atlas/sim_config message of `data`, in record order, as JSON objects."""
+    try:
+        return [parse_sim_config(text) for _, text in data.sim_configs]
+    except SimConfigError as err:
+        raise ReplayError(f'{data.path}: {SIM_CONFIG_TOPIC} {err}') from err
 
 
 def _sim_config(path: Path, raw_configs: list[dict[str, Any]],
@@ -133,19 +115,11 @@ def _sim_config(path: Path, raw_configs: list[dict[str, Any]],
                         f'published it): assuming time_to_unpin = {DEFAULT_TIME_TO_UNPIN_S} s '
                         f'and no reset after t = {DEFAULT_LAST_RESET_S} s.')
         return SimConfig(None, None, None, DEFAULT_TIME_TO_UNPIN_S, DEFAULT_LAST_RESET_S,
-                         False), 0
-    last = raw_configs[-1]
+                         recorded=False), 0
     try:
-        config = SimConfig(
-            model_file=str(last.get('model_file')) if last.get('model_file') else None,
-            model_sha1=str(last.get('model_sha1')) if last.get('model_sha1') else None,
-            timestep_s=float(last['timestep']),
-            time_to_unpin_s=float(last['time_to_unpin']),
-            last_reset_time_s=float(last['last_reset_time']),
-            recorded=True)
-    except (KeyError, TypeError, ValueError) as err:
-        raise ReplayError(f'{path}: {SIM_CONFIG_TOPIC} lacks a valid {err} (expected JSON with '
-                          'timestep, time_to_unpin, last_reset_time).') from None
+        config = SimConfig.from_dict(raw_configs[-1])
+    except SimConfigError as err:
+        raise ReplayError(f'{path}: {SIM_CONFIG_TOPIC} {err}') from None
     resets = len({float(c.get('last_reset_time', 0.0)) for c in raw_configs}) - 1
     return config, resets
 
@@ -265,10 +239,7 @@ class ReplayResult:
         config = self.config
         return {
             'bag': str(self.bag),
-            'sim_config': {'recorded': config.recorded, 'model_file': config.model_file,
-                           'model_sha1': config.model_sha1, 'timestep': config.timestep_s,
-                           'time_to_unpin': config.time_to_unpin_s,
-                           'last_reset_time': config.last_reset_time_s},
+            'sim_config': {'recorded': config.recorded, **config.to_dict()},
             'resets_in_bag': self.resets_in_bag,
             'model_sha1_matches': self.model_sha1_matches,
             'start_time': self.start_time_s,
