@@ -20,8 +20,9 @@ from tutorial_atlas_control.bags.reader import read_bag
 from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, hold_command, load_gains_yaml
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.cli.replay_bag import EXIT_DEVIATES, main
 from tutorial_atlas_control.offline.replay import (
-    EXIT_DEVIATES, ReplayError, format_report, load_recording, main, replay_bag)
+    ReplayError, format_report, load_recording, replay_bag)
 from tutorial_atlas_control.sim.sim_config import SimConfig
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode
 
