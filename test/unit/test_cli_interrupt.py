@@ -17,12 +17,19 @@ from pathlib import Path
 
 import pytest
 
-from tutorial_atlas_control.cli import analyze_bag, replay_bag, run_demo, run_offline
+from tutorial_atlas_control.cli import (
+    analyze_bag,
+    replay_bag,
+    run_demo,
+    run_offline,
+    state_publisher,
+    traj_yaml,
+)
 from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED
 from tutorial_atlas_control.node import demo
 
 REPO = Path(__file__).resolve().parents[2]
-TRAJECTORIES = REPO / 'trajectories' / 'Traj_data2.yaml'
+TRAJECTORY_FILE = REPO / 'trajectories' / 'Traj_data2.yaml'
 #: Long enough (s of sim time) that the run is still simulating when the signal comes.
 LONG_SETTLE_S = '10000'
 #: Wall-clock bounds (s): for the run to start simulating, and to end after the signal.
@@ -38,9 +45,13 @@ def interrupt(*_args: object, **_kwargs: object) -> None:
     (analyze_bag.main, (analyze_bag, 'analyze_bag'), ['run.bag']),
     (analyze_bag.main, (analyze_bag, 'compare_bags'), ['a.bag', '--compare', 'b.bag']),
     (replay_bag.main, (replay_bag, 'replay_bag'), ['run.bag']),
-    (run_offline.main, (run_offline, 'run_offline'), ['Traj_data2.yaml', 'touchdown']),
+    (run_offline.main, (run_offline, 'run_offline'), [str(TRAJECTORY_FILE), 'touchdown']),
     (run_demo.main, (demo, 'run_demo'), ['touchdown']),
-], ids=['analyze_bag', 'analyze_bag --compare', 'replay_bag', 'run_offline', 'run_demo'])
+    (traj_yaml.main, (traj_yaml, 'load_trajectory'), [str(TRAJECTORY_FILE), 'touchdown']),
+    (state_publisher.main, (state_publisher, 'matching_urdf'),
+     ['state_publisher.py', str(REPO / 'sim' / 'atlas_v1.xml')]),
+], ids=['analyze_bag', 'analyze_bag --compare', 'replay_bag', 'run_offline', 'run_demo',
+        'traj_yaml', 'state_publisher'])
 def test_ctrl_c_exits_130_quietly(main: Callable[[list[str]], int], target: tuple[object, str],
                                   argv: list[str], monkeypatch: pytest.MonkeyPatch,
                                   capsys: pytest.CaptureFixture[str]) -> None:
@@ -58,7 +69,7 @@ def test_sigint_stops_run_offline_with_130_and_leaves_no_bag(tmp_path: Path) -> 
     """A real Ctrl-C while the offline run simulates: exit 130, no traceback, no bag left."""
     bag = tmp_path / 'run.bag'
     process = subprocess.Popen(
-        [sys.executable, str(REPO / 'scripts' / 'run_offline.py'), str(TRAJECTORIES),
+        [sys.executable, str(REPO / 'scripts' / 'run_offline.py'), str(TRAJECTORY_FILE),
          'touchdown', '--settle', LONG_SETTLE_S, '--bag', str(bag)],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=dict(os.environ))
     try:

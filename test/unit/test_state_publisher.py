@@ -8,10 +8,9 @@ from pathlib import Path
 
 import pytest
 
-from tutorial_atlas_control.sim import model
-
 from tutorial_atlas_control.cli import state_publisher as state_publisher_cli
 from tutorial_atlas_control.node import state_publisher
+from tutorial_atlas_control.sim import model
 
 
 def test_usage_without_a_model_file(capsys: pytest.CaptureFixture[str]) -> None:
@@ -33,16 +32,3 @@ def test_robot_state_publisher_is_found() -> None:
     path = Path(state_publisher.robot_state_publisher_executable())
     assert path.name == 'robot_state_publisher' and path.is_file()
 
-
-def test_ctrl_c_before_the_exec_exits_130(monkeypatch: pytest.MonkeyPatch,
-                                           capsys: pytest.CaptureFixture[str]) -> None:
-    def interrupt(*_args: object) -> None:
-        raise KeyboardInterrupt
-
-    monkeypatch.setattr(state_publisher_cli, 'matching_urdf', interrupt)
-    try:
-        status = state_publisher_cli.main(['state_publisher.py', str(model.MODEL_PATH)])
-    except KeyboardInterrupt:
-        pytest.fail('Ctrl-C escaped main: the user gets a traceback, not exit 130')
-    assert status == 130
-    assert capsys.readouterr().err == ''

@@ -19,6 +19,7 @@ from tutorial_atlas_control.offline.player import (
     run_offline,
 )
 from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE
+from tutorial_atlas_control.trajectories.trajectory import locate_trajectory_file
 
 PROG = 'run_offline.py'
 
@@ -66,7 +67,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         with tempfile.TemporaryDirectory(prefix='tac_offline_') as scratch:
             # Without --bag the summary is read from a bag that is deleted afterwards.
             bag = args.bag if args.bag is not None else Path(scratch) / f'{args.name}.bag'
-            run = run_offline(args.trajectory_file, args.name, bag, args.settle,
+            trajectory_file = locate_trajectory_file(args.trajectory_file, announce=print)
+            run = run_offline(trajectory_file, args.name, bag, args.settle,
                               args.start_after, args.gains, play_after_s=args.play_after)
             analysis = analyze_bag(run.bag)
     except AtlasControlError as err:
