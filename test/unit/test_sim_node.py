@@ -38,7 +38,7 @@ def test_model_parameter_names_the_loaded_model_in_sim_config(
 
     sim = sim_node.build_node()
 
-    config = sim.config()
+    config = sim.config().to_dict()
     assert config['model_file'] == 'atlas_variant.xml'
     assert config['model_sha1'] == hashlib.sha1(variant.read_bytes()).hexdigest()
     assert sim.atlas_path == variant

@@ -27,7 +27,6 @@ Parameters (private unless noted):
 from __future__ import annotations
 
 import collections
-import json
 import sys
 import threading
 import time
@@ -212,7 +211,7 @@ class SimNode:
 
     def _publish_config(self) -> None:
         """(Re-)publish /atlas/sim_config: at start and after every reset."""
-        self.config_pub.publish(String(data=json.dumps(self.sim.config())))
+        self.config_pub.publish(String(data=self.sim.config().to_json()))
 
     # -- subscriptions and services ----------------------------------------------------
     def on_joint_commands(self, msg: RawJointCommands) -> None:

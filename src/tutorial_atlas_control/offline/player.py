@@ -15,10 +15,7 @@ CLOCK_PERIOD_NS), so every bag tool reads it as one.
 
 from __future__ import annotations
 
-import argparse
-import json
 import os
-import tempfile
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -28,12 +25,9 @@ import numpy as np
 
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.bags.analysis import analyze_bag
 from tutorial_atlas_control.bags.rosbag1_fast import BlockBagWriter, RecordBlock, TopicConnection
 from tutorial_atlas_control.bags.typestore import (
     JOINT_COMMANDS_TYPE, load_typestore, rosbags_msgtype)
-from tutorial_atlas_control.bags.report import short_summary
-from tutorial_atlas_control.cli.convention import print_error
 from tutorial_atlas_control.msgs.commands import CommandDecoder, CommandError
 from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, Gains, load_gains_yaml
 from tutorial_atlas_control.errors import AtlasControlError
@@ -48,9 +42,8 @@ from tutorial_atlas_control.trajectories.trajectory import (
 from tutorial_atlas_control.units import NS_PER_S
 from tutorial_atlas_control.msgs.wire import JointCommandsWire, StampedWire, clock_bytes
 
-__all__ = ['OfflineRunError', 'OfflineRun', 'main', 'run_offline', 'write_offline_bag']
+__all__ = ['OfflineRunError', 'OfflineRun', 'run_offline', 'write_offline_bag']
 
-PROG = 'run_offline.py'
 #: Sim time (s) before the switch to User, as `make demo`: past the 1 s torso pin.
 DEFAULT_START_AFTER_S = 1.5
 #: Sim time (s) the robot is left alone after the last command, as `make demo`.
@@ -238,7 +231,7 @@ class _OfflinePlayer:
     # -- what the user and traj_yaml do ------------------------------------------------
     def write_config(self) -> None:
         self.sink.write_message(topics.SIM_CONFIG, self.sim.sim_time_ns,
-                                self._string(data=json.dumps(self.sim.config())))
+                                self._string(data=self.sim.config().to_json()))
 
     def switch_mode(self, mode: ControlMode) -> None:
         self.sink.write_message(topics.CONTROL_MODE, self.sim.sim_time_ns,
@@ -355,59 +348,3 @@ def run_offline(trajectory_file: str, name: str, bag: Path | str,
     finally:
         partial.unlink(missing_ok=True)
     return OfflineRun(target, run.commands, run.sim_time_s, run.steps, run.wall_s)
-
-
-def _seconds(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'{text!r} is not a number of seconds') from None
-    if not (np.isfinite(value) and value >= 0.0):
-        raise argparse.ArgumentTypeError(f'{text!r} must be a finite number of seconds >= 0')
-    return value
-
-
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog=PROG, description=(
-            'Play trajectory NAME of YAML_FILE into the simulator without ROS, as `make demo` '
-            'plays it live (User mode after --start-after s, traj_yaml\'s 50 Hz commands with '
-            'the gains of --gains, then --settle s), deterministically and faster than real '
-            'time. Prints the demo\'s summary; with --bag, also keeps the run as a ROS 1 bag '
-            'that analyze_bag.py, replay_bag.py and rosbag read as a recorded run.'))
-    parser.add_argument('trajectory_file', metavar='YAML_FILE', help='trajectory file')
-    parser.add_argument('name', metavar='NAME', help='trajectory name in YAML_FILE')
-    parser.add_argument('--bag', type=Path, metavar='OUT.bag',
-                        help='write the run to this bag (replaced if it exists)')
-    parser.add_argument('--settle', type=_seconds, default=DEFAULT_SETTLE_S, metavar='S',
-                        help='sim time after the last command (default: %(default)g)')
-    parser.add_argument('--play-after', type=_seconds, default=0.0, metavar='S',
-                        help='sim time between the switch to User and the first command '
-                             '(default: 0; a live traj_yaml.py starts a few seconds after)')
-    parser.add_argument('--start-after', type=_seconds, default=DEFAULT_START_AFTER_S,
-                        metavar='S', help='sim time from spawn to User mode and the first '
-                        'command (default: %(default)g; the torso is pinned for 1 s)')
-    parser.add_argument('--gains', type=Path, default=DEFAULT_GAINS_FILE, metavar='FILE',
-                        help='controller gains YAML (default: config/atlas_controller.yaml)')
-    return parser
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    """The command line; returns the exit status (1: bad input or failed run, nothing written)."""
-    args = build_parser().parse_args(argv)
-    try:
-        with tempfile.TemporaryDirectory(prefix='tac_offline_') as scratch:
-            # Without --bag the summary is read from a bag that is deleted afterwards.
-            bag = args.bag if args.bag is not None else Path(scratch) / f'{args.name}.bag'
-            run = run_offline(args.trajectory_file, args.name, bag, args.settle,
-                              args.start_after, args.gains, play_after_s=args.play_after)
-            analysis = analyze_bag(run.bag)
-    except AtlasControlError as err:
-        print_error(PROG, err)
-        return 1
-    print(f'offline: {args.name}: {run.commands} commands, {run.sim_time_s:.3f} s of sim time '
-          f'in {run.wall_s:.2f} s ({run.real_time_factor:.1f}x real time)')
-    print(short_summary(analysis))
-    if args.bag is not None:
-        print(f'bag:   {run.bag}')
-    return 0
