@@ -148,3 +148,32 @@ def test_a_simulator_that_never_subscribes_is_refused(master: Master) -> None:
     assert 'Traceback' not in port.stderr
     assert len(lines) == 1 and 'nothing subscribed to /atlas/joint_commands within 1.5 s' in lines[0], lines
     assert simulator['received'] == 0
+
+
+def test_ctrl_c_while_playing_exits_130_without_traceback(master: Master) -> None:
+    """Ctrl-C mid-trajectory ends the port with 130, like every script (rospy handles SIGINT)."""
+    assert master.run('rosparam', 'load', str(GAINS)).returncode == 0
+    simulator = subprocess.Popen(
+        [sys.executable, str(FAKE_SIMULATOR), '--subscribe-after', '0',
+         '--run-for', str(FAKE_SIMULATOR_GUARD_S)],
+        env=master.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        start_new_session=True)
+    port = subprocess.Popen(
+        [sys.executable, str(TRAJ_YAML), str(TRAJECTORIES), 'step_and_fall'],
+        env=master.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert port.stdout is not None
+        for line in port.stdout:  # the port announces the trajectory once it plays
+            if "playing trajectory 'step_and_fall'" in line:
+                break
+        else:
+            pytest.fail(f'traj_yaml.py never started playing: {port.communicate()}')
+        port.send_signal(signal.SIGINT)
+        _, err = port.communicate(timeout=30)
+    finally:
+        stop_tree(port)
+        simulator.send_signal(signal.SIGINT)
+        simulator.communicate(timeout=30)
+        stop_tree(simulator)
+    assert port.returncode == 130, err
+    assert 'Traceback' not in err, err

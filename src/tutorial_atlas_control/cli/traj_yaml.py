@@ -2,14 +2,17 @@
 
 It keeps the tutorial's command line rather than argparse's: its usage text, exit status
 1 for every refusal, and its messages (the file and the master are checked before the
-node starts). Ctrl-C before the node starts exits 130; once it runs, rospy's own SIGINT
-handling ends the trajectory as the tutorial's did (exit 1).
+node starts). Ctrl-C exits 130, as in every script: before the node starts as a
+KeyboardInterrupt, once it runs through rospy's own SIGINT handling, which ends the
+trajectory (a shutdown for any other reason, such as `rosnode kill`, still exits 1).
 """
 
 from __future__ import annotations
 
+import signal
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from types import FrameType
 
 import rospy
 
@@ -45,6 +48,23 @@ DESCRIPTION = (
 HELP_OPTIONS = ('-h', '--help')
 
 
+class _SigintSeen:
+    """Chained in front of rospy's SIGINT handler, to tell Ctrl-C from other shutdowns."""
+
+    def __init__(self) -> None:
+        self.seen = False
+        self._rospy_handler: Callable[[int, FrameType | None], object] | int | None = None
+
+    def install(self) -> None:
+        self._rospy_handler = signal.getsignal(signal.SIGINT)
+        signal.signal(signal.SIGINT, self._handle)
+
+    def _handle(self, signum: int, frame: FrameType | None) -> None:
+        self.seen = True
+        if callable(self._rospy_handler):
+            self._rospy_handler(signum, frame)
+        else:
+            raise KeyboardInterrupt
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -84,6 +104,8 @@ def _run(path: str, name: str, raw: list[str]) -> int:
     except rospy.ROSInitException as err:
         print(f'cannot start ROS node {NODE_NAME}: {err}', file=sys.stderr)
         return EXIT_FAILED
+    sigint = _SigintSeen()
+    sigint.install()
     try:
         play(waypoints, message_type, path, name)
     except AtlasControlError as err:
@@ -94,5 +116,5 @@ def _run(path: str, name: str, raw: list[str]) -> int:
         return EXIT_FAILED
     except rospy.ROSInterruptException:
         rospy.logwarn('shut down before the trajectory finished')
-        return EXIT_FAILED
-    return 0
+        return EXIT_INTERRUPTED if sigint.seen else EXIT_FAILED
+    return EXIT_INTERRUPTED if sigint.seen else 0

@@ -253,6 +253,8 @@ def play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], path
     _wait_for_simulator(publisher, first_state, subscriber_timeout_s)
 
     def send(positions: np.ndarray) -> None:
+        if rospy.is_shutdown():  # on wall time rospy.sleep does not raise on Ctrl-C
+            raise rospy.ROSInterruptException('shut down')
         # Waits for the previous command only now: rospy's writer threads had the whole
         # interval to take it, so the wait delays the schedule only when they were starved.
         wait_until_handed_over(publisher, HANDOVER_WAIT_S)
