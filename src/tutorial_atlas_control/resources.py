@@ -4,6 +4,8 @@ In a source tree (a clone, or a catkin devel space whose src/ links to it) the d
 beside src/: <repo>/sim, <repo>/config, ... In an install space (`catkin_make install`)
 the code is in <prefix>/lib/python3/dist-packages/ and the data in
 <prefix>/share/tutorial_atlas_control/. Every module asks here, so both layouts work.
+The vendored message packages follow the same two layouts (<repo>/msg/<pkg>/msg/ and
+<prefix>/share/<pkg>/msg/).
 """
 
 from __future__ import annotations
@@ -44,3 +46,24 @@ def package_dir() -> Path:
 def package_path(*parts: str) -> Path:
     """A path inside the package's data directory, e.g. package_path('sim', 'atlas_v1.xml')."""
     return package_dir().joinpath(*parts)
+
+
+def message_file(package: str, name: str) -> Path | None:
+    """The .msg file of a vendored message package (`osrf_msgs`, `JointCommands`), or None.
+
+    Looked up beside the package's data (a source tree's msg/<pkg>/, an install space's
+    share/<pkg>/), then on ROS_PACKAGE_PATH through rospkg where it is installed.
+    """
+    relative = Path('msg') / f'{name}.msg'
+    candidates = [_MODULE_DIR.parents[1] / 'msg' / package / relative,
+                  _MODULE_DIR.parents[3] / 'share' / package / relative]
+    for candidate in candidates:
+        if candidate.is_file():
+            return candidate
+    try:
+        import rospkg  # noqa: PLC0415 - optional: present only where ROS is installed
+
+        candidate = Path(rospkg.RosPack().get_path(package)) / relative
+    except Exception:  # noqa: BLE001 - rospkg missing or the package unknown: not found
+        return None
+    return candidate if candidate.is_file() else None

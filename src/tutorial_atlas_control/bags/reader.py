@@ -27,7 +27,6 @@ from rosbags.rosbag1 import ReaderError
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags.records import BagRecords, open_bag
 from tutorial_atlas_control.bags.typestore import (
-    JOINT_COMMANDS_MSG_RELPATH,
     JOINT_COMMANDS_TYPE,
     load_typestore,
 )
@@ -335,7 +334,7 @@ def _read_commands(reading: _Reading, connections: Sequence[Connection]) -> Join
     if not parse and JOINT_COMMANDS_TYPE not in reading.typestore.fielddefs:
         raise BagAnalysisError(
             'The bag has no definition of osrf_msgs/JointCommands and '
-            f'{JOINT_COMMANDS_MSG_RELPATH} was not found; cannot read {topics.JOINT_COMMANDS}.')
+            'osrf_msgs/msg/JointCommands.msg was not found; cannot read {topics.JOINT_COMMANDS}.')
     position = np.full((len(raws), NUM_JOINTS), np.nan)
     stamps_ns = np.empty(len(raws), dtype=np.int64)
     unknown: set[str] = set()

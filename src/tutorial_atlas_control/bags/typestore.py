@@ -7,19 +7,18 @@ typestore in one place keeps the definitions (and so the bags' MD5 sums) the sam
 from __future__ import annotations
 
 from collections.abc import Sequence
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 from rosbags.interfaces import Connection
 from rosbags.typesys import Stores, TypesysError, get_types_from_msg, get_typestore
 
 from tutorial_atlas_control.errors import BagAnalysisError
+from tutorial_atlas_control.resources import message_file
 
 if TYPE_CHECKING:  # get_typestore's return type; rosbags.typesys does not re-export it
     from rosbags.typesys.store import Typestore
 
 __all__ = [
-    'JOINT_COMMANDS_MSG_RELPATH',
     'JOINT_COMMANDS_TYPE',
     'TF_MSG_DEFINITION',
     'TF_TYPE',
@@ -28,8 +27,6 @@ __all__ = [
 ]
 
 JOINT_COMMANDS_TYPE = 'osrf_msgs/msg/JointCommands'
-#: Where osrf_msgs/JointCommands.msg lives relative to the package's root in a source checkout.
-JOINT_COMMANDS_MSG_RELPATH = Path('msg') / 'osrf_msgs' / 'msg' / 'JointCommands.msg'
 #: tf2_msgs/TFMessage, field for field (its definition as Debian's ros-tf2-msgs ships it);
 #: rosbags' Noetic store does not have it.
 TF_TYPE = 'tf2_msgs/msg/TFMessage'
@@ -40,21 +37,6 @@ def rosbags_msgtype(ros1_type: str) -> str:
     """rosbags' name of the ROS 1 type `ros1_type`: 'pkg/Name' -> 'pkg/msg/Name'."""
     package, name = ros1_type.split('/')
     return f'{package}/msg/{name}'
-
-
-def _find_joint_commands_msg() -> Path | None:
-    """Locate osrf_msgs/JointCommands.msg in a source checkout or a ROS install."""
-    for parent in Path(__file__).resolve().parents:
-        candidate = parent / JOINT_COMMANDS_MSG_RELPATH
-        if candidate.is_file():
-            return candidate
-    try:
-        import rospkg  # noqa: PLC0415 - optional, only present in a ROS environment
-
-        candidate = Path(rospkg.RosPack().get_path('osrf_msgs')) / 'msg' / 'JointCommands.msg'
-    except Exception:  # noqa: BLE001 - any failure just means "not installed"
-        return None
-    return candidate if candidate.is_file() else None
 
 
 def load_typestore(connections: Sequence[Connection] = ()) -> Typestore:
@@ -80,7 +62,7 @@ def load_typestore(connections: Sequence[Connection] = ()) -> Typestore:
                    f'{connection.topic}: {err}')
             raise BagAnalysisError(msg) from err
     if JOINT_COMMANDS_TYPE not in typestore.fielddefs:
-        msg_file = _find_joint_commands_msg()
+        msg_file = message_file('osrf_msgs', 'JointCommands')
         if msg_file is not None:
             typestore.register(get_types_from_msg(msg_file.read_text(), JOINT_COMMANDS_TYPE))
     if TF_TYPE not in typestore.fielddefs:
