@@ -1,4 +1,4 @@
-"""resources: the package's data and its vendored .msg files, in a source tree and an install space."""
+"""resources: the package data and the vendored .msg files, in a source tree and an install."""
 
 from __future__ import annotations
 
