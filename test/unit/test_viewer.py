@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import threading
+import time
+from collections.abc import Callable
+
 import mujoco
 import numpy as np
 import pytest
@@ -17,6 +21,8 @@ MJCF = """
 </mujoco>
 """
 KEY_BACKSPACE = 259
+KeyCallback = Callable[[int], None]
+Physics = tuple[mujoco.MjModel, mujoco.MjData]
 
 
 class FakeViewer:
@@ -147,3 +153,79 @@ def test_paused_overlay_follows_the_node(physics) -> None:  # noqa: ANN001
     assert len(viewer.texts) == 1 and 'PAUSED' in viewer.texts[0]
     link.show_paused(False)
     assert viewer.texts == []
+
+
+class ThreadedFakeViewer(FakeViewer):
+    """A fake with MuJoCo's threads: the window lives in a thread of its own (named as
+    launch_passive's), the render loop's end takes the viewer's mutex, and after it the
+    thread still destroys the window: what the interpreter's exit must not race."""
+
+    FRAME_S = 0.001
+    DESTROY_S = 0.2
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData,
+                 key_callback: KeyCallback) -> None:
+        super().__init__(model, data, key_callback)
+        self.mutex = threading.Lock()
+        self.exit_requested = threading.Event()
+        self.render_loop_ended = threading.Event()
+        self.destroyed = False
+
+        def _launch_internal() -> None:  # the name launch_passive's thread runs
+            while not self.exit_requested.wait(self.FRAME_S):
+                pass
+            with self.mutex:  # simulate.cc: the render loop's end takes the mutex
+                self.render_loop_ended.set()
+            time.sleep(self.DESTROY_S)  # simulate.destroy(): the window goes
+            self.destroyed = True
+
+        threading.Thread(target=_launch_internal, daemon=True).start()
+
+    def lock(self) -> threading.Lock:
+        return self.mutex
+
+    def close(self) -> None:
+        # MuJoCo's close waits for the render loop's end holding the GIL: a hold in
+        # progress elsewhere could never end. The fake cannot hold the GIL; it checks.
+        assert not self.mutex.locked(), 'closed during a hold: a deadlock in MuJoCo'
+        self.exit_requested.set()
+        self.render_loop_ended.wait()
+        super().close()
+
+
+def make_threaded_link(model: mujoco.MjModel) -> tuple[ViewerLink, ThreadedFakeViewer]:
+    viewers = []
+
+    def launch(m: mujoco.MjModel, d: mujoco.MjData,
+               key_callback: KeyCallback) -> ThreadedFakeViewer:
+        viewers.append(ThreadedFakeViewer(m, d, key_callback))
+        return viewers[-1]
+
+    link = ViewerLink(model, launch=launch, modifiers=frozenset)
+    return link, viewers[0]
+
+
+def test_close_returns_once_the_window_is_destroyed(physics: Physics) -> None:
+    """The node's exit (glfw.terminate) comes right after close(): the window's thread must
+    be done by then, or the node segfaults."""
+    model, _ = physics
+    link, viewer = make_threaded_link(model)
+    link.close()
+    assert viewer.destroyed
+    link.close()  # again, as the exit hook does: nothing
+
+
+def test_close_waits_for_a_hold_in_progress(physics: Physics) -> None:
+    model, _ = physics
+    link, viewer = make_threaded_link(model)
+    hold_s = 0.3
+    holder = threading.Thread(target=link.hold, args=(hold_s,))
+    holder.start()
+    while not viewer.mutex.locked():  # the hold has the viewer's mutex
+        time.sleep(0.001)
+    link.close()  # the fake fails if it gets the close during the hold
+    holder.join()
+    assert viewer.destroyed
+    started_s = time.monotonic()
+    link.hold(hold_s)  # closed: no more holds
+    assert time.monotonic() - started_s < hold_s

@@ -447,8 +447,7 @@ class SimNode:
     def _viewer_loop(self, viewer: ViewerLink) -> None:
         """Refresh the window and pace its drawing, outside the stepping loop."""
         while not rospy.is_shutdown() and self._update_viewer(viewer):
-            with viewer.handle.lock():  # its render thread waits at the top of its next frame
-                time.sleep(VIEWER_HOLD_S)
+            viewer.hold(VIEWER_HOLD_S)  # its render thread waits at the top of its next frame
             time.sleep(VIEWER_TURN_S)
 
     def _update_viewer(self, viewer: ViewerLink) -> bool:

@@ -17,12 +17,18 @@ The viewer's own Pause/Run switch is greyed out for a passive viewer (MuJoCo's c
 "PAUSED" overlay shows the node's state instead. Mouse perturbations (Ctrl+drag) still push
 the robot: their forces are copied back to the physics data. Joint and control sliders only
 display values: the next refresh overwrites an edit (the controller owns the joints).
+
+Closing (ViewerLink.close) ends the window's thread before the node exits: the interpreter's
+exit runs glfw.terminate (an atexit hook of mujoco.viewer), and a window still being
+destroyed by its thread then is a segfault.
 """
 
 from __future__ import annotations
 
+import atexit
 import enum
 import threading
+import time
 from collections.abc import Callable
 
 import mujoco
@@ -53,6 +59,12 @@ RESET_MODIFIERS = frozenset({SHIFT, CONTROL})
 RESET_CANARY = 1.0
 #: The overlay shown while physics is paused (left and right column).
 PAUSED_TEXT = ('PAUSED', 'physics and /clock stopped; Space runs')
+#: mujoco.viewer.launch_passive runs the window in a thread whose target is this function
+#: of mujoco.viewer; Python names such a thread 'Thread-N (_launch_internal)'.
+WINDOW_THREAD_TARGET = '_launch_internal'
+#: How long close() waits for the window's thread to destroy the window (s, wall): it takes
+#: one frame; beyond this the thread is hung and left to the interpreter's exit.
+CLOSE_TIMEOUT_S = 10.0
 
 Modifiers = Callable[[], frozenset[str]]
 Launcher = Callable[..., object]
@@ -78,6 +90,13 @@ def _glfw_modifiers() -> frozenset[str]:
     return frozenset(held)
 
 
+def _window_threads(before: set[threading.Thread]) -> list[threading.Thread]:
+    """The threads a launch started, not in `before`, that run the window."""
+    suffix = f'({WINDOW_THREAD_TARGET})'
+    return [thread for thread in threading.enumerate()
+            if thread not in before and thread.name.endswith(suffix)]
+
+
 def request_for_key(key: int, modifiers: frozenset[str]) -> ViewerRequest | None:
     """The node's action for a key pressed in the window, if any."""
     if key == KEY_SPACE and not modifiers:
@@ -94,6 +113,12 @@ class ViewerLink:
     else is called by the node's loop. ``copy_in``/``copy_out`` read/write the physics data
     and belong under the node's lock; ``sync`` does not (it waits for the viewer's own
     mutex, which the viewer's thread holds while it handles window events).
+
+    ``close`` may come from another thread (the node's main thread) while the loop is in
+    ``hold``: MuJoCo's close waits for the render loop while holding the GIL, and the render
+    loop ends by taking the viewer's mutex, which a hold keeps until its thread gets the
+    GIL back. So a hold and the close take turns under ``_hold_lock`` (waiting for it
+    releases the GIL), and a closed link holds no more.
     """
 
     def __init__(self, model: mujoco.MjModel, launch: Launcher | None = None,
@@ -107,7 +132,15 @@ class ViewerLink:
         self._requests: list[ViewerRequest] = []
         self._requests_lock = threading.Lock()
         self._paused_shown = False
+        self._hold_lock = threading.Lock()
+        self._closed = False
+        before = set(threading.enumerate())
         self.handle = launch(model, self.shadow, key_callback=self.on_key)
+        self._window_threads = _window_threads(before)
+        # For an exit that skips close() (an exception): runs before mujoco.viewer's own exit
+        # hooks (registered earlier, run later), which race the window's thread. A no-op
+        # once closed.
+        atexit.register(self.close)
 
     # -- the viewer's thread -------------------------------------------------------------
     def on_key(self, key: int) -> None:
@@ -155,5 +188,23 @@ class ViewerLink:
             self.handle.clear_texts()
         self._paused_shown = paused
 
-    def close(self) -> None:
-        self.handle.close()
+    def hold(self, seconds: float) -> None:
+        """Keep the render thread waiting at the top of its next frame for `seconds` (wall).
+
+        Its drawing is paced this way (see sim_node's VIEWER_HOLD_S); nothing once closed.
+        """
+        with self._hold_lock:
+            if self._closed:
+                return
+            with self.handle.lock():
+                time.sleep(seconds)
+
+    def close(self, timeout_s: float = CLOSE_TIMEOUT_S) -> None:
+        """Close the window and wait until its thread has destroyed it; idempotent."""
+        with self._hold_lock:  # a hold in progress ends first (see the class docstring)
+            if self._closed:
+                return
+            self._closed = True
+            self.handle.close()
+        for thread in self._window_threads:
+            thread.join(timeout_s)
