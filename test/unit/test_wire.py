@@ -92,66 +92,6 @@ def test_stamp_split(stamp_ns):
     assert raw == genpy_bytes(Clock(clock=genpy.Time(secs, nsecs)))
 
 
-class FakeSocket:
-    def __init__(self, error=None):
-        self.error = error
-        self.sent = []
-
-    def gettimeout(self):
-        return wire.SEND_TIMEOUT_S
-
-    def sendall(self, data):
-        if self.error is not None:
-            raise self.error
-        self.sent.append(data)
-
-
-class FakeConnection:
-    def __init__(self, name, error=None):
-        self.endpoint_id = name
-        self.socket = FakeSocket(error)
-        self.done = False
-        self.closed = False
-
-    def close(self):
-        self.closed = True
-
-
-class FakePublisher:
-    resolved_name = '/clock'
-
-    def __init__(self, connections):
-        self.impl = self
-        self.connections = list(connections)
-
-    def remove_connection(self, connection):
-        self.connections.remove(connection)
-
-
-def test_a_subscriber_connected_twice_counts_once():
-    """rospy may hold two connections from one node for a moment (seen: a flood started
-    with only the simulator connected, and the recorder missed 114 of its commands)."""
-    pub = FakePublisher([FakeConnection('/atlas_sim'), FakeConnection('/atlas_sim')])
-    assert wire.subscriber_names(pub) == {'/atlas_sim'}
-    pub.connections.append(FakeConnection('/recorder'))
-    assert wire.subscriber_names(pub) == {'/atlas_sim', '/recorder'}
-
-
-def test_a_subscriber_that_left_is_dropped_quietly_a_stalled_one_with_a_warning(monkeypatch):
-    warnings = []
-    monkeypatch.setattr(wire.rospy, 'logwarn', warnings.append)
-    monkeypatch.setattr(wire.rospy, 'logdebug', lambda _msg: None)
-    healthy = FakeConnection('/probe')
-    left = FakeConnection('/traj_yaml', BrokenPipeError(32, 'Broken pipe'))
-    stalled = FakeConnection('/slow', TimeoutError('timed out'))
-    pub = FakePublisher([healthy, left, stalled])
-    wire.write_to_connections(pub, b'data')
-    assert healthy.socket.sent == [b'data']
-    assert pub.connections == [healthy]
-    assert left.closed and stalled.closed
-    assert len(warnings) == 1 and '/slow' in warnings[0], warnings
-
-
 def test_controller_statistics():
     from atlas_msgs.msg import ControllerStatistics
 
