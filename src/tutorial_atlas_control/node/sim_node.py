@@ -1,10 +1,12 @@
 """The simulator node: AtlasSimulator behind DRCSim's ROS interface.
 
-Thin ROS glue. Publishes /clock, /atlas/joint_states, /ground_truth_odom, /atlas/imu and
-the foot contact wrenches in sim time, /atlas/controller_statistics (command age, while
-subscribed), and a latched /atlas/sim_config (JSON: timestep, time_to_unpin, model file and
-checksum, time of the last reset) for offline replay; obeys
-/atlas/joint_commands and /atlas/control_mode; offers gazebo_ros's reset and pause services.
+The rospy shell around the stepping loop (stepping/loop.py, no ROS): publishers,
+subscriptions, services, parameters and the viewer window. Publishes /clock,
+/atlas/joint_states, /ground_truth_odom, /atlas/imu and the foot contact wrenches in sim
+time, /atlas/controller_statistics (command age, while subscribed), and a latched
+/atlas/sim_config (JSON: timestep, time_to_unpin, model file and checksum, time of the last
+reset) for offline replay; obeys /atlas/joint_commands and /atlas/control_mode; offers
+gazebo_ros's reset and pause services.
 
 Parameters (private unless noted):
     ~real_time_factor (float, 1.0): sim time per wall time; 0 runs as fast as possible.
@@ -77,6 +79,13 @@ WARN_THROTTLE_S = 2.0
 VIEWER_FRAME_PERIOD_S = 1.0 / 30.0
 VIEWER_TURN_S = 0.005
 VIEWER_HOLD_S = VIEWER_FRAME_PERIOD_S - VIEWER_TURN_S
+#: What the stepping loop publishes through the node's publishers, with their types; /tf
+#: (world -> pelvis; robot_state_publisher adds the links) only with ~tf.
+LOOP_TOPICS = (
+    (topics.CLOCK, Clock), (topics.JOINT_STATES, JointState),
+    (topics.GROUND_TRUTH_ODOM, Odometry), (topics.IMU, Imu),
+    (topics.L_FOOT_CONTACT, WrenchStamped), (topics.R_FOOT_CONTACT, WrenchStamped),
+    (topics.CONTROLLER_STATISTICS, ControllerStatistics))
 
 
 class RawJointCommands(genpy.Message):
@@ -146,29 +155,18 @@ class SimNode:
         back-pressure) instead of losing messages, until it has accepted nothing for
         transport.SEND_TIMEOUT_S and is dropped.
         """
+        published = LOOP_TOPICS + (((topics.TF, TFMessage),) if tf else ())
         with warnings.catch_warnings():
             warnings.simplefilter('ignore', SyntaxWarning)  # rospy: "explicit queue_size"
-            self.publishers = {
-                topic: rospy.Publisher(topic, msg_class, queue_size=None)
-                for topic, msg_class in (
-                    (topics.CLOCK, Clock), (topics.JOINT_STATES, JointState),
-                    (topics.GROUND_TRUTH_ODOM, Odometry), (topics.IMU, Imu),
-                    (topics.L_FOOT_CONTACT, WrenchStamped),
-                    (topics.R_FOOT_CONTACT, WrenchStamped),
-                    # world -> pelvis; robot_state_publisher adds the links from the joint
-                    # states.
-                    *(((topics.TF, TFMessage),) if tf else ()))}
+            self.publishers = {topic: rospy.Publisher(topic, msg_class, queue_size=None)
+                               for topic, msg_class in published}
         # Latched, recorded in every bag: what offline replay needs to re-create the run.
         self.config_pub = rospy.Publisher(topics.SIM_CONFIG, String, queue_size=1, latch=True)
 
     def _controller_statistics(self) -> CommandAgeStatistics:
-        """DRCSim's command age statistics and their publisher (fed and published by the
-        loop only while subscribed)."""
+        """DRCSim's command age statistics, from the parameters (fed and published by the
+        loop only while someone subscribes)."""
         rate_hz = rospy.get_param(UPDATE_RATE_PARAM) if rospy.has_param(UPDATE_RATE_PARAM) else None
-        with warnings.catch_warnings():
-            warnings.simplefilter('ignore', SyntaxWarning)  # rospy: "explicit queue_size"
-            self.publishers[topics.CONTROLLER_STATISTICS] = rospy.Publisher(
-                topics.CONTROLLER_STATISTICS, ControllerStatistics, queue_size=None)
         return CommandAgeStatistics(
             self.sim.dt_s, rospy.get_param(WINDOW_PARAM, DEFAULT_WINDOW_S), rate_hz)
 

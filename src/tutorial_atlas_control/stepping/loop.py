@@ -112,7 +112,8 @@ class SteppingLoop:
         publish_config: sends /atlas/sim_config's JSON (latched: not through the outbox).
         real_time_factor: sim time per wall time; 0 = as fast as possible.
         paused: start with physics paused.
-        pacer: the wall-time decisions (default: a Pacer at real_time_factor).
+        pacer: the wall-time decisions (default: a Pacer at real_time_factor; tests give
+            one with a fake clock).
     """
 
     def __init__(self, sim: AtlasSimulator, outbox: Outbox, outlets: Mapping[str, Hashable],
@@ -125,7 +126,6 @@ class SteppingLoop:
         self.outbox = outbox
         self.log = log
         self._send_config = publish_config
-        self.real_time_factor = real_time_factor
         self.paused = paused
         self.pacer = pacer if pacer is not None else Pacer(real_time_factor)
         self.step_count = 0
@@ -160,6 +160,11 @@ class SteppingLoop:
         self.decoder = CommandDecoder()
         self.pending_commands: collections.deque[bytes] = collections.deque(
             maxlen=MAX_PENDING_COMMANDS)
+
+    @property
+    def real_time_factor(self) -> float:
+        """Sim time per wall time (the pacer's); 0 = as fast as possible."""
+        return self.pacer.real_time_factor
 
     # -- inputs, from other threads ------------------------------------------------------
     def receive_command(self, raw: bytes) -> None:
@@ -288,6 +293,7 @@ class SteppingLoop:
         """Step, publish and pace against wall time until `is_shutdown()`; the exit status
         (1: stopped because the physics kept diverging)."""
         sim, lock, outbox, pacer = self.sim, self.lock, self.outbox, self.pacer
+        paced = pacer.real_time_factor > 0.0  # else there is nothing to wait for
         pacer.restart(sim.sim_time_ns)
         with lock:
             self.publish()  # /clock and the initial state before the first step
@@ -316,7 +322,8 @@ class SteppingLoop:
             # stream, one sendall carries many messages.
             if pacer.flush_due(sim_ns):
                 outbox.flush()
-            pacer.wait(sim_ns)
+            if paced:
+                pacer.wait(sim_ns)
         return self.exit_status
 
     def _recover(self, err: PhysicsDivergenceError) -> bool:
