@@ -3,7 +3,7 @@
 
 import sys
 
-from tutorial_atlas_control.node.state_publisher import main
+from tutorial_atlas_control.cli.state_publisher import main
 
 if __name__ == '__main__':
     sys.exit(main())

@@ -1,7 +1,7 @@
 /*
  * DRCSim 2.5.2's joint controller law for all joints in one call: the compiled twin of
- * compute_torque() in src/tutorial_atlas_control/controller.py (whose docstring gives the
- * law). Called once per step through ctypes (law_kernel.py) instead of ~25 numpy calls.
+ * compute_torque() in src/tutorial_atlas_control/sim/controller.py (whose docstring gives the
+ * law). Called once per step through ctypes (sim/law_kernel.py) instead of many numpy calls.
  *
  * It must give the numpy law's results bit for bit (offline replay depends on it), so:
  * every operation is the numpy code's, in the same order, in double precision; the build
@@ -20,7 +20,8 @@ enum {
   I_EFFORT_MIN, I_EFFORT_MAX, NUM_FIELDS
 };
 
-/* Everything one step reads and writes; laid out once by law_kernel.py (same order). */
+/* Everything one step reads and writes; laid out once by law_kernel.py, mirrored in native.py
+ * (same fields, same order; tac_sizeof_AtlasLawStep lets the loader check). */
 typedef struct {
   const double *command[NUM_FIELDS]; /* (n,) each, joint order */
   const double *qpos;                /* MjData.qpos */
@@ -82,6 +83,9 @@ void atlas_law_step(AtlasLawStep *s) {
   }
   s->initialized = 1;
 }
+
+/* sizeof(AtlasLawStep), for native.py's check of its ctypes mirror. */
+size_t tac_sizeof_AtlasLawStep(void) { return sizeof(AtlasLawStep); }
 
 /* 1 if every qpos and qvel is finite, else 0: the simulator's divergence check after each
  * step, in one call instead of four numpy ones. */

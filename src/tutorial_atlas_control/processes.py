@@ -324,17 +324,20 @@ class AtlasLaunch(_RosProcess):
     """`roslaunch tutorial_atlas_control atlas.launch ARG:=VALUE ...`.
 
     Without `master` roslaunch starts a master of its own on a free port; with one, it
-    waits for that master (several launches may then run on it in turn).
+    waits for that master (several launches may then run on it in turn). `base_env`, the
+    environment to start from without a master (default: this process's), lets a caller
+    run another workspace's package, e.g. an install space's.
     """
 
     name = 'roslaunch'
 
     def __init__(self, log_path: Path, args: Mapping[str, object], *,
                  master: RosMaster | None = None, ros_log_dir: Path | None = None,
-                 launch_file: str = 'atlas.launch') -> None:
+                 launch_file: str = 'atlas.launch',
+                 base_env: Mapping[str, str] | None = None) -> None:
         if master is None:
             self.port = free_local_port()
-            env, wait = ros_environment(self.port), []
+            env, wait = ros_environment(self.port, base=base_env), []
         else:
             self.port, env, wait = master.port, dict(master.env), ['--wait']
         if ros_log_dir is not None:

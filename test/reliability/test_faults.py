@@ -156,7 +156,7 @@ def test_forced_divergence_is_reported_reset_and_never_published(tmp_path: Path)
     assert all('resetting the robot to its initial state' in line for line in diverged[:2])
     assert f'{model.name} is unstable; stopping the simulator' in diverged[2], 'names model:='
     assert log_lines(bag, min_level=FATAL) == diverged[2:]
-    resets = [config['last_reset_time'] for config in sim_configs(bag)]
+    resets = [config.last_reset_time_s for config in sim_configs(bag)]
     assert len(resets) == 3, f'one /atlas/sim_config at start and one per reset: {resets}'
     states = read_bag(bag).joint_states
     assert states is not None and all_finite(states), 'no NaN/Inf was published'

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from tutorial_atlas_control.bags.reader import JointStateSeries, load_typestore
+from tutorial_atlas_control.bags.reader import JointStateSeries
+from tutorial_atlas_control.bags.typestore import load_typestore
+from tutorial_atlas_control.sim.sim_config import SimConfig
 
 #: rosgraph_msgs/Log levels.
 WARN, ERROR, FATAL = 4, 8, 16
@@ -40,8 +41,8 @@ def log_lines(bag: Path, node: str = '/atlas_sim', min_level: int = WARN) -> lis
             if msg.name == node and msg.level >= min_level]
 
 
-def sim_configs(bag: Path) -> list[dict]:
-    return [json.loads(msg.data) for msg in messages(bag, '/atlas/sim_config')]
+def sim_configs(bag: Path) -> list[SimConfig]:
+    return [SimConfig.from_json(msg.data) for msg in messages(bag, '/atlas/sim_config')]
 
 
 def missing_steps(states: JointStateSeries) -> int:

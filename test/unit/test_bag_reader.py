@@ -1,18 +1,27 @@
-"""Tests of bag_reader and bag_records: reading synthetic bags, fast path against rosbags."""
+"""Tests of bags.reader, records and rosbag1_fast: synthetic bags, fast paths against rosbags.
+
+The fast reader and writer use rosbags internals (pinned in requirements.txt): the tests
+against rosbags' public Reader and Writer here are the ones to run when the pin moves.
+"""
 
 from __future__ import annotations
 
 import json
 from dataclasses import fields, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from rosbags.rosbag1 import Reader, Writer
+from rosbags.rosbag1 import Reader, Writer, WriterError
 from rosbags.typesys import get_types_from_msg
 
+from tutorial_atlas_control.bags import reader as bag_reader
+from tutorial_atlas_control.bags.reader import BagData, read_bag
+from tutorial_atlas_control.bags.records import IndexedBag, PublicBag, open_bag
+from tutorial_atlas_control.bags.rosbag1_fast import BlockBagWriter, TopicConnection
 from tutorial_atlas_control.bags.synthetic import (
     STANDING_HEIGHT_M,
     TYPESTORE,
@@ -27,9 +36,7 @@ from tutorial_atlas_control.bags.synthetic import (
     unindexed_copy,
     write_bag,
 )
-from tutorial_atlas_control.bags import reader as bag_reader
-from tutorial_atlas_control.bags.reader import BagData, load_typestore, read_bag
-from tutorial_atlas_control.bags.records import IndexedBag, PublicBag, open_bag
+from tutorial_atlas_control.bags.typestore import load_typestore
 from tutorial_atlas_control.errors import AtlasControlError, BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.msgs.ros1_fields import parse_names_arrays
@@ -141,6 +148,179 @@ def test_raw_reading_matches_rosbags_reader(tmp_path: Path, compression: str | N
         bag.close()
 
 
+# ------------------------------------------------------------- fast writer vs rosbags' public API
+
+
+WRENCH = 'geometry_msgs/msg/WrenchStamped'
+STRING = 'std_msgs/msg/String'
+#: The fast writer's connections here: latched and not, Noetic types and TFMessage (which
+#: load_typestore registers), two topics written as numpy blocks.
+WRITER_TOPICS = {
+    '/atlas/sim_config': TopicConnection(STRING, '/atlas_sim', True),
+    '/clock': TopicConnection('rosgraph_msgs/msg/Clock', '/atlas_sim', False),
+    '/atlas/l_foot_contact': TopicConnection(WRENCH, '/atlas_sim', False),
+    '/atlas/r_foot_contact': TopicConnection(WRENCH, '/atlas_sim', False),
+    '/tf': TopicConnection('tf2_msgs/msg/TFMessage', '/atlas_sim', False),
+    '/atlas/control_mode': TopicConnection(STRING, '/tutorial_atlas_control', True),
+}
+WRENCH_FRAME = 'l_foot'
+#: Byte offset of WrenchStamped's six float64s: Header.seq, stamp, frame_id (length, text).
+WRENCH_AT = 4 + 8 + 4 + len(WRENCH_FRAME)
+STEP_NS = 1_000_000
+#: Steps per RecordBlock, and the chunk size: a chunk holds about two blocks.
+BLOCK_STEPS = 100
+CHUNK_BYTES = 30_000
+
+
+def serialize(message: Any, msgtype: str) -> bytes:
+    return bytes(TYPESTORE.serialize_ros1(message, msgtype))
+
+
+def wrench_stamped(seq: int, stamp_ns: int, values: np.ndarray) -> Any:
+    types = TYPESTORE.types
+    stamp = types['builtin_interfaces/msg/Time'](sec=stamp_ns // 10**9, nanosec=stamp_ns % 10**9)
+    vector = types['geometry_msgs/msg/Vector3']
+    return types[WRENCH](
+        header=types['std_msgs/msg/Header'](seq=seq, stamp=stamp, frame_id=WRENCH_FRAME),
+        wrench=types['geometry_msgs/msg/Wrench'](force=vector(*values[:3]),
+                                                 torque=vector(*values[3:])))
+
+
+def write_fast_bag(path: Path, steps: int) -> dict[str, list[tuple[int, bytes]]]:
+    """`steps` 1 ms steps written with BlockBagWriter as the offline player writes them.
+
+    /atlas/l_foot_contact goes through RecordBlock.add (the message copied as it is then),
+    /atlas/r_foot_contact through float_view and take(times, stamps); the other topics are
+    single messages, raw or serialized by the writer. Returns each topic's expected
+    (bag time (ns), serialized message), in time order.
+    """
+    expected: dict[str, list[tuple[int, bytes]]] = {topic: [] for topic in WRITER_TOPICS}
+    types = TYPESTORE.types
+    writer = BlockBagWriter(path, TYPESTORE, WRITER_TOPICS, CHUNK_BYTES)
+    template = bytearray(serialize(wrench_stamped(0, 0, np.zeros(6)), WRENCH))
+    template_floats = np.frombuffer(template, dtype='<f8', count=6, offset=WRENCH_AT)
+    left = writer.record_block('/atlas/l_foot_contact', np.frombuffer(template, np.uint8),
+                               BLOCK_STEPS)
+    right = writer.record_block('/atlas/r_foot_contact', np.frombuffer(template, np.uint8),
+                                BLOCK_STEPS)
+    right_floats = right.float_view(WRENCH_AT, 6)
+    config = types[STRING](data='{"timestep": 0.001}')
+    writer.write_message('/atlas/sim_config', 0, config)
+    expected['/atlas/sim_config'].append((0, serialize(config, STRING)))
+    times_ns, stamps_ns = [], []
+
+    def take_block() -> None:
+        writer.write_rows('/atlas/l_foot_contact', *left.take())
+        writer.write_rows('/atlas/r_foot_contact',
+                          *right.take(np.array(times_ns), np.array(stamps_ns)))
+        times_ns.clear()
+        stamps_ns.clear()
+        writer.flush()
+
+    for step in range(steps):
+        time_ns, stamp_ns = step * STEP_NS, max(0, step * STEP_NS - STEP_NS // 2)
+        values = np.arange(6.0) * 0.5 + step
+        template_floats[:] = values
+        left.add(time_ns, stamp_ns)
+        right_floats[len(times_ns)] = -values
+        times_ns.append(time_ns)
+        stamps_ns.append(stamp_ns)
+        expected['/atlas/l_foot_contact'].append(
+            (time_ns, serialize(wrench_stamped(step + 1, stamp_ns, values), WRENCH)))
+        expected['/atlas/r_foot_contact'].append(
+            (time_ns, serialize(wrench_stamped(step + 1, stamp_ns, -values), WRENCH)))
+        if step % 10 == 0:
+            clock = types['rosgraph_msgs/msg/Clock'](
+                clock=types['builtin_interfaces/msg/Time'](sec=0, nanosec=time_ns))
+            raw = serialize(clock, 'rosgraph_msgs/msg/Clock')
+            writer.write('/clock', time_ns, raw)
+            expected['/clock'].append((time_ns, raw))
+        if step % 7 == 3:
+            tf = types['tf2_msgs/msg/TFMessage'](transforms=[])
+            writer.write_message('/tf', time_ns, tf)
+            expected['/tf'].append((time_ns, serialize(tf, 'tf2_msgs/msg/TFMessage')))
+        if step == steps // 2:
+            mode = types[STRING](data='User')
+            writer.write_message('/atlas/control_mode', time_ns, mode)
+            expected['/atlas/control_mode'].append((time_ns, serialize(mode, STRING)))
+        if len(times_ns) == BLOCK_STEPS:
+            take_block()
+    take_block()
+    writer.close()
+    return expected
+
+
+def write_public_bag(path: Path, expected: dict[str, list[tuple[int, bytes]]]) -> Path:
+    """The same messages written with rosbags' public Writer, in time order."""
+    writer = Writer(path)
+    writer.chunk_threshold = CHUNK_BYTES
+    with writer:
+        connections = {topic: writer.add_connection(
+            topic, connection.msgtype, typestore=TYPESTORE, callerid=connection.callerid,
+            latching=1 if connection.latched else None)
+            for topic, connection in WRITER_TOPICS.items()}
+        for time_ns, topic, raw in sorted((time_ns, topic, raw)
+                                          for topic, messages in expected.items()
+                                          for time_ns, raw in messages):
+            writer.write(connections[topic], time_ns, raw)
+    return path
+
+
+def read_public(path: Path) -> tuple[list[tuple[Any, ...]], dict[str, list[tuple[int, bytes]]],
+                                     tuple[int, int]]:
+    """(connections, each topic's (bag time (ns), raw message), (start, end) time (ns)) of the
+    bag at `path`, read with rosbags' public Reader."""
+    with Reader(path) as reader:
+        connections = [(c.id, c.topic, c.msgtype, c.msgdef.data, c.digest, c.ext.callerid,
+                        c.ext.latching) for c in reader.connections]
+        messages = {c.topic: [(time_ns, bytes(raw)) for _, time_ns, raw in reader.messages([c])]
+                    for c in reader.connections}
+        counts = {topic: info.msgcount for topic, info in reader.topics.items()}
+        assert counts == {topic: len(raws) for topic, raws in messages.items()}
+        return connections, messages, (reader.start_time, reader.end_time)
+
+
+def test_fast_writer_bag_reads_back_with_rosbags_public_reader(tmp_path: Path) -> None:
+    """Connections, counts, bag times and message bytes as written, across many chunks."""
+    path = tmp_path / 'fast.bag'
+    steps = 10 * BLOCK_STEPS + BLOCK_STEPS // 2  # the last block is partly filled
+    expected = write_fast_bag(path, steps)
+    with Reader(path) as reader:
+        assert len(reader.chunk_infos) >= 4
+    connections, messages, (start_ns, end_ns) = read_public(path)
+    assert connections == [
+        (cid, topic, connection.msgtype, *TYPESTORE.generate_msgdef(connection.msgtype),
+         connection.callerid, 1 if connection.latched else None)
+        for cid, (topic, connection) in enumerate(WRITER_TOPICS.items())]
+    assert messages == expected
+    assert len(messages['/atlas/l_foot_contact']) == steps
+    assert (start_ns, end_ns) == (0, (steps - 1) * STEP_NS + 1)  # end: just after the last
+
+
+def test_fast_writer_bag_equals_public_writer_bag(tmp_path: Path) -> None:
+    """The same messages through rosbags' public Writer: same connections and content,
+    and the fast reader reads the fast writer's bag as rosbags reads it."""
+    expected = write_fast_bag(tmp_path / 'fast.bag', 3 * BLOCK_STEPS + 7)
+    write_public_bag(tmp_path / 'public.bag', expected)
+    assert read_public(tmp_path / 'fast.bag') == read_public(tmp_path / 'public.bag')
+    bag = open_bag(tmp_path / 'fast.bag')
+    assert isinstance(bag, IndexedBag)
+    try:
+        for topic, messages in expected.items():
+            times_ns, raws = bag.raw_messages([c for c in bag.connections if c.topic == topic])
+            assert list(zip(times_ns.tolist(), raws)) == messages, topic
+    finally:
+        bag.close()
+
+
+def test_fast_writer_refuses_an_existing_file(tmp_path: Path) -> None:
+    path = tmp_path / 'fast.bag'
+    path.write_bytes(b'previous')
+    with pytest.raises(WriterError, match='exists already'):
+        BlockBagWriter(path, TYPESTORE, WRITER_TOPICS, CHUNK_BYTES)
+    assert path.read_bytes() == b'previous'
+
+
 def test_joint_state_fast_path_matches_generic_deserializer() -> None:
     rng = np.random.default_rng(7)
     raws = []
@@ -200,6 +380,12 @@ def test_joint_commands_definition_has_the_expected_md5() -> None:
     typestore = load_typestore()
     assert typestore.generate_msgdef('osrf_msgs/msg/JointCommands')[1] == (
         bag_reader.JOINT_COMMANDS_MD5)
+
+
+def test_typestore_has_tf_messages_with_the_debian_md5() -> None:
+    """rosbags' Noetic store lacks tf2_msgs/TFMessage; load_typestore adds it, as ROS has it."""
+    assert load_typestore().generate_msgdef('tf2_msgs/msg/TFMessage')[1] == (
+        '94810edda583a504dfda3829e70d7eec')
 
 
 # ---------------------------------------------------------------- topics and series

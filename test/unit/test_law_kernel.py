@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from test_controller import random_command
 
+from tutorial_atlas_control import native
 from tutorial_atlas_control.sim import law_kernel
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.msgs.commands import FIELD_NAMES, JointCommandArrays
@@ -22,8 +23,8 @@ DT_S = 0.001
 
 @pytest.fixture(scope='module')
 def library():
-    library = law_kernel.load_library()
-    assert library is not None, (f'{law_kernel.LIBRARY_NAME} is not in the catkin workspace: '
+    library = native.load_library()
+    assert library is not None, (f'{native.LIBRARY_NAME} is not in the catkin workspace: '
                                  'run `make setup` and `source ./env.sh`')
     return library
 
@@ -146,9 +147,9 @@ def test_simulator_runs_identically_with_either_law(library) -> None:  # noqa: A
 
 def test_missing_library_falls_back_to_numpy_with_one_warning(
         monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
-    monkeypatch.setenv(law_kernel.LIBRARY_ENV, str(tmp_path / 'missing.so'))
-    monkeypatch.setattr(law_kernel, '_library', None)
-    monkeypatch.setattr(law_kernel, '_warned', False)
+    monkeypatch.setenv(native.LIBRARY_ENV, str(tmp_path / 'missing.so'))
+    monkeypatch.setattr(native, '_library', None)
+    monkeypatch.setattr(native, '_warned', False)
     with pytest.warns(RuntimeWarning, match=r'^TAC_LAW_LIBRARY=.*missing\.so does not exist; '
                                             r'using the numpy controller law'):
         first = AtlasSimulator(atlas_model.load_model(), load_gains_yaml(CONFIG))
@@ -167,37 +168,3 @@ def test_ragdoll_command_gives_zero_torque(library) -> None:  # noqa: ANN001
     sim.step()
     assert not sim.torque_nm.any() and not sim.data.ctrl.any()
     assert JointCommandArrays.zeros().position.shape == (NUM_JOINTS,)
-
-
-
-
-def test_copy_plan_equals_numpy_copies_into_unaligned_bytes(library) -> None:  # noqa: ANN001
-    """The compiled copies write what numpy's `dst[to] = src[from]` writes, bit for bit,
-    into float blocks at odd byte offsets (as in a serialized message)."""
-    rng = np.random.default_rng(7)
-    src = rng.standard_normal(40)
-    src[[3, 5]] = (np.nan, -0.0)
-    to, source = np.array([4, 0, 2, 9]), np.array([3, 5, 39, 0])
-    results = []
-    for compiled in (True, False):
-        buf = bytearray(3 + 8 * 10)
-        dst = np.frombuffer(buf, dtype='<f8', offset=3, count=10)
-        plan = law_kernel.CopyPlan([(dst, to, src, source), (dst[5:8], [0, 1, 2], src, [6, 7, 8])],
-                                   compiled=compiled)
-        assert (plan._call is not None) == compiled
-        plan()
-        results.append(bytes(buf))
-    assert results[0] == results[1]
-    copied = np.frombuffer(results[0], dtype='<f8', offset=3, count=10)
-    assert copied[0] == 0.0 and np.signbit(copied[0]) and np.isnan(copied[4])
-    assert copied[9] == src[0] and list(copied[5:8]) == list(src[6:9])
-
-
-@pytest.mark.parametrize('copy, problem', [
-    ((np.zeros(3), [0, 1], np.zeros(3), [0]), 'a copy of 1 values to 2 places'),
-    ((np.zeros(3), [0, 3], np.zeros(3), [0, 1]), 'dst index outside 0..2'),
-    ((np.zeros(3), [0, 1], np.zeros(2), [0, -1]), 'src index outside 0..1'),
-])
-def test_copy_plan_refuses_bad_indices(copy, problem) -> None:  # noqa: ANN001
-    with pytest.raises(ValueError, match=problem):
-        law_kernel.CopyPlan([copy])

@@ -18,7 +18,8 @@ import pytest
 
 from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.offline.player import main, run_offline
+from tutorial_atlas_control.cli.run_offline import main
+from tutorial_atlas_control.offline.player import run_offline
 from tutorial_atlas_control.trajectories.trajectory import TrajectoryError
 
 REPO = Path(__file__).resolve().parents[2]

@@ -20,8 +20,10 @@ from tutorial_atlas_control.bags.reader import read_bag
 from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, hold_command, load_gains_yaml
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.cli.replay_bag import EXIT_DEVIATES, main
 from tutorial_atlas_control.offline.replay import (
-    EXIT_DEVIATES, ReplayError, format_report, load_recording, main, replay_bag)
+    ReplayError, format_report, load_recording, replay_bag)
+from tutorial_atlas_control.sim.sim_config import SimConfig
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode
 
 SCRIPT = Path(__file__).resolve().parents[2] / 'scripts' / 'replay_bag.py'
@@ -59,8 +61,9 @@ def odometry_record(t_s: float, position: np.ndarray, quat_wxyz: np.ndarray) -> 
     return Record('/ground_truth_odom', 'nav_msgs/Odometry', t_s, msg)
 
 
-def sim_config_record(t_s: float, config: dict[str, object]) -> Record:
-    msg = _t('std_msgs/msg/String')(data=json.dumps(config))
+def sim_config_record(t_s: float, config: dict[str, object] | SimConfig) -> Record:
+    text = config.to_json() if isinstance(config, SimConfig) else json.dumps(config)
+    msg = _t('std_msgs/msg/String')(data=text)
     return Record('/atlas/sim_config', 'std_msgs/String', t_s, msg)
 
 

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import hashlib
-import json
 import shutil
 from pathlib import Path
 from typing import Any
@@ -14,6 +13,7 @@ import yaml
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import load_gains_yaml
+from tutorial_atlas_control.sim.sim_config import SimConfig
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode, PhysicsDivergenceError
 
 sim_node = pytest.importorskip('tutorial_atlas_control.node.sim_node',
@@ -42,7 +42,7 @@ def test_model_parameter_names_the_loaded_model_in_sim_config(
 
     sim = sim_node.build_node()
 
-    config = sim.config()
+    config = sim.config().to_dict()
     assert config['model_file'] == 'atlas_variant.xml'
     assert config['model_sha1'] == hashlib.sha1(variant.read_bytes()).hexdigest()
     assert sim.atlas_path == variant
@@ -65,7 +65,7 @@ def test_the_node_advertises_the_topics_and_steps_until_shutdown(sim: AtlasSimul
             topics.L_FOOT_CONTACT, topics.R_FOOT_CONTACT, topics.CONTROLLER_STATISTICS,
             topics.SIM_CONFIG}
         config, = node.fake_publishers[topics.SIM_CONFIG].published
-        assert json.loads(config.data) == sim.config()
+        assert SimConfig.from_json(config.data) == sim.config()
     assert sim.sim_time_ns == 50 * sim.step_ns
 
 

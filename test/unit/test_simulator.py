@@ -108,7 +108,7 @@ def test_reset_world_keeps_time_and_forgets_commands(sim: AtlasSimulator) -> Non
     assert sim.pinned and sim.user_command is None
     assert pelvis_z(sim) == pytest.approx(atlas_model.SPAWN_HEIGHT_M)
     np.testing.assert_array_equal(sim.joint_positions(), np.zeros(NUM_JOINTS))
-    assert sim.config()['last_reset_time'] == 2.0
+    assert sim.config().last_reset_time_s == 2.0
     sim.reset_simulation()
     assert sim.sim_time_ns == 0
 
@@ -135,7 +135,7 @@ def test_same_inputs_give_bitwise_equal_runs(atlas: atlas_model.AtlasModel) -> N
 
 
 def test_config_names_the_model_and_timing(sim: AtlasSimulator) -> None:
-    config = sim.config()
+    config = sim.config().to_dict()
     assert config['model_file'] == 'atlas_v1.xml'
     assert len(str(config['model_sha1'])) == 40
     assert config['timestep'] == 0.001

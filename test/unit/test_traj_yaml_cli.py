@@ -103,7 +103,7 @@ def test_script_is_thin_and_executable() -> None:
     assert os.access(SCRIPT, os.X_OK)
     text = SCRIPT.read_text(encoding='utf-8')
     assert text.startswith('#!/usr/bin/env python3\n')
-    assert 'tutorial_atlas_control.node.traj_yaml' in text
+    assert 'tutorial_atlas_control.cli.traj_yaml' in text
     assert len(text.splitlines()) <= 12
 
 

@@ -26,6 +26,11 @@ from rosbags.rosbag1 import ReaderError
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags.records import BagRecords, open_bag
+from tutorial_atlas_control.bags.typestore import (
+    JOINT_COMMANDS_MSG_RELPATH,
+    JOINT_COMMANDS_TYPE,
+    load_typestore,
+)
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS, bare_joint_name
 from tutorial_atlas_control.msgs.ros1_fields import FieldCursor, parse_names_arrays
@@ -37,12 +42,10 @@ __all__ = [
     'JointStateSeries',
     'PelvisSeries',
     'TopicSummary',
-    'load_typestore',
     'read_bag',
 ]
 
 JOINT_STATE_TYPE = 'sensor_msgs/msg/JointState'
-JOINT_COMMANDS_TYPE = 'osrf_msgs/msg/JointCommands'
 ODOMETRY_TYPE = 'nav_msgs/msg/Odometry'
 STRING_TYPE = 'std_msgs/msg/String'
 #: MD5 sums of the layouts the hand-written parsers understand.
@@ -50,8 +53,6 @@ JOINT_STATE_MD5 = '3066dcd76a6cfaef579bd0f34173e9fd'
 ODOMETRY_MD5 = 'cd5e73d190d741a2f92e81eda573aca7'
 JOINT_COMMANDS_MD5 = 'f298c98f3e9c7aae9376ac19f73bfba3'
 
-#: Where osrf_msgs/JointCommands.msg lives relative to this file in a source checkout.
-_JOINT_COMMANDS_MSG_RELPATH = Path('msg') / 'osrf_msgs' / 'msg' / 'JointCommands.msg'
 #: Header stamps further than this from bag record times (s) suggest mixed clocks.
 _CLOCK_MISMATCH_S = 1.0
 #: Nav_msgs/Odometry after the two strings: pose (7) + cov (36), twist (6) + cov (36).
@@ -123,53 +124,6 @@ class BagData:
     modes: list[tuple[float, str]]
     sim_configs: list[tuple[float, str]]
     warnings: list[str] = field(default_factory=list)
-
-
-# ---------------------------------------------------------------------------- typestore
-
-
-def _find_joint_commands_msg() -> Path | None:
-    """Locate osrf_msgs/JointCommands.msg in a source checkout or a ROS install."""
-    for parent in Path(__file__).resolve().parents:
-        candidate = parent / _JOINT_COMMANDS_MSG_RELPATH
-        if candidate.is_file():
-            return candidate
-    try:
-        import rospkg  # noqa: PLC0415 - optional, only present in a ROS environment
-
-        candidate = Path(rospkg.RosPack().get_path('osrf_msgs')) / 'msg' / 'JointCommands.msg'
-    except Exception:  # noqa: BLE001 - any failure just means "not installed"
-        return None
-    return candidate if candidate.is_file() else None
-
-
-def load_typestore(connections: Sequence[Connection] = ()) -> Any:
-    """Return a ROS 1 Noetic rosbags typestore that knows every type in `connections`.
-
-    Types missing from the Noetic store are registered from the bag's own message
-    definitions; osrf_msgs/JointCommands falls back to the package's .msg file.
-
-    Raises:
-        BagAnalysisError: A definition in the bag cannot be parsed or registered.
-    """
-    from rosbags.typesys import Stores, TypesysError, get_types_from_msg, get_typestore
-
-    typestore = get_typestore(Stores.ROS1_NOETIC)
-    for connection in connections:
-        msgdef = getattr(connection.msgdef, 'data', '')
-        if connection.msgtype in typestore.fielddefs or not msgdef:
-            continue
-        try:
-            typestore.register(get_types_from_msg(msgdef, connection.msgtype))
-        except TypesysError as err:
-            msg = (f'Could not use the bag\'s definition of {connection.msgtype!r} on '
-                   f'{connection.topic}: {err}')
-            raise BagAnalysisError(msg) from err
-    if JOINT_COMMANDS_TYPE not in typestore.fielddefs:
-        msg_file = _find_joint_commands_msg()
-        if msg_file is not None:
-            typestore.register(get_types_from_msg(msg_file.read_text(), JOINT_COMMANDS_TYPE))
-    return typestore
 
 
 def _header_stamp_ns(msg: Any) -> int:
@@ -381,7 +335,7 @@ def _read_commands(reading: _Reading, connections: Sequence[Connection]) -> Join
     if not parse and JOINT_COMMANDS_TYPE not in reading.typestore.fielddefs:
         raise BagAnalysisError(
             'The bag has no definition of osrf_msgs/JointCommands and '
-            f'{_JOINT_COMMANDS_MSG_RELPATH} was not found; cannot read {topics.JOINT_COMMANDS}.')
+            f'{JOINT_COMMANDS_MSG_RELPATH} was not found; cannot read {topics.JOINT_COMMANDS}.')
     position = np.full((len(raws), NUM_JOINTS), np.nan)
     stamps_ns = np.empty(len(raws), dtype=np.int64)
     unknown: set[str] = set()

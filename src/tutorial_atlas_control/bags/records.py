@@ -5,9 +5,9 @@ Two readers behind one small interface (`connections`, `times_ns`, `raw_messages
 * :class:`IndexedBag`, the default, reads each chunk's index as one numpy block and slices
   the messages straight out of the decompressed chunks: rosbags' `Reader.messages` builds
   Python objects per message, which makes a 1 kHz recording several times slower to read.
-  It relies on two non-public parts of rosbags' Reader (:class:`_BlockIndexReader` and
-  :meth:`IndexedBag._chunk`), so requirements.txt pins rosbags and test_bag_reader checks
-  its results against :class:`PublicBag` on the same bags.
+  It reads the bag through rosbag1_fast.BlockIndexReader, which relies on rosbags' Reader
+  internals (requirements.txt pins rosbags; test_bag_reader checks its results against
+  :class:`PublicBag` on the same bags).
 * :class:`PublicBag` uses only rosbags' public `Reader.messages()`.
 """
 
@@ -21,16 +21,14 @@ from typing import Protocol
 import numpy as np
 from rosbags.interfaces import Connection
 from rosbags.rosbag1 import Reader, ReaderError
-from rosbags.rosbag1.reader import Header, RecordType, read_uint32  # not public API: pinned
 
+from tutorial_atlas_control.bags.rosbag1_fast import BlockIndexReader
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.units import NS_PER_S
 
 __all__ = ['BagRecords', 'IndexedBag', 'PublicBag', 'open_bag']
 
 _BAG_MAGIC = b'#ROSBAG V2.0\n'
-#: One entry of an IDXDATA record: bag time (sec, nsec) and the record's offset in its chunk.
-_INDEX_ENTRY = np.dtype([('sec', '<u4'), ('nsec', '<u4'), ('offset', '<u4')])
 _U32 = struct.Struct('<I')
 #: A record header's `op` field (length 4, 'op=' and one byte) and the MSGDATA op code.
 _OP_FIELD = b'\x04\x00\x00\x00op='
@@ -52,26 +50,6 @@ class BagRecords(Protocol):
 
 
 # ---------------------------------------------------------------------------- fast reader
-
-
-class _BlockIndexReader(Reader):  # type: ignore[misc]
-    """rosbags' Reader, keeping each chunk's index of a connection as one numpy block.
-
-    Overrides `read_index_data`, the hook `Reader.open` calls per IDXDATA record, so
-    `self.indexes[connection id]` holds (chunk position, entries) blocks instead of one
-    tuple per message; `Reader.messages` cannot read those.
-    """
-
-    def read_index_data(self, pos: int, indexes: dict[int, list[object]]) -> None:
-        header = Header.read(self.bio, RecordType.IDXDATA)
-        if (version := header.get_uint32('ver')) != 1:
-            raise ReaderError(f'IDXDATA version {version} is not supported.')
-        count = header.get_uint32('count')
-        size = read_uint32(self.bio)
-        if size != count * _INDEX_ENTRY.itemsize:
-            raise ReaderError(f'IDXDATA of chunk {pos} has {size} bytes for {count} entries.')
-        entries = np.frombuffer(self.bio.read(size), dtype=_INDEX_ENTRY, count=count)
-        indexes[header.get_uint32('conn')].append((pos, entries))
 
 
 class _ReaderBag:
@@ -96,7 +74,8 @@ class _ReaderBag:
 class IndexedBag(_ReaderBag):
     """Reads messages by slicing them out of chunks, located with a numpy index."""
 
-    reader_class = _BlockIndexReader
+    reader_class = BlockIndexReader
+    _reader: BlockIndexReader
 
     def _index(self, connections: Sequence[Connection]) -> tuple[np.ndarray, ...]:
         """(bag times (ns), chunk positions, offsets in chunk) of `connections`, time-ordered.
@@ -104,7 +83,7 @@ class IndexedBag(_ReaderBag):
         Ties are in file order (chunk, then offset), as `Reader.messages` yields them.
         """
         blocks = [block for connection in connections
-                  for block in self._reader.indexes[connection.id]]
+                  for block in self._reader.index_blocks(connection.id)]
         if not blocks:
             empty = np.empty(0, dtype=np.int64)
             return empty, empty, empty
@@ -123,12 +102,6 @@ class IndexedBag(_ReaderBag):
         """Bag times (ns) of the messages of `connections`, from the index alone."""
         return self._index(connections)[0]
 
-    def _chunk(self, pos: int) -> bytes:
-        """The decompressed data of the chunk at file position `pos` (Reader's chunk table)."""
-        info = self._reader.chunks[pos]
-        self._reader.bio.seek(info.datapos)
-        return info.decompressor(self._reader.bio.read(info.datasize))
-
     def raw_messages(self, connections: Sequence[Connection]) -> tuple[np.ndarray, list[bytes]]:
         """(bag times (ns), serialized messages) of `connections`, in time order.
 
@@ -140,7 +113,7 @@ class IndexedBag(_ReaderBag):
         chunk_pos, chunk = -1, b''
         for entry_chunk, offset in zip(chunk_positions.tolist(), offsets.tolist()):
             if entry_chunk != chunk_pos:
-                chunk_pos, chunk = entry_chunk, self._chunk(entry_chunk)
+                chunk_pos, chunk = entry_chunk, self._reader.chunk_data(entry_chunk)
             while True:  # skip the CONNECTION records a chunk may hold before a message
                 (header_len,) = unpack_u32(chunk, offset)
                 header_end = offset + 4 + header_len

@@ -10,8 +10,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from tutorial_atlas_control.trajectories.schedule import TRAJECTORY_LOG_PREFIX, parse_trajectory_log_line
+from rosbags.rosbag1 import Reader, ReaderError
+
+from tutorial_atlas_control.bags.typestore import load_typestore
 from tutorial_atlas_control.topics import ROSOUT
+from tutorial_atlas_control.trajectories.schedule import (
+    TRAJECTORY_LOG_PREFIX,
+    parse_trajectory_log_line,
+)
 
 __all__ = ['PlayedTrajectory', 'played_trajectories']
 
@@ -36,10 +42,7 @@ def played_trajectories(path: Path | str) -> list[PlayedTrajectory]:
 
     An unreadable bag gives an empty list: the caller reports the bag's problem itself.
     """
-    from rosbags.rosbag1 import Reader, ReaderError
-    from rosbags.typesys import Stores, get_typestore
-
-    typestore = get_typestore(Stores.ROS1_NOETIC)
+    typestore = load_typestore()
     found = []
     marker = TRAJECTORY_LOG_PREFIX.encode()
     try:

@@ -17,39 +17,18 @@ from typing import Any, Iterable, Sequence
 
 import numpy as np
 from rosbags.rosbag1 import Writer
-from rosbags.typesys import Stores, get_typestore, get_types_from_msg
-from rosbags.typesys.store import Typestore
 
 from tutorial_atlas_control import topics
+from tutorial_atlas_control.bags.typestore import load_typestore, rosbags_msgtype
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.units import NS_PER_S
 
-#: The repository's definition of osrf_msgs/JointCommands.
-JOINT_COMMANDS_MSG = (
-    Path(__file__).resolve().parents[3] / 'msg' / 'osrf_msgs' / 'msg' / 'JointCommands.msg'
-)
-
-
-
-
-def make_typestore() -> Typestore:
-    """Return a ROS 1 Noetic typestore with osrf_msgs/JointCommands registered."""
-    typestore = get_typestore(Stores.ROS1_NOETIC)
-    typestore.register(
-        get_types_from_msg(JOINT_COMMANDS_MSG.read_text(), 'osrf_msgs/msg/JointCommands'))
-    return typestore
-
-
-TYPESTORE = make_typestore()
-
-
-def _ros2_name(msgtype: str) -> str:
-    package, name = msgtype.split('/')
-    return f'{package}/msg/{name}'
+#: ROS 1 Noetic's types with the package's osrf_msgs/JointCommands (bags.typestore).
+TYPESTORE = load_typestore()
 
 
 def _type(msgtype: str) -> Any:
-    return TYPESTORE.types[_ros2_name(msgtype)]
+    return TYPESTORE.types[rosbags_msgtype(msgtype)]
 
 
 def _time(t_s: float) -> Any:
@@ -188,9 +167,9 @@ def write_bag(path: Path | str, records: Iterable[Record], *,
             connection = connections.get(record.topic)
             if connection is None:
                 connection = writer.add_connection(
-                    record.topic, _ros2_name(record.msgtype), typestore=TYPESTORE)
+                    record.topic, rosbags_msgtype(record.msgtype), typestore=TYPESTORE)
                 connections[record.topic] = connection
-            data = TYPESTORE.serialize_ros1(record.message, _ros2_name(record.msgtype))
+            data = TYPESTORE.serialize_ros1(record.message, rosbags_msgtype(record.msgtype))
             writer.write(connection, round(record.t_s * NS_PER_S), data)
     return path
 

@@ -15,12 +15,23 @@ from tutorial_atlas_control.bags.analysis import (
 )
 from tutorial_atlas_control.bags.compare import compare_bags, format_comparison, plot_comparison
 from tutorial_atlas_control.bags.compare import to_json as comparison_json
-from tutorial_atlas_control.bags.report import format_summary, plot_run, to_json, write_csv
-from tutorial_atlas_control.cli.convention import argument_type, print_error
-from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.bags.render import (
-    DEFAULT_FPS, DEFAULT_SIZE, check_output_path, parse_fps, parse_size, render_bag_video)
+    DEFAULT_FPS,
+    DEFAULT_SIZE,
+    check_output_path,
+    parse_fps,
+    parse_size,
+    render_bag_video,
+)
+from tutorial_atlas_control.bags.report import format_summary, plot_run, to_json, write_csv
 from tutorial_atlas_control.bags.run_log import PlayedTrajectory, played_trajectories
+from tutorial_atlas_control.cli.convention import (
+    EXIT_INTERRUPTED,
+    EXIT_REFUSED,
+    argument_type,
+    print_error,
+)
+from tutorial_atlas_control.errors import AtlasControlError
 
 PROG = 'analyze_bag.py'
 
@@ -134,9 +145,9 @@ def main(argv: Sequence[str] | None = None) -> int:
                   file=sys.stderr)
     except AtlasControlError as err:
         print_error(PROG, err)
-        return 1
+        return EXIT_REFUSED
     except KeyboardInterrupt:
-        return 130
+        return EXIT_INTERRUPTED
     return 0
 
 
@@ -156,6 +167,8 @@ def _compare(args: argparse.Namespace) -> int:
         if args.plot:
             print(f'wrote {plot_comparison(comparison, args.plot)}', file=sys.stderr)
     except AtlasControlError as err:
-        print(f'{PROG}: error: {err}', file=sys.stderr)
-        return 1
+        print_error(PROG, err)
+        return EXIT_REFUSED
+    except KeyboardInterrupt:
+        return EXIT_INTERRUPTED
     return 0

@@ -18,6 +18,11 @@ from tutorial_atlas_control.errors import AtlasControlError
 
 _T = TypeVar('_T')
 
+#: Exit status of a refused input or environment (a bag, a file, no ROS master).
+EXIT_REFUSED = 1
+#: Exit status on Ctrl-C: 128 + SIGINT, as a shell reports a process the signal ended.
+EXIT_INTERRUPTED = 130
+
 
 def argument_type(convert: Callable[[str], _T]) -> Callable[[str], _T]:
     """An argparse `type=` from a converter that raises AtlasControlError on a bad value.

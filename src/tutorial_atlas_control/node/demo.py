@@ -9,18 +9,15 @@ a running one.
 
 from __future__ import annotations
 
-import argparse
 import os
 import subprocess
-import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.processes import AtlasLaunch
 from tutorial_atlas_control.resources import package_path
-
-PROG = 'run_demo.py'
 
 DEFAULT_TRAJECTORY_FILE = package_path('trajectories', 'Traj_data2.yaml')
 DEFAULT_BAG_DIR = Path.home() / '.ros' / 'tutorial_atlas_control' / 'bags'
@@ -52,24 +49,36 @@ def newest_bag(bag_dir: Path, since_s: float) -> Path:
     return max(bags, key=lambda p: p.stat().st_mtime)
 
 
+#: Where the demo tells what it is doing (a line of text each); the command line prints them.
+Report = Callable[[str], None]
+
+
+def _silent(_line: str) -> None:
+    """The default Report: say nothing."""
+
+
 def run_demo(trajectory: str, trajectory_file: Path, bag_dir: Path, real_time_factor: float,
-             log_dir: Path) -> Path:
-    """Run the tutorial once; return the closed bag's path."""
+             log_dir: Path, progress: Report = _silent, warn: Report = _silent) -> Path:
+    """Run the tutorial once; return the closed bag's path.
+
+    `progress` gets a line at each phase, `warn` one if roslaunch had to be killed.
+    """
     started_s = time.time()
     gui = 'true' if os.environ.get('DISPLAY') else 'false'
     launch = AtlasLaunch(log_dir / 'atlas_launch.log',
                          {'gui': gui, 'bag_dir': bag_dir, 'real_time_factor': real_time_factor})
     try:
-        print(f'demo: atlas.launch started (master on port {launch.port}, log {launch.log_path})')
-        drive(launch, trajectory, trajectory_file)
+        progress(f'demo: atlas.launch started (master on port {launch.port}, '
+                 f'log {launch.log_path})')
+        drive(launch, trajectory, trajectory_file, progress)
     finally:
         if not launch.close(SHUTDOWN_TIMEOUT_S):
-            print(f'demo: roslaunch did not stop within {SHUTDOWN_TIMEOUT_S:.0f} s; killed it',
-                  file=sys.stderr)
+            warn(f'demo: roslaunch did not stop within {SHUTDOWN_TIMEOUT_S:.0f} s; killed it')
     return newest_bag(bag_dir, started_s)
 
 
-def drive(launch: AtlasLaunch, trajectory: str, trajectory_file: Path) -> None:
+def drive(launch: AtlasLaunch, trajectory: str, trajectory_file: Path,
+          progress: Report = _silent) -> None:
     """What the tutorial's user does in the other terminals: User mode, then traj_yaml.py."""
     import rospy
     from rosgraph_msgs.msg import Clock
@@ -89,10 +98,10 @@ def drive(launch: AtlasLaunch, trajectory: str, trajectory_file: Path) -> None:
     wait_sim_time(Clock, START_SETTLE_S)
     mode_pub = rospy.Publisher('/atlas/control_mode', String, queue_size=1, latch=True)
     mode_pub.publish(String(data='User'))
-    print('demo: /atlas/control_mode <- "User"')
+    progress('demo: /atlas/control_mode <- "User"')
     command = ['rosrun', 'tutorial_atlas_control', 'traj_yaml.py', str(trajectory_file),
                trajectory]
-    print('demo: ' + ' '.join(command))
+    progress('demo: ' + ' '.join(command))
     result = subprocess.run(command, env=launch.env, timeout=TRAJECTORY_TIMEOUT_S, check=False)
     if result.returncode != 0:
         raise DemoError(f'traj_yaml.py exited with status {result.returncode}')
@@ -113,55 +122,24 @@ def wait_sim_time(clock_type: type, seconds: float) -> None:
         time.sleep(0.05)
 
 
-def summarise(bag: Path, video_fps: float, video_size: tuple[int, int]) -> None:
-    """Print the short summary; write the plot and (unless video_fps is 0) the video."""
+def summarise(bag: Path, video_fps: float, video_size: tuple[int, int],
+              report: Report = _silent) -> None:
+    """Report the short summary; write the plot and (unless video_fps is 0) the video.
+
+    The summary is reported before the (slower) plot and video are made.
+    """
     from tutorial_atlas_control.bags.analysis import analyze_bag
-    from tutorial_atlas_control.bags.report import plot_run, short_summary
     from tutorial_atlas_control.bags.render import render_bag_video
+    from tutorial_atlas_control.bags.report import plot_run, short_summary
 
     analysis = analyze_bag(bag)
-    print('\n' + short_summary(analysis))
+    report('\n' + short_summary(analysis))
     plot = plot_run(analysis, bag.with_suffix('.png'))
     video = None
     if video_fps > 0:
         video = render_bag_video(analysis.data, bag.with_suffix('.mp4'), video_fps,
                                  video_size).path
-    print(f'bag:   {bag}')
-    print(f'plot:  {plot}')
+    report(f'bag:   {bag}')
+    report(f'plot:  {plot}')
     if video is not None:
-        print(f'video: {video}')
-
-
-def main(argv: list[str] | None = None) -> int:
-    from tutorial_atlas_control.cli.convention import argument_type, print_error
-    from tutorial_atlas_control.bags.render import parse_size
-
-    parser = argparse.ArgumentParser(
-        prog=PROG, description=__doc__.split('\n\n')[0])
-    parser.add_argument('trajectory', nargs='?', default='step_and_fall',
-                        help='trajectory name in the file (default: step_and_fall)')
-    parser.add_argument('--file', type=Path, default=DEFAULT_TRAJECTORY_FILE,
-                        help='trajectory YAML file (default: trajectories/Traj_data2.yaml)')
-    parser.add_argument('--bag-dir', type=Path,
-                        default=Path(os.environ.get('TAC_BAG_DIR', DEFAULT_BAG_DIR)),
-                        help='where the bag goes (default: $TAC_BAG_DIR or %(default)s)')
-    parser.add_argument('--real-time-factor', type=float, default=1.0,
-                        help='simulator pace; 0 = as fast as possible (default: 1.0)')
-    parser.add_argument('--video-fps', type=float, default=DEMO_VIDEO_FPS,
-                        help='frame rate of the rendered video; 0 = no video (default: %(default)g)')
-    parser.add_argument('--video-size', type=argument_type(parse_size), default=DEMO_VIDEO_SIZE,
-                        help='video size WxH in pixels (default: %(default)s)')
-    args = parser.parse_args(argv)
-    try:
-        from tutorial_atlas_control.trajectories.trajectory import load_trajectory
-        load_trajectory(args.file, args.trajectory)  # fail before starting anything
-        bag = run_demo(args.trajectory, args.file, args.bag_dir.expanduser().resolve(),
-                       args.real_time_factor, args.bag_dir.expanduser() / 'logs')
-        summarise(bag, args.video_fps, args.video_size)
-    except AtlasControlError as err:
-        print_error(PROG, err)
-        return 1
-    except subprocess.TimeoutExpired as err:
-        print_error(PROG, f'{err.cmd[2] if len(err.cmd) > 2 else err.cmd} timed out')
-        return 1
-    return 0
+        report(f'video: {video}')

@@ -10,17 +10,12 @@ quietly, and the simulator, which makes the same check, logs the one warning.
 
 from __future__ import annotations
 
-import os
-import sys
-from pathlib import Path
-
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.topics import ROBOT_DESCRIPTION_PARAM
 
 #: The Debian package and executable started.
 RSP_PACKAGE = 'robot_state_publisher'
 RSP_EXECUTABLE = 'robot_state_publisher'
-NAME = 'state_publisher.py'
 
 
 class StatePublisherError(AtlasControlError):
@@ -44,31 +39,11 @@ def robot_state_publisher_executable() -> str:
     return found[0]
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Entry point of scripts/state_publisher.py."""
-    argv = list(sys.argv if argv is None else argv)
-    plain = [arg for arg in argv[1:] if ':=' not in arg]
-    ros_args = [arg for arg in argv[1:] if ':=' in arg]
-    if len(plain) != 1 or plain[0] in ('-h', '--help'):
-        print(__doc__.strip(), file=sys.stdout if plain[:1] in (['-h'], ['--help']) else sys.stderr)
-        return 0 if plain[:1] in (['-h'], ['--help']) else 1
-    import mujoco
-    import rosgraph
+def set_robot_description(description: str) -> None:
+    """Put the URDF where robot_state_publisher reads it: the master's /robot_description.
 
-    from tutorial_atlas_control.sim.urdf import UrdfError, matching_urdf
-    model_file = Path(plain[0])
-    try:
-        model = mujoco.MjModel.from_xml_path(str(model_file))
-        _path, description = matching_urdf(model_file, model)
-    except (ValueError, UrdfError) as err:
-        print(f'{NAME}: robot_state_publisher not started: {err}', file=sys.stdout)
-        return 0
-    try:
-        executable = robot_state_publisher_executable()
-        rosgraph.Master('/state_publisher').setParam(ROBOT_DESCRIPTION_PARAM, description)
-    except (StatePublisherError, OSError) as err:
-        print(f'{NAME}: {err}', file=sys.stderr)
-        return 1
-    sys.stdout.flush()
-    os.execv(executable, [executable, *ros_args])
-    return 1  # not reached
+    Raises:
+        OSError: the master cannot be reached.
+    """
+    import rosgraph  # noqa: PLC0415 - the module imports where ROS is not installed
+    rosgraph.Master('/state_publisher').setParam(ROBOT_DESCRIPTION_PARAM, description)

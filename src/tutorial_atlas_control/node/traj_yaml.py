@@ -11,7 +11,6 @@ joint states by name and stamps each command. File handling and interpolation li
 from __future__ import annotations
 
 import os
-import sys
 import threading
 import time
 from collections.abc import Callable, Iterable, Sequence
@@ -27,38 +26,24 @@ from tutorial_atlas_control.sim.controller import LOAD_HINT, Gains, GainsError, 
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES, NUM_JOINTS, joint_index
 from tutorial_atlas_control.trajectories.schedule import done_line, playing_line, run_trajectory, trajectory_log_line
-from tutorial_atlas_control.trajectories.trajectory import Waypoint, load_trajectory, locate_trajectory_file
+from tutorial_atlas_control.trajectories.trajectory import Waypoint
 from tutorial_atlas_control.units import finite_number
 
 __all__ = [
     'JointStateCache',
     'TrajYamlError',
     'build_command',
-    'main',
+    'joint_commands_type',
+    'play',
     'positions_by_name',
     'read_gains',
+    'require_master',
     'run_trajectory',
     'wait_for_joint_state',
     'wait_for_ros_time',
     'wait_for_subscribers',
     'wait_until_handed_over',
 ]
-
-USAGE = 'usage: traj_yaml.py YAML_FILE TRAJECTORY_NAME\n where TRAJECTORY is a dictionary defined in YAML_FILE'
-DESCRIPTION = (
-    'Play trajectory TRAJECTORY_NAME of YAML_FILE on the simulated Atlas: for each waypoint\n'
-    '[duration_s, "28 joint positions"], move every joint linearly from its measured position\n'
-    'to the waypoint over duration_s, publishing osrf_msgs/JointCommands on /atlas/joint_commands\n'
-    'at 50 Hz with the gains atlas_controller/gains/<joint>/{p,i,d,i_clamp}.\n'
-    'A YAML_FILE name not found from the current directory is taken from the package\'s\n'
-    'trajectories/ folder (as the tutorial, run from the folder holding Traj_data2.yaml).\n'
-    'Start the simulator first:\n'
-    '  roslaunch tutorial_atlas_control atlas.launch\n'
-    'ROS remapping arguments (name:=value) are accepted; ~joint_state_timeout (s, default 10)\n'
-    'sets how long to wait for the first joint state, ~subscriber_timeout (s, default 10) how\n'
-    'long to wait for the simulator to subscribe to the commands.'
-)
-HELP_OPTIONS = ('-h', '--help')
 
 #: The tutorial's node name.
 NODE_NAME = 'tutorial_atlas_control'
@@ -254,52 +239,9 @@ def build_command(
     return command
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Run ``traj_yaml.py YAML_FILE TRAJECTORY_NAME``; return the exit status.
-
-    Args:
-        argv: the arguments after the program name (default ``sys.argv[1:]``);
-            ROS remapping arguments are removed with ``rospy.myargv``.
-    """
-    raw = list(sys.argv[1:] if argv is None else argv)
-    args = rospy.myargv(raw)
-    if any(arg in HELP_OPTIONS for arg in args):
-        print(f'{USAGE}\n\n{DESCRIPTION}')
-        return 0
-    if len(args) != 2:
-        print(USAGE, file=sys.stderr)
-        return 1
-    path, name = args
-    try:
-        path = locate_trajectory_file(path)
-        waypoints = load_trajectory(path, name)
-        message_type = _joint_commands_type()
-        _require_master()
-    except AtlasControlError as err:
-        print(err, file=sys.stderr)
-        return 1
-
-    try:
-        rospy.init_node(NODE_NAME, argv=[sys.argv[0], *raw])
-    except rospy.ROSInitException as err:
-        print(f'cannot start ROS node {NODE_NAME}: {err}', file=sys.stderr)
-        return 1
-    try:
-        _play(waypoints, message_type, path, name)
-    except AtlasControlError as err:
-        rospy.logerr(str(err))
-        return 1
-    except rospy.ROSTimeMovedBackwardsException:
-        rospy.logerr('ROS time moved backwards (was the simulation reset?); trajectory aborted')
-        return 1
-    except rospy.ROSInterruptException:
-        rospy.logwarn('shut down before the trajectory finished')
-        return 1
-    return 0
-
-
-def _play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], path: str,
-          name: str) -> None:
+def play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], path: str,
+         name: str) -> None:
+    """Play `waypoints` on the running node: wait for the simulator, then send the schedule."""
     gains = read_gains()
     cache = JointStateCache()
     rospy.Subscriber(JOINT_STATES_TOPIC, JointState, cache.callback, queue_size=1)
@@ -441,7 +383,8 @@ def wait_until_handed_over(publisher: rospy.Publisher, timeout_s: float) -> bool
         time.sleep(HANDOVER_POLL_S)
 
 
-def _joint_commands_type() -> Callable[[], object]:
+def joint_commands_type() -> Callable[[], object]:
+    """osrf_msgs/JointCommands, from the built workspace."""
     try:
         from osrf_msgs.msg import JointCommands
     except ImportError as err:
@@ -452,7 +395,8 @@ def _joint_commands_type() -> Callable[[], object]:
     return JointCommands
 
 
-def _require_master() -> None:
+def require_master() -> None:
+    """Refuse to start without a ROS master (rospy would wait for one forever)."""
     try:
         uri = rosgraph.get_master_uri()
     except ValueError as err:

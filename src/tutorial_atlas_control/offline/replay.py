@@ -22,8 +22,6 @@ Times in the report are sim time (s), as stamped by the simulator.
 
 from __future__ import annotations
 
-import argparse
-import json
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -34,13 +32,13 @@ import numpy as np
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags.reader import BagData, read_bag
-from tutorial_atlas_control.cli.convention import argument_type, print_error
 from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, load_gains_yaml
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.sim.sim_config import SimConfig, SimConfigError, parse_sim_config
 from tutorial_atlas_control.sim.simulator import (
     DEFAULT_TIME_TO_UNPIN_S, AtlasSimulator, PhysicsDivergenceError)
-from tutorial_atlas_control.units import NS_PER_S, finite_number
+from tutorial_atlas_control.units import NS_PER_S
 
 __all__ = [
     'DEFAULT_TOLERANCE',
@@ -48,15 +46,12 @@ __all__ = [
     'Recording',
     'ReplayError',
     'ReplayResult',
-    'SimConfig',
     'format_report',
     'load_recording',
-    'main',
     'replay',
     'replay_bag',
 ]
 
-PROG = 'replay_bag.py'
 SIM_CONFIG_TOPIC = topics.SIM_CONFIG
 JOINT_STATES_TOPIC = topics.JOINT_STATES
 ODOM_TOPIC = topics.GROUND_TRUTH_ODOM
@@ -64,8 +59,6 @@ ODOM_TOPIC = topics.GROUND_TRUTH_ODOM
 DEFAULT_TOLERANCE = 1e-6
 #: When the bag predates /atlas/sim_config: the simulator's defaults, no reset after start (s).
 DEFAULT_LAST_RESET_S = 0.0
-#: Exit status when the replay ran but deviates beyond the tolerance.
-EXIT_DEVIATES = 3
 #: A stamp further than this fraction of a step from the step grid is not a simulator stamp.
 _GRID_TOLERANCE_STEPS = 1e-3
 
@@ -75,18 +68,6 @@ class ReplayError(AtlasControlError):
 
 
 # ---------------------------------------------------------------------------- recording
-
-
-@dataclass(frozen=True)
-class SimConfig:
-    """The simulator's /atlas/sim_config (times in s); `recorded` False = assumed defaults."""
-
-    model_file: str | None
-    model_sha1: str | None
-    timestep_s: float | None
-    time_to_unpin_s: float
-    last_reset_time_s: float
-    recorded: bool
 
 
 @dataclass(frozen=True)
@@ -112,17 +93,11 @@ class Recording:
 
 
 def _read_sim_configs(data: BagData) -> list[dict[str, Any]]:
-    """Every /atlas/sim_config message of `data`, in record order, parsed from JSON."""
-    configs = []
-    for _, text in data.sim_configs:
-        try:
-            config = json.loads(text)
-        except json.JSONDecodeError as err:
-            raise ReplayError(f'{data.path}: {SIM_CONFIG_TOPIC} is not JSON ({err}).') from err
-        if not isinstance(config, dict):
-            raise ReplayError(f'{data.path}: {SIM_CONFIG_TOPIC} is not a JSON object: {text!r}.')
-        configs.append(config)
-    return configs
+    """Every /atlas/sim_config message of `data`, in record order, as JSON objects."""
+    try:
+        return [parse_sim_config(text) for _, text in data.sim_configs]
+    except SimConfigError as err:
+        raise ReplayError(f'{data.path}: {SIM_CONFIG_TOPIC} {err}') from err
 
 
 def _sim_config(path: Path, raw_configs: list[dict[str, Any]],
@@ -133,19 +108,11 @@ def _sim_config(path: Path, raw_configs: list[dict[str, Any]],
                         f'published it): assuming time_to_unpin = {DEFAULT_TIME_TO_UNPIN_S} s '
                         f'and no reset after t = {DEFAULT_LAST_RESET_S} s.')
         return SimConfig(None, None, None, DEFAULT_TIME_TO_UNPIN_S, DEFAULT_LAST_RESET_S,
-                         False), 0
-    last = raw_configs[-1]
+                         recorded=False), 0
     try:
-        config = SimConfig(
-            model_file=str(last.get('model_file')) if last.get('model_file') else None,
-            model_sha1=str(last.get('model_sha1')) if last.get('model_sha1') else None,
-            timestep_s=float(last['timestep']),
-            time_to_unpin_s=float(last['time_to_unpin']),
-            last_reset_time_s=float(last['last_reset_time']),
-            recorded=True)
-    except (KeyError, TypeError, ValueError) as err:
-        raise ReplayError(f'{path}: {SIM_CONFIG_TOPIC} lacks a valid {err} (expected JSON with '
-                          'timestep, time_to_unpin, last_reset_time).') from None
+        config = SimConfig.from_dict(raw_configs[-1])
+    except SimConfigError as err:
+        raise ReplayError(f'{path}: {SIM_CONFIG_TOPIC} {err}') from None
     resets = len({float(c.get('last_reset_time', 0.0)) for c in raw_configs}) - 1
     return config, resets
 
@@ -265,10 +232,7 @@ class ReplayResult:
         config = self.config
         return {
             'bag': str(self.bag),
-            'sim_config': {'recorded': config.recorded, 'model_file': config.model_file,
-                           'model_sha1': config.model_sha1, 'timestep': config.timestep_s,
-                           'time_to_unpin': config.time_to_unpin_s,
-                           'last_reset_time': config.last_reset_time_s},
+            'sim_config': {'recorded': config.recorded, **config.to_dict()},
             'resets_in_bag': self.resets_in_bag,
             'model_sha1_matches': self.model_sha1_matches,
             'start_time': self.start_time_s,
@@ -532,65 +496,3 @@ def format_report(result: ReplayResult) -> str:
     verdict = 'REPRODUCED' if result.reproduced else 'DEVIATES'
     lines.append(f'{verdict} (tolerance {result.tolerance:g})')
     return '\n'.join(lines)
-
-
-DESCRIPTION = """\
-Re-simulate a recorded Atlas run without ROS and report how far the replay strays from
-the recording.
-
-Starts from the simulator's reset (/atlas/sim_config last_reset_time; the torso pinned
-for time_to_unpin), applies each step's recorded torque (/atlas/joint_states effort) with
-MuJoCo's mj_step, and compares the joint positions and velocities with every recorded
-joint state and the pelvis pose with /ground_truth_odom. Steps before the recorder
-started are re-created with the simulator's own Stand-mode controller (the gains of
-config/atlas_controller.yaml). With the same model and MuJoCo build the replay is exact
-(all deviations 0).
-"""
-
-EPILOG = """\
-JSON keys (--json): bag, sim_config {recorded, model_file, model_sha1, timestep (s),
-time_to_unpin (s), last_reset_time (s)}, resets_in_bag, model_sha1_matches (bool or null),
-start_time, end_time (s of sim time), reconstructed_steps, recorded_steps,
-joint_position and joint_velocity {max (rad, rad/s), time (s), joint, samples},
-pelvis_position {max (m), time, samples}, pelvis_orientation {max (rad), time, samples}
-(null without /ground_truth_odom), tolerance, reproduced (bool), warnings [text].
-
-Exit status: 0 when every deviation is within --tolerance, 3 when the replay deviates,
-1 when the bag cannot be read or replayed (missing topics, unsupported resets), 2 on bad
-arguments (e.g. a --tolerance that is not a number >= 0).
-
-Example: rosrun tutorial_atlas_control replay_bag.py ~/.ros/tutorial_atlas_control/bags/atlas_*.bag
-"""
-
-
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser (its --help is the documentation)."""
-    parser = argparse.ArgumentParser(prog=PROG, description=DESCRIPTION, epilog=EPILOG,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument('bag', metavar='BAG', help='the ROS 1 .bag file of the run')
-    parser.add_argument('--json', action='store_true', help='print one JSON object instead')
-    parser.add_argument('--tolerance', type=argument_type(_tolerance), default=DEFAULT_TOLERANCE,
-                        help='largest deviation (rad, rad/s, m) that still counts as '
-                             'reproduced (default: %(default)g)')
-    return parser
-
-
-def _tolerance(text: str) -> float:
-    tolerance = finite_number(text, allow_text=True)
-    if tolerance is None or tolerance < 0.0:
-        raise ReplayError(f'{text!r} is not a number >= 0')
-    return tolerance
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; return the exit status."""
-    args = build_parser().parse_args(argv)
-    try:
-        result = replay_bag(args.bag, args.tolerance)
-    except AtlasControlError as err:
-        print_error(PROG, err)
-        return 1
-    except KeyboardInterrupt:
-        return 130
-    print(json.dumps(result.to_dict(), indent=2) if args.json else format_report(result))
-    return 0 if result.reproduced else EXIT_DEVIATES

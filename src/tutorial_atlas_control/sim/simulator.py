@@ -15,10 +15,12 @@ from collections.abc import Mapping, Sequence
 import mujoco
 import numpy as np
 
+from tutorial_atlas_control import native
 from tutorial_atlas_control.sim import law_kernel
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.msgs.commands import CommandUpdate, JointCommandArrays, command_update
 from tutorial_atlas_control.sim.controller import Gains, PidState, compute_torque, hold_command
+from tutorial_atlas_control.sim.sim_config import SimConfig
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.units import NS_PER_S
@@ -107,7 +109,7 @@ class AtlasSimulator:
 
     def _make_compiled_law(self) -> law_kernel.CompiledLaw | None:
         """The C law writing torque_nm and MjData.ctrl; None (numpy law) if it is not built."""
-        library = law_kernel.load_library()
+        library = native.load_library()
         if library is None or self.data.ctrl.shape != self.torque_nm.shape:
             return None
         return law_kernel.CompiledLaw(
@@ -135,15 +137,11 @@ class AtlasSimulator:
         if self.mode in (ControlMode.FREEZE, ControlMode.USER):
             self._mode_command = self._hold_current_pose()
 
-    def config(self) -> dict[str, object]:
+    def config(self) -> SimConfig:
         """What re-creates this run offline: the model, its step, pinning and last reset."""
-        return {
-            'model_file': self.atlas_path.name,
-            'model_sha1': self.atlas_sha1,
-            'timestep': self.dt_s,
-            'time_to_unpin': self.time_to_unpin_s,
-            'last_reset_time': self.last_reset_ns / NS_PER_S,
-        }
+        return SimConfig(model_file=self.atlas_path.name, model_sha1=self.atlas_sha1,
+                         timestep_s=self.dt_s, time_to_unpin_s=self.time_to_unpin_s,
+                         last_reset_time_s=self.last_reset_ns / NS_PER_S)
 
     def reset_simulation(self, sim_time_ns: int = 0) -> None:
         """reset_world, and sim time back to `sim_time_ns`.

@@ -12,7 +12,6 @@ transport.WireBatch), a LoopLog (rospy's log) and its shutdown test; tests give 
 from __future__ import annotations
 
 import collections
-import json
 import threading
 from collections.abc import Callable, Hashable, Mapping
 from typing import Protocol
@@ -220,7 +219,7 @@ class SteppingLoop:
 
     def publish_config(self) -> None:
         """(Re-)publish /atlas/sim_config: at start and after every reset."""
-        self._send_config(json.dumps(self.sim.config()))
+        self._send_config(self.sim.config().to_json())
 
     def reset_world(self) -> None:
         with self.lock:

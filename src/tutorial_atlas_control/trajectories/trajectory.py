@@ -168,15 +168,16 @@ def resolve_trajectory_file(path: PathLike, search_dir: Path = TRAJECTORIES_DIR)
                           f'(not in the current directory, nor in {search_dir})')
 
 
-def locate_trajectory_file(path: PathLike, announce: Callable[[str], None] = print) -> str:
+def locate_trajectory_file(path: PathLike, announce: Callable[[str], None] | None = None) -> str:
     """YAML_FILE as the tutorial uses it (traj_yaml.py, run_offline.py): a bare name also finds
-    the package's trajectories/ copy, and `announce` says so in one line.
+    the package's trajectories/ copy, and `announce` (the command line's print) says so in
+    one line.
 
     Raises:
         TrajectoryError: as :func:`resolve_trajectory_file`.
     """
     found, from_package = resolve_trajectory_file(path)
-    if from_package:
+    if from_package and announce is not None:
         announce(f'{os.fspath(path)} is not in the current directory; using {found}')
     return found
 

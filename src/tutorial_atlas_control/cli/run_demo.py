@@ -1,0 +1,68 @@
+"""Command line of run_demo.py (`make demo`): the tutorial end to end, headless."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from tutorial_atlas_control.bags.render import parse_size
+from tutorial_atlas_control.cli.convention import (
+    EXIT_INTERRUPTED,
+    EXIT_REFUSED,
+    argument_type,
+    print_error,
+)
+from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.node import demo
+from tutorial_atlas_control.trajectories.trajectory import load_trajectory
+
+PROG = 'run_demo.py'
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser (its --help is the documentation)."""
+    parser = argparse.ArgumentParser(prog=PROG, description=demo.__doc__.split('\n\n')[0])
+    parser.add_argument('trajectory', nargs='?', default='step_and_fall',
+                        help='trajectory name in the file (default: step_and_fall)')
+    parser.add_argument('--file', type=Path, default=demo.DEFAULT_TRAJECTORY_FILE,
+                        help='trajectory YAML file (default: trajectories/Traj_data2.yaml)')
+    parser.add_argument('--bag-dir', type=Path,
+                        default=Path(os.environ.get('TAC_BAG_DIR', demo.DEFAULT_BAG_DIR)),
+                        help='where the bag goes (default: $TAC_BAG_DIR or %(default)s)')
+    parser.add_argument('--real-time-factor', type=float, default=1.0,
+                        help='simulator pace; 0 = as fast as possible (default: 1.0)')
+    parser.add_argument('--video-fps', type=float, default=demo.DEMO_VIDEO_FPS,
+                        help='frame rate of the rendered video; 0 = no video '
+                             '(default: %(default)g)')
+    parser.add_argument('--video-size', type=argument_type(parse_size),
+                        default=demo.DEMO_VIDEO_SIZE,
+                        help='video size WxH in pixels (default: %(default)s)')
+    return parser
+
+
+def _warn(line: str) -> None:
+    print(line, file=sys.stderr)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; return the exit status."""
+    args = build_parser().parse_args(argv)
+    try:
+        load_trajectory(args.file, args.trajectory)  # fail before starting anything
+        bag = demo.run_demo(args.trajectory, args.file, args.bag_dir.expanduser().resolve(),
+                            args.real_time_factor, args.bag_dir.expanduser() / 'logs',
+                            progress=print, warn=_warn)
+        demo.summarise(bag, args.video_fps, args.video_size, report=print)
+    except AtlasControlError as err:
+        print_error(PROG, err)
+        return EXIT_REFUSED
+    except subprocess.TimeoutExpired as err:
+        print_error(PROG, f'{err.cmd[2] if len(err.cmd) > 2 else err.cmd} timed out')
+        return EXIT_REFUSED
+    except KeyboardInterrupt:  # run_demo has stopped roslaunch on the way out
+        return EXIT_INTERRUPTED
+    return 0

@@ -1,0 +1,84 @@
+"""Command line of run_offline.py: play a trajectory offline (no ROS) and summarize the run."""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from tutorial_atlas_control.bags.analysis import analyze_bag
+from tutorial_atlas_control.bags.report import short_summary
+from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED, EXIT_REFUSED, print_error
+from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.offline.player import (
+    DEFAULT_SETTLE_S,
+    DEFAULT_START_AFTER_S,
+    run_offline,
+)
+from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE
+from tutorial_atlas_control.trajectories.trajectory import locate_trajectory_file
+
+PROG = 'run_offline.py'
+
+
+def _seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'{text!r} is not a number of seconds') from None
+    if not (np.isfinite(value) and value >= 0.0):
+        raise argparse.ArgumentTypeError(f'{text!r} must be a finite number of seconds >= 0')
+    return value
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser (its --help is the documentation)."""
+    parser = argparse.ArgumentParser(
+        prog=PROG, description=(
+            'Play trajectory NAME of YAML_FILE into the simulator without ROS, as `make demo` '
+            'plays it live (User mode after --start-after s, traj_yaml\'s 50 Hz commands with '
+            'the gains of --gains, then --settle s), deterministically and faster than real '
+            'time. Prints the demo\'s summary; with --bag, also keeps the run as a ROS 1 bag '
+            'that analyze_bag.py, replay_bag.py and rosbag read as a recorded run.'))
+    parser.add_argument('trajectory_file', metavar='YAML_FILE', help='trajectory file')
+    parser.add_argument('name', metavar='NAME', help='trajectory name in YAML_FILE')
+    parser.add_argument('--bag', type=Path, metavar='OUT.bag',
+                        help='write the run to this bag (replaced if it exists)')
+    parser.add_argument('--settle', type=_seconds, default=DEFAULT_SETTLE_S, metavar='S',
+                        help='sim time after the last command (default: %(default)g)')
+    parser.add_argument('--play-after', type=_seconds, default=0.0, metavar='S',
+                        help='sim time between the switch to User and the first command '
+                             '(default: 0; a live traj_yaml.py starts a few seconds after)')
+    parser.add_argument('--start-after', type=_seconds, default=DEFAULT_START_AFTER_S,
+                        metavar='S', help='sim time from spawn to User mode and the first '
+                        'command (default: %(default)g; the torso is pinned for 1 s)')
+    parser.add_argument('--gains', type=Path, default=DEFAULT_GAINS_FILE, metavar='FILE',
+                        help='controller gains YAML (default: config/atlas_controller.yaml)')
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """The command line; returns the exit status (1: bad input or failed run, nothing written)."""
+    args = build_parser().parse_args(argv)
+    try:
+        with tempfile.TemporaryDirectory(prefix='tac_offline_') as scratch:
+            # Without --bag the summary is read from a bag that is deleted afterwards.
+            bag = args.bag if args.bag is not None else Path(scratch) / f'{args.name}.bag'
+            trajectory_file = locate_trajectory_file(args.trajectory_file, announce=print)
+            run = run_offline(trajectory_file, args.name, bag, args.settle,
+                              args.start_after, args.gains, play_after_s=args.play_after)
+            analysis = analyze_bag(run.bag)
+    except AtlasControlError as err:
+        print_error(PROG, err)
+        return EXIT_REFUSED
+    except KeyboardInterrupt:  # run_offline leaves no partial bag behind
+        return EXIT_INTERRUPTED
+    print(f'offline: {args.name}: {run.commands} commands, {run.sim_time_s:.3f} s of sim time '
+          f'in {run.wall_s:.2f} s ({run.real_time_factor:.1f}x real time)')
+    print(short_summary(analysis))
+    if args.bag is not None:
+        print(f'bag:   {run.bag}')
+    return 0

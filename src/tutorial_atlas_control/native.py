@@ -1,0 +1,161 @@
+"""The package's compiled library (src/atlas_law.c, src/atlas_gather.c): found, loaded, checked.
+
+One place knows the library's binary interface: the ctypes mirrors of its structs, the
+signatures of its functions, and where catkin puts it (a devel space's lib/ and an
+install space's lib/ are both on CMAKE_PREFIX_PATH once their setup.bash is sourced).
+Its users, the compiled law (sim/law_kernel.py) and the messages' copies
+(msgs/copy_plan.py), ask here.
+
+A mirror that disagrees with the C struct would let C read or write past the fields
+Python laid out, so the library exports `size_t tac_sizeof_<Struct>(void)` for each
+mirrored struct, and a library whose sizes differ from the mirrors' (built from other
+sources) is refused. Refused or missing, the callers fall back to numpy after one
+warning: the same numbers, bit for bit, only slower.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from tutorial_atlas_control.msgs.commands import FIELD_NAMES
+
+__all__ = ['LIBRARY_ENV', 'LIBRARY_NAME', 'MIRRORED_STRUCTS', 'AtlasCopy', 'AtlasLawStep',
+           'address', 'find_library', 'load_library', 'size_mismatches']
+
+#: The shared library CMakeLists.txt builds (devel/lib, installed to the prefix's lib/).
+LIBRARY_NAME = 'libtutorial_atlas_control_law.so'
+#: Set to a library path to use that one (or to a missing path to force numpy).
+LIBRARY_ENV = 'TAC_LAW_LIBRARY'
+#: What the callers do without the library (the end of the one warning).
+FALLBACK = 'using the numpy controller law (same torques, slower)'
+#: How the library names the function that returns sizeof(Struct).
+SIZEOF_PREFIX = 'tac_sizeof_'
+
+
+class AtlasLawStep(ctypes.Structure):
+    """AtlasLawStep in src/atlas_law.c (same fields, same order)."""
+
+    _fields_ = [
+        ('command', ctypes.c_void_p * len(FIELD_NAMES)),
+        ('qpos', ctypes.c_void_p), ('qpos_adr', ctypes.c_void_p),
+        ('qvel', ctypes.c_void_p), ('dof_adr', ctypes.c_void_p),
+        ('lower', ctypes.c_void_p), ('upper', ctypes.c_void_p), ('effort_limit', ctypes.c_void_p),
+        ('integral', ctypes.c_void_p), ('previous_error', ctypes.c_void_p),
+        ('torque', ctypes.c_void_p), ('ctrl', ctypes.c_void_p),
+        ('dt_s', ctypes.c_double), ('n', ctypes.c_long), ('initialized', ctypes.c_long),
+        ('nq', ctypes.c_long), ('nv', ctypes.c_long),
+    ]
+
+
+class AtlasCopy(ctypes.Structure):
+    """AtlasCopy in src/atlas_gather.c (same fields, same order)."""
+
+    _fields_ = [('dst', ctypes.c_void_p), ('dst_index', ctypes.c_void_p),
+                ('src', ctypes.c_void_p), ('src_index', ctypes.c_void_p),
+                ('count', ctypes.c_long)]
+
+
+#: Every struct Python lays out for the library, by its C name: the library must export
+#: SIZEOF_PREFIX + name, returning the same size as the mirror's.
+MIRRORED_STRUCTS: dict[str, type[ctypes.Structure]] = {
+    'AtlasLawStep': AtlasLawStep,
+    'AtlasCopy': AtlasCopy,
+}
+
+
+def address(array: np.ndarray, dtype: type) -> int:
+    """Data pointer of a C-contiguous array of `dtype`, for a mirrored struct's field.
+
+    The library indexes each array flat, as that dtype; any other layout would be misread.
+    """
+    if array.dtype != dtype or not array.flags.c_contiguous:
+        raise ValueError(f'the compiled library needs C-contiguous {np.dtype(dtype)} arrays, '
+                         f'got {array.dtype} (contiguous: {array.flags.c_contiguous})')
+    return array.ctypes.data
+
+
+def find_library() -> Path | None:
+    """The compiled library: $TAC_LAW_LIBRARY if set, else the first catkin prefix's lib/.
+
+    The prefixes are those on CMAKE_PREFIX_PATH (set by a devel or install space's
+    setup.bash, which `source ./env.sh` sources, and inherited by roslaunch'd nodes), the
+    same search catkin.find_in_workspaces does.
+    """
+    override = os.environ.get(LIBRARY_ENV)
+    if override:
+        path = Path(override)
+        return path if path.is_file() else None
+    for prefix in os.environ.get('CMAKE_PREFIX_PATH', '').split(os.pathsep):
+        if prefix:
+            path = Path(prefix) / 'lib' / LIBRARY_NAME
+            if path.is_file():
+                return path
+    return None
+
+
+def size_mismatches(library: ctypes.CDLL) -> list[str]:
+    """One phrase per mirrored struct whose size the library does not report as the
+    mirror's: a different size, or no size function (built from older sources)."""
+    found = []
+    for name, mirror in MIRRORED_STRUCTS.items():
+        try:
+            sizeof = getattr(library, SIZEOF_PREFIX + name)
+        except AttributeError:
+            found.append(f'no {SIZEOF_PREFIX}{name}()')
+            continue
+        sizeof.argtypes = []
+        sizeof.restype = ctypes.c_size_t
+        library_size, mirror_size = sizeof(), ctypes.sizeof(mirror)
+        if library_size != mirror_size:
+            found.append(f'sizeof({name}) is {library_size} bytes there, '
+                         f'{mirror_size} in {__name__}')
+    return found
+
+
+def _declare(library: ctypes.CDLL) -> None:
+    """The signatures of the library's functions (ctypes would guess int otherwise)."""
+    library.atlas_law_step.argtypes = [ctypes.POINTER(AtlasLawStep)]
+    library.atlas_law_step.restype = None
+    library.atlas_state_is_finite.argtypes = [ctypes.POINTER(AtlasLawStep)]
+    library.atlas_state_is_finite.restype = ctypes.c_int
+    library.atlas_copy_all.argtypes = [ctypes.POINTER(AtlasCopy), ctypes.c_long]
+    library.atlas_copy_all.restype = None
+
+
+_library: ctypes.CDLL | None = None
+_warned = False
+
+
+def load_library() -> ctypes.CDLL | None:
+    """The loaded, checked library, or None (warning once) when it is missing, does not
+    load, or does not match the mirrors here."""
+    global _library, _warned
+    if _library is not None:
+        return _library
+    path = find_library()
+    override = os.environ.get(LIBRARY_ENV)
+    problem = (f'{LIBRARY_ENV}={override} does not exist' if override
+               else f'{LIBRARY_NAME} is not in the catkin workspace (run `make setup`)')
+    if path is not None:
+        try:
+            library = ctypes.CDLL(str(path))
+            mismatches = size_mismatches(library)
+            if not mismatches:
+                _declare(library)
+        except (OSError, AttributeError) as err:
+            problem = f'cannot load {path}: {err}'
+        else:
+            if not mismatches:
+                _library = library
+                return library
+            problem = (f'{path} does not match this code ({"; ".join(mismatches)}); '
+                       'rebuild it (`make setup`)')
+    if not _warned:
+        warnings.warn(f'{problem}; {FALLBACK}', RuntimeWarning, stacklevel=2)
+        _warned = True
+    return None

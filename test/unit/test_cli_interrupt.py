@@ -1,0 +1,91 @@
+"""Ctrl-C ends every script with exit status 130 and no traceback (README, Script conventions).
+
+Each script's main is called with the work it hands to the library replaced by a function
+that raises KeyboardInterrupt, as Ctrl-C does in the middle of it; one script is also
+interrupted for real, with SIGINT, while it simulates.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+from tutorial_atlas_control.cli import (
+    analyze_bag,
+    replay_bag,
+    run_demo,
+    run_offline,
+    state_publisher,
+    traj_yaml,
+)
+from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED
+from tutorial_atlas_control.node import demo
+
+REPO = Path(__file__).resolve().parents[2]
+TRAJECTORY_FILE = REPO / 'trajectories' / 'Traj_data2.yaml'
+#: Long enough (s of sim time) that the run is still simulating when the signal comes.
+LONG_SETTLE_S = '10000'
+#: Wall-clock bounds (s): for the run to start simulating, and to end after the signal.
+START_TIMEOUT_S = 60.0
+EXIT_TIMEOUT_S = 30.0
+
+
+def interrupt(*_args: object, **_kwargs: object) -> None:
+    raise KeyboardInterrupt
+
+
+@pytest.mark.parametrize(('main', 'target', 'argv'), [
+    (analyze_bag.main, (analyze_bag, 'analyze_bag'), ['run.bag']),
+    (analyze_bag.main, (analyze_bag, 'compare_bags'), ['a.bag', '--compare', 'b.bag']),
+    (replay_bag.main, (replay_bag, 'replay_bag'), ['run.bag']),
+    (run_offline.main, (run_offline, 'run_offline'), [str(TRAJECTORY_FILE), 'touchdown']),
+    (run_demo.main, (demo, 'run_demo'), ['touchdown']),
+    (traj_yaml.main, (traj_yaml, 'load_trajectory'), [str(TRAJECTORY_FILE), 'touchdown']),
+    (state_publisher.main, (state_publisher, 'matching_urdf'),
+     ['state_publisher.py', str(REPO / 'sim' / 'atlas_v1.xml')]),
+], ids=['analyze_bag', 'analyze_bag --compare', 'replay_bag', 'run_offline', 'run_demo',
+        'traj_yaml', 'state_publisher'])
+def test_ctrl_c_exits_130_quietly(main: Callable[[list[str]], int], target: tuple[object, str],
+                                  argv: list[str], monkeypatch: pytest.MonkeyPatch,
+                                  capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.setattr(*target, interrupt)
+    try:
+        status = main(argv)
+    except KeyboardInterrupt:
+        pytest.fail('Ctrl-C escaped main: the user gets a traceback, not exit 130')
+    assert status == EXIT_INTERRUPTED
+    captured = capsys.readouterr()
+    assert captured.err == '' and captured.out == ''
+
+
+def test_sigint_stops_run_offline_with_130_and_leaves_no_bag(tmp_path: Path) -> None:
+    """A real Ctrl-C while the offline run simulates: exit 130, no traceback, no bag left."""
+    bag = tmp_path / 'run.bag'
+    process = subprocess.Popen(
+        [sys.executable, str(REPO / 'scripts' / 'run_offline.py'), str(TRAJECTORY_FILE),
+         'touchdown', '--settle', LONG_SETTLE_S, '--bag', str(bag)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=dict(os.environ))
+    try:
+        deadline = time.monotonic() + START_TIMEOUT_S
+        # The partial bag appears once the run has started simulating.
+        while not list(tmp_path.glob('.run.bag.*.partial')):
+            assert process.poll() is None, process.communicate()
+            assert time.monotonic() < deadline, 'run_offline.py did not start simulating'
+            time.sleep(0.05)
+        process.send_signal(signal.SIGINT)
+        out, err = process.communicate(timeout=EXIT_TIMEOUT_S)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.communicate()
+    assert process.returncode == EXIT_INTERRUPTED, err
+    assert 'Traceback' not in err and err == '', err
+    assert out == ''
+    assert list(tmp_path.iterdir()) == [], 'a partial or complete bag was left behind'
