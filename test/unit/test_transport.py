@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import pytest
+
 from tutorial_atlas_control.node import transport
 
 
@@ -36,6 +38,7 @@ class FakePublisher:
     def __init__(self, connections: list[FakeConnection]) -> None:
         self.impl = self
         self.connections = list(connections)
+        self.closed = False
 
     def remove_connection(self, connection):
         self.connections.remove(connection)
@@ -63,3 +66,33 @@ def test_a_subscriber_that_left_is_dropped_quietly_a_stalled_one_with_a_warning(
     assert pub.connections == [healthy]
     assert left.closed and stalled.closed
     assert len(warnings) == 1 and '/slow' in warnings[0], warnings
+
+
+class ClosingSocket(FakeSocket):
+    """A socket whose publisher rospy shuts down (another thread) while it is written."""
+
+    def __init__(self, pub: FakePublisher) -> None:
+        super().__init__()
+        self.pub = pub
+
+    def sendall(self, data: bytes) -> None:
+        # rospy's _PublisherImpl.close(): closed, connections closed and forgotten, and
+        # remove_connection() fails from then on (its listener list is gone).
+        self.pub.closed = True
+        self.pub.connections.clear()
+        self.pub.remove_connection = None
+        raise OSError(9, 'Bad file descriptor')
+
+
+def test_a_publisher_shut_down_during_a_send_is_left_quietly(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """rosnode kill or Ctrl-C shuts rospy down while the loop flushes: no traceback."""
+    warnings = []
+    monkeypatch.setattr(transport.rospy, 'logwarn', warnings.append)
+    closing = FakeConnection('/atlas_sim')
+    later = FakeConnection('/recorder')
+    pub = FakePublisher([closing, later])
+    closing.socket = ClosingSocket(pub)
+    transport.write_to_connections(pub, b'data')
+    assert later.socket.sent == []
+    assert warnings == []

@@ -24,7 +24,8 @@ def write_to_connections(pub: rospy.Publisher, data: bytes | bytearray) -> None:
     """Send already-serialized TCPROS bytes to every subscriber of `pub`.
 
     The socket is written directly (rospy's write_data mis-handles a send timeout); a
-    subscriber that is gone, or accepts nothing for SEND_TIMEOUT_S, is dropped.
+    subscriber that is gone, or accepts nothing for SEND_TIMEOUT_S, is dropped. Once rospy
+    has shut the publisher down (node shutdown, from another thread), nothing is sent.
     """
     impl = pub.impl
     for connection in list(impl.connections):
@@ -36,6 +37,8 @@ def write_to_connections(pub: rospy.Publisher, data: bytes | bytearray) -> None:
                 sock.settimeout(SEND_TIMEOUT_S)
             sock.sendall(data)
         except (TransportTerminated, OSError) as err:  # socket.timeout is an OSError
+            if impl.closed:  # rospy closed every connection and cannot remove one any more
+                return
             if isinstance(err, (BrokenPipeError, ConnectionResetError)):
                 # The subscriber exited (traj_yaml.py at its end): routine, as in rospy.
                 rospy.logdebug(f'{pub.resolved_name}: subscriber {connection.endpoint_id} left')
