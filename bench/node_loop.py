@@ -12,14 +12,18 @@ import contextlib
 import os
 import sys
 import time
+from collections.abc import Iterator
 from pathlib import Path
-from types import SimpleNamespace
-from unittest import mock
+from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+# The fake rospy the unit tests use too: test/support, imported as `support`.
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / 'test'))
 
 import offline  # noqa: E402
 from offline import make_simulator  # noqa: E402
+
+from support import fake_rospy
 
 #: The node's law runs this long (s of sim time) before the bare physics is timed: past
 #: the 1 s torso pin, feet in contact, the robot standing.
@@ -62,119 +66,18 @@ def bare_physics_run(steps: int = 5000) -> float:
     return steps / elapsed_s
 
 
-class _NullSocket:
-    """A subscriber's socket that takes every byte with one write(2) to /dev/null."""
-
-    def __init__(self) -> None:
-        self.fd = os.open(os.devnull, os.O_WRONLY)
-
-    def gettimeout(self) -> float:
-        return 2.0
-
-    def sendall(self, data: bytes) -> None:
-        os.write(self.fd, data)
-
-    def close(self) -> None:
-        os.close(self.fd)
-
-
-#: The subscriber process of the TCP sinks: accepts connections, reads and discards.
-_DRAIN = """
-import selectors, socket
-server = socket.create_server(('127.0.0.1', 0))
-print(server.getsockname()[1], flush=True)
-selector = selectors.DefaultSelector()
-selector.register(server, selectors.EVENT_READ)
-while True:
-    for key, _ in selector.select():
-        if key.fileobj is server:
-            selector.register(server.accept()[0], selectors.EVENT_READ)
-        elif not key.fileobj.recv(1 << 20):
-            selector.unregister(key.fileobj)
-"""
-
-
-class _Sinks:
-    """Where the fake publishers' bytes go: /dev/null, or (tcp) one loopback TCP connection
-    per publisher to a draining subprocess, as to a recorder: then each write costs what it
-    costs the node, the send and the receiver's wake-up."""
-
-    def __init__(self, tcp: bool) -> None:
-        self.sockets: list = []
-        self.process = None
-        if tcp:
-            import subprocess
-
-            self.process = subprocess.Popen([sys.executable, '-c', _DRAIN],
-                                            stdout=subprocess.PIPE, text=True)
-            self.port = int(self.process.stdout.readline())
-
-    def new(self):  # noqa: ANN201 - a socket-like object
-        if self.process is None:
-            sock = _NullSocket()
-        else:
-            import socket
-
-            sock = socket.create_connection(('127.0.0.1', self.port))
-            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        self.sockets.append(sock)
-        return sock
-
-    def close(self) -> None:
-        for sock in self.sockets:
-            sock.close()
-        if self.process is not None:
-            self.process.kill()
-            self.process.wait()
-
-
-class _FakePublisher:
-    """rospy.Publisher as wire.py sees it: one subscriber connection."""
-
-    resolved_name = 'bench'
-
-    def __init__(self, sinks: _Sinks) -> None:
-        connection = SimpleNamespace(socket=sinks.new(), done=False, endpoint_id='bench')
-        self.impl = SimpleNamespace(connections=[connection])
-
-    def publish(self, *_args: object) -> None:
-        pass
-
-
 @contextlib.contextmanager
 def fake_ros_node(steps: int, warmup_steps: int = 1500, compiled_law: bool = True,
-                  tcp: bool = False):  # noqa: ANN201
-    """A real SimNode (real_time_factor 0, the launch's rates) on fake rospy, standing.
-
-    Each publisher has one subscriber (see _Sinks); rospy.is_shutdown() ends spin() after
-    `steps` steps.
-    """
-    from tutorial_atlas_control.node import sim_node
-
-    sinks = _Sinks(tcp)
+                  tcp: bool = False) -> Iterator[Any]:
+    """A real SimNode (real_time_factor 0, the launch's rates) on fake rospy, standing
+    (support.fake_rospy); rospy.is_shutdown() ends spin() after `steps` steps."""
     sim = make_simulator()
     if not compiled_law:
         sim._compiled_law = None
     for _ in range(warmup_steps):
         sim.step()
-    calls = {'left': steps}
-
-    def is_shutdown() -> bool:
-        calls['left'] -= 1
-        return calls['left'] < 0
-
-    params: dict[str, object] = {}
-    try:
-        with mock.patch.multiple(sim_node.rospy, Publisher=lambda *a, **k: _FakePublisher(sinks),
-                                 Subscriber=mock.DEFAULT, Service=mock.DEFAULT,
-                                 get_param=lambda name, default=None: params.get(name, default),
-                                 has_param=lambda name: name in params, is_shutdown=is_shutdown,
-                                 loginfo=mock.DEFAULT, logwarn=mock.DEFAULT):
-            yield sim_node.SimNode(sim, real_time_factor=0.0, paused=False,
-                                   rates_hz={'joint_states': 1000.0, 'odom': 100.0,
-                                             'imu': 1000.0, 'contact': 1000.0}, gui=False)
-    finally:
-        sinks.close()
+    with fake_rospy.fake_ros_node(sim, steps, tcp=tcp) as node:
+        yield node
 
 
 def node_spin_run(steps: int = 5000, warmup_steps: int = 1500, compiled_law: bool = True,

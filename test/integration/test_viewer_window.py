@@ -28,7 +28,7 @@ from support.xdisplay import display_env, find_window, material_mask, screenshot
 from tutorial_atlas_control.sim import model as atlas_model  # noqa: E402
 from tutorial_atlas_control.processes import (  # noqa: E402
     free_local_port, ros_environment, stop_tree)
-from tutorial_atlas_control.bags.render import configure_viewer_camera  # noqa: E402
+from tutorial_atlas_control.sim.camera import configure_viewer_camera  # noqa: E402
 
 #: A pixel is the material's colour when its r : g : b is this close (chromaticity distance).
 #: The blue (0.2, 0.3, 0.55) and the sky near the horizon (about 0.33, 0.43, 0.58) are 0.11

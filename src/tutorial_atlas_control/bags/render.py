@@ -24,6 +24,7 @@ import numpy as np
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.sim.camera import CAMERA
 from tutorial_atlas_control.units import finite_number
 
 if TYPE_CHECKING:  # pragma: no cover - typing only; mujoco is imported lazily
@@ -40,18 +41,13 @@ __all__ = [
     'StateRenderer',
     'VideoResult',
     'check_output_path',
-    'configure_viewer_camera',
-    'configure_viewer_scene',
     'parse_size',
     'prepare_gl',
     'render_bag_video',
     'render_states',
     'states_from_bag',
-    'viewer_view',
 ]
 
-#: The model's camera that follows the pelvis (sim/atlas_v1.xml).
-CAMERA = 'track'
 DEFAULT_FPS = 30.0
 DEFAULT_SIZE = (640, 480)
 #: Output formats by file suffix.
@@ -285,71 +281,6 @@ class StateRenderer:
         flags[mujoco.mjtRndFlag.mjRND_SHADOW] = False
         flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = False
         return renderer.render()
-
-
-@dataclass(frozen=True)
-class ViewerView:
-    """A MuJoCo free-camera view: distance (m), azimuth and elevation (degrees)."""
-
-    distance_m: float
-    azimuth_deg: float
-    elevation_deg: float
-
-
-def viewer_view(model: object, camera: str = CAMERA) -> ViewerView:
-    """The video camera's view as the interactive viewer's tracking camera sees it.
-
-    The model's `track` camera sits at a fixed offset from the pelvis and looks at it; the
-    viewer's camera looks at the pelvis from the same direction and distance, so the window
-    shows what the videos show, and the user can still turn and zoom it with the mouse.
-
-    Raises:
-        RenderError: the model has no such camera.
-    """
-    import mujoco
-
-    camera_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, camera)
-    if camera_id < 0:
-        raise RenderError(f'the model has no camera named {camera!r}.')
-    offset_m = np.asarray(model.cam_pos[camera_id], dtype=float)
-    rotation = np.zeros(9)
-    mujoco.mju_quat2Mat(rotation, model.cam_quat[camera_id])
-    forward = -rotation.reshape(3, 3)[:, 2]  # cameras look along their -z axis
-    return ViewerView(float(np.linalg.norm(offset_m)),
-                      float(np.degrees(np.arctan2(forward[1], forward[0]))),
-                      float(np.degrees(np.arcsin(np.clip(forward[2], -1.0, 1.0)))))
-
-
-def configure_viewer_camera(cam: object, model: object, data: object, camera: str = CAMERA) -> None:
-    """Point a viewer's MjvCamera at the robot: tracking the pelvis, from `camera`'s view.
-
-    `data` must hold the current kinematics (the tracked point is the pelvis subtree's
-    centre of mass).
-    """
-    import mujoco
-
-    view = viewer_view(model, camera)
-    body = int(model.cam_bodyid[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, camera)])
-    cam.type = mujoco.mjtCamera.mjCAMERA_TRACKING
-    cam.trackbodyid = body
-    cam.fixedcamid = -1
-    cam.distance = view.distance_m
-    cam.azimuth = view.azimuth_deg
-    cam.elevation = view.elevation_deg
-    cam.lookat[:] = data.subtree_com[body]
-
-
-def configure_viewer_scene(scene: object) -> None:
-    """The video's look in the viewer: no shadows, no reflections.
-
-    With software OpenGL (no GPU, Xvfb) they cost most of each frame, and the viewer's
-    render thread competes with the simulation for the CPU. The Rendering panel turns them
-    back on.
-    """
-    import mujoco
-
-    scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = False
-    scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = False
 
 
 def _frames(states: RunStates, width: int, height: int, progress: bool,

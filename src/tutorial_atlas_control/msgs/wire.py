@@ -1,4 +1,4 @@
-"""Pre-serialized ROS 1 messages for the simulator's 1 kHz topics, and a batching writer.
+"""Pre-serialized ROS 1 messages for the simulator's 1 kHz topics. No rospy.
 
 rospy's generic path costs the simulator most of each step: Publisher.publish() runs
 genpy's serializer into a BytesIO, then hands the bytes to one QueuedConnection per
@@ -7,10 +7,9 @@ connection's writer thread: 5 topics x 1 recorder = 5 thread handoffs per step.
 
 Here each message is a bytearray laid out once (TCPROS length prefix, std_msgs/Header,
 constant strings) whose float fields are numpy views, so a step only copies numbers in
-and stamps the header. WireBatch collects the bytes per publisher and writes each
-publisher's batch to its connections with one sendall (TCPROS is a byte stream: messages
-back to back are valid), on flush(). The layouts are checked against genpy in
-test/unit/test_wire.py.
+and stamps the header. The node sends these bytes itself (node/transport.py); offline runs
+write them, without the TCPROS length prefix, to a bag. The layouts are checked against
+genpy in test/unit/test_wire.py.
 """
 
 from __future__ import annotations
@@ -19,8 +18,6 @@ import struct
 from collections.abc import Sequence
 
 import numpy as np
-import rospy
-from rospy.impl.tcpros_base import TransportTerminated
 
 from tutorial_atlas_control.units import NS_PER_S
 
@@ -48,7 +45,7 @@ class StampedWire:
 
     def stamped(self, stamp_ns: int) -> bytearray:
         """The next message, stamped `stamp_ns`: the buffer itself, valid until the next
-        call (WireBatch.add copies it; a copy of 1 kB costs less than a new bytes object)."""
+        call (the node's batch copies it; a copy of 1 kB costs less than a new bytes object)."""
         self.seq += 1
         secs, nsecs = divmod(stamp_ns, NS_PER_S)
         _PREFIX_HEADER.pack_into(self.buf, 0, len(self.buf) - 4, self.seq, secs, nsecs)
@@ -170,77 +167,3 @@ def clock_bytes(stamp_ns: int) -> bytes:
     """rosgraph_msgs/Clock with its TCPROS length prefix."""
     secs, nsecs = divmod(stamp_ns, NS_PER_S)
     return _CLOCK.pack(8, secs, nsecs)
-
-
-#: A subscriber that accepts nothing for this long (s) is dropped rather than left to stall
-#: the simulation: sends are synchronous so that slow subscribers lose nothing.
-SEND_TIMEOUT_S = 2.0
-
-
-def write_to_connections(pub: rospy.Publisher, data: bytes | bytearray) -> None:
-    """Send already-serialized TCPROS bytes to every subscriber of `pub`.
-
-    The socket is written directly (rospy's write_data mis-handles a send timeout); a
-    subscriber that is gone, or accepts nothing for SEND_TIMEOUT_S, is dropped. Once rospy
-    has shut the publisher down (node shutdown, from another thread), nothing is sent.
-    """
-    impl = pub.impl
-    for connection in list(impl.connections):
-        sock = getattr(connection, 'socket', None)
-        try:
-            if sock is None or connection.done:
-                raise TransportTerminated('connection closed')
-            if sock.gettimeout() is None:
-                sock.settimeout(SEND_TIMEOUT_S)
-            sock.sendall(data)
-        except (TransportTerminated, OSError) as err:  # socket.timeout is an OSError
-            if impl.closed:  # rospy closed every connection and cannot remove one any more
-                return
-            if isinstance(err, (BrokenPipeError, ConnectionResetError)):
-                # The subscriber exited (traj_yaml.py at its end): routine, as in rospy.
-                rospy.logdebug(f'{pub.resolved_name}: subscriber {connection.endpoint_id} left')
-            elif not isinstance(err, TransportTerminated):
-                rospy.logwarn(f'{pub.resolved_name}: dropping subscriber '
-                              f'{connection.endpoint_id}: {err}')
-            impl.remove_connection(connection)
-            connection.close()
-
-
-def subscriber_names(pub: rospy.Publisher) -> set[str]:
-    """The nodes connected to `pub` now.
-
-    Count these, not get_num_connections(): when a subscriber connects twice at once
-    (rospy does, on two quick publisher updates), the publisher holds both connections for a
-    moment before dropping one, so a node counts twice and "the simulator and the recorder
-    are connected" can be true with only the simulator.
-    """
-    return {connection.endpoint_id for connection in list(pub.impl.connections)}
-
-
-class WireBatch:
-    """Per-publisher byte batches, written on flush() with one sendall per connection."""
-
-    def __init__(self) -> None:
-        self.pending: dict[rospy.Publisher, bytearray] = {}
-
-    @staticmethod
-    def wanted(pub: rospy.Publisher) -> bool:
-        """Anyone subscribed? (rospy skips serializing otherwise; so do we)."""
-        return bool(pub.impl.connections)
-
-    def add(self, pub: rospy.Publisher, data: bytes | bytearray) -> None:
-        """Append a copy of `data` (TCPROS-framed messages) to `pub`'s batch."""
-        batch = self.pending.get(pub)
-        if batch is None:
-            self.pending[pub] = bytearray(data)
-        else:
-            batch += data
-
-    def replace(self, pub: rospy.Publisher, data: bytes | bytearray) -> None:
-        """Queue `data` instead of anything still pending for `pub` (e.g. /clock)."""
-        self.pending[pub] = bytearray(data)
-
-    def flush(self) -> None:
-        pending, self.pending = self.pending, {}
-        for pub, data in pending.items():
-            write_to_connections(pub, data)

@@ -35,6 +35,7 @@ from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES
 from tutorial_atlas_control.trajectories.schedule import (
     done_line, playing_line, run_trajectory, trajectory_log_line)
 from tutorial_atlas_control.msgs.sim_messages import TCPROS_PREFIX_BYTES, SimMessages
+from tutorial_atlas_control.stepping.schedule import step_stamp, steps_between
 from tutorial_atlas_control.sim.simulator import (
     AtlasSimulator, ControlMode, PhysicsDivergenceError)
 from tutorial_atlas_control.trajectories.trajectory import (
@@ -149,7 +150,7 @@ class _OfflinePlayer:
         self.now_ns = np.empty(BLOCK_STEPS, dtype=np.int64)
         self.sensed_ns = np.empty(BLOCK_STEPS, dtype=np.int64)
         self.count = 0
-        self.odom_every = max(1, int(round(1.0 / (ODOM_RATE_HZ * sim.dt_s))))
+        self.odom_every = steps_between(ODOM_RATE_HZ, sim.dt_s)
         self.steps = 0
         self.next_clock_ns = 0
         self.decoder = CommandDecoder()
@@ -201,12 +202,13 @@ class _OfflinePlayer:
             velocity[:] = self.qvel[:count, atlas.dof_adr]
             effort[:] = self.torque[:count]
             now_ns, sensed_ns = self.now_ns[:count], self.sensed_ns[:count]
-            sink.write_rows(topics.JOINT_STATES, *self.joint_states.take(now_ns, now_ns))
+            sink.write_rows(topics.JOINT_STATES, *self.joint_states.take(
+                now_ns, step_stamp(topics.JOINT_STATES, now_ns, sensed_ns)))
             sensors = self.sensordata[:count]
             for topic, (block, name, (to, source)) in self.sensor_blocks.items():
                 floats = block.float_view(self.messages.float_offsets[name], max(to) + 1)
                 floats[:count, to] = sensors[:, source]
-                sink.write_rows(topic, *block.take(now_ns, sensed_ns))
+                sink.write_rows(topic, *block.take(now_ns, step_stamp(topic, now_ns, sensed_ns)))
         sink.write_rows(topics.GROUND_TRUTH_ODOM, *self.odometry.take())
         self.count = 0
         sink.flush()

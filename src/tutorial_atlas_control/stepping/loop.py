@@ -1,0 +1,339 @@
+"""The simulator node's stepping loop, without ROS.
+
+Each turn: merge the commands that arrived since the last step, step, serialize what is
+due into the outbox, decide whether to send it, and wait for wall time. The loop also owns
+what the node's services and viewer do to the simulator (resets, pause, control mode),
+under the lock that rospy's threads and the viewer's share with it.
+
+The node (node/sim_node.py) gives it an Outbox (rospy publishers behind
+transport.WireBatch), a LoopLog (rospy's log) and its shutdown test; tests give it fakes.
+"""
+
+from __future__ import annotations
+
+import collections
+import threading
+from collections.abc import Callable, Hashable, Mapping
+from typing import Protocol
+
+from tutorial_atlas_control import topics
+from tutorial_atlas_control.msgs.commands import CommandDecoder, CommandError
+from tutorial_atlas_control.msgs.ros1_fields import FieldCursor
+from tutorial_atlas_control.msgs.sim_messages import SimMessages
+from tutorial_atlas_control.msgs.wire import ControllerStatisticsWire, clock_bytes
+from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistics
+from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode, PhysicsDivergenceError
+from tutorial_atlas_control.stepping.pacing import Pacer
+from tutorial_atlas_control.stepping.schedule import STAMPED_AT_STEP_END, steps_between
+from tutorial_atlas_control.units import NS_PER_S
+
+__all__ = ['MAX_PENDING_COMMANDS', 'DivergenceGuard', 'LoopLog', 'Outbox', 'SteppingLoop']
+
+#: A divergence this soon (s of sim time) after the previous one's reset is "in a row";
+#: that many in a row means the model itself is unstable and the loop stops.
+DIVERGENCE_REPEAT_S = 1.0
+MAX_DIVERGENCES_IN_A_ROW = 3
+#: Commands waiting for the next step, at most (a second of 10 kHz of them).
+MAX_PENDING_COMMANDS = 10_000
+#: While paused, the loop looks for commands and shutdown this often (s, wall).
+PAUSED_POLL_S = 0.01
+#: The per-step messages: topic, key of its rate in `rates_hz`, name in
+#: SimMessages.step_wires.
+STEP_MESSAGES = (
+    (topics.JOINT_STATES, 'joint_states', 'joint_state'),
+    (topics.IMU, 'imu', 'imu'),
+    (topics.L_FOOT_CONTACT, 'contact', 'l'),
+    (topics.R_FOOT_CONTACT, 'contact', 'r'))
+
+
+class Outbox(Protocol):
+    """Where serialized messages go, by outlet (the node: its publishers, in a WireBatch)."""
+
+    def wanted(self, outlet: Hashable) -> bool:
+        """Anyone listening? The loop serializes nothing for an outlet without listeners."""
+
+    def add(self, outlet: Hashable, data: bytes | bytearray) -> None:
+        """Queue a copy of `data` (TCPROS-framed messages) after what is queued."""
+
+    def replace(self, outlet: Hashable, data: bytes | bytearray) -> None:
+        """Queue `data` instead of anything still queued for `outlet`."""
+
+    def flush(self) -> None:
+        """Send everything queued."""
+
+
+class LoopLog(Protocol):
+    """The loop's log lines (the node: rospy's log, which throttles refused commands)."""
+
+    def info(self, text: str) -> None: ...
+
+    def refused_command(self, text: str) -> None: ...
+
+    def error(self, text: str) -> None: ...
+
+    def fatal(self, text: str) -> None: ...
+
+
+class DivergenceGuard:
+    """Retry after a divergence (reset the robot), unless the model keeps diverging.
+
+    A divergence within DIVERGENCE_REPEAT_S of sim time after the previous one is "in a
+    row"; the MAX_DIVERGENCES_IN_A_ROW-th in a row stops the loop.
+    """
+
+    def __init__(self) -> None:
+        self.in_a_row = 0
+        self.last_ns: int | None = None
+
+    def retry(self, now_ns: int) -> bool:
+        """A divergence at sim time `now_ns`: True to reset and go on, False to stop."""
+        last_ns = self.last_ns
+        if last_ns is not None and 0 <= now_ns - last_ns <= DIVERGENCE_REPEAT_S * NS_PER_S:
+            self.in_a_row += 1
+        else:
+            self.in_a_row = 1
+        self.last_ns = now_ns
+        return self.in_a_row < MAX_DIVERGENCES_IN_A_ROW
+
+
+class SteppingLoop:
+    """Owns the simulator's lock, its pending commands and the stepping loop.
+
+    Args:
+        sim: the simulator.
+        outbox: where messages go.
+        outlets: topic -> outlet (key in the outbox) of each published topic; without
+            topics.TF, no /tf.
+        rates_hz: rate (Hz of sim time; 0 = every step) of 'joint_states', 'imu',
+            'contact' (both feet), 'odom' and, with a /tf outlet, 'tf'.
+        statistics: the command age statistics of /atlas/controller_statistics.
+        log: where log lines go.
+        publish_config: sends /atlas/sim_config's JSON (latched: not through the outbox).
+        real_time_factor: sim time per wall time; 0 = as fast as possible.
+        paused: start with physics paused.
+        pacer: the wall-time decisions (default: a Pacer at real_time_factor; tests give
+            one with a fake clock).
+    """
+
+    def __init__(self, sim: AtlasSimulator, outbox: Outbox, outlets: Mapping[str, Hashable],
+                 rates_hz: Mapping[str, float], statistics: CommandAgeStatistics,
+                 log: LoopLog, publish_config: Callable[[str], None],
+                 real_time_factor: float = 0.0, paused: bool = False,
+                 pacer: Pacer | None = None) -> None:
+        self.sim = sim
+        self.lock = threading.Lock()
+        self.outbox = outbox
+        self.log = log
+        self._send_config = publish_config
+        self.paused = paused
+        self.pacer = pacer if pacer is not None else Pacer(real_time_factor)
+        self.step_count = 0
+        self.exit_status = 0
+        self.divergences = DivergenceGuard()
+        self.every = {key: steps_between(rate, sim.dt_s) for key, rate in rates_hz.items()}
+
+        # What each message holds is sim_messages' (shared with offline runs).
+        self.messages = messages = SimMessages(sim)
+        # Those due at the same steps are filled by one plan (at the launch's rates, all).
+        due_together: dict[int, list[str]] = {}
+        for _, rate_key, name in STEP_MESSAGES:
+            due_together.setdefault(self.every[rate_key], []).append(name)
+        self.fill_plans = tuple((every, messages.fill_plan(names))
+                                for every, names in due_together.items())
+        # (every how many steps, wire message, outlet, stamped at the step's end).
+        self.step_wires = tuple(
+            (self.every[rate_key], messages.step_wires[name], outlets[topic],
+             topic in STAMPED_AT_STEP_END)
+            for topic, rate_key, name in STEP_MESSAGES)
+        self.clock_outlet = outlets[topics.CLOCK]
+        self.odom_outlet = outlets[topics.GROUND_TRUTH_ODOM]
+        self.tf_outlet = outlets.get(topics.TF)
+
+        # /atlas/controller_statistics, fed and published only while someone listens.
+        self.statistics = statistics
+        self.statistics_msg = ControllerStatisticsWire()
+        self.statistics_outlet = outlets[topics.CONTROLLER_STATISTICS]
+
+        # Commands wait here, undecoded, for the loop (see receive_command). Bounded, so
+        # that a stalled loop cannot make it grow without limit; emptied every step.
+        self.decoder = CommandDecoder()
+        self.pending_commands: collections.deque[bytes] = collections.deque(
+            maxlen=MAX_PENDING_COMMANDS)
+
+    @property
+    def real_time_factor(self) -> float:
+        """Sim time per wall time (the pacer's); 0 = as fast as possible."""
+        return self.pacer.real_time_factor
+
+    # -- inputs, from other threads ------------------------------------------------------
+    def receive_command(self, raw: bytes) -> None:
+        """Queue a serialized osrf_msgs/JointCommands for the next step, undecoded.
+
+        Nothing else happens in the receiving thread: decoding there would make several
+        fast publishers' threads and the loop fight over the GIL.
+        """
+        self.pending_commands.append(raw)
+
+    def apply_pending_commands(self) -> None:
+        """Decode, check and merge the commands received since the last step, in order.
+
+        Newest first: a valid command for every field of every joint overwrites all that
+        came before it, so the older ones in this step are dropped undecoded (DRCSim, too,
+        applied only the latest command at each step). Controllers send such complete
+        commands, so a flood costs one decode per step, not one per message.
+        """
+        pending = self.pending_commands
+        raws = []
+        while pending:
+            raws.append(pending.popleft())
+        updates = []
+        for raw in reversed(raws):
+            try:
+                update = self.decoder.decode(raw)
+            except CommandError as err:
+                self.log.refused_command(
+                    f'refused /atlas/joint_commands: {err}; previous command kept')
+                continue
+            if not updates:
+                self._note_command_stamp(raw)  # the newest applied command
+            updates.append(update)
+            if update.is_complete:
+                break
+        if not updates:
+            return
+        updates.reverse()
+        first = self.sim.user_command is None
+        self.sim.receive_updates(updates)
+        if first:
+            # Which command a trajectory started from: a late one makes the robot jump.
+            self.log.info(f'first /atlas/joint_commands since the start or last reset, at '
+                          f't={self.sim.sim_time_ns / NS_PER_S:.3f} s '
+                          f'({self.sim.mode.value} mode)')
+
+    def set_mode(self, mode: ControlMode) -> ControlMode:
+        """Switch the control mode; returns the previous one."""
+        with self.lock:
+            previous = self.sim.mode
+            self.sim.set_mode(mode)
+        return previous
+
+    def publish_config(self) -> None:
+        """(Re-)publish /atlas/sim_config: at start and after every reset."""
+        self._send_config(self.sim.config().to_json())
+
+    def reset_world(self) -> None:
+        with self.lock:
+            self.sim.reset_world()
+        self.publish_config()
+        self.log.info('reset_world: robot back to its initial pose (torso pinned '
+                      f'for {self.sim.time_to_unpin_s} s)')
+
+    def reset_simulation(self) -> None:
+        with self.lock:
+            self.sim.reset_simulation()
+            self.statistics.forget_command()  # its stamp lies in the rewound future
+        self.publish_config()
+        self.log.info('reset_simulation: robot reset and sim time back to 0')
+
+    def pause(self) -> None:
+        self.paused = True
+        self.log.info('physics paused')
+
+    def unpause(self) -> None:
+        self.paused = False
+        self.log.info('physics unpaused')
+
+    # -- publishing ----------------------------------------------------------------------
+    def publish(self) -> None:
+        """Serialize what is due this step into the outbox (called under the lock)."""
+        sim = self.sim
+        now_ns = sim.sim_time_ns
+        outbox = self.outbox
+        wanted = outbox.wanted
+        if wanted(self.clock_outlet):
+            # Only the latest time goes out per flush: every step when paced, about one
+            # per FLUSH_PERIOD_S of wall time at real_time_factor 0 (what a sim-time timer
+            # sees at real time); spares the recorder one message in five.
+            outbox.replace(self.clock_outlet, clock_bytes(now_ns))
+        count = self.step_count
+        for every, plan in self.fill_plans:
+            if count % every == 0:
+                plan()
+        # Poses and sensors describe the state at the start of the last step (schedule.py).
+        sensed_ns = sim.state_time_ns
+        for every, message, outlet, at_end in self.step_wires:
+            if count % every == 0 and wanted(outlet):
+                outbox.add(outlet, message.stamped(now_ns if at_end else sensed_ns))
+        messages = self.messages
+        if count % self.every['odom'] == 0 and wanted(self.odom_outlet):
+            outbox.add(self.odom_outlet, messages.odometry(sensed_ns))
+        tf_outlet = self.tf_outlet
+        if tf_outlet is not None and count % self.every['tf'] == 0 and wanted(tf_outlet):
+            outbox.add(tf_outlet, messages.pelvis_tf(sensed_ns))
+
+    def _note_command_stamp(self, raw: bytes) -> None:
+        """The command in `raw` is applied from the coming step on: remember its stamp."""
+        self.statistics.command_applied(FieldCursor(raw).header_stamp_ns(),
+                                        self.sim.sim_time_ns + self.sim.step_ns)
+
+    def _publish_controller_statistics(self, now_ns: int) -> None:
+        """After each step: the command age at `now_ns`, into the window and, when due, out."""
+        if not self.outbox.wanted(self.statistics_outlet):
+            return
+        stats = self.statistics
+        stats.update(now_ns)
+        if stats.publication_due(now_ns):
+            self.statistics_msg.set_values(stats.age_s, stats.mean_s, stats.variance_s2,
+                                           stats.window_s)
+            self.outbox.add(self.statistics_outlet, self.statistics_msg.stamped(now_ns))
+
+    # -- the loop ------------------------------------------------------------------------
+    def run(self, is_shutdown: Callable[[], bool]) -> int:
+        """Step, publish and pace against wall time until `is_shutdown()`; the exit status
+        (1: stopped because the physics kept diverging)."""
+        sim, lock, outbox, pacer = self.sim, self.lock, self.outbox, self.pacer
+        paced = pacer.real_time_factor > 0.0  # else there is nothing to wait for
+        pacer.restart(sim.sim_time_ns)
+        with lock:
+            self.publish()  # /clock and the initial state before the first step
+        outbox.flush()
+        pacer.flushed()
+        while not is_shutdown():
+            if self.paused:
+                with lock:
+                    self.apply_pending_commands()
+                outbox.flush()
+                pacer.sleep(PAUSED_POLL_S)
+                pacer.restart(sim.sim_time_ns)
+                continue
+            with lock:
+                self.apply_pending_commands()
+                try:
+                    sim.step()
+                except PhysicsDivergenceError as err:
+                    if not self._recover(err):
+                        break
+                self.step_count += 1
+                self.publish()
+                self._publish_controller_statistics(sim.sim_time_ns)
+                sim_ns = sim.sim_time_ns
+            # Send outside the lock, in batches when allowed (pacing.py): TCPROS is a byte
+            # stream, one sendall carries many messages.
+            if pacer.flush_due(sim_ns):
+                outbox.flush()
+            if paced:
+                pacer.wait(sim_ns)
+        return self.exit_status
+
+    def _recover(self, err: PhysicsDivergenceError) -> bool:
+        """Log a divergence and reset the robot; False (stop) when the model keeps diverging."""
+        if not self.divergences.retry(self.sim.sim_time_ns):
+            self.log.fatal(f'{err}: {MAX_DIVERGENCES_IN_A_ROW} times in a row, each within '
+                           f'{DIVERGENCE_REPEAT_S} s of the reset; the model '
+                           f'{self.sim.atlas_path} is unstable; stopping the simulator')
+            self.exit_status = 1
+            return False
+        self.log.error(f'{err}; resetting the robot to its initial state')
+        self.sim.reset_world()
+        self.publish_config()
+        return True

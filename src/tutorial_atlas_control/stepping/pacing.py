@@ -1,0 +1,84 @@
+"""When the stepping loop sends what it published, and how long it waits for wall time.
+
+Sending is a syscall per topic and subscriber and a wake-up of each subscriber, so the
+loop sends in batches whenever being on time allows: at real_time_factor 0 every
+FLUSH_PERIOD_S of wall time; paced, after every step while on schedule, and every
+CATCH_UP_FLUSH_PERIOD_S while catching up. The clock and the sleep are parameters, so that
+tests can drive the decisions with a fake clock.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+from tutorial_atlas_control.units import NS_PER_S
+
+__all__ = ['CATCH_UP_FLUSH_PERIOD_S', 'CATCH_UP_LAG_S', 'FLUSH_PERIOD_S', 'MAX_LAG_S', 'Pacer']
+
+#: When the loop falls further behind wall time than this, it stops trying to catch up.
+#: Below it, the loop runs flat out (sending in batches) until it is back on schedule,
+#: so a loaded machine's short stalls cost no sim time.
+MAX_LAG_S = 1.0
+#: At real_time_factor 0 the loop sends what it published at most this often (s, wall);
+#: paced runs send after every step while on schedule. At this period the sends cost a
+#: fraction of a physics step, and /clock still advances 250 times a wall second.
+FLUSH_PERIOD_S = 0.004
+#: A paced run more than CATCH_UP_LAG_S behind wall time sends at most every
+#: CATCH_UP_FLUSH_PERIOD_S (s, wall) until it has caught up: on a loaded machine the
+#: syscalls of sending every step are what keeps it behind.
+CATCH_UP_LAG_S = 0.005
+CATCH_UP_FLUSH_PERIOD_S = 0.004
+
+
+class Pacer:
+    """Sim time against wall time: flush decisions and the wait after each step.
+
+    `restart` sets the reference: sim time `sim_ns` is due now; at real_time_factor r,
+    sim time sim_ns + d is due d / r later.
+    """
+
+    def __init__(self, real_time_factor: float,
+                 clock: Callable[[], float] = time.perf_counter,
+                 sleep: Callable[[float], None] = time.sleep) -> None:
+        self.real_time_factor = real_time_factor
+        self.clock = clock
+        self.sleep = sleep
+        self.wall0_s = clock()
+        self.sim0_ns = 0
+        self.last_flush_s = self.wall0_s
+
+    def restart(self, sim_ns: int) -> None:
+        """Sim time `sim_ns` is due now: after a pause, a rewind, or too large a lag."""
+        self.wall0_s, self.sim0_ns = self.clock(), sim_ns
+
+    def flushed(self) -> None:
+        """The loop has just sent everything (outside flush_due)."""
+        self.last_flush_s = self.clock()
+
+    def due_s(self, sim_ns: int) -> float:
+        """The wall time (clock's seconds) at which sim time `sim_ns` is due (paced only)."""
+        return self.wall0_s + (sim_ns - self.sim0_ns) / NS_PER_S / self.real_time_factor
+
+    def flush_due(self, sim_ns: int) -> bool:
+        """After a step that ended at `sim_ns`: send now? (True counts as sent.)"""
+        if sim_ns < self.sim0_ns:  # reset_simulation rewound time
+            self.restart(sim_ns)
+        now_s = self.clock()
+        if self.real_time_factor > 0.0:
+            flush = (now_s - self.due_s(sim_ns) < CATCH_UP_LAG_S
+                     or now_s - self.last_flush_s >= CATCH_UP_FLUSH_PERIOD_S)
+        else:
+            flush = now_s - self.last_flush_s >= FLUSH_PERIOD_S
+        if flush:
+            self.last_flush_s = now_s
+        return flush
+
+    def wait(self, sim_ns: int) -> None:
+        """Sleep until sim time `sim_ns` is due; give up catching up beyond MAX_LAG_S."""
+        if self.real_time_factor > 0.0:
+            ahead_s = self.due_s(sim_ns) - self.clock()
+            if ahead_s > 0.0:
+                self.sleep(ahead_s)
+            elif ahead_s < -MAX_LAG_S:
+                self.restart(sim_ns)

@@ -1,0 +1,401 @@
+"""The node's stepping loop without ROS: what is due when, stamps, pacing and flushes,
+command merging, divergence retries. A fake outbox stands for the publishers."""
+
+from __future__ import annotations
+
+import struct
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tutorial_atlas_control import topics
+from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.msgs.commands import FIELD_NAMES
+from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.sim.controller import load_gains_yaml
+from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistics
+from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode, PhysicsDivergenceError
+from tutorial_atlas_control.stepping import pacing
+from tutorial_atlas_control.stepping.loop import (
+    DIVERGENCE_REPEAT_S,
+    MAX_DIVERGENCES_IN_A_ROW,
+    PAUSED_POLL_S,
+    DivergenceGuard,
+    SteppingLoop,
+)
+from tutorial_atlas_control.stepping.pacing import Pacer
+from tutorial_atlas_control.stepping.schedule import step_stamp, steps_between
+from tutorial_atlas_control.units import NS_PER_S
+
+CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
+#: One outlet per topic the loop publishes; the outlet is the topic's name.
+ALL_TOPICS = (topics.CLOCK, topics.JOINT_STATES, topics.IMU, topics.L_FOOT_CONTACT,
+              topics.R_FOOT_CONTACT, topics.GROUND_TRUTH_ODOM, topics.TF,
+              topics.CONTROLLER_STATISTICS)
+LAUNCH_RATES_HZ = {'joint_states': 1000.0, 'odom': 100.0, 'imu': 1000.0, 'contact': 1000.0,
+                   'tf': 100.0}
+
+
+class FakeOutbox:
+    """Records what the loop queues and sends; `listeners` are the outlets wanted."""
+
+    def __init__(self, listeners: set[str]) -> None:
+        self.listeners = listeners
+        self.pending: dict[str, list[bytes]] = {}
+        self.sent: dict[str, list[bytes]] = {}
+        self.flushes = 0
+
+    def wanted(self, outlet: str) -> bool:
+        return outlet in self.listeners
+
+    def add(self, outlet: str, data: bytes | bytearray) -> None:
+        self.pending.setdefault(outlet, []).append(bytes(data))
+
+    def replace(self, outlet: str, data: bytes | bytearray) -> None:
+        self.pending[outlet] = [bytes(data)]
+
+    def flush(self) -> None:
+        for outlet, messages in self.pending.items():
+            self.sent.setdefault(outlet, []).extend(messages)
+        self.pending = {}
+        self.flushes += 1
+
+    def queued(self) -> dict[str, list[bytes]]:
+        """Everything the loop queued: sent, then still pending (the loop does not flush
+        at shutdown)."""
+        return {outlet: self.sent.get(outlet, []) + self.pending.get(outlet, [])
+                for outlet in {*self.sent, *self.pending}}
+
+
+class FakeLog:
+    def __init__(self) -> None:
+        self.lines: list[tuple[str, str]] = []
+
+    def info(self, text: str) -> None:
+        self.lines.append(('info', text))
+
+    def refused_command(self, text: str) -> None:
+        self.lines.append(('refused', text))
+
+    def error(self, text: str) -> None:
+        self.lines.append(('error', text))
+
+    def fatal(self, text: str) -> None:
+        self.lines.append(('fatal', text))
+
+    def of(self, level: str) -> list[str]:
+        return [text for kind, text in self.lines if kind == level]
+
+
+class FakeClock:
+    """Wall time that moves only when told to, or when the loop sleeps."""
+
+    def __init__(self) -> None:
+        self.now_s = 100.0
+        self.slept_s: list[float] = []
+
+    def __call__(self) -> float:
+        return self.now_s
+
+    def sleep(self, duration_s: float) -> None:
+        self.slept_s.append(duration_s)
+        self.now_s += duration_s
+
+
+@pytest.fixture(scope='module')
+def atlas() -> atlas_model.AtlasModel:
+    return atlas_model.load_model()
+
+
+@pytest.fixture
+def sim(atlas: atlas_model.AtlasModel) -> AtlasSimulator:
+    return AtlasSimulator(atlas, load_gains_yaml(CONFIG))
+
+
+def make_loop(sim: AtlasSimulator, listeners: set[str] | None = None,
+              rates_hz: dict[str, float] | None = None, paused: bool = False,
+              real_time_factor: float = 0.0) -> tuple[SteppingLoop, FakeOutbox, FakeLog,
+                                                       list[str]]:
+    outbox = FakeOutbox(set(ALL_TOPICS) if listeners is None else listeners)
+    log = FakeLog()
+    configs: list[str] = []
+    clock = FakeClock()
+    loop = SteppingLoop(sim, outbox, {topic: topic for topic in ALL_TOPICS},
+                        rates_hz or LAUNCH_RATES_HZ, CommandAgeStatistics(sim.dt_s), log,
+                        configs.append, real_time_factor=real_time_factor, paused=paused,
+                        pacer=Pacer(real_time_factor, clock, clock.sleep))
+    return loop, outbox, log, configs
+
+
+def stops_after(steps: int):
+    left = {'turns': steps}
+
+    def is_shutdown() -> bool:
+        left['turns'] -= 1
+        return left['turns'] < 0
+    return is_shutdown
+
+
+def header_stamp_ns(data: bytes) -> int:
+    """The header stamp of a TCPROS-framed message that starts with std_msgs/Header."""
+    _, _, secs, nsecs = struct.unpack_from('<IIII', data)
+    return secs * NS_PER_S + nsecs
+
+
+def clock_ns(data: bytes) -> int:
+    _, secs, nsecs = struct.unpack_from('<III', data)
+    return secs * NS_PER_S + nsecs
+
+
+def command_bytes(names: list[str], stamp_ns: int = 0, **arrays: list[float]) -> bytes:
+    """An osrf_msgs/JointCommands as rospy hands it over (no TCPROS length prefix)."""
+    def string(text: str) -> bytes:
+        return struct.pack('<I', len(text)) + text.encode()
+    secs, nsecs = divmod(stamp_ns, NS_PER_S)
+    raw = struct.pack('<III', 0, secs, nsecs) + string('')
+    raw += struct.pack('<I', len(names)) + b''.join(string(name) for name in names)
+    for field in FIELD_NAMES:
+        values = arrays.get(field, [])
+        raw += struct.pack(f'<I{len(values)}d', len(values), *values)
+    return raw
+
+
+def complete_command(position_rad: float, stamp_ns: int = 0) -> bytes:
+    arrays = {field: [0.0] * NUM_JOINTS for field in FIELD_NAMES}
+    arrays['position'] = [position_rad] * NUM_JOINTS
+    return command_bytes(list(JOINT_NAMES), stamp_ns, **arrays)
+
+
+# -- schedule ---------------------------------------------------------------------------
+
+@pytest.mark.parametrize(('rate_hz', 'every'), [
+    (0.0, 1), (1000.0, 1), (5000.0, 1), (500.0, 2), (333.0, 3), (100.0, 10), (1.0, 1000)])
+def test_steps_between_at_a_1_ms_step(rate_hz: float, every: int) -> None:
+    assert steps_between(rate_hz, 0.001) == every
+
+
+def test_joint_states_carry_the_step_end_poses_and_sensors_its_start() -> None:
+    assert step_stamp(topics.JOINT_STATES, 2_000_000, 1_000_000) == 2_000_000
+    for topic in (topics.IMU, topics.L_FOOT_CONTACT, topics.R_FOOT_CONTACT,
+                  topics.GROUND_TRUTH_ODOM, topics.TF):
+        assert step_stamp(topic, 2_000_000, 1_000_000) == 1_000_000
+    ends, starts = np.array([2, 3]), np.array([1, 2])
+    assert step_stamp(topics.JOINT_STATES, ends, starts) is ends
+
+
+# -- what is due, and its stamps ---------------------------------------------------------
+
+def test_each_topic_is_published_at_its_rate(sim: AtlasSimulator) -> None:
+    rates = {'joint_states': 1000.0, 'imu': 500.0, 'contact': 250.0, 'odom': 100.0,
+             'tf': 50.0}
+    loop, outbox, _, _ = make_loop(sim, rates_hz=rates)
+    assert loop.run(stops_after(40)) == 0
+    queued = outbox.queued()
+    # The initial publication (step count 0) and then one every N of the 40 steps.
+    assert {topic: len(queued[topic]) for topic in ALL_TOPICS if topic != topics.CLOCK} == {
+        topics.JOINT_STATES: 41, topics.IMU: 21, topics.L_FOOT_CONTACT: 11,
+        topics.R_FOOT_CONTACT: 11, topics.GROUND_TRUTH_ODOM: 5, topics.TF: 3,
+        topics.CONTROLLER_STATISTICS: 40}
+    # /clock: only the latest time of each flush (the wall clock stands still here: only
+    # the initial one), and the last one is the run's end.
+    assert len(queued[topics.CLOCK]) == outbox.flushes + 1
+    assert clock_ns(queued[topics.CLOCK][-1]) == 40 * sim.step_ns
+
+
+def test_stamps_follow_the_schedule_rule(sim: AtlasSimulator) -> None:
+    loop, outbox, _, _ = make_loop(sim)
+    loop.run(stops_after(3))
+    queued = outbox.queued()
+    step_ns = sim.step_ns
+    ends = [k * step_ns for k in range(4)]
+    # Poses and sensors carry the state's time: the start of the step (the initial
+    # publication describes the state at 0).
+    starts = [0, 0, step_ns, 2 * step_ns]
+    assert [header_stamp_ns(m) for m in queued[topics.JOINT_STATES]] == ends
+    assert [header_stamp_ns(m) for m in queued[topics.IMU]] == starts
+    assert [header_stamp_ns(m) for m in queued[topics.L_FOOT_CONTACT]] == starts
+
+
+def test_nothing_is_serialized_for_topics_without_listeners(sim: AtlasSimulator) -> None:
+    loop, outbox, _, _ = make_loop(sim, listeners={topics.JOINT_STATES})
+    loop.run(stops_after(20))
+    assert set(outbox.queued()) == {topics.JOINT_STATES}
+    assert loop.statistics.age_ns == 0  # not even fed
+
+
+def test_without_a_tf_outlet_there_is_no_tf(sim: AtlasSimulator) -> None:
+    outbox = FakeOutbox(set(ALL_TOPICS))
+    outlets = {topic: topic for topic in ALL_TOPICS if topic != topics.TF}
+    loop = SteppingLoop(sim, outbox, outlets, LAUNCH_RATES_HZ, CommandAgeStatistics(sim.dt_s),
+                        FakeLog(), lambda _text: None)
+    loop.run(stops_after(20))
+    queued = outbox.queued()
+    assert topics.TF not in queued
+    assert len(queued[topics.GROUND_TRUTH_ODOM]) == 3
+
+
+# -- commands ------------------------------------------------------------------------------
+
+def test_commands_between_steps_merge_oldest_first(sim: AtlasSimulator) -> None:
+    loop, _, log, _ = make_loop(sim)
+    loop.receive_command(complete_command(0.1))
+    loop.receive_command(command_bytes(['neck_ay'], position=[0.3]))
+    loop.receive_command(command_bytes(['neck_ay', 'back_lbz'], position=[0.2, 0.4]))
+    loop.apply_pending_commands()
+    position = sim.user_command.position
+    assert position[JOINT_INDEX['neck_ay']] == 0.2  # the newest of the two partial ones
+    assert position[JOINT_INDEX['back_lbz']] == 0.4
+    assert position[JOINT_INDEX['l_leg_kny']] == 0.1  # the complete one underneath
+    assert log.of('info') == [
+        'first /atlas/joint_commands since the start or last reset, at t=0.000 s (Stand mode)']
+    assert not loop.pending_commands
+
+
+def test_a_complete_command_hides_older_ones_undecoded(sim: AtlasSimulator) -> None:
+    loop, _, log, _ = make_loop(sim)
+    loop.receive_command(b'not a command')  # older: never decoded, so never refused
+    loop.receive_command(command_bytes(['neck_ay'], position=[0.3]))
+    loop.receive_command(complete_command(0.1, stamp_ns=7 * NS_PER_S))
+    loop.apply_pending_commands()
+    np.testing.assert_array_equal(sim.user_command.position, [0.1] * NUM_JOINTS)
+    assert log.of('refused') == []
+    assert loop.statistics.command_stamp_ns == 7 * NS_PER_S  # the newest applied
+
+
+def test_a_refused_command_keeps_the_previous_one(sim: AtlasSimulator) -> None:
+    loop, _, log, _ = make_loop(sim)
+    loop.receive_command(complete_command(0.1, stamp_ns=3 * NS_PER_S))
+    loop.receive_command(command_bytes(['neck_ay'], kd_position=[1e12], stamp_ns=4 * NS_PER_S))
+    loop.apply_pending_commands()
+    np.testing.assert_array_equal(sim.user_command.position, [0.1] * NUM_JOINTS)
+    assert len(log.of('refused')) == 1
+    assert log.of('refused')[0].startswith('refused /atlas/joint_commands: kd_position[0]')
+    assert loop.statistics.command_stamp_ns == 3 * NS_PER_S
+
+
+def test_commands_are_applied_while_paused_without_stepping(sim: AtlasSimulator) -> None:
+    loop, outbox, _, _ = make_loop(sim, paused=True)
+    loop.receive_command(complete_command(0.1))
+    loop.run(stops_after(3))
+    assert sim.sim_time_ns == 0 and loop.step_count == 0
+    np.testing.assert_array_equal(sim.user_command.position, [0.1] * NUM_JOINTS)
+    assert len(outbox.queued()[topics.JOINT_STATES]) == 1  # the initial state only
+    assert loop.pacer.clock.slept_s == [PAUSED_POLL_S] * 3
+
+
+# -- services ------------------------------------------------------------------------------
+
+def test_resets_republish_the_config_and_set_mode_returns_the_previous(
+        sim: AtlasSimulator) -> None:
+    loop, _, log, configs = make_loop(sim)
+    loop.run(stops_after(5))
+    assert loop.set_mode(ControlMode.USER) is ControlMode.STAND
+    loop.reset_world()
+    assert sim.sim_time_ns == 5 * sim.step_ns  # sim time kept
+    loop.reset_simulation()
+    assert sim.sim_time_ns == 0
+    assert len(configs) == 2
+    assert log.of('info')[-1] == 'reset_simulation: robot reset and sim time back to 0'
+
+
+# -- pacing --------------------------------------------------------------------------------
+
+def test_unpaced_runs_flush_every_flush_period() -> None:
+    clock = FakeClock()
+    pacer = Pacer(0.0, clock, clock.sleep)
+    pacer.restart(0)
+    pacer.flushed()
+    decisions = []
+    for step in range(1, 11):
+        clock.now_s += 1 / 1024  # a step takes just under 1 ms (exact in binary)
+        decisions.append(pacer.flush_due(step * 1_000_000))
+        pacer.wait(step * 1_000_000)
+    assert pacing.FLUSH_PERIOD_S == 0.004
+    assert decisions == [False, False, False, False, True, False, False, False, False, True]
+    assert clock.slept_s == []
+
+
+def test_paced_runs_flush_every_step_on_time_and_sleep_until_due() -> None:
+    clock = FakeClock()
+    pacer = Pacer(0.5, clock, clock.sleep)  # half real time: 1 ms of sim in 2 ms of wall
+    pacer.restart(0)
+    pacer.flushed()
+    clock.now_s += 0.0005  # the step took 0.5 ms
+    assert pacer.flush_due(1_000_000)
+    pacer.wait(1_000_000)
+    assert clock.slept_s == [pytest.approx(0.0015)]
+
+
+def test_a_lagging_paced_run_flushes_less_until_it_has_caught_up() -> None:
+    clock = FakeClock()
+    pacer = Pacer(1.0, clock, clock.sleep)
+    pacer.restart(0)
+    pacer.flushed()
+    clock.now_s += 0.125  # a stall: 125 ms behind after the first step
+    decisions = []
+    for step in range(1, 8):
+        decisions.append(pacer.flush_due(step * 1_000_000))
+        pacer.wait(step * 1_000_000)
+        clock.now_s += 1 / 256  # each step takes just under 4 ms: it stays behind
+    assert decisions == [True, False, True, False, True, False, True]
+    assert clock.slept_s == []  # still behind: no sleep
+
+
+def test_a_run_too_far_behind_gives_up_catching_up() -> None:
+    clock = FakeClock()
+    pacer = Pacer(1.0, clock, clock.sleep)
+    pacer.restart(0)
+    clock.now_s += pacing.MAX_LAG_S + 0.5
+    pacer.wait(1_000_000)
+    assert clock.slept_s == []
+    # Rescheduled: the next step is due a step of sim time from now.
+    pacer.wait(2_000_000)
+    assert clock.slept_s == [pytest.approx(0.001)]
+
+
+def test_a_rewind_restarts_the_schedule() -> None:
+    clock = FakeClock()
+    pacer = Pacer(1.0, clock, clock.sleep)
+    pacer.restart(5 * NS_PER_S)
+    pacer.flush_due(1_000_000)  # reset_simulation: sim time back near 0
+    assert pacer.sim0_ns == 1_000_000
+    pacer.wait(2_000_000)
+    assert clock.slept_s == [pytest.approx(0.001)]
+
+
+# -- divergence ------------------------------------------------------------------------------
+
+def test_divergences_in_a_row_stop_spaced_ones_do_not() -> None:
+    guard = DivergenceGuard()
+    repeat_ns = int(DIVERGENCE_REPEAT_S * NS_PER_S)
+    assert guard.retry(10 * NS_PER_S)
+    assert guard.retry(10 * NS_PER_S + repeat_ns + 1)  # too late to be "in a row"
+    assert guard.retry(10 * NS_PER_S + 2 * repeat_ns)  # 2nd in a row
+    assert MAX_DIVERGENCES_IN_A_ROW == 3
+    assert not guard.retry(10 * NS_PER_S + 2 * repeat_ns + 1)  # 3rd in a row: stop
+
+
+def test_a_rewind_between_divergences_does_not_count_as_in_a_row() -> None:
+    guard = DivergenceGuard()
+    assert guard.retry(5 * NS_PER_S)
+    assert guard.retry(5 * NS_PER_S)
+    assert guard.retry(1_000_000)  # reset_simulation rewound: 1st again
+    assert guard.in_a_row == 1
+
+
+def test_a_model_that_keeps_diverging_stops_the_loop(sim: AtlasSimulator,
+                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    loop, _, log, configs = make_loop(sim)
+
+    def diverge() -> None:
+        raise PhysicsDivergenceError('physics diverged at t=0.001 s')
+    monkeypatch.setattr(sim, 'step', diverge)
+    assert loop.run(stops_after(100)) == 1
+    assert loop.exit_status == 1
+    assert len(log.of('error')) == MAX_DIVERGENCES_IN_A_ROW - 1
+    assert len(configs) == MAX_DIVERGENCES_IN_A_ROW - 1  # re-published after each reset
+    assert log.of('fatal') == [
+        f'physics diverged at t=0.001 s: 3 times in a row, each within 1.0 s of the reset; '
+        f'the model {sim.atlas_path} is unstable; stopping the simulator']
+    assert loop.step_count == MAX_DIVERGENCES_IN_A_ROW - 1
