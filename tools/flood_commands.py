@@ -85,7 +85,7 @@ def bad_commands() -> list[JointCommands]:
 
 
 class Preserialized(genpy.Message):
-    """A message serialized once and sent as is: a flood costs the sender ~10x less.
+    """A message serialized once and sent as is: a flood costs the sender no serialization.
 
     Keeps the real type and MD5, so subscribers see an ordinary osrf_msgs/JointCommands
     (only the header's seq and stamp are frozen).

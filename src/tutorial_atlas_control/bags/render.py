@@ -236,7 +236,7 @@ class StateRenderer:
         # Our own offscreen buffer limits: a request larger than the file's is fine.
         model.vis.global_.offwidth = max(int(model.vis.global_.offwidth), width)
         model.vis.global_.offheight = max(int(model.vis.global_.offheight), height)
-        model.vis.quality.offsamples = 0  # no multisampling: 2x faster in OSMesa
+        model.vis.quality.offsamples = 0  # no multisampling: much faster in OSMesa
         if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, camera) < 0:
             raise RenderError(f'the model has no camera named {camera!r}.')
         self.camera = camera

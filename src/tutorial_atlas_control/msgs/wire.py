@@ -112,7 +112,7 @@ class ControllerStatisticsWire(StampedWire):
 
     def set_values(self, age_s: float, mean_s: float, variance_s2: float,
                    window_s: float) -> None:
-        """The four values at once (one pack, where a numpy assignment costs a microsecond)."""
+        """The four values at once (one struct pack, cheaper than four numpy assignments)."""
         self._VALUES.pack_into(self.buf, self._values_at, age_s, mean_s, variance_s2, window_s)
 
 

@@ -157,7 +157,7 @@ class ViewerLink:
         return bool(self.handle.is_running())
 
     def copy_in(self, data: mujoco.MjData) -> None:
-        """Refresh the shadow from the physics data (under the node's lock; ~10 us)."""
+        """Refresh the shadow from the physics data (under the node's lock, so kept short)."""
         mujoco.mj_copyData(self.shadow, self.model, data)
         self.shadow.qacc_warmstart[:] = RESET_CANARY
 

@@ -30,7 +30,7 @@ DEFAULT_TIME_TO_UNPIN_S = 1.0
 
 
 #: MuJoCo's warnings for an unstable step (plain ints: indexing MjData's counters with the
-#: enums costs a microsecond a step), each with what it means.
+#: enums is slower, and this runs every step), each with what it means.
 DIVERGENCE_WARNINGS = (
     (int(mujoco.mjtWarning.mjWARN_BADQPOS), 'NaN/Inf/huge joint position'),
     (int(mujoco.mjtWarning.mjWARN_BADQVEL), 'NaN/Inf/huge joint velocity'),
