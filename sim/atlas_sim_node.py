@@ -3,7 +3,7 @@
 
 import sys
 
-from tutorial_atlas_control.node.sim_node import main
+from tutorial_atlas_control.cli.atlas_sim import main
 
 if __name__ == '__main__':
     sys.exit(main())

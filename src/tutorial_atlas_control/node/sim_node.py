@@ -28,7 +28,6 @@ Parameters (private unless noted):
 
 from __future__ import annotations
 
-import sys
 import threading
 import time
 import warnings
@@ -312,21 +311,3 @@ def _tf_wanted(model_file: Path, sim: AtlasSimulator) -> bool:
                       '(write a matching URDF beside it to get TF)')
         return False
     return True
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Entry point of sim/atlas_sim_node.py."""
-    args = rospy.myargv(argv if argv is not None else sys.argv)
-    if len(args) > 1 and args[1] in ('-h', '--help'):
-        print(__doc__)
-        return 0
-    rospy.init_node(NODE_NAME)
-    try:
-        node = build_node()
-    except AtlasControlError as err:
-        rospy.logfatal(f'{NODE_NAME}: {err}')
-        return 1
-    rospy.loginfo(f'Atlas v1 simulator ready: dt={node.sim.dt_s * 1000:.1f} ms, '
-                  f'real_time_factor={node.loop.real_time_factor}, paused={node.loop.paused}, '
-                  f'torso pinned for {node.sim.time_to_unpin_s} s')
-    return node.spin()

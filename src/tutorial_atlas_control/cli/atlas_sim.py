@@ -1,0 +1,37 @@
+"""Command line of sim/atlas_sim_node.py, the simulator node that atlas.launch starts.
+
+`--help` prints the node's parameters (node/sim_node.py's docstring). Like any ROS node it
+exits 0 when ROS shuts it down (Ctrl-C, `rosnode kill`), 1 when its set-up is refused.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Sequence
+
+import rospy
+
+from tutorial_atlas_control.cli.convention import EXIT_REFUSED
+from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.node import sim_node
+from tutorial_atlas_control.node.sim_node import NODE_NAME, build_node
+
+HELP_OPTIONS = ('-h', '--help')
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Start the node and step until ROS shuts it down; the exit status."""
+    args = rospy.myargv(list(argv) if argv is not None else sys.argv)
+    if any(arg in HELP_OPTIONS for arg in args[1:]):
+        print(sim_node.__doc__)
+        return 0
+    rospy.init_node(NODE_NAME)
+    try:
+        node = build_node()
+    except AtlasControlError as err:
+        rospy.logfatal(f'{NODE_NAME}: {err}')
+        return EXIT_REFUSED
+    rospy.loginfo(f'Atlas v1 simulator ready: dt={node.sim.dt_s * 1000:.1f} ms, '
+                  f'real_time_factor={node.loop.real_time_factor}, paused={node.loop.paused}, '
+                  f'torso pinned for {node.sim.time_to_unpin_s} s')
+    return node.spin()
