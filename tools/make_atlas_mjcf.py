@@ -17,6 +17,7 @@ Usage: python3 tools/make_atlas_mjcf.py [OUTPUT]   (default: sim/atlas_v1.xml; t
 from __future__ import annotations
 
 import sys
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -255,7 +256,7 @@ def rpy_to_quat(rpy: tuple[float, float, float]) -> np.ndarray:
                      cr * cp * sy - sr * sp * cy])
 
 
-def fmt(values) -> str:
+def fmt(values: Iterable[float]) -> str:
     """Space-separated shortest repr of floats (repr round-trips exactly)."""
     return ' '.join(repr(float(v)) if float(v) != int(v) else str(int(v)) for v in values)
 
@@ -365,10 +366,8 @@ def body_xml(name: str, joint_name: str | None, depth: int) -> list[str]:
     for index, (kind, size, pos, rpy) in enumerate(COLLISION_SHAPES.get(name, [])):
         extra = ' class="sole"' if name.endswith('_foot') else ''
         geom_name = f'{name}_sole' if name.endswith('_foot') else f'{name}_c{index}'
-        if kind == 'box':
-            size_text = fmt(s / 2 for s in size)
-        else:
-            size_text = fmt((size[0], size[1] / 2))
+        size_text = (fmt(s / 2 for s in size) if kind == 'box'
+                     else fmt((size[0], size[1] / 2)))
         quat = '' if not any(rpy) else f' quat="{fmt(np.round(rpy_to_quat(rpy), 9))}"'
         lines.append(f'{inner}<geom name="{geom_name}"{extra} type="{kind}" size="{size_text}" '
                      f'pos="{fmt(pos)}"{quat} material="{LINK_MATERIAL[name]}"/>')
@@ -531,7 +530,8 @@ def _z_to_direction_rpy(direction: np.ndarray) -> tuple[float, float, float]:
     return 0.0, float(np.arctan2(np.hypot(dx, dy), dz)), float(np.arctan2(dy, dx))
 
 
-def _urdf_visual(geometry: str, xyz, rpy, material: str) -> list[str]:
+def _urdf_visual(geometry: str, xyz: Iterable[float], rpy: Iterable[float],
+                 material: str) -> list[str]:
     return ['    <visual>',
             f'      <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>',
             f'      <geometry>{geometry}</geometry>',

@@ -19,10 +19,13 @@ import pytest
 
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
-from tutorial_atlas_control.bags.analysis import analyze_bag  # noqa: E402
-from tutorial_atlas_control.bags.compare import (  # noqa: E402
-    compare_bags, first_applied_command_s, format_comparison)
-from tutorial_atlas_control.offline.player import run_offline  # noqa: E402
+from tutorial_atlas_control.bags.analysis import analyze_bag
+from tutorial_atlas_control.bags.compare import (
+    compare_bags,
+    first_applied_command_s,
+    format_comparison,
+)
+from tutorial_atlas_control.offline.player import run_offline
 
 REPO = Path(__file__).resolve().parents[2]
 TRAJECTORIES = REPO / 'trajectories' / 'Traj_data2.yaml'

@@ -20,7 +20,7 @@ import pytest
 
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
-from tutorial_atlas_control.processes import RosMaster, stop_tree  # noqa: E402
+from tutorial_atlas_control.processes import RosMaster, stop_tree
 
 REPO = Path(__file__).resolve().parents[2]
 TRAJ_YAML = REPO / 'scripts' / 'traj_yaml.py'

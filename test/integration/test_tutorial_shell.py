@@ -24,7 +24,7 @@ if shutil.which('roslaunch') is None or 'TAC_HOME' not in os.environ:
     pytest.skip('needs the project environment (source env.sh)', allow_module_level=True)
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
-from tutorial_atlas_control.processes import free_local_port, stop_tree  # noqa: E402
+from tutorial_atlas_control.processes import free_local_port, stop_tree
 
 REPO = Path(__file__).resolve().parents[2]
 TRAJECTORY_FILE = REPO / 'trajectories' / 'Traj_data2.yaml'

@@ -26,8 +26,8 @@ from pathlib import Path
 import pytest
 
 from support import xdisplay
-from tutorial_atlas_control.sim.model import SPAWN_HEIGHT_M
 from tutorial_atlas_control.processes import free_local_port, ros_environment, stop_tree
+from tutorial_atlas_control.sim.model import SPAWN_HEIGHT_M
 
 if xdisplay.missing_tools():
     pytest.skip(f'needs {", ".join(xdisplay.missing_tools())} (tools/setup.sh installs '

@@ -23,12 +23,15 @@ import pytest
 
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
-from support.launch import wait_sim_time  # noqa: E402
-from support.xdisplay import display_env, find_window, material_mask, screenshot, xvfb  # noqa: E402
-from tutorial_atlas_control.sim import model as atlas_model  # noqa: E402
-from tutorial_atlas_control.processes import (  # noqa: E402
-    free_local_port, ros_environment, stop_tree)
-from tutorial_atlas_control.bags.render import configure_viewer_camera  # noqa: E402
+from support.launch import wait_sim_time
+from support.xdisplay import display_env, find_window, material_mask, screenshot, xvfb
+from tutorial_atlas_control.bags.render import configure_viewer_camera
+from tutorial_atlas_control.processes import (
+    free_local_port,
+    ros_environment,
+    stop_tree,
+)
+from tutorial_atlas_control.sim import model as atlas_model
 
 #: A pixel is the material's colour when its r : g : b is this close (chromaticity distance).
 #: The blue (0.2, 0.3, 0.55) and the sky near the horizon (about 0.33, 0.43, 0.58) are 0.11

@@ -67,7 +67,7 @@ class Probe:
         with self.lock:
             self.last_reset_s = float(json.loads(msg.data)['last_reset_time'])
 
-    def wait(self, condition, what: str, timeout_s: float = TIMEOUT_S) -> None:  # noqa: ANN001
+    def wait(self, condition, what: str, timeout_s: float = TIMEOUT_S) -> None:
         deadline = time.monotonic() + timeout_s
         while True:
             with self.lock:

@@ -25,8 +25,7 @@ import rospy
 import rostest
 from atlas_msgs.msg import ControllerStatistics
 from osrf_msgs.msg import JointCommands
-
-from sim_probe import SimProbe  # noqa: E402
+from sim_probe import SimProbe
 
 PKG = 'tutorial_atlas_control'
 TOPIC = '/atlas/controller_statistics'

@@ -11,13 +11,12 @@ import rosgraph
 import rospy
 import rostest
 from rosgraph_msgs.msg import Clock
-
 from sim_probe import SimProbe  # beside this script, on its sys.path
 
-from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.sim.controller import gains_from_params
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.sim.controller import gains_from_params
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode
 
 PKG = 'tutorial_atlas_control'

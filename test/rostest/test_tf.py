@@ -69,7 +69,7 @@ class TfTest(unittest.TestCase):
         time.sleep(0.5)  # the messages stamped before it arrive
 
     @classmethod
-    def _wait(cls, predicate, what: str) -> None:  # noqa: ANN001
+    def _wait(cls, predicate, what: str) -> None:
         deadline = time.monotonic() + WALL_TIMEOUT_S
         while not predicate():
             if time.monotonic() > deadline or rospy.is_shutdown():

@@ -20,11 +20,10 @@ import rostest
 from geometry_msgs.msg import WrenchStamped
 from nav_msgs.msg import Odometry
 from osrf_msgs.msg import JointCommands
-
 from sim_probe import SimProbe  # beside this script, on its sys.path
 
-from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.joints import JOINT_INDEX
+from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.trajectories.trajectory import load_trajectory, sample_count
 
 PKG = 'tutorial_atlas_control'

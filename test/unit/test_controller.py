@@ -11,11 +11,18 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
-from tutorial_atlas_control.msgs.commands import FIELD_NAMES, JointCommandArrays
-from tutorial_atlas_control.sim.controller import (
-    Gains, GainsError, PidState, compute_torque, gains_from_params, hold_command, load_gains_yaml)
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.msgs.commands import FIELD_NAMES, JointCommandArrays
+from tutorial_atlas_control.sim.controller import (
+    Gains,
+    GainsError,
+    PidState,
+    compute_torque,
+    gains_from_params,
+    hold_command,
+    load_gains_yaml,
+)
 
 REPO = Path(__file__).resolve().parents[2]
 GAINS_YAML = REPO / 'config' / 'atlas_controller.yaml'
@@ -55,7 +62,7 @@ def torque(command: JointCommandArrays, q: float, v: float = 0.0, state: PidStat
 def test_field_names_follow_the_message() -> None:
     lines = (REPO / 'msg' / 'osrf_msgs' / 'msg' / 'JointCommands.msg').read_text().splitlines()
     arrays = [line.split()[1] for line in lines if line.startswith('float64[]')]
-    assert FIELD_NAMES == tuple(arrays)
+    assert tuple(arrays) == FIELD_NAMES
 
 
 def test_zeros_and_copy_are_independent() -> None:

@@ -5,9 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.sim.controller_statistics import (
-    CommandAgeStatistics, StatisticsConfigError, update_period_ns, window_steps)
 from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.sim.controller_statistics import (
+    CommandAgeStatistics,
+    StatisticsConfigError,
+    update_period_ns,
+    window_steps,
+)
 
 DT_S = 0.001
 STEP_NS = 1_000_000

@@ -5,8 +5,8 @@ Short runs (a 0.1 s waypoint after 1.1 s, 0.2 s of settling) keep each test to a
 
 from __future__ import annotations
 
-import io
 import importlib.util
+import io
 import json
 import os
 import subprocess
@@ -16,10 +16,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.sim.controller import load_gains_yaml
-from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.cli.run_offline import main
+from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.offline.player import run_offline
+from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.trajectories.trajectory import TrajectoryError
 
 REPO = Path(__file__).resolve().parents[2]
@@ -55,7 +55,7 @@ def trajectory_file(tmp_path: Path) -> Path:
     return path
 
 
-def short_run(trajectory_file: Path, bag: Path):  # noqa: ANN201
+def short_run(trajectory_file: Path, bag: Path):
     return run_offline(str(trajectory_file), 'elbow', bag, settle_s=SETTLE_S,
                        start_after_s=START_AFTER_S, gains_file=GAINS)
 

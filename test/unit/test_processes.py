@@ -10,9 +10,18 @@ from pathlib import Path
 import pytest
 
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.processes import (AtlasLaunch, ProcessError, alive, command_line,
-                                              default_sigint, descendants, free_local_port,
-                                              rss_kib, stop_tree, wait_until)
+from tutorial_atlas_control.processes import (
+    AtlasLaunch,
+    ProcessError,
+    alive,
+    command_line,
+    default_sigint,
+    descendants,
+    free_local_port,
+    rss_kib,
+    stop_tree,
+    wait_until,
+)
 
 #: Guard (s) for child processes to start or be reaped, however busy the machine is.
 GUARD_S = 30.0

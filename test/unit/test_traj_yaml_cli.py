@@ -22,9 +22,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.sim.controller import Gains, GainsError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.trajectories.trajectory import Waypoint, sample_count
 from tutorial_atlas_control.node.traj_yaml import (
     JointStateCache,
     TrajYamlError,
@@ -37,6 +35,8 @@ from tutorial_atlas_control.node.traj_yaml import (
     wait_for_subscribers,
     wait_until_handed_over,
 )
+from tutorial_atlas_control.sim.controller import Gains, GainsError
+from tutorial_atlas_control.trajectories.trajectory import Waypoint, sample_count
 
 REPO = Path(__file__).resolve().parents[2]
 SCRIPT = REPO / 'scripts' / 'traj_yaml.py'

@@ -7,7 +7,12 @@ from pathlib import Path
 import pytest
 
 from tutorial_atlas_control.trajectories.trajectory import (
-    TRAJECTORIES_DIR, TrajectoryError, is_explicit_path, load_trajectory, resolve_trajectory_file)
+    TRAJECTORIES_DIR,
+    TrajectoryError,
+    is_explicit_path,
+    load_trajectory,
+    resolve_trajectory_file,
+)
 
 
 @pytest.fixture()

@@ -10,10 +10,10 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
-from support.model_table import load_table
 
-from tutorial_atlas_control.sim import model, urdf
+from support.model_table import load_table
 from tutorial_atlas_control.joints import JOINT_NAMES
+from tutorial_atlas_control.sim import model, urdf
 
 REPO = Path(__file__).resolve().parents[2]
 #: The left knee's joint origin in the URDF, and the same 1 cm lower.

@@ -22,10 +22,15 @@ import rospy
 from sensor_msgs.msg import JointState
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.sim.controller import LOAD_HINT, Gains, GainsError, gains_from_params
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES, NUM_JOINTS, joint_index
-from tutorial_atlas_control.trajectories.schedule import done_line, playing_line, run_trajectory, trajectory_log_line
+from tutorial_atlas_control.sim.controller import LOAD_HINT, Gains, GainsError, gains_from_params
+from tutorial_atlas_control.trajectories.schedule import (
+    done_line,
+    playing_line,
+    run_trajectory,
+    trajectory_log_line,
+)
 from tutorial_atlas_control.trajectories.trajectory import Waypoint
 from tutorial_atlas_control.units import finite_number
 
@@ -388,7 +393,7 @@ def wait_until_handed_over(publisher: rospy.Publisher, timeout_s: float) -> bool
 def joint_commands_type() -> Callable[[], object]:
     """osrf_msgs/JointCommands, from the built workspace."""
     try:
-        from osrf_msgs.msg import JointCommands
+        from osrf_msgs.msg import JointCommands  # noqa: PLC0415 - unbuilt workspace: one line
     except ImportError as err:
         raise TrajYamlError(
             f'cannot import osrf_msgs.msg.JointCommands ({err}): build the workspace with `make setup` '

@@ -39,13 +39,14 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import yaml
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.msgs.commands import JointCommandArrays
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.units import finite_number
+from tutorial_atlas_control.msgs.commands import JointCommandArrays
 from tutorial_atlas_control.resources import package_path
+from tutorial_atlas_control.units import finite_number
 
 #: Where the gains live on the parameter server (and in config/atlas_controller.yaml).
 GAINS_PARAM = topics.GAINS_PARAM
@@ -220,8 +221,6 @@ def load_gains_yaml(path: str | Path) -> Gains:
     Raises:
         GainsError: the file is missing or unreadable, or the gains are malformed.
     """
-    import yaml  # local: only the file path needs PyYAML
-
     path = Path(path)
     try:
         document = yaml.safe_load(path.read_text())

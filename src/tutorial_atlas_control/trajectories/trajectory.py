@@ -25,8 +25,8 @@ import yaml
 
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.units import finite_number
 from tutorial_atlas_control.resources import package_path
+from tutorial_atlas_control.units import finite_number
 
 __all__ = [
     'PUBLISH_PERIOD_S',
