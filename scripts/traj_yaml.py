@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Play a trajectory of a YAML file on the simulated Atlas: traj_yaml.py YAML_FILE TRAJECTORY_NAME."""
+"""Play a YAML file's trajectory on the simulated Atlas: traj_yaml.py YAML_FILE TRAJECTORY_NAME."""
 
 import sys
 from pathlib import Path

@@ -55,7 +55,8 @@ def touchdown_run(tmp_path_factory: pytest.TempPathFactory) -> LiveRun:
 
 
 @pytest.mark.parametrize(('trajectory', 'falls'), [('step_and_fall', True), ('touchdown', False)])
-def test_offline_run_reaches_the_live_outcome(trajectory: str, falls: bool, request: pytest.FixtureRequest,
+def test_offline_run_reaches_the_live_outcome(trajectory: str, falls: bool,
+                                              request: pytest.FixtureRequest,
                                               tmp_path: Path) -> None:
     live = request.getfixturevalue('demo_run' if trajectory == 'step_and_fall' else 'touchdown_run')
     assert live.result.returncode == 0, live.result.stdout + live.result.stderr

@@ -140,8 +140,8 @@ def test_model_variant_without_urdf_runs_without_tf(tmp_path: Path) -> None:
     output = (tmp_path / 'atlas.log').read_text(errors='replace')
     warnings = [line for line in output.splitlines() if 'TF is off' in line]
     assert len(warnings) == 1, output
-    assert f'the model {variant} has no URDF beside it ({tmp_path / "variant.urdf"} does not exist)' \
-        in warnings[0]
+    assert (f'the model {variant} has no URDF beside it '
+            f'({tmp_path / "variant.urdf"} does not exist)') in warnings[0]
     assert '/tf' not in publishers
     assert not has_description
     assert '/clock' in publishers

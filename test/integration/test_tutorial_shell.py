@@ -51,8 +51,9 @@ def fresh_env(home: Path, master_uri: str) -> dict[str, str]:
 
 def bash_i(script: str, env: dict[str, str], cwd: Path = REPO) -> subprocess.CompletedProcess[str]:
     """`script` in a fresh interactive bash, after `source ./env.sh` from the repository."""
-    return subprocess.run(['bash', '-i', '-c', f'source ./env.sh || exit 1\n{script}'], cwd=cwd, env=env,
-                          capture_output=True, text=True, timeout=SHELL_TIMEOUT_S, check=False,
+    return subprocess.run(['bash', '-i', '-c', f'source ./env.sh || exit 1\n{script}'], cwd=cwd,
+                          env=env, capture_output=True, text=True, timeout=SHELL_TIMEOUT_S,
+                          check=False,
                           stdin=subprocess.DEVNULL)
 
 

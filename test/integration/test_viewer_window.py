@@ -103,7 +103,8 @@ def test_viewer_window_shows_the_whole_robot(tmp_path: Path) -> None:
         log = open(tmp_path / 'launch.log', 'w')  # noqa: SIM115 - closed below
         process = subprocess.Popen(
             ['roslaunch', '-p', str(port), 'tutorial_atlas_control', 'atlas.launch', 'gui:=true',
-             'record:=false'], env=env, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+             'record:=false'], env=env, stdout=log, stderr=subprocess.STDOUT,
+            start_new_session=True)
         try:
             window = find_window(display, 'MuJoCo')
             wait_sim_time(env, SCREENSHOT_AT_S)
@@ -115,7 +116,8 @@ def test_viewer_window_shows_the_whole_robot(tmp_path: Path) -> None:
             log.close()
     seen = robot_on_screen(image, m)
     print(f'viewer {image.shape[1]}x{image.shape[0]}: {seen}, span {seen.span_fraction:.2f} of '
-          f'the height; launch stopped {exit_s:.1f} s after Ctrl-C; screenshot {tmp_path / "viewer.png"}')
+          f'the height; launch stopped {exit_s:.1f} s after Ctrl-C; '
+          f'screenshot {tmp_path / "viewer.png"}')
     assert seen.head_pixels >= MIN_HEAD_PIXELS, 'the head is not on screen'
     assert seen.leg_pixels >= MIN_LEG_PIXELS, 'the legs are not on screen'
     assert seen.feet_on_screen, 'the feet are below the window'

@@ -64,7 +64,8 @@ class SimInterfaceTest(unittest.TestCase):
             probe.keep_joint_states = False
             states = list(probe.joint_states)
         clock_sub.unregister()
-        stamps = np.array([s.header.stamp.to_nsec() for s in states if s.header.stamp.to_nsec() > start_ns])
+        stamps = np.array([s.header.stamp.to_nsec() for s in states
+                           if s.header.stamp.to_nsec() > start_ns])
         self.assertGreater(len(stamps), 950, 'about 1000 joint states per second of sim time')
         steps = np.diff(stamps)
         self.assertEqual(int(np.median(steps)), STEP_NS)
@@ -193,7 +194,8 @@ class SimInterfaceTest(unittest.TestCase):
             stamp_ns, z = probe.pelvis_z_stamped()
             if reset_ns <= stamp_ns < unpin_ns:
                 self.assertAlmostEqual(z, spawn_z, delta=0.002,
-                                       msg=f'pinned torso, {(stamp_ns - reset_ns) / 1e6:.0f} ms after the reset')
+                                       msg=f'pinned torso, {(stamp_ns - reset_ns) / 1e6:.0f} '
+                                           'ms after the reset')
                 pinned_readings += 1
             probe.wait_sim(0.02)
         self.assertGreaterEqual(pinned_readings, 5, 'readings of the pinned torso')

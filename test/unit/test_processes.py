@@ -53,8 +53,9 @@ def test_stop_tree_kills_what_ignores_sigint_including_other_sessions() -> None:
     parent = subprocess.Popen(['bash', '-c', STUBBORN_TREE], start_new_session=True)
     # Both sleeps running: before that, a forked child still shows its parent's command line
     # and has not set its trap yet.
-    wait_until(lambda: [command_line(pid) for pid in descendants(parent.pid)].count('sleep 300') == 2,
-               GUARD_S, 'children did not start')
+    wait_until(
+        lambda: [command_line(pid) for pid in descendants(parent.pid)].count('sleep 300') == 2,
+        GUARD_S, 'children did not start')
     children = descendants(parent.pid)
     assert stop_tree(parent, timeout_s=0.5) is False, 'it had to be killed'
     assert parent.poll() == -signal.SIGKILL

@@ -82,7 +82,8 @@ class Run:
 
     def __post_init__(self) -> None:
         self.atlas = atlas_model.load_model()
-        self.sim = AtlasSimulator(self.atlas, load_gains_yaml(DEFAULT_GAINS_FILE), self.time_to_unpin_s)
+        self.sim = AtlasSimulator(self.atlas, load_gains_yaml(DEFAULT_GAINS_FILE),
+                                  self.time_to_unpin_s)
         self.steps = 0
         self._publish_config()
 

@@ -195,7 +195,8 @@ def gains_from_params(params: Mapping[str, Any]) -> Gains:
     """
     if not isinstance(params, Mapping):
         raise GainsError(f'parameter {GAINS_PARAM} is {params!r}, not a dictionary; {LOAD_HINT}')
-    table = np.array([[_gain_value(params, joint, key) for key in GAIN_KEYS] for joint in JOINT_NAMES])
+    table = np.array([[_gain_value(params, joint, key) for key in GAIN_KEYS]
+                      for joint in JOINT_NAMES])
     return Gains(*(np.ascontiguousarray(table[:, column]) for column in range(len(GAIN_KEYS))))
 
 
