@@ -1,6 +1,7 @@
 # The project's commands. Each one sets the project up first when needed.
 #   make setup   Debian packages, virtualenv, catkin workspace (idempotent)
-#   make test    unit, integration and reliability tests (pytest), catkin_lint, then the rostests
+#   make test    unit, integration and reliability tests (pytest), ruff and catkin_lint, then the
+#                rostests
 #   make demo    the tutorial end to end, headless (TRAJ=step_and_fall|touchdown|touchdown_exhausted)
 #   make bench   the performance benchmark
 SHELL := /bin/bash
@@ -17,6 +18,7 @@ unit-test: setup
 	@$(IN_ENV) python3 -m pytest test/unit -q
 
 lint: setup
+	@$(IN_ENV) ruff check .
 	@$(IN_ENV) catkin_lint -W2 "$$TAC_WS/src"
 
 rostest: setup
@@ -24,6 +26,7 @@ rostest: setup
 
 test: setup
 	@$(IN_ENV) python3 -m pytest test/unit test/integration test/reliability -q
+	@$(IN_ENV) ruff check .
 	@$(IN_ENV) catkin_lint -W2 "$$TAC_WS/src"
 	@$(IN_ENV) bash tools/run_rostests.sh
 

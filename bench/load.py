@@ -22,8 +22,9 @@ from pathlib import Path
 
 from harness import READY_TIMEOUT_S, REPO_DIR, BenchError, Launch, Master
 from online import Probes, recorded_fraction
-from tutorial_atlas_control.processes import STOP_TIMEOUT_S, rss_kib, wait_until
+
 from tutorial_atlas_control.node.transport import subscriber_names
+from tutorial_atlas_control.processes import STOP_TIMEOUT_S, rss_kib, wait_until
 
 FLOOD = REPO_DIR / 'tools' / 'flood_commands.py'
 RUN_DEMO = REPO_DIR / 'scripts' / 'run_demo.py'

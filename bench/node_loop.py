@@ -20,8 +20,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 # The fake rospy the unit tests use too: test/support, imported as `support`.
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / 'test'))
 
-import offline  # noqa: E402
-from offline import make_simulator  # noqa: E402
+import offline
+from offline import make_simulator
 
 from support import fake_rospy
 

@@ -6,10 +6,14 @@ import hashlib
 import os
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from harness import REPO_DIR, log
 
 from tutorial_atlas_control import topics
+
+if TYPE_CHECKING:
+    from tutorial_atlas_control.sim.simulator import AtlasSimulator
 
 GAINS_YAML = REPO_DIR / 'config' / 'atlas_controller.yaml'
 #: The topics bag_reader.read_bag deserializes (the baseline reads the same ones).
@@ -18,7 +22,7 @@ ANALYSIS_TOPICS = (topics.JOINT_STATES, topics.JOINT_COMMANDS, topics.GROUND_TRU
 
 
 # ---------------------------------------------------------------------------- physics
-def make_simulator(compiled_law: bool = True):
+def make_simulator(compiled_law: bool = True) -> 'AtlasSimulator':
     """AtlasSimulator with the DRCSim gains from config/, as the node builds it."""
     from tutorial_atlas_control.sim import controller, model
     from tutorial_atlas_control.sim.simulator import AtlasSimulator

@@ -1,7 +1,8 @@
 """The benchmark's measurements against the running simulator node (a private master).
 
-fast run:     real_time_factor:=0 with the recorder subscribed (atlas_recorder, then `rosbag record`); achieved real-time
-              factor = sim time advanced / wall time over a window, both taken from the
+fast run:     real_time_factor:=0 with the recorder subscribed (atlas_recorder, then
+              `rosbag record`); achieved real-time factor = sim time advanced / wall time
+              over a window, both taken from the
               /clock messages a raw subscriber receives (first and last of the window).
 realtime run: real_time_factor:=1.0; over the window every /clock arrival is kept.
               lateness of step i = (arrival_i - sim_i) - min_j (arrival_j - sim_j), i.e.
@@ -28,12 +29,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-
 from harness import READY_TIMEOUT_S, BenchError, Launch, Master
-from tutorial_atlas_control.processes import cpu_seconds, wait_until
 from probes import RawRecorder, clock_ns, header_stamp_ns, joint_state_effort
 
 from tutorial_atlas_control import topics
+from tutorial_atlas_control.processes import cpu_seconds, wait_until
 from tutorial_atlas_control.units import NS_PER_S
 
 LATENCY_JOINT = 'neck_ay'

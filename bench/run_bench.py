@@ -34,8 +34,16 @@ import traceback
 from pathlib import Path
 
 try:
-    from harness import (BenchError, Master, busy_and_steal, check_environment,
-                         cpu_stat, load_average, log)
+    from harness import (
+        BenchError,
+        Master,
+        busy_and_steal,
+        check_environment,
+        cpu_stat,
+        load_average,
+        log,
+    )
+
     from tutorial_atlas_control.errors import AtlasControlError
 except ImportError as import_error:
     sys.exit(f'run_bench: cannot import {import_error.name}; run `make bench`, or '

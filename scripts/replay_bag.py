@@ -5,7 +5,7 @@ import sys
 from pathlib import Path
 
 sys.path.append(str(Path(__file__).resolve().parent.parent / 'src'))  # a clone without catkin
-from tutorial_atlas_control.cli.replay_bag import main  # noqa: E402
+from tutorial_atlas_control.cli.replay_bag import main
 
 if __name__ == '__main__':
     sys.exit(main())

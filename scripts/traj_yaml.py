@@ -1,11 +1,11 @@
 #!/usr/bin/env python3
-"""Play a trajectory of a YAML file on the simulated Atlas: traj_yaml.py YAML_FILE TRAJECTORY_NAME."""
+"""Play a YAML file's trajectory on the simulated Atlas: traj_yaml.py YAML_FILE TRAJECTORY_NAME."""
 
 import sys
 from pathlib import Path
 
 sys.path.append(str(Path(__file__).resolve().parent.parent / 'src'))  # a clone without catkin
-from tutorial_atlas_control.cli.traj_yaml import main  # noqa: E402
+from tutorial_atlas_control.cli.traj_yaml import main
 
 if __name__ == '__main__':
     sys.exit(main())

@@ -17,6 +17,7 @@ Usage: python3 tools/make_atlas_mjcf.py [OUTPUT]   (default: sim/atlas_v1.xml; t
 from __future__ import annotations
 
 import sys
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -57,7 +58,8 @@ class Joint:
 ROOT_LINK = 'pelvis'
 
 LINKS: dict[str, Link] = {
-    'pelvis': Link(14.2529, (0.0111, 0, 0.0271), (0.1244, 0.0958, 0.1167, 0.0008, -0.0007, -0.0005)),
+    'pelvis': Link(14.2529, (0.0111, 0, 0.0271),
+                   (0.1244, 0.0958, 0.1167, 0.0008, -0.0007, -0.0005)),
     'ltorso': Link(1.92, (-0.0112984, -3.15366e-06, 0.0746835),
                    (0.0039092, 0.00341694, 0.00174492, -5.04491e-08, -0.000342157, 4.87119e-07)),
     'mtorso': Link(0.55, (-0.00816266, -0.0131245, 0.0305974),
@@ -102,10 +104,13 @@ REFERENCE_TOTAL_MASS_KG = 90.61994
 V_MAX = 12.0  # rad/s, the same velocity limit on every joint in atlas.urdf
 
 JOINTS: dict[str, Joint] = {
-    'back_lbz': Joint('pelvis', 'ltorso', (-0.0125, 0, 0), (0, 0, 1), -0.610865, 0.610865, 124.016, V_MAX),
+    'back_lbz': Joint('pelvis', 'ltorso', (-0.0125, 0, 0), (0, 0, 1), -0.610865, 0.610865,
+                      124.016, V_MAX),
     'back_mby': Joint('ltorso', 'mtorso', (0, 0, 0.09), (0, 1, 0), -1.2, 1.28, 206.843, V_MAX),
-    'back_ubx': Joint('mtorso', 'utorso', (0, 0, 0.05), (1, 0, 0), -0.790809, 0.790809, 94.91, V_MAX),
-    'neck_ay': Joint('utorso', 'head', (0.16555, 0, 0.50823), (0, 1, 0), -0.610865238, 1.13446401, 5, V_MAX),
+    'back_ubx': Joint('mtorso', 'utorso', (0, 0, 0.05), (1, 0, 0), -0.790809, 0.790809,
+                      94.91, V_MAX),
+    'neck_ay': Joint('utorso', 'head', (0.16555, 0, 0.50823), (0, 1, 0), -0.610865238, 1.13446401,
+                     5, V_MAX),
     'l_leg_uhz': Joint('pelvis', 'l_uglut', (0, 0.089, 0), (0, 0, 1), -0.32, 1.14, 110, V_MAX),
     'l_leg_mhx': Joint('l_uglut', 'l_lglut', (0, 0, 0), (1, 0, 0), -0.47, 0.495, 180, V_MAX),
     'l_leg_lhy': Joint('l_lglut', 'l_uleg', (0.05, 0, -0.05), (0, 1, 0), -1.75, 0.524, 260, V_MAX),
@@ -119,17 +124,23 @@ JOINTS: dict[str, Joint] = {
     'r_leg_kny': Joint('r_uleg', 'r_lleg', (-0.05, 0, -0.374), (0, 1, 0), 0, 2.45, 220, V_MAX),
     'r_leg_uay': Joint('r_lleg', 'r_talus', (0, 0, -0.422), (0, 1, 0), -0.698, 0.698, 220, V_MAX),
     'r_leg_lax': Joint('r_talus', 'r_foot', (0, 0, 0), (1, 0, 0), -0.436, 0.436, 90, V_MAX),
-    'l_arm_usy': Joint('utorso', 'l_clav', (0.024, 0.221, 0.289), (0, 0.5, 0.866025), -1.9635, 1.9635, 212, V_MAX),
-    'l_arm_shx': Joint('l_clav', 'l_scap', (0, 0.075, 0.036), (1, 0, 0), -1.39626, 1.74533, 170, V_MAX),
+    'l_arm_usy': Joint('utorso', 'l_clav', (0.024, 0.221, 0.289), (0, 0.5, 0.866025),
+                       -1.9635, 1.9635, 212, V_MAX),
+    'l_arm_shx': Joint('l_clav', 'l_scap', (0, 0.075, 0.036), (1, 0, 0), -1.39626, 1.74533,
+                       170, V_MAX),
     'l_arm_ely': Joint('l_scap', 'l_uarm', (0, 0.185, 0), (0, 1, 0), 0, 3.14159, 114, V_MAX),
     'l_arm_elx': Joint('l_uarm', 'l_larm', (0, 0.121, 0.013), (1, 0, 0), 0, 2.35619, 114, V_MAX),
-    'l_arm_uwy': Joint('l_larm', 'l_farm', (0, 0.188, -0.013), (0, 1, 0), -1.571, 1.571, 114, V_MAX),
+    'l_arm_uwy': Joint('l_larm', 'l_farm', (0, 0.188, -0.013), (0, 1, 0), -1.571, 1.571,
+                       114, V_MAX),
     'l_arm_mwx': Joint('l_farm', 'l_hand', (0, 0.058, 0), (1, 0, 0), -0.436, 1.571, 60, V_MAX),
-    'r_arm_usy': Joint('utorso', 'r_clav', (0.024, -0.221, 0.289), (0, 0.5, -0.866025), -1.9635, 1.9635, 212, V_MAX),
-    'r_arm_shx': Joint('r_clav', 'r_scap', (0, -0.075, 0.036), (1, 0, 0), -1.74533, 1.39626, 170, V_MAX),
+    'r_arm_usy': Joint('utorso', 'r_clav', (0.024, -0.221, 0.289), (0, 0.5, -0.866025),
+                       -1.9635, 1.9635, 212, V_MAX),
+    'r_arm_shx': Joint('r_clav', 'r_scap', (0, -0.075, 0.036), (1, 0, 0), -1.74533, 1.39626,
+                       170, V_MAX),
     'r_arm_ely': Joint('r_scap', 'r_uarm', (0, -0.185, 0), (0, 1, 0), 0, 3.14159, 114, V_MAX),
     'r_arm_elx': Joint('r_uarm', 'r_larm', (0, -0.121, 0.013), (1, 0, 0), -2.35619, 0, 114, V_MAX),
-    'r_arm_uwy': Joint('r_larm', 'r_farm', (0, -0.188, -0.013), (0, 1, 0), -1.571, 1.571, 114, V_MAX),
+    'r_arm_uwy': Joint('r_larm', 'r_farm', (0, -0.188, -0.013), (0, 1, 0), -1.571, 1.571,
+                       114, V_MAX),
     'r_arm_mwx': Joint('r_farm', 'r_hand', (0, -0.058, 0), (1, 0, 0), -1.571, 0.436, 60, V_MAX),
 }
 
@@ -156,7 +167,8 @@ SOLE_POS_M = (0.048, 0.0, -0.076119)
 _LEFT_SHAPES: dict[str, list[tuple]] = {
     'l_uglut': [('cylinder', (0.019096, 0.078396), (0, 0, 0), (0, HALF_PI, 0)),
                 ('cylinder', (0.019841, 0.080842), (0, 0, 0), (0, 0, 0))],
-    'l_lglut': [('cylinder', (0.02009687, 0.060306), (0.049968, 0.022488, -0.0501165), (HALF_PI, 0, 0)),
+    'l_lglut': [('cylinder', (0.02009687, 0.060306), (0.049968, 0.022488, -0.0501165),
+                 (HALF_PI, 0, 0)),
                 ('cylinder', (0.02, 0.12), (0, 0, 0), (0, HALF_PI, 0))],
     'l_uleg': [('cylinder', (0.1, 0.10), (-0.0179, 0.02085, -0.13), (0, 0, 0)),
                ('cylinder', (0.07, 0.15), (-0.03, 0.01, -0.23), (0, -0.3, 0)),
@@ -255,7 +267,7 @@ def rpy_to_quat(rpy: tuple[float, float, float]) -> np.ndarray:
                      cr * cp * sy - sr * sp * cy])
 
 
-def fmt(values) -> str:
+def fmt(values: Iterable[float]) -> str:
     """Space-separated shortest repr of floats (repr round-trips exactly)."""
     return ' '.join(repr(float(v)) if float(v) != int(v) else str(int(v)) for v in values)
 
@@ -272,7 +284,8 @@ LINK_MATERIAL = {
     'pelvis': 'grey', 'ltorso': 'dark', 'mtorso': 'dark', 'utorso': 'grey', 'head': 'orange',
 }
 for _side in 'lr':
-    LINK_MATERIAL.update({f'{_side}_{n}': 'grey' for n in ('uglut', 'lglut', 'clav', 'scap', 'farm')})
+    LINK_MATERIAL.update({f'{_side}_{n}': 'grey'
+                          for n in ('uglut', 'lglut', 'clav', 'scap', 'farm')})
     LINK_MATERIAL.update({f'{_side}_{n}': 'blue' for n in ('uleg', 'lleg', 'uarm', 'larm')})
     LINK_MATERIAL.update({f'{_side}_{n}': 'dark' for n in ('talus', 'foot', 'hand')})
 
@@ -350,25 +363,25 @@ def body_xml(name: str, joint_name: str | None, depth: int) -> list[str]:
                      f'user="{fmt((joint.effort_nm, joint.velocity_rad_s))}"/>')
     inertia, changed = corrected_inertia(link.inertia)
     if changed:
-        lines.append(f'{inner}<!-- reference inertia {fmt(link.inertia)} is not physical (A + B < C); '
-                     'largest principal moment lowered to A + B, see tools/make_atlas_mjcf.py -->')
+        lines.append(f'{inner}<!-- reference inertia {fmt(link.inertia)} is not physical '
+                     '(A + B < C); largest principal moment lowered to A + B, '
+                     'see tools/make_atlas_mjcf.py -->')
     ixx, iyy, izz, ixy, ixz, iyz = inertia
     lines.append(f'{inner}<inertial pos="{fmt(link.com_m)}" mass="{link.mass_kg!r}" '
                  f'fullinertia="{fmt((ixx, iyy, izz, ixy, ixz, iyz))}"/>')
     if name == 'pelvis':
         lines.append(f'{inner}<site name="imu" size="0.01"/>')
         lines.append(f'{inner}<!-- follows the robot\'s centre of mass from its front-right -->')
-        lines.append(f'{inner}<camera name="track" mode="trackcom" pos="{fmt(TRACK_CAMERA_OFFSET_M)}" '
+        lines.append(f'{inner}<camera name="track" mode="trackcom" '
+                     f'pos="{fmt(TRACK_CAMERA_OFFSET_M)}" '
                      f'xyaxes="{camera_xyaxes(TRACK_CAMERA_OFFSET_M, np.zeros(3))}" fovy="45"/>')
     if name.endswith('_foot'):
         lines.append(f'{inner}<site name="{name}_ft" size="0.01"/>')
     for index, (kind, size, pos, rpy) in enumerate(COLLISION_SHAPES.get(name, [])):
         extra = ' class="sole"' if name.endswith('_foot') else ''
         geom_name = f'{name}_sole' if name.endswith('_foot') else f'{name}_c{index}'
-        if kind == 'box':
-            size_text = fmt(s / 2 for s in size)
-        else:
-            size_text = fmt((size[0], size[1] / 2))
+        size_text = (fmt(s / 2 for s in size) if kind == 'box'
+                     else fmt((size[0], size[1] / 2)))
         quat = '' if not any(rpy) else f' quat="{fmt(np.round(rpy_to_quat(rpy), 9))}"'
         lines.append(f'{inner}<geom name="{geom_name}"{extra} type="{kind}" size="{size_text}" '
                      f'pos="{fmt(pos)}"{quat} material="{LINK_MATERIAL[name]}"/>')
@@ -388,7 +401,8 @@ def camera_xyaxes(position: np.ndarray, target: np.ndarray) -> str:
     return fmt(np.round(np.concatenate([right, up]), 6))
 
 
-TRACK_CAMERA_OFFSET_M = np.array([2.4, -2.4, 0.35])  # m from the pelvis: in front, to the robot's right
+#: m from the pelvis: in front, to the robot's right.
+TRACK_CAMERA_OFFSET_M = np.array([2.4, -2.4, 0.35])
 
 
 def build() -> str:
@@ -397,6 +411,9 @@ def build() -> str:
     actuator_lines = [f'    <motor name="{n}" joint="{n}" gear="1"/>' for n in JOINT_NAMES]
     material_lines = [f'    <material name="{name}" rgba="{fmt(rgba)}" specular="{specular}"/>'
                       for name, (rgba, specular) in MATERIALS.items()]
+    floor_contact = (f'friction="{fmt(FLOOR_FRICTION)}" solref="{fmt(CONTACT_SOLREF)}" '
+                     f'solimp="{fmt(CONTACT_SOLIMP)}"')
+    pin_contact = f'solref="{fmt(PIN_SOLREF)}" solimp="{fmt(PIN_SOLIMP)}"'
     return f'''<!--
   Atlas v1 (DRCSim 2.5.2) for MuJoCo. GENERATED by tools/make_atlas_mjcf.py from
   its table of figures; edit the table, then run:  python3 tools/make_atlas_mjcf.py
@@ -480,7 +497,7 @@ def build() -> str:
     <light name="sun" directional="true" pos="0 0 5" dir="-0.3 0.4 -1" diffuse="0.7 0.7 0.7"
            castshadow="true"/>
     <geom name="floor" type="plane" size="0 0 0.05" material="floor" condim="3"
-          friction="{fmt(FLOOR_FRICTION)}" solref="{fmt(CONTACT_SOLREF)}" solimp="{fmt(CONTACT_SOLIMP)}"/>
+          {floor_contact}/>
 {chr(10).join(body_lines)}
   </worldbody>
 
@@ -493,7 +510,7 @@ def build() -> str:
          impedance 0.99-0.999) like DRCSim's rigid pin: a limp robot hanging
          from it moves the pelvis < 0.2 mm; the default soft weld let it
          drift 19 cm. -->
-    <weld name="pelvis_pin" body1="pelvis" active="false" solref="{fmt(PIN_SOLREF)}" solimp="{fmt(PIN_SOLIMP)}"/>
+    <weld name="pelvis_pin" body1="pelvis" active="false" {pin_contact}/>
   </equality>
 
   <actuator>
@@ -531,7 +548,8 @@ def _z_to_direction_rpy(direction: np.ndarray) -> tuple[float, float, float]:
     return 0.0, float(np.arctan2(np.hypot(dx, dy), dz)), float(np.arctan2(dy, dx))
 
 
-def _urdf_visual(geometry: str, xyz, rpy, material: str) -> list[str]:
+def _urdf_visual(geometry: str, xyz: Iterable[float], rpy: Iterable[float],
+                 material: str) -> list[str]:
     return ['    <visual>',
             f'      <origin xyz="{fmt(xyz)}" rpy="{fmt(rpy)}"/>',
             f'      <geometry>{geometry}</geometry>',
@@ -540,7 +558,7 @@ def _urdf_visual(geometry: str, xyz, rpy, material: str) -> list[str]:
 
 
 def _urdf_shape_visuals(shape: VisualShape) -> list[str]:
-    """A visual shape as URDF visuals; a capsule (no URDF primitive) is a cylinder and two spheres."""
+    """A visual shape as URDF visuals; a capsule (no URDF primitive): a cylinder, two spheres."""
     if shape.kind == 'box':
         size = fmt(2 * _floats(shape.size))
         return _urdf_visual(f'<box size="{size}"/>', _floats(shape.pos), (0, 0, 0), shape.material)
@@ -570,11 +588,12 @@ def link_urdf(name: str) -> list[str]:
     ixx, iyy, izz, ixy, ixz, iyz = inertia
     lines = [f'  <link name="{name}">', '    <inertial>']
     if changed:
-        lines.append(f'      <!-- reference inertia {fmt(link.inertia)} is not physical (A + B < C); '
-                     'largest principal moment lowered to A + B, as in the MJCF -->')
+        lines.append(f'      <!-- reference inertia {fmt(link.inertia)} is not physical '
+                     '(A + B < C); largest principal moment lowered to A + B, as in the MJCF -->')
     lines += [f'      <origin xyz="{fmt(link.com_m)}" rpy="0 0 0"/>',
               f'      <mass value="{link.mass_kg!r}"/>',
-              f'      <inertia ixx="{ixx!r}" ixy="{ixy!r}" ixz="{ixz!r}" iyy="{iyy!r}" iyz="{iyz!r}" '
+              f'      <inertia ixx="{ixx!r}" ixy="{ixy!r}" ixz="{ixz!r}" '
+              f'iyy="{iyy!r}" iyz="{iyz!r}" '
               f'izz="{izz!r}"/>',
               '    </inertial>']
     for kind, size, pos, rpy in COLLISION_SHAPES.get(name, []):
@@ -616,8 +635,10 @@ def build_urdf() -> str:
     """Return the URDF text: the MJCF's robot, for robot_state_publisher and rviz."""
     lines = ['<?xml version="1.0"?>',
              '<!--',
-             '  Atlas v1 (DRCSim 2.5.2) as URDF. GENERATED by tools/make_atlas_mjcf.py from the same',
-             '  table as sim/atlas_v1.xml (links, joints, limits, masses, inertias, shapes, colours);',
+             '  Atlas v1 (DRCSim 2.5.2) as URDF. '
+             'GENERATED by tools/make_atlas_mjcf.py from the same',
+             '  table as sim/atlas_v1.xml '
+             '(links, joints, limits, masses, inertias, shapes, colours);',
              '  edit the table, then run:  python3 tools/make_atlas_mjcf.py',
              '  The root link is pelvis; the simulator broadcasts world -> pelvis on /tf.',
              '  Capsules (no URDF primitive) are drawn as a cylinder with a sphere at each end.',

@@ -10,6 +10,7 @@ only while that pid still runs the command line it had (a reused pid is someone 
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import socket
@@ -100,10 +101,8 @@ def kill_if_unchanged(pids: Mapping[int, str]) -> None:
     """SIGKILL each pid that still runs the command line recorded for it."""
     for pid, command in pids.items():
         if command and command_line(pid) == command and alive([pid]):
-            try:
+            with contextlib.suppress(ProcessLookupError, PermissionError):
                 os.kill(pid, signal.SIGKILL)
-            except (ProcessLookupError, PermissionError):
-                pass
 
 
 def stop_tree(process: subprocess.Popen, timeout_s: float = STOP_TIMEOUT_S,
@@ -282,10 +281,8 @@ class _RosProcess:
         while alive(pids) and time.monotonic() - started_s < timeout_s:
             time.sleep(0.02)
         gone_s = time.monotonic() - started_s
-        try:
+        with contextlib.suppress(subprocess.TimeoutExpired):
             self.process.wait(timeout=max(0.0, timeout_s - gone_s))
-        except subprocess.TimeoutExpired:
-            pass
         return gone_s
 
     def close(self, timeout_s: float = STOP_TIMEOUT_S) -> bool:

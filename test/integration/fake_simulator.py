@@ -27,10 +27,12 @@ LINGER_S = 1.0
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument('--subscribe-after', type=float, required=True, help='s of wall time; < 0: never')
+    parser.add_argument('--subscribe-after', type=float, required=True,
+                        help='s of wall time; < 0: never')
     parser.add_argument('--run-for', type=float, required=True, help='s of wall time, then exit')
     parser.add_argument('--until-received', type=int, default=0,
-                        help='exit LINGER_S after this many commands arrived (0: run for --run-for)')
+                        help='exit LINGER_S after this many commands arrived '
+                             '(0: run for --run-for)')
     args = parser.parse_args(rospy.myargv()[1:])
     rospy.init_node('fake_atlas_sim')
     received: list[JointCommands] = []
@@ -43,7 +45,8 @@ def main() -> int:
             time.sleep(LINGER_S)  # a port sending too many would send the next within 20 ms
             break
         if not subscribed and 0 <= args.subscribe_after <= time.monotonic() - started:
-            rospy.Subscriber('/atlas/joint_commands', JointCommands, received.append, queue_size=1000)
+            rospy.Subscriber('/atlas/joint_commands', JointCommands, received.append,
+                             queue_size=1000)
             subscribed = True
         state.header.stamp = rospy.Time.now()
         publisher.publish(state)

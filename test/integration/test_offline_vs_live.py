@@ -19,10 +19,13 @@ import pytest
 
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
-from tutorial_atlas_control.bags.analysis import analyze_bag  # noqa: E402
-from tutorial_atlas_control.bags.compare import (  # noqa: E402
-    compare_bags, first_applied_command_s, format_comparison)
-from tutorial_atlas_control.offline.player import run_offline  # noqa: E402
+from tutorial_atlas_control.bags.analysis import analyze_bag
+from tutorial_atlas_control.bags.compare import (
+    compare_bags,
+    first_applied_command_s,
+    format_comparison,
+)
+from tutorial_atlas_control.offline.player import run_offline
 
 REPO = Path(__file__).resolve().parents[2]
 TRAJECTORIES = REPO / 'trajectories' / 'Traj_data2.yaml'
@@ -52,7 +55,8 @@ def touchdown_run(tmp_path_factory: pytest.TempPathFactory) -> LiveRun:
 
 
 @pytest.mark.parametrize(('trajectory', 'falls'), [('step_and_fall', True), ('touchdown', False)])
-def test_offline_run_reaches_the_live_outcome(trajectory: str, falls: bool, request: pytest.FixtureRequest,
+def test_offline_run_reaches_the_live_outcome(trajectory: str, falls: bool,
+                                              request: pytest.FixtureRequest,
                                               tmp_path: Path) -> None:
     live = request.getfixturevalue('demo_run' if trajectory == 'step_and_fall' else 'touchdown_run')
     assert live.result.returncode == 0, live.result.stdout + live.result.stderr

@@ -13,7 +13,7 @@ import pytest
 
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
-from rosbags.highlevel import AnyReader  # noqa: E402
+from rosbags.highlevel import AnyReader
 
 REPO = Path(__file__).resolve().parents[2]
 DRCSIM_MD5 = 'f298c98f3e9c7aae9376ac19f73bfba3'
@@ -34,7 +34,7 @@ RECORDED_TYPES = {
 CONTROLLER_STATISTICS_MD5 = '628a0c6643f9fd5708402f085735e478'
 
 
-def test_demo_exits_0_and_prints_summary_bag_and_plot(demo_run) -> None:  # noqa: ANN001
+def test_demo_exits_0_and_prints_summary_bag_and_plot(demo_run) -> None:
     result, bag_dir = demo_run.result, demo_run.bag_dir
     assert result.returncode == 0, result.stdout + result.stderr
     assert 'the robot fell: pelvis below 0.5 m at t = ' in result.stdout
@@ -49,7 +49,7 @@ def test_demo_exits_0_and_prints_summary_bag_and_plot(demo_run) -> None:  # noqa
     assert video.stat().st_size > 10_000
 
 
-def test_bag_is_closed_and_indexed(demo_run) -> None:  # noqa: ANN001
+def test_bag_is_closed_and_indexed(demo_run) -> None:
     bag_dir = demo_run.bag_dir
     assert not list(bag_dir.glob('*.active')), 'rosbag left an unclosed .bag.active'
     bag = next(bag_dir.glob('atlas_*.bag'))
@@ -58,7 +58,7 @@ def test_bag_is_closed_and_indexed(demo_run) -> None:  # noqa: ANN001
     assert info.stdout.strip() == 'True'
 
 
-def test_bag_holds_the_run(demo_run) -> None:  # noqa: ANN001
+def test_bag_holds_the_run(demo_run) -> None:
     bag_dir = demo_run.bag_dir
     bag = next(bag_dir.glob('atlas_*.bag'))
     with AnyReader([bag]) as reader:

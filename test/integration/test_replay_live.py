@@ -57,7 +57,7 @@ FALL_WINDOW_S = 5.0
 
 
 @pytest.fixture(scope='session')
-def recorded_bag(demo_run) -> Path:  # noqa: ANN001 - conftest.DemoRun
+def recorded_bag(demo_run) -> Path:  # demo_run: conftest.DemoRun
     """A step_and_fall bag: $TAC_LIVE_REPLAY_BAG, or the shared run_demo.py recording."""
     given = os.environ.get('TAC_LIVE_REPLAY_BAG')
     if given:

@@ -20,15 +20,17 @@ import pytest
 
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
-import rosgraph  # noqa: E402
+import rosgraph
+from test_viewer_window import CHROMA_TOLERANCE, MIN_BRIGHTNESS
 
-from support.launch import wait_sim_time  # noqa: E402
-from support.xdisplay import display_env, find_window, material_mask, screenshot, xvfb  # noqa: E402
-from tutorial_atlas_control.sim import model as atlas_model  # noqa: E402
-from tutorial_atlas_control.processes import (  # noqa: E402
-    free_local_port, ros_environment, stop_tree)
-
-from test_viewer_window import CHROMA_TOLERANCE, MIN_BRIGHTNESS  # noqa: E402
+from support.launch import wait_sim_time
+from support.xdisplay import display_env, find_window, material_mask, screenshot, xvfb
+from tutorial_atlas_control.processes import (
+    free_local_port,
+    ros_environment,
+    stop_tree,
+)
+from tutorial_atlas_control.sim import model as atlas_model
 
 #: rviz/atlas.rviz's background colour: the 3D view is where it shows.
 BACKGROUND_RGB = (48, 48, 48)
@@ -138,8 +140,8 @@ def test_model_variant_without_urdf_runs_without_tf(tmp_path: Path) -> None:
     output = (tmp_path / 'atlas.log').read_text(errors='replace')
     warnings = [line for line in output.splitlines() if 'TF is off' in line]
     assert len(warnings) == 1, output
-    assert f'the model {variant} has no URDF beside it ({tmp_path / "variant.urdf"} does not exist)' \
-        in warnings[0]
+    assert (f'the model {variant} has no URDF beside it '
+            f'({tmp_path / "variant.urdf"} does not exist)') in warnings[0]
     assert '/tf' not in publishers
     assert not has_description
     assert '/clock' in publishers

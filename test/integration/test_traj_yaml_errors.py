@@ -20,7 +20,7 @@ import pytest
 
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
-from tutorial_atlas_control.processes import RosMaster, stop_tree  # noqa: E402
+from tutorial_atlas_control.processes import RosMaster, stop_tree
 
 REPO = Path(__file__).resolve().parents[2]
 TRAJ_YAML = REPO / 'scripts' / 'traj_yaml.py'
@@ -121,9 +121,11 @@ def run_with_fake_simulator(master: Master, subscribe_after_s: float,
     simulator = subprocess.Popen(
         [sys.executable, str(FAKE_SIMULATOR), '--subscribe-after', str(subscribe_after_s),
          '--until-received', str(STEP_AND_FALL_COMMANDS), '--run-for', str(FAKE_SIMULATOR_GUARD_S)],
-        env=master.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+        env=master.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        start_new_session=True)
     try:
-        port = master.run(sys.executable, str(TRAJ_YAML), str(TRAJECTORIES), 'step_and_fall', *ros_args)
+        port = master.run(sys.executable, str(TRAJ_YAML), str(TRAJECTORIES), 'step_and_fall',
+                          *ros_args)
         if port.returncode != 0:
             simulator.send_signal(signal.SIGINT)
         out, err = simulator.communicate(timeout=FAKE_SIMULATOR_GUARD_S + 30)
@@ -137,7 +139,8 @@ def test_a_simulator_that_subscribes_late_gets_every_command(master: Master) -> 
     """The port waits for the simulator: it used to publish after 2 s and the robot fell."""
     port, simulator = run_with_fake_simulator(master, 3.0)
     assert port.returncode == 0, port.stderr
-    assert simulator['received'] == STEP_AND_FALL_COMMANDS, 'every command of step_and_fall reached the simulator'
+    assert simulator['received'] == STEP_AND_FALL_COMMANDS, \
+        'every command of step_and_fall reached the simulator'
     assert simulator['first_position'] == [0.0] * 28, 'the first command is the measured pose'
 
 
@@ -146,7 +149,8 @@ def test_a_simulator_that_never_subscribes_is_refused(master: Master) -> None:
     lines = [line for line in port.stderr.splitlines() if line.strip()]
     assert port.returncode == 1, port
     assert 'Traceback' not in port.stderr
-    assert len(lines) == 1 and 'nothing subscribed to /atlas/joint_commands within 1.5 s' in lines[0], lines
+    assert len(lines) == 1 \
+        and 'nothing subscribed to /atlas/joint_commands within 1.5 s' in lines[0], lines
     assert simulator['received'] == 0
 
 

@@ -24,7 +24,7 @@ if shutil.which('roslaunch') is None or 'TAC_HOME' not in os.environ:
     pytest.skip('needs the project environment (source env.sh)', allow_module_level=True)
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
-from tutorial_atlas_control.processes import free_local_port, stop_tree  # noqa: E402
+from tutorial_atlas_control.processes import free_local_port, stop_tree
 
 REPO = Path(__file__).resolve().parents[2]
 TRAJECTORY_FILE = REPO / 'trajectories' / 'Traj_data2.yaml'
@@ -51,8 +51,9 @@ def fresh_env(home: Path, master_uri: str) -> dict[str, str]:
 
 def bash_i(script: str, env: dict[str, str], cwd: Path = REPO) -> subprocess.CompletedProcess[str]:
     """`script` in a fresh interactive bash, after `source ./env.sh` from the repository."""
-    return subprocess.run(['bash', '-i', '-c', f'source ./env.sh || exit 1\n{script}'], cwd=cwd, env=env,
-                          capture_output=True, text=True, timeout=SHELL_TIMEOUT_S, check=False,
+    return subprocess.run(['bash', '-i', '-c', f'source ./env.sh || exit 1\n{script}'], cwd=cwd,
+                          env=env, capture_output=True, text=True, timeout=SHELL_TIMEOUT_S,
+                          check=False,
                           stdin=subprocess.DEVNULL)
 
 

@@ -26,8 +26,8 @@ from pathlib import Path
 import pytest
 
 from support import xdisplay
-from tutorial_atlas_control.sim.model import SPAWN_HEIGHT_M
 from tutorial_atlas_control.processes import free_local_port, ros_environment, stop_tree
+from tutorial_atlas_control.sim.model import SPAWN_HEIGHT_M
 
 if xdisplay.missing_tools():
     pytest.skip(f'needs {", ".join(xdisplay.missing_tools())} (tools/setup.sh installs '
@@ -96,7 +96,8 @@ def assert_reset_world(report: dict[str, object]) -> None:
     heights = report['pinned_heights_m']
     assert len(heights) >= MIN_PINNED_SAMPLES, heights
     worst = max(abs(z - SPAWN_HEIGHT_M) for z in heights)
-    print(f'\nreset at {report["reset_after_s"]:.3f} s (gesture at {report["gesture_clock_s"]:.3f} s, '
+    print(f'\nreset at {report["reset_after_s"]:.3f} s '
+          f'(gesture at {report["gesture_clock_s"]:.3f} s, '
           f'pelvis was at {report["collapsed_z_m"]:.3f} m): {len(heights)} heights over '
           f'{PINNED_WINDOW_TEXT}, at most {worst * 1000:.3f} mm from the spawn height; '
           f'{report["clock_count"]} /clock messages, {report["clock_backwards"]} backwards')

@@ -23,12 +23,15 @@ import pytest
 
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
-from support.launch import wait_sim_time  # noqa: E402
-from support.xdisplay import display_env, find_window, material_mask, screenshot, xvfb  # noqa: E402
-from tutorial_atlas_control.sim import model as atlas_model  # noqa: E402
-from tutorial_atlas_control.processes import (  # noqa: E402
-    free_local_port, ros_environment, stop_tree)
-from tutorial_atlas_control.sim.camera import configure_viewer_camera  # noqa: E402
+from support.launch import wait_sim_time
+from support.xdisplay import display_env, find_window, material_mask, screenshot, xvfb
+from tutorial_atlas_control.processes import (
+    free_local_port,
+    ros_environment,
+    stop_tree,
+)
+from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.sim.camera import configure_viewer_camera
 
 #: A pixel is the material's colour when its r : g : b is this close (chromaticity distance).
 #: The blue (0.2, 0.3, 0.55) and the sky near the horizon (about 0.33, 0.43, 0.58) are 0.11
@@ -100,7 +103,8 @@ def test_viewer_window_shows_the_whole_robot(tmp_path: Path) -> None:
         log = open(tmp_path / 'launch.log', 'w')  # noqa: SIM115 - closed below
         process = subprocess.Popen(
             ['roslaunch', '-p', str(port), 'tutorial_atlas_control', 'atlas.launch', 'gui:=true',
-             'record:=false'], env=env, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+             'record:=false'], env=env, stdout=log, stderr=subprocess.STDOUT,
+            start_new_session=True)
         try:
             window = find_window(display, 'MuJoCo')
             wait_sim_time(env, SCREENSHOT_AT_S)
@@ -112,7 +116,8 @@ def test_viewer_window_shows_the_whole_robot(tmp_path: Path) -> None:
             log.close()
     seen = robot_on_screen(image, m)
     print(f'viewer {image.shape[1]}x{image.shape[0]}: {seen}, span {seen.span_fraction:.2f} of '
-          f'the height; launch stopped {exit_s:.1f} s after Ctrl-C; screenshot {tmp_path / "viewer.png"}')
+          f'the height; launch stopped {exit_s:.1f} s after Ctrl-C; '
+          f'screenshot {tmp_path / "viewer.png"}')
     assert seen.head_pixels >= MIN_HEAD_PIXELS, 'the head is not on screen'
     assert seen.leg_pixels >= MIN_LEG_PIXELS, 'the legs are not on screen'
     assert seen.feet_on_screen, 'the feet are below the window'

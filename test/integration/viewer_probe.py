@@ -67,7 +67,7 @@ class Probe:
         with self.lock:
             self.last_reset_s = float(json.loads(msg.data)['last_reset_time'])
 
-    def wait(self, condition, what: str, timeout_s: float = TIMEOUT_S) -> None:  # noqa: ANN001
+    def wait(self, condition, what: str, timeout_s: float = TIMEOUT_S) -> None:
         deadline = time.monotonic() + timeout_s
         while True:
             with self.lock:
@@ -95,7 +95,8 @@ def reset_scenario(probe: Probe, gesture: list[str]) -> dict[str, object]:
         reset_s = probe.last_reset_s
     probe.wait(lambda: probe.clock_s >= reset_s + PINNED_WATCH_S, 'sim time after the reset')
     with probe.lock:
-        heights = [z for stamp, z in probe.odom if reset_s + SETTLE_S <= stamp <= reset_s + PINNED_WATCH_S]
+        heights = [z for stamp, z in probe.odom
+                   if reset_s + SETTLE_S <= stamp <= reset_s + PINNED_WATCH_S]
         return {'collapsed_z_m': collapsed_z, 'reset_before_s': before_s, 'reset_after_s': reset_s,
                 'gesture_clock_s': gesture_clock_s, 'pinned_heights_m': heights,
                 'clock_backwards': probe.clock_backwards, 'clock_count': probe.clock_count}

@@ -17,12 +17,19 @@ import yaml
 
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
-from support.bag_checks import (ERROR, FATAL, all_finite, count, log_lines,  # noqa: E402
-                                missing_steps, sim_configs)
-from support.launch import EXIT_TIMEOUT_S, TestLaunch  # noqa: E402
-from tutorial_atlas_control.bags.reader import read_bag  # noqa: E402
-from tutorial_atlas_control.processes import alive  # noqa: E402
-from tutorial_atlas_control.joints import JOINT_NAMES  # noqa: E402
+from support.bag_checks import (
+    ERROR,
+    FATAL,
+    all_finite,
+    count,
+    log_lines,
+    missing_steps,
+    sim_configs,
+)
+from support.launch import EXIT_TIMEOUT_S, TestLaunch
+from tutorial_atlas_control.bags.reader import read_bag
+from tutorial_atlas_control.joints import JOINT_NAMES
+from tutorial_atlas_control.processes import alive
 
 REPO = Path(__file__).resolve().parents[2]
 TRAJECTORIES = REPO / 'trajectories' / 'Traj_data2.yaml'

@@ -25,8 +25,7 @@ import rospy
 import rostest
 from atlas_msgs.msg import ControllerStatistics
 from osrf_msgs.msg import JointCommands
-
-from sim_probe import SimProbe  # noqa: E402
+from sim_probe import SimProbe
 
 PKG = 'tutorial_atlas_control'
 TOPIC = '/atlas/controller_statistics'
@@ -41,7 +40,8 @@ UNPIN_WAIT_S = 1.5
 PERIOD_STEPS = 20
 #: The closed form above (s, s^2).
 EXPECTED_MEAN_S = (1 + PERIOD_STEPS) / 2 * STEP_S
-EXPECTED_VARIANCE_S2 = (PERIOD_STEPS ** 2 - 1) / 12 * STEP_S ** 2 * WINDOW_STEPS / (WINDOW_STEPS - 1)
+EXPECTED_VARIANCE_S2 = ((PERIOD_STEPS ** 2 - 1) / 12 * STEP_S ** 2
+                        * WINDOW_STEPS / (WINDOW_STEPS - 1))
 #: The issue's bounds on the mean age: a command held 20 ms (mean 9.5 ms) plus one step,
 #: with room for a command that arrives a step late now and then.
 MEAN_RANGE_S = (0.010, 0.012)
@@ -183,7 +183,8 @@ class CommandAgeTest(unittest.TestCase):
         self.assertGreater(measured.max() - measured.min(), 0.6, 'the joint moves with the sine')
         self.assertGreater(len(statistics), TRACKING_S * 900)  # every step by default
         self.assertIn(int(np.median(ages)), ANSWER_AGES_STEPS)
-        self.assertGreaterEqual(share, ONE_OR_TWO_STEPS_SHARE, f'command ages (steps: count) {counts}')
+        self.assertGreaterEqual(share, ONE_OR_TWO_STEPS_SHARE,
+                                f'command ages (steps: count) {counts}')
 
 
 if __name__ == '__main__':

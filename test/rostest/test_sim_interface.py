@@ -11,13 +11,12 @@ import rosgraph
 import rospy
 import rostest
 from rosgraph_msgs.msg import Clock
-
 from sim_probe import SimProbe  # beside this script, on its sys.path
 
-from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.sim.controller import gains_from_params
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.sim.controller import gains_from_params
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode
 
 PKG = 'tutorial_atlas_control'
@@ -65,7 +64,8 @@ class SimInterfaceTest(unittest.TestCase):
             probe.keep_joint_states = False
             states = list(probe.joint_states)
         clock_sub.unregister()
-        stamps = np.array([s.header.stamp.to_nsec() for s in states if s.header.stamp.to_nsec() > start_ns])
+        stamps = np.array([s.header.stamp.to_nsec() for s in states
+                           if s.header.stamp.to_nsec() > start_ns])
         self.assertGreater(len(stamps), 950, 'about 1000 joint states per second of sim time')
         steps = np.diff(stamps)
         self.assertEqual(int(np.median(steps)), STEP_NS)
@@ -194,7 +194,8 @@ class SimInterfaceTest(unittest.TestCase):
             stamp_ns, z = probe.pelvis_z_stamped()
             if reset_ns <= stamp_ns < unpin_ns:
                 self.assertAlmostEqual(z, spawn_z, delta=0.002,
-                                       msg=f'pinned torso, {(stamp_ns - reset_ns) / 1e6:.0f} ms after the reset')
+                                       msg=f'pinned torso, {(stamp_ns - reset_ns) / 1e6:.0f} '
+                                           'ms after the reset')
                 pinned_readings += 1
             probe.wait_sim(0.02)
         self.assertGreaterEqual(pinned_readings, 5, 'readings of the pinned torso')

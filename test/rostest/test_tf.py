@@ -69,7 +69,7 @@ class TfTest(unittest.TestCase):
         time.sleep(0.5)  # the messages stamped before it arrive
 
     @classmethod
-    def _wait(cls, predicate, what: str) -> None:  # noqa: ANN001
+    def _wait(cls, predicate, what: str) -> None:
         deadline = time.monotonic() + WALL_TIMEOUT_S
         while not predicate():
             if time.monotonic() > deadline or rospy.is_shutdown():
@@ -96,7 +96,8 @@ class TfTest(unittest.TestCase):
     def _on_odom(cls, msg: Odometry) -> None:
         p, q = msg.pose.pose.position, msg.pose.pose.orientation
         with cls.lock:
-            cls.pelvis_odom[msg.header.stamp.to_nsec()] = np.array([p.x, p.y, p.z, q.x, q.y, q.z, q.w])
+            cls.pelvis_odom[msg.header.stamp.to_nsec()] = np.array(
+                [p.x, p.y, p.z, q.x, q.y, q.z, q.w])
 
     def test_every_link_of_robot_description_is_on_tf_within_2_s(self) -> None:
         root = ET.fromstring(rospy.get_param('/robot_description'))
@@ -108,7 +109,8 @@ class TfTest(unittest.TestCase):
         self.assertEqual(missing, [], 'links never seen on /tf')
         late = {link: first[link] for link in links if first[link] > ALL_LINKS_WITHIN_S}
         self.assertEqual(late, {}, f'links first on /tf after {ALL_LINKS_WITHIN_S} s of sim time')
-        rospy.loginfo(f'every link on /tf by {max(first[link] for link in links):.3f} s of sim time')
+        rospy.loginfo(
+            f'every link on /tf by {max(first[link] for link in links):.3f} s of sim time')
 
     def test_world_to_pelvis_is_the_ground_truth(self) -> None:
         with self.lock:

@@ -20,11 +20,10 @@ import rostest
 from geometry_msgs.msg import WrenchStamped
 from nav_msgs.msg import Odometry
 from osrf_msgs.msg import JointCommands
-
 from sim_probe import SimProbe  # beside this script, on its sys.path
 
-from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.joints import JOINT_INDEX
+from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.trajectories.trajectory import load_trajectory, sample_count
 
 PKG = 'tutorial_atlas_control'
@@ -252,7 +251,8 @@ class TutorialRunTest(unittest.TestCase):
         first_waypoint = load_trajectory(TRAJECTORY_FILE, self.trajectory)[0]
         first_start = ends[0] - int(first_waypoint.duration_s * 1e9)
         lift = self.right_foot_lift_m(first_start, ends[0])
-        min_force = min(f for t, f in list(self.recorder.r_force_n.items()) if first_start <= t <= ends[0])
+        min_force = min(f for t, f in list(self.recorder.r_force_n.items())
+                        if first_start <= t <= ends[0])
         rospy.loginfo(f'step_and_fall waypoint 0: right foot up {lift * 100:.1f} cm, '
                       f'smallest right ankle force {min_force:.1f} N')
         self.assertTrue(lift > FOOT_LIFT_M or min_force < FOOT_UNLOADED_N,

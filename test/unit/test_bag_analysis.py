@@ -8,6 +8,8 @@ import numpy as np
 import pytest
 from rosbags.rosbag1 import Writer
 
+from tutorial_atlas_control.bags.analysis import EFFORT_LIMITS_NM, analyze, analyze_bag
+from tutorial_atlas_control.bags.reader import read_bag
 from tutorial_atlas_control.bags.synthetic import (
     clock,
     control_mode,
@@ -18,8 +20,6 @@ from tutorial_atlas_control.bags.synthetic import (
     write_bag,
     write_run_bag,
 )
-from tutorial_atlas_control.bags.analysis import EFFORT_LIMITS_NM, analyze, analyze_bag
-from tutorial_atlas_control.bags.reader import read_bag
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 
 ELX = JOINT_NAMES.index('l_arm_elx')

@@ -1,4 +1,4 @@
-"""Every script follows tutorial_atlas_control.cli.convention's convention, run from a clone, anywhere."""
+"""Every script follows tutorial_atlas_control.cli.convention, run from a clone, anywhere."""
 
 from __future__ import annotations
 
@@ -10,7 +10,8 @@ from pathlib import Path
 import pytest
 
 SCRIPTS = Path(__file__).resolve().parents[2] / 'scripts'
-PYTHON_SCRIPTS = ('analyze_bag.py', 'replay_bag.py', 'run_demo.py', 'run_offline.py', 'traj_yaml.py')
+PYTHON_SCRIPTS = ('analyze_bag.py', 'replay_bag.py', 'run_demo.py', 'run_offline.py',
+                  'traj_yaml.py')
 
 
 def run(script: str, *args: str) -> subprocess.CompletedProcess[str]:
@@ -50,7 +51,8 @@ def test_bad_command_line_exits_2(script: str, args: list[str], message: str) ->
     ('analyze_bag.py', ['/nonexistent/run.bag'], 'no such file'),
     ('replay_bag.py', ['/nonexistent/run.bag'], 'no such file'),
     ('run_demo.py', ['--file', '/nonexistent/Traj.yaml'], '/nonexistent/Traj.yaml: cannot read'),
-    ('run_offline.py', ['/nonexistent/Traj.yaml', 'touchdown'], '/nonexistent/Traj.yaml: cannot read'),
+    ('run_offline.py', ['/nonexistent/Traj.yaml', 'touchdown'],
+     '/nonexistent/Traj.yaml: cannot read'),
 ])
 def test_refused_input_exits_1_with_one_line(script: str, args: list[str], message: str) -> None:
     result = run(script, *args)

@@ -8,10 +8,16 @@ import math
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.msgs.commands import (
-    FIELD_NAMES, MAX_MAGNITUDE, CommandDecoder, CommandError, JointCommandArrays, joint_indices,
-    merge_command)
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.msgs.commands import (
+    FIELD_NAMES,
+    MAX_MAGNITUDE,
+    CommandDecoder,
+    CommandError,
+    JointCommandArrays,
+    joint_indices,
+    merge_command,
+)
 
 
 def previous_command() -> JointCommandArrays:
@@ -154,7 +160,7 @@ def test_a_full_command_is_complete() -> None:
     (lambda raw: raw[:20], 'malformed message'),
     (lambda raw: b'', 'malformed message'),
 ])
-def test_decoder_refuses_malformed_bytes(cut, reason: str) -> None:  # noqa: ANN001
+def test_decoder_refuses_malformed_bytes(cut, reason: str) -> None:
     raw = serialized(['neck_ay', 'back_lbz'], position=[0.1, 0.2])
     with pytest.raises(CommandError, match=reason):
         CommandDecoder().decode(cut(raw))

@@ -11,11 +11,18 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
-from tutorial_atlas_control.msgs.commands import FIELD_NAMES, JointCommandArrays
-from tutorial_atlas_control.sim.controller import (
-    Gains, GainsError, PidState, compute_torque, gains_from_params, hold_command, load_gains_yaml)
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.msgs.commands import FIELD_NAMES, JointCommandArrays
+from tutorial_atlas_control.sim.controller import (
+    Gains,
+    GainsError,
+    PidState,
+    compute_torque,
+    gains_from_params,
+    hold_command,
+    load_gains_yaml,
+)
 
 REPO = Path(__file__).resolve().parents[2]
 GAINS_YAML = REPO / 'config' / 'atlas_controller.yaml'
@@ -42,7 +49,8 @@ def one_joint(**values: float) -> JointCommandArrays:
     return command
 
 
-def torque(command: JointCommandArrays, q: float, v: float = 0.0, state: PidState | None = None) -> float:
+def torque(command: JointCommandArrays, q: float, v: float = 0.0,
+           state: PidState | None = None) -> float:
     state = PidState() if state is None else state
     result = compute_torque(command, np.full(NUM_JOINTS, q), np.full(NUM_JOINTS, v), state, DT_S,
                             LOWER, UPPER, LIMIT)
@@ -55,7 +63,7 @@ def torque(command: JointCommandArrays, q: float, v: float = 0.0, state: PidStat
 def test_field_names_follow_the_message() -> None:
     lines = (REPO / 'msg' / 'osrf_msgs' / 'msg' / 'JointCommands.msg').read_text().splitlines()
     arrays = [line.split()[1] for line in lines if line.startswith('float64[]')]
-    assert FIELD_NAMES == tuple(arrays)
+    assert tuple(arrays) == FIELD_NAMES
 
 
 def test_zeros_and_copy_are_independent() -> None:
@@ -131,7 +139,8 @@ def test_negative_ki_drives_the_integral_down() -> None:
     state = PidState()
     for _ in range(100):
         last = torque(command, q=0.0, state=state)
-    assert last == pytest.approx(-0.2)  # ki < 0, e > 0: the integral torque falls to its lower bound
+    # ki < 0, e > 0: the integral torque falls to its lower bound
+    assert last == pytest.approx(-0.2)
 
 
 def test_inverted_integral_bounds_clamp_as_gazebo_did() -> None:
@@ -174,8 +183,10 @@ def test_zero_ki_adds_nothing_to_a_zero_integral() -> None:
 
 
 def test_target_is_clamped_to_the_joint_limits() -> None:
-    assert torque(one_joint(position=3.0, kp_position=10.0), q=0.0) == pytest.approx(10.0 * UPPER[0])
-    assert torque(one_joint(position=-3.0, kp_position=10.0), q=0.0) == pytest.approx(10.0 * LOWER[0])
+    assert torque(one_joint(position=3.0, kp_position=10.0), q=0.0) == \
+        pytest.approx(10.0 * UPPER[0])
+    assert torque(one_joint(position=-3.0, kp_position=10.0), q=0.0) == \
+        pytest.approx(10.0 * LOWER[0])
 
 
 def test_torque_is_clamped_to_the_effort_limit() -> None:
@@ -226,7 +237,8 @@ def random_command(rng: np.random.Generator) -> JointCommandArrays:
         position=rng.uniform(-2.0, 2.0, NUM_JOINTS),
         velocity=rng.uniform(-3.0, 3.0, NUM_JOINTS),
         effort=rng.uniform(-60.0, 60.0, NUM_JOINTS),
-        kp_position=rng.choice([0.0, 10.0, 300.0, 4000.0], NUM_JOINTS) * rng.uniform(0, 1, NUM_JOINTS),
+        kp_position=(rng.choice([0.0, 10.0, 300.0, 4000.0], NUM_JOINTS)
+                     * rng.uniform(0, 1, NUM_JOINTS)),
         ki_position=rng.choice([0.0, 1e-7, -5e-7, 50.0, -50.0, 3000.0, -3000.0], NUM_JOINTS)
         * rng.uniform(0.5, 1.5, NUM_JOINTS),
         kd_position=rng.uniform(0.0, 20.0, NUM_JOINTS),
@@ -268,7 +280,8 @@ def test_vectorized_law_equals_the_scalar_transcription() -> None:
                 largest = max(largest, abs(result[j] - expected),
                               abs(state.integral[j] - joint.integral))
             counts['tie_backs'] += sum(joint.tied_back for joint in joints)
-            counts['inverted_bounds'] += int(np.count_nonzero(command.i_effort_min > command.i_effort_max))
+            counts['inverted_bounds'] += int(
+                np.count_nonzero(command.i_effort_min > command.i_effort_max))
             counts['negative_ki'] += int(np.count_nonzero(command.ki_position < -1e-6))
     assert largest == 0.0
     assert min(counts.values()) > 1000, counts  # every case the law distinguishes was exercised
@@ -278,7 +291,8 @@ def test_vectorized_law_equals_the_scalar_transcription() -> None:
 @given(hnp.arrays(np.float64, NUM_JOINTS, elements=st.floats(-1e6, 1e6)),
        hnp.arrays(np.float64, NUM_JOINTS, elements=st.floats(-10, 10)),
        hnp.arrays(np.float64, NUM_JOINTS, elements=st.floats(-100, 100)))
-def test_torque_never_exceeds_the_effort_limit(gain: np.ndarray, q: np.ndarray, v: np.ndarray) -> None:
+def test_torque_never_exceeds_the_effort_limit(gain: np.ndarray, q: np.ndarray,
+                                               v: np.ndarray) -> None:
     command = JointCommandArrays(**{name: gain.copy() for name in FIELD_NAMES})
     state = PidState()
     for _ in range(2):
@@ -309,9 +323,11 @@ def test_config_has_the_drcsim_gains() -> None:
 def test_gains_from_params_names_the_missing_parameter() -> None:
     params = drcsim_params()
     del params['l_leg_kny']['p']
-    with pytest.raises(GainsError, match=r'^parameter atlas_controller/gains/l_leg_kny/p is missing; '
+    with pytest.raises(GainsError, match=r'^parameter atlas_controller/gains/l_leg_kny/p '
+                                         r'is missing; '
                                          r'load the gains with `roslaunch tutorial_atlas_control '
-                                         r'atlas.launch` or `rosparam load config/atlas_controller.yaml`$'):
+                                         r'atlas.launch` or '
+                                         r'`rosparam load config/atlas_controller.yaml`$'):
         gains_from_params(params)
     params = drcsim_params()
     del params['r_arm_mwx']
@@ -324,7 +340,8 @@ def test_gains_from_params_names_the_missing_parameter() -> None:
 def test_gains_from_params_rejects_non_numbers(bad: object) -> None:
     params = drcsim_params()
     params['neck_ay']['d'] = bad
-    with pytest.raises(GainsError, match='atlas_controller/gains/neck_ay/d is .*not a finite number'):
+    with pytest.raises(GainsError,
+                       match='atlas_controller/gains/neck_ay/d is .*not a finite number'):
         gains_from_params(params)
 
 

@@ -5,9 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.sim.controller_statistics import (
-    CommandAgeStatistics, StatisticsConfigError, update_period_ns, window_steps)
 from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.sim.controller_statistics import (
+    CommandAgeStatistics,
+    StatisticsConfigError,
+    update_period_ns,
+    window_steps,
+)
 
 DT_S = 0.001
 STEP_NS = 1_000_000
@@ -99,7 +103,8 @@ def test_publication_rate() -> None:
 
 
 @pytest.mark.parametrize(('rate_hz', 'period_ns'), [
-    (None, 0), (1000.0, 1_000_000), (0.0, 10 ** 9), (-5, 10 ** 9), (1e6, 100_000), (250, 4_000_000)])
+    (None, 0), (1000.0, 1_000_000), (0.0, 10 ** 9), (-5, 10 ** 9), (1e6, 100_000),
+    (250, 4_000_000)])
 def test_update_rate_is_clamped_to_1_to_10000_hz(rate_hz: float | None, period_ns: int) -> None:
     assert update_period_ns(rate_hz) == period_ns
 
@@ -107,14 +112,16 @@ def test_update_rate_is_clamped_to_1_to_10000_hz(rate_hz: float | None, period_n
 @pytest.mark.parametrize('bad', ['fast', float('nan'), float('inf'), True, [10]])
 def test_bad_update_rate_names_the_parameter(bad: object) -> None:
     with pytest.raises(StatisticsConfigError,
-                       match=r'^parameter /atlas/controller_statistics/update_rate is .*rate in Hz'):
+                       match=r'^parameter /atlas/controller_statistics/update_rate '
+                             r'is .*rate in Hz'):
         update_period_ns(bad)  # type: ignore[arg-type]
 
 
 @pytest.mark.parametrize('bad', [0.0, -1.0, float('nan'), 1e9, 'long', False])
 def test_bad_window_names_the_parameter(bad: object) -> None:
     with pytest.raises(StatisticsConfigError,
-                       match=r'^parameter atlas_controller/statistics_time_window_size is .*seconds'):
+                       match=r'^parameter atlas_controller/statistics_time_window_size '
+                             r'is .*seconds'):
         window_steps(bad, DT_S)  # type: ignore[arg-type]
     assert issubclass(StatisticsConfigError, AtlasControlError)
 

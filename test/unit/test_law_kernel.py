@@ -10,11 +10,11 @@ import pytest
 from test_controller import random_command
 
 from tutorial_atlas_control import native
+from tutorial_atlas_control.joints import NUM_JOINTS
+from tutorial_atlas_control.msgs.commands import FIELD_NAMES, JointCommandArrays
 from tutorial_atlas_control.sim import law_kernel
 from tutorial_atlas_control.sim import model as atlas_model
-from tutorial_atlas_control.msgs.commands import FIELD_NAMES, JointCommandArrays
 from tutorial_atlas_control.sim.controller import PidState, compute_torque, load_gains_yaml
-from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode
 
 CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
@@ -47,7 +47,7 @@ class Joints:
         self.qvel[self.dof_adr] = v
 
 
-def test_compiled_law_equals_the_numpy_law_on_random_inputs(library) -> None:  # noqa: ANN001
+def test_compiled_law_equals_the_numpy_law_on_random_inputs(library) -> None:
     """300 runs of 60 steps: saturation, tie-back, ki changes and sign flips, inverted
     integral bounds, targets beyond the limits, resets mid-run; torque and memory compared."""
     rng = np.random.default_rng(18)
@@ -97,7 +97,7 @@ def test_compiled_law_equals_the_numpy_law_on_random_inputs(library) -> None:  #
     assert min(counts.values()) > 1000, counts  # every case the law distinguishes was exercised
 
 
-def test_compiled_law_refuses_misshapen_arrays(library) -> None:  # noqa: ANN001
+def test_compiled_law_refuses_misshapen_arrays(library) -> None:
     state = PidState()
     good = np.zeros(NUM_JOINTS)
     adr = np.arange(NUM_JOINTS, dtype=np.intp)
@@ -135,7 +135,7 @@ def run_simulator(compiled_law: bool) -> tuple[AtlasSimulator, list[bytes]]:
     return sim, states
 
 
-def test_simulator_runs_identically_with_either_law(library) -> None:  # noqa: ANN001
+def test_simulator_runs_identically_with_either_law(library) -> None:
     _, with_c = run_simulator(True)
     _, with_numpy = run_simulator(False)
     first_difference = next((i for i, (a, b) in enumerate(zip(with_c, with_numpy)) if a != b),
@@ -162,7 +162,7 @@ def test_missing_library_falls_back_to_numpy_with_one_warning(
     assert np.isfinite(second.torque_nm).all()
 
 
-def test_ragdoll_command_gives_zero_torque(library) -> None:  # noqa: ANN001
+def test_ragdoll_command_gives_zero_torque(library) -> None:
     sim = AtlasSimulator(atlas_model.load_model(), load_gains_yaml(CONFIG))
     sim.set_mode(ControlMode.RAGDOLL)
     sim.step()

@@ -42,7 +42,8 @@ def test_simulator_subscribes_with_the_real_type_and_md5() -> None:
 
 
 def test_controller_statistics_is_drcsim_atlas_msgs() -> None:
-    atlas = pytest.importorskip('atlas_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
+    atlas = pytest.importorskip('atlas_msgs.msg',
+                                reason='needs the catkin workspace: source ./env.sh')
     assert atlas.ControllerStatistics._type == 'atlas_msgs/ControllerStatistics'
     assert atlas.ControllerStatistics._md5sum == '628a0c6643f9fd5708402f085735e478'
     assert atlas.ControllerStatistics.__slots__ == [

@@ -8,12 +8,11 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
+
 from support.model_table import load_table
-
-from tutorial_atlas_control.msgs import commands
-
-from tutorial_atlas_control.sim import controller, model
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.msgs import commands
+from tutorial_atlas_control.sim import controller, model
 
 REPO = Path(__file__).resolve().parents[2]
 REFERENCE = REPO.parent / 'shared' / 'reference'
@@ -88,7 +87,8 @@ def test_every_link_matches_the_table(atlas: model.AtlasModel) -> None:
 def test_corrected_inertias_change_only_the_largest_principal_moment() -> None:
     for name in ('utorso', 'head'):
         original = np.linalg.eigvalsh(TABLE.inertia_matrix(TABLE.LINKS[name].inertia))
-        fixed = np.linalg.eigvalsh(TABLE.inertia_matrix(TABLE.corrected_inertia(TABLE.LINKS[name].inertia)[0]))
+        fixed = np.linalg.eigvalsh(
+            TABLE.inertia_matrix(TABLE.corrected_inertia(TABLE.LINKS[name].inertia)[0]))
         np.testing.assert_allclose(fixed[:2], original[:2], rtol=1e-5)
         assert fixed[2] < original[2]
         assert fixed[0] + fixed[1] >= fixed[2]
@@ -116,7 +116,8 @@ def test_simulation_options(atlas: model.AtlasModel) -> None:
     assert m.opt.integrator == mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     assert m.vis.global_.offwidth >= 1280 and m.vis.global_.offheight >= 720
     camera = m.camera('track')
-    assert int(camera.mode[0]) in (int(mujoco.mjtCamLight.mjCAMLIGHT_TRACKCOM), int(mujoco.mjtCamLight.mjCAMLIGHT_TRACK))
+    assert int(camera.mode[0]) in (int(mujoco.mjtCamLight.mjCAMLIGHT_TRACKCOM),
+                                   int(mujoco.mjtCamLight.mjCAMLIGHT_TRACK))
     assert body_name(m, int(camera.bodyid[0])) == 'pelvis'
     assert m.nlight >= 1
 
@@ -151,7 +152,8 @@ def test_load_model_errors(tmp_path: Path) -> None:
 # --- initial state -----------------------------------------------------------------------------
 
 def test_spawn_puts_the_soles_on_the_floor(atlas: model.AtlasModel) -> None:
-    assert model.SPAWN_HEIGHT_M == pytest.approx(TABLE.SPAWN_HEIGHT_M, abs=1e-12)
+    # SIM300 below: pytest.approx goes on the right (the rule takes SPAWN_HEIGHT_M for a literal)
+    assert model.SPAWN_HEIGHT_M == pytest.approx(TABLE.SPAWN_HEIGHT_M, abs=1e-12)  # noqa: SIM300
     data = mujoco.MjData(atlas.model)
     data.qpos[:] = 1.0
     model.reset_to_initial(atlas, data)
@@ -164,7 +166,7 @@ def test_spawn_puts_the_soles_on_the_floor(atlas: model.AtlasModel) -> None:
         bottom = data.geom(sole.id).xpos[2] - sole.size[2]
         assert bottom == pytest.approx(0.0, abs=1e-9)
     # DRCSim spawned the pelvis at 0.93 m, 2.9 mm higher.
-    assert 0.93 - model.SPAWN_HEIGHT_M == pytest.approx(0.002881, abs=1e-6)
+    assert 0.93 - model.SPAWN_HEIGHT_M == pytest.approx(0.002881, abs=1e-6)  # noqa: SIM300
 
 
 def test_pin_holds_the_spawn_pose_without_a_jump(atlas: model.AtlasModel) -> None:
@@ -207,12 +209,14 @@ def simulate(atlas: model.AtlasModel, command: commands.JointCommandArrays, seco
             model.set_pelvis_pinned(atlas, data, False)
         controller.compute_torque(command, model.joint_positions(atlas, data),
                                   model.joint_velocities(atlas, data), state, dt_s,
-                                  atlas.lower_rad, atlas.upper_rad, atlas.effort_limit_nm, out=torque)
+                                  atlas.lower_rad, atlas.upper_rad, atlas.effort_limit_nm,
+                                  out=torque)
         data.ctrl[:] = torque
         mujoco.mj_step(m, data)
         z = data.qpos[atlas.free_qpos_adr + 2]
         worst_dz = max(worst_dz, abs(z - z_start))
-        worst_slide = max(worst_slide, float(np.linalg.norm(data.xpos[feet, :2] - feet_start, axis=1).max()))
+        worst_slide = max(worst_slide,
+                          float(np.linalg.norm(data.xpos[feet, :2] - feet_start, axis=1).max()))
         if z < 0.5:
             fall_time = data.time
             break
@@ -223,7 +227,8 @@ def simulate(atlas: model.AtlasModel, command: commands.JointCommandArrays, seco
 @pytest.mark.parametrize('pin_seconds', [1.0, 0.0], ids=['pinned_1s', 'never_pinned'])
 def test_stands_30s_on_the_pd_law_alone(atlas: model.AtlasModel, pin_seconds: float) -> None:
     gains = controller.load_gains_yaml(GAINS_YAML)
-    result = simulate(atlas, controller.hold_command(gains, np.zeros(NUM_JOINTS)), 30.0, pin_seconds)
+    result = simulate(atlas, controller.hold_command(gains, np.zeros(NUM_JOINTS)), 30.0,
+                      pin_seconds)
     assert result['fall_time'] == float('inf')
     assert result['dz'] < 0.02   # m, pelvis height
     assert result['slide'] < 0.01  # m, each foot, horizontally
@@ -246,8 +251,9 @@ def test_simulation_is_deterministic(atlas: model.AtlasModel) -> None:
         state = controller.PidState()
         for _ in range(1500):
             data.ctrl[:] = controller.compute_torque(
-                command, model.joint_positions(atlas, data), model.joint_velocities(atlas, data), state,
-                atlas.model.opt.timestep, atlas.lower_rad, atlas.upper_rad, atlas.effort_limit_nm)
+                command, model.joint_positions(atlas, data), model.joint_velocities(atlas, data),
+                state, atlas.model.opt.timestep, atlas.lower_rad, atlas.upper_rad,
+                atlas.effort_limit_nm)
             mujoco.mj_step(atlas.model, data)
         return data.qpos.copy()
 
@@ -302,7 +308,8 @@ def test_table_matches_atlas_urdf() -> None:
     assert tuple(float(inertia.get(k)) for k in ('ixx', 'iyy', 'izz', 'ixy', 'ixz', 'iyz')) \
         == TABLE.LINKS['head'].inertia
     assert total + head_mass == pytest.approx(TABLE.REFERENCE_TOTAL_MASS_KG, rel=1e-12)
-    assert model.load_model().model.body_subtreemass[1] == pytest.approx(total + head_mass, rel=1e-3)
+    assert model.load_model().model.body_subtreemass[1] == \
+        pytest.approx(total + head_mass, rel=1e-3)
 
 
 @needs_reference

@@ -5,8 +5,8 @@ Short runs (a 0.1 s waypoint after 1.1 s, 0.2 s of settling) keep each test to a
 
 from __future__ import annotations
 
-import io
 import importlib.util
+import io
 import json
 import os
 import subprocess
@@ -16,10 +16,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.sim.controller import load_gains_yaml
-from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.cli.run_offline import main
+from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.offline.player import run_offline
+from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.trajectories.trajectory import TrajectoryError
 
 REPO = Path(__file__).resolve().parents[2]
@@ -55,7 +55,7 @@ def trajectory_file(tmp_path: Path) -> Path:
     return path
 
 
-def short_run(trajectory_file: Path, bag: Path):  # noqa: ANN201
+def short_run(trajectory_file: Path, bag: Path):
     return run_offline(str(trajectory_file), 'elbow', bag, settle_s=SETTLE_S,
                        start_after_s=START_AFTER_S, gains_file=GAINS)
 
@@ -86,7 +86,8 @@ def test_bag_opens_in_debian_rosbag_as_a_live_run(trajectory_file: Path, tmp_pat
         assert {topic: (value.msg_type, ) for topic, value in info.topics.items()} == {
             topic: (msgtype, ) for topic, (msgtype, _md5) in RECORDED.items()}
         assert {msgtype: md5 for msgtype, md5 in info.msg_types.items()} == dict(RECORDED.values())
-        commands = [(msg, t) for _, msg, t in opened.read_messages(topics=['/atlas/joint_commands'])]
+        commands = [(msg, t)
+                    for _, msg, t in opened.read_messages(topics=['/atlas/joint_commands'])]
         modes = [(msg.data, t.to_sec()) for _, msg, t in
                  opened.read_messages(topics=['/atlas/control_mode'])]
         logs = [msg.msg for _, msg, _ in opened.read_messages(topics=['/rosout'])]
@@ -163,11 +164,13 @@ def run_script(args: list[str], cwd: Path) -> subprocess.CompletedProcess[str]:
 
 
 @pytest.mark.parametrize(('args', 'message'), [
-    (['missing.yaml', 'elbow'], 'missing.yaml: cannot read trajectory file: No such file or directory'),
+    (['missing.yaml', 'elbow'],
+     'missing.yaml: cannot read trajectory file: No such file or directory'),
     (['short.yaml', 'nope'], 'unable to find trajectory nope in short.yaml'),
     (['bad.yaml', 'elbow'], "bad.yaml: trajectory 'elbow', waypoint 0: duration must be positive"),
     (['short.yaml', 'elbow', '--gains', 'missing_gains.yaml'], 'Could not read gains from'),
-    (['short.yaml', 'elbow', '--bag', 'no/such/dir/out.bag'], 'directory no/such/dir does not exist'),
+    (['short.yaml', 'elbow', '--bag', 'no/such/dir/out.bag'],
+     'directory no/such/dir does not exist'),
 ])
 def test_errors_are_one_line_and_write_nothing(trajectory_file: Path, args: list[str],
                                                 message: str) -> None:

@@ -10,9 +10,18 @@ from pathlib import Path
 import pytest
 
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.processes import (AtlasLaunch, ProcessError, alive, command_line,
-                                              default_sigint, descendants, free_local_port,
-                                              rss_kib, stop_tree, wait_until)
+from tutorial_atlas_control.processes import (
+    AtlasLaunch,
+    ProcessError,
+    alive,
+    command_line,
+    default_sigint,
+    descendants,
+    free_local_port,
+    rss_kib,
+    stop_tree,
+    wait_until,
+)
 
 #: Guard (s) for child processes to start or be reaped, however busy the machine is.
 GUARD_S = 30.0
@@ -44,8 +53,9 @@ def test_stop_tree_kills_what_ignores_sigint_including_other_sessions() -> None:
     parent = subprocess.Popen(['bash', '-c', STUBBORN_TREE], start_new_session=True)
     # Both sleeps running: before that, a forked child still shows its parent's command line
     # and has not set its trap yet.
-    wait_until(lambda: [command_line(pid) for pid in descendants(parent.pid)].count('sleep 300') == 2,
-               GUARD_S, 'children did not start')
+    wait_until(
+        lambda: [command_line(pid) for pid in descendants(parent.pid)].count('sleep 300') == 2,
+        GUARD_S, 'children did not start')
     children = descendants(parent.pid)
     assert stop_tree(parent, timeout_s=0.5) is False, 'it had to be killed'
     assert parent.poll() == -signal.SIGKILL

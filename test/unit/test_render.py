@@ -13,13 +13,25 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from tutorial_atlas_control.bags.synthetic import STANDING_HEIGHT_M, joint_state, odometry, write_bag, write_run_bag
-from tutorial_atlas_control.cli.analyze_bag import main as analyze_main
 from tutorial_atlas_control.bags.reader import read_bag
-from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.bags.render import (
-    RenderError, RunStates, StateRenderer, check_output_path, parse_size, render_states,
-    states_from_bag)
+    RenderError,
+    RunStates,
+    StateRenderer,
+    check_output_path,
+    parse_size,
+    render_states,
+    states_from_bag,
+)
+from tutorial_atlas_control.bags.synthetic import (
+    STANDING_HEIGHT_M,
+    joint_state,
+    odometry,
+    write_bag,
+    write_run_bag,
+)
+from tutorial_atlas_control.cli.analyze_bag import main as analyze_main
+from tutorial_atlas_control.joints import NUM_JOINTS
 
 SCRIPT = Path(__file__).resolve().parents[2] / 'scripts' / 'analyze_bag.py'
 UPRIGHT = np.array([1.0, 0.0, 0.0, 0.0])

@@ -14,15 +14,19 @@ from typing import Any, Callable
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.bags.synthetic import TYPESTORE, Record, joint_state, write_bag
-from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.bags.reader import read_bag
-from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, hold_command, load_gains_yaml
+from tutorial_atlas_control.bags.synthetic import TYPESTORE, Record, joint_state, write_bag
+from tutorial_atlas_control.cli.replay_bag import EXIT_DEVIATES, main
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.cli.replay_bag import EXIT_DEVIATES, main
 from tutorial_atlas_control.offline.replay import (
-    ReplayError, format_report, load_recording, replay_bag)
+    ReplayError,
+    format_report,
+    load_recording,
+    replay_bag,
+)
+from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, hold_command, load_gains_yaml
 from tutorial_atlas_control.sim.sim_config import SimConfig
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode
 
@@ -78,7 +82,8 @@ class Run:
 
     def __post_init__(self) -> None:
         self.atlas = atlas_model.load_model()
-        self.sim = AtlasSimulator(self.atlas, load_gains_yaml(DEFAULT_GAINS_FILE), self.time_to_unpin_s)
+        self.sim = AtlasSimulator(self.atlas, load_gains_yaml(DEFAULT_GAINS_FILE),
+                                  self.time_to_unpin_s)
         self.steps = 0
         self._publish_config()
 

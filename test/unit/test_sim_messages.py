@@ -7,10 +7,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.sim import controller, model
-from tutorial_atlas_control.trajectories.schedule import parse_trajectory_log_line, trajectory_log_line
 from tutorial_atlas_control.msgs.sim_messages import SimMessages
+from tutorial_atlas_control.sim import controller, model
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
+from tutorial_atlas_control.trajectories.schedule import (
+    parse_trajectory_log_line,
+    trajectory_log_line,
+)
 
 GAINS = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
 

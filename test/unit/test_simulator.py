@@ -7,12 +7,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.sim import model as atlas_model
-from tutorial_atlas_control.msgs.commands import CommandError
-from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.joints import JOINT_INDEX, NUM_JOINTS
+from tutorial_atlas_control.msgs.commands import CommandError
+from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.sim.simulator import (
-    AtlasSimulator, ControlMode, ModeError, PhysicsDivergenceError, parse_mode)
+    AtlasSimulator,
+    ControlMode,
+    ModeError,
+    PhysicsDivergenceError,
+    parse_mode,
+)
 
 CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
 

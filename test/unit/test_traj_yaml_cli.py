@@ -22,9 +22,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.sim.controller import Gains, GainsError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.trajectories.trajectory import Waypoint, sample_count
 from tutorial_atlas_control.node.traj_yaml import (
     JointStateCache,
     TrajYamlError,
@@ -37,11 +35,14 @@ from tutorial_atlas_control.node.traj_yaml import (
     wait_for_subscribers,
     wait_until_handed_over,
 )
+from tutorial_atlas_control.sim.controller import Gains, GainsError
+from tutorial_atlas_control.trajectories.trajectory import Waypoint, sample_count
 
 REPO = Path(__file__).resolve().parents[2]
 SCRIPT = REPO / 'scripts' / 'traj_yaml.py'
 TRAJECTORY_FILE = REPO / 'trajectories' / 'Traj_data2.yaml'
-USAGE_LINES = ['usage: traj_yaml.py YAML_FILE TRAJECTORY_NAME', ' where TRAJECTORY is a dictionary defined in YAML_FILE']
+USAGE_LINES = ['usage: traj_yaml.py YAML_FILE TRAJECTORY_NAME',
+               ' where TRAJECTORY is a dictionary defined in YAML_FILE']
 #: Guard (s) against a run that hangs; that a run did not touch ROS is what
 #: assert_untouched checks, not how fast it was.
 HANG_GUARD_S = 120.0
@@ -70,7 +71,8 @@ def assert_untouched(server: socket.socket) -> None:
         connection.close()
 
 
-def run_script(args: list[str], master_uri: str, tmp_path: Path) -> subprocess.CompletedProcess[str]:
+def run_script(args: list[str], master_uri: str,
+               tmp_path: Path) -> subprocess.CompletedProcess[str]:
     env = dict(os.environ)
     env['PYTHONPATH'] = os.pathsep.join(filter(None, [str(REPO / 'src'), env.get('PYTHONPATH')]))
     env['ROS_MASTER_URI'] = master_uri
@@ -107,8 +109,10 @@ def test_script_is_thin_and_executable() -> None:
     assert len(text.splitlines()) <= 12
 
 
-@pytest.mark.parametrize('args', [[], ['Traj.yaml'], ['Traj.yaml', 'step', 'extra'], ['a:=b'], ['Traj.yaml', 'x:=y']])
-def test_wrong_number_of_arguments_prints_usage(args: list[str], fake_master, tmp_path: Path) -> None:
+@pytest.mark.parametrize('args', [[], ['Traj.yaml'], ['Traj.yaml', 'step', 'extra'], ['a:=b'],
+                                  ['Traj.yaml', 'x:=y']])
+def test_wrong_number_of_arguments_prints_usage(args: list[str], fake_master,
+                                                tmp_path: Path) -> None:
     server, uri = fake_master
     result = run_script(args, uri, tmp_path)
     assert result.returncode == 1
@@ -131,7 +135,8 @@ def test_help(flag: str, fake_master, tmp_path: Path) -> None:
 def test_missing_file(fake_master, tmp_path: Path) -> None:
     server, uri = fake_master
     result = run_script(['absent.yaml', 'step_and_fall'], uri, tmp_path)
-    assert_one_line_error(result, 'absent.yaml: cannot read trajectory file: No such file or directory')
+    assert_one_line_error(result,
+                          'absent.yaml: cannot read trajectory file: No such file or directory')
     assert_untouched(server)
 
 
@@ -141,17 +146,21 @@ def test_missing_file(fake_master, tmp_path: Path) -> None:
         ('', 'Traj.yaml: the file is empty'),
         ('step:\n  - [1.0, "0 0"\n  - [oops\n', 'Traj.yaml: invalid YAML at line 3, column 3:'),
         ("step: !!python/object/apply:os.system ['touch pwned']\n",
-         "Traj.yaml: unsupported YAML at line 1, column 7: could not determine a constructor for the tag "
+         "Traj.yaml: unsupported YAML at line 1, column 7: "
+         "could not determine a constructor for the tag "
          "'tag:yaml.org,2002:python/object/apply:os.system'"),
-        ('- [1.0, "0"]\n', 'Traj.yaml: expected a mapping of trajectory names to waypoints at the top level'),
-        (f'step_and_fall:\n  - [1.0, "{ZEROS}"]\n  - [1.0, "{ZEROS}"]\n  - [1.0, "{" ".join(["0"] * 27)}"]\n',
+        ('- [1.0, "0"]\n',
+         'Traj.yaml: expected a mapping of trajectory names to waypoints at the top level'),
+        (f'step_and_fall:\n  - [1.0, "{ZEROS}"]\n  - [1.0, "{ZEROS}"]\n'
+         f'  - [1.0, "{" ".join(["0"] * 27)}"]\n',
          "Traj.yaml: trajectory 'step_and_fall', waypoint 2: expected 28 joint positions, got 27"),
         (f'step_and_fall:\n  - [-1, "{ZEROS}"]\n',
          "Traj.yaml: trajectory 'step_and_fall', waypoint 0: duration must be positive, got -1 s"),
         ('step_and_fall: []\n', "Traj.yaml: trajectory 'step_and_fall': has no waypoints"),
     ],
 )
-def test_bad_file_is_one_line_without_ros(text: str, expected: str, fake_master, tmp_path: Path) -> None:
+def test_bad_file_is_one_line_without_ros(text: str, expected: str, fake_master,
+                                          tmp_path: Path) -> None:
     server, uri = fake_master
     write(tmp_path, text)
     result = run_script(['Traj.yaml', 'step_and_fall'], uri, tmp_path)
@@ -170,7 +179,8 @@ def test_missing_trajectory_keeps_the_tutorial_message(fake_master, tmp_path: Pa
 
 def test_remapping_arguments_are_ignored(fake_master, tmp_path: Path) -> None:
     server, uri = fake_master
-    result = run_script(['__name:=other', str(TRAJECTORY_FILE), '_joint_state_timeout:=3', 'nope'], uri, tmp_path)
+    result = run_script(['__name:=other', str(TRAJECTORY_FILE), '_joint_state_timeout:=3', 'nope'],
+                        uri, tmp_path)
     assert_one_line_error(result, f'unable to find trajectory nope in {TRAJECTORY_FILE}')
     assert_untouched(server)
 
@@ -180,9 +190,11 @@ def test_valid_file_without_master_fails_with_a_hint(tmp_path: Path) -> None:
     with socket.socket() as probe:
         probe.bind(('127.0.0.1', 0))
         port = probe.getsockname()[1]
-    result = run_script([str(TRAJECTORY_FILE), 'step_and_fall'], f'http://127.0.0.1:{port}', tmp_path)
+    result = run_script([str(TRAJECTORY_FILE), 'step_and_fall'], f'http://127.0.0.1:{port}',
+                        tmp_path)
     if HAVE_OSRF_MSGS:
-        assert_one_line_error(result, f'no ROS master at http://127.0.0.1:{port}: start the simulator with '
+        assert_one_line_error(result, f'no ROS master at http://127.0.0.1:{port}: '
+                                      'start the simulator with '
                                       '`roslaunch tutorial_atlas_control atlas.launch`')
     else:
         assert_one_line_error(result, 'cannot import osrf_msgs.msg.JointCommands')
@@ -196,12 +208,14 @@ def test_positions_by_name_reorders_and_accepts_both_spellings() -> None:
     order = list(reversed(range(NUM_JOINTS)))
     names = [(ATLAS_PREFIX if i % 2 else '') + JOINT_NAMES[i] for i in order]
     positions = [expected[i] for i in order]
-    np.testing.assert_array_equal(positions_by_name(names + ['hokuyo_joint'], positions + [9.0]), expected)
+    np.testing.assert_array_equal(
+        positions_by_name(names + ['hokuyo_joint'], positions + [9.0]), expected)
 
 
 def test_positions_by_name_missing_joint() -> None:
     names = [name for name in JOINT_NAMES if name not in ('r_leg_kny', 'neck_ay')]
-    with pytest.raises(TrajYamlError, match=r'/atlas/joint_states: the message lacks 2 Atlas joint\(s\): neck_ay, r_leg_kny'):
+    with pytest.raises(TrajYamlError, match=r'/atlas/joint_states: the message lacks 2 Atlas '
+                                            r'joint\(s\): neck_ay, r_leg_kny'):
         positions_by_name(names, [0.0] * len(names))
 
 
@@ -227,8 +241,9 @@ def test_positions_by_name_not_finite() -> None:
 
 
 def test_wait_for_joint_state_times_out_with_a_hint() -> None:
-    with pytest.raises(TrajYamlError, match=r'no simulator is publishing /atlas/joint_states: nothing arrived '
-                                            r'within 0\.05 s; start it with `roslaunch tutorial_atlas_control'):
+    with pytest.raises(TrajYamlError, match=r'no simulator is publishing /atlas/joint_states: '
+                                            r'nothing arrived within 0\.05 s; '
+                                            r'start it with `roslaunch tutorial_atlas_control'):
         wait_for_joint_state(JointStateCache(), 0.05, is_shutdown=lambda: False)
 
 
@@ -249,7 +264,8 @@ def test_cache_without_message() -> None:
 
 
 def gains_tree() -> dict[str, dict[str, float]]:
-    return {name: {'p': 100.0 + i, 'i': 0.5 * i, 'd': 1.0, 'i_clamp': 2.0 * i} for i, name in enumerate(JOINT_NAMES)}
+    return {name: {'p': 100.0 + i, 'i': 0.5 * i, 'd': 1.0, 'i_clamp': 2.0 * i}
+            for i, name in enumerate(JOINT_NAMES)}
 
 
 def test_read_gains_reads_the_tutorial_parameters() -> None:
@@ -275,7 +291,8 @@ def test_read_gains_missing_namespace() -> None:
 def test_read_gains_missing_parameter_is_named() -> None:
     tree = gains_tree()
     del tree['l_leg_kny']['i_clamp']
-    with pytest.raises(GainsError, match=r'atlas_controller/gains/l_leg_kny/i_clamp is missing;.*rosparam load'):
+    with pytest.raises(GainsError, match=r'atlas_controller/gains/l_leg_kny/i_clamp is missing;'
+                                         r'.*rosparam load'):
         read_gains(lambda *args: tree)
 
 
@@ -301,7 +318,8 @@ def check_command(command: object, positions: np.ndarray, gains: Gains, stamp: o
 def test_build_command_like_the_tutorial() -> None:
     gains = read_gains(lambda *args: gains_tree())
     positions = np.linspace(-1.0, 1.0, NUM_JOINTS)
-    check_command(build_command(FakeJointCommands, positions, gains, 'stamp'), positions, gains, 'stamp')
+    check_command(build_command(FakeJointCommands, positions, gains, 'stamp'), positions, gains,
+                  'stamp')
 
 
 @pytest.mark.skipif(not HAVE_OSRF_MSGS, reason='needs the catkin workspace: source ./env.sh')
@@ -333,7 +351,8 @@ def test_run_trajectory_plays_each_waypoint_from_the_measured_pose() -> None:
     sent: list[np.ndarray] = []
     sleeps: list[float] = []
     logs: list[str] = []
-    count = run_trajectory(waypoints, lambda: measured[len(logs)], sent.append, sleeps.append, logs.append)
+    count = run_trajectory(waypoints, lambda: measured[len(logs)], sent.append, sleeps.append,
+                           logs.append)
     assert count == len(sent) == len(sleeps) == 50 + 25 + 1
     assert len(logs) == 3
     assert logs[0].startswith('waypoint 0 (1 of 3): 1 s, 50 commands; all joints move')
@@ -398,7 +417,8 @@ def test_waypoint_log_names_the_moving_joints() -> None:
     target[JOINT_INDEX['r_leg_kny']] = 1.4
     target[JOINT_INDEX['neck_ay']] = 0.005  # under the threshold
     logs: list[str] = []
-    run_trajectory([Waypoint(0.1, target)], lambda: np.zeros(NUM_JOINTS), lambda _: None, lambda _: None, logs.append)
+    run_trajectory([Waypoint(0.1, target)], lambda: np.zeros(NUM_JOINTS), lambda _: None,
+                   lambda _: None, logs.append)
     assert logs == [f'waypoint 0 (1 of 1): 0.1 s, {sample_count(0.1)} commands; moving r_leg_kny']
 
 
@@ -428,7 +448,8 @@ def test_the_port_waits_until_rospy_has_taken_each_command() -> None:
     publisher = SimpleNamespace(impl=SimpleNamespace(connections=[connection]))
     try:
         connection.write_data(b'first')
-        assert wait_until_handed_over(publisher, THREAD_GUARD_S), 'the writer thread takes the first command'
+        assert wait_until_handed_over(publisher, THREAD_GUARD_S), \
+            'the writer thread takes the first command'
         connection.write_data(b'second')  # the writer is still busy with 'first'
         started = time.monotonic()
         assert not wait_until_handed_over(publisher, 0.05)
@@ -474,7 +495,8 @@ def never_shut_down() -> bool:
 
 def test_subscribers_all_connected_return_at_once() -> None:
     connected = Connecting({SIM: 0, RECORDER: 0})
-    assert wait_for_subscribers(connected, lambda: {SIM, RECORDER}, SIM, 5.0, never_shut_down) == set()
+    assert wait_for_subscribers(connected, lambda: {SIM, RECORDER}, SIM, 5.0,
+                                never_shut_down) == set()
     assert connected.polls == 1
 
 
@@ -482,7 +504,8 @@ def test_a_simulator_that_connects_late_is_waited_for() -> None:
     """The CI failure: the simulator connected after the old 2 s and missed the first commands."""
     connected = Connecting({RECORDER: 0, SIM: 30})  # 30 polls of 10 ms
     started = time.monotonic()
-    assert wait_for_subscribers(connected, lambda: {SIM, RECORDER}, SIM, 5.0, never_shut_down) == set()
+    assert wait_for_subscribers(connected, lambda: {SIM, RECORDER}, SIM, 5.0,
+                                never_shut_down) == set()
     assert connected.polls == 31
     assert time.monotonic() - started >= 0.25
 
@@ -491,18 +514,20 @@ def test_a_simulator_that_never_connects_is_an_error_naming_it() -> None:
     connected = Connecting({RECORDER: 0})
     with pytest.raises(TrajYamlError) as err:
         wait_for_subscribers(connected, lambda: {SIM, RECORDER}, SIM, 0.2, never_shut_down)
-    assert f'the simulator {SIM} subscribes to /atlas/joint_commands but did not connect within 0.2 s' \
-        in str(err.value)
+    assert (f'the simulator {SIM} subscribes to /atlas/joint_commands '
+            'but did not connect within 0.2 s') in str(err.value)
     assert '~subscriber_timeout' in str(err.value)
 
 
 def test_no_subscriber_at_all_is_an_error() -> None:
-    with pytest.raises(TrajYamlError, match='nothing subscribed to /atlas/joint_commands within 0.2 s.*atlas.launch'):
+    with pytest.raises(TrajYamlError, match='nothing subscribed to /atlas/joint_commands '
+                                            'within 0.2 s.*atlas.launch'):
         wait_for_subscribers(Connecting({}), set, SIM, 0.2, never_shut_down)
 
 
 def test_another_late_subscriber_is_returned_for_a_warning() -> None:
-    missing = wait_for_subscribers(Connecting({SIM: 0}), lambda: {SIM, RECORDER}, SIM, 0.2, never_shut_down)
+    missing = wait_for_subscribers(Connecting({SIM: 0}), lambda: {SIM, RECORDER}, SIM, 0.2,
+                                   never_shut_down)
     assert missing == {RECORDER}
 
 
@@ -510,7 +535,8 @@ def test_a_master_that_cannot_tell_keeps_the_last_list() -> None:
     """None from the master is no answer: the recorder it listed before is still waited for."""
     answers = iter([{SIM, RECORDER}] + [None] * 1000)
     connected = Connecting({SIM: 0, RECORDER: 15})
-    assert wait_for_subscribers(connected, lambda: next(answers), SIM, 5.0, never_shut_down) == set()
+    assert wait_for_subscribers(connected, lambda: next(answers), SIM, 5.0,
+                                never_shut_down) == set()
     assert connected.polls == 16
 
 
@@ -530,17 +556,20 @@ def test_ros_time_is_awaited_until_the_first_clock() -> None:
 
 
 def test_no_clock_is_an_error() -> None:
-    with pytest.raises(TrajYamlError, match='/use_sim_time is set but no /clock arrived within 0.1 s'):
+    with pytest.raises(TrajYamlError,
+                       match='/use_sim_time is set but no /clock arrived within 0.1 s'):
         wait_for_ros_time(0.1, lambda: 0.0, never_shut_down)
 
 
-def test_bare_name_is_taken_from_the_package_trajectories_folder(fake_master, tmp_path: Path) -> None:
-    """The tutorial's `traj_yaml.py Traj_data2.yaml ...` from anywhere: one info line names the file."""
+def test_bare_name_is_taken_from_the_package_trajectories_folder(fake_master,
+                                                                 tmp_path: Path) -> None:
+    """The tutorial's `traj_yaml.py Traj_data2.yaml ...` from anywhere: one line names the file."""
     server, uri = fake_master
     result = run_script(['Traj_data2.yaml', 'no_such_trajectory'], uri, tmp_path)
     assert result.stdout.splitlines() == [
         f'Traj_data2.yaml is not in the current directory; using {TRAJECTORY_FILE}']
-    assert_one_line_error(result, f'unable to find trajectory no_such_trajectory in {TRAJECTORY_FILE}')
+    assert_one_line_error(result,
+                          f'unable to find trajectory no_such_trajectory in {TRAJECTORY_FILE}')
     assert_untouched(server)
 
 
@@ -548,5 +577,6 @@ def test_explicit_missing_path_is_not_redirected(fake_master, tmp_path: Path) ->
     server, uri = fake_master
     result = run_script(['./Traj_data2.yaml', 'step_and_fall'], uri, tmp_path)
     assert result.stdout == ''
-    assert_one_line_error(result, './Traj_data2.yaml: cannot read trajectory file: No such file or directory')
+    assert_one_line_error(
+        result, './Traj_data2.yaml: cannot read trajectory file: No such file or directory')
     assert_untouched(server)

@@ -1,4 +1,7 @@
-"""Unit tests for tutorial_atlas_control.trajectories.trajectory: file validation, the tutorial's file, interpolation."""
+"""Unit tests for tutorial_atlas_control.trajectories.trajectory.
+
+File validation, the tutorial's file, interpolation.
+"""
 
 from __future__ import annotations
 
@@ -104,7 +107,8 @@ def test_every_trajectory_of_the_file_is_validated(tmp_path: Path) -> None:
 
 def test_missing_file(tmp_path: Path) -> None:
     path = tmp_path / 'absent.yaml'
-    with pytest.raises(TrajectoryError, match=r'absent\.yaml: cannot read trajectory file: No such file'):
+    with pytest.raises(TrajectoryError,
+                       match=r'absent\.yaml: cannot read trajectory file: No such file'):
         load_trajectory(path, 'x')
 
 
@@ -116,7 +120,8 @@ def test_directory_instead_of_file(tmp_path: Path) -> None:
 def test_not_utf8(tmp_path: Path) -> None:
     path = tmp_path / 'Traj.yaml'
     path.write_bytes(b'\xff\xfe\x00garbage')
-    with pytest.raises(TrajectoryError, match=r'Traj\.yaml: cannot read trajectory file: not UTF-8'):
+    with pytest.raises(TrajectoryError,
+                       match=r'Traj\.yaml: cannot read trajectory file: not UTF-8'):
         load_trajectory_file(path)
 
 
@@ -129,21 +134,24 @@ def test_empty_file(tmp_path: Path, text: str) -> None:
 
 def test_yaml_syntax_error(tmp_path: Path) -> None:
     path = write(tmp_path, 'step:\n  - [1.0, "0 0"\n  - [oops\n')
-    with pytest.raises(TrajectoryError, match=r'Traj\.yaml: invalid YAML at line \d+, column \d+: ') as info:
+    with pytest.raises(TrajectoryError,
+                       match=r'Traj\.yaml: invalid YAML at line \d+, column \d+: ') as info:
         load_trajectory_file(path)
     assert '\n' not in str(info.value)
 
 
 def test_python_tag_is_refused(tmp_path: Path) -> None:
     path = write(tmp_path, "step: !!python/object/apply:os.system ['echo pwned']\n")
-    with pytest.raises(TrajectoryError, match=r'Traj\.yaml: unsupported YAML at line 1.*python/object/apply') as info:
+    with pytest.raises(TrajectoryError, match=r'Traj\.yaml: unsupported YAML at line 1'
+                                              r'.*python/object/apply') as info:
         load_trajectory_file(path)
     assert '\n' not in str(info.value)
 
 
 @pytest.mark.parametrize(
     ('text', 'kind'),
-    [('- [1.0, "0"]\n', 'a list of 1 items'), ('42\n', 'int 42'), ('just text\n', "str 'just text'")],
+    [('- [1.0, "0"]\n', 'a list of 1 items'), ('42\n', 'int 42'),
+     ('just text\n', "str 'just text'")],
 )
 def test_root_must_be_a_mapping(tmp_path: Path, text: str, kind: str) -> None:
     path = write(tmp_path, text)
@@ -194,7 +202,8 @@ GOOD_ROW = f'  - [1.0, "{ZEROS}"]\n'
         (f'  - [1.0, "{positions_text(29)}"]\n', 'expected 28 joint positions, got 29'),
         ('  - [1.0, ""]\n', 'expected 28 joint positions, got 0'),
         (f'  - [1.0, {[0] * 27}]\n', 'expected 28 joint positions, got 27'),
-        ('  - [1.0]\n', r'expected a pair \[duration_s, "28 joint positions"\], got a list of 1 items'),
+        ('  - [1.0]\n',
+         r'expected a pair \[duration_s, "28 joint positions"\], got a list of 1 items'),
         (f'  - [1.0, "{ZEROS}", 3]\n', 'expected a pair .* got a list of 3 items'),
         ('  - 1.0\n', 'expected a pair .* got float 1.0'),
         (f'  - {{duration: 1.0, positions: "{ZEROS}"}}\n', 'expected a pair .* got a mapping'),
@@ -205,20 +214,27 @@ GOOD_ROW = f'  - [1.0, "{ZEROS}"]\n'
         (f'  - [true, "{ZEROS}"]\n', 'duration must be a finite number of seconds, got True'),
         (f'  - ["1.0", "{ZEROS}"]\n', "duration must be a finite number of seconds, got '1.0'"),
         (f'  - [~, "{ZEROS}"]\n', 'duration must be a finite number of seconds, got None'),
-        ('  - [1.0, 5]\n', 'joint positions must be a string of 28 numbers or a list of them, got int 5'),
+        ('  - [1.0, 5]\n',
+         'joint positions must be a string of 28 numbers or a list of them, got int 5'),
         ('  - [1.0, ~]\n', r'joint positions must be .* got nothing \(null\)'),
-        (f'  - [1.0, "abc {positions_text(27)}"]\n', r"joint position 0 \(back_lbz\) must be a finite number, got 'abc'"),
+        (f'  - [1.0, "abc {positions_text(27)}"]\n',
+         r"joint position 0 \(back_lbz\) must be a finite number, got 'abc'"),
         (f'  - [1.0, "{positions_text(13)} nan {positions_text(14)}"]\n',
          r"joint position 13 \(r_leg_kny\) must be a finite number, got 'nan'"),
-        (f'  - [1.0, "{positions_text(27)} 1e999"]\n', r"joint position 27 \(r_arm_mwx\) .* got '1e999'"),
-        (f'  - [1.0, [{", ".join(["0"] * 27)}, .inf]]\n', r'joint position 27 \(r_arm_mwx\) .* got inf'),
-        (f'  - [1.0, [true, {", ".join(["0"] * 27)}]]\n', r'joint position 0 \(back_lbz\) .* got True'),
-        (f'  - [1.0, ["0", {", ".join(["0"] * 27)}]]\n', r"joint position 0 \(back_lbz\) .* got '0'"),
+        (f'  - [1.0, "{positions_text(27)} 1e999"]\n',
+         r"joint position 27 \(r_arm_mwx\) .* got '1e999'"),
+        (f'  - [1.0, [{", ".join(["0"] * 27)}, .inf]]\n',
+         r'joint position 27 \(r_arm_mwx\) .* got inf'),
+        (f'  - [1.0, [true, {", ".join(["0"] * 27)}]]\n',
+         r'joint position 0 \(back_lbz\) .* got True'),
+        (f'  - [1.0, ["0", {", ".join(["0"] * 27)}]]\n',
+         r"joint position 0 \(back_lbz\) .* got '0'"),
     ],
 )
 def test_bad_waypoint_is_named(tmp_path: Path, row: str, problem: str) -> None:
     path = write(tmp_path, 'step_and_fall:\n' + GOOD_ROW + GOOD_ROW + row)
-    with pytest.raises(TrajectoryError, match=rf"^.*Traj\.yaml: trajectory 'step_and_fall', waypoint 2: {problem}$"):
+    with pytest.raises(TrajectoryError,
+                       match=rf"^.*Traj\.yaml: trajectory 'step_and_fall', waypoint 2: {problem}$"):
         load_trajectory(path, 'step_and_fall')
 
 
@@ -232,7 +248,8 @@ def test_error_uses_the_path_as_given() -> None:
     doc = {'step': [[1.0, positions_text(27)]]}
     with pytest.raises(TrajectoryError) as info:
         parse_trajectory(doc, 'step', 'Traj.yaml')
-    assert str(info.value) == "Traj.yaml: trajectory 'step', waypoint 0: expected 28 joint positions, got 27"
+    assert str(info.value) == \
+        "Traj.yaml: trajectory 'step', waypoint 0: expected 28 joint positions, got 27"
 
 
 # --- property: malformed documents raise TrajectoryError, never anything else ------------
@@ -243,7 +260,8 @@ yaml_scalars = st.one_of(
     st.integers(min_value=-(10 ** 400), max_value=10 ** 400),
     st.floats(allow_nan=True, allow_infinity=True),
     st.text(max_size=30),
-    st.sampled_from([ZEROS, positions_text(27), positions_text(28, 'nan'), positions_text(28, '1e999')]),
+    st.sampled_from([ZEROS, positions_text(27), positions_text(28, 'nan'),
+                     positions_text(28, '1e999')]),
 )
 yaml_values = st.recursive(
     yaml_scalars,
@@ -263,7 +281,8 @@ waypoint_like = st.one_of(
 )
 docs = st.one_of(
     yaml_values,
-    st.dictionaries(st.sampled_from(['step', 'other']), st.one_of(yaml_values, st.lists(waypoint_like, max_size=4))),
+    st.dictionaries(st.sampled_from(['step', 'other']),
+                    st.one_of(yaml_values, st.lists(waypoint_like, max_size=4))),
 )
 
 
@@ -277,9 +296,8 @@ def test_malformed_documents_raise_only_trajectory_error(doc: object) -> None:
     except TrajectoryError as err:
         message = str(err)
         assert '\n' not in message
-        assert message.startswith('unable to find trajectory step in Traj.yaml') or message.startswith(
-            "Traj.yaml: trajectory 'step'"
-        )
+        assert (message.startswith('unable to find trajectory step in Traj.yaml')
+                or message.startswith("Traj.yaml: trajectory 'step'"))
         return
     # Anything accepted is a valid trajectory.
     assert waypoints
@@ -291,7 +309,8 @@ def test_malformed_documents_raise_only_trajectory_error(doc: object) -> None:
 
 @settings(max_examples=200, deadline=None)
 @given(text=st.text(max_size=200))
-def test_arbitrary_file_text_raises_only_trajectory_error(tmp_path_factory: pytest.TempPathFactory, text: str) -> None:
+def test_arbitrary_file_text_raises_only_trajectory_error(
+        tmp_path_factory: pytest.TempPathFactory, text: str) -> None:
     path = tmp_path_factory.mktemp('prop') / 'Traj.yaml'
     path.write_text(text, encoding='utf-8')
     try:
@@ -305,7 +324,8 @@ def test_arbitrary_file_text_raises_only_trajectory_error(tmp_path_factory: pyte
 
 @pytest.mark.parametrize(
     ('duration_s', 'count'),
-    [(1.0, 50), (0.5, 25), (1.5, 75), (2.0, 100), (3.0, 150), (0.14, 7), (0.03, 2), (0.02, 1), (0.001, 1), (1e-300, 1)],
+    [(1.0, 50), (0.5, 25), (1.5, 75), (2.0, 100), (3.0, 150), (0.14, 7), (0.03, 2), (0.02, 1),
+     (0.001, 1), (1e-300, 1)],
 )
 def test_sample_count(duration_s: float, count: int) -> None:
     result = sample_count(duration_s)
@@ -331,7 +351,8 @@ def test_interpolate_follows_the_tutorial() -> None:
     assert sum(s for _, s in samples) == pytest.approx(1.0)
     # Exactly the tutorial's formula.
     for (positions, _), ratio in zip(samples, np.linspace(0, 1, 50)):
-        np.testing.assert_allclose(positions, (1 - ratio) * initial + ratio * target, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(positions, (1 - ratio) * initial + ratio * target,
+                                   rtol=0, atol=1e-12)
 
 
 def test_interpolate_is_50_hz_or_faster_and_lasts_the_duration() -> None:

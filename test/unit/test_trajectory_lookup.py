@@ -1,4 +1,4 @@
-"""Where traj_yaml.py finds YAML_FILE: from the current directory, else the package's trajectories/."""
+"""Where traj_yaml.py finds YAML_FILE: the current directory, else the package's trajectories/."""
 
 from __future__ import annotations
 
@@ -7,7 +7,12 @@ from pathlib import Path
 import pytest
 
 from tutorial_atlas_control.trajectories.trajectory import (
-    TRAJECTORIES_DIR, TrajectoryError, is_explicit_path, load_trajectory, resolve_trajectory_file)
+    TRAJECTORIES_DIR,
+    TrajectoryError,
+    is_explicit_path,
+    load_trajectory,
+    resolve_trajectory_file,
+)
 
 
 @pytest.fixture()
@@ -39,7 +44,8 @@ def test_a_file_in_the_current_directory_wins(dirs: tuple[Path, Path]) -> None:
 
 
 @pytest.mark.parametrize('name', ['Traj.yaml', 'sub/Traj.yaml'])
-def test_a_bare_or_relative_name_falls_back_to_the_package(dirs: tuple[Path, Path], name: str) -> None:
+def test_a_bare_or_relative_name_falls_back_to_the_package(dirs: tuple[Path, Path],
+                                                           name: str) -> None:
     _, package = dirs
     (package / name).parent.mkdir(exist_ok=True)
     (package / name).write_text('{}')

@@ -10,10 +10,10 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
-from support.model_table import load_table
 
-from tutorial_atlas_control.sim import model, urdf
+from support.model_table import load_table
 from tutorial_atlas_control.joints import JOINT_NAMES
+from tutorial_atlas_control.sim import model, urdf
 
 REPO = Path(__file__).resolve().parents[2]
 #: The left knee's joint origin in the URDF, and the same 1 cm lower.
@@ -63,7 +63,8 @@ def test_same_joints_in_the_same_order_with_the_same_limits(mjcf: mujoco.MjModel
     assert set(mjcf_hinges) == set(JOINT_NAMES)  # bare names, no atlas:: prefix
     for joint in joints:
         assert joint.kind == 'revolute', joint.name
-        np.testing.assert_array_equal([joint.lower_rad, joint.upper_rad], mjcf.joint(joint.name).range)
+        np.testing.assert_array_equal([joint.lower_rad, joint.upper_rad],
+                                      mjcf.joint(joint.name).range)
 
 
 def test_same_links_masses_and_inertias(mjcf: mujoco.MjModel, urdf_model: mujoco.MjModel) -> None:
@@ -136,7 +137,8 @@ def test_same_shapes_and_colours(mjcf: mujoco.MjModel) -> None:
         geoms = [g for g in range(mjcf.ngeom) if mjcf.geom_bodyid[g] == body]
         capsules = sum(mjcf.geom_type[g] == mujoco.mjtGeom.mjGEOM_CAPSULE for g in geoms)
         assert len(visuals) == len(geoms) + 2 * capsules, name
-        colours = {tuple(float(v) for v in root.find(f"material[@name='{v.find('material').get('name')}']")
+        colours = {tuple(float(v) for v in
+                         root.find(f"material[@name='{v.find('material').get('name')}']")
                          .find('color').get('rgba').split()) for v in visuals}
         assert colours == _visual_colours(mjcf, name), name
 
@@ -150,7 +152,8 @@ def test_the_shipped_urdf_matches_the_shipped_model(mjcf: mujoco.MjModel) -> Non
 def test_a_variant_without_urdf_has_none(tmp_path: Path, mjcf: mujoco.MjModel) -> None:
     variant = tmp_path / 'variant.xml'
     shutil.copy(model.MODEL_PATH, variant)
-    with pytest.raises(urdf.UrdfError, match=re.escape(f'({tmp_path / "variant.urdf"} does not exist)')):
+    with pytest.raises(urdf.UrdfError,
+                       match=re.escape(f'({tmp_path / "variant.urdf"} does not exist)')):
         urdf.matching_urdf(variant, mjcf)
 
 

@@ -11,7 +11,14 @@ import numpy as np
 import pytest
 
 from tutorial_atlas_control.node.viewer import (
-    CONTROL, KEY_R, KEY_SPACE, SHIFT, ViewerLink, ViewerRequest, request_for_key)
+    CONTROL,
+    KEY_R,
+    KEY_SPACE,
+    SHIFT,
+    ViewerLink,
+    ViewerRequest,
+    request_for_key,
+)
 
 MJCF = """
 <mujoco>
@@ -28,7 +35,7 @@ Physics = tuple[mujoco.MjModel, mujoco.MjData]
 class FakeViewer:
     """Stands in for mujoco.viewer.Handle; `press_reset` does what the Reset button does."""
 
-    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, key_callback) -> None:  # noqa: ANN001
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, key_callback) -> None:
         self.model, self.data, self.key_callback = model, data, key_callback
         self.reset_pending = False
         self.force = np.zeros(6)
@@ -65,10 +72,11 @@ def physics() -> tuple[mujoco.MjModel, mujoco.MjData]:
     return model, data
 
 
-def make_link(model: mujoco.MjModel, held: frozenset[str] = frozenset()) -> tuple[ViewerLink, FakeViewer]:
+def make_link(model: mujoco.MjModel,
+              held: frozenset[str] = frozenset()) -> tuple[ViewerLink, FakeViewer]:
     viewers = []
 
-    def launch(m: mujoco.MjModel, d: mujoco.MjData, key_callback) -> FakeViewer:  # noqa: ANN001
+    def launch(m: mujoco.MjModel, d: mujoco.MjData, key_callback) -> FakeViewer:
         viewers.append(FakeViewer(m, d, key_callback))
         return viewers[-1]
 
@@ -83,7 +91,7 @@ def refresh(link: ViewerLink, data: mujoco.MjData) -> list[ViewerRequest]:
     return link.take_requests()
 
 
-def test_the_viewer_never_gets_the_physics_data(physics) -> None:  # noqa: ANN001
+def test_the_viewer_never_gets_the_physics_data(physics) -> None:
     model, data = physics
     link, viewer = make_link(model)
     assert viewer.data is not data
@@ -92,7 +100,7 @@ def test_the_viewer_never_gets_the_physics_data(physics) -> None:  # noqa: ANN00
     assert viewer.data.time == data.time
 
 
-def test_reset_button_becomes_a_request_and_leaves_physics_alone(physics) -> None:  # noqa: ANN001
+def test_reset_button_becomes_a_request_and_leaves_physics_alone(physics) -> None:
     model, data = physics
     link, viewer = make_link(model)
     qpos, time_s = data.qpos.copy(), data.time
@@ -103,7 +111,7 @@ def test_reset_button_becomes_a_request_and_leaves_physics_alone(physics) -> Non
     assert refresh(link, data) == []  # one reset, one request
 
 
-def test_reset_is_seen_at_time_zero(physics) -> None:  # noqa: ANN001
+def test_reset_is_seen_at_time_zero(physics) -> None:
     model, _ = physics
     link, viewer = make_link(model)
     fresh = mujoco.MjData(model)
@@ -114,7 +122,7 @@ def test_reset_is_seen_at_time_zero(physics) -> None:  # noqa: ANN001
     assert refresh(link, fresh) == [ViewerRequest.RESET_WORLD]
 
 
-def test_mouse_forces_reach_the_physics(physics) -> None:  # noqa: ANN001
+def test_mouse_forces_reach_the_physics(physics) -> None:
     model, data = physics
     link, viewer = make_link(model)
     viewer.force = np.array([0.0, 0.0, 50.0, 0.0, 0.0, 0.0])
@@ -137,7 +145,7 @@ def test_keys(key: int, held: frozenset[str], expected: ViewerRequest | None) ->
     assert request_for_key(key, held) is expected
 
 
-def test_key_callback_queues_until_taken(physics) -> None:  # noqa: ANN001
+def test_key_callback_queues_until_taken(physics) -> None:
     model, data = physics
     link, viewer = make_link(model, frozenset({SHIFT, CONTROL}))
     viewer.key_callback(KEY_R)
@@ -146,7 +154,7 @@ def test_key_callback_queues_until_taken(physics) -> None:  # noqa: ANN001
     assert link.take_requests() == []
 
 
-def test_paused_overlay_follows_the_node(physics) -> None:  # noqa: ANN001
+def test_paused_overlay_follows_the_node(physics) -> None:
     model, _ = physics
     link, viewer = make_link(model)
     link.show_paused(True)

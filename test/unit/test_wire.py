@@ -5,16 +5,15 @@ import io
 import genpy
 import numpy as np
 import pytest
-from geometry_msgs.msg import WrenchStamped
+from geometry_msgs.msg import TransformStamped, WrenchStamped
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
 from rospy.msg import serialize_message
 from sensor_msgs.msg import Imu, JointState
-from geometry_msgs.msg import TransformStamped
 from tf2_msgs.msg import TFMessage
 
-from tutorial_atlas_control.msgs import wire
 from tutorial_atlas_control.joints import JOINT_NAMES
+from tutorial_atlas_control.msgs import wire
 
 STAMP_NS = 12 * wire.NS_PER_S + 345_678
 
@@ -51,9 +50,9 @@ def test_imu():
     expected.header.stamp = genpy.Time(12, 345_678)
     o = expected.orientation
     o.x, o.y, o.z, o.w = 0.1, 0.2, 0.3, 0.9
-    a, l = expected.angular_velocity, expected.linear_acceleration
+    a, acc = expected.angular_velocity, expected.linear_acceleration
     a.x, a.y, a.z = 1.0, 2.0, 3.0
-    l.x, l.y, l.z = 4.0, 5.0, 9.81
+    acc.x, acc.y, acc.z = 4.0, 5.0, 9.81
     assert msg.to_bytes(STAMP_NS) == genpy_bytes(expected)
 
 

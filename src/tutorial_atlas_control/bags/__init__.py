@@ -1,1 +1,4 @@
-"""Recorded runs: bag records, reading, analysis, comparison, reports, videos, run logs, synthetic bags. No ROS."""
+"""Recorded runs: bag records, reading, analysis, comparison, reports, videos, run logs.
+
+Also synthetic bags for the tests. No ROS.
+"""

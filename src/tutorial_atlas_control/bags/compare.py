@@ -23,9 +23,9 @@ import numpy as np
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags.analysis import FALL_HEIGHT_M, Analysis, analyze_bag
 from tutorial_atlas_control.bags.report import json_safe, save_figure
+from tutorial_atlas_control.bags.run_log import PlayedTrajectory, played_trajectories
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_INDEX
-from tutorial_atlas_control.bags.run_log import PlayedTrajectory, played_trajectories
 
 __all__ = ['ALIGNED_ON', 'Comparison', 'JointDifference', 'compare', 'compare_bags',
            'format_comparison', 'plot_comparison', 'to_json']

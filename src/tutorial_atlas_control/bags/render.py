@@ -24,6 +24,7 @@ import numpy as np
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.joints import NUM_JOINTS, joint_index
 from tutorial_atlas_control.sim.camera import CAMERA
 from tutorial_atlas_control.units import finite_number
 
@@ -187,8 +188,6 @@ def states_from_bag(data: BagData, fps: float = DEFAULT_FPS) -> RunStates:
     Raises:
         RenderError: the bag lacks /ground_truth_odom or /atlas/joint_states.
     """
-    from tutorial_atlas_control.joints import NUM_JOINTS, joint_index
-
     pelvis, states = data.pelvis, data.joint_states
     missing = [topic for topic, series in ((topics.GROUND_TRUTH_ODOM, pelvis),
                                            (topics.JOINT_STATES, states))
@@ -226,9 +225,10 @@ class StateRenderer:
     def __init__(self, width: int, height: int, atlas: AtlasModel | None = None,
                  camera: str = CAMERA) -> None:
         prepare_gl()
-        import mujoco
+        # After prepare_gl(): MuJoCo picks its OpenGL back-end when first imported.
+        import mujoco  # noqa: PLC0415
 
-        from tutorial_atlas_control.sim.model import load_model
+        from tutorial_atlas_control.sim.model import load_model  # noqa: PLC0415 - imports mujoco
 
         self._mujoco = mujoco
         self.atlas = atlas if atlas is not None else load_model()
@@ -243,7 +243,7 @@ class StateRenderer:
         self.data = mujoco.MjData(model)
         try:
             self._renderer = mujoco.Renderer(model, height=height, width=width)
-        except Exception as err:  # noqa: BLE001 - GL back-ends raise many kinds
+        except Exception as err:
             raise RenderError(f'cannot open an offscreen OpenGL context ({err}); on a machine '
                               'without a display install libosmesa6 and set MUJOCO_GL=osmesa.'
                               ) from err
@@ -285,7 +285,7 @@ class StateRenderer:
 
 def _frames(states: RunStates, width: int, height: int, progress: bool,
             time_label: bool) -> Iterator[np.ndarray]:
-    from tqdm import tqdm
+    from tqdm import tqdm  # noqa: PLC0415 - only videos need it
 
     with StateRenderer(width, height) as renderer, \
             tqdm(total=len(states), unit='frame', desc='rendering', file=sys.stderr,
@@ -301,7 +301,7 @@ def _frames(states: RunStates, width: int, height: int, progress: bool,
 
 def _label(frame: np.ndarray, text: str) -> np.ndarray:
     """Draw `text` in the top-left corner, white on a dark box."""
-    from PIL import Image, ImageDraw
+    from PIL import Image, ImageDraw  # noqa: PLC0415 - only videos need it
 
     image = Image.fromarray(frame)
     draw = ImageDraw.Draw(image)
@@ -312,7 +312,7 @@ def _label(frame: np.ndarray, text: str) -> np.ndarray:
 
 
 def _write_mp4(path: Path, frames: Iterable[np.ndarray], fps: float) -> int:
-    import imageio.v2 as imageio
+    import imageio.v2 as imageio  # noqa: PLC0415 - only videos need it (slow to import)
 
     count = 0
     writer = imageio.get_writer(str(path), format='FFMPEG', mode='I', fps=fps, codec='libx264',
@@ -328,7 +328,7 @@ def _write_mp4(path: Path, frames: Iterable[np.ndarray], fps: float) -> int:
 
 
 def _write_gif(path: Path, frames: Iterable[np.ndarray], fps: float) -> int:
-    from PIL import Image
+    from PIL import Image  # noqa: PLC0415 - only videos need it
 
     images = [Image.fromarray(frame).quantize(GIF_COLORS, method=Image.Quantize.FASTOCTREE)
               for frame in frames]

@@ -254,7 +254,7 @@ def save_figure(fig: Any, path: Path | str) -> Path:
     Raises:
         BagAnalysisError: The image cannot be written.
     """
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # noqa: PLC0415 - only needed with --plot
 
     fig.tight_layout()
     try:

@@ -1,1 +1,4 @@
-"""ROS 1 wire layouts: the JointCommands schema and decoding, pre-serialized messages and their filling. No rospy."""
+"""ROS 1 wire layouts: the JointCommands schema and decoding, pre-serialized messages.
+
+And their filling. No rospy.
+"""

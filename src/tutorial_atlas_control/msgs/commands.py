@@ -20,7 +20,6 @@ from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import NUM_JOINTS, joint_index
 from tutorial_atlas_control.msgs.ros1_fields import FieldCursor
 
-
 #: The array fields of osrf_msgs/JointCommands, in message order.
 FIELD_NAMES: tuple[str, ...] = (
     'position', 'velocity', 'effort', 'kp_position', 'ki_position', 'kd_position',

@@ -16,10 +16,16 @@ import numpy as np
 
 from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.msgs.copy_plan import Copy, CopyPlan
+from tutorial_atlas_control.msgs.wire import (
+    ImuWire,
+    JointStateWire,
+    OdometryWire,
+    StampedWire,
+    TransformWire,
+    WrenchStampedWire,
+)
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
 from tutorial_atlas_control.topics import PELVIS_FRAME, WORLD_FRAME
-from tutorial_atlas_control.msgs.wire import (
-    ImuWire, JointStateWire, OdometryWire, StampedWire, TransformWire, WrenchStampedWire)
 
 __all__ = ['TCPROS_PREFIX_BYTES', 'SimMessages']
 

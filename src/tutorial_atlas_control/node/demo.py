@@ -15,6 +15,9 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+from tutorial_atlas_control.bags.analysis import analyze_bag
+from tutorial_atlas_control.bags.render import render_bag_video
+from tutorial_atlas_control.bags.report import plot_run, short_summary
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.processes import AtlasLaunch
 from tutorial_atlas_control.resources import package_path
@@ -80,10 +83,10 @@ def run_demo(trajectory: str, trajectory_file: Path, bag_dir: Path, real_time_fa
 def drive(launch: AtlasLaunch, trajectory: str, trajectory_file: Path,
           progress: Report = _silent) -> None:
     """What the tutorial's user does in the other terminals: User mode, then traj_yaml.py."""
-    import rospy
-    from rosgraph_msgs.msg import Clock
-    from sensor_msgs.msg import JointState
-    from std_msgs.msg import String
+    import rospy  # noqa: PLC0415 - rospy loads only once a launch runs
+    from rosgraph_msgs.msg import Clock  # noqa: PLC0415
+    from sensor_msgs.msg import JointState  # noqa: PLC0415
+    from std_msgs.msg import String  # noqa: PLC0415
 
     os.environ.update(ROS_MASTER_URI=launch.uri, ROS_HOSTNAME=launch.env['ROS_HOSTNAME'])
     # The master first: init_node would print "Unable to register with master node ... Will
@@ -110,7 +113,7 @@ def drive(launch: AtlasLaunch, trajectory: str, trajectory_file: Path,
 
 def wait_sim_time(clock_type: type, seconds: float) -> None:
     """Block until `seconds` of sim time have passed (bounded in wall time)."""
-    import rospy
+    import rospy  # noqa: PLC0415 - rospy loads only once a launch runs
     start = rospy.wait_for_message('/clock', clock_type, timeout=STARTUP_TIMEOUT_S).clock
     deadline = time.monotonic() + STARTUP_TIMEOUT_S
     while True:
@@ -128,10 +131,6 @@ def summarise(bag: Path, video_fps: float, video_size: tuple[int, int],
 
     The summary is reported before the (slower) plot and video are made.
     """
-    from tutorial_atlas_control.bags.analysis import analyze_bag
-    from tutorial_atlas_control.bags.render import render_bag_video
-    from tutorial_atlas_control.bags.report import plot_run, short_summary
-
     analysis = analyze_bag(bag)
     report('\n' + short_summary(analysis))
     plot = plot_run(analysis, bag.with_suffix('.png'))

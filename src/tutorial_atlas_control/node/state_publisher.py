@@ -28,7 +28,7 @@ def robot_state_publisher_executable() -> str:
     Raises:
         StatePublisherError: it is not installed.
     """
-    import roslib.packages
+    import roslib.packages  # noqa: PLC0415 - the module imports where ROS is not installed
     try:
         found = roslib.packages.find_node(RSP_PACKAGE, RSP_EXECUTABLE)
     except Exception:  # noqa: BLE001 - rospkg raises several kinds for a missing package

@@ -22,10 +22,15 @@ import rospy
 from sensor_msgs.msg import JointState
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.sim.controller import LOAD_HINT, Gains, GainsError, gains_from_params
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES, NUM_JOINTS, joint_index
-from tutorial_atlas_control.trajectories.schedule import done_line, playing_line, run_trajectory, trajectory_log_line
+from tutorial_atlas_control.sim.controller import LOAD_HINT, Gains, GainsError, gains_from_params
+from tutorial_atlas_control.trajectories.schedule import (
+    done_line,
+    playing_line,
+    run_trajectory,
+    trajectory_log_line,
+)
 from tutorial_atlas_control.trajectories.trajectory import Waypoint
 from tutorial_atlas_control.units import finite_number
 
@@ -109,7 +114,8 @@ def positions_by_name(names: Sequence[str], positions: Sequence[float]) -> np.nd
     """
     if len(names) != len(positions):
         raise TrajYamlError(
-            f'{JOINT_STATES_TOPIC}: the message has {len(names)} names but {len(positions)} positions'
+            f'{JOINT_STATES_TOPIC}: the message has {len(names)} names '
+            f'but {len(positions)} positions'
         )
     result = np.full(NUM_JOINTS, np.nan)
     seen = np.zeros(NUM_JOINTS, dtype=bool)
@@ -124,11 +130,13 @@ def positions_by_name(names: Sequence[str], positions: Sequence[float]) -> np.nd
     if not seen.all():
         missing = [JOINT_NAMES[index] for index in np.flatnonzero(~seen)]
         raise TrajYamlError(
-            f'{JOINT_STATES_TOPIC}: the message lacks {len(missing)} Atlas joint(s): {", ".join(missing)}'
+            f'{JOINT_STATES_TOPIC}: the message lacks {len(missing)} Atlas joint(s): '
+            f'{", ".join(missing)}'
         )
     if not np.isfinite(result).all():
         bad = int(np.flatnonzero(~np.isfinite(result))[0])
-        raise TrajYamlError(f'{JOINT_STATES_TOPIC}: the position of {JOINT_NAMES[bad]} is {result[bad]}')
+        raise TrajYamlError(
+            f'{JOINT_STATES_TOPIC}: the position of {JOINT_NAMES[bad]} is {result[bad]}')
     return result
 
 
@@ -167,7 +175,8 @@ def wait_for_joint_state(
         rospy.ROSInterruptException: the node was shut down while waiting.
     """
     return _poll(cache.latest, timeout_s, is_shutdown, 'joint states',
-                 f'no simulator is publishing {JOINT_STATES_TOPIC}: nothing arrived within {timeout_s:g} s; '
+                 f'no simulator is publishing {JOINT_STATES_TOPIC}: '
+                 f'nothing arrived within {timeout_s:g} s; '
                  f'start it with `{LAUNCH_HINT}`')
 
 
@@ -269,18 +278,20 @@ def play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], path
     rospy.loginfo(done_line(name))
 
 
-def _wait_for_simulator(publisher: rospy.Publisher, first_state: JointState, timeout_s: float) -> None:
+def _wait_for_simulator(publisher: rospy.Publisher, first_state: JointState,
+                        timeout_s: float) -> None:
     """wait_for_subscribers for our publisher; the simulator is the sender of `first_state`."""
     simulator = (getattr(first_state, '_connection_header', None) or {}).get('callerid')
     started = time.monotonic()
-    missing = wait_for_subscribers(lambda: _connected_subscribers(publisher), _registered_subscribers,
-                                   simulator, timeout_s)
+    missing = wait_for_subscribers(lambda: _connected_subscribers(publisher),
+                                   _registered_subscribers, simulator, timeout_s)
     connected = ', '.join(sorted(_connected_subscribers(publisher)))
-    rospy.loginfo(f'{JOINT_COMMANDS_TOPIC}: subscribers connected after {time.monotonic() - started:.2f} s: '
+    rospy.loginfo(f'{JOINT_COMMANDS_TOPIC}: subscribers connected after '
+                  f'{time.monotonic() - started:.2f} s: '
                   f'{connected} (simulator: {simulator or "unknown"})')
     if missing:
-        rospy.logwarn(f'not connected to {JOINT_COMMANDS_TOPIC} in time, so missing the first commands: '
-                      + ', '.join(sorted(missing)))
+        rospy.logwarn(f'not connected to {JOINT_COMMANDS_TOPIC} in time, '
+                      'so missing the first commands: ' + ', '.join(sorted(missing)))
 
 
 def _timeout_param(name: str, default: float) -> float:
@@ -356,12 +367,14 @@ def wait_for_subscribers(
             raise rospy.ROSInterruptException('shut down while waiting for subscribers')
         if time.monotonic() >= deadline:
             if not now_connected:
-                raise TrajYamlError(f'nothing subscribed to {JOINT_COMMANDS_TOPIC} within {timeout_s:g} s: '
-                                    f'the commands would reach no simulator; start it with `{LAUNCH_HINT}`')
+                raise TrajYamlError(
+                    f'nothing subscribed to {JOINT_COMMANDS_TOPIC} within {timeout_s:g} s: '
+                    f'the commands would reach no simulator; start it with `{LAUNCH_HINT}`')
             if simulator in missing:
-                raise TrajYamlError(f'the simulator {simulator} subscribes to {JOINT_COMMANDS_TOPIC} but did not '
-                                    f'connect within {timeout_s:g} s; it would miss the start of the trajectory '
-                                    f'(a busy host? raise {SUBSCRIBER_TIMEOUT_PARAM})')
+                raise TrajYamlError(
+                    f'the simulator {simulator} subscribes to {JOINT_COMMANDS_TOPIC} but did not '
+                    f'connect within {timeout_s:g} s; it would miss the start of the trajectory '
+                    f'(a busy host? raise {SUBSCRIBER_TIMEOUT_PARAM})')
             return missing
         time.sleep(POLL_PERIOD_S)
 
@@ -388,11 +401,11 @@ def wait_until_handed_over(publisher: rospy.Publisher, timeout_s: float) -> bool
 def joint_commands_type() -> Callable[[], object]:
     """osrf_msgs/JointCommands, from the built workspace."""
     try:
-        from osrf_msgs.msg import JointCommands
+        from osrf_msgs.msg import JointCommands  # noqa: PLC0415 - unbuilt workspace: one line
     except ImportError as err:
         raise TrajYamlError(
-            f'cannot import osrf_msgs.msg.JointCommands ({err}): build the workspace with `make setup` '
-            'and `source ./env.sh`'
+            f'cannot import osrf_msgs.msg.JointCommands ({err}): '
+            'build the workspace with `make setup` and `source ./env.sh`'
         ) from err
     return JointCommands
 

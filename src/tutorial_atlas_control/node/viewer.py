@@ -76,7 +76,8 @@ def _glfw_modifiers() -> frozenset[str]:
     The passive viewer's key callback receives only the key code; its thread has the
     window's GL context current, so GLFW can be asked for the modifiers' state.
     """
-    import glfw  # the viewer's own GLFW binding; imported late: it needs a display library
+    # The viewer's own GLFW binding, imported late: it needs a display library.
+    import glfw  # noqa: PLC0415
 
     window = glfw.get_current_context()
     if not window:
@@ -124,7 +125,7 @@ class ViewerLink:
     def __init__(self, model: mujoco.MjModel, launch: Launcher | None = None,
                  modifiers: Modifiers = _glfw_modifiers) -> None:
         if launch is None:  # imported late: it needs GLFW, hence a display library
-            from mujoco import viewer as mujoco_viewer
+            from mujoco import viewer as mujoco_viewer  # noqa: PLC0415
             launch = mujoco_viewer.launch_passive
         self.model = model
         self.shadow = mujoco.MjData(model)

@@ -23,25 +23,34 @@ from pathlib import Path
 
 import numpy as np
 
-from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags.rosbag1_fast import BlockBagWriter, RecordBlock, TopicConnection
 from tutorial_atlas_control.bags.typestore import (
-    JOINT_COMMANDS_TYPE, load_typestore, rosbags_msgtype)
-from tutorial_atlas_control.msgs.commands import CommandDecoder, CommandError
-from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, Gains, load_gains_yaml
+    JOINT_COMMANDS_TYPE,
+    load_typestore,
+    rosbags_msgtype,
+)
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES
-from tutorial_atlas_control.trajectories.schedule import (
-    done_line, playing_line, run_trajectory, trajectory_log_line)
+from tutorial_atlas_control.msgs.commands import CommandDecoder, CommandError
 from tutorial_atlas_control.msgs.sim_messages import TCPROS_PREFIX_BYTES, SimMessages
-from tutorial_atlas_control.stepping.schedule import step_stamp, steps_between
-from tutorial_atlas_control.sim.simulator import (
-    AtlasSimulator, ControlMode, PhysicsDivergenceError)
-from tutorial_atlas_control.trajectories.trajectory import (
-    Waypoint, load_trajectory, locate_trajectory_file)
-from tutorial_atlas_control.units import NS_PER_S
 from tutorial_atlas_control.msgs.wire import JointCommandsWire, StampedWire, clock_bytes
+from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, Gains, load_gains_yaml
+from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode, PhysicsDivergenceError
+from tutorial_atlas_control.stepping.schedule import step_stamp, steps_between
+from tutorial_atlas_control.trajectories.schedule import (
+    done_line,
+    playing_line,
+    run_trajectory,
+    trajectory_log_line,
+)
+from tutorial_atlas_control.trajectories.trajectory import (
+    Waypoint,
+    load_trajectory,
+    locate_trajectory_file,
+)
+from tutorial_atlas_control.units import NS_PER_S
 
 __all__ = ['OfflineRunError', 'OfflineRun', 'run_offline', 'write_offline_bag']
 

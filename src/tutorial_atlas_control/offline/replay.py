@@ -29,15 +29,18 @@ from typing import Any
 
 import numpy as np
 
-from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags.reader import BagData, read_bag
-from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, load_gains_yaml
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, load_gains_yaml
 from tutorial_atlas_control.sim.sim_config import SimConfig, SimConfigError, parse_sim_config
 from tutorial_atlas_control.sim.simulator import (
-    DEFAULT_TIME_TO_UNPIN_S, AtlasSimulator, PhysicsDivergenceError)
+    DEFAULT_TIME_TO_UNPIN_S,
+    AtlasSimulator,
+    PhysicsDivergenceError,
+)
 from tutorial_atlas_control.units import NS_PER_S
 
 __all__ = [

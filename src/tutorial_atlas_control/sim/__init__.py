@@ -1,1 +1,4 @@
-"""The simulation: the MuJoCo model and its URDF, the controller law (numpy and compiled), the simulator. No ROS."""
+"""The simulation: the MuJoCo model and its URDF, the controller law, the simulator. No ROS.
+
+The controller law comes in two implementations, numpy and compiled.
+"""

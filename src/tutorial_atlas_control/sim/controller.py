@@ -39,13 +39,14 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import yaml
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.msgs.commands import JointCommandArrays
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.units import finite_number
+from tutorial_atlas_control.msgs.commands import JointCommandArrays
 from tutorial_atlas_control.resources import package_path
+from tutorial_atlas_control.units import finite_number
 
 #: Where the gains live on the parameter server (and in config/atlas_controller.yaml).
 GAINS_PARAM = topics.GAINS_PARAM
@@ -194,7 +195,8 @@ def gains_from_params(params: Mapping[str, Any]) -> Gains:
     """
     if not isinstance(params, Mapping):
         raise GainsError(f'parameter {GAINS_PARAM} is {params!r}, not a dictionary; {LOAD_HINT}')
-    table = np.array([[_gain_value(params, joint, key) for key in GAIN_KEYS] for joint in JOINT_NAMES])
+    table = np.array([[_gain_value(params, joint, key) for key in GAIN_KEYS]
+                      for joint in JOINT_NAMES])
     return Gains(*(np.ascontiguousarray(table[:, column]) for column in range(len(GAIN_KEYS))))
 
 
@@ -220,8 +222,6 @@ def load_gains_yaml(path: str | Path) -> Gains:
     Raises:
         GainsError: the file is missing or unreadable, or the gains are malformed.
     """
-    import yaml  # local: only the file path needs PyYAML
-
     path = Path(path)
     try:
         document = yaml.safe_load(path.read_text())

@@ -177,4 +177,5 @@ def sensor(atlas: AtlasModel, data: mujoco.MjData, name: str) -> np.ndarray:
     try:
         return data.sensordata[atlas.sensor_slices[name]].copy()
     except KeyError:
-        raise ModelError(f'Unknown sensor {name!r}; choose one of {", ".join(SENSOR_NAMES)}.') from None
+        raise ModelError(f'Unknown sensor {name!r}; '
+                         f'choose one of {", ".join(SENSOR_NAMES)}.') from None

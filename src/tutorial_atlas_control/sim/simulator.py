@@ -16,13 +16,13 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control import native
-from tutorial_atlas_control.sim import law_kernel
-from tutorial_atlas_control.sim import model as atlas_model
-from tutorial_atlas_control.msgs.commands import CommandUpdate, JointCommandArrays, command_update
-from tutorial_atlas_control.sim.controller import Gains, PidState, compute_torque, hold_command
-from tutorial_atlas_control.sim.sim_config import SimConfig
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import NUM_JOINTS
+from tutorial_atlas_control.msgs.commands import CommandUpdate, JointCommandArrays, command_update
+from tutorial_atlas_control.sim import law_kernel
+from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.sim.controller import Gains, PidState, compute_torque, hold_command
+from tutorial_atlas_control.sim.sim_config import SimConfig
 from tutorial_atlas_control.units import NS_PER_S
 
 #: DRCSim released the pinned torso after this long (s); `/atlas/time_to_unpin` overrides it.

@@ -119,7 +119,8 @@ def matching_urdf(model_path: Path | str, model: mujoco.MjModel) -> tuple[Path, 
         axis = joint.axis / np.linalg.norm(joint.axis)
         if ((joint.parent, joint.child) != (parent, child)
                 or not np.allclose(joint.origin_m, model.body_pos[body], atol=KINEMATICS_TOLERANCE)
-                or not np.allclose(np.abs(quat @ model.body_quat[body]), 1.0, atol=KINEMATICS_TOLERANCE)
+                or not np.allclose(np.abs(quat @ model.body_quat[body]), 1.0,
+                                   atol=KINEMATICS_TOLERANCE)
                 or not np.allclose(axis, model.jnt_axis[joint_id], atol=KINEMATICS_TOLERANCE)):
             raise UrdfError(f'{path} does not match the model {model_path}: joint {name!r} '
                             'connects other links or has another origin or axis')

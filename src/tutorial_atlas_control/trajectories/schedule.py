@@ -24,7 +24,8 @@ __all__ = [
     'trajectory_log_line',
 ]
 
-#: A joint "moves" in a waypoint's log line if its target is this far (rad) from its measured position.
+#: A joint "moves" in a waypoint's log line if its target is this far (rad) from its measured
+#: position.
 MOVING_JOINT_THRESHOLD_RAD = 0.01
 #: Start of the one machine-readable log line a player writes before its first command
 #: (followed by JSON with the trajectory file and name): how a bag tells what it played.

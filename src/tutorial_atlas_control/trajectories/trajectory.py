@@ -25,8 +25,8 @@ import yaml
 
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.units import finite_number
 from tutorial_atlas_control.resources import package_path
+from tutorial_atlas_control.units import finite_number
 
 __all__ = [
     'PUBLISH_PERIOD_S',
@@ -62,7 +62,7 @@ class TrajectoryError(AtlasControlError):
 
 @dataclass(frozen=True)
 class Waypoint:
-    """One row of a trajectory: reach `positions` (rad, tutorial joint order) in `duration_s` (s)."""
+    """A trajectory's row: reach `positions` (rad, tutorial joint order) in `duration_s` (s)."""
 
     duration_s: float
     positions: np.ndarray
@@ -89,7 +89,8 @@ def load_trajectory_file(path: PathLike) -> dict[str, object]:
         reason = err.strerror or str(err)
         raise TrajectoryError(f'{path}: cannot read trajectory file: {reason}') from err
     except UnicodeDecodeError as err:
-        raise TrajectoryError(f'{path}: cannot read trajectory file: not UTF-8 text ({err.reason})') from err
+        raise TrajectoryError(
+            f'{path}: cannot read trajectory file: not UTF-8 text ({err.reason})') from err
 
     try:
         doc = yaml.safe_load(text)
@@ -103,7 +104,8 @@ def load_trajectory_file(path: PathLike) -> dict[str, object]:
         raise TrajectoryError(f'{path}: invalid YAML{_yaml_where(err)}: {problem}') from err
 
     if doc is None:
-        raise TrajectoryError(f'{path}: the file is empty; expected a mapping of trajectory names to waypoints')
+        raise TrajectoryError(
+            f'{path}: the file is empty; expected a mapping of trajectory names to waypoints')
     if not isinstance(doc, dict):
         raise TrajectoryError(
             f'{path}: expected a mapping of trajectory names to waypoints at the top level, '
@@ -135,7 +137,8 @@ def parse_trajectory(doc: Mapping[object, object], name: str, path: PathLike) ->
     rows = doc[name]
     where = f"{path}: trajectory '{name}'"
     if not isinstance(rows, list):
-        raise TrajectoryError(f'{where}: expected a list of waypoints [duration_s, "positions"], got {_kind(rows)}')
+        raise TrajectoryError(
+            f'{where}: expected a list of waypoints [duration_s, "positions"], got {_kind(rows)}')
     if not rows:
         raise TrajectoryError(f'{where}: has no waypoints')
     return [_parse_waypoint(row, f'{where}, waypoint {index}') for index, row in enumerate(rows)]
@@ -147,7 +150,8 @@ def is_explicit_path(path: PathLike) -> bool:
     return os.path.isabs(text) or text.split(os.sep, 1)[0] in ('.', '..')
 
 
-def resolve_trajectory_file(path: PathLike, search_dir: Path = TRAJECTORIES_DIR) -> tuple[str, bool]:
+def resolve_trajectory_file(path: PathLike,
+                            search_dir: Path = TRAJECTORIES_DIR) -> tuple[str, bool]:
     """The file a YAML_FILE argument names, and whether it was found in `search_dir`.
 
     The argument as given when it exists from the current directory, or when it is an
@@ -245,11 +249,13 @@ def interpolate(
 def _parse_waypoint(row: object, where: str) -> Waypoint:
     if not isinstance(row, list) or len(row) != 2:
         raise TrajectoryError(
-            f'{where}: expected a pair [duration_s, "{NUM_JOINTS} joint positions"], got {_kind(row)}'
+            f'{where}: expected a pair [duration_s, "{NUM_JOINTS} joint positions"], '
+            f'got {_kind(row)}'
         )
     duration_s = finite_number(row[0])
     if duration_s is None:
-        raise TrajectoryError(f'{where}: duration must be a finite number of seconds, got {_show(row[0])}')
+        raise TrajectoryError(
+            f'{where}: duration must be a finite number of seconds, got {_show(row[0])}')
     if duration_s <= 0.0:
         raise TrajectoryError(f'{where}: duration must be positive, got {_show(row[0])} s')
     return Waypoint(duration_s=duration_s, positions=_parse_positions(row[1], where))
