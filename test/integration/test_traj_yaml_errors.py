@@ -9,9 +9,11 @@ parameter server.
 from __future__ import annotations
 
 import json
+import queue
 import signal
 import subprocess
 import sys
+import threading
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -20,7 +22,7 @@ import pytest
 
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
-from tutorial_atlas_control.processes import RosMaster, stop_tree
+from tutorial_atlas_control.processes import RosMaster, default_sigint, stop_tree
 
 REPO = Path(__file__).resolve().parents[2]
 TRAJ_YAML = REPO / 'scripts' / 'traj_yaml.py'
@@ -32,6 +34,8 @@ MASTER_TIMEOUT_S = 60.0
 STEP_AND_FALL_COMMANDS = 200
 #: Wall-clock guard (s): how long the fake simulator runs at most.
 FAKE_SIMULATOR_GUARD_S = 90.0
+#: Wall-clock guard (s): how long the port may take to start playing beside the fake simulator.
+PLAYING_TIMEOUT_S = 60.0
 
 
 class Master(RosMaster):
@@ -161,19 +165,26 @@ def test_ctrl_c_while_playing_exits_130_without_traceback(master: Master) -> Non
         [sys.executable, str(FAKE_SIMULATOR), '--subscribe-after', '0',
          '--run-for', str(FAKE_SIMULATOR_GUARD_S)],
         env=master.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-        start_new_session=True)
+        start_new_session=True, preexec_fn=default_sigint)
+    # Its own session, SIGINT at its default even when the suite runs as a background job.
     port = subprocess.Popen(
         [sys.executable, str(TRAJ_YAML), str(TRAJECTORIES), 'step_and_fall'],
-        env=master.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        env={**master.env, 'PYTHONUNBUFFERED': '1'}, stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE, text=True, start_new_session=True, preexec_fn=default_sigint)
+    lines: queue.Queue[str] = queue.Queue()
+    threading.Thread(target=lambda: [lines.put(line) for line in port.stdout or ()],
+                     daemon=True).start()
     try:
-        assert port.stdout is not None
-        for line in port.stdout:  # the port announces the trajectory once it plays
-            if "playing trajectory 'step_and_fall'" in line:
-                break
-        else:
-            pytest.fail(f'traj_yaml.py never started playing: {port.communicate()}')
+        deadline = time.monotonic() + PLAYING_TIMEOUT_S
+        # The port announces the trajectory once it plays.
+        while "playing trajectory 'step_and_fall'" not in lines.get(
+                timeout=max(0.0, deadline - time.monotonic())):
+            pass
         port.send_signal(signal.SIGINT)
-        _, err = port.communicate(timeout=30)
+        port.wait(timeout=30)
+        err = port.stderr.read() if port.stderr else ''
+    except queue.Empty:
+        pytest.fail(f'traj_yaml.py did not start playing within {PLAYING_TIMEOUT_S} s')
     finally:
         stop_tree(port)
         simulator.send_signal(signal.SIGINT)
