@@ -15,7 +15,6 @@ Wall time about 90 s for the module (one simulator for all gestures).
 from __future__ import annotations
 
 import json
-import shutil
 import subprocess
 import sys
 import time
@@ -29,12 +28,7 @@ from support import xdisplay
 from tutorial_atlas_control.processes import free_local_port, ros_environment, stop_tree
 from tutorial_atlas_control.sim.model import SPAWN_HEIGHT_M
 
-if xdisplay.missing_tools():
-    pytest.skip(f'needs {", ".join(xdisplay.missing_tools())} (tools/setup.sh installs '
-                'xvfb, xdotool and imagemagick)', allow_module_level=True)
-if shutil.which('roslaunch') is None:
-    pytest.skip('roslaunch is not on PATH (source env.sh)', allow_module_level=True)
-pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
+xdisplay.skip_module_unless_launchable()
 
 PROBE = Path(__file__).resolve().parent / 'viewer_probe.py'
 WINDOW_NAME = 'MuJoCo'

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import os
 import re
-import shutil
 import signal
 from collections.abc import Callable
 from pathlib import Path
@@ -24,12 +23,7 @@ import pytest
 from support import xdisplay
 from support.launch import TestLaunch
 
-if xdisplay.missing_tools():
-    pytest.skip(f'needs {", ".join(xdisplay.missing_tools())} (tools/setup.sh installs '
-                'xvfb, xdotool and imagemagick)', allow_module_level=True)
-if shutil.which('roslaunch') is None:
-    pytest.skip('roslaunch is not on PATH (source env.sh)', allow_module_level=True)
-pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
+xdisplay.skip_module_unless_launchable()
 
 WINDOW_NAME = 'MuJoCo'
 NODE = '/atlas_sim'

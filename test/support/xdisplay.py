@@ -52,6 +52,16 @@ def missing_tools() -> list[str]:
     return [tool for tool in TOOLS if shutil.which(tool) is None]
 
 
+def skip_module_unless_launchable() -> None:
+    """Skip the calling test module unless the X tools, roslaunch and the workspace are there."""
+    if missing_tools():
+        pytest.skip(f'needs {", ".join(missing_tools())} (tools/setup.sh installs '
+                    'xvfb, xdotool and imagemagick)', allow_module_level=True)
+    if shutil.which('roslaunch') is None:
+        pytest.skip('roslaunch is not on PATH (source env.sh)', allow_module_level=True)
+    pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
+
+
 def _socket(number: int) -> Path:
     return Path(f'/tmp/.X11-unix/X{number}')
 

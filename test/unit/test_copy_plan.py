@@ -11,14 +11,6 @@ from tutorial_atlas_control import native
 from tutorial_atlas_control.msgs.copy_plan import CopyPlan
 
 
-@pytest.fixture(scope='module')
-def library():
-    library = native.load_library()
-    assert library is not None, (f'{native.LIBRARY_NAME} is not in the catkin workspace: '
-                                 'run `make setup` and `source ./env.sh`')
-    return library
-
-
 def test_copy_plan_equals_numpy_copies_into_unaligned_bytes(library) -> None:
     """The compiled copies write what numpy's `dst[to] = src[from]` writes, bit for bit,
     into float blocks at odd byte offsets (as in a serialized message)."""

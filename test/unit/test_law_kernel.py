@@ -21,14 +21,6 @@ CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml
 DT_S = 0.001
 
 
-@pytest.fixture(scope='module')
-def library():
-    library = native.load_library()
-    assert library is not None, (f'{native.LIBRARY_NAME} is not in the catkin workspace: '
-                                 'run `make setup` and `source ./env.sh`')
-    return library
-
-
 def same_bits(a: np.ndarray, b: np.ndarray) -> bool:
     return a.tobytes() == b.tobytes()
 
