@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import signal
 import sys
+import threading
 from collections.abc import Callable, Sequence
 from types import FrameType
 
@@ -46,25 +47,43 @@ DESCRIPTION = (
     'long to wait for the simulator to subscribe to the commands.'
 )
 HELP_OPTIONS = ('-h', '--help')
+#: How long (s) a Ctrl-C'd port waits for rospy to unregister from the master.
+SHUTDOWN_WAIT_S = 5.0
 
 
 class _SigintSeen:
-    """Chained in front of rospy's SIGINT handler, to tell Ctrl-C from other shutdowns."""
+    """Chained in front of rospy's SIGINT handler, to tell Ctrl-C from other shutdowns.
+
+    rospy's handler shuts the node down inside the signal handler, on the main thread; when
+    the signal lands while that thread is in an XML-RPC call to the master (a log line's
+    first /rosout parameter look-up), the shutdown waits for the lock that very call holds,
+    forever. So the handler runs on a thread of its own, and the main thread sees the
+    shutdown at its next command.
+    """
 
     def __init__(self) -> None:
         self.seen = False
         self._rospy_handler: Callable[[int, FrameType | None], object] | int | None = None
+        self._shutdown: threading.Thread | None = None
 
     def install(self) -> None:
         self._rospy_handler = signal.getsignal(signal.SIGINT)
         signal.signal(signal.SIGINT, self._handle)
 
-    def _handle(self, signum: int, frame: FrameType | None) -> None:
+    def _handle(self, signum: int, _frame: FrameType | None) -> None:
         self.seen = True
-        if callable(self._rospy_handler):
-            self._rospy_handler(signum, frame)
-        else:
+        handler = self._rospy_handler
+        if not callable(handler):
             raise KeyboardInterrupt
+        if self._shutdown is None:
+            self._shutdown = threading.Thread(target=handler, args=(signum, None),
+                                              name='sigint-shutdown', daemon=True)
+            self._shutdown.start()
+
+    def wait(self, timeout_s: float) -> None:
+        """Let rospy's shutdown (unregistering from the master) finish before exiting."""
+        if self._shutdown is not None:
+            self._shutdown.join(timeout_s)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -117,4 +136,6 @@ def _run(path: str, name: str, raw: list[str]) -> int:
     except rospy.ROSInterruptException:
         rospy.logwarn('shut down before the trajectory finished')
         return EXIT_INTERRUPTED if sigint.seen else EXIT_FAILED
+    finally:
+        sigint.wait(SHUTDOWN_WAIT_S)
     return EXIT_INTERRUPTED if sigint.seen else 0
