@@ -23,10 +23,16 @@ def _is_package_root(directory: Path) -> bool:
     return manifest.is_file() and f'<name>{PACKAGE_NAME}</name>' in manifest.read_text()
 
 
+def _source_root() -> Path:
+    return _MODULE_DIR.parents[1]  # <repo>/src/tutorial_atlas_control -> <repo>
+
+
+def _install_share() -> Path:
+    return _MODULE_DIR.parents[3] / 'share'  # <prefix>/lib/python3/dist-packages/<pkg>
+
+
 def _candidates() -> list[Path]:
-    source_root = _MODULE_DIR.parents[1]  # <repo>/src/tutorial_atlas_control -> <repo>
-    install_prefix = _MODULE_DIR.parents[3]  # <prefix>/lib/python3/dist-packages/<pkg>
-    return [source_root, install_prefix / 'share' / PACKAGE_NAME]
+    return [_source_root(), _install_share() / PACKAGE_NAME]
 
 
 def package_dir() -> Path:
@@ -55,8 +61,8 @@ def message_file(package: str, name: str) -> Path | None:
     share/<pkg>/), then on ROS_PACKAGE_PATH through rospkg where it is installed.
     """
     relative = Path('msg') / f'{name}.msg'
-    candidates = [_MODULE_DIR.parents[1] / 'msg' / package / relative,
-                  _MODULE_DIR.parents[3] / 'share' / package / relative]
+    candidates = [_source_root() / 'msg' / package / relative,
+                  _install_share() / package / relative]
     for candidate in candidates:
         if candidate.is_file():
             return candidate
