@@ -4,7 +4,7 @@ One line on stderr per error, `<script>: error: <message>` as argparse prints it
 traceback. Exit status 0 on success, 1 when the input or the environment is refused (a
 bag, a file, no ROS master), 2 when the command line is (argparse, including option values
 out of range), 3 when replay_bag.py's replay deviates, 130 on Ctrl-C. traj_yaml.py keeps
-the DRCSim tutorial's command line instead: its usage and exit status 1.
+the DRCSim tutorial's command line instead: its usage and exit status 1 (130 on Ctrl-C too).
 """
 
 from __future__ import annotations
