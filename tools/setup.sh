@@ -18,7 +18,7 @@ APT_PACKAGES=(
   ros-message-generation ros-message-runtime python3-genpy python3-gencpp python3-genmsg
   ros-std-msgs ros-sensor-msgs ros-nav-msgs ros-geometry-msgs ros-std-srvs ros-rosgraph-msgs
   python3-std-msgs python3-sensor-msgs python3-nav-msgs python3-geometry-msgs python3-std-srvs
-  python3-rosgraph-msgs libstd-msgs-dev libroscpp-dev libsensor-msgs-dev
+  python3-rosgraph-msgs libstd-msgs-dev libroscpp-dev libsensor-msgs-dev libgeometry-msgs-dev
   librostest-dev librosbag-storage-dev libtopic-tools-dev python3-venv python3-yaml python3-numpy
   libosmesa6 libegl1 libopengl0 libgl1-mesa-dri
   ros-robot-state-publisher ros-tf2-msgs python3-tf2-msgs python3-tf2-ros rviz

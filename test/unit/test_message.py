@@ -49,3 +49,41 @@ def test_controller_statistics_is_drcsim_atlas_msgs() -> None:
     assert atlas.ControllerStatistics.__slots__ == [
         'header', 'command_age', 'command_age_mean', 'command_age_variance',
         'command_age_window_size']
+
+
+#: DRCSim 2.7.0's genmsg MD5 sums (the reference README's table): a field out of place, a
+#: changed type or a lost constant changes them.
+ATLAS_MSGS_MD5 = {
+    'AtlasCommand': '3a56dd1f50633ad975636160b665384a',
+    'AtlasState': 'f401ea8c0dd89918d4fa3a58c57816e6',
+    'ForceTorqueSensors': '608f43cae98f77f5fb6cfbbbfa4c9253',
+    'Test': '62f63cd4b6db15007d8d3d4a23411c4c',
+    'ControllerStatistics': '628a0c6643f9fd5708402f085735e478',
+    'SynchronizationStatistics': '27bc1701ef8ff889822573f985ebb2b6',
+}
+
+
+@pytest.mark.parametrize(('name', 'md5'), sorted(ATLAS_MSGS_MD5.items()))
+def test_atlas_msgs_md5_match_drcsim_2_7_0(name: str, md5: str) -> None:
+    atlas = pytest.importorskip('atlas_msgs.msg',
+                                reason='needs the catkin workspace: source ./env.sh')
+    message = getattr(atlas, name)
+    assert message._type == f'atlas_msgs/{name}'
+    assert message._md5sum == md5
+
+
+def test_reset_controls_service_md5_matches_drcsim_2_7_0() -> None:
+    srv = pytest.importorskip('atlas_msgs.srv',
+                              reason='needs the catkin workspace: source ./env.sh')
+    assert srv.ResetControls._type == 'atlas_msgs/ResetControls'
+    assert srv.ResetControls._md5sum == '132418be2559866cd92987f80ed5ce8a'
+
+
+def test_atlas_state_joint_constants_are_the_joint_order() -> None:
+    """AtlasState's constants index its arrays in the port's joint order."""
+    atlas = pytest.importorskip('atlas_msgs.msg',
+                                reason='needs the catkin workspace: source ./env.sh')
+    from tutorial_atlas_control.joints import JOINT_NAMES
+
+    assert [getattr(atlas.AtlasState, name) for name in JOINT_NAMES] == list(range(28))
+    assert 'back_lbz' not in atlas.AtlasState.__slots__
