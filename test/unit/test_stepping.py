@@ -78,6 +78,12 @@ class FakeLog:
     def refused_command(self, text: str) -> None:
         self.lines.append(('refused', text))
 
+    def kept_fields(self, text: str) -> None:
+        self.lines.append(('kept', text))
+
+    def warn(self, text: str) -> None:
+        self.lines.append(('warn', text))
+
     def error(self, text: str) -> None:
         self.lines.append(('error', text))
 
