@@ -138,19 +138,32 @@ class RawTest(RawMessage):
 
 
 class RosLog:
-    """The stepping loop's log lines, into rospy's log (stepping.loop.LoopLog)."""
+    """The stepping loop's log lines, into rospy's log (stepping.loop.LoopLog).
+
+    Refusals are throttled per topic and kind (rospy's logwarn_throttle throttles per call
+    site, so a refused JointCommands would hide a refused AtlasCommand for WARN_THROTTLE_S).
+    """
+
+    def __init__(self, clock: Callable[[], float] = time.monotonic) -> None:
+        self._clock = clock
+        self._last_s: dict[tuple[str, str], float] = {}
+
+    def _throttled(self, key: tuple[str, str], text: str) -> None:
+        now_s = self._clock()
+        last_s = self._last_s.get(key)
+        if last_s is None or now_s - last_s >= WARN_THROTTLE_S:
+            self._last_s[key] = now_s
+            rospy.logwarn(text)
 
     @staticmethod
     def info(text: str) -> None:
         rospy.loginfo(text)
 
-    @staticmethod
-    def refused_command(text: str) -> None:
-        rospy.logwarn_throttle(WARN_THROTTLE_S, text)
+    def refused_command(self, text: str, topic: str = topics.JOINT_COMMANDS) -> None:
+        self._throttled(('refused', topic), text)
 
-    @staticmethod
-    def kept_fields(text: str) -> None:
-        rospy.logwarn_throttle(WARN_THROTTLE_S, text)
+    def kept_fields(self, text: str, topic: str) -> None:
+        self._throttled(('kept', topic), text)
 
     @staticmethod
     def warn(text: str) -> None:

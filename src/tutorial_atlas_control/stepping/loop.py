@@ -95,10 +95,11 @@ class LoopLog(Protocol):
 
     def info(self, text: str) -> None: ...
 
-    def refused_command(self, text: str) -> None: ...
+    def refused_command(self, text: str, topic: str = topics.JOINT_COMMANDS) -> None:
+        """Throttled per topic: a command message was refused."""
 
-    def kept_fields(self, text: str) -> None:
-        """Throttled: an AtlasCommand/Test array of the wrong length was left out."""
+    def kept_fields(self, text: str, topic: str) -> None:
+        """Throttled per topic: an AtlasCommand/Test array of the wrong length was left out."""
 
     def warn(self, text: str) -> None: ...
 
@@ -258,7 +259,7 @@ class SteppingLoop:
             try:
                 result = self._decode(topic, raw)
             except CommandError as err:
-                self.log.refused_command(f'refused {topic}: {err}; previous command kept')
+                self.log.refused_command(f'refused {topic}: {err}; previous command kept', topic)
                 continue
             if not stamped and topic in STAMPED_COMMANDS:
                 self._note_command_stamp(raw)  # the newest applied command
@@ -280,7 +281,7 @@ class SteppingLoop:
                 updates.append(result)
                 continue
             if result.ignored:
-                self.log.kept_fields(f'{topic}: {result.ignored_text()}')
+                self.log.kept_fields(f'{topic}: {result.ignored_text()}', topic)
             if result.damping is not None:
                 self.sim.set_joint_damping(result.damping)
             if result.desired_controller_period_ms is not None:
