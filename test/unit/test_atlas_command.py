@@ -421,3 +421,14 @@ def test_reset_controls_applies_the_commands_received_before_it(sim: AtlasSimula
     reset(loop, command=atlas_bytes(position=full(0.7)))
     np.testing.assert_array_equal(sim.user_command.position, full(0.7))
     np.testing.assert_array_equal(sim.user_command.kp_position, full(5.0))
+
+
+def test_a_mode_switch_comes_after_the_commands_received_before_it(
+        sim: AtlasSimulator) -> None:
+    loop, _, _, _ = make_loop(sim)
+    loop.set_mode(ControlMode.USER)
+    loop.receive_command(atlas_bytes(position=full(0.1), k_effort=[255] * N),
+                         topics.ATLAS_COMMAND)
+    loop.set_mode(ControlMode.STAND)  # AtlasPlugin::OnRobotMode zeroes k_effort after it
+    np.testing.assert_array_equal(sim.user_command.position, full(0.1))
+    assert not sim.user_command.k_effort.any() and sim.blended_command() is None

@@ -351,8 +351,13 @@ class SteppingLoop:
         return done
 
     def set_mode(self, mode: ControlMode) -> ControlMode:
-        """Switch the control mode; returns the previous one."""
+        """Switch the control mode; returns the previous one.
+
+        Commands received before the switch are applied first, as DRCSim's single callback
+        queue did: the switch then sets their k_effort (AtlasPlugin::OnRobotMode).
+        """
         with self.lock:
+            self.apply_pending_commands()
             previous = self.sim.mode
             self.sim.set_mode(mode)
         return previous
