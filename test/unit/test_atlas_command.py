@@ -432,3 +432,19 @@ def test_a_mode_switch_comes_after_the_commands_received_before_it(
     loop.set_mode(ControlMode.STAND)  # AtlasPlugin::OnRobotMode zeroes k_effort after it
     np.testing.assert_array_equal(sim.user_command.position, full(0.1))
     assert not sim.user_command.k_effort.any() and sim.blended_command() is None
+
+
+def test_the_fast_path_for_full_commands_agrees_with_the_general_one() -> None:
+    from tutorial_atlas_control.msgs.atlas_command import ATLAS_COMMAND_FIELDS, _decode
+
+    rng = np.random.default_rng(3)
+    arrays = {name: rng.uniform(-5.0, 5.0, N) for name, _ in ATLAS_COMMAND_FIELDS}
+    arrays['k_effort'] = rng.integers(0, 256, N)
+    raw = encode_atlas_command(9, arrays, 11)
+    fast, general = decode_atlas_command(raw), _decode(raw, ATLAS_COMMAND_FIELDS, True)
+    assert fast.update.rows == general.update.rows
+    assert fast.update.values.tobytes() == general.update.values.tobytes()
+    assert (fast.stamp_ns, fast.desired_controller_period_ms) == (9, 11)
+    arrays['kd_position'][5] = float('nan')
+    with pytest.raises(CommandError, match=r'^kd_position\[5\] is nan \(NaN/Inf are refused\)$'):
+        decode_atlas_command(encode_atlas_command(0, arrays))

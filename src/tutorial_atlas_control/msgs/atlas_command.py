@@ -138,12 +138,48 @@ def _decode(raw: bytes, layout: Sequence[tuple[str, np.dtype]],
     return _checked(arrays, stamp_ns, period_ms)
 
 
+#: A controller's usual AtlasCommand: every array of 28. Its body (after the header) has one
+#: layout: read at once, its counts checked by one struct call (the pad bytes skip the data).
+_FULL_BODY = np.dtype([item for name, dtype in ATLAS_COMMAND_FIELDS
+                       for item in ((f'{name}_count', '<u4'), (name, dtype, (NUM_JOINTS,)))]
+                      + [('desired_controller_period_ms', 'u1')])
+_FULL_COUNTS = struct.Struct('<' + ''.join(f'I{dtype.itemsize * NUM_JOINTS}x'
+                                           for _, dtype in ATLAS_COMMAND_FIELDS))
+_FULL_ROWS = tuple(LAW_FIELDS.index(name) for name, _ in ATLAS_COMMAND_FIELDS)
+_K_EFFORT_INDEX = _FULL_ROWS.index(K_EFFORT_ROW)
+
+
+def _decode_full(raw: bytes) -> AtlasUpdate | None:
+    """The fast path for an AtlasCommand whose arrays all have 28 entries; None otherwise."""
+    try:
+        cursor = FieldCursor(raw)
+        stamp_ns = cursor.header_stamp_ns()
+    except (ValueError, struct.error, UnicodeDecodeError):
+        return None
+    start = cursor.pos
+    if len(raw) - start != _FULL_BODY.itemsize:
+        return None
+    if any(count != NUM_JOINTS for count in _FULL_COUNTS.unpack_from(raw, start)):
+        return None
+    body = np.frombuffer(raw, dtype=_FULL_BODY, count=1, offset=start)[0]
+    block = np.empty((len(_FULL_ROWS), NUM_JOINTS))
+    for row, (name, _) in enumerate(ATLAS_COMMAND_FIELDS):
+        block[row] = body[name]
+    check_values(_FULL_ROWS, block)
+    block[_K_EFFORT_INDEX] /= K_EFFORT_FULL_SCALE
+    return AtlasUpdate(CommandUpdate(_ALL_JOINTS, _FULL_ROWS, block), (), stamp_ns,
+                       int(body['desired_controller_period_ms']))
+
+
 def decode_atlas_command(raw: bytes) -> AtlasUpdate:
     """A serialized atlas_msgs/AtlasCommand (2.7.0) as an AtlasUpdate.
 
     Raises:
         CommandError: malformed, or NaN/Inf or an absurd magnitude in any array.
     """
+    full = _decode_full(raw)
+    if full is not None:
+        return full
     return _decode(raw, ATLAS_COMMAND_FIELDS, with_period=True)
 
 
