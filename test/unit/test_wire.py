@@ -164,3 +164,8 @@ def test_force_torque_sensors():
     for k, name in enumerate(wire.FORCE_TORQUE_SENSORS):
         _wrench(getattr(expected, name), values[6 * k:6 * k + 6])
     assert msg.to_bytes(STAMP_NS) == genpy_bytes(expected)
+
+
+def test_atlas_state_joint_indices_are_the_tutorial_order():
+    """AtlasState's constants index its arrays; the port fills them in JOINT_NAMES order."""
+    assert [getattr(AtlasState, name) for name in JOINT_NAMES] == list(range(len(JOINT_NAMES)))
