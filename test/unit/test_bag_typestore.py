@@ -106,3 +106,16 @@ def test_the_synthetic_writer_writes_genmsg_md5(tmp_path: Path) -> None:
     path = synthetic.write_bag(tmp_path / 'synthetic.bag', [
         synthetic.Record('/atlas/atlas_state', 'atlas_msgs/AtlasState', 1.5, message)])
     _check_bag(path, positions)
+
+
+def test_a_bad_constant_in_a_bag_definition_is_one_clear_error() -> None:
+    from types import SimpleNamespace
+
+    from tutorial_atlas_control.errors import BagAnalysisError
+
+    connection = SimpleNamespace(topic='/broken', msgtype='demo_msgs/msg/Broken',
+                                 msgdef=SimpleNamespace(data='int32 limit = ten\nint32 value\n'))
+    with pytest.raises(BagAnalysisError, match=(
+            r"^Could not use the bag's definition of 'demo_msgs/msg/Broken' on /broken: "
+            r"Could not parse constant 'limit' of demo_msgs/msg/Broken: 'ten'\.$")):
+        load_typestore([connection])
