@@ -27,6 +27,9 @@ from tutorial_atlas_control.units import NS_PER_S
 
 #: DRCSim released the pinned torso after this long (s); `/atlas/time_to_unpin` overrides it.
 DEFAULT_TIME_TO_UNPIN_S = 1.0
+#: AtlasState's k_effort of a joint driven by the PID law alone (DRCSim: k_effort / 255
+#: weighs the PID torque against BDI's f_out, which the port does not have).
+K_EFFORT_PID = 255
 
 
 #: MuJoCo's warnings for an unstable step (plain ints: indexing MjData's counters with the
@@ -96,6 +99,8 @@ class AtlasSimulator:
         self.mode = ControlMode.STAND
         self.user_command: JointCommandArrays | None = None
         self.torque_nm = np.zeros(NUM_JOINTS)
+        #: The active k_effort per joint (uint8, tutorial order), read by active_k_effort().
+        self.k_effort = np.full(NUM_JOINTS, K_EFFORT_PID, dtype=np.uint8)
         self._pid = PidState()
         self._compiled_law = self._make_compiled_law() if compiled_law else None
         self._warning_counts = self.data.warning.number  # a view: MuJoCo's counters
@@ -217,6 +222,13 @@ class AtlasSimulator:
         if self.mode is ControlMode.USER and self.user_command is not None:
             return self.user_command
         return self._mode_command
+
+    def active_k_effort(self) -> np.ndarray:
+        """The k_effort the law applies (uint8, (28,)): the one place AtlasState reads it.
+
+        All K_EFFORT_PID (the PID torque alone) until a command sets it (AtlasCommand).
+        """
+        return self.k_effort
 
     # -- stepping ----------------------------------------------------------------------
     def step(self, torque_nm: np.ndarray | None = None) -> None:
