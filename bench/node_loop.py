@@ -33,6 +33,8 @@ STANDING_AFTER_S = 1.5
 #: with the torques held, the pelvis sinks 2 mm in 200 steps, 14 mm in 500 (by then on one
 #: contact instead of 8) and 20 cm in 1000.
 RESTORE_EVERY_STEPS = 200
+#: unheard_topic_run times the unheard outlets this many times over.
+UNHEARD_REPEAT = 25
 
 
 def bare_physics_run(steps: int = 5000) -> float:
@@ -93,6 +95,41 @@ def node_spin_run(steps: int = 5000, warmup_steps: int = 1500, compiled_law: boo
         return (time.process_time() - start) / steps * 1e6
 
 
+def unheard_topic_run(calls: int = 20000, rounds: int = 5) -> float:
+    """µs per step that one published topic nobody subscribes to costs the node's loop.
+
+    The node on fake rospy as launched (DRCSim's on-demand topics advertised, unheard:
+    support.fake_rospy.UNHEARD_TOPICS); its SteppingLoop.publish() is timed with those
+    topics' outlets and without them (interleaved rounds, best of each, the queued bytes
+    dropped after each call), and the difference divided by their number. Those outlets
+    are repeated UNHEARD_REPEAT times so that their cost stands out of publish()'s own
+    (several µs, and its noise on a shared machine).
+    """
+    with fake_ros_node(0, warmup_steps=0) as node:
+        loop = node.loop
+        pending = loop.outbox.pending
+        publish = loop.publish
+        unheard = loop.demand_wires
+        if not unheard or any(loop.outbox.wanted(wire[3]) for wire in unheard):
+            raise RuntimeError('expected the on-demand topics advertised and unheard')
+
+        def timed(demand_wires: tuple[Any, ...]) -> float:
+            loop.demand_wires = demand_wires
+            start = time.perf_counter()
+            for _ in range(calls):
+                publish()
+                pending.clear()
+            return time.perf_counter() - start
+
+        repeated = unheard * UNHEARD_REPEAT
+        with_s, without_s = [], []
+        for _ in range(rounds):
+            with_s.append(timed(repeated))
+            without_s.append(timed(()))
+        loop.demand_wires = unheard
+        return (min(with_s) - min(without_s)) / calls / len(repeated) * 1e6
+
+
 def main() -> int:
     rounds = int(sys.argv[1]) if len(sys.argv) > 1 else 3
     best: dict[str, float] = {}
@@ -104,6 +141,7 @@ def main() -> int:
             'node spin, C law': node_spin_run(),
             'node spin, numpy law': node_spin_run(compiled_law=False),
             'node spin, C law, TCP': node_spin_run(tcp=True),
+            'one unheard topic': unheard_topic_run(),
         }
         for name, value in figures.items():
             best[name] = min(best.get(name, value), value)

@@ -72,6 +72,7 @@ ROWS = (
     ('bare_physics_steps_per_s', 'bare mj_step, plain loop', 'steps/s', '', 0),
     ('physics_limit_steps_per_s', 'physics + law, plain loop', 'steps/s', '', 0),
     ('physics_numpy_law_steps_per_s', 'physics + numpy law, plain loop', 'steps/s', '', 0),
+    ('unheard_topic_us_per_step', 'a topic nobody subscribes to', 'us/step', '< 1', 3),
     ('offline_rtf', 'run_offline.py to a bag', 'x real time', '', 2),
     ('offline_ratio', 'offline_rtf*1000 / physics limit', '', '>= 0.8', 3),
     ('fast_rtf', 'node rtf:=0 + recorder', 'x real time', '>= 0.6 x bare/1000', 2),
@@ -164,6 +165,9 @@ def run_offline(args: argparse.Namespace, samples: dict[str, list[float]],
                 log(f'physics run {run + 1}: ' + ', '.join(
                     f'{key} {rate:.0f}' for key, rate in rates.items()))
                 add(samples, rates)
+                unheard_us = node_loop.unheard_topic_run(5000 if args.quick else 20000)
+                log(f'physics run {run + 1}: an unheard topic costs {unheard_us:.3f} us/step')
+                add(samples, {'unheard_topic_us_per_step': unheard_us})
     if 'offline' in args.sections:
         steps_per_s = offline.steps_per_sim_second()
         with Section('offline', loads), tempfile.TemporaryDirectory(prefix='tac_bench_') as tmp:

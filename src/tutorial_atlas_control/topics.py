@@ -13,6 +13,12 @@ GROUND_TRUTH_ODOM = '/ground_truth_odom'
 IMU = '/atlas/imu'
 L_FOOT_CONTACT = '/atlas/l_foot_contact'
 R_FOOT_CONTACT = '/atlas/r_foot_contact'
+#: DRCSim's atlas_msgs/AtlasState (joints, active gains, k_effort, IMU, four wrenches) and
+#: atlas_msgs/ForceTorqueSensors; the ankle contact wrenches of its debug topics.
+ATLAS_STATE = '/atlas/atlas_state'
+FORCE_TORQUE_SENSORS = '/atlas/force_torque_sensors'
+DEBUG_L_FOOT_CONTACT = '/atlas/debug/l_foot_contact'
+DEBUG_R_FOOT_CONTACT = '/atlas/debug/r_foot_contact'
 #: atlas_msgs/ControllerStatistics: the age of the command the robot obeys (DRCSim's).
 CONTROLLER_STATISTICS = '/atlas/controller_statistics'
 #: Latched JSON (timestep, time_to_unpin, model file and sha1, last reset): what replay needs.
@@ -37,7 +43,7 @@ RECORDED_TOPICS: tuple[str, ...] = (
     ATLAS_COMMAND, ATLAS_TEST,
 )
 
-#: The ROS 1 message type of each recorded topic.
+#: The ROS 1 message type of each recorded topic, and of the simulator's other topics.
 MSG_TYPES: dict[str, str] = {
     CLOCK: 'rosgraph_msgs/Clock',
     JOINT_STATES: 'sensor_msgs/JointState',
@@ -51,6 +57,11 @@ MSG_TYPES: dict[str, str] = {
     ROSOUT: 'rosgraph_msgs/Log',
     CONTROLLER_STATISTICS: 'atlas_msgs/ControllerStatistics',
     TF: 'tf2_msgs/TFMessage',
+    # Published, not recorded by default (README: the 1 kHz duplicates double a bag).
+    ATLAS_STATE: 'atlas_msgs/AtlasState',
+    FORCE_TORQUE_SENSORS: 'atlas_msgs/ForceTorqueSensors',
+    DEBUG_L_FOOT_CONTACT: 'geometry_msgs/WrenchStamped',
+    DEBUG_R_FOOT_CONTACT: 'geometry_msgs/WrenchStamped',
     ATLAS_COMMAND: 'atlas_msgs/AtlasCommand',
     ATLAS_TEST: 'atlas_msgs/Test',
 }

@@ -19,11 +19,15 @@ from typing import Any
 from unittest import mock
 
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
+from tutorial_atlas_control.stepping.loop import ON_DEMAND_MESSAGES
 
-__all__ = ['LAUNCH_RATES_HZ', 'FakePublisher', 'Sinks', 'fake_ros_node']
+__all__ = ['LAUNCH_RATES_HZ', 'UNHEARD_TOPICS', 'FakePublisher', 'Sinks', 'fake_ros_node']
 
 #: atlas.launch's rates (Hz of sim time), without /tf.
 LAUNCH_RATES_HZ = {'joint_states': 1000.0, 'odom': 100.0, 'imu': 1000.0, 'contact': 1000.0}
+#: The topics no fake subscriber listens to: as in a live launch, where the recorder
+#: subscribes to what it records and DRCSim's 1 kHz duplicates are not recorded.
+UNHEARD_TOPICS = frozenset(topic for topic, _, _ in ON_DEMAND_MESSAGES)
 #: What the fake sockets report as their send timeout (s): set, so transport.py leaves it.
 SOCKET_TIMEOUT_S = 2.0
 
@@ -92,15 +96,19 @@ class Sinks:
 
 
 class FakePublisher:
-    """rospy.Publisher as transport.py sees it: one subscriber connection. `published`
-    keeps what went through publish() (the latched /atlas/sim_config)."""
+    """rospy.Publisher as transport.py sees it: one subscriber connection (none for
+    UNHEARD_TOPICS, or `heard` False). `published` keeps what went through publish() (the
+    latched /atlas/sim_config)."""
 
     resolved_name = 'fake'
 
-    def __init__(self, sinks: Sinks, topic: str = '') -> None:
+    def __init__(self, sinks: Sinks, topic: str = '', heard: bool | None = None) -> None:
         self.topic = topic
-        connection = SimpleNamespace(socket=sinks.new(), done=False, endpoint_id='fake')
-        self.impl = SimpleNamespace(connections=[connection])
+        if heard is None:
+            heard = topic not in UNHEARD_TOPICS
+        connections = ([SimpleNamespace(socket=sinks.new(), done=False, endpoint_id='fake')]
+                       if heard else [])
+        self.impl = SimpleNamespace(connections=connections)
         self.published: list[object] = []
 
     def publish(self, msg: object) -> None:

@@ -4,9 +4,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import mujoco
 import numpy as np
 import pytest
 
+from tutorial_atlas_control.msgs.atlas_command import decode_atlas_command, encode_atlas_command
 from tutorial_atlas_control.msgs.sim_messages import SimMessages
 from tutorial_atlas_control.sim import controller, model
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
@@ -67,3 +69,125 @@ def test_trajectory_log_line_round_trip() -> None:
     for other in ('playing trajectory x', 'trajectory: not json', 'trajectory: {"file": 1}',
                   'trajectory: ["a"]'):
         assert parse_trajectory_log_line(other) is None, other
+
+
+# -- DRCSim's AtlasState, ForceTorqueSensors and debug foot contacts ---------------------
+
+#: Standing 3 s (2 s after the pin is released): the robot is still, on both feet.
+STANDING_STEPS = 3000
+GRAVITY_MPS2 = 9.81
+
+
+@pytest.fixture(scope='module')
+def standing() -> AtlasSimulator:
+    sim = AtlasSimulator(model.load_model(), controller.load_gains_yaml(GAINS))
+    for _ in range(STANDING_STEPS):
+        sim.step()
+    return sim
+
+
+def _mass_kg(sim: AtlasSimulator, body: str) -> float:
+    return float(sim.model.body_mass[sim.model.body(body).id])
+
+
+def test_standing_ankles_carry_the_robot_as_drcsim_reports_it(standing: AtlasSimulator) -> None:
+    """Fz of each ankle is the leg's push on the foot: about -(weight above the feet) / 2,
+    i.e. -430 N; DRCSim's other three components are 0."""
+    messages = SimMessages(standing)
+    assert messages.fill_atlas_state()
+    state = messages.atlas_state_wire
+    total_kg = float(standing.model.body_subtreemass[standing.atlas.pelvis_body_id])
+    above_feet_n = (total_kg - _mass_kg(standing, 'l_foot') - _mass_kg(standing, 'r_foot')) \
+        * GRAVITY_MPS2
+    l_foot, r_foot = state.wrenches['l_foot'], state.wrenches['r_foot']
+    for foot in (l_foot, r_foot):
+        assert -460.0 < foot[2] < -400.0
+        assert foot[0] == foot[1] == foot[5] == 0.0  # Fx, Fy, Mz: not reported, as DRCSim
+        assert abs(foot[3]) < 20.0 and abs(foot[4]) < 20.0  # N m: the feet are flat
+    assert l_foot[2] + r_foot[2] == pytest.approx(-above_feet_n, rel=0.02)
+    # They are the ankle force-torque sensors' readings (foot frame, at the ankle joint).
+    for side, foot in (('l', l_foot), ('r', r_foot)):
+        assert foot[2] == standing.data.sensor(f'{side}_foot_force').data[2]
+        assert np.array_equal(foot[3:5], standing.data.sensor(f'{side}_foot_torque').data[:2])
+
+
+def test_standing_imu_reads_gravity_up(standing: AtlasSimulator) -> None:
+    messages = SimMessages(standing)
+    messages.fill_atlas_state()
+    state = messages.atlas_state_wire
+    assert state.linear_acceleration[2] == pytest.approx(GRAVITY_MPS2, abs=0.05)
+    assert np.abs(state.linear_acceleration[:2]).max() < 0.5
+    assert np.abs(state.angular_velocity).max() < 0.05
+    assert state.orientation_xyzw[3] == pytest.approx(1.0, abs=0.01)  # upright
+    messages.fill_plan(('imu',))()
+    assert np.array_equal(state.floats[:10], np.r_[messages.imu_wire.orientation_xyzw,
+                                                   messages.imu_wire.angular_velocity,
+                                                   messages.imu_wire.linear_acceleration])
+
+
+def test_atlas_state_joints_gains_and_k_effort(standing: AtlasSimulator) -> None:
+    """The joint fields as /atlas/joint_states (in float32), the gains of the command the
+    law applied, k_effort from the simulator's hook."""
+    messages = SimMessages(standing)
+    messages.fill_atlas_state()
+    arrays = messages.atlas_state_wire.arrays
+    f32 = np.float32
+    assert np.array_equal(arrays['position'], standing.joint_positions().astype(f32))
+    assert np.array_equal(arrays['velocity'], standing.joint_velocities().astype(f32))
+    assert np.array_equal(arrays['effort'], standing.torque_nm.astype(f32))
+    gains = controller.load_gains_yaml(GAINS)
+    assert np.array_equal(arrays['kp_position'], gains.p.astype(f32))  # Stand: the params
+    assert np.array_equal(arrays['kd_position'], gains.d.astype(f32))
+    assert np.array_equal(arrays['i_effort_max'], gains.i_clamp.astype(f32))
+    assert np.array_equal(arrays['kp_velocity'], np.zeros(len(gains.p), f32))
+    assert set(messages.atlas_state_wire.k_effort) == {255}
+    # An AtlasCommand handing neck_ay to its PID at 7/255 in Stand: that PID's gains and k.
+    k_effort = [0] * len(gains.p)
+    k_effort[3] = 7
+    command = decode_atlas_command(encode_atlas_command(
+        0, {'k_effort': k_effort, 'kp_position': [5.0] * len(gains.p)}))
+    try:
+        standing.receive_updates([command.update])
+        messages.fill_atlas_state()
+        assert list(messages.atlas_state_wire.k_effort) == k_effort
+        assert set(arrays['kp_position']) == {5.0}
+    finally:
+        standing.user_command = None
+
+
+def test_hands_carry_what_the_last_wrist_joint_transmits(standing: AtlasSimulator) -> None:
+    """The hand link hangs on l_arm_mwx / r_arm_mwx: the joint's force holds its weight."""
+    messages = SimMessages(standing)
+    messages.fill_force_torque_sensors()
+    wrenches = messages.force_torque_wire.wrenches
+    for side in 'lr':
+        hand = standing.model.body(f'{side}_hand').id
+        weight_n = float(standing.model.body_subtreemass[hand]) * GRAVITY_MPS2
+        force_world = standing.data.xmat[hand].reshape(3, 3) @ wrenches[f'{side}_hand'][:3]
+        assert force_world == pytest.approx([0.0, 0.0, weight_n], abs=0.05 * weight_n)
+    # The same transformation reads the ankle sensors exactly.
+    for side in 'lr':
+        foot = standing.model.body(f'{side}_foot').id
+        wrench = messages.body_wrench(standing.data.cfrc_int[foot], f'{side}_foot')
+        assert np.allclose(wrench, np.r_[standing.data.sensor(f'{side}_foot_force').data,
+                                         standing.data.sensor(f'{side}_foot_torque').data],
+                           rtol=1e-12, atol=1e-9)
+    messages.fill_atlas_state()
+    assert np.array_equal(messages.atlas_state_wire.wrench_floats,
+                          messages.force_torque_wire.floats)
+
+
+def test_debug_foot_contacts_are_the_ground_push_and_stop_in_the_air(
+        standing: AtlasSimulator) -> None:
+    messages = SimMessages(standing)
+    total_n = float(standing.model.body_subtreemass[standing.atlas.pelvis_body_id]) \
+        * GRAVITY_MPS2
+    assert messages.fill_debug_contact('l') and messages.fill_debug_contact('r')
+    l_force = messages.debug_contact_wires['l'].force
+    r_force = messages.debug_contact_wires['r'].force
+    assert l_force[2] > 400.0 and r_force[2] > 400.0  # up on the foot, foot frame
+    assert l_force[2] + r_force[2] == pytest.approx(total_n, rel=0.02)
+    airborne = AtlasSimulator(model.load_model(), controller.load_gains_yaml(GAINS))
+    airborne.data.qpos[2] += 1.0  # the free joint's z: a metre above the ground
+    mujoco.mj_forward(airborne.model, airborne.data)
+    assert not SimMessages(airborne).fill_debug_contact('l')

@@ -63,7 +63,8 @@ def test_the_node_advertises_the_topics_and_steps_until_shutdown(sim: AtlasSimul
         assert set(node.fake_publishers) == {
             topics.CLOCK, topics.JOINT_STATES, topics.GROUND_TRUTH_ODOM, topics.IMU,
             topics.L_FOOT_CONTACT, topics.R_FOOT_CONTACT, topics.CONTROLLER_STATISTICS,
-            topics.SIM_CONFIG}
+            topics.SIM_CONFIG, topics.ATLAS_STATE, topics.FORCE_TORQUE_SENSORS,
+            topics.DEBUG_L_FOOT_CONTACT, topics.DEBUG_R_FOOT_CONTACT}
         config, = node.fake_publishers[topics.SIM_CONFIG].published
         assert SimConfig.from_json(config.data) == sim.config()
     assert sim.sim_time_ns == 50 * sim.step_ns

@@ -20,6 +20,7 @@ from tutorial_atlas_control.stepping import pacing
 from tutorial_atlas_control.stepping.loop import (
     DIVERGENCE_REPEAT_S,
     MAX_DIVERGENCES_IN_A_ROW,
+    ON_DEMAND_MESSAGES,
     PAUSED_POLL_S,
     DivergenceGuard,
     SteppingLoop,
@@ -239,6 +240,60 @@ def test_without_a_tf_outlet_there_is_no_tf(sim: AtlasSimulator) -> None:
     queued = outbox.queued()
     assert topics.TF not in queued
     assert len(queued[topics.GROUND_TRUTH_ODOM]) == 3
+
+
+# -- DRCSim's messages, filled only when heard ------------------------------------------
+
+DRCSIM_TOPICS = tuple(topic for topic, _, _ in ON_DEMAND_MESSAGES)
+
+
+def make_drcsim_loop(sim: AtlasSimulator, listeners: set[str],
+                     rates_hz: dict[str, float] | None = None) -> tuple[SteppingLoop, FakeOutbox]:
+    outbox = FakeOutbox(listeners)
+    outlets = {topic: topic for topic in ALL_TOPICS + DRCSIM_TOPICS}
+    loop = SteppingLoop(sim, outbox, outlets, {**LAUNCH_RATES_HZ, **(rates_hz or {})},
+                        CommandAgeStatistics(sim.dt_s), FakeLog(), lambda _text: None)
+    return loop, outbox
+
+
+def test_drcsim_messages_at_their_rates_and_stamps(sim: AtlasSimulator) -> None:
+    """AtlasState as the joint states (step end), the sensors at the step's start; the
+    debug contacts while the feet touch the ground (standing: every step)."""
+    loop, outbox = make_drcsim_loop(sim, set(DRCSIM_TOPICS) | {topics.JOINT_STATES},
+                                    {'force_torque_sensors': 500.0})
+    loop.run(stops_after(4))
+    queued = outbox.queued()
+    ends = [k * sim.step_ns for k in range(5)]
+    starts = [0, 0, sim.step_ns, 2 * sim.step_ns, 3 * sim.step_ns]
+    assert [header_stamp_ns(m) for m in queued[topics.ATLAS_STATE]] == ends
+    assert [header_stamp_ns(m) for m in queued[topics.FORCE_TORQUE_SENSORS]] == starts[::2]
+    for topic in (topics.DEBUG_L_FOOT_CONTACT, topics.DEBUG_R_FOOT_CONTACT):
+        assert [header_stamp_ns(m) for m in queued[topic]] == starts
+    # The joint fields are the joint state's, rounded to float32.
+    state, joint_state = queued[topics.ATLAS_STATE][-1], queued[topics.JOINT_STATES][-1]
+    count = NUM_JOINTS
+    positions = np.frombuffer(state, '<f4', count, offset=24)
+    assert np.array_equal(positions, np.frombuffer(joint_state, '<f8', count,
+                                                   offset=len(joint_state) - 3 * (4 + 8 * count)
+                                                   + 4).astype(np.float32))
+
+
+def test_unheard_drcsim_messages_are_never_filled(sim: AtlasSimulator,
+                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+    from tutorial_atlas_control.msgs.sim_messages import SimMessages
+
+    fills: list[str] = []
+    for name in ('fill_atlas_state', 'fill_force_torque_sensors', 'fill_debug_contact'):
+        original = getattr(SimMessages, name)
+        monkeypatch.setattr(SimMessages, name, lambda self, *args, _o=original, _n=name: (
+            fills.append(_n), _o(self, *args))[1])
+    loop, outbox = make_drcsim_loop(sim, {topics.JOINT_STATES})
+    loop.run(stops_after(20))
+    assert set(outbox.queued()) == {topics.JOINT_STATES}
+    assert fills == []
+    loop, outbox = make_drcsim_loop(sim, {topics.FORCE_TORQUE_SENSORS})
+    loop.run(stops_after(2))
+    assert fills == ['fill_force_torque_sensors'] * 3
 
 
 # -- commands ------------------------------------------------------------------------------

@@ -5,6 +5,7 @@ import io
 import genpy
 import numpy as np
 import pytest
+from atlas_msgs.msg import AtlasState, ForceTorqueSensors
 from geometry_msgs.msg import TransformStamped, WrenchStamped
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
@@ -118,3 +119,53 @@ def test_transform():
     assert msg.to_bytes(STAMP_NS) == genpy_bytes(TFMessage(transforms=[expected]))
     expected.header.seq = 2
     assert msg.to_bytes(STAMP_NS) == genpy_bytes(TFMessage(transforms=[expected]))
+
+
+def _wrench(target, values) -> None:
+    f, t = target.force, target.torque
+    f.x, f.y, f.z, t.x, t.y, t.z = (float(v) for v in values)
+
+
+def test_atlas_state():
+    """Every field in place: float32 joint arrays (rounded as genpy rounds), k_effort as
+    bytes, IMU and the four wrenches as float64."""
+    rng = np.random.default_rng(2)
+    joints = rng.normal(size=(9, len(JOINT_NAMES))) * 100
+    k_effort = rng.integers(0, 256, size=len(JOINT_NAMES), dtype=np.uint8)
+    tail = rng.normal(size=34)
+    msg = wire.AtlasStateWire(len(JOINT_NAMES))
+    msg.joints[:] = joints  # float64 in, float32 stored
+    msg.k_effort[:] = k_effort
+    msg.floats[:] = tail
+    expected = AtlasState()
+    expected.header.stamp = genpy.Time(12, 345_678)
+    for field, row in zip(wire.AtlasStateWire.FIELDS, joints):
+        setattr(expected, field, [float(v) for v in row])
+    expected.k_effort = k_effort.tobytes()
+    o = expected.orientation
+    o.x, o.y, o.z, o.w = tail[0:4]
+    v, a = expected.angular_velocity, expected.linear_acceleration
+    v.x, v.y, v.z = tail[4:7]
+    a.x, a.y, a.z = tail[7:10]
+    for k, name in enumerate(wire.FORCE_TORQUE_SENSORS):
+        _wrench(getattr(expected, name), tail[10 + 6 * k:16 + 6 * k])
+    assert msg.to_bytes(STAMP_NS) == genpy_bytes(expected)
+    assert np.array_equal(msg.arrays['kd_position'], joints[5].astype(np.float32))
+    assert np.array_equal(msg.wrenches['l_hand'], tail[22:28])
+
+
+def test_force_torque_sensors():
+    msg = wire.ForceTorqueSensorsWire()
+    values = np.arange(24, dtype=float) - 430.0
+    for k, name in enumerate(wire.FORCE_TORQUE_SENSORS):
+        msg.wrenches[name][:] = values[6 * k:6 * k + 6]
+    expected = ForceTorqueSensors()
+    expected.header.stamp = genpy.Time(12, 345_678)
+    for k, name in enumerate(wire.FORCE_TORQUE_SENSORS):
+        _wrench(getattr(expected, name), values[6 * k:6 * k + 6])
+    assert msg.to_bytes(STAMP_NS) == genpy_bytes(expected)
+
+
+def test_atlas_state_joint_indices_are_the_tutorial_order():
+    """AtlasState's constants index its arrays; the port fills them in JOINT_NAMES order."""
+    assert [getattr(AtlasState, name) for name in JOINT_NAMES] == list(range(len(JOINT_NAMES)))

@@ -9,7 +9,7 @@ and stamps the header; nothing is serialized field by field.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import mujoco
 import numpy as np
@@ -17,6 +17,9 @@ import numpy as np
 from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.msgs.copy_plan import Copy, CopyPlan
 from tutorial_atlas_control.msgs.wire import (
+    WRENCH_FLOATS,
+    AtlasStateWire,
+    ForceTorqueSensorsWire,
     ImuWire,
     JointStateWire,
     OdometryWire,
@@ -27,7 +30,7 @@ from tutorial_atlas_control.msgs.wire import (
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
 from tutorial_atlas_control.topics import PELVIS_FRAME, WORLD_FRAME
 
-__all__ = ['TCPROS_PREFIX_BYTES', 'SimMessages']
+__all__ = ['DRCSIM_FOOT_COMPONENTS', 'HAND_BODIES', 'TCPROS_PREFIX_BYTES', 'SimMessages']
 
 #: wire.py's messages start with TCPROS's 4-byte length; a bag record holds what follows.
 TCPROS_PREFIX_BYTES = 4
@@ -35,6 +38,17 @@ TCPROS_PREFIX_BYTES = 4
 #: The MuJoCo sensors the messages read, by name in the model.
 SENSOR_NAMES = ('imu_orientation', 'imu_angular_velocity', 'imu_linear_acceleration',
                 'l_foot_force', 'l_foot_torque', 'r_foot_force', 'r_foot_torque')
+
+
+#: What DRCSim 2.5.2 reported of each ankle's wrench in AtlasState and ForceTorqueSensors
+#: (Fz, Mx, My: the components of Atlas' 3-axis foot sensors), as indices into a wrench's
+#: six floats (force x y z, torque x y z); the other three stay 0, as in DRCSim.
+DRCSIM_FOOT_COMPONENTS = (2, 3, 4)
+#: The body after each last wrist joint (l_arm_mwx, r_arm_mwx): DRCSim's hand wrenches are
+#: what that joint transmits to it (the model has the wrist link, no hand beyond it).
+HAND_BODIES = {'l_hand': 'l_hand', 'r_hand': 'r_hand'}
+#: The feet, whose contact wrench /atlas/debug/{l,r}_foot_contact carry.
+FOOT_BODIES = {'l': 'l_foot', 'r': 'r_foot'}
 
 
 def _float_offset(message: StampedWire) -> int:
@@ -94,6 +108,101 @@ class SimMessages:
         #: The wire message of each per-step message, by the same names.
         self.step_wires: dict[str, StampedWire] = {
             'joint_state': self.joint_state_wire, 'imu': self.imu_wire, **self.contact_wires}
+        self._init_drcsim_messages(adr)
+
+    # -- DRCSim's AtlasState, ForceTorqueSensors and debug foot contacts -----------------
+    def _init_drcsim_messages(self, adr: dict[str, int]) -> None:
+        """The messages filled only when someone listens (see fill_on_demand)."""
+        sim, data = self.sim, self.sim.data
+        model = sim.model
+        self.atlas_state_wire = AtlasStateWire(len(JOINT_NAMES))
+        self.force_torque_wire = ForceTorqueSensorsWire()
+        self.debug_contact_wires = {side: WrenchStampedWire(f'{side}_foot') for side in 'lr'}
+        self._body = {name: int(model.body(name).id)
+                      for name in (*HAND_BODIES.values(), *FOOT_BODIES.values())}
+        self._root = {name: int(model.body_rootid[body]) for name, body in self._body.items()}
+        self._spatial = np.zeros(6)  # MuJoCo's (torque, force) at a new point
+        self._wrench = np.zeros(WRENCH_FLOATS)  # (force, torque) in a body frame
+        # AtlasState's float32 joint rows in float64 first: position, velocity, effort
+        # by plan; the gains of the active command at each fill.
+        self._joint_rows = np.zeros(self.atlas_state_wire.joints.shape)
+        joints = np.arange(len(JOINT_NAMES))
+        feet = {side: np.r_[adr[f'{side}_foot_force'] + 2, adr[f'{side}_foot_torque'],
+                            adr[f'{side}_foot_torque'] + 1] for side in 'lr'}
+        state, torque = self.atlas_state_wire, self.force_torque_wire
+        foot_at = np.array(DRCSIM_FOOT_COMPONENTS)
+        self._atlas_state_plan = CopyPlan([
+            (self._joint_rows[0], joints, data.qpos, sim.atlas.qpos_adr),
+            (self._joint_rows[1], joints, data.qvel, sim.atlas.dof_adr),
+            (self._joint_rows[2], joints, sim.torque_nm, joints),
+            (state.floats, np.arange(10), data.sensordata, self.imu_map[1]),
+            *((state.wrench_floats, k * WRENCH_FLOATS + foot_at, data.sensordata, feet[side])
+              for k, side in enumerate('lr'))])
+        self._force_torque_plan = CopyPlan([
+            (torque.floats, k * WRENCH_FLOATS + foot_at, data.sensordata, feet[side])
+            for k, side in enumerate('lr')])
+        #: Name -> (wire message, fill: True when the message is to be sent).
+        self.on_demand: dict[str, tuple[StampedWire, Callable[[], bool]]] = {
+            'atlas_state': (state, self.fill_atlas_state),
+            'force_torque_sensors': (torque, self.fill_force_torque_sensors),
+            'debug_l': (self.debug_contact_wires['l'], lambda: self.fill_debug_contact('l')),
+            'debug_r': (self.debug_contact_wires['r'], lambda: self.fill_debug_contact('r')),
+        }
+
+    def body_wrench(self, spatial: np.ndarray, body_name: str) -> np.ndarray:
+        """A MuJoCo com-based spatial force (cfrc_int or cfrc_ext of the body) as a wrench in
+        the body's frame about its origin: (force x y z, torque x y z), N and N m.
+
+        The force sensors' own transformation (a site at the body origin reads the same).
+        The result is a scratch array, valid until the next call.
+        """
+        data, body = self.sim.data, self._body[body_name]
+        # Moved to the body origin and rotated into the body frame (xmat: body to world).
+        mujoco.mju_transformSpatial(self._spatial, spatial, 1, data.xpos[body],
+                                    data.subtree_com[self._root[body_name]], data.xmat[body])
+        wrench = self._wrench
+        wrench[:3] = self._spatial[3:]
+        wrench[3:] = self._spatial[:3]
+        return wrench
+
+    def _fill_hands(self, wrenches: dict[str, np.ndarray]) -> None:
+        """What each last wrist joint transmits to the hand link (parent on child)."""
+        interaction = self.sim.data.cfrc_int
+        for field, body in HAND_BODIES.items():
+            wrenches[field][:] = self.body_wrench(interaction[self._body[body]], body)
+
+    def fill_atlas_state(self) -> bool:
+        """AtlasState: joints after the step (as joint_state), the active gains and
+        k_effort, IMU and wrenches from the step's start. Always sent."""
+        self._atlas_state_plan()
+        rows, command = self._joint_rows, self.sim.pid_command()
+        rows[3] = command.kp_position
+        rows[4] = command.ki_position
+        rows[5] = command.kd_position
+        rows[6] = command.kp_velocity
+        rows[7] = command.i_effort_min
+        rows[8] = command.i_effort_max
+        state = self.atlas_state_wire
+        state.joints[:] = rows
+        state.k_effort[:] = self.sim.active_k_effort()
+        self._fill_hands(state.wrenches)
+        return True
+
+    def fill_force_torque_sensors(self) -> bool:
+        """ForceTorqueSensors: ankles (Fz, Mx, My) and wrists. Always sent."""
+        self._force_torque_plan()
+        self._fill_hands(self.force_torque_wire.wrenches)
+        return True
+
+    def fill_debug_contact(self, side: str) -> bool:
+        """The ground's (or anything's) push on a foot, in the foot frame about the ankle;
+        False, nothing to send, while nothing touches it (DRCSim sent only on contact)."""
+        body = FOOT_BODIES[side]
+        external = self.sim.data.cfrc_ext[self._body[body]]
+        if not external.any():
+            return False
+        self.debug_contact_wires[side].floats[:] = self.body_wrench(external, body)
+        return True
 
     def fill_plan(self, names: Sequence[str]) -> CopyPlan:
         """One call that writes the current state into the named per-step messages.

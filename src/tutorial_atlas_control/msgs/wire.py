@@ -89,6 +89,54 @@ class WrenchStampedWire(StampedWire):
         self.torque = self.floats[3:6]
 
 
+#: A geometry_msgs/Wrench's six float64s: force (x y z), then torque (x y z).
+WRENCH_FLOATS = 6
+#: AtlasState's and ForceTorqueSensors' wrenches, in their order in both messages.
+FORCE_TORQUE_SENSORS = ('l_foot', 'r_foot', 'l_hand', 'r_hand')
+
+
+class AtlasStateWire(StampedWire):
+    """atlas_msgs/AtlasState for a fixed number of joints.
+
+    Its nine float32 joint arrays are the rows of `joints` (a (9, N) strided view that
+    skips each array's length prefix; `arrays[field]` is one row), `k_effort` a uint8
+    view; the float64 tail holds orientation (x y z w), angular_velocity,
+    linear_acceleration and the four wrenches (`wrenches[name]`: force, then torque).
+    """
+
+    FIELDS = ('position', 'velocity', 'effort', 'kp_position', 'ki_position', 'kd_position',
+              'kp_velocity', 'i_effort_min', 'i_effort_max')
+
+    def __init__(self, joint_count: int) -> None:
+        count = struct.pack('<I', joint_count)
+        array = count + bytes(4 * joint_count)
+        super().__init__('', 4 + 3 + 3 + WRENCH_FLOATS * len(FORCE_TORQUE_SENSORS),
+                         array * len(self.FIELDS) + count + bytes(joint_count))
+        first = 16 + 4  # the first array's length: after TCPROS length, seq, stamp, frame_id ''
+        self.joints = np.ndarray((len(self.FIELDS), joint_count), dtype='<f4', buffer=self.buf,
+                                 offset=first + 4, strides=(len(array), 4))
+        self.arrays = dict(zip(self.FIELDS, self.joints))
+        k_effort_at = first + len(self.FIELDS) * len(array) + 4
+        self.k_effort = np.frombuffer(self.buf, dtype=np.uint8, offset=k_effort_at,
+                                      count=joint_count)
+        self.orientation_xyzw = self.floats[0:4]
+        self.angular_velocity = self.floats[4:7]
+        self.linear_acceleration = self.floats[7:10]
+        self.wrench_floats = self.floats[10:]
+        self.wrenches = {name: self.wrench_floats[k * WRENCH_FLOATS:(k + 1) * WRENCH_FLOATS]
+                         for k, name in enumerate(FORCE_TORQUE_SENSORS)}
+
+
+class ForceTorqueSensorsWire(StampedWire):
+    """atlas_msgs/ForceTorqueSensors: `wrenches[name]` (force, then torque) are views of
+    `floats`, in FORCE_TORQUE_SENSORS order."""
+
+    def __init__(self) -> None:
+        super().__init__('', WRENCH_FLOATS * len(FORCE_TORQUE_SENSORS))
+        self.wrenches = {name: self.floats[k * WRENCH_FLOATS:(k + 1) * WRENCH_FLOATS]
+                         for k, name in enumerate(FORCE_TORQUE_SENSORS)}
+
+
 class OdometryWire(StampedWire):
     """nav_msgs/Odometry, covariances 0: position, orientation (x y z w), linear, angular."""
 

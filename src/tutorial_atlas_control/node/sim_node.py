@@ -3,7 +3,9 @@
 The rospy shell around the stepping loop (stepping/loop.py, no ROS): publishers,
 subscriptions, services, parameters and the viewer window. Publishes /clock,
 /atlas/joint_states, /ground_truth_odom, /atlas/imu and the foot contact wrenches in sim
-time, /atlas/controller_statistics (command age, while subscribed), and a latched
+time, /atlas/controller_statistics (command age, while subscribed), DRCSim's
+/atlas/atlas_state, /atlas/force_torque_sensors and /atlas/debug/{l,r}_foot_contact (while
+subscribed), and a latched
 /atlas/sim_config (JSON: timestep, time_to_unpin, model file and checksum, time of the last
 reset) for offline replay; obeys /atlas/joint_commands, /atlas/atlas_command,
 /atlas/debug/test and /atlas/control_mode; offers /atlas/reset_controls and gazebo_ros's
@@ -15,6 +17,9 @@ Parameters (private unless noted):
     ~gui (bool, false): open the MuJoCo viewer (needs a display); its Reset button and key
         (Backspace) and Shift+Ctrl+R do reset_world, Space pauses/unpauses (viewer.py).
     ~joint_states_rate, ~imu_rate, ~contact_rate (Hz, 1000): 0 or >= 1000 = every step.
+    ~atlas_state_rate, ~force_torque_sensors_rate, ~debug_contact_rate (Hz, 1000): DRCSim's
+        /atlas/atlas_state, /atlas/force_torque_sensors, /atlas/debug/{l,r}_foot_contact
+        (those only while the foot touches something); each filled only while subscribed.
     ~odom_rate (Hz, 100): /ground_truth_odom rate, as DRCSim.
     ~tf (bool, true): broadcast world -> pelvis on /tf from the ground truth, if the model
         has a matching URDF (urdf.matching_urdf); else one warning and no /tf.
@@ -38,7 +43,7 @@ from pathlib import Path
 
 import genpy
 import rospy
-from atlas_msgs.msg import AtlasCommand, ControllerStatistics, Test
+from atlas_msgs.msg import AtlasCommand, AtlasState, ControllerStatistics, ForceTorqueSensors, Test
 from atlas_msgs.srv import ResetControls, ResetControlsResponse
 from geometry_msgs.msg import WrenchStamped
 from nav_msgs.msg import Odometry
@@ -87,7 +92,9 @@ LOOP_TOPICS = (
     (topics.CLOCK, Clock), (topics.JOINT_STATES, JointState),
     (topics.GROUND_TRUTH_ODOM, Odometry), (topics.IMU, Imu),
     (topics.L_FOOT_CONTACT, WrenchStamped), (topics.R_FOOT_CONTACT, WrenchStamped),
-    (topics.CONTROLLER_STATISTICS, ControllerStatistics))
+    (topics.CONTROLLER_STATISTICS, ControllerStatistics),
+    (topics.ATLAS_STATE, AtlasState), (topics.FORCE_TORQUE_SENSORS, ForceTorqueSensors),
+    (topics.DEBUG_L_FOOT_CONTACT, WrenchStamped), (topics.DEBUG_R_FOOT_CONTACT, WrenchStamped))
 
 
 class RawMessage(genpy.Message):
@@ -367,6 +374,9 @@ def build_node() -> SimNode:
         'imu': _float_param('~imu_rate', 1000.0),
         'contact': _float_param('~contact_rate', 1000.0),
         'tf': _float_param('~tf_rate', 100.0),
+        'atlas_state': _float_param('~atlas_state_rate', 1000.0),
+        'force_torque_sensors': _float_param('~force_torque_sensors_rate', 1000.0),
+        'debug_contact': _float_param('~debug_contact_rate', 1000.0),
     }
     model_file = rospy.get_param('~model_file', str(atlas_model.MODEL_PATH))
     if not isinstance(model_file, str) or not model_file:

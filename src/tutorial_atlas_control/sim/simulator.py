@@ -40,6 +40,9 @@ from tutorial_atlas_control.units import NS_PER_S
 
 #: DRCSim released the pinned torso after this long (s); `/atlas/time_to_unpin` overrides it.
 DEFAULT_TIME_TO_UNPIN_S = 1.0
+#: AtlasState's k_effort of a joint driven by the PID law alone (DRCSim: k_effort / 255
+#: weighs the PID torque against BDI's f_out, which the port does not have).
+K_EFFORT_PID = 255
 
 
 #: MuJoCo's warnings for an unstable step (plain ints: indexing MjData's counters with the
@@ -296,6 +299,16 @@ class AtlasSimulator:
         """Set the joints' viscous damping (N m s/rad, (28,)), as /atlas/debug/test does
         (Gazebo's Joint::SetDamping); kept across resets, as in Gazebo."""
         self.model.dof_damping[self.atlas.dof_adr] = damping
+
+    def pid_command(self) -> JointCommandArrays:
+        """The command whose PID torque k_effort weighs, as AtlasState reports it: the user
+        command blended under a hold, else the mode's command (the hold's PID alone)."""
+        blended = self.blended_command()
+        return self.active_command() if blended is None else blended
+
+    def active_k_effort(self) -> np.ndarray:
+        """AtlasState's k_effort (uint8, (28,)): pid_command()'s, times 255."""
+        return np.rint(self.pid_command().k_effort * K_EFFORT_PID).astype(np.uint8)
 
     # -- stepping ----------------------------------------------------------------------
     def step(self, torque_nm: np.ndarray | None = None) -> None:

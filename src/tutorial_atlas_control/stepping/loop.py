@@ -41,7 +41,7 @@ from tutorial_atlas_control.stepping.pacing import Pacer
 from tutorial_atlas_control.stepping.schedule import STAMPED_AT_STEP_END, steps_between
 from tutorial_atlas_control.units import NS_PER_S
 
-__all__ = ['MAX_PENDING_COMMANDS', 'DivergenceGuard', 'LoopLog', 'Outbox',
+__all__ = ['MAX_PENDING_COMMANDS', 'ON_DEMAND_MESSAGES', 'DivergenceGuard', 'LoopLog', 'Outbox',
            'ResetControlsRequest', 'SteppingLoop']
 
 #: A divergence this soon (s of sim time) after the previous one's reset is "in a row";
@@ -59,6 +59,15 @@ STEP_MESSAGES = (
     (topics.IMU, 'imu', 'imu'),
     (topics.L_FOOT_CONTACT, 'contact', 'l'),
     (topics.R_FOOT_CONTACT, 'contact', 'r'))
+#: DRCSim's messages filled only when due and someone listens (an unheard one costs a
+#: test per step): topic, key of its rate in `rates_hz`, name in SimMessages.on_demand.
+ON_DEMAND_MESSAGES = (
+    (topics.ATLAS_STATE, 'atlas_state', 'atlas_state'),
+    (topics.FORCE_TORQUE_SENSORS, 'force_torque_sensors', 'force_torque_sensors'),
+    (topics.DEBUG_L_FOOT_CONTACT, 'debug_contact', 'debug_l'),
+    (topics.DEBUG_R_FOOT_CONTACT, 'debug_contact', 'debug_r'))
+#: Their rate (Hz of sim time) when `rates_hz` does not name it: DRCSim's 1 kHz.
+ON_DEMAND_RATE_HZ = 1000.0
 #: Rows (commands.LAW_FIELDS indices) each command topic can set; DAMPING_ROW stands for
 #: /atlas/debug/test's damping. An older message whose rows a newer one set for every
 #: joint is dropped undecoded (apply_pending_commands).
@@ -156,7 +165,9 @@ class SteppingLoop:
         outlets: topic -> outlet (key in the outbox) of each published topic; without
             topics.TF, no /tf.
         rates_hz: rate (Hz of sim time; 0 = every step) of 'joint_states', 'imu',
-            'contact' (both feet), 'odom' and, with a /tf outlet, 'tf'.
+            'contact' (both feet), 'odom' and, with a /tf outlet, 'tf'; optionally of
+            'atlas_state', 'force_torque_sensors', 'debug_contact' (else
+            ON_DEMAND_RATE_HZ). An ON_DEMAND_MESSAGES topic without an outlet is not sent.
         statistics: the command age statistics of /atlas/controller_statistics.
         log: where log lines go.
         publish_config: sends /atlas/sim_config's JSON (latched: not through the outbox).
@@ -181,6 +192,7 @@ class SteppingLoop:
         self.step_count = 0
         self.exit_status = 0
         self.divergences = DivergenceGuard()
+        rates_hz = {**{key: ON_DEMAND_RATE_HZ for _, key, _ in ON_DEMAND_MESSAGES}, **rates_hz}
         self.every = {key: steps_between(rate, sim.dt_s) for key, rate in rates_hz.items()}
 
         # What each message holds is sim_messages' (shared with offline runs).
@@ -196,6 +208,11 @@ class SteppingLoop:
             (self.every[rate_key], messages.step_wires[name], outlets[topic],
              topic in STAMPED_AT_STEP_END)
             for topic, rate_key, name in STEP_MESSAGES)
+        # (every how many steps, fill (True: send), wire message, outlet, stamped at end).
+        self.demand_wires = tuple(
+            (self.every[rate_key], messages.on_demand[name][1], messages.on_demand[name][0],
+             outlets[topic], topic in STAMPED_AT_STEP_END)
+            for topic, rate_key, name in ON_DEMAND_MESSAGES if topic in outlets)
         self.clock_outlet = outlets[topics.CLOCK]
         self.odom_outlet = outlets[topics.GROUND_TRUTH_ODOM]
         self.tf_outlet = outlets.get(topics.TF)
@@ -408,6 +425,9 @@ class SteppingLoop:
         sensed_ns = sim.state_time_ns
         for every, message, outlet, at_end in self.step_wires:
             if count % every == 0 and wanted(outlet):
+                outbox.add(outlet, message.stamped(now_ns if at_end else sensed_ns))
+        for every, fill, message, outlet, at_end in self.demand_wires:
+            if count % every == 0 and wanted(outlet) and fill():
                 outbox.add(outlet, message.stamped(now_ns if at_end else sensed_ns))
         messages = self.messages
         if count % self.every['odom'] == 0 and wanted(self.odom_outlet):
