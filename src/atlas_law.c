@@ -14,10 +14,11 @@
 /* Gazebo's math::equal tolerance (controller.TIE_BACK_EPSILON). */
 #define TIE_BACK_EPSILON 1e-6
 
-/* The fields of osrf_msgs/JointCommands, in message order (commands.FIELD_NAMES). */
+/* The fields of osrf_msgs/JointCommands, in message order, then AtlasCommand's k_effort as
+ * a fraction (commands.LAW_FIELDS). */
 enum {
   POSITION, VELOCITY, EFFORT, KP_POSITION, KI_POSITION, KD_POSITION, KP_VELOCITY,
-  I_EFFORT_MIN, I_EFFORT_MAX, NUM_FIELDS
+  I_EFFORT_MIN, I_EFFORT_MAX, K_EFFORT, NUM_FIELDS
 };
 
 /* Everything one step reads and writes; laid out once by law_kernel.py, mirrored in native.py
@@ -35,6 +36,7 @@ typedef struct {
   double *previous_error;            /* (n,) PidState.previous_error (rad), updated */
   double *torque;                    /* (n,) result (N m) */
   double *ctrl;                      /* (n,) MjData.ctrl, also set to the result; or NULL */
+  const double *f_out;               /* (n,) torque blended in by 1 - k_effort; NULL: 0 */
   double dt_s;
   long n;
   long initialized;                  /* PidState.initialized; set to 1 */
@@ -69,6 +71,13 @@ void atlas_law_step(AtlasLawStep *s) {
     u += (c[VELOCITY][j] - s->qvel[s->dof_adr[j]]) * c[KP_VELOCITY][j];
     u += c[EFFORT][j];
     s->previous_error[j] = error;
+
+    /* AtlasCommand's k_effort: 2.5.2's k * u + (1 - k) * f_out, skipped at k = 1 */
+    const double k_effort = c[K_EFFORT][j];
+    if (k_effort != 1.0) {
+      const double f_out = s->f_out != NULL ? s->f_out[j] : 0.0;
+      u = k_effort * u + (1.0 - k_effort) * f_out;
+    }
 
     const double limit = s->effort_limit[j];
     const double torque = clamp(u, -limit, limit);

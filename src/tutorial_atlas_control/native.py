@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tutorial_atlas_control.msgs.commands import FIELD_NAMES
+from tutorial_atlas_control.msgs.commands import LAW_FIELDS
 
 __all__ = ['LIBRARY_ENV', 'LIBRARY_NAME', 'MIRRORED_STRUCTS', 'AtlasCopy', 'AtlasLawStep',
            'address', 'find_library', 'load_library', 'size_mismatches']
@@ -41,12 +41,12 @@ class AtlasLawStep(ctypes.Structure):
     """AtlasLawStep in src/atlas_law.c (same fields, same order)."""
 
     _fields_ = [
-        ('command', ctypes.c_void_p * len(FIELD_NAMES)),
+        ('command', ctypes.c_void_p * len(LAW_FIELDS)),
         ('qpos', ctypes.c_void_p), ('qpos_adr', ctypes.c_void_p),
         ('qvel', ctypes.c_void_p), ('dof_adr', ctypes.c_void_p),
         ('lower', ctypes.c_void_p), ('upper', ctypes.c_void_p), ('effort_limit', ctypes.c_void_p),
         ('integral', ctypes.c_void_p), ('previous_error', ctypes.c_void_p),
-        ('torque', ctypes.c_void_p), ('ctrl', ctypes.c_void_p),
+        ('torque', ctypes.c_void_p), ('ctrl', ctypes.c_void_p), ('f_out', ctypes.c_void_p),
         ('dt_s', ctypes.c_double), ('n', ctypes.c_long), ('initialized', ctypes.c_long),
         ('nq', ctypes.c_long), ('nv', ctypes.c_long),
     ]

@@ -26,6 +26,12 @@ SIM_CONFIG = '/atlas/sim_config'
 ROSOUT = '/rosout'
 #: world -> pelvis from the simulator; robot_state_publisher adds the links.
 TF = '/tf'
+#: atlas_msgs/AtlasCommand (2.7.0): commands with k_effort, beside JointCommands.
+ATLAS_COMMAND = '/atlas/atlas_command'
+#: atlas_msgs/Test: DRCSim's testing hook (joint damping, gains, k_effort).
+ATLAS_TEST = '/atlas/debug/test'
+#: atlas_msgs/ResetControls: reset the PID, reload the gains or load an AtlasCommand.
+RESET_CONTROLS_SERVICE = '/atlas/reset_controls'
 #: The URDF of the simulated model (set by atlas.launch's state_publisher.py).
 ROBOT_DESCRIPTION_PARAM = '/robot_description'
 
@@ -34,6 +40,7 @@ ROBOT_DESCRIPTION_PARAM = '/robot_description'
 RECORDED_TOPICS: tuple[str, ...] = (
     CLOCK, JOINT_STATES, GROUND_TRUTH_ODOM, IMU, L_FOOT_CONTACT, R_FOOT_CONTACT,
     JOINT_COMMANDS, CONTROL_MODE, SIM_CONFIG, ROSOUT, CONTROLLER_STATISTICS, TF,
+    ATLAS_COMMAND, ATLAS_TEST,
 )
 
 #: The ROS 1 message type of each recorded topic, and of the simulator's other topics.
@@ -55,6 +62,8 @@ MSG_TYPES: dict[str, str] = {
     FORCE_TORQUE_SENSORS: 'atlas_msgs/ForceTorqueSensors',
     DEBUG_L_FOOT_CONTACT: 'geometry_msgs/WrenchStamped',
     DEBUG_R_FOOT_CONTACT: 'geometry_msgs/WrenchStamped',
+    ATLAS_COMMAND: 'atlas_msgs/AtlasCommand',
+    ATLAS_TEST: 'atlas_msgs/Test',
 }
 
 #: Gazebo's services, as gazebo_ros offered them.

@@ -148,10 +148,12 @@ def test_decoder_maps_a_new_name_list_after_a_memoized_one() -> None:
     assert list(update.indices) == [JOINT_INDEX['back_lbz'], JOINT_INDEX['neck_ay']]
 
 
-def test_a_full_command_is_complete() -> None:
+def test_a_full_command_sets_every_joint_commands_field_but_not_k_effort() -> None:
     update = CommandDecoder().decode(serialized(
         list(JOINT_NAMES), **{field: [0.0] * NUM_JOINTS for field in FIELD_NAMES}))
-    assert update.is_complete
+    assert update.all_joints and update.rows == tuple(range(len(FIELD_NAMES)))
+    # an older AtlasCommand's k_effort survives it
+    assert not update.is_complete
 
 
 @pytest.mark.parametrize(('cut', 'reason'), [

@@ -369,3 +369,29 @@ def test_bad_tolerance_is_a_usage_error(value: str, capsys: pytest.CaptureFixtur
     assert exit_info.value.code == 2
     assert capsys.readouterr().err.splitlines()[-1].startswith(
         'replay_bag.py: error: argument --tolerance: ')
+
+
+def test_debug_test_messages_are_reported(tmp_path: Path) -> None:
+    """/atlas/debug/test's damping changes the model, which the torques do not carry."""
+    from rosbags.typesys import get_types_from_msg
+
+    from tutorial_atlas_control.bags.synthetic import TYPESTORE
+    from tutorial_atlas_control.resources import message_file
+
+    if 'atlas_msgs/msg/Test' not in TYPESTORE.fielddefs:
+        TYPESTORE.register(get_types_from_msg(message_file('atlas_msgs', 'Test').read_text(),
+                                              'atlas_msgs/msg/Test'))
+    run = Run()
+    run.step(60)
+    header = _t('std_msgs/msg/Header')(
+        seq=0, stamp=_t('builtin_interfaces/msg/Time')(sec=0, nanosec=30_000_000), frame_id='')
+    empty32 = np.zeros(0, dtype=np.float32)
+    message = _t('atlas_msgs/msg/Test')(
+        header=header, damping=np.full(NUM_JOINTS, 0.5, dtype=np.float32), kp_position=empty32,
+        ki_position=empty32, kd_position=empty32, kp_velocity=empty32, i_effort_min=empty32,
+        i_effort_max=empty32, k_effort=np.zeros(0, dtype=np.uint8))
+    run.records.append(Record('/atlas/debug/test', 'atlas_msgs/Test', 0.03, message))
+    result = replay_bag(run.write(tmp_path / 'test.bag'))
+    assert ('the run has 1 /atlas/debug/test message(s): joint damping they set is not '
+            're-applied offline, so the replay deviates from the first that set it.'
+            in result.warnings)

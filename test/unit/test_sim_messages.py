@@ -8,6 +8,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from tutorial_atlas_control.msgs.atlas_command import decode_atlas_command, encode_atlas_command
 from tutorial_atlas_control.msgs.sim_messages import SimMessages
 from tutorial_atlas_control.sim import controller, model
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
@@ -140,12 +141,18 @@ def test_atlas_state_joints_gains_and_k_effort(standing: AtlasSimulator) -> None
     assert np.array_equal(arrays['i_effort_max'], gains.i_clamp.astype(f32))
     assert np.array_equal(arrays['kp_velocity'], np.zeros(len(gains.p), f32))
     assert set(messages.atlas_state_wire.k_effort) == {255}
-    standing.k_effort[3] = 7  # what AtlasCommand will set
+    # An AtlasCommand handing neck_ay to its PID at 7/255 in Stand: that PID's gains and k.
+    k_effort = [0] * len(gains.p)
+    k_effort[3] = 7
+    command = decode_atlas_command(encode_atlas_command(
+        0, {'k_effort': k_effort, 'kp_position': [5.0] * len(gains.p)}))
     try:
+        standing.receive_updates([command.update])
         messages.fill_atlas_state()
-        assert messages.atlas_state_wire.k_effort[3] == 7
+        assert list(messages.atlas_state_wire.k_effort) == k_effort
+        assert set(arrays['kp_position']) == {5.0}
     finally:
-        standing.k_effort[3] = 255
+        standing.user_command = None
 
 
 def test_hands_carry_what_the_last_wrist_joint_transmits(standing: AtlasSimulator) -> None:

@@ -96,3 +96,35 @@ def test_an_unknown_control_mode_is_refused_and_the_mode_kept(sim: AtlasSimulato
         assert sim.mode is ControlMode.STAND
         node.on_control_mode(String(data='User'))
         assert sim.mode is ControlMode.USER
+
+
+def test_refusals_are_throttled_per_topic(monkeypatch: pytest.MonkeyPatch) -> None:
+    """One line per topic and kind every WARN_THROTTLE_S: a JointCommands flood does not hide
+    a refused AtlasCommand."""
+    lines: list[str] = []
+    monkeypatch.setattr(sim_node.rospy, 'logwarn', lines.append)
+    now_s = [0.0]
+    log = sim_node.RosLog(clock=lambda: now_s[0])
+    for _ in range(3):
+        log.refused_command('refused /atlas/joint_commands: a', topics.JOINT_COMMANDS)
+        log.refused_command('refused /atlas/atlas_command: b', topics.ATLAS_COMMAND)
+        log.kept_fields('/atlas/atlas_command: c', topics.ATLAS_COMMAND)
+        now_s[0] += 0.5
+    now_s[0] = sim_node.WARN_THROTTLE_S
+    log.refused_command('refused /atlas/joint_commands: d', topics.JOINT_COMMANDS)
+    assert lines == ['refused /atlas/joint_commands: a', 'refused /atlas/atlas_command: b',
+                     '/atlas/atlas_command: c', 'refused /atlas/joint_commands: d']
+
+
+def test_the_node_hands_atlas_command_and_test_to_the_loop_in_order(sim: AtlasSimulator) -> None:
+    from support.fake_rospy import fake_ros_node
+    from tutorial_atlas_control.msgs.atlas_command import encode_atlas_command, encode_test
+
+    with fake_ros_node(sim, steps=0) as node:
+        command, test = sim_node.RawAtlasCommand(), sim_node.RawTest()
+        node.on_atlas_command(command.deserialize(encode_atlas_command(0, {})))
+        node.on_test(test.deserialize(encode_test(0, {})))
+        assert [topic for topic, _raw in node.loop.pending_commands] == [
+            topics.ATLAS_COMMAND, topics.ATLAS_TEST]
+        assert sim_node.RawAtlasCommand._md5sum == '3a56dd1f50633ad975636160b665384a'
+        assert sim_node.RawTest._md5sum == '62f63cd4b6db15007d8d3d4a23411c4c'

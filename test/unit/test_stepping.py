@@ -76,8 +76,14 @@ class FakeLog:
     def info(self, text: str) -> None:
         self.lines.append(('info', text))
 
-    def refused_command(self, text: str) -> None:
+    def refused_command(self, text: str, _topic: str = '') -> None:
         self.lines.append(('refused', text))
+
+    def kept_fields(self, text: str, _topic: str = '') -> None:
+        self.lines.append(('kept', text))
+
+    def warn(self, text: str) -> None:
+        self.lines.append(('warn', text))
 
     def error(self, text: str) -> None:
         self.lines.append(('error', text))

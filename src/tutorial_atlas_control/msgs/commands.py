@@ -25,10 +25,18 @@ FIELD_NAMES: tuple[str, ...] = (
     'position', 'velocity', 'effort', 'kp_position', 'ki_position', 'kd_position',
     'kp_velocity', 'i_effort_min', 'i_effort_max',
 )
+#: What the law reads per joint: JointCommands' fields and atlas_msgs/AtlasCommand's
+#: k_effort (as the fraction k_effort/255 the law blends with).
+LAW_FIELDS: tuple[str, ...] = FIELD_NAMES + ('k_effort',)
+K_EFFORT_ROW = LAW_FIELDS.index('k_effort')
 
 
 def _zeros() -> np.ndarray:
     return np.zeros(NUM_JOINTS)
+
+
+def _ones() -> np.ndarray:
+    return np.ones(NUM_JOINTS)
 
 
 @dataclass
@@ -37,7 +45,10 @@ class JointCommandArrays:
 
     Units: position rad, velocity rad/s, effort N m; kp_position N m/rad,
     ki_position N m/(rad s), kd_position N m s/rad, kp_velocity N m s/rad;
-    i_effort_min/max N m (bounds of the integral term's torque).
+    i_effort_min/max N m (bounds of the integral term's torque); k_effort: the share of
+    this command's PID torque in the joint's torque (AtlasCommand's uint8 / 255; the rest
+    is the behaviour's torque, see controller.compute_torque). 1 unless an AtlasCommand,
+    /atlas/debug/test or a mode switch set it.
     """
 
     position: np.ndarray = field(default_factory=_zeros)
@@ -49,18 +60,19 @@ class JointCommandArrays:
     kp_velocity: np.ndarray = field(default_factory=_zeros)
     i_effort_min: np.ndarray = field(default_factory=_zeros)
     i_effort_max: np.ndarray = field(default_factory=_zeros)
+    k_effort: np.ndarray = field(default_factory=_ones)
 
     @classmethod
     def zeros(cls) -> JointCommandArrays:
-        """All fields 0: no target gains, no feed-forward, i.e. a limp robot."""
+        """All fields 0 (k_effort 1): no target gains, no feed-forward, a limp robot."""
         return cls()
 
     def copy(self) -> JointCommandArrays:
         """Deep copy (the arrays are copied, so the copy can be handed to another thread)."""
-        return JointCommandArrays(**{name: getattr(self, name).copy() for name in FIELD_NAMES})
+        return JointCommandArrays(**{name: getattr(self, name).copy() for name in LAW_FIELDS})
 
 
-assert tuple(f.name for f in fields(JointCommandArrays)) == FIELD_NAMES
+assert tuple(f.name for f in fields(JointCommandArrays)) == LAW_FIELDS
 
 
 #: Largest magnitude accepted per field; beyond it a value is a mistake, not a command, and
@@ -84,8 +96,8 @@ class CommandError(AtlasControlError):
     """A JointCommands message that cannot be applied; the text says why."""
 
 
-#: MAX_MAGNITUDE per field in FIELD_NAMES order (inf: no bound).
-_BOUNDS = np.array([MAX_MAGNITUDE.get(name, np.inf) for name in FIELD_NAMES])
+#: MAX_MAGNITUDE per field in LAW_FIELDS order (inf: no bound).
+_BOUNDS = np.array([MAX_MAGNITUDE.get(name, np.inf) for name in LAW_FIELDS])
 _ALL_JOINTS = np.arange(NUM_JOINTS)
 _ALL_JOINTS.setflags(write=False)
 
@@ -122,9 +134,9 @@ def _indices_of(names: tuple[str, ...]) -> np.ndarray:
 
 @dataclass(frozen=True)
 class CommandUpdate:
-    """One checked JointCommands message: what it sets, ready to apply to any command.
+    """One checked command message: what it sets, ready to apply to any command.
 
-    `values[k]` holds field FIELD_NAMES[rows[k]] for the joints `indices`; every value is
+    `values[k]` holds field LAW_FIELDS[rows[k]] for the joints `indices`; every value is
     finite and within MAX_MAGNITUDE.
     """
 
@@ -133,14 +145,20 @@ class CommandUpdate:
     values: np.ndarray
 
     @property
+    def all_joints(self) -> bool:
+        """Sets its fields for every joint: an older message's values of them do not
+        survive it."""
+        return len(self.indices) == NUM_JOINTS
+
+    @property
     def is_complete(self) -> bool:
         """Sets every field of every joint: nothing of an earlier command survives it."""
-        return len(self.rows) == len(FIELD_NAMES) and len(self.indices) == NUM_JOINTS
+        return len(set(self.rows)) == len(LAW_FIELDS) and self.all_joints
 
     def apply_to(self, command: JointCommandArrays) -> None:
         """Write this update into `command` (in place)."""
         for row, values in zip(self.rows, self.values):
-            getattr(command, FIELD_NAMES[row])[self.indices] = values
+            getattr(command, LAW_FIELDS[row])[self.indices] = values
 
 
 def command_update(names: Sequence[str],
@@ -167,18 +185,28 @@ def _checked_update(indices: np.ndarray, fields: Sequence[Sequence[float]]) -> C
         given.append(values)
     # One (fields, joints) block: the checks below are a few numpy calls, not 9 x 3.
     block = np.array(given, dtype=np.float64).reshape(len(rows), expected)
+    check_values(rows, block)
+    return CommandUpdate(indices, tuple(rows), block)
+
+
+def check_values(rows: Sequence[int], block: np.ndarray) -> None:
+    """Refuse NaN/Inf and magnitudes beyond MAX_MAGNITUDE in a (fields, joints) block whose
+    row k holds field LAW_FIELDS[rows[k]].
+
+    Raises:
+        CommandError: naming the first bad entry, in message order.
+    """
     bad = ~np.isfinite(block)
     if bad.any():
         row, column = np.argwhere(bad)[0]
-        raise CommandError(f'{FIELD_NAMES[rows[row]]}[{column}] is {block[row, column]} '
+        raise CommandError(f'{LAW_FIELDS[rows[row]]}[{column}] is {block[row, column]} '
                            '(NaN/Inf are refused)')
-    bounds = _BOUNDS[rows]
+    bounds = _BOUNDS[list(rows)]
     beyond = np.abs(block) > bounds[:, np.newaxis]
     if beyond.any():
         row, column = np.argwhere(beyond)[0]
-        raise CommandError(f'{FIELD_NAMES[rows[row]]}[{column}] is {block[row, column]:g}, '
+        raise CommandError(f'{LAW_FIELDS[rows[row]]}[{column}] is {block[row, column]:g}, '
                            f'beyond the sane bound of {bounds[row]:g} in magnitude')
-    return CommandUpdate(indices, tuple(rows), block)
 
 
 def merge_command(previous: JointCommandArrays, names: Sequence[str],

@@ -54,6 +54,19 @@ class FieldCursor:
         self.pos += 8 * count
         return values
 
+    def array(self, dtype: np.dtype) -> np.ndarray:
+        """A read-only view of the next array of little-endian `dtype` (no copy)."""
+        count = self.u32()
+        values = np.frombuffer(self.data, dtype=dtype, count=count, offset=self.pos)
+        self.pos += dtype.itemsize * count
+        return values
+
+    def u8(self) -> int:
+        if self.pos >= len(self.data):
+            raise ValueError('the message ends before its last uint8')
+        self.pos += 1
+        return self.data[self.pos - 1]
+
     def header_stamp_ns(self) -> int:
         """Read std_msgs/Header; return its stamp (ns)."""
         self.pos += 4  # seq

@@ -7,8 +7,9 @@ time, /atlas/controller_statistics (command age, while subscribed), DRCSim's
 /atlas/atlas_state, /atlas/force_torque_sensors and /atlas/debug/{l,r}_foot_contact (while
 subscribed), and a latched
 /atlas/sim_config (JSON: timestep, time_to_unpin, model file and checksum, time of the last
-reset) for offline replay; obeys /atlas/joint_commands and /atlas/control_mode; offers
-gazebo_ros's reset and pause services.
+reset) for offline replay; obeys /atlas/joint_commands, /atlas/atlas_command,
+/atlas/debug/test and /atlas/control_mode; offers /atlas/reset_controls and gazebo_ros's
+reset and pause services.
 
 Parameters (private unless noted):
     ~real_time_factor (float, 1.0): sim time per wall time; 0 runs as fast as possible.
@@ -33,6 +34,7 @@ Parameters (private unless noted):
 
 from __future__ import annotations
 
+import io
 import threading
 import time
 import warnings
@@ -41,7 +43,8 @@ from pathlib import Path
 
 import genpy
 import rospy
-from atlas_msgs.msg import AtlasState, ControllerStatistics, ForceTorqueSensors
+from atlas_msgs.msg import AtlasCommand, AtlasState, ControllerStatistics, ForceTorqueSensors, Test
+from atlas_msgs.srv import ResetControls, ResetControlsResponse
 from geometry_msgs.msg import WrenchStamped
 from nav_msgs.msg import Odometry
 from osrf_msgs.msg import JointCommands
@@ -57,7 +60,7 @@ from tutorial_atlas_control.node.transport import WireBatch
 from tutorial_atlas_control.node.viewer import ViewerLink, ViewerRequest
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.camera import configure_viewer_camera, configure_viewer_scene
-from tutorial_atlas_control.sim.controller import gains_from_params
+from tutorial_atlas_control.sim.controller import GainsError, gains_from_params
 from tutorial_atlas_control.sim.controller_statistics import (
     DEFAULT_WINDOW_S,
     UPDATE_RATE_PARAM,
@@ -71,7 +74,7 @@ from tutorial_atlas_control.sim.simulator import (
     parse_mode,
 )
 from tutorial_atlas_control.sim.urdf import UrdfError, matching_urdf
-from tutorial_atlas_control.stepping.loop import SteppingLoop
+from tutorial_atlas_control.stepping.loop import ResetControlsRequest, SteppingLoop
 from tutorial_atlas_control.units import finite_number
 
 NODE_NAME = 'atlas_sim'
@@ -94,39 +97,84 @@ LOOP_TOPICS = (
     (topics.DEBUG_L_FOOT_CONTACT, WrenchStamped), (topics.DEBUG_R_FOOT_CONTACT, WrenchStamped))
 
 
-class RawJointCommands(genpy.Message):
-    """osrf_msgs/JointCommands as it arrives, left undecoded by rospy.
+class RawMessage(genpy.Message):
+    """A command message as it arrives, left undecoded by rospy.
 
     genpy's decoder would run in the receiving thread, under the GIL the stepping loop
-    needs, and at thousands of commands a second starve the loop. This class keeps the real
+    needs, and at thousands of commands a second starve the loop. A subclass keeps the real
     type, MD5 and definition, so the subscription is registered, negotiated and shown as
-    osrf_msgs/JointCommands; the loop decodes `raw` itself with commands.CommandDecoder.
+    that type; the loop decodes `raw` itself (msgs/commands.py, msgs/atlas_command.py).
     """
 
-    _type = JointCommands._type
-    _md5sum = JointCommands._md5sum
-    _full_text = JointCommands._full_text
     _has_header = True
     __slots__ = ['raw']
 
     def __init__(self) -> None:
         self.raw = b''
 
-    def deserialize(self, str: bytes) -> RawJointCommands:  # noqa: A002 - genpy's name
+    def deserialize(self, str: bytes) -> RawMessage:  # noqa: A002 - genpy's name
         self.raw = str
         return self
 
 
+class RawJointCommands(RawMessage):
+    """osrf_msgs/JointCommands, undecoded."""
+
+    _type = JointCommands._type
+    _md5sum = JointCommands._md5sum
+    _full_text = JointCommands._full_text
+    __slots__: list[str] = []
+
+
+class RawAtlasCommand(RawMessage):
+    """atlas_msgs/AtlasCommand, undecoded."""
+
+    _type = AtlasCommand._type
+    _md5sum = AtlasCommand._md5sum
+    _full_text = AtlasCommand._full_text
+    __slots__: list[str] = []
+
+
+class RawTest(RawMessage):
+    """atlas_msgs/Test, undecoded (it goes through the loop's queue, in order)."""
+
+    _type = Test._type
+    _md5sum = Test._md5sum
+    _full_text = Test._full_text
+    __slots__: list[str] = []
+
+
 class RosLog:
-    """The stepping loop's log lines, into rospy's log (stepping.loop.LoopLog)."""
+    """The stepping loop's log lines, into rospy's log (stepping.loop.LoopLog).
+
+    Refusals are throttled per topic and kind (rospy's logwarn_throttle throttles per call
+    site, so a refused JointCommands would hide a refused AtlasCommand for WARN_THROTTLE_S).
+    """
+
+    def __init__(self, clock: Callable[[], float] = time.monotonic) -> None:
+        self._clock = clock
+        self._last_s: dict[tuple[str, str], float] = {}
+
+    def _throttled(self, key: tuple[str, str], text: str) -> None:
+        now_s = self._clock()
+        last_s = self._last_s.get(key)
+        if last_s is None or now_s - last_s >= WARN_THROTTLE_S:
+            self._last_s[key] = now_s
+            rospy.logwarn(text)
 
     @staticmethod
     def info(text: str) -> None:
         rospy.loginfo(text)
 
+    def refused_command(self, text: str, topic: str = topics.JOINT_COMMANDS) -> None:
+        self._throttled(('refused', topic), text)
+
+    def kept_fields(self, text: str, topic: str) -> None:
+        self._throttled(('kept', topic), text)
+
     @staticmethod
-    def refused_command(text: str) -> None:
-        rospy.logwarn_throttle(WARN_THROTTLE_S, text)
+    def warn(text: str) -> None:
+        rospy.logwarn(text)
 
     @staticmethod
     def error(text: str) -> None:
@@ -180,9 +228,13 @@ class SimNode:
         """The command and mode subscriptions and gazebo_ros's services."""
         rospy.Subscriber(topics.JOINT_COMMANDS, RawJointCommands, self.on_joint_commands,
                          queue_size=10, tcp_nodelay=True)
+        rospy.Subscriber(topics.ATLAS_COMMAND, RawAtlasCommand, self.on_atlas_command,
+                         queue_size=10, tcp_nodelay=True)
+        rospy.Subscriber(topics.ATLAS_TEST, RawTest, self.on_test, queue_size=10)
         rospy.Subscriber(topics.CONTROL_MODE, String, self.on_control_mode, queue_size=10)
         loop = self.loop
         self.services = [
+            rospy.Service(topics.RESET_CONTROLS_SERVICE, ResetControls, self.on_reset_controls),
             rospy.Service(topics.RESET_WORLD_SERVICE, Empty, self._service(loop.reset_world)),
             rospy.Service(topics.RESET_SIMULATION_SERVICE, Empty,
                           self._service(loop.reset_simulation)),
@@ -198,6 +250,32 @@ class SimNode:
     def on_joint_commands(self, msg: RawJointCommands) -> None:
         """Hand the raw message to the loop, which decodes it before its next step."""
         self.loop.receive_command(msg.raw)
+
+    def on_atlas_command(self, msg: RawAtlasCommand) -> None:
+        self.loop.receive_command(msg.raw, topics.ATLAS_COMMAND)
+
+    def on_test(self, msg: RawTest) -> None:
+        self.loop.receive_command(msg.raw, topics.ATLAS_TEST)
+
+    def on_reset_controls(self, request: ResetControls._request_class
+                          ) -> ResetControlsResponse:
+        """atlas_msgs/ResetControls: the loop checks and applies it (stepping/loop.py)."""
+        gains = None
+        if request.reload_pid_from_ros:
+            try:
+                gains = gains_from_params(rospy.get_param(topics.GAINS_PARAM, {}))
+            except GainsError as err:
+                gains = str(err)
+        buffer = io.BytesIO()
+        request.atlas_command.serialize(buffer)
+        success, status = self.loop.reset_controls(ResetControlsRequest(
+            bool(request.reset_bdi_controller), bool(request.reset_pid_controller),
+            bool(request.reload_pid_from_ros), buffer.getvalue(), gains))
+        if success:
+            rospy.loginfo(f'{topics.RESET_CONTROLS_SERVICE}: {status}')
+        else:
+            rospy.logwarn(f'refused {topics.RESET_CONTROLS_SERVICE}: {status}')
+        return ResetControlsResponse(success=success, status_message=status)
 
     def on_control_mode(self, msg: String) -> None:
         try:

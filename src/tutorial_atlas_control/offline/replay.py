@@ -153,6 +153,12 @@ def load_recording(path: Path | str, data: BagData | None = None) -> Recording:
         raise ReplayError(f'{path} has no {JOINT_STATES_TOPIC}: the replay needs the recorded '
                           'torques (effort) of every step.')
     config, resets = _sim_config(path, _read_sim_configs(data), warnings)
+    tests = data.topics.get(topics.ATLAS_TEST)
+    if tests is not None and tests.count:
+        # Its damping changes the model, which the recorded torques do not carry.
+        warnings.append(f'the run has {tests.count} {topics.ATLAS_TEST} message(s): joint '
+                        'damping they set is not re-applied offline, so the replay deviates '
+                        'from the first that set it.')
     columns = []
     missing = []
     for name in JOINT_NAMES:

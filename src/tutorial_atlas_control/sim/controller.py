@@ -8,6 +8,8 @@ Per joint, each 1 ms step (AtlasPlugin::UpdateStates in DRCSim 2.5.2):
     qd_p     = velocity - v
     I        = clamp(I + dt * ki_position * e, i_effort_min, i_effort_max)   # a torque (N m)
     u        = kp_position * e + I + kd_position * de/dt + kp_velocity * qd_p + effort
+    if k_effort != 1:                                  # AtlasCommand's k_effort / 255
+        u    = k_effort * u + (1 - k_effort) * f_out
     tau      = clamp(u, -effort_limit, effort_limit)
     if |tau - u| > 1e-6 and |ki_position| > 1e-6:                         # tie-back
         I = clamp(I + (tau - u), i_effort_min, i_effort_max)
@@ -23,9 +25,11 @@ Where this differs from 2.5.2, on purpose:
   DRCSim started from e_prev = 0, which kicks the joints with kd * e / dt on
   the first step after a command arrives (e.g. 10 * 0.1 / 0.001 = 1000 N m on
   a knee, then clamped to the effort limit).
-* Not a change of the law, a part left out: 2.5.2 also added the feed-forward torque of
-  the BDI AtlasSimInterface (its walking behaviours) inside the final clamp; there is no
-  BDI library here, so that term is always 0.
+* f_out: 2.5.2 blended in the torque of BDI's AtlasSimInterface (its Stand, Walk, ...
+  behaviours) by 1 - k_effort. There is no BDI library here: the simulator passes its own
+  Stand/StandPrep/Freeze hold's torque where BDI's behaviour would act, and 0 in User and
+  ragdoll, where BDI outputs nothing (simulator.py). With k_effort = 1 the term is skipped,
+  so u is the PID sum exactly (2.5.2's 1 * u + 0 * f_out, up to the sign of a zero).
 
 The torque clamp here is the only place the effort limits are enforced (the
 MuJoCo motors have no ctrlrange).
@@ -97,7 +101,8 @@ def _clamp(value: np.ndarray, low: np.ndarray, high: np.ndarray, out: np.ndarray
 
 def compute_torque(command: JointCommandArrays, q: np.ndarray, v: np.ndarray, state: PidState,
                    dt_s: float, lower: np.ndarray, upper: np.ndarray, effort_limit: np.ndarray,
-                   out: np.ndarray | None = None) -> np.ndarray:
+                   out: np.ndarray | None = None,
+                   f_out: np.ndarray | None = None) -> np.ndarray:
     """Joint torques (N m, (28,)) for one control step; updates `state` in place.
 
     The operations run in the order of the scalar law in the module docstring, so each
@@ -111,6 +116,7 @@ def compute_torque(command: JointCommandArrays, q: np.ndarray, v: np.ndarray, st
         lower, upper: position limits (rad) the target is clamped to.
         effort_limit: |torque| bound (N m), >= 0.
         out: optional (28,) buffer for the result.
+        f_out: the behaviour's torque (N m, (28,)) blended in by 1 - k_effort; None: 0.
     """
     error, term, unclamped = state._error, state._term, state._unclamped
     torque = np.empty(NUM_JOINTS) if out is None else out
@@ -141,6 +147,9 @@ def compute_torque(command: JointCommandArrays, q: np.ndarray, v: np.ndarray, st
     term *= command.kp_velocity
     unclamped += term
     unclamped += command.effort
+    k_effort = command.k_effort
+    if (k_effort != 1.0).any():
+        _blend(k_effort, f_out, unclamped, term)
 
     np.negative(effort_limit, out=term)
     _clamp(unclamped, term, effort_limit, out=torque)
@@ -149,6 +158,21 @@ def compute_torque(command: JointCommandArrays, q: np.ndarray, v: np.ndarray, st
     if ki.any():
         _tie_back(command, torque, unclamped, integral, term)
     return torque
+
+
+#: f_out where the behaviour outputs nothing (N m).
+_NO_TORQUE = np.zeros(NUM_JOINTS)
+_NO_TORQUE.setflags(write=False)
+
+
+def _blend(k_effort: np.ndarray, f_out: np.ndarray | None, unclamped: np.ndarray,
+           scratch: np.ndarray) -> None:
+    """u = k * u + (1 - k) * f_out on the joints whose k_effort is not 1 (2.5.2's order)."""
+    blended = k_effort * unclamped
+    np.subtract(1.0, k_effort, out=scratch)
+    scratch *= _NO_TORQUE if f_out is None else f_out
+    blended += scratch
+    np.copyto(unclamped, blended, where=k_effort != 1.0)
 
 
 def _tie_back(command: JointCommandArrays, torque: np.ndarray, unclamped: np.ndarray,

@@ -15,7 +15,7 @@ import ctypes
 
 import numpy as np
 
-from tutorial_atlas_control.msgs.commands import FIELD_NAMES, JointCommandArrays
+from tutorial_atlas_control.msgs.commands import LAW_FIELDS, JointCommandArrays
 from tutorial_atlas_control.native import AtlasLawStep, address
 from tutorial_atlas_control.sim.controller import PidState
 
@@ -30,7 +30,9 @@ class CompiledLaw:
     def __init__(self, library: ctypes.CDLL, qpos: np.ndarray, qpos_adr: np.ndarray,
                  qvel: np.ndarray, dof_adr: np.ndarray, lower: np.ndarray, upper: np.ndarray,
                  effort_limit: np.ndarray, dt_s: float, state: PidState, torque: np.ndarray,
-                 ctrl: np.ndarray | None = None) -> None:
+                 ctrl: np.ndarray | None = None, f_out: np.ndarray | None = None) -> None:
+        """`ctrl`: also written with the torque; `f_out`: the torque (N m) blended in by
+        1 - k_effort (None: 0), read at each call."""
         count = len(torque)
         for name, array in (('qpos_adr', qpos_adr), ('dof_adr', dof_adr), ('lower', lower),
                             ('upper', upper), ('effort_limit', effort_limit),
@@ -38,10 +40,11 @@ class CompiledLaw:
                             ('previous_error', state.previous_error)):
             if array.shape != (count,):
                 raise ValueError(f'{name} has shape {array.shape}, expected ({count},)')
-        if ctrl is not None and ctrl.shape != (count,):
-            raise ValueError(f'ctrl has shape {ctrl.shape}, expected ({count},)')
+        for name, optional in (('ctrl', ctrl), ('f_out', f_out)):
+            if optional is not None and optional.shape != (count,):
+                raise ValueError(f'{name} has shape {optional.shape}, expected ({count},)')
         self._keep = (qpos, qpos_adr, qvel, dof_adr, lower, upper, effort_limit, state, torque,
-                      ctrl)
+                      ctrl, f_out)
         self.state = state
         step = self._step = AtlasLawStep()
         step.qpos = address(qpos, np.float64)
@@ -55,6 +58,7 @@ class CompiledLaw:
         step.previous_error = address(state.previous_error, np.float64)
         step.torque = address(torque, np.float64)
         step.ctrl = None if ctrl is None else address(ctrl, np.float64)
+        step.f_out = None if f_out is None else address(f_out, np.float64)
         step.dt_s = dt_s
         step.n = count
         step.nq, step.nv = qpos.size, qvel.size
@@ -80,10 +84,10 @@ class CompiledLaw:
 
     def _bind(self, command: JointCommandArrays) -> None:
         """Point the kernel at another command's arrays (a new command arrived)."""
-        arrays = tuple(getattr(command, name) for name in FIELD_NAMES)
+        arrays = tuple(getattr(command, name) for name in LAW_FIELDS)
         count = self._step.n
-        for name, array in zip(FIELD_NAMES, arrays):
+        for index, (name, array) in enumerate(zip(LAW_FIELDS, arrays)):
             if array.shape != (count,):
                 raise ValueError(f'command.{name} has shape {array.shape}, expected ({count},)')
-            self._step.command[FIELD_NAMES.index(name)] = address(array, np.float64)
+            self._step.command[index] = address(array, np.float64)
         self._command, self._command_arrays = command, arrays

@@ -3,6 +3,14 @@
 The ROS node (sim_node.py) owns one AtlasSimulator and only translates messages;
 everything that decides what torque a joint gets lives here, so it is unit-tested
 without a master and shared with offline replay.
+
+Which torque a joint gets (DRCSim 2.5.2's AtlasPlugin, with the port's holds standing in
+for BDI's behaviours): in User mode, the law on the user command (JointCommands,
+AtlasCommand), its k_effort blending with nothing (BDI outputs no torque in User: a joint
+at k_effort 0 is limp); in Stand/StandPrep/Freeze, the hold's torque (what BDI's behaviour
+gave), blended with the user command's PID torque on the joints whose k_effort is not 0;
+in ragdoll, 0 blended likewise. As AtlasPlugin::OnRobotMode does, a switch to User sets
+every k_effort to 1 (255) and any other switch sets them to 0.
 """
 
 from __future__ import annotations
@@ -18,7 +26,12 @@ import numpy as np
 from tutorial_atlas_control import native
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import NUM_JOINTS
-from tutorial_atlas_control.msgs.commands import CommandUpdate, JointCommandArrays, command_update
+from tutorial_atlas_control.msgs.commands import (
+    LAW_FIELDS,
+    CommandUpdate,
+    JointCommandArrays,
+    command_update,
+)
 from tutorial_atlas_control.sim import law_kernel
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import Gains, PidState, compute_torque, hold_command
@@ -51,6 +64,9 @@ class ControlMode(str, enum.Enum):
 
 
 VALID_MODES: tuple[str, ...] = tuple(mode.value for mode in ControlMode)
+#: What ResetControls' reload_pid_from_ros sets in the user command (k_effort to 1).
+GAIN_FIELDS: tuple[str, ...] = ('kp_position', 'ki_position', 'kd_position', 'i_effort_min',
+                                'i_effort_max', 'k_effort')
 
 
 class ModeError(AtlasControlError):
@@ -99,10 +115,14 @@ class AtlasSimulator:
         self.mode = ControlMode.STAND
         self.user_command: JointCommandArrays | None = None
         self.torque_nm = np.zeros(NUM_JOINTS)
-        #: The active k_effort per joint (uint8, tutorial order), read by active_k_effort().
-        self.k_effort = np.full(NUM_JOINTS, K_EFFORT_PID, dtype=np.uint8)
+        # The law's memory for the mode's command (the user command in User mode, else the
+        # hold), and for the user command's PID while it is blended with a hold.
         self._pid = PidState()
-        self._compiled_law = self._make_compiled_law() if compiled_law else None
+        self._blend_pid = PidState()
+        self._hold_torque_nm = np.zeros(NUM_JOINTS)  # the hold's torque: f_out when blending
+        self._compiled_law = self._compiled_hold = self._compiled_blend = None
+        if compiled_law:
+            self._make_compiled_laws()
         self._warning_counts = self.data.warning.number  # a view: MuJoCo's counters
         # Stand/StandPrep hold the initial pose (all joints 0) with the parameter gains.
         self._stand_command = hold_command(gains, np.zeros(NUM_JOINTS))
@@ -112,15 +132,23 @@ class AtlasSimulator:
         self.pinned = False
         self.reset_world()
 
-    def _make_compiled_law(self) -> law_kernel.CompiledLaw | None:
-        """The C law writing torque_nm and MjData.ctrl; None (numpy law) if it is not built."""
+    def _make_compiled_laws(self) -> None:
+        """The C law: the mode's command into torque_nm and MjData.ctrl, or into the hold's
+        torque, and the blended user command; left None (numpy law) if it is not built."""
         library = native.load_library()
         if library is None or self.data.ctrl.shape != self.torque_nm.shape:
-            return None
-        return law_kernel.CompiledLaw(
-            library, self.data.qpos, self.atlas.qpos_adr, self.data.qvel, self.atlas.dof_adr,
-            self.atlas.lower_rad, self.atlas.upper_rad, self.atlas.effort_limit_nm, self.dt_s,
-            self._pid, self.torque_nm, self.data.ctrl)
+            return
+
+        def law(state: PidState, torque: np.ndarray, ctrl: np.ndarray | None,
+                f_out: np.ndarray | None = None) -> law_kernel.CompiledLaw:
+            return law_kernel.CompiledLaw(
+                library, self.data.qpos, self.atlas.qpos_adr, self.data.qvel,
+                self.atlas.dof_adr, self.atlas.lower_rad, self.atlas.upper_rad,
+                self.atlas.effort_limit_nm, self.dt_s, state, torque, ctrl, f_out)
+        self._compiled_law = law(self._pid, self.torque_nm, self.data.ctrl)
+        self._compiled_hold = law(self._pid, self._hold_torque_nm, None)
+        self._compiled_blend = law(self._blend_pid, self.torque_nm, self.data.ctrl,
+                                   self._hold_torque_nm)
 
     @property
     def uses_compiled_law(self) -> bool:
@@ -134,6 +162,7 @@ class AtlasSimulator:
         self.last_reset_ns = self.sim_time_ns
         self.state_time_ns = self.sim_time_ns
         self._pid.reset()
+        self._blend_pid.reset()
         self.torque_nm[:] = 0.0
         # A reset robot waits for fresh commands rather than jumping to a stale target.
         self.user_command = None
@@ -168,14 +197,27 @@ class AtlasSimulator:
 
     # -- commands ----------------------------------------------------------------------
     def set_mode(self, mode: ControlMode) -> None:
-        """Switch control mode; Freeze and User start by holding the current pose."""
+        """Switch control mode; Freeze and User start by holding the current pose.
+
+        The user command's k_effort becomes 1 in User, 0 otherwise (AtlasPlugin::OnRobotMode:
+        LoadPIDGainsFromParameter, ZeroAtlasCommand); its other fields are kept.
+        """
         if mode in (ControlMode.STAND, ControlMode.STAND_PREP):
             self._mode_command = self._stand_command
         elif mode in (ControlMode.FREEZE, ControlMode.USER):
             self._mode_command = self._hold_current_pose()
         # The target changed: restart the derivative so the switch gives no kick.
         self._pid.initialized = False
+        self._blend_pid.initialized = False
         self.mode = mode
+        if self.user_command is not None:
+            command = self.user_command.copy()
+            command.k_effort.fill(self._mode_k_effort())
+            self.user_command = command
+
+    def _mode_k_effort(self) -> float:
+        """k_effort a mode gives the user command: 1 in User (the PID alone), else 0."""
+        return 1.0 if self.mode is ControlMode.USER else 0.0
 
     def _hold_current_pose(self) -> JointCommandArrays:
         """Target = the measured pose, feed-forward = the torque applied now.
@@ -211,24 +253,62 @@ class AtlasSimulator:
             previous = (self._mode_command if self.mode is ControlMode.USER
                         else self._hold_current_pose())
         merged = previous.copy()  # the law may hold `previous`; never edit it in place
+        if self.user_command is None:
+            merged.k_effort.fill(self._mode_k_effort())
         for update in updates:
             update.apply_to(merged)
         self.user_command = merged
 
     def active_command(self) -> JointCommandArrays:
-        """The command the law applies this step, given the mode."""
+        """The mode's command the law applies this step: the user command in User mode,
+        else the hold (or ragdoll's zeros), whose torque is f_out for blended_command()."""
         if self.mode is ControlMode.RAGDOLL:
             return self._ragdoll_command
         if self.mode is ControlMode.USER and self.user_command is not None:
             return self.user_command
         return self._mode_command
 
-    def active_k_effort(self) -> np.ndarray:
-        """The k_effort the law applies (uint8, (28,)): the one place AtlasState reads it.
+    def blended_command(self) -> JointCommandArrays | None:
+        """Outside User mode, the user command when some of its k_effort are not 0: its PID
+        torque is blended with the hold's; else None (the hold alone)."""
+        command = self.user_command
+        if self.mode is ControlMode.USER or command is None or not command.k_effort.any():
+            return None
+        return command
 
-        All K_EFFORT_PID (the PID torque alone) until a command sets it (AtlasCommand).
-        """
-        return self.k_effort
+    def reset_pid(self) -> None:
+        """Forget the law's integrals and previous errors (ResetControls'
+        reset_pid_controller); the derivative restarts without a kick."""
+        self._pid.reset()
+        self._blend_pid.reset()
+
+    def load_gains(self, gains: Gains) -> None:
+        """The user command's gains from `gains`, k_effort 1 on every joint
+        (ResetControls' reload_pid_from_ros: AtlasPlugin::LoadPIDGainsFromParameter);
+        targets, velocity gain and feed-forward kept."""
+        gain_command = hold_command(gains, np.zeros(NUM_JOINTS))
+        rows = tuple(LAW_FIELDS.index(name) for name in GAIN_FIELDS)
+        values = np.array([getattr(gain_command, name) for name in GAIN_FIELDS])  # k_effort 1
+        self.receive_updates([CommandUpdate(np.arange(NUM_JOINTS), rows, values)])
+
+    def joint_damping(self) -> np.ndarray:
+        """The joints' viscous damping (N m s/rad), tutorial order."""
+        return self.model.dof_damping[self.atlas.dof_adr].copy()
+
+    def set_joint_damping(self, damping: np.ndarray) -> None:
+        """Set the joints' viscous damping (N m s/rad, (28,)), as /atlas/debug/test does
+        (Gazebo's Joint::SetDamping); kept across resets, as in Gazebo."""
+        self.model.dof_damping[self.atlas.dof_adr] = damping
+
+    def pid_command(self) -> JointCommandArrays:
+        """The command whose PID torque k_effort weighs, as AtlasState reports it: the user
+        command blended under a hold, else the mode's command (the hold's PID alone)."""
+        blended = self.blended_command()
+        return self.active_command() if blended is None else blended
+
+    def active_k_effort(self) -> np.ndarray:
+        """AtlasState's k_effort (uint8, (28,)): pid_command()'s, times 255."""
+        return np.rint(self.pid_command().k_effort * K_EFFORT_PID).astype(np.uint8)
 
     # -- stepping ----------------------------------------------------------------------
     def step(self, torque_nm: np.ndarray | None = None) -> None:
@@ -246,7 +326,12 @@ class AtlasSimulator:
             self.torque_nm[:] = torque_nm
             self.data.ctrl[:] = self.torque_nm
         elif self._compiled_law is not None:
-            self._compiled_law(self.active_command())  # sets torque_nm and data.ctrl
+            blended = self.blended_command()
+            if blended is None:
+                self._compiled_law(self.active_command())  # sets torque_nm and data.ctrl
+            else:
+                self._compiled_hold(self.active_command())  # f_out
+                self._compiled_blend(blended)
         else:
             self._law_torque(self._pid, out=self.torque_nm)
             self.data.ctrl[:] = self.torque_nm
@@ -259,13 +344,19 @@ class AtlasSimulator:
 
     def next_law_torque(self) -> np.ndarray:
         """The torque (N m) the law would apply at the next step; the law's memory is kept."""
-        return self._law_torque(copy.deepcopy(self._pid))
+        return self._law_torque(copy.deepcopy(self._pid), copy.deepcopy(self._blend_pid))
 
-    def _law_torque(self, pid: PidState, out: np.ndarray | None = None) -> np.ndarray:
-        return compute_torque(
-            self.active_command(), self.joint_positions(), self.joint_velocities(),
-            pid, self.dt_s, self.atlas.lower_rad, self.atlas.upper_rad,
-            self.atlas.effort_limit_nm, out=out)
+    def _law_torque(self, pid: PidState, blend_pid: PidState | None = None,
+                    out: np.ndarray | None = None) -> np.ndarray:
+        q, v = self.joint_positions(), self.joint_velocities()
+        limits = (self.atlas.lower_rad, self.atlas.upper_rad, self.atlas.effort_limit_nm)
+        blended = self.blended_command()
+        if blended is None:
+            return compute_torque(self.active_command(), q, v, pid, self.dt_s, *limits, out=out)
+        hold = compute_torque(self.active_command(), q, v, pid, self.dt_s, *limits,
+                              out=self._hold_torque_nm)
+        return compute_torque(blended, q, v, self._blend_pid if blend_pid is None else blend_pid,
+                              self.dt_s, *limits, out=out, f_out=hold)
 
     def _check_divergence(self) -> None:
         """Raise on an unstable step.

@@ -14,13 +14,27 @@ from __future__ import annotations
 import collections
 import threading
 from collections.abc import Callable, Hashable, Mapping
+from dataclasses import dataclass
 from typing import Protocol
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.msgs.commands import CommandDecoder, CommandError
+from tutorial_atlas_control.joints import NUM_JOINTS
+from tutorial_atlas_control.msgs.atlas_command import (
+    AtlasUpdate,
+    decode_atlas_command,
+    decode_test,
+)
+from tutorial_atlas_control.msgs.commands import (
+    FIELD_NAMES,
+    LAW_FIELDS,
+    CommandDecoder,
+    CommandError,
+    CommandUpdate,
+)
 from tutorial_atlas_control.msgs.ros1_fields import FieldCursor
 from tutorial_atlas_control.msgs.sim_messages import SimMessages
 from tutorial_atlas_control.msgs.wire import ControllerStatisticsWire, clock_bytes
+from tutorial_atlas_control.sim.controller import Gains
 from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistics
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode, PhysicsDivergenceError
 from tutorial_atlas_control.stepping.pacing import Pacer
@@ -28,7 +42,7 @@ from tutorial_atlas_control.stepping.schedule import STAMPED_AT_STEP_END, steps_
 from tutorial_atlas_control.units import NS_PER_S
 
 __all__ = ['MAX_PENDING_COMMANDS', 'ON_DEMAND_MESSAGES', 'DivergenceGuard', 'LoopLog', 'Outbox',
-           'SteppingLoop']
+           'ResetControlsRequest', 'SteppingLoop']
 
 #: A divergence this soon (s of sim time) after the previous one's reset is "in a row";
 #: that many in a row means the model itself is unstable and the loop stops.
@@ -54,6 +68,19 @@ ON_DEMAND_MESSAGES = (
     (topics.DEBUG_R_FOOT_CONTACT, 'debug_contact', 'debug_r'))
 #: Their rate (Hz of sim time) when `rates_hz` does not name it: DRCSim's 1 kHz.
 ON_DEMAND_RATE_HZ = 1000.0
+#: Rows (commands.LAW_FIELDS indices) each command topic can set; DAMPING_ROW stands for
+#: /atlas/debug/test's damping. An older message whose rows a newer one set for every
+#: joint is dropped undecoded (apply_pending_commands).
+DAMPING_ROW = len(LAW_FIELDS)
+CAN_SET: dict[str, frozenset[int]] = {
+    topics.JOINT_COMMANDS: frozenset(range(len(FIELD_NAMES))),
+    topics.ATLAS_COMMAND: frozenset(range(len(LAW_FIELDS))),
+    topics.ATLAS_TEST: frozenset({DAMPING_ROW, *(LAW_FIELDS.index(name) for name in (
+        'kp_position', 'ki_position', 'kd_position', 'kp_velocity', 'i_effort_min',
+        'i_effort_max', 'k_effort'))}),
+}
+#: Where DRCSim takes the command's header stamp for /atlas/controller_statistics.
+STAMPED_COMMANDS = (topics.JOINT_COMMANDS, topics.ATLAS_COMMAND)
 
 
 class Outbox(Protocol):
@@ -77,7 +104,13 @@ class LoopLog(Protocol):
 
     def info(self, text: str) -> None: ...
 
-    def refused_command(self, text: str) -> None: ...
+    def refused_command(self, text: str, topic: str = topics.JOINT_COMMANDS) -> None:
+        """Throttled per topic: a command message was refused."""
+
+    def kept_fields(self, text: str, topic: str) -> None:
+        """Throttled per topic: an AtlasCommand/Test array of the wrong length was left out."""
+
+    def warn(self, text: str) -> None: ...
 
     def error(self, text: str) -> None: ...
 
@@ -104,6 +137,23 @@ class DivergenceGuard:
             self.in_a_row = 1
         self.last_ns = now_ns
         return self.in_a_row < MAX_DIVERGENCES_IN_A_ROW
+
+
+@dataclass(frozen=True)
+class ResetControlsRequest:
+    """atlas_msgs/ResetControls' request, with what the node read for it.
+
+    Attributes:
+        atlas_command: the request's AtlasCommand, serialized.
+        gains: with reload_pid_from_ros, the gains on the parameter server, or the
+            reason they could not be read (GainsError's text).
+    """
+
+    reset_bdi_controller: bool
+    reset_pid_controller: bool
+    reload_pid_from_ros: bool
+    atlas_command: bytes
+    gains: Gains | str | None = None
 
 
 class SteppingLoop:
@@ -175,8 +225,11 @@ class SteppingLoop:
         # Commands wait here, undecoded, for the loop (see receive_command). Bounded, so
         # that a stalled loop cannot make it grow without limit; emptied every step.
         self.decoder = CommandDecoder()
-        self.pending_commands: collections.deque[bytes] = collections.deque(
+        self.pending_commands: collections.deque[tuple[str, bytes]] = collections.deque(
             maxlen=MAX_PENDING_COMMANDS)
+        # AtlasCommand's synchronization request (issue 26 will honour it): stored only.
+        self.desired_controller_period_ms = 0
+        self._period_warned = False
 
     @property
     def real_time_factor(self) -> float:
@@ -184,53 +237,144 @@ class SteppingLoop:
         return self.pacer.real_time_factor
 
     # -- inputs, from other threads ------------------------------------------------------
-    def receive_command(self, raw: bytes) -> None:
-        """Queue a serialized osrf_msgs/JointCommands for the next step, undecoded.
+    def receive_command(self, raw: bytes, topic: str = topics.JOINT_COMMANDS) -> None:
+        """Queue a serialized osrf_msgs/JointCommands (or, by `topic`, an
+        atlas_msgs/AtlasCommand or Test) for the next step, undecoded.
 
         Nothing else happens in the receiving thread: decoding there would make several
-        fast publishers' threads and the loop fight over the GIL.
+        fast publishers' threads and the loop fight over the GIL. One queue keeps the
+        topics' messages in the order they came: the newest sets the fields it carries.
         """
-        self.pending_commands.append(raw)
+        self.pending_commands.append((topic, raw))
+
+    def _decode(self, topic: str, raw: bytes) -> CommandUpdate | AtlasUpdate:
+        if topic == topics.JOINT_COMMANDS:
+            return self.decoder.decode(raw)
+        if topic == topics.ATLAS_COMMAND:
+            return decode_atlas_command(raw)
+        return decode_test(raw)
 
     def apply_pending_commands(self) -> None:
         """Decode, check and merge the commands received since the last step, in order.
 
-        Newest first: a valid command for every field of every joint overwrites all that
-        came before it, so the older ones in this step are dropped undecoded (DRCSim, too,
-        applied only the latest command at each step). Controllers send such complete
-        commands, so a flood costs one decode per step, not one per message.
+        Newest first: a message that sets some fields for every joint hides those fields
+        of all that came before it, so an older message with nothing else to set is
+        dropped undecoded (DRCSim, too, applied only the latest command at each step).
+        Controllers send such complete commands, so a flood costs one decode per step,
+        not one per message.
         """
         pending = self.pending_commands
-        raws = []
+        received = []
         while pending:
-            raws.append(pending.popleft())
-        updates = []
-        for raw in reversed(raws):
-            try:
-                update = self.decoder.decode(raw)
-            except CommandError as err:
-                self.log.refused_command(
-                    f'refused /atlas/joint_commands: {err}; previous command kept')
+            received.append(pending.popleft())
+        hidden: set[int] = set()
+        decoded: list[tuple[str, CommandUpdate | AtlasUpdate]] = []
+        stamped = False
+        for topic, raw in reversed(received):
+            if CAN_SET[topic] <= hidden:
                 continue
-            if not updates:
+            try:
+                result = self._decode(topic, raw)
+            except CommandError as err:
+                self.log.refused_command(f'refused {topic}: {err}; previous command kept', topic)
+                continue
+            if not stamped and topic in STAMPED_COMMANDS:
                 self._note_command_stamp(raw)  # the newest applied command
-            updates.append(update)
-            if update.is_complete:
-                break
-        if not updates:
-            return
-        updates.reverse()
+                stamped = True
+            decoded.append((topic, result))
+            update = result if isinstance(result, CommandUpdate) else result.update
+            if update.all_joints:
+                hidden.update(update.rows)
+            if isinstance(result, AtlasUpdate) and result.damping is not None:
+                hidden.add(DAMPING_ROW)
+        if decoded:
+            self._apply(decoded[::-1])
+
+    def _apply(self, decoded: list[tuple[str, CommandUpdate | AtlasUpdate]]) -> None:
+        """Apply decoded messages, oldest first."""
+        updates = []
+        for topic, result in decoded:
+            if isinstance(result, CommandUpdate):
+                updates.append(result)
+                continue
+            if result.ignored:
+                self.log.kept_fields(f'{topic}: {result.ignored_text()}', topic)
+            if result.damping is not None:
+                self.sim.set_joint_damping(result.damping)
+            if result.desired_controller_period_ms is not None:
+                self._store_period(result.desired_controller_period_ms)
+            updates.append(result.update)
         first = self.sim.user_command is None
         self.sim.receive_updates(updates)
         if first:
             # Which command a trajectory started from: a late one makes the robot jump.
-            self.log.info(f'first /atlas/joint_commands since the start or last reset, at '
+            self.log.info(f'first {decoded[0][0]} since the start or last reset, at '
                           f't={self.sim.sim_time_ns / NS_PER_S:.3f} s '
                           f'({self.sim.mode.value} mode)')
 
-    def set_mode(self, mode: ControlMode) -> ControlMode:
-        """Switch the control mode; returns the previous one."""
+    def _store_period(self, period_ms: int) -> None:
+        self.desired_controller_period_ms = period_ms
+        if period_ms and not self._period_warned:
+            self._period_warned = True
+            self.log.warn(f'{topics.ATLAS_COMMAND}: desired_controller_period_ms = {period_ms} '
+                          'is stored but not enforced yet: commands are applied as they '
+                          'come, with no synchronization window')
+
+    def reset_controls(self, request: ResetControlsRequest) -> tuple[bool, str]:
+        """atlas_msgs/ResetControls, as AtlasPlugin::ResetControls: (success, status).
+
+        Commands received before the request are applied first. Everything is checked
+        before anything is done: a refused request changes nothing.
+        """
         with self.lock:
+            self.apply_pending_commands()
+            atlas: AtlasUpdate | None = None
+            if request.reload_pid_from_ros:
+                if not isinstance(request.gains, Gains):
+                    return False, (f'reload_pid_from_ros: {request.gains}; nothing was done')
+            else:
+                try:
+                    atlas = decode_atlas_command(request.atlas_command)
+                except CommandError as err:
+                    return False, f'atlas_command refused: {err}; nothing was done'
+            done = []
+            if request.reset_bdi_controller:
+                done.append('reset_bdi_controller: there is no BDI controller in this '
+                            'simulator, nothing to reset')
+            if request.reset_pid_controller:
+                self.sim.reset_pid()
+                done.append('PID state reset (integral terms and previous errors)')
+            if atlas is None:
+                assert isinstance(request.gains, Gains)
+                self.sim.load_gains(request.gains)
+                done.append(f'gains reloaded from {topics.GAINS_PARAM}, k_effort 255 on every '
+                            'joint (atlas_command ignored)')
+            else:
+                done.extend(self._load_atlas_command(atlas))
+        return True, '; '.join(done)
+
+    def _load_atlas_command(self, atlas: AtlasUpdate) -> list[str]:
+        """ResetControls' atlas_command applied as an AtlasCommand; what was done."""
+        done = []
+        if atlas.update.rows:
+            self.sim.receive_updates([atlas.update])
+            done.append('atlas_command loaded: ' + ', '.join(atlas.fields_set()))
+        else:
+            done.append(f'atlas_command has no array of {NUM_JOINTS}: no field loaded')
+        if atlas.ignored:
+            done.append(atlas.ignored_text())
+        assert atlas.desired_controller_period_ms is not None
+        self._store_period(atlas.desired_controller_period_ms)
+        return done
+
+    def set_mode(self, mode: ControlMode) -> ControlMode:
+        """Switch the control mode; returns the previous one.
+
+        Commands received before the switch are applied first, as DRCSim's single callback
+        queue did: the switch then sets their k_effort (AtlasPlugin::OnRobotMode).
+        """
+        with self.lock:
+            self.apply_pending_commands()
             previous = self.sim.mode
             self.sim.set_mode(mode)
         return previous
