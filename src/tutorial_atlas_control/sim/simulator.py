@@ -27,6 +27,7 @@ from tutorial_atlas_control.sim.sim_config import SimConfig
 from tutorial_atlas_control.sim.vrc import (
     DEFAULT_STARTUP_MODE,
     CmdVelInput,
+    InputEvent,
     ModeInput,
     PoseInput,
     SimInput,
@@ -224,6 +225,11 @@ class AtlasSimulator:
         else:  # pragma: no cover - the union is closed
             raise TypeError(f'not a simulator input: {item!r}')
         self.input_log.append((self.sim_time_ns, item))
+
+    def last_input_event(self) -> InputEvent:
+        """The input apply_input logged last, as /atlas/sim_inputs carries it."""
+        time_ns, item = self.input_log[-1]
+        return InputEvent(time_ns, self.last_reset_ns, len(self.input_log) - 1, item)
 
     def joint_positions(self) -> np.ndarray:
         return atlas_model.joint_positions(self.atlas, self.data)

@@ -20,6 +20,7 @@ Mapping to MuJoCo:
 from __future__ import annotations
 
 import enum
+import json
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -35,6 +36,7 @@ from tutorial_atlas_control.units import NS_PER_S
 
 __all__ = [
     'DEFAULT_STARTUP_MODE', 'STARTUP_MODES', 'VALID_VRC_MODES', 'CmdVelInput', 'InputError',
+    'InputEvent',
     'ModeInput', 'PoseInput', 'SimInput', 'TrajectoryInput', 'VrcMode', 'VrcState',
     'WrenchInput', 'cmd_vel_input', 'input_from_dict', 'parse_vrc_mode', 'pose_input',
     'trajectory_input', 'wrench_input',
@@ -292,6 +294,32 @@ def input_from_dict(item: Mapping[str, Any]) -> SimInput:
     except (KeyError, TypeError, ValueError) as err:
         raise InputError(f'not a logged input ({type(err).__name__}: {err})') from None
     raise InputError(f'unknown input kind {kind!r}')
+
+
+@dataclass(frozen=True)
+class InputEvent:
+    """One applied input as /atlas/sim_inputs carries it: the sim time (ns) before the step
+    it first acted in, the reset it belongs to (last_reset, ns), its number since that
+    reset (from 0), and the input."""
+
+    time_ns: int
+    reset_ns: int
+    seq: int
+    item: SimInput
+
+    def to_json(self) -> str:
+        return json.dumps({'time_ns': self.time_ns, 'reset_ns': self.reset_ns, 'seq': self.seq,
+                           'input': self.item.to_dict()})
+
+    @classmethod
+    def from_json(cls, text: str) -> InputEvent:
+        """Raises: InputError: not an /atlas/sim_inputs text."""
+        try:
+            event = json.loads(text)
+            return cls(int(event['time_ns']), int(event['reset_ns']), int(event['seq']),
+                       input_from_dict(event['input']))
+        except (json.JSONDecodeError, KeyError, TypeError, ValueError) as err:
+            raise InputError(f'not an input event ({type(err).__name__}: {err})') from None
 
 
 # ---------------------------------------------------------------------------- the physics

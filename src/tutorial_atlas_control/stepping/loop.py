@@ -23,6 +23,7 @@ from tutorial_atlas_control.msgs.sim_messages import SimMessages
 from tutorial_atlas_control.msgs.wire import ControllerStatisticsWire, clock_bytes
 from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistics
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode, PhysicsDivergenceError
+from tutorial_atlas_control.sim.vrc import SimInput
 from tutorial_atlas_control.stepping.pacing import Pacer
 from tutorial_atlas_control.stepping.schedule import STAMPED_AT_STEP_END, steps_between
 from tutorial_atlas_control.units import NS_PER_S
@@ -74,6 +75,14 @@ class LoopLog(Protocol):
     def fatal(self, text: str) -> None: ...
 
 
+def _summary(item: SimInput) -> str:
+    """A short text of an input for the log (a trajectory's numbers are not repeated)."""
+    data = item.to_dict()
+    if 'positions' in data:
+        return f'{len(data["joints"])} joints, {len(data["positions"])} points'
+    return ', '.join(f'{key}={value}' for key, value in data.items() if key != 'kind')
+
+
 class DivergenceGuard:
     """Retry after a divergence (reset the robot), unless the model keeps diverging.
 
@@ -113,14 +122,17 @@ class SteppingLoop:
         paused: start with physics paused.
         pacer: the wall-time decisions (default: a Pacer at real_time_factor; tests give
             one with a fake clock).
+        publish_input: sends /atlas/sim_inputs' JSON of each applied cheat (None: nowhere).
     """
 
     def __init__(self, sim: AtlasSimulator, outbox: Outbox, outlets: Mapping[str, Hashable],
                  rates_hz: Mapping[str, float], statistics: CommandAgeStatistics,
                  log: LoopLog, publish_config: Callable[[str], None],
                  real_time_factor: float = 0.0, paused: bool = False,
-                 pacer: Pacer | None = None) -> None:
+                 pacer: Pacer | None = None,
+                 publish_input: Callable[[str], None] | None = None) -> None:
         self.sim = sim
+        self._send_input = publish_input
         self.lock = threading.Lock()
         self.outbox = outbox
         self.log = log
@@ -216,6 +228,17 @@ class SteppingLoop:
             previous = self.sim.mode
             self.sim.set_mode(mode)
         return previous
+
+    def apply_input(self, item: SimInput) -> None:
+        """Apply one checked VRCPlugin input between two steps, then log and publish it (the
+        replay re-applies it before the same step)."""
+        with self.lock:
+            self.sim.apply_input(item)
+            event = self.sim.last_input_event()
+        if self._send_input is not None:
+            self._send_input(event.to_json())
+        self.log.info(f'{item.kind} applied at t={event.time_ns / NS_PER_S:.3f} s: '
+                      f'{_summary(item)}')
 
     def publish_config(self) -> None:
         """(Re-)publish /atlas/sim_config: at start and after every reset."""
