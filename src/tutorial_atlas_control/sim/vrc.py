@@ -36,7 +36,7 @@ from tutorial_atlas_control.units import NS_PER_S
 
 __all__ = [
     'DEFAULT_STARTUP_MODE', 'STARTUP_MODES', 'VALID_VRC_MODES', 'CmdVelInput', 'InputError',
-    'InputEvent',
+    'InputEvent', 'describe_input',
     'ModeInput', 'PoseInput', 'SimInput', 'TrajectoryInput', 'VrcMode', 'VrcState',
     'WrenchInput', 'cmd_vel_input', 'input_from_dict', 'parse_vrc_mode', 'pose_input',
     'trajectory_input', 'wrench_input',
@@ -264,6 +264,24 @@ def trajectory_input(frame_id: str, stamp_ns: int, joint_names: Sequence[str],
                 f'time_from_start not increasing at point {number} '
                 f'({times[number] / NS_PER_S:g} s after {times[number - 1] / NS_PER_S:g} s)')
     return TrajectoryInput(tuple(joints), tuple(rows), tuple(times), int(stamp_ns))
+
+
+#: The topic each input kind comes from (for logs and the bag report's timeline).
+INPUT_TOPICS = {'mode': '/atlas/mode', 'set_pose': '/atlas/set_pose', 'cmd_vel': '/atlas/cmd_vel',
+                'pelvis_wrench': '/atlas/apply_pelvis_force',
+                'joint_trajectory': '/joint_trajectory'}
+
+
+def describe_input(item: SimInput) -> str:
+    """One short line: the input's topic and values (a trajectory's only counted)."""
+    data = item.to_dict()
+    if isinstance(item, TrajectoryInput):
+        values = f'{len(item.joints)} joints, {len(item.times_ns)} points'
+    elif isinstance(item, ModeInput):
+        values = item.mode.value
+    else:
+        values = ', '.join(f'{key}={value}' for key, value in data.items() if key != 'kind')
+    return f'{INPUT_TOPICS[item.kind]} {values}'
 
 
 def input_from_dict(item: Mapping[str, Any]) -> SimInput:

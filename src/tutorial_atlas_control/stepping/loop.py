@@ -23,7 +23,7 @@ from tutorial_atlas_control.msgs.sim_messages import SimMessages
 from tutorial_atlas_control.msgs.wire import ControllerStatisticsWire, clock_bytes
 from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistics
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode, PhysicsDivergenceError
-from tutorial_atlas_control.sim.vrc import SimInput
+from tutorial_atlas_control.sim.vrc import SimInput, describe_input
 from tutorial_atlas_control.stepping.pacing import Pacer
 from tutorial_atlas_control.stepping.schedule import STAMPED_AT_STEP_END, steps_between
 from tutorial_atlas_control.units import NS_PER_S
@@ -73,14 +73,6 @@ class LoopLog(Protocol):
     def error(self, text: str) -> None: ...
 
     def fatal(self, text: str) -> None: ...
-
-
-def _summary(item: SimInput) -> str:
-    """A short text of an input for the log (a trajectory's numbers are not repeated)."""
-    data = item.to_dict()
-    if 'positions' in data:
-        return f'{len(data["joints"])} joints, {len(data["positions"])} points'
-    return ', '.join(f'{key}={value}' for key, value in data.items() if key != 'kind')
 
 
 class DivergenceGuard:
@@ -237,8 +229,7 @@ class SteppingLoop:
             event = self.sim.last_input_event()
         if self._send_input is not None:
             self._send_input(event.to_json())
-        self.log.info(f'{item.kind} applied at t={event.time_ns / NS_PER_S:.3f} s: '
-                      f'{_summary(item)}')
+        self.log.info(f'applied at t={event.time_ns / NS_PER_S:.3f} s: {describe_input(item)}')
 
     def publish_config(self) -> None:
         """(Re-)publish /atlas/sim_config: at start and after every reset."""
