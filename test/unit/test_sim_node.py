@@ -142,10 +142,10 @@ def test_each_cheat_refuses_bad_input_in_one_line_and_applies_good_input(
     with fake_ros_node(sim, steps=5) as node:
         rospy = sim_node.rospy
         for topic, bad, good, reason in _bad_and_good_messages():
-            rospy.logwarn_throttle.reset_mock()
+            rospy.logwarn_throttle_identical.reset_mock()
             before = sim.data.qpos.copy()
             _subscribed(topic)(bad)
-            (_, text), _ = rospy.logwarn_throttle.call_args
+            (_, text), _ = rospy.logwarn_throttle_identical.call_args
             assert text.startswith(f'refused {topic}: ') and reason in text, text
             assert text.endswith('; nothing applied') and '\n' not in text
             assert not sim.input_log and not sim.vrc.active

@@ -235,7 +235,10 @@ class SimNode:
             try:
                 item = decode(msg)
             except InputError as err:
-                rospy.logwarn_throttle(WARN_THROTTLE_S, f'refused {topic}: {err}; nothing applied')
+                # Per message text: rospy's plain throttle is per call site, and would
+                # hide a refusal on one topic behind another's.
+                rospy.logwarn_throttle_identical(WARN_THROTTLE_S,
+                                                 f'refused {topic}: {err}; nothing applied')
                 return
             self.loop.apply_input(item)
         return handle
