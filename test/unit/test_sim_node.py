@@ -148,10 +148,10 @@ def test_each_cheat_refuses_bad_input_in_one_line_and_applies_good_input(
             (_, text), _ = rospy.logwarn_throttle_identical.call_args
             assert text.startswith(f'refused {topic}: ') and reason in text, text
             assert text.endswith('; nothing applied') and '\n' not in text
-            assert not sim.input_log and not sim.vrc.active
+            assert not sim.inputs_since_reset and not sim.vrc.active
             assert (sim.data.qpos == before).all()
             _subscribed(topic)(good)
-            assert len(sim.input_log) == 1
+            assert sim.inputs_since_reset == 1
             event = node.fake_publishers[topics.SIM_INPUTS].published[-1].data
             assert '"seq": 0' in event and '"time_ns": 0' in event
             node.loop.reset_world()
@@ -175,7 +175,7 @@ def test_configuration_is_logged_as_not_implemented_and_reset_models_is_reset_wo
         assert set(services) >= {topics.RESET_WORLD_SERVICE, topics.RESET_MODELS_SERVICE}
         node.loop.apply_input(ModeInput(VrcMode.NO_GRAVITY))
         services[topics.RESET_MODELS_SERVICE](None)
-        assert not sim.vrc.active and not sim.input_log and sim.pinned
+        assert not sim.vrc.active and not sim.inputs_since_reset and sim.pinned
 
 
 def test_startup_mode_parameter_is_checked(monkeypatch: pytest.MonkeyPatch) -> None:

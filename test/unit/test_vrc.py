@@ -245,7 +245,7 @@ def test_reset_world_clears_every_cheat(atlas) -> None:
     sim.apply_input(vrc.wrench_input((10, 0, 0), (0, 0, 0)))
     sim.apply_input(vrc.cmd_vel_input((1, 0, 0), (0, 0, 0)))
     sim.reset_world()
-    assert not sim.vrc.active and not sim.input_log
+    assert not sim.vrc.active and not sim.inputs_since_reset
     fresh = make(atlas)
     run(sim, 1.5)
     run(fresh, 1.5)

@@ -125,9 +125,11 @@ class AtlasSimulator:
         self.startup_mode = startup_mode
         # VRCPlugin's cheats (modes, teleport, cmd_vel, pelvis wrench, kinematic playback).
         self.vrc = VrcState(atlas, self.data)
-        #: The inputs applied since the last reset: (sim time (ns) before the step they
-        #: first acted in, input); /atlas/sim_inputs publishes them for replay.
-        self.input_log: list[tuple[int, SimInput]] = []
+        #: How many inputs were applied since the last reset, and the last one (sim time (ns)
+        #: before the step it first acted in, input): /atlas/sim_inputs publishes each for
+        #: replay. Only a count is kept: a 1 kHz wrench stream must not grow a list.
+        self.inputs_since_reset = 0
+        self._last_input: tuple[int, SimInput] | None = None
         self._release_pending = False
         self.reset_world()
 
@@ -157,7 +159,8 @@ class AtlasSimulator:
         # A reset robot waits for fresh commands rather than jumping to a stale target.
         self.user_command = None
         self.vrc.reset()
-        self.input_log = []
+        self.inputs_since_reset = 0
+        self._last_input = None
         self._pin_until_ns = self.sim_time_ns + int(round(self.time_to_unpin_s * NS_PER_S))
         startup = self.startup_mode
         if startup is VrcMode.PINNED:
@@ -224,12 +227,14 @@ class AtlasSimulator:
             vrc.start_playback(item, self.sim_time_ns)
         else:  # pragma: no cover - the union is closed
             raise TypeError(f'not a simulator input: {item!r}')
-        self.input_log.append((self.sim_time_ns, item))
+        self.inputs_since_reset += 1
+        self._last_input = (self.sim_time_ns, item)
 
     def last_input_event(self) -> InputEvent:
         """The input apply_input logged last, as /atlas/sim_inputs carries it."""
-        time_ns, item = self.input_log[-1]
-        return InputEvent(time_ns, self.last_reset_ns, len(self.input_log) - 1, item)
+        assert self._last_input is not None, 'no input applied since the last reset'
+        time_ns, item = self._last_input
+        return InputEvent(time_ns, self.last_reset_ns, self.inputs_since_reset - 1, item)
 
     def joint_positions(self) -> np.ndarray:
         return atlas_model.joint_positions(self.atlas, self.data)
