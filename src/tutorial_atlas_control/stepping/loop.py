@@ -36,6 +36,9 @@ DIVERGENCE_REPEAT_S = 1.0
 MAX_DIVERGENCES_IN_A_ROW = 3
 #: Commands waiting for the next step, at most (a second of 10 kHz of them).
 MAX_PENDING_COMMANDS = 10_000
+#: An applied input of a kind is logged at most once per this much sim time (s): a
+#: disturbance generator streaming a wrench at 1 kHz must not flood /rosout.
+INPUT_LOG_PERIOD_S = 1.0
 #: While paused, the loop looks for commands and shutdown this often (s, wall).
 PAUSED_POLL_S = 0.01
 #: The per-step messages: topic, key of its rate in `rates_hz`, name in
@@ -125,6 +128,7 @@ class SteppingLoop:
                  publish_input: Callable[[str], None] | None = None) -> None:
         self.sim = sim
         self._send_input = publish_input
+        self._input_logged_ns: dict[str, int] = {}  # kind -> sim time it was last logged
         self.lock = threading.Lock()
         self.outbox = outbox
         self.log = log
@@ -229,7 +233,11 @@ class SteppingLoop:
             event = self.sim.last_input_event()
         if self._send_input is not None:
             self._send_input(event.to_json())
-        self.log.info(f'applied at t={event.time_ns / NS_PER_S:.3f} s: {describe_input(item)}')
+        last_ns = self._input_logged_ns.get(item.kind)
+        if last_ns is None or not 0 <= event.time_ns - last_ns < INPUT_LOG_PERIOD_S * NS_PER_S:
+            self._input_logged_ns[item.kind] = event.time_ns
+            self.log.info(f'applied at t={event.time_ns / NS_PER_S:.3f} s: '
+                          f'{describe_input(item)}')
 
     def publish_config(self) -> None:
         """(Re-)publish /atlas/sim_config: at start and after every reset."""
