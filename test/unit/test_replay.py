@@ -408,6 +408,9 @@ INPUT_SCRIPTS: dict[str, dict[int, list[vrc.SimInput]]] = {
         'world', 0, ('l_arm_shx', 'r_leg_kny', 'back_mby'),
         ((-0.4, 0.2, 0.1), (-0.8, 0.5, 0.2), (-0.2, 0.3, 0.0)), (0, 20_000_000, 50_000_000),
         ATLAS.lower_rad, ATLAS.upper_rad)]},
+    'joint_trajectory_in_a_foot_frame': {100: [vrc.trajectory_input(
+        'l_foot', 0, ('l_leg_lhy', 'l_leg_kny', 'l_leg_uay'), ((-0.3, 0.6, -0.3),), (0,),
+        ATLAS.lower_rad, ATLAS.upper_rad, ('l_foot',))]},
 }
 
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import mujoco
 import numpy as np
 import pytest
 
@@ -208,6 +209,24 @@ def test_joint_trajectory_sets_positions_exactly_with_physics_off(atlas) -> None
     assert abs(sim.joint_positions()[index[0]] - 0.25) < 5e-3
 
 
+def test_a_trajectory_in_a_link_frame_keeps_that_link_in_place(atlas) -> None:
+    sim = standing(atlas)
+    foot = sim.atlas.model.body('l_foot').id
+    mujoco.mj_forward(sim.model, sim.data)
+    before = sim.data.xpos[foot].copy(), sim.data.xquat[foot].copy()
+    pelvis_before = pelvis(sim)[0]
+    item = vrc.trajectory_input('atlas::l_foot', 0, ('l_leg_lhy', 'l_leg_kny', 'l_leg_uay'),
+                                ((-0.6, 1.2, -0.6),), (0,), sim.atlas.lower_rad,
+                                sim.atlas.upper_rad, sim.vrc.link_names)
+    assert item.reference_link == 'l_foot'
+    sim.apply_input(item)
+    sim.step()
+    assert not sim.playing
+    np.testing.assert_allclose(sim.data.xpos[foot], before[0], atol=1e-9)
+    np.testing.assert_allclose(sim.data.xquat[foot], before[1], atol=1e-9)
+    assert pelvis(sim)[0][2] < pelvis_before[2] - 0.05  # the pelvis crouched over the foot
+
+
 @pytest.mark.parametrize(('args', 'message'), [
     (('', 0, ('l_arm_shx', 'hand'), ((0, 0),), (0,)), "unknown joint name 'hand'"),
     (('', 0, ('l_arm_shx', 'atlas::l_arm_shx'), ((0, 0),), (0,)), 'named twice'),
@@ -220,11 +239,12 @@ def test_joint_trajectory_sets_positions_exactly_with_physics_off(atlas) -> None
     (('', 0, ('l_arm_shx',), ((5.0,),), (0,)), 'l_arm_shx = 5 rad is outside its limits'),
     (('', 0, ('l_arm_shx',), (), ()), 'no points'),
     (('', 0, (), ((),), (0,)), 'joint_names is empty'),
-    (('l_foot', 0, ('l_arm_shx',), ((0,),), (0,)), "frame_id 'l_foot'"),
+    (('l_hoof', 0, ('l_arm_shx',), ((0,),), (0,)),
+     "header.frame_id 'l_hoof' is neither world, map nor a link of the robot"),
 ])
 def test_bad_trajectories_are_refused_with_one_line(atlas, args, message) -> None:
     with pytest.raises(InputError, match=message) as info:
-        vrc.trajectory_input(*args, atlas.lower_rad, atlas.upper_rad)
+        vrc.trajectory_input(*args, atlas.lower_rad, atlas.upper_rad, ('pelvis', 'l_foot'))
     assert '\n' not in str(info.value)
 
 

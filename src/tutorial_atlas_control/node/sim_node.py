@@ -207,6 +207,7 @@ class SimNode:
     def _subscribe_cheats(self) -> None:
         """VRCPlugin's, gazebo_ros_force's and gazebo_ros_joint_trajectory's topics."""
         lower, upper = self.sim.atlas.lower_rad, self.sim.atlas.upper_rad
+        links = frozenset(self.sim.vrc.link_names)
         cheats: tuple[tuple[str, type, Callable[[Any], SimInput]], ...] = (
             (topics.MODE, String, lambda msg: ModeInput(parse_vrc_mode(msg.data))),
             (topics.SET_POSE, Pose, lambda msg: pose_input(
@@ -221,7 +222,8 @@ class SimNode:
             (topics.JOINT_TRAJECTORY, JointTrajectory, lambda msg: trajectory_input(
                 msg.header.frame_id, msg.header.stamp.to_nsec(), msg.joint_names,
                 [point.positions for point in msg.points],
-                [point.time_from_start.to_nsec() for point in msg.points], lower, upper)),
+                [point.time_from_start.to_nsec() for point in msg.points], lower, upper,
+                links)),
         )
         for topic, msg_class, decode in cheats:
             rospy.Subscriber(topic, msg_class, self._cheat_handler(topic, decode),

@@ -22,7 +22,7 @@ from __future__ import annotations
 import enum
 import json
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Union
 
@@ -30,7 +30,7 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.joints import JOINT_NAMES, joint_index
+from tutorial_atlas_control.joints import JOINT_NAMES, bare_joint_name, joint_index
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.units import NS_PER_S
 
@@ -77,7 +77,9 @@ MAX_TURN_RAD_S = 1e2
 MAX_TRAJECTORY_POINTS = 100_000
 #: A quaternion shorter than this cannot be normalized into an orientation.
 MIN_QUATERNION_NORM = 1e-9
-_WORLD_FRAMES = ('', 'world', 'map', '/map', atlas_model.PELVIS_BODY)
+#: `header.frame_id`s that keep the robot's own pose (gazebo_ros_joint_trajectory's
+#: world/map; the pelvis is the model's root). Any other names a link kept in place.
+_WORLD_FRAMES = ('', 'world', 'map', '/map')
 
 
 class InputError(AtlasControlError):
@@ -175,12 +177,14 @@ class TrajectoryInput:
     positions_rad: tuple[tuple[float, ...], ...]
     times_ns: tuple[int, ...]
     start_ns: int
+    reference_link: str = ''  # a link kept where it is while the joints move; '' = the pelvis
     kind = 'joint_trajectory'
 
     def to_dict(self) -> dict[str, Any]:
         return {'kind': self.kind, 'joints': [JOINT_NAMES[i] for i in self.joints],
                 'positions': [list(row) for row in self.positions_rad],
-                'times_ns': list(self.times_ns), 'start_ns': self.start_ns}
+                'times_ns': list(self.times_ns), 'start_ns': self.start_ns,
+                'reference_link': self.reference_link}
 
 
 SimInput = Union[ModeInput, PoseInput, CmdVelInput, WrenchInput, TrajectoryInput]
@@ -216,17 +220,24 @@ def wrench_input(force: Sequence[float], torque: Sequence[float]) -> WrenchInput
 
 def trajectory_input(frame_id: str, stamp_ns: int, joint_names: Sequence[str],
                      positions: Sequence[Sequence[float]], times_ns: Sequence[int],
-                     lower_rad: np.ndarray, upper_rad: np.ndarray) -> TrajectoryInput:
+                     lower_rad: np.ndarray, upper_rad: np.ndarray,
+                     links: Collection[str] = (atlas_model.PELVIS_BODY,)) -> TrajectoryInput:
     """Check a trajectory_msgs/JointTrajectory (positions and time_from_start per point).
+
+    `header.frame_id` is world/map (or empty: the robot keeps its pose) or one of `links`
+    (bare or `atlas::`), kept in place as gazebo_ros_joint_trajectory's reference link.
 
     Raises:
         InputError: an unknown or repeated joint name, no points, a point whose positions
             do not match the names, a non-finite or out-of-limits position, times that are
-            negative or not strictly increasing, or a frame other than world/pelvis.
+            negative or not strictly increasing, or a frame that is no link of the robot.
     """
-    if frame_id not in _WORLD_FRAMES:
-        raise InputError(f'header.frame_id {frame_id!r}: only world, map or pelvis '
-                         '(the robot keeps its pelvis pose) are supported')
+    reference = bare_joint_name(frame_id)
+    if frame_id in _WORLD_FRAMES or reference == atlas_model.PELVIS_BODY:
+        reference = ''
+    elif reference not in links:
+        raise InputError(f'header.frame_id {frame_id[:40]!r} is neither world, map nor a link '
+                         'of the robot')
     if not joint_names:
         raise InputError('joint_names is empty')
     joints: list[int] = []
@@ -263,7 +274,7 @@ def trajectory_input(frame_id: str, stamp_ns: int, joint_names: Sequence[str],
             raise InputError(
                 f'time_from_start not increasing at point {number} '
                 f'({times[number] / NS_PER_S:g} s after {times[number - 1] / NS_PER_S:g} s)')
-    return TrajectoryInput(tuple(joints), tuple(rows), tuple(times), int(stamp_ns))
+    return TrajectoryInput(tuple(joints), tuple(rows), tuple(times), int(stamp_ns), reference)
 
 
 #: The topic each input kind comes from (for logs and the bag report's timeline).
@@ -308,7 +319,7 @@ def input_from_dict(item: Mapping[str, Any]) -> SimInput:
             return TrajectoryInput(joints, tuple(tuple(float(v) for v in row)
                                                  for row in item['positions']),
                                    tuple(int(t) for t in item['times_ns']),
-                                   int(item['start_ns']))
+                                   int(item['start_ns']), str(item.get('reference_link', '')))
     except (KeyError, TypeError, ValueError) as err:
         raise InputError(f'not a logged input ({type(err).__name__}: {err})') from None
     raise InputError(f'unknown input kind {kind!r}')
@@ -346,11 +357,13 @@ class InputEvent:
 class _Playback:
     """A trajectory being played: the sim time (ns) each point is due, and the next one."""
 
-    def __init__(self, trajectory: TrajectoryInput, now_ns: int, qpos_adr: np.ndarray) -> None:
+    def __init__(self, trajectory: TrajectoryInput, now_ns: int, qpos_adr: np.ndarray,
+                 reference_body: int) -> None:
         start_ns = max(trajectory.start_ns, now_ns)
         self.due_ns = [start_ns + t for t in trajectory.times_ns]
         self.qpos_adr = qpos_adr[list(trajectory.joints)]
         self.rows = [np.array(row) for row in trajectory.positions_rad]
+        self.reference_body = reference_body  # -1: the pelvis stays
         self.next = 0
 
 
@@ -493,8 +506,19 @@ class VrcState:
     def start_playback(self, item: TrajectoryInput, now_ns: int) -> None:
         """Physics off from now until the last point is set (a new trajectory replaces one
         playing)."""
-        self.playback = _Playback(item, now_ns, self.atlas.qpos_adr)
+        reference = -1
+        if item.reference_link:
+            reference = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY,
+                                          item.reference_link)
+            if reference < 0:  # checked against the model's links before
+                raise InputError(f'no link {item.reference_link!r} in the model')
+        self.playback = _Playback(item, now_ns, self.atlas.qpos_adr, reference)
         self._update()
+
+    @property
+    def link_names(self) -> tuple[str, ...]:
+        """The model's bodies (links), what a trajectory's frame_id may name."""
+        return tuple(self.model.body(i).name for i in range(1, self.model.nbody))
 
     # -- stepping ------------------------------------------------------------------------
     def warp_step(self, dt_s: float) -> None:
@@ -511,13 +535,34 @@ class VrcState:
         self._set_pelvis_pose(pos, quat)
         self.pin_at(pos, quat)
 
+    def _set_keeping(self, body: int, qpos_adr: np.ndarray, values: np.ndarray) -> None:
+        """Set joint positions and move the pelvis so that `body` keeps its world pose."""
+        model, data = self.model, self.data
+        mujoco.mj_kinematics(model, data)
+        old_pos, old_quat = data.xpos[body].copy(), data.xquat[body].copy()
+        data.qpos[qpos_adr] = values
+        mujoco.mj_kinematics(model, data)
+        inv_pos, inv_quat = np.zeros(3), np.zeros(4)
+        mujoco.mju_negPose(inv_pos, inv_quat, data.xpos[body], data.xquat[body])
+        shift_pos, shift_quat = np.zeros(3), np.zeros(4)
+        mujoco.mju_mulPose(shift_pos, shift_quat, old_pos, old_quat, inv_pos, inv_quat)
+        pelvis_pos, pelvis_quat = self.pelvis_pose()
+        new_pos, new_quat = np.zeros(3), np.zeros(4)
+        mujoco.mju_mulPose(new_pos, new_quat, shift_pos, shift_quat, pelvis_pos, pelvis_quat)
+        mujoco.mju_normalize4(new_quat)
+        self._set_pelvis_pose(new_pos, new_quat)
+
     def playback_step(self, now_ns: int) -> None:
         """One step with physics off: set the points due by `now_ns`, the robot at rest."""
         playback = self.playback
         assert playback is not None
         qpos = self.data.qpos
         while playback.next < len(playback.rows) and playback.due_ns[playback.next] <= now_ns:
-            qpos[playback.qpos_adr] = playback.rows[playback.next]
+            if playback.reference_body >= 0:
+                self._set_keeping(playback.reference_body, playback.qpos_adr,
+                                  playback.rows[playback.next])
+            else:
+                qpos[playback.qpos_adr] = playback.rows[playback.next]
             playback.next += 1
         self.data.qvel[:] = 0.0
         mujoco.mj_forward(self.model, self.data)
