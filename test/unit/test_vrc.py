@@ -248,6 +248,17 @@ def test_bad_trajectories_are_refused_with_one_line(atlas, args, message) -> Non
     assert '\n' not in str(info.value)
 
 
+def test_ignored_trajectory_fields_are_still_checked(atlas) -> None:
+    def check(**fields: list[float]) -> None:
+        vrc.trajectory_input('', 0, ('l_arm_shx', 'r_arm_shx'), ((0, 0),), (0,),
+                             atlas.lower_rad, atlas.upper_rad, unused=[fields])
+    check(velocities=[], accelerations=[1.0, 2.0], effort=[])
+    with pytest.raises(InputError, match='^point 0 has 1 velocities for 2 joint names$'):
+        check(velocities=[1.0])
+    with pytest.raises(InputError, match=r'^point 0 effort is not finite \(nan\)$'):
+        check(effort=[0.0, math.nan])
+
+
 def test_bad_poses_twists_and_wrenches_are_refused() -> None:
     with pytest.raises(InputError, match='zero quaternion'):
         vrc.pose_input((0, 0, 1), (0, 0, 0, 0))

@@ -223,7 +223,8 @@ class SimNode:
                 msg.header.frame_id, msg.header.stamp.to_nsec(), msg.joint_names,
                 [point.positions for point in msg.points],
                 [point.time_from_start.to_nsec() for point in msg.points], lower, upper,
-                links)),
+                links, [{'velocities': point.velocities, 'accelerations': point.accelerations,
+                         'effort': point.effort} for point in msg.points])),
         )
         for topic, msg_class, decode in cheats:
             rospy.Subscriber(topic, msg_class, self._cheat_handler(topic, decode),

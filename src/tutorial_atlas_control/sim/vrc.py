@@ -221,11 +221,14 @@ def wrench_input(force: Sequence[float], torque: Sequence[float]) -> WrenchInput
 def trajectory_input(frame_id: str, stamp_ns: int, joint_names: Sequence[str],
                      positions: Sequence[Sequence[float]], times_ns: Sequence[int],
                      lower_rad: np.ndarray, upper_rad: np.ndarray,
-                     links: Collection[str] = (atlas_model.PELVIS_BODY,)) -> TrajectoryInput:
+                     links: Collection[str] = (atlas_model.PELVIS_BODY,),
+                     unused: Sequence[Mapping[str, Sequence[float]]] = ()) -> TrajectoryInput:
     """Check a trajectory_msgs/JointTrajectory (positions and time_from_start per point).
 
     `header.frame_id` is world/map (or empty: the robot keeps its pose) or one of `links`
     (bare or `atlas::`), kept in place as gazebo_ros_joint_trajectory's reference link.
+    `unused`: per point, the fields playback ignores (velocities, accelerations, effort), as
+    gazebo_ros_joint_trajectory did; still checked, so that a broken message is refused whole.
 
     Raises:
         InputError: an unknown or repeated joint name, no points, a point whose positions
@@ -264,6 +267,12 @@ def trajectory_input(frame_id: str, stamp_ns: int, joint_names: Sequence[str],
                     f'point {number}: {JOINT_NAMES[index]} = {value:g} rad is outside its '
                     f'limits [{lower_rad[index]:g}, {upper_rad[index]:g}]')
         rows.append(values)
+    for number, fields in enumerate(unused):
+        for name, values in fields.items():
+            if len(values) not in (0, len(joints)):
+                raise InputError(f'point {number} has {len(values)} {name} for '
+                                 f'{len(joints)} joint names')
+            _finite(values, f'point {number} {name}', 1e6)
     times = [int(t) for t in times_ns]
     if len(times) != len(rows):
         raise InputError(f'{len(times)} times for {len(rows)} points')
