@@ -6,7 +6,11 @@ subscriptions, services, parameters and the viewer window. Publishes /clock,
 time, /atlas/controller_statistics (command age, while subscribed), and a latched
 /atlas/sim_config (JSON: timestep, time_to_unpin, model file and checksum, time of the last
 reset) for offline replay; obeys /atlas/joint_commands and /atlas/control_mode; offers
-gazebo_ros's reset and pause services.
+gazebo_ros's reset and pause services (and DRCSim's /gazebo/reset_models). VRCPlugin's
+/atlas/mode, set_pose, cmd_vel, gazebo_ros_force's /atlas/apply_pelvis_force and
+gazebo_ros_joint_trajectory's /joint_trajectory are checked here and applied by the loop
+(sim/vrc.py), each applied one echoed on /atlas/sim_inputs; /atlas/configuration is
+logged as not implemented, as in DRCSim.
 
 Parameters (private unless noted):
     ~real_time_factor (float, 1.0): sim time per wall time; 0 runs as fast as possible.
