@@ -97,7 +97,8 @@ def test_cheats_live_refusals_effects_reset_models_and_exact_replay(tmp_path: Pa
         launch.wait(lambda: '/atlas/configuration is not implemented' in launch.output(),
                     30.0, 'no not-implemented line for /atlas/configuration')
         after = pelvis_position(launch)
-        assert max(abs(a - b) for a, b in zip(before, after)) < 0.01, 'standing, unmoved'
+        # Standing, the robot sways by about a centimetre; a teleport or push moves it metres.
+        assert after[2] > 0.9 and max(abs(a - b) for a, b in zip(before, after)) < 0.05
         assert 'applied at t=' not in launch.output(), 'a refused input was applied'
 
         for topic, msg_type, yaml_text in GOOD_INPUTS[:2]:
