@@ -22,6 +22,7 @@ APT_PACKAGES=(
   librostest-dev librosbag-storage-dev libtopic-tools-dev python3-venv python3-yaml python3-numpy
   libosmesa6 libegl1 libopengl0 libgl1-mesa-dri
   ros-robot-state-publisher ros-tf2-msgs python3-tf2-msgs python3-tf2-ros rviz
+  ros-trajectory-msgs python3-trajectory-msgs
   xvfb xdotool x11-apps imagemagick
 )
 

@@ -24,6 +24,16 @@ CONTROLLER_STATISTICS = '/atlas/controller_statistics'
 #: Latched JSON (timestep, time_to_unpin, model file and sha1, last reset): what replay needs.
 SIM_CONFIG = '/atlas/sim_config'
 ROSOUT = '/rosout'
+#: VRCPlugin's inputs (DRCSim's "cheats"): std_msgs/String, geometry_msgs/Pose, Twist,
+#: Wrench (gazebo_ros_force), trajectory_msgs/JointTrajectory, sensor_msgs/JointState.
+MODE = '/atlas/mode'
+SET_POSE = '/atlas/set_pose'
+CMD_VEL = '/atlas/cmd_vel'
+APPLY_PELVIS_FORCE = '/atlas/apply_pelvis_force'
+JOINT_TRAJECTORY = '/joint_trajectory'
+CONFIGURATION = '/atlas/configuration'
+#: JSON, one per applied cheat: when it took effect (sim time, ns) and what, for replay.
+SIM_INPUTS = '/atlas/sim_inputs'
 #: world -> pelvis from the simulator; robot_state_publisher adds the links.
 TF = '/tf'
 #: atlas_msgs/AtlasCommand (2.7.0): commands with k_effort, beside JointCommands.
@@ -41,6 +51,7 @@ RECORDED_TOPICS: tuple[str, ...] = (
     CLOCK, JOINT_STATES, GROUND_TRUTH_ODOM, IMU, L_FOOT_CONTACT, R_FOOT_CONTACT,
     JOINT_COMMANDS, CONTROL_MODE, SIM_CONFIG, ROSOUT, CONTROLLER_STATISTICS, TF,
     ATLAS_COMMAND, ATLAS_TEST,
+    MODE, SET_POSE, CMD_VEL, APPLY_PELVIS_FORCE, JOINT_TRAJECTORY, SIM_INPUTS,
 )
 
 #: The ROS 1 message type of each recorded topic, and of the simulator's other topics.
@@ -64,6 +75,12 @@ MSG_TYPES: dict[str, str] = {
     DEBUG_R_FOOT_CONTACT: 'geometry_msgs/WrenchStamped',
     ATLAS_COMMAND: 'atlas_msgs/AtlasCommand',
     ATLAS_TEST: 'atlas_msgs/Test',
+    MODE: 'std_msgs/String',
+    SET_POSE: 'geometry_msgs/Pose',
+    CMD_VEL: 'geometry_msgs/Twist',
+    APPLY_PELVIS_FORCE: 'geometry_msgs/Wrench',
+    JOINT_TRAJECTORY: 'trajectory_msgs/JointTrajectory',
+    SIM_INPUTS: 'std_msgs/String',
 }
 
 #: Gazebo's services, as gazebo_ros offered them.
@@ -71,10 +88,14 @@ RESET_WORLD_SERVICE = '/gazebo/reset_world'
 RESET_SIMULATION_SERVICE = '/gazebo/reset_simulation'
 PAUSE_PHYSICS_SERVICE = '/gazebo/pause_physics'
 UNPAUSE_PHYSICS_SERVICE = '/gazebo/unpause_physics'
+#: DRCSim 2.x's fork of gazebo_ros_api_plugin named reset_world so ("Reset Model Poses").
+RESET_MODELS_SERVICE = '/gazebo/reset_models'
 
 #: Parameters DRCSim loaded and the tutorial reads.
 GAINS_PARAM = 'atlas_controller/gains'
 TIME_TO_UNPIN_PARAM = '/atlas/time_to_unpin'
+#: VRCPlugin's `atlas/startup_mode` (read from the root namespace, as its NodeHandle("")).
+STARTUP_MODE_PARAM = '/atlas/startup_mode'
 
 WORLD_FRAME = 'world'
 PELVIS_FRAME = 'pelvis'

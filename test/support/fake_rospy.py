@@ -146,7 +146,9 @@ def fake_ros_node(sim: AtlasSimulator, steps: int, tcp: bool = False,
                                  has_param=lambda name: name in known, is_shutdown=is_shutdown,
                                  signal_shutdown=mock.DEFAULT, loginfo=mock.DEFAULT,
                                  logwarn=mock.DEFAULT, logwarn_throttle=mock.DEFAULT,
-                                 logerr=mock.DEFAULT, logfatal=mock.DEFAULT):
+                                 logwarn_throttle_identical=mock.DEFAULT,
+                                 logerr=mock.DEFAULT, logerr_throttle=mock.DEFAULT,
+                                 logfatal=mock.DEFAULT):
             node = sim_node.SimNode(sim, real_time_factor=0.0, paused=False,
                                     rates_hz=dict(rates_hz), gui=False)
             node.fake_publishers = publishers

@@ -49,6 +49,32 @@ def test_mode_timeline_collapses_repeats_and_uses_bag_time(tmp_path: Path) -> No
     assert analysis.to_dict()['mode_timeline'][1] == {'time': 1.0, 'mode': 'User'}
 
 
+def test_applied_vrc_inputs_join_the_mode_timeline(tmp_path: Path) -> None:
+    from tutorial_atlas_control.bags.report import format_summary
+    from tutorial_atlas_control.bags.synthetic import TYPESTORE, Record
+    from tutorial_atlas_control.sim import vrc
+
+    def applied(t_s: float, item: vrc.SimInput, seq: int) -> Record:
+        event = vrc.InputEvent(round(t_s * 1e9), 0, seq, item)
+        msg = TYPESTORE.types['std_msgs/msg/String'](data=event.to_json())
+        return Record('/atlas/sim_inputs', 'std_msgs/String', t_s, msg)
+    trajectory = vrc.TrajectoryInput((0, 3), ((0.1, 0.2), (0.3, 0.4)), (0, 10**8), 0)
+    records = [clock(0.5), control_mode(0.5, 'Stand'), control_mode(1.5, 'User'),
+               applied(1.25, vrc.ModeInput(vrc.VrcMode.HARNESSED), 0),
+               applied(2.0, vrc.WrenchInput((300.0, 0.0, 0.0), (0.0, 0.0, 0.0)), 1),
+               applied(2.5, trajectory, 2)]
+    analysis = analyze_bag(write_bag(tmp_path / 'run.bag', records))
+    assert analysis.input_timeline == [
+        (0.75, '/atlas/mode mode=harnessed'),
+        (1.5, '/atlas/apply_pelvis_force force=[300.0, 0.0, 0.0], torque=[0.0, 0.0, 0.0]'),
+        (2.0, '/joint_trajectory 2 joints, 2 points')]
+    text = format_summary(analysis)
+    assert ('  0.000 s  Stand\n      0.750 s  /atlas/mode mode=harnessed\n'
+            '      1.000 s  User\n      1.500 s  /atlas/apply_pelvis_force') in text
+    assert analysis.to_dict()['inputs'][0] == {'time': 0.75,
+                                               'input': '/atlas/mode mode=harnessed'}
+
+
 def test_fall_time_is_first_pelvis_height_below_threshold(tmp_path: Path) -> None:
     # Bag starts at 0.25 s sim time; the pelvis first dips below 0.5 m at 3.137 s.
     fall_s = 3.137

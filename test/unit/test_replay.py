@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import shutil
@@ -23,9 +24,11 @@ from tutorial_atlas_control.offline.replay import (
     ReplayError,
     format_report,
     load_recording,
+    replay,
     replay_bag,
 )
 from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.sim import vrc
 from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, hold_command, load_gains_yaml
 from tutorial_atlas_control.sim.sim_config import SimConfig
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode
@@ -395,3 +398,104 @@ def test_debug_test_messages_are_reported(tmp_path: Path) -> None:
     assert ('the run has 1 /atlas/debug/test message(s): joint damping they set is not '
             're-applied offline, so the replay deviates from the first that set it.'
             in result.warnings)
+
+
+# -- VRCPlugin's inputs: re-applied from /atlas/sim_inputs at the same steps ----------------
+
+def _apply(run: Run, item: vrc.SimInput, logged: bool = True) -> None:
+    """What SteppingLoop.apply_input does: apply between steps, publish the event."""
+    run.sim.apply_input(item)
+    if logged:
+        msg = _t('std_msgs/msg/String')(data=run.sim.last_input_event().to_json())
+        run.records.append(Record('/atlas/sim_inputs', 'std_msgs/String',
+                                  max(run._t_s(), 0.001), msg))
+
+
+def _pose(position: tuple[float, float, float], yaw: float) -> vrc.PoseInput:
+    return vrc.pose_input(position, (0.0, 0.0, np.sin(yaw / 2), np.cos(yaw / 2)))
+
+
+ATLAS = atlas_model.load_model()
+#: Per input kind, what is applied before which step (time_to_unpin is 50 ms).
+INPUT_SCRIPTS: dict[str, dict[int, list[vrc.SimInput]]] = {
+    'pelvis_force': {100: [vrc.wrench_input((300, 0, 0), (0, 0, 20))],
+                     250: [vrc.wrench_input((0, 0, 0), (0, 0, 0))]},
+    'set_pose': {100: [_pose((0.5, 0.2, 1.0), 0.3)]},
+    'modes': {
+        60: [vrc.ModeInput(vrc.VrcMode.NO_GRAVITY)], 110: [vrc.ModeInput(vrc.VrcMode.FEET)],
+        160: [vrc.ModeInput(vrc.VrcMode.HARNESSED)],
+        210: [vrc.ModeInput(vrc.VrcMode.PINNED_WITH_GRAVITY)],
+        260: [vrc.ModeInput(vrc.VrcMode.PINNED)], 310: [vrc.ModeInput(vrc.VrcMode.NOMINAL)],
+        360: [vrc.ModeInput(vrc.VrcMode.BDI_STAND)]},
+    'cmd_vel': {80: [vrc.ModeInput(vrc.VrcMode.PINNED)],
+                100: [vrc.cmd_vel_input((0.3, 0.1, 0.0), (0.0, 0.0, 0.5))],
+                300: [vrc.cmd_vel_input((0, 0, 0), (0, 0, 0)), vrc.ModeInput(vrc.VrcMode.NOMINAL)]},
+    'joint_trajectory': {100: [vrc.trajectory_input(
+        'world', 0, ('l_arm_shx', 'r_leg_kny', 'back_mby'),
+        ((-0.4, 0.2, 0.1), (-0.8, 0.5, 0.2), (-0.2, 0.3, 0.0)), (0, 20_000_000, 50_000_000),
+        ATLAS.lower_rad, ATLAS.upper_rad)]},
+    'joint_trajectory_in_a_foot_frame': {100: [vrc.trajectory_input(
+        'l_foot', 0, ('l_leg_lhy', 'l_leg_kny', 'l_leg_uay'), ((-0.3, 0.6, -0.3),), (0,),
+        ATLAS.lower_rad, ATLAS.upper_rad, ('l_foot',))]},
+}
+
+
+def _scripted_run(script: dict[int, list[vrc.SimInput]], logged: bool = True) -> Run:
+    run = Run()
+
+    def before(sim: AtlasSimulator, step: int) -> None:
+        crouch(sim, step)
+        for item in script.get(step, []):
+            _apply(run, item, logged)
+    run.step(450, before)
+    return run
+
+
+@pytest.mark.parametrize('kind', sorted(INPUT_SCRIPTS))
+def test_runs_with_vrc_inputs_replay_bit_exactly(kind: str, tmp_path: Path) -> None:
+    bag = _scripted_run(INPUT_SCRIPTS[kind]).write(tmp_path / f'{kind}.bag')
+    recording = load_recording(bag)
+    assert len(recording.inputs) == sum(len(items) for items in INPUT_SCRIPTS[kind].values())
+    result = replay(recording)
+    assert result.joint_position.max_abs == 0.0 and result.joint_velocity.max_abs == 0.0
+    assert result.pelvis_position.max_abs == 0.0 and result.pelvis_orientation.max_abs == 0.0
+    assert result.reproduced and not result.warnings
+    # and the inputs matter: without them the replay strays
+    blind = replay(dataclasses.replace(recording, inputs=[]))
+    assert blind.pelvis_position.max_abs > 1e-3 or blind.joint_position.max_abs > 1e-3
+
+
+def test_a_missing_input_refuses_the_replay(tmp_path: Path) -> None:
+    run = Run()
+    run.step(50)
+    _apply(run, vrc.wrench_input((50, 0, 0), (0, 0, 0)), logged=False)  # recorder not there yet
+    run.step(20)
+    _apply(run, vrc.wrench_input((0, 0, 0), (0, 0, 0)))
+    run.step(20)
+    with pytest.raises(ReplayError, match=r'lacks /atlas/sim_inputs input #0 after the reset at '
+                                          r'0\.000 s \(the recorder started after it or '
+                                          r'dropped it\); the run cannot be replayed exactly\.$'):
+        load_recording(run.write(tmp_path / 'missing.bag'))
+
+
+def test_inputs_before_a_reset_are_not_replayed(tmp_path: Path) -> None:
+    run = Run()
+    run.step(60, lambda sim, step: step == 30 and _apply(run, vrc.ModeInput(
+        vrc.VrcMode.NO_GRAVITY)))
+    run.reset_world()
+    run.step(80, lambda sim, step: step == 100 and _apply(run, _pose((0, 0, 1.2), 0.0)))
+    recording = load_recording(run.write(tmp_path / 'reset.bag'))
+    assert [event.seq for event in recording.inputs] == [0]
+    assert replay(recording).joint_position.max_abs == 0.0
+
+
+def test_startup_mode_comes_from_sim_config(tmp_path: Path) -> None:
+    run = Run()
+    run.sim = AtlasSimulator(run.atlas, load_gains_yaml(DEFAULT_GAINS_FILE), TIME_TO_UNPIN_S,
+                             startup_mode=vrc.VrcMode.PINNED)
+    run.records.clear()
+    run._publish_config()
+    run.step(150, crouch)
+    result = replay_bag(run.write(tmp_path / 'pinned_start.bag'))
+    assert result.config.startup_mode == 'pinned'
+    assert result.joint_position.max_abs == 0.0 and result.pelvis_position.max_abs == 0.0

@@ -15,6 +15,7 @@ from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.sim.sim_config import SimConfig
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode, PhysicsDivergenceError
+from tutorial_atlas_control.sim.vrc import ModeInput, VrcMode
 
 sim_node = pytest.importorskip('tutorial_atlas_control.node.sim_node',
                                reason='needs the catkin workspace: source ./env.sh')
@@ -64,7 +65,7 @@ def test_the_node_advertises_the_topics_and_steps_until_shutdown(sim: AtlasSimul
             topics.CLOCK, topics.JOINT_STATES, topics.GROUND_TRUTH_ODOM, topics.IMU,
             topics.L_FOOT_CONTACT, topics.R_FOOT_CONTACT, topics.CONTROLLER_STATISTICS,
             topics.SIM_CONFIG, topics.ATLAS_STATE, topics.FORCE_TORQUE_SENSORS,
-            topics.DEBUG_L_FOOT_CONTACT, topics.DEBUG_R_FOOT_CONTACT}
+            topics.DEBUG_L_FOOT_CONTACT, topics.DEBUG_R_FOOT_CONTACT, topics.SIM_INPUTS}
         config, = node.fake_publishers[topics.SIM_CONFIG].published
         assert SimConfig.from_json(config.data) == sim.config()
     assert sim.sim_time_ns == 50 * sim.step_ns
@@ -128,3 +129,98 @@ def test_the_node_hands_atlas_command_and_test_to_the_loop_in_order(sim: AtlasSi
             topics.ATLAS_COMMAND, topics.ATLAS_TEST]
         assert sim_node.RawAtlasCommand._md5sum == '3a56dd1f50633ad975636160b665384a'
         assert sim_node.RawTest._md5sum == '62f63cd4b6db15007d8d3d4a23411c4c'
+
+
+# -- VRCPlugin's topics and /gazebo/reset_models --------------------------------------------
+
+def _subscribed(topic: str) -> Any:
+    """The callback the node subscribed to `topic` (rospy.Subscriber is a mock here)."""
+    for call in sim_node.rospy.Subscriber.call_args_list:
+        if call.args[0] == topic:
+            return call.args[2]
+    raise AssertionError(f'{topic} is not subscribed')
+
+
+def _bad_and_good_messages() -> list[tuple[str, Any, Any, str]]:
+    import genpy
+    from geometry_msgs.msg import Point, Pose, Quaternion, Twist, Vector3, Wrench
+    from std_msgs.msg import String
+    from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
+
+    def trajectory(names: list[str], times_s: list[float]) -> JointTrajectory:
+        return JointTrajectory(joint_names=names, points=[
+            JointTrajectoryPoint(positions=[0.1] * len(names),
+                                 time_from_start=genpy.Duration.from_sec(t)) for t in times_s])
+    nan = float('nan')
+    return [
+        (topics.MODE, String(data='flying'), String(data='pinned'),
+         "unknown mode 'flying'; valid modes: harnessed, pinned"),
+        (topics.SET_POSE, Pose(Point(nan, 0, 1), Quaternion(0, 0, 0, 1)),
+         Pose(Point(0, 0, 1), Quaternion(0, 0, 0, 1)), 'position is not finite (nan)'),
+        (topics.CMD_VEL, Twist(Vector3(0, 0, 0), Vector3(0, 0, float('inf'))),
+         Twist(Vector3(0.1, 0, 0), Vector3(0, 0, 0)), 'angular velocity is not finite (inf)'),
+        (topics.APPLY_PELVIS_FORCE, Wrench(Vector3(1e9, 0, 0), Vector3(0, 0, 0)),
+         Wrench(Vector3(30, 0, 0), Vector3(0, 0, 0)), 'force 1e+09 exceeds 100000'),
+        (topics.JOINT_TRAJECTORY, trajectory(['l_arm_shx', 'wing'], [0.0]),
+         trajectory(['l_arm_shx'], [0.0, 0.1]), "unknown joint name 'wing'"),
+        (topics.JOINT_TRAJECTORY, trajectory(['l_arm_shx'], [0.2, 0.1]),
+         trajectory(['l_arm_shx'], [0.0, 0.1]), 'time_from_start not increasing at point 1'),
+    ]
+
+
+def test_each_cheat_refuses_bad_input_in_one_line_and_applies_good_input(
+        sim: AtlasSimulator) -> None:
+    from support.fake_rospy import fake_ros_node
+
+    with fake_ros_node(sim, steps=5) as node:
+        rospy = sim_node.rospy
+        for topic, bad, good, reason in _bad_and_good_messages():
+            rospy.logwarn_throttle_identical.reset_mock()
+            before = sim.data.qpos.copy()
+            _subscribed(topic)(bad)
+            (_, text), _ = rospy.logwarn_throttle_identical.call_args
+            assert text.startswith(f'refused {topic}: ') and reason in text, text
+            assert text.endswith('; nothing applied') and '\n' not in text
+            assert not sim.inputs_since_reset and not sim.vrc.active
+            assert (sim.data.qpos == before).all()
+            _subscribed(topic)(good)
+            assert sim.inputs_since_reset == 1
+            event = node.fake_publishers[topics.SIM_INPUTS].published[-1].data
+            assert '"seq": 0' in event and '"time_ns": 0' in event
+            node.loop.reset_world()
+        assert node.spin() == 0  # and it keeps stepping
+    assert sim.sim_time_ns == 5 * sim.step_ns
+
+
+def test_configuration_is_logged_as_not_implemented_and_reset_models_is_reset_world(
+        sim: AtlasSimulator) -> None:
+    from sensor_msgs.msg import JointState
+
+    from support.fake_rospy import fake_ros_node
+
+    with fake_ros_node(sim, steps=0) as node:
+        rospy = sim_node.rospy
+        _subscribed(topics.CONFIGURATION)(JointState(name=['l_arm_shx'], position=[1.0]))
+        (_, text), _ = rospy.logerr_throttle.call_args
+        assert text == '/atlas/configuration is not implemented (nor was it in DRCSim); ' \
+                       'nothing applied'
+        services = {call.args[0]: call.args[2] for call in rospy.Service.call_args_list}
+        assert set(services) >= {topics.RESET_WORLD_SERVICE, topics.RESET_MODELS_SERVICE}
+        node.loop.apply_input(ModeInput(VrcMode.NO_GRAVITY))
+        services[topics.RESET_MODELS_SERVICE](None)
+        assert not sim.vrc.active and not sim.inputs_since_reset and sim.pinned
+
+
+def test_startup_mode_parameter_is_checked(monkeypatch: pytest.MonkeyPatch) -> None:
+    params: dict[str, Any] = {
+        'atlas_controller/gains': yaml.safe_load(CONFIG.read_text())['atlas_controller']['gains'],
+        topics.STARTUP_MODE_PARAM: 'harnessed'}
+    monkeypatch.setattr(sim_node.rospy, 'get_param',
+                        lambda name, default=None: params.get(name, default))
+    with pytest.raises(sim_node.AtlasControlError,
+                       match='^parameter /atlas/startup_mode must be one of pinned_with_gravity, '
+                             "pinned, bdi_stand, got 'harnessed'$"):
+        sim_node.build_node()
+    params[topics.STARTUP_MODE_PARAM] = 'bdi_stand'
+    monkeypatch.setattr(sim_node, 'SimNode', lambda sim, *args: sim)
+    assert sim_node.build_node().startup_mode is VrcMode.BDI_STAND

@@ -360,6 +360,27 @@ def test_resets_republish_the_config_and_set_mode_returns_the_previous(
     assert log.of('info')[-1] == 'reset_simulation: robot reset and sim time back to 0'
 
 
+def test_inputs_apply_between_steps_publish_their_event_and_log_once_a_second(
+        sim: AtlasSimulator) -> None:
+    from tutorial_atlas_control.sim.vrc import InputEvent, wrench_input
+
+    outbox = FakeOutbox(set(ALL_TOPICS))
+    log, events = FakeLog(), []
+    loop = SteppingLoop(sim, outbox, {topic: topic for topic in ALL_TOPICS}, LAUNCH_RATES_HZ,
+                        CommandAgeStatistics(sim.dt_s), log, lambda text: None,
+                        publish_input=events.append)
+    loop.run(stops_after(3))
+    for _ in range(5):  # a 1 kHz wrench stream
+        loop.apply_input(wrench_input((1.0, 0.0, 0.0), (0.0, 0.0, 0.0)))
+        loop.run(stops_after(1))
+    parsed = [InputEvent.from_json(text) for text in events]
+    assert [(e.time_ns, e.seq) for e in parsed] == [(3_000_000 + k * 1_000_000, k)
+                                                    for k in range(5)]
+    assert log.of('info')[-1] == ('applied at t=0.003 s: /atlas/apply_pelvis_force '
+                                  'force=[1.0, 0.0, 0.0], torque=[0.0, 0.0, 0.0]')
+    assert sum('applied at' in text for text in log.of('info')) == 1
+
+
 # -- pacing --------------------------------------------------------------------------------
 
 def test_unpaced_runs_flush_every_flush_period() -> None:

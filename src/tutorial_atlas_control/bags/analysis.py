@@ -6,6 +6,7 @@ all times are seconds from the bag's start.
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -33,6 +34,7 @@ __all__ = [
     'JointTracking',
     'analyze',
     'analyze_bag',
+    'input_timeline',
 ]
 
 #: Pelvis height (m) below which the robot counts as fallen (standing is ~0.93 m).
@@ -82,6 +84,35 @@ class EffortSaturation:
     samples: int
 
 
+#: /atlas/sim_inputs' input kinds -> the topic the input came from.
+_INPUT_TOPICS = {'mode': topics.MODE, 'set_pose': topics.SET_POSE, 'cmd_vel': topics.CMD_VEL,
+                 'pelvis_wrench': topics.APPLY_PELVIS_FORCE,
+                 'joint_trajectory': topics.JOINT_TRAJECTORY}
+
+
+def input_timeline(data: BagData) -> list[tuple[float, str]]:
+    """(time from the bag's start (s), 'topic values') of each input the simulator applied
+    (/atlas/sim_inputs: sim time of the step it first acted in); unreadable ones are shown
+    as such."""
+    timeline = []
+    for t_s, text in data.sim_inputs:
+        try:
+            event = json.loads(text)
+            item = dict(event['input'])
+            t_s = int(event['time_ns']) / 1e9 - data.start_time_s
+            kind = item.pop('kind')
+        except (ValueError, KeyError, TypeError):
+            timeline.append((t_s, f'{topics.SIM_INPUTS} (unreadable)'))
+            continue
+        if kind == 'joint_trajectory':
+            values = (f'{len(item.get("joints", []))} joints, '
+                      f'{len(item.get("positions", []))} points')
+        else:
+            values = ', '.join(f'{key}={value}' for key, value in item.items())
+        timeline.append((t_s, f'{_INPUT_TOPICS.get(kind, kind)} {values}'))
+    return timeline
+
+
 @dataclass(frozen=True)
 class Analysis:
     """The metrics of one run. Times are seconds from bag start; None = not available."""
@@ -101,6 +132,11 @@ class Analysis:
     def mode_timeline(self) -> list[tuple[float, str]]:
         return self.data.modes
 
+    @property
+    def input_timeline(self) -> list[tuple[float, str]]:
+        """(time from the bag's start (s), description) of each applied VRCPlugin input."""
+        return input_timeline(self.data)
+
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready dict (see analyze_bag --help for the keys and units)."""
         data = self.data
@@ -111,6 +147,7 @@ class Analysis:
             'topics': {name: {'type': topic.msgtype, 'count': topic.count,
                               'rate': topic.rate_hz} for name, topic in data.topics.items()},
             'mode_timeline': [{'time': t_s, 'mode': mode} for t_s, mode in data.modes],
+            'inputs': [{'time': t_s, 'input': text} for t_s, text in input_timeline(data)],
             'fell': self.fell,
             'fall_time': self.fall_time_s,
             'min_pelvis_height': self.min_pelvis_height_m,

@@ -110,7 +110,8 @@ class BagData:
     """What :func:`read_bag` extracted; series are None when the topic is absent.
 
     `modes` are (time, mode) at each change of /atlas/control_mode; `sim_configs` are
-    (time, JSON text) of every /atlas/sim_config message, which replay parses.
+    (time, JSON text) of every /atlas/sim_config message, which replay parses, and
+    `sim_inputs` those of /atlas/sim_inputs (the applied VRCPlugin inputs).
     """
 
     path: Path
@@ -123,6 +124,7 @@ class BagData:
     modes: list[tuple[float, str]]
     sim_configs: list[tuple[float, str]]
     warnings: list[str] = field(default_factory=list)
+    sim_inputs: list[tuple[float, str]] = field(default_factory=list)
 
 
 def _header_stamp_ns(msg: Any) -> int:
@@ -437,8 +439,9 @@ def _read_open_bag(path: Path, records: BagRecords, fast: bool) -> BagData:
     pelvis = series(topics.GROUND_TRUTH_ODOM, _read_pelvis)
     modes = _mode_changes(series(topics.CONTROL_MODE, _read_strings) or [])
     sim_configs = series(topics.SIM_CONFIG, _read_strings) or []
+    sim_inputs = series(topics.SIM_INPUTS, _read_strings) or []
     return BagData(path, start_ns / NS_PER_S, (end_ns - start_ns) / NS_PER_S, summaries,
-                   states, commands, pelvis, modes, sim_configs, reading.warnings)
+                   states, commands, pelvis, modes, sim_configs, reading.warnings, sim_inputs)
 
 
 def read_bag(path: Path | str, fast: bool = True) -> BagData:

@@ -15,6 +15,7 @@ from tutorial_atlas_control.bags.analysis import (
     FALL_HEIGHT_M,
     MOVED_RANGE_RAD,
     Analysis,
+    input_timeline,
 )
 from tutorial_atlas_control.bags.reader import BagData
 from tutorial_atlas_control.errors import BagAnalysisError
@@ -49,7 +50,10 @@ def _topic_lines(data: BagData, trajectory: str | None = None) -> list[str]:
     if not data.topics:
         lines.append('  (none: the bag is empty)')
     lines.append('Control modes:')
-    lines.extend(f'  {t_s:9.3f} s  {mode}' for t_s, mode in data.modes)
+    # VRCPlugin's inputs (mode, teleport, wrench, ...) on the same timeline, when applied.
+    timeline = sorted([(t_s, mode) for t_s, mode in data.modes] + input_timeline(data),
+                      key=lambda entry: entry[0])
+    lines.extend(f'  {t_s:9.3f} s  {text}' for t_s, text in timeline)
     if not data.modes:
         lines.append(f'  (no {topics.CONTROL_MODE} messages)')
     return lines

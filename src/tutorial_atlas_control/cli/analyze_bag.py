@@ -55,7 +55,8 @@ given in seconds from the bag's start.
 
 EPILOG = """\
 JSON keys (--json): bag, start_time (s), duration (s), topics {name: {type, count,
-rate (Hz or null)}}, mode_timeline [{time (s), mode}], fell (bool, null without
+rate (Hz or null)}}, mode_timeline [{time (s), mode}], inputs [{time (s), input}]
+(VRCPlugin's inputs the simulator applied, also on the text timeline), fell (bool, null without
 odometry), fall_time (s or null), min_pelvis_height (m), joints {name: {rms_error,
 max_error (rad), samples, commanded, measured_range (rad)}} (joints that moved),
 command_rate (Hz), command_count, command_age {mean, max} (s), effort_saturation

@@ -9,7 +9,11 @@ subscribed), and a latched
 /atlas/sim_config (JSON: timestep, time_to_unpin, model file and checksum, time of the last
 reset) for offline replay; obeys /atlas/joint_commands, /atlas/atlas_command,
 /atlas/debug/test and /atlas/control_mode; offers /atlas/reset_controls and gazebo_ros's
-reset and pause services.
+reset and pause services (and DRCSim's /gazebo/reset_models). VRCPlugin's
+/atlas/mode, set_pose, cmd_vel, gazebo_ros_force's /atlas/apply_pelvis_force and
+gazebo_ros_joint_trajectory's /joint_trajectory are checked here and applied by the loop
+(sim/vrc.py), each applied one echoed on /atlas/sim_inputs; /atlas/configuration is
+logged as not implemented, as in DRCSim.
 
 Parameters (private unless noted):
     ~real_time_factor (float, 1.0): sim time per wall time; 0 runs as fast as possible.
@@ -27,6 +31,7 @@ Parameters (private unless noted):
     ~model_file (str, the package's sim/atlas_v1.xml): the MJCF to simulate; it must have
         Atlas v1's joints, actuators and sensors (a variant of the package's model).
     /atlas/time_to_unpin (float, 1.0): seconds the torso stays pinned after start/reset.
+    /atlas/startup_mode (str, pinned_with_gravity): VRCPlugin's start (sim/vrc.py STARTUP_MODES).
     atlas_controller/gains/<joint>/{p,i,d,i_clamp}: the gains Stand/Freeze/User-hold use.
     atlas_controller/statistics_time_window_size (s, 1.0): window of the command age statistics.
     /atlas/controller_statistics/update_rate (Hz, unset = every step): clamped to 1..10000.
@@ -40,12 +45,13 @@ import time
 import warnings
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import genpy
 import rospy
 from atlas_msgs.msg import AtlasCommand, AtlasState, ControllerStatistics, ForceTorqueSensors, Test
 from atlas_msgs.srv import ResetControls, ResetControlsResponse
-from geometry_msgs.msg import WrenchStamped
+from geometry_msgs.msg import Pose, Twist, Wrench, WrenchStamped
 from nav_msgs.msg import Odometry
 from osrf_msgs.msg import JointCommands
 from rosgraph_msgs.msg import Clock
@@ -53,6 +59,7 @@ from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import String
 from std_srvs.srv import Empty, EmptyResponse
 from tf2_msgs.msg import TFMessage
+from trajectory_msgs.msg import JointTrajectory
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.errors import AtlasControlError
@@ -74,6 +81,19 @@ from tutorial_atlas_control.sim.simulator import (
     parse_mode,
 )
 from tutorial_atlas_control.sim.urdf import UrdfError, matching_urdf
+from tutorial_atlas_control.sim.vrc import (
+    DEFAULT_STARTUP_MODE,
+    STARTUP_MODES,
+    InputError,
+    ModeInput,
+    SimInput,
+    VrcMode,
+    cmd_vel_input,
+    parse_vrc_mode,
+    pose_input,
+    trajectory_input,
+    wrench_input,
+)
 from tutorial_atlas_control.stepping.loop import ResetControlsRequest, SteppingLoop
 from tutorial_atlas_control.units import finite_number
 
@@ -197,7 +217,8 @@ class SimNode:
         statistics = self._controller_statistics()
         self.loop = SteppingLoop(sim, WireBatch(), self.publishers, rates_hz, statistics,
                                  RosLog(), self._publish_config,
-                                 real_time_factor=real_time_factor, paused=paused)
+                                 real_time_factor=real_time_factor, paused=paused,
+                                 publish_input=self._publish_input)
         self.loop.publish_config()
         self._subscribe()
 
@@ -216,6 +237,8 @@ class SimNode:
                                for topic, msg_class in published}
         # Latched, recorded in every bag: what offline replay needs to re-create the run.
         self.config_pub = rospy.Publisher(topics.SIM_CONFIG, String, queue_size=1, latch=True)
+        # Each applied cheat, with the sim time it took effect: what replay re-applies.
+        self.inputs_pub = rospy.Publisher(topics.SIM_INPUTS, String, queue_size=100)
 
     def _controller_statistics(self) -> CommandAgeStatistics:
         """DRCSim's command age statistics, from the parameters (fed and published by the
@@ -240,7 +263,61 @@ class SimNode:
                           self._service(loop.reset_simulation)),
             rospy.Service(topics.PAUSE_PHYSICS_SERVICE, Empty, self._service(loop.pause)),
             rospy.Service(topics.UNPAUSE_PHYSICS_SERVICE, Empty, self._service(loop.unpause)),
+            rospy.Service(topics.RESET_MODELS_SERVICE, Empty, self._service(loop.reset_world)),
         ]
+        self._subscribe_cheats()
+
+    def _subscribe_cheats(self) -> None:
+        """VRCPlugin's, gazebo_ros_force's and gazebo_ros_joint_trajectory's topics."""
+        lower, upper = self.sim.atlas.lower_rad, self.sim.atlas.upper_rad
+        links = frozenset(self.sim.vrc.link_names)
+        cheats: tuple[tuple[str, type, Callable[[Any], SimInput]], ...] = (
+            (topics.MODE, String, lambda msg: ModeInput(parse_vrc_mode(msg.data))),
+            (topics.SET_POSE, Pose, lambda msg: pose_input(
+                (msg.position.x, msg.position.y, msg.position.z),
+                (msg.orientation.x, msg.orientation.y, msg.orientation.z, msg.orientation.w))),
+            (topics.CMD_VEL, Twist, lambda msg: cmd_vel_input(
+                (msg.linear.x, msg.linear.y, msg.linear.z),
+                (msg.angular.x, msg.angular.y, msg.angular.z))),
+            (topics.APPLY_PELVIS_FORCE, Wrench, lambda msg: wrench_input(
+                (msg.force.x, msg.force.y, msg.force.z),
+                (msg.torque.x, msg.torque.y, msg.torque.z))),
+            (topics.JOINT_TRAJECTORY, JointTrajectory, lambda msg: trajectory_input(
+                msg.header.frame_id, msg.header.stamp.to_nsec(), msg.joint_names,
+                [point.positions for point in msg.points],
+                [point.time_from_start.to_nsec() for point in msg.points], lower, upper,
+                links, [{'velocities': point.velocities, 'accelerations': point.accelerations,
+                         'effort': point.effort} for point in msg.points])),
+        )
+        for topic, msg_class, decode in cheats:
+            rospy.Subscriber(topic, msg_class, self._cheat_handler(topic, decode),
+                             queue_size=100)
+        rospy.Subscriber(topics.CONFIGURATION, JointState, self.on_configuration, queue_size=10)
+
+    def _cheat_handler(self, topic: str,
+                       decode: Callable[[Any], SimInput]) -> Callable[[Any], None]:
+        """A callback that checks the message whole, then hands it to the loop."""
+        def handle(msg: Any) -> None:
+            try:
+                item = decode(msg)
+            except InputError as err:
+                # Per message text: rospy's plain throttle is per call site, and would
+                # hide a refusal on one topic behind another's.
+                rospy.logwarn_throttle_identical(WARN_THROTTLE_S,
+                                                 f'refused {topic}: {err}; nothing applied')
+                return
+            self.loop.apply_input(item)
+        return handle
+
+    @staticmethod
+    def on_configuration(_msg: JointState) -> None:
+        """As VRCPlugin: planned but never implemented; said once per message."""
+        rospy.logerr_throttle(WARN_THROTTLE_S, f'{topics.CONFIGURATION} is not implemented '
+                              '(nor was it in DRCSim); nothing applied')
+
+    def _publish_input(self, text: str) -> None:
+        """/atlas/sim_inputs (recorded): one applied cheat."""
+        self.inputs_pub.publish(String(data=text))
 
     def _publish_config(self, text: str) -> None:
         """/atlas/sim_config (latched, recorded in every bag): what replay needs."""
@@ -382,7 +459,12 @@ def build_node() -> SimNode:
     if not isinstance(model_file, str) or not model_file:
         raise AtlasControlError(f'parameter {rospy.resolve_name("~model_file")} must be the '
                                 f'path of an MJCF file, got {model_file!r}')
-    sim = AtlasSimulator(atlas_model.load_model(Path(model_file)), gains, time_to_unpin_s)
+    startup_mode = rospy.get_param(topics.STARTUP_MODE_PARAM, DEFAULT_STARTUP_MODE.value)
+    if startup_mode not in STARTUP_MODES:
+        raise AtlasControlError(f'parameter {topics.STARTUP_MODE_PARAM} must be one of '
+                                f'{", ".join(STARTUP_MODES)}, got {startup_mode!r}')
+    sim = AtlasSimulator(atlas_model.load_model(Path(model_file)), gains, time_to_unpin_s,
+                         startup_mode=VrcMode(startup_mode))
     return SimNode(sim, _float_param('~real_time_factor', 1.0),
                    bool(rospy.get_param('~paused', False)), rates_hz,
                    bool(rospy.get_param('~gui', False)), _tf_wanted(Path(model_file), sim))

@@ -38,6 +38,7 @@ from tutorial_atlas_control.msgs.wire import JointCommandsWire, StampedWire, clo
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, Gains, load_gains_yaml
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode, PhysicsDivergenceError
+from tutorial_atlas_control.sim.vrc import SimInput
 from tutorial_atlas_control.stepping.schedule import step_stamp, steps_between
 from tutorial_atlas_control.trajectories.schedule import (
     done_line,
@@ -248,6 +249,13 @@ class _OfflinePlayer:
         self.sink.write_message(topics.CONTROL_MODE, self.sim.sim_time_ns,
                                 self._string(data=mode.value))
         self.sim.set_mode(mode)
+
+    def apply_input(self, item: SimInput) -> None:
+        """A VRCPlugin input, applied and written to /atlas/sim_inputs as the node does
+        (the sink needs a connection for that topic)."""
+        self.sim.apply_input(item)
+        self.sink.write_message(topics.SIM_INPUTS, self.sim.sim_time_ns,
+                                self._string(data=self.sim.last_input_event().to_json()))
 
     def send(self, positions: np.ndarray) -> None:
         """One traj_yaml command: written to the bag, then decoded as the simulator does."""

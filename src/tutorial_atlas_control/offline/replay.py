@@ -12,6 +12,10 @@ Two details make that exact:
 * The replay starts at the reset the simulator started from (`last_reset_time`), never
   from a recorded mid-run state: MuJoCo's solver warm-start (and the free joint's
   velocity) are not in the bag.
+* The inputs that act on the physics beside the torques (VRCPlugin's modes, teleports,
+  cmd_vel, the pelvis wrench, kinematic playback) are re-applied from /atlas/sim_inputs
+  before the very step they first acted in; a bag that lacks one of them after the last
+  reset is refused.
 * `rosbag record` usually starts a few hundred steps after the simulator. The steps before
   the first recorded joint state are re-created with :class:`AtlasSimulator` itself in
   Stand mode with the gains of config/atlas_controller.yaml (what the simulator does
@@ -41,6 +45,7 @@ from tutorial_atlas_control.sim.simulator import (
     AtlasSimulator,
     PhysicsDivergenceError,
 )
+from tutorial_atlas_control.sim.vrc import STARTUP_MODES, InputError, InputEvent, VrcMode
 from tutorial_atlas_control.units import NS_PER_S
 
 __all__ = [
@@ -93,6 +98,7 @@ class Recording:
     odom_quat_wxyz: np.ndarray
     has_odom: bool
     warnings: list[str] = field(default_factory=list)
+    inputs: list[InputEvent] = field(default_factory=list)  # since the last reset, in order
 
 
 def _read_sim_configs(data: BagData) -> list[dict[str, Any]]:
@@ -118,6 +124,43 @@ def _sim_config(path: Path, raw_configs: list[dict[str, Any]],
         raise ReplayError(f'{path}: {SIM_CONFIG_TOPIC} {err}') from None
     resets = len({float(c.get('last_reset_time', 0.0)) for c in raw_configs}) - 1
     return config, resets
+
+
+#: The topics whose messages become /atlas/sim_inputs when applied.
+CHEAT_TOPICS = (topics.MODE, topics.SET_POSE, topics.CMD_VEL, topics.APPLY_PELVIS_FORCE,
+                topics.JOINT_TRAJECTORY)
+
+
+def _input_events(path: Path, data: BagData, config: SimConfig,
+                  warnings: list[str]) -> list[InputEvent]:
+    """The applied inputs of the last segment, all of them from the first, in order.
+
+    Raises:
+        ReplayError: an /atlas/sim_inputs text is not an input, or one is missing.
+    """
+    reset_ns = int(round(config.last_reset_time_s * NS_PER_S))
+    events = []
+    for _, text in data.sim_inputs:
+        try:
+            event = InputEvent.from_json(text)
+        except InputError as err:
+            raise ReplayError(f'{path}: {topics.SIM_INPUTS} {err}.') from None
+        if event.reset_ns == reset_ns:
+            events.append(event)
+    events.sort(key=lambda event: event.seq)
+    for expected, event in enumerate(events):
+        if event.seq != expected:
+            raise ReplayError(
+                f'{path} lacks {topics.SIM_INPUTS} input #{expected} after the reset at '
+                f'{reset_ns / NS_PER_S:.3f} s (the recorder started after it or dropped it); '
+                'the run cannot be replayed exactly.')
+    if not data.sim_inputs:
+        sent = [topic for topic in CHEAT_TOPICS
+                if topic in data.topics and data.topics[topic].count]
+        if sent:
+            warnings.append(f'the bag has {", ".join(sent)} but no {topics.SIM_INPUTS}: if '
+                            'the simulator applied any of them, the replay deviates.')
+    return events
 
 
 def _stamps_ns(data: BagData, t_s: np.ndarray) -> np.ndarray:
@@ -187,8 +230,9 @@ def load_recording(path: Path | str, data: BagData | None = None) -> Recording:
         warnings.append(f'the bag has no {ODOM_TOPIC}: the pelvis pose is not compared.')
         odom_stamp_ns = np.empty(0, dtype=np.int64)
         odom_position, odom_quat = np.empty((0, 3)), np.empty((0, 4))
+    inputs = _input_events(path, data, config, warnings)
     return Recording(path, config, resets, state_stamp_ns, position, velocity, effort,
-                     odom_stamp_ns, odom_position, odom_quat, has_odom, warnings)
+                     odom_stamp_ns, odom_position, odom_quat, has_odom, warnings, inputs)
 
 
 # ---------------------------------------------------------------------------- replay
@@ -369,9 +413,27 @@ def _reset_step(config: SimConfig, step_ns: int) -> int:
     return reset_ns // step_ns
 
 
+class _InputQueue:
+    """The recorded inputs, each applied right before the step it first acted in."""
+
+    def __init__(self, events: Sequence[InputEvent]) -> None:
+        self.events = list(events)
+        self.next = 0
+
+    def apply_due(self, sim: AtlasSimulator) -> None:
+        events = self.events
+        while self.next < len(events) and events[self.next].time_ns <= sim.sim_time_ns:
+            event = events[self.next]
+            if event.time_ns < sim.sim_time_ns:  # pragma: no cover - stamps are checked
+                raise ReplayError(f'{topics.SIM_INPUTS} #{event.seq} at '
+                                  f'{event.time_ns / NS_PER_S:.3f} s is off the step grid.')
+            sim.apply_input(event.item)
+            self.next += 1
+
+
 def _recreate_prefix(sim: AtlasSimulator, config: SimConfig, reset_step: int, first_step: int,
                      first_effort_nm: np.ndarray, probe: _OdomProbe,
-                     warnings: list[str]) -> int:
+                     warnings: list[str], inputs: _InputQueue) -> int:
     """Step the simulator's Stand law up to the first recorded step; return how many steps.
 
     Raises:
@@ -387,6 +449,7 @@ def _recreate_prefix(sim: AtlasSimulator, config: SimConfig, reset_step: int, fi
             'only the steps before the recording of a run that starts at t = 0 can be '
             're-created (Stand mode).')
     for step in range(1, first_step):
+        inputs.apply_due(sim)
         _step(sim)
         probe.after_step(sim, step)
     # The first recorded torque must be what the Stand law gives, or the run had left
@@ -412,11 +475,12 @@ def _step(sim: AtlasSimulator, torque_nm: np.ndarray | None = None) -> None:
 
 
 def _replay_recorded(sim: AtlasSimulator, steps: np.ndarray, effort_nm: np.ndarray,
-                     probe: _OdomProbe) -> tuple[np.ndarray, np.ndarray]:
+                     probe: _OdomProbe, inputs: _InputQueue) -> tuple[np.ndarray, np.ndarray]:
     """Apply the recorded torques; the joint positions and velocities after each step."""
     position = np.empty((len(steps), NUM_JOINTS))
     velocity = np.empty((len(steps), NUM_JOINTS))
     for index, step in enumerate(steps.tolist()):
+        inputs.apply_due(sim)
         _step(sim, effort_nm[index])
         position[index] = sim.joint_positions()
         velocity[index] = sim.joint_velocities()
@@ -434,8 +498,11 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
     """
     warnings = list(recording.warnings)
     config = recording.config
+    if config.startup_mode not in STARTUP_MODES:
+        raise ReplayError(f'{SIM_CONFIG_TOPIC} startup_mode {config.startup_mode!r} is not '
+                          f'one of {", ".join(STARTUP_MODES)}.')
     sim = AtlasSimulator(atlas_model.load_model(), load_gains_yaml(gains_file),
-                         config.time_to_unpin_s)
+                         config.time_to_unpin_s, startup_mode=VrcMode(config.startup_mode))
     sha1_matches = _check_model(config, sim, warnings)
     step_ns = sim.step_ns
     reset_step = _reset_step(config, step_ns)
@@ -448,8 +515,10 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
     rows = _segment(recording, all_steps, reset_step, sim.dt_s, warnings)
     steps, effort = all_steps[rows], recording.effort_nm[rows]
     probe = _OdomProbe(odom_steps, reset_step, int(steps[-1]))
-    prefix = _recreate_prefix(sim, config, reset_step, int(steps[0]), effort[0], probe, warnings)
-    position, velocity = _replay_recorded(sim, steps, effort, probe)
+    inputs = _InputQueue(recording.inputs)
+    prefix = _recreate_prefix(sim, config, reset_step, int(steps[0]), effort[0], probe, warnings,
+                              inputs)
+    position, velocity = _replay_recorded(sim, steps, effort, probe, inputs)
     pelvis_position, pelvis_orientation = (probe.deviations(recording, odom_steps, step_ns)
                                            if recording.has_odom else (None, None))
     return ReplayResult(

@@ -18,6 +18,9 @@ __all__ = ['REQUIRED_KEYS', 'SimConfig', 'SimConfigError', 'parse_sim_config']
 
 #: The keys a config needs to be replayed (model_file and model_sha1 may be missing).
 REQUIRED_KEYS = ('timestep', 'time_to_unpin', 'last_reset_time')
+#: The start-up mode when the config does not say (/atlas/startup_mode unset): written only
+#: when another was chosen, so that the text of a default run stays what it always was.
+DEFAULT_STARTUP_MODE = 'pinned_with_gravity'
 
 
 class SimConfigError(AtlasControlError):
@@ -38,16 +41,20 @@ class SimConfig:
     time_to_unpin_s: float
     last_reset_time_s: float
     recorded: bool = True
+    startup_mode: str = DEFAULT_STARTUP_MODE
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON object, keys in the order the simulator has always published them."""
-        return {
+        config = {
             'model_file': self.model_file,
             'model_sha1': self.model_sha1,
             'timestep': self.timestep_s,
             'time_to_unpin': self.time_to_unpin_s,
             'last_reset_time': self.last_reset_time_s,
         }
+        if self.startup_mode != DEFAULT_STARTUP_MODE:
+            config['startup_mode'] = self.startup_mode
+        return config
 
     def to_json(self) -> str:
         """The /atlas/sim_config message text."""
@@ -66,7 +73,8 @@ class SimConfig:
                 model_sha1=str(config.get('model_sha1')) if config.get('model_sha1') else None,
                 timestep_s=float(config['timestep']),
                 time_to_unpin_s=float(config['time_to_unpin']),
-                last_reset_time_s=float(config['last_reset_time']))
+                last_reset_time_s=float(config['last_reset_time']),
+                startup_mode=str(config.get('startup_mode', DEFAULT_STARTUP_MODE)))
         except (KeyError, TypeError, ValueError) as err:
             raise SimConfigError(f'lacks a valid {err} (expected JSON with '
                                  f'{", ".join(REQUIRED_KEYS)}).') from None

@@ -16,6 +16,7 @@ every k_effort to 1 (255) and any other switch sets them to 0.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import enum
 import hashlib
 from collections.abc import Mapping, Sequence
@@ -36,6 +37,18 @@ from tutorial_atlas_control.sim import law_kernel
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import Gains, PidState, compute_torque, hold_command
 from tutorial_atlas_control.sim.sim_config import SimConfig
+from tutorial_atlas_control.sim.vrc import (
+    DEFAULT_STARTUP_MODE,
+    CmdVelInput,
+    InputEvent,
+    ModeInput,
+    PoseInput,
+    SimInput,
+    TrajectoryInput,
+    VrcMode,
+    VrcState,
+    WrenchInput,
+)
 from tutorial_atlas_control.units import NS_PER_S
 
 #: DRCSim released the pinned torso after this long (s); `/atlas/time_to_unpin` overrides it.
@@ -99,9 +112,14 @@ class AtlasSimulator:
 
     def __init__(self, atlas: atlas_model.AtlasModel, gains: Gains,
                  time_to_unpin_s: float = DEFAULT_TIME_TO_UNPIN_S,
-                 compiled_law: bool = True) -> None:
+                 compiled_law: bool = True,
+                 startup_mode: VrcMode = DEFAULT_STARTUP_MODE) -> None:
         """`compiled_law`: run the law through law_kernel's C kernel when it is built
-        (the same torques bit for bit, faster); False: always controller.compute_torque."""
+        (the same torques bit for bit, faster); False: always controller.compute_torque.
+        `startup_mode`: one of vrc.STARTUP_MODES, what reset_world starts the robot in."""
+        # A model of its own: the cheats move the pin weld's target (model.eq_data), which
+        # must not move the pin of another simulator sharing the compiled model.
+        atlas = dataclasses.replace(atlas, model=copy.deepcopy(atlas.model))
         self.atlas = atlas
         # The path comes with the compiled model, so the config cannot name another file.
         self.atlas_path = atlas.path
@@ -129,7 +147,15 @@ class AtlasSimulator:
         self._mode_command = self._stand_command
         self._ragdoll_command = JointCommandArrays.zeros()
         self.sim_time_ns = 0
-        self.pinned = False
+        self.startup_mode = startup_mode
+        # VRCPlugin's cheats (modes, teleport, cmd_vel, pelvis wrench, kinematic playback).
+        self.vrc = VrcState(atlas, self.data)
+        #: How many inputs were applied since the last reset, and the last one (sim time (ns)
+        #: before the step it first acted in, input): /atlas/sim_inputs publishes each for
+        #: replay. Only a count is kept: a 1 kHz wrench stream must not grow a list.
+        self.inputs_since_reset = 0
+        self._last_input: tuple[int, SimInput] | None = None
+        self._release_pending = False
         self.reset_world()
 
     def _make_compiled_laws(self) -> None:
@@ -166,8 +192,20 @@ class AtlasSimulator:
         self.torque_nm[:] = 0.0
         # A reset robot waits for fresh commands rather than jumping to a stale target.
         self.user_command = None
+        self.vrc.reset()
+        self.inputs_since_reset = 0
+        self._last_input = None
         self._pin_until_ns = self.sim_time_ns + int(round(self.time_to_unpin_s * NS_PER_S))
-        self._set_pinned(self.time_to_unpin_s > 0.0)
+        startup = self.startup_mode
+        if startup is VrcMode.PINNED:
+            # DRCSim's: pinned with gravity off, nominal after time_to_unpin (0: for good).
+            self.vrc.set_mode(VrcMode.PINNED)
+            self._release_pending = self.time_to_unpin_s > 0.0
+        elif startup is VrcMode.BDI_STAND:
+            self._release_pending = False
+        else:  # the port's historical start: pinned with gravity for time_to_unpin
+            self._set_pinned(self.time_to_unpin_s > 0.0)
+            self._release_pending = self.pinned
         if self.mode in (ControlMode.FREEZE, ControlMode.USER):
             self._mode_command = self._hold_current_pose()
 
@@ -175,7 +213,8 @@ class AtlasSimulator:
         """What re-creates this run offline: the model, its step, pinning and last reset."""
         return SimConfig(model_file=self.atlas_path.name, model_sha1=self.atlas_sha1,
                          timestep_s=self.dt_s, time_to_unpin_s=self.time_to_unpin_s,
-                         last_reset_time_s=self.last_reset_ns / NS_PER_S)
+                         last_reset_time_s=self.last_reset_ns / NS_PER_S,
+                         startup_mode=self.startup_mode.value)
 
     def reset_simulation(self, sim_time_ns: int = 0) -> None:
         """reset_world, and sim time back to `sim_time_ns`.
@@ -187,7 +226,49 @@ class AtlasSimulator:
 
     def _set_pinned(self, pinned: bool) -> None:
         atlas_model.set_pelvis_pinned(self.atlas, self.data, pinned)
-        self.pinned = pinned
+
+    @property
+    def pinned(self) -> bool:
+        """The pelvis is welded (the start-up pin, a pinned mode, or cmd_vel's warp)."""
+        return self.vrc.is_pinned()
+
+    @property
+    def playing(self) -> bool:
+        """A /joint_trajectory is playing: physics is off."""
+        return self.vrc.playback is not None
+
+    # -- VRCPlugin's inputs ----------------------------------------------------------------
+    def apply_input(self, item: SimInput) -> None:
+        """Apply one checked input now, between two steps, and log it for replay.
+
+        An explicit /atlas/mode cancels the start-up release (the user's mode stays);
+        `bdi_stand` also switches the control mode to Stand (the port's stand-in for BDI's
+        stand behaviour).
+        """
+        vrc = self.vrc
+        if isinstance(item, ModeInput):
+            self._release_pending = False
+            vrc.set_mode(item.mode)
+            if item.mode is VrcMode.BDI_STAND:
+                self.set_mode(ControlMode.STAND)
+        elif isinstance(item, PoseInput):
+            vrc.set_pose(item)
+        elif isinstance(item, CmdVelInput):
+            vrc.set_cmd_vel(item)
+        elif isinstance(item, WrenchInput):
+            vrc.set_wrench(item)
+        elif isinstance(item, TrajectoryInput):
+            vrc.start_playback(item, self.sim_time_ns)
+        else:  # pragma: no cover - the union is closed
+            raise TypeError(f'not a simulator input: {item!r}')
+        self.inputs_since_reset += 1
+        self._last_input = (self.sim_time_ns, item)
+
+    def last_input_event(self) -> InputEvent:
+        """The input apply_input logged last, as /atlas/sim_inputs carries it."""
+        assert self._last_input is not None, 'no input applied since the last reset'
+        time_ns, item = self._last_input
+        return InputEvent(time_ns, self.last_reset_ns, self.inputs_since_reset - 1, item)
 
     def joint_positions(self) -> np.ndarray:
         return atlas_model.joint_positions(self.atlas, self.data)
@@ -320,8 +401,16 @@ class AtlasSimulator:
         Raises:
             PhysicsDivergenceError: the new state is not finite (the caller resets).
         """
-        if self.pinned and self.sim_time_ns >= self._pin_until_ns:
-            self._set_pinned(False)
+        if self._release_pending and self.sim_time_ns >= self._pin_until_ns:
+            self._release_pending = False
+            if self.startup_mode is VrcMode.PINNED:
+                self.vrc.set_mode(VrcMode.NOMINAL)
+            else:
+                self._set_pinned(False)
+        vrc = self.vrc
+        if vrc.active:
+            self._step_with_cheats(torque_nm)
+            return
         if torque_nm is not None:
             self.torque_nm[:] = torque_nm
             self.data.ctrl[:] = self.torque_nm
@@ -338,6 +427,36 @@ class AtlasSimulator:
         mujoco.mj_step(self.model, self.data)
         # mj_step integrates last: joint positions/velocities are at the new time, while body
         # poses and sensor readings were computed before integrating, at the step's start.
+        self.state_time_ns = self.sim_time_ns
+        self.sim_time_ns += self.step_ns
+        self._check_divergence()
+
+    def _step_with_cheats(self, torque_nm: np.ndarray | None) -> None:
+        """step() while a cheat acts: kinematic playback (physics off, no torque), or the
+        warp and the extra body forces around the usual step."""
+        vrc = self.vrc
+        if vrc.playback is not None:
+            vrc.playback_step(self.sim_time_ns)
+            self.torque_nm[:] = 0.0
+            self.data.ctrl[:] = 0.0
+            self.state_time_ns = self.sim_time_ns
+            self.sim_time_ns += self.step_ns
+            self.data.time = self.sim_time_ns / NS_PER_S
+            return
+        vrc.warp_step(self.dt_s)
+        data = self.data
+        viewer_xfrc = data.xfrc_applied.copy()  # the viewer's mouse forces, if any
+        data.xfrc_applied += vrc.xfrc
+        if torque_nm is not None:
+            self.torque_nm[:] = torque_nm
+            data.ctrl[:] = self.torque_nm
+        elif self._compiled_law is not None:
+            self._compiled_law(self.active_command())
+        else:
+            self._law_torque(self._pid, out=self.torque_nm)
+            data.ctrl[:] = self.torque_nm
+        mujoco.mj_step(self.model, data)
+        data.xfrc_applied[:] = viewer_xfrc
         self.state_time_ns = self.sim_time_ns
         self.sim_time_ns += self.step_ns
         self._check_divergence()

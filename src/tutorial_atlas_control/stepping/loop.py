@@ -37,6 +37,7 @@ from tutorial_atlas_control.msgs.wire import ControllerStatisticsWire, clock_byt
 from tutorial_atlas_control.sim.controller import Gains
 from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistics
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode, PhysicsDivergenceError
+from tutorial_atlas_control.sim.vrc import SimInput, describe_input
 from tutorial_atlas_control.stepping.pacing import Pacer
 from tutorial_atlas_control.stepping.schedule import STAMPED_AT_STEP_END, steps_between
 from tutorial_atlas_control.units import NS_PER_S
@@ -50,6 +51,9 @@ DIVERGENCE_REPEAT_S = 1.0
 MAX_DIVERGENCES_IN_A_ROW = 3
 #: Commands waiting for the next step, at most (a second of 10 kHz of them).
 MAX_PENDING_COMMANDS = 10_000
+#: An applied input of a kind is logged at most once per this much sim time (s): a
+#: disturbance generator streaming a wrench at 1 kHz must not flood /rosout.
+INPUT_LOG_PERIOD_S = 1.0
 #: While paused, the loop looks for commands and shutdown this often (s, wall).
 PAUSED_POLL_S = 0.01
 #: The per-step messages: topic, key of its rate in `rates_hz`, name in
@@ -175,14 +179,18 @@ class SteppingLoop:
         paused: start with physics paused.
         pacer: the wall-time decisions (default: a Pacer at real_time_factor; tests give
             one with a fake clock).
+        publish_input: sends /atlas/sim_inputs' JSON of each applied cheat (None: nowhere).
     """
 
     def __init__(self, sim: AtlasSimulator, outbox: Outbox, outlets: Mapping[str, Hashable],
                  rates_hz: Mapping[str, float], statistics: CommandAgeStatistics,
                  log: LoopLog, publish_config: Callable[[str], None],
                  real_time_factor: float = 0.0, paused: bool = False,
-                 pacer: Pacer | None = None) -> None:
+                 pacer: Pacer | None = None,
+                 publish_input: Callable[[str], None] | None = None) -> None:
         self.sim = sim
+        self._send_input = publish_input
+        self._input_logged_ns: dict[str, int] = {}  # kind -> sim time it was last logged
         self.lock = threading.Lock()
         self.outbox = outbox
         self.log = log
@@ -378,6 +386,20 @@ class SteppingLoop:
             previous = self.sim.mode
             self.sim.set_mode(mode)
         return previous
+
+    def apply_input(self, item: SimInput) -> None:
+        """Apply one checked VRCPlugin input between two steps, then log and publish it (the
+        replay re-applies it before the same step)."""
+        with self.lock:
+            self.sim.apply_input(item)
+            event = self.sim.last_input_event()
+        if self._send_input is not None:
+            self._send_input(event.to_json())
+        last_ns = self._input_logged_ns.get(item.kind)
+        if last_ns is None or not 0 <= event.time_ns - last_ns < INPUT_LOG_PERIOD_S * NS_PER_S:
+            self._input_logged_ns[item.kind] = event.time_ns
+            self.log.info(f'applied at t={event.time_ns / NS_PER_S:.3f} s: '
+                          f'{describe_input(item)}')
 
     def publish_config(self) -> None:
         """(Re-)publish /atlas/sim_config: at start and after every reset."""

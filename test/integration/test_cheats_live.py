@@ -1,0 +1,139 @@
+"""VRCPlugin's topics and /gazebo/reset_models against a running, recording atlas.launch.
+
+Bad input on every new topic is refused with one line naming the topic, nothing is applied
+(no /atlas/sim_inputs, the pose unchanged) and the simulator keeps stepping; good input is
+applied (set_pose within 1 mm, a held pelvis push topples the robot); reset_models resets;
+and the recorded bag, inputs and all, replays offline bit for bit and shows the inputs on
+analyze_bag's timeline.
+
+Run with `python3 -m pytest test/integration/test_cheats_live.py -q -s` after `source
+env.sh` (needs roslaunch and the workspace's messages; skipped otherwise). Wall time about
+60-90 s (each `rostopic pub -1` takes a second or two).
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
+pytest.importorskip('trajectory_msgs.msg', reason='needs python3-trajectory-msgs')
+if shutil.which('roslaunch') is None:
+    pytest.skip('roslaunch is not on PATH (source env.sh)', allow_module_level=True)
+
+from support.bag_checks import count
+from support.launch import EXIT_TIMEOUT_S, TestLaunch
+from tutorial_atlas_control import topics
+from tutorial_atlas_control.bags.analysis import analyze_bag
+from tutorial_atlas_control.bags.reader import read_bag
+from tutorial_atlas_control.offline.replay import replay_bag
+
+pytestmark = pytest.mark.filterwarnings('ignore::DeprecationWarning')
+
+#: (topic, type, bad message as rostopic pub YAML, what the refusal says).
+BAD_INPUTS = (
+    (topics.MODE, 'std_msgs/String', "{data: flying}",
+     "refused /atlas/mode: unknown mode 'flying'; valid modes: harnessed, pinned, "
+     'pinned_with_gravity, nominal, feet, no_gravity, bdi_stand; nothing applied'),
+    (topics.SET_POSE, 'geometry_msgs/Pose', '{position: {z: 1.0}}',
+     'refused /atlas/set_pose: orientation is a zero quaternion (set w = 1 for upright); '
+     'nothing applied'),
+    (topics.CMD_VEL, 'geometry_msgs/Twist', '{linear: {x: .nan}}',
+     'refused /atlas/cmd_vel: linear velocity is not finite (nan); nothing applied'),
+    (topics.APPLY_PELVIS_FORCE, 'geometry_msgs/Wrench', '{force: {x: 1.0e+9}}',
+     'refused /atlas/apply_pelvis_force: force 1e+09 exceeds 100000; nothing applied'),
+    (topics.JOINT_TRAJECTORY, 'trajectory_msgs/JointTrajectory',
+     '{joint_names: [l_arm_shx, l_wing], points: [{positions: [0, 0]}]}',
+     "refused /joint_trajectory: unknown joint name 'l_wing'; nothing applied"),
+    (topics.JOINT_TRAJECTORY, 'trajectory_msgs/JointTrajectory',
+     '{joint_names: [l_arm_shx], points: [{positions: [0], time_from_start: {secs: 1}}, '
+     '{positions: [0.1], time_from_start: {secs: 1}}]}',
+     'refused /joint_trajectory: time_from_start not increasing at point 1 (1 s after 1 s); '
+     'nothing applied'),
+)
+GOOD_INPUTS = (
+    (topics.MODE, 'std_msgs/String', '{data: pinned}'),
+    (topics.SET_POSE, 'geometry_msgs/Pose',
+     '{position: {x: 0.5, y: -0.25, z: 1.0}, orientation: {w: 1.0}}'),
+    (topics.JOINT_TRAJECTORY, 'trajectory_msgs/JointTrajectory',
+     '{joint_names: [l_arm_shx, atlas::r_arm_shx], points: ['
+     '{positions: [-0.5, 0.5]}, {positions: [-1.0, 1.0], time_from_start: {nsecs: 200000000}}]}'),
+    (topics.CMD_VEL, 'geometry_msgs/Twist', '{linear: {x: 0.2}, angular: {z: 0.3}}'),
+    (topics.CMD_VEL, 'geometry_msgs/Twist', '{}'),
+    (topics.MODE, 'std_msgs/String', '{data: nominal}'),
+)
+#: DRCSim-era push: 300 N forward on the pelvis, held about 0.5 s of sim time, then zero.
+PUSH = '{force: {x: 300.0}}'
+
+
+def publish(launch: TestLaunch, topic: str, msg_type: str, yaml_text: str) -> None:
+    result = launch.run('rostopic', 'pub', '-1', topic, msg_type, '--', yaml_text)
+    assert result.returncode == 0, result.stderr
+
+
+def pelvis_position(launch: TestLaunch) -> tuple[float, float, float]:
+    result = launch.run('rostopic', 'echo', '-n', '1', '--noarr',
+                        '/ground_truth_odom/pose/pose/position')
+    assert result.returncode == 0, result.stderr
+    fields = dict(line.split(': ') for line in result.stdout.splitlines() if ': ' in line)
+    return float(fields['x']), float(fields['y']), float(fields['z'])
+
+
+def test_cheats_live_refusals_effects_reset_models_and_exact_replay(tmp_path: Path) -> None:
+    with TestLaunch(tmp_path) as launch:
+        launch.wait_ready()
+        launch.wait(lambda: '/atlas_sim' in launch.subscribers(topics.JOINT_TRAJECTORY),
+                    120.0, 'the simulator did not subscribe to /joint_trajectory')
+        launch.wait_sim_until(1.5)
+        before = pelvis_position(launch)
+        for topic, msg_type, yaml_text, refusal in BAD_INPUTS:
+            publish(launch, topic, msg_type, yaml_text)
+            launch.wait(lambda refusal=refusal: refusal in launch.output(), 30.0,
+                        f'no refusal line {refusal!r}')
+        publish(launch, topics.CONFIGURATION, 'sensor_msgs/JointState',
+                '{name: [l_arm_shx], position: [1.0]}')
+        launch.wait(lambda: '/atlas/configuration is not implemented' in launch.output(),
+                    30.0, 'no not-implemented line for /atlas/configuration')
+        after = pelvis_position(launch)
+        # Standing, the robot sways by about a centimetre; a teleport or push moves it metres.
+        assert after[2] > 0.9 and max(abs(a - b) for a, b in zip(before, after)) < 0.05
+        assert 'applied at t=' not in launch.output(), 'a refused input was applied'
+
+        for topic, msg_type, yaml_text in GOOD_INPUTS[:2]:
+            publish(launch, topic, msg_type, yaml_text)
+        launch.wait_sim_s(0.5)
+        x, y, z = pelvis_position(launch)  # pinned there: the teleport stays put
+        assert abs(x - 0.5) < 1e-3 and abs(y + 0.25) < 1e-3 and abs(z - 1.0) < 1e-3
+        for topic, msg_type, yaml_text in GOOD_INPUTS[2:]:
+            publish(launch, topic, msg_type, yaml_text)
+            launch.wait_sim_s(0.3)
+
+        launch.run('rosservice', 'call', topics.RESET_MODELS_SERVICE)
+        launch.wait(lambda: 'reset_world: robot back to its initial pose' in launch.output(),
+                    30.0, '/gazebo/reset_models did not reset the world')
+        launch.wait_sim_s(1.5)  # unpinned, standing
+        publish(launch, topics.APPLY_PELVIS_FORCE, 'geometry_msgs/Wrench', PUSH)
+        launch.wait_sim_s(0.5)
+        publish(launch, topics.APPLY_PELVIS_FORCE, 'geometry_msgs/Wrench', '{}')
+        launch.wait_sim_s(3.0)
+        assert pelvis_position(launch)[2] < 0.5, 'the 300 N push toppled the robot'
+        launch.interrupt(EXIT_TIMEOUT_S)
+        bag = launch.bag()
+
+    applied = len(GOOD_INPUTS) + 2  # and the push and its release, after the reset
+    assert count(bag, topics.SIM_INPUTS) == applied
+    for topic in (topics.MODE, topics.SET_POSE, topics.CMD_VEL, topics.APPLY_PELVIS_FORCE,
+                  topics.JOINT_TRAJECTORY):
+        assert count(bag, topic) > 0, f'{topic} is recorded'
+    result = replay_bag(bag)
+    print(f'figures: replay after reset_models with a 300 N push: '
+          f'{result.recorded_steps} steps, max joint deviation {result.joint_position.max_abs}')
+    assert result.resets_in_bag == 1
+    assert result.joint_position.max_abs == 0.0 and result.pelvis_position.max_abs == 0.0
+    assert result.reproduced
+    timeline = [text for _, text in analyze_bag(bag).input_timeline]
+    assert timeline[0] == '/atlas/mode mode=pinned'
+    assert timeline[-2].startswith('/atlas/apply_pelvis_force force=[300.0, 0.0, 0.0]')
+    assert read_bag(bag).sim_inputs
