@@ -21,7 +21,12 @@ from typing import Any
 import numpy as np
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.bags.analysis import FALL_HEIGHT_M, Analysis, analyze_bag
+from tutorial_atlas_control.bags.analysis import (
+    FALL_HEIGHT_M,
+    Analysis,
+    analyze_bag,
+)
+from tutorial_atlas_control.bags.analysis import first_applied_command_s as first_applied_command
 from tutorial_atlas_control.bags.report import json_safe, save_figure
 from tutorial_atlas_control.bags.run_log import PlayedTrajectory, played_trajectories
 from tutorial_atlas_control.errors import BagAnalysisError
@@ -34,7 +39,6 @@ __all__ = ['ALIGNED_ON', 'Comparison', 'JointDifference', 'compare', 'compare_ba
 ALIGNED_ON = 'first applied joint command'
 ALIGNED_ON_DETAIL = ('the first /atlas/joint_commands at or after the switch to User mode '
                      '(header stamp; the first command if the bag has no mode switch)')
-USER_MODE = 'User'
 #: Plot: decimate longer series to about this many points.
 PLOT_MAX_POINTS = 4000
 PLOT_ROW_HEIGHT_IN = 1.6
@@ -102,16 +106,11 @@ def first_applied_command_s(analysis: Analysis) -> float:
         BagAnalysisError: the bag has no joint commands (nothing to align on).
     """
     data = analysis.data
-    commands = data.commands
-    if commands is None or not len(commands.t_s):
+    first_s = first_applied_command(data)
+    if first_s is None:
         raise BagAnalysisError(f'{data.path} has no {topics.JOINT_COMMANDS}: cannot align it on '
                                f'its {ALIGNED_ON}.')
-    user_s = next((t_s for t_s, mode in data.modes if mode == USER_MODE), None)
-    if user_s is not None:
-        after = np.flatnonzero(commands.t_s >= user_s)
-        if len(after):
-            return float(commands.t_s[after[0]])
-    return float(commands.t_s[0])
+    return first_s
 
 
 def _held_commands(analysis: Analysis, t_s: np.ndarray, align_s: float) -> np.ndarray:
