@@ -130,10 +130,13 @@ def _rows(t_s: np.ndarray, start_s: float, end_s: float) -> np.ndarray:
 def window(data: BagData, start_s: float, end_s: float) -> BagData:
     """`data` cut to [start_s, end_s) on the run timeline, times unchanged.
 
+    An `end_s` at or after the bag's end keeps everything to the end (its last message).
     The control mode in force at `start_s` is kept as the window's first mode, and the
     commands' held positions are re-held from the window's first command (so a try does
     not inherit the targets of the try before it).
     """
+    if end_s >= data.duration_s:
+        end_s = np.inf
     states = data.joint_states
     if states is not None:
         rows = _rows(states.t_s, start_s, end_s)
