@@ -124,11 +124,22 @@ class IndexedBag(_ReaderBag):
         return times_ns, keys
 
     def _find_epochs(self) -> None:
-        """Where record times go back (file order), and each epoch's shift to run time."""
+        """Where record times go back (file order), and each epoch's shift to run time.
+
+        A rewind is a message recorded more than REWIND_NS before the one before it on the
+        same connection: writers that write a block per topic (offline runs) are in time
+        order per connection only. The epochs' boundaries are the rewinds of the connection
+        that shows the most (a dense one such as /clock); a live recorder writes in arrival
+        order, so file positions then order the other connections' messages against them.
+        """
+        self._epoch_keys = np.empty(0, dtype=np.int64)
+        for connection in self.connections:
+            own_ns, own_keys = self._in_file_order([connection])
+            rewinds = own_keys[np.flatnonzero(np.diff(own_ns) < -REWIND_NS) + 1]
+            if len(rewinds) > len(self._epoch_keys):
+                self._epoch_keys = rewinds
         times_ns, keys = self._in_file_order(self.connections)
-        # A rewind: a time more than REWIND_NS below the one recorded just before it.
-        starts = np.flatnonzero(np.diff(times_ns) < -REWIND_NS) + 1
-        self._epoch_keys = keys[starts]
+        starts = np.searchsorted(keys, self._epoch_keys)
         self._shifts_ns = [0]
         self._starts_ns: list[int] = []
         bounds = [0, *starts.tolist(), len(times_ns)]

@@ -246,8 +246,9 @@ def _decimate(t_s: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return t_s[::step], values[::step]
 
 
-def _plot_joint(ax: Any, name: str, data: BagData) -> None:
-    """Commanded (steps, held to the end of the run) and measured position of joint `name`."""
+def _plot_joint(ax: Any, name: str, data: BagData, resets_s: list[float]) -> None:
+    """Commanded (steps, held to the end of the run or the next reset, `resets_s`) and
+    measured position of joint `name`."""
     states, commands = data.joint_states, data.commands
     if commands is not None and name in JOINT_NAMES:
         sent = commands.position[:, JOINT_NAMES.index(name)]
@@ -256,6 +257,11 @@ def _plot_joint(ax: Any, name: str, data: BagData) -> None:
             t_s, values = commands.t_s[finite], sent[finite]
             if states is not None and len(states.t_s) and states.t_s[-1] > t_s[-1]:
                 t_s, values = np.append(t_s, states.t_s[-1]), np.append(values, values[-1])
+            if resets_s:  # a reset drops the held command: break the line there
+                t_s = np.append(t_s, resets_s)
+                values = np.append(values, np.full(len(resets_s), np.nan))
+                order = np.argsort(t_s, kind='stable')
+                t_s, values = t_s[order], values[order]
             ax.plot(t_s, values, drawstyle='steps-post', color='tab:orange', label='commanded')
     if states is not None:
         ax.plot(*_decimate(states.t_s, states.position[:, states.names.index(name)]),
@@ -339,8 +345,9 @@ def plot_run(analysis: Analysis, path: Path | str) -> Path:
     fig, axes = plt.subplots(max(rows, 1), 1, sharex=True, squeeze=False,
                              figsize=(PLOT_WIDTH_IN, PLOT_ROW_HEIGHT_IN * max(rows, 2) + 1.0))
     axes = list(axes[:, 0])
+    resets_s = [each.window.start_s for each in analysis.tries if each.window.cause != RUN_START]
     for ax, name in zip(axes, names):
-        _plot_joint(ax, name, data)
+        _plot_joint(ax, name, data, resets_s)
     if data.pelvis is not None:
         _plot_pelvis(axes[len(names)], analysis)
     if rows == 0:

@@ -39,6 +39,9 @@ RUN_START = 'start'
 RESET_WORLD = 'reset_world'
 RESET_SIMULATION = 'reset_simulation'
 TIME_WENT_BACK = 'sim time went back'
+#: A reset_world try starts this long (s) after the reset's time, half a 1 ms step: the
+#: simulator's joint state stamped at that time was published before the reset.
+_AFTER_RESET_S = 0.0005
 #: A rewind of sim time this close (s, run time) to a config's reset is that reset.
 _SAME_RESET_S = 2.0 * EPOCH_GAP_NS / NS_PER_S
 
@@ -85,7 +88,8 @@ def _config_resets(data: BagData) -> list[tuple[float, str, str]]:
             start_s = max(data.run_time_s(0.0, data.epoch_at(rewind_s)), rewind_s)
             resets.append((start_s, RESET_SIMULATION, text))
         else:
-            start_s = min(max(data.run_time_s(last_reset_s, epoch), 0.0), t_s)
+            # The joint state stamped at the reset time is the last one before it.
+            start_s = min(max(data.run_time_s(last_reset_s, epoch), 0.0), t_s) + _AFTER_RESET_S
             resets.append((start_s, RESET_WORLD, text))
     return resets
 
