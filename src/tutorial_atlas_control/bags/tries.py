@@ -59,10 +59,6 @@ class Try:
     cause: str
     config: str | None
 
-    def contains(self, t_s: np.ndarray) -> np.ndarray:
-        """Which of times `t_s` fall in this try."""
-        return (t_s >= self.start_s) & (t_s < self.end_s)
-
 
 def _last_reset_s(text: str) -> float | None:
     """The config's last_reset_time (s of sim time), None if the text has none."""
