@@ -64,6 +64,8 @@ def test_session_is_split_into_three_tries(session_bag: Path) -> None:
     assert tries[2].start_s == pytest.approx(tries[1].start_s + 6.0 + 1.0 - 0.01, abs=0.011)
     assert data.sim_time_s(tries[2].start_s + 2.0) == pytest.approx(2.0, abs=0.011)
     assert np.all(np.diff(data.joint_states.t_s) > 0)  # one rising timeline, no interleaving
+    # Topic rates over the time recorded: not inflated by the rewind, nor diluted by the gap.
+    assert data.topics['/atlas/joint_states'].rate_hz == pytest.approx(100.0, rel=1e-3)
 
 
 def test_each_try_gets_its_own_summary(session_bag: Path) -> None:

@@ -28,7 +28,7 @@ from rosbags.interfaces import Connection
 from rosbags.rosbag1 import ReaderError
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.bags.records import REWIND_NS, BagRecords, open_bag
+from tutorial_atlas_control.bags.records import EPOCH_GAP_NS, REWIND_NS, BagRecords, open_bag
 from tutorial_atlas_control.bags.run_log import PlayedTrajectory, trajectory_lines
 from tutorial_atlas_control.bags.typestore import (
     JOINT_COMMANDS_TYPE,
@@ -274,16 +274,20 @@ class _Reading:
                    connections: Sequence[Connection], zero_unset: bool) -> np.ndarray:
         """Header stamps (sim time, ns) moved to the run timeline, as the bag times are.
 
-        A message stamped before a reset_simulation but recorded after it (its stamp far
-        ahead of its record time) keeps the epoch it was stamped in. `zero_unset`: a zero
-        stamp means "not stamped" (commands) and stays 0, else it is sim time 0 (states).
+        A message whose stamp is far from its record time around a reset_simulation (stamped
+        before it and recorded after it, or the other way round) keeps the epoch it was
+        stamped in. `zero_unset`: a zero stamp means "not stamped" (commands) and stays 0,
+        else it is sim time 0 (states).
         """
         shifts_ns = np.asarray(self.records.epoch_shifts_ns, dtype=np.int64)
         if len(shifts_ns) == 1:
             return stamps_ns
         epochs = self.records.epochs(connections)
-        late = (epochs > 0) & (stamps_ns > bag_ns - shifts_ns[epochs] + REWIND_NS)
-        epochs = np.where(late, epochs - 1, epochs)
+        recorded_ns = bag_ns - shifts_ns[epochs]
+        stamped = (stamps_ns > 0) | (not zero_unset)
+        late = stamped & (epochs > 0) & (stamps_ns > recorded_ns + REWIND_NS)
+        early = stamped & (epochs < len(shifts_ns) - 1) & (stamps_ns < recorded_ns - REWIND_NS)
+        epochs = np.where(late, epochs - 1, np.where(early, epochs + 1, epochs))
         shifted = stamps_ns + shifts_ns[epochs]
         return np.where(stamps_ns > 0, shifted, stamps_ns) if zero_unset else shifted
 
@@ -474,8 +478,11 @@ def _topic_summaries(records: BagRecords, by_topic: dict[str, list[Connection]])
             first_ns, last_ns = int(times_ns[0]), int(times_ns[-1])
             start_ns = first_ns if start_ns is None else min(start_ns, first_ns)
             end_ns = last_ns if end_ns is None else max(end_ns, last_ns)
-            if last_ns > first_ns:
-                rate_hz = (len(times_ns) - 1) / ((last_ns - first_ns) / NS_PER_S)
+            # Over the time recorded: without the gaps put between epochs (reset_simulation).
+            gaps = sum(first_ns < epoch_ns < last_ns for epoch_ns in records.epoch_starts_ns)
+            span_ns = last_ns - first_ns - gaps * EPOCH_GAP_NS
+            if span_ns > 0:
+                rate_hz = (len(times_ns) - 1) / (span_ns / NS_PER_S)
         # 'sensor_msgs/msg/JointState' -> 'sensor_msgs/JointState', as rosbag info shows it.
         msgtypes = sorted({c.msgtype.replace('/msg/', '/') for c in connections})
         summaries[topic] = TopicSummary(' | '.join(msgtypes), len(times_ns), rate_hz)

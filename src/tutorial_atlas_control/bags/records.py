@@ -98,8 +98,10 @@ class IndexedBag(_ReaderBag):
 
     reader_class = BlockIndexReader
     _reader: BlockIndexReader
-    #: File positions (chunk position << 32 | offset) where epochs 1, 2, ... start.
-    _epoch_keys: np.ndarray
+    #: With resets: every message's file position (chunk position << 32 | offset), in file
+    #: order, and its epoch; empty without.
+    _keys: np.ndarray
+    _epochs: np.ndarray
     _shifts_ns: list[int]
 
     def open(self) -> None:
@@ -118,37 +120,42 @@ class IndexedBag(_ReaderBag):
         chunk_pos = np.repeat([pos for pos, _ in blocks],
                               [len(entries) for _, entries in blocks]).astype(np.int64)
         keys = (chunk_pos << 32) | entries['offset'].astype(np.int64)
-        if len(connections) > 1:  # Reader.open sorts each connection's blocks by position
-            in_file = np.argsort(keys, kind='stable')
-            times_ns, keys = times_ns[in_file], keys[in_file]
-        return times_ns, keys
+        # A chunk's index is in time order (rosbag sorts it), not always in file order.
+        in_file = np.argsort(keys, kind='stable')
+        return times_ns[in_file], keys[in_file]
 
     def _find_epochs(self) -> None:
-        """Where record times go back (file order), and each epoch's shift to run time.
+        """Which epoch each message belongs to, and each epoch's shift to run time.
 
-        A rewind is a message recorded more than REWIND_NS before the one before it on the
-        same connection: writers that write a block per topic (offline runs) are in time
-        order per connection only. The epochs' boundaries are the rewinds of the connection
-        that shows the most (a dense one such as /clock); a live recorder writes in arrival
-        order, so file positions then order the other connections' messages against them.
+        Only when some connection's record times go back by more than REWIND_NS: writers
+        that write a block per topic (offline runs) are in time order per connection only,
+        and have no resets. A live recorder writes in arrival order, so a new epoch starts
+        at each message recorded more than REWIND_NS before the one written just before it.
         """
-        self._epoch_keys = np.empty(0, dtype=np.int64)
-        for connection in self.connections:
-            own_ns, own_keys = self._in_file_order([connection])
-            rewinds = own_keys[np.flatnonzero(np.diff(own_ns) < -REWIND_NS) + 1]
-            if len(rewinds) > len(self._epoch_keys):
-                self._epoch_keys = rewinds
-        times_ns, keys = self._in_file_order(self.connections)
-        starts = np.searchsorted(keys, self._epoch_keys)
+        self._keys = self._epochs = np.empty(0, dtype=np.int64)
         self._shifts_ns = [0]
         self._starts_ns: list[int] = []
+        rewinds = any(np.any(np.diff(self._in_file_order([connection])[0]) < -REWIND_NS)
+                      for connection in self.connections)
+        if not rewinds:
+            return
+        times_ns, self._keys = self._in_file_order(self.connections)
+        starts = np.flatnonzero(np.diff(times_ns) < -REWIND_NS) + 1
+        self._epochs = np.zeros(len(times_ns), dtype=np.int64)
+        self._epochs[starts] = 1
+        self._epochs = np.cumsum(self._epochs)
         bounds = [0, *starts.tolist(), len(times_ns)]
         for epoch in range(1, len(bounds) - 1):
-            previous = times_ns[bounds[epoch - 1]:bounds[epoch]]
-            end_ns = int(previous.max()) + self._shifts_ns[-1]
+            end_ns = int(times_ns[bounds[epoch - 1]:bounds[epoch]].max()) + self._shifts_ns[-1]
             first_ns = int(times_ns[bounds[epoch]:bounds[epoch + 1]].min())
             self._shifts_ns.append(end_ns + EPOCH_GAP_NS - first_ns)
             self._starts_ns.append(end_ns + EPOCH_GAP_NS // 2)
+
+    def _epochs_of(self, keys: np.ndarray) -> np.ndarray:
+        """The epochs of the messages at file positions `keys`."""
+        if not len(self._keys):
+            return np.zeros(len(keys), dtype=np.int64)
+        return self._epochs[np.searchsorted(self._keys, keys)]
 
     @property
     def epoch_starts_ns(self) -> list[int]:
@@ -167,7 +174,7 @@ class IndexedBag(_ReaderBag):
         `Reader.messages` yields them.
         """
         times_ns, keys = self._in_file_order(connections)
-        epochs = np.searchsorted(self._epoch_keys, keys, side='right')
+        epochs = self._epochs_of(keys)
         times_ns = times_ns + np.asarray(self._shifts_ns, dtype=np.int64)[epochs]
         order = np.argsort(times_ns, kind='stable')
         keys = keys[order]
