@@ -31,7 +31,7 @@ def test_help_works_from_anywhere(script: str) -> None:
 
 
 @pytest.mark.parametrize(('script', 'args', 'message'), [
-    ('analyze_bag.py', [], 'the following arguments are required: BAG'),
+    ('analyze_bag.py', ['run.bag', '--latest'], 'give BAG or --latest, not both'),
     ('replay_bag.py', ['run.bag', '--tolerance', '-1'], "argument --tolerance: '-1' is not"),
     ('run_demo.py', ['--video-size', 'big'], "argument --video-size: 'big' is not WIDTHxHEIGHT"),
     ('run_offline.py', ['Traj_data2.yaml', 'touchdown', '--settle', '-1'],

@@ -42,8 +42,8 @@ def interrupt(*_args: object, **_kwargs: object) -> None:
 
 
 @pytest.mark.parametrize(('main', 'target', 'argv'), [
-    (analyze_bag.main, (analyze_bag, 'analyze_bag'), ['run.bag']),
-    (analyze_bag.main, (analyze_bag, 'compare_bags'), ['a.bag', '--compare', 'b.bag']),
+    (analyze_bag.main, (analyze_bag, 'read_bag'), ['run.bag']),
+    (analyze_bag.main, (analyze_bag, 'read_bag'), ['a.bag', '--compare', 'b.bag']),
     (replay_bag.main, (replay_bag, 'replay_bag'), ['run.bag']),
     (run_offline.main, (run_offline, 'run_offline'), [str(TRAJECTORY_FILE), 'touchdown']),
     (run_demo.main, (demo, 'run_demo'), ['touchdown']),

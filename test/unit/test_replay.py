@@ -82,6 +82,8 @@ class Run:
     record_from_step: int = 1
     with_config: bool = True
     records: list[Record] = field(default_factory=list)
+    #: Records before a reset_simulation, in record order.
+    earlier: list[Record] = field(default_factory=list)
 
     def __post_init__(self) -> None:
         self.atlas = atlas_model.load_model()
@@ -122,7 +124,17 @@ class Run:
         self.sim.reset_world()
         self._publish_config()
 
+    def reset_simulation(self) -> None:
+        """Sim time back to 0: the records so far come first in the bag (record order)."""
+        self.sim.reset_simulation()
+        self.earlier += sorted(self.records, key=lambda record: record.t_s)
+        self.records = []
+        self._publish_config()
+
     def write(self, path: Path) -> Path:
+        if self.earlier:
+            return write_bag(path, self.earlier + sorted(self.records, key=lambda r: r.t_s),
+                             in_given_order=True)
         return write_bag(path, self.records)
 
 
@@ -192,6 +204,40 @@ def test_mid_run_reset_replays_the_last_segment(tmp_path: Path) -> None:
     assert result.joint_position.max_abs == 0.0 and result.pelvis_position.max_abs == 0.0
     assert any('1 reset(s); replaying the last segment' in text for text in result.warnings)
     assert result.reproduced
+
+
+@pytest.fixture(scope='module')
+def three_tries(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Crouch 120 steps; reset_world; 100 steps; reset_simulation; crouch 150 steps."""
+    run = Run()
+    run.step(120, crouch)
+    run.reset_world()
+    run.step(100, lambda sim, step: crouch(sim, step, user_step=10_000, bend_step=150))
+    run.reset_simulation()
+    run.steps = 0
+    run.step(150, lambda sim, step: crouch(sim, step, user_step=10_000, bend_step=40))
+    return run.write(tmp_path_factory.mktemp('replay') / 'tries.bag')
+
+
+@pytest.mark.parametrize(('number', 'start_s', 'steps', 'end_s'), [
+    (1, 0.0, 120, 0.12), (2, 0.12, 100, 0.22), (3, 0.0, 150, 0.15), (None, 0.0, 150, 0.15)])
+def test_any_try_replays_exactly(three_tries: Path, number: int | None, start_s: float,
+                                 steps: int, end_s: float) -> None:
+    result = replay_bag(three_tries, try_number=number)
+    assert (result.try_number, result.tries) == (number or 3, 3)
+    assert result.start_time_s == start_s and result.end_time_s == pytest.approx(end_s)
+    assert result.recorded_steps == steps and result.reconstructed_steps == 0
+    assert result.joint_position.max_abs == 0.0 and result.joint_velocity.max_abs == 0.0
+    assert result.pelvis_position is not None and result.pelvis_position.max_abs == 0.0
+    assert result.pelvis_position.samples == steps // ODOM_EVERY
+    assert result.reproduced and result.resets_in_bag == 2
+
+
+def test_try_that_does_not_exist_is_one_line(three_tries: Path,
+                                             capsys: pytest.CaptureFixture[str]) -> None:
+    assert main([str(three_tries), '--try', '4']) == 1
+    assert capsys.readouterr().err == (f'replay_bag.py: error: {three_tries} holds 3 tries '
+                                       '(1..3); there is no try 4.\n')
 
 
 def test_bag_without_sim_config_assumes_the_defaults(tmp_path: Path) -> None:

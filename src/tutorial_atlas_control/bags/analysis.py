@@ -1,13 +1,15 @@
 """The tutorial's metrics of a recorded run: fall, tracking, command timing, effort limits.
 
 Works on the :class:`~tutorial_atlas_control.bags.reader.BagData` that bag_reader extracts;
-all times are seconds from the bag's start.
+all times are seconds from the bag's start (run timeline). A bag with resets is cut into
+tries (bags.tries): each try gets its own metrics, and the whole-run metrics never pair a
+state with a command of another try.
 """
 
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -21,6 +23,9 @@ from tutorial_atlas_control.bags.reader import (
     PelvisSeries,
     read_bag,
 )
+from tutorial_atlas_control.bags.run_log import PlayedTrajectory
+from tutorial_atlas_control.bags.tries import Try, find_tries, pick_try, window
+from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES
 
 __all__ = [
@@ -29,13 +34,20 @@ __all__ = [
     'EFFORT_LIMIT_TOLERANCE_NM',
     'FALL_HEIGHT_M',
     'MOVED_RANGE_RAD',
+    'USER_MODE',
     'Analysis',
     'EffortSaturation',
     'JointTracking',
+    'TryAnalysis',
     'analyze',
     'analyze_bag',
+    'analyze_try',
+    'first_applied_command_s',
     'input_timeline',
 ]
+
+#: The control mode in which the simulator obeys /atlas/joint_commands.
+USER_MODE = 'User'
 
 #: Pelvis height (m) below which the robot counts as fallen (standing is ~0.93 m).
 FALL_HEIGHT_M = 0.5
@@ -127,6 +139,7 @@ class Analysis:
     command_age_max_s: float | None
     effort_saturation: dict[str, EffortSaturation] | None
     unavailable: dict[str, str]
+    tries: list[TryAnalysis] = field(default_factory=list)
 
     @property
     def mode_timeline(self) -> list[tuple[float, str]]:
@@ -136,6 +149,22 @@ class Analysis:
     def input_timeline(self) -> list[tuple[float, str]]:
         """(time from the bag's start (s), description) of each applied VRCPlugin input."""
         return input_timeline(self.data)
+
+    def warnings(self) -> list[str]:
+        """The bag's warnings, and one when the run holds several tries."""
+        extra = []
+        if len(self.tries) > 1:
+            starts = ', '.join(f'{t.window.cause} at {t.window.start_s:.3f} s'
+                               for t in self.tries[1:])
+            extra.append(f'the bag holds {len(self.tries)} tries ({starts}); the whole-run '
+                         'figures span them all: see each try (--try N).')
+        return list(self.data.warnings) + extra
+
+    def falls(self) -> list[float]:
+        """The time (s) of every fall: one per try that fell."""
+        if not self.tries:
+            return [] if self.fall_time_s is None else [self.fall_time_s]
+        return [t.analysis.fall_time_s for t in self.tries if t.analysis.fall_time_s is not None]
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready dict (see analyze_bag --help for the keys and units)."""
@@ -167,7 +196,72 @@ class Analysis:
                            'command_change': COMMAND_CHANGE_RAD,
                            'effort_tolerance': EFFORT_LIMIT_TOLERANCE_NM},
             'unavailable': dict(self.unavailable),
-            'warnings': list(data.warnings),
+            'warnings': self.warnings,
+            'tries': [each.to_dict() for each in self.tries],
+        }
+
+
+def first_applied_command_s(data: BagData) -> float | None:
+    """Time (s) of the first /atlas/joint_commands at or after the switch to User mode.
+
+    The first command at all when the bag has no switch to User (None: no commands).
+    """
+    commands = data.commands
+    if commands is None or not len(commands.t_s):
+        return None
+    user_s = next((t_s for t_s, mode in data.modes if mode == USER_MODE), None)
+    if user_s is not None:
+        after = np.flatnonzero(commands.t_s >= user_s)
+        if len(after):
+            return float(commands.t_s[after[0]])
+    return float(commands.t_s[0])
+
+
+@dataclass(frozen=True)
+class TryAnalysis:
+    """One try's metrics (`analysis` of the try's window) and what was played in it.
+
+    `first_command_s`: the try's first applied command (s from bag start; None: none).
+    """
+
+    window: Try
+    analysis: Analysis
+    first_command_s: float | None
+    trajectories: list[PlayedTrajectory]
+
+    @property
+    def fall_after_command_s(self) -> float | None:
+        """Fall time from the try's first applied command (s); None: no fall or no command."""
+        fall_s = self.analysis.fall_time_s
+        if fall_s is None or self.first_command_s is None:
+            return None
+        return fall_s - self.first_command_s
+
+    def to_dict(self) -> dict[str, Any]:
+        a, data = self.analysis, self.analysis.data
+        return {
+            'try': self.window.number,
+            'start': self.window.start_s,
+            'end': self.window.end_s,
+            'sim_start': data.sim_time_s(self.window.start_s),
+            'began_with': self.window.cause,
+            'trajectory': (None if not self.trajectories else
+                           {'file': self.trajectories[0].file, 'name': self.trajectories[0].name}),
+            'trajectories': [{'file': p.file, 'name': p.name} for p in self.trajectories],
+            'mode_timeline': [{'time': t_s, 'mode': mode} for t_s, mode in data.modes],
+            'first_command': self.first_command_s,
+            'fell': a.fell,
+            'fall_time': a.fall_time_s,
+            'fall_after_command': self.fall_after_command_s,
+            'min_pelvis_height': a.min_pelvis_height_m,
+            'command_count': 0 if data.commands is None else len(data.commands.t_s),
+            'command_rate': a.command_rate_hz,
+            'command_age': (None if a.command_age_mean_s is None else
+                            {'mean': a.command_age_mean_s, 'max': a.command_age_max_s}),
+            'joints': {name: {'rms_error': joint.rms_error_rad, 'max_error': joint.max_error_rad,
+                              'samples': joint.samples, 'commanded': joint.commanded,
+                              'measured_range': joint.measured_range_rad}
+                       for name, joint in a.joints.items()},
         }
 
 
@@ -207,17 +301,32 @@ def _fall(pelvis: PelvisSeries) -> tuple[bool, float | None, float]:
     return fell, float(pelvis.t_s[np.argmax(below)]) if fell else None, float(height_m.min())
 
 
-def _command_rate_hz(commands: JointCommandSeries) -> float | None:
-    if len(commands.t_s) > 1 and commands.t_s[-1] > commands.t_s[0]:
-        return (len(commands.t_s) - 1) / float(commands.t_s[-1] - commands.t_s[0])
-    return None
+def _command_rate_hz(commands: JointCommandSeries, starts_s: list[float]) -> float | None:
+    """Commands per second while they arrive: intervals over time spanned, try by try."""
+    segment = np.searchsorted(starts_s, commands.t_s, side='right')
+    intervals, span_s = 0, 0.0
+    for number in np.unique(segment):
+        t_s = commands.t_s[segment == number]
+        intervals += len(t_s) - 1
+        span_s += float(t_s[-1] - t_s[0])
+    return intervals / span_s if intervals and span_s > 0 else None
 
 
-def _latest_command(states: JointStateSeries,
-                    commands: JointCommandSeries) -> tuple[np.ndarray, float | None, float | None]:
-    """Row of the latest command at each state (-1: none yet), and mean and max command age (s)."""
+def _latest_command(states: JointStateSeries, commands: JointCommandSeries,
+                    starts_s: list[float]) -> tuple[np.ndarray, float | None, float | None]:
+    """Row of the latest command of the same try at each state (-1: none yet), and the mean
+    and max command age (s) over the states while commands arrive: up to one command
+    interval (the median) after the try's last command, not the idle time after it."""
     latest = np.searchsorted(commands.t_s, states.t_s, side='right') - 1
-    with_command = latest >= 0
+    state_try = np.searchsorted(starts_s, states.t_s, side='right')
+    command_try = np.searchsorted(starts_s, commands.t_s, side='right')
+    latest = np.where((latest >= 0) & (command_try[np.maximum(latest, 0)] == state_try),
+                      latest, -1)
+    last_command_s = np.full(len(starts_s) + 1, -np.inf)
+    np.maximum.at(last_command_s, command_try, commands.t_s)
+    same_try = np.diff(command_try) == 0
+    interval_s = float(np.median(np.diff(commands.t_s)[same_try])) if same_try.any() else 0.0
+    with_command = (latest >= 0) & (states.t_s <= last_command_s[state_try] + interval_s)
     if not with_command.any():
         return latest, None, None
     ages_s = states.t_s[with_command] - commands.t_s[latest[with_command]]
@@ -248,13 +357,13 @@ def _joint_tracking(name: str, measured: np.ndarray, commands: JointCommandSerie
     return JointTracking(rms, max_error, samples, commanded, measured_range) if moved else None
 
 
-def _tracking(states: JointStateSeries, commands: JointCommandSeries | None) -> tuple[
-        dict[str, JointTracking], float | None, float | None]:
+def _tracking(states: JointStateSeries, commands: JointCommandSeries | None,
+              starts_s: list[float]) -> tuple[dict[str, JointTracking], float | None, float | None]:
     """Tracking of every joint that moved, and mean and max command age (s)."""
     age_mean_s = age_max_s = None
     latest = np.full(len(states.t_s), -1)
     if commands is not None:
-        latest, age_mean_s, age_max_s = _latest_command(states, commands)
+        latest, age_mean_s, age_max_s = _latest_command(states, commands, starts_s)
     joints = {}
     for column, name in enumerate(states.names):
         joint = _joint_tracking(name, states.position[:, column], commands, latest)
@@ -263,8 +372,8 @@ def _tracking(states: JointStateSeries, commands: JointCommandSeries | None) -> 
     return joints, age_mean_s, age_max_s
 
 
-def analyze(data: BagData) -> Analysis:
-    """Compute fall, tracking, command timing and effort saturation from `data`."""
+def _analyze(data: BagData, starts_s: list[float]) -> Analysis:
+    """The metrics of `data`, whose tries begin at `starts_s` (s, after the first)."""
     unavailable: dict[str, str] = {}
     fell = fall_time_s = min_height_m = None
     if data.pelvis is None or not len(data.pelvis.t_s):
@@ -278,7 +387,7 @@ def analyze(data: BagData) -> Analysis:
         commands = None
         unavailable['commands'] = f'no {topics.JOINT_COMMANDS} in the bag'
     else:
-        command_rate_hz = _command_rate_hz(commands)
+        command_rate_hz = _command_rate_hz(commands, starts_s)
 
     states = data.joint_states
     joints: dict[str, JointTracking] = {}
@@ -288,13 +397,47 @@ def analyze(data: BagData) -> Analysis:
         unavailable.update(joints=reason, command_age=reason, effort_saturation=reason)
     else:
         saturation = _effort_saturation(states)
-        joints, age_mean_s, age_max_s = _tracking(states, commands)
+        joints, age_mean_s, age_max_s = _tracking(states, commands, starts_s)
         if commands is None:
             unavailable['command_age'] = f'no {topics.JOINT_COMMANDS} in the bag'
     return Analysis(data, fell, fall_time_s, min_height_m, joints, command_rate_hz,
                     age_mean_s, age_max_s, saturation, unavailable)
 
 
+def _analyze_try(data: BagData, each: Try) -> TryAnalysis:
+    part = window(data, each.start_s, each.end_s)
+    return TryAnalysis(each, _analyze(part, []), first_applied_command_s(part),
+                       [played for _, played in part.played])
+
+
+def analyze(data: BagData, start_s: float | None = None, end_s: float | None = None) -> Analysis:
+    """Compute fall, tracking, command timing and effort saturation from `data`, for the
+    whole run and for each of its tries; with `start_s`/`end_s` (s from bag start), only
+    for that part of the run (the tries it overlaps, cut to it)."""
+    tries = find_tries(data)
+    if start_s is not None or end_s is not None:
+        lower = -np.inf if start_s is None else start_s
+        upper = np.inf if end_s is None else end_s
+        tries = [replace(each, start_s=max(each.start_s, lower), end_s=min(each.end_s, upper))
+                 for each in tries if each.start_s < upper and each.end_s > lower]
+        if not tries:
+            raise BagAnalysisError(f'{data.path}: nothing recorded from {lower:.3f} s to '
+                                   f'{upper:.3f} s (the run spans 0 to {data.duration_s:.3f} s).')
+        data = window(data, tries[0].start_s, tries[-1].end_s)
+    whole = _analyze(data, [each.start_s for each in tries[1:]])
+    return replace(whole, tries=[_analyze_try(data, each) for each in tries])
+
+
 def analyze_bag(path: Path | str) -> Analysis:
     """:func:`~tutorial_atlas_control.bags.reader.read_bag` then :func:`analyze`."""
     return analyze(read_bag(path))
+
+
+def analyze_try(data: BagData, number: int | None) -> Analysis:
+    """:func:`analyze` of try `number` only (1-based, negative from the end, None: last).
+
+    Raises:
+        BagAnalysisError: the bag has no such try.
+    """
+    chosen = pick_try(find_tries(data), number, data.path)
+    return analyze(data, chosen.start_s, chosen.end_s)

@@ -21,9 +21,15 @@ from typing import Any
 import numpy as np
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.bags.analysis import FALL_HEIGHT_M, Analysis, analyze_bag
+from tutorial_atlas_control.bags.analysis import (
+    FALL_HEIGHT_M,
+    Analysis,
+    analyze_try,
+)
+from tutorial_atlas_control.bags.analysis import first_applied_command_s as first_applied_command
+from tutorial_atlas_control.bags.reader import read_bag
 from tutorial_atlas_control.bags.report import json_safe, save_figure
-from tutorial_atlas_control.bags.run_log import PlayedTrajectory, played_trajectories
+from tutorial_atlas_control.bags.run_log import PlayedTrajectory
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_INDEX
 
@@ -34,11 +40,12 @@ __all__ = ['ALIGNED_ON', 'Comparison', 'JointDifference', 'compare', 'compare_ba
 ALIGNED_ON = 'first applied joint command'
 ALIGNED_ON_DETAIL = ('the first /atlas/joint_commands at or after the switch to User mode '
                      '(header stamp; the first command if the bag has no mode switch)')
-USER_MODE = 'User'
 #: Plot: decimate longer series to about this many points.
 PLOT_MAX_POINTS = 4000
 PLOT_ROW_HEIGHT_IN = 1.6
 PLOT_WIDTH_IN = 11.0
+#: The plot spans the compared window, plus this fraction of it on each side.
+PLOT_MARGIN = 0.02
 
 
 @dataclass(frozen=True)
@@ -102,16 +109,11 @@ def first_applied_command_s(analysis: Analysis) -> float:
         BagAnalysisError: the bag has no joint commands (nothing to align on).
     """
     data = analysis.data
-    commands = data.commands
-    if commands is None or not len(commands.t_s):
+    first_s = first_applied_command(data)
+    if first_s is None:
         raise BagAnalysisError(f'{data.path} has no {topics.JOINT_COMMANDS}: cannot align it on '
                                f'its {ALIGNED_ON}.')
-    user_s = next((t_s for t_s, mode in data.modes if mode == USER_MODE), None)
-    if user_s is not None:
-        after = np.flatnonzero(commands.t_s >= user_s)
-        if len(after):
-            return float(commands.t_s[after[0]])
-    return float(commands.t_s[0])
+    return first_s
 
 
 def _held_commands(analysis: Analysis, t_s: np.ndarray, align_s: float) -> np.ndarray:
@@ -185,11 +187,18 @@ def compare(a: Analysis, b: Analysis, trajectory_a: PlayedTrajectory | None = No
                       moved, pelvis_rms, pelvis_max, fall(a, align_a_s), fall(b, align_b_s))
 
 
-def compare_bags(path_a: Path | str, path_b: Path | str) -> Comparison:
-    """Analyze both bags and :func:`compare` them, with the trajectories their /rosout names."""
-    a, b = analyze_bag(path_a), analyze_bag(path_b)
-    played_a, played_b = played_trajectories(path_a), played_trajectories(path_b)
-    return compare(a, b, played_a[0] if played_a else None, played_b[0] if played_b else None)
+def compare_bags(path_a: Path | str, path_b: Path | str, try_a: int = -1,
+                 try_b: int = -1) -> Comparison:
+    """:func:`compare` try `try_a` of A with try `try_b` of B (default: the last of each),
+    with the trajectories their /rosout names.
+
+    Raises:
+        BagAnalysisError: unreadable bag, no such try, nothing to compare.
+    """
+    a, b = analyze_try(read_bag(path_a), try_a), analyze_try(read_bag(path_b), try_b)
+    played_a, played_b = a.data.played, b.data.played
+    return compare(a, b, played_a[0][1] if played_a else None,
+                   played_b[0][1] if played_b else None)
 
 
 def _fmt(value: float | None, spec: str, unit: str = '') -> str:
@@ -280,6 +289,8 @@ def plot_comparison(comparison: Comparison, path: Path | str) -> Path:
     ax.set_ylabel('pelvis\nheight (m)', fontsize=8)
     for ax in axes:
         ax.axvline(0.0, color='gray', linestyle='--', linewidth=0.8)
+    margin_s = PLOT_MARGIN * (c.window_s[1] - c.window_s[0])
+    axes[-1].set_xlim(c.window_s[0] - margin_s, c.window_s[1] + margin_s)
     axes[0].legend(loc='upper right', fontsize=7)
     axes[-1].legend(loc='upper right', fontsize=7)
     axes[-1].set_xlabel(f'time from the {ALIGNED_ON} (s)')

@@ -9,7 +9,10 @@ own message definitions.
 
 Times: messages with a header are placed at their header stamp (sim time), others at
 their bag record time (also sim time, since the simulator runs with /use_sim_time).
-All times in :class:`BagData` are seconds from the bag's start.
+All times in :class:`BagData` are seconds from the bag's start on the *run timeline*: sim
+time, except that after a `/gazebo/reset_simulation` (sim time back to 0) times go on
+from where the run before it stopped, plus a gap (records.EPOCH_GAP_NS), so they only
+rise; :meth:`BagData.sim_time_s` gives the sim time back.
 """
 
 from __future__ import annotations
@@ -25,7 +28,8 @@ from rosbags.interfaces import Connection
 from rosbags.rosbag1 import ReaderError
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.bags.records import BagRecords, open_bag
+from tutorial_atlas_control.bags.records import EPOCH_GAP_NS, REWIND_NS, BagRecords, open_bag
+from tutorial_atlas_control.bags.run_log import PlayedTrajectory, trajectory_lines
 from tutorial_atlas_control.bags.typestore import (
     JOINT_COMMANDS_TYPE,
     load_typestore,
@@ -42,11 +46,13 @@ __all__ = [
     'PelvisSeries',
     'TopicSummary',
     'read_bag',
+    'zero_order_hold',
 ]
 
 JOINT_STATE_TYPE = 'sensor_msgs/msg/JointState'
 ODOMETRY_TYPE = 'nav_msgs/msg/Odometry'
 STRING_TYPE = 'std_msgs/msg/String'
+LOG_TYPE = 'rosgraph_msgs/msg/Log'
 #: MD5 sums of the layouts the hand-written parsers understand.
 JOINT_STATE_MD5 = '3066dcd76a6cfaef579bd0f34173e9fd'
 ODOMETRY_MD5 = 'cd5e73d190d741a2f92e81eda573aca7'
@@ -110,8 +116,11 @@ class BagData:
     """What :func:`read_bag` extracted; series are None when the topic is absent.
 
     `modes` are (time, mode) at each change of /atlas/control_mode; `sim_configs` are
-    (time, JSON text) of every /atlas/sim_config message, which replay parses, and
-    `sim_inputs` those of /atlas/sim_inputs (the applied VRCPlugin inputs).
+    (time, JSON text) of every /atlas/sim_config message, which replay parses; `played`
+    the trajectories players logged on /rosout (time, trajectory). `epoch_starts_s` are
+    the times where sim time went back (reset_simulation), `epoch_shifts_s` what was added
+    to each epoch's sim times (see the module docstring); `sim_inputs` the (time, JSON
+    text) of /atlas/sim_inputs (the applied VRCPlugin inputs).
     """
 
     path: Path
@@ -124,7 +133,22 @@ class BagData:
     modes: list[tuple[float, str]]
     sim_configs: list[tuple[float, str]]
     warnings: list[str] = field(default_factory=list)
+    played: list[tuple[float, PlayedTrajectory]] = field(default_factory=list)
+    epoch_starts_s: list[float] = field(default_factory=list)
+    epoch_shifts_s: list[float] = field(default_factory=lambda: [0.0])
     sim_inputs: list[tuple[float, str]] = field(default_factory=list)
+
+    def epoch_at(self, t_s: float) -> int:
+        """The epoch (0: before any rewind of sim time) time `t_s` falls in."""
+        return int(np.searchsorted(self.epoch_starts_s, t_s, side='right'))
+
+    def sim_time_s(self, t_s: float) -> float:
+        """The sim time (s) of time `t_s` (s from the bag's start, run timeline)."""
+        return self.start_time_s + t_s - self.epoch_shifts_s[self.epoch_at(t_s)]
+
+    def run_time_s(self, sim_time_s: float, epoch: int) -> float:
+        """Sim time `sim_time_s` of epoch `epoch` on the run timeline (s from bag start)."""
+        return sim_time_s - self.start_time_s + self.epoch_shifts_s[epoch]
 
 
 def _header_stamp_ns(msg: Any) -> int:
@@ -248,6 +272,27 @@ class _Reading:
     def raw(self, connections: Sequence[Connection]) -> tuple[np.ndarray, list[bytes]]:
         return self.records.raw_messages(connections)
 
+    def run_stamps(self, stamps_ns: np.ndarray, bag_ns: np.ndarray,
+                   connections: Sequence[Connection], zero_unset: bool) -> np.ndarray:
+        """Header stamps (sim time, ns) moved to the run timeline, as the bag times are.
+
+        A message whose stamp is far from its record time around a reset_simulation (stamped
+        before it and recorded after it, or the other way round) keeps the epoch it was
+        stamped in. `zero_unset`: a zero stamp means "not stamped" (commands) and stays 0,
+        else it is sim time 0 (states).
+        """
+        shifts_ns = np.asarray(self.records.epoch_shifts_ns, dtype=np.int64)
+        if len(shifts_ns) == 1:
+            return stamps_ns
+        epochs = self.records.epochs(connections)
+        recorded_ns = bag_ns - shifts_ns[epochs]
+        stamped = (stamps_ns > 0) | (not zero_unset)
+        late = stamped & (epochs > 0) & (stamps_ns > recorded_ns + REWIND_NS)
+        early = stamped & (epochs < len(shifts_ns) - 1) & (stamps_ns < recorded_ns - REWIND_NS)
+        epochs = np.where(late, epochs - 1, np.where(early, epochs + 1, epochs))
+        shifted = stamps_ns + shifts_ns[epochs]
+        return np.where(stamps_ns > 0, shifted, stamps_ns) if zero_unset else shifted
+
     def seconds(self, times_ns: np.ndarray) -> np.ndarray:
         """Times (ns) as seconds from the bag's start."""
         return (times_ns - self.start_ns) / NS_PER_S
@@ -306,11 +351,17 @@ def _read_joint_states(reading: _Reading, connections: Sequence[Connection]) -> 
             names = list(JOINT_NAMES[:arrays[0].shape[1]])
     else:
         stamps_ns, names, arrays = _joint_states_per_message(raws, parse, reading.typestore)
+    if stamps_ns.any():
+        stamps_ns = reading.run_stamps(stamps_ns, bag_ns, connections, zero_unset=False)
     warning = _clock_mismatch(stamps_ns, bag_ns)
     if warning:
         reading.warnings.append(warning)
     position, velocity, effort = arrays
     t_s = reading.seconds(_series_times(stamps_ns, bag_ns))
+    if np.any(np.diff(t_s) < 0):  # only around a reset_simulation
+        order = np.argsort(t_s, kind='stable')
+        t_s, position, velocity, effort = (t_s[order], position[order], velocity[order],
+                                           effort[order])
     return JointStateSeries(t_s, tuple(names), position, velocity, effort)
 
 
@@ -323,7 +374,7 @@ def _command_message(raw: bytes, parse: bool, typestore: Any) -> tuple[int, list
     return _header_stamp_ns(msg), msg.name, msg.position
 
 
-def _zero_order_hold(position: np.ndarray) -> np.ndarray:
+def zero_order_hold(position: np.ndarray) -> np.ndarray:
     """Each joint's latest commanded value at every row (NaN = not commanded yet)."""
     latest = np.where(np.isnan(position), -1, np.arange(len(position))[:, None])
     latest = np.maximum.accumulate(latest, axis=0) if len(position) else latest
@@ -352,10 +403,11 @@ def _read_commands(reading: _Reading, connections: Sequence[Connection]) -> Join
     if unknown:
         reading.warnings.append(f'{topics.JOINT_COMMANDS} names unknown joints, ignored: '
                                 f'{", ".join(sorted(unknown))}.')
+    stamps_ns = reading.run_stamps(stamps_ns, bag_ns, connections, zero_unset=True)
     t_ns = _stamps_or_bag_times(stamps_ns, bag_ns)
     order = np.argsort(t_ns, kind='stable')
     return JointCommandSeries(reading.seconds(t_ns[order]), position[order],
-                              _zero_order_hold(position[order]))
+                              zero_order_hold(position[order]))
 
 
 def _odometry_per_message(raws: list[bytes], typestore: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -378,7 +430,12 @@ def _read_pelvis(reading: _Reading, connections: Sequence[Connection]) -> Pelvis
     bag_ns, raws = reading.raw(connections)
     fast = _odometry_fast(raws) if reading.parses(connections, ODOMETRY_MD5) else None
     stamps_ns, floats = fast or _odometry_per_message(raws, reading.typestore)
+    if stamps_ns.any():
+        stamps_ns = reading.run_stamps(stamps_ns, bag_ns, connections, zero_unset=False)
     t_s = reading.seconds(_series_times(stamps_ns, bag_ns))
+    if np.any(np.diff(t_s) < 0):  # only around a reset_simulation
+        order = np.argsort(t_s, kind='stable')
+        t_s, floats = t_s[order], floats[order]
     return PelvisSeries(t_s, floats[:, 0:3].copy(), floats[:, 3:7].copy(),
                         floats[:, 43:46].copy(), floats[:, 46:49].copy())
 
@@ -388,6 +445,14 @@ def _read_strings(reading: _Reading, connections: Sequence[Connection]) -> list[
     bag_ns, raws = reading.raw(connections)
     return [(float(t_s), reading.typestore.deserialize_ros1(raw, STRING_TYPE).data)
             for t_s, raw in zip(reading.seconds(bag_ns), raws)]
+
+
+def _read_played(reading: _Reading,
+                 connections: Sequence[Connection]) -> list[tuple[float, PlayedTrajectory]]:
+    """(time, trajectory) of every trajectory a player logged on /rosout."""
+    bag_ns, raws = reading.raw([c for c in connections if c.msgtype == LOG_TYPE])
+    return trajectory_lines(reading.seconds(bag_ns).tolist(), bag_ns.tolist(), raws,
+                            reading.typestore)
 
 
 def _mode_changes(strings: list[tuple[float, str]]) -> list[tuple[float, str]]:
@@ -415,8 +480,11 @@ def _topic_summaries(records: BagRecords, by_topic: dict[str, list[Connection]])
             first_ns, last_ns = int(times_ns[0]), int(times_ns[-1])
             start_ns = first_ns if start_ns is None else min(start_ns, first_ns)
             end_ns = last_ns if end_ns is None else max(end_ns, last_ns)
-            if last_ns > first_ns:
-                rate_hz = (len(times_ns) - 1) / ((last_ns - first_ns) / NS_PER_S)
+            # Over the time recorded: without the gaps put between epochs (reset_simulation).
+            gaps = sum(first_ns < epoch_ns < last_ns for epoch_ns in records.epoch_starts_ns)
+            span_ns = last_ns - first_ns - gaps * EPOCH_GAP_NS
+            if span_ns > 0:
+                rate_hz = (len(times_ns) - 1) / (span_ns / NS_PER_S)
         # 'sensor_msgs/msg/JointState' -> 'sensor_msgs/JointState', as rosbag info shows it.
         msgtypes = sorted({c.msgtype.replace('/msg/', '/') for c in connections})
         summaries[topic] = TopicSummary(' | '.join(msgtypes), len(times_ns), rate_hz)
@@ -440,8 +508,11 @@ def _read_open_bag(path: Path, records: BagRecords, fast: bool) -> BagData:
     modes = _mode_changes(series(topics.CONTROL_MODE, _read_strings) or [])
     sim_configs = series(topics.SIM_CONFIG, _read_strings) or []
     sim_inputs = series(topics.SIM_INPUTS, _read_strings) or []
+    played = series(topics.ROSOUT, _read_played) or []
     return BagData(path, start_ns / NS_PER_S, (end_ns - start_ns) / NS_PER_S, summaries,
-                   states, commands, pelvis, modes, sim_configs, reading.warnings, sim_inputs)
+                   states, commands, pelvis, modes, sim_configs, reading.warnings, played,
+                   [(t_ns - start_ns) / NS_PER_S for t_ns in records.epoch_starts_ns],
+                   [t_ns / NS_PER_S for t_ns in records.epoch_shifts_ns], sim_inputs)
 
 
 def read_bag(path: Path | str, fast: bool = True) -> BagData:
@@ -450,7 +521,8 @@ def read_bag(path: Path | str, fast: bool = True) -> BagData:
     Args:
         path: The .bag file.
         fast: Read with the numpy index and parsers (see bag_records); False reads through
-            rosbags' public API and typestore only, several times slower, same result.
+            rosbags' public API and typestore only, several times slower, same result, except
+            that it cannot tell the runs before and after a reset_simulation apart.
 
     Returns:
         The extracted series; a series is None when its topic is not in the bag.

@@ -9,6 +9,14 @@ Two readers behind one small interface (`connections`, `times_ns`, `raw_messages
   internals (requirements.txt pins rosbags; test_bag_reader checks its results against
   :class:`PublicBag` on the same bags).
 * :class:`PublicBag` uses only rosbags' public `Reader.messages()`.
+
+Sim time can go back within a bag: `/gazebo/reset_simulation` sets it to 0, and the
+recorder stamps each message with the sim time it arrived. Ordering such a bag by time
+would interleave the run before the reset with the run after it, so :class:`IndexedBag`
+cuts the bag into *epochs* where record times go back in file (arrival) order, and shifts
+each later epoch to start :data:`EPOCH_GAP_NS` after the previous one ended: `times_ns`
+then rises through the whole bag ("run time"), and `epoch_shifts_ns` undoes the shift.
+:class:`PublicBag` cannot see the file order: it reports one epoch, in time order.
 """
 
 from __future__ import annotations
@@ -26,7 +34,13 @@ from tutorial_atlas_control.bags.rosbag1_fast import BlockIndexReader
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.units import NS_PER_S
 
-__all__ = ['BagRecords', 'IndexedBag', 'PublicBag', 'open_bag']
+__all__ = ['EPOCH_GAP_NS', 'REWIND_NS', 'BagRecords', 'IndexedBag', 'PublicBag', 'open_bag']
+
+#: Record times going back by more than this (ns) in file order start a new epoch (arrival
+#: times of different topics may be out of order by a few ms; a reset rewinds to 0).
+REWIND_NS = 200_000_000
+#: Run time (ns) between the last message of an epoch and the first of the next.
+EPOCH_GAP_NS = 1_000_000_000
 
 _BAG_MAGIC = b'#ROSBAG V2.0\n'
 _U32 = struct.Struct('<I')
@@ -42,6 +56,14 @@ class BagRecords(Protocol):
     def connections(self) -> list[Connection]: ...
 
     def times_ns(self, connections: Sequence[Connection]) -> np.ndarray: ...
+
+    def epochs(self, connections: Sequence[Connection]) -> np.ndarray: ...
+
+    @property
+    def epoch_shifts_ns(self) -> list[int]: ...
+
+    @property
+    def epoch_starts_ns(self) -> list[int]: ...
 
     def raw_messages(self, connections: Sequence[Connection]) -> tuple[np.ndarray, list[bytes]]:
         ...
@@ -76,38 +98,102 @@ class IndexedBag(_ReaderBag):
 
     reader_class = BlockIndexReader
     _reader: BlockIndexReader
+    #: With resets: every message's file position (chunk position << 32 | offset), in file
+    #: order, and its epoch; empty without.
+    _keys: np.ndarray
+    _epochs: np.ndarray
+    _shifts_ns: list[int]
 
-    def _index(self, connections: Sequence[Connection]) -> tuple[np.ndarray, ...]:
-        """(bag times (ns), chunk positions, offsets in chunk) of `connections`, time-ordered.
+    def open(self) -> None:
+        super().open()
+        self._find_epochs()
 
-        Ties are in file order (chunk, then offset), as `Reader.messages` yields them.
-        """
+    def _in_file_order(self, connections: Sequence[Connection]) -> tuple[np.ndarray, np.ndarray]:
+        """(bag times (ns), file keys) of the messages of `connections`, in file order."""
         blocks = [block for connection in connections
                   for block in self._reader.index_blocks(connection.id)]
         if not blocks:
             empty = np.empty(0, dtype=np.int64)
-            return empty, empty, empty
+            return empty, empty
         entries = np.concatenate([entries for _, entries in blocks])
         times_ns = entries['sec'].astype(np.int64) * NS_PER_S + entries['nsec']
         chunk_pos = np.repeat([pos for pos, _ in blocks],
                               [len(entries) for _, entries in blocks]).astype(np.int64)
-        offsets = entries['offset'].astype(np.int64)
-        if len(connections) > 1:  # Reader.open sorts each connection's blocks by position
-            in_file = np.lexsort((offsets, chunk_pos))
-            times_ns, chunk_pos, offsets = times_ns[in_file], chunk_pos[in_file], offsets[in_file]
+        keys = (chunk_pos << 32) | entries['offset'].astype(np.int64)
+        # A chunk's index is in time order (rosbag sorts it), not always in file order.
+        in_file = np.argsort(keys, kind='stable')
+        return times_ns[in_file], keys[in_file]
+
+    def _find_epochs(self) -> None:
+        """Which epoch each message belongs to, and each epoch's shift to run time.
+
+        Only when some connection's record times go back by more than REWIND_NS: writers
+        that write a block per topic (offline runs) are in time order per connection only,
+        and have no resets. A live recorder writes in arrival order, so a new epoch starts
+        at each message recorded more than REWIND_NS before the one written just before it.
+        """
+        self._keys = self._epochs = np.empty(0, dtype=np.int64)
+        self._shifts_ns = [0]
+        self._starts_ns: list[int] = []
+        rewinds = any(np.any(np.diff(self._in_file_order([connection])[0]) < -REWIND_NS)
+                      for connection in self.connections)
+        if not rewinds:
+            return
+        times_ns, self._keys = self._in_file_order(self.connections)
+        starts = np.flatnonzero(np.diff(times_ns) < -REWIND_NS) + 1
+        self._epochs = np.zeros(len(times_ns), dtype=np.int64)
+        self._epochs[starts] = 1
+        self._epochs = np.cumsum(self._epochs)
+        bounds = [0, *starts.tolist(), len(times_ns)]
+        for epoch in range(1, len(bounds) - 1):
+            end_ns = int(times_ns[bounds[epoch - 1]:bounds[epoch]].max()) + self._shifts_ns[-1]
+            first_ns = int(times_ns[bounds[epoch]:bounds[epoch + 1]].min())
+            self._shifts_ns.append(end_ns + EPOCH_GAP_NS - first_ns)
+            self._starts_ns.append(end_ns + EPOCH_GAP_NS // 2)
+
+    def _epochs_of(self, keys: np.ndarray) -> np.ndarray:
+        """The epochs of the messages at file positions `keys`."""
+        if not len(self._keys):
+            return np.zeros(len(keys), dtype=np.int64)
+        return self._epochs[np.searchsorted(self._keys, keys)]
+
+    @property
+    def epoch_starts_ns(self) -> list[int]:
+        """Run time (ns) where epochs 1, 2, ... begin: mid-gap (epoch 0 starts the bag)."""
+        return list(self._starts_ns)
+
+    @property
+    def epoch_shifts_ns(self) -> list[int]:
+        """Per epoch, what was added (ns) to its record times to make them run times."""
+        return list(self._shifts_ns)
+
+    def _index(self, connections: Sequence[Connection]) -> tuple[np.ndarray, ...]:
+        """(run times (ns), chunk positions, offsets, epochs) of `connections`, in order.
+
+        Ordered by epoch, then time; ties in file order (chunk, then offset), as
+        `Reader.messages` yields them.
+        """
+        times_ns, keys = self._in_file_order(connections)
+        epochs = self._epochs_of(keys)
+        times_ns = times_ns + np.asarray(self._shifts_ns, dtype=np.int64)[epochs]
         order = np.argsort(times_ns, kind='stable')
-        return times_ns[order], chunk_pos[order], offsets[order]
+        keys = keys[order]
+        return times_ns[order], keys >> 32, keys & 0xFFFFFFFF, epochs[order]
 
     def times_ns(self, connections: Sequence[Connection]) -> np.ndarray:
-        """Bag times (ns) of the messages of `connections`, from the index alone."""
+        """Run times (ns) of the messages of `connections`, from the index alone."""
         return self._index(connections)[0]
+
+    def epochs(self, connections: Sequence[Connection]) -> np.ndarray:
+        """The epoch of each message of `connections`, in the order of `times_ns`."""
+        return self._index(connections)[3]
 
     def raw_messages(self, connections: Sequence[Connection]) -> tuple[np.ndarray, list[bytes]]:
         """(bag times (ns), serialized messages) of `connections`, in time order.
 
         The record parsing is inlined: it runs once per message (60,000 for a 60 s run).
         """
-        times_ns, chunk_positions, offsets = self._index(connections)
+        times_ns, chunk_positions, offsets, _ = self._index(connections)
         raws: list[bytes] = []
         unpack_u32 = _U32.unpack_from
         chunk_pos, chunk = -1, b''
@@ -132,7 +218,18 @@ class IndexedBag(_ReaderBag):
 
 
 class PublicBag(_ReaderBag):
-    """Reads messages with rosbags' public `Reader.messages()` only."""
+    """Reads messages with rosbags' public `Reader.messages()` only (one epoch)."""
+
+    @property
+    def epoch_shifts_ns(self) -> list[int]:
+        return [0]
+
+    @property
+    def epoch_starts_ns(self) -> list[int]:
+        return []
+
+    def epochs(self, connections: Sequence[Connection]) -> np.ndarray:
+        return np.zeros(len(self.times_ns(connections)), dtype=np.int64)
 
     def times_ns(self, connections: Sequence[Connection]) -> np.ndarray:
         """Bag times (ns) of the messages of `connections` (reads the messages too)."""
@@ -181,6 +278,10 @@ def _open_error(path: Path, err: Exception) -> BagAnalysisError:
             return BagAnalysisError(
                 f'{path} is not indexed (an interrupted `rosbag record` leaves an unindexed '
                 f'.bag.active file); run `rosbag reindex {path}` and analyze it again.')
+        if 'index looks damaged' in text or 'could not be read' in text:
+            return BagAnalysisError(
+                f'{path} is truncated or its index is damaged (was the recording cut short?); '
+                f'run `rosbag reindex {path}` and analyze it again.')
         if 'magic' in text or 'empty' in text:
             return BagAnalysisError(
                 f'{path} is not a ROS 1 bag (it does not start with "#ROSBAG V2.0").')

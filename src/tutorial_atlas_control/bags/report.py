@@ -15,9 +15,11 @@ from tutorial_atlas_control.bags.analysis import (
     FALL_HEIGHT_M,
     MOVED_RANGE_RAD,
     Analysis,
+    TryAnalysis,
     input_timeline,
 )
 from tutorial_atlas_control.bags.reader import BagData
+from tutorial_atlas_control.bags.tries import RUN_START
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_NAMES
 
@@ -36,7 +38,8 @@ def _fmt(value: float | None, spec: str, unit: str = '') -> str:
     return 'n/a' if value is None else f'{value:{spec}}{unit}'
 
 
-def _topic_lines(data: BagData, trajectory: str | None = None) -> list[str]:
+def _topic_lines(data: BagData, trajectory: str | None = None,
+                 resets: list[tuple[float, str]] | None = None) -> list[str]:
     lines = [f'Bag:      {data.path}',
              f'Duration: {data.duration_s:.3f} s (start {data.start_time_s:.3f} s)']
     if trajectory is not None:
@@ -49,11 +52,11 @@ def _topic_lines(data: BagData, trajectory: str | None = None) -> list[str]:
                      f'{_fmt(topic.rate_hz, "9.2f", " Hz")}')
     if not data.topics:
         lines.append('  (none: the bag is empty)')
-    lines.append('Control modes:')
+    lines.append('Control modes (and resets):')
     # VRCPlugin's inputs (mode, teleport, wrench, ...) on the same timeline, when applied.
-    timeline = sorted([(t_s, mode) for t_s, mode in data.modes] + input_timeline(data),
-                      key=lambda entry: entry[0])
-    lines.extend(f'  {t_s:9.3f} s  {text}' for t_s, text in timeline)
+    events = sorted([*data.modes, *(resets or []), *input_timeline(data)],
+                    key=lambda entry: entry[0])
+    lines.extend(f'  {t_s:9.3f} s  {text}' for t_s, text in events)
     if not data.modes:
         lines.append(f'  (no {topics.CONTROL_MODE} messages)')
     return lines
@@ -110,15 +113,49 @@ def _effort_lines(analysis: Analysis) -> list[str]:
     return lines
 
 
+def _try_lines(each: TryAnalysis) -> list[str]:
+    """Two lines for one try: when and what, then fall, commands and tracking."""
+    a, window = each.analysis, each.window
+    played = ', then '.join(f"'{p.name}'" for p in each.trajectories) or '(none logged)'
+    lines = [f'  try {window.number}: {window.start_s:.3f} to {window.end_s:.3f} s (sim time '
+             f'{a.data.sim_time_s(window.start_s):.3f} s at {window.cause}); trajectory {played}']
+    if a.fell is None:
+        fall = 'fall unknown'
+    elif a.fell:
+        after = each.fall_after_command_s
+        fall = (f'FELL at {a.fall_time_s:.3f} s' + ('' if after is None else
+                                                       f', {after:.3f} s after its first command'))
+    else:
+        fall = f'no fall (lowest {a.min_pelvis_height_m:.3f} m)'
+    count = 0 if a.data.commands is None else len(a.data.commands.t_s)
+    commands = f'{count} commands at {_fmt(a.command_rate_hz, ".1f", " Hz")}'
+    if a.command_age_mean_s is not None:
+        commands += f', age mean {a.command_age_mean_s * 1e3:.1f} ms'
+    tracked = [(joint.rms_error_rad, name) for name, joint in a.joints.items()
+               if joint.rms_error_rad is not None]
+    tracking = ('' if not tracked else
+                '; worst tracking RMS {:.4f} rad ({})'.format(*max(tracked)))
+    lines.append(f'         {fall}; {commands}{tracking}')
+    return lines
+
+
 def format_summary(analysis: Analysis, trajectory: str | None = None) -> str:
     """The human-readable report, several lines, no trailing newline.
 
     `trajectory`: what the bag's /rosout says was played (run_log), shown when given.
     """
-    lines = _topic_lines(analysis.data, trajectory)
+    resets = [(each.window.start_s, f'{each.window.cause}: try {each.window.number} begins')
+              for each in analysis.tries if each.window.cause != RUN_START]
+    lines = _topic_lines(analysis.data, trajectory, resets)
     lines += [_fall_line(analysis), _commands_line(analysis)]
     lines += _tracking_lines(analysis) + _effort_lines(analysis)
-    lines.extend(f'Warning:  {warning}' for warning in analysis.data.warnings)
+    tries = analysis.tries
+    if len(tries) > 1 or (tries and tries[0].window.cause != RUN_START):
+        lines.append(f'Tries ({len(tries)}; a try starts at the bag\'s start or at a reset; '
+                     'times from bag start):')
+        for each in tries:
+            lines += _try_lines(each)
+    lines.extend(f'Warning:  {warning}' for warning in analysis.warnings)
     return '\n'.join(lines)
 
 
@@ -212,8 +249,9 @@ def _decimate(t_s: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return t_s[::step], values[::step]
 
 
-def _plot_joint(ax: Any, name: str, data: BagData) -> None:
-    """Commanded (steps, held to the end of the run) and measured position of joint `name`."""
+def _plot_joint(ax: Any, name: str, data: BagData, resets_s: list[float]) -> None:
+    """Commanded (steps, held to the end of the run or the next reset, `resets_s`) and
+    measured position of joint `name`."""
     states, commands = data.joint_states, data.commands
     if commands is not None and name in JOINT_NAMES:
         sent = commands.position[:, JOINT_NAMES.index(name)]
@@ -222,6 +260,11 @@ def _plot_joint(ax: Any, name: str, data: BagData) -> None:
             t_s, values = commands.t_s[finite], sent[finite]
             if states is not None and len(states.t_s) and states.t_s[-1] > t_s[-1]:
                 t_s, values = np.append(t_s, states.t_s[-1]), np.append(values, values[-1])
+            if resets_s:  # a reset drops the held command: break the line there
+                t_s = np.append(t_s, resets_s)
+                values = np.append(values, np.full(len(resets_s), np.nan))
+                order = np.argsort(t_s, kind='stable')
+                t_s, values = t_s[order], values[order]
             ax.plot(t_s, values, drawstyle='steps-post', color='tab:orange', label='commanded')
     if states is not None:
         ax.plot(*_decimate(states.t_s, states.position[:, states.names.index(name)]),
@@ -235,8 +278,9 @@ def _plot_pelvis(ax: Any, analysis: Analysis) -> None:
     assert pelvis is not None
     ax.plot(*_decimate(pelvis.t_s, pelvis.position_m[:, 2]), color='tab:green', label='pelvis z')
     ax.axhline(FALL_HEIGHT_M, color='tab:red', linestyle=':', label='fall threshold')
-    if analysis.fall_time_s is not None:
-        ax.plot([analysis.fall_time_s], [FALL_HEIGHT_M], 'rx', label='fall')
+    falls = analysis.falls()
+    if falls:
+        ax.plot(falls, [FALL_HEIGHT_M] * len(falls), 'rx', label='fall')
     ax.set_ylabel('pelvis\nheight (m)', fontsize=8)
 
 
@@ -250,6 +294,19 @@ def _mark_modes(axes: list[Any], modes: list[tuple[float, str]]) -> None:
         axes[0].annotate(mode, (t_s, 1.0), xycoords=('data', 'axes fraction'),
                          xytext=(2, 2 + 10 * (number % 2)), textcoords='offset points',
                          fontsize=8)
+
+
+def _mark_resets(axes: list[Any], analysis: Analysis) -> None:
+    """A red vertical line at each reset that starts a try, labelled with the try."""
+    for each in analysis.tries:
+        if each.window.cause == RUN_START:
+            continue
+        for ax in axes:
+            ax.axvline(each.window.start_s, color='tab:red', linewidth=1.2)
+        axes[-1].annotate(f'try {each.window.number} ({each.window.cause})',
+                          (each.window.start_s, 0.0), xycoords=('data', 'axes fraction'),
+                          xytext=(2, 2), textcoords='offset points', fontsize=8,
+                          color='tab:red')
 
 
 def save_figure(fig: Any, path: Path | str) -> Path:
@@ -291,14 +348,16 @@ def plot_run(analysis: Analysis, path: Path | str) -> Path:
     fig, axes = plt.subplots(max(rows, 1), 1, sharex=True, squeeze=False,
                              figsize=(PLOT_WIDTH_IN, PLOT_ROW_HEIGHT_IN * max(rows, 2) + 1.0))
     axes = list(axes[:, 0])
+    resets_s = [each.window.start_s for each in analysis.tries if each.window.cause != RUN_START]
     for ax, name in zip(axes, names):
-        _plot_joint(ax, name, data)
+        _plot_joint(ax, name, data, resets_s)
     if data.pelvis is not None:
         _plot_pelvis(axes[len(names)], analysis)
     if rows == 0:
         axes[0].text(0.5, 0.5, 'nothing to plot: no joint moved and no pelvis data',
                      ha='center', va='center', transform=axes[0].transAxes)
     _mark_modes(axes, data.modes)
+    _mark_resets(axes, analysis)
     for ax in axes[:1] + axes[-1:] if rows else []:
         ax.legend(loc='upper right', fontsize=7)
     axes[-1].set_xlabel('time from bag start (s)')

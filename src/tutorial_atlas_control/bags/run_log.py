@@ -7,8 +7,10 @@ trajectory it played without any file beside it.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from rosbags.rosbag1 import Reader, ReaderError
 
@@ -19,7 +21,7 @@ from tutorial_atlas_control.trajectories.schedule import (
     parse_trajectory_log_line,
 )
 
-__all__ = ['PlayedTrajectory', 'played_trajectories']
+__all__ = ['PlayedTrajectory', 'played_trajectories', 'trajectory_lines']
 
 LOG_TYPE = 'rosgraph_msgs/msg/Log'
 
@@ -35,6 +37,25 @@ class PlayedTrajectory:
 
     def describe(self) -> str:
         return f"'{self.name}' of {self.file} (played by {self.node})"
+
+
+def trajectory_lines(times: Sequence[Any], times_ns: Sequence[int], raws: Sequence[bytes],
+                     typestore: Any) -> list[tuple[Any, PlayedTrajectory]]:
+    """(time, trajectory) of the player lines among /rosout messages `raws`.
+
+    `times` are passed through (bag_reader's run times); `times_ns` are the bag times.
+    """
+    marker = TRAJECTORY_LOG_PREFIX.encode()
+    found = []
+    for time, time_ns, raw in zip(times, times_ns, raws):
+        if marker not in raw:  # most lines are not ours: skip deserializing them
+            continue
+        message = typestore.deserialize_ros1(raw, LOG_TYPE)
+        fields = parse_trajectory_log_line(message.msg)
+        if fields is not None:
+            found.append((time, PlayedTrajectory(fields['file'], fields['name'], message.name,
+                                                 int(time_ns))))
+    return found
 
 
 def played_trajectories(path: Path | str) -> list[PlayedTrajectory]:

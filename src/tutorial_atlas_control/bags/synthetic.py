@@ -10,6 +10,7 @@ seconds; bag record time equals the header stamp, as with ``/use_sim_time`` true
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,6 +22,7 @@ from rosbags.rosbag1 import Writer
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags.typestore import load_typestore, rosbags_msgtype
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.trajectories.schedule import trajectory_log_line
 from tutorial_atlas_control.units import NS_PER_S
 
 #: ROS 1 Noetic's types with the package's osrf_msgs/JointCommands (bags.typestore).
@@ -148,14 +150,17 @@ def foot_contact(t_s: float, side: str, fz_n: float = 450.0) -> Record:
 
 
 def write_bag(path: Path | str, records: Iterable[Record], *,
-              compression: str | None = None, chunk_bytes: int | None = None) -> Path:
+              compression: str | None = None, chunk_bytes: int | None = None,
+              in_given_order: bool = False) -> Path:
     """Write `records` (any order; sorted by time, stably) to a new ROS 1 bag at `path`.
 
     `compression` is None, 'bz2' or 'lz4' (chunk compression, as `rosbag record -j/--lz4`);
-    `chunk_bytes` overrides the chunk size (default 1 MiB) to get many chunks.
+    `chunk_bytes` overrides the chunk size (default 1 MiB) to get many chunks;
+    `in_given_order` writes the records as given (a run whose sim time goes back).
     """
     path = Path(path)
-    ordered = sorted(records, key=lambda record: record.t_s)
+    records = list(records)
+    ordered = records if in_given_order else sorted(records, key=lambda record: record.t_s)
     writer = Writer(path)
     if chunk_bytes is not None:
         writer.chunk_threshold = chunk_bytes
@@ -221,6 +226,74 @@ def run_records(duration_s: float = 60.0, *, state_period_s: float = 0.001,
 def write_run_bag(path: Path | str, duration_s: float = 60.0, **kwargs: Any) -> Path:
     """Write :func:`run_records` to `path` (the 60 s default is the speed benchmark)."""
     return write_bag(path, run_records(duration_s, **kwargs))
+
+def sim_config(t_s: float, last_reset_s: float, time_to_unpin_s: float = 1.0) -> Record:
+    """A /atlas/sim_config message (as the simulator publishes at start and on resets)."""
+    text = json.dumps({'model_file': 'atlas_v1.xml', 'model_sha1': None, 'timestep': 0.001,
+                       'time_to_unpin': time_to_unpin_s, 'last_reset_time': last_reset_s})
+    return Record(topics.SIM_CONFIG, 'std_msgs/String', t_s, _type('std_msgs/String')(data=text))
+
+
+@dataclass(frozen=True)
+class TrySpec:
+    """One try of :func:`tries_records`: how it began, what was played, when it fell.
+
+    `reset`: None (the first try), 'reset_world' (sim time goes on) or 'reset_simulation'
+    (sim time back to 0). Times are seconds from the try's start.
+    """
+
+    reset: str | None
+    trajectory: str
+    duration_s: float = 6.0
+    first_command_s: float = 1.0
+    commands_s: float = 2.0
+    fall_s: float | None = None
+    command_period_s: float = 0.02
+
+
+def _try_records(spec: TrySpec, start_s: float, first: bool, state_period_s: float,
+                 file: str) -> list[Record]:
+    """One try's records from sim time `start_s`, in time order."""
+    records = [sim_config(start_s + (0.0005 if first else 0.0002), 0.0 if first else start_s)]
+    if first:
+        records.append(control_mode(start_s + 0.5, 'User'))
+    shx = JOINT_NAMES.index('l_arm_shx')
+    first_s = start_s + spec.first_command_s
+    records.append(rosout(first_s - 0.01, trajectory_log_line(file, spec.trajectory),
+                          node='/traj_yaml'))
+    for step in range(round(spec.commands_s / spec.command_period_s)):
+        t_s = first_s + step * spec.command_period_s
+        records.append(joint_commands(t_s, _with_joint(shx, 0.1 * step * spec.command_period_s)))
+    for step in range(1, round(spec.duration_s / state_period_s)):
+        t_s = start_s + step * state_period_s
+        held = min(max(t_s - 0.01 - first_s, 0.0), spec.commands_s - spec.command_period_s)
+        records.append(joint_state(t_s, _with_joint(shx, 0.1 * held), seq=step))
+        records.append(clock(t_s))
+        z_m = STANDING_HEIGHT_M
+        if spec.fall_s is not None and t_s - start_s > spec.fall_s:
+            z_m = max(0.2, STANDING_HEIGHT_M - (t_s - start_s - spec.fall_s))
+        records.append(odometry(t_s, z_m))
+    return sorted(records, key=lambda record: record.t_s)
+
+
+def tries_records(specs: Sequence[TrySpec], state_period_s: float = 0.01,
+                  file: str = 'Traj_data2.yaml') -> list[Record]:
+    """A launch with several tries, in record order (write with `in_given_order=True`).
+
+    States, /clock and odometry every `state_period_s`; commands on l_arm_shx (a ramp of
+    0.1 rad/s) from each try's `first_command_s`, measured 10 ms late; the player's start
+    line on /rosout just before; /atlas/sim_config at the start and after each reset; User
+    mode from 0.5 s of the first try.
+    """
+    records: list[Record] = []
+    start_s = 0.0
+    for number, spec in enumerate(specs):
+        if spec.reset == 'reset_simulation':
+            start_s = 0.0
+        records += _try_records(spec, start_s, number == 0, state_period_s, file)
+        start_s += spec.duration_s
+    return records
+
 
 def _with_joint(index: int, value: float) -> np.ndarray:
     position = np.zeros(NUM_JOINTS)

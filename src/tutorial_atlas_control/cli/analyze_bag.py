@@ -11,10 +11,14 @@ from tutorial_atlas_control.bags.analysis import (
     EFFORT_LIMIT_TOLERANCE_NM,
     FALL_HEIGHT_M,
     MOVED_RANGE_RAD,
-    analyze_bag,
+    Analysis,
+    analyze,
+    analyze_try,
 )
-from tutorial_atlas_control.bags.compare import compare_bags, format_comparison, plot_comparison
+from tutorial_atlas_control.bags.bag_dir import latest_bag
+from tutorial_atlas_control.bags.compare import compare, format_comparison, plot_comparison
 from tutorial_atlas_control.bags.compare import to_json as comparison_json
+from tutorial_atlas_control.bags.reader import read_bag
 from tutorial_atlas_control.bags.render import (
     DEFAULT_FPS,
     DEFAULT_SIZE,
@@ -24,7 +28,7 @@ from tutorial_atlas_control.bags.render import (
     render_bag_video,
 )
 from tutorial_atlas_control.bags.report import format_summary, plot_run, to_json, write_csv
-from tutorial_atlas_control.bags.run_log import PlayedTrajectory, played_trajectories
+from tutorial_atlas_control.bags.run_log import PlayedTrajectory
 from tutorial_atlas_control.cli.convention import (
     EXIT_INTERRUPTED,
     EXIT_REFUSED,
@@ -50,7 +54,15 @@ and the joints that reached their effort limit (|effort| >= limit - {tol} N·m) 
 how long.
 
 Times are header stamps (sim time) where messages have them, bag record time otherwise,
-given in seconds from the bag's start.
+given in seconds from the bag's start; after a /gazebo/reset_simulation (sim time back to
+0) they go on from where the run stopped, plus 1 s.
+
+Tries: a launch in which the robot was reset between trajectories (/gazebo/reset_world,
+/gazebo/reset_simulation, the viewer's reset) holds several tries. The bag is split at
+each reset (the re-published /atlas/sim_config, and sim time going back), each try gets
+its own summary (trajectory, fall and its time from the try's first applied command,
+commands, tracking), and the plot marks the resets and every fall. --try N (or --start,
+--end) limits the summary, plot, CSV and video to one try.
 """
 
 EPILOG = """\
@@ -61,12 +73,19 @@ odometry), fall_time (s or null), min_pelvis_height (m), joints {name: {rms_erro
 max_error (rad), samples, commanded, measured_range (rad)}} (joints that moved),
 command_rate (Hz), command_count, command_age {mean, max} (s), effort_saturation
 {name: {limit (N·m), duration (s), first_time (s), samples}}, thresholds,
-unavailable {metric: reason}, warnings [text].
+unavailable {metric: reason}, warnings [text] (one when the bag holds several tries),
+tries [{try (number from 1), start, end (s), sim_start (s of sim time), began_with
+(start, reset_world, reset_simulation, sim time went back), trajectory {file, name} or
+null, trajectories, mode_timeline, first_command (s), fell, fall_time (s),
+fall_after_command (s from the try's first applied command), min_pelvis_height,
+command_count, command_rate, command_age, joints}]. Whole-run command_rate and
+command_age count each try's commands alone, while they arrive.
 
 With a player's start line on /rosout (traj_yaml.py, run_offline.py), the summary names the
 trajectory played (JSON: trajectory {file, name} or null).
 
---compare B.bag (JSON keys): a, b {bag, trajectory}, aligned_on {event, time_a, time_b (s
+--compare B.bag compares A's try --try N (default: its last) with B's try --try-b M
+(default: its last). JSON keys: a, b {bag, trajectory}, aligned_on {event, time_a, time_b (s
 from each bag's start), window [s, s]}, joints {name: {rms_diff, max_diff, command_rms_diff
 (rad, A - B)}}, pelvis_height_rms_diff (m), fall_time_a, fall_time_b (s from the first
 applied command, null: did not fall). The runs are aligned on their first applied joint
@@ -74,16 +93,20 @@ command (the first /atlas/joint_commands at or after the switch to User mode) an
 at A's joint states over the time both cover after it.
 
 Exit status: 0 on success (also when some metrics are unavailable), 1 when the bag
-cannot be read (missing, not a bag, unindexed: run `rosbag reindex BAG`) or an output
-cannot be written, 2 on bad arguments.
+cannot be read (missing, not a bag, unindexed or truncated: run `rosbag reindex BAG`), has
+no such try, or an output cannot be written, 2 on bad arguments.
 
 Video (--video): each frame poses the model as recorded at the frame's time (pelvis
 from /ground_truth_odom, interpolated; joints from /atlas/joint_states) and draws it
 offscreen through the model's `track` camera (software OSMesa when there is no display);
 each frame is labelled with its time from the bag's start. Needs both topics.
 
-Example: rosrun tutorial_atlas_control analyze_bag.py run.bag --plot run.png --csv run_csv
-         rosrun tutorial_atlas_control analyze_bag.py run.bag --video run.mp4 --fps 30
+Without BAG (or with --latest), the newest .bag in atlas.launch's bag directory
+($TAC_BAG_DIR, else ~/.ros/tutorial_atlas_control/bags) is analyzed.
+
+Example: rosrun tutorial_atlas_control analyze_bag.py --latest --plot run.png
+         rosrun tutorial_atlas_control analyze_bag.py run.bag --try 2 --video try2.mp4 --fps 30
+         rosrun tutorial_atlas_control analyze_bag.py run.bag --try 1 --compare run.bag --try-b 3
 """
 
 
@@ -94,7 +117,21 @@ def build_parser() -> argparse.ArgumentParser:
         description=DESCRIPTION.format(fall=FALL_HEIGHT_M, moved=MOVED_RANGE_RAD,
                                        change=COMMAND_CHANGE_RAD, tol=EFFORT_LIMIT_TOLERANCE_NM),
         epilog=EPILOG)
-    parser.add_argument('bag', metavar='BAG', help='the ROS 1 .bag file to analyze')
+    parser.add_argument('bag', metavar='BAG', nargs='?',
+                        help='the ROS 1 .bag file to analyze (default: the newest bag in the '
+                             'bag directory, as --latest)')
+    parser.add_argument('--latest', action='store_true',
+                        help='analyze the newest .bag in $TAC_BAG_DIR, else '
+                             '~/.ros/tutorial_atlas_control/bags')
+    parser.add_argument('--try', dest='try_number', metavar='N', type=int,
+                        help='only try N (from 1; -1 is the last) of a bag with resets: the '
+                             'summary, --plot, --csv, --video and --compare')
+    parser.add_argument('--start', type=float, metavar='S',
+                        help='only from S seconds from the bag\'s start (as the times shown)')
+    parser.add_argument('--end', type=float, metavar='S',
+                        help='only up to S seconds from the bag\'s start')
+    parser.add_argument('--try-b', dest='try_b', metavar='M', type=int,
+                        help='with --compare: B\'s try to compare (default: its last)')
     parser.add_argument('--compare', metavar='B.bag',
                         help='compare BAG (A) with this run (B), aligned on their first applied '
                              'joint command: per joint RMS/max difference of measured and '
@@ -120,19 +157,43 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _check_arguments(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """Exit 2 (argparse) on options that contradict each other."""
+    if args.bag and args.latest:
+        parser.error('give BAG or --latest, not both')
+    if args.try_number is not None and (args.start is not None or args.end is not None):
+        parser.error('give --try or --start/--end, not both')
+    if args.start is not None and args.end is not None and args.end <= args.start:
+        parser.error(f'--end {args.end:g} must be after --start {args.start:g}')
+    if args.try_b is not None and not args.compare:
+        parser.error('--try-b chooses the try of the --compare bag; give --compare B.bag')
+    if args.compare and (args.csv or args.video):
+        parser.error('--csv and --video describe one run; leave them out with --compare')
+
+
+def _chosen(path: str, args: argparse.Namespace) -> Analysis:
+    """The analysis of the bag, or of the try or time window the options choose."""
+    data = read_bag(path)
+    if args.try_number is not None:
+        return analyze_try(data, args.try_number)
+    return analyze(data, args.start, args.end)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status."""
     parser = build_parser()
     args = parser.parse_args(argv)
-    if args.compare:
-        if args.csv or args.video:
-            parser.error('--csv and --video describe one run; leave them out with --compare')
-        return _compare(args)
+    _check_arguments(parser, args)
     try:
+        if not args.bag:
+            args.bag = str(latest_bag())
+            print(f'analyzing {args.bag} (the newest bag)', file=sys.stderr)
+        if args.compare:
+            return _compare(args)
         if args.video:  # fail on a bad output before reading and analyzing the bag
             check_output_path(args.video, *args.size, args.fps)
-        analysis = analyze_bag(args.bag)
-        played = played_trajectories(args.bag)
+        analysis = _chosen(args.bag, args)
+        played = [p for _, p in analysis.data.played]
         print(to_json(analysis, {'trajectory': _played_dict(played)}) if args.json
               else format_summary(analysis, trajectory=_played_text(played)))
         if args.csv:
@@ -161,9 +222,14 @@ def _played_text(played: list[PlayedTrajectory]) -> str | None:
 
 
 def _compare(args: argparse.Namespace) -> int:
-    """`BAG --compare B.bag`: bag_compare's report, JSON or plot."""
+    """`BAG --compare B.bag`: bag_compare's report, JSON or plot, of A's and B's tries."""
     try:
-        comparison = compare_bags(args.bag, args.compare)
+        a = analyze_try(read_bag(args.bag), -1 if args.try_number is None else args.try_number)
+        b = analyze_try(read_bag(args.compare), -1 if args.try_b is None else args.try_b)
+        played_a = [p for _, p in a.data.played]
+        played_b = [p for _, p in b.data.played]
+        comparison = compare(a, b, played_a[0] if played_a else None,
+                             played_b[0] if played_b else None)
         print(comparison_json(comparison) if args.json else format_comparison(comparison))
         if args.plot:
             print(f'wrote {plot_comparison(comparison, args.plot)}', file=sys.stderr)

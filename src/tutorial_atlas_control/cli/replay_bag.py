@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from collections.abc import Sequence
 
+from tutorial_atlas_control.bags.bag_dir import latest_bag
 from tutorial_atlas_control.cli.convention import (
     EXIT_INTERRUPTED,
     EXIT_REFUSED,
@@ -29,6 +31,9 @@ DESCRIPTION = """\
 Re-simulate a recorded Atlas run without ROS and report how far the replay strays from
 the recording.
 
+A bag with resets holds several tries (see analyze_bag.py): one try is replayed, by
+default the last (--try N for another), from the reset it began with.
+
 Starts from the simulator's reset (/atlas/sim_config last_reset_time; the torso pinned
 for time_to_unpin), applies each step's recorded torque (/atlas/joint_states effort) with
 MuJoCo's mj_step, and compares the joint positions and velocities with every recorded
@@ -40,26 +45,38 @@ config/atlas_controller.yaml). With the same model and MuJoCo build the replay i
 
 EPILOG = """\
 JSON keys (--json): bag, sim_config {recorded, model_file, model_sha1, timestep (s),
-time_to_unpin (s), last_reset_time (s)}, resets_in_bag, model_sha1_matches (bool or null),
+time_to_unpin (s), last_reset_time (s)}, resets_in_bag, try (the try replayed, from 1),
+tries (how many the bag holds), model_sha1_matches (bool or null),
 start_time, end_time (s of sim time), reconstructed_steps, recorded_steps,
 joint_position and joint_velocity {max (rad, rad/s), time (s), joint, samples},
 pelvis_position {max (m), time, samples}, pelvis_orientation {max (rad), time, samples}
 (null without /ground_truth_odom), tolerance, reproduced (bool), warnings [text].
 
 Exit status: 0 when every deviation is within --tolerance, 3 when the replay deviates,
-1 when the bag cannot be read or replayed (missing topics, unsupported resets), 2 on bad
-arguments (e.g. a --tolerance that is not a number >= 0).
+1 when the bag cannot be read or replayed (missing topics, no such try, a recording that
+starts after a mid-run reset), 2 on bad arguments (e.g. a --tolerance that is not a number
+>= 0).
 
-Example: rosrun tutorial_atlas_control replay_bag.py ~/.ros/tutorial_atlas_control/bags/atlas_*.bag
+Without BAG (or with --latest), the newest .bag in atlas.launch's bag directory
+($TAC_BAG_DIR, else ~/.ros/tutorial_atlas_control/bags) is replayed.
+
+Example: rosrun tutorial_atlas_control replay_bag.py --latest
+         rosrun tutorial_atlas_control replay_bag.py atlas_2026-11-24-19-30-00.bag --try 2
 """
-
 
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser (its --help is the documentation)."""
     parser = argparse.ArgumentParser(prog=PROG, description=DESCRIPTION, epilog=EPILOG,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument('bag', metavar='BAG', help='the ROS 1 .bag file of the run')
+    parser.add_argument('bag', metavar='BAG', nargs='?',
+                        help='the ROS 1 .bag file of the run (default: the newest bag in the '
+                             'bag directory, as --latest)')
+    parser.add_argument('--latest', action='store_true',
+                        help='replay the newest .bag in $TAC_BAG_DIR, else '
+                             '~/.ros/tutorial_atlas_control/bags')
+    parser.add_argument('--try', dest='try_number', metavar='N', type=int,
+                        help='the try to replay, from 1 (-1: the last, the default)')
     parser.add_argument('--json', action='store_true', help='print one JSON object instead')
     parser.add_argument('--tolerance', type=argument_type(_tolerance), default=DEFAULT_TOLERANCE,
                         help='largest deviation (rad, rad/s, m) that still counts as '
@@ -76,9 +93,15 @@ def _tolerance(text: str) -> float:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status."""
-    args = build_parser().parse_args(argv)
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.bag and args.latest:
+        parser.error('give BAG or --latest, not both')
     try:
-        result = replay_bag(args.bag, args.tolerance)
+        if not args.bag:
+            args.bag = str(latest_bag())
+            print(f'replaying {args.bag} (the newest bag)', file=sys.stderr)
+        result = replay_bag(args.bag, args.tolerance, args.try_number)
     except AtlasControlError as err:
         print_error(PROG, err)
         return EXIT_REFUSED

@@ -16,6 +16,9 @@ Two details make that exact:
   cmd_vel, the pelvis wrench, kinematic playback) are re-applied from /atlas/sim_inputs
   before the very step they first acted in; a bag that lacks one of them after the last
   reset is refused.
+* A bag with resets holds several tries (bags.tries); one try is replayed, by default
+  the last, from its reset with the config re-published then: the sim time of a try is
+  its own (after a /gazebo/reset_simulation it starts again from 0).
 * `rosbag record` usually starts a few hundred steps after the simulator. The steps before
   the first recorded joint state are re-created with :class:`AtlasSimulator` itself in
   Stand mode with the gains of config/atlas_controller.yaml (what the simulator does
@@ -35,6 +38,7 @@ import numpy as np
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags.reader import BagData, read_bag
+from tutorial_atlas_control.bags.tries import Try, find_tries, pick_try, window
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.sim import model as atlas_model
@@ -98,7 +102,9 @@ class Recording:
     odom_quat_wxyz: np.ndarray
     has_odom: bool
     warnings: list[str] = field(default_factory=list)
-    inputs: list[InputEvent] = field(default_factory=list)  # since the last reset, in order
+    inputs: list[InputEvent] = field(default_factory=list)  # since the try's reset, in order
+    try_number: int = 1
+    tries: int = 1
 
 
 def _read_sim_configs(data: BagData) -> list[dict[str, Any]]:
@@ -109,9 +115,9 @@ def _read_sim_configs(data: BagData) -> list[dict[str, Any]]:
         raise ReplayError(f'{data.path}: {SIM_CONFIG_TOPIC} {err}') from err
 
 
-def _sim_config(path: Path, raw_configs: list[dict[str, Any]],
-                warnings: list[str]) -> tuple[SimConfig, int]:
-    """The config in force for the last segment, and how many resets the bag shows."""
+def _sim_config(path: Path, raw_configs: list[dict[str, Any]], chosen: dict[str, Any] | None,
+                resets: int, warnings: list[str]) -> tuple[SimConfig, int]:
+    """The config in force for the chosen try, and how many resets the bag shows."""
     if not raw_configs:
         warnings.append(f'the bag has no {SIM_CONFIG_TOPIC} (recorded before the simulator '
                         f'published it): assuming time_to_unpin = {DEFAULT_TIME_TO_UNPIN_S} s '
@@ -119,10 +125,9 @@ def _sim_config(path: Path, raw_configs: list[dict[str, Any]],
         return SimConfig(None, None, None, DEFAULT_TIME_TO_UNPIN_S, DEFAULT_LAST_RESET_S,
                          recorded=False), 0
     try:
-        config = SimConfig.from_dict(raw_configs[-1])
+        config = SimConfig.from_dict(raw_configs[-1] if chosen is None else chosen)
     except SimConfigError as err:
         raise ReplayError(f'{path}: {SIM_CONFIG_TOPIC} {err}') from None
-    resets = len({float(c.get('last_reset_time', 0.0)) for c in raw_configs}) - 1
     return config, resets
 
 
@@ -164,8 +169,17 @@ def _input_events(path: Path, data: BagData, config: SimConfig,
 
 
 def _stamps_ns(data: BagData, t_s: np.ndarray) -> np.ndarray:
-    """Absolute sim time stamps (ns) from BagData's seconds-from-bag-start."""
-    return np.round((data.start_time_s + t_s) * NS_PER_S).astype(np.int64)
+    """Sim time stamps (ns) from BagData's seconds-from-bag-start (run timeline)."""
+    epochs = np.searchsorted(data.epoch_starts_s, t_s, side='right')
+    sim_s = data.start_time_s + t_s - np.asarray(data.epoch_shifts_s)[epochs]
+    return np.round(sim_s * NS_PER_S).astype(np.int64)
+
+
+def _chosen_try(data: BagData, try_number: int | None) -> tuple[BagData, Try, int]:
+    """(`data` cut to the chosen try, the try, how many tries the bag holds)."""
+    tries = find_tries(data)
+    chosen = pick_try(tries, try_number, data.path)
+    return window(data, chosen.start_s, chosen.end_s), chosen, len(tries)
 
 
 def _to_steps(stamps_ns: np.ndarray, step_ns: int, what: str) -> np.ndarray:
@@ -179,23 +193,30 @@ def _to_steps(stamps_ns: np.ndarray, step_ns: int, what: str) -> np.ndarray:
     return steps
 
 
-def load_recording(path: Path | str, data: BagData | None = None) -> Recording:
+def load_recording(path: Path | str, data: BagData | None = None,
+                   try_number: int | None = None) -> Recording:
     """Read what replay needs from the bag at `path` (`data`: an already read BagData).
 
     The bag is opened once: /atlas/sim_config comes with the series in `data`.
+    `try_number`: the try to replay (1-based, negative from the end; None: the last).
 
     Raises:
-        ReplayError / BagAnalysisError: unreadable bag, missing joint states or joints,
-            a sim_config without the needed keys, stamps off the step grid.
+        ReplayError / BagAnalysisError: unreadable bag, no such try, missing joint states or
+            joints, a sim_config without the needed keys, stamps off the step grid.
     """
     path = Path(path)
     data = read_bag(path) if data is None else data
     warnings: list[str] = []
+    raw_configs = _read_sim_configs(data)
+    data, chosen, tries = _chosen_try(data, try_number)
     states = data.joint_states
     if states is None or not len(states.t_s):
-        raise ReplayError(f'{path} has no {JOINT_STATES_TOPIC}: the replay needs the recorded '
-                          'torques (effort) of every step.')
-    config, resets = _sim_config(path, _read_sim_configs(data), warnings)
+        where = '' if tries == 1 else f' in try {chosen.number}'
+        raise ReplayError(f'{path} has no {JOINT_STATES_TOPIC}{where}: the replay needs the '
+                          'recorded torques (effort) of every step.')
+    chosen_config = (None if chosen.config is None or not raw_configs
+                     else parse_sim_config(chosen.config))
+    config, resets = _sim_config(path, raw_configs, chosen_config, tries - 1, warnings)
     tests = data.topics.get(topics.ATLAS_TEST)
     if tests is not None and tests.count:
         # Its damping changes the model, which the recorded torques do not carry.
@@ -232,7 +253,8 @@ def load_recording(path: Path | str, data: BagData | None = None) -> Recording:
         odom_position, odom_quat = np.empty((0, 3)), np.empty((0, 4))
     inputs = _input_events(path, data, config, warnings)
     return Recording(path, config, resets, state_stamp_ns, position, velocity, effort,
-                     odom_stamp_ns, odom_position, odom_quat, has_odom, warnings, inputs)
+                     odom_stamp_ns, odom_position, odom_quat, has_odom, warnings, inputs,
+                     chosen.number, tries)
 
 
 # ---------------------------------------------------------------------------- replay
@@ -266,6 +288,8 @@ class ReplayResult:
     pelvis_orientation: Deviation | None
     tolerance: float
     warnings: list[str]
+    try_number: int = 1          # the try replayed (bags.tries), of
+    tries: int = 1               # the tries the bag holds
 
     @property
     def reproduced(self) -> bool:
@@ -287,6 +311,8 @@ class ReplayResult:
             'bag': str(self.bag),
             'sim_config': {'recorded': config.recorded, **config.to_dict()},
             'resets_in_bag': self.resets_in_bag,
+            'try': self.try_number,
+            'tries': self.tries,
             'model_sha1_matches': self.model_sha1_matches,
             'start_time': self.start_time_s,
             'end_time': self.end_time_s,
@@ -508,8 +534,10 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
     reset_step = _reset_step(config, step_ns)
     sim.reset_simulation(reset_step * step_ns)
     if recording.resets_in_bag:
-        warnings.append(f'the bag holds {recording.resets_in_bag} reset(s); replaying the last '
-                        f'segment, from the reset at {config.last_reset_time_s:.3f} s.')
+        which = ('the last segment' if recording.try_number == recording.tries
+                 else f'try {recording.try_number} of {recording.tries}')
+        warnings.append(f'the bag holds {recording.resets_in_bag} reset(s); replaying {which}, '
+                        f'from the reset at {config.last_reset_time_s:.3f} s (sim time).')
     all_steps = _to_steps(recording.state_stamp_ns, step_ns, JOINT_STATES_TOPIC)
     odom_steps = _to_steps(recording.odom_stamp_ns, step_ns, ODOM_TOPIC)
     rows = _segment(recording, all_steps, reset_step, sim.dt_s, warnings)
@@ -531,12 +559,14 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
         joint_velocity=_deviation(velocity, recording.velocity_rad_s[rows], steps, step_ns,
                                   JOINT_NAMES),
         pelvis_position=pelvis_position, pelvis_orientation=pelvis_orientation,
-        tolerance=tolerance, warnings=warnings)
+        tolerance=tolerance, warnings=warnings, try_number=recording.try_number,
+        tries=recording.tries)
 
 
-def replay_bag(path: Path | str, tolerance: float = DEFAULT_TOLERANCE) -> ReplayResult:
-    """:func:`load_recording` then :func:`replay`."""
-    return replay(load_recording(path), tolerance)
+def replay_bag(path: Path | str, tolerance: float = DEFAULT_TOLERANCE,
+               try_number: int | None = None) -> ReplayResult:
+    """:func:`load_recording` (of try `try_number`, None: the last) then :func:`replay`."""
+    return replay(load_recording(path, try_number=try_number), tolerance)
 
 
 # ---------------------------------------------------------------------------- report
@@ -558,8 +588,9 @@ def format_report(result: ReplayResult) -> str:
     source = 'from /atlas/sim_config' if config.recorded else 'assumed (no /atlas/sim_config)'
     model = {True: 'same model file as recorded', False: 'model file DIFFERS from the recording',
              None: 'model checksum not recorded'}[result.model_sha1_matches]
+    which = '' if result.tries == 1 else f', try {result.try_number} of {result.tries}'
     lines = [
-        f'Replay of {result.bag}',
+        f'Replay of {result.bag}{which}',
         f'  reset at {result.start_time_s:.3f} s, torso pinned {config.time_to_unpin_s:g} s '
         f'({source}); {model}',
         f'  replayed {result.reconstructed_steps + result.recorded_steps} steps to '
