@@ -118,6 +118,10 @@ class RosLog:
         rospy.loginfo(text)
 
     @staticmethod
+    def warn(text: str) -> None:
+        rospy.logwarn(text)
+
+    @staticmethod
     def refused_command(text: str) -> None:
         rospy.logwarn_throttle(WARN_THROTTLE_S, text)
 
@@ -144,6 +148,7 @@ class SimNode:
                                  RosLog(), self._publish_config,
                                  real_time_factor=real_time_factor, paused=paused)
         self.loop.publish_config()
+        self.mode_pub.publish(String(data=sim.mode.value))
         self._subscribe()
 
     def _advertise(self, tf: bool) -> None:
@@ -161,6 +166,9 @@ class SimNode:
                                for topic, msg_class in published}
         # Latched, recorded in every bag: what offline replay needs to re-create the run.
         self.config_pub = rospy.Publisher(topics.SIM_CONFIG, String, queue_size=1, latch=True)
+        # Latched: the mode now, for traj_yaml.py's warning and `rostopic echo`.
+        self.mode_pub = rospy.Publisher(topics.CURRENT_CONTROL_MODE, String, queue_size=1,
+                                        latch=True)
 
     def _controller_statistics(self) -> CommandAgeStatistics:
         """DRCSim's command age statistics, from the parameters (fed and published by the
@@ -199,6 +207,7 @@ class SimNode:
             rospy.logwarn_throttle(WARN_THROTTLE_S, f'refused /atlas/control_mode: {err}')
             return
         previous = self.loop.set_mode(mode)
+        self.mode_pub.publish(String(data=mode.value))
         rospy.loginfo(f'control mode: {previous.value} -> {mode.value}')
 
     def _service(self, action: Callable[[], None]) -> Callable[[object], EmptyResponse]:
@@ -260,8 +269,7 @@ class SimNode:
             viewer.copy_out(self.sim.data)
         for request in viewer.take_requests():
             if request is ViewerRequest.RESET_WORLD:
-                rospy.loginfo('viewer: Reset -> reset_world')
-                loop.reset_world()
+                loop.reset_world(by=' (viewer)')
             elif loop.paused:  # ViewerRequest.TOGGLE_PAUSE
                 loop.unpause()
             else:

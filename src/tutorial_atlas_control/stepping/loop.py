@@ -22,6 +22,7 @@ from tutorial_atlas_control.msgs.ros1_fields import FieldCursor
 from tutorial_atlas_control.msgs.sim_messages import SimMessages
 from tutorial_atlas_control.msgs.wire import ControllerStatisticsWire, clock_bytes
 from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistics
+from tutorial_atlas_control.sim.model import FALL_HEIGHT_M
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode, PhysicsDivergenceError
 from tutorial_atlas_control.stepping.pacing import Pacer
 from tutorial_atlas_control.stepping.schedule import STAMPED_AT_STEP_END, steps_between
@@ -35,6 +36,9 @@ DIVERGENCE_REPEAT_S = 1.0
 MAX_DIVERGENCES_IN_A_ROW = 3
 #: Commands waiting for the next step, at most (a second of 10 kHz of them).
 MAX_PENDING_COMMANDS = 10_000
+#: Commands arriving while the mode is not User are warned about at once, then at most
+#: this often (s of sim time) while they keep coming.
+NOT_USER_WARN_PERIOD_S = 5.0
 #: While paused, the loop looks for commands and shutdown this often (s, wall).
 PAUSED_POLL_S = 0.01
 #: The per-step messages: topic, key of its rate in `rates_hz`, name in
@@ -66,6 +70,8 @@ class LoopLog(Protocol):
     """The loop's log lines (the node: rospy's log, which throttles refused commands)."""
 
     def info(self, text: str) -> None: ...
+
+    def warn(self, text: str) -> None: ...
 
     def refused_command(self, text: str) -> None: ...
 
@@ -160,6 +166,12 @@ class SteppingLoop:
         self.pending_commands: collections.deque[bytes] = collections.deque(
             maxlen=MAX_PENDING_COMMANDS)
 
+        # Headless feedback (a log line per fall, per reset, and for ignored commands).
+        self.pelvis_z_index = sim.atlas.free_qpos_adr + 2  # the pelvis height in qpos
+        self.fall_armed = True  # one line per fall: disarmed by it, re-armed by a reset
+        self.first_command_ns: int | None = None  # since the start or last reset
+        self.not_user_warned_ns: int | None = None
+
     @property
     def real_time_factor(self) -> float:
         """Sim time per wall time (the pacer's); 0 = as fast as possible."""
@@ -204,34 +216,53 @@ class SteppingLoop:
         updates.reverse()
         first = self.sim.user_command is None
         self.sim.receive_updates(updates)
+        if self.sim.mode is not ControlMode.USER:
+            self._warn_not_user()
         if first:
+            self.first_command_ns = self.sim.sim_time_ns
             # Which command a trajectory started from: a late one makes the robot jump.
             self.log.info(f'first /atlas/joint_commands since the start or last reset, at '
                           f't={self.sim.sim_time_ns / NS_PER_S:.3f} s '
                           f'({self.sim.mode.value} mode)')
+
+    def _warn_not_user(self) -> None:
+        """Commands arrived in a mode that does not apply them: say how to switch (the
+        tutorial's step most often forgotten), at once, then every NOT_USER_WARN_PERIOD_S."""
+        now_ns = self.sim.sim_time_ns
+        last_ns = self.not_user_warned_ns
+        if last_ns is not None and 0 <= now_ns - last_ns < NOT_USER_WARN_PERIOD_S * NS_PER_S:
+            return  # (a rewind, reset_simulation, warns again)
+        self.not_user_warned_ns = now_ns
+        self.log.warn(f'{topics.JOINT_COMMANDS} arrive in {self.sim.mode.value} mode, which does '
+                      f'not apply them; switch to User mode: {topics.SWITCH_TO_USER}')
 
     def set_mode(self, mode: ControlMode) -> ControlMode:
         """Switch the control mode; returns the previous one."""
         with self.lock:
             previous = self.sim.mode
             self.sim.set_mode(mode)
+            self.not_user_warned_ns = None  # a new mode: warn again at once
         return previous
 
     def publish_config(self) -> None:
         """(Re-)publish /atlas/sim_config: at start and after every reset."""
         self._send_config(self.sim.config().to_json())
 
-    def reset_world(self) -> None:
+    def reset_world(self, by: str = '') -> None:
+        """/gazebo/reset_world, or the viewer's Reset (`by`: ' (viewer)', said in the line)."""
         with self.lock:
             self.sim.reset_world()
+            self._rearm()
         self.publish_config()
-        self.log.info('reset_world: robot back to its initial pose (torso pinned '
+        self.log.info(f'reset_world{by}: robot back to its initial pose at '
+                      f't={self.sim.sim_time_ns / NS_PER_S:.3f} s (torso pinned '
                       f'for {self.sim.time_to_unpin_s} s)')
 
     def reset_simulation(self) -> None:
         with self.lock:
             self.sim.reset_simulation()
             self.statistics.forget_command()  # its stamp lies in the rewound future
+            self._rearm()
         self.publish_config()
         self.log.info('reset_simulation: robot reset and sim time back to 0')
 
@@ -242,6 +273,25 @@ class SteppingLoop:
     def unpause(self) -> None:
         self.paused = False
         self.log.info('physics unpaused')
+
+    def _rearm(self) -> None:
+        """After a reset: the next fall and the next first command are new."""
+        self.fall_armed = True
+        self.first_command_ns = None
+        self.not_user_warned_ns = None
+
+    def watch_fall(self) -> None:
+        """After a step: one line when the pelvis drops below FALL_HEIGHT_M (headless, the
+        only sign of a fall), then nothing until a reset."""
+        if self.fall_armed and self.sim.data.qpos[self.pelvis_z_index] < FALL_HEIGHT_M:
+            self.fall_armed = False
+            sim = self.sim
+            line = (f'the robot fell: pelvis below {FALL_HEIGHT_M} m at '
+                    f't={sim.sim_time_ns / NS_PER_S:.3f} s')
+            if self.first_command_ns is not None:
+                line += (f', {(sim.sim_time_ns - self.first_command_ns) / NS_PER_S:.3f} s '
+                         'after the first command since the start or last reset')
+            self.log.info(line)
 
     # -- publishing ----------------------------------------------------------------------
     def publish(self) -> None:
@@ -314,6 +364,8 @@ class SteppingLoop:
                     if not self._recover(err):
                         break
                 self.step_count += 1
+                if self.fall_armed:
+                    self.watch_fall()
                 self.publish()
                 self._publish_controller_statistics(sim.sim_time_ns)
                 sim_ns = sim.sim_time_ns
@@ -335,5 +387,6 @@ class SteppingLoop:
             return False
         self.log.error(f'{err}; resetting the robot to its initial state')
         self.sim.reset_world()
+        self._rearm()
         self.publish_config()
         return True
