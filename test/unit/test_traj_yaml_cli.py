@@ -173,7 +173,8 @@ def test_missing_trajectory_keeps_the_tutorial_message(fake_master, tmp_path: Pa
     server, uri = fake_master
     result = run_script([str(TRAJECTORY_FILE), 'nope'], uri, tmp_path)
     assert_one_line_error(result, f'unable to find trajectory nope in {TRAJECTORY_FILE}')
-    assert result.stderr == f'unable to find trajectory nope in {TRAJECTORY_FILE}\n'
+    assert result.stderr == (f'unable to find trajectory nope in {TRAJECTORY_FILE}; it holds: '
+                             'step_and_fall, touchdown, touchdown_exhausted\n')
     assert_untouched(server)
 
 

@@ -62,5 +62,6 @@ def main(argv: Sequence[str] | None = None) -> int:
                   f'torso pinned for {node.sim.time_to_unpin_s} s')
     status = node.spin()
     if reason.taken_over():
-        print(took_over_line(rospy.get_name(), rosgraph.get_master_uri()), file=sys.stderr)
+        print(took_over_line(rospy.get_name(), rosgraph.get_master_uri().rstrip('/')),
+              file=sys.stderr)
     return status

@@ -28,6 +28,7 @@ Parameters (private unless noted):
 
 from __future__ import annotations
 
+import os
 import threading
 import time
 import warnings
@@ -49,7 +50,7 @@ from tf2_msgs.msg import TFMessage
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.node.transport import WireBatch
-from tutorial_atlas_control.node.viewer import ViewerLink, ViewerRequest
+from tutorial_atlas_control.node.viewer import ViewerLink, ViewerRequest, display_problem
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.camera import configure_viewer_camera, configure_viewer_scene
 from tutorial_atlas_control.sim.controller import gains_from_params
@@ -232,6 +233,11 @@ class SimNode:
     def _open_viewer(self) -> ViewerLink | None:
         """The viewer window, framing the whole robot and following the pelvis, kept up to
         date by a thread of its own (_viewer_loop)."""
+        problem = display_problem(os.environ.get('DISPLAY'))
+        if problem is not None:
+            rospy.logwarn(f'cannot open the MuJoCo viewer: {problem}; running headless, '
+                          'recording on (gui:=false starts without trying)')
+            return None
         try:
             link = ViewerLink(self.sim.model)
         except Exception as err:  # noqa: BLE001 - no display, no GL: run headless
