@@ -75,3 +75,34 @@ def test_a_display_without_x_server_runs_headless_with_one_line(tmp_path: Path) 
     states = read_bag(bag).joint_states
     assert states is not None and len(states.t_s) > 1000, 'the bag holds the run'
     assert missing_steps(states) == 0
+
+
+def test_forgotten_user_mode_a_reset_and_a_fall_each_say_so(tmp_path: Path) -> None:
+    """The headless feedback, live: traj_yaml.py and the simulator warn about commands sent
+    in Stand mode; a reset and a fall (ragdoll) each give the simulator's one line."""
+    trajectory = tmp_path / 'short.yaml'
+    trajectory.write_text('arms: [[0.2, "' + ' '.join(['0.0'] * 28) + '"]]\n')
+    with TestLaunch(tmp_path) as launch:
+        launch.wait_ready()
+        launch.wait_sim_s(1.5)
+        played = launch.run('rosrun', 'tutorial_atlas_control', 'traj_yaml.py', str(trajectory),
+                            'arms', timeout_s=120.0)
+        assert played.returncode == 0, played.stdout + played.stderr
+        port_warning = ('the simulator is in Stand mode, which does not apply these commands: '
+                        'the robot will not move; switch to User mode first: '
+                        'rostopic pub /atlas/control_mode std_msgs/String -- "User"')
+        assert (played.stdout + played.stderr).count(port_warning) == 1, played
+        reset = launch.run('rosservice', 'call', '/gazebo/reset_world')
+        assert reset.returncode == 0, reset.stderr
+        launch.set_mode('ragdoll')
+        launch.wait_sim_s(3.0)
+        output = launch.output()
+    sim_warning = ('/atlas/joint_commands arrive in Stand mode, which does not apply them; '
+                   'switch to User mode: '
+                   'rostopic pub /atlas/control_mode std_msgs/String -- "User"')
+    assert output.count(sim_warning) == 1, output  # 11 commands in 0.2 s: one warning
+    resets = [line for line in output.splitlines() if 'reset_world: robot back' in line]
+    assert len(resets) == 1, output
+    falls = [line for line in output.splitlines() if 'the robot fell' in line]
+    assert len(falls) == 1, output
+    assert falls[0].split(']: ', 1)[1].startswith('the robot fell: pelvis below 0.5 m at t='), falls
