@@ -408,3 +408,12 @@ def test_interpolate_rejects_mismatched_shapes() -> None:
 def test_waypoint_is_a_plain_record() -> None:
     waypoint = Waypoint(duration_s=1.0, positions=np.zeros(NUM_JOINTS))
     assert waypoint.duration_s == 1.0
+
+
+def test_odd_trajectory_names_are_listed_quoted_on_one_line(tmp_path: Path) -> None:
+    path = write(tmp_path, f'"a, b":\n  - [1.0, "{ZEROS}"]\n"x\\ny":\n  - [1.0, "{ZEROS}"]\n'
+                           f'7:\n  - [1.0, "{ZEROS}"]\n')
+    with pytest.raises(TrajectoryError) as info:
+        load_trajectory(path, 'nope')
+    assert str(info.value) == (f"unable to find trajectory nope in {path}; it holds: 'a, b', "
+                               "'x\\ny', 7")

@@ -150,13 +150,21 @@ MAX_NAMES_LISTED = 20
 
 def unknown_trajectory(doc: Mapping[object, object], name: str, path: PathLike) -> str:
     """The tutorial's "unable to find trajectory NAME in FILE", and the names the file has."""
-    names = [str(key) for key in doc]
+    names = [_shown_name(key) for key in doc]
     if not names:
         return f'unable to find trajectory {name} in {path}; it holds no trajectories'
     listed = ', '.join(names[:MAX_NAMES_LISTED])
     if len(names) > MAX_NAMES_LISTED:
         listed += f', ... ({len(names)} in all)'
     return f'unable to find trajectory {name} in {path}; it holds: {listed}'
+
+
+def _shown_name(key: object) -> str:
+    """A trajectory name as the error lists it: as written when plain, else quoted (one line)."""
+    text = str(key)
+    if text and text.isprintable() and text == text.strip() and ',' not in text:
+        return text
+    return repr(text)
 
 
 def is_explicit_path(path: PathLike) -> bool:
