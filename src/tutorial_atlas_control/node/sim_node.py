@@ -5,14 +5,17 @@ subscriptions, services, parameters and the viewer window. Publishes /clock,
 /atlas/joint_states, /ground_truth_odom, /atlas/imu and the foot contact wrenches in sim
 time, /atlas/controller_statistics (command age, while subscribed), and a latched
 /atlas/sim_config (JSON: timestep, time_to_unpin, model file and checksum, time of the last
-reset) for offline replay; obeys /atlas/joint_commands and /atlas/control_mode; offers
-gazebo_ros's reset and pause services.
+reset) for offline replay, and a latched /atlas/current_control_mode (the mode now); obeys
+/atlas/joint_commands and /atlas/control_mode; offers gazebo_ros's reset and pause services.
+Logs one line per fall (pelvis below 0.5 m, once until a reset) and per reset, and warns
+when commands arrive in a mode that does not apply them.
 
 Parameters (private unless noted):
     ~real_time_factor (float, 1.0): sim time per wall time; 0 runs as fast as possible.
     ~paused (bool, false): start with physics paused (/gazebo/unpause_physics starts it).
-    ~gui (bool, false): open the MuJoCo viewer (needs a display); its Reset button and key
-        (Backspace) and Shift+Ctrl+R do reset_world, Space pauses/unpauses (viewer.py).
+    ~gui (bool, false): open the MuJoCo viewer (needs a display; a $DISPLAY no X server
+        answers gives one warning and a headless run); its Reset button and key (Backspace)
+        and Shift+Ctrl+R do reset_world, Space pauses/unpauses (viewer.py).
     ~joint_states_rate, ~imu_rate, ~contact_rate (Hz, 1000): 0 or >= 1000 = every step.
     ~odom_rate (Hz, 100): /ground_truth_odom rate, as DRCSim.
     ~tf (bool, true): broadcast world -> pelvis on /tf from the ground truth, if the model
