@@ -4,6 +4,9 @@ Each turn: merge the commands that arrived since the last step, step, serialize 
 due into the outbox, decide whether to send it, and wait for wall time. The loop also owns
 what the node's services and viewer do to the simulator (resets, pause, control mode),
 under the lock that rospy's threads and the viewer's share with it.
+Headless, its log lines are what the user sees of a run: one per fall (pelvis below
+FALL_HEIGHT_M, once until a reset), one per reset, and a warning when commands arrive in a
+mode that does not apply them.
 
 The node (node/sim_node.py) gives it an Outbox (rospy publishers behind
 transport.WireBatch), a LoopLog (rospy's log) and its shutdown test; tests give it fakes.
