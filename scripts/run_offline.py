@@ -5,7 +5,7 @@ import sys
 from pathlib import Path
 
 sys.path.append(str(Path(__file__).resolve().parent.parent / 'src'))  # a clone without catkin
-from tutorial_atlas_control.cli.run_offline import main
+from tutorial_atlas_control.cli.environment import run_script
 
 if __name__ == '__main__':
-    sys.exit(main())
+    sys.exit(run_script('run_offline.py', 'tutorial_atlas_control.cli.run_offline'))

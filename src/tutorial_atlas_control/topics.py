@@ -23,6 +23,11 @@ DEBUG_R_FOOT_CONTACT = '/atlas/debug/r_foot_contact'
 CONTROLLER_STATISTICS = '/atlas/controller_statistics'
 #: Latched JSON (timestep, time_to_unpin, model file and sha1, last reset): what replay needs.
 SIM_CONFIG = '/atlas/sim_config'
+#: Latched std_msgs/String: the simulator's control mode now (not recorded: the bag has the
+#: /atlas/control_mode requests). traj_yaml.py reads it to warn when it is not User.
+CURRENT_CONTROL_MODE = '/atlas/current_control_mode'
+#: The tutorial's command switching the simulator to User mode (the README's form).
+SWITCH_TO_USER = 'rostopic pub /atlas/control_mode std_msgs/String -- "User"'
 ROSOUT = '/rosout'
 #: VRCPlugin's inputs (DRCSim's "cheats"): std_msgs/String, geometry_msgs/Pose, Twist,
 #: Wrench (gazebo_ros_force), trajectory_msgs/JointTrajectory, sensor_msgs/JointState.

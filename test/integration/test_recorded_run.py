@@ -5,6 +5,7 @@ Needs the catkin workspace (`source ./env.sh`); runs roslaunch on its own master
 
 from __future__ import annotations
 
+import re
 import subprocess
 from pathlib import Path
 
@@ -85,3 +86,23 @@ def test_bag_holds_the_run(demo_run) -> None:
     # Joint states every 1 ms of sim time (bag time is sim time under /use_sim_time).
     span_s = (state_stamps[-1] - state_stamps[0]) / 1e9
     assert len(state_stamps) / span_s == pytest.approx(1000.0, rel=0.02)
+
+
+def test_the_simulator_logged_the_fall_once_as_the_pelvis_dropped(demo_run) -> None:
+    """Headless, the fall line is the user's sign of a fall: one, at the odometry's fall."""
+    from support.bag_checks import log_lines, messages
+
+    info = 2  # rosgraph_msgs/Log INFO
+    falls = [line for line in log_lines(demo_run.bag, min_level=info) if 'the robot fell' in line]
+    assert len(falls) == 1, falls
+    match = re.fullmatch(r'the robot fell: pelvis below 0\.5 m at t=(\d+\.\d{3}) s, '
+                         r'(\d+\.\d{3}) s after the first command since the start or last reset',
+                         falls[0])
+    assert match, falls[0]
+    odom = [(msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9, msg.pose.pose.position.z)
+            for msg in messages(demo_run.bag, '/ground_truth_odom')]
+    odom_fall_s = next(t_s for t_s, z_m in odom if z_m < 0.5)
+    # The line comes at the end of the step that crossed 0.5 m, odometry every 10 ms: its first
+    # reading below comes up to 10 ms later.
+    assert odom_fall_s - 0.011 <= float(match[1]) <= odom_fall_s + 0.002
+    assert 1.0 < float(match[2]) < 3.0  # step_and_fall: 1.8-2.0 s after its first command

@@ -29,3 +29,40 @@ def test_a_refused_set_up_exits_1_with_one_fatal_line(monkeypatch: pytest.Monkey
     monkeypatch.setattr(atlas_sim, 'build_node', refuse)
     assert atlas_sim.main(['atlas_sim_node.py']) == 1
     assert fatal == ['atlas_sim: gain atlas_controller/gains/back_lbz/p is missing']
+
+
+class FakeNode:
+    """spin() ends as rospy does when the master hands our name to a newer node."""
+
+    def __init__(self, hooks: list, reason: str) -> None:
+        self.hooks = hooks
+        self.reason = reason
+        self.sim = type('Sim', (), {'dt_s': 0.001, 'time_to_unpin_s': 1.0})()
+        self.loop = type('Loop', (), {'real_time_factor': 1.0, 'paused': False})()
+
+    def spin(self) -> int:
+        for hook in self.hooks:
+            hook(self.reason)
+        return 0
+
+
+@pytest.mark.parametrize(('reason', 'line'), [
+    ('external shutdown request from [/master]: [/atlas_sim] Reason: new node registered '
+     'with same name',
+     'atlas_sim: another atlas_sim took over: a second simulator registered as /atlas_sim on '
+     'http://localhost:11311, so this one stops (its launch and recording end); run one '
+     'atlas.launch per master, or give the second its own (roslaunch -p PORT)\n'),
+    ('signal-caught', ''),  # Ctrl-C: nothing to explain
+])
+def test_a_simulator_another_one_replaced_exits_0_with_one_line(
+        reason: str, line: str, capsys: pytest.CaptureFixture[str],
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    hooks: list = []
+    monkeypatch.setattr(atlas_sim.rospy, 'init_node', lambda *_: None)
+    monkeypatch.setattr(atlas_sim.rospy, 'loginfo', lambda _text: None)
+    monkeypatch.setattr(atlas_sim.rospy, 'get_name', lambda: '/atlas_sim')
+    monkeypatch.setattr(atlas_sim.rospy.core, 'add_preshutdown_hook', hooks.append)
+    monkeypatch.setattr(atlas_sim.rosgraph, 'get_master_uri', lambda: 'http://localhost:11311')
+    monkeypatch.setattr(atlas_sim, 'build_node', lambda: FakeNode(hooks, reason))
+    assert atlas_sim.main(['atlas_sim_node.py']) == 0
+    assert capsys.readouterr().err == line

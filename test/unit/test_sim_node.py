@@ -5,6 +5,7 @@ from __future__ import annotations
 import hashlib
 import shutil
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 import pytest
@@ -65,8 +66,13 @@ def test_the_node_advertises_the_topics_and_steps_until_shutdown(sim: AtlasSimul
             topics.CLOCK, topics.JOINT_STATES, topics.GROUND_TRUTH_ODOM, topics.IMU,
             topics.L_FOOT_CONTACT, topics.R_FOOT_CONTACT, topics.CONTROLLER_STATISTICS,
             topics.SIM_CONFIG, topics.ATLAS_STATE, topics.FORCE_TORQUE_SENSORS,
-            topics.DEBUG_L_FOOT_CONTACT, topics.DEBUG_R_FOOT_CONTACT, topics.SIM_INPUTS}
+            topics.DEBUG_L_FOOT_CONTACT, topics.DEBUG_R_FOOT_CONTACT, topics.SIM_INPUTS,
+            topics.CURRENT_CONTROL_MODE}
         config, = node.fake_publishers[topics.SIM_CONFIG].published
+        mode, = node.fake_publishers[topics.CURRENT_CONTROL_MODE].published
+        assert mode.data == 'Stand'
+        node.on_control_mode(SimpleNamespace(data='User'))
+        assert node.fake_publishers[topics.CURRENT_CONTROL_MODE].published[-1].data == 'User'
         assert SimConfig.from_json(config.data) == sim.config()
     assert sim.sim_time_ns == 50 * sim.step_ns
 
@@ -95,7 +101,7 @@ def test_an_unknown_control_mode_is_refused_and_the_mode_kept(sim: AtlasSimulato
         warning = sim_node.rospy.logwarn_throttle.call_args.args[1]
         assert warning.startswith("refused /atlas/control_mode: unknown control mode 'user'")
         assert sim.mode is ControlMode.STAND
-        node.on_control_mode(String(data='User'))
+        node.on_control_mode(SimpleNamespace(data='User'))
         assert sim.mode is ControlMode.USER
 
 

@@ -15,11 +15,13 @@ from tutorial_atlas_control.msgs.commands import FIELD_NAMES
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistics
+from tutorial_atlas_control.sim.model import FALL_HEIGHT_M, pelvis_height_m
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode, PhysicsDivergenceError
 from tutorial_atlas_control.stepping import pacing
 from tutorial_atlas_control.stepping.loop import (
     DIVERGENCE_REPEAT_S,
     MAX_DIVERGENCES_IN_A_ROW,
+    NOT_USER_WARN_PERIOD_S,
     ON_DEMAND_MESSAGES,
     PAUSED_POLL_S,
     DivergenceGuard,
@@ -357,7 +359,81 @@ def test_resets_republish_the_config_and_set_mode_returns_the_previous(
     loop.reset_simulation()
     assert sim.sim_time_ns == 0
     assert len(configs) == 2
-    assert log.of('info')[-1] == 'reset_simulation: robot reset and sim time back to 0'
+    assert log.of('info')[-2:] == [
+        'reset_world: robot back to its initial pose at t=0.005 s (torso pinned for 1.0 s)',
+        'reset_simulation: robot reset and sim time back to 0']
+    loop.reset_world(by=' (viewer)')
+    assert log.of('info')[-1] == ('reset_world (viewer): robot back to its initial pose at '
+                                  't=0.000 s (torso pinned for 1.0 s)')
+
+
+# -- headless feedback: falls and commands the mode ignores -------------------------------
+
+def first_step_below_fall_height(atlas: atlas_model.AtlasModel, steps: int) -> int:
+    """The same limp robot stepped by hand: the step after which its pelvis is first below
+    FALL_HEIGHT_M (determinism makes it the loop's too)."""
+    twin = AtlasSimulator(atlas, load_gains_yaml(CONFIG), time_to_unpin_s=0.0)
+    twin.set_mode(ControlMode.RAGDOLL)
+    for step in range(1, steps + 1):
+        twin.step()
+        if pelvis_height_m(atlas, twin.data) < FALL_HEIGHT_M:
+            return step
+    raise AssertionError(f'the limp robot did not fall within {steps} steps')
+
+
+def test_a_fall_is_logged_once_and_again_after_a_reset(atlas: atlas_model.AtlasModel) -> None:
+    limp = AtlasSimulator(atlas, load_gains_yaml(CONFIG), time_to_unpin_s=0.0)
+    loop, _, log, _ = make_loop(limp)
+    loop.set_mode(ControlMode.RAGDOLL)
+    fall_step = first_step_below_fall_height(atlas, 3000)
+    loop.run(stops_after(fall_step + 500))  # lying on the ground 0.5 s on: still one line
+    assert pelvis_height_m(atlas, limp.data) < FALL_HEIGHT_M
+    falls = [line for line in log.of('info') if 'fell' in line]
+    assert falls == [f'the robot fell: pelvis below 0.5 m at t={fall_step / 1000:.3f} s']
+
+    loop.reset_world()
+    start_ns = limp.sim_time_ns
+    loop.receive_command(complete_command(0.0))  # ignored in ragdoll, but the first command
+    loop.run(stops_after(fall_step))
+    falls = [line for line in log.of('info') if 'fell' in line]
+    assert len(falls) == 2
+    assert falls[1] == (f'the robot fell: pelvis below 0.5 m at '
+                        f't={(start_ns / NS_PER_S) + fall_step / 1000:.3f} s, '
+                        f'{fall_step / 1000:.3f} s after the first command since the start '
+                        'or last reset')
+
+
+def test_a_standing_robot_logs_no_fall(sim: AtlasSimulator) -> None:
+    loop, _, log, _ = make_loop(sim)
+    loop.run(stops_after(2000))
+    assert pelvis_height_m(sim.atlas, sim.data) > 0.8
+    assert not [line for line in log.of('info') if 'fell' in line]
+
+
+NOT_USER_WARNING = ('/atlas/joint_commands arrive in {mode} mode, which does not apply them; '
+                    'switch to User mode: '
+                    'rostopic pub /atlas/control_mode std_msgs/String -- "User"')
+
+
+def test_commands_outside_user_mode_warn_at_once_then_throttled(sim: AtlasSimulator) -> None:
+    loop, _, log, _ = make_loop(sim)
+    period_steps = int(NOT_USER_WARN_PERIOD_S * 1000)
+
+    def play(steps: int) -> None:  # a command every step, as a 1 kHz controller
+        for _ in range(steps):
+            loop.receive_command(complete_command(0.0))
+            loop.run(stops_after(1))
+
+    play(period_steps)  # 5 s of commands in Stand: one warning
+    assert log.of('warn') == [NOT_USER_WARNING.format(mode='Stand')]
+    play(2)  # the period is over: a second one
+    assert log.of('warn') == [NOT_USER_WARNING.format(mode='Stand')] * 2
+    loop.set_mode(ControlMode.USER)
+    play(10)
+    assert len(log.of('warn')) == 2  # applied: nothing to say
+    loop.set_mode(ControlMode.FREEZE)  # a new mode that ignores them: at once
+    play(1)
+    assert log.of('warn')[2:] == [NOT_USER_WARNING.format(mode='Freeze')]
 
 
 def test_inputs_apply_between_steps_publish_their_event_and_log_once_a_second(

@@ -27,6 +27,7 @@ from tutorial_atlas_control.node.traj_yaml import (
     JointStateCache,
     TrajYamlError,
     build_command,
+    mode_warning,
     positions_by_name,
     read_gains,
     run_trajectory,
@@ -173,7 +174,8 @@ def test_missing_trajectory_keeps_the_tutorial_message(fake_master, tmp_path: Pa
     server, uri = fake_master
     result = run_script([str(TRAJECTORY_FILE), 'nope'], uri, tmp_path)
     assert_one_line_error(result, f'unable to find trajectory nope in {TRAJECTORY_FILE}')
-    assert result.stderr == f'unable to find trajectory nope in {TRAJECTORY_FILE}\n'
+    assert result.stderr == (f'unable to find trajectory nope in {TRAJECTORY_FILE}; it holds: '
+                             'step_and_fall, touchdown, touchdown_exhausted\n')
     assert_untouched(server)
 
 
@@ -580,3 +582,16 @@ def test_explicit_missing_path_is_not_redirected(fake_master, tmp_path: Path) ->
     assert_one_line_error(
         result, './Traj_data2.yaml: cannot read trajectory file: No such file or directory')
     assert_untouched(server)
+
+
+@pytest.mark.parametrize('mode', ['Stand', 'StandPrep', 'Freeze', 'ragdoll'])
+def test_a_mode_other_than_user_is_warned_about_with_the_command_to_send(mode: str) -> None:
+    assert mode_warning(mode) == (
+        f'the simulator is in {mode} mode, which does not apply these commands: the robot will '
+        'not move; switch to User mode first: '
+        'rostopic pub /atlas/control_mode std_msgs/String -- "User"')
+
+
+@pytest.mark.parametrize('mode', ['User', None])  # None: a simulator that does not say
+def test_user_mode_or_an_unknown_one_gives_no_warning(mode: str | None) -> None:
+    assert mode_warning(mode) is None

@@ -166,7 +166,17 @@ def test_unknown_trajectory_keeps_the_tutorial_message(tmp_path: Path) -> None:
     path = write(tmp_path, f'good:\n  - [1.0, "{ZEROS}"]\n')
     with pytest.raises(TrajectoryError) as info:
         load_trajectory(path, 'nope')
-    assert str(info.value) == f'unable to find trajectory nope in {path}'
+    assert str(info.value) == f'unable to find trajectory nope in {path}; it holds: good'
+
+
+def test_an_unknown_name_lists_the_file_s_trajectories(tmp_path: Path) -> None:
+    many = ''.join(f'traj_{index}:\n  - [1.0, "{ZEROS}"]\n' for index in range(25))
+    path = write(tmp_path, many)
+    with pytest.raises(TrajectoryError) as info:
+        load_trajectory(path, 'nope')
+    listed = ', '.join(f'traj_{index}' for index in range(20))
+    assert str(info.value) == (f'unable to find trajectory nope in {path}; it holds: {listed}, '
+                               '... (25 in all)')
 
 
 def test_unknown_name_is_reported_before_other_problems(tmp_path: Path) -> None:
@@ -398,3 +408,12 @@ def test_interpolate_rejects_mismatched_shapes() -> None:
 def test_waypoint_is_a_plain_record() -> None:
     waypoint = Waypoint(duration_s=1.0, positions=np.zeros(NUM_JOINTS))
     assert waypoint.duration_s == 1.0
+
+
+def test_odd_trajectory_names_are_listed_quoted_on_one_line(tmp_path: Path) -> None:
+    path = write(tmp_path, f'"a, b":\n  - [1.0, "{ZEROS}"]\n"x\\ny":\n  - [1.0, "{ZEROS}"]\n'
+                           f'7:\n  - [1.0, "{ZEROS}"]\n')
+    with pytest.raises(TrajectoryError) as info:
+        load_trajectory(path, 'nope')
+    assert str(info.value) == (f"unable to find trajectory nope in {path}; it holds: 'a, b', "
+                               "'x\\ny', 7")

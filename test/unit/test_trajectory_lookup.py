@@ -11,6 +11,7 @@ from tutorial_atlas_control.trajectories.trajectory import (
     TrajectoryError,
     is_explicit_path,
     load_trajectory,
+    locate_trajectory_file,
     resolve_trajectory_file,
 )
 
@@ -77,3 +78,20 @@ def test_a_name_found_nowhere_is_one_line_naming_both_places(dirs: tuple[Path, P
     assert '\n' not in message
     assert message.startswith('absent.yaml: cannot read trajectory file: No such file or directory')
     assert 'not in the current directory' in message and str(package) in message
+
+
+def test_the_package_copy_is_announced_except_from_the_package_directory(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    package = tmp_path / 'package'
+    (package / 'trajectories').mkdir(parents=True)
+    (package / 'trajectories' / 'Traj.yaml').write_text('{}')
+    (tmp_path / 'elsewhere').mkdir()
+    (tmp_path / 'link').symlink_to(package)  # as the workspace's src/ link, where roscd lands
+    found = str(package / 'trajectories' / 'Traj.yaml')
+    for cwd, said in ((tmp_path / 'elsewhere',
+                       [f'Traj.yaml is not in the current directory; using {found}']),
+                      (package, []), (tmp_path / 'link', [])):
+        monkeypatch.chdir(cwd)
+        lines: list[str] = []
+        assert locate_trajectory_file('Traj.yaml', lines.append, package / 'trajectories') == found
+        assert lines == said, cwd

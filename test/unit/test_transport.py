@@ -96,3 +96,34 @@ def test_a_publisher_shut_down_during_a_send_is_left_quietly(
     transport.write_to_connections(pub, b'data')
     assert later.socket.sent == []
     assert warnings == []
+
+
+class ClosedDuringRemoval(FakePublisher):
+    """rospy closes the publisher between the send's failure and its removal (seen with a
+    second atlas.launch on the same master: TypeError in rospy's remove_connection)."""
+
+    def remove_connection(self, connection):
+        self.closed = True
+        self.connections.clear()
+        listeners = None
+        for _listener in listeners:  # rospy's _PublisherImpl.remove_connection, after close()
+            pass
+
+
+def test_a_publisher_closed_while_a_connection_is_removed_is_left_quietly(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(transport.rospy, 'logdebug', lambda _msg: None)
+    left = FakeConnection('/recorder', BrokenPipeError(32, 'Broken pipe'))
+    later = FakeConnection('/probe')
+    pub = ClosedDuringRemoval([left, later])
+    transport.write_to_connections(pub, b'data')  # no TypeError
+    assert later.socket.sent == []
+
+
+def test_a_type_error_of_an_open_publisher_is_not_hidden(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(transport.rospy, 'logdebug', lambda _msg: None)
+    pub = FakePublisher([FakeConnection('/recorder', BrokenPipeError(32, 'Broken pipe'))])
+    pub.remove_connection = lambda _connection: len(None)
+    with pytest.raises(TypeError):
+        transport.write_to_connections(pub, b'data')

@@ -5,6 +5,7 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -237,3 +238,21 @@ def test_close_waits_for_a_hold_in_progress(physics: Physics) -> None:
     started_s = time.monotonic()
     link.hold(hold_s)  # closed: no more holds
     assert time.monotonic() - started_s < hold_s
+
+
+def free_display() -> str:
+    """An X display number no server uses here."""
+    for number in range(87, 200):
+        if not Path(f'/tmp/.X11-unix/X{number}').exists():
+            return f':{number}'
+    pytest.skip('no free X display number')
+
+
+def test_an_unusable_display_is_named_before_glfw_can_end_the_process() -> None:
+    from tutorial_atlas_control.node.viewer import display_problem
+    display = free_display()
+    assert display_problem(display) == (
+        f'no X server answers at DISPLAY={display} (none running there, or a broken ssh -X '
+        'forwarding)')
+    assert display_problem('') == '$DISPLAY is not set'
+    assert display_problem(None) == '$DISPLAY is not set'

@@ -150,6 +150,7 @@ class Analysis:
         """(time from the bag's start (s), description) of each applied VRCPlugin input."""
         return input_timeline(self.data)
 
+    @property
     def warnings(self) -> list[str]:
         """The bag's warnings, and one when the run holds several tries."""
         extra = []

@@ -1,7 +1,8 @@
 """Command line of sim/atlas_sim_node.py, the simulator node that atlas.launch starts.
 
 `--help` prints the node's parameters (node/sim_node.py's docstring). Like any ROS node it
-exits 0 when ROS shuts it down (Ctrl-C, `rosnode kill`), 1 when its set-up is refused.
+exits 0 when ROS shuts it down (Ctrl-C, `rosnode kill`, another atlas_sim registering on the
+same master: then with one line saying so), 1 when its set-up is refused.
 """
 
 from __future__ import annotations
@@ -9,6 +10,7 @@ from __future__ import annotations
 import sys
 from collections.abc import Sequence
 
+import rosgraph
 import rospy
 
 from tutorial_atlas_control.cli.convention import EXIT_REFUSED
@@ -17,6 +19,28 @@ from tutorial_atlas_control.node import sim_node
 from tutorial_atlas_control.node.sim_node import NODE_NAME, build_node
 
 HELP_OPTIONS = ('-h', '--help')
+#: What the master gives as the reason when another node registers under our name.
+SAME_NAME_REASON = 'new node registered with same name'
+
+
+class ShutdownReason:
+    """Remembers why rospy shut the node down (a pre-shutdown hook gets the reason)."""
+
+    def __init__(self) -> None:
+        self.text = ''
+
+    def __call__(self, reason: str) -> None:
+        self.text = str(reason)
+
+    def taken_over(self) -> bool:
+        return SAME_NAME_REASON in self.text
+
+
+def took_over_line(name: str, master_uri: str) -> str:
+    """The one line of a simulator that another one replaced."""
+    return (f'{NODE_NAME}: another {NODE_NAME} took over: a second simulator registered as '
+            f'{name} on {master_uri}, so this one stops (its launch and recording end); run '
+            'one atlas.launch per master, or give the second its own (roslaunch -p PORT)')
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -26,6 +50,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(sim_node.__doc__)
         return 0
     rospy.init_node(NODE_NAME)
+    reason = ShutdownReason()
+    rospy.core.add_preshutdown_hook(reason)
     try:
         node = build_node()
     except AtlasControlError as err:
@@ -34,4 +60,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     rospy.loginfo(f'Atlas v1 simulator ready: dt={node.sim.dt_s * 1000:.1f} ms, '
                   f'real_time_factor={node.loop.real_time_factor}, paused={node.loop.paused}, '
                   f'torso pinned for {node.sim.time_to_unpin_s} s')
-    return node.spin()
+    status = node.spin()
+    if reason.taken_over():
+        print(took_over_line(rospy.get_name(), rosgraph.get_master_uri().rstrip('/')),
+              file=sys.stderr)
+    return status

@@ -13,13 +13,16 @@ reset and pause services (and DRCSim's /gazebo/reset_models). VRCPlugin's
 /atlas/mode, set_pose, cmd_vel, gazebo_ros_force's /atlas/apply_pelvis_force and
 gazebo_ros_joint_trajectory's /joint_trajectory are checked here and applied by the loop
 (sim/vrc.py), each applied one echoed on /atlas/sim_inputs; /atlas/configuration is
-logged as not implemented, as in DRCSim.
+logged as not implemented, as in DRCSim. Publishes a latched /atlas/current_control_mode (the
+mode now). Logs one line per fall (pelvis below 0.5 m, once until a reset) and per reset,
+and warns when joint commands arrive in a mode that does not apply them.
 
 Parameters (private unless noted):
     ~real_time_factor (float, 1.0): sim time per wall time; 0 runs as fast as possible.
     ~paused (bool, false): start with physics paused (/gazebo/unpause_physics starts it).
-    ~gui (bool, false): open the MuJoCo viewer (needs a display); its Reset button and key
-        (Backspace) and Shift+Ctrl+R do reset_world, Space pauses/unpauses (viewer.py).
+    ~gui (bool, false): open the MuJoCo viewer (needs a display; a $DISPLAY no X server
+        answers gives one warning and a headless run); its Reset button and key (Backspace)
+        and Shift+Ctrl+R do reset_world, Space pauses/unpauses (viewer.py).
     ~joint_states_rate, ~imu_rate, ~contact_rate (Hz, 1000): 0 or >= 1000 = every step.
     ~atlas_state_rate, ~force_torque_sensors_rate, ~debug_contact_rate (Hz, 1000): DRCSim's
         /atlas/atlas_state, /atlas/force_torque_sensors, /atlas/debug/{l,r}_foot_contact
@@ -40,6 +43,7 @@ Parameters (private unless noted):
 from __future__ import annotations
 
 import io
+import os
 import threading
 import time
 import warnings
@@ -64,7 +68,7 @@ from trajectory_msgs.msg import JointTrajectory
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.node.transport import WireBatch
-from tutorial_atlas_control.node.viewer import ViewerLink, ViewerRequest
+from tutorial_atlas_control.node.viewer import ViewerLink, ViewerRequest, display_problem
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.camera import configure_viewer_camera, configure_viewer_scene
 from tutorial_atlas_control.sim.controller import GainsError, gains_from_params
@@ -220,6 +224,7 @@ class SimNode:
                                  real_time_factor=real_time_factor, paused=paused,
                                  publish_input=self._publish_input)
         self.loop.publish_config()
+        self.mode_pub.publish(String(data=sim.mode.value))
         self._subscribe()
 
     def _advertise(self, tf: bool) -> None:
@@ -239,6 +244,9 @@ class SimNode:
         self.config_pub = rospy.Publisher(topics.SIM_CONFIG, String, queue_size=1, latch=True)
         # Each applied cheat, with the sim time it took effect: what replay re-applies.
         self.inputs_pub = rospy.Publisher(topics.SIM_INPUTS, String, queue_size=100)
+        # Latched: the mode now, for traj_yaml.py's warning and `rostopic echo`.
+        self.mode_pub = rospy.Publisher(topics.CURRENT_CONTROL_MODE, String, queue_size=1,
+                                        latch=True)
 
     def _controller_statistics(self) -> CommandAgeStatistics:
         """DRCSim's command age statistics, from the parameters (fed and published by the
@@ -361,6 +369,7 @@ class SimNode:
             rospy.logwarn_throttle(WARN_THROTTLE_S, f'refused /atlas/control_mode: {err}')
             return
         previous = self.loop.set_mode(mode)
+        self.mode_pub.publish(String(data=mode.value))
         rospy.loginfo(f'control mode: {previous.value} -> {mode.value}')
 
     def _service(self, action: Callable[[], None]) -> Callable[[object], EmptyResponse]:
@@ -385,6 +394,11 @@ class SimNode:
     def _open_viewer(self) -> ViewerLink | None:
         """The viewer window, framing the whole robot and following the pelvis, kept up to
         date by a thread of its own (_viewer_loop)."""
+        problem = display_problem(os.environ.get('DISPLAY'))
+        if problem is not None:
+            rospy.logwarn(f'cannot open the MuJoCo viewer: {problem}; running headless, '
+                          'recording on (gui:=false starts without trying)')
+            return None
         try:
             link = ViewerLink(self.sim.model)
         except Exception as err:  # noqa: BLE001 - no display, no GL: run headless
@@ -422,8 +436,7 @@ class SimNode:
             viewer.copy_out(self.sim.data)
         for request in viewer.take_requests():
             if request is ViewerRequest.RESET_WORLD:
-                rospy.loginfo('viewer: Reset -> reset_world')
-                loop.reset_world()
+                loop.reset_world(by=' (viewer)')
             elif loop.paused:  # ViewerRequest.TOGGLE_PAUSE
                 loop.unpause()
             else:

@@ -14,12 +14,13 @@ import os
 import threading
 import time
 from collections.abc import Callable, Iterable, Sequence
-from typing import TypeVar
+from typing import Generic, TypeVar
 
 import numpy as np
 import rosgraph
 import rospy
 from sensor_msgs.msg import JointState
+from std_msgs.msg import String
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.errors import AtlasControlError
@@ -48,6 +49,7 @@ __all__ = [
     'wait_for_ros_time',
     'wait_for_subscribers',
     'wait_until_handed_over',
+    'mode_warning',
 ]
 
 #: The tutorial's node name.
@@ -76,9 +78,15 @@ MASTER_POLL_PERIOD_S = 0.1
 HANDOVER_WAIT_S = 0.05
 #: Polling interval (s, wall clock) of that wait.
 HANDOVER_POLL_S = 0.0005
+#: Longest wait (s, wall clock) for the simulator's latched mode once it is connected; a
+#: simulator that does not publish it (an older one, a stand-in) gets no mode check.
+MODE_WAIT_S = 1.0
+#: The mode in which the simulator applies the commands.
+USER_MODE = 'User'
 
 
 _T = TypeVar('_T')
+_M = TypeVar('_M')
 
 
 class TrajYamlError(AtlasControlError):
@@ -140,20 +148,24 @@ def positions_by_name(names: Sequence[str], positions: Sequence[float]) -> np.nd
     return result
 
 
-class JointStateCache:
-    """The latest JointState, filled by a subscriber callback (another thread)."""
+class LatestMessage(Generic[_M]):
+    """The latest message of a topic, filled by a subscriber callback (another thread)."""
 
     def __init__(self) -> None:
         self._lock = threading.Lock()
-        self._message: JointState | None = None
+        self._message: _M | None = None
 
-    def callback(self, message: JointState) -> None:
+    def callback(self, message: _M) -> None:
         with self._lock:
             self._message = message
 
-    def latest(self) -> JointState | None:
+    def latest(self) -> _M | None:
         with self._lock:
             return self._message
+
+
+class JointStateCache(LatestMessage[JointState]):
+    """The latest JointState, filled by a subscriber callback (another thread)."""
 
     def positions(self) -> np.ndarray:
         """The latest joint positions in tutorial order (rad); see :func:`positions_by_name`."""
@@ -218,6 +230,18 @@ def _poll(value: Callable[[], _T | None], timeout_s: float, is_shutdown: Callabl
     return result
 
 
+def mode_warning(mode: str | None) -> str | None:
+    """The start-up warning for the simulator's control mode `mode` (None: unknown).
+
+    The tutorial has the user switch to User first; forgotten, the robot does not move and
+    nothing else says why. traj_yaml.py does not switch itself: that step is the tutorial's.
+    """
+    if mode is None or mode == USER_MODE:
+        return None
+    return (f'the simulator is in {mode} mode, which does not apply these commands: the robot '
+            f'will not move; switch to User mode first: {topics.SWITCH_TO_USER}')
+
+
 def build_command(
     message_type: Callable[[], object], positions: Iterable[float], gains: Gains, stamp: object
 ) -> object:
@@ -254,12 +278,17 @@ def play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], path
     gains = read_gains()
     cache = JointStateCache()
     rospy.Subscriber(JOINT_STATES_TOPIC, JointState, cache.callback, queue_size=1)
+    mode: LatestMessage[String] = LatestMessage()
+    rospy.Subscriber(topics.CURRENT_CONTROL_MODE, String, mode.callback, queue_size=1)
     publisher = rospy.Publisher(JOINT_COMMANDS_TOPIC, message_type, queue_size=1)
     joint_state_timeout_s = _timeout_param(JOINT_STATE_TIMEOUT_PARAM, JOINT_STATE_TIMEOUT_S)
     subscriber_timeout_s = _timeout_param(SUBSCRIBER_TIMEOUT_PARAM, SUBSCRIBER_TIMEOUT_S)
     first_state = wait_for_joint_state(cache, joint_state_timeout_s)
     wait_for_ros_time(joint_state_timeout_s)
     _wait_for_simulator(publisher, first_state, subscriber_timeout_s)
+    warning = mode_warning(_current_mode(mode))
+    if warning is not None:
+        rospy.logwarn(warning)
 
     def send(positions: np.ndarray) -> None:
         if rospy.is_shutdown():  # on wall time rospy.sleep does not raise on Ctrl-C
@@ -292,6 +321,19 @@ def _wait_for_simulator(publisher: rospy.Publisher, first_state: JointState,
     if missing:
         rospy.logwarn(f'not connected to {JOINT_COMMANDS_TOPIC} in time, '
                       'so missing the first commands: ' + ', '.join(sorted(missing)))
+
+
+def _current_mode(cache: LatestMessage[String]) -> str | None:
+    """The simulator's mode (its latched /atlas/current_control_mode), waited for at most
+    MODE_WAIT_S; None if it says nothing."""
+    deadline = time.monotonic() + MODE_WAIT_S
+    while (message := cache.latest()) is None:
+        if rospy.is_shutdown():
+            raise rospy.ROSInterruptException('shut down while waiting for the mode')
+        if time.monotonic() >= deadline:
+            return None
+        time.sleep(POLL_PERIOD_S)
+    return str(message.data)
 
 
 def _timeout_param(name: str, default: float) -> float:

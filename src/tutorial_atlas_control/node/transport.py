@@ -45,7 +45,15 @@ def write_to_connections(pub: rospy.Publisher, data: bytes | bytearray) -> None:
             elif not isinstance(err, TransportTerminated):
                 rospy.logwarn(f'{pub.resolved_name}: dropping subscriber '
                               f'{connection.endpoint_id}: {err}')
-            impl.remove_connection(connection)
+            try:
+                impl.remove_connection(connection)
+            except (TypeError, AttributeError):
+                # rospy closed the publisher after the check above (another thread: a
+                # shutdown, such as a second atlas_sim registering): its listener list is
+                # gone, and with it every connection. Nothing left to send to.
+                if impl.closed:
+                    return
+                raise
             connection.close()
 
 

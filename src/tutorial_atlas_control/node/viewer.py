@@ -26,6 +26,8 @@ destroyed by its thread then is a segfault.
 from __future__ import annotations
 
 import atexit
+import ctypes
+import ctypes.util
 import enum
 import threading
 import time
@@ -104,6 +106,29 @@ def request_for_key(key: int, modifiers: frozenset[str]) -> ViewerRequest | None
         return ViewerRequest.TOGGLE_PAUSE
     if key == KEY_R and modifiers == RESET_MODIFIERS:
         return ViewerRequest.RESET_WORLD
+    return None
+
+
+def display_problem(display: str | None) -> str | None:
+    """Why no window can open on X display `display` ($DISPLAY); None when a server answers.
+
+    MuJoCo's viewer ends the whole process when GLFW cannot open the display ("could not
+    initialize GLFW"), which took the launch down with it; so the node asks X first.
+    """
+    if not display:
+        return '$DISPLAY is not set'
+    name = ctypes.util.find_library('X11')
+    if name is None:
+        return 'the X11 library (libX11) is not installed'
+    xlib = ctypes.CDLL(name)
+    xlib.XOpenDisplay.restype = ctypes.c_void_p
+    xlib.XOpenDisplay.argtypes = [ctypes.c_char_p]
+    xlib.XCloseDisplay.argtypes = [ctypes.c_void_p]
+    connection = xlib.XOpenDisplay(display.encode())
+    if not connection:
+        return (f'no X server answers at DISPLAY={display} (none running there, or a broken '
+                'ssh -X forwarding)')
+    xlib.XCloseDisplay(connection)
     return None
 
 

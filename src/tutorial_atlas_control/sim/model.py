@@ -25,6 +25,10 @@ MODEL_PATH: Path = package_path('sim', 'atlas_v1.xml')
 #: dropped the robot 2.9 mm onto the ground; we start in contact instead.
 SPAWN_HEIGHT_M: float = 0.05 + 0.374 + 0.422 + 0.076119 + 0.005
 
+#: The robot has fallen once its pelvis is below this height (m): the simulator's log line
+#: and the bag analysis use the same criterion (standing, the pelvis is at about 0.92 m).
+FALL_HEIGHT_M: float = 0.5
+
 PELVIS_BODY = 'pelvis'
 PIN_EQUALITY = 'pelvis_pin'
 
@@ -166,6 +170,11 @@ def pelvis_pose(atlas: AtlasModel, data: mujoco.MjData) -> tuple[np.ndarray, np.
     """(position (3,) m, quaternion (4,) w x y z) of the pelvis in the world."""
     adr = atlas.free_qpos_adr
     return data.qpos[adr:adr + 3].copy(), data.qpos[adr + 3:adr + 7].copy()
+
+
+def pelvis_height_m(atlas: AtlasModel, data: mujoco.MjData) -> float:
+    """Height (m) of the pelvis origin above the ground, z = 0."""
+    return float(data.qpos[atlas.free_qpos_adr + 2])
 
 
 def sensor(atlas: AtlasModel, data: mujoco.MjData, name: str) -> np.ndarray:

@@ -4,6 +4,9 @@ Each turn: merge the commands that arrived since the last step, step, serialize 
 due into the outbox, decide whether to send it, and wait for wall time. The loop also owns
 what the node's services and viewer do to the simulator (resets, pause, control mode),
 under the lock that rospy's threads and the viewer's share with it.
+Headless, its log lines are what the user sees of a run: one per fall (pelvis below
+FALL_HEIGHT_M, once until a reset), one per reset, and a warning when commands arrive in a
+mode that does not apply them.
 
 The node (node/sim_node.py) gives it an Outbox (rospy publishers behind
 transport.WireBatch), a LoopLog (rospy's log) and its shutdown test; tests give it fakes.
@@ -36,6 +39,7 @@ from tutorial_atlas_control.msgs.sim_messages import SimMessages
 from tutorial_atlas_control.msgs.wire import ControllerStatisticsWire, clock_bytes
 from tutorial_atlas_control.sim.controller import Gains
 from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistics
+from tutorial_atlas_control.sim.model import FALL_HEIGHT_M
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode, PhysicsDivergenceError
 from tutorial_atlas_control.sim.vrc import SimInput, describe_input
 from tutorial_atlas_control.stepping.pacing import Pacer
@@ -54,6 +58,9 @@ MAX_PENDING_COMMANDS = 10_000
 #: An applied input of a kind is logged at most once per this much sim time (s): a
 #: disturbance generator streaming a wrench at 1 kHz must not flood /rosout.
 INPUT_LOG_PERIOD_S = 1.0
+#: Commands arriving while the mode is not User are warned about at once, then at most
+#: this often (s of sim time) while they keep coming.
+NOT_USER_WARN_PERIOD_S = 5.0
 #: While paused, the loop looks for commands and shutdown this often (s, wall).
 PAUSED_POLL_S = 0.01
 #: The per-step messages: topic, key of its rate in `rates_hz`, name in
@@ -239,6 +246,12 @@ class SteppingLoop:
         self.desired_controller_period_ms = 0
         self._period_warned = False
 
+        # Headless feedback (a log line per fall, per reset, and for ignored commands).
+        self.pelvis_z_index = sim.atlas.free_qpos_adr + 2  # the pelvis height in qpos
+        self.fall_armed = True  # one line per fall: disarmed by it, re-armed by a reset
+        self.first_command_ns: int | None = None  # since the start or last reset
+        self.not_user_warned_ns: int | None = None
+
     @property
     def real_time_factor(self) -> float:
         """Sim time per wall time (the pacer's); 0 = as fast as possible."""
@@ -314,11 +327,26 @@ class SteppingLoop:
             updates.append(result.update)
         first = self.sim.user_command is None
         self.sim.receive_updates(updates)
+        if (self.sim.mode is not ControlMode.USER
+                and any(topic == topics.JOINT_COMMANDS for topic, _ in decoded)):
+            self._warn_not_user()  # AtlasCommands with k_effort act in any mode
         if first:
+            self.first_command_ns = self.sim.sim_time_ns
             # Which command a trajectory started from: a late one makes the robot jump.
             self.log.info(f'first {decoded[0][0]} since the start or last reset, at '
                           f't={self.sim.sim_time_ns / NS_PER_S:.3f} s '
                           f'({self.sim.mode.value} mode)')
+
+    def _warn_not_user(self) -> None:
+        """Commands arrived in a mode that does not apply them: say how to switch (the
+        tutorial's step most often forgotten), at once, then every NOT_USER_WARN_PERIOD_S."""
+        now_ns = self.sim.sim_time_ns
+        last_ns = self.not_user_warned_ns
+        if last_ns is not None and 0 <= now_ns - last_ns < NOT_USER_WARN_PERIOD_S * NS_PER_S:
+            return  # (a rewind, reset_simulation, warns again)
+        self.not_user_warned_ns = now_ns
+        self.log.warn(f'{topics.JOINT_COMMANDS} arrive in {self.sim.mode.value} mode, which does '
+                      f'not apply them; switch to User mode: {topics.SWITCH_TO_USER}')
 
     def _store_period(self, period_ms: int) -> None:
         self.desired_controller_period_ms = period_ms
@@ -385,6 +413,7 @@ class SteppingLoop:
             self.apply_pending_commands()
             previous = self.sim.mode
             self.sim.set_mode(mode)
+            self.not_user_warned_ns = None  # a new mode: warn again at once
         return previous
 
     def apply_input(self, item: SimInput) -> None:
@@ -405,17 +434,21 @@ class SteppingLoop:
         """(Re-)publish /atlas/sim_config: at start and after every reset."""
         self._send_config(self.sim.config().to_json())
 
-    def reset_world(self) -> None:
+    def reset_world(self, by: str = '') -> None:
+        """/gazebo/reset_world, or the viewer's Reset (`by`: ' (viewer)', said in the line)."""
         with self.lock:
             self.sim.reset_world()
+            self._rearm()
         self.publish_config()
-        self.log.info('reset_world: robot back to its initial pose (torso pinned '
+        self.log.info(f'reset_world{by}: robot back to its initial pose at '
+                      f't={self.sim.sim_time_ns / NS_PER_S:.3f} s (torso pinned '
                       f'for {self.sim.time_to_unpin_s} s)')
 
     def reset_simulation(self) -> None:
         with self.lock:
             self.sim.reset_simulation()
             self.statistics.forget_command()  # its stamp lies in the rewound future
+            self._rearm()
         self.publish_config()
         self.log.info('reset_simulation: robot reset and sim time back to 0')
 
@@ -426,6 +459,25 @@ class SteppingLoop:
     def unpause(self) -> None:
         self.paused = False
         self.log.info('physics unpaused')
+
+    def _rearm(self) -> None:
+        """After a reset: the next fall and the next first command are new."""
+        self.fall_armed = True
+        self.first_command_ns = None
+        self.not_user_warned_ns = None
+
+    def watch_fall(self) -> None:
+        """After a step: one line when the pelvis drops below FALL_HEIGHT_M (headless, the
+        only sign of a fall), then nothing until a reset."""
+        if self.fall_armed and self.sim.data.qpos[self.pelvis_z_index] < FALL_HEIGHT_M:
+            self.fall_armed = False
+            sim = self.sim
+            line = (f'the robot fell: pelvis below {FALL_HEIGHT_M} m at '
+                    f't={sim.sim_time_ns / NS_PER_S:.3f} s')
+            if self.first_command_ns is not None:
+                line += (f', {(sim.sim_time_ns - self.first_command_ns) / NS_PER_S:.3f} s '
+                         'after the first command since the start or last reset')
+            self.log.info(line)
 
     # -- publishing ----------------------------------------------------------------------
     def publish(self) -> None:
@@ -501,6 +553,8 @@ class SteppingLoop:
                     if not self._recover(err):
                         break
                 self.step_count += 1
+                if self.fall_armed:
+                    self.watch_fall()
                 self.publish()
                 self._publish_controller_statistics(sim.sim_time_ns)
                 sim_ns = sim.sim_time_ns
@@ -522,5 +576,6 @@ class SteppingLoop:
             return False
         self.log.error(f'{err}; resetting the robot to its initial state')
         self.sim.reset_world()
+        self._rearm()
         self.publish_config()
         return True

@@ -133,7 +133,7 @@ def parse_trajectory(doc: Mapping[object, object], name: str, path: PathLike) ->
             waypoint index and problem.
     """
     if name not in doc:
-        raise TrajectoryError(f'unable to find trajectory {name} in {path}')
+        raise TrajectoryError(unknown_trajectory(doc, name, path))
     rows = doc[name]
     where = f"{path}: trajectory '{name}'"
     if not isinstance(rows, list):
@@ -142,6 +142,29 @@ def parse_trajectory(doc: Mapping[object, object], name: str, path: PathLike) ->
     if not rows:
         raise TrajectoryError(f'{where}: has no waypoints')
     return [_parse_waypoint(row, f'{where}, waypoint {index}') for index, row in enumerate(rows)]
+
+
+#: The unknown-name error lists at most this many of the file's trajectories.
+MAX_NAMES_LISTED = 20
+
+
+def unknown_trajectory(doc: Mapping[object, object], name: str, path: PathLike) -> str:
+    """The tutorial's "unable to find trajectory NAME in FILE", and the names the file has."""
+    names = [_shown_name(key) for key in doc]
+    if not names:
+        return f'unable to find trajectory {name} in {path}; it holds no trajectories'
+    listed = ', '.join(names[:MAX_NAMES_LISTED])
+    if len(names) > MAX_NAMES_LISTED:
+        listed += f', ... ({len(names)} in all)'
+    return f'unable to find trajectory {name} in {path}; it holds: {listed}'
+
+
+def _shown_name(key: object) -> str:
+    """A trajectory name as the error lists it: as written when plain, else quoted (one line)."""
+    text = str(key)
+    if text and text.isprintable() and text == text.strip() and ',' not in text:
+        return text
+    return repr(text)
 
 
 def is_explicit_path(path: PathLike) -> bool:
@@ -172,18 +195,29 @@ def resolve_trajectory_file(path: PathLike,
                           f'(not in the current directory, nor in {search_dir})')
 
 
-def locate_trajectory_file(path: PathLike, announce: Callable[[str], None] | None = None) -> str:
+def locate_trajectory_file(path: PathLike, announce: Callable[[str], None] | None = None,
+                           search_dir: Path = TRAJECTORIES_DIR) -> str:
     """YAML_FILE as the tutorial uses it (traj_yaml.py, run_offline.py): a bare name also finds
     the package's trajectories/ copy, and `announce` (the command line's print) says so in
-    one line.
+    one line, unless the current directory is the package's own (`roscd
+    tutorial_atlas_control`, the tutorial's way): there its trajectories/ is the expected place.
 
     Raises:
         TrajectoryError: as :func:`resolve_trajectory_file`.
     """
-    found, from_package = resolve_trajectory_file(path)
-    if from_package and announce is not None:
+    found, from_package = resolve_trajectory_file(path, search_dir)
+    if from_package and announce is not None and not _in_package_dir(search_dir.parent):
         announce(f'{os.fspath(path)} is not in the current directory; using {found}')
     return found
+
+
+def _in_package_dir(package_dir: Path) -> bool:
+    """Whether the current directory is `package_dir` (through any symlink: roscd lands in
+    the catkin workspace's src/ link to the clone)."""
+    try:
+        return Path.cwd().resolve() == package_dir.resolve()
+    except OSError:  # the current directory was removed
+        return False
 
 
 def load_trajectory(path: PathLike, name: str) -> list[Waypoint]:
@@ -197,7 +231,7 @@ def load_trajectory(path: PathLike, name: str) -> list[Waypoint]:
     """
     doc = load_trajectory_file(path)
     if name not in doc:
-        raise TrajectoryError(f'unable to find trajectory {name} in {path}')
+        raise TrajectoryError(unknown_trajectory(doc, name, path))
     for other in doc:
         if other != name:
             parse_trajectory(doc, other, path)

@@ -1,0 +1,37 @@
+"""The scripts' entry: their main() imported only once the environment is known to hold it.
+
+Run from a shell without `source ./env.sh`, a script finds the package (its wrapper puts
+src/ on the path) but not the virtualenv's modules (rosbags, mujoco, ...) nor the
+workspace's messages: an import error then says so in one line instead of a traceback,
+even for --help. traj_yaml.py says the same in its own words (node/traj_yaml.py).
+"""
+
+from __future__ import annotations
+
+import importlib
+
+from tutorial_atlas_control.cli.convention import EXIT_REFUSED, print_error
+
+__all__ = ['ENV_HINT', 'run_script']
+
+PACKAGE = 'tutorial_atlas_control'
+#: What a shell needs before running the scripts.
+ENV_HINT = 'run `source ./env.sh` in the repository first (after `make setup`)'
+
+
+def run_script(prog: str, module: str) -> int:
+    """Import `module` and return its main()'s exit status.
+
+    A module missing from the environment (not one of the package's own, which would be
+    a bug and keeps its traceback): one stderr line naming it, exit status 1.
+    """
+    try:
+        main = importlib.import_module(module).main
+    except ModuleNotFoundError as err:
+        missing = err.name or str(err)
+        if missing.split('.')[0] == PACKAGE:
+            raise
+        print_error(prog, f'cannot import {missing}: this shell lacks the project\'s '
+                          f'environment; {ENV_HINT}')
+        return EXIT_REFUSED
+    return main()
