@@ -96,13 +96,14 @@ NOT_YET_SERVED = frozenset({
     '/atlas/synchronization_statistics', '/atlas/debug/sync_delay',
 })
 
-#: The port's own topics, beside DRCSim's (README): the per-step ankle wrenches, and the
-#: latched configuration that offline replay reads.
+#: The port's own topics, beside DRCSim's (README): the per-step ankle wrenches, the
+#: latched configuration and the applied cheats that offline replay reads, the mode now.
 PORT_OWN_TOPICS = {
     '/atlas/l_foot_contact': 'geometry_msgs/WrenchStamped',
     '/atlas/r_foot_contact': 'geometry_msgs/WrenchStamped',
     '/atlas/sim_config': 'std_msgs/String',
     '/atlas/sim_inputs': 'std_msgs/String',
+    '/atlas/current_control_mode': 'std_msgs/String',
 }
 
 EXPECTED = DRCSIM_2_5_2 + DRCSIM_2_7_0
