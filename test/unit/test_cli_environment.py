@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -46,3 +48,25 @@ def test_the_entry_returns_main_s_status(monkeypatch: pytest.MonkeyPatch) -> Non
     from tutorial_atlas_control.cli import run_offline
     monkeypatch.setattr(run_offline, 'main', lambda: 7)
     assert run_script('run_offline.py', 'tutorial_atlas_control.cli.run_offline') == 7
+
+
+
+def test_output_piped_into_head_ends_quietly_with_141(tmp_path: Path) -> None:
+    """A script piped into `head`: the reader leaves early; no BrokenPipeError traceback.
+
+    The script writes 1 MB, more than a pipe holds, so its writes fail once `head` is gone.
+    """
+    (tmp_path / 'chatty.py').write_text(
+        'def main() -> int:\n'
+        '    for _ in range(1000):\n'
+        '        print("x" * 1000)\n'
+        '    return 0\n')
+    entry = ('import sys; from tutorial_atlas_control.cli.environment import run_script; '
+             'sys.exit(run_script("chatty.py", "chatty"))')
+    pipeline = subprocess.run(
+        ['bash', '-c', f'set -o pipefail; "{sys.executable}" -c \'{entry}\' | head -c 3'],
+        capture_output=True, text=True, check=False, timeout=120,
+        env={**os.environ, 'PYTHONPATH': f'{tmp_path}:{REPO / "src"}'})
+    assert pipeline.stdout == 'xxx'
+    assert pipeline.stderr == ''
+    assert pipeline.returncode == 141

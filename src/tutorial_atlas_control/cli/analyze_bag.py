@@ -15,7 +15,6 @@ from tutorial_atlas_control.bags.analysis import (
     analyze,
     analyze_try,
 )
-from tutorial_atlas_control.bags.bag_dir import latest_bag
 from tutorial_atlas_control.bags.compare import compare, format_comparison, plot_comparison
 from tutorial_atlas_control.bags.compare import to_json as comparison_json
 from tutorial_atlas_control.bags.reader import read_bag
@@ -32,7 +31,10 @@ from tutorial_atlas_control.bags.run_log import PlayedTrajectory
 from tutorial_atlas_control.cli.convention import (
     EXIT_INTERRUPTED,
     EXIT_REFUSED,
+    add_bag_arguments,
     argument_type,
+    check_bag_arguments,
+    chosen_bag,
     print_error,
 )
 from tutorial_atlas_control.errors import AtlasControlError
@@ -117,12 +119,7 @@ def build_parser() -> argparse.ArgumentParser:
         description=DESCRIPTION.format(fall=FALL_HEIGHT_M, moved=MOVED_RANGE_RAD,
                                        change=COMMAND_CHANGE_RAD, tol=EFFORT_LIMIT_TOLERANCE_NM),
         epilog=EPILOG)
-    parser.add_argument('bag', metavar='BAG', nargs='?',
-                        help='the ROS 1 .bag file to analyze (default: the newest bag in the '
-                             'bag directory, as --latest)')
-    parser.add_argument('--latest', action='store_true',
-                        help='analyze the newest .bag in $TAC_BAG_DIR, else '
-                             '~/.ros/tutorial_atlas_control/bags')
+    add_bag_arguments(parser, 'analyze')
     parser.add_argument('--try', dest='try_number', metavar='N', type=int,
                         help='only try N (from 1; -1 is the last) of a bag with resets: the '
                              'summary, --plot, --csv, --video and --compare')
@@ -159,8 +156,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _check_arguments(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
     """Exit 2 (argparse) on options that contradict each other."""
-    if args.bag and args.latest:
-        parser.error('give BAG or --latest, not both')
+    check_bag_arguments(parser, args)
     if args.try_number is not None and (args.start is not None or args.end is not None):
         parser.error('give --try or --start/--end, not both')
     if args.start is not None and args.end is not None and args.end <= args.start:
@@ -185,9 +181,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     _check_arguments(parser, args)
     try:
-        if not args.bag:
-            args.bag = str(latest_bag())
-            print(f'analyzing {args.bag} (the newest bag)', file=sys.stderr)
+        args.bag = chosen_bag(args, 'analyzing')
         if args.compare:
             return _compare(args)
         if args.video:  # fail on a bad output before reading and analyzing the bag

@@ -14,6 +14,7 @@ import sys
 from collections.abc import Callable
 from typing import TypeVar
 
+from tutorial_atlas_control.bags.bag_dir import latest_bag
 from tutorial_atlas_control.errors import AtlasControlError
 
 _T = TypeVar('_T')
@@ -41,3 +42,32 @@ def argument_type(convert: Callable[[str], _T]) -> Callable[[str], _T]:
 def print_error(prog: str, message: object) -> None:
     """The one stderr line of a refused run."""
     print(f'{prog}: error: {message}', file=sys.stderr)
+
+
+def add_bag_arguments(parser: argparse.ArgumentParser, verb: str) -> None:
+    """BAG, optional, and --latest: the newest bag in atlas.launch's bag directory."""
+    parser.add_argument('bag', metavar='BAG', nargs='?',
+                        help=f'the ROS 1 .bag file to {verb} (default: the newest bag in the '
+                             'bag directory, as --latest)')
+    parser.add_argument('--latest', action='store_true',
+                        help=f'{verb} the newest .bag in $TAC_BAG_DIR, else '
+                             '~/.ros/tutorial_atlas_control/bags')
+
+
+def check_bag_arguments(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """Exit 2 (argparse) when both BAG and --latest are given."""
+    if args.bag and args.latest:
+        parser.error('give BAG or --latest, not both')
+
+
+def chosen_bag(args: argparse.Namespace, doing: str) -> str:
+    """BAG, or the newest bag (said on stderr: `<doing> PATH (the newest bag)`).
+
+    Raises:
+        AtlasControlError: no BAG, and no bag in the bag directory.
+    """
+    if args.bag:
+        return str(args.bag)
+    path = str(latest_bag())
+    print(f'{doing} {path} (the newest bag)', file=sys.stderr)
+    return path

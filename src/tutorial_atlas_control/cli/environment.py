@@ -9,12 +9,16 @@ even for --help. traj_yaml.py says the same in its own words (node/traj_yaml.py)
 from __future__ import annotations
 
 import importlib
+import os
+import sys
 
 from tutorial_atlas_control.cli.convention import EXIT_REFUSED, print_error
 
-__all__ = ['ENV_HINT', 'run_script']
+__all__ = ['ENV_HINT', 'EXIT_BROKEN_PIPE', 'run_script']
 
 PACKAGE = 'tutorial_atlas_control'
+#: Exit status when stdout's reader went away: 128 + SIGPIPE, as a shell reports it.
+EXIT_BROKEN_PIPE = 141
 #: What a shell needs before running the scripts.
 ENV_HINT = 'run `source ./env.sh` in the repository first (after `make setup`)'
 
@@ -34,4 +38,10 @@ def run_script(prog: str, module: str) -> int:
         print_error(prog, f'cannot import {missing}: this shell lacks the project\'s '
                           f'environment; {ENV_HINT}')
         return EXIT_REFUSED
-    return main()
+    try:
+        return main()
+    except BrokenPipeError:
+        # Output piped into `head` and the like: the reader left, which is no error. stdout
+        # goes to /dev/null so that the interpreter's final flush does not raise again.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_BROKEN_PIPE

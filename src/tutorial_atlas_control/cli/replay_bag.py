@@ -4,14 +4,15 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 from collections.abc import Sequence
 
-from tutorial_atlas_control.bags.bag_dir import latest_bag
 from tutorial_atlas_control.cli.convention import (
     EXIT_INTERRUPTED,
     EXIT_REFUSED,
+    add_bag_arguments,
     argument_type,
+    check_bag_arguments,
+    chosen_bag,
     print_error,
 )
 from tutorial_atlas_control.errors import AtlasControlError
@@ -69,12 +70,7 @@ def build_parser() -> argparse.ArgumentParser:
     """The argument parser (its --help is the documentation)."""
     parser = argparse.ArgumentParser(prog=PROG, description=DESCRIPTION, epilog=EPILOG,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument('bag', metavar='BAG', nargs='?',
-                        help='the ROS 1 .bag file of the run (default: the newest bag in the '
-                             'bag directory, as --latest)')
-    parser.add_argument('--latest', action='store_true',
-                        help='replay the newest .bag in $TAC_BAG_DIR, else '
-                             '~/.ros/tutorial_atlas_control/bags')
+    add_bag_arguments(parser, 'replay')
     parser.add_argument('--try', dest='try_number', metavar='N', type=int,
                         help='the try to replay, from 1 (-1: the last, the default)')
     parser.add_argument('--json', action='store_true', help='print one JSON object instead')
@@ -95,13 +91,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status."""
     parser = build_parser()
     args = parser.parse_args(argv)
-    if args.bag and args.latest:
-        parser.error('give BAG or --latest, not both')
+    check_bag_arguments(parser, args)
     try:
-        if not args.bag:
-            args.bag = str(latest_bag())
-            print(f'replaying {args.bag} (the newest bag)', file=sys.stderr)
-        result = replay_bag(args.bag, args.tolerance, args.try_number)
+        result = replay_bag(chosen_bag(args, 'replaying'), args.tolerance, args.try_number)
     except AtlasControlError as err:
         print_error(PROG, err)
         return EXIT_REFUSED
