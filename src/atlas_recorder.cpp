@@ -200,20 +200,24 @@ int main(int argc, char** argv)
            bag_path.c_str(), compression_name.c_str());
 
   ros::CallbackQueue* callbacks = ros::getGlobalCallbackQueue();
+  // One message at a time, so that a stop request is seen at once even when the recorder is
+  // far behind (callAvailable() would first write everything queued when it was called).
   while (!g_stop_requested && ros::ok())
-    callbacks->callAvailable(ros::WallDuration(0.1));
+    callbacks->callOne(ros::WallDuration(0.1));
 
   // Write what has already arrived, and what is still arriving: a recorder starved of CPU is
   // behind, and what the publishers sent before they stopped may still be in its sockets. Drain
   // until kQuietWaits waits of kDrainWaitS in a row bring nothing (counted in waits, not wall
   // time, so that a starved recorder is not cut short), kDrainMaxS at most (roslaunch
-  // escalates to SIGTERM after 15 s). Then stop receiving (shutting a subscriber down first
-  // would discard its queued messages).
+  // escalates to SIGTERM after 15 s, to SIGKILL 2 s later, which leaves the bag unindexed).
+  // One message at a time, for the same reason: callAvailable() could take longer than
+  // kDrainMaxS (bz2 chunks at real_time_factor 0 on a busy machine did). Then stop receiving
+  // (shutting a subscriber down first would discard its queued messages).
   const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(kDrainMaxS);
   unsigned long seen = writer.written();
   for (int quiet = 0; quiet < kQuietWaits && ros::WallTime::now() < give_up && !writer.failed();)
   {
-    callbacks->callAvailable(ros::WallDuration(kDrainWaitS));
+    callbacks->callOne(ros::WallDuration(kDrainWaitS));
     if (writer.written() != seen)
     {
       seen = writer.written();
@@ -224,9 +228,17 @@ int main(int argc, char** argv)
       ++quiet;
     }
   }
+  // What is still queued after kDrainMaxS is dropped at once: unsubscribing removes a
+  // subscription's queued callbacks one deque erase at a time, which with hundreds of
+  // thousands queued took longer than roslaunch waits before SIGKILL (an unindexed bag).
+  const bool gave_up = !callbacks->isEmpty();
+  callbacks->clear();
   for (ros::Subscriber& subscriber : subscribers)
     subscriber.shutdown();
   bag.close();
+  if (gave_up && !writer.failed())
+    std::fprintf(stderr, "atlas_recorder: stopped writing after %.0f s of draining with messages "
+                 "still queued (the recorder was behind); they are not in the bag\n", kDrainMaxS);
   ros::shutdown();
   if (writer.failed())
   {
