@@ -22,7 +22,7 @@ from tutorial_atlas_control.bags.records import IndexedBag, PublicBag
 
 #: Sim time (s) recorded after the launch is ready.
 RUN_S = 3.0
-#: Wall-clock guard (s) for `rosbag play` of a few seconds of bag at 20 x.
+#: Wall-clock guard (s) for `rosbag play` of a few seconds of bag at 20 x (and its master).
 PLAY_TIMEOUT_S = 60.0
 
 
@@ -45,7 +45,7 @@ def record(tmp_path: Path, recorder: str, compression: str) -> Path:
 
 @pytest.mark.parametrize(('recorder', 'compression'), [
     ('atlas_recorder', 'none'), ('atlas_recorder', 'lz4'), ('atlas_recorder', 'bz2'),
-    ('rosbag', 'lz4'), ('rosbag', 'bz2'),
+    ('rosbag', 'lz4'),
 ])
 def test_bag_is_compressed_as_asked_and_reads_back(tmp_path: Path, recorder: str,
                                                    compression: str) -> None:
@@ -75,14 +75,12 @@ def test_bag_is_compressed_as_asked_and_reads_back(tmp_path: Path, recorder: str
     finally:
         fast.close()
         public.close()
-
-
-def test_rosbag_play_reads_a_compressed_bag(tmp_path: Path) -> None:
-    bag = record(tmp_path / 'run', 'atlas_recorder', 'bz2')
+    # rosbag play (C++ rosbag_storage) decompresses the chunks too.
     with processes.RosMaster(tmp_path / 'master.log') as master:
         master.wait_online()
-        result = subprocess.run(['rosbag', 'play', '-q', '-r', '20', str(bag)], env=master.env,
+        played = subprocess.run(['rosbag', 'play', '-q', '-r', '20', str(bag)], env=master.env,
                                 capture_output=True, text=True, timeout=PLAY_TIMEOUT_S,
                                 check=False)
-    assert result.returncode == 0, result.stdout + result.stderr
-    assert 'ERROR' not in result.stdout + result.stderr
+    assert played.returncode == 0, played.stdout + played.stderr
+    assert 'ERROR' not in played.stdout + played.stderr
+
