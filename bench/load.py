@@ -8,7 +8,9 @@ load run:     the node at real_time_factor:=1.0 with the launch's default record
               are asserted). Each publisher reports sim time advanced / wall time over its
               own window; the simulator's resident memory is read every second.
 tutorial run: `run_demo.py step_and_fall --video-fps 0` (its own master), then the rate of
-              the port's commands in sim time, from the recorded bag.
+              the port's commands in sim time, from the recorded bag, and the bag's size
+              per minute of sim time (its bytes / the span of its bag times, which are
+              sim times): MB are 10^6 bytes.
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from online import Probes, recorded_fraction
 
 from tutorial_atlas_control.node.transport import subscriber_names
 from tutorial_atlas_control.processes import STOP_TIMEOUT_S, rss_kib, wait_until
+from tutorial_atlas_control.units import NS_PER_S
 
 FLOOD = REPO_DIR / 'tools' / 'flood_commands.py'
 RUN_DEMO = REPO_DIR / 'scripts' / 'run_demo.py'
@@ -140,7 +143,19 @@ def tutorial_run(work_dir: Path, name: str) -> dict[str, float]:
     if completed.returncode != 0 or not bags:
         raise BenchError(f'run_demo.py failed ({completed.returncode}); see {log_path}')
     rate_hz = analyze_bag(bags[-1]).command_rate_hz
+    mb_per_min = bag_mb_per_min(bags[-1])
     shutil.rmtree(bag_dir, ignore_errors=True)
     if rate_hz is None:
         raise BenchError(f'the tutorial run recorded no commands; see {log_path}')
-    return {'tutorial_command_rate_hz': rate_hz}
+    return {'tutorial_command_rate_hz': rate_hz, 'bag_mb_per_min': mb_per_min}
+
+
+def bag_mb_per_min(bag: Path) -> float:
+    """The bag's size (MB, 10^6 bytes) per minute of the sim time it spans."""
+    from rosbags.rosbag1 import Reader
+
+    with Reader(bag) as reader:
+        span_s = reader.duration / NS_PER_S
+    if span_s <= 0:
+        raise BenchError(f'{bag} spans no sim time')
+    return bag.stat().st_size / 1e6 / (span_s / 60.0)

@@ -17,7 +17,11 @@ Sections (see bench/README.md for what each figure means and how it is measured)
   load      the node at real_time_factor:=1.0 under 3 x 2 kHz of valid commands for 30 s:
             achieved factor, commands lost by the recorder, simulator memory growth,
             then the time SIGINT takes to stop the launch
-  tutorial  run_demo.py step_and_fall: the port's command rate in sim time
+  tutorial  run_demo.py step_and_fall: the port's command rate in sim time, and the bag's
+            size per minute of sim time
+
+--compression sets the bags' chunk compression for every launch (TAC_BAG_COMPRESSION, which
+atlas.launch's `compression` argument defaults to); without it, the launch's default (lz4).
 """
 
 from __future__ import annotations
@@ -65,6 +69,8 @@ class Section:
         self.loads[self.name] = f'load {self.load}, busy {busy:.0f}%, steal {steal:.0f}%'
 
 
+#: The recorder's chunk compressions (atlas.launch's `compression` argument).
+COMPRESSIONS = ('lz4', 'bz2', 'none')
 SECTIONS = ('physics', 'offline', 'analysis', 'fast', 'realtime', 'load', 'tutorial')
 
 #: (key, label, unit, target text, digits) in table order.
@@ -82,6 +88,7 @@ ROWS = (
     ('node_us_per_step', 'node CPU per step at rtf:=0', 'us', '<= 1.5 x bare', 1),
     ('node_bare_ratio', 'node_us_per_step / bare mj_step', '', '<= 1.5', 2),
     ('fast_recorder_cpu', 'recorder CPU at rtf:=0', 'cores', '', 2),
+    ('recorder_us_per_step', 'recorder CPU per step at rtf:=0', 'us', '', 1),
     ('fast_state_publisher_cpu', 'robot_state_publisher CPU at rtf:=0', 'cores', '', 2),
     ('fast_master_cpu', 'rosmaster CPU at rtf:=0', 'cores', '', 2),
     ('fast_cpu_us_per_step', 'all of them: CPU per step at rtf:=0', 'us', '', 1),
@@ -110,6 +117,7 @@ ROWS = (
     ('load_rss_growth_mib', 'simulator RSS growth under load', 'MiB', '<= 4', 2),
     ('shutdown_s', 'SIGINT until every process is gone', 's', '<= 5', 2),
     ('tutorial_command_rate_hz', 'step_and_fall commands (sim time)', 'Hz', '50 (45-51)', 2),
+    ('bag_mb_per_min', 'step_and_fall bag per sim minute', 'MB/min', '<= 80 (lz4)', 1),
     ('analysis_s', 'analyze_bag, 60 s bag', 's', '< 2', 2),
     ('analysis_msgs_per_s', 'analyze_bag, 60 s bag', 'msgs/s', '', 0),
     ('rosbag_msgs_per_s', 'rosbag API, same topics', 'msgs/s', '', 0),
@@ -130,6 +138,8 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
                              '(a path, or a file name in tutorial_atlas_control); it must take '
                              'the same arguments (gui, real_time_factor, record, bag_dir)')
     parser.add_argument('--keep', action='store_true', help='keep the scratch directory')
+    parser.add_argument('--compression', choices=COMPRESSIONS,
+                        help='chunk compression of every bag recorded (default: the launch\'s)')
     args = parser.parse_args(argv)
     args.sections = [s.strip() for s in args.only.split(',') if s.strip()]
     unknown = set(args.sections) - set(SECTIONS)
@@ -254,7 +264,8 @@ def run_tutorial(args: argparse.Namespace, samples: dict[str, list[float]],
         for run in range(args.runs):
             values = load.tutorial_run(work_dir, f'tutorial{run + 1}')
             log(f'tutorial run {run + 1}: commands at '
-                f'{values["tutorial_command_rate_hz"]:.2f} Hz of sim time')
+                f'{values["tutorial_command_rate_hz"]:.2f} Hz of sim time, bag '
+                f'{values["bag_mb_per_min"]:.1f} MB per sim minute')
             add(samples, values)
 
 
@@ -302,13 +313,14 @@ def summarize(samples: dict[str, list[float]]) -> dict[str, float]:
         physics = medians['physics_limit_steps_per_s']
         samples['fast_ratio'] = [rtf * per_sim_s / physics for rtf in samples['fast_rtf']]
         medians['fast_ratio'] = medians['fast_rtf'] * per_sim_s / physics
-    if 'fast_node_cpu' in samples:  # node CPU (µs) per simulated step
-        import offline
+    for process, key in (('node', 'node_us_per_step'), ('recorder', 'recorder_us_per_step')):
+        if f'fast_{process}_cpu' in samples:  # the process's CPU (µs) per simulated step
+            import offline
 
-        per_sim_s = offline.steps_per_sim_second()
-        samples['node_us_per_step'] = [cpu * 1e6 / (rtf * per_sim_s) for cpu, rtf
-                                       in zip(samples['fast_node_cpu'], samples['fast_rtf'])]
-        medians['node_us_per_step'] = statistics.median(samples['node_us_per_step'])
+            per_sim_s = offline.steps_per_sim_second()
+            samples[key] = [cpu * 1e6 / (rtf * per_sim_s) for cpu, rtf
+                            in zip(samples[f'fast_{process}_cpu'], samples['fast_rtf'])]
+            medians[key] = statistics.median(samples[key])
     # What one sim step costs the machine (a launch with tf:=false has no state publisher).
     cpu_keys = [key for key in (f'fast_{name}_cpu' for name in
                                 ('node', 'recorder', 'state_publisher', 'master'))
@@ -339,11 +351,13 @@ def summarize(samples: dict[str, list[float]]) -> dict[str, float]:
     return medians
 
 
-def table(samples: dict[str, list[float]], loads: dict[str, str], runs: int) -> str:
+def table(samples: dict[str, list[float]], loads: dict[str, str], runs: int,
+          compression: str) -> str:
     lines = [f'tutorial_atlas_control benchmark, {os.cpu_count()} CPUs; per section: load '
              'average (1/5/15 min) at its start, CPU busy and hypervisor steal % during it:']
     lines += [f'  {section:<9} {load}' for section, load in loads.items()]
-    lines += [f'min / median / max over {runs} runs (physics: over >= 5 runs)', '']
+    lines += [f'bags: chunk compression {compression}',
+              f'min / median / max over {runs} runs (physics: over >= 5 runs)', '']
     header = f'{"figure":<38} {"min":>10} {"median":>10} {"max":>10}  {"unit":<12} target'
     lines += [header, '-' * len(header)]
     for key, label, unit, target, digits in ROWS:
@@ -364,6 +378,9 @@ def main(argv: list[str] | None = None) -> int:
     except BenchError as err:
         print(f'run_bench: {err}', file=sys.stderr)
         return 2
+    if args.compression:
+        os.environ['TAC_BAG_COMPRESSION'] = args.compression
+    compression = os.environ.get('TAC_BAG_COMPRESSION') or 'the launch\'s default'
     work_dir = Path(tempfile.mkdtemp(prefix='tac_bench_'))
     samples: dict[str, list[float]] = {}
     loads: dict[str, str] = {}
@@ -391,9 +408,10 @@ def main(argv: list[str] | None = None) -> int:
     if not ok:
         return 1
     medians = summarize(samples)
-    print(table(samples, loads, args.runs))
+    print(table(samples, loads, args.runs, compression))
     result = {key: round(value, 4) for key, value in medians.items()}
     result.update({'runs': args.runs, 'quick': args.quick, 'cpus': os.cpu_count(),
+                   'compression': compression,
                    'load_avg': load_average(), 'wall_s': round(time.monotonic() - started, 1)})
     print(json.dumps(result, sort_keys=True), flush=True)
     return 0

@@ -10,13 +10,20 @@
 // bag v2.0: `NAME.bag.active` while recording, closed, indexed and renamed to `NAME.bag` on
 // SIGINT or SIGTERM, after the messages already received have been written.
 //
-// usage: atlas_recorder PREFIX TOPIC... [ROS remappings]
-//   writes PREFIX_<YYYY-MM-DD-HH-MM-SS>.bag, as `rosbag record -o PREFIX` does.
+// Chunks are compressed as `rosbag record --lz4` / `--bz2` compress them (rosbag's own
+// compression, so `rosbag info` shows it and every bag reader decompresses it). lz4 halves
+// the bag for no measurable CPU; bz2 saves a tenth more for ~25 us a message (bench/README.md).
+// The 1 kHz float64s change in their low bits every step: little more compresses.
+//
+// usage: atlas_recorder [--compression none|lz4|bz2] PREFIX TOPIC... [ROS remappings]
+//   writes PREFIX_<YYYY-MM-DD-HH-MM-SS>.bag, as `rosbag record -o PREFIX` does; chunks are
+//   not compressed unless --compression says so.
 
 #include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <ctime>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,6 +57,18 @@ std::atomic<bool> g_stop_requested(false);
 void requestStop(int /*signal*/)
 {
   g_stop_requested = true;
+}
+
+// The chunk compression named NAME (as the launch's `compression` argument spells it).
+std::optional<rosbag::CompressionType> compressionNamed(const std::string& name)
+{
+  if (name == "none")
+    return rosbag::compression::Uncompressed;
+  if (name == "lz4")
+    return rosbag::compression::LZ4;
+  if (name == "bz2")
+    return rosbag::compression::BZ2;
+  return std::nullopt;
 }
 
 std::string timestampedName(const std::string& prefix)
@@ -131,12 +150,29 @@ int main(int argc, char** argv)
   ros::init(argc, argv, "recorder", ros::init_options::NoSigintHandler);
   std::vector<std::string> args;
   ros::removeROSArgs(argc, argv, args);
-  if (args.size() < 3 || args[1] == "-h" || args[1] == "--help")
+  const bool help = args.size() >= 2 && (args[1] == "-h" || args[1] == "--help");
+  std::string compression_name = "none";
+  rosbag::CompressionType compression = rosbag::compression::Uncompressed;
+  if (!help && args.size() >= 3 && args[1] == "--compression")
   {
-    std::fprintf(args.size() >= 2 ? stdout : stderr,
-                 "usage: atlas_recorder PREFIX TOPIC...\n"
-                 "Records TOPICs to PREFIX_<date-time>.bag without dropping messages; SIGINT closes it.\n");
-    return args.size() >= 2 && (args[1] == "-h" || args[1] == "--help") ? 0 : 1;
+    compression_name = args[2];
+    const std::optional<rosbag::CompressionType> named = compressionNamed(compression_name);
+    if (!named)
+    {
+      std::fprintf(stderr, "atlas_recorder: unknown compression '%s' (expected none, lz4 or bz2)\n",
+                   args[2].c_str());
+      return 1;
+    }
+    compression = *named;
+    args.erase(args.begin() + 1, args.begin() + 3);
+  }
+  if (help || args.size() < 3)
+  {
+    std::fprintf(help ? stdout : stderr,
+                 "usage: atlas_recorder [--compression none|lz4|bz2] PREFIX TOPIC...\n"
+                 "Records TOPICs to PREFIX_<date-time>.bag without dropping messages; SIGINT closes it.\n"
+                 "--compression: rosbag's chunk compression (default: none).\n");
+    return help ? 0 : 1;
   }
   const std::string bag_path = timestampedName(args[1]);
   const std::string active_path = bag_path + ".active";
@@ -145,6 +181,7 @@ int main(int argc, char** argv)
   try
   {
     bag.open(active_path, rosbag::bagmode::Write);
+    bag.setCompression(compression);
   }
   catch (const rosbag::BagException& error)
   {
@@ -159,23 +196,28 @@ int main(int argc, char** argv)
   std::vector<ros::Subscriber> subscribers;
   for (size_t i = 2; i < args.size(); ++i)
     subscribers.push_back(subscribeAnyType(node, args[i], writer));
-  ROS_INFO("atlas_recorder: recording %zu topics to %s", subscribers.size(), bag_path.c_str());
+  ROS_INFO("atlas_recorder: recording %zu topics to %s (chunk compression: %s)", subscribers.size(),
+           bag_path.c_str(), compression_name.c_str());
 
   ros::CallbackQueue* callbacks = ros::getGlobalCallbackQueue();
+  // One message at a time, so that a stop request is seen at once even when the recorder is
+  // far behind (callAvailable() would first write everything queued when it was called).
   while (!g_stop_requested && ros::ok())
-    callbacks->callAvailable(ros::WallDuration(0.1));
+    callbacks->callOne(ros::WallDuration(0.1));
 
   // Write what has already arrived, and what is still arriving: a recorder starved of CPU is
   // behind, and what the publishers sent before they stopped may still be in its sockets. Drain
   // until kQuietWaits waits of kDrainWaitS in a row bring nothing (counted in waits, not wall
   // time, so that a starved recorder is not cut short), kDrainMaxS at most (roslaunch
-  // escalates to SIGTERM after 15 s). Then stop receiving (shutting a subscriber down first
-  // would discard its queued messages).
+  // escalates to SIGTERM after 15 s, to SIGKILL 2 s later, which leaves the bag unindexed).
+  // One message at a time, for the same reason: callAvailable() could take longer than
+  // kDrainMaxS when far behind. Then stop receiving (shutting a subscriber down first would
+  // discard its queued messages).
   const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(kDrainMaxS);
   unsigned long seen = writer.written();
   for (int quiet = 0; quiet < kQuietWaits && ros::WallTime::now() < give_up && !writer.failed();)
   {
-    callbacks->callAvailable(ros::WallDuration(kDrainWaitS));
+    callbacks->callOne(ros::WallDuration(kDrainWaitS));
     if (writer.written() != seen)
     {
       seen = writer.written();
@@ -186,9 +228,18 @@ int main(int argc, char** argv)
       ++quiet;
     }
   }
+  // What is still queued after kDrainMaxS is dropped at once: unsubscribing removes a
+  // subscription's queued callbacks one deque erase at a time, which with hundreds of
+  // thousands queued took longer than roslaunch waits before SIGKILL (an unindexed bag; bz2
+  // chunks at real_time_factor 0 on a busy machine).
+  const bool gave_up = ros::WallTime::now() >= give_up && !callbacks->isEmpty();
+  callbacks->clear();
   for (ros::Subscriber& subscriber : subscribers)
     subscriber.shutdown();
   bag.close();
+  if (gave_up && !writer.failed())
+    std::fprintf(stderr, "atlas_recorder: stopped writing after %.0f s of draining with messages "
+                 "still queued (the recorder was behind); they are not in the bag\n", kDrainMaxS);
   ros::shutdown();
   if (writer.failed())
   {

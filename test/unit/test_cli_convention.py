@@ -36,8 +36,11 @@ def test_help_works_from_anywhere(script: str) -> None:
     ('run_demo.py', ['--video-size', 'big'], "argument --video-size: 'big' is not WIDTHxHEIGHT"),
     ('run_offline.py', ['Traj_data2.yaml', 'touchdown', '--settle', '-1'],
      "argument --settle: '-1' must be a finite number of seconds >= 0"),
-    ('record_run.sh', [], 'expected BAG_DIR [atlas_recorder|rosbag], got 0 argument(s)'),
+    ('record_run.sh', [], 'expected BAG_DIR [atlas_recorder|rosbag [lz4|bz2|none]], got 0 '
+     'argument(s)'),
     ('record_run.sh', ['/tmp', 'rosbag2'], "unknown recorder 'rosbag2'"),
+    ('record_run.sh', ['/tmp', 'rosbag', 'zstd'],
+     "unknown compression 'zstd' (expected lz4, bz2 or none)"),
 ])
 def test_bad_command_line_exits_2(script: str, args: list[str], message: str) -> None:
     result = run(script, *args)

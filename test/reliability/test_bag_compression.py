@@ -1,0 +1,86 @@
+"""atlas.launch's `compression` argument: each recorder writes the chunks it names, and every
+reader of the project's bags (`rosbag info`, `rosbag play`, the analysis) still reads them.
+
+A short standing run per setting: 3 s of sim time after the launch is ready.
+"""
+
+from __future__ import annotations
+
+import subprocess
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
+
+from support.bag_checks import all_finite, missing_steps
+from support.launch import TestLaunch
+from tutorial_atlas_control import processes, topics
+from tutorial_atlas_control.bags.analysis import analyze_bag
+from tutorial_atlas_control.bags.reader import read_bag
+from tutorial_atlas_control.bags.records import IndexedBag, PublicBag
+
+#: Sim time (s) recorded after the launch is ready.
+RUN_S = 3.0
+#: Wall-clock guard (s) for `rosbag play` of a few seconds of bag at 20 x (and its master).
+PLAY_TIMEOUT_S = 60.0
+
+
+def rosbag_info(bag: Path, key: str) -> str:
+    result = subprocess.run(['rosbag', 'info', '--yaml', f'--key={key}', str(bag)],
+                            capture_output=True, text=True, timeout=60, check=False)
+    assert result.returncode == 0, result.stderr
+    return result.stdout.strip()
+
+
+def record(tmp_path: Path, recorder: str, compression: str) -> Path:
+    """A standing run of RUN_S recorded by `recorder` with `compression`; its closed bag."""
+    with TestLaunch(tmp_path, f'recorder:={recorder}', f'compression:={compression}') as launch:
+        launch.wait_ready()
+        launch.wait_sim_s(RUN_S)
+        launch.interrupt()
+        assert f'chunks compressed: {compression}' in launch.output()
+        return launch.bag()
+
+
+@pytest.mark.parametrize(('recorder', 'compression'), [
+    ('atlas_recorder', 'none'), ('atlas_recorder', 'lz4'), ('atlas_recorder', 'bz2'),
+    ('rosbag', 'lz4'),
+])
+def test_bag_is_compressed_as_asked_and_reads_back(tmp_path: Path, recorder: str,
+                                                   compression: str) -> None:
+    bag = record(tmp_path, recorder, compression)
+
+    assert rosbag_info(bag, 'compression') == compression
+    assert rosbag_info(bag, 'indexed') == 'True'
+    # The analysis: every 1 ms step's joint state, standing, no fall.
+    data = read_bag(bag)
+    assert len(data.joint_states.t_s) >= RUN_S * 1000
+    assert all_finite(data.joint_states)
+    if recorder == 'atlas_recorder':  # rosbag record may drop some (its 100-message queue)
+        assert missing_steps(data.joint_states) == 0
+    assert analyze_bag(bag).fell is False
+    # The fast reader (decompressed chunks sliced by its numpy index) reads what rosbags'
+    # public reader reads.
+    fast, public = IndexedBag(bag), PublicBag(bag)
+    fast.open()
+    public.open()
+    try:
+        wanted = [c for c in fast.connections if c.topic == topics.JOINT_STATES]
+        fast_ns, fast_raw = fast.raw_messages(wanted)
+        public_ns, public_raw = public.raw_messages(
+            [c for c in public.connections if c.topic == topics.JOINT_STATES])
+        assert fast_ns.tolist() == public_ns.tolist()
+        assert fast_raw == public_raw
+    finally:
+        fast.close()
+        public.close()
+    # rosbag play (C++ rosbag_storage) decompresses the chunks too.
+    with processes.RosMaster(tmp_path / 'master.log') as master:
+        master.wait_online()
+        played = subprocess.run(['rosbag', 'play', '-q', '-r', '20', str(bag)], env=master.env,
+                                capture_output=True, text=True, timeout=PLAY_TIMEOUT_S,
+                                check=False)
+    assert played.returncode == 0, played.stdout + played.stderr
+    assert 'ERROR' not in played.stdout + played.stderr
+
