@@ -90,7 +90,9 @@ def _wait_floods_started(launch: Launch, floods: list[Flood]) -> None:
         launch.check_running()
         for flood in floods:
             if not flood.started.is_set() and flood.poll() is not None:
-                flood.reader.join(timeout=1.0)
+                flood.reader.join(timeout=1.0)  # its last lines may still be in the pipe
+                if flood.started.is_set():
+                    continue
                 raise BenchError(f'flood_commands.py exited ({flood.poll()}) before its flood '
                                  f'began: {"".join(flood.stderr_lines).strip()}')
 
