@@ -115,7 +115,7 @@ ROWS = (
     ('cmd_latency_p99_ms_raw_1khz', 'command latency p99, 1 kHz (raw)', 'ms', '', 2),
     ('cmd_applied_1khz', 'commands applied, 1 kHz', 'fraction', '', 3),
     ('load_rtf', 'node rtf:=1 under 3 x 2 kHz commands', 'x real time', '1.00 +- 0.05', 4),
-    ('load_publish_rate_hz', 'commands published under load', 'msgs/s', '6000', 0),
+    ('load_publish_rate_hz', 'commands published under load', 'msgs/s', '>= 5880 (98%)', 0),
     ('load_commands_lost', 'commands lost by the recorder', 'count', '0', 0),
     ('load_recorded_fraction', 'joint_states recorded under load', 'fraction', '1', 4),
     ('load_rss_growth_mib', 'simulator RSS growth under load', 'MiB', '<= 4', 2),
