@@ -1,7 +1,7 @@
 # The project's commands. Each one sets the project up first when needed.
 #   make setup   Debian packages, virtualenv, catkin workspace (idempotent)
-#   make test    unit, integration and reliability tests (pytest), ruff and catkin_lint, then the
-#                rostests
+#   make test    unit, integration and reliability tests (pytest), ruff and catkin_lint, the
+#                rostests, then a one-run --quick bench (its arithmetic, not its speed)
 #   make demo    the tutorial end to end, headless (TRAJ=step_and_fall|touchdown|touchdown_exhausted)
 #   make bench   the performance benchmark
 SHELL := /bin/bash
@@ -9,7 +9,7 @@ SHELL := /bin/bash
 TRAJ ?= step_and_fall
 IN_ENV := source ./env.sh &&
 
-.PHONY: setup test unit-test lint rostest demo bench clean-workspace
+.PHONY: setup test unit-test lint rostest demo bench bench-quick clean-workspace
 
 setup:
 	@bash tools/setup.sh
@@ -29,6 +29,12 @@ test: setup
 	@$(IN_ENV) ruff check .
 	@$(IN_ENV) catkin_lint -W2 "$$TAC_WS/src"
 	@$(IN_ENV) bash tools/run_rostests.sh
+	@$(IN_ENV) python3 bench/run_bench.py --quick --runs 1 > /dev/null
+
+# Every section once, short windows (~1.5 min): fails if the bench crashes or a figure is
+# missing or NaN; a MISSED target does not fail it (bench/README.md).
+bench-quick: setup
+	@$(IN_ENV) python3 bench/run_bench.py --quick --runs 1
 
 demo: setup
 	@$(IN_ENV) python3 scripts/run_demo.py "$(TRAJ)"

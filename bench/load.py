@@ -6,7 +6,8 @@ load run:     the node at real_time_factor:=1.0 with the launch's default record
               each send 2 kHz of valid 28-joint commands for 30 s (what the reliability
               test test_flood_and_load.py applies, where only speed-independent outcomes
               are asserted). Each publisher reports sim time advanced / wall time over its
-              own window; the simulator's resident memory is read every second.
+              own window; the simulator's resident memory is read every second, from
+              a baseline taken once every publisher has reported that its flood began.
 tutorial run: `run_demo.py step_and_fall --video-fps 0` (its own master), then the rate of
               the port's commands in sim time, from the recorded bag, and the bag's size
               per minute of sim time (its bytes / the span of its bag times, which are
@@ -19,7 +20,9 @@ import json
 import shutil
 import subprocess
 import sys
+import threading
 import time
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from harness import READY_TIMEOUT_S, REPO_DIR, BenchError, Launch, Master
@@ -35,33 +38,81 @@ LOAD_PUBLISHERS = 3
 LOAD_RATE_HZ = 2000.0
 #: Sim time (s) the floods start at: after the torso is released (time_to_unpin 1 s).
 LOAD_START_SIM_S = 2.0
-#: Wall time (s) after starting the floods before the first memory reading: they have
-#: begun and the simulator has warmed up.
-LOAD_WARMUP_S = 5.0
+#: Wall time (s) after the last flood reported its start before the baseline memory
+#: reading: every flood's commands are then arriving (2 kHz each) and the simulator's
+#: connections to them and its per-message buffers exist, so growth counts only what the
+#: flood keeps adding.
+LOAD_SETTLE_S = 1.0
+#: What flood_commands.py prints on stderr when its flood begins.
+FLOOD_STARTED = 'flood_commands.py: started'
+#: Longest wait for every flood to start (s, wall): each waits up to 60 s itself for the
+#: sim time and the subscribers.
+FLOOD_START_TIMEOUT_S = 75.0
 KIB_PER_MIB = 1024.0
 #: Wall-clock guards (s).
 FLOOD_EXTRA_S = 90.0
 DEMO_TIMEOUT_S = 300.0
 
 
-def _start_floods(master: Master, duration_s: float) -> list[subprocess.Popen]:
+@dataclass
+class Flood:
+    """One flood_commands.py, its stderr read line by line by a thread (for its start)."""
+
+    process: subprocess.Popen
+    started: threading.Event = field(default_factory=threading.Event)
+    stderr_lines: list[str] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.reader = threading.Thread(target=self._read_stderr, daemon=True)
+        self.reader.start()
+
+    def _read_stderr(self) -> None:
+        for line in self.process.stderr:
+            self.stderr_lines.append(line)
+            if line.startswith(FLOOD_STARTED):
+                self.started.set()
+
+    def poll(self) -> int | None:
+        return self.process.poll()
+
+
+def _start_floods(master: Master, duration_s: float) -> list[Flood]:
     command = [sys.executable, str(FLOOD), '--kind', 'valid', '--rate', str(LOAD_RATE_HZ),
                '--duration', str(duration_s), '--start-sim', str(LOAD_START_SIM_S)]
-    return [subprocess.Popen(command, env=master.env, stdout=subprocess.PIPE,
-                             stderr=subprocess.PIPE, text=True)
+    return [Flood(subprocess.Popen(command, env=master.env, stdout=subprocess.PIPE,
+                                   stderr=subprocess.PIPE, text=True))
             for _ in range(LOAD_PUBLISHERS)]
 
 
-def _flood_figures(floods: list[subprocess.Popen], duration_s: float) -> list[dict]:
+def _wait_floods_started(launch: Launch, floods: list[Flood]) -> None:
+    """Until every flood has reported that it began publishing (bounded)."""
+    def check() -> None:
+        launch.check_running()
+        for flood in floods:
+            if not flood.started.is_set() and flood.poll() is not None:
+                flood.reader.join(timeout=1.0)  # its last lines may still be in the pipe
+                if flood.started.is_set():
+                    continue
+                raise BenchError(f'flood_commands.py exited ({flood.poll()}) before its flood '
+                                 f'began: {"".join(flood.stderr_lines).strip()}')
+
+    wait_until(lambda: all(flood.started.is_set() for flood in floods), FLOOD_START_TIMEOUT_S,
+               'the floods did not start', check)
+
+
+def _flood_figures(floods: list[Flood], duration_s: float) -> list[dict]:
     figures = []
     for flood in floods:
-        try:
-            stdout, stderr = flood.communicate(timeout=duration_s + FLOOD_EXTRA_S)
+        try:  # its stdout is one JSON line: the pipe cannot fill up before it exits
+            flood.process.wait(timeout=duration_s + FLOOD_EXTRA_S)
         except subprocess.TimeoutExpired as err:
-            flood.kill()
+            flood.process.kill()
             raise BenchError('flood_commands.py did not finish in time') from err
-        if flood.returncode != 0:
-            raise BenchError(f'flood_commands.py failed ({flood.returncode}): {stderr.strip()}')
+        stdout = flood.process.stdout.read() if flood.process.stdout else ''
+        flood.reader.join(timeout=5.0)
+        if flood.process.returncode != 0:
+            raise BenchError(f'flood_commands.py failed ({flood.process.returncode}): '
+                             f'{"".join(flood.stderr_lines).strip()}')
         figures.append(json.loads(stdout.strip().splitlines()[-1]))
     return figures
 
@@ -76,12 +127,16 @@ def _recorded_commands(bag_dir: Path) -> int:
         return sum(c.msgcount for c in reader.connections if c.topic == '/atlas/joint_commands')
 
 
-def _watch_memory(launch: Launch, floods: list[subprocess.Popen]) -> tuple[int, int]:
-    """(first, highest) resident memory (KiB) of the simulator while the floods run."""
+def _watch_memory(launch: Launch, floods: list[Flood]) -> tuple[int, int]:
+    """(first, highest) resident memory (KiB) of the simulator while the floods run.
+
+    The first reading is the baseline: LOAD_SETTLE_S after every flood reported its start.
+    """
     sim_pid = launch.node_pid('atlas_sim')
     if sim_pid is None:
         raise BenchError(f'no atlas_sim node in the launch; see {launch.log_path}')
-    time.sleep(LOAD_WARMUP_S)
+    _wait_floods_started(launch, floods)
+    time.sleep(LOAD_SETTLE_S)
     samples_kib = [rss_kib(sim_pid) or 0]
     while any(flood.poll() is None for flood in floods):
         launch.check_running()
@@ -105,8 +160,14 @@ def load_run(master: Master, launch_file: str, probes: Probes, work_dir: Path, n
                    'the simulator did not subscribe to the mode', launch.check_running)
         probes.mode_pub.publish(String(data='User'))
         floods = _start_floods(master, duration_s)
-        rss_start_kib, rss_max_kib = _watch_memory(launch, floods)
-        figures = _flood_figures(floods, duration_s)
+        try:
+            rss_start_kib, rss_max_kib = _watch_memory(launch, floods)
+            figures = _flood_figures(floods, duration_s)
+        finally:  # a failed run leaves no flood behind
+            for flood in floods:
+                if flood.poll() is None:
+                    flood.process.kill()
+                    flood.process.wait(timeout=STOP_TIMEOUT_S)
         shutdown_s = launch.interrupt(STOP_TIMEOUT_S)
     sent = sum(f['sent'] for f in figures)
     result = {

@@ -15,7 +15,9 @@ realtime run: real_time_factor:=1.0; over the window every /clock arrival is kep
               simulator publishes for neck_ay is exactly the commanded one from the step
               that first applied it. latency = arrival of the first /atlas/joint_states
               carrying that effort - the publish() call. `net` subtracts the median
-              JointState transport measured by js_transport_probe.py on the same master.
+              JointState transport measured by js_transport_probe.py on the same master,
+              which sends pre-serialized joint states through the node's own transport
+              (queue_size=None publisher, WireBatch / write_to_connections).
 """
 
 from __future__ import annotations
@@ -204,7 +206,10 @@ def _match_latencies(sent: list[tuple[float, float]],
 
 def js_transport(master: Master, probes: Probes, work_dir: Path, count: int = 2000,
                  rate_hz: float = 1000.0) -> dict[str, float]:
-    """JointState transport between two rospy processes (ms): p50 and p99."""
+    """JointState transport between two processes, on the node's send path (ms): p50, p99.
+
+    js_transport_probe.py sends through node/transport.py as the simulator does (see there).
+    """
     probes.js_probe.start()
     probe_log = (work_dir / 'js_probe.log').open('w')
     try:

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import shutil
 import statistics
@@ -35,6 +36,7 @@ import sys
 import tempfile
 import time
 import traceback
+from dataclasses import dataclass
 from pathlib import Path
 
 try:
@@ -71,6 +73,8 @@ class Section:
 
 #: The recorder's chunk compressions (atlas.launch's `compression` argument).
 COMPRESSIONS = ('lz4', 'bz2', 'none')
+#: What the table and the JSON call the launch's own compression (lz4, atlas.launch).
+DEFAULT_COMPRESSION = 'the launch\'s default'
 SECTIONS = ('physics', 'offline', 'analysis', 'fast', 'realtime', 'load', 'tutorial')
 
 #: (key, label, unit, target text, digits) in table order.
@@ -111,7 +115,7 @@ ROWS = (
     ('cmd_latency_p99_ms_raw_1khz', 'command latency p99, 1 kHz (raw)', 'ms', '', 2),
     ('cmd_applied_1khz', 'commands applied, 1 kHz', 'fraction', '', 3),
     ('load_rtf', 'node rtf:=1 under 3 x 2 kHz commands', 'x real time', '1.00 +- 0.05', 4),
-    ('load_publish_rate_hz', 'commands published under load', 'msgs/s', '6000', 0),
+    ('load_publish_rate_hz', 'commands published under load', 'msgs/s', '>= 5880 (98%)', 0),
     ('load_commands_lost', 'commands lost by the recorder', 'count', '0', 0),
     ('load_recorded_fraction', 'joint_states recorded under load', 'fraction', '1', 4),
     ('load_rss_growth_mib', 'simulator RSS growth under load', 'MiB', '<= 4', 2),
@@ -123,6 +127,119 @@ ROWS = (
     ('rosbag_msgs_per_s', 'rosbag API, same topics', 'msgs/s', '', 0),
     ('analysis_speedup', 'analyze_bag / rosbag', 'x', '>= 5', 1),
 )
+
+
+@dataclass(frozen=True)
+class Target:
+    """A figure's target, judged on its median: low <= value <= high (strict: < and >).
+
+    `per_bare`: the bounds are multiples of a bare mj_step (steps/s or µs), known only once
+    `bare_physics_steps_per_s` has been measured in the same bench run.
+    """
+
+    low: float = -math.inf
+    high: float = math.inf
+    strict: bool = False
+    per_bare: str = ''  # '' | 'rtf' (x bare steps/s / 1000) | 'us' (x 1e6 / bare steps/s)
+    lz4_only: bool = False  # a bag size: only with the launch's lz4 chunks
+
+    def bounds(self, medians: dict[str, float]) -> tuple[float, float] | None:
+        if not self.per_bare:
+            return self.low, self.high
+        bare = medians.get('bare_physics_steps_per_s')
+        if bare is None or not bare > 0:
+            return None
+        scale = bare / 1000.0 if self.per_bare == 'rtf' else 1e6 / bare
+        return self.low * scale, self.high * scale
+
+    def met(self, value: float, medians: dict[str, float]) -> bool | None:
+        """True / False; None when it cannot be judged in this run (no bare figure)."""
+        bounds = self.bounds(medians)
+        if bounds is None:
+            return None
+        low, high = bounds
+        if self.strict:
+            return low < value < high
+        return low <= value <= high
+
+
+#: The targets of issues 8, 18, 19 and 25 (bench/README.md), by JSON key.
+TARGETS = {
+    'unheard_topic_us_per_step': Target(high=1.0, strict=True),
+    'offline_ratio': Target(low=0.8),
+    'fast_rtf': Target(low=0.6, per_bare='rtf'),
+    'fast_bare_ratio': Target(low=0.6),
+    'node_us_per_step': Target(high=1.5, per_bare='us'),
+    'node_bare_ratio': Target(high=1.5),
+    'fast_recorded_fraction': Target(low=1.0, high=1.0),
+    'realtime_rtf': Target(low=0.99, high=1.01),
+    'lateness_p99_ms': Target(high=2.0, strict=True),
+    'cmd_latency_p99_ms_50hz': Target(high=2.0, strict=True),
+    'cmd_latency_p99_ms_1khz': Target(high=2.0, strict=True),
+    'load_rtf': Target(low=0.95, high=1.05),
+    # The floods pace to 6000/s on average; 2 % short (start and end of their windows) is
+    # still the load asked for, more means they were starved of CPU.
+    'load_publish_rate_hz': Target(low=0.98 * 6000.0),
+    'load_commands_lost': Target(low=0.0, high=0.0),
+    'load_recorded_fraction': Target(low=1.0, high=1.0),
+    'load_rss_growth_mib': Target(high=4.0),
+    'shutdown_s': Target(high=5.0),
+    'tutorial_command_rate_hz': Target(low=45.0, high=51.0),
+    'bag_mb_per_min': Target(high=80.0, lz4_only=True),
+    'analysis_s': Target(high=2.0, strict=True),
+    'analysis_speedup': Target(low=5.0),
+}
+
+#: The keys each section must produce (a crash or an empty window shows as a missing key).
+EXPECTED = {
+    'physics': ('bare_physics_steps_per_s', 'physics_limit_steps_per_s',
+                'physics_numpy_law_steps_per_s', 'unheard_topic_us_per_step'),
+    'offline': ('offline_rtf', 'offline_ratio'),
+    'analysis': ('analysis_s', 'rosbag_s', 'analysis_msgs_per_s', 'rosbag_msgs_per_s',
+                 'analysis_speedup'),
+    'fast': ('fast_rtf', 'fast_recorded_fraction', 'fast_node_cpu', 'fast_recorder_cpu',
+             'node_us_per_step', 'recorder_us_per_step', 'fast_cpu_us_per_step',
+             'fast_rosbag_rtf', 'fast_rosbag_recorded_fraction'),
+    'realtime': ('realtime_rtf', 'lateness_p50_ms', 'lateness_p99_ms', 'lateness_max_ms',
+                 'js_transport_p50_ms', 'js_transport_p99_ms', 'cmd_latency_p50_ms',
+                 'cmd_latency_p99_ms', 'cmd_applied_1khz',
+                 *(f'cmd_latency_p{pct}_ms{raw}_{rate}' for pct in (50, 99)
+                   for raw in ('', '_raw') for rate in ('50hz', '1khz'))),
+    'load': ('load_rtf', 'load_publish_rate_hz', 'load_commands_lost',
+             'load_recorded_fraction', 'load_rss_growth_mib', 'shutdown_s'),
+    'tutorial': ('tutorial_command_rate_hz', 'bag_mb_per_min'),
+}
+#: Keys computed from two sections, expected when both ran.
+EXPECTED_ACROSS = {('physics', 'fast'): ('fast_ratio', 'fast_bare_ratio', 'node_bare_ratio')}
+
+
+def verdicts(medians: dict[str, float], compression: str) -> dict[str, str]:
+    """'met' or 'MISSED' for every measured figure with a target, judged on its median;
+    'unjudged (...)' only where this run has nothing to judge it by."""
+    result = {}
+    for key, target in TARGETS.items():
+        if key not in medians:
+            continue
+        if target.lz4_only and compression not in ('lz4', DEFAULT_COMPRESSION):
+            result[key] = f'unjudged ({compression} chunks; the target is for lz4)'
+            continue
+        met = target.met(medians[key], medians)
+        if met is None:
+            result[key] = 'unjudged (no bare_physics_steps_per_s: run the physics section)'
+        else:
+            result[key] = 'met' if met else 'MISSED'
+    return result
+
+
+def invalid_figures(medians: dict[str, float], sections: list[str]) -> list[str]:
+    """The keys the sections run should have produced but did not, or that are not finite."""
+    expected = [key for section in sections for key in EXPECTED[section]]
+    for pair, keys in EXPECTED_ACROSS.items():
+        if set(pair) <= set(sections):
+            expected += keys
+    bad = [key for key in expected if key not in medians]
+    bad += [key for key, value in medians.items() if not math.isfinite(value)]
+    return sorted(set(bad))
 
 
 def parse_args(argv: list[str]) -> argparse.Namespace:
@@ -304,20 +421,21 @@ def run_realtime(args, samples, master, probes, work_dir) -> None:  # noqa: ANN0
         add(samples, values)
 
 
-def summarize(samples: dict[str, list[float]]) -> dict[str, float]:
+def summarize(samples: dict[str, list[float]],
+              per_sim_s: float | None = None) -> dict[str, float]:
+    """The medians, and the figures derived from several keys (added to `samples` per run
+    too). `per_sim_s`: simulated steps per sim second (default: the model's timestep)."""
     medians = {key: statistics.median(values) for key, values in samples.items()}
-    if 'fast_rtf' in samples and 'physics_limit_steps_per_s' in medians:
+    if per_sim_s is None and samples:
         import offline
 
         per_sim_s = offline.steps_per_sim_second()
+    if 'fast_rtf' in samples and 'physics_limit_steps_per_s' in medians:
         physics = medians['physics_limit_steps_per_s']
         samples['fast_ratio'] = [rtf * per_sim_s / physics for rtf in samples['fast_rtf']]
         medians['fast_ratio'] = medians['fast_rtf'] * per_sim_s / physics
     for process, key in (('node', 'node_us_per_step'), ('recorder', 'recorder_us_per_step')):
         if f'fast_{process}_cpu' in samples:  # the process's CPU (µs) per simulated step
-            import offline
-
-            per_sim_s = offline.steps_per_sim_second()
             samples[key] = [cpu * 1e6 / (rtf * per_sim_s) for cpu, rtf
                             in zip(samples[f'fast_{process}_cpu'], samples['fast_rtf'])]
             medians[key] = statistics.median(samples[key])
@@ -326,18 +444,12 @@ def summarize(samples: dict[str, list[float]]) -> dict[str, float]:
                                 ('node', 'recorder', 'state_publisher', 'master'))
                 if len(samples.get(key, ())) == len(samples.get('fast_rtf', ()))]
     if 'fast_rtf' in samples and 'fast_node_cpu' in cpu_keys:
-        import offline
-
-        per_sim_s = offline.steps_per_sim_second()
         samples['fast_cpu_us_per_step'] = [
             sum(cpus) * 1e6 / (rtf * per_sim_s)
             for rtf, *cpus in zip(samples['fast_rtf'], *(samples[key] for key in cpu_keys))]
         medians['fast_cpu_us_per_step'] = statistics.median(samples['fast_cpu_us_per_step'])
     if 'bare_physics_steps_per_s' in medians:  # issue 18's targets: ratios to bare mj_step
-        import offline
-
         bare = medians['bare_physics_steps_per_s']
-        per_sim_s = offline.steps_per_sim_second()
         for key, ratio in (('fast_rtf', lambda rtf: rtf * per_sim_s / bare),
                            ('node_us_per_step', lambda us: us * bare / 1e6)):
             if key in samples:
@@ -352,21 +464,26 @@ def summarize(samples: dict[str, list[float]]) -> dict[str, float]:
 
 
 def table(samples: dict[str, list[float]], loads: dict[str, str], runs: int,
-          compression: str) -> str:
+          compression: str, judged: dict[str, str]) -> str:
     lines = [f'tutorial_atlas_control benchmark, {os.cpu_count()} CPUs; per section: load '
              'average (1/5/15 min) at its start, CPU busy and hypervisor steal % during it:']
     lines += [f'  {section:<9} {load}' for section, load in loads.items()]
     lines += [f'bags: chunk compression {compression}',
               f'min / median / max over {runs} runs (physics: over >= 5 runs)', '']
-    header = f'{"figure":<38} {"min":>10} {"median":>10} {"max":>10}  {"unit":<12} target'
+    header = (f'{"figure":<38} {"min":>10} {"median":>10} {"max":>10}  {"unit":<12} '
+              f'{"target":<20} verdict')
     lines += [header, '-' * len(header)]
     for key, label, unit, target, digits in ROWS:
         values = samples.get(key)
         if not values:
             continue
         low, mid, high = min(values), statistics.median(values), max(values)
-        lines.append(f'{label:<38} {low:>10.{digits}f} {mid:>10.{digits}f} {high:>10.{digits}f}'
-                     f'  {unit:<12} {target}')
+        lines.append((f'{label:<38} {low:>10.{digits}f} {mid:>10.{digits}f} '
+                      f'{high:>10.{digits}f}  {unit:<12} {target:<20} '
+                      f'{judged.get(key, "")}').rstrip())
+    missed = [key for key, verdict in judged.items() if verdict == 'MISSED']
+    lines += ['', f'targets: {len(judged) - len(missed)} of {len(judged)} met'
+              + (f'; MISSED: {", ".join(missed)}' if missed else '')]
     return '\n'.join(lines)
 
 
@@ -380,7 +497,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     if args.compression:
         os.environ['TAC_BAG_COMPRESSION'] = args.compression
-    compression = os.environ.get('TAC_BAG_COMPRESSION') or 'the launch\'s default'
+    compression = os.environ.get('TAC_BAG_COMPRESSION') or DEFAULT_COMPRESSION
     work_dir = Path(tempfile.mkdtemp(prefix='tac_bench_'))
     samples: dict[str, list[float]] = {}
     loads: dict[str, str] = {}
@@ -408,12 +525,20 @@ def main(argv: list[str] | None = None) -> int:
     if not ok:
         return 1
     medians = summarize(samples)
-    print(table(samples, loads, args.runs, compression))
-    result = {key: round(value, 4) for key, value in medians.items()}
+    judged = verdicts(medians, compression)
+    invalid = invalid_figures(medians, args.sections)
+    print(table(samples, loads, args.runs, compression, judged))
+    result: dict[str, object] = {key: round(value, 4) for key, value in medians.items()}
     result.update({'runs': args.runs, 'quick': args.quick, 'cpus': os.cpu_count(),
                    'compression': compression,
-                   'load_avg': load_average(), 'wall_s': round(time.monotonic() - started, 1)})
+                   'load_avg': load_average(), 'wall_s': round(time.monotonic() - started, 1),
+                   'missed': sorted(key for key, verdict in judged.items()
+                                    if verdict == 'MISSED'),
+                   'invalid': invalid})
     print(json.dumps(result, sort_keys=True), flush=True)
+    if invalid:  # a missed target is a figure; a missing or NaN one is a broken bench
+        print(f'run_bench: missing or not finite: {", ".join(invalid)}', file=sys.stderr)
+        return 1
     return 0
 
 

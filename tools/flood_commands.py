@@ -146,6 +146,9 @@ def flood(kind: str, rate_hz: float, duration_s: float, start_sim_s: float,
     period_s = 1.0 / rate_hz
     sent = bad_modes = 0
     sim0_ns, wall0_s = clock.now_ns(), time.monotonic()
+    # One line when the flood begins: the benchmark waits for it before its memory baseline.
+    print(f'flood_commands.py: started at sim {sim0_ns / 1e9:.3f} s', file=sys.stderr,
+          flush=True)
     next_s = wall0_s
     while not rospy.is_shutdown():
         now_s = time.monotonic()

@@ -1,0 +1,168 @@
+"""The benchmark's arithmetic and its verdicts, from synthetic figures (bench/run_bench.py).
+
+Speed is never asserted here: these check that the figures the bench derives are the
+right formulas of what it measured, that a missed target says MISSED, and that a missing
+or NaN figure makes the bench fail. `make test` also runs `run_bench.py --quick`.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+import run_bench
+
+PER_SIM_S = 1000.0  # simulated steps per sim second (1 ms steps)
+
+
+def fast_samples() -> dict[str, list[float]]:
+    """Two fast runs and three physics runs, with figures easy to check by hand."""
+    return {
+        'fast_rtf': [8.0, 10.0],
+        'fast_node_cpu': [0.8, 0.9],
+        'fast_recorder_cpu': [0.5, 0.6],
+        'fast_state_publisher_cpu': [0.1, 0.1],
+        'fast_master_cpu': [0.1, 0.1],
+        'bare_physics_steps_per_s': [20000.0, 25000.0, 22000.0],
+        'physics_limit_steps_per_s': [16000.0, 20000.0, 18000.0],
+    }
+
+
+def test_per_step_figures_are_cpu_over_simulated_steps() -> None:
+    samples = fast_samples()
+    medians = run_bench.summarize(samples, per_sim_s=PER_SIM_S)
+    # node: 0.8 cores at 8x real time = 0.8e6 µs per 8000 steps = 100 µs; then 90 µs.
+    assert samples['node_us_per_step'] == pytest.approx([100.0, 90.0])
+    assert medians['node_us_per_step'] == pytest.approx(95.0)
+    assert samples['recorder_us_per_step'] == pytest.approx([62.5, 60.0])
+    # all four processes: 1.5 cores / 8000 steps, 1.7 cores / 10000 steps.
+    assert samples['fast_cpu_us_per_step'] == pytest.approx([187.5, 170.0])
+    assert medians['fast_cpu_us_per_step'] == pytest.approx(178.75)
+    # ratios to the median plain loop (18000/s) and the median bare mj_step (22000/s).
+    assert medians['fast_ratio'] == pytest.approx(9.0 * 1000 / 18000)
+    assert medians['fast_bare_ratio'] == pytest.approx(9.0 * 1000 / 22000)
+    assert medians['node_bare_ratio'] == pytest.approx(95.0 / (1e6 / 22000))
+
+
+def test_per_step_cpu_sum_skips_a_process_missing_from_some_runs() -> None:
+    samples = fast_samples()
+    samples['fast_state_publisher_cpu'] = [0.1]  # one run without robot_state_publisher
+    run_bench.summarize(samples, per_sim_s=PER_SIM_S)
+    assert samples['fast_cpu_us_per_step'] == pytest.approx([1.4e6 / 8000, 1.6e6 / 10000])
+
+
+def test_headline_command_latency_is_the_worse_rate() -> None:
+    medians = run_bench.summarize({'cmd_latency_p99_ms_50hz': [1.0, 3.0, 2.0],
+                                   'cmd_latency_p99_ms_1khz': [1.5, 1.5, 1.6],
+                                   'cmd_latency_p50_ms_50hz': [0.5],
+                                   'cmd_latency_p50_ms_1khz': [0.7]}, per_sim_s=PER_SIM_S)
+    assert medians['cmd_latency_p99_ms'] == 2.0
+    assert medians['cmd_latency_p50_ms'] == 0.7
+
+
+@pytest.mark.parametrize(('key', 'value', 'verdict'), [
+    ('offline_ratio', 0.8, 'met'),             # >= 0.8: the bound itself meets it
+    ('offline_ratio', 0.79, 'MISSED'),
+    ('lateness_p99_ms', 1.99, 'met'),
+    ('lateness_p99_ms', 2.0, 'MISSED'),       # < 2: the bound itself misses
+    ('realtime_rtf', 1.009, 'met'),
+    ('realtime_rtf', 0.989, 'MISSED'),
+    ('realtime_rtf', 1.011, 'MISSED'),
+    ('load_commands_lost', 0.0, 'met'),
+    ('load_commands_lost', 1.0, 'MISSED'),
+    ('fast_recorded_fraction', 1.0, 'met'),
+    ('fast_recorded_fraction', 0.9999, 'MISSED'),
+    ('tutorial_command_rate_hz', 50.1, 'met'),
+    ('tutorial_command_rate_hz', 44.9, 'MISSED'),
+    ('tutorial_command_rate_hz', 51.1, 'MISSED'),
+    ('load_publish_rate_hz', 5900.0, 'met'),
+    ('load_publish_rate_hz', 5800.0, 'MISSED'),
+    ('unheard_topic_us_per_step', 1.0, 'MISSED'),
+    ('analysis_speedup', 5.0, 'met'),
+])
+def test_verdict_of_a_plain_target(key: str, value: float, verdict: str) -> None:
+    assert run_bench.verdicts({key: value}, 'lz4') == {key: verdict}
+
+
+def test_targets_relative_to_bare_physics() -> None:
+    medians = run_bench.summarize(fast_samples(), per_sim_s=PER_SIM_S)
+    judged = run_bench.verdicts(medians, run_bench.DEFAULT_COMPRESSION)
+    # fast_rtf 9 < 0.6 x 22 = 13.2; node 95 µs > 1.5 x 45.5 µs: the ratios say the same.
+    assert {key: judged[key] for key in ('fast_rtf', 'fast_bare_ratio', 'node_us_per_step',
+                                         'node_bare_ratio')} == dict.fromkeys(
+        ('fast_rtf', 'fast_bare_ratio', 'node_us_per_step', 'node_bare_ratio'), 'MISSED')
+    met = run_bench.verdicts({'bare_physics_steps_per_s': 20000.0, 'fast_rtf': 12.0,
+                              'node_us_per_step': 75.0}, 'lz4')
+    assert met == {'fast_rtf': 'met', 'node_us_per_step': 'met'}  # 12 >= 12, 75 <= 75
+
+
+def test_relative_target_without_bare_physics_is_not_judged() -> None:
+    judged = run_bench.verdicts({'fast_rtf': 12.0}, 'lz4')
+    assert judged == {'fast_rtf': 'unjudged (no bare_physics_steps_per_s: run the physics '
+                                  'section)'}
+
+
+def test_bag_size_target_applies_to_lz4_only() -> None:
+    assert run_bench.verdicts({'bag_mb_per_min': 90.0}, 'lz4') == {'bag_mb_per_min': 'MISSED'}
+    assert run_bench.verdicts({'bag_mb_per_min': 70.0}, run_bench.DEFAULT_COMPRESSION) == {
+        'bag_mb_per_min': 'met'}
+    assert run_bench.verdicts({'bag_mb_per_min': 143.0}, 'none') == {
+        'bag_mb_per_min': 'unjudged (none chunks; the target is for lz4)'}
+
+
+def test_figures_without_target_get_no_verdict() -> None:
+    assert run_bench.verdicts({'lateness_p50_ms': 9.0, 'fast_node_cpu': 2.0}, 'lz4') == {}
+
+
+def test_missing_and_nan_figures_are_invalid() -> None:
+    physics = {key: 1.0 for key in run_bench.EXPECTED['physics']}
+    assert run_bench.invalid_figures(physics, ['physics']) == []
+    del physics['unheard_topic_us_per_step']
+    physics['bare_physics_steps_per_s'] = math.nan
+    assert run_bench.invalid_figures(physics, ['physics']) == [
+        'bare_physics_steps_per_s', 'unheard_topic_us_per_step']
+    # physics and fast together also owe the ratios between them.
+    both = {key: 1.0 for section in ('physics', 'fast') for key in run_bench.EXPECTED[section]}
+    assert run_bench.invalid_figures(both, ['physics', 'fast']) == [
+        'fast_bare_ratio', 'fast_ratio', 'node_bare_ratio']
+
+
+def run_main_with(monkeypatch: pytest.MonkeyPatch, figures: dict[str, list[float]],
+                  argv: list[str]) -> int:
+    """run_bench.main() with its sections replaced by `figures` (no ROS, no timing)."""
+    monkeypatch.setattr(run_bench, 'check_environment', lambda: None)
+    monkeypatch.setattr(run_bench, 'run_offline',
+                        lambda args, samples, loads: samples.update(figures))
+    monkeypatch.setattr(run_bench, 'run_online', lambda *args: None)
+    monkeypatch.setattr(run_bench, 'run_tutorial', lambda *args: None)
+    return run_bench.main(argv)
+
+
+def test_main_fails_on_a_nan_figure_and_keeps_the_json_last(
+        monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    figures = {key: [1.0] for key in run_bench.EXPECTED['analysis']}
+    figures['analysis_speedup'] = [math.nan]
+    assert run_main_with(monkeypatch, figures, ['--only', 'analysis', '--runs', '1']) == 1
+    out, err = capsys.readouterr()
+    result = json.loads(out.strip().splitlines()[-1])
+    assert result['invalid'] == ['analysis_speedup']
+    assert err.strip().splitlines()[-1] == 'run_bench: missing or not finite: analysis_speedup'
+
+
+def test_main_lists_missed_targets_and_still_succeeds(
+        monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    figures = {key: [1.0] for key in run_bench.EXPECTED['analysis']}
+    figures['analysis_speedup'] = [4.0, 6.0, 3.0]   # median 4: below 5
+    figures['analysis_s'] = [0.3, 0.3, 0.3]         # < 2 s: met
+    assert run_main_with(monkeypatch, figures, ['--only', 'analysis', '--runs', '3']) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    result = json.loads(lines[-1])
+    assert result['missed'] == ['analysis_speedup']
+    assert result['invalid'] == []
+    speedup_row = next(line for line in lines if line.startswith('analyze_bag / rosbag'))
+    assert speedup_row.split()[-1] == 'MISSED'
+    time_row = next(line for line in lines if line.startswith('analyze_bag, 60 s bag')
+                    and ' s ' in line)
+    assert time_row.split()[-1] == 'met'
+    assert 'targets: 1 of 2 met; MISSED: analysis_speedup' in lines
