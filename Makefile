@@ -15,7 +15,7 @@ setup:
 	@bash tools/setup.sh
 
 unit-test: setup
-	@$(IN_ENV) python3 -m pytest test/unit -q
+	@$(IN_ENV) python3 -m pytest test/unit -q -rs
 
 lint: setup
 	@$(IN_ENV) ruff check .
@@ -25,7 +25,7 @@ rostest: setup
 	@$(IN_ENV) bash tools/run_rostests.sh
 
 test: setup
-	@$(IN_ENV) python3 -m pytest test/unit test/integration test/reliability -q
+	@$(IN_ENV) python3 -m pytest test/unit test/integration test/reliability -q -rs
 	@$(IN_ENV) ruff check .
 	@$(IN_ENV) catkin_lint -W2 "$$TAC_WS/src"
 	@$(IN_ENV) bash tools/run_rostests.sh

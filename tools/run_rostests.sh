@@ -15,6 +15,11 @@ counts=$(printf '%s\n' "$summary" | sed -n \
   's/^Summary: \([0-9]*\) tests, \([0-9]*\) errors, \([0-9]*\) failures, \([0-9]*\) skipped$/\1 \2 \3 \4/p')
 if [ -n "$counts" ]; then
   read -r tests errors failures skipped <<< "$counts"
-  echo "rostests: $((tests - errors - failures - skipped)) passed, $((errors + failures)) failed"
+  echo "rostests: $((tests - errors - failures - skipped)) passed, $((errors + failures)) failed, $skipped skipped"
+  # As for pytest (test/conftest.py): with TAC_REQUIRE_ALL=1 (CI) a skip fails the run.
+  if [ "$skipped" -gt 0 ] && [ "${TAC_REQUIRE_ALL:-0}" != 0 ]; then
+    echo "rostests: TAC_REQUIRE_ALL=1: $skipped test(s) skipped, which fails the run" >&2
+    status=1
+  fi
 fi
 exit "$status"

@@ -1,29 +1,37 @@
 """atlas.launch's `compression` argument: each recorder writes the chunks it names, and every
 reader of the project's bags (`rosbag info`, `rosbag play`, the analysis) still reads them.
+`recorder:=rosbag` end to end: its bag, closed by the launch's SIGINT, goes through the
+user's tools, `analyze_bag.py` and `replay_bag.py`, as one `atlas_recorder` wrote.
 
 A short standing run per setting: 3 s of sim time after the launch is ready.
 """
 
 from __future__ import annotations
 
+import json
+import re
 import subprocess
+import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
 from support.bag_checks import all_finite, missing_steps
-from support.launch import TestLaunch
+from support.launch import REPO, TestLaunch
 from tutorial_atlas_control import processes, topics
 from tutorial_atlas_control.bags.analysis import analyze_bag
-from tutorial_atlas_control.bags.reader import read_bag
+from tutorial_atlas_control.bags.reader import BagData, read_bag
 from tutorial_atlas_control.bags.records import IndexedBag, PublicBag
 
 #: Sim time (s) recorded after the launch is ready.
 RUN_S = 3.0
 #: Wall-clock guard (s) for `rosbag play` of a few seconds of bag at 20 x (and its master).
 PLAY_TIMEOUT_S = 60.0
+#: Wall-clock guard (s) for analyze_bag.py and replay_bag.py on a few seconds of bag.
+TOOL_TIMEOUT_S = 120.0
 
 
 def rosbag_info(bag: Path, key: str) -> str:
@@ -31,6 +39,12 @@ def rosbag_info(bag: Path, key: str) -> str:
                             capture_output=True, text=True, timeout=60, check=False)
     assert result.returncode == 0, result.stderr
     return result.stdout.strip()
+
+
+def run_script(name: str, *args: str) -> subprocess.CompletedProcess:
+    """One of the package's scripts, as a user runs it after `source ./env.sh`."""
+    return subprocess.run([sys.executable, str(REPO / 'scripts' / name), *args],
+                          capture_output=True, text=True, timeout=TOOL_TIMEOUT_S, check=False)
 
 
 def record(tmp_path: Path, recorder: str, compression: str) -> Path:
@@ -83,4 +97,32 @@ def test_bag_is_compressed_as_asked_and_reads_back(tmp_path: Path, recorder: str
                                 check=False)
     assert played.returncode == 0, played.stdout + played.stderr
     assert 'ERROR' not in played.stdout + played.stderr
+    if recorder == 'rosbag':
+        check_user_tools(bag, data)
 
+
+def check_user_tools(bag: Path, data: BagData) -> None:
+    """analyze_bag.py and replay_bag.py on the bag: exit 0, standing, replayed exactly."""
+    analysed = run_script('analyze_bag.py', str(bag), '--json')
+    assert analysed.returncode == 0, analysed.stderr
+    report = json.loads(analysed.stdout)
+    assert report['fell'] is False
+    assert report['topics'][topics.JOINT_STATES]['count'] == len(data.joint_states.t_s)
+    # The pelvis at standing height (about 0.93 m pinned and after; a fall is below 0.5 m).
+    assert report['min_pelvis_height'] > 0.8
+    replayed = run_script('replay_bag.py', str(bag))
+    assert replayed.returncode == 0, replayed.stdout + replayed.stderr
+    assert replayed.stdout.splitlines()[-1].startswith('REPRODUCED (tolerance '), replayed.stdout
+    # The steps up to the bag's start (rosbag stamps a message when it hears it) are re-created
+    # in Stand mode; every joint state after them is replayed from its torque and compared.
+    steps = re.search(r'replayed (\d+) steps to [\d.]+ s: (\d+) before the recording re-created '
+                      r'in Stand mode, (\d+) with the recorded torques', replayed.stdout)
+    assert steps, replayed.stdout
+    total, before, compared = (int(n) for n in steps.groups())
+    assert total == before + compared
+    stamps_ms = np.rint((data.joint_states.t_s + data.start_time_s) * 1000).astype(int)
+    assert compared == np.count_nonzero(stamps_ms > before) > (RUN_S - 0.5) * 1000
+    # Same model, same MuJoCo: the replay is exact (replay_bag.py --help).
+    for label, unit in (('joint positions', 'rad'), ('joint velocities', 'rad/s')):
+        assert re.search(rf'^  {label} +max \|diff\| 0 {unit}, {compared} samples$',
+                         replayed.stdout, re.MULTILINE), replayed.stdout

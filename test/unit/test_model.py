@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from collections.abc import Callable
 from pathlib import Path
 
 import mujoco
@@ -260,10 +261,83 @@ def test_simulation_is_deterministic(atlas: model.AtlasModel) -> None:
     assert run().tobytes() == run().tobytes()
 
 
+# --- DRCSim's figures typed here: checked in every clone, without the reference files ---------
+
+#: A subset of DRCSim 2.x's atlas.urdf (Atlas v1), typed from it by hand: joint -> (axis,
+#: lower, upper (rad), effort (N m), velocity (rad/s)). Chosen where a slip would not show
+#: elsewhere: the tilted shoulder axes, the mirrored limits of the two sides (not always exact
+#: mirrors: l_leg_lhy -1.75, r_leg_lhy -1.745), the neck from multisense_sl.urdf.
+DRCSIM_JOINTS = {
+    'back_lbz': ((0, 0, 1), -0.610865, 0.610865, 124.016, 12),
+    'back_mby': ((0, 1, 0), -1.2, 1.28, 206.843, 12),
+    'back_ubx': ((1, 0, 0), -0.790809, 0.790809, 94.91, 12),
+    'neck_ay': ((0, 1, 0), -0.610865238, 1.13446401, 5, 12),
+    'l_arm_usy': ((0, 0.5, 0.866025), -1.9635, 1.9635, 212, 12),
+    'r_arm_usy': ((0, 0.5, -0.866025), -1.9635, 1.9635, 212, 12),
+    'l_arm_shx': ((1, 0, 0), -1.39626, 1.74533, 170, 12),
+    'r_arm_shx': ((1, 0, 0), -1.74533, 1.39626, 170, 12),
+    'l_arm_elx': ((1, 0, 0), 0, 2.35619, 114, 12),
+    'r_arm_elx': ((1, 0, 0), -2.35619, 0, 114, 12),
+    'l_arm_mwx': ((1, 0, 0), -0.436, 1.571, 60, 12),
+    'r_arm_mwx': ((1, 0, 0), -1.571, 0.436, 60, 12),
+    'l_leg_uhz': ((0, 0, 1), -0.32, 1.14, 110, 12),
+    'r_leg_uhz': ((0, 0, 1), -1.14, 0.32, 110, 12),
+    'l_leg_mhx': ((1, 0, 0), -0.47, 0.495, 180, 12),
+    'r_leg_mhx': ((1, 0, 0), -0.495, 0.47, 180, 12),
+    'l_leg_lhy': ((0, 1, 0), -1.75, 0.524, 260, 12),
+    'r_leg_lhy': ((0, 1, 0), -1.745, 0.524, 260, 12),
+    'l_leg_kny': ((0, 1, 0), 0, 2.45, 220, 12),
+    'l_leg_uay': ((0, 1, 0), -0.698, 0.698, 220, 12),
+    'l_leg_lax': ((1, 0, 0), -0.436, 0.436, 90, 12),
+}
+#: Every link's mass (kg) in atlas.urdf (the same on both sides), and the MultiSense head's
+#: (multisense_sl.urdf's first `head` link).
+DRCSIM_MASSES_KG = {
+    'pelvis': 14.2529, 'ltorso': 1.92, 'mtorso': 0.55, 'utorso': 18.484, 'head': 1.41984,
+    'uglut': 0.5166, 'lglut': 0.69, 'uleg': 7.34, 'lleg': 4.367, 'talus': 0.1, 'foot': 1.634,
+    'clav': 2.369, 'scap': 2.707, 'uarm': 1.881, 'larm': 2.148, 'farm': 0.981, 'hand': 2.263,
+}
+CENTRE_LINKS = ('pelvis', 'ltorso', 'mtorso', 'utorso', 'head')
+
+
+def test_drcsim_figures_typed_here(atlas: model.AtlasModel) -> None:
+    """The simulated model carries DRCSim's axes, limits and masses (the gains are checked
+    against DRCSim's the same way in test_controller.py, DRCSIM_PD)."""
+    m = atlas.model
+    index = {name: i for i, name in enumerate(JOINT_NAMES)}
+    for name, (axis, lower, upper, effort, velocity) in DRCSIM_JOINTS.items():
+        joint_id = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)
+        # MuJoCo normalizes the axis: DRCSim's (0, 0.5, 0.866025) is 2e-7 short of unit length.
+        np.testing.assert_allclose(m.jnt_axis[joint_id], np.asarray(axis) / np.linalg.norm(axis),
+                                   atol=1e-9, err_msg=name)
+        i = index[name]
+        assert (atlas.lower_rad[i], atlas.upper_rad[i]) == (lower, upper), name
+        assert atlas.effort_limit_nm[i] == effort, name
+        assert atlas.velocity_limit_rad_s[i] == velocity, name
+    links = [*CENTRE_LINKS, *(f'{side}_{link}' for side in 'lr'
+                              for link in DRCSIM_MASSES_KG if link not in CENTRE_LINKS)]
+    for link in links:
+        body_id = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, link)
+        assert body_id >= 0, f'no body {link}'
+        assert m.body_mass[body_id] == DRCSIM_MASSES_KG[link.removeprefix('l_').removeprefix(
+            'r_')], link
+    # 90.61994 kg in all: 889 N of weight.
+    expected_total = sum(DRCSIM_MASSES_KG[name.removeprefix('l_').removeprefix('r_')]
+                         for name in links)
+    assert expected_total == pytest.approx(90.61994, abs=1e-9)
+    assert m.body_subtreemass[atlas.pelvis_body_id] == pytest.approx(expected_total, abs=1e-9)
+
+
 # --- cross-check against the reference files, when they are beside the repository -------------
 
-needs_reference = pytest.mark.skipif(not (REFERENCE / 'atlas_v1.urdf').is_file(),
-                                     reason='../shared/reference not present')
+_reference_absent = pytest.mark.skipif(
+    not (REFERENCE / 'atlas_v1.urdf').is_file(),
+    reason=f'{REFERENCE} not present (test_drcsim_figures_typed_here checks a subset)')
+
+
+def needs_reference(test: Callable[[], None]) -> Callable[[], None]:
+    """Skips without the reference files, even under TAC_REQUIRE_ALL (test/conftest.py)."""
+    return pytest.mark.optional('DRCSim reference files')(_reference_absent(test))
 
 
 def _floats(text: str) -> list[float]:

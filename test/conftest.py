@@ -1,0 +1,72 @@
+"""Skips that hide gaps: with TAC_REQUIRE_ALL=1 (CI sets it, .ci/run) any skip fails the run.
+
+A skip says a test did not check its claim. On a machine set up by `make setup` every test
+can run, so under TAC_REQUIRE_ALL=1 a skip means a broken workspace or a missing tool, and
+the run ends with one line naming the skipped tests and exit status 1. Only tests marked
+`@pytest.mark.optional(reason)` may skip there: they need something no clone carries (the
+DRCSim reference files beside the repository); their skips are listed, and allowed.
+"""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+#: The environment variable that turns skips into a failed run.
+REQUIRE_ALL_ENV = 'TAC_REQUIRE_ALL'
+OPTIONAL_MARKER = 'optional'
+
+_unexpected: list[str] = []
+_optional: list[str] = []
+
+
+def require_all() -> bool:
+    return os.environ.get(REQUIRE_ALL_ENV, '') not in ('', '0')
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line(
+        'markers', f'{OPTIONAL_MARKER}(reason): may skip even with {REQUIRE_ALL_ENV}=1 '
+                   '(it needs files no clone carries)')
+
+
+def _skip_reason(report: pytest.TestReport | pytest.CollectReport) -> str:
+    longrepr = report.longrepr
+    if isinstance(longrepr, tuple) and len(longrepr) == 3:
+        return str(longrepr[2]).removeprefix('Skipped: ')
+    return str(longrepr)
+
+
+def _note(report: pytest.TestReport | pytest.CollectReport, optional: bool) -> None:
+    entry = f'{report.nodeid} ({_skip_reason(report)})'
+    (_optional if optional else _unexpected).append(entry)
+
+
+def pytest_runtest_logreport(report: pytest.TestReport) -> None:
+    if report.skipped and not hasattr(report, 'wasxfail'):
+        _note(report, OPTIONAL_MARKER in report.keywords)
+
+
+def pytest_collectreport(report: pytest.CollectReport) -> None:
+    if report.skipped:  # a module-level skip (importorskip): never optional
+        _note(report, False)
+
+
+def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+    if require_all() and _unexpected and exitstatus in (pytest.ExitCode.OK,
+                                                    pytest.ExitCode.NO_TESTS_COLLECTED):
+        session.exitstatus = pytest.ExitCode.TESTS_FAILED
+
+
+def pytest_terminal_summary(terminalreporter: pytest.TerminalReporter) -> None:
+    if not require_all():
+        return
+    if _optional:
+        terminalreporter.write_line(
+            f'{REQUIRE_ALL_ENV}: {len(_optional)} optional test(s) skipped, allowed: '
+            + '; '.join(_optional))
+    if _unexpected:
+        terminalreporter.write_line(
+            f'{REQUIRE_ALL_ENV}=1: {len(_unexpected)} test(s) skipped, which fails the run: '
+            + '; '.join(_unexpected), red=True, bold=True)
