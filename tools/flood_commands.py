@@ -2,12 +2,14 @@
 """Floods /atlas/joint_commands from outside; prints one JSON line of figures.
 
     flood_commands.py --kind valid|bad --rate HZ --duration S [--start-sim S]
-                      [--subscribers N] [--elbow RAD]
+                      [--subscribers N] [--elbow RAD] [--neck RAD] [--last-neck RAD]
 
 The reliability tests (test/reliability) and the benchmark's `load` section run it against
 a running atlas.launch, as a separate process.
 `valid`: one full 28-joint command (the standing pose, left elbow at --elbow, the
-parameter-server gains) over and over: the load's publishers.
+parameter-server gains) over and over: the load's publishers. `--neck` sets its neck_ay
+target, so that several publishers send different commands; `--last-neck`, a last one sent
+right after the flood with that neck_ay target: which command was applied last shows.
 `bad`: one valid command (the same), then a cycle of every kind of broken message and of
 bad /atlas/control_mode strings: the flooding test. The simulator must refuse them all.
 
@@ -39,15 +41,17 @@ from tutorial_atlas_control.node.transport import subscriber_names
 #: The valid command's default left elbow target (rad).
 DEFAULT_ELBOW_RAD = 1.2
 ELBOW = JOINT_NAMES.index('l_arm_elx')
+NECK = JOINT_NAMES.index('neck_ay')
 #: Every `BAD_MODE_EVERY`-th bad message is followed by a bad control mode.
 BAD_MODE_EVERY = 50
 BAD_MODES = ('', 'Dance', 'user', 'U' * 100_000, 'User\x00Stand')
 
 
-def valid_command(elbow_rad: float) -> JointCommands:
+def valid_command(elbow_rad: float, neck_rad: float = 0.0) -> JointCommands:
     """What traj_yaml.py sends (all 28 joints, parameter-server gains): stand, elbow bent."""
     position = [0.0] * NUM_JOINTS
     position[ELBOW] = elbow_rad
+    position[NECK] = neck_rad
     return build_command(JointCommands, position, read_gains(), rospy.Time())
 
 
@@ -124,7 +128,8 @@ class ClockWatch:
 
 
 def flood(kind: str, rate_hz: float, duration_s: float, start_sim_s: float,
-          subscribers: int, elbow_rad: float) -> dict:
+          subscribers: int, elbow_rad: float, neck_rad: float = 0.0,
+          last_neck_rad: float | None = None) -> dict:
     # queue_size=None: synchronous writes, no per-connection writer thread to hand off to.
     with warnings.catch_warnings():
         warnings.simplefilter('ignore', SyntaxWarning)  # rospy: "explicit queue_size"
@@ -138,7 +143,7 @@ def flood(kind: str, rate_hz: float, duration_s: float, start_sim_s: float,
             raise SystemExit(f'flood_commands.py: no /clock, or fewer than {subscribers} '
                              'subscribers to /atlas/joint_commands')
         time.sleep(0.01)
-    valid = Preserialized(valid_command(elbow_rad))
+    valid = Preserialized(valid_command(elbow_rad, neck_rad))
     bad = [Preserialized(message) for message in bad_commands()]
     if kind == 'bad':
         commands.publish(valid)
@@ -166,6 +171,9 @@ def flood(kind: str, rate_hz: float, duration_s: float, start_sim_s: float,
         pause_s = next_s - time.monotonic()
         if pause_s > 0.0:
             time.sleep(pause_s)
+    if last_neck_rad is not None and not rospy.is_shutdown():
+        commands.publish(Preserialized(valid_command(elbow_rad, last_neck_rad)))  # no pause
+        sent += 1
     wall_s = time.monotonic() - wall0_s
     sim_s = (clock.now_ns() - sim0_ns) / 1e9
     return {'kind': kind, 'sent': sent, 'bad_modes': bad_modes, 'wall_s': wall_s,
@@ -185,10 +193,14 @@ def main() -> int:
                         'the recorder)')
     parser.add_argument('--elbow', type=float, default=DEFAULT_ELBOW_RAD,
                         help='left elbow target of the valid command (rad, default %(default)g)')
+    parser.add_argument('--neck', type=float, default=0.0,
+                        help='neck_ay target of the valid command (rad, default %(default)g)')
+    parser.add_argument('--last-neck', type=float, default=None,
+                        help='send one last valid command with this neck_ay target (rad)')
     args = parser.parse_args(rospy.myargv()[1:])
     rospy.init_node('flood_commands', anonymous=True)
     figures = flood(args.kind, args.rate, args.duration, args.start_sim, args.subscribers,
-                    args.elbow)
+                    args.elbow, args.neck, args.last_neck)
     print(json.dumps(figures), flush=True)
     return 0
 

@@ -1,10 +1,11 @@
 """An offline run (run_offline.py) reaches the outcome of the live run (`make demo`) it stands for.
 
-The live runs are run_demo.py's (step_and_fall: the shared demo_run fixture; touchdown: its
-own); each is compared with the offline run of the same trajectory, aligned on the first
-applied command (bag_compare). Transport and scheduling move a live run a little (the
-trajectory starts from a pose the robot held longer, commands arrive 1-2 ms late), so only
-the outcome must agree: the robot falls in both or in neither, within FALL_TOLERANCE_S.
+The live runs are run_demo.py's (step_and_fall: the shared demo_run fixture; touchdown and
+touchdown_exhausted, the README's slow sway that ends on the ground: their own); each is
+compared with the offline run of the same trajectory, aligned on the first applied command
+(bag_compare). Transport and scheduling move a live run a little (the trajectory starts from
+a pose the robot held longer, commands arrive 1-2 ms late), so only the outcome must agree:
+the robot falls in both or in neither, within FALL_TOLERANCE_S.
 """
 
 from __future__ import annotations
@@ -42,23 +43,34 @@ class LiveRun:
     bag: Path
 
 
-@pytest.fixture(scope='module')
-def touchdown_run(tmp_path_factory: pytest.TempPathFactory) -> LiveRun:
-    bag_dir = tmp_path_factory.mktemp('touchdown')
+def run_live(bag_dir: Path, trajectory: str) -> LiveRun:
+    """run_demo.py on `trajectory`, recording into `bag_dir`."""
     env = dict(os.environ, ROS_LOG_DIR=str(bag_dir / 'ros_log'))
     result = subprocess.run(
-        [sys.executable, str(RUN_DEMO), 'touchdown', '--bag-dir', str(bag_dir), '--video-fps', '0'],
+        [sys.executable, str(RUN_DEMO), trajectory, '--bag-dir', str(bag_dir), '--video-fps', '0'],
         env=env, capture_output=True, text=True, timeout=DEMO_TIMEOUT_S, check=False)
     bags = sorted(bag_dir.glob('atlas_*.bag'))
     assert bags, f'run_demo.py left no bag in {bag_dir}:\n{result.stderr}'
     return LiveRun(result, bags[-1])
 
 
-@pytest.mark.parametrize(('trajectory', 'falls'), [('step_and_fall', True), ('touchdown', False)])
+@pytest.fixture(scope='module')
+def touchdown_run(tmp_path_factory: pytest.TempPathFactory) -> LiveRun:
+    return run_live(tmp_path_factory.mktemp('touchdown'), 'touchdown')
+
+
+@pytest.fixture(scope='module')
+def touchdown_exhausted_run(tmp_path_factory: pytest.TempPathFactory) -> LiveRun:
+    return run_live(tmp_path_factory.mktemp('touchdown_exhausted'), 'touchdown_exhausted')
+
+
+@pytest.mark.parametrize(('trajectory', 'falls'), [('step_and_fall', True), ('touchdown', False),
+                                                   ('touchdown_exhausted', True)])
 def test_offline_run_reaches_the_live_outcome(trajectory: str, falls: bool,
                                               request: pytest.FixtureRequest,
                                               tmp_path: Path) -> None:
-    live = request.getfixturevalue('demo_run' if trajectory == 'step_and_fall' else 'touchdown_run')
+    live = request.getfixturevalue('demo_run' if trajectory == 'step_and_fall'
+                                   else f'{trajectory}_run')
     assert live.result.returncode == 0, live.result.stdout + live.result.stderr
     # The offline run on the live run's schedule: User and the first command at the same sim
     # times (traj_yaml.py's start-up after the switch depends on how busy the machine is).

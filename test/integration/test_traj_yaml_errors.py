@@ -8,6 +8,7 @@ parameter server.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import queue
 import signal
@@ -36,6 +37,11 @@ STEP_AND_FALL_COMMANDS = 200
 FAKE_SIMULATOR_GUARD_S = 90.0
 #: Wall-clock guard (s): how long the port may take to start playing beside the fake simulator.
 PLAYING_TIMEOUT_S = 60.0
+#: The positive control's command: one joint position (rad) no trajectory of the file has.
+CONTROL_POSITION = 0.123456
+#: Wall-clock guard (s): rostopic echo polls the master for the topic, then gets the latched
+#: control message; seconds on a loaded machine.
+CONTROL_TIMEOUT_S = 30.0
 
 
 class Master(RosMaster):
@@ -49,17 +55,39 @@ class Master(RosMaster):
                               timeout=timeout_s, check=False)
 
     def traj_yaml(self, *ros_args: str) -> tuple[subprocess.CompletedProcess, str]:
-        """Run the port on step_and_fall; return its result and what was published meanwhile."""
+        """Run the port on step_and_fall; return its result and what was published meanwhile.
+
+        Positive control: after the port, a command published on purpose must reach the same
+        `rostopic echo`; else an echo that never connected would make "nothing was published"
+        pass whatever the port did.
+        """
         echo = subprocess.Popen(['rostopic', 'echo', '/atlas/joint_commands/position'],
                                 env=self.env, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
                                 text=True, start_new_session=True)
+        lines: queue.Queue[str] = queue.Queue()
+        reader = threading.Thread(target=lambda: [lines.put(line) for line in echo.stdout or ()],
+                                  daemon=True)
+        reader.start()
+        heard: list[str] = []
         try:
             time.sleep(1.0)  # rostopic echo registered before the port starts
             result = self.run(sys.executable, str(TRAJ_YAML), str(TRAJECTORIES),
                               'step_and_fall', *ros_args)
+            control = self.run('rostopic', 'pub', '-1', '/atlas/joint_commands',
+                               'osrf_msgs/JointCommands', f'{{position: [{CONTROL_POSITION}]}}')
+            assert control.returncode == 0, control.stderr
+            deadline = time.monotonic() + CONTROL_TIMEOUT_S
+            while not any(str(CONTROL_POSITION) in line for line in heard):
+                assert time.monotonic() < deadline, (
+                    f'rostopic echo did not show the control command within {CONTROL_TIMEOUT_S}'
+                    f' s: it would not have shown the port\'s either (heard {heard!r})')
+                with contextlib.suppress(queue.Empty):
+                    heard.append(lines.get(timeout=0.1))
         finally:
             stop_tree(echo)
-        return result, echo.stdout.read() if echo.stdout else ''
+        before_control = heard[:next(k for k, line in enumerate(heard)
+                                     if str(CONTROL_POSITION) in line)]
+        return result, ''.join(before_control)
 
 
 @pytest.fixture()

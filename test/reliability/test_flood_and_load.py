@@ -7,6 +7,7 @@ under the load (its real-time factor) is `make bench`'s `load` section.
 from __future__ import annotations
 
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -23,6 +24,8 @@ from support.bag_checks import (
 )
 from support.launch import TestLaunch, flood_figures
 from tutorial_atlas_control.bags.reader import read_bag
+from tutorial_atlas_control.bags.typestore import load_typestore
+from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.processes import rss_kib
 
 #: The issue's figures.
@@ -39,6 +42,41 @@ ELBOW_TOLERANCE_RAD = 0.1
 #: Resident memory the simulator may gain over the load (KiB): Python's allocator settling,
 #: far below what a queue of 30 s x 6 kHz commands (~100 MB) would take.
 RSS_GROWTH_BOUND_KIB = 4096
+#: The load's distinct commands: publisher k's neck_ay target in its flood, then in its last
+#: command (rad, well inside the joint's -0.61..1.13 rad); its flood lasts k x LAST_STAGGER_S
+#: longer (wall s: the publishers' ends far apart on a loaded machine).
+NECK_STEP_RAD = 0.1
+LAST_STAGGER_S = 0.5
+NECK = JOINT_NAMES.index('neck_ay')
+#: Sim time (s) after the floods before stopping: the neck reaching its last target.
+SETTLE_S = 1.0
+#: How far the neck may end from its last target (rad): P-gain slack holding the head up
+#: (0.038 measured at 0.5 rad); besides, it must be nearer that target than any other sent.
+NECK_TOLERANCE_RAD = NECK_STEP_RAD
+
+
+def last_command_position(bag: Path) -> np.ndarray:
+    """Positions of the last /atlas/joint_commands in the bag (receipt order)."""
+    from rosbags.rosbag1 import Reader
+
+    with Reader(bag) as reader:
+        connections = [c for c in reader.connections if c.topic == '/atlas/joint_commands']
+        last = None
+        for connection, _t, raw in reader.messages(connections=connections):
+            last = connection, raw
+        assert last is not None, 'no command recorded'
+        message = load_typestore(reader.connections).deserialize_ros1(last[1], last[0].msgtype)
+    return np.asarray(message.position)
+
+
+def flood_neck_rad(k: int) -> float:
+    return round(k * NECK_STEP_RAD, 6)
+
+
+def last_neck_rad(k: int) -> float:
+    return round((LOAD_PUBLISHERS + k) * NECK_STEP_RAD, 6)
+
+
 #: Sim time (s) the floods start at: after the torso is released (time_to_unpin 1 s).
 START_SIM_S = 2.0
 #: Sim time (s) of the first memory reading: a third into the floods, when the allocator has
@@ -91,10 +129,15 @@ def test_three_publishers_at_2_khz_lose_nothing_and_keep_memory_flat(
     atlas_launch.wait_ready()
     atlas_launch.set_mode('User')
     sim_pid = atlas_launch.pid_of('atlas_sim_node.py')
+    # Distinct commands: each publisher its own neck target, then a last command with another,
+    # the publishers ending LAST_STAGGER_S apart: the last sent of all is the last publisher's.
     floods = [atlas_launch.start_flood('--kind', 'valid', '--rate', str(LOAD_RATE_HZ),
                                        '--elbow', str(VALID_ELBOW_RAD),
-                                       '--duration', str(LOAD_S), '--start-sim', str(START_SIM_S))
-              for _ in range(LOAD_PUBLISHERS)]
+                                       '--neck', str(flood_neck_rad(k)),
+                                       '--last-neck', str(last_neck_rad(k)),
+                                       '--duration', str(LOAD_S + k * LAST_STAGGER_S),
+                                       '--start-sim', str(START_SIM_S))
+              for k in range(LOAD_PUBLISHERS)]
     atlas_launch.wait_sim_until(RSS_START_SIM_S)
     rss_start_kib = rss_kib(sim_pid)
     rss_kib_samples = []
@@ -103,6 +146,7 @@ def test_three_publishers_at_2_khz_lose_nothing_and_keep_memory_flat(
         time.sleep(1.0)
     rss_end_kib = rss_kib(sim_pid)
     figures = [flood_figures(flood, timeout_s=30.0) for flood in floods]
+    atlas_launch.wait_sim_s(SETTLE_S)
     atlas_launch.interrupt()
     bag = atlas_launch.bag()
     data = read_bag(bag)
@@ -122,6 +166,19 @@ def test_three_publishers_at_2_khz_lose_nothing_and_keep_memory_flat(
     assert all_finite(data.joint_states)
     elbow = data.joint_states.position[-1, data.joint_states.names.index('l_arm_elx')]
     assert abs(elbow - VALID_ELBOW_RAD) < ELBOW_TOLERANCE_RAD, 'the commands were applied'
+    # The last command sent is the one applied: recorded last, and the neck ends nearest its
+    # target of all those sent. (The merge order within one 1 ms step is test_stepping.py's:
+    # with the loop merging oldest first, this test passed, the last command alone in its step.)
+    expected_neck = last_neck_rad(LOAD_PUBLISHERS - 1)
+    last_recorded = last_command_position(bag)
+    neck = data.joint_states.position[-1, data.joint_states.names.index('neck_ay')]
+    print(f'figures: load: last recorded neck_ay target {last_recorded[NECK]:.3f} rad, '
+          f'neck_ay at the end {neck:.3f} rad (last sent {expected_neck:.3f})')
+    assert last_recorded[NECK] == expected_neck
+    targets = [f(k) for f in (flood_neck_rad, last_neck_rad) for k in range(LOAD_PUBLISHERS)]
+    assert min(targets, key=lambda target: abs(neck - target)) == expected_neck, (
+        f'neck_ay ends at {neck:.3f} rad, nearer another command than the last sent')
+    assert abs(neck - expected_neck) < NECK_TOLERANCE_RAD, 'the last command sent was applied'
     # Nothing lost: atlas_recorder queues what it has not written yet (`rosbag record`, with
     # its 100-message queue, dropped 6-25 % of these commands; recorder:=rosbag).
     assert recorded == sent, f'the recorder lost {sent - recorded} of {sent} commands'

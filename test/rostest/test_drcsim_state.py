@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """rostest: DRCSim's /atlas/atlas_state, /atlas/force_torque_sensors and debug foot contacts,
 live: every step, genpy's types (rospy checks the MD5s), the joint state's numbers, and a
-standing robot's forces and IMU.
+standing robot's forces and IMU, also on the port's own /atlas/imu and ankle topics.
 
 The launch starts paused; the test subscribes, waits for its connections, unpauses and
 keeps every message of the first WATCH_S of sim time.
@@ -19,7 +19,7 @@ import rostest
 from atlas_msgs.msg import AtlasState, ForceTorqueSensors
 from geometry_msgs.msg import WrenchStamped
 from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import JointState
+from sensor_msgs.msg import Imu, JointState
 from std_srvs.srv import Empty
 
 from tutorial_atlas_control import topics
@@ -34,6 +34,8 @@ STANDING_S = 0.5
 GRAVITY_MPS2 = 9.81
 #: Atlas v1 (90.6 kg) weighs this much (N): the feet's contacts carry it all.
 WEIGHT_N = 889.0
+#: What the legs carry above the ankles (N): the weight less the two feet's (README: 857 N).
+ABOVE_ANKLES_N = 857.0
 WALL_TIMEOUT_S = 120.0
 
 
@@ -60,7 +62,8 @@ class DrcsimStateTest(unittest.TestCase):
                 (topics.ATLAS_STATE, AtlasState), (topics.FORCE_TORQUE_SENSORS, ForceTorqueSensors),
                 (topics.DEBUG_L_FOOT_CONTACT, WrenchStamped),
                 (topics.DEBUG_R_FOOT_CONTACT, WrenchStamped),
-                (topics.JOINT_STATES, JointState))]
+                (topics.JOINT_STATES, JointState), (topics.IMU, Imu),
+                (topics.L_FOOT_CONTACT, WrenchStamped), (topics.R_FOOT_CONTACT, WrenchStamped))]
         rospy.Subscriber(topics.CLOCK, Clock, cls._on_clock, queue_size=10)
         cls._wait(lambda: all(s.get_num_connections() >= 1 for s in subscribers),
                   'the simulator\'s connections')
@@ -143,6 +146,24 @@ class DrcsimStateTest(unittest.TestCase):
                    for msg in left]
         self.assertTrue(all(msg.header.frame_id == 'l_foot' for msg in left))
         self.assertAlmostEqual(float(np.mean(weights)), WEIGHT_N, delta=0.03 * WEIGHT_N)
+
+    def test_the_ports_imu_and_ankle_topics_standing(self) -> None:
+        """/atlas/imu: +g up; /atlas/{l,r}_foot_contact: in the foot frames, each leg pushing
+        its foot down (Fz < 0), the two Fz summing to the weight above the ankles (2 %: the
+        robot sways slowly; the unit test derives the figure from the model's masses)."""
+        imu = self._standing(topics.IMU)
+        self.assertEqual(len(imu), round(STANDING_S * 1000) + 1)  # every step
+        for msg in imu:
+            self.assertAlmostEqual(msg.linear_acceleration.z, GRAVITY_MPS2, delta=0.1)
+        left = self._standing(topics.L_FOOT_CONTACT)
+        right = {msg.header.stamp.to_nsec(): msg for msg in self._standing(topics.R_FOOT_CONTACT)}
+        self.assertEqual(len(left), round(STANDING_S * 1000) + 1)
+        for msg in left:
+            other = right[msg.header.stamp.to_nsec()]
+            self.assertEqual((msg.header.frame_id, other.header.frame_id), ('l_foot', 'r_foot'))
+            self.assertTrue(msg.wrench.force.z < 0.0 and other.wrench.force.z < 0.0)
+            self.assertAlmostEqual(msg.wrench.force.z + other.wrench.force.z, -ABOVE_ANKLES_N,
+                                   delta=0.02 * ABOVE_ANKLES_N)
 
 
 if __name__ == '__main__':

@@ -314,6 +314,20 @@ def test_the_newest_message_sets_the_fields_it_carries(sim: AtlasSimulator) -> N
         'first /atlas/atlas_command since the start or last reset, at t=0.000 s (User mode)']
 
 
+def test_a_refused_newest_atlas_command_keeps_the_joint_command_and_its_stamp(
+        sim: AtlasSimulator) -> None:
+    """Across the two topics: the valid JointCommands stays applied, with its stamp."""
+    loop, _, log, _ = make_loop(sim)
+    loop.receive_command(complete_command(0.1, stamp_ns=3 * NS_PER_S))
+    loop.receive_command(atlas_bytes(stamp_ns=4 * NS_PER_S, position=full(float('nan'))),
+                         topics.ATLAS_COMMAND)
+    loop.apply_pending_commands()
+    np.testing.assert_array_equal(sim.user_command.position, full(0.1))
+    assert log.of('refused') == ['refused /atlas/atlas_command: position[0] is nan '
+                                 '(NaN/Inf are refused); previous command kept']
+    assert loop.statistics.command_stamp_ns == 3 * NS_PER_S
+
+
 def test_refusals_and_left_out_fields_are_one_line_each(sim: AtlasSimulator) -> None:
     loop, _, log, _ = make_loop(sim)
     loop.receive_command(atlas_bytes(position=full(0.1)), topics.ATLAS_COMMAND)

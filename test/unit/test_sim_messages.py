@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import struct
 from pathlib import Path
 
 import mujoco
@@ -191,3 +192,40 @@ def test_debug_foot_contacts_are_the_ground_push_and_stop_in_the_air(
     airborne.data.qpos[2] += 1.0  # the free joint's z: a metre above the ground
     mujoco.mj_forward(airborne.model, airborne.data)
     assert not SimMessages(airborne).fill_debug_contact('l')
+
+
+def _frame_id(wire: object) -> str:
+    """The header's frame_id of a stamped wire message (after length, seq and stamp)."""
+    (length,) = struct.unpack_from('<I', wire.buf, 16)
+    return bytes(wire.buf[20:20 + length]).decode()
+
+
+def test_the_ports_imu_and_ankle_topics_mean_gravity_and_the_weight(
+        standing: AtlasSimulator) -> None:
+    """/atlas/imu and /atlas/{l,r}_foot_contact (the port's own) against physics, standing.
+
+    The accelerometer reads the ground's push, +g up; the legs push each foot down with half
+    the weight above the ankles (the model's masses less the feet's), README's "Fz about
+    -430 N", in the foot frame about the ankle; horizontally the two pushes cancel (the robot
+    is still). Tolerances: 2 % of the weight (the robot sways slowly), as above.
+    """
+    gravity_mps2 = -float(standing.model.opt.gravity[2])
+    messages = SimMessages(standing)
+    messages.fill_plan(('imu', 'l', 'r'))()
+    imu = messages.imu_wire
+    assert imu.linear_acceleration[2] == pytest.approx(gravity_mps2, abs=0.05)
+    assert np.abs(imu.linear_acceleration[:2]).max() < 0.5
+    assert np.abs(imu.angular_velocity).max() < 0.05
+    assert abs(imu.orientation_xyzw[3]) == pytest.approx(1.0, abs=0.01)  # upright
+    total_kg = float(standing.model.body_subtreemass[standing.atlas.pelvis_body_id])
+    above_ankles_n = (total_kg - _mass_kg(standing, 'l_foot') - _mass_kg(standing, 'r_foot')) \
+        * gravity_mps2
+    pushes_world = np.zeros(3)
+    for side in 'lr':
+        contact = messages.contact_wires[side]
+        assert _frame_id(contact) == f'{side}_foot'
+        assert contact.force[2] == pytest.approx(-above_ankles_n / 2, rel=0.02)  # down: < 0
+        assert np.abs(contact.torque[:2]).max() < 20.0  # N m about the ankle: flat feet
+        foot = standing.model.body(f'{side}_foot').id
+        pushes_world += standing.data.xmat[foot].reshape(3, 3) @ contact.force
+    assert pushes_world == pytest.approx([0.0, 0.0, -above_ankles_n], abs=0.02 * above_ankles_n)

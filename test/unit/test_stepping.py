@@ -326,6 +326,23 @@ def test_a_complete_command_hides_older_ones_undecoded(sim: AtlasSimulator) -> N
     assert loop.statistics.command_stamp_ns == 7 * NS_PER_S  # the newest applied
 
 
+def test_of_complete_commands_only_the_newest_is_decoded(
+        sim: AtlasSimulator, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A flood costs one decode per step: the newest complete command hides the rest."""
+    loop, _, _, _ = make_loop(sim)
+    decoded: list[bytes] = []
+    original = loop._decode
+    monkeypatch.setattr(loop, '_decode', lambda topic, raw: (decoded.append(raw),
+                                                             original(topic, raw))[1])
+    sent = [complete_command(0.1 * k, stamp_ns=k * NS_PER_S) for k in (1, 2, 3)]
+    for raw in sent:
+        loop.receive_command(raw)
+    loop.apply_pending_commands()
+    assert decoded == [sent[-1]]
+    np.testing.assert_array_equal(sim.user_command.position, [0.1 * 3] * NUM_JOINTS)
+    assert loop.statistics.command_stamp_ns == 3 * NS_PER_S
+
+
 def test_a_refused_command_keeps_the_previous_one(sim: AtlasSimulator) -> None:
     loop, _, log, _ = make_loop(sim)
     loop.receive_command(complete_command(0.1, stamp_ns=3 * NS_PER_S))
