@@ -127,3 +127,22 @@ def test_a_type_error_of_an_open_publisher_is_not_hidden(
     pub.remove_connection = lambda _connection: len(None)
     with pytest.raises(TypeError):
         transport.write_to_connections(pub, b'data')
+
+
+def test_clock_goes_out_after_the_messages_stamped_with_it(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """Seen in CI: the node stopped between /clock's send and the joint states', and the
+    bag held a time no joint state was stamped with. The latest /clock is now sent last."""
+    sent: list[tuple[str, bytes]] = []
+    monkeypatch.setattr(transport, 'write_to_connections',
+                        lambda pub, data: sent.append((pub, bytes(data))))
+    batch = transport.WireBatch()
+    for step in (b'1', b'2'):
+        batch.replace('clock', b'clock ' + step)
+        batch.add('joint_states', b'state ' + step)
+        batch.add('imu', b'imu ' + step)
+    batch.flush()
+    assert sent == [('joint_states', b'state 1state 2'), ('imu', b'imu 1imu 2'),
+                    ('clock', b'clock 2')]
+    batch.flush()
+    assert len(sent) == 3, 'a flush sent twice'

@@ -69,10 +69,16 @@ def subscriber_names(pub: rospy.Publisher) -> set[str]:
 
 
 class WireBatch:
-    """Per-publisher byte batches, written on flush() with one sendall per connection."""
+    """Per-publisher byte batches, written on flush() with one sendall per connection.
+
+    Replaced outlets (/clock: only its latest value goes out) are written after the
+    batches, so a subscriber never gets a time before the messages stamped with it, even
+    when the node stops in the middle of a flush.
+    """
 
     def __init__(self) -> None:
         self.pending: dict[rospy.Publisher, bytearray] = {}
+        self.latest: dict[rospy.Publisher, bytearray] = {}
 
     @staticmethod
     def wanted(pub: rospy.Publisher) -> bool:
@@ -88,10 +94,13 @@ class WireBatch:
             batch += data
 
     def replace(self, pub: rospy.Publisher, data: bytes | bytearray) -> None:
-        """Queue `data` instead of anything still pending for `pub` (e.g. /clock)."""
-        self.pending[pub] = bytearray(data)
+        """Queue `data` instead of anything still queued for `pub` (e.g. /clock), to be
+        sent after every batch."""
+        self.latest[pub] = bytearray(data)
 
     def flush(self) -> None:
         pending, self.pending = self.pending, {}
-        for pub, data in pending.items():
-            write_to_connections(pub, data)
+        latest, self.latest = self.latest, {}
+        for batches in (pending, latest):
+            for pub, data in batches.items():
+                write_to_connections(pub, data)
