@@ -9,7 +9,8 @@
 // follows amplitude * (1 - cos(2 pi t / period)), t from the first joint state.
 // ~transport: how /atlas/joint_states is asked for: udp_tcp (default, DRCSim's own clients:
 // .unreliable().reliable(), UDP preferred), udp (DRCSim's C++ tutorial: .unreliable() only)
-// or tcp (.reliable()).
+// or tcp (.reliable()); ~max_datagram_size (bytes, 0: roscpp's 1500) for UDP: below a joint
+// state's 1067 bytes, each comes in blocks that roscpp reassembles.
 
 #include <cmath>
 #include <cstddef>
@@ -67,7 +68,8 @@ private:
 };
 
 // The transport hints ~transport names; false for an unknown name.
-bool transportHints(const std::string &transport, ros::TransportHints &hints)
+bool transportHints(const std::string &transport, int max_datagram_size,
+                    ros::TransportHints &hints)
 {
   if (transport == "udp_tcp")
     hints = ros::TransportHints().unreliable().reliable().tcpNoDelay(true);
@@ -77,6 +79,8 @@ bool transportHints(const std::string &transport, ros::TransportHints &hints)
     hints = ros::TransportHints().reliable().tcpNoDelay(true);
   else
     return false;
+  if (max_datagram_size > 0)
+    hints.maxDatagramSize(max_datagram_size);
   return true;
 }
 
@@ -104,8 +108,10 @@ int main(int argc, char **argv)
   private_nh.param("period_s", period_s, 4.0);
   std::string transport;
   private_nh.param<std::string>("transport", transport, "udp_tcp");
+  int max_datagram_size;
+  private_nh.param("max_datagram_size", max_datagram_size, 0);
   ros::TransportHints hints;
-  if (!transportHints(transport, hints))
+  if (!transportHints(transport, max_datagram_size, hints))
   {
     ROS_FATAL("~transport is %s, not one of udp_tcp, udp, tcp", transport.c_str());
     return 1;
