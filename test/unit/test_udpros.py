@@ -273,3 +273,41 @@ def test_a_closed_connection_raises_transport_terminated_and_has_no_fileno(handl
     assert connection.fileno() is None
     with pytest.raises(node_udpros.TransportTerminated):
         connection.write_data(framed(b'x'))
+
+
+class FakeTcpHandler:
+    @staticmethod
+    def supports(protocol: str) -> bool:
+        return protocol == 'TCPROS'
+
+
+class FakeRosHandler:
+    """rospy's ROSHandler as serve() sees it: requestTopic picks the first offered protocol
+    a handler supports, else answers 0 with no parameters."""
+
+    def __init__(self) -> None:
+        self.protocol_handlers = [FakeTcpHandler()]
+
+    def requestTopic(self, caller_id, topic, protocols):  # rospy's name
+        for protocol in protocols:
+            for handler in self.protocol_handlers:
+                if handler.supports(protocol[0]):
+                    return 1, 'ready', [protocol[0]]
+        return 0, 'no supported protocol implementations', []
+
+
+def test_serve_registers_udpros_and_names_an_unservable_subscriber_once(monkeypatch):
+    ros_handler = FakeRosHandler()
+    monkeypatch.setattr(node_udpros, '_node_handler', lambda: ros_handler)
+    monkeypatch.setattr(node_udpros.rospy, 'get_name', lambda: '/atlas_sim')
+    warnings = []
+    handler = node_udpros.serve(warn=warnings.append)
+    assert ros_handler.protocol_handlers[-1] is handler
+    assert handler.get_supported() == []  # the node's own subscriptions stay TCPROS
+    for _ in range(2):
+        assert ros_handler.requestTopic('/sub', '/clock', [['FOOROS'], ['BAROS']]) == (
+            0, 'no supported protocol implementations', [])
+    assert ros_handler.requestTopic('/sub', '/clock', [['FOOROS'], ['TCPROS']])[0] == 1
+    assert warnings == [
+        'subscriber /sub of /clock offers only FOOROS, BAROS; /atlas_sim serves TCPROS and '
+        'UDPROS: not connected (roscpp: ros::TransportHints().reliable() or .unreliable())']
