@@ -311,3 +311,13 @@ def test_serve_registers_udpros_and_names_an_unservable_subscriber_once(monkeypa
     assert warnings == [
         'subscriber /sub of /clock offers only FOOROS, BAROS; /atlas_sim serves TCPROS and '
         'UDPROS: not connected (roscpp: ros::TransportHints().reliable() or .unreliable())']
+
+
+def test_ros_bound_to_localhost_sends_to_this_machine_only(monkeypatch):
+    """As roscpp with ROS_HOSTNAME=localhost (env.sh): no datagrams leave the machine."""
+    monkeypatch.setattr(node_udpros.rosgraph.network, 'get_address_override',
+                        lambda: 'localhost')
+    with pytest.raises(node_udpros.AtlasControlError,
+                       match='ROS is bound to localhost; 192.0.2.1 is not on this machine'):
+        node_udpros._connected_socket('192.0.2.1', 9)
+    node_udpros._connected_socket('127.0.0.1', 9).close()
