@@ -7,6 +7,10 @@
 //
 // Private parameters: ~joint (l_arm_elx), ~amplitude_rad (0.4), ~period_s (4.0): the joint
 // follows amplitude * (1 - cos(2 pi t / period)), t from the first joint state.
+// ~transport: how /atlas/joint_states is asked for: udp_tcp (default, DRCSim's own clients:
+// .unreliable().reliable(), UDP preferred), udp (DRCSim's C++ tutorial: .unreliable() only)
+// or tcp (.reliable()); ~max_datagram_size (bytes, 0: roscpp's 1500) for UDP: below a joint
+// state's 1067 bytes, each comes in blocks that roscpp reassembles.
 
 #include <cmath>
 #include <cstddef>
@@ -33,15 +37,13 @@ class SineClient
 {
 public:
   SineClient(ros::NodeHandle &nh, const osrf_msgs::JointCommands &command, std::size_t sine_joint,
-             double amplitude_rad, double period_s)
+             double amplitude_rad, double period_s, const ros::TransportHints &hints)
     : command_(command), sine_joint_(sine_joint), amplitude_rad_(amplitude_rad),
       period_s_(period_s)
   {
     // Latched, as DRCSim's examples: a late-connecting simulator still gets the last command.
     publisher_ = nh.advertise<osrf_msgs::JointCommands>("/atlas/joint_commands", 1, true);
-    // UDP preferred, TCP accepted (the simulator's rospy publisher offers TCPROS only).
-    subscriber_ = nh.subscribe("/atlas/joint_states", 1, &SineClient::onJointState, this,
-                               ros::TransportHints().unreliable().reliable().tcpNoDelay(true));
+    subscriber_ = nh.subscribe("/atlas/joint_states", 1, &SineClient::onJointState, this, hints);
   }
 
 private:
@@ -65,6 +67,23 @@ private:
   ros::Subscriber subscriber_;
 };
 
+// The transport hints ~transport names; false for an unknown name.
+bool transportHints(const std::string &transport, int max_datagram_size,
+                    ros::TransportHints &hints)
+{
+  if (transport == "udp_tcp")
+    hints = ros::TransportHints().unreliable().reliable().tcpNoDelay(true);
+  else if (transport == "udp")
+    hints = ros::TransportHints().unreliable();
+  else if (transport == "tcp")
+    hints = ros::TransportHints().reliable().tcpNoDelay(true);
+  else
+    return false;
+  if (max_datagram_size > 0)
+    hints.maxDatagramSize(max_datagram_size);
+  return true;
+}
+
 bool readGain(ros::NodeHandle &nh, const std::string &joint, const std::string &key, double &value)
 {
   const std::string name = "atlas_controller/gains/" + joint + "/" + key;
@@ -87,6 +106,16 @@ int main(int argc, char **argv)
   private_nh.param<std::string>("joint", sine_joint_name, "l_arm_elx");
   private_nh.param("amplitude_rad", amplitude_rad, 0.4);
   private_nh.param("period_s", period_s, 4.0);
+  std::string transport;
+  private_nh.param<std::string>("transport", transport, "udp_tcp");
+  int max_datagram_size;
+  private_nh.param("max_datagram_size", max_datagram_size, 0);
+  ros::TransportHints hints;
+  if (!transportHints(transport, max_datagram_size, hints))
+  {
+    ROS_FATAL("~transport is %s, not one of udp_tcp, udp, tcp", transport.c_str());
+    return 1;
+  }
 
   // Under /use_sim_time, ROS time is 0 until the simulator's first /clock.
   ros::Time::waitForValid();
@@ -119,7 +148,7 @@ int main(int argc, char **argv)
     return 1;
   }
 
-  SineClient client(nh, command, sine_joint, amplitude_rad, period_s);
+  SineClient client(nh, command, sine_joint, amplitude_rad, period_s, hints);
   ros::spin();
   return 0;
 }

@@ -9,8 +9,10 @@ from __future__ import annotations
 import json
 import threading
 import time
+import xmlrpc.client
 from collections.abc import Callable, Sequence
 
+import rosgraph
 import rospy
 from geometry_msgs.msg import WrenchStamped
 from nav_msgs.msg import Odometry
@@ -167,3 +169,18 @@ class SimProbe:
     def warnings_containing(self, text: str) -> list[str]:
         with self.lock:
             return [w for w in self.warnings if text in w]
+
+
+def bus_connections(node: str, caller_id: str = '/sim_probe') -> list[list]:
+    """`node`'s getBusInfo (its XML-RPC API, what `rosnode info` shows): one
+    [id, peer, direction, transport, topic, connected, info] per connection."""
+    uri = rosgraph.Master(caller_id).lookupNode(node)
+    code, text, connections = xmlrpc.client.ServerProxy(uri).getBusInfo(caller_id)
+    if code != 1:
+        raise AssertionError(f'getBusInfo of {node}: {text}')
+    return connections
+
+
+def transports_to(peer: str, topic: str, node: str = '/atlas_sim') -> list[str]:
+    """The transports (TCPROS, UDPROS) of `node`'s connections to `peer` on `topic`."""
+    return [c[3] for c in bus_connections(node) if c[1] == peer and c[4] == topic]

@@ -10,6 +10,9 @@ Private parameter ~client:
   cpp        test/rostest/joint_commands_client.cpp (roscpp) answers every joint state with a
              command stamped with the state's stamp, moving l_arm_elx along a sine: the
              simulator tracks that joint, and the command it obeys is 1 or 2 steps old.
+Private parameters ~transport (cpp only, optional): the transport (UDPROS, TCPROS) the
+simulator's /atlas/joint_states connection to the client must use (getBusInfo), and
+~max_datagram_size (with UDPROS, optional): the datagram size it must show.
 """
 
 from __future__ import annotations
@@ -25,7 +28,7 @@ import rospy
 import rostest
 from atlas_msgs.msg import ControllerStatistics
 from osrf_msgs.msg import JointCommands
-from sim_probe import SimProbe
+from sim_probe import SimProbe, bus_connections, transports_to
 
 PKG = 'tutorial_atlas_control'
 TOPIC = '/atlas/controller_statistics'
@@ -55,6 +58,7 @@ GOOD_WINDOWS = 0.8
 STATISTICS_RATE_HZ = 100.0  # set in controller_statistics.test
 
 # -- the roscpp client -----------------------------------------------------------------------
+CPP_CLIENT = '/joint_commands_client'
 SINE_JOINT = 'l_arm_elx'
 TRACKING_S = 4.0
 SETTLE_S = 1.0
@@ -146,6 +150,14 @@ class CommandAgeTest(unittest.TestCase):
     # -- the roscpp client ---------------------------------------------------------------
     def scenario_cpp(self) -> None:
         self.probe.wait_until(lambda: len(self.commands) > 100, 'the roscpp client to answer')
+        transport = rospy.get_param('~transport', None)
+        if transport is not None:
+            self.assertEqual(transports_to(CPP_CLIENT, '/atlas/joint_states'), [transport])
+        size = rospy.get_param('~max_datagram_size', None)
+        if size is not None:
+            [info] = [c[6] for c in bus_connections('/atlas_sim')
+                      if c[1] == CPP_CLIENT and c[4] == '/atlas/joint_states']
+            self.assertIn(f', {size}-byte datagrams', info)
         self.probe.set_mode('User')
         start_ns = self.probe.clock_ns + int(SETTLE_S * 1e9)
         self.probe.wait_sim(SETTLE_S + TRACKING_S)

@@ -148,7 +148,8 @@ def fake_ros_node(sim: AtlasSimulator, steps: int, tcp: bool = False,
                                  logwarn=mock.DEFAULT, logwarn_throttle=mock.DEFAULT,
                                  logwarn_throttle_identical=mock.DEFAULT,
                                  logerr=mock.DEFAULT, logerr_throttle=mock.DEFAULT,
-                                 logfatal=mock.DEFAULT):
+                                 logfatal=mock.DEFAULT), \
+                mock.patch.object(sim_node, 'serve_udpros'):  # no rospy node to register with
             node = sim_node.SimNode(sim, real_time_factor=0.0, paused=False,
                                     rates_hz=dict(rates_hz), gui=False)
             node.fake_publishers = publishers

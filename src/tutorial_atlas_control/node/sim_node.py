@@ -68,6 +68,7 @@ from trajectory_msgs.msg import JointTrajectory
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.node.transport import WireBatch
+from tutorial_atlas_control.node.udpros import serve as serve_udpros
 from tutorial_atlas_control.node.viewer import ViewerLink, ViewerRequest, display_problem
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.camera import configure_viewer_camera, configure_viewer_scene
@@ -217,6 +218,8 @@ class SimNode:
                  rates_hz: dict[str, float], gui: bool, tf: bool = False) -> None:
         self.sim = sim
         self.gui = gui
+        # UDPROS for roscpp's unreliable() subscribers, before the master announces a topic.
+        self.udpros = serve_udpros()
         self._advertise(tf)
         statistics = self._controller_statistics()
         self.loop = SteppingLoop(sim, WireBatch(), self.publishers, rates_hz, statistics,

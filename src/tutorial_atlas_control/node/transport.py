@@ -39,8 +39,9 @@ def write_to_connections(pub: rospy.Publisher, data: bytes | bytearray) -> None:
         except (TransportTerminated, OSError) as err:  # socket.timeout is an OSError
             if impl.closed:  # rospy closed every connection and cannot remove one any more
                 return
-            if isinstance(err, (BrokenPipeError, ConnectionResetError)):
+            if isinstance(err, (BrokenPipeError, ConnectionResetError, ConnectionRefusedError)):
                 # The subscriber exited (traj_yaml.py at its end): routine, as in rospy.
+                # Refused: a UDPROS subscriber's port is closed (node/udpros.py).
                 rospy.logdebug(f'{pub.resolved_name}: subscriber {connection.endpoint_id} left')
             elif not isinstance(err, TransportTerminated):
                 rospy.logwarn(f'{pub.resolved_name}: dropping subscriber '
