@@ -70,6 +70,7 @@ from trajectory_msgs.msg import JointTrajectory
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags.bag_dir import unwritable_reason
 from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.node.master_watch import start_master_watch
 from tutorial_atlas_control.node.recorder_watch import start_recorder_watch
 from tutorial_atlas_control.node.transport import WireBatch
 from tutorial_atlas_control.node.viewer import ViewerLink, ViewerRequest, display_problem
@@ -387,9 +388,11 @@ class SimNode:
         """Run the stepping loop until ROS shuts down (with the viewer, if asked); the exit
         status."""
         viewer = self._open_viewer() if self.gui else None
-        # One line if the recorder goes (killed, disk full) while the simulation goes on.
+        # One line if the recorder goes (killed, disk full) while the simulation goes on;
+        # registered again with a restarted master.
         watch = start_recorder_watch(self.publishers[topics.JOINT_STATES],
                                      lambda: self.sim.sim_time_ns * 1e-9, time.monotonic)
+        start_master_watch(watch)
         status = self.loop.run(rospy.is_shutdown)
         watch.set()
         if status:
