@@ -126,10 +126,12 @@ private:
       // errno still holds why the write failed (ENOSPC, EFBIG); rosbag's text does not say.
       const int cause = errno;
       reason_ = cause != 0 ? std::strerror(cause) : error.what();
+      // On a full disk `rosbag reindex` cannot make its backup copy (and still exits 0):
+      // it must write elsewhere.
       ROS_ERROR("atlas_recorder: recording stopped: cannot write %s to %s (%s); the bag holds "
-                "the run up to here: `rosbag reindex %s` to read it",
+                "the run up to here: `rosbag reindex %s%s` to read it",
                 topic.c_str(), bag_.getFileName().c_str(), reason_.c_str(),
-                bag_.getFileName().c_str());
+                cause == ENOSPC ? "--output-dir DIR_WITH_ROOM " : "", bag_.getFileName().c_str());
       failed_ = true;
       g_stop_requested = true;
     }

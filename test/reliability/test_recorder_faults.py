@@ -158,3 +158,40 @@ def test_bag_dir_that_cannot_be_written_is_refused_before_the_simulator_starts(
             'not be recorded; give a writable bag_dir:=, or record:=false') in output, output
     assert 'Atlas v1 simulator ready' not in output
     assert 'REQUIRED process [atlas_sim' in output
+
+
+@pytest.mark.optional('needs root and a tmpfs mount (a container may forbid it)')
+def test_a_full_tmpfs_bag_dir_stops_the_recorder(tmp_path: Path) -> None:
+    """A real full disk: a 4 MiB tmpfs as bag_dir (~3 s of a run). `rosbag reindex` cannot
+    work in place there (its backup copy fails), so the line says --output-dir."""
+    disk = tmp_path / 'small_disk'
+    disk.mkdir()
+    mounted = subprocess.run(['mount', '-t', 'tmpfs', '-o', 'size=4m', 'tmpfs', str(disk)],
+                             capture_output=True, text=True, check=False)
+    if mounted.returncode != 0:
+        pytest.skip(f'cannot mount a tmpfs: {mounted.stderr.strip()}')
+    try:
+        with TestLaunch(tmp_path, f'bag_dir:={disk}') as launch:
+            launch.wait_ready()
+            line = wait_line(launch, 'atlas_recorder: recording stopped: cannot write ')
+            active = sorted(disk.glob('atlas_*.bag.active'))[0]
+            assert (f' to {active} (No space left on device); the bag holds the run up to '
+                    f'here: `rosbag reindex --output-dir DIR_WITH_ROOM {active}` to read it'
+                    ) in line, line
+            failed_s = float(re.search(r'\[\d+\.\d+, (\d+\.\d+)\]', line).group(1))
+            sim_line = wait_line(launch, SIM_STOPPED)
+            stopped_s = float(sim_line.split(SIM_STOPPED)[1].split(' s:')[0])
+            launch.wait_sim_until(stopped_s + 2.0)
+            launch.interrupt()
+        room = tmp_path / 'room'
+        room.mkdir()
+        reindex = subprocess.run(['rosbag', 'reindex', '--output-dir', str(room), str(active)],
+                                 capture_output=True, text=True, timeout=600, check=False)
+        assert reindex.returncode == 0, reindex.stderr
+        states = read_bag(room / active.name).joint_states
+        assert states is not None and missing_steps(states) == 0
+        print(f'figures: full 4 MiB tmpfs: write failed at sim {failed_s:.2f} s; '
+              f'{states.t_s[0]:.3f} to {states.t_s[-1]:.2f} s readable after '
+              '`rosbag reindex --output-dir`')
+    finally:
+        subprocess.run(['umount', '-l', str(disk)], check=False)
