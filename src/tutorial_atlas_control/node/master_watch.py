@@ -35,6 +35,9 @@ __all__ = ['MasterWatch', 'back_line', 'gone_line', 'start_master_watch']
 POLL_S = 1.0
 #: Wall seconds an XML-RPC call to the master may take before it counts as gone.
 CALL_TIMEOUT_S = 3.0
+#: Polls in a row without an answer before the master counts as gone: one slow answer
+#: (a master busy on a loaded machine) is no restart.
+MISSES_FOR_GONE = 2
 #: Parameters every master sets itself: never set again from the old one.
 MASTER_OWN_PARAMS = frozenset({'run_id', 'rosdistro', 'rosversion', 'roslaunch'})
 
@@ -70,15 +73,18 @@ class MasterWatch:
         self.uri = uri
         self.pid = first_pid
         self.gone = False
+        self.misses = 0
         self._warn, self._info = log_warn, log_info
 
     def update(self, pid_now: int | None,
                reregister: Callable[[], tuple[int, int, int, int]]) -> None:
         if pid_now is None:
-            if not self.gone:
+            self.misses += 1
+            if not self.gone and self.misses >= MISSES_FOR_GONE:
                 self.gone = True
                 self._warn(gone_line(self.uri))
             return
+        self.misses = 0
         if pid_now != self.pid:  # a new master, seen down or not (a quick restart)
             counts = reregister()
             self.pid, self.gone = pid_now, False
