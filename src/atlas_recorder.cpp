@@ -20,8 +20,11 @@
 //   not compressed unless --compression says so.
 
 #include <atomic>
+#include <cerrno>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <ctime>
 #include <optional>
 #include <string>
@@ -104,6 +107,7 @@ public:
   }
 
   bool failed() const { return failed_; }
+  const std::string& reason() const { return reason_; }
   unsigned long written() const { return written_; }
   size_t unwritten() const { return early_.size(); }
 
@@ -119,7 +123,15 @@ private:
     }
     catch (const rosbag::BagException& error)
     {
-      ROS_ERROR("atlas_recorder: cannot write %s to the bag: %s", topic.c_str(), error.what());
+      // errno still holds why the write failed (ENOSPC, EFBIG); rosbag's text does not say.
+      const int cause = errno;
+      reason_ = cause != 0 ? std::strerror(cause) : error.what();
+      // On a full disk `rosbag reindex` cannot make its backup copy (and still exits 0):
+      // it must write elsewhere.
+      ROS_ERROR("atlas_recorder: recording stopped: cannot write %s to %s (%s); the bag holds "
+                "the run up to here: `rosbag reindex %s%s` to read it",
+                topic.c_str(), bag_.getFileName().c_str(), reason_.c_str(),
+                cause == ENOSPC ? "--output-dir DIR_WITH_ROOM " : "", bag_.getFileName().c_str());
       failed_ = true;
       g_stop_requested = true;
     }
@@ -128,6 +140,7 @@ private:
   rosbag::Bag& bag_;
   std::vector<std::pair<std::string, RecordedEvent>> early_;
   bool failed_ = false;
+  std::string reason_;
   unsigned long written_ = 0;
 };
 
@@ -190,6 +203,9 @@ int main(int argc, char** argv)
   }
   std::signal(SIGINT, requestStop);
   std::signal(SIGTERM, requestStop);
+  // Past a file-size limit (ulimit -f), a write fails with EFBIG, reported as a full disk is,
+  // instead of SIGXFSZ killing the recorder with the bag unindexed and nothing said.
+  std::signal(SIGXFSZ, SIG_IGN);
 
   ros::NodeHandle node;
   BagWriter writer(bag);
@@ -236,17 +252,27 @@ int main(int argc, char** argv)
     callbacks->clear();
   for (ros::Subscriber& subscriber : subscribers)
     subscriber.shutdown();
-  bag.close();
+  try
+  {
+    bag.close();  // writes the last chunk and the index: fails again on a full disk
+  }
+  catch (const rosbag::BagException& error)
+  {
+    if (!writer.failed())
+      std::fprintf(stderr, "atlas_recorder: cannot close %s: %s; `rosbag reindex %s` to read it\n",
+                   active_path.c_str(), error.what(), active_path.c_str());
+    ros::shutdown();
+    // Not `return`: rosbag::Bag's destructor would try to close it again and throw from a
+    // destructor (std::terminate, an abort and a core dump on top of the one line said).
+    std::fflush(nullptr);
+    std::_Exit(1);
+  }
   if (gave_up && !writer.failed())
     std::fprintf(stderr, "atlas_recorder: stopped writing after %.0f s of draining with messages "
                  "still queued (the recorder was behind); they are not in the bag\n", kDrainMaxS);
   ros::shutdown();
-  if (writer.failed())
-  {
-    std::fprintf(stderr, "atlas_recorder: recording stopped on a write error; partial bag left at %s\n",
-                 active_path.c_str());
+  if (writer.failed())  // said in one line when it happened
     return 1;
-  }
   if (std::rename(active_path.c_str(), bag_path.c_str()) != 0)
   {
     std::perror(("atlas_recorder: cannot rename " + active_path).c_str());

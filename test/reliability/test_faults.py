@@ -46,6 +46,8 @@ def test_sigint_stops_every_process_and_closes_the_bag(atlas_launch: TestLaunch)
     gone_s = atlas_launch.interrupt(EXIT_TIMEOUT_S)
     print(f'figures: SIGINT to roslaunch: {len(pids)} processes gone in {gone_s:.2f} s')
     assert not alive(pids), f'processes left {gone_s:.0f} s after SIGINT: {alive(pids)}'
+    assert 'the recorder (/recorder) stopped' not in atlas_launch.output(), \
+        'a recorder stopped by Ctrl-C is not reported as a fault'
     bag = atlas_launch.bag()
     states = read_bag(bag).joint_states
     assert states is not None and len(states.t_s) > 2000, 'the bag holds the run'

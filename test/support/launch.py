@@ -37,13 +37,14 @@ class TestLaunch(processes.AtlasLaunch):
 
     def __init__(self, tmp_path: Path, *args: str,
                  base_env: Mapping[str, str] | None = None,
-                 launch_file: str = 'atlas.launch') -> None:
+                 launch_file: str = 'atlas.launch',
+                 master: processes.RosMaster | None = None) -> None:
         self.bag_dir = tmp_path / 'bags'
         launch_args = {'gui': 'false', 'bag_dir': str(self.bag_dir)}
         launch_args.update(arg.split(':=', 1) for arg in args)
         super().__init__(tmp_path / 'atlas_launch.log', launch_args,
                          ros_log_dir=tmp_path / 'ros_log', base_env=base_env,
-                         launch_file=launch_file)
+                         launch_file=launch_file, master=master)
 
     # -- processes ------------------------------------------------------------------------
     def pid_of(self, fragment: str) -> int:

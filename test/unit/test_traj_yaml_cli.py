@@ -37,6 +37,7 @@ from tutorial_atlas_control.node.traj_yaml import (
     wait_until_handed_over,
 )
 from tutorial_atlas_control.sim.controller import Gains, GainsError
+from tutorial_atlas_control.trajectories.schedule import TimeWentBackError
 from tutorial_atlas_control.trajectories.trajectory import Waypoint, sample_count
 
 REPO = Path(__file__).resolve().parents[2]
@@ -412,6 +413,26 @@ def test_a_stall_restarts_the_schedule_instead_of_a_burst() -> None:
     periods = np.diff(clock.send_times)
     assert periods.min() > 0.0, 'no two commands at the same time (a burst)'
     np.testing.assert_allclose(periods[10:], 0.02, atol=1e-9)
+
+
+def test_sim_time_going_back_between_sends_aborts_with_one_line() -> None:
+    """/gazebo/reset_simulation while playing (a jump within a sleep: traj_yaml's _sleep)."""
+    clock = FakeClock(0.0)
+    clock.t_s = 12.0
+
+    def send(positions: np.ndarray) -> None:
+        clock.send(positions)
+        if len(clock.send_times) == 10:
+            clock.t_s = 0.05  # reset_simulation: sim time back to 0
+
+    with pytest.raises(TimeWentBackError) as raised:
+        run_trajectory([Waypoint(1.0, np.ones(NUM_JOINTS))], lambda: np.zeros(NUM_JOINTS),
+                       send, clock.sleep, lambda _: None, lambda: clock.t_s)
+    assert str(raised.value) == (
+        'sim time went back from 12.160 s to 0.050 s (the simulation was reset: '
+        '/gazebo/reset_simulation?); trajectory aborted, run traj_yaml.py again to play it '
+        'from the start')
+    assert len(clock.send_times) == 10, 'nothing sent after the jump'
 
 
 def test_waypoint_log_names_the_moving_joints() -> None:

@@ -8,11 +8,12 @@ names every bag there, so the scripts pick the newest themselves.
 from __future__ import annotations
 
 import os
+import tempfile
 from pathlib import Path
 
 from tutorial_atlas_control.errors import BagAnalysisError
 
-__all__ = ['BAG_DIR_ENV', 'default_bag_dir', 'latest_bag']
+__all__ = ['BAG_DIR_ENV', 'default_bag_dir', 'latest_bag', 'unwritable_reason']
 
 #: The environment variable atlas.launch's bag_dir default reads.
 BAG_DIR_ENV = 'TAC_BAG_DIR'
@@ -48,3 +49,18 @@ def latest_bag(directory: Path | None = None) -> Path:
         raise BagAnalysisError(f'no bag given and no .bag in {directory}{hint}; give BAG, or set '
                                f'{BAG_DIR_ENV}.')
     return max(bags, key=lambda path: (path.stat().st_mtime, path.name))
+
+
+def unwritable_reason(directory: Path) -> str | None:
+    """Why no bag can be written in `directory` (created if missing), or None if one can.
+
+    Tried by creating and removing a file: permission bits say nothing to root, nor about a
+    read-only mount.
+    """
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=directory, prefix='.atlas_write_check_'):
+            pass
+    except OSError as err:
+        return err.strerror or str(err)
+    return None

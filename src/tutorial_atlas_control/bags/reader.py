@@ -492,12 +492,40 @@ def _topic_summaries(records: BagRecords, by_topic: dict[str, list[Connection]])
     return summaries, start_ns, end_ns or start_ns
 
 
+#: The topics read_bag decodes: a wrong MD5 on one of them makes the bag unreadable.
+_DECODED_TOPICS = (topics.JOINT_STATES, topics.JOINT_COMMANDS, topics.GROUND_TRUTH_ODOM,
+                   topics.CONTROL_MODE, topics.SIM_CONFIG, topics.SIM_INPUTS, topics.ROSOUT)
+
+
+def _check_digests(path: Path, typestore: Any, by_topic: dict[str, list[Connection]]) -> None:
+    """Refuse a decoded topic whose MD5 is not its type's (as the typestore defines it: Noetic's,
+    else the bag's own definition). Its messages would be decoded with a layout they may not
+    have: numbers made up from other fields, or a failure half-way.
+
+    Raises:
+        BagAnalysisError: the first such connection, named with both MD5s.
+    """
+    for topic in _DECODED_TOPICS:
+        for connection in by_topic.get(topic, ()):
+            try:
+                expected = typestore.generate_msgdef(connection.msgtype, ros_version=1)[1]
+            except Exception:  # noqa: BLE001 - an unknown type is read (or refused) later
+                continue
+            if connection.digest and connection.digest != expected:
+                ros1_type = connection.msgtype.replace('/msg/', '/')
+                raise BagAnalysisError(
+                    f'{path}: {topic} is recorded as {ros1_type} with MD5 {connection.digest}, '
+                    f'but {ros1_type} has MD5 {expected}: the bag is damaged or was recorded '
+                    'with another version of the message; it cannot be read.')
+
+
 def _read_open_bag(path: Path, records: BagRecords, fast: bool) -> BagData:
     by_topic: dict[str, list[Connection]] = {}
     for connection in records.connections:
         by_topic.setdefault(connection.topic, []).append(connection)
     summaries, start_ns, end_ns = _topic_summaries(records, by_topic)
     reading = _Reading(records, load_typestore(records.connections), start_ns, [], fast)
+    _check_digests(path, reading.typestore, by_topic)
 
     def series(topic: str, read: Any) -> Any:
         return read(reading, by_topic[topic]) if by_topic.get(topic) else None

@@ -82,7 +82,11 @@ class BlockIndexReader(Reader):  # type: ignore[misc]
         """The decompressed data of the chunk at file position `pos` (Reader's chunk table)."""
         info = self.chunks[pos]
         self.bio.seek(info.datapos)
-        return info.decompressor(self.bio.read(info.datasize))
+        try:
+            return info.decompressor(self.bio.read(info.datasize))
+        except (OSError, RuntimeError, ValueError, EOFError) as err:  # bz2, lz4: corrupt data
+            raise ReaderError(f'the chunk at byte {pos} cannot be decompressed '
+                              f'({type(err).__name__}: {err})') from err
 
 
 # ---------------------------------------------------------------------------- writing

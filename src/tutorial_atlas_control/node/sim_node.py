@@ -31,6 +31,8 @@ Parameters (private unless noted):
     ~tf (bool, true): broadcast world -> pelvis on /tf from the ground truth, if the model
         has a matching URDF (urdf.matching_urdf); else one warning and no /tf.
     ~tf_rate (Hz, 100): /tf rate.
+    ~bag_dir (str, unset): where the launch's recorder writes; if set and no file can be
+        written there, the node refuses to start (one line).
     ~model_file (str, the package's sim/atlas_v1.xml): the MJCF to simulate; it must have
         Atlas v1's joints, actuators and sensors (a variant of the package's model).
     /atlas/time_to_unpin (float, 1.0): seconds the torso stays pinned after start/reset.
@@ -66,7 +68,10 @@ from tf2_msgs.msg import TFMessage
 from trajectory_msgs.msg import JointTrajectory
 
 from tutorial_atlas_control import topics
+from tutorial_atlas_control.bags.bag_dir import unwritable_reason
 from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.node.master_watch import start_master_watch
+from tutorial_atlas_control.node.recorder_watch import start_recorder_watch
 from tutorial_atlas_control.node.transport import WireBatch
 from tutorial_atlas_control.node.udpros import serve as serve_udpros
 from tutorial_atlas_control.node.viewer import ViewerLink, ViewerRequest, display_problem
@@ -386,7 +391,13 @@ class SimNode:
         """Run the stepping loop until ROS shuts down (with the viewer, if asked); the exit
         status."""
         viewer = self._open_viewer() if self.gui else None
+        # One line if the recorder goes (killed, disk full) while the simulation goes on;
+        # registered again with a restarted master.
+        watch = start_recorder_watch(self.publishers[topics.JOINT_STATES],
+                                     lambda: self.sim.sim_time_ns * 1e-9, time.monotonic)
+        start_master_watch(watch)
         status = self.loop.run(rospy.is_shutdown)
+        watch.set()
         if status:
             rospy.signal_shutdown('physics diverges after every reset')
         if viewer is not None:
@@ -459,6 +470,7 @@ def _float_param(name: str, default: float, minimum: float = 0.0) -> float:
 
 def build_node() -> SimNode:
     """Read parameters, load the model and gains; raise AtlasControlError on bad ones."""
+    _check_bag_dir()
     gains = gains_from_params(rospy.get_param(topics.GAINS_PARAM, {}))
     time_to_unpin_s = _float_param(topics.TIME_TO_UNPIN_PARAM, DEFAULT_TIME_TO_UNPIN_S)
     rates_hz = {
@@ -484,6 +496,17 @@ def build_node() -> SimNode:
     return SimNode(sim, _float_param('~real_time_factor', 1.0),
                    bool(rospy.get_param('~paused', False)), rates_hz,
                    bool(rospy.get_param('~gui', False)), _tf_wanted(Path(model_file), sim))
+
+
+def _check_bag_dir() -> None:
+    """~bag_dir (set by atlas.launch when it records): refuse to run unrecorded from the start."""
+    bag_dir = rospy.get_param('~bag_dir', '')
+    if not bag_dir:
+        return
+    reason = unwritable_reason(Path(str(bag_dir)).expanduser())
+    if reason is not None:
+        raise AtlasControlError(f'bag_dir {bag_dir} cannot be written ({reason}): the run would '
+                                'not be recorded; give a writable bag_dir:=, or record:=false')
 
 
 def _tf_wanted(model_file: Path, sim: AtlasSimulator) -> bool:

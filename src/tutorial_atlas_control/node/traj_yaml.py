@@ -27,6 +27,7 @@ from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES, NUM_JOINTS, joint_index
 from tutorial_atlas_control.sim.controller import LOAD_HINT, Gains, GainsError, gains_from_params
 from tutorial_atlas_control.trajectories.schedule import (
+    TimeWentBackError,
     done_line,
     playing_line,
     run_trajectory,
@@ -302,9 +303,18 @@ def play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], path
     # how analyze_bag.py tells which trajectory a bag played.
     rospy.loginfo(trajectory_log_line(os.path.abspath(path), name))
     rospy.loginfo(playing_line(name, waypoints))
-    run_trajectory(waypoints, cache.positions, send, rospy.sleep, rospy.loginfo, rospy.get_time)
+    run_trajectory(waypoints, cache.positions, send, _sleep, rospy.loginfo, rospy.get_time)
     wait_until_handed_over(publisher, HANDOVER_WAIT_S)  # the last command, before shutdown
     rospy.loginfo(done_line(name))
+
+
+def _sleep(duration_s: float) -> None:
+    """rospy.sleep in sim time; sim time going back under it raises TimeWentBackError."""
+    before_s = rospy.get_time()
+    try:
+        rospy.sleep(duration_s)
+    except rospy.ROSTimeMovedBackwardsException:
+        raise TimeWentBackError(before_s, rospy.get_time()) from None
 
 
 def _wait_for_simulator(publisher: rospy.Publisher, first_state: JointState,

@@ -11,12 +11,14 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.trajectories.trajectory import Waypoint, interpolate, sample_count
 
 __all__ = [
     'MOVING_JOINT_THRESHOLD_RAD',
     'TRAJECTORY_LOG_PREFIX',
+    'TimeWentBackError',
     'done_line',
     'parse_trajectory_log_line',
     'playing_line',
@@ -30,6 +32,21 @@ MOVING_JOINT_THRESHOLD_RAD = 0.01
 #: Start of the one machine-readable log line a player writes before its first command
 #: (followed by JSON with the trajectory file and name): how a bag tells what it played.
 TRAJECTORY_LOG_PREFIX = 'trajectory: '
+
+
+class TimeWentBackError(AtlasControlError):
+    """Sim time went back under a playing trajectory (/gazebo/reset_simulation sets it to 0).
+
+    The player stops rather than carry on: its schedule is in sim time, and the reset put
+    the robot back at its initial pose, so the rest of the trajectory would start from a
+    pose it was not planned from. Running the player again plays it from the start.
+    """
+
+    def __init__(self, before_s: float, after_s: float) -> None:
+        super().__init__(
+            f'sim time went back from {before_s:.3f} s to {after_s:.3f} s (the simulation was '
+            'reset: /gazebo/reset_simulation?); trajectory aborted, run traj_yaml.py again to '
+            'play it from the start')
 
 
 def trajectory_log_line(path: str, name: str) -> str:
@@ -80,9 +97,12 @@ def run_trajectory(
     due time, so the trajectory keeps its 50 Hz and its durations. Falling more than one
     interval behind restarts the schedule rather than sending a burst (the publisher keeps
     the tutorial's queue_size=1). Without `now`, ``sleep(duration_s / n)`` as the tutorial.
+
+    Raises:
+        TimeWentBackError: `now` went back.
     """
     sent = 0
-    due_s = now() if now is not None else 0.0
+    due_s = last_s = now() if now is not None else 0.0
     for index, waypoint in enumerate(waypoints):
         initial = measure()
         log(waypoint_line(index, len(waypoints), waypoint, initial))
@@ -93,7 +113,11 @@ def run_trajectory(
                 sleep(sleep_s)
                 continue
             due_s += sleep_s
-            remaining_s = due_s - now()
+            now_s = now()
+            if now_s < last_s:  # (a jump during a sleep is the sleep's to raise)
+                raise TimeWentBackError(last_s, now_s)
+            last_s = now_s
+            remaining_s = due_s - now_s
             if remaining_s > 0.0:
                 sleep(remaining_s)
             elif remaining_s < -sleep_s:
