@@ -38,6 +38,11 @@ Parameters (private unless noted):
     atlas_controller/gains/<joint>/{p,i,d,i_clamp}: the gains Stand/Freeze/User-hold use.
     atlas_controller/statistics_time_window_size (s, 1.0): window of the command age statistics.
     /atlas/controller_statistics/update_rate (Hz, unset = every step): clamped to 1..10000.
+    /atlas/delay_window_size (s, 5.0), /atlas/delay_max_per_window (s, 0.25),
+        /atlas/delay_max_per_step (s, 0.025): DRCSim 2.6's synchronization window budgets
+        (wall time; stepping/synchronization.py), used while an AtlasCommand's
+        desired_controller_period_ms is non-zero; /atlas/synchronization_statistics is then
+        published every step, and a message on /atlas/debug/sync_delay ends a wait early.
 """
 
 from __future__ import annotations
@@ -53,7 +58,14 @@ from typing import Any
 
 import genpy
 import rospy
-from atlas_msgs.msg import AtlasCommand, AtlasState, ControllerStatistics, ForceTorqueSensors, Test
+from atlas_msgs.msg import (
+    AtlasCommand,
+    AtlasState,
+    ControllerStatistics,
+    ForceTorqueSensors,
+    SynchronizationStatistics,
+    Test,
+)
 from atlas_msgs.srv import ResetControls, ResetControlsResponse
 from geometry_msgs.msg import Pose, Twist, Wrench, WrenchStamped
 from nav_msgs.msg import Odometry
@@ -100,6 +112,7 @@ from tutorial_atlas_control.sim.vrc import (
     wrench_input,
 )
 from tutorial_atlas_control.stepping.loop import ResetControlsRequest, SteppingLoop
+from tutorial_atlas_control.stepping.synchronization import DelayBudgets, SynchronizationWindow
 from tutorial_atlas_control.units import finite_number
 
 NODE_NAME = 'atlas_sim'
@@ -119,7 +132,8 @@ LOOP_TOPICS = (
     (topics.L_FOOT_CONTACT, WrenchStamped), (topics.R_FOOT_CONTACT, WrenchStamped),
     (topics.CONTROLLER_STATISTICS, ControllerStatistics),
     (topics.ATLAS_STATE, AtlasState), (topics.FORCE_TORQUE_SENSORS, ForceTorqueSensors),
-    (topics.DEBUG_L_FOOT_CONTACT, WrenchStamped), (topics.DEBUG_R_FOOT_CONTACT, WrenchStamped))
+    (topics.DEBUG_L_FOOT_CONTACT, WrenchStamped), (topics.DEBUG_R_FOOT_CONTACT, WrenchStamped),
+    (topics.SYNCHRONIZATION_STATISTICS, SynchronizationStatistics))
 
 
 class RawMessage(genpy.Message):
@@ -215,7 +229,8 @@ class SimNode:
     services, parameters and the viewer window."""
 
     def __init__(self, sim: AtlasSimulator, real_time_factor: float, paused: bool,
-                 rates_hz: dict[str, float], gui: bool, tf: bool = False) -> None:
+                 rates_hz: dict[str, float], gui: bool, tf: bool = False,
+                 sync_budgets: DelayBudgets | None = None) -> None:
         self.sim = sim
         self.gui = gui
         # UDPROS for roscpp's unreliable() subscribers, before the master announces a topic.
@@ -225,7 +240,9 @@ class SimNode:
         self.loop = SteppingLoop(sim, WireBatch(), self.publishers, rates_hz, statistics,
                                  RosLog(), self._publish_config,
                                  real_time_factor=real_time_factor, paused=paused,
-                                 publish_input=self._publish_input)
+                                 publish_input=self._publish_input,
+                                 synchronization=SynchronizationWindow(
+                                     sync_budgets or DelayBudgets()))
         self.loop.publish_config()
         self.mode_pub.publish(String(data=sim.mode.value))
         self._subscribe()
@@ -266,6 +283,10 @@ class SimNode:
                          queue_size=10, tcp_nodelay=True)
         rospy.Subscriber(topics.ATLAS_TEST, RawTest, self.on_test, queue_size=10)
         rospy.Subscriber(topics.CONTROL_MODE, String, self.on_control_mode, queue_size=10)
+        # DRCSim 2.6's cheat: any message ends the synchronization window's wait early.
+        rospy.Subscriber(topics.SYNC_DELAY, String, lambda _msg: self.loop.wake(), queue_size=1,
+                         tcp_nodelay=True)
+        rospy.on_shutdown(self.loop.wake)  # a wait in progress ends at once
         loop = self.loop
         self.services = [
             rospy.Service(topics.RESET_CONTROLS_SERVICE, ResetControls, self.on_reset_controls),
@@ -483,7 +504,8 @@ def build_node() -> SimNode:
                          startup_mode=VrcMode(startup_mode))
     return SimNode(sim, _float_param('~real_time_factor', 1.0),
                    bool(rospy.get_param('~paused', False)), rates_hz,
-                   bool(rospy.get_param('~gui', False)), _tf_wanted(Path(model_file), sim))
+                   bool(rospy.get_param('~gui', False)), _tf_wanted(Path(model_file), sim),
+                   DelayBudgets.from_params(rospy.get_param))
 
 
 def _tf_wanted(model_file: Path, sim: AtlasSimulator) -> bool:
