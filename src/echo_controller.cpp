@@ -72,7 +72,8 @@ private:
       return;
     }
     command_.header.stamp = state->header.stamp;
-    command_.position = state->position;
+    // AtlasState's positions are float32, AtlasCommand's float64: widened exactly.
+    command_.position.assign(state->position.begin(), state->position.end());
     publisher_.publish(command_);
     if (++answered_ == 1)
       ROS_INFO("echo_controller: answering /atlas/atlas_state (first stamp %.3f s)",
