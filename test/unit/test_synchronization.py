@@ -322,3 +322,22 @@ def test_a_command_wakes_the_wait_only_while_the_window_is_on(sim: AtlasSimulato
     loop.apply_pending_commands()
     loop.receive_command(atlas_bytes(0, 1), topics.ATLAS_COMMAND)
     assert loop.wait_for_command(0.0)
+
+
+def test_shutdown_ends_the_wait(sim: AtlasSimulator) -> None:
+    loop, _, _, clock = make_sync_loop(sim, DelayBudgets(1000.0, 1000.0, 100.0))
+    state = {'down': False, 'waits': 0}
+
+    def wait(timeout_s: float) -> bool:
+        state['waits'] += 1
+        if state['waits'] == 1:
+            state['down'] = True  # rospy shuts down during the wait; its hook:
+            loop.stop_waiting()
+            return True
+        clock.now_s += timeout_s  # (a wait that went on would wait out the step's 100 s)
+        return False
+    loop.wait_for_command = wait
+    loop.receive_command(atlas_bytes(0, 1), topics.ATLAS_COMMAND)
+    turns = stops_after(3)
+    loop.run(lambda: turns() or state['down'])
+    assert state['waits'] == 1  # woken, it saw the shutdown and waited no more

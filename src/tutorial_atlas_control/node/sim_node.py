@@ -286,7 +286,7 @@ class SimNode:
         # DRCSim 2.6's cheat: any message ends the synchronization window's wait early.
         rospy.Subscriber(topics.SYNC_DELAY, String, lambda _msg: self.loop.wake(), queue_size=1,
                          tcp_nodelay=True)
-        rospy.on_shutdown(self.loop.wake)  # a wait in progress ends at once
+        rospy.on_shutdown(self.loop.stop_waiting)  # a wait in progress ends at once
         loop = self.loop
         self.services = [
             rospy.Service(topics.RESET_CONTROLS_SERVICE, ResetControls, self.on_reset_controls),

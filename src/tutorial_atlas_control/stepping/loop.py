@@ -269,6 +269,7 @@ class SteppingLoop:
         self.wait_for_command: Callable[[float], bool] = self._command_arrived.wait
         self._sync_warned_ns: int | None = None
         self._sync_gave_up = 0
+        self._stopping = False  # shutting down: no more waits
 
         # Headless feedback (a log line per fall, per reset, and for ignored commands).
         self.pelvis_z_index = sim.atlas.free_qpos_adr + 2  # the pelvis height in qpos
@@ -296,7 +297,13 @@ class SteppingLoop:
 
     def wake(self) -> None:
         """End the synchronization window's current wait early (DRCSim's
-        /atlas/debug/sync_delay, and shutdown): it checks the commands again."""
+        /atlas/debug/sync_delay): it checks the commands again."""
+        self._command_arrived.set()
+
+    def stop_waiting(self) -> None:
+        """At shutdown: end the current wait and wait no more (a step's budget may be
+        long, and the controller gone)."""
+        self._stopping = True
         self._command_arrived.set()
 
     def _decode(self, topic: str, raw: bytes) -> CommandUpdate | AtlasUpdate:
@@ -628,8 +635,10 @@ class SteppingLoop:
 
     def _command_fresh(self) -> bool:
         """Apply what arrived; True when the newest command is fresh enough for the coming
-        step, or no longer asks for the window."""
+        step, or no longer asks for the window; True at shutdown (wake() ends the wait)."""
         self._command_arrived.clear()  # before looking: a later arrival wakes the wait
+        if self._stopping:
+            return True
         with self.lock:
             self.apply_pending_commands()
             period_ms = self.desired_controller_period_ms
