@@ -4,6 +4,7 @@ that ask for it."""
 
 from __future__ import annotations
 
+import io
 import struct
 from pathlib import Path
 
@@ -341,3 +342,39 @@ def test_shutdown_ends_the_wait(sim: AtlasSimulator) -> None:
     turns = stops_after(3)
     loop.run(lambda: turns() or state['down'])
     assert state['waits'] == 1  # woken, it saw the shutdown and waited no more
+
+
+def test_statistics_match_genpy_and_the_latch_is_what_rospy_sends() -> None:
+    from atlas_msgs.msg import SynchronizationStatistics
+    from rospy.msg import serialize_message
+
+    from tutorial_atlas_control.node.sim_node import RawLatched
+
+    clock = FakeClock()
+    window = SynchronizationWindow(BUDGETS, clock)
+    report = window.enforce(never_fresh, SilentController(clock))
+    data = statistics_bytes(report)
+    buff = io.BytesIO()
+    SynchronizationStatistics(report.delay_in_step_s, report.delay_in_window_s,
+                              report.delay_window_remain_s).serialize(buff)
+    assert data[4:] == buff.getvalue()
+    sent = io.BytesIO()
+    serialize_message(sent, 7, RawLatched(data[4:]))  # rospy's latch to a new subscriber
+    assert sent.getvalue() == data
+
+
+def test_the_latest_statistics_are_kept_for_later_subscribers(sim: AtlasSimulator) -> None:
+    outbox = FakeOutbox(set(ALL_TOPICS))  # nobody subscribes to the statistics
+    clock = FakeClock()
+    latched: list[bytes] = []
+    loop = SteppingLoop(sim, outbox, {topic: topic for topic in SYNC_TOPICS}, LAUNCH_RATES_HZ,
+                        CommandAgeStatistics(sim.dt_s), FakeLog(), lambda _text: None,
+                        pacer=Pacer(0.0, clock, clock.sleep),
+                        synchronization=SynchronizationWindow(BUDGETS, clock),
+                        latch_synchronization=latched.append)
+    loop.wait_for_command = SilentController(clock)
+    loop.receive_command(atlas_bytes(0, 1), topics.ATLAS_COMMAND)
+    loop.run(stops_after(3))
+    assert sync_statistics(outbox) == []
+    assert [struct.unpack('<3d', data)[:2] for data in latched] == [
+        pytest.approx((0.025, 0.025)), pytest.approx((0.025, 0.05))]

@@ -132,8 +132,7 @@ LOOP_TOPICS = (
     (topics.L_FOOT_CONTACT, WrenchStamped), (topics.R_FOOT_CONTACT, WrenchStamped),
     (topics.CONTROLLER_STATISTICS, ControllerStatistics),
     (topics.ATLAS_STATE, AtlasState), (topics.FORCE_TORQUE_SENSORS, ForceTorqueSensors),
-    (topics.DEBUG_L_FOOT_CONTACT, WrenchStamped), (topics.DEBUG_R_FOOT_CONTACT, WrenchStamped),
-    (topics.SYNCHRONIZATION_STATISTICS, SynchronizationStatistics))
+    (topics.DEBUG_L_FOOT_CONTACT, WrenchStamped), (topics.DEBUG_R_FOOT_CONTACT, WrenchStamped))
 
 
 class RawMessage(genpy.Message):
@@ -181,6 +180,19 @@ class RawTest(RawMessage):
     _md5sum = Test._md5sum
     _full_text = Test._full_text
     __slots__: list[str] = []
+
+
+class RawLatched:
+    """A pre-serialized message as rospy's latch: what a new subscriber of a latched
+    publisher gets first (rospy serializes the latch with serialize_message)."""
+
+    _has_header = False
+
+    def __init__(self, data: bytes) -> None:
+        self.data = data
+
+    def serialize(self, buff: io.BytesIO) -> None:
+        buff.write(self.data)
 
 
 class RosLog:
@@ -242,7 +254,8 @@ class SimNode:
                                  real_time_factor=real_time_factor, paused=paused,
                                  publish_input=self._publish_input,
                                  synchronization=SynchronizationWindow(
-                                     sync_budgets or DelayBudgets()))
+                                     sync_budgets or DelayBudgets()),
+                                 latch_synchronization=self._latch_synchronization)
         self.loop.publish_config()
         self.mode_pub.publish(String(data=sim.mode.value))
         self._subscribe()
@@ -260,6 +273,10 @@ class SimNode:
             warnings.simplefilter('ignore', SyntaxWarning)  # rospy: "explicit queue_size"
             self.publishers = {topic: rospy.Publisher(topic, msg_class, queue_size=None)
                                for topic, msg_class in published}
+            # Latched, as DRCSim's: a new subscriber gets the latest step's delays at once.
+            self.publishers[topics.SYNCHRONIZATION_STATISTICS] = rospy.Publisher(
+                topics.SYNCHRONIZATION_STATISTICS, SynchronizationStatistics, queue_size=None,
+                latch=True)
         # Latched, recorded in every bag: what offline replay needs to re-create the run.
         self.config_pub = rospy.Publisher(topics.SIM_CONFIG, String, queue_size=1, latch=True)
         # Each applied cheat, with the sim time it took effect: what replay re-applies.
@@ -346,6 +363,11 @@ class SimNode:
         """As VRCPlugin: planned but never implemented; said once per message."""
         rospy.logerr_throttle(WARN_THROTTLE_S, f'{topics.CONFIGURATION} is not implemented '
                               '(nor was it in DRCSim); nothing applied')
+
+    def _latch_synchronization(self, message: bytes) -> None:
+        """The latest /atlas/synchronization_statistics (without its length prefix), for
+        subscribers to come."""
+        self.publishers[topics.SYNCHRONIZATION_STATISTICS].impl.latch = RawLatched(message)
 
     def _publish_input(self, text: str) -> None:
         """/atlas/sim_inputs (recorded): one applied cheat."""

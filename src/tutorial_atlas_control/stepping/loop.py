@@ -200,6 +200,8 @@ class SteppingLoop:
         publish_input: sends /atlas/sim_inputs' JSON of each applied cheat (None: nowhere).
         synchronization: DRCSim 2.6's synchronization window (default: DRCSim's budgets);
             its statistics go to the topics.SYNCHRONIZATION_STATISTICS outlet, if any.
+        latch_synchronization: keeps the latest statistics message (serialized, without
+            its length prefix) for later subscribers (None: not kept).
     """
 
     def __init__(self, sim: AtlasSimulator, outbox: Outbox, outlets: Mapping[str, Hashable],
@@ -208,7 +210,8 @@ class SteppingLoop:
                  real_time_factor: float = 0.0, paused: bool = False,
                  pacer: Pacer | None = None,
                  publish_input: Callable[[str], None] | None = None,
-                 synchronization: SynchronizationWindow | None = None) -> None:
+                 synchronization: SynchronizationWindow | None = None,
+                 latch_synchronization: Callable[[bytes], None] | None = None) -> None:
         self.sim = sim
         self._send_input = publish_input
         self._input_logged_ns: dict[str, int] = {}  # kind -> sim time it was last logged
@@ -263,6 +266,7 @@ class SteppingLoop:
         self.synchronization = (synchronization if synchronization is not None
                                 else SynchronizationWindow(DelayBudgets()))
         self.sync_outlet = outlets.get(topics.SYNCHRONIZATION_STATISTICS)
+        self._latch_sync = latch_synchronization
         self._command_arrived = threading.Event()
         #: Blocks up to the given seconds (wall) for a command; True when woken (tests
         #: replace it to drive the window with a fake clock).
@@ -630,8 +634,13 @@ class SteppingLoop:
         if report.outcome is not SyncOutcome.FRESH:
             self._warn_gave_up(report)
         outlet = self.sync_outlet
-        if outlet is not None and self.outbox.wanted(outlet):
-            self.outbox.add(outlet, statistics_bytes(report))
+        if outlet is None:
+            return
+        data = statistics_bytes(report)
+        if self.outbox.wanted(outlet):
+            self.outbox.add(outlet, data)
+        if self._latch_sync is not None:
+            self._latch_sync(data[4:])
 
     def _command_fresh(self) -> bool:
         """Apply what arrived; True when the newest command is fresh enough for the coming
