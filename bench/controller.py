@@ -4,8 +4,9 @@ age run:     real_time_factor:=1.0, echo_controller answering every /atlas/atlas
              TCP (then over UDP): the command age /atlas/controller_statistics reports at
              each step (1 ms: the answer to a state arrived before the next step), p50 and
              p99, and the simulator's CPU per step while it serves the controller. A
-             `udp`-only subscription connects only to a publisher that serves UDPROS: until
-             the node does, the UDP figures are absent and the run says so.
+             `udp`-only subscription connects only to a publisher that serves UDPROS (the
+             node does, node/udpros.py): with one that does not (an older node, a
+             --launch-file prototype), the UDP figures are absent and the run says so.
 window run:  real_time_factor:=0 with echo_controller --period-ms 1 (DRCSim 2.6's
              synchronization window): every step waits for the answer to the state before
              it, so the pair's pace is one round trip per step. Every step waits, so the
