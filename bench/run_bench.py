@@ -19,6 +19,10 @@ Sections (see bench/README.md for what each figure means and how it is measured)
             then the time SIGINT takes to stop the launch
   tutorial  run_demo.py step_and_fall: the port's command rate in sim time, and the bag's
             size per minute of sim time
+  controller  echo_controller answering every /atlas/atlas_state: command age p50/p99 and
+            the node's CPU per step at real_time_factor:=1 over TCP and over UDP ("n/a"
+            while the node serves no UDPROS); steps per second of the pair with DRCSim
+            2.6's synchronization window on (--period-ms 1) at real_time_factor:=0
 
 --compression sets the bags' chunk compression for every launch (TAC_BAG_COMPRESSION, which
 atlas.launch's `compression` argument defaults to); without it, the launch's default (lz4).
@@ -75,7 +79,10 @@ class Section:
 COMPRESSIONS = ('lz4', 'bz2', 'none')
 #: What the table and the JSON call the launch's own compression (lz4, atlas.launch).
 DEFAULT_COMPRESSION = 'the launch\'s default'
-SECTIONS = ('physics', 'offline', 'analysis', 'fast', 'realtime', 'load', 'tutorial')
+SECTIONS = ('physics', 'offline', 'analysis', 'fast', 'realtime', 'load', 'tutorial',
+            'controller')
+#: What the table and the JSON say for the UDP figures while no UDP connection is made.
+NO_UDP = 'n/a (no UDP connection)'
 
 #: (key, label, unit, target text, digits) in table order.
 ROWS = (
@@ -126,7 +133,18 @@ ROWS = (
     ('analysis_msgs_per_s', 'analyze_bag, 60 s bag', 'msgs/s', '', 0),
     ('rosbag_msgs_per_s', 'rosbag API, same topics', 'msgs/s', '', 0),
     ('analysis_speedup', 'analyze_bag / rosbag', 'x', '>= 5', 1),
+    ('controller_tcp_age_p50_ms', 'echo_controller TCP: command age p50', 'ms', '', 2),
+    ('controller_tcp_age_p99_ms', 'echo_controller TCP: command age p99', 'ms', '', 2),
+    ('controller_tcp_node_us_per_step', 'echo_controller TCP: node CPU/step', 'us', '', 1),
+    ('controller_udp_age_p50_ms', 'echo_controller UDP: command age p50', 'ms', '', 2),
+    ('controller_udp_age_p99_ms', 'echo_controller UDP: command age p99', 'ms', '', 2),
+    ('controller_udp_node_us_per_step', 'echo_controller UDP: node CPU/step', 'us', '', 1),
+    ('controller_window_steps_per_s', 'sync window, rtf:=0: steps/s of pair', 'steps/s', '', 0),
+    ('controller_window_age_p99_ms', 'sync window, rtf:=0: command age p99', 'ms', '1', 2),
 )
+#: Rows shown as NO_UDP when the controller section ran without a UDP connection.
+UDP_ROWS = ('controller_udp_age_p50_ms', 'controller_udp_age_p99_ms',
+            'controller_udp_node_us_per_step')
 
 
 @dataclass(frozen=True)
@@ -188,6 +206,8 @@ TARGETS = {
     'bag_mb_per_min': Target(high=80.0, lz4_only=True),
     'analysis_s': Target(high=2.0, strict=True),
     'analysis_speedup': Target(low=5.0),
+    # The window's promise: every step obeys the answer to the state before it.
+    'controller_window_age_p99_ms': Target(low=1.0, high=1.0),
 }
 
 #: The keys each section must produce (a crash or an empty window shows as a missing key).
@@ -208,6 +228,10 @@ EXPECTED = {
     'load': ('load_rtf', 'load_publish_rate_hz', 'load_commands_lost',
              'load_recorded_fraction', 'load_rss_growth_mib', 'shutdown_s'),
     'tutorial': ('tutorial_command_rate_hz', 'bag_mb_per_min'),
+    # The UDP keys only once the node serves UDPROS (else the JSON says NO_UDP).
+    'controller': ('controller_tcp_age_p50_ms', 'controller_tcp_age_p99_ms',
+                   'controller_tcp_node_us_per_step', 'controller_window_steps_per_s',
+                   'controller_window_age_p99_ms'),
 }
 #: Keys computed from two sections, expected when both ran.
 EXPECTED_ACROSS = {('physics', 'fast'): ('fast_ratio', 'fast_bare_ratio', 'node_bare_ratio')}
@@ -327,7 +351,7 @@ def run_offline(args: argparse.Namespace, samples: dict[str, list[float]],
 
 def run_online(args: argparse.Namespace, samples: dict[str, list[float]],
                loads: dict[str, str], work_dir: Path) -> None:
-    if not {'fast', 'realtime', 'load'} & set(args.sections):
+    if not {'fast', 'realtime', 'load', 'controller'} & set(args.sections):
         return
     import online
 
@@ -351,6 +375,9 @@ def run_online(args: argparse.Namespace, samples: dict[str, list[float]],
         if 'load' in args.sections:
             with Section('load', loads):
                 run_load(args, samples, master, probes, work_dir)
+        if 'controller' in args.sections:
+            with Section('controller', loads):
+                run_controller(args, samples, master, probes, work_dir)
         rospy.signal_shutdown('bench done')
     finally:
         master.close()
@@ -369,6 +396,43 @@ def run_load(args, samples, master, probes, work_dir) -> None:  # noqa: ANN001
         if values['load_commands_lost']:
             args.keep = True
             log(f'load run {run + 1} lost commands: its bag and launch log stay in {work_dir}')
+
+
+def run_controller(args, samples, master, probes, work_dir) -> None:  # noqa: ANN001
+    """Each run: echo_controller over TCP, then over UDP (at real_time_factor:=1), then
+    with the synchronization window at real_time_factor:=0 (bench/controller.py)."""
+    import controller
+    import offline
+    from probes import RawRecorder
+
+    from tutorial_atlas_control import topics
+
+    per_sim_s = offline.steps_per_sim_second()
+    statistics = RawRecorder(topics.CONTROLLER_STATISTICS)
+    window_s = 4.0 if args.quick else 15.0
+    for run in range(args.runs):
+        values: dict[str, float] = {}
+        for transport in ('tcp', 'udp'):
+            figures = controller.age_run(
+                master, args.launch_file, probes.clock, statistics, work_dir,
+                f'controller_{transport}{run + 1}', transport, warmup_s=2.0,
+                window_s=window_s, per_sim_s=per_sim_s)
+            if figures is None:
+                log(f'controller run {run + 1}: {NO_UDP}: echo_controller --transport udp '
+                    'never connected (the node serves no UDPROS)')
+                args.udp = NO_UDP
+            else:
+                values.update(figures)
+        values.update(controller.window_run(
+            master, args.launch_file, probes.clock, statistics, work_dir,
+            f'controller_window{run + 1}', warmup_s=2.0, window_s=window_s,
+            per_sim_s=per_sim_s))
+        log(f'controller run {run + 1}: TCP age p99 '
+            f'{values["controller_tcp_age_p99_ms"]:.2f} ms, UDP age p99 '
+            + (f'{values["controller_udp_age_p99_ms"]:.2f} ms'
+               if 'controller_udp_age_p99_ms' in values else NO_UDP)
+            + f', window {values["controller_window_steps_per_s"]:.0f} steps/s')
+        add(samples, values)
 
 
 def run_tutorial(args: argparse.Namespace, samples: dict[str, list[float]],
@@ -464,7 +528,7 @@ def summarize(samples: dict[str, list[float]],
 
 
 def table(samples: dict[str, list[float]], loads: dict[str, str], runs: int,
-          compression: str, judged: dict[str, str]) -> str:
+          compression: str, judged: dict[str, str], udp: str = '') -> str:
     lines = [f'tutorial_atlas_control benchmark, {os.cpu_count()} CPUs; per section: load '
              'average (1/5/15 min) at its start, CPU busy and hypervisor steal % during it:']
     lines += [f'  {section:<9} {load}' for section, load in loads.items()]
@@ -475,6 +539,9 @@ def table(samples: dict[str, list[float]], loads: dict[str, str], runs: int,
     lines += [header, '-' * len(header)]
     for key, label, unit, target, digits in ROWS:
         values = samples.get(key)
+        if not values and udp and key in UDP_ROWS:
+            lines.append(f'{label:<38} {udp}')
+            continue
         if not values:
             continue
         low, mid, high = min(values), statistics.median(values), max(values)
@@ -527,7 +594,8 @@ def main(argv: list[str] | None = None) -> int:
     medians = summarize(samples)
     judged = verdicts(medians, compression)
     invalid = invalid_figures(medians, args.sections)
-    print(table(samples, loads, args.runs, compression, judged))
+    udp = getattr(args, 'udp', '')
+    print(table(samples, loads, args.runs, compression, judged, udp))
     result: dict[str, object] = {key: round(value, 4) for key, value in medians.items()}
     result.update({'runs': args.runs, 'quick': args.quick, 'cpus': os.cpu_count(),
                    'compression': compression,
@@ -535,6 +603,8 @@ def main(argv: list[str] | None = None) -> int:
                    'missed': sorted(key for key, verdict in judged.items()
                                     if verdict == 'MISSED'),
                    'invalid': invalid})
+    if udp:
+        result['controller_udp'] = udp
     print(json.dumps(result, sort_keys=True), flush=True)
     if invalid:  # a missed target is a figure; a missing or NaN one is a broken bench
         print(f'run_bench: missing or not finite: {", ".join(invalid)}', file=sys.stderr)

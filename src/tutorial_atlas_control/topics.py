@@ -45,6 +45,10 @@ TF = '/tf'
 ATLAS_COMMAND = '/atlas/atlas_command'
 #: atlas_msgs/Test: DRCSim's testing hook (joint damping, gains, k_effort).
 ATLAS_TEST = '/atlas/debug/test'
+#: atlas_msgs/SynchronizationStatistics (DRCSim 2.6+): the synchronization window's delays.
+SYNCHRONIZATION_STATISTICS = '/atlas/synchronization_statistics'
+#: std_msgs/String (DRCSim 2.6+ cheat): any message ends the window's current wait early.
+SYNC_DELAY = '/atlas/debug/sync_delay'
 #: atlas_msgs/ResetControls: reset the PID, reload the gains or load an AtlasCommand.
 RESET_CONTROLS_SERVICE = '/atlas/reset_controls'
 #: The URDF of the simulated model (set by atlas.launch's state_publisher.py).
@@ -78,6 +82,8 @@ MSG_TYPES: dict[str, str] = {
     FORCE_TORQUE_SENSORS: 'atlas_msgs/ForceTorqueSensors',
     DEBUG_L_FOOT_CONTACT: 'geometry_msgs/WrenchStamped',
     DEBUG_R_FOOT_CONTACT: 'geometry_msgs/WrenchStamped',
+    SYNCHRONIZATION_STATISTICS: 'atlas_msgs/SynchronizationStatistics',
+    SYNC_DELAY: 'std_msgs/String',
     ATLAS_COMMAND: 'atlas_msgs/AtlasCommand',
     ATLAS_TEST: 'atlas_msgs/Test',
     MODE: 'std_msgs/String',

@@ -122,7 +122,10 @@ class UdprosTest(unittest.TestCase):
                     received[topic] = msg_class().deserialize(payload)
         for sock in receivers:
             sock.close()
-        self.assertEqual(sorted(received), published)
+        # /atlas/synchronization_statistics is sent only while an AtlasCommand asks for the
+        # synchronization window (issue 26), which none does here: served, never sent.
+        self.assertEqual(sorted(received), [topic for topic in published
+                                            if topic != '/atlas/synchronization_statistics'])
         rospy.loginfo(f'UDPROS: one message from each of {len(published)} topics; blocks '
                       f'per message (DATA0 counts): {blocks}')
         self.assertEqual(len(received['/atlas/joint_states'].name), 28)

@@ -341,9 +341,11 @@ def test_refusals_and_left_out_fields_are_one_line_each(sim: AtlasSimulator) -> 
                                  '(NaN/Inf are refused); previous command kept']
     assert log.of('kept') == ['/atlas/atlas_command: velocity (5 entries) not 28 long; that '
                               'field keeps its previous values']
-    assert log.of('warn') == ['/atlas/atlas_command: desired_controller_period_ms = 10 is '
-                              'stored but not enforced yet: commands are applied as they '
-                              'come, with no synchronization window']
+    assert log.of('warn') == []
+    assert [line for line in log.of('info') if 'synchronization' in line] == [
+        'synchronization window on (/atlas/atlas_command desired_controller_period_ms = 10): '
+        'each step waits for a command stamped no more than 10 ms before its end, at most '
+        '0.025 s per step and 0.25 s per 5 s']
     assert loop.desired_controller_period_ms == 20
 
 

@@ -166,3 +166,42 @@ def test_main_lists_missed_targets_and_still_succeeds(
                     and ' s ' in line)
     assert time_row.split()[-1] == 'met'
     assert 'targets: 1 of 2 met; MISSED: analysis_speedup' in lines
+
+
+@pytest.mark.parametrize(('value', 'verdict'), [(1.0, 'met'), (2.0, 'MISSED')])
+def test_the_synchronization_window_owes_one_step_of_age(value: float, verdict: str) -> None:
+    assert run_bench.verdicts({'controller_window_age_p99_ms': value}, 'lz4') == {
+        'controller_window_age_p99_ms': verdict}
+
+
+def test_controller_section_without_udp_says_so_and_passes(
+        monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    figures = {key: [1.0] for key in run_bench.EXPECTED['controller']}
+
+    def online(args, samples, loads, work_dir) -> None:
+        samples.update(figures)
+        args.udp = run_bench.NO_UDP
+    monkeypatch.setattr(run_bench, 'check_environment', lambda: None)
+    monkeypatch.setattr(run_bench, 'run_offline', lambda *args: None)
+    monkeypatch.setattr(run_bench, 'run_online', online)
+    monkeypatch.setattr(run_bench, 'run_tutorial', lambda *args: None)
+    monkeypatch.setattr(run_bench, 'summarize', lambda samples: {
+        key: values[0] for key, values in samples.items()})
+    assert run_bench.main(['--only', 'controller', '--runs', '1']) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    result = json.loads(lines[-1])
+    assert result['controller_udp'] == 'n/a (no UDP connection)'
+    assert result['invalid'] == []
+    assert 'controller_udp_age_p99_ms' not in result
+    row = next(line for line in lines if line.startswith('echo_controller UDP: command age p99'))
+    assert row.endswith('  n/a (no UDP connection)')
+
+
+def test_command_age_is_read_from_the_wire_message() -> None:
+    import controller
+
+    from tutorial_atlas_control.msgs.wire import ControllerStatisticsWire
+
+    wire = ControllerStatisticsWire()
+    wire.set_values(0.001, 0.002, 3e-7, 1.0)
+    assert controller.command_age_s(bytes(wire.stamped(5_000_000))) == 0.001

@@ -40,6 +40,11 @@ Parameters (private unless noted):
     atlas_controller/gains/<joint>/{p,i,d,i_clamp}: the gains Stand/Freeze/User-hold use.
     atlas_controller/statistics_time_window_size (s, 1.0): window of the command age statistics.
     /atlas/controller_statistics/update_rate (Hz, unset = every step): clamped to 1..10000.
+    /atlas/delay_window_size (s, 5.0), /atlas/delay_max_per_window (s, 0.25),
+        /atlas/delay_max_per_step (s, 0.025): DRCSim 2.6's synchronization window budgets
+        (wall time; stepping/synchronization.py), used while an AtlasCommand's
+        desired_controller_period_ms is non-zero; /atlas/synchronization_statistics is then
+        published every step, and a message on /atlas/debug/sync_delay ends a wait early.
 """
 
 from __future__ import annotations
@@ -55,7 +60,14 @@ from typing import Any
 
 import genpy
 import rospy
-from atlas_msgs.msg import AtlasCommand, AtlasState, ControllerStatistics, ForceTorqueSensors, Test
+from atlas_msgs.msg import (
+    AtlasCommand,
+    AtlasState,
+    ControllerStatistics,
+    ForceTorqueSensors,
+    SynchronizationStatistics,
+    Test,
+)
 from atlas_msgs.srv import ResetControls, ResetControlsResponse
 from geometry_msgs.msg import Pose, Twist, Wrench, WrenchStamped
 from nav_msgs.msg import Odometry
@@ -105,6 +117,7 @@ from tutorial_atlas_control.sim.vrc import (
     wrench_input,
 )
 from tutorial_atlas_control.stepping.loop import ResetControlsRequest, SteppingLoop
+from tutorial_atlas_control.stepping.synchronization import DelayBudgets, SynchronizationWindow
 from tutorial_atlas_control.units import finite_number
 
 NODE_NAME = 'atlas_sim'
@@ -174,6 +187,19 @@ class RawTest(RawMessage):
     __slots__: list[str] = []
 
 
+class RawLatched:
+    """A pre-serialized message as rospy's latch: what a new subscriber of a latched
+    publisher gets first (rospy serializes the latch with serialize_message)."""
+
+    _has_header = False
+
+    def __init__(self, data: bytes) -> None:
+        self.data = data
+
+    def serialize(self, buff: io.BytesIO) -> None:
+        buff.write(self.data)
+
+
 class RosLog:
     """The stepping loop's log lines, into rospy's log (stepping.loop.LoopLog).
 
@@ -220,7 +246,8 @@ class SimNode:
     services, parameters and the viewer window."""
 
     def __init__(self, sim: AtlasSimulator, real_time_factor: float, paused: bool,
-                 rates_hz: dict[str, float], gui: bool, tf: bool = False) -> None:
+                 rates_hz: dict[str, float], gui: bool, tf: bool = False,
+                 sync_budgets: DelayBudgets | None = None) -> None:
         self.sim = sim
         self.gui = gui
         # UDPROS for roscpp's unreliable() subscribers, before the master announces a topic.
@@ -230,7 +257,10 @@ class SimNode:
         self.loop = SteppingLoop(sim, WireBatch(), self.publishers, rates_hz, statistics,
                                  RosLog(), self._publish_config,
                                  real_time_factor=real_time_factor, paused=paused,
-                                 publish_input=self._publish_input)
+                                 publish_input=self._publish_input,
+                                 synchronization=SynchronizationWindow(
+                                     sync_budgets or DelayBudgets()),
+                                 latch_synchronization=self._latch_synchronization)
         self.loop.publish_config()
         self.mode_pub.publish(String(data=sim.mode.value))
         self._subscribe()
@@ -248,6 +278,10 @@ class SimNode:
             warnings.simplefilter('ignore', SyntaxWarning)  # rospy: "explicit queue_size"
             self.publishers = {topic: rospy.Publisher(topic, msg_class, queue_size=None)
                                for topic, msg_class in published}
+            # Latched, as DRCSim's: a new subscriber gets the latest step's delays at once.
+            self.publishers[topics.SYNCHRONIZATION_STATISTICS] = rospy.Publisher(
+                topics.SYNCHRONIZATION_STATISTICS, SynchronizationStatistics, queue_size=None,
+                latch=True)
         # Latched, recorded in every bag: what offline replay needs to re-create the run.
         self.config_pub = rospy.Publisher(topics.SIM_CONFIG, String, queue_size=1, latch=True)
         # Each applied cheat, with the sim time it took effect: what replay re-applies.
@@ -271,6 +305,10 @@ class SimNode:
                          queue_size=10, tcp_nodelay=True)
         rospy.Subscriber(topics.ATLAS_TEST, RawTest, self.on_test, queue_size=10)
         rospy.Subscriber(topics.CONTROL_MODE, String, self.on_control_mode, queue_size=10)
+        # DRCSim 2.6's cheat: any message ends the synchronization window's wait early.
+        rospy.Subscriber(topics.SYNC_DELAY, String, lambda _msg: self.loop.wake(), queue_size=1,
+                         tcp_nodelay=True)
+        rospy.on_shutdown(self.loop.stop_waiting)  # a wait in progress ends at once
         loop = self.loop
         self.services = [
             rospy.Service(topics.RESET_CONTROLS_SERVICE, ResetControls, self.on_reset_controls),
@@ -330,6 +368,11 @@ class SimNode:
         """As VRCPlugin: planned but never implemented; said once per message."""
         rospy.logerr_throttle(WARN_THROTTLE_S, f'{topics.CONFIGURATION} is not implemented '
                               '(nor was it in DRCSim); nothing applied')
+
+    def _latch_synchronization(self, message: bytes) -> None:
+        """The latest /atlas/synchronization_statistics (without its length prefix), for
+        subscribers to come."""
+        self.publishers[topics.SYNCHRONIZATION_STATISTICS].impl.latch = RawLatched(message)
 
     def _publish_input(self, text: str) -> None:
         """/atlas/sim_inputs (recorded): one applied cheat."""
@@ -495,7 +538,8 @@ def build_node() -> SimNode:
                          startup_mode=VrcMode(startup_mode))
     return SimNode(sim, _float_param('~real_time_factor', 1.0),
                    bool(rospy.get_param('~paused', False)), rates_hz,
-                   bool(rospy.get_param('~gui', False)), _tf_wanted(Path(model_file), sim))
+                   bool(rospy.get_param('~gui', False)), _tf_wanted(Path(model_file), sim),
+                   DelayBudgets.from_params(rospy.get_param))
 
 
 def _check_bag_dir() -> None:

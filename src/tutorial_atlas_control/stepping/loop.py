@@ -44,6 +44,14 @@ from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode, Ph
 from tutorial_atlas_control.sim.vrc import SimInput, describe_input
 from tutorial_atlas_control.stepping.pacing import Pacer
 from tutorial_atlas_control.stepping.schedule import STAMPED_AT_STEP_END, steps_between
+from tutorial_atlas_control.stepping.synchronization import (
+    DelayBudgets,
+    DelayReport,
+    SynchronizationWindow,
+    SyncOutcome,
+    is_fresh,
+    statistics_bytes,
+)
 from tutorial_atlas_control.units import NS_PER_S
 
 __all__ = ['MAX_PENDING_COMMANDS', 'ON_DEMAND_MESSAGES', 'DivergenceGuard', 'LoopLog', 'Outbox',
@@ -61,6 +69,9 @@ INPUT_LOG_PERIOD_S = 1.0
 #: Commands arriving while the mode is not User are warned about at once, then at most
 #: this often (s of sim time) while they keep coming.
 NOT_USER_WARN_PERIOD_S = 5.0
+#: Steps the synchronization window gave up waiting for are warned about at once, then at
+#: most this often (s of sim time), with their count.
+SYNC_WARN_PERIOD_S = 5.0
 #: While paused, the loop looks for commands and shutdown this often (s, wall).
 PAUSED_POLL_S = 0.01
 #: The per-step messages: topic, key of its rate in `rates_hz`, name in
@@ -187,6 +198,10 @@ class SteppingLoop:
         pacer: the wall-time decisions (default: a Pacer at real_time_factor; tests give
             one with a fake clock).
         publish_input: sends /atlas/sim_inputs' JSON of each applied cheat (None: nowhere).
+        synchronization: DRCSim 2.6's synchronization window (default: DRCSim's budgets);
+            its statistics go to the topics.SYNCHRONIZATION_STATISTICS outlet, if any.
+        latch_synchronization: keeps the latest statistics message (serialized, without
+            its length prefix) for later subscribers (None: not kept).
     """
 
     def __init__(self, sim: AtlasSimulator, outbox: Outbox, outlets: Mapping[str, Hashable],
@@ -194,7 +209,9 @@ class SteppingLoop:
                  log: LoopLog, publish_config: Callable[[str], None],
                  real_time_factor: float = 0.0, paused: bool = False,
                  pacer: Pacer | None = None,
-                 publish_input: Callable[[str], None] | None = None) -> None:
+                 publish_input: Callable[[str], None] | None = None,
+                 synchronization: SynchronizationWindow | None = None,
+                 latch_synchronization: Callable[[bytes], None] | None = None) -> None:
         self.sim = sim
         self._send_input = publish_input
         self._input_logged_ns: dict[str, int] = {}  # kind -> sim time it was last logged
@@ -242,9 +259,21 @@ class SteppingLoop:
         self.decoder = CommandDecoder()
         self.pending_commands: collections.deque[tuple[str, bytes]] = collections.deque(
             maxlen=MAX_PENDING_COMMANDS)
-        # AtlasCommand's synchronization request (issue 26 will honour it): stored only.
+        # DRCSim 2.6's synchronization window (synchronization.py): on while the latest
+        # AtlasCommand's desired_controller_period_ms is non-zero. A command wakes the wait.
         self.desired_controller_period_ms = 0
-        self._period_warned = False
+        self.command_stamp_ns = 0  # header.stamp of the newest applied command, as sent
+        self.synchronization = (synchronization if synchronization is not None
+                                else SynchronizationWindow(DelayBudgets()))
+        self.sync_outlet = outlets.get(topics.SYNCHRONIZATION_STATISTICS)
+        self._latch_sync = latch_synchronization
+        self._command_arrived = threading.Event()
+        #: Blocks up to the given seconds (wall) for a command; True when woken (tests
+        #: replace it to drive the window with a fake clock).
+        self.wait_for_command: Callable[[float], bool] = self._command_arrived.wait
+        self._sync_warned_ns: int | None = None
+        self._sync_gave_up = 0
+        self._stopping = False  # shutting down: no more waits
 
         # Headless feedback (a log line per fall, per reset, and for ignored commands).
         self.pelvis_z_index = sim.atlas.free_qpos_adr + 2  # the pelvis height in qpos
@@ -267,6 +296,19 @@ class SteppingLoop:
         topics' messages in the order they came: the newest sets the fields it carries.
         """
         self.pending_commands.append((topic, raw))
+        if self.desired_controller_period_ms:
+            self._command_arrived.set()  # the window may be waiting for it
+
+    def wake(self) -> None:
+        """End the synchronization window's current wait early (DRCSim's
+        /atlas/debug/sync_delay): it checks the commands again."""
+        self._command_arrived.set()
+
+    def stop_waiting(self) -> None:
+        """At shutdown: end the current wait and wait no more (a step's budget may be
+        long, and the controller gone)."""
+        self._stopping = True
+        self._command_arrived.set()
 
     def _decode(self, topic: str, raw: bytes) -> CommandUpdate | AtlasUpdate:
         if topic == topics.JOINT_COMMANDS:
@@ -349,12 +391,21 @@ class SteppingLoop:
                       f'not apply them; switch to User mode: {topics.SWITCH_TO_USER}')
 
     def _store_period(self, period_ms: int) -> None:
+        """An AtlasCommand's desired_controller_period_ms; a line when the window turns
+        on or off."""
+        previous = self.desired_controller_period_ms
         self.desired_controller_period_ms = period_ms
-        if period_ms and not self._period_warned:
-            self._period_warned = True
-            self.log.warn(f'{topics.ATLAS_COMMAND}: desired_controller_period_ms = {period_ms} '
-                          'is stored but not enforced yet: commands are applied as they '
-                          'come, with no synchronization window')
+        if bool(previous) == bool(period_ms):
+            return
+        if period_ms:
+            budgets = self.synchronization.budgets
+            self.log.info(f'synchronization window on ({topics.ATLAS_COMMAND} '
+                          f'desired_controller_period_ms = {period_ms}): each step waits for '
+                          f'a command stamped no more than {period_ms} ms before its end, at '
+                          f'most {budgets.max_per_step_s:g} s per step and '
+                          f'{budgets.max_per_window_s:g} s per {budgets.window_size_s:g} s')
+        else:
+            self.log.info('synchronization window off (desired_controller_period_ms = 0)')
 
     def reset_controls(self, request: ResetControlsRequest) -> tuple[bool, str]:
         """atlas_msgs/ResetControls, as AtlasPlugin::ResetControls: (success, status).
@@ -448,6 +499,7 @@ class SteppingLoop:
         with self.lock:
             self.sim.reset_simulation()
             self.statistics.forget_command()  # its stamp lies in the rewound future
+            self.command_stamp_ns = 0
             self._rearm()
         self.publish_config()
         self.log.info('reset_simulation: robot reset and sim time back to 0')
@@ -512,8 +564,9 @@ class SteppingLoop:
 
     def _note_command_stamp(self, raw: bytes) -> None:
         """The command in `raw` is applied from the coming step on: remember its stamp."""
-        self.statistics.command_applied(FieldCursor(raw).header_stamp_ns(),
-                                        self.sim.sim_time_ns + self.sim.step_ns)
+        stamp_ns = FieldCursor(raw).header_stamp_ns()
+        self.command_stamp_ns = stamp_ns
+        self.statistics.command_applied(stamp_ns, self.sim.sim_time_ns + self.sim.step_ns)
 
     def _publish_controller_statistics(self, now_ns: int) -> None:
         """After each step: the command age at `now_ns`, into the window and, when due, out."""
@@ -545,6 +598,8 @@ class SteppingLoop:
                 pacer.sleep(PAUSED_POLL_S)
                 pacer.restart(sim.sim_time_ns)
                 continue
+            if self.desired_controller_period_ms:
+                self._synchronize()
             with lock:
                 self.apply_pending_commands()
                 try:
@@ -565,6 +620,62 @@ class SteppingLoop:
             if paced:
                 pacer.wait(sim_ns)
         return self.exit_status
+
+    # -- the synchronization window -----------------------------------------------------
+    def _synchronize(self) -> None:
+        """Before a step: wait, within the budgets, for a command fresh enough
+        (synchronization.py); queue /atlas/synchronization_statistics.
+
+        The wait replaces none of the pacing: at real_time_factor > 0 the time waited is
+        part of the step's wall time, and the pacer (pacing.py) sleeps only what is left
+        of the step's share, or catches up when the wait made the loop late.
+        """
+        report = self.synchronization.enforce(self._command_fresh, self._wait_sent)
+        if report.outcome is not SyncOutcome.FRESH:
+            self._warn_gave_up(report)
+        outlet = self.sync_outlet
+        if outlet is None:
+            return
+        data = statistics_bytes(report)
+        if self.outbox.wanted(outlet):
+            self.outbox.add(outlet, data)
+        if self._latch_sync is not None:
+            self._latch_sync(data[4:])
+
+    def _command_fresh(self) -> bool:
+        """Apply what arrived; True when the newest command is fresh enough for the coming
+        step, or no longer asks for the window; True at shutdown (wake() ends the wait)."""
+        self._command_arrived.clear()  # before looking: a later arrival wakes the wait
+        if self._stopping:
+            return True
+        with self.lock:
+            self.apply_pending_commands()
+            period_ms = self.desired_controller_period_ms
+            return period_ms == 0 or is_fresh(self.sim.sim_time_ns + self.sim.step_ns,
+                                              self.command_stamp_ns, period_ms)
+
+    def _wait_sent(self, timeout_s: float) -> bool:
+        """Send what is queued (the state the controller must answer), then wait."""
+        self.outbox.flush()
+        self.pacer.flushed()
+        return self.wait_for_command(timeout_s)
+
+    def _warn_gave_up(self, report: DelayReport) -> None:
+        """A step went on without a fresh command: a line at once, then one per
+        SYNC_WARN_PERIOD_S of sim time with the count (DRCSim warned at every one)."""
+        self._sync_gave_up += 1
+        now_ns = self.sim.sim_time_ns
+        last_ns = self._sync_warned_ns
+        if last_ns is not None and 0 <= now_ns - last_ns < SYNC_WARN_PERIOD_S * NS_PER_S:
+            return
+        self._sync_warned_ns = now_ns
+        count, self._sync_gave_up = self._sync_gave_up, 0
+        self.log.warn(f'synchronization window: no command stamped within '
+                      f'{self.desired_controller_period_ms} ms of t='
+                      f'{(now_ns + self.sim.step_ns) / NS_PER_S:.3f} s ({report.outcome.value}, '
+                      f'{report.delay_in_window_s:.3f} s waited in this window); stepping on '
+                      f'with the latest command ({count} step(s) so since the last such line; '
+                      'controller stopped or messages lost?)')
 
     def _recover(self, err: PhysicsDivergenceError) -> bool:
         """Log a divergence and reset the robot; False (stop) when the model keeps diverging."""

@@ -5,6 +5,11 @@ loop sends in batches whenever being on time allows: at real_time_factor 0 every
 FLUSH_PERIOD_S of wall time; paced, after every step while on schedule, and every
 CATCH_UP_FLUSH_PERIOD_S while catching up. The clock and the sleep are parameters, so that
 tests can drive the decisions with a fake clock.
+
+With DRCSim 2.6's synchronization window on (synchronization.py), the loop also waits before
+a step for the controller's command, after sending what is queued: that wait is part of the
+step's wall time, so the pacer sleeps only what is left of the step's share, or catches up
+(within MAX_LAG_S) when the wait made the loop late. real_time_factor stays a ceiling.
 """
 
 from __future__ import annotations
