@@ -4,7 +4,8 @@ Each damage gives one line on stderr (`<prog>: error: ...`) and exit status 1, n
 traceback: a truncated bag (cut in its header, a chunk or its index), a wrong MD5 on a
 topic the tools decode, a compressed chunk whose bytes are damaged. A bag without
 /atlas/sim_config is no damage: the analysis does not need it, and replay says in one
-warning that it assumes the defaults (an older bag).
+warning that it assumes the defaults (an older bag) with --assume-defaults, and one line
+and exit 1 without it.
 """
 
 from __future__ import annotations
@@ -85,13 +86,21 @@ def test_a_damaged_bag_is_one_line_and_exit_1(bags: dict[str, Path], name: str, 
     assert err.startswith(f'{prog}: error: {_expected(name, bags[name])}'), err
 
 
-def test_a_bag_without_sim_config_is_analyzed_and_replayed_with_one_warning(
+def test_a_bag_without_sim_config_is_analyzed_and_replayed_only_on_request(
         bags: dict[str, Path], capsys: pytest.CaptureFixture[str]) -> None:
+    """The analysis needs no sim_config; a replay does (the pin time, the last reset)."""
     bag = bags['no_sim_config']
     assert analyze_bag.main([str(bag)]) == 0
     assert analyze_bag.main([str(bag), '--compare', str(bags['good'])]) == 0
     capsys.readouterr()
-    assert replay_bag.main([str(bag)]) in (0, 3)  # 3: the synthetic run is no physics
+    assert replay_bag.main([str(bag)]) == 1
+    out, err = capsys.readouterr()
+    assert out == '' and err == (
+        f'replay_bag.py: error: {bag} has no /atlas/sim_config (not recorded by atlas.launch, '
+        'or before the simulator published it): the pin time and the last reset are unknown; '
+        '--assume-defaults replays it with time_to_unpin = 1.0 s and no reset after '
+        't = 0.0 s.\n')
+    assert replay_bag.main([str(bag), '--assume-defaults']) in (0, 3)  # 3: no physics
     out, err = capsys.readouterr()
     warnings = [line for line in out.splitlines() if line.lstrip().startswith('warning:')]
     assert len(warnings) == 1 and 'the bag has no /atlas/sim_config' in warnings[0], out

@@ -240,10 +240,13 @@ def test_try_that_does_not_exist_is_one_line(three_tries: Path,
                                        '(1..3); there is no try 4.\n')
 
 
-def test_bag_without_sim_config_assumes_the_defaults(tmp_path: Path) -> None:
+def test_bag_without_sim_config_is_refused_unless_defaults_are_assumed(tmp_path: Path) -> None:
     run = Run(time_to_unpin_s=1.0, with_config=False)
     run.step(60)
-    result = replay_bag(run.write(tmp_path / 'old.bag'))
+    bag = run.write(tmp_path / 'old.bag')
+    with pytest.raises(ReplayError, match='has no /atlas/sim_config .*--assume-defaults'):
+        replay_bag(bag)
+    result = replay_bag(bag, assume_defaults=True)
     assert not result.config.recorded and result.config.time_to_unpin_s == 1.0
     assert result.model_sha1_matches is None
     assert result.joint_position.max_abs == 0.0
@@ -253,7 +256,7 @@ def test_bag_without_sim_config_assumes_the_defaults(tmp_path: Path) -> None:
 def test_wrong_pin_time_shows_as_a_deviation(tmp_path: Path) -> None:
     run = Run(with_config=False)  # really 0.05 s, but replay assumes the default 1 s
     run.step(200, crouch)
-    result = replay_bag(run.write(tmp_path / 'pin.bag'))
+    result = replay_bag(run.write(tmp_path / 'pin.bag'), assume_defaults=True)
     assert not result.reproduced
     assert result.pelvis_position.max_abs > 1e-4
     assert result.joint_position.time_s is not None and result.joint_position.joint in JOINT_NAMES
@@ -305,7 +308,7 @@ def test_missing_joint_is_an_error(tmp_path: Path) -> None:
     bag = write_bag(tmp_path / 'x.bag', [
         joint_state(0.001, np.zeros(27), names=JOINT_NAMES[:27])])
     with pytest.raises(ReplayError, match=r'lacks joints r_arm_mwx; the replay needs'):
-        load_recording(bag)
+        load_recording(bag, assume_defaults=True)
 
 
 def test_sim_time_going_backwards_is_unsupported(tmp_path: Path) -> None:
@@ -315,7 +318,7 @@ def test_sim_time_going_backwards_is_unsupported(tmp_path: Path) -> None:
     records[-1] = Record(records[-1].topic, records[-1].msgtype, 0.004, records[-1].message)
     bag = write_bag(tmp_path / 'x.bag', records)
     with pytest.raises(ReplayError, match=r'go backwards or repeat at 0.001 s .*reset_simulation'):
-        replay_bag(bag)
+        replay_bag(bag, assume_defaults=True)
 
 
 def test_late_recording_after_a_reset_is_unsupported(tmp_path: Path) -> None:
@@ -333,7 +336,7 @@ def test_late_recording_after_a_reset_is_unsupported(tmp_path: Path) -> None:
 def test_off_grid_stamps_are_an_error(tmp_path: Path) -> None:
     bag = write_bag(tmp_path / 'x.bag', [joint_state(0.0015, np.zeros(NUM_JOINTS))])
     with pytest.raises(ReplayError, match=r'0.001500000 s is not a multiple of the timestep'):
-        replay_bag(bag)
+        replay_bag(bag, assume_defaults=True)
 
 
 def test_other_timestep_is_an_error(tmp_path: Path) -> None:
@@ -396,7 +399,7 @@ def test_cli_text_and_json(full_run: Path, capsys: pytest.CaptureFixture[str]) -
 def test_cli_deviation_exit_status(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     run = Run(with_config=False)
     run.step(200, crouch)
-    assert main([str(run.write(tmp_path / 'pin.bag'))]) == EXIT_DEVIATES
+    assert main([str(run.write(tmp_path / 'pin.bag')), '--assume-defaults']) == EXIT_DEVIATES
     assert 'DEVIATES (tolerance 1e-06)' in capsys.readouterr().out
 
 

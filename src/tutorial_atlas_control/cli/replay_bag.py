@@ -54,9 +54,9 @@ pelvis_position {max (m), time, samples}, pelvis_orientation {max (rad), time, s
 (null without /ground_truth_odom), tolerance, reproduced (bool), warnings [text].
 
 Exit status: 0 when every deviation is within --tolerance, 3 when the replay deviates,
-1 when the bag cannot be read or replayed (missing topics, no such try, a recording that
-starts after a mid-run reset), 2 on bad arguments (e.g. a --tolerance that is not a number
->= 0).
+1 when the bag cannot be read or replayed (missing topics, no /atlas/sim_config without
+--assume-defaults, no such try, a recording that starts after a mid-run reset), 2 on bad
+arguments (e.g. a --tolerance that is not a number >= 0).
 
 Without BAG (or with --latest), the newest .bag in atlas.launch's bag directory
 ($TAC_BAG_DIR, else ~/.ros/tutorial_atlas_control/bags) is replayed.
@@ -74,6 +74,10 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument('--try', dest='try_number', metavar='N', type=int,
                         help='the try to replay, from 1 (-1: the last, the default)')
     parser.add_argument('--json', action='store_true', help='print one JSON object instead')
+    parser.add_argument('--assume-defaults', action='store_true',
+                        help='replay a bag without /atlas/sim_config (not recorded by '
+                             'atlas.launch) as if pinned for 1 s after t = 0 (otherwise '
+                             'refused: exit 1)')
     parser.add_argument('--tolerance', type=argument_type(_tolerance), default=DEFAULT_TOLERANCE,
                         help='largest deviation (rad, rad/s, m) that still counts as '
                              'reproduced (default: %(default)g)')
@@ -93,7 +97,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     check_bag_arguments(parser, args)
     try:
-        result = replay_bag(chosen_bag(args, 'replaying'), args.tolerance, args.try_number)
+        result = replay_bag(chosen_bag(args, 'replaying'), args.tolerance, args.try_number,
+                            args.assume_defaults)
     except AtlasControlError as err:
         print_error(PROG, err)
         return EXIT_REFUSED

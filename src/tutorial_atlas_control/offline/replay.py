@@ -116,9 +116,20 @@ def _read_sim_configs(data: BagData) -> list[dict[str, Any]]:
 
 
 def _sim_config(path: Path, raw_configs: list[dict[str, Any]], chosen: dict[str, Any] | None,
-                resets: int, warnings: list[str]) -> tuple[SimConfig, int]:
-    """The config in force for the chosen try, and how many resets the bag shows."""
+                resets: int, warnings: list[str],
+                assume_defaults: bool = False) -> tuple[SimConfig, int]:
+    """The config in force for the chosen try, and how many resets the bag shows.
+
+    Without /atlas/sim_config the pin time and the last reset are unknown: refused unless
+    `assume_defaults` (the simulator's defaults, with a warning).
+    """
     if not raw_configs:
+        if not assume_defaults:
+            raise ReplayError(
+                f'{path} has no {SIM_CONFIG_TOPIC} (not recorded by atlas.launch, or before '
+                'the simulator published it): the pin time and the last reset are unknown; '
+                f'--assume-defaults replays it with time_to_unpin = {DEFAULT_TIME_TO_UNPIN_S} s '
+                f'and no reset after t = {DEFAULT_LAST_RESET_S} s.')
         warnings.append(f'the bag has no {SIM_CONFIG_TOPIC} (recorded before the simulator '
                         f'published it): assuming time_to_unpin = {DEFAULT_TIME_TO_UNPIN_S} s '
                         f'and no reset after t = {DEFAULT_LAST_RESET_S} s.')
@@ -194,11 +205,13 @@ def _to_steps(stamps_ns: np.ndarray, step_ns: int, what: str) -> np.ndarray:
 
 
 def load_recording(path: Path | str, data: BagData | None = None,
-                   try_number: int | None = None) -> Recording:
+                   try_number: int | None = None, assume_defaults: bool = False) -> Recording:
     """Read what replay needs from the bag at `path` (`data`: an already read BagData).
 
     The bag is opened once: /atlas/sim_config comes with the series in `data`.
     `try_number`: the try to replay (1-based, negative from the end; None: the last).
+    `assume_defaults`: replay a bag without /atlas/sim_config with the simulator's defaults
+    (otherwise refused).
 
     Raises:
         ReplayError / BagAnalysisError: unreadable bag, no such try, missing joint states or
@@ -216,7 +229,8 @@ def load_recording(path: Path | str, data: BagData | None = None,
                           'recorded torques (effort) of every step.')
     chosen_config = (None if chosen.config is None or not raw_configs
                      else parse_sim_config(chosen.config))
-    config, resets = _sim_config(path, raw_configs, chosen_config, tries - 1, warnings)
+    config, resets = _sim_config(path, raw_configs, chosen_config, tries - 1, warnings,
+                                 assume_defaults)
     tests = data.topics.get(topics.ATLAS_TEST)
     if tests is not None and tests.count:
         # Its damping changes the model, which the recorded torques do not carry.
@@ -564,9 +578,10 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
 
 
 def replay_bag(path: Path | str, tolerance: float = DEFAULT_TOLERANCE,
-               try_number: int | None = None) -> ReplayResult:
+               try_number: int | None = None, assume_defaults: bool = False) -> ReplayResult:
     """:func:`load_recording` (of try `try_number`, None: the last) then :func:`replay`."""
-    return replay(load_recording(path, try_number=try_number), tolerance)
+    return replay(load_recording(path, try_number=try_number,
+                                 assume_defaults=assume_defaults), tolerance)
 
 
 # ---------------------------------------------------------------------------- report
