@@ -221,7 +221,8 @@ def test_newest_bag_is_the_default(bag_dir: Path, args: list[str],
 
 def test_latest_replay(bag_dir: Path, capsys: pytest.CaptureFixture[str]) -> None:
     bag = write_run_bag(bag_dir / 'atlas_x.bag', 0.05, with_imu=False)
-    assert replay_cli.main(['--json', '--assume-defaults']) == replay_cli.EXIT_DEVIATES  # not a simulator's run
+    # No sim_config, and not a simulator's run: it deviates.
+    assert replay_cli.main(['--json', '--assume-defaults']) == replay_cli.EXIT_DEVIATES
     captured = capsys.readouterr()
     assert captured.err == f'replaying {bag} (the newest bag)\n'
     assert json.loads(captured.out)['bag'] == str(bag)
