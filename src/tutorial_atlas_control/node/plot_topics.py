@@ -13,6 +13,7 @@ from __future__ import annotations
 import collections
 import contextlib
 import os
+import signal
 import sys
 import time
 from collections.abc import Callable
@@ -165,6 +166,11 @@ class PlotSession:
         self._last_s: float | None = None
         self._clock_wait_since = time.monotonic()
         self._clock_said = False
+        self.interrupted = False
+
+    def interrupt(self, _signum: int, _frame: object) -> None:
+        """SIGINT: end the loops at their next turn."""
+        self.interrupted = True
 
     @property
     def time_label(self) -> str:
@@ -214,13 +220,19 @@ def run_plot(options: PlotOptions, say: Callable[[str], None]) -> int:
     with contextlib.suppress(OSError):  # a process may not be allowed to renice
         os.nice(NICENESS)
     session = PlotSession(options, say)
+    # Ctrl-C while Tk's event loop runs would land in a Tk callback (printed, then ignored):
+    # the loops check this flag instead, and KeyboardInterrupt is raised once out of them.
+    previous = signal.signal(signal.SIGINT, session.interrupt)
     try:
         if options.png is not None:
             return _run_png(session, options)
         return _run_window(session, backend)
     finally:
+        signal.signal(signal.SIGINT, previous)
         session.close()
         rospy.signal_shutdown('plot_topics.py done')
+        if session.interrupted:
+            raise KeyboardInterrupt
 
 
 def _open_backend(options: PlotOptions) -> object:
@@ -259,9 +271,11 @@ def _run_png(session: PlotSession, options: PlotOptions) -> int:
     FigureCanvasAgg(figure)
     view = PlotFigure(figure, session.plot, session.time_label)
     duration_s = options.duration_s if options.duration_s is not None else options.window_s
-    while session.elapsed_s < duration_s:
+    while session.elapsed_s < duration_s and not session.interrupted:
         session.step()
         time.sleep(FRAME_PERIOD_S)
+    if session.interrupted:
+        return _refused_count(session.plot)
     session.step()
     for line in session.plot.silent_lines(session.elapsed_s):
         session.say(line)
@@ -302,7 +316,8 @@ def _run_window(session: PlotSession, plt: object) -> int:
     plt.show(block=False)
     duration_s = session.options.duration_s
     next_draw_s = 0.0
-    while not state['closed'] and (duration_s is None or session.elapsed_s < duration_s):
+    while (not state['closed'] and not session.interrupted
+           and (duration_s is None or session.elapsed_s < duration_s)):
         frame_start = time.monotonic()
         session.step()
         if session.elapsed_s >= SILENCE_NOTICE_S:
