@@ -19,6 +19,8 @@ Sections (see bench/README.md for what each figure means and how it is measured)
             then the time SIGINT takes to stop the launch
   tutorial  run_demo.py step_and_fall: the port's command rate in sim time, and the bag's
             size per minute of sim time
+  plot      realtime_rtf and node_us_per_step without and with plot_topics.py plotting
+            three 1 kHz fields (bench/plot_cost.py)
 
 --compression sets the bags' chunk compression for every launch (TAC_BAG_COMPRESSION, which
 atlas.launch's `compression` argument defaults to); without it, the launch's default (lz4).
@@ -75,7 +77,7 @@ class Section:
 COMPRESSIONS = ('lz4', 'bz2', 'none')
 #: What the table and the JSON call the launch's own compression (lz4, atlas.launch).
 DEFAULT_COMPRESSION = 'the launch\'s default'
-SECTIONS = ('physics', 'offline', 'analysis', 'fast', 'realtime', 'load', 'tutorial')
+SECTIONS = ('physics', 'offline', 'analysis', 'fast', 'realtime', 'load', 'tutorial', 'plot')
 
 #: (key, label, unit, target text, digits) in table order.
 ROWS = (
@@ -126,6 +128,11 @@ ROWS = (
     ('analysis_msgs_per_s', 'analyze_bag, 60 s bag', 'msgs/s', '', 0),
     ('rosbag_msgs_per_s', 'rosbag API, same topics', 'msgs/s', '', 0),
     ('analysis_speedup', 'analyze_bag / rosbag', 'x', '>= 5', 1),
+    ('plot_off_realtime_rtf', 'node rtf:=1, no plotter', 'x real time', '', 4),
+    ('plot_on_realtime_rtf', 'node rtf:=1, 3 x 1 kHz fields plotted', 'x real time', '', 4),
+    ('plot_off_node_us_per_step', 'node CPU per step rtf:=0, no plotter', 'us', '', 1),
+    ('plot_on_node_us_per_step', 'node CPU per step rtf:=0, plotted', 'us', '', 1),
+    ('plot_on_plotter_cpu', 'plot_topics.py CPU at rtf:=1', 'cores', '', 2),
 )
 
 
@@ -208,6 +215,8 @@ EXPECTED = {
     'load': ('load_rtf', 'load_publish_rate_hz', 'load_commands_lost',
              'load_recorded_fraction', 'load_rss_growth_mib', 'shutdown_s'),
     'tutorial': ('tutorial_command_rate_hz', 'bag_mb_per_min'),
+    'plot': ('plot_off_realtime_rtf', 'plot_on_realtime_rtf', 'plot_off_node_us_per_step',
+             'plot_on_node_us_per_step', 'plot_on_plotter_cpu'),
 }
 #: Keys computed from two sections, expected when both ran.
 EXPECTED_ACROSS = {('physics', 'fast'): ('fast_ratio', 'fast_bare_ratio', 'node_bare_ratio')}
@@ -327,7 +336,7 @@ def run_offline(args: argparse.Namespace, samples: dict[str, list[float]],
 
 def run_online(args: argparse.Namespace, samples: dict[str, list[float]],
                loads: dict[str, str], work_dir: Path) -> None:
-    if not {'fast', 'realtime', 'load'} & set(args.sections):
+    if not {'fast', 'realtime', 'load', 'plot'} & set(args.sections):
         return
     import online
 
@@ -351,6 +360,9 @@ def run_online(args: argparse.Namespace, samples: dict[str, list[float]],
         if 'load' in args.sections:
             with Section('load', loads):
                 run_load(args, samples, master, probes, work_dir)
+        if 'plot' in args.sections:
+            with Section('plot', loads):
+                run_plot(args, samples, master, probes, work_dir)
         rospy.signal_shutdown('bench done')
     finally:
         master.close()
@@ -369,6 +381,22 @@ def run_load(args, samples, master, probes, work_dir) -> None:  # noqa: ANN001
         if values['load_commands_lost']:
             args.keep = True
             log(f'load run {run + 1} lost commands: its bag and launch log stay in {work_dir}')
+
+
+def run_plot(args, samples, master, probes, work_dir) -> None:  # noqa: ANN001
+    import offline
+    import plot_cost
+
+    for run in range(args.runs):
+        values = plot_cost.plot_run(master, args.launch_file, probes, work_dir, f'plot{run + 1}',
+                                    warmup_s=2.0, window_s=4.0 if args.quick else 15.0,
+                                    steps_per_sim_s=offline.steps_per_sim_second())
+        log(f'plot run {run + 1}: rtf {values["plot_off_realtime_rtf"]:.4f} without, '
+            f'{values["plot_on_realtime_rtf"]:.4f} with the plotter; node '
+            f'{values["plot_off_node_us_per_step"]:.1f} / '
+            f'{values["plot_on_node_us_per_step"]:.1f} us per step; plotter '
+            f'{values["plot_on_plotter_cpu"]:.2f} cores')
+        add(samples, values)
 
 
 def run_tutorial(args: argparse.Namespace, samples: dict[str, list[float]],
