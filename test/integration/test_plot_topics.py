@@ -178,3 +178,28 @@ def test_no_master_gives_one_line(tmp_path: Path) -> None:
         'tutorial_atlas_control atlas.launch, or roscore) or set ROS_MASTER_URI\n')
     assert not (tmp_path / 'x.png').exists()
 
+
+
+def test_a_reset_of_sim_time_clears_the_plot(sine_launch: TestLaunch, tmp_path: Path) -> None:
+    """Last in this module: the reset sends sim time back to 0 (the driver stops there)."""
+    out = tmp_path / 'reset.png'
+    process = subprocess.Popen([sys.executable, str(PLOT), ELBOW, '--png', str(out),
+                                '--duration', '3', '--window', '3'], env=sine_launch.env,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        sine_launch.wait(lambda: any('plot_topics' in node for node in
+                                     sine_launch.subscribers('/atlas/joint_states')),
+                         STARTUP_TIMEOUT_S, 'plot_topics.py did not subscribe')
+        sine_launch.wait_sim_s(1.0)
+        reset = sine_launch.run('rosservice', 'call', '/gazebo/reset_simulation')
+        assert reset.returncode == 0, reset.stderr
+        _stdout, stderr = process.communicate(timeout=RUN_TIMEOUT_S)
+    finally:
+        stop_tree(process)
+    lines = stderr.splitlines()
+    assert process.returncode == 0, stderr
+    assert len(lines) == 1 and lines[0].startswith('plot_topics.py: ROS time moved back to '), \
+        lines
+    assert lines[0].endswith(' s (a reset): plot cleared')
+    assert float(lines[0].split(' to ')[1].split(' s ')[0]) < 1.0
+    assert out.exists()

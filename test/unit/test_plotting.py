@@ -302,3 +302,17 @@ def test_a_sine_shows_as_a_curve_and_flat_or_empty_plots_do_not() -> None:
     assert sine.shows_a_curve()
     assert not flat.shows_a_curve() and flat.columns_fraction > 0.6  # across, but flat
     assert not empty.shows_a_curve()
+
+
+def test_the_time_axis_follows_ros_time_from_0() -> None:
+    from matplotlib.figure import Figure
+
+    plot = live('/atlas/joint_states/position[19]', window_s=4.0)
+    view = PlotFigure(Figure(), plot, 'sim time (s)')
+    plot.advance(1.0)
+    view.update()
+    assert view.axes.get_xlim() == (0.0, 4.0)
+    plot.advance(10.5)
+    view.update(paused=True, autoscale=False)
+    assert view.axes.get_xlim() == (6.5, 10.5)
+    assert view.status.get_text() == 'PAUSED  autoscale off'

@@ -81,7 +81,9 @@ class PlotFigure:
             line.set_data(times, values)
             shown.append(values[times >= start_s])
         self._refresh_legend()
-        self.axes.set_xlim(start_s, now_s if now_s > start_s else start_s + plot.window_s)
+        # The axis starts at 0 (sim time's start, or the plotter's) until a window has passed.
+        left_s = max(start_s, 0.0)
+        self.axes.set_xlim(left_s, left_s + plot.window_s)
         if autoscale:
             limits = y_range(shown)
             if limits is not None and all(math.isfinite(x) for x in limits):
