@@ -40,6 +40,8 @@ WINDOW_S = 4.0
 #: A screen wide enough for two plot windows (833 x 518) side by side; the second's corner.
 SCREEN = '1920x1200x24'
 EMPTY_WINDOW_AT = ('900', '600')
+#: Sim time (s) between the screenshots of the paused and of the resumed window.
+PAUSE_CHECK_S = 1.0
 #: Wall-clock guard for a --png run of a few seconds of sim time on a loaded machine.
 RUN_TIMEOUT_S = 180.0
 STARTUP_TIMEOUT_S = 120.0
@@ -61,6 +63,14 @@ def sine_launch(tmp_path_factory: pytest.TempPathFactory) -> Iterator[TestLaunch
             yield launch
         finally:
             stop_tree(driver)
+
+
+def key(display: str, window: str, name: str) -> None:
+    """Press a key in `window`, given the keyboard focus first: with two Tk windows and no
+    window manager, Tk drops keys sent to the window that did not get the focus."""
+    for command in (['windowfocus', '--sync', window], ['key', '--window', window, name]):
+        subprocess.run(['xdotool', *command], check=True, env=dict(os.environ, DISPLAY=display),
+                       timeout=EXIT_TIMEOUT_S, capture_output=True)
 
 
 def plot(launch: TestLaunch, *args: str, env: dict[str, str] | None = None
@@ -96,6 +106,14 @@ def test_the_window_shows_the_elbow_s_sine_and_an_empty_plot_does_not(
             sine_launch.wait_sim_s(WINDOW_S + 1.0)  # the window filled with samples
             images = {name: screenshot(display, ids[name], tmp_path / f'window_{name}.png')
                       for name in ids}
+            # space pauses: the picture stays while sim time goes on; space again resumes
+            pictures = []
+            for step in ('paused', 'resumed'):
+                key(display, ids['sine'], 'space')
+                for shot in range(2):
+                    sine_launch.wait_sim_s(PAUSE_CHECK_S)
+                    pictures.append(screenshot(display, ids['sine'],
+                                               tmp_path / f'window_{step}_{shot}.png'))
             for process in windows.values():
                 process.send_signal(signal.SIGINT)
             outcomes = {name: process.communicate(timeout=EXIT_TIMEOUT_S)
@@ -103,6 +121,9 @@ def test_the_window_shows_the_elbow_s_sine_and_an_empty_plot_does_not(
         finally:
             for process in windows.values():
                 stop_tree(process)
+    paused_a, paused_b, resumed_a, resumed_b = pictures
+    assert np.array_equal(paused_a, paused_b), 'the paused window kept moving'
+    assert not np.array_equal(resumed_a, resumed_b), 'the resumed window does not move'
     sine, empty = curve_extent(images['sine']), curve_extent(images['empty'])
     print(f'sine window {sine}, empty window {empty}; screenshots in {tmp_path}')
     assert sine.shows_a_curve(), f'no curve in {tmp_path / "window_sine.png"}: {sine}'
@@ -146,6 +167,19 @@ def test_bad_fields_and_a_silent_topic_give_one_line_each_and_the_rest_is_plotte
         f'plot_topics.py: no data for {NEVER}: no topic it names is published ('), lines
     assert lines[2].endswith(' s of ROS time)')
     assert curve_extent(read_png(out)).columns_fraction > 0.6  # the elbow is plotted
+
+
+def test_nothing_to_plot_writes_no_png(sine_launch: TestLaunch, tmp_path: Path) -> None:
+    out = tmp_path / 'never.png'
+    result = plot(sine_launch, NEVER, '--png', str(out), '--duration', '1')
+    assert result.returncode == 1
+    lines = result.stderr.splitlines()
+    assert len(lines) == 2, lines
+    assert lines[0].startswith(f'plot_topics.py: no data for {NEVER}: no topic it names is '
+                               'published (')
+    assert lines[1].startswith('plot_topics.py: nothing to plot after ')
+    assert lines[1].endswith(f' s of ROS time: {out} not written')
+    assert not out.exists()
 
 
 def test_a_command_line_error_exits_2(sine_launch: TestLaunch) -> None:
