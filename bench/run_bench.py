@@ -23,6 +23,8 @@ Sections (see bench/README.md for what each figure means and how it is measured)
             the node's CPU per step at real_time_factor:=1 over TCP and over UDP ("n/a"
             while the node serves no UDPROS); steps per second of the pair with DRCSim
             2.6's synchronization window on (--period-ms 1) at real_time_factor:=0
+  plot      realtime_rtf and node_us_per_step without and with plot_topics.py plotting
+            three 1 kHz fields (bench/plot_cost.py)
 
 --compression sets the bags' chunk compression for every launch (TAC_BAG_COMPRESSION, which
 atlas.launch's `compression` argument defaults to); without it, the launch's default (lz4).
@@ -80,7 +82,7 @@ COMPRESSIONS = ('lz4', 'bz2', 'none')
 #: What the table and the JSON call the launch's own compression (lz4, atlas.launch).
 DEFAULT_COMPRESSION = 'the launch\'s default'
 SECTIONS = ('physics', 'offline', 'analysis', 'fast', 'realtime', 'load', 'tutorial',
-            'controller')
+            'controller', 'plot')
 #: What the table and the JSON say for the UDP figures while no UDP connection is made.
 NO_UDP = 'n/a (no UDP connection)'
 
@@ -141,6 +143,11 @@ ROWS = (
     ('controller_udp_node_us_per_step', 'echo_controller UDP: node CPU/step', 'us', '', 1),
     ('controller_window_steps_per_s', 'sync window, rtf:=0: steps/s of pair', 'steps/s', '', 0),
     ('controller_window_age_p99_ms', 'sync window, rtf:=0: command age p99', 'ms', '1', 2),
+    ('plot_off_realtime_rtf', 'node rtf:=1, no plotter', 'x real time', '', 4),
+    ('plot_on_realtime_rtf', 'node rtf:=1, 3 x 1 kHz fields plotted', 'x real time', '', 4),
+    ('plot_off_node_us_per_step', 'node CPU per step rtf:=0, no plotter', 'us', '', 1),
+    ('plot_on_node_us_per_step', 'node CPU per step rtf:=0, plotted', 'us', '', 1),
+    ('plot_on_plotter_cpu', 'plot_topics.py CPU at rtf:=1', 'cores', '', 2),
 )
 #: Rows shown as NO_UDP when the controller section ran without a UDP connection.
 UDP_ROWS = ('controller_udp_age_p50_ms', 'controller_udp_age_p99_ms',
@@ -232,6 +239,8 @@ EXPECTED = {
     'controller': ('controller_tcp_age_p50_ms', 'controller_tcp_age_p99_ms',
                    'controller_tcp_node_us_per_step', 'controller_window_steps_per_s',
                    'controller_window_age_p99_ms'),
+    'plot': ('plot_off_realtime_rtf', 'plot_on_realtime_rtf', 'plot_off_node_us_per_step',
+             'plot_on_node_us_per_step', 'plot_on_plotter_cpu'),
 }
 #: Keys computed from two sections, expected when both ran.
 EXPECTED_ACROSS = {('physics', 'fast'): ('fast_ratio', 'fast_bare_ratio', 'node_bare_ratio')}
@@ -351,7 +360,7 @@ def run_offline(args: argparse.Namespace, samples: dict[str, list[float]],
 
 def run_online(args: argparse.Namespace, samples: dict[str, list[float]],
                loads: dict[str, str], work_dir: Path) -> None:
-    if not {'fast', 'realtime', 'load', 'controller'} & set(args.sections):
+    if not {'fast', 'realtime', 'load', 'controller', 'plot'} & set(args.sections):
         return
     import online
 
@@ -378,6 +387,9 @@ def run_online(args: argparse.Namespace, samples: dict[str, list[float]],
         if 'controller' in args.sections:
             with Section('controller', loads):
                 run_controller(args, samples, master, probes, work_dir)
+        if 'plot' in args.sections:
+            with Section('plot', loads):
+                run_plot(args, samples, master, probes, work_dir)
         rospy.signal_shutdown('bench done')
     finally:
         master.close()
@@ -432,6 +444,22 @@ def run_controller(args, samples, master, probes, work_dir) -> None:  # noqa: AN
             + (f'{values["controller_udp_age_p99_ms"]:.2f} ms'
                if 'controller_udp_age_p99_ms' in values else NO_UDP)
             + f', window {values["controller_window_steps_per_s"]:.0f} steps/s')
+        add(samples, values)
+
+
+def run_plot(args, samples, master, probes, work_dir) -> None:  # noqa: ANN001
+    import offline
+    import plot_cost
+
+    for run in range(args.runs):
+        values = plot_cost.plot_run(master, args.launch_file, probes, work_dir, f'plot{run + 1}',
+                                    warmup_s=2.0, window_s=4.0 if args.quick else 15.0,
+                                    steps_per_sim_s=offline.steps_per_sim_second())
+        log(f'plot run {run + 1}: rtf {values["plot_off_realtime_rtf"]:.4f} without, '
+            f'{values["plot_on_realtime_rtf"]:.4f} with the plotter; node '
+            f'{values["plot_off_node_us_per_step"]:.1f} / '
+            f'{values["plot_on_node_us_per_step"]:.1f} us per step; plotter '
+            f'{values["plot_on_plotter_cpu"]:.2f} cores')
         add(samples, values)
 
 

@@ -24,6 +24,7 @@ APT_PACKAGES=(
   ros-robot-state-publisher ros-tf2-msgs python3-tf2-msgs python3-tf2-ros rviz
   ros-trajectory-msgs python3-trajectory-msgs
   xvfb xdotool x11-apps imagemagick
+  python3-tk
 )
 
 log() { printf 'setup: %s\n' "$*"; }

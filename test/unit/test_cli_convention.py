@@ -11,7 +11,7 @@ import pytest
 
 SCRIPTS = Path(__file__).resolve().parents[2] / 'scripts'
 PYTHON_SCRIPTS = ('analyze_bag.py', 'replay_bag.py', 'run_demo.py', 'run_offline.py',
-                  'traj_yaml.py')
+                  'traj_yaml.py', 'plot_topics.py')
 
 
 def run(script: str, *args: str) -> subprocess.CompletedProcess[str]:
@@ -36,6 +36,8 @@ def test_help_works_from_anywhere(script: str) -> None:
     ('run_demo.py', ['--video-size', 'big'], "argument --video-size: 'big' is not WIDTHxHEIGHT"),
     ('run_offline.py', ['Traj_data2.yaml', 'touchdown', '--settle', '-1'],
      "argument --settle: '-1' must be a finite number of seconds >= 0"),
+    ('plot_topics.py', ['/a/b', '--window', '0'],
+     "argument --window: '0' must be a finite number of seconds > 0"),
     ('record_run.sh', [], 'expected BAG_DIR [atlas_recorder|rosbag [lz4|bz2|none]], got 0 '
      'argument(s)'),
     ('record_run.sh', ['/tmp', 'rosbag2'], "unknown recorder 'rosbag2'"),

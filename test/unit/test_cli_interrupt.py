@@ -19,6 +19,7 @@ import pytest
 
 from tutorial_atlas_control.cli import (
     analyze_bag,
+    plot_topics,
     replay_bag,
     run_demo,
     run_offline,
@@ -27,6 +28,7 @@ from tutorial_atlas_control.cli import (
 )
 from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED
 from tutorial_atlas_control.node import demo
+from tutorial_atlas_control.node import plot_topics as plot_node
 
 REPO = Path(__file__).resolve().parents[2]
 TRAJECTORY_FILE = REPO / 'trajectories' / 'Traj_data2.yaml'
@@ -50,8 +52,9 @@ def interrupt(*_args: object, **_kwargs: object) -> None:
     (traj_yaml.main, (traj_yaml, 'load_trajectory'), [str(TRAJECTORY_FILE), 'touchdown']),
     (state_publisher.main, (state_publisher, 'matching_urdf'),
      ['state_publisher.py', str(REPO / 'sim' / 'atlas_v1.xml')]),
+    (plot_topics.main, (plot_node, 'require_master'), ['/atlas/joint_states/position[19]']),
 ], ids=['analyze_bag', 'analyze_bag --compare', 'replay_bag', 'run_offline', 'run_demo',
-        'traj_yaml', 'state_publisher'])
+        'traj_yaml', 'state_publisher', 'plot_topics'])
 def test_ctrl_c_exits_130_quietly(main: Callable[[list[str]], int], target: tuple[object, str],
                                   argv: list[str], monkeypatch: pytest.MonkeyPatch,
                                   capsys: pytest.CaptureFixture[str]) -> None:
