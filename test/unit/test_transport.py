@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import socket
+import threading
+
 import pytest
 
 from tutorial_atlas_control.node import transport
@@ -381,10 +384,55 @@ def test_the_shutdown_hook_in_a_write_drains_only_while_it_waits(
     writer.write(FakePublisher([blocked]), b'xyzw')
     blocked.socket.reads_per_slice = 3  # it would take the rest now
     writer.lock.acquire()
-    writer._holder = __import__('threading').get_ident()
+    writer._holder = threading.get_ident()
     try:
         writer.drain()
     finally:
         writer._holder = None
         writer.lock.release()
     assert bytes(writer.backlogs[blocked].data) == b'zw'
+
+
+class SocketPairConnection(FakeConnection):
+    """A TCPROS connection over a real socket pair: `peer` is the subscriber's end."""
+
+    transport_type = 'TCPROS'
+
+    def __init__(self, name: str) -> None:
+        super().__init__(name)
+        self.socket, self.peer = socket.socketpair()
+        for sock, option in ((self.socket, socket.SO_SNDBUF), (self.peer, socket.SO_RCVBUF)):
+            sock.setsockopt(socket.SOL_SOCKET, option, 4096)
+
+    def close(self):
+        self.closed = self.done = True
+        self.socket.close()
+
+
+def test_real_sockets_a_stalled_reader_is_left_then_drained_in_order(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """The same with the kernel's buffers and poll(): a write to a reader that takes
+    nothing returns (after one slice) with the rest kept; the hook sends it all once the
+    reader reads again."""
+    monkeypatch.setattr(transport.rospy, 'logwarn', lambda msg: pytest.fail(msg))
+    writer = transport.ConnectionWriter()
+    conn = SocketPairConnection('/recorder')
+    pub = FakePublisher([conn])
+    sent = bytes(range(256)) * 4096  # 1 MiB: far more than both buffers
+    writer.write(pub, sent[:1 << 19])
+    writer.write(pub, sent[1 << 19:])
+    assert conn.socket.gettimeout() == 0.0
+    assert len(writer.backlogs[conn].data) > 1 << 19, 'kept, not waited for'
+    received = bytearray()
+
+    def read() -> None:
+        while len(received) < len(sent):
+            received.extend(conn.peer.recv(1 << 16))
+
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    writer.drain(timeout_s=60.0)  # a guard only
+    reader.join(60.0)
+    assert writer.backlogs == {} and bytes(received) == sent
+    conn.close()
+    conn.peer.close()
