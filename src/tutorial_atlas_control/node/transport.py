@@ -127,9 +127,9 @@ class ConnectionWriter:
                 if not backlog.data:
                     backlogs.pop(connection, None)  # back to normal
                 elif len(backlog.data) > MAX_BACKLOG_BYTES:
-                    raise BacklogFull(f'more than {MAX_BACKLOG_BYTES >> 20} MiB not taken')
+                    raise BacklogFull(f'more than {MAX_BACKLOG_BYTES} bytes not taken')
                 elif self.clock() - backlog.progress_s >= SEND_TIMEOUT_S:
-                    raise TimeoutError('timed out')
+                    raise TimeoutError(f'timed out: nothing taken for {SEND_TIMEOUT_S:g} s')
             except (TransportTerminated, OSError) as err:  # socket.timeout is an OSError
                 backlogs.pop(connection, None)
                 if impl.closed:  # rospy closed every connection and cannot remove one any more
