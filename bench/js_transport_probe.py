@@ -6,7 +6,7 @@ another process. So that the figure is the transport the command latency include
 uses the node's path, not rospy's publish(): a publisher with queue_size=None (synchronous,
 no writer thread), the message pre-serialized by msgs/wire.JointStateWire (the node's
 layout, same names and size), and one WireBatch.add() + flush() per message, i.e. one
-transport.write_to_connections() sendall per step as the node does at real_time_factor 1.
+transport.ConnectionWriter send per step as the node does at real_time_factor 1.
 The stamp is CLOCK_MONOTONIC (time.perf_counter_ns on Linux), which all processes share,
 taken just before the message is batched and flushed.
 

@@ -17,7 +17,7 @@ realtime run: real_time_factor:=1.0; over the window every /clock arrival is kep
               carrying that effort - the publish() call. `net` subtracts the median
               JointState transport measured by js_transport_probe.py on the same master,
               which sends pre-serialized joint states through the node's own transport
-              (queue_size=None publisher, WireBatch / write_to_connections).
+              (queue_size=None publisher, WireBatch / ConnectionWriter).
 """
 
 from __future__ import annotations

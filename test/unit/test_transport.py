@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import socket
+import threading
+
 import pytest
 
 from tutorial_atlas_control.node import transport
@@ -61,7 +64,7 @@ def test_a_subscriber_that_left_is_dropped_quietly_a_stalled_one_with_a_warning(
     left = FakeConnection('/traj_yaml', BrokenPipeError(32, 'Broken pipe'))
     stalled = FakeConnection('/slow', TimeoutError('timed out'))
     pub = FakePublisher([healthy, left, stalled])
-    transport.write_to_connections(pub, b'data')
+    transport.ConnectionWriter().write(pub, b'data')
     assert healthy.socket.sent == [b'data']
     assert pub.connections == [healthy]
     assert left.closed and stalled.closed
@@ -93,7 +96,7 @@ def test_a_publisher_shut_down_during_a_send_is_left_quietly(
     later = FakeConnection('/recorder')
     pub = FakePublisher([closing, later])
     closing.socket = ClosingSocket(pub)
-    transport.write_to_connections(pub, b'data')
+    transport.ConnectionWriter().write(pub, b'data')
     assert later.socket.sent == []
     assert warnings == []
 
@@ -116,7 +119,7 @@ def test_a_publisher_closed_while_a_connection_is_removed_is_left_quietly(
     left = FakeConnection('/recorder', BrokenPipeError(32, 'Broken pipe'))
     later = FakeConnection('/probe')
     pub = ClosedDuringRemoval([left, later])
-    transport.write_to_connections(pub, b'data')  # no TypeError
+    transport.ConnectionWriter().write(pub, b'data')  # no TypeError
     assert later.socket.sent == []
 
 
@@ -126,7 +129,7 @@ def test_a_type_error_of_an_open_publisher_is_not_hidden(
     pub = FakePublisher([FakeConnection('/recorder', BrokenPipeError(32, 'Broken pipe'))])
     pub.remove_connection = lambda _connection: len(None)
     with pytest.raises(TypeError):
-        transport.write_to_connections(pub, b'data')
+        transport.ConnectionWriter().write(pub, b'data')
 
 
 def test_clock_goes_out_after_the_messages_stamped_with_it(
@@ -134,9 +137,12 @@ def test_clock_goes_out_after_the_messages_stamped_with_it(
     """Seen in CI: the node stopped between /clock's send and the joint states', and the
     bag held a time no joint state was stamped with. The latest /clock is now sent last."""
     sent: list[tuple[str, bytes]] = []
-    monkeypatch.setattr(transport, 'write_to_connections',
-                        lambda pub, data: sent.append((pub, bytes(data))))
-    batch = transport.WireBatch()
+
+    class Writer:
+        def write(self, pub, data):
+            sent.append((pub, bytes(data)))
+
+    batch = transport.WireBatch(Writer())
     for step in (b'1', b'2'):
         batch.replace('clock', b'clock ' + step)
         batch.add('joint_states', b'state ' + step)
@@ -146,3 +152,287 @@ def test_clock_goes_out_after_the_messages_stamped_with_it(
                     ('clock', b'clock 2')]
     batch.flush()
     assert len(sent) == 3, 'a flush sent twice'
+
+
+# -- TCP subscribers that read slowly, or stop reading (issue 29) ---------------------------
+class Clock:
+    def __init__(self) -> None:
+        self.now_s = 100.0
+
+    def __call__(self) -> float:
+        return self.now_s
+
+
+class TcpSocket:
+    """A non-blocking TCP socket whose kernel buffer holds `space` bytes; the subscriber
+    reads `reads_per_slice` bytes each time the writer waits (a slice of fake time)."""
+
+    def __init__(self, space: int, reads_per_slice: int) -> None:
+        self.space = space
+        self.free = space
+        self.reads_per_slice = reads_per_slice
+        self.timeout: float | None = None
+        self.in_buffer = bytearray()
+        self.received = bytearray()
+        self.send_calls = 0
+
+    def gettimeout(self):
+        return self.timeout
+
+    def setblocking(self, flag):
+        self.timeout = None if flag else 0.0
+
+    def send(self, data):
+        assert self.timeout == 0.0, 'a TCP socket written while blocking'
+        self.send_calls += 1
+        taken = min(len(data), self.free)
+        if taken == 0:
+            raise BlockingIOError(11, 'Resource temporarily unavailable')
+        self.in_buffer += bytes(data[:taken])
+        self.free -= taken
+        return taken
+
+    def read_some(self) -> None:
+        chunk = self.in_buffer[:self.reads_per_slice]
+        del self.in_buffer[:len(chunk)]
+        self.received += chunk
+        self.free += len(chunk)
+
+    def sendall(self, data):
+        raise AssertionError('TCP sockets are written with send(), not sendall()')
+
+
+class TcpConnection(FakeConnection):
+    transport_type = 'TCPROS'
+
+    def __init__(self, name: str, space: int = 1 << 20, reads_per_slice: int = 0) -> None:
+        super().__init__(name)
+        self.socket = TcpSocket(space, reads_per_slice)
+
+    def close(self):
+        self.closed = True
+        self.done = True
+
+
+class UdpConnection(FakeConnection):
+    transport_type = 'UDPROS'
+
+
+class Waits:
+    """The writer's wait for a socket: a slice of fake time, during which subscribers read."""
+
+    def __init__(self, clock: Clock) -> None:
+        self.clock = clock
+        self.slices = 0
+        self.timeouts_s: list[float] = []
+        self.during: list = []
+
+    def __call__(self, sock: TcpSocket, timeout_s: float) -> bool:
+        self.timeouts_s.append(timeout_s)
+        self.slices += 1
+        actions, self.during = self.during, []  # once (the hook waits too)
+        for action in actions:
+            action()
+        self.clock.now_s += min(timeout_s, transport.STALL_PROBE_S)
+        before = sock.free
+        sock.read_some()
+        return sock.free > before or sock.free > 0
+
+
+def writer_and_waits(monkeypatch: pytest.MonkeyPatch) -> tuple:
+    warnings: list[str] = []
+    monkeypatch.setattr(transport.rospy, 'logwarn', warnings.append)
+    clock = Clock()
+    waits = Waits(clock)
+    return transport.ConnectionWriter(clock, waits), waits, clock, warnings
+
+
+def test_a_stalled_reader_holds_the_loop_one_slice_then_is_dropped_after_the_timeout(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    writer, waits, clock, warnings = writer_and_waits(monkeypatch)
+    stalled = TcpConnection('/stalled', space=100, reads_per_slice=0)
+    other = TcpConnection('/recorder')
+    pub = FakePublisher([stalled, other])
+    step = b'x' * 60
+    writer.write(pub, step)
+    writer.write(pub, step)  # the buffer fills: one slice waited, the rest kept
+    assert waits.timeouts_s == [transport.STALL_PROBE_S]
+    assert len(writer.backlogs[stalled].data) == 20
+    steps = 2
+    while clock.now_s - 100.0 < transport.SEND_TIMEOUT_S - 0.01:
+        writer.write(pub, step)  # not waited for any more: the loop goes on at full speed
+        steps += 1
+        clock.now_s += 0.001
+    assert waits.slices == 1
+    assert stalled in pub.connections and warnings == []
+    assert len(writer.backlogs[stalled].data) == steps * 60 - 100
+    clock.now_s += 0.01
+    writer.write(pub, step)
+    steps += 1
+    assert pub.connections == [other] and stalled.closed
+    assert warnings == ['/clock: dropping subscriber /stalled: timed out: nothing taken for 2 s']
+    assert writer.backlogs == {}, 'the stalled backlog is freed'
+    assert other.socket.in_buffer == step * steps, 'the other subscriber lost nothing'
+
+
+def test_a_backlog_past_its_bound_drops_the_subscriber_at_once(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(transport, 'MAX_BACKLOG_BYTES', 1000)
+    writer, waits, clock, warnings = writer_and_waits(monkeypatch)
+    stalled = TcpConnection('/stalled', space=100)
+    pub = FakePublisher([stalled])
+    for _ in range(11):
+        writer.write(pub, b'y' * 100)
+    assert stalled in pub.connections and len(writer.backlogs[stalled].data) == 1000
+    writer.write(pub, b'y')
+    assert pub.connections == [] and writer.backlogs == {}
+    assert warnings == ['/clock: dropping subscriber /stalled: more than 1000 bytes not taken']
+    assert waits.timeouts_s == [transport.STALL_PROBE_S], 'one slice waited in all'
+
+
+def test_a_slow_reader_gets_back_pressure_and_loses_nothing_in_order(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    writer, waits, clock, warnings = writer_and_waits(monkeypatch)
+    slow = TcpConnection('/recorder', space=50, reads_per_slice=7)
+    pub = FakePublisher([slow])
+    sent = b''.join(bytes([65 + i % 26]) * 40 for i in range(30))
+    for i in range(30):
+        writer.write(pub, sent[i * 40:(i + 1) * 40])
+        assert writer.backlogs == {}, 'a reader that keeps taking bytes is waited for'
+    while slow.socket.in_buffer:
+        slow.socket.read_some()
+    assert bytes(slow.socket.received) == sent
+    assert warnings == [] and slow in pub.connections
+
+
+def test_a_stalled_reader_that_reads_again_gets_its_backlog_first(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    writer, waits, clock, warnings = writer_and_waits(monkeypatch)
+    conn = TcpConnection('/recorder', space=30, reads_per_slice=0)
+    pub = FakePublisher([conn])
+    sent = b''.join(bytes([97 + i]) * 20 for i in range(10))
+    for i in range(5):
+        writer.write(pub, sent[i * 20:(i + 1) * 20])
+    assert len(writer.backlogs[conn].data) == 70
+    conn.socket.reads_per_slice = 9
+    conn.socket.read_some()  # it reads again (a disk that was slow for a moment)
+    for i in range(5, 10):
+        writer.write(pub, sent[i * 20:(i + 1) * 20])
+    assert writer.backlogs == {}, 'back to normal'
+    while conn.socket.in_buffer:
+        conn.socket.read_some()
+    assert bytes(conn.socket.received) == sent
+    assert warnings == []
+
+
+def test_nothing_backlogged_costs_one_send_per_connection(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    writer, waits, clock, warnings = writer_and_waits(monkeypatch)
+    connections = [TcpConnection('/a'), TcpConnection('/b')]
+    pub = FakePublisher(connections)
+    for _ in range(3):
+        writer.write(pub, b'step')
+    assert [c.socket.send_calls for c in connections] == [3, 3]
+    assert waits.slices == 0 and clock.now_s == 100.0
+
+
+def test_udp_connections_keep_their_sendall(monkeypatch: pytest.MonkeyPatch) -> None:
+    writer, waits, clock, warnings = writer_and_waits(monkeypatch)
+    udp = UdpConnection('/cpp_tutorial')
+    udp.socket.gettimeout = lambda: None
+    udp.socket.settimeout = lambda t: setattr(udp.socket, 'timeout', t)
+    pub = FakePublisher([udp])
+    writer.write(pub, b'two messages')
+    assert udp.socket.sent == [b'two messages'] and udp.socket.timeout == transport.SEND_TIMEOUT_S
+    assert writer.backlogs == {}
+
+
+def test_the_shutdown_hook_sends_what_a_live_subscriber_has_not_taken(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    writer, waits, clock, warnings = writer_and_waits(monkeypatch)
+    conn = TcpConnection('/recorder', space=10, reads_per_slice=0)
+    pub = FakePublisher([conn])
+    writer.write(pub, b'0123456789abcdef')
+    writer.write(pub, b'ghij')
+    assert bytes(writer.backlogs[conn].data) == b'abcdefghij'
+    conn.socket.reads_per_slice = 4  # the recorder reads again: the hook waits for it
+    writer.drain()
+    conn.socket.read_some()
+    conn.socket.read_some()
+    assert bytes(conn.socket.received) == b'0123456789abcdefghij'
+    assert writer.backlogs == {}
+
+
+def test_the_shutdown_hook_in_a_write_drains_only_while_it_waits(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """SIGINT runs rospy's hooks in the loop's thread, inside whatever it was doing."""
+    writer, waits, clock, warnings = writer_and_waits(monkeypatch)
+    conn = TcpConnection('/recorder', space=10, reads_per_slice=0)
+    pub = FakePublisher([conn])
+    writer.write(pub, b'0123456789')
+    writer.write(pub, b'abcd')  # waits one slice: the hook runs there
+    conn.socket.reads_per_slice = 4
+    conn.socket.read_some()
+    waits.during.append(writer.drain)
+    writer.write(pub, b'efgh')  # reads again: waited for, the hook drains from the wait
+    assert waits.during == [] and writer.backlogs == {}
+    while conn.socket.in_buffer:
+        conn.socket.read_some()
+    assert bytes(conn.socket.received) == b'0123456789abcdefgh', 'nothing twice, in order'
+    # Inside a write but not in its wait (a send in progress): the hook leaves it.
+    blocked = TcpConnection('/slow', space=2)
+    writer.write(FakePublisher([blocked]), b'xyzw')
+    blocked.socket.reads_per_slice = 3  # it would take the rest now
+    writer.lock.acquire()
+    writer._holder = threading.get_ident()
+    try:
+        writer.drain()
+    finally:
+        writer._holder = None
+        writer.lock.release()
+    assert bytes(writer.backlogs[blocked].data) == b'zw'
+
+
+class SocketPairConnection(FakeConnection):
+    """A TCPROS connection over a real socket pair: `peer` is the subscriber's end."""
+
+    transport_type = 'TCPROS'
+
+    def __init__(self, name: str) -> None:
+        super().__init__(name)
+        self.socket, self.peer = socket.socketpair()
+        for sock, option in ((self.socket, socket.SO_SNDBUF), (self.peer, socket.SO_RCVBUF)):
+            sock.setsockopt(socket.SOL_SOCKET, option, 4096)
+
+    def close(self):
+        self.closed = self.done = True
+        self.socket.close()
+
+
+def test_real_sockets_a_stalled_reader_is_left_then_drained_in_order(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """The same with the kernel's buffers and poll(): a write to a reader that takes
+    nothing returns (after one slice) with the rest kept; the hook sends it all once the
+    reader reads again."""
+    monkeypatch.setattr(transport.rospy, 'logwarn', lambda msg: pytest.fail(msg))
+    writer = transport.ConnectionWriter()
+    conn = SocketPairConnection('/recorder')
+    pub = FakePublisher([conn])
+    sent = bytes(range(256)) * 4096  # 1 MiB: far more than both buffers
+    writer.write(pub, sent[:1 << 19])
+    writer.write(pub, sent[1 << 19:])
+    assert conn.socket.gettimeout() == 0.0
+    assert len(writer.backlogs[conn].data) > 1 << 19, 'kept, not waited for'
+    received = bytearray()
+
+    def read() -> None:
+        while len(received) < len(sent):
+            received.extend(conn.peer.recv(1 << 16))
+
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    writer.drain(timeout_s=60.0)  # a guard only
+    reader.join(60.0)
+    assert writer.backlogs == {} and bytes(received) == sent
+    conn.close()
+    conn.peer.close()

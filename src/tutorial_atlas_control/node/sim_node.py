@@ -254,7 +254,11 @@ class SimNode:
         self.udpros = serve_udpros()
         self._advertise(tf)
         statistics = self._controller_statistics()
-        self.loop = SteppingLoop(sim, WireBatch(), self.publishers, rates_hz, statistics,
+        outbox = WireBatch()
+        # Before rospy closes the connections: what a stalled-then-live subscriber (the
+        # recorder) has not taken yet (transport.ConnectionWriter.drain).
+        rospy.on_shutdown(outbox.drain)
+        self.loop = SteppingLoop(sim, outbox, self.publishers, rates_hz, statistics,
                                  RosLog(), self._publish_config,
                                  real_time_factor=real_time_factor, paused=paused,
                                  publish_input=self._publish_input,
@@ -270,8 +274,9 @@ class SimNode:
 
         queue_size=None: plain synchronous connections, without rospy's per-message
         writer-thread handoff. A subscriber that cannot keep up slows the loop (TCP
-        back-pressure) instead of losing messages, until it has accepted nothing for
-        transport.SEND_TIMEOUT_S and is dropped.
+        back-pressure) instead of losing messages; one that stops reading is not waited
+        for, and is dropped once it has accepted nothing for transport.SEND_TIMEOUT_S
+        (node/transport.py).
         """
         published = LOOP_TOPICS + (((topics.TF, TFMessage),) if tf else ())
         with warnings.catch_warnings():

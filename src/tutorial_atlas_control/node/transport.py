@@ -2,60 +2,237 @@
 
 rospy's Publisher.publish() serializes with genpy and hands the bytes to a writer thread
 per subscriber; the simulator's loop instead collects each step's bytes per publisher in a
-WireBatch and writes each publisher's batch to its connections with one sendall on
-flush() (TCPROS is a byte stream: messages back to back are valid). The publishers are
-created with queue_size=None, so the sends are synchronous: a slow subscriber slows the
-loop rather than losing messages, until it is dropped (SEND_TIMEOUT_S).
+WireBatch and writes each publisher's batch to its connections with one send on flush()
+(TCPROS is a byte stream: messages back to back are valid). The publishers are created
+with queue_size=None: no rospy queue, the loop writes the sockets itself (ConnectionWriter).
+
+A TCP subscriber that reads slowly but keeps reading (the bag recorder at
+real_time_factor:=0) gets back-pressure: the loop waits for it and it loses nothing. One
+that stops reading (issue 29) is not waited for beyond STALL_PROBE_S: what it has not
+taken is kept in a bounded backlog while the loop and the other subscribers go on, and it
+is dropped once it has accepted nothing for SEND_TIMEOUT_S or its backlog passes
+MAX_BACKLOG_BYTES.
 """
 
 from __future__ import annotations
 
+import select
+import socket
+import threading
+import time
+from collections.abc import Callable
+
 import rospy
 from rospy.impl.tcpros_base import TransportTerminated
 
-__all__ = ['SEND_TIMEOUT_S', 'WireBatch', 'subscriber_names', 'write_to_connections']
+__all__ = ['MAX_BACKLOG_BYTES', 'SEND_TIMEOUT_S', 'STALL_PROBE_S', 'ConnectionWriter',
+           'WireBatch', 'subscriber_names']
 
-#: A subscriber that accepts nothing for this long (s) is dropped rather than left to stall
-#: the simulation: sends are synchronous so that slow subscribers lose nothing.
+#: A subscriber that accepts nothing for this long (s) is dropped: slow subscribers lose
+#: nothing, stalled ones do not hold their bytes (and the node's memory) forever.
 SEND_TIMEOUT_S = 2.0
+#: How long (s) one flush waits for a TCP subscriber whose kernel buffer is full before it
+#: keeps the rest in a backlog and goes on; as long as the subscriber takes bytes within
+#: each such slice, the flush keeps waiting (back-pressure, nothing lost).
+STALL_PROBE_S = 0.05
+#: A backlog past this (bytes) drops its subscriber at once: the memory bound per connection.
+MAX_BACKLOG_BYTES = 16 * 1024 * 1024
 
 
-def write_to_connections(pub: rospy.Publisher, data: bytes | bytearray) -> None:
-    """Send already-serialized TCPROS bytes to every subscriber of `pub`.
+def wait_writable(sock: socket.socket, timeout_s: float) -> bool:
+    """True once `sock` can take bytes, False after `timeout_s` (poll: no FD_SETSIZE limit)."""
+    poller = select.poll()
+    poller.register(sock, select.POLLOUT)
+    return bool(poller.poll(max(0.0, timeout_s) * 1000.0))
 
-    The socket is written directly (rospy's write_data mis-handles a send timeout); a
-    subscriber that is gone, or accepts nothing for SEND_TIMEOUT_S, is dropped. Once rospy
-    has shut the publisher down (node shutdown, from another thread), nothing is sent.
+
+class Backlog:
+    """What one TCP connection has not taken yet, and when it last took something."""
+
+    __slots__ = ('data', 'progress_s')
+
+    def __init__(self, data: bytes | bytearray, progress_s: float) -> None:
+        self.data = bytearray(data)
+        self.progress_s = progress_s
+
+
+class BacklogFull(OSError):
+    """A backlog past MAX_BACKLOG_BYTES (dropped like a send timeout, with its reason)."""
+
+
+class ConnectionWriter:
+    """Writes already-serialized TCPROS bytes to every subscriber of a publisher.
+
+    The socket is written directly (rospy's write_data mis-handles a send timeout). TCP
+    sockets are made non-blocking: with nothing backlogged, a flush costs one send() per
+    connection. UDPROS connections (node/udpros.py's DatagramStream) keep their sendall,
+    which cuts the batch into datagrams and never waits for the subscriber.
     """
-    impl = pub.impl
-    for connection in list(impl.connections):
-        sock = getattr(connection, 'socket', None)
-        try:
-            if sock is None or connection.done:
-                raise TransportTerminated('connection closed')
-            if sock.gettimeout() is None:
-                sock.settimeout(SEND_TIMEOUT_S)
-            sock.sendall(data)
-        except (TransportTerminated, OSError) as err:  # socket.timeout is an OSError
-            if impl.closed:  # rospy closed every connection and cannot remove one any more
-                return
-            if isinstance(err, (BrokenPipeError, ConnectionResetError, ConnectionRefusedError)):
-                # The subscriber exited (traj_yaml.py at its end): routine, as in rospy.
-                # Refused: a UDPROS subscriber's port is closed (node/udpros.py).
-                rospy.logdebug(f'{pub.resolved_name}: subscriber {connection.endpoint_id} left')
-            elif not isinstance(err, TransportTerminated):
-                rospy.logwarn(f'{pub.resolved_name}: dropping subscriber '
-                              f'{connection.endpoint_id}: {err}')
+
+    def __init__(self, clock: Callable[[], float] = time.monotonic,
+                 wait: Callable[[socket.socket, float], bool] = wait_writable) -> None:
+        self.clock = clock
+        self.wait = wait
+        #: TCP connections with bytes not taken yet (only those: the hot path is a miss).
+        self.backlogs: dict[object, Backlog] = {}
+        #: Held by write() and drain(): drain() runs in rospy's SIGINT handler, which runs
+        #: in the loop's thread, possibly in the middle of a write (see drain()).
+        self.lock = threading.Lock()
+        self._holder: int | None = None
+        #: True only while write() waits for a socket with every backlog committed.
+        self._waiting = False
+
+    def write(self, pub: rospy.Publisher, data: bytes | bytearray) -> None:
+        """Send `data` to every subscriber of `pub`; drop those that left or stalled. Once
+        rospy has shut the publisher down (node shutdown, from another thread), nothing
+        is sent."""
+        with self.lock:
+            self._holder = threading.get_ident()
             try:
-                impl.remove_connection(connection)
-            except (TypeError, AttributeError):
-                # rospy closed the publisher after the check above (another thread: a
-                # shutdown, such as a second atlas_sim registering): its listener list is
-                # gone, and with it every connection. Nothing left to send to.
-                if impl.closed:
+                self._write(pub, data)
+            finally:
+                self._holder = None
+
+    def _write(self, pub: rospy.Publisher, data: bytes | bytearray) -> None:
+        impl, backlogs = pub.impl, self.backlogs
+        if backlogs:
+            self._forget_closed()
+        for connection in list(impl.connections):
+            sock = getattr(connection, 'socket', None)
+            try:
+                if sock is None or connection.done:
+                    raise TransportTerminated('connection closed')
+                if getattr(connection, 'transport_type', None) != 'TCPROS':
+                    if sock.gettimeout() is None:
+                        sock.settimeout(SEND_TIMEOUT_S)
+                    sock.sendall(data)  # UDPROS: datagrams, never held by the subscriber
+                    continue
+                backlog = backlogs.get(connection)
+                if backlog is None:
+                    if sock.gettimeout() != 0.0:
+                        sock.setblocking(False)
+                    try:
+                        sent = sock.send(data)
+                    except BlockingIOError:
+                        sent = 0
+                    if sent == len(data):
+                        continue  # the hot path: everything taken at once
+                    backlog = backlogs[connection] = Backlog(memoryview(data)[sent:],
+                                                             self.clock())
+                    patient = True  # a live subscriber whose buffer is full: wait a slice
+                else:
+                    backlog.data += data
+                    patient = False  # stalled so far: wait only if it takes bytes again
+                self._send_backlog(sock, backlog, patient)
+                if not backlog.data:
+                    backlogs.pop(connection, None)  # back to normal
+                elif len(backlog.data) > MAX_BACKLOG_BYTES:
+                    raise BacklogFull(f'more than {MAX_BACKLOG_BYTES} bytes not taken')
+                elif self.clock() - backlog.progress_s >= SEND_TIMEOUT_S:
+                    raise TimeoutError(f'timed out: nothing taken for {SEND_TIMEOUT_S:g} s')
+            except (TransportTerminated, OSError) as err:  # socket.timeout is an OSError
+                backlogs.pop(connection, None)
+                if impl.closed:  # rospy closed every connection and cannot remove one any more
                     return
-                raise
-            connection.close()
+                if isinstance(err, (BrokenPipeError, ConnectionResetError,
+                                    ConnectionRefusedError)):
+                    # The subscriber exited (traj_yaml.py at its end): routine, as in rospy.
+                    # Refused: a UDPROS subscriber's port is closed (node/udpros.py).
+                    rospy.logdebug(f'{pub.resolved_name}: subscriber {connection.endpoint_id} '
+                                   'left')
+                elif not isinstance(err, TransportTerminated):
+                    rospy.logwarn(f'{pub.resolved_name}: dropping subscriber '
+                                  f'{connection.endpoint_id}: {err}')
+                try:
+                    impl.remove_connection(connection)
+                except (TypeError, AttributeError):
+                    # rospy closed the publisher after the check above (another thread: a
+                    # shutdown, such as a second atlas_sim registering): its listener list
+                    # is gone, and with it every connection. Nothing left to send to.
+                    if impl.closed:
+                        return
+                    raise
+                connection.close()
+
+    def _send_backlog(self, sock: socket.socket, backlog: Backlog, patient: bool) -> None:
+        """Send what `backlog` holds, in order. Without `patient`, give up at once unless
+        the subscriber takes bytes; once it does (or with `patient`), wait for it slice by
+        slice (STALL_PROBE_S) as long as it takes some within each slice."""
+        data = backlog.data
+        while data:
+            try:
+                sent = sock.send(data)
+            except BlockingIOError:
+                sent = 0
+            if sent:
+                del data[:sent]  # cheap: CPython drops a bytearray's head in place
+                backlog.progress_s = self.clock()
+                patient = True
+                continue
+            if not patient:
+                return
+            # Every byte not sent is in its backlog here: drain() may send them (see there).
+            self._waiting = True
+            ready = self.wait(sock, STALL_PROBE_S)
+            self._waiting = False
+            if not ready:
+                return
+
+    def _forget_closed(self) -> None:
+        """Backlogs of connections rospy closed (subscriber gone): not kept in memory."""
+        for connection in [c for c in self.backlogs if c.done or c.socket is None]:
+            del self.backlogs[connection]
+
+    def drain(self, timeout_s: float = SEND_TIMEOUT_S) -> None:
+        """Send every backlog, waiting up to `timeout_s` in all: the rospy.on_shutdown hook.
+
+        rospy's signal_shutdown runs client hooks, then closes every publisher connection:
+        without this, what a live subscriber had not taken yet (the recorder's last joint
+        states, stamped before a /clock value it already has) would be lost. On SIGINT the
+        hook runs in the loop's own thread, between two bytecodes of whatever it was doing,
+        possibly inside write(). Waiting for the lock there would deadlock, and a write
+        interrupted between a send() and the bookkeeping of what it sent cannot be
+        resumed by anyone else. So: the lock is taken without waiting; if write() holds it
+        in this thread, the backlogs are drained only when it is inside its wait for a
+        socket (every unsent byte is in its backlog then, and the write() then resumes on
+        sockets that rospy has closed, and stops), else they are left (a rare, short
+        window: the bytes of one send in progress). From another thread (a shutdown
+        requested elsewhere), the lock is waited for.
+        """
+        if self.lock.acquire(blocking=False):
+            try:
+                self._drain(timeout_s)
+            finally:
+                self.lock.release()
+        elif self._holder == threading.get_ident():
+            if self._waiting:
+                self._drain(timeout_s)
+        elif self.lock.acquire(timeout=timeout_s):
+            try:
+                self._drain(timeout_s)
+            finally:
+                self.lock.release()
+
+    def _drain(self, timeout_s: float) -> None:
+        deadline_s = self.clock() + timeout_s
+        for connection, backlog in list(self.backlogs.items()):
+            sock, data = getattr(connection, 'socket', None), backlog.data
+            try:
+                while data and not connection.done and sock is not None:
+                    try:
+                        sent = sock.send(data)
+                    except BlockingIOError:
+                        sent = 0
+                    if sent:
+                        del data[:sent]
+                        continue
+                    remaining_s = deadline_s - self.clock()
+                    if remaining_s <= 0.0 or not self.wait(sock, remaining_s):
+                        break
+            except OSError:
+                pass  # the subscriber is gone: nothing to save
+            if not data:
+                self.backlogs.pop(connection, None)
 
 
 def subscriber_names(pub: rospy.Publisher) -> set[str]:
@@ -70,14 +247,18 @@ def subscriber_names(pub: rospy.Publisher) -> set[str]:
 
 
 class WireBatch:
-    """Per-publisher byte batches, written on flush() with one sendall per connection.
+    """Per-publisher byte batches, written on flush() with one send per connection.
 
     Replaced outlets (/clock: only its latest value goes out) are written after the
     batches, so a subscriber never gets a time before the messages stamped with it, even
-    when the node stops in the middle of a flush.
+    when the node stops in the middle of a flush. With a backlog (a subscriber that
+    stalled, ConnectionWriter) this holds per connection: the recorder's /clock connection
+    may be ahead of its joint states one until the backlog drains; drain() (an on_shutdown
+    hook, sim_node.py) sends what is left when the node stops.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, writer: ConnectionWriter | None = None) -> None:
+        self.writer = writer if writer is not None else ConnectionWriter()
         self.pending: dict[rospy.Publisher, bytearray] = {}
         self.latest: dict[rospy.Publisher, bytearray] = {}
 
@@ -102,6 +283,11 @@ class WireBatch:
     def flush(self) -> None:
         pending, self.pending = self.pending, {}
         latest, self.latest = self.latest, {}
+        write = self.writer.write
         for batches in (pending, latest):
             for pub, data in batches.items():
-                write_to_connections(pub, data)
+                write(pub, data)
+
+    def drain(self) -> None:
+        """Send what stalled connections still hold (rospy.on_shutdown: see ConnectionWriter)."""
+        self.writer.drain()

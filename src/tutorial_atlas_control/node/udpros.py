@@ -11,7 +11,7 @@ for an offered ['UDPROS', header, host, port, max_datagram_size] it checks the h
 opens a UDP socket connected to the subscriber, and adds a UdprosConnection to the topic's
 publisher like a TCPROS connection. Both publish paths then reach it:
 
-- the stepping loop's (transport.write_to_connections): it writes each publisher's batch
+- the stepping loop's (transport.ConnectionWriter): it writes each publisher's batch
   of TCPROS-framed messages with `connection.socket.sendall(batch)`; here `socket` is a
   DatagramStream, which cuts the batch into messages and sends each as its datagrams, so
   the TCP path is untouched;
@@ -54,7 +54,7 @@ LOOPBACK_NAMES = ('localhost', '127.', '::1')
 
 
 class DatagramStream:
-    """A UDPROS connection seen as the byte stream transport.write_to_connections writes:
+    """A UDPROS connection seen as the byte stream transport.ConnectionWriter writes:
     sendall() takes TCPROS-framed messages back to back and sends each as its datagrams.
 
     A lock keeps one message's datagrams together when two threads send (rospy's latched
