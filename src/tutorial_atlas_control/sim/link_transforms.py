@@ -101,9 +101,11 @@ class LinkTransforms:
         # A prismatic joint slides along its axis as seen in the parent (origin-rotated).
         self._slide_axes = np.array([rotate(q, a) for q, a in zip(self._origin_quat, axes)])
         self._slide_axes[self._rotating] = 0.0
-        self._rot_axes = axes * self._rotating[:, None]
+        # origin * (axis sin(q/2), cos(q/2)) = sin(q/2) origin * (axis, 0) + cos(q/2) origin:
+        # two constant quaternions per joint, so a publication costs two products and a sum.
+        rot_axes = np.c_[axes * self._rotating[:, None], np.zeros(len(moving))]
+        self._sin_part = quaternion_multiply(self._origin_quat, rot_axes).reshape(-1, 4)
         self._has_sliding = not bool(np.all(self._rotating))
-        self._motion = np.zeros((len(moving), 4))
         #: Fixed joints, published once on /tf_static (in joint name order).
         self.static: tuple[StaticTransform, ...] = tuple(
             StaticTransform(j.parent, j.child, np.array(j.origin_m, dtype=float),
@@ -118,11 +120,9 @@ class LinkTransforms:
         """Write each moving joint's transform for `positions` (rad or m, in position_names
         order) into `translations` (N, 3) and `rotations_xyzw` (N, 4) (views of a wire)."""
         q = positions[self.position_index]
-        half = 0.5 * q * self._rotating
-        motion = self._motion
-        motion[:, :3] = self._rot_axes * np.sin(half)[:, None]
-        motion[:, 3] = np.cos(half)
-        rotations_xyzw[:] = quaternion_multiply(self._origin_quat, motion)
+        half = (0.5 * q * self._rotating)[:, None]
+        np.multiply(self._sin_part, np.sin(half), out=rotations_xyzw)
+        rotations_xyzw += self._origin_quat * np.cos(half)
         if self._has_sliding:
             translations[:] = self._origin_xyz + self._slide_axes * q[:, None]
         else:
