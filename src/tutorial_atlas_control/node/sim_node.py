@@ -28,7 +28,8 @@ Parameters (private unless noted):
         /atlas/atlas_state, /atlas/force_torque_sensors, /atlas/debug/{l,r}_foot_contact
         (those only while the foot touches something); each filled only while subscribed.
     ~odom_rate (Hz, 100): /ground_truth_odom rate, as DRCSim.
-    ~tf (bool, true): broadcast world -> pelvis on /tf from the ground truth, if the model
+    ~tf (bool, true): broadcast world -> pelvis on /tf from the ground truth (and, with
+        ~tf_publisher sim, the links), if the model
         has a matching URDF (urdf.matching_urdf); else one warning and no /tf.
     ~tf_rate (Hz, 100): /tf rate.
     ~tf_publisher (str, sim): who publishes the links' transforms. sim: this node sets
@@ -146,7 +147,7 @@ TF_PUBLISHERS = ('sim', 'robot_state_publisher')
 TF_STATIC = '/tf_static'
 
 #: What the stepping loop publishes through the node's publishers, with their types; /tf
-#: (world -> pelvis; robot_state_publisher adds the links) only with ~tf.
+#: (world -> pelvis, and the links with ~tf_publisher sim) only with ~tf.
 LOOP_TOPICS = (
     (topics.CLOCK, Clock), (topics.JOINT_STATES, JointState),
     (topics.GROUND_TRUTH_ODOM, Odometry), (topics.IMU, Imu),
