@@ -75,9 +75,10 @@ def make_probes() -> Probes:
 
 
 def _launch(master: Master, launch_file: str, work_dir: Path, name: str,
-            rtf: float, recorder: str | None = None) -> Launch:
+            rtf: float, recorder: str | None = None,
+            extra_args: dict[str, str] | None = None) -> Launch:
     args = {'gui': 'false', 'real_time_factor': str(rtf), 'record': 'true',
-            'bag_dir': str(work_dir / f'{name}_bags')}
+            'bag_dir': str(work_dir / f'{name}_bags'), **(extra_args or {})}
     if recorder:
         args['recorder'] = recorder
     return Launch(master, launch_file, args, work_dir / f'{name}.launch.log')
@@ -129,10 +130,11 @@ def _clock_series(samples: list[tuple[float, bytes]]) -> tuple[np.ndarray, np.nd
 
 def fast_run(master: Master, launch_file: str, probes: Probes, work_dir: Path, name: str,
              warmup_s: float, window_s: float, recorder: str,
-             prefix: str = 'fast') -> dict[str, float]:
+             prefix: str = 'fast', extra_args: dict[str, str] | None = None) -> dict[str, float]:
     """One run at real_time_factor:=0: `<prefix>_rtf`, `<prefix>_recorded_fraction`, and the
-    CPU (cores) of each process that shares the machine's cores at that pace."""
-    with _launch(master, launch_file, work_dir, name, 0.0, recorder) as launch:
+    CPU (cores) of each process that shares the machine's cores at that pace (`extra_args`:
+    more launch arguments)."""
+    with _launch(master, launch_file, work_dir, name, 0.0, recorder, extra_args) as launch:
         _wait_ready(master, launch, probes)
         time.sleep(warmup_s)
         pids = {'node': launch.node_pid('atlas_sim'), 'recorder': launch.node_pid('recorder'),

@@ -103,7 +103,10 @@ ROWS = (
     ('fast_recorder_cpu', 'recorder CPU at rtf:=0', 'cores', '', 2),
     ('recorder_us_per_step', 'recorder CPU per step at rtf:=0', 'us', '', 1),
     ('fast_state_publisher_cpu', 'robot_state_publisher CPU at rtf:=0', 'cores', '', 2),
-    ('fast_master_cpu', 'rosmaster CPU at rtf:=0', 'cores', '', 2),
+    ('fast_master_cpu', 'rosmaster CPU at rtf:=0', 'cores', '< 0.01', 3),
+    ('fast_rsp_master_cpu', 'rosmaster CPU, RSP publishing links', 'cores', '', 3),
+    ('fast_rsp_state_publisher_cpu', 'robot_state_publisher CPU then', 'cores', '', 3),
+    ('fast_rsp_rtf', 'node rtf:=0 + recorder, RSP on', 'x real time', '', 2),
     ('fast_cpu_us_per_step', 'all of them: CPU per step at rtf:=0', 'us', '', 1),
     ('fast_recorded_fraction', 'joint_states recorded at rtf:=0', 'fraction', '1', 4),
     ('fast_rosbag_rtf', 'same, `rosbag record` recording', 'x real time', '', 2),
@@ -197,6 +200,8 @@ TARGETS = {
     'node_us_per_step': Target(high=1.5, per_bare='us'),
     'node_bare_ratio': Target(high=1.5),
     'fast_recorded_fraction': Target(low=1.0, high=1.0),
+    # Issue 28: with TF on (the simulator publishing the links), the master idles.
+    'fast_master_cpu': Target(high=0.01, strict=True),
     'realtime_rtf': Target(low=0.99, high=1.01),
     'lateness_p99_ms': Target(high=2.0, strict=True),
     'cmd_latency_p99_ms_50hz': Target(high=2.0, strict=True),
@@ -226,7 +231,8 @@ EXPECTED = {
                  'analysis_speedup'),
     'fast': ('fast_rtf', 'fast_recorded_fraction', 'fast_node_cpu', 'fast_recorder_cpu',
              'node_us_per_step', 'recorder_us_per_step', 'fast_cpu_us_per_step',
-             'fast_rosbag_rtf', 'fast_rosbag_recorded_fraction'),
+             'fast_rosbag_rtf', 'fast_rosbag_recorded_fraction', 'fast_master_cpu',
+             'fast_rsp_rtf', 'fast_rsp_master_cpu', 'fast_rsp_state_publisher_cpu'),
     'realtime': ('realtime_rtf', 'lateness_p50_ms', 'lateness_p99_ms', 'lateness_max_ms',
                  'js_transport_p50_ms', 'js_transport_p99_ms', 'cmd_latency_p50_ms',
                  'cmd_latency_p99_ms', 'cmd_applied_1khz',
@@ -485,13 +491,20 @@ def run_fast(args, samples, master, probes, work_dir) -> None:  # noqa: ANN001
 
     for run in range(args.runs):
         values = {}
-        for recorder, prefix in (('atlas_recorder', 'fast'), ('rosbag', 'fast_rosbag')):
+        # Then with Debian's robot_state_publisher publishing the links (issue 28: the
+        # master's and its CPU, beside the default's).
+        for recorder, prefix, extra in (
+                ('atlas_recorder', 'fast', None), ('rosbag', 'fast_rosbag', None),
+                ('atlas_recorder', 'fast_rsp', {'tf_publisher': 'robot_state_publisher'})):
             values.update(online.fast_run(
                 master, args.launch_file, probes, work_dir, f'{prefix}{run + 1}',
                 warmup_s=2.0, window_s=4.0 if args.quick else 10.0, recorder=recorder,
-                prefix=prefix))
+                prefix=prefix, extra_args=extra))
         log(f'fast run {run + 1}: rtf {values["fast_rtf"]:.3f} (atlas_recorder), '
-            f'{values["fast_rosbag_rtf"]:.3f} (rosbag record)')
+            f'{values["fast_rosbag_rtf"]:.3f} (rosbag record); master '
+            f'{values["fast_master_cpu"]:.4f} cores, with robot_state_publisher '
+            f'{values["fast_rsp_master_cpu"]:.4f} (it: '
+            f'{values.get("fast_rsp_state_publisher_cpu", 0.0):.3f})')
         add(samples, values)
 
 

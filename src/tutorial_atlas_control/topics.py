@@ -39,7 +39,8 @@ JOINT_TRAJECTORY = '/joint_trajectory'
 CONFIGURATION = '/atlas/configuration'
 #: JSON, one per applied cheat: when it took effect (sim time, ns) and what, for replay.
 SIM_INPUTS = '/atlas/sim_inputs'
-#: world -> pelvis from the simulator; robot_state_publisher adds the links.
+#: world -> pelvis from the simulator, and the links (the simulator's, or with
+#: tf_publisher:=robot_state_publisher that node's).
 TF = '/tf'
 #: atlas_msgs/AtlasCommand (2.7.0): commands with k_effort, beside JointCommands.
 ATLAS_COMMAND = '/atlas/atlas_command'
@@ -51,7 +52,8 @@ SYNCHRONIZATION_STATISTICS = '/atlas/synchronization_statistics'
 SYNC_DELAY = '/atlas/debug/sync_delay'
 #: atlas_msgs/ResetControls: reset the PID, reload the gains or load an AtlasCommand.
 RESET_CONTROLS_SERVICE = '/atlas/reset_controls'
-#: The URDF of the simulated model (set by atlas.launch's state_publisher.py).
+#: The URDF of the simulated model (set by the simulator, or with
+#: tf_publisher:=robot_state_publisher by atlas.launch's state_publisher.py).
 ROBOT_DESCRIPTION_PARAM = '/robot_description'
 
 #: What scripts/record_run.sh records: the simulator's output, the commands and modes that

@@ -37,7 +37,7 @@ from tutorial_atlas_control.stepping.schedule import steps_between
 #: Sim time (s) recorded after the launch is ready.
 RUN_S = 4.0
 STEP_NS = 1_000_000
-#: The simulator's own transform on /tf (robot_state_publisher sends the links' there too).
+#: The simulator's own transform on /tf (the links' transforms go there too, at 50 Hz).
 PELVIS_TF = ('world', 'pelvis')
 
 WRAPPER = '''<launch>

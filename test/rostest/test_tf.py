@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
-"""rostest: atlas.launch publishes the robot to TF (robot_description, robot_state_publisher,
+"""rostest: atlas.launch publishes the robot to TF (robot_description, the links' transforms,
 world -> pelvis from the simulator), as rviz needs it.
 
-The launch starts paused; the test subscribes to /tf and /ground_truth_odom, waits for both
-/tf publishers (the simulator and robot_state_publisher), then unpauses: it sees /tf from
-sim time 0.
+The launch starts paused; the test subscribes to /tf and /ground_truth_odom, waits for the
+/tf publishers (the simulator; with tf_publisher:=robot_state_publisher, that node too),
+then unpauses: it sees /tf from sim time 0.
 """
 
 from __future__ import annotations
@@ -59,9 +59,10 @@ class TfTest(unittest.TestCase):
         tf_sub = rospy.Subscriber('/tf', TFMessage, cls._on_tf, queue_size=1000)
         rospy.Subscriber('/ground_truth_odom', Odometry, cls._on_odom, queue_size=1000)
         rospy.Subscriber('/clock', Clock, cls._on_clock, queue_size=10)
-        cls._wait(lambda: tf_sub.get_num_connections() >= 2 and cls.listener is not None
-                  and rospy.has_param('/robot_description'),
-                  'the simulator and robot_state_publisher to publish /tf')
+        publishers = 2 if rospy.get_param('/atlas_sim/tf_publisher') != 'sim' else 1
+        cls._wait(lambda: tf_sub.get_num_connections() >= publishers
+                  and cls.listener is not None and rospy.has_param('/robot_description'),
+                  f'{publishers} publishers of /tf')
         time.sleep(1.0)  # the listener's own /tf subscription connects too
         rospy.wait_for_service('/gazebo/unpause_physics', timeout=WALL_TIMEOUT_S)
         rospy.ServiceProxy('/gazebo/unpause_physics', Empty)()

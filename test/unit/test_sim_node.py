@@ -223,6 +223,7 @@ def test_startup_mode_parameter_is_checked(monkeypatch: pytest.MonkeyPatch) -> N
         topics.STARTUP_MODE_PARAM: 'harnessed'}
     monkeypatch.setattr(sim_node.rospy, 'get_param',
                         lambda name, default=None: params.get(name, default))
+    monkeypatch.setattr(sim_node.rospy, 'set_param', params.__setitem__)
     with pytest.raises(sim_node.AtlasControlError,
                        match='^parameter /atlas/startup_mode must be one of pinned_with_gravity, '
                              "pinned, bdi_stand, got 'harnessed'$"):
@@ -230,3 +231,32 @@ def test_startup_mode_parameter_is_checked(monkeypatch: pytest.MonkeyPatch) -> N
     params[topics.STARTUP_MODE_PARAM] = 'bdi_stand'
     monkeypatch.setattr(sim_node, 'SimNode', lambda sim, *args: sim)
     assert sim_node.build_node().startup_mode is VrcMode.BDI_STAND
+
+
+def test_tf_publisher_parameter_chooses_who_publishes_the_links(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """~tf_publisher: sim (default) sets /robot_description and hands the loop the links;
+    robot_state_publisher leaves both to state_publisher.py; anything else is refused."""
+    params: dict[str, Any] = {
+        'atlas_controller/gains': yaml.safe_load(CONFIG.read_text())['atlas_controller']['gains']}
+    monkeypatch.setattr(sim_node.rospy, 'get_param',
+                        lambda name, default=None: params.get(name, default))
+    monkeypatch.setattr(sim_node.rospy, 'set_param', params.__setitem__)
+    monkeypatch.setattr(sim_node.rospy, 'resolve_name', lambda name: '/atlas_sim/' + name[1:])
+    built: list[tuple[Any, ...]] = []
+    monkeypatch.setattr(sim_node, 'SimNode', lambda *args: built.append(args))
+    sim_node.build_node()
+    tf, links = built[-1][5], built[-1][7]
+    assert tf and links.frames[:2] == (('pelvis', 'ltorso'), ('ltorso', 'mtorso'))
+    assert len(links) == 28 and links.static == ()
+    assert params[topics.ROBOT_DESCRIPTION_PARAM].startswith('<?xml')
+    del params[topics.ROBOT_DESCRIPTION_PARAM]
+    params['~tf_publisher'] = 'robot_state_publisher'
+    sim_node.build_node()
+    assert built[-1][5] and built[-1][7] is None
+    assert topics.ROBOT_DESCRIPTION_PARAM not in params
+    params['~tf_publisher'] = 'rsp'
+    with pytest.raises(sim_node.AtlasControlError,
+                       match="^parameter /atlas_sim/tf_publisher must be one of sim, "
+                             "robot_state_publisher, got 'rsp'$"):
+        sim_node.build_node()

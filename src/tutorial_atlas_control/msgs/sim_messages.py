@@ -24,9 +24,11 @@ from tutorial_atlas_control.msgs.wire import (
     JointStateWire,
     OdometryWire,
     StampedWire,
+    TransformsWire,
     TransformWire,
     WrenchStampedWire,
 )
+from tutorial_atlas_control.sim.link_transforms import LinkTransforms
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
 from tutorial_atlas_control.topics import PELVIS_FRAME, WORLD_FRAME
 
@@ -75,6 +77,7 @@ class SimMessages:
         self.imu_wire = ImuWire(PELVIS_FRAME)
         self.contact_wires = {side: WrenchStampedWire(f'{side}_foot') for side in 'lr'}
         self.pelvis_tf_wire = TransformWire(WORLD_FRAME, PELVIS_FRAME)
+        self.links: LinkTransforms | None = None  # see use_link_transforms
         model = sim.model
         adr = {name: int(model.sensor_adr[model.sensor(name).id]) for name in SENSOR_NAMES}
         orientation = adr['imu_orientation']
@@ -242,3 +245,19 @@ class SimMessages:
     def pelvis_tf(self, stamp_ns: int) -> bytes:
         self.fill_pelvis_tf()
         return self.pelvis_tf_wire.to_bytes(stamp_ns)
+
+    # -- the links' transforms, in robot_state_publisher's stead (link_transforms.py) ------
+    def use_link_transforms(self, links: LinkTransforms) -> None:
+        """Lay out the links' /tf message for `links` (built on JOINT_NAMES' positions)."""
+        self.links = links
+        self.links_tf_wire = TransformsWire(links.frames)
+        self._links_qpos_adr = self.sim.atlas.qpos_adr
+
+    def links_tf(self, stamp_ns: int) -> bytearray:
+        """Every moving joint's parent -> child transform at the joint positions now (those
+        /atlas/joint_states carries when stamped with `sim.sim_time_ns`), stamped
+        `stamp_ns`: the wire's buffer, valid until the next call."""
+        wire = self.links_tf_wire
+        self.links.compute(self.sim.data.qpos[self._links_qpos_adr], wire.translations,
+                           wire.rotations_xyzw)
+        return wire.stamped(stamp_ns)

@@ -211,6 +211,52 @@ class TransformWire:
         return bytes(self.buf)
 
 
+class TransformsWire:
+    """tf2_msgs/TFMessage holding one geometry_msgs/TransformStamped per (parent, child) of
+    `frames`, all stamped alike (robot_state_publisher's moving joints); `translations`
+    (N, 3) and `rotations_xyzw` (N, 4) are views of a staging block.
+
+    The transforms' numbers sit between names of varying length, so they are not one
+    strided view of the message: stamped() scatters the staging block (stamp and seven
+    float64s per transform) into the message with one precomputed byte index. The headers'
+    seq stays 0, as roscpp leaves it in a TFMessage.
+    """
+
+    _STAGE = np.dtype([('secs', '<u4'), ('nsecs', '<u4'), ('floats', '<f8', (7,))])
+
+    def __init__(self, frames: Sequence[tuple[str, str]]) -> None:
+        parts = [struct.pack('<II', 0, len(frames))]  # TCPROS length (set below), count
+        starts = []  # byte offset of each transform's stamp, then of its floats
+        at = 8
+        for parent, child in frames:
+            names = _string(parent) + _string(child)
+            starts.append((at + 4, at + 12 + len(names)))
+            parts.append(bytes(12) + names + bytes(56))
+            at += 12 + len(names) + 56
+        self.buf = bytearray(b''.join(parts))
+        struct.pack_into('<I', self.buf, 0, len(self.buf) - 4)
+        self._bytes = np.frombuffer(self.buf, dtype=np.uint8)
+        self._stage = np.zeros(len(frames), dtype=self._STAGE)
+        self._index = np.array([np.r_[stamp:stamp + 8, floats:floats + 56]
+                                for stamp, floats in starts], dtype=np.intp).reshape(-1)
+        self._stage_bytes = self._stage.view(np.uint8).reshape(-1)
+        self.translations = self._stage['floats'][:, 0:3]
+        self.rotations_xyzw = self._stage['floats'][:, 3:7]
+        self.rotations_xyzw[:, 3] = 1.0
+
+    def stamped(self, stamp_ns: int) -> bytearray:
+        """The message with every transform stamped `stamp_ns`: the buffer itself, valid
+        until the next call."""
+        secs, nsecs = divmod(stamp_ns, NS_PER_S)
+        self._stage['secs'] = secs
+        self._stage['nsecs'] = nsecs
+        self._bytes[self._index] = self._stage_bytes
+        return self.buf
+
+    def to_bytes(self, stamp_ns: int) -> bytes:
+        return bytes(self.stamped(stamp_ns))
+
+
 def clock_bytes(stamp_ns: int) -> bytes:
     """rosgraph_msgs/Clock with its TCPROS length prefix."""
     secs, nsecs = divmod(stamp_ns, NS_PER_S)

@@ -28,9 +28,15 @@ Parameters (private unless noted):
         /atlas/atlas_state, /atlas/force_torque_sensors, /atlas/debug/{l,r}_foot_contact
         (those only while the foot touches something); each filled only while subscribed.
     ~odom_rate (Hz, 100): /ground_truth_odom rate, as DRCSim.
-    ~tf (bool, true): broadcast world -> pelvis on /tf from the ground truth, if the model
+    ~tf (bool, true): broadcast world -> pelvis on /tf from the ground truth (and, with
+        ~tf_publisher sim, the links), if the model
         has a matching URDF (urdf.matching_urdf); else one warning and no /tf.
     ~tf_rate (Hz, 100): /tf rate.
+    ~tf_publisher (str, sim): who publishes the links' transforms. sim: this node sets
+        /robot_description and publishes, in robot_state_publisher's stead and equal to
+        it, every moving joint's transform on /tf at ~links_tf_rate (Hz of sim time, 50)
+        and the fixed joints on latched /tf_static (sim/link_transforms.py);
+        robot_state_publisher: atlas.launch's state_publisher.py does both.
     ~bag_dir (str, unset): where the launch's recorder writes; if set and no file can be
         written there, the node refuses to start (one line).
     ~model_file (str, the package's sim/atlas_v1.xml): the MJCF to simulate; it must have
@@ -69,7 +75,7 @@ from atlas_msgs.msg import (
     Test,
 )
 from atlas_msgs.srv import ResetControls, ResetControlsResponse
-from geometry_msgs.msg import Pose, Twist, Wrench, WrenchStamped
+from geometry_msgs.msg import Pose, TransformStamped, Twist, Wrench, WrenchStamped
 from nav_msgs.msg import Odometry
 from osrf_msgs.msg import JointCommands
 from rosgraph_msgs.msg import Clock
@@ -82,6 +88,7 @@ from trajectory_msgs.msg import JointTrajectory
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags.bag_dir import unwritable_reason
 from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.node.master_watch import start_master_watch
 from tutorial_atlas_control.node.recorder_watch import start_recorder_watch
 from tutorial_atlas_control.node.transport import WireBatch
@@ -96,13 +103,14 @@ from tutorial_atlas_control.sim.controller_statistics import (
     WINDOW_PARAM,
     CommandAgeStatistics,
 )
+from tutorial_atlas_control.sim.link_transforms import LinkTransforms
 from tutorial_atlas_control.sim.simulator import (
     DEFAULT_TIME_TO_UNPIN_S,
     AtlasSimulator,
     ModeError,
     parse_mode,
 )
-from tutorial_atlas_control.sim.urdf import UrdfError, matching_urdf
+from tutorial_atlas_control.sim.urdf import UrdfError, matching_urdf, read_joints
 from tutorial_atlas_control.sim.vrc import (
     DEFAULT_STARTUP_MODE,
     STARTUP_MODES,
@@ -116,7 +124,11 @@ from tutorial_atlas_control.sim.vrc import (
     trajectory_input,
     wrench_input,
 )
-from tutorial_atlas_control.stepping.loop import ResetControlsRequest, SteppingLoop
+from tutorial_atlas_control.stepping.loop import (
+    LINKS_TF_RATE_HZ,
+    ResetControlsRequest,
+    SteppingLoop,
+)
 from tutorial_atlas_control.stepping.synchronization import DelayBudgets, SynchronizationWindow
 from tutorial_atlas_control.units import finite_number
 
@@ -129,8 +141,13 @@ WARN_THROTTLE_S = 2.0
 VIEWER_FRAME_PERIOD_S = 1.0 / 30.0
 VIEWER_TURN_S = 0.005
 VIEWER_HOLD_S = VIEWER_FRAME_PERIOD_S - VIEWER_TURN_S
+#: Who publishes the links' transforms (~tf_publisher; the first is the default).
+TF_PUBLISHERS = ('sim', 'robot_state_publisher')
+#: robot_state_publisher's latched topic of the fixed joints' transforms.
+TF_STATIC = '/tf_static'
+
 #: What the stepping loop publishes through the node's publishers, with their types; /tf
-#: (world -> pelvis; robot_state_publisher adds the links) only with ~tf.
+#: (world -> pelvis, and the links with ~tf_publisher sim) only with ~tf.
 LOOP_TOPICS = (
     (topics.CLOCK, Clock), (topics.JOINT_STATES, JointState),
     (topics.GROUND_TRUTH_ODOM, Odometry), (topics.IMU, Imu),
@@ -247,7 +264,8 @@ class SimNode:
 
     def __init__(self, sim: AtlasSimulator, real_time_factor: float, paused: bool,
                  rates_hz: dict[str, float], gui: bool, tf: bool = False,
-                 sync_budgets: DelayBudgets | None = None) -> None:
+                 sync_budgets: DelayBudgets | None = None,
+                 links: LinkTransforms | None = None) -> None:
         self.sim = sim
         self.gui = gui
         # UDPROS for roscpp's unreliable() subscribers, before the master announces a topic.
@@ -264,7 +282,10 @@ class SimNode:
                                  publish_input=self._publish_input,
                                  synchronization=SynchronizationWindow(
                                      sync_budgets or DelayBudgets()),
-                                 latch_synchronization=self._latch_synchronization)
+                                 latch_synchronization=self._latch_synchronization,
+                                 links=links if tf else None)
+        if tf and links is not None:
+            self._publish_static_transforms(links)
         self.loop.publish_config()
         self.mode_pub.publish(String(data=sim.mode.value))
         self._subscribe()
@@ -294,6 +315,22 @@ class SimNode:
         # Latched: the mode now, for traj_yaml.py's warning and `rostopic echo`.
         self.mode_pub = rospy.Publisher(topics.CURRENT_CONTROL_MODE, String, queue_size=1,
                                         latch=True)
+
+    def _publish_static_transforms(self, links: LinkTransforms) -> None:
+        """The fixed joints once on latched /tf_static, as robot_state_publisher 1.15 does
+        (an empty message for a robot without any)."""
+        stamp = genpy.Time(*divmod(self.sim.sim_time_ns, 1_000_000_000))
+        message = TFMessage()
+        for fixed in links.static:
+            transform = TransformStamped()
+            transform.header.stamp = stamp
+            transform.header.frame_id, transform.child_frame_id = fixed.parent, fixed.child
+            t, r = transform.transform.translation, transform.transform.rotation
+            t.x, t.y, t.z = (float(v) for v in fixed.translation_m)
+            r.x, r.y, r.z, r.w = (float(v) for v in fixed.rotation_xyzw)
+            message.transforms.append(transform)
+        self.static_tf_pub = rospy.Publisher(TF_STATIC, TFMessage, queue_size=1, latch=True)
+        self.static_tf_pub.publish(message)
 
     def _controller_statistics(self) -> CommandAgeStatistics:
         """DRCSim's command age statistics, from the parameters (fed and published by the
@@ -530,7 +567,12 @@ def build_node() -> SimNode:
         'atlas_state': _float_param('~atlas_state_rate', 1000.0),
         'force_torque_sensors': _float_param('~force_torque_sensors_rate', 1000.0),
         'debug_contact': _float_param('~debug_contact_rate', 1000.0),
+        'links_tf': _float_param('~links_tf_rate', LINKS_TF_RATE_HZ, minimum=1.0),
     }
+    tf_publisher = rospy.get_param('~tf_publisher', TF_PUBLISHERS[0])
+    if tf_publisher not in TF_PUBLISHERS:
+        raise AtlasControlError(f'parameter {rospy.resolve_name("~tf_publisher")} must be one '
+                                f'of {", ".join(TF_PUBLISHERS)}, got {tf_publisher!r}')
     model_file = rospy.get_param('~model_file', str(atlas_model.MODEL_PATH))
     if not isinstance(model_file, str) or not model_file:
         raise AtlasControlError(f'parameter {rospy.resolve_name("~model_file")} must be the '
@@ -541,10 +583,12 @@ def build_node() -> SimNode:
                                 f'{", ".join(STARTUP_MODES)}, got {startup_mode!r}')
     sim = AtlasSimulator(atlas_model.load_model(Path(model_file)), gains, time_to_unpin_s,
                          startup_mode=VrcMode(startup_mode))
+    description = _tf_wanted(Path(model_file), sim)
     return SimNode(sim, _float_param('~real_time_factor', 1.0),
                    bool(rospy.get_param('~paused', False)), rates_hz,
-                   bool(rospy.get_param('~gui', False)), _tf_wanted(Path(model_file), sim),
-                   DelayBudgets.from_params(rospy.get_param))
+                   bool(rospy.get_param('~gui', False)), description is not None,
+                   DelayBudgets.from_params(rospy.get_param),
+                   _links_publisher(description) if tf_publisher == 'sim' else None)
 
 
 def _check_bag_dir() -> None:
@@ -558,14 +602,25 @@ def _check_bag_dir() -> None:
                                 'not be recorded; give a writable bag_dir:=, or record:=false')
 
 
-def _tf_wanted(model_file: Path, sim: AtlasSimulator) -> bool:
-    """~tf, unless the model has no matching URDF: then one warning saying why."""
+def _tf_wanted(model_file: Path, sim: AtlasSimulator) -> str | None:
+    """The model's URDF if ~tf, unless the model has none matching: then one warning
+    saying why, and None (as for ~tf false)."""
     if not rospy.get_param('~tf', True):
-        return False
+        return None
     try:
-        matching_urdf(model_file, sim.model)
+        _path, description = matching_urdf(model_file, sim.model)
     except UrdfError as err:
         rospy.logwarn(f'TF is off: {err}; rviz cannot show this model '
                       '(write a matching URDF beside it to get TF)')
-        return False
-    return True
+        return None
+    return description
+
+
+def _links_publisher(description: str | None) -> LinkTransforms | None:
+    """~tf_publisher sim: set /robot_description (for rviz) and publish the links' TF
+    from `description`'s joints; None without TF."""
+    if description is None:
+        return None
+    rospy.set_param(topics.ROBOT_DESCRIPTION_PARAM, description)
+    _links, joints = read_joints(description)
+    return LinkTransforms(joints, JOINT_NAMES)

@@ -1,4 +1,5 @@
-"""Start Debian's robot_state_publisher on the simulated model's URDF (atlas.launch).
+"""Start Debian's robot_state_publisher on the simulated model's URDF (atlas.launch with
+tf_publisher:=robot_state_publisher; by default the simulator publishes the links itself).
 
 usage: state_publisher.py MODEL_FILE [ROS arguments]
 

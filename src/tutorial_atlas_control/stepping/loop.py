@@ -39,6 +39,7 @@ from tutorial_atlas_control.msgs.sim_messages import SimMessages
 from tutorial_atlas_control.msgs.wire import ControllerStatisticsWire, clock_bytes
 from tutorial_atlas_control.sim.controller import Gains
 from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistics
+from tutorial_atlas_control.sim.link_transforms import LinkTransforms, RspSchedule
 from tutorial_atlas_control.sim.model import FALL_HEIGHT_M
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode, PhysicsDivergenceError
 from tutorial_atlas_control.sim.vrc import SimInput, describe_input
@@ -90,6 +91,9 @@ ON_DEMAND_MESSAGES = (
     (topics.DEBUG_R_FOOT_CONTACT, 'debug_contact', 'debug_r'))
 #: Their rate (Hz of sim time) when `rates_hz` does not name it: DRCSim's 1 kHz.
 ON_DEMAND_RATE_HZ = 1000.0
+#: The links' /tf rate (Hz of sim time): robot_state_publisher's publish_frequency in
+#: DRCSim's launch.
+LINKS_TF_RATE_HZ = 50.0
 #: Rows (commands.LAW_FIELDS indices) each command topic can set; DAMPING_ROW stands for
 #: /atlas/debug/test's damping. An older message whose rows a newer one set for every
 #: joint is dropped undecoded (apply_pending_commands).
@@ -202,6 +206,9 @@ class SteppingLoop:
             its statistics go to the topics.SYNCHRONIZATION_STATISTICS outlet, if any.
         latch_synchronization: keeps the latest statistics message (serialized, without
             its length prefix) for later subscribers (None: not kept).
+        links: with a /tf outlet, the links' transforms published in robot_state_publisher's
+            stead (link_transforms.py), at rates_hz['links_tf'] (default
+            LINKS_TF_RATE_HZ, as robot_state_publisher's publish_frequency); None: not.
     """
 
     def __init__(self, sim: AtlasSimulator, outbox: Outbox, outlets: Mapping[str, Hashable],
@@ -211,7 +218,8 @@ class SteppingLoop:
                  pacer: Pacer | None = None,
                  publish_input: Callable[[str], None] | None = None,
                  synchronization: SynchronizationWindow | None = None,
-                 latch_synchronization: Callable[[bytes], None] | None = None) -> None:
+                 latch_synchronization: Callable[[bytes], None] | None = None,
+                 links: LinkTransforms | None = None) -> None:
         self.sim = sim
         self._send_input = publish_input
         self._input_logged_ns: dict[str, int] = {}  # kind -> sim time it was last logged
@@ -248,6 +256,11 @@ class SteppingLoop:
         self.clock_outlet = outlets[topics.CLOCK]
         self.odom_outlet = outlets[topics.GROUND_TRUTH_ODOM]
         self.tf_outlet = outlets.get(topics.TF)
+        # The links' /tf, decided as robot_state_publisher decides on each joint_states.
+        self.links_schedule: RspSchedule | None = None
+        if links is not None and self.tf_outlet is not None:
+            messages.use_link_transforms(links)
+            self.links_schedule = RspSchedule(rates_hz.get('links_tf', LINKS_TF_RATE_HZ))
 
         # /atlas/controller_statistics, fed and published only while someone listens.
         self.statistics = statistics
@@ -561,6 +574,10 @@ class SteppingLoop:
         tf_outlet = self.tf_outlet
         if tf_outlet is not None and count % self.every['tf'] == 0 and wanted(tf_outlet):
             outbox.add(tf_outlet, messages.pelvis_tf(sensed_ns))
+        links = self.links_schedule  # stamped as the joint_states published with them
+        if (links is not None and count % self.every['joint_states'] == 0
+                and links.due(now_ns) and wanted(tf_outlet)):
+            outbox.add(tf_outlet, messages.links_tf(now_ns))
 
     def _note_command_stamp(self, raw: bytes) -> None:
         """The command in `raw` is applied from the coming step on: remember its stamp."""
