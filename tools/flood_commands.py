@@ -110,6 +110,10 @@ class Preserialized(genpy.Message):
         buff.write(self.raw)
 
 
+#: How long (s, wall) the subscribers' connections must stay as they are before a flood.
+CONNECTIONS_SETTLE_S = 0.2
+
+
 class ClockWatch:
     """The latest /clock, for the real-time factor and for --start-sim."""
 
@@ -138,8 +142,21 @@ def flood(kind: str, rate_hz: float, duration_s: float, start_sim_s: float,
     modes = rospy.Publisher('/atlas/control_mode', String, queue_size=10)
     clock = ClockWatch()
     deadline = time.monotonic() + 60.0
-    while clock.now_ns() < start_sim_s * 1e9 or len(subscriber_names(commands)) < subscribers:
-        if time.monotonic() > deadline or rospy.is_shutdown():
+    settled_since: float | None = None
+    while True:
+        # Every subscriber connected once, for CONNECTIONS_SETTLE_S: a subscriber may connect
+        # twice at first and drop one; what is sent on the dropped one alone would be lost to it.
+        names = subscriber_names(commands)
+        ready = (clock.now_ns() >= start_sim_s * 1e9 and len(names) >= subscribers
+                 and len(commands.impl.connections) == len(names))
+        now_s = time.monotonic()
+        if not ready:
+            settled_since = None
+        elif settled_since is None:
+            settled_since = now_s
+        elif now_s - settled_since >= CONNECTIONS_SETTLE_S:
+            break
+        if now_s > deadline or rospy.is_shutdown():
             raise SystemExit(f'flood_commands.py: no /clock, or fewer than {subscribers} '
                              'subscribers to /atlas/joint_commands')
         time.sleep(0.01)
