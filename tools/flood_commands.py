@@ -23,6 +23,7 @@ import argparse
 import io
 import json
 import math
+import socket
 import sys
 import threading
 import time
@@ -110,6 +111,8 @@ class Preserialized(genpy.Message):
         buff.write(self.raw)
 
 
+#: How long (s, wall) the flood waits at its end for its subscribers to read what it sent.
+UNREAD_TIMEOUT_S = 60.0
 #: How long (s, wall) the subscribers' connections must stay as they are before a flood.
 CONNECTIONS_SETTLE_S = 0.2
 
@@ -129,6 +132,58 @@ class ClockWatch:
     def now_ns(self) -> int:
         with self.lock:
             return self.ns
+
+
+def _tcp_queues() -> dict[tuple[str, str], tuple[int, int]]:
+    """(local, remote) address in /proc/net/tcp's hex form -> (tx_queue, rx_queue) bytes."""
+    queues = {}
+    for table in ('/proc/net/tcp', '/proc/net/tcp6'):
+        try:
+            with open(table, encoding='ascii') as lines:
+                next(lines)
+                for line in lines:
+                    fields = line.split()
+                    tx, rx = fields[4].split(':')
+                    queues[(fields[1], fields[2])] = (int(tx, 16), int(rx, 16))
+        except OSError:
+            continue
+    return queues
+
+
+def _hex_address(address: tuple) -> str:
+    """An IPv4 (host, port) as /proc/net/tcp writes it: 0100007F:1F90."""
+    host = socket.inet_aton(address[0])
+    return f'{int.from_bytes(host, "little"):08X}:{address[1]:04X}'
+
+
+def wait_until_read(pub: rospy.Publisher, timeout_s: float = UNREAD_TIMEOUT_S) -> None:
+    """Stay registered until every subscriber has read what was sent to it.
+
+    When a publisher unregisters, roscpp's subscribers (the recorder) drop the connection at
+    once, discarding what their kernel has received but they have not read yet: a recorder
+    starved of CPU lost the last seconds of two floods (2771 and 3820 of 60 001 commands,
+    load 9). So the flood ends only once no byte waits in either direction, or after
+    `timeout_s` (then with one line on stderr).
+    """
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline and not rospy.is_shutdown():
+        queues = _tcp_queues()
+        waiting = 0
+        for connection in list(pub.impl.connections):
+            sock = getattr(connection, 'socket', None)
+            try:
+                local, remote = sock.getsockname(), sock.getpeername()
+                ours = (_hex_address(local), _hex_address(remote))
+            except (AttributeError, OSError, ValueError):
+                continue  # closed, or not IPv4: nothing to wait for that can be seen
+            tx, _ = queues.get(ours, (0, 0))
+            _, rx = queues.get((ours[1], ours[0]), (0, 0))
+            waiting += tx + rx
+        if waiting == 0:
+            return
+        time.sleep(0.05)
+    print(f'flood_commands.py: subscribers still had bytes to read after {timeout_s:.0f} s',
+          file=sys.stderr, flush=True)
 
 
 def flood(kind: str, rate_hz: float, duration_s: float, start_sim_s: float,
@@ -193,6 +248,7 @@ def flood(kind: str, rate_hz: float, duration_s: float, start_sim_s: float,
         sent += 1
     wall_s = time.monotonic() - wall0_s
     sim_s = (clock.now_ns() - sim0_ns) / 1e9
+    wait_until_read(commands)
     return {'kind': kind, 'sent': sent, 'bad_modes': bad_modes, 'wall_s': wall_s,
             'sim_s': sim_s, 'rate_hz': sent / wall_s, 'real_time_factor': sim_s / wall_s,
             'sim_start_s': sim0_ns / 1e9}

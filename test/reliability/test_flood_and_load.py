@@ -26,6 +26,7 @@ from support.launch import TestLaunch, flood_figures
 from tutorial_atlas_control.bags.reader import read_bag
 from tutorial_atlas_control.bags.typestore import load_typestore
 from tutorial_atlas_control.joints import JOINT_NAMES
+from tutorial_atlas_control.node.transport import MAX_BACKLOG_BYTES
 from tutorial_atlas_control.processes import rss_kib
 
 #: The issue's figures.
@@ -161,8 +162,12 @@ def test_three_publishers_at_2_khz_lose_nothing_and_keep_memory_flat(
           f'(max {max(rss_kib_samples) / 1024:.1f}); the recorder kept {recorded} of {sent} '
           f'commands; {missing} joint states missing')
     assert all(f['sent'] > 0 for f in figures), f'a publisher sent nothing: {figures}'
+    # Once the floods are over (they end when the recorder has read them all, so the
+    # recorder has caught up), memory is back; on the way, a recorder starved of CPU may
+    # hold a backlog of the simulator's messages (transport.py), bounded.
     assert rss_end_kib - rss_start_kib <= RSS_GROWTH_BOUND_KIB
-    assert max(rss_kib_samples) - rss_start_kib <= RSS_GROWTH_BOUND_KIB
+    assert (max(rss_kib_samples) - rss_start_kib
+            <= RSS_GROWTH_BOUND_KIB + MAX_BACKLOG_BYTES // 1024)
     assert all_finite(data.joint_states)
     elbow = data.joint_states.position[-1, data.joint_states.names.index('l_arm_elx')]
     assert abs(elbow - VALID_ELBOW_RAD) < ELBOW_TOLERANCE_RAD, 'the commands were applied'
