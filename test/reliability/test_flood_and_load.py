@@ -41,7 +41,8 @@ VALID_ELBOW_RAD = 1.2
 #: sim_interface rostest. A refused command would send it to 0.
 ELBOW_TOLERANCE_RAD = 0.1
 #: Resident memory the simulator may gain over the load (KiB): Python's allocator settling,
-#: far below what a queue of 30 s x 6 kHz commands (~100 MB) would take.
+#: far below what a queue of 30 s x 6 kHz commands (~100 MB) would take; plus, on a busy
+#: machine, the transport's bounded backlog for a starved subscriber (MAX_BACKLOG_BYTES).
 RSS_GROWTH_BOUND_KIB = 4096
 #: The load's distinct commands: publisher k's neck_ay target in its flood, then in its last
 #: command (rad, well inside the joint's -0.61..1.13 rad); its flood lasts k x LAST_STAGGER_S
@@ -162,12 +163,12 @@ def test_three_publishers_at_2_khz_lose_nothing_and_keep_memory_flat(
           f'(max {max(rss_kib_samples) / 1024:.1f}); the recorder kept {recorded} of {sent} '
           f'commands; {missing} joint states missing')
     assert all(f['sent'] > 0 for f in figures), f'a publisher sent nothing: {figures}'
-    # Once the floods are over (they end when the recorder has read them all, so the
-    # recorder has caught up), memory is back; on the way, a recorder starved of CPU may
-    # hold a backlog of the simulator's messages (transport.py), bounded.
-    assert rss_end_kib - rss_start_kib <= RSS_GROWTH_BOUND_KIB
-    assert (max(rss_kib_samples) - rss_start_kib
-            <= RSS_GROWTH_BOUND_KIB + MAX_BACKLOG_BYTES // 1024)
+    # A recorder starved of CPU (other work on the machine) may hold a backlog of the
+    # simulator's messages (transport.py), bounded, which the allocator need not give back:
+    # seen +11.7 MiB with two CPU hogs beside the test (rtf 0.63), +0.1 without.
+    bound_kib = RSS_GROWTH_BOUND_KIB + MAX_BACKLOG_BYTES // 1024
+    assert rss_end_kib - rss_start_kib <= bound_kib
+    assert max(rss_kib_samples) - rss_start_kib <= bound_kib
     assert all_finite(data.joint_states)
     elbow = data.joint_states.position[-1, data.joint_states.names.index('l_arm_elx')]
     assert abs(elbow - VALID_ELBOW_RAD) < ELBOW_TOLERANCE_RAD, 'the commands were applied'
