@@ -93,9 +93,9 @@ def spec_gains(gains: Gains) -> tuple[tuple[float, ...], ...]:
 #: The table's columns, in order: inputs, then outcome. No wall-clock field (determinism).
 TABLE_COLUMNS: tuple[str, ...] = (
     'index', 'trajectory', 'name', 'gains', 'gain_scale', 'time_scale', 'push', 'seed',
-    'fell', 'fall_time_s', 'stood_after_s', 'pelvis_dx_m', 'pelvis_dy_m', 'pelvis_z_min_m',
-    'pelvis_z_end_m', 'r_foot_dx_m', 'r_foot_dy_m', 'r_foot_dz_end_m', 'r_foot_lift_max_m',
-    'l_foot_dx_m', 'l_foot_dy_m', 'tracking_rms_rad', 'error')
+    'played_s', 'fell', 'fall_time_s', 'stood_after_s', 'pelvis_dx_m', 'pelvis_dy_m',
+    'pelvis_z_min_m', 'pelvis_z_end_m', 'r_foot_dx_m', 'r_foot_dy_m', 'r_foot_dz_end_m',
+    'r_foot_lift_max_m', 'l_foot_dx_m', 'l_foot_dy_m', 'tracking_rms_rad', 'error')
 
 
 class RunProbe:
@@ -182,7 +182,8 @@ def input_columns(spec: RunSpec) -> dict[str, Any]:
     return {'index': spec.index, 'trajectory': spec.trajectory, 'name': spec.name,
             'gains': spec.gains_label, 'gain_scale': spec.gain_scale,
             'time_scale': spec.time_scale, 'push': spec.push.label() if spec.push else '',
-            'seed': spec.seed}
+            'seed': spec.seed,
+            'played_s': round(sum(d for d, _ in spec.waypoints) * spec.time_scale, 9)}
 
 
 def run_one(spec: RunSpec) -> dict[str, Any]:
