@@ -48,9 +48,12 @@ class Objective:
 
 
 def _fall_cost(row: Mapping[str, Any], stand_s: float) -> float:
-    """Seconds of standing lost after the trajectory (+ FALL_PENALTY on a fall)."""
-    shortfall = max(0.0, stand_s - float(row['stood_after_s']))
-    return shortfall + (FALL_PENALTY if row['fell'] else 0.0)
+    """Seconds of the run lost to a fall (+ FALL_PENALTY), or of standing short after it:
+    a later fall costs less, so the search has a slope to follow among runs that fall."""
+    if row['fell']:
+        return FALL_PENALTY + max(0.0, float(row['played_s']) + stand_s
+                                  - float(row['fall_time_s']))
+    return max(0.0, stand_s - float(row['stood_after_s']))
 
 
 def _stay_up(row: Mapping[str, Any], p: Mapping[str, float]) -> float:
