@@ -20,6 +20,9 @@ __all__ = ['Objective', 'OBJECTIVES', 'parse_objective']
 FALL_PENALTY = 1.0
 #: Weight of a shortfall in metres against one in seconds (1 cm ~ 0.1 s).
 PER_M = 10.0
+#: A step_forward run that falls costs at least this: more than any that stands (whose
+#: shortfalls in metres, x PER_M, stay below it for any step the robot can take).
+FALLEN_STEP_COST = 10.0
 #: The swing foot must rise at least this much (m) to count as lifted, not slid.
 MIN_LIFT_M = 0.03
 
@@ -66,6 +69,8 @@ def _stay_up(row: Mapping[str, Any], p: Mapping[str, float]) -> float:
 
 
 def _step_forward(row: Mapping[str, Any], p: Mapping[str, float]) -> float:
+    if row['fell']:  # where the feet lie after a fall says nothing: only when it fell counts
+        return FALLEN_STEP_COST + _fall_cost(row, p['stand'])
     forward = max(0.0, p['dx'] - float(row['r_foot_dx_m']))
     lift = max(0.0, MIN_LIFT_M - float(row['r_foot_lift_max_m']))
     down = abs(float(row['r_foot_dz_end_m']))
