@@ -129,3 +129,23 @@ def test_missing_file_and_unknown_name(tmp_path: Path, tiny: Path) -> None:
         assert result.returncode == 1 and len(result.stderr.splitlines()) == 1
         assert message in result.stderr
         assert not (tmp_path / 'log.jsonl').exists() and not (tmp_path / 'found.yaml').exists()
+
+
+def test_robust_cost_is_the_mean_over_variants(tmp_path: Path, tiny: Path) -> None:
+    """--robust GAIN:TIME plays each candidate again with those scales; its cost is the mean."""
+    result = _search(str(tiny), 'bend', '--objective', 'pelvis_height:z=0.8,settle=0.3',
+                     '--vary', SQUAT, '--robust', '0.5:1.5', '--popsize', '2',
+                     '--generations', '1', '--workers', '1', '--log', str(tmp_path / 'log.jsonl'),
+                     '--yaml', str(tmp_path / 'found.yaml'))
+    assert result.returncode == 0, result.stderr
+    header, start, generation = _records(tmp_path / 'log.jsonl')
+    assert header['config']['variants'] == [[0.5, 1.5]]
+    assert len(generation['rows']) == 2  # the nominal rows only, one per candidate
+    inputs = SweepInputs([(str(tiny), 'bend')], [str(REPO / 'config' / 'atlas_controller.yaml')],
+                         gain_scales=(1.0, 0.5), time_scales=(1.0, 1.5), settle_s=0.3)
+    rows = run_sweep(build_specs(inputs), workers=1, progress=False).rows
+    by_scale = {(row['gain_scale'], row['time_scale']): row for row in rows}
+    costs = [abs(by_scale[key]['pelvis_z_end_m'] - 0.8) + float(by_scale[key]['fell'])
+             for key in ((1.0, 1.0), (0.5, 1.5))]
+    assert costs[0] != costs[1]
+    assert start['cost'] == pytest.approx(sum(costs) / 2, abs=1e-12)

@@ -41,6 +41,16 @@ def _count(text: str) -> int:
     return value
 
 
+def _variant(text: str) -> tuple[float, float]:
+    try:
+        gain, time = (float(part) for part in text.split(':'))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'{text!r} is not GAIN:TIME (e.g. 0.9:1)') from None
+    if not (0.0 < gain < float('inf') and 0.0 < time < float('inf')):
+        raise argparse.ArgumentTypeError(f'{text!r}: both scales must be finite and > 0')
+    return gain, time
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser (its --help is the documentation)."""
     objectives = '; '.join(f'{name} ({", ".join(f"{k}={v:g}" for k, v in defaults.items())}): '
@@ -71,6 +81,10 @@ def build_parser() -> argparse.ArgumentParser:
                         help='generations in all, counting resumed ones (default: %(default)s)')
     parser.add_argument('--step-scale', type=float, default=1.0, metavar='X',
                         help='factor on the initial steps (0.05 rad, 0.2 and 0.3 log-factors)')
+    parser.add_argument('--robust', type=_variant, nargs='+', default=[],
+                        metavar='GAIN:TIME',
+                        help='also play each candidate with these gain and timing scales '
+                             '(e.g. 0.9:1 1.1:1 1:0.9 1:1.1); its cost is the mean')
     parser.add_argument('--log', type=Path, required=True, metavar='FILE',
                         help='the search log (JSON lines)')
     parser.add_argument('--resume', action='store_true', help='continue the search in --log')
@@ -133,7 +147,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.vary_gain:
             gains_out = args.gains_out or args.yaml.with_name(args.yaml.stem + '_gains.yaml')
         problem = SearchProblem(base, parameters, objective, args.seed, args.popsize,
-                                args.generations, args.step_scale)
+                                args.generations, args.step_scale, args.robust)
         with SweepEngine(args.workers, args.scheduler) as engine:
             result = run_search(problem, lambda s: engine.run(s, progress=False), args.log,
                                 args.resume, on_best=_writer(args, problem, gains_out))

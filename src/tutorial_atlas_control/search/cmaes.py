@@ -17,6 +17,7 @@ uninterrupted one would have.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import re
@@ -120,6 +121,9 @@ class SearchProblem:
     popsize: int = 6
     generations: int = 10
     step_scale: float = 1.0
+    #: (gain scale, time scale) each candidate is also played at; its cost is the mean over
+    #: the nominal run and these (a search for a step that survives them).
+    variants: Sequence[tuple[float, float]] = ()
 
     def config(self) -> dict[str, Any]:
         """The problem as the log's header holds it (a resume must match it exactly)."""
@@ -129,7 +133,8 @@ class SearchProblem:
                 'gain_table': [list(row) for row in self.base.gains],
                 'parameters': [[p.kind, p.text] for p in self.parameters],
                 'objective': self.objective.text(), 'seed': self.seed, 'popsize': self.popsize,
-                'step_scale': self.step_scale, 'settle_s': self.base.settle_s}
+                'step_scale': self.step_scale, 'settle_s': self.base.settle_s,
+                'variants': [list(v) for v in self.variants]}
 
     def candidate(self, x: Sequence[float], index: int = 0) -> RunSpec:
         """The run of vector `x`, rounded as its files will hold it."""
@@ -160,6 +165,34 @@ class SearchProblem:
         return RunSpec(index, base.trajectory, base.name, base.gains_label, waypoints, gains,
                        base.gain_scale, base.time_scale, base.push, self.seed + index,
                        base.settle_s)
+
+    def runs(self, x: Sequence[float], index: int) -> list[RunSpec]:
+        """Candidate `index`'s runs: nominal first, then each variant."""
+        nominal = self.candidate(x, index)
+        count = 1 + len(self.variants)
+        specs = [dataclasses.replace(nominal, index=index * count)]
+        for j, (gain_scale, time_scale) in enumerate(self.variants, start=1):
+            specs.append(dataclasses.replace(nominal, index=index * count + j,
+                                             gain_scale=gain_scale, time_scale=time_scale))
+        return specs
+
+    def costs(self, rows: Sequence[dict[str, Any]]) -> tuple[list[float], list[dict[str, Any]]]:
+        """Each candidate's cost (the mean over its runs) and its nominal row."""
+        count = 1 + len(self.variants)
+        costs, nominal = [], []
+        for k in range(0, len(rows), count):
+            group = rows[k:k + count]
+            costs.append(float(np.mean([self.objective.cost(row) for row in group])))
+            nominal.append(group[0])
+        return costs, nominal
+
+    def evaluate(self, evaluate: Evaluate, xs: Sequence[Sequence[float]]
+                 ) -> tuple[list[float], list[dict[str, Any]]] | None:
+        """Costs and nominal rows of candidates `xs`; None if the sweep was interrupted."""
+        outcome = evaluate([spec for k, x in enumerate(xs) for spec in self.runs(x, k)])
+        if outcome.interrupted:
+            return None
+        return self.costs(outcome.rows)
 
     def steps(self) -> list[float]:
         return [DEFAULT_STEP[p.kind] * self.step_scale for p in self.parameters]
@@ -223,11 +256,10 @@ def run_search(problem: SearchProblem, evaluate: Evaluate, log_path: Path, resum
     es = problem.strategy()
     start = next((r for r in records if r['kind'] == 'start'), None)
     if start is None:
-        outcome = evaluate([problem.candidate(np.zeros(len(problem.parameters)))])
-        if outcome.interrupted:
+        evaluated = problem.evaluate(evaluate, [np.zeros(len(problem.parameters))])
+        if evaluated is None:
             raise KeyboardInterrupt
-        row = outcome.rows[0]
-        start = {'kind': 'start', 'cost': problem.objective.cost(row), 'row': row}
+        start = {'kind': 'start', 'cost': evaluated[0][0], 'row': evaluated[1][0]}
         atomic_write(log_path, json.dumps(_header(problem)) + '\n' + json.dumps(start) + '\n')
     result = SearchResult(start['cost'], start['cost'], [0.0] * len(problem.parameters),
                           start['row'], problem.candidate(np.zeros(len(problem.parameters))), 0)
@@ -256,15 +288,15 @@ def run_search(problem: SearchProblem, evaluate: Evaluate, log_path: Path, resum
                f'{result.best_cost:.4g}')
     while result.generations < problem.generations and result.best_cost > 0.0:
         xs = es.ask()
-        outcome = evaluate([problem.candidate(x, k) for k, x in enumerate(xs)])
-        if outcome.interrupted:
+        evaluated = problem.evaluate(evaluate, xs)
+        if evaluated is None:
             result.interrupted = True
             break
-        costs = [problem.objective.cost(row) for row in outcome.rows]
+        costs, rows = evaluated
         es.tell(xs, costs)
-        consider(xs, costs, outcome.rows)
+        consider(xs, costs, rows)
         record = {'kind': 'generation', 'gen': result.generations + 1,
-                  'x': [[float(v) for v in x] for x in xs], 'cost': costs, 'rows': outcome.rows}
+                  'x': [[float(v) for v in x] for x in xs], 'cost': costs, 'rows': rows}
         with log_path.open('a') as log:
             log.write(json.dumps(record) + '\n')
         result.generations += 1

@@ -123,7 +123,7 @@ def _client(scheduler: str | None, workers: int) -> Any:
                              f'{str(err).splitlines()[0] if str(err) else type(err).__name__}'
                              ) from None
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                           dashboard_address=None, silence_logs=logging.ERROR)
+                           dashboard_address=':0', silence_logs=logging.ERROR)
     return Client(cluster)
 
 
