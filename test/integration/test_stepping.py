@@ -40,3 +40,18 @@ def test_the_tutorial_gains_do_not_hold_it() -> None:
                                     [str(REPO / 'config' / 'atlas_controller.yaml')],
                                     settle_s=STAND_S))
     assert run_one(spec)['fell'] is True
+
+
+def test_step_and_stand_survives_ten_percent_on_gains_or_timing() -> None:
+    """What the robust search asked for: gains or timing 10 % off, one at a time, and it
+    still steps and stands (both off together can fell it: Stepping.yaml says which)."""
+    specs = build_specs(SweepInputs([(str(STEPPING), 'step_and_stand')], [str(GAINS)],
+                                    gain_scales=(0.9, 1.1), settle_s=STAND_S))
+    specs += build_specs(SweepInputs([(str(STEPPING), 'step_and_stand')], [str(GAINS)],
+                                     time_scales=(0.9, 1.1), settle_s=STAND_S))
+    for spec in specs:
+        row = run_one(spec)
+        label = f'gains x{spec.gain_scale}, timing x{spec.time_scale}'
+        assert row['fell'] is False, label
+        assert row['r_foot_dx_m'] >= FORWARD_M, label
+        assert row['pelvis_z_min_m'] > PELVIS_ABOVE_M, label
