@@ -82,7 +82,7 @@ COMPRESSIONS = ('lz4', 'bz2', 'none')
 #: What the table and the JSON call the launch's own compression (lz4, atlas.launch).
 DEFAULT_COMPRESSION = 'the launch\'s default'
 SECTIONS = ('physics', 'offline', 'analysis', 'fast', 'realtime', 'load', 'tutorial',
-            'controller', 'plot')
+            'controller', 'plot', 'sweep')
 #: What the table and the JSON say for the UDP figures while no UDP connection is made.
 NO_UDP = 'n/a (no UDP connection)'
 
@@ -151,6 +151,9 @@ ROWS = (
     ('plot_off_node_us_per_step', 'node CPU per step rtf:=0, no plotter', 'us', '', 1),
     ('plot_on_node_us_per_step', 'node CPU per step rtf:=0, plotted', 'us', '', 1),
     ('plot_on_plotter_cpu', 'plot_topics.py CPU at rtf:=1', 'cores', '', 2),
+    ('sweep_runs_per_s_1', 'sweep.py offline runs, 1 worker', 'runs/s', '', 3),
+    ('sweep_runs_per_s_2', 'sweep.py offline runs, 2 workers', 'runs/s', '', 3),
+    ('sweep_scaling', 'sweep runs/s, 2 workers / 1', 'x', '', 2),
 )
 #: Rows shown as NO_UDP when the controller section ran without a UDP connection.
 UDP_ROWS = ('controller_udp_age_p50_ms', 'controller_udp_age_p99_ms',
@@ -247,6 +250,7 @@ EXPECTED = {
                    'controller_window_age_p99_ms'),
     'plot': ('plot_off_realtime_rtf', 'plot_on_realtime_rtf', 'plot_off_node_us_per_step',
              'plot_on_node_us_per_step', 'plot_on_plotter_cpu'),
+    'sweep': ('sweep_runs_per_s_1', 'sweep_runs_per_s_2', 'sweep_scaling'),
 }
 #: Keys computed from two sections, expected when both ran.
 EXPECTED_ACROSS = {('physics', 'fast'): ('fast_ratio', 'fast_bare_ratio', 'node_bare_ratio')}
@@ -362,6 +366,22 @@ def run_offline(args: argparse.Namespace, samples: dict[str, list[float]],
                               'analysis_msgs_per_s': count / analysis_s,
                               'rosbag_msgs_per_s': count / rosbag_s,
                               'analysis_speedup': rosbag_s / analysis_s})
+
+
+def run_sweep(args: argparse.Namespace, samples: dict[str, list[float]],
+              loads: dict[str, str]) -> None:
+    """Offline runs per second through sweep.py's Dask engine on 1 and 2 workers (issue 27)."""
+    if 'sweep' not in args.sections:
+        return
+    import sweep_rate
+
+    with Section('sweep', loads):
+        for run in range(args.runs):
+            runs = 4 if args.quick else 16
+            one, two = sweep_rate.runs_per_s(1, runs), sweep_rate.runs_per_s(2, runs)
+            log(f'sweep run {run + 1}: {one:.3f} runs/s on 1 worker, {two:.3f} on 2')
+            add(samples, {'sweep_runs_per_s_1': one, 'sweep_runs_per_s_2': two,
+                          'sweep_scaling': two / one})
 
 
 def run_online(args: argparse.Namespace, samples: dict[str, list[float]],
@@ -612,6 +632,7 @@ def main(argv: list[str] | None = None) -> int:
     ok = False
     try:
         run_offline(args, samples, loads)
+        run_sweep(args, samples, loads)
         run_online(args, samples, loads, work_dir)
         run_tutorial(args, samples, loads, work_dir)
         ok = True

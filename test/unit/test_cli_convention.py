@@ -11,7 +11,7 @@ import pytest
 
 SCRIPTS = Path(__file__).resolve().parents[2] / 'scripts'
 PYTHON_SCRIPTS = ('analyze_bag.py', 'replay_bag.py', 'run_demo.py', 'run_offline.py',
-                  'traj_yaml.py', 'plot_topics.py')
+                  'traj_yaml.py', 'plot_topics.py', 'sweep.py', 'search.py')
 
 
 def run(script: str, *args: str) -> subprocess.CompletedProcess[str]:

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import os
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -69,6 +69,8 @@ SIMULATOR_NODE = '/atlas_sim'
 PLAYER_NODE = '/tutorial_atlas_control'
 #: rosgraph_msgs/Log's INFO level.
 LOG_INFO = 2
+#: Called after each step with the simulator (write_offline_bag's `on_step`).
+StepHook = Callable[[AtlasSimulator], None]
 #: Bag chunk size (bytes): rosbag record's default.
 CHUNK_BYTES = 768 * 1024
 
@@ -138,9 +140,11 @@ class _OfflinePlayer:
     turn them into messages, all at once (write_steps).
     """
 
-    def __init__(self, sim: AtlasSimulator, sink: BlockBagWriter) -> None:
+    def __init__(self, sim: AtlasSimulator, sink: BlockBagWriter,
+                 on_step: StepHook | None = None) -> None:
         self.sim = sim
         self.sink = sink
+        self.on_step = on_step
         self.messages = messages = SimMessages(sim)
         self.joint_states = self._block(topics.JOINT_STATES, messages.joint_state_wire)
         self.odometry = self._block(topics.GROUND_TRUTH_ODOM, messages.odometry_wire)
@@ -227,12 +231,14 @@ class _OfflinePlayer:
         """Step and publish for `duration_s` of sim time (whole steps, rounded up)."""
         sim = self.sim
         until_ns = sim.sim_time_ns + int(round(duration_s * NS_PER_S))
-        step, publish = sim.step, self.publish
+        step, publish, on_step = sim.step, self.publish, self.on_step
         try:
             while sim.sim_time_ns < until_ns:
                 step()
                 self.steps += 1
                 publish()
+                if on_step is not None:
+                    on_step(sim)
         except PhysicsDivergenceError as err:
             raise OfflineRunError(f'{err}; the live simulator would reset the robot here, '
                                   'an offline run stops') from None
@@ -304,14 +310,19 @@ def _command_wire(gains: Gains) -> JointCommandsWire:
 def write_offline_bag(bag: Path, trajectory_file: str, name: str, waypoints: Sequence[Waypoint],
                       gains: Gains, settle_s: float, start_after_s: float,
                       model_path: Path = atlas_model.MODEL_PATH,
-                      play_after_s: float = 0.0) -> OfflineRun:
-    """Simulate the run and write it to `bag` (a new file; see run_offline for the checks)."""
+                      play_after_s: float = 0.0,
+                      on_step: StepHook | None = None) -> OfflineRun:
+    """Simulate the run and write it to `bag` (a new file; see run_offline for the checks).
+
+    `on_step`, if given, is called with the simulator after every step (and its messages):
+    the sweep measures a run there, and applies its pushes, without reading the bag back.
+    """
     sim = AtlasSimulator(atlas_model.load_model(model_path), gains)
     sink = _open_bag(bag)
     # The run's time, without loading the model and the message types (fixed costs).
     started_s = time.perf_counter()
     try:
-        player = _OfflinePlayer(sim, sink)
+        player = _OfflinePlayer(sim, sink, on_step)
         player.write_config()
         player.publish()  # the initial state, before the first step, as the node does
         player.advance(start_after_s)

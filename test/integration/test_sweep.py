@@ -1,0 +1,121 @@
+"""sweep.py: many offline runs on Dask; the table, its determinism, the tutorial's outcomes,
+and the refusals (one line, exit 1, nothing written)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from tutorial_atlas_control.search.sweep import (
+    SweepEngine,
+    SweepInputs,
+    build_specs,
+    table_texts,
+)
+
+REPO = Path(__file__).resolve().parents[2]
+SWEEP = REPO / 'scripts' / 'sweep.py'
+TRAJ_DATA2 = REPO / 'trajectories' / 'Traj_data2.yaml'
+#: The tutorial's falls, s after the first command (test_tutorial_run.py's README figures),
+#: and that test's tolerance.
+FALL_AFTER_FIRST_COMMAND_S = {'step_and_fall': 1.959, 'touchdown_exhausted': 6.837}
+FALL_TIME_TOLERANCE_S = 0.6
+UPRIGHT_ABOVE_M = 0.7
+#: Short trajectories: a fifth of a second each, so that a determinism sweep costs seconds.
+TINY = """\
+bend:
+  - [0.2, "0 0 0 0  0 0 -0.3 0.6 -0.3 0  0 0 -0.3 0.6 -0.3 0  0 0 0 0 0 0  0 0 0 0 0 0"]
+arms:
+  - [0.2, "0 0 0 0  0 0 0 0 0 0  0 0 0 0 0 0  0 -0.5 0 1 0 0  0 0.5 0 -1 0 0"]
+"""
+
+
+@pytest.fixture(scope='module')
+def tiny_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    path = tmp_path_factory.mktemp('tiny') / 'tiny.yaml'
+    path.write_text(TINY)
+    return path
+
+
+def _sweep(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, str(SWEEP), *args], capture_output=True, text=True,
+                          timeout=600, check=False)
+
+
+def test_same_table_on_one_and_two_workers(tiny_file: Path) -> None:
+    inputs = SweepInputs([(str(tiny_file), 'bend'), (str(tiny_file), 'arms')],
+                         [str(REPO / 'config' / 'atlas_controller.yaml')],
+                         gain_scales=(0.5, 1.0), time_scales=(1.0,), settle_s=0.3, seed=7)
+    specs = build_specs(inputs)
+    tables = []
+    for workers in (1, 2):
+        with SweepEngine(workers) as engine:
+            outcome = engine.run(specs, progress=False)
+        assert not outcome.interrupted
+        tables.append(table_texts(outcome.rows))
+    assert tables[0] == tables[1]
+    rows = json.loads(tables[0][1])
+    assert [row['index'] for row in rows] == [0, 1, 2, 3]
+    assert [row['seed'] for row in rows] == [7, 8, 9, 10]
+    assert [(row['name'], row['gain_scale']) for row in rows] == [
+        ('bend', 0.5), ('bend', 1.0), ('arms', 0.5), ('arms', 1.0)]
+    # The runs differ (half gains sag more): the table is not one row copied.
+    assert rows[0]['tracking_rms_rad'] != rows[1]['tracking_rms_rad']
+
+
+def test_tutorial_trajectories_classified(tmp_path: Path) -> None:
+    out = tmp_path / 'tutorial'
+    result = _sweep(str(TRAJ_DATA2), 'step_and_fall', 'touchdown', 'touchdown_exhausted',
+                    '--workers', '2', '--out', str(out), '--no-progress')
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.splitlines()[-1].startswith('sweep: 3 runs, 1 stayed up; table: ')
+    rows = {row['name']: row for row in json.loads((tmp_path / 'tutorial.json').read_text())}
+    for name, expected_s in FALL_AFTER_FIRST_COMMAND_S.items():
+        assert rows[name]['fell'] is True
+        assert abs(rows[name]['fall_time_s'] - expected_s) < FALL_TIME_TOLERANCE_S
+        assert rows[name]['pelvis_z_end_m'] < 0.5
+    touchdown = rows['touchdown']
+    assert touchdown['fell'] is False and touchdown['fall_time_s'] is None
+    assert touchdown['pelvis_z_min_m'] > UPRIGHT_ABOVE_M
+    assert touchdown['stood_after_s'] == pytest.approx(3.0)
+    assert abs(touchdown['r_foot_dx_m']) < 0.01 and abs(touchdown['l_foot_dx_m']) < 0.01
+    # step_and_fall lifts its right foot (its first waypoint) before it falls.
+    assert rows['step_and_fall']['r_foot_lift_max_m'] > 0.03
+    header = (tmp_path / 'tutorial.csv').read_text().splitlines()[0]
+    assert header.startswith('index,trajectory,name,gains,gain_scale,time_scale,push,seed,'
+                             'played_s,fell,fall_time_s,')
+
+
+def test_push_topples_touchdown(tmp_path: Path, tiny_file: Path) -> None:
+    """A 0.2 s, 300 N forward shove 1 s into touchdown fells it; the same run unpushed stands."""
+    out = tmp_path / 'push'
+    result = _sweep(str(TRAJ_DATA2), 'touchdown', '--push', 'none', '--push', '1:300,0,0:0.2',
+                    '--workers', '1', '--out', str(out), '--no-progress', '--settle', '1')
+    assert result.returncode == 0, result.stderr
+    rows = json.loads((tmp_path / 'push.json').read_text())
+    assert [row['push'] for row in rows] == ['', '1:300,0,0:0.2']
+    assert rows[0]['fell'] is False
+    assert rows[1]['fell'] is True and rows[1]['pelvis_dx_m'] > 0.3  # forward, the push's way
+
+
+@pytest.mark.parametrize('args, message', [
+    (['missing.yaml', 'bend'], 'missing.yaml'),
+    (['{tiny}', 'nope'], 'nope'),
+    (['{tiny}', 'bend', '--push', '1:300,0:0.2'], "push '1:300,0:0.2' is not AT_S:FX,FY,FZ"),
+    (['{tiny}', 'bend', '--gains', 'no_gains.yaml'], 'gains file no_gains.yaml does not exist'),
+    (['{tiny}', 'bend', '--scheduler', 'tcp://127.0.0.1:9'],
+     'cannot reach the Dask scheduler at tcp://127.0.0.1:9'),
+])
+def test_bad_input_one_line_exit_1_nothing_written(tmp_path: Path, tiny_file: Path,
+                                                    args: list[str], message: str) -> None:
+    args = [arg.replace('{tiny}', str(tiny_file)) for arg in args]
+    result = _sweep(*args, '--out', str(tmp_path / 'table'), '--no-progress')
+    assert result.returncode == 1
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1, result.stderr
+    assert lines[0].startswith('sweep.py: error: ') and message in lines[0]
+    assert list(tmp_path.iterdir()) == []
