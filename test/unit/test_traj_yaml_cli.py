@@ -616,3 +616,39 @@ def test_a_mode_other_than_user_is_warned_about_with_the_command_to_send(mode: s
 @pytest.mark.parametrize('mode', ['User', None])  # None: a simulator that does not say
 def test_user_mode_or_an_unknown_one_gives_no_warning(mode: str | None) -> None:
     assert mode_warning(mode) is None
+
+
+@pytest.mark.parametrize('shut_down, expected', [(True, 130), (False, None)])
+def test_a_publish_racing_the_ctrl_c_shutdown_is_an_interrupt(
+        monkeypatch: pytest.MonkeyPatch, tmp_path: Path, shut_down: bool,
+        expected: int | None) -> None:
+    """Seen beside a busy core: rospy's shutdown thread closed the publisher between the
+    node's check and its publish(), and the port died with a traceback and exit 1."""
+    import rospy
+
+    from tutorial_atlas_control.cli import traj_yaml as cli
+
+    class SeenSigint:
+        seen = True
+
+        def install(self) -> None: ...
+
+        def wait(self, _timeout_s: float) -> None: ...
+
+    def play(*_args: object) -> None:
+        raise rospy.ROSException('publish() to a closed topic')
+
+    monkeypatch.setattr(cli, 'locate_trajectory_file', lambda path, announce: path)
+    monkeypatch.setattr(cli, 'load_trajectory', lambda path, name: [])
+    monkeypatch.setattr(cli, 'joint_commands_type', lambda: object)
+    monkeypatch.setattr(cli, 'require_master', lambda: None)
+    monkeypatch.setattr(cli.rospy, 'init_node', lambda *args, **kwargs: None)
+    monkeypatch.setattr(cli.rospy, 'is_shutdown', lambda: shut_down)
+    monkeypatch.setattr(cli.rospy, 'logwarn', lambda _text: None)
+    monkeypatch.setattr(cli, '_SigintSeen', SeenSigint)
+    monkeypatch.setattr(cli, 'play', play)
+    if expected is None:  # not a shutdown: a real error, not hidden
+        with pytest.raises(rospy.ROSException):
+            cli.main([str(tmp_path / 'x.yaml'), 'step_and_fall'])
+    else:
+        assert cli.main([str(tmp_path / 'x.yaml'), 'step_and_fall']) == expected

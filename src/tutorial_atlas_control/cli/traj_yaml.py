@@ -133,7 +133,11 @@ def _run(path: str, name: str, raw: list[str]) -> int:
     except rospy.ROSTimeMovedBackwardsException:
         rospy.logerr('ROS time moved backwards (was the simulation reset?); trajectory aborted')
         return EXIT_FAILED
-    except rospy.ROSInterruptException:
+    except rospy.ROSException as err:
+        # ROSInterruptException, or a publish() racing the shutdown thread that closed the
+        # publisher ("publish() to a closed topic", seen with a busy core): both a shutdown.
+        if not (isinstance(err, rospy.ROSInterruptException) or rospy.is_shutdown()):
+            raise
         rospy.logwarn('shut down before the trajectory finished')
         return EXIT_INTERRUPTED if sigint.seen else EXIT_FAILED
     finally:
