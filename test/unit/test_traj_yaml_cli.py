@@ -643,7 +643,7 @@ def test_a_publish_racing_the_ctrl_c_shutdown_is_an_interrupt(
     monkeypatch.setattr(cli, 'joint_commands_type', lambda: object)
     monkeypatch.setattr(cli, 'require_master', lambda: None)
     monkeypatch.setattr(cli.rospy, 'init_node', lambda *args, **kwargs: None)
-    monkeypatch.setattr(cli.rospy, 'is_shutdown', lambda: shut_down)
+    monkeypatch.setattr(cli.rospy.core, 'is_shutdown_requested', lambda: shut_down)
     monkeypatch.setattr(cli.rospy, 'logwarn', lambda _text: None)
     monkeypatch.setattr(cli, '_SigintSeen', SeenSigint)
     monkeypatch.setattr(cli, 'play', play)

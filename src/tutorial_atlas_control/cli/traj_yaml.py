@@ -136,7 +136,9 @@ def _run(path: str, name: str, raw: list[str]) -> int:
     except rospy.ROSException as err:
         # ROSInterruptException, or a publish() racing the shutdown thread that closed the
         # publisher ("publish() to a closed topic", seen with a busy core): both a shutdown.
-        if not (isinstance(err, rospy.ROSInterruptException) or rospy.is_shutdown()):
+        # rospy closes topics in its pre-shutdown hooks, before is_shutdown() turns true.
+        if not (isinstance(err, rospy.ROSInterruptException)
+                or rospy.core.is_shutdown_requested()):
             raise
         rospy.logwarn('shut down before the trajectory finished')
         return EXIT_INTERRUPTED if sigint.seen else EXIT_FAILED
