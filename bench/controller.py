@@ -129,12 +129,26 @@ def _age_window(master: Master, launch: Launch, echo: EchoController, clock: Raw
     time.sleep(warmup_s)
     pid = launch.node_pid('atlas_sim')
     cpu0 = cpu_seconds(pid) if pid else 0.0
+    age_ms, steps, span_s = _record_window(launch, echo, clock, statistics, name, window_s,
+                                           per_sim_s)
+    cpu1 = cpu_seconds(pid) if pid else 0.0
+    log(f'{name}: /atlas/atlas_state over {connected}')
+    return {f'controller_{transport}_age_p50_ms': float(np.percentile(age_ms, 50)),
+            f'controller_{transport}_age_p99_ms': float(np.percentile(age_ms, 99)),
+            f'controller_{transport}_node_us_per_step':
+                (cpu1 - cpu0) * 1e6 / (steps * window_s / span_s)}
+
+
+def _record_window(launch: Launch, echo: EchoController, clock: RawRecorder,
+                   statistics: RawRecorder, name: str, window_s: float,
+                   per_sim_s: float) -> tuple[np.ndarray, float, float]:
+    """Record /clock and the controller statistics for `window_s` (wall): the command ages
+    (ms), the steps simulated and the wall time (s) between the first and last /clock."""
     clock.start()
     statistics.start()
     time.sleep(window_s)
     ages = statistics.stop()
     clocks = clock.stop()
-    cpu1 = cpu_seconds(pid) if pid else 0.0
     launch.check_running()
     echo.check_running()
     if len(ages) < 100 or len(clocks) < 2:
@@ -142,12 +156,7 @@ def _age_window(master: Master, launch: Launch, echo: EchoController, clock: Raw
                          'messages in the window')
     age_ms = np.array([command_age_s(raw) for _, raw in ages]) * 1000.0
     steps = (clock_ns(clocks[-1][1]) - clock_ns(clocks[0][1])) / NS_PER_S * per_sim_s
-    span_s = clocks[-1][0] - clocks[0][0]
-    log(f'{name}: /atlas/atlas_state over {connected}')
-    return {f'controller_{transport}_age_p50_ms': float(np.percentile(age_ms, 50)),
-            f'controller_{transport}_age_p99_ms': float(np.percentile(age_ms, 99)),
-            f'controller_{transport}_node_us_per_step':
-                (cpu1 - cpu0) * 1e6 / (steps * window_s / span_s)}
+    return age_ms, steps, clocks[-1][0] - clocks[0][0]
 
 
 def window_run(master: Master, launch_file: str, clock: RawRecorder, statistics: RawRecorder,
@@ -169,17 +178,7 @@ def _window_window(master: Master, launch: Launch, echo: EchoController, clock: 
     wait_until(lambda: state_transport(master) is not None, READY_TIMEOUT_S,
                'echo_controller did not connect', launch.check_running)
     time.sleep(warmup_s)
-    clock.start()
-    statistics.start()
-    time.sleep(window_s)
-    ages = statistics.stop()
-    clocks = clock.stop()
-    launch.check_running()
-    echo.check_running()
-    if len(ages) < 100 or len(clocks) < 2:
-        raise BenchError(f'{name}: {len(ages)} controller statistics, {len(clocks)} /clock '
-                         'messages in the window')
-    age_ms = np.array([command_age_s(raw) for _, raw in ages]) * 1000.0
-    steps = (clock_ns(clocks[-1][1]) - clock_ns(clocks[0][1])) / NS_PER_S * per_sim_s
-    return {'controller_window_steps_per_s': steps / (clocks[-1][0] - clocks[0][0]),
+    age_ms, steps, span_s = _record_window(launch, echo, clock, statistics, name, window_s,
+                                           per_sim_s)
+    return {'controller_window_steps_per_s': steps / span_s,
             'controller_window_age_p99_ms': float(np.percentile(age_ms, 99))}
