@@ -3,6 +3,7 @@ exactly, writes files the tutorial's loaders read, refuses bad input in one line
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import subprocess
 import sys
@@ -11,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tutorial_atlas_control.search.cmaes import LATENCY_SEED
 from tutorial_atlas_control.search.sweep import SweepInputs, build_specs, run_sweep
 from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.trajectories.trajectory import load_trajectory
@@ -106,6 +108,10 @@ def test_gain_search_writes_a_gains_file(tmp_path: Path, tiny: Path) -> None:
     (['--objective', 'stay_up', '--vary', '4:l_leg_kny'], 'waypoint 4 does not exist'),
     (['--objective', 'stay_up', '--vary', '0:l_leg_kny', '--resume'], 'cannot resume from'),
     (['--objective', 'stay_up'], 'nothing to search'),
+    (['--objective', 'stay_up', '--vary', '0:l_leg_kny', '--latency-ms', '0:20'],
+     'give --latency-ms LO:HI and --latency-draws N (N >= 1) together'),
+    (['--objective', 'stay_up', '--vary', '0:l_leg_kny', '--latency-ms', 'x',
+      '--latency-draws', '2'], "latency 'x' is not LO:HI"),
 ])
 def test_bad_input_one_line_exit_1_nothing_written(tmp_path: Path, tiny: Path,
                                                     args: list[str], message: str) -> None:
@@ -149,3 +155,25 @@ def test_robust_cost_is_the_mean_over_variants(tmp_path: Path, tiny: Path) -> No
              for key in ((1.0, 1.0), (0.5, 1.5))]
     assert costs[0] != costs[1]
     assert start['cost'] == pytest.approx(sum(costs) / 2, abs=1e-12)
+
+
+def test_latency_draws_are_the_same_for_every_candidate(tmp_path: Path, tiny: Path) -> None:
+    """--latency-ms/--latency-draws: each candidate is played again N times with its commands
+    delayed, the same N draws for all (seeds fixed), and its cost is the mean."""
+    result = _search(str(tiny), 'bend', '--objective', 'pelvis_height:z=0.8,settle=0.3',
+                     '--vary', SQUAT, '--latency-ms', '0:20', '--latency-draws', '2',
+                     '--popsize', '2', '--generations', '1', '--workers', '1',
+                     '--log', str(tmp_path / 'log.jsonl'), '--yaml', str(tmp_path / 'found.yaml'))
+    assert result.returncode == 0, result.stderr
+    header, start, generation = _records(tmp_path / 'log.jsonl')
+    assert header['config']['latency'] == [0, 20, 2]
+    assert len(generation['rows']) == 2
+    base = build_specs(SweepInputs([(str(tiny), 'bend')],
+                                   [str(REPO / 'config' / 'atlas_controller.yaml')],
+                                   settle_s=0.3))[0]
+    specs = [base] + [dataclasses.replace(base, index=j, latency_steps=(0, 20),
+                                          seed=LATENCY_SEED + j - 1) for j in (1, 2)]
+    rows = run_sweep(specs, workers=1, progress=False).rows
+    costs = [abs(row['pelvis_z_end_m'] - 0.8) + float(row['fell']) for row in rows]
+    assert len(set(costs)) > 1  # the delays change the run
+    assert start['cost'] == pytest.approx(sum(costs) / 3, abs=1e-12)

@@ -107,6 +107,8 @@ def test_push_topples_touchdown(tmp_path: Path, tiny_file: Path) -> None:
     (['{tiny}', 'nope'], 'nope'),
     (['{tiny}', 'bend', '--push', '1:300,0:0.2'], "push '1:300,0:0.2' is not AT_S:FX,FY,FZ"),
     (['{tiny}', 'bend', '--gains', 'no_gains.yaml'], 'gains file no_gains.yaml does not exist'),
+    (['{tiny}', 'bend', '--latency-ms', '20:5'], "latency '20:5' is not LO:HI whole milliseconds"),
+    (['{tiny}', 'bend', '--repeat', '0'], '--repeat 0: give 1 or more'),
     (['{tiny}', 'bend', '--scheduler', 'tcp://127.0.0.1:9'],
      'cannot reach the Dask scheduler at tcp://127.0.0.1:9'),
 ])

@@ -25,6 +25,7 @@ from tutorial_atlas_control.search.sweep import (
     atomic_write,
     build_specs,
     check_output,
+    parse_latency,
 )
 from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE
 
@@ -85,6 +86,11 @@ def build_parser() -> argparse.ArgumentParser:
                         metavar='GAIN:TIME',
                         help='also play each candidate with these gain and timing scales '
                              '(e.g. 0.9:1 1.1:1 1:0.9 1:1.1); its cost is the mean')
+    parser.add_argument('--latency-ms', metavar='LO:HI',
+                        help='with --latency-draws: each command delayed LO..HI ms, as live')
+    parser.add_argument('--latency-draws', type=int, default=0, metavar='N',
+                        help='also play each candidate N times with --latency-ms (the same N '
+                             'draws for every candidate); its cost is the mean (default: 0)')
     parser.add_argument('--log', type=Path, required=True, metavar='FILE',
                         help='the search log (JSON lines)')
     parser.add_argument('--resume', action='store_true', help='continue the search in --log')
@@ -146,8 +152,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         gains_out = None
         if args.vary_gain:
             gains_out = args.gains_out or args.yaml.with_name(args.yaml.stem + '_gains.yaml')
+        if args.latency_draws < 0 or bool(args.latency_draws) != bool(args.latency_ms):
+            raise AtlasControlError('give --latency-ms LO:HI and --latency-draws N (N >= 1) '
+                                    'together')
+        lo, hi = parse_latency(args.latency_ms) if args.latency_ms else (0, 0)
         problem = SearchProblem(base, parameters, objective, args.seed, args.popsize,
-                                args.generations, args.step_scale, args.robust)
+                                args.generations, args.step_scale, args.robust,
+                                (lo, hi, args.latency_draws))
         with SweepEngine(args.workers, args.scheduler) as engine:
             result = run_search(problem, lambda s: engine.run(s, progress=False), args.log,
                                 args.resume, on_best=_writer(args, problem, gains_out))

@@ -14,6 +14,7 @@ from tutorial_atlas_control.search.sweep import (
     SweepInputs,
     build_specs,
     check_output,
+    parse_latency,
     parse_push,
     run_sweep,
     write_table,
@@ -62,6 +63,12 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument('--push', action='append', metavar='AT_S:FX,FY,FZ:DURATION_S',
                         help='a world-frame force (N) on the pelvis, AT_S s after the first '
                              'command (repeatable: one row each; "none" for a row without)')
+    parser.add_argument('--latency-ms', metavar='LO:HI',
+                        help='delay each command by LO..HI ms (1 ms steps, drawn from the row\'s '
+                             'seed) as live delivery does (default: none: at once)')
+    parser.add_argument('--repeat', type=int, default=1, metavar='N',
+                        help='play each combination N times, seeds apart (with --latency-ms: '
+                             'N draws of the latency; default: 1)')
     parser.add_argument('--settle', type=float, default=3.0, metavar='S',
                         help='sim time after the last waypoint (default: %(default)g)')
     parser.add_argument('--seed', type=int, default=0,
@@ -81,10 +88,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         pushes = [None if text == 'none' else parse_push(text) for text in args.push or ['none']]
+        latency = parse_latency(args.latency_ms) if args.latency_ms else (0, 0)
+        if args.repeat < 1:
+            raise SweepError(f'--repeat {args.repeat}: give 1 or more')
         inputs = SweepInputs(
             [(args.trajectory_file, name) for name in args.names] + args.trajectory,
             args.gains or [str(DEFAULT_GAINS_FILE)], args.gain_scale, args.time_scale,
-            pushes, args.settle, args.seed)
+            pushes, args.settle, args.seed, latency, args.repeat)
         check_output(args.out)
         specs = build_specs(inputs)
         outcome = run_sweep(specs, args.workers, args.scheduler, not args.no_progress)

@@ -32,7 +32,7 @@ from tutorial_atlas_control.bags.typestore import (
 )
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES
-from tutorial_atlas_control.msgs.commands import CommandDecoder, CommandError
+from tutorial_atlas_control.msgs.commands import CommandDecoder, CommandError, CommandUpdate
 from tutorial_atlas_control.msgs.sim_messages import TCPROS_PREFIX_BYTES, SimMessages
 from tutorial_atlas_control.msgs.wire import JointCommandsWire, StampedWire, clock_bytes
 from tutorial_atlas_control.sim import model as atlas_model
@@ -53,7 +53,7 @@ from tutorial_atlas_control.trajectories.trajectory import (
 )
 from tutorial_atlas_control.units import NS_PER_S
 
-__all__ = ['OfflineRunError', 'OfflineRun', 'run_offline', 'write_offline_bag']
+__all__ = ['CommandLatency', 'OfflineRunError', 'OfflineRun', 'run_offline', 'write_offline_bag']
 
 #: Sim time (s) before the switch to User, as `make demo`: past the 1 s torso pin.
 DEFAULT_START_AFTER_S = 1.5
@@ -93,6 +93,25 @@ PUBLISHERS: dict[str, tuple[str, bool]] = {
 TOPIC_TYPES: dict[str, TopicConnection] = {
     topic: TopicConnection(rosbags_msgtype(topics.MSG_TYPES[topic]), node, latched)
     for topic, (node, latched) in PUBLISHERS.items()}
+
+
+@dataclass(frozen=True)
+class CommandLatency:
+    """Live delivery, modelled: each command takes effect a whole number of steps later,
+    drawn uniformly from [min_steps, max_steps] by a generator seeded with `seed`.
+
+    Live, traj_yaml wakes on the /clock after a send is due and the node applies the command
+    at its next step (1-3 steps at real time, more on a busy machine); offline every command
+    takes effect at once. Commands keep their order, as over one TCP connection.
+    """
+
+    min_steps: int
+    max_steps: int
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        if not 0 <= self.min_steps <= self.max_steps:
+            raise ValueError(f'latency {self.min_steps}..{self.max_steps} steps is not a range')
 
 
 class OfflineRunError(AtlasControlError):
@@ -141,8 +160,12 @@ class _OfflinePlayer:
     """
 
     def __init__(self, sim: AtlasSimulator, sink: BlockBagWriter,
-                 on_step: StepHook | None = None) -> None:
+                 on_step: StepHook | None = None, latency: CommandLatency | None = None) -> None:
         self.sim = sim
+        self.latency = latency
+        self.latency_rng = np.random.default_rng(latency.seed) if latency else None
+        #: Delayed commands: (the step count at which each takes effect, its update).
+        self.pending: list[tuple[int, CommandUpdate]] = []
         self.sink = sink
         self.on_step = on_step
         self.messages = messages = SimMessages(sim)
@@ -234,6 +257,8 @@ class _OfflinePlayer:
         step, publish, on_step = sim.step, self.publish, self.on_step
         try:
             while sim.sim_time_ns < until_ns:
+                if self.pending:
+                    self._deliver()
                 step()
                 self.steps += 1
                 publish()
@@ -242,6 +267,15 @@ class _OfflinePlayer:
         except PhysicsDivergenceError as err:
             raise OfflineRunError(f'{err}; the live simulator would reset the robot here, '
                                   'an offline run stops') from None
+
+    def _deliver(self) -> None:
+        """Apply the delayed commands due before this step, in order."""
+        due = 0
+        while due < len(self.pending) and self.pending[due][0] <= self.steps:
+            due += 1
+        if due:
+            self.sim.receive_updates([update for _, update in self.pending[:due]])
+            del self.pending[:due]
 
     def now_s(self) -> float:
         return self.sim.sim_time_ns / NS_PER_S
@@ -273,7 +307,15 @@ class _OfflinePlayer:
             update = self.decoder.decode(raw)
         except CommandError as err:  # traj_yaml's commands are valid: a defect here
             raise OfflineRunError(f'the simulator refused an offline command: {err}') from err
-        self.sim.receive_updates([update])
+        if self.latency is None or self.latency_rng is None:
+            self.sim.receive_updates([update])
+        else:
+            delay = int(self.latency_rng.integers(self.latency.min_steps,
+                                                  self.latency.max_steps + 1))
+            after = self.pending[-1][0] if self.pending else 0
+            self.pending.append((max(after, self.steps + delay), update))
+            if delay == 0 and len(self.pending) == 1:
+                self._deliver()
         self.commands_sent += 1
 
     def log(self, text: str) -> None:
@@ -311,18 +353,20 @@ def write_offline_bag(bag: Path, trajectory_file: str, name: str, waypoints: Seq
                       gains: Gains, settle_s: float, start_after_s: float,
                       model_path: Path = atlas_model.MODEL_PATH,
                       play_after_s: float = 0.0,
-                      on_step: StepHook | None = None) -> OfflineRun:
+                      on_step: StepHook | None = None,
+                      latency: CommandLatency | None = None) -> OfflineRun:
     """Simulate the run and write it to `bag` (a new file; see run_offline for the checks).
 
     `on_step`, if given, is called with the simulator after every step (and its messages):
     the sweep measures a run there, and applies its pushes, without reading the bag back.
+    `latency`, if given, delays each command as a live run's delivery does (CommandLatency).
     """
     sim = AtlasSimulator(atlas_model.load_model(model_path), gains)
     sink = _open_bag(bag)
     # The run's time, without loading the model and the message types (fixed costs).
     started_s = time.perf_counter()
     try:
-        player = _OfflinePlayer(sim, sink, on_step)
+        player = _OfflinePlayer(sim, sink, on_step, latency)
         player.write_config()
         player.publish()  # the initial state, before the first step, as the node does
         player.advance(start_after_s)

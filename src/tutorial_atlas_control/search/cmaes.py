@@ -44,6 +44,9 @@ MIN_DURATION_S = 0.02
 GAIN_DIGITS = 4
 #: Initial step of each kind of coordinate: rad for joints, log-factor for durations and gains.
 DEFAULT_STEP = {'joint': 0.05, 'duration': 0.2, 'gain': 0.3}
+#: Seed of a candidate's first latency draw: every candidate meets the same draws (common
+#: random numbers), so a difference in cost is the candidate's, not the draw's.
+LATENCY_SEED = 1_000_000
 _TERM = re.compile(r'([+-]?)(?:(\d+(?:\.\d*)?)\*)?([a-z_]+)')
 
 
@@ -124,6 +127,9 @@ class SearchProblem:
     #: (gain scale, time scale) each candidate is also played at; its cost is the mean over
     #: the nominal run and these (a search for a step that survives them).
     variants: Sequence[tuple[float, float]] = ()
+    #: (lo ms, hi ms, draws): each candidate is also played `draws` times with each command
+    #: delayed lo..hi ms (CommandLatency), as live delivery on a busy machine; (0, 0, 0) none.
+    latency: tuple[int, int, int] = (0, 0, 0)
 
     def config(self) -> dict[str, Any]:
         """The problem as the log's header holds it (a resume must match it exactly)."""
@@ -134,7 +140,8 @@ class SearchProblem:
                 'parameters': [[p.kind, p.text] for p in self.parameters],
                 'objective': self.objective.text(), 'seed': self.seed, 'popsize': self.popsize,
                 'step_scale': self.step_scale, 'settle_s': self.base.settle_s,
-                'variants': [list(v) for v in self.variants]}
+                'variants': [list(v) for v in self.variants],
+                **({'latency': list(self.latency)} if self.latency[2] else {})}
 
     def candidate(self, x: Sequence[float], index: int = 0) -> RunSpec:
         """The run of vector `x`, rounded as its files will hold it."""
@@ -169,16 +176,23 @@ class SearchProblem:
     def runs(self, x: Sequence[float], index: int) -> list[RunSpec]:
         """Candidate `index`'s runs: nominal first, then each variant."""
         nominal = self.candidate(x, index)
-        count = 1 + len(self.variants)
+        count = self.runs_per_candidate()
         specs = [dataclasses.replace(nominal, index=index * count)]
         for j, (gain_scale, time_scale) in enumerate(self.variants, start=1):
             specs.append(dataclasses.replace(nominal, index=index * count + j,
                                              gain_scale=gain_scale, time_scale=time_scale))
+        lo, hi, draws = self.latency
+        for j in range(draws):
+            specs.append(dataclasses.replace(nominal, index=index * count + len(specs),
+                                             latency_steps=(lo, hi), seed=LATENCY_SEED + j))
         return specs
+
+    def runs_per_candidate(self) -> int:
+        return 1 + len(self.variants) + self.latency[2]
 
     def costs(self, rows: Sequence[dict[str, Any]]) -> tuple[list[float], list[dict[str, Any]]]:
         """Each candidate's cost (the mean over its runs) and its nominal row."""
-        count = 1 + len(self.variants)
+        count = self.runs_per_candidate()
         costs, nominal = [], []
         for k in range(0, len(rows), count):
             group = rows[k:k + count]

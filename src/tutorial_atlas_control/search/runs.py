@@ -19,7 +19,11 @@ import numpy as np
 
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import NUM_JOINTS
-from tutorial_atlas_control.offline.player import OfflineRunError, write_offline_bag
+from tutorial_atlas_control.offline.player import (
+    CommandLatency,
+    OfflineRunError,
+    write_offline_bag,
+)
 from tutorial_atlas_control.sim.controller import Gains
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
 from tutorial_atlas_control.sim.vrc import wrench_input
@@ -56,7 +60,8 @@ class Push:
 @dataclass(frozen=True)
 class RunSpec:
     """One row's inputs. `waypoints` are (duration_s, 28 positions) before time scaling;
-    `gains` are (p, i, d, i_clamp) rows of 28 before gain scaling."""
+    `gains` are (p, i, d, i_clamp) rows of 28 before gain scaling; `latency_steps` (lo, hi)
+    delays each command by lo..hi steps drawn from `seed` (CommandLatency), (0, 0) none."""
 
     index: int
     trajectory: str
@@ -69,6 +74,11 @@ class RunSpec:
     push: Push | None = None
     seed: int = 0
     settle_s: float = 3.0
+    latency_steps: tuple[int, int] = (0, 0)
+
+    def latency(self) -> CommandLatency | None:
+        lo, hi = self.latency_steps
+        return CommandLatency(lo, hi, self.seed) if hi > 0 else None
 
     def scaled_waypoints(self) -> list[Waypoint]:
         return [Waypoint(duration_s * self.time_scale, np.array(positions))
@@ -92,8 +102,8 @@ def spec_gains(gains: Gains) -> tuple[tuple[float, ...], ...]:
 
 #: The table's columns, in order: inputs, then outcome. No wall-clock field (determinism).
 TABLE_COLUMNS: tuple[str, ...] = (
-    'index', 'trajectory', 'name', 'gains', 'gain_scale', 'time_scale', 'push', 'seed',
-    'played_s', 'fell', 'fall_time_s', 'stood_after_s', 'pelvis_dx_m', 'pelvis_dy_m',
+    'index', 'trajectory', 'name', 'gains', 'gain_scale', 'time_scale', 'push', 'latency_ms',
+    'seed', 'played_s', 'fell', 'fall_time_s', 'stood_after_s', 'pelvis_dx_m', 'pelvis_dy_m',
     'pelvis_z_min_m', 'pelvis_z_end_m', 'r_foot_dx_m', 'r_foot_dy_m', 'r_foot_dz_end_m',
     'r_foot_lift_max_m', 'l_foot_dx_m', 'l_foot_dy_m', 'tracking_rms_rad', 'error')
 
@@ -182,6 +192,8 @@ def input_columns(spec: RunSpec) -> dict[str, Any]:
     return {'index': spec.index, 'trajectory': spec.trajectory, 'name': spec.name,
             'gains': spec.gains_label, 'gain_scale': spec.gain_scale,
             'time_scale': spec.time_scale, 'push': spec.push.label() if spec.push else '',
+            'latency_ms': (f'{spec.latency_steps[0]}:{spec.latency_steps[1]}'
+                           if spec.latency_steps[1] > 0 else ''),
             'seed': spec.seed,
             'played_s': round(sum(d for d, _ in spec.waypoints) * spec.time_scale, 9)}
 
@@ -198,7 +210,7 @@ def run_one(spec: RunSpec) -> dict[str, Any]:
         try:
             run = write_offline_bag(bag, spec.trajectory, spec.name, waypoints,
                                     spec.scaled_gains(), spec.settle_s, START_AFTER_S,
-                                    on_step=probe)
+                                    on_step=probe, latency=spec.latency())
             run_end_ns = int(round(run.sim_time_s * NS_PER_S))
         except OfflineRunError as err:
             error = str(err)

@@ -40,7 +40,8 @@ from tutorial_atlas_control.trajectories.trajectory import (
     locate_trajectory_file,
 )
 
-__all__ = ['SweepEngine', 'SweepInputs', 'SweepOutcome', 'build_specs', 'run_sweep', 'write_table']
+__all__ = ['SweepEngine', 'SweepInputs', 'SweepOutcome', 'build_specs', 'parse_latency',
+           'run_sweep', 'write_table']
 
 #: Seconds the client waits for a given scheduler before refusing it.
 CONNECT_TIMEOUT_S = 5
@@ -48,7 +49,8 @@ CONNECT_TIMEOUT_S = 5
 
 @dataclass(frozen=True)
 class SweepInputs:
-    """The grid: every trajectory x gains x gain scale x time scale x push (or none)."""
+    """The grid: every trajectory x gains x gain scale x time scale x push (or none) x
+    repeat. Repeats differ only in their seed, which draws the command latency (if any)."""
 
     trajectories: Sequence[tuple[str, str]]  # (file, name)
     gains_files: Sequence[str]
@@ -57,6 +59,23 @@ class SweepInputs:
     pushes: Sequence[Push | None] = (None,)
     settle_s: float = 3.0
     seed: int = 0
+    latency_steps: tuple[int, int] = (0, 0)
+    repeats: int = 1
+
+
+def parse_latency(text: str) -> tuple[int, int]:
+    """`LO:HI` whole milliseconds (1 ms steps), 0 <= LO <= HI, or `MS` for MS:MS."""
+    parts = text.split(':')
+    try:
+        if len(parts) not in (1, 2):
+            raise ValueError
+        lo, hi = int(parts[0]), int(parts[-1])
+        if not 0 <= lo <= hi:
+            raise ValueError
+    except ValueError:
+        raise SweepError(f'latency {text!r} is not LO:HI whole milliseconds, 0 <= LO <= HI '
+                         '(e.g. 1:3)') from None
+    return lo, hi
 
 
 def parse_push(text: str) -> Push:
@@ -99,10 +118,10 @@ def build_specs(inputs: SweepInputs) -> list[RunSpec]:
             raise SweepError(str(err)) from None
     specs = []
     grid = itertools.product(loaded, gains, inputs.gain_scales, inputs.time_scales,
-                             inputs.pushes)
-    for index, ((file, name, waypoints), (gains_file, table), g, t, push) in enumerate(grid):
+                             inputs.pushes, range(inputs.repeats))
+    for index, ((file, name, waypoints), (gains_file, table), g, t, push, _) in enumerate(grid):
         specs.append(RunSpec(index, file, name, gains_file, waypoints, table, g, t, push,
-                             inputs.seed + index, inputs.settle_s))
+                             inputs.seed + index, inputs.settle_s, inputs.latency_steps))
     return specs
 
 
