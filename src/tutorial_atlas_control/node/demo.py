@@ -73,13 +73,14 @@ def run_demo(trajectory: str, trajectory_file: Path, bag_dir: Path, real_time_fa
     args: dict[str, object] = {'gui': gui, 'bag_dir': bag_dir,
                                'real_time_factor': real_time_factor}
     if gains is not None:
-        progress(f'demo: gains {gains.describe()}')
         # Absolute: roslaunch's rosparam loader must not depend on its working directory.
         args['gains_file'] = gains.path.resolve()
     launch = AtlasLaunch(log_dir / 'atlas_launch.log', args)
     try:
         progress(f'demo: atlas.launch started (master on port {launch.port}, '
                  f'log {launch.log_path})')
+        if gains is not None:
+            progress(f'demo: gains {gains.describe()}')
         drive(launch, trajectory, trajectory_file, progress)
     finally:
         if not launch.close(SHUTDOWN_TIMEOUT_S):
