@@ -3,6 +3,7 @@
 #   make test    unit, integration and reliability tests (pytest), ruff and catkin_lint, the
 #                rostests, then a one-run --quick bench (its arithmetic, not its speed)
 #   make demo    the tutorial end to end, headless (TRAJ=step_and_fall|touchdown|touchdown_exhausted)
+#                or a step that stands: make demo TRAJ=step_and_stand (Stepping.yaml, its gains)
 #   make bench   the performance benchmark
 SHELL := /bin/bash
 .SHELLFLAGS := -eo pipefail -c

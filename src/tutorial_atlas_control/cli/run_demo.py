@@ -18,6 +18,8 @@ from tutorial_atlas_control.cli.convention import (
 )
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.node import demo
+from tutorial_atlas_control.sim.controller import load_gains_yaml
+from tutorial_atlas_control.trajectories.catalog import find_trajectory, gains_for
 from tutorial_atlas_control.trajectories.trajectory import load_trajectory
 
 PROG = 'run_demo.py'
@@ -27,9 +29,18 @@ def build_parser() -> argparse.ArgumentParser:
     """The argument parser (its --help is the documentation)."""
     parser = argparse.ArgumentParser(prog=PROG, description=demo.__doc__.split('\n\n')[0])
     parser.add_argument('trajectory', nargs='?', default='step_and_fall',
-                        help='trajectory name in the file (default: step_and_fall)')
-    parser.add_argument('--file', type=Path, default=demo.DEFAULT_TRAJECTORY_FILE,
-                        help='trajectory YAML file (default: trajectories/Traj_data2.yaml)')
+                        help='trajectory name (default: step_and_fall); without --file it '
+                             "must be in exactly one of the package's trajectories/*.yaml, "
+                             'e.g. step_and_stand (trajectories/Stepping.yaml)')
+    parser.add_argument('--file', type=Path,
+                        help="trajectory YAML file (default: the one of the package's "
+                             'trajectories/*.yaml that holds TRAJECTORY, e.g. Traj_data2.yaml '
+                             'for step_and_fall)')
+    parser.add_argument('--gains-file', type=Path, metavar='FILE',
+                        help="controller gains YAML, atlas.launch's gains_file (default: the "
+                             "trajectory file's companion ../config/<its stem in lower "
+                             'case>_gains.yaml if it exists, e.g. config/stepping_gains.yaml '
+                             'for trajectories/Stepping.yaml; else config/atlas_controller.yaml)')
     parser.add_argument('--bag-dir', type=Path,
                         default=Path(os.environ.get('TAC_BAG_DIR', demo.DEFAULT_BAG_DIR)),
                         help='where the bag goes (default: $TAC_BAG_DIR or %(default)s)')
@@ -52,10 +63,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status."""
     args = build_parser().parse_args(argv)
     try:
-        load_trajectory(args.file, args.trajectory)  # fail before starting anything
-        bag = demo.run_demo(args.trajectory, args.file, args.bag_dir.expanduser().resolve(),
+        # Everything is checked before anything starts.
+        trajectory_file = args.file or find_trajectory(args.trajectory)
+        load_trajectory(trajectory_file, args.trajectory)
+        gains = gains_for(trajectory_file, args.gains_file)
+        load_gains_yaml(gains.path)
+        bag = demo.run_demo(args.trajectory, trajectory_file, args.bag_dir.expanduser().resolve(),
                             args.real_time_factor, args.bag_dir.expanduser() / 'logs',
-                            progress=print, warn=_warn)
+                            progress=print, warn=_warn, gains=gains)
         demo.summarise(bag, args.video_fps, args.video_size, report=print)
     except AtlasControlError as err:
         print_error(PROG, err)

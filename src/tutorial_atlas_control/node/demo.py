@@ -16,13 +16,13 @@ from collections.abc import Callable
 from pathlib import Path
 
 from tutorial_atlas_control.bags.analysis import analyze_bag
+from tutorial_atlas_control.bags.feet import foot_line
 from tutorial_atlas_control.bags.render import render_bag_video
 from tutorial_atlas_control.bags.report import plot_run, short_summary
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.processes import AtlasLaunch
-from tutorial_atlas_control.resources import package_path
+from tutorial_atlas_control.trajectories.catalog import GainsChoice
 
-DEFAULT_TRAJECTORY_FILE = package_path('trajectories', 'Traj_data2.yaml')
 DEFAULT_BAG_DIR = Path.home() / '.ros' / 'tutorial_atlas_control' / 'bags'
 #: Sim time to wait before switching to User: the torso is pinned for 1 s after start.
 START_SETTLE_S = 1.5
@@ -61,18 +61,26 @@ def _silent(_line: str) -> None:
 
 
 def run_demo(trajectory: str, trajectory_file: Path, bag_dir: Path, real_time_factor: float,
-             log_dir: Path, progress: Report = _silent, warn: Report = _silent) -> Path:
+             log_dir: Path, progress: Report = _silent, warn: Report = _silent,
+             gains: GainsChoice | None = None) -> Path:
     """Run the tutorial once; return the closed bag's path.
 
+    `gains` is atlas.launch's gains_file (None: the launch's default, the tutorial's).
     `progress` gets a line at each phase, `warn` one if roslaunch had to be killed.
     """
     started_s = time.time()
     gui = 'true' if os.environ.get('DISPLAY') else 'false'
-    launch = AtlasLaunch(log_dir / 'atlas_launch.log',
-                         {'gui': gui, 'bag_dir': bag_dir, 'real_time_factor': real_time_factor})
+    args: dict[str, object] = {'gui': gui, 'bag_dir': bag_dir,
+                               'real_time_factor': real_time_factor}
+    if gains is not None:
+        # Absolute: roslaunch's rosparam loader must not depend on its working directory.
+        args['gains_file'] = gains.path.resolve()
+    launch = AtlasLaunch(log_dir / 'atlas_launch.log', args)
     try:
         progress(f'demo: atlas.launch started (master on port {launch.port}, '
                  f'log {launch.log_path})')
+        if gains is not None:
+            progress(f'demo: gains {gains.describe()}')
         drive(launch, trajectory, trajectory_file, progress)
     finally:
         if not launch.close(SHUTDOWN_TIMEOUT_S):
@@ -133,6 +141,9 @@ def summarise(bag: Path, video_fps: float, video_size: tuple[int, int],
     """
     analysis = analyze_bag(bag)
     report('\n' + short_summary(analysis))
+    foot = foot_line(analysis.data)
+    if foot is not None:
+        report(foot)
     plot = plot_run(analysis, bag.with_suffix('.png'))
     video = None
     if video_fps > 0:

@@ -198,28 +198,37 @@ class Gains:
     i_clamp: np.ndarray  # N m
 
 
-def _gain_value(params: Mapping[str, Any], joint: str, key: str) -> float:
+def _gain_value(params: Mapping[str, Any], joint: str, key: str, source: Path | None) -> float:
     name = f'{GAINS_PARAM}/{joint}/{key}'
     entry = params.get(joint) if isinstance(params, Mapping) else None
     if not isinstance(entry, Mapping) or key not in entry:
+        if source is not None:
+            raise GainsError(f'{source}: {name} is missing')
         raise GainsError(f'parameter {name} is missing; {LOAD_HINT}')
     value = finite_number(entry[key])
     if value is None:
+        if source is not None:
+            raise GainsError(f'{source}: {name} is {entry[key]!r}, not a finite number')
         raise GainsError(f'parameter {name} is {entry[key]!r}, not a finite number; '
                          'fix it in config/atlas_controller.yaml and reload it')
     return value
 
 
-def gains_from_params(params: Mapping[str, Any]) -> Gains:
+def gains_from_params(params: Mapping[str, Any], source: Path | None = None) -> Gains:
     """Gains from the dict under `atlas_controller/gains` ({joint: {p, i, d, i_clamp}}).
+
+    `source` is the YAML file the dict was read from (None: the parameter server); the
+    messages name it instead of telling how to load the parameters.
 
     Raises:
         GainsError: a joint or key is missing, or a value is not a finite number;
             the message names the parameter.
     """
     if not isinstance(params, Mapping):
+        if source is not None:
+            raise GainsError(f'{source}: {GAINS_PARAM} is {params!r}, not a dictionary')
         raise GainsError(f'parameter {GAINS_PARAM} is {params!r}, not a dictionary; {LOAD_HINT}')
-    table = np.array([[_gain_value(params, joint, key) for key in GAIN_KEYS]
+    table = np.array([[_gain_value(params, joint, key, source) for key in GAIN_KEYS]
                       for joint in JOINT_NAMES])
     return Gains(*(np.ascontiguousarray(table[:, column]) for column in range(len(GAIN_KEYS))))
 
@@ -240,6 +249,14 @@ def hold_command(gains: Gains, position: np.ndarray) -> JointCommandArrays:
     return command
 
 
+def _yaml_problem(err: yaml.YAMLError) -> str:
+    """A YAML error in one line: where (1-based line, column) and what."""
+    mark = getattr(err, 'problem_mark', None)
+    where = f' at line {mark.line + 1}, column {mark.column + 1}' if mark is not None else ''
+    problem = getattr(err, 'problem', None) or ' '.join(str(err).split())
+    return f'invalid YAML{where}: {problem}'
+
+
 def load_gains_yaml(path: str | Path) -> Gains:
     """Gains from a YAML file laid out like config/atlas_controller.yaml.
 
@@ -249,12 +266,14 @@ def load_gains_yaml(path: str | Path) -> Gains:
     path = Path(path)
     try:
         document = yaml.safe_load(path.read_text())
-    except (OSError, yaml.YAMLError) as err:
-        raise GainsError(f'Could not read gains from {path}: {err}') from err
+    except OSError as err:
+        raise GainsError(f'Could not read gains from {path}: {err.strerror or err}') from err
+    except yaml.YAMLError as err:
+        raise GainsError(f'Could not read gains from {path}: {_yaml_problem(err)}') from err
     node: Any = document
     for key in GAINS_PARAM.split('/'):
         if not isinstance(node, Mapping) or key not in node:
             raise GainsError(f'{path} has no {GAINS_PARAM} section; '
                              'see config/atlas_controller.yaml for the layout')
         node = node[key]
-    return gains_from_params(node)
+    return gains_from_params(node, path)
