@@ -82,7 +82,7 @@ COMPRESSIONS = ('lz4', 'bz2', 'none')
 #: What the table and the JSON call the launch's own compression (lz4, atlas.launch).
 DEFAULT_COMPRESSION = 'the launch\'s default'
 SECTIONS = ('physics', 'offline', 'analysis', 'fast', 'realtime', 'load', 'tutorial',
-            'controller', 'plot', 'sweep')
+            'controller', 'plot', 'sweep', 'search')
 #: What the table and the JSON say for the UDP figures while no UDP connection is made.
 NO_UDP = 'n/a (no UDP connection)'
 
@@ -154,6 +154,10 @@ ROWS = (
     ('sweep_runs_per_s_1', 'sweep.py offline runs, 1 worker', 'runs/s', '', 3),
     ('sweep_runs_per_s_2', 'sweep.py offline runs, 2 workers', 'runs/s', '', 3),
     ('sweep_scaling', 'sweep runs/s, 2 workers / 1', 'x', '', 2),
+    ('search_wall_s', 'search.py: the step\'s search, wall', 's', '', 1),
+    ('search_generations', 'search.py: its generations', 'count', '', 0),
+    ('search_runs_per_s', 'search.py: offline runs per second', 'runs/s', '', 3),
+    ('search_reproduced', 'search.py: found Stepping.yaml again', 'yes=1', '1', 0),
 )
 #: Rows shown as NO_UDP when the controller section ran without a UDP connection.
 UDP_ROWS = ('controller_udp_age_p50_ms', 'controller_udp_age_p99_ms',
@@ -223,6 +227,8 @@ TARGETS = {
     'analysis_speedup': Target(low=5.0),
     # The window's promise: every step obeys the answer to the state before it.
     'controller_window_age_p99_ms': Target(low=1.0, high=1.0),
+    # Issue 27: the search, run again whole, finds the committed step (one machine).
+    'search_reproduced': Target(low=1.0, high=1.0),
 }
 
 #: The keys each section must produce (a crash or an empty window shows as a missing key).
@@ -251,6 +257,8 @@ EXPECTED = {
     'plot': ('plot_off_realtime_rtf', 'plot_on_realtime_rtf', 'plot_off_node_us_per_step',
              'plot_on_node_us_per_step', 'plot_on_plotter_cpu'),
     'sweep': ('sweep_runs_per_s_1', 'sweep_runs_per_s_2', 'sweep_scaling'),
+    # search_reproduced only from a whole search (not --quick's one generation).
+    'search': ('search_wall_s', 'search_generations', 'search_runs_per_s'),
 }
 #: Keys computed from two sections, expected when both ran.
 EXPECTED_ACROSS = {('physics', 'fast'): ('fast_ratio', 'fast_bare_ratio', 'node_bare_ratio')}
@@ -382,6 +390,26 @@ def run_sweep(args: argparse.Namespace, samples: dict[str, list[float]],
             log(f'sweep run {run + 1}: {one:.3f} runs/s on 1 worker, {two:.3f} on 2')
             add(samples, {'sweep_runs_per_s_1': one, 'sweep_runs_per_s_2': two,
                           'sweep_scaling': two / one})
+
+
+def run_search(args: argparse.Namespace, samples: dict[str, list[float]],
+               loads: dict[str, str], work_dir: Path) -> None:
+    """The wall time of the search that found Stepping.yaml's step (issue 27): whole, once
+    (about ten minutes on 2 cores), whatever --runs says; --quick: one generation."""
+    if 'search' not in args.sections:
+        return
+    import search_time
+
+    with Section('search', loads):
+        timed = search_time.search_time(work_dir, args.quick)
+        figures = {'search_wall_s': timed.wall_s, 'search_generations': timed.generations,
+                   'search_runs_per_s': timed.runs / timed.wall_s}
+        if timed.reproduced is not None:
+            figures['search_reproduced'] = float(timed.reproduced)
+        log(f'search: {timed.generations} generations, {timed.runs} runs in '
+            f'{timed.wall_s:.1f} s' + ('' if timed.reproduced is None else
+                                      f'; found Stepping.yaml again: {timed.reproduced}'))
+        add(samples, figures)
 
 
 def run_online(args: argparse.Namespace, samples: dict[str, list[float]],
@@ -633,6 +661,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         run_offline(args, samples, loads)
         run_sweep(args, samples, loads)
+        run_search(args, samples, loads, work_dir)
         run_online(args, samples, loads, work_dir)
         run_tutorial(args, samples, loads, work_dir)
         ok = True

@@ -28,6 +28,7 @@ from tutorial_atlas_control.trajectories.trajectory import TrajectoryError
 REPO = Path(__file__).resolve().parents[2]
 TUTORIAL = REPO / 'trajectories' / 'Traj_data2.yaml'
 STEPPING = REPO / 'trajectories' / 'Stepping.yaml'
+QUICK_STEP = REPO / 'trajectories' / 'QuickStep.yaml'
 STEPPING_GAINS = REPO / 'config' / 'stepping_gains.yaml'
 WAYPOINT = '  - [1, "' + ' '.join(['0'] * NUM_JOINTS) + '"]\n'
 
@@ -147,11 +148,13 @@ def launched(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> Launched:
 @pytest.mark.parametrize(('argv', 'file', 'gains'), [
     ([], TUTORIAL, GainsChoice(DEFAULT_GAINS_FILE, "the tutorial's")),
     (['step_and_stand'], STEPPING, GainsChoice(STEPPING_GAINS, 'the companion of Stepping.yaml')),
+    (['quick_step'], QUICK_STEP, GainsChoice(REPO / 'config' / 'quickstep_gains.yaml',
+                                             'the companion of QuickStep.yaml')),
     (['step_and_stand', '--gains-file', str(DEFAULT_GAINS_FILE)], STEPPING,
      GainsChoice(DEFAULT_GAINS_FILE, 'given with --gains-file')),
     (['touchdown', '--file', str(TUTORIAL)], TUTORIAL,
      GainsChoice(DEFAULT_GAINS_FILE, "the tutorial's")),
-], ids=['default', 'step_and_stand', 'gains-file wins', '--file'])
+], ids=['default', 'step_and_stand', 'quick_step', 'gains-file wins', '--file'])
 def test_main_runs_the_name_with_its_gains(launched: Launched, argv: list[str], file: Path,
                                            gains: GainsChoice) -> None:
     assert run_demo.main(argv) == 0
@@ -164,7 +167,7 @@ def test_main_runs_the_name_with_its_gains(launched: Launched, argv: list[str], 
     (['--gains-file', '{tmp}/bad.yaml'],
      "{tmp}/bad.yaml: atlas_controller/gains/back_lbz/p is 'x', not a finite number"),
     (['jump'], "no trajectory named jump in the package's trajectory files (searched "
-               f'{TUTORIAL}, {STEPPING}); give its file with --file'),
+               f'{TUTORIAL}, {QUICK_STEP}, {STEPPING}); give its file with --file'),
     (['step_and_stand', '--file', str(TUTORIAL)],
      f'unable to find trajectory step_and_stand in {TUTORIAL}; it holds: step_and_fall, '
      'touchdown, touchdown_exhausted'),
