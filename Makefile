@@ -4,10 +4,13 @@
 #                rostests, then a one-run --quick bench (its arithmetic, not its speed)
 #   make demo    the tutorial end to end, headless (TRAJ=step_and_fall|touchdown|touchdown_exhausted)
 #                or a step that stands: make demo TRAJ=step_and_stand (Stepping.yaml, its gains)
+#                RTF=0.5 runs the simulator at half real time (a busy machine's late commands
+#                matter half as much in sim time)
 #   make bench   the performance benchmark
 SHELL := /bin/bash
 .SHELLFLAGS := -eo pipefail -c
 TRAJ ?= step_and_fall
+RTF ?= 1.0
 IN_ENV := source ./env.sh &&
 
 .PHONY: setup test unit-test lint rostest demo bench bench-quick clean-workspace
@@ -38,7 +41,7 @@ bench-quick: setup
 	@$(IN_ENV) python3 bench/run_bench.py --quick --runs 1
 
 demo: setup
-	@$(IN_ENV) python3 scripts/run_demo.py "$(TRAJ)"
+	@$(IN_ENV) python3 scripts/run_demo.py "$(TRAJ)" --real-time-factor "$(RTF)"
 
 bench: setup
 	@$(IN_ENV) python3 bench/run_bench.py

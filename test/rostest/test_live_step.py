@@ -97,6 +97,9 @@ class LiveStepTest(unittest.TestCase):
         self.assertEqual(result.returncode, 0, f'traj_yaml.py failed:\n{result.stderr}')
         self.probe.wait_sim(STAND_S + 0.1)
         self.assertTrue(self.poses.command_ns, 'no command heard')
+        stamps_ns = sorted(self.poses.command_ns)
+        rospy.loginfo(f'{self.trajectory} live: {len(stamps_ns)} commands, longest gap between '
+                      f'stamps {max(np.diff(stamps_ns)) / 1e6:.0f} ms of sim time (planned 20)')
         first_ns = min(self.poses.command_ns)
         end_ns = max(self.poses.command_ns) + int(COMMAND_PERIOD_S * 1e9)
         stand_until_ns = end_ns + int(STAND_S * 1e9)

@@ -235,3 +235,15 @@ def test_the_summary_line_and_a_bag_without_pose() -> None:
                                '+0.000 m up from the start (t = 0.00 s) to the end '
                                '(t = 1.00 s)')
     assert foot_line(BagData(Path('empty.bag'), 0.0, 0.0, {}, None, None, None, [], [])) is None
+
+
+@pytest.mark.parametrize('text', ['-1', 'nan', 'inf', 'abc'])
+def test_a_bad_real_time_factor_is_refused(launched: Launched, text: str,
+                                           capsys: pytest.CaptureFixture[str]) -> None:
+    """`make demo RTF=...` passes --real-time-factor: argparse's exit 2, nothing started."""
+    with pytest.raises(SystemExit) as exit_info:
+        run_demo.main(['step_and_stand', '--real-time-factor', text])
+    assert exit_info.value.code == 2
+    assert (f"argument --real-time-factor: real time factor '{text}' is not a finite number "
+            '>= 0') in capsys.readouterr().err
+    assert launched.calls == []

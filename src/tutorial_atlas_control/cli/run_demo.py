@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import subprocess
 import sys
@@ -44,7 +45,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument('--bag-dir', type=Path,
                         default=Path(os.environ.get('TAC_BAG_DIR', demo.DEFAULT_BAG_DIR)),
                         help='where the bag goes (default: $TAC_BAG_DIR or %(default)s)')
-    parser.add_argument('--real-time-factor', type=float, default=1.0,
+    parser.add_argument('--real-time-factor', type=argument_type(real_time_factor), default=1.0,
                         help='simulator pace; 0 = as fast as possible (default: 1.0)')
     parser.add_argument('--video-fps', type=float, default=demo.DEMO_VIDEO_FPS,
                         help='frame rate of the rendered video; 0 = no video '
@@ -53,6 +54,17 @@ def build_parser() -> argparse.ArgumentParser:
                         default=demo.DEMO_VIDEO_SIZE,
                         help='video size WxH in pixels (default: %(default)s)')
     return parser
+
+
+def real_time_factor(text: str) -> float:
+    """A pace for atlas.launch: a finite number >= 0 (0: as fast as possible)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not 0.0 <= value < math.inf:
+        raise AtlasControlError(f'real time factor {text!r} is not a finite number >= 0')
+    return value
 
 
 def _warn(line: str) -> None:
