@@ -50,8 +50,11 @@ def test_ctrl_c_while_playing_stops_everything_and_exits_130(tmp_path: Path) -> 
     pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
     env = dict(os.environ, ROS_LOG_DIR=str(tmp_path / 'ros_log'))
     process = subprocess.Popen(
+        # A quarter of real time: touchdown then plays for about a minute, so the signal lands
+        # while it plays even if this process is starved for a while (a fresh-clone run
+        # beside busy workers once saw the demo finish, exit 0, before its Ctrl-C).
         [sys.executable, '-u', str(RUN_DEMO), 'touchdown', '--video-fps', '0',
-         '--bag-dir', str(tmp_path)],
+         '--bag-dir', str(tmp_path), '--real-time-factor', '0.25'],
         env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         assert process.stdout is not None

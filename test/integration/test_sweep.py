@@ -86,8 +86,8 @@ def test_tutorial_trajectories_classified(tmp_path: Path) -> None:
     # step_and_fall lifts its right foot (its first waypoint) before it falls.
     assert rows['step_and_fall']['r_foot_lift_max_m'] > 0.03
     header = (tmp_path / 'tutorial.csv').read_text().splitlines()[0]
-    assert header.startswith('index,trajectory,name,gains,gain_scale,time_scale,push,seed,'
-                             'played_s,fell,fall_time_s,')
+    assert header.startswith('index,trajectory,name,gains,gain_scale,time_scale,push,'
+                             'latency_ms,seed,played_s,fell,fall_time_s,')
 
 
 def test_push_topples_touchdown(tmp_path: Path, tiny_file: Path) -> None:

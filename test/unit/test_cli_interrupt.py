@@ -36,7 +36,7 @@ TRAJECTORY_FILE = REPO / 'trajectories' / 'Traj_data2.yaml'
 LONG_SETTLE_S = '10000'
 #: Wall-clock bounds (s): for the run to start simulating, and to end after the signal.
 START_TIMEOUT_S = 60.0
-EXIT_TIMEOUT_S = 30.0
+EXIT_TIMEOUT_S = 60.0
 
 
 def interrupt(*_args: object, **_kwargs: object) -> None:
@@ -72,7 +72,9 @@ def test_sigint_stops_run_offline_with_130_and_leaves_no_bag(tmp_path: Path) -> 
     """A real Ctrl-C while the offline run simulates: exit 130, no traceback, no bag left."""
     bag = tmp_path / 'run.bag'
     process = subprocess.Popen(
-        [sys.executable, str(REPO / 'scripts' / 'run_offline.py'), str(TRAJECTORY_FILE),
+        # -X faulthandler: if it does not exit, SIGABRT makes it print where it hangs.
+        [sys.executable, '-X', 'faulthandler', str(REPO / 'scripts' / 'run_offline.py'),
+         str(TRAJECTORY_FILE),
          'touchdown', '--settle', LONG_SETTLE_S, '--bag', str(bag)],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=dict(os.environ))
     try:
@@ -83,7 +85,15 @@ def test_sigint_stops_run_offline_with_130_and_leaves_no_bag(tmp_path: Path) -> 
             assert time.monotonic() < deadline, 'run_offline.py did not start simulating'
             time.sleep(0.05)
         process.send_signal(signal.SIGINT)
-        out, err = process.communicate(timeout=EXIT_TIMEOUT_S)
+        try:
+            out, err = process.communicate(timeout=EXIT_TIMEOUT_S)
+        except subprocess.TimeoutExpired:
+            # Seen once in a fresh-clone run beside two busy search workers (load ~5), not
+            # reproduced at load 8: the stacks say where it was.
+            process.send_signal(signal.SIGABRT)
+            _out, err = process.communicate(timeout=EXIT_TIMEOUT_S)
+            pytest.fail(f'run_offline.py did not exit within {EXIT_TIMEOUT_S:g} s of SIGINT; '
+                        f'its threads:\n{err}')
     finally:
         if process.poll() is None:
             process.kill()
