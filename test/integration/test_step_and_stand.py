@@ -22,6 +22,8 @@ LIFTED_M = 0.03
 LATE_PASSES = 8
 #: Put down: the foot's height at the end, against where it started (m).
 DOWN_WITHIN_M = 0.01
+#: two_steps: the left foot ends at least this much further forward than the right (m).
+PAST_M = 0.1
 
 
 def test_step_and_stand_offline() -> None:
@@ -72,3 +74,21 @@ def test_step_and_stand_survives_late_commands() -> None:
         passed.append(not row['fell'] and row['r_foot_dx_m'] >= FORWARD_M
                       and row['pelvis_z_min_m'] > PELVIS_ABOVE_M)
     assert sum(passed) >= LATE_PASSES, passed
+
+
+def test_two_steps_offline() -> None:
+    """The stretch goal's start (two steps in a row, Stepping.yaml's two_steps): after
+    step_and_stand's right step, the left foot lifts, swings past the right one and is put
+    down, and the robot stands the 5 s after. Offline and as written only: its header gives
+    how rarely it survives gains, timing or latency off."""
+    spec, = build_specs(SweepInputs([(str(STEPPING), 'two_steps')], [str(GAINS)],
+                                    settle_s=STAND_S))
+    row = run_one(spec)
+    assert row['fell'] is False, row
+    assert row['r_foot_dx_m'] >= FORWARD_M
+    assert row['l_foot_lift_max_m'] > LIFTED_M
+    assert row['l_foot_dx_m'] > row['r_foot_dx_m'] + PAST_M
+    for foot in ('r', 'l'):
+        assert abs(row[f'{foot}_foot_dz_end_m']) < DOWN_WITHIN_M, foot
+    assert row['stood_after_s'] >= STAND_S
+    assert row['pelvis_z_end_m'] > PELVIS_ABOVE_M

@@ -25,6 +25,9 @@ PER_M = 10.0
 FALLEN_STEP_COST = 10.0
 #: The swing foot must rise at least this much (m) to count as lifted, not slid.
 MIN_LIFT_M = 0.03
+#: steps_forward counts a foot's end height off the ground up to this (m): it bounds the cost
+#: of a run that stands, so that any fall costs more.
+MAX_DZ_M = 0.1
 
 
 @dataclass(frozen=True)
@@ -78,6 +81,24 @@ def _step_forward(row: Mapping[str, Any], p: Mapping[str, float]) -> float:
     return _fall_cost(row, p['stand']) + PER_M * (forward + lift + down + low)
 
 
+def _steps_bound(p: Mapping[str, float]) -> float:
+    """The most a steps_forward run that stands can cost (every shortfall at its cap)."""
+    return p['stand'] + PER_M * (p['r'] + p['l'] + 2 * (p['lift'] + MAX_DZ_M) + max(0.0, p['z']))
+
+
+def _steps_forward(row: Mapping[str, Any], p: Mapping[str, float]) -> float:
+    """Both feet lifted and put down R and L m further forward (a walk's steps), then stand."""
+    if row['fell']:  # as step_forward: a fall costs more than any run that stands
+        return _steps_bound(p) + FALL_PENALTY + _fall_cost(row, p['stand'])
+    short = 0.0
+    for foot in ('r', 'l'):
+        short += max(0.0, p[foot] - max(0.0, float(row[f'{foot}_foot_dx_m'])))
+        short += max(0.0, p['lift'] - max(0.0, float(row[f'{foot}_foot_lift_max_m'])))
+        short += min(MAX_DZ_M, abs(float(row[f'{foot}_foot_dz_end_m'])))
+    low = min(max(0.0, p['z']), max(0.0, p['z'] - float(row['pelvis_z_end_m'])))
+    return _fall_cost(row, p['stand']) + PER_M * (short + low)
+
+
 def _pelvis_height(row: Mapping[str, Any], p: Mapping[str, float]) -> float:
     return abs(float(row['pelvis_z_end_m']) - p['z']) + (FALL_PENALTY if row['fell'] else 0.0)
 
@@ -90,6 +111,10 @@ OBJECTIVES: dict[str, tuple[Callable[[Mapping[str, Any], Mapping[str, float]], f
     'step_forward': (_step_forward, {'dx': 0.15, 'stand': 5.0, 'z': 0.8},
                      'lift the right foot, put it down DX m further forward, stand STAND s '
                      'after with the pelvis above Z m'),
+    'steps_forward': (_steps_forward,
+                      {'r': 0.15, 'l': 0.15, 'lift': MIN_LIFT_M, 'stand': 5.0, 'z': 0.8},
+                      'lift each foot at least LIFT m; the right ends R m and the left L m '
+                      'further forward; stand STAND s after with the pelvis above Z m'),
     'pelvis_height': (_pelvis_height, {'z': 0.85, 'settle': 0.5},
                       'end with the pelvis at Z m, standing (a toy problem)'),
 }

@@ -105,7 +105,8 @@ TABLE_COLUMNS: tuple[str, ...] = (
     'index', 'trajectory', 'name', 'gains', 'gain_scale', 'time_scale', 'push', 'latency_ms',
     'seed', 'played_s', 'fell', 'fall_time_s', 'stood_after_s', 'pelvis_dx_m', 'pelvis_dy_m',
     'pelvis_z_min_m', 'pelvis_z_end_m', 'r_foot_dx_m', 'r_foot_dy_m', 'r_foot_dz_end_m',
-    'r_foot_lift_max_m', 'l_foot_dx_m', 'l_foot_dy_m', 'tracking_rms_rad', 'error')
+    'r_foot_lift_max_m', 'l_foot_dx_m', 'l_foot_dy_m', 'l_foot_dz_end_m', 'l_foot_lift_max_m',
+    'tracking_rms_rad', 'error')
 
 
 class RunProbe:
@@ -125,6 +126,7 @@ class RunProbe:
         self.z_min_m = math.inf
         self.start: dict[str, np.ndarray] | None = None
         self.lift_max_m = 0.0
+        self.l_lift_max_m = 0.0
         self.sq_error = 0.0
         self.error_count = 0
         self.last: dict[str, np.ndarray] = {}
@@ -161,6 +163,8 @@ class RunProbe:
             return
         self.last = poses = self._poses(sim)
         self.lift_max_m = max(self.lift_max_m, float(poses['r_foot'][2] - self.start['r_foot'][2]))
+        self.l_lift_max_m = max(self.l_lift_max_m,
+                                float(poses['l_foot'][2] - self.start['l_foot'][2]))
         if now_ns <= self.end_ns:
             error = sim.joint_positions() - sim.active_command().position
             self.sq_error += float(error @ error)
@@ -183,6 +187,7 @@ class RunProbe:
             'r_foot_dx_m': delta('r_foot', 0), 'r_foot_dy_m': delta('r_foot', 1),
             'r_foot_dz_end_m': delta('r_foot', 2), 'r_foot_lift_max_m': self.lift_max_m,
             'l_foot_dx_m': delta('l_foot', 0), 'l_foot_dy_m': delta('l_foot', 1),
+            'l_foot_dz_end_m': delta('l_foot', 2), 'l_foot_lift_max_m': self.l_lift_max_m,
             'tracking_rms_rad': (math.sqrt(self.sq_error / self.error_count)
                                  if self.error_count else math.nan),
         }
