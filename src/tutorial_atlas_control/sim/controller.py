@@ -51,6 +51,7 @@ from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.msgs.commands import JointCommandArrays
 from tutorial_atlas_control.resources import package_path
 from tutorial_atlas_control.units import finite_number
+from tutorial_atlas_control.yaml_errors import yaml_problem
 
 #: Where the gains live on the parameter server (and in config/atlas_controller.yaml).
 GAINS_PARAM = topics.GAINS_PARAM
@@ -249,14 +250,6 @@ def hold_command(gains: Gains, position: np.ndarray) -> JointCommandArrays:
     return command
 
 
-def _yaml_problem(err: yaml.YAMLError) -> str:
-    """A YAML error in one line: where (1-based line, column) and what."""
-    mark = getattr(err, 'problem_mark', None)
-    where = f' at line {mark.line + 1}, column {mark.column + 1}' if mark is not None else ''
-    problem = getattr(err, 'problem', None) or ' '.join(str(err).split())
-    return f'invalid YAML{where}: {problem}'
-
-
 def load_gains_yaml(path: str | Path) -> Gains:
     """Gains from a YAML file laid out like config/atlas_controller.yaml.
 
@@ -269,7 +262,7 @@ def load_gains_yaml(path: str | Path) -> Gains:
     except OSError as err:
         raise GainsError(f'Could not read gains from {path}: {err.strerror or err}') from err
     except yaml.YAMLError as err:
-        raise GainsError(f'Could not read gains from {path}: {_yaml_problem(err)}') from err
+        raise GainsError(f'Could not read gains from {path}: {yaml_problem(err)}') from err
     node: Any = document
     for key in GAINS_PARAM.split('/'):
         if not isinstance(node, Mapping) or key not in node:

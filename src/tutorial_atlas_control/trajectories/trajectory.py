@@ -27,6 +27,7 @@ from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.resources import package_path
 from tutorial_atlas_control.units import finite_number
+from tutorial_atlas_control.yaml_errors import yaml_problem, yaml_where
 
 __all__ = [
     'PUBLISH_PERIOD_S',
@@ -96,12 +97,11 @@ def load_trajectory_file(path: PathLike) -> dict[str, object]:
         doc = yaml.safe_load(text)
     except yaml.constructor.ConstructorError as err:
         raise TrajectoryError(
-            f'{path}: unsupported YAML{_yaml_where(err)}: {err.problem}; '
+            f'{path}: unsupported YAML{yaml_where(err)}: {err.problem}; '
             'trajectory files may only hold plain mappings, lists, numbers and strings'
         ) from err
     except yaml.YAMLError as err:
-        problem = getattr(err, 'problem', None) or _one_line(str(err))
-        raise TrajectoryError(f'{path}: invalid YAML{_yaml_where(err)}: {problem}') from err
+        raise TrajectoryError(f'{path}: {yaml_problem(err)}') from err
 
     if doc is None:
         raise TrajectoryError(
@@ -317,11 +317,6 @@ def _parse_positions(value: object, where: str) -> np.ndarray:
             )
         positions[index] = number
     return positions
-
-
-def _yaml_where(err: yaml.YAMLError) -> str:
-    mark = getattr(err, 'problem_mark', None) or getattr(err, 'context_mark', None)
-    return f' at line {mark.line + 1}, column {mark.column + 1}' if mark is not None else ''
 
 
 def _one_line(text: str) -> str:
