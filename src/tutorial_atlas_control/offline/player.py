@@ -163,7 +163,7 @@ class _OfflinePlayer:
                  on_step: StepHook | None = None, latency: CommandLatency | None = None) -> None:
         self.sim = sim
         self.latency = latency
-        self.latency_rng = np.random.default_rng(latency.seed) if latency else None
+        self.latency_rng = np.random.default_rng(latency.seed if latency else 0)
         #: Delayed commands: (the step count at which each takes effect, its update).
         self.pending: list[tuple[int, CommandUpdate]] = []
         self.sink = sink
@@ -307,15 +307,13 @@ class _OfflinePlayer:
             update = self.decoder.decode(raw)
         except CommandError as err:  # traj_yaml's commands are valid: a defect here
             raise OfflineRunError(f'the simulator refused an offline command: {err}') from err
-        if self.latency is None or self.latency_rng is None:
+        if self.latency is None:
             self.sim.receive_updates([update])
-        else:
+        else:  # applied by advance(), before the step it is due at
             delay = int(self.latency_rng.integers(self.latency.min_steps,
                                                   self.latency.max_steps + 1))
             after = self.pending[-1][0] if self.pending else 0
             self.pending.append((max(after, self.steps + delay), update))
-            if delay == 0 and len(self.pending) == 1:
-                self._deliver()
         self.commands_sent += 1
 
     def log(self, text: str) -> None:
