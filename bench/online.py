@@ -98,6 +98,8 @@ def recorded_fraction(bag_dir: Path, topic: str = topics.JOINT_STATES) -> float 
     seqs = []
     with Reader(bags[-1]) as reader:
         connections = [c for c in reader.connections if c.topic == topic]
+        if not connections:  # Reader.messages reads every connection when given none
+            return None
         for _, _, raw in reader.messages(connections=connections):
             seqs.append(struct.unpack_from('<I', raw, 0)[0])
     if len(seqs) < 2:

@@ -23,7 +23,7 @@ APT_PACKAGES=(
   libosmesa6 libegl1 libopengl0 libgl1-mesa-dri
   ros-robot-state-publisher ros-tf2-msgs python3-tf2-msgs python3-tf2-ros rviz
   ros-trajectory-msgs python3-trajectory-msgs
-  xvfb xdotool x11-apps imagemagick
+  xvfb xdotool x11-apps imagemagick iproute2
   python3-tk
 )
 

@@ -63,6 +63,7 @@ def last_command_position(bag: Path) -> np.ndarray:
 
     with Reader(bag) as reader:
         connections = [c for c in reader.connections if c.topic == '/atlas/joint_commands']
+        assert connections, 'no command recorded'  # none: Reader.messages reads every topic
         last = None
         for connection, _t, raw in reader.messages(connections=connections):
             last = connection, raw

@@ -23,6 +23,8 @@ def messages(bag: Path, topic: str) -> list[Any]:
 
     with Reader(bag) as reader:
         connections = [c for c in reader.connections if c.topic == topic]
+        if not connections:  # Reader.messages reads every connection when given none
+            return []
         typestore = load_typestore(reader.connections)
         return [typestore.deserialize_ros1(raw, connection.msgtype)
                 for connection, _, raw in reader.messages(connections=connections)]

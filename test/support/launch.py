@@ -13,6 +13,7 @@ import json
 import subprocess
 import sys
 import time
+import xmlrpc.client
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -22,6 +23,7 @@ from tutorial_atlas_control import processes
 
 REPO = Path(__file__).resolve().parents[2]
 FLOOD = REPO / 'tools' / 'flood_commands.py'
+SIM, RECORDER = '/atlas_sim', '/recorder'
 #: Wall-clock guards (s): far beyond what any step takes on a loaded machine.
 STARTUP_TIMEOUT_S = 120.0
 EXIT_TIMEOUT_S = 60.0
@@ -61,10 +63,32 @@ class TestLaunch(processes.AtlasLaunch):
             pytest.fail(f'{err}:\n{self.output()}')
 
     def wait_ready(self) -> None:
-        """Until the simulator and the recorder are both subscribed to the commands."""
-        self.wait(lambda: {'/atlas_sim', '/recorder'} <= set(
+        """Until the simulator and the recorder are both subscribed to the commands, and
+        the recorder is connected to every topic of the simulator's it records."""
+        self.wait(lambda: {SIM, RECORDER} <= set(
             self.subscribers('/atlas/joint_commands')), STARTUP_TIMEOUT_S,
             'atlas.launch was not ready')
+        self.wait(lambda: self.unrecorded_topics() == [], STARTUP_TIMEOUT_S,
+                  f'the recorder was not connected to all of {SIM}\'s topics')
+
+    def unrecorded_topics(self) -> list[str] | None:
+        """The simulator's topics the recorder subscribes to but has no connection to yet
+        (the simulator's getBusInfo, what `rosnode info` shows); None while unknown."""
+        caller = '/tutorial_atlas_control_tests'
+        try:
+            publishers, subscribers = processes.system_state(self.uri)
+            code, _, sim_uri = xmlrpc.client.ServerProxy(self.uri).lookupNode(caller, SIM)
+            if code != 1:
+                return None
+            code, _, bus = xmlrpc.client.ServerProxy(sim_uri).getBusInfo(caller)
+        except OSError:
+            return None
+        recorded = {topic for topic, nodes in publishers.items()
+                    if SIM in nodes and RECORDER in subscribers.get(topic, [])}
+        if code != 1 or not recorded:
+            return None
+        connected = {row[4] for row in bus if row[1] == RECORDER and row[2] == 'o'}
+        return sorted(recorded - connected)
 
     def wait_exit(self, timeout_s: float = EXIT_TIMEOUT_S) -> int:
         try:

@@ -91,7 +91,7 @@ from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.node.master_watch import start_master_watch
 from tutorial_atlas_control.node.recorder_watch import start_recorder_watch
-from tutorial_atlas_control.node.transport import WireBatch
+from tutorial_atlas_control.node.transport import WireBatch, widen_accept_queue
 from tutorial_atlas_control.node.udpros import serve as serve_udpros
 from tutorial_atlas_control.node.viewer import ViewerLink, ViewerRequest, display_problem
 from tutorial_atlas_control.sim import model as atlas_model
@@ -270,6 +270,7 @@ class SimNode:
         self.gui = gui
         # UDPROS for roscpp's unreliable() subscribers, before the master announces a topic.
         self.udpros = serve_udpros()
+        widen_accept_queue()  # a dozen subscribers connect at once when it advertises
         self._advertise(tf)
         statistics = self._controller_statistics()
         outbox = WireBatch()

@@ -23,10 +23,11 @@ import time
 from collections.abc import Callable
 
 import rospy
+from rospy.impl import tcpros_base
 from rospy.impl.tcpros_base import TransportTerminated
 
 __all__ = ['MAX_BACKLOG_BYTES', 'SEND_TIMEOUT_S', 'STALL_PROBE_S', 'ConnectionWriter',
-           'WireBatch', 'subscriber_names']
+           'WireBatch', 'subscriber_names', 'widen_accept_queue']
 
 #: A subscriber that accepts nothing for this long (s) is dropped: slow subscribers lose
 #: nothing, stalled ones do not hold their bytes (and the node's memory) forever.
@@ -37,6 +38,24 @@ SEND_TIMEOUT_S = 2.0
 STALL_PROBE_S = 0.05
 #: A backlog past this (bytes) drops its subscriber at once: the memory bound per connection.
 MAX_BACKLOG_BYTES = 16 * 1024 * 1024
+
+
+def widen_accept_queue() -> int:
+    """Let the node's TCPROS server queue as many connections as the kernel allows.
+
+    rospy listens with a backlog of 5. At startup the recorder, rosout and the tools connect
+    to a dozen of the simulator's topics at once while its accept thread waits for the GIL:
+    the kernel drops the connections past 5 and their subscribers retry a second or more
+    later (TcpExtListenOverflows), missing what was published meanwhile (a forced-divergence
+    run lost /atlas/sim_config from its bag). Returns the new backlog, 0 if rospy could not
+    start its TCPROS server. Call after init_node, before advertising.
+    """
+    tcpros_base.start_tcpros_server()  # what the first publisher does; idempotent
+    server = tcpros_base._tcpros_server  # rospy offers no setter
+    if server is None or server.tcp_ros_server is None:
+        return 0
+    server.tcp_ros_server.server_sock.listen(socket.SOMAXCONN)  # Linux: updates the backlog
+    return socket.SOMAXCONN
 
 
 def wait_writable(sock: socket.socket, timeout_s: float) -> bool:
