@@ -80,12 +80,9 @@ class LiveStepTest(unittest.TestCase):
             states = {m.header.stamp.to_nsec(): m.position for m in self.probe.joint_states}
         rows = []
         for t_ns, (position, quat) in sorted(list(self.poses.odom.items())):
-            if not start_ns <= t_ns <= end_ns or t_ns not in states:
-                continue
-            self.data.qpos[:3], self.data.qpos[3:7] = position, quat
-            self.data.qpos[self.atlas.qpos_adr] = states[t_ns]
-            mujoco.mj_kinematics(self.atlas.model, self.data)
-            rows.append((t_ns, float(position[2]), self.data.xpos[foot].copy()))
+            if start_ns <= t_ns <= end_ns and t_ns in states:
+                rows.append((t_ns, float(position[2]), atlas_model.body_position_in_pose(
+                    self.atlas, self.data, foot, position, quat, states[t_ns])))
         return rows
 
     def test_step_and_stand(self) -> None:

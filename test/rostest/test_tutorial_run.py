@@ -168,12 +168,10 @@ class TutorialRunTest(unittest.TestCase):
                 states[msg.header.stamp.to_nsec()] = msg.position
         lift = -np.inf
         for t_ns, (position, quat) in list(self.recorder.odom.items()):
-            if not start_ns <= t_ns <= end_ns or t_ns not in states:
-                continue
-            self.data.qpos[:3], self.data.qpos[3:7] = position, quat
-            self.data.qpos[self.atlas.qpos_adr] = states[t_ns]
-            mujoco.mj_kinematics(self.atlas.model, self.data)
-            lift = max(lift, self.data.xpos[foot][2] - rest_z)
+            if start_ns <= t_ns <= end_ns and t_ns in states:
+                at = atlas_model.body_position_in_pose(self.atlas, self.data, foot, position,
+                                                       quat, states[t_ns])
+                lift = max(lift, at[2] - rest_z)
         return float(lift)
 
     def first_command_ns(self) -> int:

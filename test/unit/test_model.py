@@ -170,6 +170,32 @@ def test_spawn_puts_the_soles_on_the_floor(atlas: model.AtlasModel) -> None:
     assert 0.93 - model.SPAWN_HEIGHT_M == pytest.approx(0.002881, abs=1e-6)  # noqa: SIM300
 
 
+def test_body_position_in_pose_is_the_simulated_pose(atlas: model.AtlasModel) -> None:
+    """Forward kinematics of a recorded pose gives where the simulator had the foot."""
+    data = mujoco.MjData(atlas.model)
+    model.reset_to_initial(atlas, data)
+    data.qpos[atlas.qpos_adr] = np.linspace(-0.3, 0.3, NUM_JOINTS)
+    adr = atlas.free_qpos_adr
+    data.qpos[adr:adr + 7] = (0.4, -0.2, 0.8, np.cos(0.3), 0.0, 0.0, np.sin(0.3))
+    mujoco.mj_forward(atlas.model, data)
+    foot = atlas.model.body('r_foot').id
+    position, quaternion = model.pelvis_pose(atlas, data)
+    scratch = mujoco.MjData(atlas.model)
+    found = model.body_position_in_pose(atlas, scratch, foot, position, quaternion,
+                                        model.joint_positions(atlas, data))
+    np.testing.assert_allclose(found, data.xpos[foot], atol=1e-12)
+    # Each input counts: the pelvis 0.1 m higher lifts the foot 0.1 m; a bent knee lifts it.
+    higher = model.body_position_in_pose(atlas, scratch, foot, position + [0, 0, 0.1],
+                                         quaternion, model.joint_positions(atlas, data))
+    np.testing.assert_allclose(higher - found, [0, 0, 0.1], atol=1e-12)
+    standing = model.body_position_in_pose(atlas, scratch, foot, position, [1, 0, 0, 0],
+                                           np.zeros(NUM_JOINTS))
+    bent = np.zeros(NUM_JOINTS)
+    bent[JOINT_NAMES.index('r_leg_kny')] = 1.0
+    kneeling = model.body_position_in_pose(atlas, scratch, foot, position, [1, 0, 0, 0], bent)
+    assert kneeling[2] - standing[2] > 0.1
+
+
 def test_pin_holds_the_spawn_pose_without_a_jump(atlas: model.AtlasModel) -> None:
     data = mujoco.MjData(atlas.model)
     model.reset_to_initial(atlas, data)

@@ -14,7 +14,7 @@ import numpy as np
 from tutorial_atlas_control.bags.analysis import first_applied_command_s
 from tutorial_atlas_control.bags.reader import BagData
 from tutorial_atlas_control.bags.render import prepare_gl
-from tutorial_atlas_control.joints import joint_index
+from tutorial_atlas_control.joints import NUM_JOINTS, joint_index
 
 __all__ = ['FootDisplacement', 'foot_displacement', 'foot_line']
 
@@ -51,26 +51,26 @@ def foot_displacement(data: BagData, body: str = RIGHT_FOOT_BODY) -> FootDisplac
     prepare_gl()  # before mujoco's first import: a video may be rendered afterwards
     import mujoco  # noqa: PLC0415
 
-    from tutorial_atlas_control.sim.model import load_model  # noqa: PLC0415 - imports mujoco
+    from tutorial_atlas_control.sim.model import (  # noqa: PLC0415 - imports mujoco
+        body_position_in_pose,
+        load_model,
+    )
 
     atlas = load_model()
-    model = atlas.model
-    body_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, body)
+    body_id = mujoco.mj_name2id(atlas.model, mujoco.mjtObj.mjOBJ_BODY, body)
     if body_id < 0:
         return None
-    kinematics = mujoco.MjData(model)
-    columns = [(column, joint_index(name)) for column, name in enumerate(states.names)]
+    kinematics = mujoco.MjData(atlas.model)
+    columns = [(column, index) for column, name in enumerate(states.names)
+               if (index := joint_index(name)) is not None]
 
     def position_at(at_s: float) -> np.ndarray:
         pose_row, joint_row = _row_at(pelvis.t_s, at_s), _row_at(states.t_s, at_s)
-        adr = atlas.free_qpos_adr
-        kinematics.qpos[adr:adr + 3] = pelvis.position_m[pose_row]
-        kinematics.qpos[adr + 3:adr + 7] = pelvis.orientation_xyzw[pose_row, [3, 0, 1, 2]]
+        angles = np.zeros(NUM_JOINTS)  # a joint the bag lacks stays at 0
         for column, index in columns:
-            if index is not None:
-                kinematics.qpos[atlas.qpos_adr[index]] = states.position[joint_row, column]
-        mujoco.mj_kinematics(model, kinematics)
-        return kinematics.xpos[body_id].copy()
+            angles[index] = states.position[joint_row, column]
+        return body_position_in_pose(atlas, kinematics, body_id, pelvis.position_m[pose_row],
+                                     pelvis.orientation_xyzw[pose_row, [3, 0, 1, 2]], angles)
 
     return FootDisplacement(body, start_s, end_s, position_at(end_s) - position_at(start_s))
 

@@ -172,6 +172,23 @@ def pelvis_pose(atlas: AtlasModel, data: mujoco.MjData) -> tuple[np.ndarray, np.
     return data.qpos[adr:adr + 3].copy(), data.qpos[adr + 3:adr + 7].copy()
 
 
+def body_position_in_pose(atlas: AtlasModel, data: mujoco.MjData, body_id: int,
+                          pelvis_position: np.ndarray, pelvis_quat_wxyz: np.ndarray,
+                          joint_angles: np.ndarray) -> np.ndarray:
+    """World position (m) of body `body_id` with the pelvis at `pelvis_position` (3,),
+    `pelvis_quat_wxyz` (4,) and the joints at `joint_angles` (28, JOINT_NAMES order).
+
+    Forward kinematics only (no dynamics), so a recorded pose (odometry and joint states)
+    gives where a foot was; `data` is scratch space and is overwritten.
+    """
+    adr = atlas.free_qpos_adr
+    data.qpos[adr:adr + 3] = pelvis_position
+    data.qpos[adr + 3:adr + 7] = pelvis_quat_wxyz
+    data.qpos[atlas.qpos_adr] = joint_angles
+    mujoco.mj_kinematics(atlas.model, data)
+    return data.xpos[body_id].copy()
+
+
 def pelvis_height_m(atlas: AtlasModel, data: mujoco.MjData) -> float:
     """Height (m) of the pelvis origin above the ground, z = 0."""
     return float(data.qpos[atlas.free_qpos_adr + 2])
