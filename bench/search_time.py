@@ -17,6 +17,8 @@ from pathlib import Path
 
 from harness import REPO_DIR
 
+from tutorial_atlas_control.search.cmaes import runs_per_candidate
+
 SEARCH = REPO_DIR / 'scripts' / 'search.py'
 STEPPING = REPO_DIR / 'trajectories' / 'Stepping.yaml'
 STEPPING_GAINS = REPO_DIR / 'config' / 'stepping_gains.yaml'
@@ -64,7 +66,7 @@ def search_time(out_dir: Path, quick: bool) -> SearchTime:
     if result.returncode != 0:
         raise RuntimeError(f'search.py exited {result.returncode}: {result.stderr.strip()}')
     records = [json.loads(line) for line in log.read_text().splitlines()]
-    runs_per_candidate = 1 + 4 + 4  # nominal, --robust's four, four latency draws
+    header = next(r for r in records if r['kind'] == 'search')
     candidates = 1 + sum(len(r['x']) for r in records if r['kind'] == 'generation')
     done = sum(r['kind'] == 'generation' for r in records)
     reproduced = None
@@ -73,4 +75,5 @@ def search_time(out_dir: Path, quick: bool) -> SearchTime:
         start = stepping.index('step_and_stand:')
         reproduced = (_data_lines(found) == stepping[start:start + len(_data_lines(found))]
                       and _data_lines(gains) == _data_lines(STEPPING_GAINS))
-    return SearchTime(wall_s, candidates * runs_per_candidate, done, reproduced)
+    return SearchTime(wall_s, candidates * runs_per_candidate(header['config']), done,
+                      reproduced)

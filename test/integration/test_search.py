@@ -5,20 +5,20 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import subprocess
-import sys
+from functools import partial
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.search.cmaes import LATENCY_SEED
+from support.scripts import run_script
+from tutorial_atlas_control.search.cmaes import LATENCY_SEED, runs_per_candidate
 from tutorial_atlas_control.search.sweep import SweepInputs, build_specs, run_sweep
 from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.trajectories.trajectory import load_trajectory
 
 REPO = Path(__file__).resolve().parents[2]
-SEARCH = REPO / 'scripts' / 'search.py'
+_search = partial(run_script, 'search.py')
 #: A squat held briefly: the toy problem is to end with the pelvis 0.80 m high (it starts
 #: about 0.90 m), by bending knees twice as much as hips and ankles.
 TINY = """\
@@ -35,11 +35,6 @@ def tiny(tmp_path_factory: pytest.TempPathFactory) -> Path:
     path = tmp_path_factory.mktemp('tiny') / 'tiny.yaml'
     path.write_text(TINY)
     return path
-
-
-def _search(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, str(SEARCH), *args], capture_output=True, text=True,
-                          timeout=600, check=False)
 
 
 def _records(log: Path) -> list[dict]:
@@ -146,6 +141,7 @@ def test_robust_cost_is_the_mean_over_variants(tmp_path: Path, tiny: Path) -> No
     assert result.returncode == 0, result.stderr
     header, start, generation = _records(tmp_path / 'log.jsonl')
     assert header['config']['variants'] == [[0.5, 1.5]]
+    assert runs_per_candidate(header['config']) == 2  # what bench/search_time counts
     assert len(generation['rows']) == 2  # the nominal rows only, one per candidate
     inputs = SweepInputs([(str(tiny), 'bend')], [str(REPO / 'config' / 'atlas_controller.yaml')],
                          gain_scales=(1.0, 0.5), time_scales=(1.0, 1.5), settle_s=0.3)
@@ -167,6 +163,7 @@ def test_latency_draws_are_the_same_for_every_candidate(tmp_path: Path, tiny: Pa
     assert result.returncode == 0, result.stderr
     header, start, generation = _records(tmp_path / 'log.jsonl')
     assert header['config']['latency'] == [0, 20, 2]
+    assert runs_per_candidate(header['config']) == 3
     assert len(generation['rows']) == 2
     base = build_specs(SweepInputs([(str(tiny), 'bend')],
                                    [str(REPO / 'config' / 'atlas_controller.yaml')],

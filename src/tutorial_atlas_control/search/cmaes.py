@@ -34,7 +34,8 @@ from tutorial_atlas_control.search.objectives import Objective
 from tutorial_atlas_control.search.runs import RunSpec, SweepError
 from tutorial_atlas_control.search.sweep import SweepOutcome, atomic_write
 
-__all__ = ['Parameter', 'SearchProblem', 'SearchResult', 'parse_parameter', 'run_search']
+__all__ = ['Parameter', 'SearchProblem', 'SearchResult', 'parse_parameter', 'run_search',
+           'runs_per_candidate']
 
 #: Written (and evaluated) precision: positions to 1e-4 rad, durations to 10 ms (at least
 #: one 20 ms command period), gains to 4 significant digits.
@@ -113,6 +114,12 @@ def _round_gain(value: float) -> float:
     return float(f'{value:.{GAIN_DIGITS}g}')
 
 
+def runs_per_candidate(config: dict[str, Any]) -> int:
+    """Runs each candidate costs, from a search log's header config (SearchProblem.config):
+    the nominal run, one per (gains, timing) variant, one per late-command draw."""
+    return 1 + len(config['variants']) + config.get('latency', (0, 0, 0))[2]
+
+
 @dataclass
 class SearchProblem:
     """What is searched: the starting trajectory and gains, the coordinates, the objective."""
@@ -188,7 +195,7 @@ class SearchProblem:
         return specs
 
     def runs_per_candidate(self) -> int:
-        return 1 + len(self.variants) + self.latency[2]
+        return runs_per_candidate(self.config())
 
     def costs(self, rows: Sequence[dict[str, Any]]) -> tuple[list[float], list[dict[str, Any]]]:
         """Each candidate's cost (the mean over its runs) and its nominal row."""
