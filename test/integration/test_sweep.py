@@ -4,12 +4,12 @@ and the refusals (one line, exit 1, nothing written)."""
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
+from functools import partial
 from pathlib import Path
 
 import pytest
 
+from support.scripts import run_script
 from tutorial_atlas_control.search.sweep import (
     SweepEngine,
     SweepInputs,
@@ -18,7 +18,7 @@ from tutorial_atlas_control.search.sweep import (
 )
 
 REPO = Path(__file__).resolve().parents[2]
-SWEEP = REPO / 'scripts' / 'sweep.py'
+_sweep = partial(run_script, 'sweep.py')
 TRAJ_DATA2 = REPO / 'trajectories' / 'Traj_data2.yaml'
 #: The tutorial's falls, s after the first command (test_tutorial_run.py's README figures),
 #: and that test's tolerance.
@@ -39,11 +39,6 @@ def tiny_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
     path = tmp_path_factory.mktemp('tiny') / 'tiny.yaml'
     path.write_text(TINY)
     return path
-
-
-def _sweep(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, str(SWEEP), *args], capture_output=True, text=True,
-                          timeout=600, check=False)
 
 
 def test_same_table_on_one_and_two_workers(tiny_file: Path) -> None:

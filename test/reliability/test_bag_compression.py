@@ -11,7 +11,6 @@ from __future__ import annotations
 import json
 import re
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +19,8 @@ import pytest
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
 from support.bag_checks import all_finite, missing_steps
-from support.launch import REPO, TestLaunch
+from support.launch import TestLaunch
+from support.scripts import run_script
 from tutorial_atlas_control import processes, topics
 from tutorial_atlas_control.bags.analysis import analyze_bag
 from tutorial_atlas_control.bags.reader import BagData, read_bag
@@ -39,12 +39,6 @@ def rosbag_info(bag: Path, key: str) -> str:
                             capture_output=True, text=True, timeout=60, check=False)
     assert result.returncode == 0, result.stderr
     return result.stdout.strip()
-
-
-def run_script(name: str, *args: str) -> subprocess.CompletedProcess:
-    """One of the package's scripts, as a user runs it after `source ./env.sh`."""
-    return subprocess.run([sys.executable, str(REPO / 'scripts' / name), *args],
-                          capture_output=True, text=True, timeout=TOOL_TIMEOUT_S, check=False)
 
 
 def record(tmp_path: Path, recorder: str, compression: str) -> Path:
@@ -103,14 +97,14 @@ def test_bag_is_compressed_as_asked_and_reads_back(tmp_path: Path, recorder: str
 
 def check_user_tools(bag: Path, data: BagData) -> None:
     """analyze_bag.py and replay_bag.py on the bag: exit 0, standing, replayed exactly."""
-    analysed = run_script('analyze_bag.py', str(bag), '--json')
+    analysed = run_script('analyze_bag.py', str(bag), '--json', timeout_s=TOOL_TIMEOUT_S)
     assert analysed.returncode == 0, analysed.stderr
     report = json.loads(analysed.stdout)
     assert report['fell'] is False
     assert report['topics'][topics.JOINT_STATES]['count'] == len(data.joint_states.t_s)
     # The pelvis at standing height (about 0.93 m pinned and after; a fall is below 0.5 m).
     assert report['min_pelvis_height'] > 0.8
-    replayed = run_script('replay_bag.py', str(bag))
+    replayed = run_script('replay_bag.py', str(bag), timeout_s=TOOL_TIMEOUT_S)
     assert replayed.returncode == 0, replayed.stdout + replayed.stderr
     assert replayed.stdout.splitlines()[-1].startswith('REPRODUCED (tolerance '), replayed.stdout
     # The steps up to the bag's start (rosbag stamps a message when it hears it) are re-created
