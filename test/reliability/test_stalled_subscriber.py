@@ -16,14 +16,13 @@ import socket
 import struct
 import threading
 import time
-import xmlrpc.client
 
 import pytest
 
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
 from support.bag_checks import missing_steps
-from support.launch import TestLaunch
+from support.launch import SIM, TestLaunch, node_api
 from tutorial_atlas_control.bags.reader import JOINT_STATE_MD5, read_bag
 from tutorial_atlas_control.node.transport import MAX_BACKLOG_BYTES
 from tutorial_atlas_control.processes import rss_kib
@@ -46,10 +45,7 @@ def _field(text: str) -> bytes:
 
 def joint_states_subscriber(master_uri: str, name: str, rcvbuf: int | None) -> socket.socket:
     """A TCPROS connection to atlas_sim's /atlas/joint_states, its header exchanged."""
-    master = xmlrpc.client.ServerProxy(master_uri)
-    code, message, node_uri = master.lookupNode(name, '/atlas_sim')
-    assert code == 1, message
-    code, message, protocol = xmlrpc.client.ServerProxy(node_uri).requestTopic(
+    code, message, protocol = node_api(master_uri, SIM, name).requestTopic(
         name, '/atlas/joint_states', [['TCPROS']])
     assert code == 1, message
     _, host, port = protocol

@@ -13,11 +13,10 @@ from __future__ import annotations
 
 import shutil
 import subprocess
-import xmlrpc.client
 
 import pytest
 
-from support.launch import SIM, TestLaunch
+from support.launch import SIM, TestLaunch, node_api
 
 #: rospy's own backlog is 5; a dozen topics connect at once.
 MIN_BACKLOG = 64
@@ -26,9 +25,7 @@ MIN_BACKLOG = 64
 def tcpros_port(master_uri: str) -> int:
     """The port of the simulator's TCPROS server, as a subscriber learns it."""
     caller = '/test_startup_connections'
-    code, message, node_uri = xmlrpc.client.ServerProxy(master_uri).lookupNode(caller, SIM)
-    assert code == 1, message
-    code, message, protocol = xmlrpc.client.ServerProxy(node_uri).requestTopic(
+    code, message, protocol = node_api(master_uri, SIM, caller).requestTopic(
         caller, '/atlas/joint_states', [['TCPROS']])
     assert code == 1, message
     return int(protocol[2])
@@ -48,5 +45,4 @@ def test_the_simulator_accepts_a_dozen_connections_at_once(atlas_launch: TestLau
     if shutil.which('ss') is None:
         pytest.fail('ss (iproute2) is not installed: run `make setup`')
     atlas_launch.wait_ready()  # includes: the recorder is connected to all of SIM's topics
-    assert atlas_launch.unrecorded_topics() == []
     assert listen_backlog(tcpros_port(atlas_launch.uri)) >= MIN_BACKLOG

@@ -32,6 +32,17 @@ SIM_TIME_TIMEOUT_S = 120.0
 WAIT_SIM_TIME_TIMEOUT_S = 180.0
 
 
+def node_api(master_uri: str, node: str, caller: str) -> xmlrpc.client.ServerProxy:
+    """`node`'s XML-RPC API (requestTopic, getBusInfo), looked up on the master as `caller`.
+
+    Raises OSError if the master does not know `node`.
+    """
+    code, message, uri = xmlrpc.client.ServerProxy(master_uri).lookupNode(caller, node)
+    if code != 1:
+        raise OSError(f'{node}: {message}')
+    return xmlrpc.client.ServerProxy(uri)
+
+
 class TestLaunch(processes.AtlasLaunch):
     """One `roslaunch tutorial_atlas_control atlas.launch` run, and what it left behind."""
 
@@ -77,10 +88,7 @@ class TestLaunch(processes.AtlasLaunch):
         caller = '/tutorial_atlas_control_tests'
         try:
             publishers, subscribers = processes.system_state(self.uri)
-            code, _, sim_uri = xmlrpc.client.ServerProxy(self.uri).lookupNode(caller, SIM)
-            if code != 1:
-                return None
-            code, _, bus = xmlrpc.client.ServerProxy(sim_uri).getBusInfo(caller)
+            code, _, bus = node_api(self.uri, SIM, caller).getBusInfo(caller)
         except OSError:
             return None
         recorded = {topic for topic, nodes in publishers.items()

@@ -40,22 +40,19 @@ STALL_PROBE_S = 0.05
 MAX_BACKLOG_BYTES = 16 * 1024 * 1024
 
 
-def widen_accept_queue() -> int:
+def widen_accept_queue() -> None:
     """Let the node's TCPROS server queue as many connections as the kernel allows.
 
     rospy listens with a backlog of 5. At startup the recorder, rosout and the tools connect
     to a dozen of the simulator's topics at once while its accept thread waits for the GIL:
     the kernel drops the connections past 5 and their subscribers retry a second or more
     later (TcpExtListenOverflows), missing what was published meanwhile (a forced-divergence
-    run lost /atlas/sim_config from its bag). Returns the new backlog, 0 if rospy could not
-    start its TCPROS server. Call after init_node, before advertising.
+    run lost /atlas/sim_config from its bag). Call after init_node, before advertising.
     """
     tcpros_base.start_tcpros_server()  # what the first publisher does; idempotent
     server = tcpros_base._tcpros_server  # rospy offers no setter
-    if server is None or server.tcp_ros_server is None:
-        return 0
-    server.tcp_ros_server.server_sock.listen(socket.SOMAXCONN)  # Linux: updates the backlog
-    return socket.SOMAXCONN
+    if server is not None and server.tcp_ros_server is not None:  # else rospy has logged why
+        server.tcp_ros_server.server_sock.listen(socket.SOMAXCONN)  # Linux: updates the backlog
 
 
 def wait_writable(sock: socket.socket, timeout_s: float) -> bool:
