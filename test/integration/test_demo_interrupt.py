@@ -22,7 +22,7 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[2]
 RUN_DEMO = REPO / 'scripts' / 'run_demo.py'
-#: Exit status on Ctrl-C (README, Script conventions).
+#: Exit status on Ctrl-C (docs/troubleshooting.md, Script conventions).
 EXIT_INTERRUPTED = 130
 #: Wall-clock bounds (s): until traj_yaml.py starts (atlas.launch up, torso unpinned), and
 #: from the signal to the demo's exit (it stops roslaunch, which waits for its nodes).

@@ -1,4 +1,5 @@
-"""Ctrl-C ends every script with exit status 130 and no traceback (README, Script conventions).
+"""Ctrl-C ends every script with exit status 130 and no traceback (docs/troubleshooting.md,
+Script conventions).
 
 Each script's main is called with the work it hands to the library replaced by a function
 that raises KeyboardInterrupt, as Ctrl-C does in the middle of it; one script is also

@@ -205,9 +205,9 @@ def test_the_ports_imu_and_ankle_topics_mean_gravity_and_the_weight(
     """/atlas/imu and /atlas/{l,r}_foot_contact (the port's own) against physics, standing.
 
     The accelerometer reads the ground's push, +g up; the legs push each foot down with half
-    the weight above the ankles (the model's masses less the feet's), README's "Fz about
-    -430 N", in the foot frame about the ankle; horizontally the two pushes cancel (the robot
-    is still). Tolerances: 2 % of the weight (the robot sways slowly), as above.
+    the weight above the ankles (the model's masses less the feet's), docs/ros_interface.md's
+    "Fz about -430 N", in the foot frame about the ankle; horizontally the two pushes cancel
+    (the robot is still). Tolerances: 2 % of the weight (the robot sways slowly), as above.
     """
     gravity_mps2 = -float(standing.model.opt.gravity[2])
     messages = SimMessages(standing)
