@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import sys
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -14,6 +15,10 @@ from tutorial_atlas_control import topics
 
 if TYPE_CHECKING:
     from tutorial_atlas_control.sim.simulator import AtlasSimulator
+
+# The synthetic run bag is a test fixture: test/support, imported as `support` (as the tests
+# and node_loop.py do).
+sys.path.insert(0, str(REPO_DIR / 'test'))
 
 GAINS_YAML = REPO_DIR / 'config' / 'atlas_controller.yaml'
 #: The topics bag_reader.read_bag deserializes (the baseline reads the same ones).
@@ -60,7 +65,7 @@ def run_bag(cache_dir: Path, duration_s: float = 60.0) -> Path:
     Cached under a name that hashes synthetic_bags.py, so a changed generator makes a new
     bag; written to a temporary name and renamed, so an interrupted run leaves no half bag.
     """
-    from tutorial_atlas_control.bags import synthetic as synthetic_bags
+    from support import synthetic_bags
 
     source = Path(synthetic_bags.__file__).read_bytes()
     key = hashlib.sha1(source + str(duration_s).encode()).hexdigest()[:12]

@@ -14,7 +14,7 @@ from pathlib import Path
 import mujoco
 
 from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED, EXIT_REFUSED
-from tutorial_atlas_control.node import state_publisher
+from tutorial_atlas_control.sim import state_publisher_node as state_publisher
 from tutorial_atlas_control.sim.urdf import UrdfError, matching_urdf
 
 PROG = 'state_publisher.py'

@@ -19,15 +19,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tutorial_atlas_control.joints import NUM_JOINTS
-from tutorial_atlas_control.msgs.commands import (
-    _ALL_JOINTS,
+from tutorial_atlas_control.command.arrays import (
+    ALL_JOINTS,
     K_EFFORT_ROW,
     LAW_FIELDS,
     CommandError,
     CommandUpdate,
     check_values,
 )
+from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.msgs.ros1_fields import FieldCursor
 from tutorial_atlas_control.units import NS_PER_S
 
@@ -109,7 +109,7 @@ def _checked(arrays: Sequence[tuple[str, np.ndarray]], stamp_ns: int,
     check_values(rows, block)
     if K_EFFORT_ROW in rows:
         block[rows.index(K_EFFORT_ROW)] /= K_EFFORT_FULL_SCALE
-    return AtlasUpdate(CommandUpdate(_ALL_JOINTS, tuple(rows), block), tuple(ignored),
+    return AtlasUpdate(CommandUpdate(ALL_JOINTS, tuple(rows), block), tuple(ignored),
                        stamp_ns, period_ms, damping)
 
 
@@ -167,7 +167,7 @@ def _decode_full(raw: bytes) -> AtlasUpdate | None:
         block[row] = body[name]
     check_values(_FULL_ROWS, block)
     block[_K_EFFORT_INDEX] /= K_EFFORT_FULL_SCALE
-    return AtlasUpdate(CommandUpdate(_ALL_JOINTS, _FULL_ROWS, block), (), stamp_ns,
+    return AtlasUpdate(CommandUpdate(ALL_JOINTS, _FULL_ROWS, block), (), stamp_ns,
                        int(body['desired_controller_period_ms']))
 
 

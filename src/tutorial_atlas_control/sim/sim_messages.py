@@ -15,7 +15,6 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control.joints import JOINT_NAMES
-from tutorial_atlas_control.msgs.copy_plan import Copy, CopyPlan
 from tutorial_atlas_control.msgs.wire import (
     WRENCH_FLOATS,
     AtlasStateWire,
@@ -28,6 +27,7 @@ from tutorial_atlas_control.msgs.wire import (
     TransformWire,
     WrenchStampedWire,
 )
+from tutorial_atlas_control.sim.copy_plan import Copy, CopyPlan
 from tutorial_atlas_control.sim.link_transforms import LinkTransforms
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
 from tutorial_atlas_control.topics import PELVIS_FRAME, WORLD_FRAME

@@ -21,26 +21,26 @@ from dataclasses import dataclass
 from typing import Protocol
 
 from tutorial_atlas_control import topics
+from tutorial_atlas_control.command.arrays import (
+    FIELD_NAMES,
+    LAW_FIELDS,
+    CommandError,
+    CommandUpdate,
+)
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.msgs.atlas_command import (
     AtlasUpdate,
     decode_atlas_command,
     decode_test,
 )
-from tutorial_atlas_control.msgs.commands import (
-    FIELD_NAMES,
-    LAW_FIELDS,
-    CommandDecoder,
-    CommandError,
-    CommandUpdate,
-)
+from tutorial_atlas_control.msgs.joint_commands import CommandDecoder
 from tutorial_atlas_control.msgs.ros1_fields import FieldCursor
-from tutorial_atlas_control.msgs.sim_messages import SimMessages
 from tutorial_atlas_control.msgs.wire import ControllerStatisticsWire, clock_bytes
 from tutorial_atlas_control.sim.controller import Gains
 from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistics
 from tutorial_atlas_control.sim.link_transforms import LinkTransforms, RspSchedule
 from tutorial_atlas_control.sim.model import FALL_HEIGHT_M
+from tutorial_atlas_control.sim.sim_messages import SimMessages
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode, PhysicsDivergenceError
 from tutorial_atlas_control.sim.vrc import SimInput, describe_input
 from tutorial_atlas_control.stepping.pacing import Pacer
