@@ -21,7 +21,7 @@ if TYPE_CHECKING:
 sys.path.insert(0, str(REPO_DIR / 'test'))
 
 GAINS_YAML = REPO_DIR / 'config' / 'atlas_controller.yaml'
-#: The topics bag_reader.read_bag deserializes (the baseline reads the same ones).
+#: The topics bags.reader.read_bag deserializes (the baseline reads the same ones).
 ANALYSIS_TOPICS = (topics.JOINT_STATES, topics.JOINT_COMMANDS, topics.GROUND_TRUTH_ODOM,
                    topics.CONTROL_MODE)
 
@@ -94,7 +94,7 @@ def analysis_message_count(path: Path) -> int:
 
 
 def analysis_run(path: Path) -> float:
-    """Wall seconds of bag_analysis.analyze_bag (read_bag + metrics) on `path`."""
+    """Wall seconds of bags.analysis.analyze_bag (read_bag + metrics) on `path`."""
     from tutorial_atlas_control.bags.analysis import analyze_bag
 
     start = time.perf_counter()

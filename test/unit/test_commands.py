@@ -1,4 +1,4 @@
-"""JointCommands mapping and refusal rules (commands.merge_command)."""
+"""JointCommands mapping and refusal rules (command/arrays.py's merge_command)."""
 
 from __future__ import annotations
 

@@ -4,7 +4,7 @@ DRCSim 2.5.2's AtlasPlugin copies each array of exactly 28 entries into the comm
 keeps the previous values of any array of another length (SetAtlasCommand,
 SetExperimentalDampingPID). We do the same, and say so: an array of another non-zero length
 is named in one warning (an empty array is the usual way not to set a field: silent). On top
-of DRCSim, a message with NaN/Inf or an absurd magnitude anywhere (commands.MAX_MAGNITUDE,
+of DRCSim, a message with NaN/Inf or an absurd magnitude anywhere (arrays.MAX_MAGNITUDE,
 MAX_DAMPING) is refused whole, as JointCommands are.
 
 The k_effort bytes become the fraction k_effort / 255 the law blends with (AtlasPlugin's

@@ -7,7 +7,7 @@ transport, no scheduling jitter, so two runs of the same inputs are identical.
 
 Each piece is the live one: trajectory loading and validation (trajectory.py), the
 schedule (schedule.run_trajectory), the commands traj_yaml sends (every field as
-traj_yaml_node.build_command sets it), the simulator decoding them (commands.CommandDecoder)
+traj_yaml_node.build_command sets it), the simulator decoding them (joint_commands.CommandDecoder)
 and stepping (AtlasSimulator), its messages (sim_messages.SimMessages). The bag has the
 topics, types, MD5 sums and header stamps of a recorded live run (/clock thinned to
 CLOCK_PERIOD_NS), so every bag tool reads it as one.

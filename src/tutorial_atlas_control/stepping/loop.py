@@ -94,7 +94,7 @@ ON_DEMAND_RATE_HZ = 1000.0
 #: The links' /tf rate (Hz of sim time): robot_state_publisher's publish_frequency in
 #: DRCSim's launch.
 LINKS_TF_RATE_HZ = 50.0
-#: Rows (commands.LAW_FIELDS indices) each command topic can set; DAMPING_ROW stands for
+#: Rows (arrays.LAW_FIELDS indices) each command topic can set; DAMPING_ROW stands for
 #: /atlas/debug/test's damping. An older message whose rows a newer one set for every
 #: joint is dropped undecoded (apply_pending_commands).
 DAMPING_ROW = len(LAW_FIELDS)
