@@ -3,7 +3,4 @@
 ROS side only (demo_node.py imports rospy once a launch runs): import it by its module.
 """
 
-from tutorial_atlas_control.exports import lazy_exports
-
-__all__, __getattr__, __dir__ = lazy_exports(__name__, {
-})
+__all__: list[str] = []
