@@ -429,7 +429,7 @@ def build() -> str:
   Conventions:
   * Body frames coincide with the URDF joint frames (all joint rpy are 0).
   * Effort limits are enforced in ONE place: the controller law
-    (tutorial_atlas_control.sim.controller.compute_torque) clamps each torque to
+    (tutorial_atlas_control.controller.compute_torque) clamps each torque to
     the joint's effort limit, so the motors below have no ctrlrange.
   * Each joint's user="effort velocity" holds its effort limit (N m) and
     velocity limit (rad/s). The velocity limits are data only, exposed by
