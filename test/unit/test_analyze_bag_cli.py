@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.bags.synthetic import (
+from support.synthetic_bags import (
     clock,
     control_mode,
     joint_commands,

@@ -12,6 +12,7 @@ from test_controller import DT_S, LIMIT, LOWER, UPPER, one_joint
 from test_stepping import command_bytes, complete_command, make_loop
 
 from tutorial_atlas_control import topics
+from tutorial_atlas_control.command.arrays import CommandError
 from tutorial_atlas_control.joints import JOINT_INDEX, NUM_JOINTS
 from tutorial_atlas_control.msgs.atlas_command import (
     decode_atlas_command,
@@ -19,7 +20,6 @@ from tutorial_atlas_control.msgs.atlas_command import (
     encode_atlas_command,
     encode_test,
 )
-from tutorial_atlas_control.msgs.commands import CommandError
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import (
     PidState,

@@ -11,10 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.bags.analysis import analyze, analyze_bag
-from tutorial_atlas_control.bags.reader import read_bag
-from tutorial_atlas_control.bags.report import format_summary
-from tutorial_atlas_control.bags.synthetic import (
+from support.synthetic_bags import (
     TrySpec,
     clock,
     joint_state,
@@ -22,6 +19,9 @@ from tutorial_atlas_control.bags.synthetic import (
     write_bag,
     write_run_bag,
 )
+from tutorial_atlas_control.bags.analysis import analyze, analyze_bag
+from tutorial_atlas_control.bags.reader import read_bag
+from tutorial_atlas_control.bags.report import format_summary
 from tutorial_atlas_control.bags.tries import (
     RESET_SIMULATION,
     RESET_WORLD,

@@ -28,8 +28,8 @@ from tutorial_atlas_control.cli import (
     traj_yaml,
 )
 from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED
-from tutorial_atlas_control.node import demo
-from tutorial_atlas_control.node import plot_topics as plot_node
+from tutorial_atlas_control.demo import demo_node as demo
+from tutorial_atlas_control.plotting import plot_topics_node as plot_node
 
 REPO = Path(__file__).resolve().parents[2]
 TRAJECTORY_FILE = REPO / 'trajectories' / 'Traj_data2.yaml'

@@ -13,8 +13,8 @@ from tutorial_atlas_control.bags.feet import foot_displacement, foot_line
 from tutorial_atlas_control.bags.reader import BagData, JointStateSeries, PelvisSeries
 from tutorial_atlas_control.cli import run_demo
 from tutorial_atlas_control.cli.convention import EXIT_REFUSED
+from tutorial_atlas_control.demo import demo_node as demo
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.node import demo
 from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, GainsError, load_gains_yaml
 from tutorial_atlas_control.sim.model import load_model
 from tutorial_atlas_control.trajectories.catalog import (

@@ -10,8 +10,8 @@ import pytest
 from test_controller import random_command
 
 from tutorial_atlas_control import native
+from tutorial_atlas_control.command.arrays import FIELD_NAMES, JointCommandArrays
 from tutorial_atlas_control.joints import NUM_JOINTS
-from tutorial_atlas_control.msgs.commands import FIELD_NAMES, JointCommandArrays
 from tutorial_atlas_control.sim import law_kernel
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import PidState, compute_torque, load_gains_yaml

@@ -121,7 +121,7 @@ def test_commands_are_the_bytes_traj_yaml_publishes(trajectory_file: Path, tmp_p
     from osrf_msgs.msg import JointCommands
     from rospy.msg import serialize_message
 
-    from tutorial_atlas_control.node.traj_yaml import build_command
+    from tutorial_atlas_control.trajectories.traj_yaml_node import build_command
 
     bag = tmp_path / 'run.bag'
     short_run(trajectory_file, bag)

@@ -15,8 +15,8 @@ from typing import Any, Callable
 import numpy as np
 import pytest
 
+from support.synthetic_bags import TYPESTORE, Record, joint_state, write_bag
 from tutorial_atlas_control.bags.reader import read_bag
-from tutorial_atlas_control.bags.synthetic import TYPESTORE, Record, joint_state, write_bag
 from tutorial_atlas_control.cli.replay_bag import EXIT_DEVIATES, main
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
@@ -427,7 +427,7 @@ def test_debug_test_messages_are_reported(tmp_path: Path) -> None:
     """/atlas/debug/test's damping changes the model, which the torques do not carry."""
     from rosbags.typesys import get_types_from_msg
 
-    from tutorial_atlas_control.bags.synthetic import TYPESTORE
+    from support.synthetic_bags import TYPESTORE
     from tutorial_atlas_control.resources import message_file
 
     if 'atlas_msgs/msg/Test' not in TYPESTORE.fielddefs:

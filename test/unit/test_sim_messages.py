@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from tutorial_atlas_control.msgs.atlas_command import decode_atlas_command, encode_atlas_command
-from tutorial_atlas_control.msgs.sim_messages import SimMessages
 from tutorial_atlas_control.sim import controller, model
+from tutorial_atlas_control.sim.sim_messages import SimMessages
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
 from tutorial_atlas_control.trajectories.schedule import (
     parse_trajectory_log_line,

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from tutorial_atlas_control import topics
+from tutorial_atlas_control.command.arrays import FIELD_NAMES
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.msgs.commands import FIELD_NAMES
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistics
@@ -282,7 +282,7 @@ def test_drcsim_messages_at_their_rates_and_stamps(sim: AtlasSimulator) -> None:
 
 def test_unheard_drcsim_messages_are_never_filled(sim: AtlasSimulator,
                                                   monkeypatch: pytest.MonkeyPatch) -> None:
-    from tutorial_atlas_control.msgs.sim_messages import SimMessages
+    from tutorial_atlas_control.sim.sim_messages import SimMessages
 
     fills: list[str] = []
     for name in ('fill_atlas_state', 'fill_force_torque_sensors', 'fill_debug_contact'):

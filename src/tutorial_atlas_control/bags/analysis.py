@@ -1,6 +1,6 @@
 """The tutorial's metrics of a recorded run: fall, tracking, command timing, effort limits.
 
-Works on the :class:`~tutorial_atlas_control.bags.reader.BagData` that bag_reader extracts;
+Works on the :class:`~tutorial_atlas_control.bags.reader.BagData` that reader.py extracts;
 all times are seconds from the bag's start (run timeline). A bag with resets is cut into
 tries (bags.tries): each try gets its own metrics, and the whole-run metrics never pair a
 state with a command of another try.

@@ -548,7 +548,7 @@ def read_bag(path: Path | str, fast: bool = True) -> BagData:
 
     Args:
         path: The .bag file.
-        fast: Read with the numpy index and parsers (see bag_records); False reads through
+        fast: Read with the numpy index and parsers (see records.py); False reads through
             rosbags' public API and typestore only, several times slower, same result, except
             that it cannot tell the runs before and after a reset_simulation apart.
 

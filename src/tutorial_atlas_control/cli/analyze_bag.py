@@ -216,7 +216,7 @@ def _played_text(played: list[PlayedTrajectory]) -> str | None:
 
 
 def _compare(args: argparse.Namespace) -> int:
-    """`BAG --compare B.bag`: bag_compare's report, JSON or plot, of A's and B's tries."""
+    """`BAG --compare B.bag`: bags/compare.py's report, JSON or plot, of A's and B's tries."""
     try:
         a = analyze_try(read_bag(args.bag), -1 if args.try_number is None else args.try_number)
         b = analyze_try(read_bag(args.compare), -1 if args.try_b is None else args.try_b)

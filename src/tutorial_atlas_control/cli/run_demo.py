@@ -17,8 +17,8 @@ from tutorial_atlas_control.cli.convention import (
     argument_type,
     print_error,
 )
+from tutorial_atlas_control.demo import demo_node as demo
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.node import demo
 from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.trajectories.catalog import find_trajectory, gains_for
 from tutorial_atlas_control.trajectories.trajectory import load_trajectory

@@ -1,7 +1,7 @@
 """Command line of state_publisher.py: robot_state_publisher on the model's URDF (atlas.launch).
 
 It keeps roslaunch's command line (MODEL_FILE and `name:=value` ROS arguments, usage from
-node/state_publisher.py's docstring) rather than argparse's.
+sim/state_publisher_node.py's docstring) rather than argparse's.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from pathlib import Path
 import mujoco
 
 from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED, EXIT_REFUSED
-from tutorial_atlas_control.node import state_publisher
+from tutorial_atlas_control.sim import state_publisher_node as state_publisher
 from tutorial_atlas_control.sim.urdf import UrdfError, matching_urdf
 
 PROG = 'state_publisher.py'

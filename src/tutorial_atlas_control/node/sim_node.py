@@ -163,7 +163,7 @@ class RawMessage(genpy.Message):
     genpy's decoder would run in the receiving thread, under the GIL the stepping loop
     needs, and at thousands of commands a second starve the loop. A subclass keeps the real
     type, MD5 and definition, so the subscription is registered, negotiated and shown as
-    that type; the loop decodes `raw` itself (msgs/commands.py, msgs/atlas_command.py).
+    that type; the loop decodes `raw` itself (msgs/joint_commands.py, msgs/atlas_command.py).
     """
 
     _has_header = True

@@ -1,6 +1,6 @@
 """The drawing of a live plot on a matplotlib Figure: the window's and the PNG's alike.
 
-node/plot_topics.py hands it a pyplot figure on the Tk backend (the window) or a plain
+plot_topics_node.py hands it a pyplot figure on the Tk backend (the window) or a plain
 Figure on Agg (--png); `update` sets the lines, the time axis (the last `window_s` seconds
 of ROS time), the y range and the legend, and the caller draws or saves.
 """

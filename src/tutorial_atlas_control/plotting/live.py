@@ -5,7 +5,7 @@ connection header, it decodes them with that type's class, reads only the fields
 and keeps floats, nothing else. An argument that cannot be plotted gets one line saying why
 (`cannot plot ARG: ...`) and is dropped; the others go on. ROS time moving back (a reset of
 sim time) clears every series. The ROS side (subscribing, the clock, the master's topic
-list) is node/plot_topics.py; this module has no ROS import, so its logic is unit-tested.
+list) is plot_topics_node.py; this module has no ROS import, so its logic is unit-tested.
 """
 
 from __future__ import annotations

@@ -46,9 +46,9 @@ import numpy as np
 import yaml
 
 from tutorial_atlas_control import topics
+from tutorial_atlas_control.command.arrays import JointCommandArrays
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.msgs.commands import JointCommandArrays
 from tutorial_atlas_control.resources import package_path
 from tutorial_atlas_control.units import finite_number
 from tutorial_atlas_control.yaml_errors import yaml_problem

@@ -15,7 +15,7 @@ import ctypes
 
 import numpy as np
 
-from tutorial_atlas_control.msgs.commands import LAW_FIELDS, JointCommandArrays
+from tutorial_atlas_control.command.arrays import LAW_FIELDS, JointCommandArrays
 from tutorial_atlas_control.native import AtlasLawStep, address
 from tutorial_atlas_control.sim.controller import PidState
 

@@ -25,14 +25,14 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control import native
-from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.joints import NUM_JOINTS
-from tutorial_atlas_control.msgs.commands import (
+from tutorial_atlas_control.command.arrays import (
     LAW_FIELDS,
     CommandUpdate,
     JointCommandArrays,
     command_update,
 )
+from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.sim import law_kernel
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import Gains, PidState, compute_torque, hold_command

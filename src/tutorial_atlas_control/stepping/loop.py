@@ -21,26 +21,26 @@ from dataclasses import dataclass
 from typing import Protocol
 
 from tutorial_atlas_control import topics
+from tutorial_atlas_control.command.arrays import (
+    FIELD_NAMES,
+    LAW_FIELDS,
+    CommandError,
+    CommandUpdate,
+)
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.msgs.atlas_command import (
     AtlasUpdate,
     decode_atlas_command,
     decode_test,
 )
-from tutorial_atlas_control.msgs.commands import (
-    FIELD_NAMES,
-    LAW_FIELDS,
-    CommandDecoder,
-    CommandError,
-    CommandUpdate,
-)
+from tutorial_atlas_control.msgs.joint_commands import CommandDecoder
 from tutorial_atlas_control.msgs.ros1_fields import FieldCursor
-from tutorial_atlas_control.msgs.sim_messages import SimMessages
 from tutorial_atlas_control.msgs.wire import ControllerStatisticsWire, clock_bytes
 from tutorial_atlas_control.sim.controller import Gains
 from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistics
 from tutorial_atlas_control.sim.link_transforms import LinkTransforms, RspSchedule
 from tutorial_atlas_control.sim.model import FALL_HEIGHT_M
+from tutorial_atlas_control.sim.sim_messages import SimMessages
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode, PhysicsDivergenceError
 from tutorial_atlas_control.sim.vrc import SimInput, describe_input
 from tutorial_atlas_control.stepping.pacing import Pacer
@@ -94,7 +94,7 @@ ON_DEMAND_RATE_HZ = 1000.0
 #: The links' /tf rate (Hz of sim time): robot_state_publisher's publish_frequency in
 #: DRCSim's launch.
 LINKS_TF_RATE_HZ = 50.0
-#: Rows (commands.LAW_FIELDS indices) each command topic can set; DAMPING_ROW stands for
+#: Rows (arrays.LAW_FIELDS indices) each command topic can set; DAMPING_ROW stands for
 #: /atlas/debug/test's damping. An older message whose rows a newer one set for every
 #: joint is dropped undecoded (apply_pending_commands).
 DAMPING_ROW = len(LAW_FIELDS)
