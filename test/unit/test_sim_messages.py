@@ -153,7 +153,7 @@ def test_atlas_state_joints_gains_and_k_effort(standing: AtlasSimulator) -> None
         assert list(messages.atlas_state_wire.k_effort) == k_effort
         assert set(arrays['kp_position']) == {5.0}
     finally:
-        standing.user_command = None
+        standing.commands.user_command = None
 
 
 def test_hands_carry_what_the_last_wrist_joint_transmits(standing: AtlasSimulator) -> None:
