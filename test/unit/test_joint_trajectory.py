@@ -12,6 +12,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from support.joint_animation import (
+    FRAME_ID,
+    SINE_AMPLITUDE_RAD,
+    TUTORIAL_DT_NS,
+    TUTORIAL_ORDER,
+    TUTORIAL_POINTS,
+    tutorial_positions,
+    tutorial_sines,
+)
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import load_gains_yaml
@@ -22,42 +31,18 @@ from tutorial_atlas_control.units import NS_PER_S
 
 CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
 
-#: The animate-joints tutorial's trajectory: its joint order (legs listed outside in, arms
-#: alphabetically), points 0.01 s apart, two sines of 0.5 rad at 0.05 and 0.1 Hz.
-TUTORIAL_ORDER = (
-    'back_lbz', 'back_mby', 'back_ubx', 'neck_ay',
-    'l_leg_uhz', 'l_leg_mhx', 'l_leg_lhy', 'l_leg_kny', 'l_leg_uay', 'l_leg_lax',
-    'r_leg_lax', 'r_leg_uay', 'r_leg_kny', 'r_leg_lhy', 'r_leg_mhx', 'r_leg_uhz',
-    'l_arm_elx', 'l_arm_ely', 'l_arm_mwx', 'l_arm_shx', 'l_arm_usy', 'l_arm_uwy',
-    'r_arm_elx', 'r_arm_ely', 'r_arm_mwx', 'r_arm_shx', 'r_arm_usy', 'r_arm_uwy',
-)
-TUTORIAL_POINTS = 1500
-TUTORIAL_DT_NS = 10_000_000
-SINE_AMPLITUDE_RAD = 0.5
-SINE_HZ = 0.05
-
 
 @pytest.fixture(scope='module')
 def atlas() -> atlas_model.AtlasModel:
     return atlas_model.load_model()
 
 
-def tutorial_sines(t_s: np.ndarray) -> np.ndarray:
-    """Each of TUTORIAL_ORDER's joints (columns) at times `t_s` (rows), before clamping:
-    the slow sine on even columns, the fast one, negated, on odd ones."""
-    theta = 2.0 * math.pi * SINE_HZ * t_s
-    slow, fast = SINE_AMPLITUDE_RAD * np.sin(theta), -SINE_AMPLITUDE_RAD * np.sin(2.0 * theta)
-    return np.stack([fast if column % 2 else slow for column in range(len(TUTORIAL_ORDER))],
-                    axis=1)
-
-
 def tutorial_message() -> TrajectoryMessage:
     """As the tutorial's client sent it: atlas:: names, frame atlas::pelvis, every point's
     time_from_start 0.01 s."""
-    point_s = np.arange(TUTORIAL_POINTS) * TUTORIAL_DT_NS / NS_PER_S
-    rows = tutorial_sines(point_s)
-    return TrajectoryMessage('atlas::pelvis', 0, tuple('atlas::' + n for n in TUTORIAL_ORDER),
-                             [tuple(row) for row in rows], [TUTORIAL_DT_NS] * TUTORIAL_POINTS)
+    return TrajectoryMessage(FRAME_ID, 0, tuple('atlas::' + n for n in TUTORIAL_ORDER),
+                             [tuple(row) for row in tutorial_positions()],
+                             [TUTORIAL_DT_NS] * TUTORIAL_POINTS)
 
 
 def limits_in_order(atlas: atlas_model.AtlasModel) -> tuple[np.ndarray, np.ndarray]:
