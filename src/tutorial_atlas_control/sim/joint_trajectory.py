@@ -8,7 +8,10 @@ animate-joints tutorial: 1500 points of 0.01 s, ±0.5 rad sines) rely on both, s
 * times that do not increase are read as DRCSim read them (one info line says so): point 0
   at the start, point k at the start + the first k points' `time_from_start` (the last
   point's is not used); strictly increasing times keep the message's own definition, each
-  point at the start + its `time_from_start`.
+  point at the start + its `time_from_start`. (2.5.2's SetTrajectory copied only the
+  positions into the points it played, so there every time_from_start read as 0 and each
+  point came one world update, 1 ms, after the last; the port plays the times the client
+  sent, as the tutorial's 0.01 s means.)
 Anything else that cannot be played is refused whole, with one line naming the field:
 NaN/Inf or absurd numbers, unknown or repeated joint names, lengths that do not match,
 negative times, a frame that is no link of the robot.
