@@ -14,6 +14,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'controller_statistics': ['CommandAgeStatistics', 'DEFAULT_WINDOW_S', 'UPDATE_RATE_PARAM',
                               'WINDOW_PARAM'],
     'copy_plan': ['CopyPlan'],
+    'joint_trajectory': ['TrajectoryMessage', 'trajectory_input'],
     'link_transforms': ['LinkTransforms', 'RspSchedule'],
     'model': ['AtlasModel', 'FALL_HEIGHT_M', 'SPAWN_HEIGHT_M', 'body_position_in_pose',
               'load_model', 'reset_to_initial'],
@@ -22,7 +23,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'simulator': ['AtlasSimulator', 'ControlMode', 'DEFAULT_TIME_TO_UNPIN_S', 'ModeError',
                   'PhysicsDivergenceError', 'parse_mode'],
     'urdf': ['UrdfError', 'matching_urdf', 'read_joints'],
-    'vrc': ['DEFAULT_STARTUP_MODE', 'InputError', 'InputEvent', 'ModeInput', 'STARTUP_MODES',
-            'SimInput', 'VrcMode', 'cmd_vel_input', 'describe_input', 'parse_vrc_mode',
-            'pose_input', 'trajectory_input', 'wrench_input'],
+    'vrc': ['DEFAULT_STARTUP_MODE', 'InputError', 'InputEvent', 'InputNote', 'ModeInput',
+            'STARTUP_MODES', 'SimInput', 'TrajectoryInput', 'VrcMode', 'cmd_vel_input',
+            'describe_input', 'input_notes', 'parse_vrc_mode', 'pose_input', 'wrench_input'],
 })
