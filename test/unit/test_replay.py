@@ -30,6 +30,7 @@ from tutorial_atlas_control.offline.replay import (
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim import vrc
 from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, hold_command, load_gains_yaml
+from tutorial_atlas_control.sim.joint_trajectory import TrajectoryMessage, trajectory_input
 from tutorial_atlas_control.sim.sim_config import SimConfig
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode
 
@@ -479,12 +480,12 @@ INPUT_SCRIPTS: dict[str, dict[int, list[vrc.SimInput]]] = {
     'cmd_vel': {80: [vrc.ModeInput(vrc.VrcMode.PINNED)],
                 100: [vrc.cmd_vel_input((0.3, 0.1, 0.0), (0.0, 0.0, 0.5))],
                 300: [vrc.cmd_vel_input((0, 0, 0), (0, 0, 0)), vrc.ModeInput(vrc.VrcMode.NOMINAL)]},
-    'joint_trajectory': {100: [vrc.trajectory_input(
+    'joint_trajectory': {100: [trajectory_input(TrajectoryMessage(
         'world', 0, ('l_arm_shx', 'r_leg_kny', 'back_mby'),
-        ((-0.4, 0.2, 0.1), (-0.8, 0.5, 0.2), (-0.2, 0.3, 0.0)), (0, 20_000_000, 50_000_000),
+        ((-0.4, 0.2, 0.1), (-0.8, 0.5, 0.2), (-0.2, 0.3, 0.0)), (0, 20_000_000, 50_000_000)),
         ATLAS.lower_rad, ATLAS.upper_rad)]},
-    'joint_trajectory_in_a_foot_frame': {100: [vrc.trajectory_input(
-        'l_foot', 0, ('l_leg_lhy', 'l_leg_kny', 'l_leg_uay'), ((-0.3, 0.6, -0.3),), (0,),
+    'joint_trajectory_in_a_foot_frame': {100: [trajectory_input(TrajectoryMessage(
+        'l_foot', 0, ('l_leg_lhy', 'l_leg_kny', 'l_leg_uay'), ((-0.3, 0.6, -0.3),), (0,)),
         ATLAS.lower_rad, ATLAS.upper_rad, ('l_foot',))]},
 }
 

@@ -16,6 +16,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'copy_plan': ['CopyPlan'],
     'divergence': ['DivergenceCheck', 'PhysicsDivergenceError'],
     'joint_law': ['JointLaw'],
+    'joint_trajectory': ['TrajectoryMessage', 'trajectory_input'],
     'law_kernel': ['CompiledLaw', 'LawJoints'],
     'link_transforms': ['LinkTransforms', 'RspSchedule'],
     'model': ['AtlasModel', 'FALL_HEIGHT_M', 'SPAWN_HEIGHT_M', 'body_position_in_pose',
@@ -26,7 +27,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'simulator': ['AtlasSimulator', 'DEFAULT_TIME_TO_UNPIN_S'],
     'startup_pin': ['StartupPin'],
     'urdf': ['UrdfError', 'matching_urdf', 'read_joints'],
-    'vrc': ['DEFAULT_STARTUP_MODE', 'InputError', 'InputEvent', 'ModeInput', 'STARTUP_MODES',
-            'SimInput', 'VrcMode', 'cmd_vel_input', 'describe_input', 'parse_vrc_mode',
-            'pose_input', 'trajectory_input', 'wrench_input'],
+    'vrc': ['DEFAULT_STARTUP_MODE', 'InputError', 'InputEvent', 'InputNote', 'ModeInput',
+            'STARTUP_MODES', 'SimInput', 'TrajectoryInput', 'VrcMode', 'cmd_vel_input',
+            'describe_input', 'input_notes', 'parse_vrc_mode', 'pose_input', 'wrench_input'],
 })
