@@ -38,6 +38,9 @@ esac
 topics=$(python3 -c 'from tutorial_atlas_control.topics import RECORDED_TOPICS; print(*RECORDED_TOPICS)' 2>/dev/null) \
   || fail "cannot import tutorial_atlas_control.topics for the topic list; source ./env.sh (or the workspace's setup.bash) first"
 read -r -a TOPICS <<< "$topics"
+# Another launch's recorder on this master: refuse before registering (the master would
+# hand it our name and stop it), one line (tutorial_atlas_control.node.single_instance).
+python3 -m tutorial_atlas_control.node.single_instance "$prog" recorder "${ros_args[@]}" || exit 1
 mkdir -p "$bag_dir" || fail "cannot create bag directory $bag_dir"
 echo "$prog: recording to $bag_dir/atlas_<date-time>.bag with $recorder, chunks compressed: $compression"
 # exec: roslaunch's SIGINT must reach the recorder itself so that it closes the bag.

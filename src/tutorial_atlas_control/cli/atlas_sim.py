@@ -2,7 +2,9 @@
 
 `--help` prints the node's parameters (node/sim_node.py's docstring). Like any ROS node it
 exits 0 when ROS shuts it down (Ctrl-C, `rosnode kill`, another atlas_sim registering on the
-same master: then with one line saying so), 1 when its set-up is refused.
+same master: then with one line saying so), 1 when its set-up is refused, or when an
+atlas_sim already runs on the master (node/single_instance.py: checked before registering,
+so the first launch and its master go on).
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ import rospy
 
 from tutorial_atlas_control.cli.convention import EXIT_REFUSED
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.node import sim_node
+from tutorial_atlas_control.node import sim_node, single_instance
 from tutorial_atlas_control.node.sim_node import NODE_NAME, build_node
 
 HELP_OPTIONS = ('-h', '--help')
@@ -45,10 +47,13 @@ def took_over_line(name: str, master_uri: str) -> str:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Start the node and step until ROS shuts it down; the exit status."""
-    args = rospy.myargv(list(argv) if argv is not None else sys.argv)
+    full_argv = list(argv) if argv is not None else list(sys.argv)
+    args = rospy.myargv(full_argv)
     if any(arg in HELP_OPTIONS for arg in args[1:]):
         print(sim_node.__doc__)
         return 0
+    if single_instance.refuse_if_running(NODE_NAME, NODE_NAME, full_argv):
+        return EXIT_REFUSED
     rospy.init_node(NODE_NAME)
     reason = ShutdownReason()
     rospy.core.add_preshutdown_hook(reason)
