@@ -556,11 +556,15 @@ def read_bag(path: Path | str, fast: bool = True) -> BagData:
         The extracted series; a series is None when its topic is not in the bag.
 
     Raises:
-        BagAnalysisError: Missing file, not a bag, unindexed or damaged bag.
+        BagAnalysisError: Missing file, not a bag, unindexed, damaged or empty bag.
     """
     path = Path(path)
     records = open_bag(path, fast)
     try:
+        if not any(connection.msgcount for connection in records.connections):
+            raise BagAnalysisError(
+                f'{path} holds no message (a launch that stopped before its simulator was '
+                'ready records nothing); give a bag of a run.')
         return _read_open_bag(path, records, fast)
     except (ReaderError, struct.error, ValueError, KeyError, IndexError,
             UnicodeDecodeError) as err:
