@@ -119,4 +119,5 @@ def test_forgotten_user_mode_a_reset_and_a_fall_each_say_so(tmp_path: Path) -> N
     assert len(resets) == 1, output
     falls = [line for line in output.splitlines() if 'the robot fell' in line]
     assert len(falls) == 1, output
-    assert falls[0].split(']: ', 1)[1].startswith('the robot fell: pelvis below 0.5 m at t='), falls
+    assert falls[0].split(']: ', 1)[1].startswith(
+        'the robot fell: pelvis below 0.5 m at sim time '), falls

@@ -96,7 +96,7 @@ def test_text_summary_lists_the_tries_and_resets(session_bag: Path) -> None:
     assert 'Tries (3; a try starts' in text
     assert "try 2: 6.000 to 12.9" in text and "trajectory 'touchdown'" in text
     assert '6.000 s  reset_world: try 2 begins' in text
-    assert 'FELL at 3.429 s, 2.430 s after its first command' in text
+    assert "FELL at sim time 3.430 s, 2.430 s after the try's first command" in text
 
 
 def test_single_run_is_one_try_without_warning(tmp_path: Path) -> None:

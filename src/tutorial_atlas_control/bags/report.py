@@ -21,6 +21,7 @@ from tutorial_atlas_control.bags.analysis import (
 from tutorial_atlas_control.bags.reader import BagData
 from tutorial_atlas_control.bags.tries import RUN_START
 from tutorial_atlas_control.errors import BagAnalysisError
+from tutorial_atlas_control.fall_report import fall_line, fall_when
 from tutorial_atlas_control.joints import JOINT_NAMES
 
 __all__ = ['format_summary', 'plot_run', 'to_json', 'write_csv']
@@ -65,9 +66,13 @@ def _topic_lines(data: BagData, trajectory: str | None = None,
 def _fall_line(analysis: Analysis) -> str:
     if analysis.fell is None:
         return f'Fall:     unknown ({analysis.unavailable.get("fall", "no pelvis data")})'
-    if analysis.fell:
-        return (f'Fall:     FELL at {analysis.fall_time_s:.3f} s (pelvis below '
-                f'{FALL_HEIGHT_M} m; lowest {analysis.min_pelvis_height_m:.3f} m)')
+    first = analysis.first_fall()
+    if analysis.fell and first is not None:
+        number, fall = first
+        where = '' if number is None else f'try {number}, '
+        return (f'Fall:     FELL {fall_when(fall.sim_time_s, fall.after_command_s)} ({where}'
+                f'{analysis.fall_time_s:.3f} s from bag start; pelvis below {FALL_HEIGHT_M} m; '
+                f'lowest {analysis.min_pelvis_height_m:.3f} m)')
     return (f'Fall:     no (pelvis stayed above {FALL_HEIGHT_M} m; lowest '
             f'{analysis.min_pelvis_height_m:.3f} m)')
 
@@ -121,10 +126,10 @@ def _try_lines(each: TryAnalysis) -> list[str]:
              f'{a.data.sim_time_s(window.start_s):.3f} s at {window.cause}); trajectory {played}']
     if a.fell is None:
         fall = 'fall unknown'
-    elif a.fell:
-        after = each.fall_after_command_s
-        fall = (f'FELL at {a.fall_time_s:.3f} s' + ('' if after is None else
-                                                       f', {after:.3f} s after its first command'))
+    elif a.fell and each.fall is not None:
+        fall = f'FELL {fall_when(each.fall.sim_time_s, each.fall.after_command_s)}'
+    elif each.fall is not None:  # the simulator saw it, the 100 Hz odometry did not
+        fall = f'fell {fall_when(each.fall.sim_time_s, each.fall.after_command_s)}'
     else:
         fall = f'no fall (lowest {a.min_pelvis_height_m:.3f} m)'
     count = 0 if a.data.commands is None else len(a.data.commands.t_s)
@@ -165,9 +170,8 @@ def short_summary(analysis: Analysis) -> str:
     lines = ['=== summary ===']
     if analysis.fell is None:
         lines.append(f'fall: unknown (no {topics.GROUND_TRUTH_ODOM} in the bag)')
-    elif analysis.fell:
-        lines.append(f'the robot fell: pelvis below {FALL_HEIGHT_M} m at '
-                     f't = {analysis.fall_time_s:.2f} s from bag start')
+    elif (first := analysis.first_fall()) is not None:
+        lines.append(fall_line(FALL_HEIGHT_M, first[1].sim_time_s, first[1].after_command_s))
     else:
         lines.append('the robot did not fall (lowest pelvis height '
                      f'{analysis.min_pelvis_height_m:.2f} m)')
