@@ -18,19 +18,23 @@ from tutorial_atlas_control.bags.analysis import (
     TryAnalysis,
     input_timeline,
 )
+from tutorial_atlas_control.bags.overview_plot import draw_overview
 from tutorial_atlas_control.bags.reader import BagData
 from tutorial_atlas_control.bags.tries import RUN_START
+from tutorial_atlas_control.control_modes import is_refused_mode
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.fall_report import fall_line, fall_when
 from tutorial_atlas_control.joints import JOINT_NAMES
 
-__all__ = ['format_summary', 'plot_run', 'to_json', 'write_csv']
+__all__ = ['format_summary', 'plot_joints', 'plot_run', 'to_json', 'write_csv']
 
 #: Most points drawn per line; longer series are decimated (plots, not analysis).
 PLOT_MAX_POINTS = 4000
 #: Height of one subplot (inches) and the figure width (inches).
 PLOT_ROW_HEIGHT_IN = 1.6
 PLOT_WIDTH_IN = 11.0
+#: After a mode the simulator refused (the bag records every string published).
+REFUSED_NOTE = '  (refused: not a control mode; the mode did not change)'
 #: Significant digits written to CSV files.
 CSV_FORMAT = '%.10g'
 
@@ -57,7 +61,9 @@ def _topic_lines(data: BagData, trajectory: str | None = None,
     # VRCPlugin's inputs (mode, teleport, wrench, ...) on the same timeline, when applied.
     events = sorted([*data.modes, *(resets or []), *input_timeline(data)],
                     key=lambda entry: entry[0])
-    lines.extend(f'  {t_s:9.3f} s  {text}' for t_s, text in events)
+    lines.extend(f'  {t_s:9.3f} s  {text}' + (REFUSED_NOTE if is_refused_mode(text) and
+                                                (t_s, text) in data.modes else '')
+                 for t_s, text in events)
     if not data.modes:
         lines.append(f'  (no {topics.CONTROL_MODE} messages)')
     return lines
@@ -295,9 +301,11 @@ def _mark_modes(axes: list[Any], modes: list[tuple[float, str]]) -> None:
             ax.axvline(t_s, color='gray', linestyle='--', linewidth=0.8)
     for number, (t_s, mode) in enumerate(modes):
         # Alternate label heights so modes that change in quick succession stay legible.
-        axes[0].annotate(mode, (t_s, 1.0), xycoords=('data', 'axes fraction'),
-                         xytext=(2, 2 + 10 * (number % 2)), textcoords='offset points',
-                         fontsize=8)
+        refused = is_refused_mode(mode)
+        axes[0].annotate(f'{mode} (refused)' if refused else mode, (t_s, 1.0),
+                         xycoords=('data', 'axes fraction'), xytext=(2, 2 + 10 * (number % 2)),
+                         textcoords='offset points', fontsize=8,
+                         color='tab:red' if refused else 'black')
 
 
 def _mark_resets(axes: list[Any], analysis: Analysis) -> None:
@@ -333,15 +341,28 @@ def save_figure(fig: Any, path: Path | str) -> Path:
 
 
 def plot_run(analysis: Analysis, path: Path | str) -> Path:
-    """Plot commanded vs measured positions of the joints that moved, and pelvis height.
-
-    One subplot per moved joint plus one for the pelvis height, sharing the time axis;
-    control-mode changes are vertical lines labelled with the mode.
+    """The first page (overview_plot): pelvis height and falls, the tries with what was
+    played and its waypoints, the control modes, the worst-tracked joints.
 
     Raises:
         BagAnalysisError: The image cannot be written.
     """
     import matplotlib  # noqa: PLC0415 - only needed with --plot
+
+    matplotlib.use('Agg')
+    refused = {mode for _, mode in analysis.data.modes if is_refused_mode(mode)}
+    return save_figure(draw_overview(analysis, refused), path)
+
+
+def plot_joints(analysis: Analysis, path: Path | str) -> Path:
+    """The per-joint pages: commanded vs measured positions of the joints that moved, and
+    the pelvis height, one subplot each, sharing the time axis; control-mode changes are
+    vertical lines labelled with the mode.
+
+    Raises:
+        BagAnalysisError: The image cannot be written.
+    """
+    import matplotlib  # noqa: PLC0415 - only needed with --plot-joints
 
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt  # noqa: PLC0415
