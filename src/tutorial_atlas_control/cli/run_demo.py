@@ -7,6 +7,7 @@ import math
 import os
 import subprocess
 import sys
+import time
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -74,6 +75,7 @@ def _warn(line: str) -> None:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status."""
     args = build_parser().parse_args(argv)
+    started_s = time.time()
     try:
         # Everything is checked before anything starts.
         trajectory_file = args.file or find_trajectory(args.trajectory)
@@ -91,5 +93,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         print_error(PROG, f'{err.cmd[2] if len(err.cmd) > 2 else err.cmd} timed out')
         return EXIT_REFUSED
     except KeyboardInterrupt:  # run_demo has stopped roslaunch on the way out
+        _name_partial_bag(args.bag_dir.expanduser().resolve(), started_s)
         return EXIT_INTERRUPTED
     return 0
+
+
+def _name_partial_bag(bag_dir: Path, started_s: float) -> None:
+    """After Ctrl-C: where the run so far was recorded (the recorder closed it), if at all."""
+    try:
+        bag = demo.newest_bag(bag_dir, started_s)
+    except (AtlasControlError, OSError):
+        return  # interrupted before the recorder wrote anything
+    print(f'{PROG}: interrupted; the run so far is in {bag} (analyze_bag.py {bag})',
+          file=sys.stderr)
