@@ -69,3 +69,22 @@ def test_a_bag_without_the_line_reports_its_own_figures_the_same_way(tmp_path: P
     assert short_summary(analysis).splitlines()[1] == (
         "the robot fell: pelvis below 0.5 m at sim time 32.810 s, 1.810 s after the try's "
         'first command')
+
+
+def test_the_demo_summary_is_a_few_lines_the_table_on_request(tmp_path: Path) -> None:
+    from tutorial_atlas_control.bags.synthetic import write_run_bag
+
+    analysis = analyze_bag(write_run_bag(tmp_path / 'run.bag', 3.0, with_imu=False,
+                                         fall_time_s=1.5))
+    tracked = sorted(((joint.rms_error_rad, name) for name, joint in analysis.joints.items()
+                      if joint.rms_error_rad is not None), reverse=True)
+    assert len(tracked) >= 2
+    short = short_summary(analysis).splitlines()
+    assert len(short) == 3 and short[1].startswith('the robot fell: ')
+    assert short[2] == (f'worst tracking (RMS |commanded - measured|, of {len(tracked)} joints '
+                        'that moved): ' + ', '.join(f'{name} {rms:.3f} rad'
+                                                     for rms, name in tracked[:3])
+                        + '; --table lists them all')
+    table = short_summary(analysis, table=True).splitlines()
+    assert [row.split()[0] for row in table[3:]] == [name for _, name in tracked]
+    assert len(table) == 3 + len(tracked)

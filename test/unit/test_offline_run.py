@@ -158,8 +158,11 @@ def test_summary_without_bag(trajectory_file: Path, capsys: pytest.CaptureFixtur
     out = capsys.readouterr().out
     assert '=== summary ===' in out
     assert 'the robot did not fall' in out
-    assert 'l_arm_elx  RMS ' in out
+    assert 'that moved): l_arm_elx ' in out
     assert 'bag:' not in out
+    assert main([str(trajectory_file), 'elbow', '--start-after', '1.1', '--settle', '0.2',
+                 '--table']) == 0
+    assert '  l_arm_elx  RMS ' in capsys.readouterr().out
 
 
 def run_script(args: list[str], cwd: Path) -> subprocess.CompletedProcess[str]:

@@ -33,6 +33,8 @@ PLOT_MAX_POINTS = 4000
 #: Height of one subplot (inches) and the figure width (inches).
 PLOT_ROW_HEIGHT_IN = 1.6
 PLOT_WIDTH_IN = 11.0
+#: How many of the worst-tracked joints the short summary names.
+SUMMARY_WORST_JOINTS = 3
 #: After a mode the simulator refused (the bag records every string published).
 REFUSED_NOTE = '  (refused: not a control mode; the mode did not change)'
 #: Significant digits written to CSV files.
@@ -170,22 +172,33 @@ def format_summary(analysis: Analysis, trajectory: str | None = None) -> str:
     return '\n'.join(lines)
 
 
-def short_summary(analysis: Analysis) -> str:
-    """The demo's summary of a run (make demo, run_offline.py): fall, then tracking of the
-    joints that moved."""
+def short_summary(analysis: Analysis, table: bool = False) -> str:
+    """The demo's summary of a run (make demo, run_offline.py), a few lines: the fall, then
+    the joints that tracked worst; with `table`, every joint that moved, a row each."""
     lines = ['=== summary ===']
+    first = analysis.first_fall()
     if analysis.fell is None:
         lines.append(f'fall: unknown (no {topics.GROUND_TRUTH_ODOM} in the bag)')
-    elif (first := analysis.first_fall()) is not None:
+    elif first is not None:
         lines.append(fall_line(FALL_HEIGHT_M, first[1].sim_time_s, first[1].after_command_s))
     else:
         lines.append('the robot did not fall (lowest pelvis height '
                      f'{analysis.min_pelvis_height_m:.2f} m)')
-    lines.append('tracking error of the joints that moved (commanded vs measured):')
-    for name, tracking in analysis.joints.items():
-        if tracking.rms_error_rad is not None:
-            lines.append(f'  {name:10s} RMS {tracking.rms_error_rad:.4f} rad, '
-                         f'max {tracking.max_error_rad:.4f} rad')
+    tracked = sorted(((joint.rms_error_rad, joint.max_error_rad, name)
+                      for name, joint in analysis.joints.items()
+                      if joint.rms_error_rad is not None), reverse=True)
+    if not tracked:
+        lines.append('tracking: no joint moved under a command')
+    elif table:
+        lines.append('tracking error of the joints that moved (commanded vs measured), '
+                     'worst first:')
+        lines.extend(f'  {name:10s} RMS {rms:.4f} rad, max {peak:.4f} rad'
+                     for rms, peak, name in tracked)
+    else:
+        worst = ', '.join(f'{name} {rms:.3f} rad' for rms, _peak, name in
+                          tracked[:SUMMARY_WORST_JOINTS])
+        lines.append(f'worst tracking (RMS |commanded - measured|, of {len(tracked)} joints '
+                     f'that moved): {worst}; --table lists them all')
     return '\n'.join(lines)
 
 

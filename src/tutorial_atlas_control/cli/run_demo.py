@@ -48,6 +48,9 @@ def build_parser() -> argparse.ArgumentParser:
                         help='where the bag goes (default: $TAC_BAG_DIR or %(default)s)')
     parser.add_argument('--real-time-factor', type=argument_type(real_time_factor), default=1.0,
                         help='simulator pace; 0 = as fast as possible (default: 1.0)')
+    parser.add_argument('--table', action='store_true',
+                        help='list the tracking error of every joint that moved, not only the '
+                             'worst three')
     parser.add_argument('--video-fps', type=float, default=demo.DEMO_VIDEO_FPS,
                         help='frame rate of the rendered video; 0 = no video '
                              '(default: %(default)g)')
@@ -85,7 +88,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         bag = demo.run_demo(args.trajectory, trajectory_file, args.bag_dir.expanduser().resolve(),
                             args.real_time_factor, args.bag_dir.expanduser() / 'logs',
                             progress=print, warn=_warn, gains=gains)
-        demo.summarise(bag, args.video_fps, args.video_size, report=print)
+        demo.summarise(bag, args.video_fps, args.video_size, report=print, table=args.table)
     except AtlasControlError as err:
         print_error(PROG, err)
         return EXIT_REFUSED
