@@ -121,3 +121,15 @@ def test_forgotten_user_mode_a_reset_and_a_fall_each_say_so(tmp_path: Path) -> N
     assert len(falls) == 1, output
     assert falls[0].split(']: ', 1)[1].startswith(
         'the robot fell: pelvis below 0.5 m at sim time '), falls
+
+
+def test_a_mistyped_launch_argument_gets_one_warning(tmp_path: Path) -> None:
+    """roslaunch ignores recrod:=false; the simulator reads roslaunch's command line."""
+    with TestLaunch(tmp_path, 'recrod:=false') as launch:
+        launch.wait_ready()  # record's default, true, is what runs
+        launch.interrupt(EXIT_TIMEOUT_S)
+        output = launch.output()
+    warnings = [line for line in output.splitlines() if 'roslaunch ignored' in line]
+    assert len(warnings) == 1, output
+    assert ('roslaunch ignored the argument recrod:=false: atlas.launch has no argument '
+            'recrod; did you mean record:=false? (its arguments: ') in warnings[0]

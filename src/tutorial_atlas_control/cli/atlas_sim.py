@@ -9,16 +9,21 @@ so the first launch and its master go on).
 
 from __future__ import annotations
 
+import os
 import sys
 from collections.abc import Sequence
+from pathlib import Path
 
 import rosgraph
 import rospy
 
 from tutorial_atlas_control.cli.convention import EXIT_REFUSED
 from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.launch_args import unknown_arg_lines
 from tutorial_atlas_control.node import sim_node, single_instance
 from tutorial_atlas_control.node.sim_node import NODE_NAME, build_node
+from tutorial_atlas_control.processes import PACKAGE
+from tutorial_atlas_control.resources import package_path
 
 HELP_OPTIONS = ('-h', '--help')
 #: What the master gives as the reason when another node registers under our name.
@@ -45,6 +50,24 @@ def took_over_line(name: str, master_uri: str) -> str:
             'one atlas.launch per master, or give the second its own (roslaunch -p PORT)')
 
 
+def _package_launch_file(package: str, name: str) -> Path | None:
+    path = package_path('launch', name)
+    return path if package == PACKAGE and path.is_file() else None
+
+
+def unknown_launch_arg_lines(parent_pid: int) -> list[str]:
+    """launch_args' warnings when roslaunch (the parent) was given arguments no launch file
+    of its command line declares; [] for any other parent."""
+    try:
+        raw = (Path('/proc') / str(parent_pid) / 'cmdline').read_bytes()
+    except OSError:
+        return []
+    argv = [part.decode(errors='replace') for part in raw.split(b'\0') if part]
+    if not any(Path(part).name == 'roslaunch' for part in argv[:2]):
+        return []
+    return unknown_arg_lines(argv, _package_launch_file)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Start the node and step until ROS shuts it down; the exit status."""
     full_argv = list(argv) if argv is not None else list(sys.argv)
@@ -65,6 +88,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     rospy.loginfo(f'Atlas v1 simulator ready: dt={node.sim.dt_s * 1000:.1f} ms, '
                   f'real_time_factor={node.loop.real_time_factor}, paused={node.loop.paused}, '
                   f'torso pinned for {node.sim.time_to_unpin_s} s')
+    for line in unknown_launch_arg_lines(os.getppid()):
+        rospy.logwarn(line)
     status = node.spin()
     if reason.taken_over():
         print(took_over_line(rospy.get_name(), rosgraph.get_master_uri().rstrip('/')),
