@@ -12,7 +12,6 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
-from tutorial_atlas_control.bags.records import open_bag
 from tutorial_atlas_control.errors import BagAnalysisError
 
 __all__ = ['BAG_DIR_ENV', 'NewestBag', 'bag_problem', 'default_bag_dir', 'latest_bag',
@@ -34,6 +33,10 @@ def bag_problem(path: Path) -> str | None:
     """Why `path` cannot be "the newest bag": 'empty' (no message, as a launch that stopped
     before its simulator was ready leaves with `rosbag record`), 'unreadable (...)'; None
     if it opens and holds messages. Reads the index only."""
+    # Here, not at the top: the scripts' convention module imports this one before it can
+    # say that the shell lacks the environment (rosbags).
+    from tutorial_atlas_control.bags.records import open_bag  # noqa: PLC0415
+
     try:
         bag = open_bag(path, fast=False)
     except BagAnalysisError as err:
