@@ -11,9 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.bags.analysis import analyze_bag
-from tutorial_atlas_control.bags.report import format_summary, short_summary
-from tutorial_atlas_control.bags.synthetic import (
+from support.synthetic_bags import (
     clock,
     control_mode,
     joint_commands,
@@ -21,6 +19,8 @@ from tutorial_atlas_control.bags.synthetic import (
     rosout,
     write_bag,
 )
+from tutorial_atlas_control.bags.analysis import analyze_bag
+from tutorial_atlas_control.bags.report import format_summary, short_summary
 from tutorial_atlas_control.fall_report import LoggedFall, fall_line, parse_fall_line
 from tutorial_atlas_control.joints import NUM_JOINTS
 
@@ -72,7 +72,7 @@ def test_a_bag_without_the_line_reports_its_own_figures_the_same_way(tmp_path: P
 
 
 def test_the_demo_summary_is_a_few_lines_the_table_on_request(tmp_path: Path) -> None:
-    from tutorial_atlas_control.bags.synthetic import write_run_bag
+    from support.synthetic_bags import write_run_bag
 
     analysis = analyze_bag(write_run_bag(tmp_path / 'run.bag', 3.0, with_imu=False,
                                          fall_time_s=1.5))

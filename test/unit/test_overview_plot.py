@@ -9,6 +9,7 @@ import matplotlib
 import numpy as np
 import pytest
 
+from support.synthetic_bags import TrySpec, control_mode, tries_records, write_bag
 from tutorial_atlas_control.bags.analysis import Analysis, analyze_bag
 from tutorial_atlas_control.bags.overview_plot import (
     axis_shift_s,
@@ -17,7 +18,6 @@ from tutorial_atlas_control.bags.overview_plot import (
     waypoint_times,
 )
 from tutorial_atlas_control.bags.report import plot_run
-from tutorial_atlas_control.bags.synthetic import TrySpec, control_mode, tries_records, write_bag
 from tutorial_atlas_control.trajectories.trajectory import load_trajectory
 
 matplotlib.use('Agg')

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from support.synthetic_bags import clock, control_mode, write_bag
 from tutorial_atlas_control.bags.analysis import analyze_bag
 from tutorial_atlas_control.bags.report import format_summary
-from tutorial_atlas_control.bags.synthetic import clock, control_mode, write_bag
 from tutorial_atlas_control.control_modes import VALID_CONTROL_MODES, is_refused_mode
 from tutorial_atlas_control.sim.simulator import VALID_MODES
 

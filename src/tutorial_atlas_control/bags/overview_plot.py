@@ -168,9 +168,9 @@ def draw_overview(analysis: Analysis, refused: set[str]) -> Any:
     _draw_tracking(bottom, analysis, shift_s)
     _draw_tries([top, bottom], analysis, shift_s)
     _draw_marks([top, bottom], analysis, refused, shift_s)
-    top.legend(loc='upper right', fontsize=8)
-    if bottom.get_legend_handles_labels()[0]:
-        bottom.legend(loc='upper right', fontsize=8)
+    for ax in (top, bottom):
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(loc='upper right', fontsize=8)
     bottom.set_xlabel('sim time (s), as the live log' if shift_s else
                       'time from the bag\'s start (s): sim time went back (reset_simulation); '
                       'falls labelled in sim time')
