@@ -83,4 +83,6 @@ def test_ctrl_c_while_playing_stops_everything_and_exits_130(tmp_path: Path) -> 
     with pytest.raises(OSError), socket.create_connection(('127.0.0.1', int(port[1])), 1.0):
         pass  # the demo's master is gone with its launch
     assert not list(tmp_path.glob('atlas_*.bag.active')), 'the recorder did not close its bag'
-    assert len(list(tmp_path.glob('atlas_*.bag'))) == 1
+    bag, = tmp_path.glob('atlas_*.bag')
+    assert stderr.splitlines()[-1] == (f'run_demo.py: interrupted; the run so far is in {bag} '
+                                       f'(analyze_bag.py {bag})'), stderr

@@ -232,6 +232,11 @@ def test_any_try_replays_exactly(three_tries: Path, number: int | None, start_s:
     assert result.pelvis_position is not None and result.pelvis_position.max_abs == 0.0
     assert result.pelvis_position.samples == steps // ODOM_EVERY
     assert result.reproduced and result.resets_in_bag == 2
+    # The reset warning only when the try was not asked for (the report names the try).
+    warned = [text for text in result.warnings if 'reset(s); replaying' in text]
+    assert warned == ([] if number is not None else [
+        'the bag holds 2 reset(s); replaying the last segment, from the reset at 0.000 s '
+        '(sim time).'])
 
 
 def test_try_that_does_not_exist_is_one_line(three_tries: Path,

@@ -161,4 +161,5 @@ def window(data: BagData, start_s: float, end_s: float) -> BagData:
         modes, [(t_s, text) for t_s, text in data.sim_configs if start_s <= t_s < end_s],
         list(data.warnings), [(t_s, p) for t_s, p in data.played if start_s <= t_s < end_s],
         list(data.epoch_starts_s), list(data.epoch_shifts_s),
-        [(t_s, text) for t_s, text in data.sim_inputs if start_s <= t_s < end_s])
+        [(t_s, text) for t_s, text in data.sim_inputs if start_s <= t_s < end_s],
+        [(t_s, fall) for t_s, fall in data.logged_falls if start_s <= t_s < end_s])

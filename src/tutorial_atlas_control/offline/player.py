@@ -74,6 +74,9 @@ LOG_INFO = 2
 StepHook = Callable[[AtlasSimulator], None]
 #: Bag chunk size (bytes): rosbag record's default.
 CHUNK_BYTES = 768 * 1024
+#: Chunk compression, a live run's default (atlas.launch's compression:=lz4): an 8.5 s
+#: step_and_fall run takes 8.8 MB instead of 16.3 MB, in no measurably longer time.
+CHUNK_COMPRESSION = 'lz4'
 
 #: Topic -> (publishing node, latched), as in a live run; this order is the bag's
 #: connections' order (their ids).
@@ -144,7 +147,7 @@ def _open_bag(path: Path) -> BlockBagWriter:
     if JOINT_COMMANDS_TYPE not in typestore.fielddefs:
         raise OfflineRunError('cannot find osrf_msgs/JointCommands.msg (msg/osrf_msgs in '
                               'the package): the commands could not be written')
-    return BlockBagWriter(path, typestore, TOPIC_TYPES, CHUNK_BYTES)
+    return BlockBagWriter(path, typestore, TOPIC_TYPES, CHUNK_BYTES, CHUNK_COMPRESSION)
 
 
 def _serialized(message: StampedWire) -> np.ndarray:

@@ -105,6 +105,7 @@ class Recording:
     inputs: list[InputEvent] = field(default_factory=list)  # since the try's reset, in order
     try_number: int = 1
     tries: int = 1
+    try_asked: bool = False  # --try given: the report's 'try N of M' says it, no warning
 
 
 def _read_sim_configs(data: BagData) -> list[dict[str, Any]]:
@@ -249,7 +250,7 @@ def load_recording(path: Path | str, data: BagData | None = None,
     inputs = _input_events(path, data, config, warnings)
     return Recording(path, config, resets, state_stamp_ns, position, velocity, effort,
                      odom_stamp_ns, odom_position, odom_quat, len(odom_stamp_ns) > 0, warnings,
-                     inputs, chosen.number, tries)
+                     inputs, chosen.number, tries, try_asked=try_number is not None)
 
 
 def _joint_columns(path: Path, names: Sequence[str]) -> list[int]:
@@ -553,7 +554,7 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
     step_ns = sim.step_ns
     reset_step = _reset_step(config, step_ns)
     sim.reset_simulation(reset_step * step_ns)
-    if recording.resets_in_bag:
+    if recording.resets_in_bag and not recording.try_asked:
         which = ('the last segment' if recording.try_number == recording.tries
                  else f'try {recording.try_number} of {recording.tries}')
         warnings.append(f'the bag holds {recording.resets_in_bag} reset(s); replaying {which}, '

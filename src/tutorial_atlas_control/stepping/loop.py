@@ -27,6 +27,7 @@ from tutorial_atlas_control.command.arrays import (
     CommandError,
     CommandUpdate,
 )
+from tutorial_atlas_control.fall_report import fall_line
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.msgs.atlas_command import (
     AtlasUpdate,
@@ -537,12 +538,9 @@ class SteppingLoop:
         if self.fall_armed and self.sim.data.qpos[self.pelvis_z_index] < FALL_HEIGHT_M:
             self.fall_armed = False
             sim = self.sim
-            line = (f'the robot fell: pelvis below {FALL_HEIGHT_M} m at '
-                    f't={sim.sim_time_ns / NS_PER_S:.3f} s')
-            if self.first_command_ns is not None:
-                line += (f', {(sim.sim_time_ns - self.first_command_ns) / NS_PER_S:.3f} s '
-                         'after the first command since the start or last reset')
-            self.log.info(line)
+            after_s = (None if self.first_command_ns is None else
+                       (sim.sim_time_ns - self.first_command_ns) / NS_PER_S)
+            self.log.info(fall_line(FALL_HEIGHT_M, sim.sim_time_ns / NS_PER_S, after_s))
 
     # -- publishing ----------------------------------------------------------------------
     def publish(self) -> None:
