@@ -5,15 +5,17 @@
 #   make demo    the tutorial end to end, headless (TRAJ=step_and_fall|touchdown|touchdown_exhausted)
 #                or a step that stands: make demo TRAJ=step_and_stand (Stepping.yaml, its gains)
 #                RTF=0.5 runs the simulator at half real time (a busy machine's late commands
-#                matter half as much in sim time)
+#                matter half as much in sim time); TABLE=1 lists every joint's tracking error
 #   make bench   the performance benchmark
+#   make clean-bags  delete the bags in $TAC_BAG_DIR (else ~/.ros/tutorial_atlas_control/bags);
+#                KEEP=N keeps the newest N
 SHELL := /bin/bash
 .SHELLFLAGS := -eo pipefail -c
 TRAJ ?= step_and_fall
 RTF ?= 1.0
 IN_ENV := source ./env.sh &&
 
-.PHONY: setup test unit-test lint rostest demo bench bench-quick clean-workspace
+.PHONY: setup test unit-test lint rostest demo bench bench-quick clean-workspace clean-bags
 
 setup:
 	@bash tools/setup.sh
@@ -41,10 +43,13 @@ bench-quick: setup
 	@$(IN_ENV) python3 bench/run_bench.py --quick --runs 1
 
 demo: setup
-	@$(IN_ENV) python3 scripts/run_demo.py "$(TRAJ)" --real-time-factor "$(RTF)"
+	@$(IN_ENV) python3 scripts/run_demo.py "$(TRAJ)" --real-time-factor "$(RTF)" $(if $(TABLE),--table)
 
 bench: setup
 	@$(IN_ENV) python3 bench/run_bench.py
+
+clean-bags: setup
+	@$(IN_ENV) python3 -m tutorial_atlas_control.cli.bag_housekeeping clean --keep "$(or $(KEEP),0)"
 
 clean-workspace:
 	@bash -c 'repo_dir=$$(pwd -P); source tools/paths.sh; rm -rf "$$TAC_HOME"; echo "removed $$TAC_HOME"'

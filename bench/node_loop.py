@@ -73,9 +73,7 @@ def fake_ros_node(steps: int, warmup_steps: int = 1500, compiled_law: bool = Tru
                   tcp: bool = False) -> Iterator[Any]:
     """A real SimNode (real_time_factor 0, the launch's rates) on fake rospy, standing
     (support.fake_rospy); rospy.is_shutdown() ends spin() after `steps` steps."""
-    sim = make_simulator()
-    if not compiled_law:
-        sim._compiled_law = None
+    sim = make_simulator(compiled_law)
     for _ in range(warmup_steps):
         sim.step()
     with fake_rospy.fake_ros_node(sim, steps, tcp=tcp) as node:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import sys
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -15,8 +16,12 @@ from tutorial_atlas_control import topics
 if TYPE_CHECKING:
     from tutorial_atlas_control.sim.simulator import AtlasSimulator
 
+# The synthetic run bag is a test fixture: test/support, imported as `support` (as the tests
+# and node_loop.py do).
+sys.path.insert(0, str(REPO_DIR / 'test'))
+
 GAINS_YAML = REPO_DIR / 'config' / 'atlas_controller.yaml'
-#: The topics bag_reader.read_bag deserializes (the baseline reads the same ones).
+#: The topics bags.reader.read_bag deserializes (the baseline reads the same ones).
 ANALYSIS_TOPICS = (topics.JOINT_STATES, topics.JOINT_COMMANDS, topics.GROUND_TRUTH_ODOM,
                    topics.CONTROL_MODE)
 
@@ -60,7 +65,7 @@ def run_bag(cache_dir: Path, duration_s: float = 60.0) -> Path:
     Cached under a name that hashes synthetic_bags.py, so a changed generator makes a new
     bag; written to a temporary name and renamed, so an interrupted run leaves no half bag.
     """
-    from tutorial_atlas_control.bags import synthetic as synthetic_bags
+    from support import synthetic_bags
 
     source = Path(synthetic_bags.__file__).read_bytes()
     key = hashlib.sha1(source + str(duration_s).encode()).hexdigest()[:12]
@@ -89,7 +94,7 @@ def analysis_message_count(path: Path) -> int:
 
 
 def analysis_run(path: Path) -> float:
-    """Wall seconds of bag_analysis.analyze_bag (read_bag + metrics) on `path`."""
+    """Wall seconds of bags.analysis.analyze_bag (read_bag + metrics) on `path`."""
     from tutorial_atlas_control.bags.analysis import analyze_bag
 
     start = time.perf_counter()

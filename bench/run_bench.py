@@ -9,7 +9,7 @@ Sections (see bench/README.md for what each figure means and how it is measured)
   physics   bare mj_step, and AtlasSimulator.step() (law + mj_step; C and numpy law) in a
             plain loop, no ROS
   offline   run_offline.py's run of touchdown to a bag, against the plain loop
-  analysis  bag_analysis.analyze_bag vs Debian's rosbag API on a 60 s run bag
+  analysis  bags.analysis.analyze_bag vs Debian's rosbag API on a 60 s run bag
   fast      the node at real_time_factor:=0 with atlas_recorder (the launch's default; the
             fast_* keys), then with `rosbag record` (fast_rosbag_*); the CPU of every process
   realtime  the node at real_time_factor:=1.0: achieved factor, step lateness, then the

@@ -6,6 +6,7 @@
 # atlas_recorder (default): the package's recorder, which never drops a message that arrived;
 # rosbag: Debian's `rosbag record`, which drops the oldest past 100 queued messages per topic.
 # lz4 (default), bz2, none: the bag's chunk compression (`rosbag record --lz4`, `--bz2`).
+# It first says what BAG_DIR holds; $TAC_KEEP_BAGS=N / $TAC_MAX_BAGS_MB=M delete its oldest bags.
 # Exit status: 1 when it cannot record, 2 on a bad command line.
 set -euo pipefail
 prog=record_run.sh
@@ -17,7 +18,7 @@ for arg in "$@"; do
 done
 set -- "${args[@]}"
 if [ $# -ge 1 ] && { [ "$1" = "-h" ] || [ "$1" = "--help" ]; }; then
-  sed -n '2,9p' "$0" | sed 's/^# \{0,1\}//'
+  sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'
   exit 0
 fi
 [ $# -ge 1 ] && [ $# -le 3 ] || fail "expected BAG_DIR [atlas_recorder|rosbag [lz4|bz2|none]], got $# argument(s); see --help" 2
@@ -38,7 +39,12 @@ esac
 topics=$(python3 -c 'from tutorial_atlas_control.topics import RECORDED_TOPICS; print(*RECORDED_TOPICS)' 2>/dev/null) \
   || fail "cannot import tutorial_atlas_control.topics for the topic list; source ./env.sh (or the workspace's setup.bash) first"
 read -r -a TOPICS <<< "$topics"
+# Another launch's recorder on this master: refuse before registering (the master would
+# hand it our name and stop it), one line (tutorial_atlas_control.node.single_instance).
+python3 -m tutorial_atlas_control.node.single_instance "$prog" recorder "${ros_args[@]}" || exit 1
 mkdir -p "$bag_dir" || fail "cannot create bag directory $bag_dir"
+# What the directory holds, and $TAC_KEEP_BAGS / $TAC_MAX_BAGS_MB's retention (off if unset).
+python3 -m tutorial_atlas_control.cli.bag_housekeeping launch "$bag_dir" || exit 2
 echo "$prog: recording to $bag_dir/atlas_<date-time>.bag with $recorder, chunks compressed: $compression"
 # exec: roslaunch's SIGINT must reach the recorder itself so that it closes the bag.
 case $recorder in

@@ -7,7 +7,7 @@
 #include <stddef.h>
 #include <string.h>
 
-/* dst[dst_index[i]] = src[src_index[i]] for i < count; laid out by msgs/copy_plan.py, mirrored
+/* dst[dst_index[i]] = src[src_index[i]] for i < count; laid out by sim/copy_plan.py, mirrored
  * in native.py (same fields, same order; tac_sizeof_AtlasCopy lets the loader check).
  * dst is a message's float block inside its serialized bytes, not necessarily 8-byte
  * aligned: it is written with memcpy. */

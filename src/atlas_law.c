@@ -15,7 +15,7 @@
 #define TIE_BACK_EPSILON 1e-6
 
 /* The fields of osrf_msgs/JointCommands, in message order, then AtlasCommand's k_effort as
- * a fraction (commands.LAW_FIELDS). */
+ * a fraction (command/arrays.py's LAW_FIELDS). */
 enum {
   POSITION, VELOCITY, EFFORT, KP_POSITION, KI_POSITION, KD_POSITION, KP_VELOCITY,
   I_EFFORT_MIN, I_EFFORT_MAX, K_EFFORT, NUM_FIELDS

@@ -144,6 +144,13 @@ private:
   unsigned long written_ = 0;
 };
 
+// The directory part of `path` ("." for a bare file name).
+std::string bagDirOf(const std::string& path)
+{
+  const std::string::size_type slash = path.rfind('/');
+  return slash == std::string::npos ? std::string(".") : path.substr(0, slash);
+}
+
 ros::Subscriber subscribeAnyType(ros::NodeHandle& node, const std::string& topic, BagWriter& writer)
 {
   ros::SubscribeOptions options;
@@ -273,6 +280,19 @@ int main(int argc, char** argv)
   ros::shutdown();
   if (writer.failed())  // said in one line when it happened
     return 1;
+  if (writer.written() == 0)
+  {
+    // No message with a valid (sim) time: the simulator never ran (its launch stopped before
+    // it was ready). An empty bag would only become "the newest bag" of the bag tools.
+    if (std::remove(active_path.c_str()) != 0)
+    {
+      std::perror(("atlas_recorder: cannot remove " + active_path).c_str());
+      return 1;
+    }
+    std::printf("atlas_recorder: no message to write (the simulator never published a sim time); "
+                "no bag left in %s\n", bagDirOf(bag_path).c_str());
+    return 0;
+  }
   if (std::rename(active_path.c_str(), bag_path.c_str()) != 0)
   {
     std::perror(("atlas_recorder: cannot rename " + active_path).c_str());

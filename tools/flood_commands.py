@@ -36,8 +36,8 @@ from rosgraph_msgs.msg import Clock
 from std_msgs.msg import String
 
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.node.traj_yaml import build_command, read_gains
 from tutorial_atlas_control.node.transport import subscriber_names
+from tutorial_atlas_control.trajectories.traj_yaml_node import build_command, read_gains
 
 #: The valid command's default left elbow target (rad).
 DEFAULT_ELBOW_RAD = 1.2

@@ -23,6 +23,13 @@ APT_PACKAGES=(
   libosmesa6 libegl1 libopengl0 libgl1-mesa-dri
   ros-robot-state-publisher ros-tf2-msgs python3-tf2-msgs python3-tf2-ros rviz
   ros-trajectory-msgs python3-trajectory-msgs
+  # What DRC-era Python clients import: tf.transformations, tf_conversions.posemath with
+  # PyKDL, actionlib, roslib.load_manifest, tf2_geometry_msgs, tf2_kdl, angles; and the
+  # package.xml files that let rospack, rosmsg and a client's manifest find tf,
+  # tf_conversions and trajectory_msgs (Debian ships them in the -dev packages).
+  python3-tf python3-tf-conversions python3-pykdl python3-actionlib python3-actionlib-msgs
+  ros-actionlib-msgs python3-roslib python3-tf2-geometry-msgs python3-tf2-kdl python3-angles
+  libtf-dev libtf-conversions-dev libtrajectory-msgs-dev
   xvfb xdotool x11-apps imagemagick iproute2
   python3-tk
 )

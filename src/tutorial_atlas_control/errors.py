@@ -11,6 +11,6 @@ class AtlasControlError(Exception):
 class BagAnalysisError(AtlasControlError):
     """A bag cannot be read or analyzed, or a report on it cannot be written.
 
-    Shared by bag_records, bag_reader, bag_analysis and bag_report, which analyze_bag.py
+    Shared by bags/ (records, reader, analysis, report), which analyze_bag.py
     runs as one tool; the message says what to do about it.
     """

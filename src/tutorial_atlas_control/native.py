@@ -4,7 +4,7 @@ One place knows the library's binary interface: the ctypes mirrors of its struct
 signatures of its functions, and where catkin puts it (a devel space's lib/ and an
 install space's lib/ are both on CMAKE_PREFIX_PATH once their setup.bash is sourced).
 Its users, the compiled law (sim/law_kernel.py) and the messages' copies
-(msgs/copy_plan.py), ask here.
+(sim/copy_plan.py), ask here.
 
 A mirror that disagrees with the C struct would let C read or write past the fields
 Python laid out, so the library exports `size_t tac_sizeof_<Struct>(void)` for each
@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tutorial_atlas_control.msgs.commands import LAW_FIELDS
+from tutorial_atlas_control.command.arrays import LAW_FIELDS
 
 __all__ = ['LIBRARY_ENV', 'LIBRARY_NAME', 'MIRRORED_STRUCTS', 'AtlasCopy', 'AtlasLawStep',
            'address', 'find_library', 'load_library', 'size_mismatches']

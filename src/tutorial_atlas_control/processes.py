@@ -320,8 +320,10 @@ class RosMaster(_RosProcess):
 class AtlasLaunch(_RosProcess):
     """`roslaunch tutorial_atlas_control atlas.launch ARG:=VALUE ...`.
 
-    Without `master` roslaunch starts a master of its own on a free port; with one, it
-    waits for that master (several launches may then run on it in turn). `base_env`, the
+    Without `master` roslaunch starts a master of its own on a free port; with a RosMaster,
+    it waits for that master (several launches may then run on it in turn); with another
+    AtlasLaunch, it runs as a second terminal's plain `roslaunch` does: on the master that
+    launch started, without starting one. `base_env`, the
     environment to start from without a master (default: this process's), lets a caller
     run another workspace's package, e.g. an install space's.
     """
@@ -329,14 +331,16 @@ class AtlasLaunch(_RosProcess):
     name = 'roslaunch'
 
     def __init__(self, log_path: Path, args: Mapping[str, object], *,
-                 master: RosMaster | None = None, ros_log_dir: Path | None = None,
+                 master: RosMaster | AtlasLaunch | None = None,
+                 ros_log_dir: Path | None = None,
                  launch_file: str = 'atlas.launch',
                  base_env: Mapping[str, str] | None = None) -> None:
         if master is None:
             self.port = free_local_port()
             env, wait = ros_environment(self.port, base=base_env), []
         else:
-            self.port, env, wait = master.port, dict(master.env), ['--wait']
+            wait = ['--wait'] if isinstance(master, RosMaster) else []
+            self.port, env = master.port, dict(master.env)
         if ros_log_dir is not None:
             env['ROS_LOG_DIR'] = str(ros_log_dir)
         self.args = {key: str(value) for key, value in args.items()}

@@ -20,7 +20,7 @@ from osrf_msgs.msg import JointCommands
 from std_msgs.msg import String
 
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.node.traj_yaml import build_command, read_gains
+from tutorial_atlas_control.trajectories.traj_yaml_node import build_command, read_gains
 
 ELBOW = JOINT_NAMES.index('l_arm_elx')
 #: The elbow's sine (rad): inside the joint's range, far from the standing 0.

@@ -49,9 +49,8 @@ BAD_INPUTS = (
      "refused /joint_trajectory: unknown joint name 'l_wing'; nothing applied"),
     (topics.JOINT_TRAJECTORY, 'trajectory_msgs/JointTrajectory',
      '{joint_names: [l_arm_shx], points: [{positions: [0], time_from_start: {secs: 1}}, '
-     '{positions: [0.1], time_from_start: {secs: 1}}]}',
-     'refused /joint_trajectory: time_from_start not increasing at point 1 (1 s after 1 s); '
-     'nothing applied'),
+     '{positions: [0.1], time_from_start: {secs: -1}}]}',
+     'refused /joint_trajectory: point 1 time_from_start -1 s is negative; nothing applied'),
 )
 GOOD_INPUTS = (
     (topics.MODE, 'std_msgs/String', '{data: pinned}'),
@@ -60,9 +59,22 @@ GOOD_INPUTS = (
     (topics.JOINT_TRAJECTORY, 'trajectory_msgs/JointTrajectory',
      '{joint_names: [l_arm_shx, atlas::r_arm_shx], points: ['
      '{positions: [-0.5, 0.5]}, {positions: [-1.0, 1.0], time_from_start: {nsecs: 200000000}}]}'),
+    # As DRCSim's animate-joints tutorial: past a limit, every point 0.1 s after the last.
+    (topics.JOINT_TRAJECTORY, 'trajectory_msgs/JointTrajectory',
+     "{header: {frame_id: 'atlas::pelvis'}, joint_names: [atlas::l_arm_ely, atlas::l_arm_shx], "
+     'points: [{positions: [-0.5, 0.2], time_from_start: {nsecs: 100000000}}, '
+     '{positions: [0.5, 0.4], time_from_start: {nsecs: 100000000}}]}'),
     (topics.CMD_VEL, 'geometry_msgs/Twist', '{linear: {x: 0.2}, angular: {z: 0.3}}'),
     (topics.CMD_VEL, 'geometry_msgs/Twist', '{}'),
     (topics.MODE, 'std_msgs/String', '{data: nominal}'),
+)
+#: What the simulator says about the tutorial-like trajectory: once each, and it plays.
+DRCSIM_ERA_LINES = (
+    "/joint_trajectory: positions outside their joints' limits, clamped to the limits: "
+    'l_arm_ely by up to 0.5 rad beyond [0, 3.14159] (1 of 2 points)',
+    '/joint_trajectory: time_from_start does not increase (point 1: 0.1 s after 0.1 s), read '
+    "as DRCSim 2.5.2 read it: each point's time_from_start added to the previous point's "
+    'time; the 2 points play over 0.1 s',
 )
 #: DRCSim-era push: 300 N forward on the pelvis, held about 0.5 s of sim time, then zero.
 PUSH = '{force: {x: 300.0}}'
@@ -109,6 +121,8 @@ def test_cheats_live_refusals_effects_reset_models_and_exact_replay(tmp_path: Pa
         for topic, msg_type, yaml_text in GOOD_INPUTS[2:]:
             publish(launch, topic, msg_type, yaml_text)
             launch.wait_sim_s(0.3)
+        for line in DRCSIM_ERA_LINES:
+            launch.wait(lambda line=line: line in launch.output(), 30.0, f'no line {line!r}')
 
         launch.run('rosservice', 'call', topics.RESET_MODELS_SERVICE)
         launch.wait(lambda: 'reset_world: robot back to its initial pose' in launch.output(),
@@ -121,6 +135,8 @@ def test_cheats_live_refusals_effects_reset_models_and_exact_replay(tmp_path: Pa
         assert pelvis_position(launch)[2] < 0.5, 'the 300 N push toppled the robot'
         launch.interrupt(EXIT_TIMEOUT_S)
         bag = launch.bag()
+        for line in DRCSIM_ERA_LINES:
+            assert launch.output().count(line) == 1, f'not once: {line!r}'
 
     applied = len(GOOD_INPUTS) + 2  # and the push and its release, after the reset
     assert count(bag, topics.SIM_INPUTS) == applied

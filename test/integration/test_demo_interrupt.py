@@ -22,7 +22,7 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[2]
 RUN_DEMO = REPO / 'scripts' / 'run_demo.py'
-#: Exit status on Ctrl-C (README, Script conventions).
+#: Exit status on Ctrl-C (docs/troubleshooting.md, Script conventions).
 EXIT_INTERRUPTED = 130
 #: Wall-clock bounds (s): until traj_yaml.py starts (atlas.launch up, torso unpinned), and
 #: from the signal to the demo's exit (it stops roslaunch, which waits for its nodes).
@@ -83,4 +83,6 @@ def test_ctrl_c_while_playing_stops_everything_and_exits_130(tmp_path: Path) -> 
     with pytest.raises(OSError), socket.create_connection(('127.0.0.1', int(port[1])), 1.0):
         pass  # the demo's master is gone with its launch
     assert not list(tmp_path.glob('atlas_*.bag.active')), 'the recorder did not close its bag'
-    assert len(list(tmp_path.glob('atlas_*.bag'))) == 1
+    bag, = tmp_path.glob('atlas_*.bag')
+    assert stderr.splitlines()[-1] == (f'run_demo.py: interrupted; the run so far is in {bag} '
+                                       f'(analyze_bag.py {bag})'), stderr

@@ -1,7 +1,8 @@
 """Slips with atlas.launch, each ending in one line and a closed, readable bag.
 
-A second atlas.launch on the same master: the first simulator says another one took over
-and stops, its launch ends and its bag is closed and readable; the second runs on. A
+A second atlas.launch on the master the first one started: the second's simulator refuses
+in one line before registering, the second launch ends without a bag, and the first one
+(master, simulator, recorder) goes on and records its whole run. A
 $DISPLAY no X server answers (gui's default is true whenever $DISPLAY is set): one line,
 and the simulator runs headless, recording. Real launches, about a minute each.
 """
@@ -9,7 +10,6 @@ and the simulator runs headless, recording. Real launches, about a minute each.
 from __future__ import annotations
 
 import os
-import subprocess
 from pathlib import Path
 
 import pytest
@@ -17,38 +17,52 @@ import pytest
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
 from support.bag_checks import missing_steps
-from support.launch import EXIT_TIMEOUT_S, STARTUP_TIMEOUT_S, TestLaunch, wait_sim_time
+from support.launch import (
+    EXIT_TIMEOUT_S,
+    RECORDER,
+    SIM,
+    STARTUP_TIMEOUT_S,
+    TestLaunch,
+    wait_sim_time,
+)
 from tutorial_atlas_control import processes
 from tutorial_atlas_control.bags.reader import read_bag
 
 
-def test_a_second_launch_replaces_the_first_which_exits_with_one_line(tmp_path: Path) -> None:
+def test_a_second_launch_is_refused_in_one_line_and_the_first_goes_on(
+        tmp_path: Path) -> None:
+    """As in the tutorial's two terminals: the first `roslaunch` starts the master, the
+    second finds it running."""
     with TestLaunch(tmp_path / 'first') as first:
         first.wait_ready()
         first.wait_sim_s(2.0)
-        second_bags = tmp_path / 'second' / 'bags'
-        second = processes.AtlasLaunch(
-            tmp_path / 'second.log', {'gui': 'false', 'bag_dir': str(second_bags)},
-            master=first, ros_log_dir=tmp_path / 'second' / 'ros_log')
-        with second:
-            status = first.wait_exit(EXIT_TIMEOUT_S + STARTUP_TIMEOUT_S)
-            output = first.output()
-            master_uri = first.env['ROS_MASTER_URI'].rstrip('/')
-            line = ('atlas_sim: another atlas_sim took over: a second simulator registered as '
-                    f'/atlas_sim on {master_uri}, so this one stops (its launch and recording '
-                    'end); run one atlas.launch per master, or give the second its own '
-                    '(roslaunch -p PORT)')
-            assert status == 0, output
-            assert output.count(line) == 1, output
-            assert 'Traceback' not in output, output
-            bag = first.bag()  # closed: no .active left
-            info = subprocess.run(['rosbag', 'info', '--yaml', '--key=indexed', str(bag)],
-                                  capture_output=True, text=True, check=True)
-            assert info.stdout.strip() == 'True'
-            states = read_bag(bag).joint_states
-            assert states is not None and len(states.t_s) > 1000, 'the bag holds the run'
-            assert missing_steps(states) == 0
-            second.check_running()  # the second launch goes on
+        sim_pid, recorder_pid = first.pid_of('atlas_sim_node'), first.pid_of('atlas_recorder')
+        with TestLaunch(tmp_path / 'second', master=first) as second:
+            second.wait_exit(EXIT_TIMEOUT_S + STARTUP_TIMEOUT_S)
+            refused = second.output()
+        master_uri = first.uri.rstrip('/')
+        port = first.port + 1
+        line = (f'atlas_sim: not started: /atlas_sim already runs on the ROS master '
+                f'{master_uri} (an atlas.launch is running there); that one goes on, this '
+                'launch stops. Stop the first (Ctrl-C in its terminal) before launching '
+                f'again, or give this one its own master: roslaunch -p {port} '
+                f'tutorial_atlas_control atlas.launch (and ROS_MASTER_URI=http://localhost:'
+                f'{port} in the terminals that use it)')
+        assert refused.count(line) == 1, refused
+        assert 'Traceback' not in refused and 'took over' not in refused, refused
+        assert not list((tmp_path / 'second' / 'bags').glob('*.bag*')), 'the second recorded'
+        first.wait_sim_s(2.0)  # the first's master, simulator and recorder go on
+        assert first.pid_of('atlas_sim_node') == sim_pid
+        assert first.pid_of('atlas_recorder') == recorder_pid
+        assert {SIM, RECORDER} <= set(first.subscribers('/atlas/joint_commands'))
+        first.interrupt(EXIT_TIMEOUT_S)
+        status = first.process.wait(timeout=EXIT_TIMEOUT_S)
+        output = first.output()
+    assert status == 0, output
+    assert 'took over' not in output and 'has died' not in output, output
+    states = read_bag(first.bag()).joint_states
+    assert states is not None and len(states.t_s) > 3000, 'the bag holds the whole run'
+    assert missing_steps(states) == 0
 
 
 def test_a_display_without_x_server_runs_headless_with_one_line(tmp_path: Path) -> None:
@@ -105,4 +119,17 @@ def test_forgotten_user_mode_a_reset_and_a_fall_each_say_so(tmp_path: Path) -> N
     assert len(resets) == 1, output
     falls = [line for line in output.splitlines() if 'the robot fell' in line]
     assert len(falls) == 1, output
-    assert falls[0].split(']: ', 1)[1].startswith('the robot fell: pelvis below 0.5 m at t='), falls
+    assert falls[0].split(']: ', 1)[1].startswith(
+        'the robot fell: pelvis below 0.5 m at sim time '), falls
+
+
+def test_a_mistyped_launch_argument_gets_one_warning(tmp_path: Path) -> None:
+    """roslaunch ignores recrod:=false; the simulator reads roslaunch's command line."""
+    with TestLaunch(tmp_path, 'recrod:=false') as launch:
+        launch.wait_ready()  # record's default, true, is what runs
+        launch.interrupt(EXIT_TIMEOUT_S)
+        output = launch.output()
+    warnings = [line for line in output.splitlines() if 'roslaunch ignored' in line]
+    assert len(warnings) == 1, output
+    assert ('roslaunch ignored the argument recrod:=false: atlas.launch has no argument '
+            'recrod; did you mean record:=false? (its arguments: ') in warnings[0]

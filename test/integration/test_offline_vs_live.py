@@ -3,7 +3,7 @@
 The live runs are run_demo.py's (step_and_fall: the shared demo_run fixture; touchdown and
 touchdown_exhausted, the README's slow sway that ends on the ground: their own); each is
 compared with the offline run of the same trajectory, aligned on the first applied command
-(bag_compare). Transport and scheduling move a live run a little (the trajectory starts from
+(bags/compare.py). Transport and scheduling move a live run a little (the trajectory starts from
 a pose the robot held longer, commands arrive 1-2 ms late), so only the outcome must agree:
 the robot falls in both or in neither, within FALL_TOLERANCE_S.
 """

@@ -6,7 +6,8 @@ support.xdisplay.find_reset_button); viewer_probe.py, a ROS node in its own proc
 ragdolls the robot until it lies down and reports what the gesture did. A reset must be the
 node's reset_world: the pelvis back at the spawn height and held there (pinned) for the
 watch window, /clock never going backwards, /atlas/sim_config carrying the new reset time
-(in sim time, not 0).
+(in sim time, not 0). The window opens with MuJoCo's panels hidden; the button test shows
+the left one with Tab first, as a user would.
 
 Needs Xvfb, xdotool and ImageMagick (tools/setup.sh installs them) and `source ./env.sh`.
 Wall time about 90 s for the module (one simulator for all gestures).
@@ -113,6 +114,8 @@ def test_shift_ctrl_r_is_reset_world(viewer: Viewer) -> None:
 
 
 def test_reset_button_is_reset_world(viewer: Viewer) -> None:
+    subprocess.run(['xdotool', 'key', '--window', viewer.window, 'Tab'], env=viewer.env,
+                   check=True)  # the left panel, hidden when the window opens
     deadline = time.monotonic() + UI_DRAWN_TIMEOUT_S
     while True:
         pixels = xdisplay.screenshot(viewer.display, viewer.window)

@@ -7,7 +7,8 @@ brightness, not their proportions r : g : b (support.xdisplay.material_mask). Th
 and dark parts cannot be told from the grey floor, so the feet are judged from the blue
 shins above them: the shins' lowest pixel must leave room for the feet (their height on
 screen, from the model's ankle height and the robot's height on screen) above the window's
-edge.
+edge. MuJoCo's panels are hidden when the window opens (Tab shows them): no section title
+bar of its left panel is drawn.
 """
 
 from __future__ import annotations
@@ -24,7 +25,14 @@ import pytest
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
 from support.launch import wait_sim_time
-from support.xdisplay import display_env, find_window, material_mask, screenshot, xvfb
+from support.xdisplay import (
+    display_env,
+    find_reset_button,
+    find_window,
+    material_mask,
+    screenshot,
+    xvfb,
+)
 from tutorial_atlas_control.processes import (
     free_local_port,
     ros_environment,
@@ -122,6 +130,8 @@ def test_viewer_window_shows_the_whole_robot(tmp_path: Path) -> None:
     assert seen.leg_pixels >= MIN_LEG_PIXELS, 'the legs are not on screen'
     assert seen.feet_on_screen, 'the feet are below the window'
     assert seen.span_fraction >= MIN_SPAN_FRACTION
+    with pytest.raises(LookupError, match='found 0 UI section title bars'):
+        find_reset_button(image)  # the panels are a key away, not on screen
     output = (tmp_path / 'launch.log').read_text(errors='replace')
     assert 'cannot open the MuJoCo viewer' not in output
 

@@ -70,7 +70,7 @@ def test_master_killed_and_restarted(tmp_path: Path) -> None:
             assert '/atlas_sim' in publishers['/atlas/joint_states']
             assert '/atlas_sim' in subscribers['/atlas/joint_commands']
             assert '/recorder' not in subscribers.get('/atlas/joint_states', []), \
-                'roscpp nodes do not register again (README)'
+                'roscpp nodes do not register again (docs/troubleshooting.md)'
             master = xmlrpc.client.ServerProxy(uri)
             code, _, _ = master.lookupService('/test', '/gazebo/reset_simulation')
             assert code == 1, 'the services are found again'

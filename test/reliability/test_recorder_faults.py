@@ -160,6 +160,18 @@ def test_bag_dir_that_cannot_be_written_is_refused_before_the_simulator_starts(
     assert 'REQUIRED process [atlas_sim' in output
 
 
+def test_a_launch_refused_before_the_simulator_is_ready_leaves_no_bag(tmp_path: Path) -> None:
+    """The recorder started beside a simulator that refused its set-up: no empty bag left
+    to become the bag tools' "newest bag", and one line saying so."""
+    with TestLaunch(tmp_path, 'real_time_factor:=fast') as launch:
+        launch.wait_exit(STARTUP_TIMEOUT_S)
+        output = launch.output()
+    assert "parameter /atlas_sim/real_time_factor must be a number >= 0.0, got 'fast'" in output
+    assert (f'atlas_recorder: no message to write (the simulator never published a sim time); '
+            f'no bag left in {launch.bag_dir}') in output, output
+    assert list(launch.bag_dir.iterdir()) == []
+
+
 @pytest.mark.optional('needs root and a tmpfs mount (a container may forbid it)')
 def test_a_full_tmpfs_bag_dir_stops_the_recorder(tmp_path: Path) -> None:
     """A real full disk: a 4 MiB tmpfs as bag_dir (~3 s of a run). `rosbag reindex` cannot

@@ -94,7 +94,7 @@ SERVICES = {
 #: they merge; the test prints the entries that are served and could leave it.
 NOT_YET_SERVED: frozenset[str] = frozenset()
 
-#: The port's own topics, beside DRCSim's (README): the per-step ankle wrenches, the
+#: The port's own topics, beside DRCSim's (docs/ros_interface.md): the per-step ankle wrenches, the
 #: latched configuration and the applied cheats that offline replay reads, the mode now.
 PORT_OWN_TOPICS = {
     '/atlas/l_foot_contact': 'geometry_msgs/WrenchStamped',

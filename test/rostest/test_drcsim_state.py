@@ -34,7 +34,8 @@ STANDING_S = 0.5
 GRAVITY_MPS2 = 9.81
 #: Atlas v1 (90.6 kg) weighs this much (N): the feet's contacts carry it all.
 WEIGHT_N = 889.0
-#: What the legs carry above the ankles (N): the weight less the two feet's (README: 857 N).
+#: What the legs carry above the ankles (N): the weight less the two feet's
+#: (docs/ros_interface.md: 857 N).
 ABOVE_ANKLES_N = 857.0
 WALL_TIMEOUT_S = 120.0
 

@@ -1,4 +1,5 @@
 """Helpers shared by the test directories: imported as `support` (pytest.ini puts test/ on
-the path). What the benchmark needs too lives in the package (processes, synthetic_bags)
-or in tools/ (flood_commands.py), except fake_rospy, the node on a fake rospy, which
-bench/node_loop.py times and the unit tests drive."""
+the path; bench/ adds it to its own). The benchmark uses two of them: fake_rospy, the node
+on a fake rospy, which bench/node_loop.py times and the unit tests drive, and
+synthetic_bags, the run bag bench/offline.py reads. Beside them: statics, the gravity
+stiffness of a stance joint (test_statics.py)."""

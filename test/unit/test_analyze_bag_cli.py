@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.bags.synthetic import (
+from support.synthetic_bags import (
     clock,
     control_mode,
     joint_commands,
@@ -49,7 +49,7 @@ def test_summary(run_bag: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert 'Duration: 2.999 s' in out
     assert '/atlas/joint_states' in out and 'sensor_msgs/JointState' in out and '1000.00 Hz' in out
     assert '0.000 s  Stand' in out and '1.000 s  User' in out
-    assert 'FELL at 2.090 s' in out
+    assert 'FELL at sim time 2.090 s, ' in out and '2.090 s from bag start' in out
     assert 'l_arm_shx' in out and 'r_arm_shx' in out
     assert 'Commands: 150 on /atlas/joint_commands at 50.0 Hz' in out
     assert 'no joint reached its effort limit' in out

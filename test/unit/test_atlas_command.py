@@ -12,6 +12,7 @@ from test_controller import DT_S, LIMIT, LOWER, UPPER, one_joint
 from test_stepping import command_bytes, complete_command, make_loop
 
 from tutorial_atlas_control import topics
+from tutorial_atlas_control.command.arrays import CommandError
 from tutorial_atlas_control.joints import JOINT_INDEX, NUM_JOINTS
 from tutorial_atlas_control.msgs.atlas_command import (
     decode_atlas_command,
@@ -19,7 +20,6 @@ from tutorial_atlas_control.msgs.atlas_command import (
     encode_atlas_command,
     encode_test,
 )
-from tutorial_atlas_control.msgs.commands import CommandError
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import (
     PidState,
@@ -185,9 +185,8 @@ def test_compiled_law_equals_numpy_with_k_effort_and_f_out(library) -> None:
         joints = Joints(rng)
         numpy_state, c_state = PidState(), PidState()
         torque, f_out = np.zeros(N), np.zeros(N)
-        law = law_kernel.CompiledLaw(library, joints.qpos, joints.qpos_adr, joints.qvel,
-                                     joints.dof_adr, lower, upper, limit, DT_S, c_state, torque,
-                                     None, f_out)
+        law = law_kernel.CompiledLaw(library, joints.law_joints(lower, upper, limit), c_state,
+                                     torque, None, f_out)
         for _step in range(30):
             command = random_command(rng)
             command.k_effort[:] = rng.choice([0.0, 1.0, 128 / 255.0, 3 / 255.0], N)
@@ -363,7 +362,7 @@ def user_with_integral(sim: AtlasSimulator) -> None:
     sim.receive_updates([atlas_update(position=full(0.3), ki_position=full(50.0),
                                       i_effort_min=full(-10.0), i_effort_max=full(10.0))])
     run(sim, 100)
-    assert sim._pid.integral.all()
+    assert sim.law.pid.integral.all()
 
 
 def test_reset_pid_controller_zeroes_the_law_memory(sim: AtlasSimulator) -> None:
@@ -372,7 +371,7 @@ def test_reset_pid_controller_zeroes_the_law_memory(sim: AtlasSimulator) -> None
     assert reset(loop, pid=True) == (True, 'PID state reset (integral terms and previous '
                                            'errors); atlas_command has no array of 28: no '
                                            'field loaded')
-    assert not sim._pid.integral.any() and not sim._pid.initialized
+    assert not sim.law.pid.integral.any() and not sim.law.pid.initialized
 
 
 def test_reload_pid_from_ros_sets_the_gains_and_k_effort(sim: AtlasSimulator) -> None:
@@ -391,7 +390,7 @@ def test_reload_pid_from_ros_sets_the_gains_and_k_effort(sim: AtlasSimulator) ->
     np.testing.assert_array_equal(command.i_effort_max, gains.i_clamp)
     np.testing.assert_array_equal(command.position, full(0.3))  # targets kept
     assert (command.k_effort == 1.0).all()
-    assert sim._pid.integral.any()  # reset_pid_controller was not asked
+    assert sim.law.pid.integral.any()  # reset_pid_controller was not asked
 
 
 def test_reset_controls_loads_an_atlas_command(sim: AtlasSimulator) -> None:
@@ -411,7 +410,7 @@ def test_a_refused_reset_controls_changes_nothing(sim: AtlasSimulator) -> None:
     loop, _, _, _ = make_loop(sim)
     user_with_integral(sim)
     before = sim.user_command
-    integral = sim._pid.integral.copy()
+    integral = sim.law.pid.integral.copy()
     ok, status = reset(loop, pid=True, command=atlas_bytes(effort=full(1e9)))
     assert (ok, status) == (False, 'atlas_command refused: effort[0] is 1e+09, beyond the sane '
                                    'bound of 100000 in magnitude; nothing was done')
@@ -424,7 +423,7 @@ def test_a_refused_reset_controls_changes_nothing(sim: AtlasSimulator) -> None:
     assert status.startswith('reload_pid_from_ros: parameter atlas_controller/gains/back_lbz/p '
                              'is missing')
     assert sim.user_command is before
-    np.testing.assert_array_equal(sim._pid.integral, integral)
+    np.testing.assert_array_equal(sim.law.pid.integral, integral)
     run(sim, 10)  # and the simulator goes on
     assert np.isfinite(sim.torque_nm).all()
 

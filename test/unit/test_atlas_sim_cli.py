@@ -10,6 +10,12 @@ from tutorial_atlas_control.cli import atlas_sim
 from tutorial_atlas_control.errors import AtlasControlError
 
 
+@pytest.fixture(autouse=True)
+def no_other_simulator(monkeypatch: pytest.MonkeyPatch) -> None:
+    """No master to ask: the single-instance check passes (test_single_instance.py's)."""
+    monkeypatch.setattr(atlas_sim.single_instance, 'refuse_if_running', lambda *_: False)
+
+
 def test_help_prints_the_parameters_and_starts_no_node(
         capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(atlas_sim.rospy, 'init_node', lambda *_: pytest.fail('node started'))

@@ -8,9 +8,7 @@ import numpy as np
 import pytest
 from rosbags.rosbag1 import Writer
 
-from tutorial_atlas_control.bags.analysis import EFFORT_LIMITS_NM, analyze, analyze_bag
-from tutorial_atlas_control.bags.reader import read_bag
-from tutorial_atlas_control.bags.synthetic import (
+from support.synthetic_bags import (
     clock,
     control_mode,
     joint_commands,
@@ -20,6 +18,9 @@ from tutorial_atlas_control.bags.synthetic import (
     write_bag,
     write_run_bag,
 )
+from tutorial_atlas_control.bags.analysis import EFFORT_LIMITS_NM, analyze, analyze_bag
+from tutorial_atlas_control.bags.reader import read_bag
+from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 
 ELX = JOINT_NAMES.index('l_arm_elx')
@@ -50,8 +51,8 @@ def test_mode_timeline_collapses_repeats_and_uses_bag_time(tmp_path: Path) -> No
 
 
 def test_applied_vrc_inputs_join_the_mode_timeline(tmp_path: Path) -> None:
+    from support.synthetic_bags import TYPESTORE, Record
     from tutorial_atlas_control.bags.report import format_summary
-    from tutorial_atlas_control.bags.synthetic import TYPESTORE, Record
     from tutorial_atlas_control.sim import vrc
 
     def applied(t_s: float, item: vrc.SimInput, seq: int) -> Record:
@@ -190,12 +191,14 @@ def test_bag_without_joint_states_still_summarizes(tmp_path: Path) -> None:
     assert '/atlas/joint_states' in analysis.unavailable['joints']
 
 
-def test_empty_bag(tmp_path: Path) -> None:
+def test_an_empty_bag_is_refused(tmp_path: Path) -> None:
     path = tmp_path / 'empty.bag'
     with Writer(path):
         pass
-    analysis = analyze_bag(path)
-    assert (analysis.data.topics, analysis.data.duration_s, analysis.fell) == ({}, 0.0, None)
+    with pytest.raises(BagAnalysisError, match=(
+            r'^.*empty\.bag holds no message \(a launch that stopped before its simulator was '
+            r'ready records nothing\); give a bag of a run\.$')):
+        analyze_bag(path)
 
 
 def test_analysis_is_deterministic(tmp_path: Path) -> None:

@@ -11,9 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.bags.analysis import analyze_bag
-from tutorial_atlas_control.bags.compare import compare, compare_bags, first_applied_command_s
-from tutorial_atlas_control.bags.synthetic import (
+from support.synthetic_bags import (
     clock,
     control_mode,
     joint_commands,
@@ -22,6 +20,8 @@ from tutorial_atlas_control.bags.synthetic import (
     rosout,
     write_bag,
 )
+from tutorial_atlas_control.bags.analysis import analyze_bag
+from tutorial_atlas_control.bags.compare import compare, compare_bags, first_applied_command_s
 from tutorial_atlas_control.cli.analyze_bag import main
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS

@@ -18,11 +18,7 @@ from hypothesis import strategies as st
 from rosbags.rosbag1 import Reader, Writer, WriterError
 from rosbags.typesys import get_types_from_msg
 
-from tutorial_atlas_control.bags import reader as bag_reader
-from tutorial_atlas_control.bags.reader import BagData, read_bag
-from tutorial_atlas_control.bags.records import IndexedBag, PublicBag, open_bag
-from tutorial_atlas_control.bags.rosbag1_fast import BlockBagWriter, TopicConnection
-from tutorial_atlas_control.bags.synthetic import (
+from support.synthetic_bags import (
     STANDING_HEIGHT_M,
     TYPESTORE,
     Record,
@@ -36,6 +32,10 @@ from tutorial_atlas_control.bags.synthetic import (
     unindexed_copy,
     write_bag,
 )
+from tutorial_atlas_control.bags import reader as bag_reader
+from tutorial_atlas_control.bags.reader import BagData, read_bag
+from tutorial_atlas_control.bags.records import IndexedBag, PublicBag, open_bag
+from tutorial_atlas_control.bags.rosbag1_fast import BlockBagWriter, TopicConnection
 from tutorial_atlas_control.bags.typestore import load_typestore
 from tutorial_atlas_control.errors import AtlasControlError, BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS

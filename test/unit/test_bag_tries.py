@@ -10,11 +10,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from rosbags.rosbag1 import Writer
 
-from tutorial_atlas_control.bags.analysis import analyze, analyze_bag
-from tutorial_atlas_control.bags.reader import read_bag
-from tutorial_atlas_control.bags.report import format_summary
-from tutorial_atlas_control.bags.synthetic import (
+from support.synthetic_bags import (
     TrySpec,
     clock,
     joint_state,
@@ -22,6 +20,9 @@ from tutorial_atlas_control.bags.synthetic import (
     write_bag,
     write_run_bag,
 )
+from tutorial_atlas_control.bags.analysis import analyze, analyze_bag
+from tutorial_atlas_control.bags.reader import read_bag
+from tutorial_atlas_control.bags.report import format_summary
 from tutorial_atlas_control.bags.tries import (
     RESET_SIMULATION,
     RESET_WORLD,
@@ -95,7 +96,7 @@ def test_text_summary_lists_the_tries_and_resets(session_bag: Path) -> None:
     assert 'Tries (3; a try starts' in text
     assert "try 2: 6.000 to 12.9" in text and "trajectory 'touchdown'" in text
     assert '6.000 s  reset_world: try 2 begins' in text
-    assert 'FELL at 3.429 s, 2.430 s after its first command' in text
+    assert "FELL at sim time 3.430 s, 2.430 s after the try's first command" in text
 
 
 def test_single_run_is_one_try_without_warning(tmp_path: Path) -> None:
@@ -260,3 +261,44 @@ def test_truncated_bag_is_one_line_naming_reindex(tmp_path: Path, cli: object,
     assert capsys.readouterr().err == (
         f'{cli.PROG}: error: {truncated} is truncated or its index is damaged (was '  # type: ignore[attr-defined]
         f'the recording cut short?); run `rosbag reindex {truncated}` and analyze it again.\n')
+
+
+def _empty_bag(path: Path) -> Path:
+    with Writer(path):
+        pass
+    return path
+
+
+def test_the_newest_bag_skips_empty_and_unreadable_ones_and_says_so(
+        bag_dir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    good = write_run_bag(bag_dir / 'atlas_2026-01-01-00-00-01.bag', 0.5, with_imu=False)
+    empty = _empty_bag(bag_dir / 'atlas_2026-01-01-00-00-02.bag')
+    broken = bag_dir / 'atlas_2026-01-01-00-00-03.bag'
+    broken.write_bytes(b'#ROSBAG V2.0\n' + bytes(64))
+    for age_s, path in enumerate([broken, empty, good]):
+        os.utime(path, (2_000_000 - age_s, 2_000_000 - age_s))
+    assert analyze_cli.main(['--latest', '--json']) == 0
+    captured = capsys.readouterr()
+    assert json.loads(captured.out)['bag'] == str(good)
+    err = captured.err
+    assert err.startswith(f'analyzing {good} (the newest bag; skipped {broken.name} '
+                          '(unreadable: ')
+    assert err.endswith(f'), {empty.name} (empty))\n'), err
+
+
+def test_only_empty_bags_in_the_bag_dir_is_one_line(
+        bag_dir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    _empty_bag(bag_dir / 'atlas_1.bag')
+    assert analyze_cli.main([]) == 1
+    assert capsys.readouterr().err == (
+        f'analyze_bag.py: error: no bag given and no usable .bag in {bag_dir} (atlas_1.bag: '
+        'empty); give BAG, or set TAC_BAG_DIR.\n')
+
+
+def test_an_empty_bag_given_by_name_exits_1_with_one_line(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    bag = _empty_bag(tmp_path / 'atlas_1.bag')
+    assert analyze_cli.main([str(bag)]) == 1
+    assert capsys.readouterr().err == (
+        f'analyze_bag.py: error: {bag} holds no message (a launch that stopped before its '
+        'simulator was ready records nothing); give a bag of a run.\n')

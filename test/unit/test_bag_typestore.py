@@ -15,7 +15,7 @@ import pytest
 from rosbags.rosbag1 import Reader
 from rosbags.typesys import get_types_from_msg
 
-from tutorial_atlas_control.bags import synthetic
+from support import synthetic_bags as synthetic
 from tutorial_atlas_control.bags.rosbag1_fast import BlockBagWriter, TopicConnection
 from tutorial_atlas_control.bags.typestore import (
     ATLAS_MSGS,

@@ -1,4 +1,5 @@
-"""Ctrl-C ends every script with exit status 130 and no traceback (README, Script conventions).
+"""Ctrl-C ends every script with exit status 130 and no traceback (docs/troubleshooting.md,
+Script conventions).
 
 Each script's main is called with the work it hands to the library replaced by a function
 that raises KeyboardInterrupt, as Ctrl-C does in the middle of it; one script is also
@@ -27,8 +28,8 @@ from tutorial_atlas_control.cli import (
     traj_yaml,
 )
 from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED
-from tutorial_atlas_control.node import demo
-from tutorial_atlas_control.node import plot_topics as plot_node
+from tutorial_atlas_control.demo import demo_node as demo
+from tutorial_atlas_control.plotting import plot_topics_node as plot_node
 
 REPO = Path(__file__).resolve().parents[2]
 TRAJECTORY_FILE = REPO / 'trajectories' / 'Traj_data2.yaml'
@@ -110,3 +111,17 @@ def test_sigint_stops_run_offline_with_130_and_leaves_no_bag(tmp_path: Path) -> 
     assert 'Traceback' not in err and err == '', err
     assert out == ''
     assert list(tmp_path.iterdir()) == [], 'a partial or complete bag was left behind'
+
+
+def test_ctrl_c_during_the_demo_names_the_bag_recorded_so_far(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    def record_then_interrupt(*_args: object, **_kwargs: object) -> None:
+        (tmp_path / 'atlas_2026-01-01-00-00-00.bag').write_bytes(b'')  # closed by the launch
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(demo, 'run_demo', record_then_interrupt)
+    assert run_demo.main(['touchdown', '--bag-dir', str(tmp_path)]) == EXIT_INTERRUPTED
+    bag = tmp_path / 'atlas_2026-01-01-00-00-00.bag'
+    assert capsys.readouterr().err == (f'run_demo.py: interrupted; the run so far is in {bag} '
+                                       f'(analyze_bag.py {bag})\n')

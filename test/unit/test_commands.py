@@ -1,4 +1,4 @@
-"""JointCommands mapping and refusal rules (commands.merge_command)."""
+"""JointCommands mapping and refusal rules (command/arrays.py's merge_command)."""
 
 from __future__ import annotations
 
@@ -8,16 +8,16 @@ import math
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.msgs.commands import (
+from tutorial_atlas_control.command.arrays import (
     FIELD_NAMES,
     MAX_MAGNITUDE,
-    CommandDecoder,
     CommandError,
     JointCommandArrays,
     joint_indices,
     merge_command,
 )
+from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.msgs.joint_commands import CommandDecoder
 
 
 def previous_command() -> JointCommandArrays:

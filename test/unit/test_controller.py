@@ -11,9 +11,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
+from tutorial_atlas_control.command.arrays import FIELD_NAMES, JointCommandArrays
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.msgs.commands import FIELD_NAMES, JointCommandArrays
 from tutorial_atlas_control.sim.controller import (
     Gains,
     GainsError,

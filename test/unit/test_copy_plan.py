@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from tutorial_atlas_control import native
-from tutorial_atlas_control.msgs.copy_plan import CopyPlan
+from tutorial_atlas_control.sim.copy_plan import CopyPlan
 
 
 def test_copy_plan_equals_numpy_copies_into_unaligned_bytes(library) -> None:

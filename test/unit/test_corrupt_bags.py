@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from tutorial_atlas_control.bags import synthetic
+from support import synthetic_bags as synthetic
 from tutorial_atlas_control.bags.reader import JOINT_STATE_MD5
 from tutorial_atlas_control.cli import analyze_bag, replay_bag
 

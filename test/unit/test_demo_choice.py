@@ -13,8 +13,8 @@ from tutorial_atlas_control.bags.feet import foot_displacement, foot_line
 from tutorial_atlas_control.bags.reader import BagData, JointStateSeries, PelvisSeries
 from tutorial_atlas_control.cli import run_demo
 from tutorial_atlas_control.cli.convention import EXIT_REFUSED
+from tutorial_atlas_control.demo import demo_node as demo
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.node import demo
 from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, GainsError, load_gains_yaml
 from tutorial_atlas_control.sim.model import load_model
 from tutorial_atlas_control.trajectories.catalog import (
@@ -23,7 +23,7 @@ from tutorial_atlas_control.trajectories.catalog import (
     gains_for,
     trajectory_files,
 )
-from tutorial_atlas_control.trajectories.trajectory import TrajectoryError
+from tutorial_atlas_control.trajectories.trajectory import TrajectoryError, load_trajectory_file
 
 REPO = Path(__file__).resolve().parents[2]
 TUTORIAL = REPO / 'trajectories' / 'Traj_data2.yaml'
@@ -70,8 +70,8 @@ def test_a_name_in_no_file_is_refused_listing_the_files(tmp_path: Path) -> None:
     with pytest.raises(TrajectoryError) as caught:
         find_trajectory('jump', folder)
     assert str(caught.value) == (
-        "no trajectory named jump in the package's trajectory files (searched "
-        f'{folder}/Traj_data2.yaml, {folder}/Other.yaml); give its file with --file')
+        "no trajectory named jump in the package's trajectory files (valid names: "
+        'Traj_data2.yaml: t; Other.yaml: o); give its file with --file')
 
 
 def test_the_package_names_are_where_the_readme_says() -> None:
@@ -166,8 +166,10 @@ def test_main_runs_the_name_with_its_gains(launched: Launched, argv: list[str], 
      'Could not read gains from {tmp}/missing.yaml: No such file or directory'),
     (['--gains-file', '{tmp}/bad.yaml'],
      "{tmp}/bad.yaml: atlas_controller/gains/back_lbz/p is 'x', not a finite number"),
-    (['jump'], "no trajectory named jump in the package's trajectory files (searched "
-               f'{TUTORIAL}, {QUICK_STEP}, {STEPPING}); give its file with --file'),
+    (['jump'], "no trajectory named jump in the package's trajectory files (valid names: "
+               'Traj_data2.yaml: step_and_fall, touchdown, touchdown_exhausted; '
+               f'{QUICK_STEP.name}: {", ".join(load_trajectory_file(QUICK_STEP))}; Stepping.yaml: '
+               f'{", ".join(load_trajectory_file(STEPPING))}); give its file with --file'),
     (['step_and_stand', '--file', str(TUTORIAL)],
      f'unable to find trajectory step_and_stand in {TUTORIAL}; it holds: step_and_fall, '
      'touchdown, touchdown_exhausted'),

@@ -10,12 +10,14 @@ import pytest
 from test_controller import random_command
 
 from tutorial_atlas_control import native
+from tutorial_atlas_control.command.arrays import FIELD_NAMES, JointCommandArrays
 from tutorial_atlas_control.joints import NUM_JOINTS
-from tutorial_atlas_control.msgs.commands import FIELD_NAMES, JointCommandArrays
+from tutorial_atlas_control.msgs.atlas_command import decode_atlas_command, encode_atlas_command
 from tutorial_atlas_control.sim import law_kernel
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import PidState, compute_torque, load_gains_yaml
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode
+from tutorial_atlas_control.sim.vrc import ModeInput, SimInput, VrcMode, WrenchInput
 
 CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
 DT_S = 0.001
@@ -38,6 +40,11 @@ class Joints:
         self.qpos[self.qpos_adr] = q
         self.qvel[self.dof_adr] = v
 
+    def law_joints(self, lower: np.ndarray, upper: np.ndarray,
+                   limit: np.ndarray) -> law_kernel.LawJoints:
+        return law_kernel.LawJoints(self.qpos, self.qpos_adr, self.qvel, self.dof_adr, lower,
+                                    upper, limit, DT_S)
+
 
 def test_compiled_law_equals_the_numpy_law_on_random_inputs(library) -> None:
     """300 runs of 60 steps: saturation, tie-back, ki changes and sign flips, inverted
@@ -53,9 +60,8 @@ def test_compiled_law_equals_the_numpy_law_on_random_inputs(library) -> None:
         joints = Joints(rng)
         numpy_state, c_state = PidState(), PidState()
         torque, ctrl = np.zeros(NUM_JOINTS), np.full(NUM_JOINTS, np.nan)
-        law = law_kernel.CompiledLaw(library, joints.qpos, joints.qpos_adr, joints.qvel,
-                                     joints.dof_adr, lower, upper, limit, DT_S, c_state, torque,
-                                     ctrl)
+        law = law_kernel.CompiledLaw(library, joints.law_joints(lower, upper, limit), c_state,
+                                     torque, ctrl)
         command = random_command(rng)
         q = rng.uniform(-2.0, 2.0, NUM_JOINTS)
         v = rng.uniform(-5.0, 5.0, NUM_JOINTS)
@@ -94,11 +100,13 @@ def test_compiled_law_refuses_misshapen_arrays(library) -> None:
     good = np.zeros(NUM_JOINTS)
     adr = np.arange(NUM_JOINTS, dtype=np.intp)
     with pytest.raises(ValueError, match=r'qpos_adr has shape \(3,\), expected \(28,\)'):
-        law_kernel.CompiledLaw(library, good, adr[:3], good, adr, good, good, good, DT_S, state,
-                               np.zeros(NUM_JOINTS))
+        law_kernel.CompiledLaw(library, law_kernel.LawJoints(good, adr[:3], good, adr, good,
+                                                             good, good, DT_S),
+                               state, np.zeros(NUM_JOINTS))
     with pytest.raises(ValueError, match='C-contiguous int64 arrays, got int32'):
-        law_kernel.CompiledLaw(library, good, adr.astype(np.int32), good, adr, good, good, good,
-                               DT_S, state, np.zeros(NUM_JOINTS))
+        law_kernel.CompiledLaw(library, law_kernel.LawJoints(good, adr.astype(np.int32), good,
+                                                             adr, good, good, good, DT_S),
+                               state, np.zeros(NUM_JOINTS))
 
 
 def run_simulator(compiled_law: bool) -> tuple[AtlasSimulator, list[bytes]]:
@@ -123,7 +131,7 @@ def run_simulator(compiled_law: bool) -> tuple[AtlasSimulator, list[bytes]]:
             sim.set_mode(ControlMode.FREEZE)
         sim.step()
         states.append(sim.data.qpos.tobytes() + sim.torque_nm.tobytes()
-                      + sim._pid.integral.tobytes())
+                      + sim.law.pid.integral.tobytes())
     return sim, states
 
 
@@ -160,3 +168,59 @@ def test_ragdoll_command_gives_zero_torque(library) -> None:
     sim.step()
     assert not sim.torque_nm.any() and not sim.data.ctrl.any()
     assert JointCommandArrays.zeros().position.shape == (NUM_JOINTS,)
+
+
+K_EFFORT_128 = 128 / 255.0
+
+
+def stand_with_cheat(atlas: atlas_model.AtlasModel, compiled_law: bool,
+                     cheat: SimInput) -> AtlasSimulator:
+    """Standing in Stand mode, past the pin, with `cheat` acting for 50 steps."""
+    sim = AtlasSimulator(atlas, load_gains_yaml(CONFIG), time_to_unpin_s=0.0,
+                         compiled_law=compiled_law)
+    assert sim.uses_compiled_law is compiled_law
+    for _ in range(300):
+        sim.step()
+    sim.apply_input(cheat)
+    for _ in range(50):
+        sim.step()
+    return sim
+
+
+@pytest.mark.parametrize('cheat', [WrenchInput((40.0, 0.0, 0.0), (0.0, 0.0, 0.0)),
+                                   ModeInput(VrcMode.HARNESSED)], ids=['wrench', 'harnessed'])
+def test_both_laws_blend_an_atlas_command_while_a_cheat_acts(library, cheat: SimInput) -> None:
+    """Stand's hold blended with an AtlasCommand at k_effort 128 while a cheat acts: the
+    compiled and numpy laws give the same torques, and both are k u + (1 - k) f_out with u
+    the command's PID torque and f_out the hold's (a twin without the command)."""
+    atlas = atlas_model.load_model()
+    compiled, numpy_law, hold_only = (stand_with_cheat(atlas, flag, cheat)
+                                      for flag in (True, False, False))
+    assert compiled.vrc.active
+    q, v = compiled.joint_positions(), compiled.joint_velocities()
+    assert same_bits(q, hold_only.joint_positions()) and same_bits(q, numpy_law.joint_positions())
+    target = np.linspace(-0.3, 0.3, NUM_JOINTS)
+    update = decode_atlas_command(encode_atlas_command(
+        0, {'position': list(target), 'k_effort': [128] * NUM_JOINTS})).update
+    for sim in (compiled, numpy_law):
+        sim.receive_updates([update])
+    user = compiled.user_command.copy()
+    assert (user.k_effort == K_EFFORT_128).all()
+    for sim in (compiled, numpy_law, hold_only):
+        sim.step()
+    hold_nm = hold_only.torque_nm
+    # u: the command's PID torque on its first step (no derivative), unclamped
+    user.k_effort[:] = 1.0
+    u_nm = compute_torque(user, q, v, PidState(), DT_S, atlas.lower_rad, atlas.upper_rad,
+                          np.full(NUM_JOINTS, np.inf))
+    expected_nm = np.clip(K_EFFORT_128 * u_nm + (1.0 - K_EFFORT_128) * hold_nm,
+                          -atlas.effort_limit_nm, atlas.effort_limit_nm)
+    np.testing.assert_allclose(numpy_law.torque_nm, expected_nm, rtol=1e-12, atol=1e-9)
+    assert same_bits(compiled.torque_nm, numpy_law.torque_nm)
+    np.testing.assert_allclose(compiled.torque_nm, expected_nm, rtol=1e-12, atol=1e-9)
+    assert np.abs(compiled.torque_nm - hold_nm).max() > 5.0  # the blend is not the hold
+    for _ in range(200):
+        compiled.step()
+        numpy_law.step()
+    assert same_bits(compiled.data.qpos, numpy_law.data.qpos)
+    assert same_bits(compiled.torque_nm, numpy_law.torque_nm)

@@ -1,14 +1,19 @@
-"""The package's layer rule: rospy lives in node/ and cli/ only.
+"""The package's layer rules: rospy only on the ROS side, and the layers in one order.
 
-Everything else (the facts modules, sim/, msgs/, stepping/, trajectories/, bags/, offline/)
+The ROS side is node/ (the simulator node's machinery), cli/ (the scripts' command lines)
+and every module named *_node.py: a program's rospy side, which lives beside the logic it
+drives (trajectories/traj_yaml_node.py, plotting/plot_topics_node.py, ...). Everything else
 must import without a ROS graph, so offline runs, replay and the bag tools work on a
 machine without ROS and the simulation can be tested without it. Two checks, each shown
 to fail on a deliberate violation:
-- statically: no module of the ROS-free layer names a ROS client module in any import, at
-  module level or inside a function, nor a module of the rospy layer (which would bring
-  rospy in through another module);
+- statically: no ROS-free module names a ROS client module in any import, at module level
+  or inside a function, nor a ROS-side module (which would bring rospy in through it);
 - at run time: every ROS-free module imports in a fresh interpreter whose import system
   refuses the ROS client modules.
+
+The layers (LAYERS, lowest first): a module imports only from its own layer or lower ones,
+and the units (subpackages and top-level modules) import each other without a cycle. Every
+unit of the tree is placed in a layer, so a new one is placed deliberately.
 """
 
 from __future__ import annotations
@@ -22,8 +27,10 @@ from pathlib import Path
 
 PACKAGE = 'tutorial_atlas_control'
 PACKAGE_DIR = Path(__file__).resolve().parents[2] / 'src' / PACKAGE
-#: The subpackages allowed to import rospy: the ROS nodes and the scripts' command lines.
+#: The subpackages allowed to import rospy: the simulator node and the scripts' command lines.
 ROSPY_LAYER = ('node', 'cli')
+#: Elsewhere, a module whose name ends so is a program's ROS side (rospy allowed).
+ROS_SIDE_SUFFIX = '_node'
 #: Top-level modules of ROS 1's Python client side. rospkg (package paths, no graph) and
 #: rosbags (pure Python bags) are not among them.
 ROS_CLIENT_MODULES = frozenset({
@@ -45,8 +52,11 @@ def module_name(path: Path) -> str:
 
 
 def in_rospy_layer(name: str) -> bool:
+    """A module of node/ or cli/, or a *_node module (or a name inside one)."""
     parts = name.split('.')
-    return len(parts) > 1 and parts[0] == PACKAGE and parts[1] in ROSPY_LAYER
+    if len(parts) < 2 or parts[0] != PACKAGE:
+        return False
+    return parts[1] in ROSPY_LAYER or any(part.endswith(ROS_SIDE_SUFFIX) for part in parts[1:])
 
 
 def ros_free_modules() -> list[Path]:
@@ -89,7 +99,8 @@ def test_the_ros_free_layer_names_no_ros_client_module() -> None:
     violations = []
     for path in ros_free_modules():
         violations += layer_violations(path.read_text(), module_name(path))
-    assert not violations, 'rospy belongs in node/ or cli/:\n' + '\n'.join(violations)
+    assert not violations, ('rospy belongs in node/, cli/ or a *_node.py module:\n'
+                            + '\n'.join(violations))
 
 
 def test_the_static_check_catches_violations() -> None:
@@ -102,6 +113,8 @@ def test_the_static_check_catches_violations() -> None:
         from tutorial_atlas_control.node import transport
         from ..node.sim_node import SimNode
         from tutorial_atlas_control import cli
+        from tutorial_atlas_control.trajectories.traj_yaml_node import play
+        from tutorial_atlas_control.plotting import plot_topics_node
     ''')
     found = layer_violations(source, f'{PACKAGE}.bags.example')
     assert found == [
@@ -110,6 +123,8 @@ def test_the_static_check_catches_violations() -> None:
         f'{PACKAGE}.bags.example:7: imports {PACKAGE}.node (rospy layer)',
         f'{PACKAGE}.bags.example:8: imports {PACKAGE}.node.sim_node (rospy layer)',
         f'{PACKAGE}.bags.example:9: imports {PACKAGE}.cli (rospy layer)',
+        f'{PACKAGE}.bags.example:10: imports {PACKAGE}.trajectories.traj_yaml_node (rospy layer)',
+        f'{PACKAGE}.bags.example:11: imports {PACKAGE}.plotting.plot_topics_node (rospy layer)',
     ]
 
 
@@ -159,3 +174,149 @@ def test_the_import_check_catches_a_module_that_needs_rospy(tmp_path: Path) -> N
     result = import_without_ros(['needs_ros_through_another'], extra_path=tmp_path)
     assert result.returncode == 1
     assert 'needs_ros_through_another: ImportError: rospy is refused' in result.stdout
+
+
+# -- The layers' order --------------------------------------------------------------------
+#: The units (subpackages and top-level modules) by layer, lowest first. Why each sits where
+#: it does: the facts (names, units, errors, paths) need nothing; the command model is what
+#: msgs' decoders produce and sim's law reads, so it sits below both; native (the compiled
+#: library's binding) mirrors the command's fields for the compiled law; msgs are the wire
+#: formats, plotting reads messages; sim fills messages from the simulator; stepping (the
+#: live loop) and trajectories run the simulation; bags read recorded runs, of trajectories;
+#: offline runs write and replay bags, demo runs the tutorial and reads its bag; search
+#: sweeps offline runs; node is the simulator node over all of these; cli, each script's
+#: command line, over everything.
+LAYERS: tuple[tuple[str, ...], ...] = (
+    ('', 'control_modes', 'errors', 'exports', 'fall_report', 'joints', 'launch_args',
+     'processes', 'resources', 'topics', 'units', 'yaml_errors'),
+    ('command',),
+    ('native',),
+    ('msgs', 'plotting'),
+    ('sim',),
+    ('stepping', 'trajectories'),
+    ('bags',),
+    ('offline', 'demo'),
+    ('search',),
+    ('node',),
+    ('cli',),
+)
+LAYER_OF = {unit: rank for rank, units in enumerate(LAYERS) for unit in units}
+
+
+def unit_of(name: str) -> str | None:
+    """The unit a module of the package belongs to ('' for the package itself), or None for
+    a module outside the package."""
+    parts = name.split('.')
+    if parts[0] != PACKAGE:
+        return None
+    return parts[1] if len(parts) > 1 else ''
+
+
+def package_units() -> set[str]:
+    return {unit_of(module_name(path)) or '' for path in PACKAGE_DIR.rglob('*.py')}
+
+
+def layer_order_violations(source: str, current: str) -> list[str]:
+    """What `source` (the module `current`) imports from a higher layer, or from a unit
+    LAYERS does not place: one line per offending import statement."""
+    own = LAYER_OF.get(unit_of(current) or '')
+    found = []
+    for line, names in imported_names(source, current):
+        for name in names:
+            unit = unit_of(name)
+            if unit is None or unit == '':
+                continue
+            layer = LAYER_OF.get(unit)
+            if layer is None or own is None:
+                found.append(f'{current}:{line}: imports {name} (in no layer)')
+                break
+            if layer > own:
+                found.append(f'{current}:{line}: imports {name} (layer {layer} above layer {own})')
+                break
+    return found
+
+
+def unit_edges() -> dict[str, set[str]]:
+    """unit -> the other units its modules import."""
+    edges: dict[str, set[str]] = {}
+    for path in PACKAGE_DIR.rglob('*.py'):
+        current = module_name(path)
+        importer = unit_of(current) or ''
+        for _, names in imported_names(path.read_text(), current):
+            for name in names:
+                unit = unit_of(name)
+                if unit and unit != importer and unit in package_units():
+                    edges.setdefault(importer, set()).add(unit)
+    return edges
+
+
+def find_cycle(edges: dict[str, set[str]]) -> list[str]:
+    """One cycle of the directed graph `edges` as [a, b, ..., a], or [] if it has none."""
+    done: set[str] = set()
+
+    def visit(node: str, path: list[str]) -> list[str]:
+        if node in path:
+            return path[path.index(node):] + [node]
+        if node in done:
+            return []
+        for target in sorted(edges.get(node, ())):
+            cycle = visit(target, path + [node])
+            if cycle:
+                return cycle
+        done.add(node)
+        return []
+
+    for start in sorted(edges):
+        cycle = visit(start, [])
+        if cycle:
+            return cycle
+    return []
+
+
+def test_every_unit_of_the_package_has_a_layer() -> None:
+    units = package_units()
+    assert units - set(LAYER_OF) == set(), 'place each new subpackage or module in LAYERS'
+    assert set(LAYER_OF) - units == set(), 'LAYERS names units the package no longer has'
+
+
+def test_modules_import_only_from_their_own_or_lower_layers() -> None:
+    violations = []
+    for path in sorted(PACKAGE_DIR.rglob('*.py')):
+        violations += layer_order_violations(path.read_text(), module_name(path))
+    assert not violations, 'an import goes up the layers (LAYERS):\n' + '\n'.join(violations)
+
+
+def test_the_layer_check_catches_upward_imports() -> None:
+    source = textwrap.dedent('''
+        import numpy as np
+        from tutorial_atlas_control import errors, topics
+        from tutorial_atlas_control.command.arrays import LAW_FIELDS
+        from tutorial_atlas_control.msgs.wire import ImuWire
+        from tutorial_atlas_control.plotting.fields import PlotError
+        from tutorial_atlas_control.sim.simulator import AtlasSimulator
+        def later():
+            from tutorial_atlas_control.offline import player
+        from ..bags import reader
+        from tutorial_atlas_control import native, stepping
+        from tutorial_atlas_control.nowhere import thing
+    ''')
+    found = layer_order_violations(source, f'{PACKAGE}.msgs.example')
+    assert found == [
+        f'{PACKAGE}.msgs.example:7: imports {PACKAGE}.sim.simulator (layer 4 above layer 3)',
+        f'{PACKAGE}.msgs.example:9: imports {PACKAGE}.offline (layer 7 above layer 3)',
+        f'{PACKAGE}.msgs.example:10: imports {PACKAGE}.bags (layer 6 above layer 3)',
+        f'{PACKAGE}.msgs.example:11: imports {PACKAGE}.stepping (layer 5 above layer 3)',
+        f'{PACKAGE}.msgs.example:12: imports {PACKAGE}.nowhere (in no layer)',
+    ]
+
+
+def test_the_units_import_each_other_without_a_cycle() -> None:
+    edges = unit_edges()
+    assert edges['sim'] >= {'command', 'native', 'msgs'}, 'the import graph was not read'
+    assert find_cycle(edges) == []
+
+
+def test_the_cycle_check_catches_a_cycle() -> None:
+    edges = {'msgs': {'command', 'sim'}, 'sim': {'command', 'native'}, 'native': {'msgs'}}
+    assert find_cycle(edges) == ['msgs', 'sim', 'native', 'msgs']
+    assert find_cycle({'msgs': {'command'}, 'sim': {'msgs', 'command'}}) == []

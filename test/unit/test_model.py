@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from support.model_table import load_table
+from tutorial_atlas_control.command import arrays as commands
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.msgs import commands
 from tutorial_atlas_control.sim import controller, model
 
 REPO = Path(__file__).resolve().parents[2]

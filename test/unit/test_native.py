@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from tutorial_atlas_control import native
-from tutorial_atlas_control.msgs.copy_plan import CopyPlan
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import load_gains_yaml
+from tutorial_atlas_control.sim.copy_plan import CopyPlan
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
 
 REPO = Path(__file__).resolve().parents[2]

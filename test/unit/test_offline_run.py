@@ -94,6 +94,10 @@ def test_bag_opens_in_debian_rosbag_as_a_live_run(trajectory_file: Path, tmp_pat
         config = [json.loads(msg.data) for _, msg, _ in
                   opened.read_messages(topics=['/atlas/sim_config'])]
         states = [msg for _, msg, _ in opened.read_messages(topics=['/atlas/joint_states'])]
+        compression = opened.get_compression_info()
+    # Chunks compressed as a live run's (atlas.launch's lz4 default): about half the bytes.
+    assert compression.compression == 'lz4'
+    assert compression.compressed < 0.7 * compression.uncompressed
     assert run.commands == 5 == len(commands)
     # traj_yaml's schedule on the sim clock: every 20 ms from the switch to User mode.
     stamps_ns = [msg.header.stamp.to_nsec() for msg, _ in commands]
@@ -121,7 +125,7 @@ def test_commands_are_the_bytes_traj_yaml_publishes(trajectory_file: Path, tmp_p
     from osrf_msgs.msg import JointCommands
     from rospy.msg import serialize_message
 
-    from tutorial_atlas_control.node.traj_yaml import build_command
+    from tutorial_atlas_control.trajectories.traj_yaml_node import build_command
 
     bag = tmp_path / 'run.bag'
     short_run(trajectory_file, bag)
@@ -154,8 +158,11 @@ def test_summary_without_bag(trajectory_file: Path, capsys: pytest.CaptureFixtur
     out = capsys.readouterr().out
     assert '=== summary ===' in out
     assert 'the robot did not fall' in out
-    assert 'l_arm_elx  RMS ' in out
+    assert 'that moved): l_arm_elx ' in out
     assert 'bag:' not in out
+    assert main([str(trajectory_file), 'elbow', '--start-after', '1.1', '--settle', '0.2',
+                 '--table']) == 0
+    assert '  l_arm_elx  RMS ' in capsys.readouterr().out
 
 
 def run_script(args: list[str], cwd: Path) -> subprocess.CompletedProcess[str]:

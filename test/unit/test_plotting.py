@@ -316,3 +316,42 @@ def test_the_time_axis_follows_ros_time_from_0() -> None:
     view.update(paused=True, autoscale=False)
     assert view.axes.get_xlim() == (6.5, 10.5)
     assert view.status.get_text() == 'PAUSED  autoscale off'
+
+
+# -- legends, units, the picture's window ------------------------------------------------
+def test_a_joint_state_element_is_named_in_the_legend_with_units() -> None:
+    from matplotlib.figure import Figure
+
+    plot = live('/atlas/joint_states/position[19]', '/atlas/joint_states/velocity[2]',
+                '/ground_truth_odom/pose/pose/position/z', '/clock/clock')
+    plot.feed('/atlas/joint_states', 'sensor_msgs/JointState',
+              [(0.0, joint_state(1.0, 0.5))], lookup)
+    odom = Odometry()
+    odom.header.stamp = genpy.Time.from_sec(1.0)
+    plot.feed('/ground_truth_odom', 'nav_msgs/Odometry', [(0.0, serialized(odom))], lookup)
+    elbow, speed, height, clock = plot.fields
+    assert (elbow.label, speed.label) == ('/atlas/joint_states/position[19] (j19)',
+                                          '/atlas/joint_states/velocity[2] (j2)')
+    assert height.label == '/ground_truth_odom/pose/pose/position/z'  # no name list there
+    assert (elbow.unit, speed.unit, height.unit) == ('rad', 'rad/s', 'm')
+    assert clock.unit is None  # not matched yet (no message): no unit claimed
+    view = PlotFigure(Figure(), plot, 'sim time (s)')
+    view.update()
+    legend = [text.get_text() for text in view.axes.get_legend().get_texts()]
+    assert legend == ['/atlas/joint_states/position[19] (j19)',
+                      '/atlas/joint_states/velocity[2] (j2)',
+                      '/ground_truth_odom/pose/pose/position/z',
+                      '/clock/clock (no data yet)']
+    assert view.axes.get_ylabel() == 'm, rad, rad/s'
+
+
+@pytest.mark.parametrize(('argv', 'window_s'), [
+    (['x/y', '--png', 'a.png', '--duration', '5'], 5.0),  # the picture is all data
+    (['x/y', '--png', 'a.png', '--duration', '5', '--window', '2'], 2.0),
+    (['x/y', '--duration', '5'], 10.0),  # a window on screen keeps its default
+    (['x/y'], 10.0),
+])
+def test_the_pictures_window_fits_its_duration(argv: list[str], window_s: float) -> None:
+    from tutorial_atlas_control.cli import plot_topics as cli
+
+    assert cli.window_s(cli.parse_args(argv)) == window_s

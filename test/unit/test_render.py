@@ -13,6 +13,13 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from support.synthetic_bags import (
+    STANDING_HEIGHT_M,
+    joint_state,
+    odometry,
+    write_bag,
+    write_run_bag,
+)
 from tutorial_atlas_control.bags.reader import read_bag
 from tutorial_atlas_control.bags.render import (
     RenderError,
@@ -22,13 +29,6 @@ from tutorial_atlas_control.bags.render import (
     parse_size,
     render_states,
     states_from_bag,
-)
-from tutorial_atlas_control.bags.synthetic import (
-    STANDING_HEIGHT_M,
-    joint_state,
-    odometry,
-    write_bag,
-    write_run_bag,
 )
 from tutorial_atlas_control.cli.analyze_bag import main as analyze_main
 from tutorial_atlas_control.joints import NUM_JOINTS

@@ -15,8 +15,8 @@ from typing import Any, Callable
 import numpy as np
 import pytest
 
+from support.synthetic_bags import TYPESTORE, Record, joint_state, write_bag
 from tutorial_atlas_control.bags.reader import read_bag
-from tutorial_atlas_control.bags.synthetic import TYPESTORE, Record, joint_state, write_bag
 from tutorial_atlas_control.cli.replay_bag import EXIT_DEVIATES, main
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
@@ -30,6 +30,7 @@ from tutorial_atlas_control.offline.replay import (
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim import vrc
 from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, hold_command, load_gains_yaml
+from tutorial_atlas_control.sim.joint_trajectory import TrajectoryMessage, trajectory_input
 from tutorial_atlas_control.sim.sim_config import SimConfig
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode
 
@@ -231,6 +232,11 @@ def test_any_try_replays_exactly(three_tries: Path, number: int | None, start_s:
     assert result.pelvis_position is not None and result.pelvis_position.max_abs == 0.0
     assert result.pelvis_position.samples == steps // ODOM_EVERY
     assert result.reproduced and result.resets_in_bag == 2
+    # The reset warning only when the try was not asked for (the report names the try).
+    warned = [text for text in result.warnings if 'reset(s); replaying' in text]
+    assert warned == ([] if number is not None else [
+        'the bag holds 2 reset(s); replaying the last segment, from the reset at 0.000 s '
+        '(sim time).'])
 
 
 def test_try_that_does_not_exist_is_one_line(three_tries: Path,
@@ -427,7 +433,7 @@ def test_debug_test_messages_are_reported(tmp_path: Path) -> None:
     """/atlas/debug/test's damping changes the model, which the torques do not carry."""
     from rosbags.typesys import get_types_from_msg
 
-    from tutorial_atlas_control.bags.synthetic import TYPESTORE
+    from support.synthetic_bags import TYPESTORE
     from tutorial_atlas_control.resources import message_file
 
     if 'atlas_msgs/msg/Test' not in TYPESTORE.fielddefs:
@@ -479,12 +485,12 @@ INPUT_SCRIPTS: dict[str, dict[int, list[vrc.SimInput]]] = {
     'cmd_vel': {80: [vrc.ModeInput(vrc.VrcMode.PINNED)],
                 100: [vrc.cmd_vel_input((0.3, 0.1, 0.0), (0.0, 0.0, 0.5))],
                 300: [vrc.cmd_vel_input((0, 0, 0), (0, 0, 0)), vrc.ModeInput(vrc.VrcMode.NOMINAL)]},
-    'joint_trajectory': {100: [vrc.trajectory_input(
+    'joint_trajectory': {100: [trajectory_input(TrajectoryMessage(
         'world', 0, ('l_arm_shx', 'r_leg_kny', 'back_mby'),
-        ((-0.4, 0.2, 0.1), (-0.8, 0.5, 0.2), (-0.2, 0.3, 0.0)), (0, 20_000_000, 50_000_000),
+        ((-0.4, 0.2, 0.1), (-0.8, 0.5, 0.2), (-0.2, 0.3, 0.0)), (0, 20_000_000, 50_000_000)),
         ATLAS.lower_rad, ATLAS.upper_rad)]},
-    'joint_trajectory_in_a_foot_frame': {100: [vrc.trajectory_input(
-        'l_foot', 0, ('l_leg_lhy', 'l_leg_kny', 'l_leg_uay'), ((-0.3, 0.6, -0.3),), (0,),
+    'joint_trajectory_in_a_foot_frame': {100: [trajectory_input(TrajectoryMessage(
+        'l_foot', 0, ('l_leg_lhy', 'l_leg_kny', 'l_leg_uay'), ((-0.3, 0.6, -0.3),), (0,)),
         ATLAS.lower_rad, ATLAS.upper_rad, ('l_foot',))]},
 }
 

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from tutorial_atlas_control.msgs.atlas_command import decode_atlas_command, encode_atlas_command
-from tutorial_atlas_control.msgs.sim_messages import SimMessages
 from tutorial_atlas_control.sim import controller, model
+from tutorial_atlas_control.sim.sim_messages import SimMessages
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
 from tutorial_atlas_control.trajectories.schedule import (
     parse_trajectory_log_line,
@@ -153,7 +153,7 @@ def test_atlas_state_joints_gains_and_k_effort(standing: AtlasSimulator) -> None
         assert list(messages.atlas_state_wire.k_effort) == k_effort
         assert set(arrays['kp_position']) == {5.0}
     finally:
-        standing.user_command = None
+        standing.commands.user_command = None
 
 
 def test_hands_carry_what_the_last_wrist_joint_transmits(standing: AtlasSimulator) -> None:
@@ -205,9 +205,9 @@ def test_the_ports_imu_and_ankle_topics_mean_gravity_and_the_weight(
     """/atlas/imu and /atlas/{l,r}_foot_contact (the port's own) against physics, standing.
 
     The accelerometer reads the ground's push, +g up; the legs push each foot down with half
-    the weight above the ankles (the model's masses less the feet's), README's "Fz about
-    -430 N", in the foot frame about the ankle; horizontally the two pushes cancel (the robot
-    is still). Tolerances: 2 % of the weight (the robot sways slowly), as above.
+    the weight above the ankles (the model's masses less the feet's), docs/ros_interface.md's
+    "Fz about -430 N", in the foot frame about the ankle; horizontally the two pushes cancel
+    (the robot is still). Tolerances: 2 % of the weight (the robot sways slowly), as above.
     """
     gravity_mps2 = -float(standing.model.opt.gravity[2])
     messages = SimMessages(standing)

@@ -169,8 +169,8 @@ def _bad_and_good_messages() -> list[tuple[str, Any, Any, str]]:
          Wrench(Vector3(30, 0, 0), Vector3(0, 0, 0)), 'force 1e+09 exceeds 100000'),
         (topics.JOINT_TRAJECTORY, trajectory(['l_arm_shx', 'wing'], [0.0]),
          trajectory(['l_arm_shx'], [0.0, 0.1]), "unknown joint name 'wing'"),
-        (topics.JOINT_TRAJECTORY, trajectory(['l_arm_shx'], [0.2, 0.1]),
-         trajectory(['l_arm_shx'], [0.0, 0.1]), 'time_from_start not increasing at point 1'),
+        (topics.JOINT_TRAJECTORY, trajectory(['l_arm_shx'], [0.2, -0.1]),
+         trajectory(['l_arm_shx'], [0.0, 0.1]), 'point 1 time_from_start -0.1 s is negative'),
     ]
 
 
@@ -196,6 +196,37 @@ def test_each_cheat_refuses_bad_input_in_one_line_and_applies_good_input(
             node.loop.reset_world()
         assert node.spin() == 0  # and it keeps stepping
     assert sim.sim_time_ns == 5 * sim.step_ns
+
+
+def test_a_drcsim_era_trajectory_is_clamped_and_run_on_with_one_line_each(
+        sim: AtlasSimulator) -> None:
+    """As the animate-joints tutorial sends it: past the limits, every time 0.01 s."""
+    import genpy
+    from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
+
+    from support.fake_rospy import fake_ros_node
+
+    msg = JointTrajectory(joint_names=['atlas::l_arm_ely', 'atlas::l_arm_shx'], points=[
+        JointTrajectoryPoint(positions=[-0.5 * k, 0.1 * k],
+                             time_from_start=genpy.Duration(0, 10_000_000)) for k in range(3)])
+    msg.header.frame_id = 'atlas::pelvis'
+    with fake_ros_node(sim, steps=0) as node:
+        rospy = sim_node.rospy
+        rospy.logwarn.reset_mock()
+        rospy.loginfo.reset_mock()
+        _subscribed(topics.JOINT_TRAJECTORY)(msg)
+        assert [call.args for call in rospy.logwarn.call_args_list] == [(
+            "/joint_trajectory: positions outside their joints' limits, clamped to the limits: "
+            'l_arm_ely by up to 1 rad beyond [0, 3.14159] (2 of 3 points)',)]
+        assert [call.args for call in rospy.loginfo.call_args_list] == [(
+            '/joint_trajectory: time_from_start does not increase (point 1: 0.01 s after '
+            "0.01 s), read as DRCSim 2.5.2 read it: each point's time_from_start added to the "
+            "previous point's time; the 3 points play over 0.02 s",),
+            ('applied at t=0.000 s: /joint_trajectory 2 joints, 3 points',)]
+        assert sim.inputs_since_reset == 1 and sim.playing
+        event = node.fake_publishers[topics.SIM_INPUTS].published[-1].data
+        assert '"positions": [[0.0, 0.0], [0.0, 0.1], [0.0, 0.2]]' in event
+        assert '"times_ns": [0, 10000000, 20000000]' in event
 
 
 def test_configuration_is_logged_as_not_implemented_and_reset_models_is_reset_world(

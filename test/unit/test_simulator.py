@@ -7,8 +7,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tutorial_atlas_control.command.arrays import CommandError
 from tutorial_atlas_control.joints import JOINT_INDEX, NUM_JOINTS
-from tutorial_atlas_control.msgs.commands import CommandError
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.sim.simulator import (

@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 
 from tutorial_atlas_control.cli import state_publisher as state_publisher_cli
-from tutorial_atlas_control.node import state_publisher
 from tutorial_atlas_control.sim import model
+from tutorial_atlas_control.sim import state_publisher_node as state_publisher
 
 
 def test_usage_without_a_model_file(capsys: pytest.CaptureFixture[str]) -> None:

@@ -8,10 +8,10 @@ from pathlib import Path
 
 import pytest
 
+from support.statics import gravity_stiffness
 from tutorial_atlas_control.joints import JOINT_INDEX
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import load_gains_yaml
-from tutorial_atlas_control.sim.statics import gravity_stiffness
 
 REPO = Path(__file__).resolve().parents[2]
 

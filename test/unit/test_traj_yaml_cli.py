@@ -23,7 +23,9 @@ import numpy as np
 import pytest
 
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.node.traj_yaml import (
+from tutorial_atlas_control.sim.controller import Gains, GainsError
+from tutorial_atlas_control.trajectories.schedule import TimeWentBackError
+from tutorial_atlas_control.trajectories.traj_yaml_node import (
     JointStateCache,
     TrajYamlError,
     build_command,
@@ -36,8 +38,6 @@ from tutorial_atlas_control.node.traj_yaml import (
     wait_for_subscribers,
     wait_until_handed_over,
 )
-from tutorial_atlas_control.sim.controller import Gains, GainsError
-from tutorial_atlas_control.trajectories.schedule import TimeWentBackError
 from tutorial_atlas_control.trajectories.trajectory import Waypoint, sample_count
 
 REPO = Path(__file__).resolve().parents[2]

@@ -36,8 +36,10 @@ Physics = tuple[mujoco.MjModel, mujoco.MjData]
 class FakeViewer:
     """Stands in for mujoco.viewer.Handle; `press_reset` does what the Reset button does."""
 
-    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, key_callback) -> None:
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, key_callback,
+                 **options: bool) -> None:
         self.model, self.data, self.key_callback = model, data, key_callback
+        self.options = options  # launch_passive's show_left_ui, show_right_ui
         self.reset_pending = False
         self.force = np.zeros(6)
         self.texts: list[object] = []
@@ -77,8 +79,9 @@ def make_link(model: mujoco.MjModel,
               held: frozenset[str] = frozenset()) -> tuple[ViewerLink, FakeViewer]:
     viewers = []
 
-    def launch(m: mujoco.MjModel, d: mujoco.MjData, key_callback) -> FakeViewer:
-        viewers.append(FakeViewer(m, d, key_callback))
+    def launch(m: mujoco.MjModel, d: mujoco.MjData, key_callback,
+               **options: bool) -> FakeViewer:
+        viewers.append(FakeViewer(m, d, key_callback, **options))
         return viewers[-1]
 
     link = ViewerLink(model, launch=launch, modifiers=lambda: held)
@@ -99,6 +102,13 @@ def test_the_viewer_never_gets_the_physics_data(physics) -> None:
     refresh(link, data)
     np.testing.assert_array_equal(viewer.data.qpos, data.qpos)
     assert viewer.data.time == data.time
+
+
+def test_the_window_opens_with_the_3d_view_only(physics) -> None:
+    """MuJoCo's two panels would leave the robot a third of the window; Tab shows them."""
+    model, _ = physics
+    _, viewer = make_link(model)
+    assert viewer.options == {'show_left_ui': False, 'show_right_ui': False}
 
 
 def test_reset_button_becomes_a_request_and_leaves_physics_alone(physics) -> None:
@@ -173,8 +183,8 @@ class ThreadedFakeViewer(FakeViewer):
     DESTROY_S = 0.2
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData,
-                 key_callback: KeyCallback) -> None:
-        super().__init__(model, data, key_callback)
+                 key_callback: KeyCallback, **options: bool) -> None:
+        super().__init__(model, data, key_callback, **options)
         self.mutex = threading.Lock()
         self.exit_requested = threading.Event()
         self.render_loop_ended = threading.Event()
@@ -206,8 +216,8 @@ def make_threaded_link(model: mujoco.MjModel) -> tuple[ViewerLink, ThreadedFakeV
     viewers = []
 
     def launch(m: mujoco.MjModel, d: mujoco.MjData,
-               key_callback: KeyCallback) -> ThreadedFakeViewer:
-        viewers.append(ThreadedFakeViewer(m, d, key_callback))
+               key_callback: KeyCallback, **options: bool) -> ThreadedFakeViewer:
+        viewers.append(ThreadedFakeViewer(m, d, key_callback, **options))
         return viewers[-1]
 
     link = ViewerLink(model, launch=launch, modifiers=frozenset)

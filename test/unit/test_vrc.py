@@ -14,6 +14,7 @@ from tutorial_atlas_control.joints import JOINT_INDEX
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim import vrc
 from tutorial_atlas_control.sim.controller import load_gains_yaml
+from tutorial_atlas_control.sim.joint_trajectory import TrajectoryMessage, trajectory_input
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode
 from tutorial_atlas_control.sim.vrc import InputError, ModeInput, VrcMode
 
@@ -190,8 +191,8 @@ def test_joint_trajectory_sets_positions_exactly_with_physics_off(atlas) -> None
     sim = standing(atlas)
     names = ('l_arm_shx', 'atlas::r_leg_kny')
     points = ((-0.5, 0.3), (-1.0, 0.6), (0.25, 0.1))
-    item = vrc.trajectory_input('', 0, names, points, (0, 10_000_000, 25_000_000),
-                                sim.atlas.lower_rad, sim.atlas.upper_rad)
+    item = trajectory_input(TrajectoryMessage('', 0, names, points, (0, 10_000_000, 25_000_000)),
+                            sim.atlas.lower_rad, sim.atlas.upper_rad)
     pelvis_before = pelvis(sim)
     index = [JOINT_INDEX['l_arm_shx'], JOINT_INDEX['r_leg_kny']]
     sim.apply_input(item)
@@ -215,9 +216,10 @@ def test_a_trajectory_in_a_link_frame_keeps_that_link_in_place(atlas) -> None:
     mujoco.mj_forward(sim.model, sim.data)
     before = sim.data.xpos[foot].copy(), sim.data.xquat[foot].copy()
     pelvis_before = pelvis(sim)[0]
-    item = vrc.trajectory_input('atlas::l_foot', 0, ('l_leg_lhy', 'l_leg_kny', 'l_leg_uay'),
-                                ((-0.6, 1.2, -0.6),), (0,), sim.atlas.lower_rad,
-                                sim.atlas.upper_rad, sim.vrc.link_names)
+    message = TrajectoryMessage('atlas::l_foot', 0, ('l_leg_lhy', 'l_leg_kny', 'l_leg_uay'),
+                                ((-0.6, 1.2, -0.6),), (0,))
+    item = trajectory_input(message, sim.atlas.lower_rad, sim.atlas.upper_rad,
+                            sim.vrc.link_names)
     assert item.reference_link == 'l_foot'
     sim.apply_input(item)
     sim.step()
@@ -225,38 +227,6 @@ def test_a_trajectory_in_a_link_frame_keeps_that_link_in_place(atlas) -> None:
     np.testing.assert_allclose(sim.data.xpos[foot], before[0], atol=1e-9)
     np.testing.assert_allclose(sim.data.xquat[foot], before[1], atol=1e-9)
     assert pelvis(sim)[0][2] < pelvis_before[2] - 0.05  # the pelvis crouched over the foot
-
-
-@pytest.mark.parametrize(('args', 'message'), [
-    (('', 0, ('l_arm_shx', 'hand'), ((0, 0),), (0,)), "unknown joint name 'hand'"),
-    (('', 0, ('l_arm_shx', 'atlas::l_arm_shx'), ((0, 0),), (0,)), 'named twice'),
-    (('', 0, ('l_arm_shx',), ((0,), (0.1,)), (0, 0)),
-     r'time_from_start not increasing at point 1 \(0 s after 0 s\)'),
-    (('', 0, ('l_arm_shx',), ((0,), (0.1,)), (5, 2)), 'not increasing at point 1'),
-    (('', 0, ('l_arm_shx',), ((0,),), (-1,)), 'negative'),
-    (('', 0, ('l_arm_shx',), ((0, 1),), (0,)), 'point 0 has 2 positions for 1 joint names'),
-    (('', 0, ('l_arm_shx',), ((math.nan,),), (0,)), 'not finite'),
-    (('', 0, ('l_arm_shx',), ((5.0,),), (0,)), 'l_arm_shx = 5 rad is outside its limits'),
-    (('', 0, ('l_arm_shx',), (), ()), 'no points'),
-    (('', 0, (), ((),), (0,)), 'joint_names is empty'),
-    (('l_hoof', 0, ('l_arm_shx',), ((0,),), (0,)),
-     "header.frame_id 'l_hoof' is neither world, map nor a link of the robot"),
-])
-def test_bad_trajectories_are_refused_with_one_line(atlas, args, message) -> None:
-    with pytest.raises(InputError, match=message) as info:
-        vrc.trajectory_input(*args, atlas.lower_rad, atlas.upper_rad, ('pelvis', 'l_foot'))
-    assert '\n' not in str(info.value)
-
-
-def test_ignored_trajectory_fields_are_still_checked(atlas) -> None:
-    def check(**fields: list[float]) -> None:
-        vrc.trajectory_input('', 0, ('l_arm_shx', 'r_arm_shx'), ((0, 0),), (0,),
-                             atlas.lower_rad, atlas.upper_rad, unused=[fields])
-    check(velocities=[], accelerations=[1.0, 2.0], effort=[])
-    with pytest.raises(InputError, match='^point 0 has 1 velocities for 2 joint names$'):
-        check(velocities=[1.0])
-    with pytest.raises(InputError, match=r'^point 0 effort is not finite \(nan\)$'):
-        check(effort=[0.0, math.nan])
 
 
 def test_bad_poses_twists_and_wrenches_are_refused() -> None:

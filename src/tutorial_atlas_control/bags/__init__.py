@@ -1,4 +1,27 @@
-"""Recorded runs: bag records, reading, analysis, comparison, reports, videos, run logs.
+"""Recorded runs: bag records and reading, analysis, comparison, reports, videos, run logs.
 
-Also synthetic bags for the tests. No ROS.
+No ROS: bags are read and written with rosbags. Synthetic bags for the tests are
+test/support/synthetic_bags.py. compare.compare (the submodule's name) and the two to_json
+(compare's, report's) are imported from their modules.
 """
+
+from tutorial_atlas_control.exports import lazy_exports
+
+__all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    'analysis': ['Analysis', 'COMMAND_CHANGE_RAD', 'EFFORT_LIMIT_TOLERANCE_NM', 'FALL_HEIGHT_M',
+                 'MOVED_RANGE_RAD', 'analyze', 'analyze_bag', 'analyze_try'],
+    'bag_dir': ['latest_bag', 'unwritable_reason'],
+    'compare': ['compare_bags', 'first_applied_command_s', 'format_comparison',
+                'plot_comparison'],
+    'feet': ['foot_displacement', 'foot_line'],
+    'reader': ['BagData', 'JointStateSeries', 'read_bag'],
+    'records': ['open_bag'],
+    'render': ['DEFAULT_FPS', 'DEFAULT_SIZE', 'check_output_path', 'parse_fps', 'parse_size',
+               'render_bag_video'],
+    'report': ['format_summary', 'plot_run', 'short_summary', 'write_csv'],
+    'rosbag1_fast': ['BlockBagWriter', 'RecordBlock', 'TopicConnection'],
+    'run_log': ['PlayedTrajectory'],
+    'tries': ['RESET_SIMULATION', 'RESET_WORLD', 'RUN_START', 'Try', 'find_tries', 'pick_try',
+              'window'],
+    'typestore': ['JOINT_COMMANDS_TYPE', 'load_typestore', 'rosbags_msgtype'],
+})

@@ -1,6 +1,6 @@
 """The tutorial's metrics of a recorded run: fall, tracking, command timing, effort limits.
 
-Works on the :class:`~tutorial_atlas_control.bags.reader.BagData` that bag_reader extracts;
+Works on the :class:`~tutorial_atlas_control.bags.reader.BagData` that reader.py extracts;
 all times are seconds from the bag's start (run timeline). A bag with resets is cut into
 tries (bags.tries): each try gets its own metrics, and the whole-run metrics never pair a
 state with a command of another try.
@@ -26,6 +26,7 @@ from tutorial_atlas_control.bags.reader import (
 from tutorial_atlas_control.bags.run_log import PlayedTrajectory
 from tutorial_atlas_control.bags.tries import Try, find_tries, pick_try, window
 from tutorial_atlas_control.errors import BagAnalysisError
+from tutorial_atlas_control.fall_report import LoggedFall
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES
 
 __all__ = [
@@ -161,6 +162,16 @@ class Analysis:
                          'figures span them all: see each try (--try N).')
         return list(self.data.warnings) + extra
 
+    def first_fall(self) -> tuple[int | None, LoggedFall] | None:
+        """(try number, figures) of the run's first fall (fall_report's figures); None if
+        it did not fall."""
+        for each in self.tries:
+            if each.fall is not None:
+                return each.window.number, each.fall
+        if self.fall_time_s is None:
+            return None
+        return None, LoggedFall(self.data.sim_time_s(self.fall_time_s), None)
+
     def falls(self) -> list[float]:
         """The time (s) of every fall: one per try that fell."""
         if not self.tries:
@@ -180,6 +191,7 @@ class Analysis:
             'inputs': [{'time': t_s, 'input': text} for t_s, text in input_timeline(data)],
             'fell': self.fell,
             'fall_time': self.fall_time_s,
+            **_first_fall_dict(self.first_fall()),
             'min_pelvis_height': self.min_pelvis_height_m,
             'joints': {name: {'rms_error': joint.rms_error_rad, 'max_error': joint.max_error_rad,
                               'samples': joint.samples, 'commanded': joint.commanded,
@@ -200,6 +212,12 @@ class Analysis:
             'warnings': self.warnings,
             'tries': [each.to_dict() for each in self.tries],
         }
+
+
+def _first_fall_dict(first: tuple[int | None, LoggedFall] | None) -> dict[str, Any]:
+    if first is None:
+        return {'fall_sim_time': None, 'fall_after_command': None}
+    return {'fall_sim_time': first[1].sim_time_s, 'fall_after_command': first[1].after_command_s}
 
 
 def first_applied_command_s(data: BagData) -> float | None:
@@ -231,12 +249,23 @@ class TryAnalysis:
     trajectories: list[PlayedTrajectory]
 
     @property
+    def fall(self) -> LoggedFall | None:
+        """The try's fall in fall_report's figures (sim time, s after the try's first
+        command): the simulator's own log line when the bag holds it (it saw the pelvis
+        every step), else from the bag's odometry and commands. None: no fall."""
+        if self.analysis.data.logged_falls:
+            return self.analysis.data.logged_falls[0][1]
+        fall_s = self.analysis.fall_time_s
+        if fall_s is None:
+            return None
+        after_s = None if self.first_command_s is None else fall_s - self.first_command_s
+        return LoggedFall(self.analysis.data.sim_time_s(fall_s), after_s)
+
+    @property
     def fall_after_command_s(self) -> float | None:
         """Fall time from the try's first applied command (s); None: no fall or no command."""
-        fall_s = self.analysis.fall_time_s
-        if fall_s is None or self.first_command_s is None:
-            return None
-        return fall_s - self.first_command_s
+        fall = self.fall
+        return None if fall is None else fall.after_command_s
 
     def to_dict(self) -> dict[str, Any]:
         a, data = self.analysis, self.analysis.data
@@ -253,6 +282,7 @@ class TryAnalysis:
             'first_command': self.first_command_s,
             'fell': a.fell,
             'fall_time': a.fall_time_s,
+            'fall_sim_time': None if self.fall is None else self.fall.sim_time_s,
             'fall_after_command': self.fall_after_command_s,
             'min_pelvis_height': a.min_pelvis_height_m,
             'command_count': 0 if data.commands is None else len(data.commands.t_s),

@@ -8,7 +8,7 @@ all when the bag has no mode switch). Times below are seconds from that command.
 Over the time both runs cover after it, at each of A's joint states: B's measured
 positions (linearly interpolated) and each run's latest commanded position are compared
 per joint; B's pelvis height likewise at A's /ground_truth_odom times. Fall times are each
-run's (bag_analysis's definition), from its first applied command.
+run's (analysis.py's definition), from its first applied command.
 """
 
 from __future__ import annotations

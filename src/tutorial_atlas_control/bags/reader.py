@@ -35,6 +35,7 @@ from tutorial_atlas_control.bags.typestore import (
     load_typestore,
 )
 from tutorial_atlas_control.errors import BagAnalysisError
+from tutorial_atlas_control.fall_report import FALL_LINE_PREFIX, LoggedFall, parse_fall_line
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS, bare_joint_name
 from tutorial_atlas_control.msgs.ros1_fields import FieldCursor, parse_names_arrays
 from tutorial_atlas_control.units import NS_PER_S
@@ -120,7 +121,8 @@ class BagData:
     the trajectories players logged on /rosout (time, trajectory). `epoch_starts_s` are
     the times where sim time went back (reset_simulation), `epoch_shifts_s` what was added
     to each epoch's sim times (see the module docstring); `sim_inputs` the (time, JSON
-    text) of /atlas/sim_inputs (the applied VRCPlugin inputs).
+    text) of /atlas/sim_inputs (the applied VRCPlugin inputs); `logged_falls` the
+    (time, figures) of the simulator's fall lines on /rosout (fall_report).
     """
 
     path: Path
@@ -137,6 +139,7 @@ class BagData:
     epoch_starts_s: list[float] = field(default_factory=list)
     epoch_shifts_s: list[float] = field(default_factory=lambda: [0.0])
     sim_inputs: list[tuple[float, str]] = field(default_factory=list)
+    logged_falls: list[tuple[float, LoggedFall]] = field(default_factory=list)
 
     def epoch_at(self, t_s: float) -> int:
         """The epoch (0: before any rewind of sim time) time `t_s` falls in."""
@@ -455,6 +458,21 @@ def _read_played(reading: _Reading,
                             reading.typestore)
 
 
+def _read_logged_falls(reading: _Reading,
+                       connections: Sequence[Connection]) -> list[tuple[float, LoggedFall]]:
+    """(time, figures) of every fall the simulator logged on /rosout (fall_report's line)."""
+    bag_ns, raws = reading.raw([c for c in connections if c.msgtype == LOG_TYPE])
+    marker = FALL_LINE_PREFIX.encode()
+    found = []
+    for t_s, raw in zip(reading.seconds(bag_ns).tolist(), raws):
+        if marker not in raw:  # most lines are not falls: skip deserializing them
+            continue
+        fall = parse_fall_line(reading.typestore.deserialize_ros1(raw, LOG_TYPE).msg)
+        if fall is not None:
+            found.append((float(t_s), fall))
+    return found
+
+
 def _mode_changes(strings: list[tuple[float, str]]) -> list[tuple[float, str]]:
     """The control modes with repeats of the same mode dropped."""
     modes: list[tuple[float, str]] = []
@@ -540,7 +558,8 @@ def _read_open_bag(path: Path, records: BagRecords, fast: bool) -> BagData:
     return BagData(path, start_ns / NS_PER_S, (end_ns - start_ns) / NS_PER_S, summaries,
                    states, commands, pelvis, modes, sim_configs, reading.warnings, played,
                    [(t_ns - start_ns) / NS_PER_S for t_ns in records.epoch_starts_ns],
-                   [t_ns / NS_PER_S for t_ns in records.epoch_shifts_ns], sim_inputs)
+                   [t_ns / NS_PER_S for t_ns in records.epoch_shifts_ns], sim_inputs,
+                   series(topics.ROSOUT, _read_logged_falls) or [])
 
 
 def read_bag(path: Path | str, fast: bool = True) -> BagData:
@@ -548,7 +567,7 @@ def read_bag(path: Path | str, fast: bool = True) -> BagData:
 
     Args:
         path: The .bag file.
-        fast: Read with the numpy index and parsers (see bag_records); False reads through
+        fast: Read with the numpy index and parsers (see records.py); False reads through
             rosbags' public API and typestore only, several times slower, same result, except
             that it cannot tell the runs before and after a reset_simulation apart.
 
@@ -556,11 +575,15 @@ def read_bag(path: Path | str, fast: bool = True) -> BagData:
         The extracted series; a series is None when its topic is not in the bag.
 
     Raises:
-        BagAnalysisError: Missing file, not a bag, unindexed or damaged bag.
+        BagAnalysisError: Missing file, not a bag, unindexed, damaged or empty bag.
     """
     path = Path(path)
     records = open_bag(path, fast)
     try:
+        if not any(connection.msgcount for connection in records.connections):
+            raise BagAnalysisError(
+                f'{path} holds no message (a launch that stopped before its simulator was '
+                'ready records nothing); give a bag of a run.')
         return _read_open_bag(path, records, fast)
     except (ReaderError, struct.error, ValueError, KeyError, IndexError,
             UnicodeDecodeError) as err:

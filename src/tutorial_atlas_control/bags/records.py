@@ -1,4 +1,4 @@
-"""The raw messages of a ROS 1 bag, per connection and in time order: bag_reader's file layer.
+"""The raw messages of a ROS 1 bag, per connection and in time order: reader.py's file layer.
 
 Two readers behind one small interface (`connections`, `times_ns`, `raw_messages`, `close`):
 

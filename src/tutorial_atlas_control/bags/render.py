@@ -374,7 +374,7 @@ def render_states(states: RunStates, path: Path | str, fps: float = DEFAULT_FPS,
 
 def render_bag_video(data: BagData, path: Path | str, fps: float = DEFAULT_FPS,
                      size: tuple[int, int] = DEFAULT_SIZE, progress: bool = True) -> VideoResult:
-    """Render the run in `data` (from bag_reader.read_bag) to `path`.
+    """Render the run in `data` (from reader.read_bag) to `path`.
 
     Frame times are seconds from the bag's start (as in the analysis), labelled on the frame.
 

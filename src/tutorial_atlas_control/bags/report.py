@@ -18,18 +18,25 @@ from tutorial_atlas_control.bags.analysis import (
     TryAnalysis,
     input_timeline,
 )
+from tutorial_atlas_control.bags.overview_plot import draw_overview
 from tutorial_atlas_control.bags.reader import BagData
 from tutorial_atlas_control.bags.tries import RUN_START
+from tutorial_atlas_control.control_modes import is_refused_mode
 from tutorial_atlas_control.errors import BagAnalysisError
+from tutorial_atlas_control.fall_report import fall_line, fall_when
 from tutorial_atlas_control.joints import JOINT_NAMES
 
-__all__ = ['format_summary', 'plot_run', 'to_json', 'write_csv']
+__all__ = ['format_summary', 'plot_joints', 'plot_run', 'to_json', 'write_csv']
 
 #: Most points drawn per line; longer series are decimated (plots, not analysis).
 PLOT_MAX_POINTS = 4000
 #: Height of one subplot (inches) and the figure width (inches).
 PLOT_ROW_HEIGHT_IN = 1.6
 PLOT_WIDTH_IN = 11.0
+#: How many of the worst-tracked joints the short summary names.
+SUMMARY_WORST_JOINTS = 3
+#: After a mode the simulator refused (the bag records every string published).
+REFUSED_NOTE = '  (refused: not a control mode; the mode did not change)'
 #: Significant digits written to CSV files.
 CSV_FORMAT = '%.10g'
 
@@ -56,7 +63,9 @@ def _topic_lines(data: BagData, trajectory: str | None = None,
     # VRCPlugin's inputs (mode, teleport, wrench, ...) on the same timeline, when applied.
     events = sorted([*data.modes, *(resets or []), *input_timeline(data)],
                     key=lambda entry: entry[0])
-    lines.extend(f'  {t_s:9.3f} s  {text}' for t_s, text in events)
+    lines.extend(f'  {t_s:9.3f} s  {text}' + (REFUSED_NOTE if is_refused_mode(text) and
+                                                (t_s, text) in data.modes else '')
+                 for t_s, text in events)
     if not data.modes:
         lines.append(f'  (no {topics.CONTROL_MODE} messages)')
     return lines
@@ -65,9 +74,13 @@ def _topic_lines(data: BagData, trajectory: str | None = None,
 def _fall_line(analysis: Analysis) -> str:
     if analysis.fell is None:
         return f'Fall:     unknown ({analysis.unavailable.get("fall", "no pelvis data")})'
-    if analysis.fell:
-        return (f'Fall:     FELL at {analysis.fall_time_s:.3f} s (pelvis below '
-                f'{FALL_HEIGHT_M} m; lowest {analysis.min_pelvis_height_m:.3f} m)')
+    first = analysis.first_fall()
+    if analysis.fell and first is not None:
+        number, fall = first
+        where = '' if number is None else f'try {number}, '
+        return (f'Fall:     FELL {fall_when(fall.sim_time_s, fall.after_command_s)} ({where}'
+                f'{analysis.fall_time_s:.3f} s from bag start; pelvis below {FALL_HEIGHT_M} m; '
+                f'lowest {analysis.min_pelvis_height_m:.3f} m)')
     return (f'Fall:     no (pelvis stayed above {FALL_HEIGHT_M} m; lowest '
             f'{analysis.min_pelvis_height_m:.3f} m)')
 
@@ -121,10 +134,10 @@ def _try_lines(each: TryAnalysis) -> list[str]:
              f'{a.data.sim_time_s(window.start_s):.3f} s at {window.cause}); trajectory {played}']
     if a.fell is None:
         fall = 'fall unknown'
-    elif a.fell:
-        after = each.fall_after_command_s
-        fall = (f'FELL at {a.fall_time_s:.3f} s' + ('' if after is None else
-                                                       f', {after:.3f} s after its first command'))
+    elif a.fell and each.fall is not None:
+        fall = f'FELL {fall_when(each.fall.sim_time_s, each.fall.after_command_s)}'
+    elif each.fall is not None:  # the simulator saw it, the 100 Hz odometry did not
+        fall = f'fell {fall_when(each.fall.sim_time_s, each.fall.after_command_s)}'
     else:
         fall = f'no fall (lowest {a.min_pelvis_height_m:.3f} m)'
     count = 0 if a.data.commands is None else len(a.data.commands.t_s)
@@ -159,23 +172,33 @@ def format_summary(analysis: Analysis, trajectory: str | None = None) -> str:
     return '\n'.join(lines)
 
 
-def short_summary(analysis: Analysis) -> str:
-    """The demo's summary of a run (make demo, run_offline.py): fall, then tracking of the
-    joints that moved."""
+def short_summary(analysis: Analysis, table: bool = False) -> str:
+    """The demo's summary of a run (make demo, run_offline.py), a few lines: the fall, then
+    the joints that tracked worst; with `table`, every joint that moved, a row each."""
     lines = ['=== summary ===']
+    first = analysis.first_fall()
     if analysis.fell is None:
         lines.append(f'fall: unknown (no {topics.GROUND_TRUTH_ODOM} in the bag)')
-    elif analysis.fell:
-        lines.append(f'the robot fell: pelvis below {FALL_HEIGHT_M} m at '
-                     f't = {analysis.fall_time_s:.2f} s from bag start')
+    elif first is not None:
+        lines.append(fall_line(FALL_HEIGHT_M, first[1].sim_time_s, first[1].after_command_s))
     else:
         lines.append('the robot did not fall (lowest pelvis height '
                      f'{analysis.min_pelvis_height_m:.2f} m)')
-    lines.append('tracking error of the joints that moved (commanded vs measured):')
-    for name, tracking in analysis.joints.items():
-        if tracking.rms_error_rad is not None:
-            lines.append(f'  {name:10s} RMS {tracking.rms_error_rad:.4f} rad, '
-                         f'max {tracking.max_error_rad:.4f} rad')
+    tracked = sorted(((joint.rms_error_rad, joint.max_error_rad, name)
+                      for name, joint in analysis.joints.items()
+                      if joint.rms_error_rad is not None), reverse=True)
+    if not tracked:
+        lines.append('tracking: no joint moved under a command')
+    elif table:
+        lines.append('tracking error of the joints that moved (commanded vs measured), '
+                     'worst first:')
+        lines.extend(f'  {name:10s} RMS {rms:.4f} rad, max {peak:.4f} rad'
+                     for rms, peak, name in tracked)
+    else:
+        worst = ', '.join(f'{name} {rms:.3f} rad' for rms, _peak, name in
+                          tracked[:SUMMARY_WORST_JOINTS])
+        lines.append(f'worst tracking (RMS |commanded - measured|, of {len(tracked)} joints '
+                     f'that moved): {worst}; --table lists them all')
     return '\n'.join(lines)
 
 
@@ -291,9 +314,11 @@ def _mark_modes(axes: list[Any], modes: list[tuple[float, str]]) -> None:
             ax.axvline(t_s, color='gray', linestyle='--', linewidth=0.8)
     for number, (t_s, mode) in enumerate(modes):
         # Alternate label heights so modes that change in quick succession stay legible.
-        axes[0].annotate(mode, (t_s, 1.0), xycoords=('data', 'axes fraction'),
-                         xytext=(2, 2 + 10 * (number % 2)), textcoords='offset points',
-                         fontsize=8)
+        refused = is_refused_mode(mode)
+        axes[0].annotate(f'{mode} (refused)' if refused else mode, (t_s, 1.0),
+                         xycoords=('data', 'axes fraction'), xytext=(2, 2 + 10 * (number % 2)),
+                         textcoords='offset points', fontsize=8,
+                         color='tab:red' if refused else 'black')
 
 
 def _mark_resets(axes: list[Any], analysis: Analysis) -> None:
@@ -329,15 +354,28 @@ def save_figure(fig: Any, path: Path | str) -> Path:
 
 
 def plot_run(analysis: Analysis, path: Path | str) -> Path:
-    """Plot commanded vs measured positions of the joints that moved, and pelvis height.
-
-    One subplot per moved joint plus one for the pelvis height, sharing the time axis;
-    control-mode changes are vertical lines labelled with the mode.
+    """The first page (overview_plot): pelvis height and falls, the tries with what was
+    played and its waypoints, the control modes, the worst-tracked joints.
 
     Raises:
         BagAnalysisError: The image cannot be written.
     """
     import matplotlib  # noqa: PLC0415 - only needed with --plot
+
+    matplotlib.use('Agg')
+    refused = {mode for _, mode in analysis.data.modes if is_refused_mode(mode)}
+    return save_figure(draw_overview(analysis, refused), path)
+
+
+def plot_joints(analysis: Analysis, path: Path | str) -> Path:
+    """The per-joint pages: commanded vs measured positions of the joints that moved, and
+    the pelvis height, one subplot each, sharing the time axis; control-mode changes are
+    vertical lines labelled with the mode.
+
+    Raises:
+        BagAnalysisError: The image cannot be written.
+    """
+    import matplotlib  # noqa: PLC0415 - only needed with --plot-joints
 
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt  # noqa: PLC0415

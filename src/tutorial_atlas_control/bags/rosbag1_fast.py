@@ -26,6 +26,7 @@ from io import BytesIO
 from pathlib import Path
 from typing import Any, NamedTuple
 
+import lz4.frame
 import numpy as np
 from rosbags.rosbag1 import Reader, ReaderError, Writer
 
@@ -182,6 +183,19 @@ def _new_chunk() -> WriteChunk:
     return WriteChunk(BytesIO(), -1, MAXSIZE, 0, defaultdict(_IndexEntries))
 
 
+def _roslz4_frame(data: bytes) -> bytes:
+    """`data` as an LZ4 frame laid out as ROS 1's roslz4 writes one, and so reads one:
+    independent 4 MB blocks, a content checksum, no content size. rosbags' own (lz4's
+    defaults: the content size in the header) makes Debian's rosbag fail ("malformed data
+    to decompress")."""
+    return lz4.frame.compress(data, block_size=lz4.frame.BLOCKSIZE_MAX4MB, block_linked=False,
+                              content_checksum=True, store_size=False)
+
+
+#: atlas.launch's compression names, as rosbags' Writer calls them.
+CHUNK_COMPRESSIONS = {'lz4': Writer.CompressionFormat.LZ4, 'bz2': Writer.CompressionFormat.BZ2}
+
+
 class _IndexedWriter(Writer):  # type: ignore[misc]
     """rosbags' rosbag1 Writer, its chunk index kept and written by numpy.
 
@@ -235,15 +249,21 @@ class BlockBagWriter:
     """
 
     def __init__(self, path: Path, typestore: Typestore,
-                 connections: Mapping[str, TopicConnection], chunk_bytes: int) -> None:
+                 connections: Mapping[str, TopicConnection], chunk_bytes: int,
+                 compression: str = 'none') -> None:
         """Create the bag at `path` (which must not exist) with `connections`, in order.
 
-        A chunk is closed after the flush() that takes it past `chunk_bytes`.
+        A chunk is closed after the flush() that takes it past `chunk_bytes`; chunks are
+        compressed as `compression` says: 'lz4', 'bz2' or 'none' (atlas.launch's values).
         """
         self.typestore = typestore
         self.msgtypes = {topic: connection.msgtype for topic, connection in connections.items()}
         self.writer = _IndexedWriter(path)
         self.writer.chunk_threshold = chunk_bytes
+        if compression != 'none':
+            self.writer.set_compression(CHUNK_COMPRESSIONS[compression])
+            if compression == 'lz4':
+                self.writer.compressor = _roslz4_frame
         self.writer.open()
         self.connection_ids: dict[str, int] = {}
         self.prefixes: dict[str, bytes] = {}

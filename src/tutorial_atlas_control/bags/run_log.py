@@ -38,7 +38,7 @@ def trajectory_lines(times: Sequence[Any], times_ns: Sequence[int], raws: Sequen
                      typestore: Any) -> list[tuple[Any, PlayedTrajectory]]:
     """(time, trajectory) of the player lines among /rosout messages `raws`.
 
-    `times` are passed through (bag_reader's run times); `times_ns` are the bag times.
+    `times` are passed through (reader.py's run times); `times_ns` are the bag times.
     """
     marker = TRAJECTORY_LOG_PREFIX.encode()
     found = []

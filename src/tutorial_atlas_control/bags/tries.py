@@ -7,10 +7,10 @@ start or at a reset, which the bag shows in two ways:
 * `/atlas/sim_config` is re-published after every reset (`/gazebo/reset_world`,
   `/gazebo/reset_simulation`, the viewer's reset) with the sim time of that reset; the
   first config in a bag is the one in force when recording began, not a reset.
-* Sim time going back (`/gazebo/reset_simulation` sets it to 0): bag_reader's epochs.
+* Sim time going back (`/gazebo/reset_simulation` sets it to 0): reader.py's epochs.
   A rewind with no config near it (an older bag) still starts a try.
 
-Times are bag_reader's run timeline (seconds from the bag's start).
+Times are reader.py's run timeline (seconds from the bag's start).
 """
 
 from __future__ import annotations
@@ -161,4 +161,5 @@ def window(data: BagData, start_s: float, end_s: float) -> BagData:
         modes, [(t_s, text) for t_s, text in data.sim_configs if start_s <= t_s < end_s],
         list(data.warnings), [(t_s, p) for t_s, p in data.played if start_s <= t_s < end_s],
         list(data.epoch_starts_s), list(data.epoch_shifts_s),
-        [(t_s, text) for t_s, text in data.sim_inputs if start_s <= t_s < end_s])
+        [(t_s, text) for t_s, text in data.sim_inputs if start_s <= t_s < end_s],
+        [(t_s, fall) for t_s, fall in data.logged_falls if start_s <= t_s < end_s])

@@ -17,6 +17,7 @@ from tutorial_atlas_control.bags.analysis import (
 )
 from tutorial_atlas_control.bags.compare import compare, format_comparison, plot_comparison
 from tutorial_atlas_control.bags.compare import to_json as comparison_json
+from tutorial_atlas_control.bags.overview_plot import WORST_JOINTS
 from tutorial_atlas_control.bags.reader import read_bag
 from tutorial_atlas_control.bags.render import (
     DEFAULT_FPS,
@@ -26,7 +27,13 @@ from tutorial_atlas_control.bags.render import (
     parse_size,
     render_bag_video,
 )
-from tutorial_atlas_control.bags.report import format_summary, plot_run, to_json, write_csv
+from tutorial_atlas_control.bags.report import (
+    format_summary,
+    plot_joints,
+    plot_run,
+    to_json,
+    write_csv,
+)
 from tutorial_atlas_control.bags.run_log import PlayedTrajectory
 from tutorial_atlas_control.cli.convention import (
     EXIT_INTERRUPTED,
@@ -137,8 +144,13 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument('--json', action='store_true',
                         help='print the results as one JSON object instead of the text summary')
     parser.add_argument('--plot', metavar='FILE.png',
-                        help='write commanded vs measured positions of the joints that moved and '
-                             'the pelvis height, with mode changes marked, to this image')
+                        help='write the run at a glance to this image: pelvis height and each '
+                             'fall (sim time, s after the try\'s first command), the tries with '
+                             'their trajectories and waypoints, control modes, and the '
+                             f'{WORST_JOINTS} worst-tracked joints\' error')
+    parser.add_argument('--plot-joints', metavar='FILE.png',
+                        help='write commanded vs measured positions of every joint that moved '
+                             '(one panel each) and the pelvis height to this image')
     parser.add_argument('--csv', metavar='DIR',
                         help='write joint_states.csv (t, <joint>_position..., _velocity..., '
                              '_effort...), joint_commands.csv (t, <joint>_position as sent, nan = '
@@ -195,6 +207,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                 print(f'wrote {path}', file=sys.stderr)
         if args.plot:
             print(f'wrote {plot_run(analysis, args.plot)}', file=sys.stderr)
+        if args.plot_joints:
+            print(f'wrote {plot_joints(analysis, args.plot_joints)}', file=sys.stderr)
         if args.video:
             video = render_bag_video(analysis.data, args.video, args.fps, args.size)
             print(f'wrote {video.path} ({video.frames} frames at {video.fps:g} fps)',
@@ -216,7 +230,7 @@ def _played_text(played: list[PlayedTrajectory]) -> str | None:
 
 
 def _compare(args: argparse.Namespace) -> int:
-    """`BAG --compare B.bag`: bag_compare's report, JSON or plot, of A's and B's tries."""
+    """`BAG --compare B.bag`: bags/compare.py's report, JSON or plot, of A's and B's tries."""
     try:
         a = analyze_try(read_bag(args.bag), -1 if args.try_number is None else args.try_number)
         b = analyze_try(read_bag(args.compare), -1 if args.try_b is None else args.try_b)

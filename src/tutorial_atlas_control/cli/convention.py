@@ -14,7 +14,7 @@ import sys
 from collections.abc import Callable
 from typing import TypeVar
 
-from tutorial_atlas_control.bags.bag_dir import latest_bag
+from tutorial_atlas_control.bags.bag_dir import newest_bag
 from tutorial_atlas_control.errors import AtlasControlError
 
 _T = TypeVar('_T')
@@ -61,13 +61,14 @@ def check_bag_arguments(parser: argparse.ArgumentParser, args: argparse.Namespac
 
 
 def chosen_bag(args: argparse.Namespace, doing: str) -> str:
-    """BAG, or the newest bag (said on stderr: `<doing> PATH (the newest bag)`).
+    """BAG, or the newest bag (said on stderr: `<doing> PATH (the newest bag)`, naming the
+    newer empty or unreadable bags it skipped).
 
     Raises:
         AtlasControlError: no BAG, and no bag in the bag directory.
     """
     if args.bag:
         return str(args.bag)
-    path = str(latest_bag())
-    print(f'{doing} {path} (the newest bag)', file=sys.stderr)
-    return path
+    newest = newest_bag()
+    print(f'{doing} {newest.path} (the newest bag{newest.skipped_note()})', file=sys.stderr)
+    return str(newest.path)

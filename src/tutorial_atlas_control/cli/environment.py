@@ -3,7 +3,7 @@
 Run from a shell without `source ./env.sh`, a script finds the package (its wrapper puts
 src/ on the path) but not the virtualenv's modules (rosbags, mujoco, ...) nor the
 workspace's messages: an import error then says so in one line instead of a traceback,
-even for --help. traj_yaml.py says the same in its own words (node/traj_yaml.py).
+even for --help. traj_yaml.py says the same in its own words (trajectories/traj_yaml_node.py).
 """
 
 from __future__ import annotations

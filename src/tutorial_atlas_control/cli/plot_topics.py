@@ -23,7 +23,7 @@ from tutorial_atlas_control.cli.convention import (
     argument_type,
     print_error,
 )
-from tutorial_atlas_control.node import plot_topics
+from tutorial_atlas_control.plotting import plot_topics_node as plot_topics
 from tutorial_atlas_control.plotting.fields import PlotError, expand_arguments, parse_field_path
 
 PROG = 'plot_topics.py'
@@ -67,9 +67,9 @@ def parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
                         type=argument_type(_argument),
                         help='TOPIC/FIELD, TOPIC/FIELD[INDEX], TOPIC/FIELD1:FIELD2, nested '
                              'TOPIC/FIELD/SUBFIELD; all in one plot')
-    parser.add_argument('--window', type=argument_type(_seconds), default=DEFAULT_WINDOW_S,
-                        metavar='S',
-                        help=f'seconds of ROS time shown (default {DEFAULT_WINDOW_S:g})')
+    parser.add_argument('--window', type=argument_type(_seconds), metavar='S',
+                        help='seconds of ROS time shown (default: --duration with --png, else '
+                             f'{DEFAULT_WINDOW_S:g})')
     parser.add_argument('--png', type=Path, metavar='OUT.png',
                         help='no window: write the plot to OUT.png after --duration and exit')
     parser.add_argument('--duration', type=argument_type(_seconds), metavar='S',
@@ -78,11 +78,20 @@ def parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
     return parser.parse_args(argv)
 
 
+def window_s(args: argparse.Namespace) -> float:
+    """--window, else for a picture (--png) --duration, so that it fills the time axis."""
+    if args.window is not None:
+        return float(args.window)
+    if args.png is not None and args.duration is not None:
+        return float(args.duration)
+    return DEFAULT_WINDOW_S
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of scripts/plot_topics.py."""
     args = parse_args(argv)
-    options = plot_topics.PlotOptions(expand_arguments(args.arguments), args.window, args.png,
-                                      args.duration)
+    options = plot_topics.PlotOptions(expand_arguments(args.arguments), window_s(args),
+                                      args.png, args.duration)
     try:
         plot_topics.require_master()
         not_plotted = plot_topics.run_plot(options, plot_topics.stderr_line(PROG))

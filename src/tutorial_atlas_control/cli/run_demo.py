@@ -7,6 +7,7 @@ import math
 import os
 import subprocess
 import sys
+import time
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -17,8 +18,8 @@ from tutorial_atlas_control.cli.convention import (
     argument_type,
     print_error,
 )
+from tutorial_atlas_control.demo import demo_node as demo
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.node import demo
 from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.trajectories.catalog import find_trajectory, gains_for
 from tutorial_atlas_control.trajectories.trajectory import load_trajectory
@@ -47,6 +48,9 @@ def build_parser() -> argparse.ArgumentParser:
                         help='where the bag goes (default: $TAC_BAG_DIR or %(default)s)')
     parser.add_argument('--real-time-factor', type=argument_type(real_time_factor), default=1.0,
                         help='simulator pace; 0 = as fast as possible (default: 1.0)')
+    parser.add_argument('--table', action='store_true',
+                        help='list the tracking error of every joint that moved, not only the '
+                             'worst three')
     parser.add_argument('--video-fps', type=float, default=demo.DEMO_VIDEO_FPS,
                         help='frame rate of the rendered video; 0 = no video '
                              '(default: %(default)g)')
@@ -74,6 +78,7 @@ def _warn(line: str) -> None:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status."""
     args = build_parser().parse_args(argv)
+    started_s = time.time()
     try:
         # Everything is checked before anything starts.
         trajectory_file = args.file or find_trajectory(args.trajectory)
@@ -83,7 +88,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         bag = demo.run_demo(args.trajectory, trajectory_file, args.bag_dir.expanduser().resolve(),
                             args.real_time_factor, args.bag_dir.expanduser() / 'logs',
                             progress=print, warn=_warn, gains=gains)
-        demo.summarise(bag, args.video_fps, args.video_size, report=print)
+        demo.summarise(bag, args.video_fps, args.video_size, report=print, table=args.table)
     except AtlasControlError as err:
         print_error(PROG, err)
         return EXIT_REFUSED
@@ -91,5 +96,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         print_error(PROG, f'{err.cmd[2] if len(err.cmd) > 2 else err.cmd} timed out')
         return EXIT_REFUSED
     except KeyboardInterrupt:  # run_demo has stopped roslaunch on the way out
+        _name_partial_bag(args.bag_dir.expanduser().resolve(), started_s)
         return EXIT_INTERRUPTED
     return 0
+
+
+def _name_partial_bag(bag_dir: Path, started_s: float) -> None:
+    """After Ctrl-C: where the run so far was recorded (the recorder closed it), if at all."""
+    try:
+        bag = demo.newest_bag(bag_dir, started_s)
+    except (AtlasControlError, OSError):
+        return  # interrupted before the recorder wrote anything
+    print(f'{PROG}: interrupted; the run so far is in {bag} (analyze_bag.py {bag})',
+          file=sys.stderr)

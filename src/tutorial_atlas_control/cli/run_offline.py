@@ -47,6 +47,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument('name', metavar='NAME', help='trajectory name in YAML_FILE')
     parser.add_argument('--bag', type=Path, metavar='OUT.bag',
                         help='write the run to this bag (replaced if it exists)')
+    parser.add_argument('--table', action='store_true',
+                        help='list the tracking error of every joint that moved, not only the '
+                             'worst three')
     parser.add_argument('--settle', type=_seconds, default=DEFAULT_SETTLE_S, metavar='S',
                         help='sim time after the last command (default: %(default)g)')
     parser.add_argument('--play-after', type=_seconds, default=0.0, metavar='S',
@@ -78,7 +81,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_INTERRUPTED
     print(f'offline: {args.name}: {run.commands} commands, {run.sim_time_s:.3f} s of sim time '
           f'in {run.wall_s:.2f} s ({run.real_time_factor:.1f}x real time)')
-    print(short_summary(analysis))
+    print(short_summary(analysis, args.table))
     if args.bag is not None:
         print(f'bag:   {run.bag}')
     return 0

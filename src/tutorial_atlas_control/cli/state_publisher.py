@@ -1,7 +1,7 @@
 """Command line of state_publisher.py: robot_state_publisher on the model's URDF (atlas.launch).
 
 It keeps roslaunch's command line (MODEL_FILE and `name:=value` ROS arguments, usage from
-node/state_publisher.py's docstring) rather than argparse's.
+sim/state_publisher_node.py's docstring) rather than argparse's.
 """
 
 from __future__ import annotations
@@ -14,7 +14,8 @@ from pathlib import Path
 import mujoco
 
 from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED, EXIT_REFUSED
-from tutorial_atlas_control.node import state_publisher
+from tutorial_atlas_control.node import single_instance
+from tutorial_atlas_control.sim import state_publisher_node as state_publisher
 from tutorial_atlas_control.sim.urdf import UrdfError, matching_urdf
 
 PROG = 'state_publisher.py'
@@ -30,6 +31,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         asked = bool(plain) and plain[0] in HELP_OPTIONS
         print(state_publisher.__doc__.strip(), file=sys.stdout if asked else sys.stderr)
         return 0 if asked else EXIT_REFUSED
+    if single_instance.refuse_if_running(PROG, 'robot_state_publisher', argv, full=False):
+        return EXIT_REFUSED
     try:
         return _start(Path(plain[0]), ros_args)
     except KeyboardInterrupt:

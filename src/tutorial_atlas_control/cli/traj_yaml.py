@@ -19,7 +19,7 @@ import rospy
 
 from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.node.traj_yaml import (
+from tutorial_atlas_control.trajectories.traj_yaml_node import (
     NODE_NAME,
     joint_commands_type,
     play,

@@ -1,4 +1,15 @@
-"""ROS 1 wire layouts: the JointCommands schema and decoding, pre-serialized messages.
+"""ROS 1 wire formats: schemas, decoding, checks and pre-serialized messages. No rospy.
 
-And their filling. No rospy.
+What fills the messages from the simulator each step is sim/sim_messages.py.
 """
+
+from tutorial_atlas_control.exports import lazy_exports
+
+__all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    'atlas_command': ['AtlasUpdate', 'decode_atlas_command', 'decode_test'],
+    'joint_commands': ['CommandDecoder'],
+    'ros1_fields': ['FieldCursor', 'parse_names_arrays'],
+    'wire': ['AtlasStateWire', 'ControllerStatisticsWire', 'ForceTorqueSensorsWire', 'ImuWire',
+             'JointCommandsWire', 'JointStateWire', 'OdometryWire', 'StampedWire', 'TransformWire',
+             'TransformsWire', 'WRENCH_FLOATS', 'WrenchStampedWire', 'clock_bytes'],
+})

@@ -4,7 +4,7 @@ DRCSim 2.5.2's AtlasPlugin copies each array of exactly 28 entries into the comm
 keeps the previous values of any array of another length (SetAtlasCommand,
 SetExperimentalDampingPID). We do the same, and say so: an array of another non-zero length
 is named in one warning (an empty array is the usual way not to set a field: silent). On top
-of DRCSim, a message with NaN/Inf or an absurd magnitude anywhere (commands.MAX_MAGNITUDE,
+of DRCSim, a message with NaN/Inf or an absurd magnitude anywhere (arrays.MAX_MAGNITUDE,
 MAX_DAMPING) is refused whole, as JointCommands are.
 
 The k_effort bytes become the fraction k_effort / 255 the law blends with (AtlasPlugin's
@@ -19,15 +19,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tutorial_atlas_control.joints import NUM_JOINTS
-from tutorial_atlas_control.msgs.commands import (
-    _ALL_JOINTS,
+from tutorial_atlas_control.command.arrays import (
+    ALL_JOINTS,
     K_EFFORT_ROW,
     LAW_FIELDS,
     CommandError,
     CommandUpdate,
     check_values,
 )
+from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.msgs.ros1_fields import FieldCursor
 from tutorial_atlas_control.units import NS_PER_S
 
@@ -109,7 +109,7 @@ def _checked(arrays: Sequence[tuple[str, np.ndarray]], stamp_ns: int,
     check_values(rows, block)
     if K_EFFORT_ROW in rows:
         block[rows.index(K_EFFORT_ROW)] /= K_EFFORT_FULL_SCALE
-    return AtlasUpdate(CommandUpdate(_ALL_JOINTS, tuple(rows), block), tuple(ignored),
+    return AtlasUpdate(CommandUpdate(ALL_JOINTS, tuple(rows), block), tuple(ignored),
                        stamp_ns, period_ms, damping)
 
 
@@ -167,7 +167,7 @@ def _decode_full(raw: bytes) -> AtlasUpdate | None:
         block[row] = body[name]
     check_values(_FULL_ROWS, block)
     block[_K_EFFORT_INDEX] /= K_EFFORT_FULL_SCALE
-    return AtlasUpdate(CommandUpdate(_ALL_JOINTS, _FULL_ROWS, block), (), stamp_ns,
+    return AtlasUpdate(CommandUpdate(ALL_JOINTS, _FULL_ROWS, block), (), stamp_ns,
                        int(body['desired_controller_period_ms']))
 
 

@@ -1,5 +1,12 @@
-"""Everything that imports rospy.
+"""The simulator node's machinery: the node, its transport, the master and recorder
+watches, the viewer link. Imports rospy.
 
-The simulator node, its transport, viewer link, state publisher, the traj_yaml node and the
-demo driver.
+The other programs' ROS sides live with their concern, in modules named *_node.py.
 """
+
+from tutorial_atlas_control.exports import lazy_exports
+
+__all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    'sim_node': ['NODE_NAME', 'build_node'],
+    'transport': ['WireBatch', 'subscriber_names'],
+})

@@ -1,4 +1,4 @@
-"""The simulator node across a restart of the ROS master (issue 29).
+"""The simulator node across a restart of the ROS master.
 
 ROS 1 nodes register with the master once: after `roscore` is restarted, the new master
 knows none of them, and new clients (`rostopic echo`, traj_yaml.py) cannot find the

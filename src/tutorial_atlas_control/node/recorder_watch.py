@@ -1,4 +1,4 @@
-"""One line from the simulator when the run stops being recorded (issue 29).
+"""One line from the simulator when the run stops being recorded.
 
 A recorder killed (SIGKILL, OOM) or stopped by a full disk leaves the simulator running
 with nobody recording, and nothing in the simulator's output would say so. The simulator

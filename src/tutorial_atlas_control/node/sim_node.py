@@ -56,6 +56,7 @@ Parameters (private unless noted):
 from __future__ import annotations
 
 import io
+import logging
 import os
 import threading
 import time
@@ -103,6 +104,7 @@ from tutorial_atlas_control.sim.controller_statistics import (
     WINDOW_PARAM,
     CommandAgeStatistics,
 )
+from tutorial_atlas_control.sim.joint_trajectory import TrajectoryMessage, trajectory_input
 from tutorial_atlas_control.sim.link_transforms import LinkTransforms
 from tutorial_atlas_control.sim.simulator import (
     DEFAULT_TIME_TO_UNPIN_S,
@@ -119,9 +121,9 @@ from tutorial_atlas_control.sim.vrc import (
     SimInput,
     VrcMode,
     cmd_vel_input,
+    input_notes,
     parse_vrc_mode,
     pose_input,
-    trajectory_input,
     wrench_input,
 )
 from tutorial_atlas_control.stepping.loop import (
@@ -163,7 +165,7 @@ class RawMessage(genpy.Message):
     genpy's decoder would run in the receiving thread, under the GIL the stepping loop
     needs, and at thousands of commands a second starve the loop. A subclass keeps the real
     type, MD5 and definition, so the subscription is registered, negotiated and shown as
-    that type; the loop decodes `raw` itself (msgs/commands.py, msgs/atlas_command.py).
+    that type; the loop decodes `raw` itself (msgs/joint_commands.py, msgs/atlas_command.py).
     """
 
     _has_header = True
@@ -380,11 +382,7 @@ class SimNode:
                 (msg.force.x, msg.force.y, msg.force.z),
                 (msg.torque.x, msg.torque.y, msg.torque.z))),
             (topics.JOINT_TRAJECTORY, JointTrajectory, lambda msg: trajectory_input(
-                msg.header.frame_id, msg.header.stamp.to_nsec(), msg.joint_names,
-                [point.positions for point in msg.points],
-                [point.time_from_start.to_nsec() for point in msg.points], lower, upper,
-                links, [{'velocities': point.velocities, 'accelerations': point.accelerations,
-                         'effort': point.effort} for point in msg.points])),
+                TrajectoryMessage.from_ros(msg), lower, upper, links)),
         )
         for topic, msg_class, decode in cheats:
             rospy.Subscriber(topic, msg_class, self._cheat_handler(topic, decode),
@@ -403,6 +401,9 @@ class SimNode:
                 rospy.logwarn_throttle_identical(WARN_THROTTLE_S,
                                                  f'refused {topic}: {err}; nothing applied')
                 return
+            for note in input_notes(item):  # what the check changed, once per message
+                log = rospy.logwarn if note.level >= logging.WARNING else rospy.loginfo
+                log(f'{topic}: {note.text}')
             self.loop.apply_input(item)
         return handle
 

@@ -8,7 +8,7 @@ with queue_size=None: no rospy queue, the loop writes the sockets itself (Connec
 
 A TCP subscriber that reads slowly but keeps reading (the bag recorder at
 real_time_factor:=0) gets back-pressure: the loop waits for it and it loses nothing. One
-that stops reading (issue 29) is not waited for beyond STALL_PROBE_S: what it has not
+that stops reading is not waited for beyond STALL_PROBE_S: what it has not
 taken is kept in a bounded backlog while the loop and the other subscribers go on, and it
 is dropped once it has accepted nothing for SEND_TIMEOUT_S or its backlog passes
 MAX_BACKLOG_BYTES.

@@ -13,6 +13,10 @@ the node adds, as Gazebo had them:
     Space                              pause / unpause physics and /clock
                                        (/gazebo/pause_physics, /gazebo/unpause_physics)
 
+The window opens with the 3-D view filling it; MuJoCo's own keys show its panels: Tab the
+left one (File, Option, Simulation with "Reset", ...), Shift+Tab the right one (joints,
+controls).
+
 The viewer's own Pause/Run switch is greyed out for a passive viewer (MuJoCo's choice); a
 "PAUSED" overlay shows the node's state instead. Mouse perturbations (Ctrl+drag) still push
 the robot: their forces are copied back to the physics data. Joint and control sliders only
@@ -59,6 +63,10 @@ RESET_MODIFIERS = frozenset({SHIFT, CONTROL})
 #: reset) zeroes that field, and nothing else on the shadow writes it (the shadow is never
 #: stepped; mj_forward reads it only). Unlike data.time, it also tells a reset at t = 0.
 RESET_CANARY = 1.0
+#: Whether MuJoCo's left and right UI panels show when the window opens. Shown, the two
+#: leave the robot about a third of a 1280-pixel-wide window; Tab and Shift+Tab (MuJoCo's
+#: keys) toggle them.
+PANELS_SHOWN_AT_OPEN = False
 #: The overlay shown while physics is paused (left and right column).
 PAUSED_TEXT = ('PAUSED', 'physics and /clock stopped; Space runs')
 #: mujoco.viewer.launch_passive runs the window in a thread whose target is this function
@@ -161,7 +169,9 @@ class ViewerLink:
         self._hold_lock = threading.Lock()
         self._closed = False
         before = set(threading.enumerate())
-        self.handle = launch(model, self.shadow, key_callback=self.on_key)
+        self.handle = launch(model, self.shadow, key_callback=self.on_key,
+                             show_left_ui=PANELS_SHOWN_AT_OPEN,
+                             show_right_ui=PANELS_SHOWN_AT_OPEN)
         self._window_threads = _window_threads(before)
         # For an exit that skips close() (an exception): runs before mujoco.viewer's own exit
         # hooks (registered earlier, run later), which race the window's thread. A no-op

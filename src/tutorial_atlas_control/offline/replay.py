@@ -105,6 +105,7 @@ class Recording:
     inputs: list[InputEvent] = field(default_factory=list)  # since the try's reset, in order
     try_number: int = 1
     tries: int = 1
+    try_asked: bool = False  # --try given: the report's 'try N of M' says it, no warning
 
 
 def _read_sim_configs(data: BagData) -> list[dict[str, Any]]:
@@ -237,16 +238,7 @@ def load_recording(path: Path | str, data: BagData | None = None,
         warnings.append(f'the run has {tests.count} {topics.ATLAS_TEST} message(s): joint '
                         'damping they set is not re-applied offline, so the replay deviates '
                         'from the first that set it.')
-    columns = []
-    missing = []
-    for name in JOINT_NAMES:
-        if name in states.names:
-            columns.append(states.names.index(name))
-        else:
-            missing.append(name)
-    if missing:
-        raise ReplayError(f'{JOINT_STATES_TOPIC} in {path} lacks joints {", ".join(missing)}; '
-                          'the replay needs the torque of all 28.')
+    columns = _joint_columns(path, states.names)
     state_stamp_ns = _stamps_ns(data, states.t_s)
     effort = states.effort[:, columns]
     position = states.position[:, columns]
@@ -254,21 +246,36 @@ def load_recording(path: Path | str, data: BagData | None = None,
     if not (np.isfinite(effort).all() and np.isfinite(position).all()):
         raise ReplayError(f'{JOINT_STATES_TOPIC} in {path} has missing (NaN) positions or '
                           'efforts; every message must carry all 28 joints.')
-    pelvis = data.pelvis
-    has_odom = pelvis is not None and len(pelvis.t_s) > 0
-    if has_odom:
-        assert pelvis is not None
-        odom_stamp_ns = _stamps_ns(data, pelvis.t_s)
-        odom_position = pelvis.position_m
-        odom_quat = pelvis.orientation_xyzw[:, [3, 0, 1, 2]]
-    else:
-        warnings.append(f'the bag has no {ODOM_TOPIC}: the pelvis pose is not compared.')
-        odom_stamp_ns = np.empty(0, dtype=np.int64)
-        odom_position, odom_quat = np.empty((0, 3)), np.empty((0, 4))
+    odom_stamp_ns, odom_position, odom_quat = _pelvis_series(data, warnings)
     inputs = _input_events(path, data, config, warnings)
     return Recording(path, config, resets, state_stamp_ns, position, velocity, effort,
-                     odom_stamp_ns, odom_position, odom_quat, has_odom, warnings, inputs,
-                     chosen.number, tries)
+                     odom_stamp_ns, odom_position, odom_quat, len(odom_stamp_ns) > 0, warnings,
+                     inputs, chosen.number, tries, try_asked=try_number is not None)
+
+
+def _joint_columns(path: Path, names: Sequence[str]) -> list[int]:
+    """Where each of the 28 joints (tutorial order) is in the recorded joint states.
+
+    Raises:
+        ReplayError: some joints are missing (the message names them).
+    """
+    missing = [name for name in JOINT_NAMES if name not in names]
+    if missing:
+        raise ReplayError(f'{JOINT_STATES_TOPIC} in {path} lacks joints {", ".join(missing)}; '
+                          'the replay needs the torque of all 28.')
+    return [names.index(name) for name in JOINT_NAMES]
+
+
+def _pelvis_series(data: BagData,
+                   warnings: list[str]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The recorded pelvis pose: stamps (ns), positions (m), quaternions (w, x, y, z); all
+    empty, with a warning, when the bag has no odometry."""
+    pelvis = data.pelvis
+    if pelvis is None or not len(pelvis.t_s):
+        warnings.append(f'the bag has no {ODOM_TOPIC}: the pelvis pose is not compared.')
+        return np.empty(0, dtype=np.int64), np.empty((0, 3)), np.empty((0, 4))
+    return (_stamps_ns(data, pelvis.t_s), pelvis.position_m,
+            pelvis.orientation_xyzw[:, [3, 0, 1, 2]])
 
 
 # ---------------------------------------------------------------------------- replay
@@ -547,7 +554,7 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
     step_ns = sim.step_ns
     reset_step = _reset_step(config, step_ns)
     sim.reset_simulation(reset_step * step_ns)
-    if recording.resets_in_bag:
+    if recording.resets_in_bag and not recording.try_asked:
         which = ('the last segment' if recording.try_number == recording.tries
                  else f'try {recording.try_number} of {recording.tries}')
         warnings.append(f'the bag holds {recording.resets_in_bag} reset(s); replaying {which}, '

@@ -105,6 +105,31 @@ def split_topic(argument: str, topics: Iterable[str]) -> tuple[str, str] | None:
 
 MessageClassLookup = Callable[[str], object]
 
+#: Units of common fields, by (the field holding it, the field read); '*' for any holder.
+#: sensor_msgs/JointState's position is in rad for Atlas's revolute joints.
+UNITS: dict[tuple[str, str], str] = {
+    ('*', 'position'): 'rad', ('*', 'velocity'): 'rad/s', ('*', 'effort'): 'N·m',
+    ('position', 'x'): 'm', ('position', 'y'): 'm', ('position', 'z'): 'm',
+    ('linear', 'x'): 'm/s', ('linear', 'y'): 'm/s', ('linear', 'z'): 'm/s',
+    ('angular', 'x'): 'rad/s', ('angular', 'y'): 'rad/s', ('angular', 'z'): 'rad/s',
+    ('angular_velocity', 'x'): 'rad/s', ('angular_velocity', 'y'): 'rad/s',
+    ('angular_velocity', 'z'): 'rad/s',
+    ('linear_acceleration', 'x'): 'm/s²', ('linear_acceleration', 'y'): 'm/s²',
+    ('linear_acceleration', 'z'): 'm/s²',
+    ('force', 'x'): 'N', ('force', 'y'): 'N', ('force', 'z'): 'N',
+    ('torque', 'x'): 'N·m', ('torque', 'y'): 'N·m', ('torque', 'z'): 'N·m',
+}
+
+
+def unit_of(path: Sequence[FieldStep], leaf_type: str) -> str | None:
+    """The unit of the field at `path` when it is a common one (UNITS), else None."""
+    if leaf_type in TIME_TYPES:
+        return 's'
+    names = [step.name for step in path]
+    holder = names[-2] if len(names) > 1 else ''
+    return UNITS.get((holder, names[-1])) or (
+        UNITS.get(('*', names[-1])) if len(names) == 1 else None)
+
 
 def _qualified(type_name: str, package: str) -> str:
     """A slot's message type with its package (`Header` is std_msgs', as in genmsg)."""
@@ -176,6 +201,24 @@ class FieldReader:
                 raise PlotError(f'no message class for {type_name} (is its package built and '
                                 'the workspace sourced?)')
         raise PlotError('no field given')
+
+    def element_name(self, message: object) -> str | None:
+        """The name of the array element read, when the message holding the array also holds
+        a `name` list of the same length (sensor_msgs/JointState and its kind): `position[19]`
+        of /atlas/joint_states is l_arm_elx. None otherwise."""
+        last = self.path[-1]
+        if last.index is None:
+            return None
+        holder = message
+        for step in self.path[:-1]:
+            holder = getattr(holder, step.name, None)
+            if step.index is not None and holder is not None:
+                holder = holder[step.index] if step.index < len(holder) else None
+        names = getattr(holder, 'name', None)
+        values = getattr(holder, last.name, None)
+        if not isinstance(names, (list, tuple)) or values is None or len(names) != len(values):
+            return None
+        return str(names[last.index]) if last.index < len(names) else None
 
     def read(self, message: object) -> float:
         """The field's value in `message` as a float (s for time and duration).

@@ -1,6 +1,6 @@
 """The drawing of a live plot on a matplotlib Figure: the window's and the PNG's alike.
 
-node/plot_topics.py hands it a pyplot figure on the Tk backend (the window) or a plain
+plot_topics_node.py hands it a pyplot figure on the Tk backend (the window) or a plain
 Figure on Agg (--png); `update` sets the lines, the time axis (the last `window_s` seconds
 of ROS time), the y range and the legend, and the caller draws or saves.
 """
@@ -62,7 +62,7 @@ class PlotFigure:
             self.lines[plot_field.argument] = line
         self.status = self.axes.text(1.0, -0.12, '', transform=self.axes.transAxes,
                                      ha='right', va='top', color='tab:red')
-        self._legend_for: tuple[tuple[str, bool], ...] = ()
+        self._legend_for: tuple[tuple[str, str, bool], ...] = ()
         self._refresh_legend()
 
     def update(self, *, autoscale: bool = True, paused: bool = False) -> None:
@@ -95,17 +95,20 @@ class PlotFigure:
     def _refresh_legend(self) -> None:
         """The legend above the axes (it never hides data): one entry per plotted argument,
         `(no data yet)` after those without a sample."""
-        entries = tuple((f.argument, f.samples > 0) for f in self.plot.fields if f.plotted)
+        entries = tuple((f.argument, f.label, f.samples > 0) for f in self.plot.fields
+                        if f.plotted)
         if entries == self._legend_for:
             return
         self._legend_for = entries
+        units = sorted({f.unit for f in self.plot.fields if f.plotted and f.unit})
+        self.axes.set_ylabel(', '.join(units))
         legend = self.axes.get_legend()
         if legend is not None:
             legend.remove()
         if entries:
             self.axes.legend(
-                handles=[self.lines[argument] for argument, _ in entries],
-                labels=[argument if has_data else f'{argument} (no data yet)'
-                        for argument, has_data in entries],
+                handles=[self.lines[argument] for argument, _, _ in entries],
+                labels=[label if has_data else f'{label} (no data yet)'
+                        for _, label, has_data in entries],
                 loc='lower left', bbox_to_anchor=(0.0, 1.01), ncols=LEGEND_COLUMNS,
                 fontsize='small', frameon=False, borderaxespad=0.0)

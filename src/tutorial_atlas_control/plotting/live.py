@@ -5,7 +5,7 @@ connection header, it decodes them with that type's class, reads only the fields
 and keeps floats, nothing else. An argument that cannot be plotted gets one line saying why
 (`cannot plot ARG: ...`) and is dropped; the others go on. ROS time moving back (a reset of
 sim time) clears every series. The ROS side (subscribing, the clock, the master's topic
-list) is node/plot_topics.py; this module has no ROS import, so its logic is unit-tested.
+list) is plot_topics_node.py; this module has no ROS import, so its logic is unit-tested.
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ from tutorial_atlas_control.plotting.fields import (
     PlotError,
     parse_field_path,
     split_topic,
+    unit_of,
 )
 from tutorial_atlas_control.plotting.series import ClockWatch, RollingSeries
 
@@ -50,10 +51,20 @@ class PlotField:
     refused: str | None = None
     samples: int = 0
     reported_silent: bool = field(default=False, repr=False)
+    #: The array element's name (JointState's `name`) once a message was read ('' if the
+    #: message names none).
+    element: str | None = None
+    #: The field's unit when it is a common one (fields.unit_of).
+    unit: str | None = None
 
     @property
     def plotted(self) -> bool:
         return self.refused is None
+
+    @property
+    def label(self) -> str:
+        """The legend's text: the argument, and the element's name when known."""
+        return f'{self.argument} ({self.element})' if self.element else self.argument
 
 
 class LivePlot:
@@ -123,6 +134,8 @@ class LivePlot:
                     plot_field.reader = FieldReader.for_class(message_class, plot_field.path,
                                                               lookup)
                     plot_field.checked_type = type_name
+                    plot_field.unit = unit_of(plot_field.path, plot_field.reader.leaf_type)
+                    plot_field.element = None
                 except PlotError as err:
                     lines.append(self._refuse(plot_field, f'{topic}: {err}'))
         fields = [f for f in fields if f.plotted]
@@ -146,6 +159,8 @@ class LivePlot:
             for column, plot_field in zip(values, fields):
                 if plot_field.plotted:
                     try:
+                        if plot_field.element is None:
+                            plot_field.element = plot_field.reader.element_name(message) or ''
                         column.append(plot_field.reader.read(message))
                         continue
                     except PlotError as err:

@@ -1,1 +1,12 @@
-"""Sweeps of many offline runs on Dask, and the search over them (issue 27). No ROS."""
+"""Sweeps of many offline runs on Dask, and the CMA-ES search over them. No ROS."""
+
+from tutorial_atlas_control.exports import lazy_exports
+
+__all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    'cmaes': ['LATENCY_SEED', 'SearchProblem', 'SearchResult', 'gains_yaml', 'parse_parameter',
+              'run_search', 'runs_per_candidate', 'trajectory_yaml'],
+    'objectives': ['OBJECTIVES', 'parse_objective'],
+    'runs': ['RunSpec', 'SweepError', 'run_one'],
+    'sweep': ['SweepEngine', 'SweepInputs', 'atomic_write', 'build_specs', 'check_output',
+              'parse_latency', 'parse_push', 'run_sweep', 'table_texts', 'write_table'],
+})

@@ -275,13 +275,7 @@ def run_search(problem: SearchProblem, evaluate: Evaluate, log_path: Path, resum
         raise SweepError(f'{log_path} exists; give --resume to continue that search, or '
                          'another --log')
     es = problem.strategy()
-    start = next((r for r in records if r['kind'] == 'start'), None)
-    if start is None:
-        evaluated = problem.evaluate(evaluate, [np.zeros(len(problem.parameters))])
-        if evaluated is None:
-            raise KeyboardInterrupt
-        start = {'kind': 'start', 'cost': evaluated[0][0], 'row': evaluated[1][0]}
-        atomic_write(log_path, json.dumps(_header(problem)) + '\n' + json.dumps(start) + '\n')
+    start = _start_record(problem, evaluate, log_path, records)
     result = SearchResult(start['cost'], start['cost'], [0.0] * len(problem.parameters),
                           start['row'], problem.candidate(np.zeros(len(problem.parameters))), 0)
     report(f'search: start: cost {result.start_cost:.4g}')
@@ -325,6 +319,21 @@ def run_search(problem: SearchProblem, evaluate: Evaluate, log_path: Path, resum
         report(f'search: generation {result.generations}: best of generation '
                f'{min(costs):.4g}, best {result.best_cost:.4g}')
     return result
+
+
+def _start_record(problem: SearchProblem, evaluate: Evaluate, log_path: Path,
+                  records: Sequence[dict[str, Any]]) -> dict[str, Any]:
+    """The start's record (the unchanged spec, x = 0): the log's, or evaluated now and
+    written with the log's header (a new log)."""
+    start = next((r for r in records if r['kind'] == 'start'), None)
+    if start is not None:
+        return start
+    evaluated = problem.evaluate(evaluate, [np.zeros(len(problem.parameters))])
+    if evaluated is None:
+        raise KeyboardInterrupt
+    start = {'kind': 'start', 'cost': evaluated[0][0], 'row': evaluated[1][0]}
+    atomic_write(log_path, json.dumps(_header(problem)) + '\n' + json.dumps(start) + '\n')
+    return start
 
 
 # -- the files the search writes --------------------------------------------------------

@@ -1,4 +1,33 @@
-"""The simulation: the MuJoCo model and its URDF, the controller law, the simulator. No ROS.
+"""The simulation: the MuJoCo model and its URDF, the controller law, the simulator, the
+messages filled from its state. No ROS.
 
-The controller law comes in two implementations, numpy and compiled.
+The controller law comes in two implementations, numpy and compiled. The ROS side of the
+robot description, state_publisher_node.py, is imported by its module.
 """
+
+from tutorial_atlas_control.exports import lazy_exports
+
+__all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    'camera': ['CAMERA', 'configure_viewer_camera', 'configure_viewer_scene'],
+    'controller': ['DEFAULT_GAINS_FILE', 'Gains', 'GainsError', 'LOAD_HINT', 'gains_from_params',
+                   'load_gains_yaml'],
+    'controller_statistics': ['CommandAgeStatistics', 'DEFAULT_WINDOW_S', 'UPDATE_RATE_PARAM',
+                              'WINDOW_PARAM'],
+    'copy_plan': ['CopyPlan'],
+    'divergence': ['DivergenceCheck', 'PhysicsDivergenceError'],
+    'joint_law': ['JointLaw'],
+    'joint_trajectory': ['TrajectoryMessage', 'trajectory_input'],
+    'law_kernel': ['CompiledLaw', 'LawJoints'],
+    'link_transforms': ['LinkTransforms', 'RspSchedule'],
+    'model': ['AtlasModel', 'FALL_HEIGHT_M', 'SPAWN_HEIGHT_M', 'body_position_in_pose',
+              'load_model', 'reset_to_initial'],
+    'mode_commands': ['ControlMode', 'ModeCommands', 'ModeError', 'VALID_MODES', 'parse_mode'],
+    'sim_config': ['SimConfig', 'SimConfigError', 'parse_sim_config'],
+    'sim_messages': ['SimMessages', 'TCPROS_PREFIX_BYTES'],
+    'simulator': ['AtlasSimulator', 'DEFAULT_TIME_TO_UNPIN_S'],
+    'startup_pin': ['StartupPin'],
+    'urdf': ['UrdfError', 'matching_urdf', 'read_joints'],
+    'vrc': ['DEFAULT_STARTUP_MODE', 'InputError', 'InputEvent', 'InputNote', 'ModeInput',
+            'STARTUP_MODES', 'SimInput', 'TrajectoryInput', 'VrcMode', 'cmd_vel_input',
+            'describe_input', 'input_notes', 'parse_vrc_mode', 'pose_input', 'wrench_input'],
+})

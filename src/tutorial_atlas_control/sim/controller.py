@@ -28,8 +28,9 @@ Where this differs from 2.5.2, on purpose:
 * f_out: 2.5.2 blended in the torque of BDI's AtlasSimInterface (its Stand, Walk, ...
   behaviours) by 1 - k_effort. There is no BDI library here: the simulator passes its own
   Stand/StandPrep/Freeze hold's torque where BDI's behaviour would act, and 0 in User and
-  ragdoll, where BDI outputs nothing (simulator.py). With k_effort = 1 the term is skipped,
-  so u is the PID sum exactly (2.5.2's 1 * u + 0 * f_out, up to the sign of a zero).
+  ragdoll, where BDI outputs nothing (mode_commands.py, joint_law.py). With k_effort = 1
+  the term is skipped, so u is the PID sum exactly (2.5.2's 1 * u + 0 * f_out, up to the
+  sign of a zero).
 
 The torque clamp here is the only place the effort limits are enforced (the
 MuJoCo motors have no ctrlrange).
@@ -46,9 +47,9 @@ import numpy as np
 import yaml
 
 from tutorial_atlas_control import topics
+from tutorial_atlas_control.command.arrays import JointCommandArrays
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.msgs.commands import JointCommandArrays
 from tutorial_atlas_control.resources import package_path
 from tutorial_atlas_control.units import finite_number
 from tutorial_atlas_control.yaml_errors import yaml_problem

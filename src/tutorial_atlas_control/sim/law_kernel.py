@@ -12,12 +12,36 @@ its bag and its offline replay do not depend on which one ran.
 from __future__ import annotations
 
 import ctypes
+from dataclasses import dataclass
 
 import numpy as np
 
-from tutorial_atlas_control.msgs.commands import LAW_FIELDS, JointCommandArrays
+from tutorial_atlas_control.command.arrays import LAW_FIELDS, JointCommandArrays
 from tutorial_atlas_control.native import AtlasLawStep, address
 from tutorial_atlas_control.sim.controller import PidState
+
+
+@dataclass(frozen=True)
+class LawJoints:
+    """Where the law reads the joints (MjData's qpos and qvel, and each joint's address in
+    them) and what bounds them, in the tutorial's joint order."""
+
+    qpos: np.ndarray          # MjData.qpos
+    qpos_adr: np.ndarray      # (28,) intp
+    qvel: np.ndarray          # MjData.qvel
+    dof_adr: np.ndarray       # (28,) intp
+    lower: np.ndarray         # rad
+    upper: np.ndarray         # rad
+    effort_limit: np.ndarray  # N m
+    dt_s: float
+
+    def positions(self) -> np.ndarray:
+        """The joint angles (rad, (28,), a new array)."""
+        return self.qpos[self.qpos_adr]
+
+    def velocities(self) -> np.ndarray:
+        """The joint velocities (rad/s, (28,), a new array)."""
+        return self.qvel[self.dof_adr]
 
 
 class CompiledLaw:
@@ -27,15 +51,15 @@ class CompiledLaw:
     MjData's arrays never move, and PidState's are only ever written in place.
     """
 
-    def __init__(self, library: ctypes.CDLL, qpos: np.ndarray, qpos_adr: np.ndarray,
-                 qvel: np.ndarray, dof_adr: np.ndarray, lower: np.ndarray, upper: np.ndarray,
-                 effort_limit: np.ndarray, dt_s: float, state: PidState, torque: np.ndarray,
-                 ctrl: np.ndarray | None = None, f_out: np.ndarray | None = None) -> None:
+    def __init__(self, library: ctypes.CDLL, joints: LawJoints, state: PidState,
+                 torque: np.ndarray, ctrl: np.ndarray | None = None,
+                 f_out: np.ndarray | None = None) -> None:
         """`ctrl`: also written with the torque; `f_out`: the torque (N m) blended in by
         1 - k_effort (None: 0), read at each call."""
         count = len(torque)
-        for name, array in (('qpos_adr', qpos_adr), ('dof_adr', dof_adr), ('lower', lower),
-                            ('upper', upper), ('effort_limit', effort_limit),
+        for name, array in (('qpos_adr', joints.qpos_adr), ('dof_adr', joints.dof_adr),
+                            ('lower', joints.lower), ('upper', joints.upper),
+                            ('effort_limit', joints.effort_limit),
                             ('integral', state.integral),
                             ('previous_error', state.previous_error)):
             if array.shape != (count,):
@@ -43,25 +67,24 @@ class CompiledLaw:
         for name, optional in (('ctrl', ctrl), ('f_out', f_out)):
             if optional is not None and optional.shape != (count,):
                 raise ValueError(f'{name} has shape {optional.shape}, expected ({count},)')
-        self._keep = (qpos, qpos_adr, qvel, dof_adr, lower, upper, effort_limit, state, torque,
-                      ctrl, f_out)
+        self._keep = (joints, state, torque, ctrl, f_out)
         self.state = state
         step = self._step = AtlasLawStep()
-        step.qpos = address(qpos, np.float64)
-        step.qpos_adr = address(qpos_adr, np.intp)
-        step.qvel = address(qvel, np.float64)
-        step.dof_adr = address(dof_adr, np.intp)
-        step.lower = address(lower, np.float64)
-        step.upper = address(upper, np.float64)
-        step.effort_limit = address(effort_limit, np.float64)
+        step.qpos = address(joints.qpos, np.float64)
+        step.qpos_adr = address(joints.qpos_adr, np.intp)
+        step.qvel = address(joints.qvel, np.float64)
+        step.dof_adr = address(joints.dof_adr, np.intp)
+        step.lower = address(joints.lower, np.float64)
+        step.upper = address(joints.upper, np.float64)
+        step.effort_limit = address(joints.effort_limit, np.float64)
         step.integral = address(state.integral, np.float64)
         step.previous_error = address(state.previous_error, np.float64)
         step.torque = address(torque, np.float64)
         step.ctrl = None if ctrl is None else address(ctrl, np.float64)
         step.f_out = None if f_out is None else address(f_out, np.float64)
-        step.dt_s = dt_s
+        step.dt_s = joints.dt_s
         step.n = count
-        step.nq, step.nv = qpos.size, qvel.size
+        step.nq, step.nv = joints.qpos.size, joints.qvel.size
         self._call = library.atlas_law_step
         self._finite = library.atlas_state_is_finite
         self._pointer = ctypes.byref(step)

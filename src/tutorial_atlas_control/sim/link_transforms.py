@@ -3,7 +3,7 @@
 Debian's robot_state_publisher 1.15 looks its tf_prefix parameter up on the master at
 every publication (searchParam, hasParam, getParam): at real_time_factor 0 that is the
 master's busiest client. The simulator has the joint angles already, so it publishes the
-same transforms itself (issue 28). What is reproduced, from robot_state_publisher 1.15:
+same transforms itself. What is reproduced, from robot_state_publisher 1.15:
 
 - one transform per moving URDF joint (revolute, continuous, prismatic), parent link ->
   child link, equal to `origin * motion(position)`: a rotation about the joint's axis

@@ -3,7 +3,8 @@ the held pelvis wrench (gazebo_ros_force) and kinematic joint playback
 (gazebo_ros_joint_trajectory).
 
 The node decodes each message into one of the frozen inputs below (checked whole: a bad
-field refuses the message and nothing is applied); the stepping loop hands it to
+field refuses the message and nothing is applied; /joint_trajectory's check is
+sim/joint_trajectory.py); the stepping loop hands it to
 AtlasSimulator.apply_input between two steps, under its lock. Every applied input is also
 logged, with the sim time it took effect, on /atlas/sim_inputs (JSON, `to_dict`), so that
 offline replay re-applies it before the very same step.
@@ -22,24 +23,23 @@ from __future__ import annotations
 import enum
 import json
 import math
-from collections.abc import Collection, Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 from typing import Any, Union
 
 import mujoco
 import numpy as np
 
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.joints import JOINT_NAMES, bare_joint_name, joint_index
+from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.sim import model as atlas_model
-from tutorial_atlas_control.units import NS_PER_S
 
 __all__ = [
     'DEFAULT_STARTUP_MODE', 'STARTUP_MODES', 'VALID_VRC_MODES', 'CmdVelInput', 'InputError',
-    'InputEvent', 'describe_input',
+    'InputEvent', 'InputNote', 'describe_input', 'finite_values', 'input_notes',
     'ModeInput', 'PoseInput', 'SimInput', 'TrajectoryInput', 'VrcMode', 'VrcState',
     'WrenchInput', 'cmd_vel_input', 'input_from_dict', 'parse_vrc_mode', 'pose_input',
-    'trajectory_input', 'wrench_input',
+    'wrench_input',
 ]
 
 
@@ -74,12 +74,8 @@ MAX_FORCE_N = 1e5
 MAX_TORQUE_NM = 1e5
 MAX_SPEED_M_S = 1e2
 MAX_TURN_RAD_S = 1e2
-MAX_TRAJECTORY_POINTS = 100_000
 #: A quaternion shorter than this cannot be normalized into an orientation.
 MIN_QUATERNION_NORM = 1e-9
-#: `header.frame_id`s that keep the robot's own pose (gazebo_ros_joint_trajectory's
-#: world/map; the pelvis is the model's root). Any other names a link kept in place.
-_WORLD_FRAMES = ('', 'world', 'map', '/map')
 
 
 class InputError(AtlasControlError):
@@ -100,7 +96,8 @@ def parse_vrc_mode(text: str) -> VrcMode:
                          + ', '.join(VALID_VRC_MODES)) from None
 
 
-def _finite(values: Sequence[float], what: str, bound: float) -> tuple[float, ...]:
+def finite_values(values: Sequence[float], what: str, bound: float) -> tuple[float, ...]:
+    """`values` as floats; refused if one is NaN/Inf or its magnitude exceeds `bound`."""
     out = tuple(float(v) for v in values)
     for value in out:
         if not math.isfinite(value):
@@ -168,16 +165,28 @@ class WrenchInput:
 
 
 @dataclass(frozen=True)
+class InputNote:
+    """A line about an accepted input for the node to log: a `logging` level and the text
+    (e.g. what a trajectory's check clamped)."""
+
+    level: int
+    text: str
+
+
+@dataclass(frozen=True)
 class TrajectoryInput:
     """/joint_trajectory: joint indices (JOINT_NAMES order), one row of positions (rad) per
     point, each point's time from the start (ns), and the requested start (sim time, ns; a
-    start in the past, e.g. a zero stamp, means at once)."""
+    start in the past, e.g. a zero stamp, means at once). `notes` say what the check
+    changed; they are not part of the logged input (replay applies the positions and times
+    played)."""
 
     joints: tuple[int, ...]
     positions_rad: tuple[tuple[float, ...], ...]
     times_ns: tuple[int, ...]
     start_ns: int
     reference_link: str = ''  # a link kept where it is while the joints move; '' = the pelvis
+    notes: tuple[InputNote, ...] = field(default=(), compare=False, repr=False)
     kind = 'joint_trajectory'
 
     def to_dict(self) -> dict[str, Any]:
@@ -196,8 +205,8 @@ def pose_input(position: Sequence[float], orientation_xyzw: Sequence[float]) -> 
     Raises:
         InputError: non-finite or absurd numbers, or a quaternion of (near) zero length.
     """
-    pos = _finite(position, 'position', MAX_POSITION_M)
-    x, y, z, w = _finite(orientation_xyzw, 'orientation', 1e6)
+    pos = finite_values(position, 'position', MAX_POSITION_M)
+    x, y, z, w = finite_values(orientation_xyzw, 'orientation', 1e6)
     norm = math.sqrt(w * w + x * x + y * y + z * z)
     if norm < MIN_QUATERNION_NORM:
         raise InputError('orientation is a zero quaternion (set w = 1 for upright)')
@@ -206,90 +215,27 @@ def pose_input(position: Sequence[float], orientation_xyzw: Sequence[float]) -> 
 
 def cmd_vel_input(linear: Sequence[float], angular: Sequence[float]) -> CmdVelInput:
     """Check a geometry_msgs/Twist (all six fields must be finite; three are used)."""
-    lin = _finite(linear, 'linear velocity', MAX_SPEED_M_S)
-    ang = _finite(angular, 'angular velocity', MAX_TURN_RAD_S)
+    lin = finite_values(linear, 'linear velocity', MAX_SPEED_M_S)
+    ang = finite_values(angular, 'angular velocity', MAX_TURN_RAD_S)
     return CmdVelInput(lin[0], lin[1], ang[2])
 
 
 def wrench_input(force: Sequence[float], torque: Sequence[float]) -> WrenchInput:
     """Check a geometry_msgs/Wrench."""
-    f = _finite(force, 'force', MAX_FORCE_N)
-    t = _finite(torque, 'torque', MAX_TORQUE_NM)
+    f = finite_values(force, 'force', MAX_FORCE_N)
+    t = finite_values(torque, 'torque', MAX_TORQUE_NM)
     return WrenchInput((f[0], f[1], f[2]), (t[0], t[1], t[2]))
-
-
-def trajectory_input(frame_id: str, stamp_ns: int, joint_names: Sequence[str],
-                     positions: Sequence[Sequence[float]], times_ns: Sequence[int],
-                     lower_rad: np.ndarray, upper_rad: np.ndarray,
-                     links: Collection[str] = (atlas_model.PELVIS_BODY,),
-                     unused: Sequence[Mapping[str, Sequence[float]]] = ()) -> TrajectoryInput:
-    """Check a trajectory_msgs/JointTrajectory (positions and time_from_start per point).
-
-    `header.frame_id` is world/map (or empty: the robot keeps its pose) or one of `links`
-    (bare or `atlas::`), kept in place as gazebo_ros_joint_trajectory's reference link.
-    `unused`: per point, the fields playback ignores (velocities, accelerations, effort), as
-    gazebo_ros_joint_trajectory did; still checked, so that a broken message is refused whole.
-
-    Raises:
-        InputError: an unknown or repeated joint name, no points, a point whose positions
-            do not match the names, a non-finite or out-of-limits position, times that are
-            negative or not strictly increasing, or a frame that is no link of the robot.
-    """
-    reference = bare_joint_name(frame_id)
-    if frame_id in _WORLD_FRAMES or reference == atlas_model.PELVIS_BODY:
-        reference = ''
-    elif reference not in links:
-        raise InputError(f'header.frame_id {frame_id[:40]!r} is neither world, map nor a link '
-                         'of the robot')
-    if not joint_names:
-        raise InputError('joint_names is empty')
-    joints: list[int] = []
-    for name in joint_names:
-        index = joint_index(name)
-        if index is None:
-            raise InputError(f'unknown joint name {name[:40]!r}')
-        if index in joints:
-            raise InputError(f'joint {name!r} named twice')
-        joints.append(index)
-    if not positions:
-        raise InputError('the trajectory has no points')
-    if len(positions) > MAX_TRAJECTORY_POINTS:
-        raise InputError(f'{len(positions)} points (at most {MAX_TRAJECTORY_POINTS})')
-    rows: list[tuple[float, ...]] = []
-    for number, row in enumerate(positions):
-        if len(row) != len(joints):
-            raise InputError(f'point {number} has {len(row)} positions for '
-                             f'{len(joints)} joint names')
-        values = _finite(row, f'point {number} position', 1e3)
-        for index, value in zip(joints, values):
-            if not lower_rad[index] <= value <= upper_rad[index]:
-                raise InputError(
-                    f'point {number}: {JOINT_NAMES[index]} = {value:g} rad is outside its '
-                    f'limits [{lower_rad[index]:g}, {upper_rad[index]:g}]')
-        rows.append(values)
-    for number, fields in enumerate(unused):
-        for name, values in fields.items():
-            if len(values) not in (0, len(joints)):
-                raise InputError(f'point {number} has {len(values)} {name} for '
-                                 f'{len(joints)} joint names')
-            _finite(values, f'point {number} {name}', 1e6)
-    times = [int(t) for t in times_ns]
-    if len(times) != len(rows):
-        raise InputError(f'{len(times)} times for {len(rows)} points')
-    if times[0] < 0:
-        raise InputError(f'point 0 time_from_start {times[0] / NS_PER_S:g} s is negative')
-    for number in range(1, len(times)):
-        if times[number] <= times[number - 1]:
-            raise InputError(
-                f'time_from_start not increasing at point {number} '
-                f'({times[number] / NS_PER_S:g} s after {times[number - 1] / NS_PER_S:g} s)')
-    return TrajectoryInput(tuple(joints), tuple(rows), tuple(times), int(stamp_ns), reference)
 
 
 #: The topic each input kind comes from (for logs and the bag report's timeline).
 INPUT_TOPICS = {'mode': '/atlas/mode', 'set_pose': '/atlas/set_pose', 'cmd_vel': '/atlas/cmd_vel',
                 'pelvis_wrench': '/atlas/apply_pelvis_force',
                 'joint_trajectory': '/joint_trajectory'}
+
+
+def input_notes(item: SimInput) -> tuple[InputNote, ...]:
+    """The lines to log about an accepted input (only a trajectory's check has any)."""
+    return item.notes if isinstance(item, TrajectoryInput) else ()
 
 
 def describe_input(item: SimInput) -> str:

@@ -21,26 +21,27 @@ from dataclasses import dataclass
 from typing import Protocol
 
 from tutorial_atlas_control import topics
+from tutorial_atlas_control.command.arrays import (
+    FIELD_NAMES,
+    LAW_FIELDS,
+    CommandError,
+    CommandUpdate,
+)
+from tutorial_atlas_control.fall_report import fall_line
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.msgs.atlas_command import (
     AtlasUpdate,
     decode_atlas_command,
     decode_test,
 )
-from tutorial_atlas_control.msgs.commands import (
-    FIELD_NAMES,
-    LAW_FIELDS,
-    CommandDecoder,
-    CommandError,
-    CommandUpdate,
-)
+from tutorial_atlas_control.msgs.joint_commands import CommandDecoder
 from tutorial_atlas_control.msgs.ros1_fields import FieldCursor
-from tutorial_atlas_control.msgs.sim_messages import SimMessages
 from tutorial_atlas_control.msgs.wire import ControllerStatisticsWire, clock_bytes
 from tutorial_atlas_control.sim.controller import Gains
 from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistics
 from tutorial_atlas_control.sim.link_transforms import LinkTransforms, RspSchedule
 from tutorial_atlas_control.sim.model import FALL_HEIGHT_M
+from tutorial_atlas_control.sim.sim_messages import SimMessages
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode, PhysicsDivergenceError
 from tutorial_atlas_control.sim.vrc import SimInput, describe_input
 from tutorial_atlas_control.stepping.pacing import Pacer
@@ -94,7 +95,7 @@ ON_DEMAND_RATE_HZ = 1000.0
 #: The links' /tf rate (Hz of sim time): robot_state_publisher's publish_frequency in
 #: DRCSim's launch.
 LINKS_TF_RATE_HZ = 50.0
-#: Rows (commands.LAW_FIELDS indices) each command topic can set; DAMPING_ROW stands for
+#: Rows (arrays.LAW_FIELDS indices) each command topic can set; DAMPING_ROW stands for
 #: /atlas/debug/test's damping. An older message whose rows a newer one set for every
 #: joint is dropped undecoded (apply_pending_commands).
 DAMPING_ROW = len(LAW_FIELDS)
@@ -537,12 +538,9 @@ class SteppingLoop:
         if self.fall_armed and self.sim.data.qpos[self.pelvis_z_index] < FALL_HEIGHT_M:
             self.fall_armed = False
             sim = self.sim
-            line = (f'the robot fell: pelvis below {FALL_HEIGHT_M} m at '
-                    f't={sim.sim_time_ns / NS_PER_S:.3f} s')
-            if self.first_command_ns is not None:
-                line += (f', {(sim.sim_time_ns - self.first_command_ns) / NS_PER_S:.3f} s '
-                         'after the first command since the start or last reset')
-            self.log.info(line)
+            after_s = (None if self.first_command_ns is None else
+                       (sim.sim_time_ns - self.first_command_ns) / NS_PER_S)
+            self.log.info(fall_line(FALL_HEIGHT_M, sim.sim_time_ns / NS_PER_S, after_s))
 
     # -- publishing ----------------------------------------------------------------------
     def publish(self) -> None:

@@ -46,13 +46,16 @@ def find_trajectory(name: str, directory: Path = TRAJECTORIES_DIR) -> Path:
             searched), or a file cannot be read (its own one-line error).
     """
     files = trajectory_files(directory)
-    holding = [path for path in files if name in load_trajectory_file(path)]
+    docs = {path: load_trajectory_file(path) for path in files}
+    holding = [path for path in files if name in docs[path]]
     if len(holding) == 1:
         return holding[0]
     searched = ', '.join(str(path) for path in files) or f'no *.yaml in {directory}'
     if not holding:
+        names = '; '.join(f'{path.name}: ' + ', '.join(str(key) for key in docs[path])
+                          for path in files) or f'none: no *.yaml in {directory}'
         raise TrajectoryError(f'no trajectory named {name} in the package\'s trajectory files '
-                              f'(searched {searched}); give its file with --file')
+                              f'(valid names: {names}); give its file with --file')
     both = ' and '.join(path.name for path in holding)
     raise TrajectoryError(f'trajectory {name} is in {both} (searched {searched}); '
                           'choose one with --file')

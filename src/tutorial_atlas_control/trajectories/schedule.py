@@ -1,7 +1,7 @@
 """traj_yaml's schedule, without ROS: when each command of a trajectory is sent.
 
 Shared by the live player (traj_yaml_node.py: ROS time, a publisher) and offline runs
-(offline_run.py: the simulator's own clock, a bag), so both play a trajectory the same way.
+(offline/player.py: the simulator's own clock, a bag), so both play a trajectory the same way.
 """
 
 from __future__ import annotations

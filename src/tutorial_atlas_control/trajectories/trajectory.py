@@ -8,7 +8,7 @@ of whitespace-separated numbers, as in the tutorial's ``Traj_data2.yaml``, or a
 YAML list of numbers.
 
 This module is pure (no rospy) so it can be tested without a ROS master; the
-ROS glue is :mod:`tutorial_atlas_control.node.traj_yaml`.
+ROS glue is :mod:`tutorial_atlas_control.trajectories.traj_yaml_node`.
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 What each 1 kHz message holds (which array, which time, which quaternion order) is
 decided once, here, for both writers of those messages: the ROS node (sim_node.py),
-which sends the bytes over TCPROS, and offline runs (offline_run.py), which write them
+which sends the bytes over TCPROS, and offline runs (offline/player.py), which write them
 to a bag. The bytes come from wire.py's pre-laid-out messages: a step copies numbers in
 and stamps the header; nothing is serialized field by field.
 """
@@ -15,7 +15,6 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control.joints import JOINT_NAMES
-from tutorial_atlas_control.msgs.copy_plan import Copy, CopyPlan
 from tutorial_atlas_control.msgs.wire import (
     WRENCH_FLOATS,
     AtlasStateWire,
@@ -28,6 +27,7 @@ from tutorial_atlas_control.msgs.wire import (
     TransformWire,
     WrenchStampedWire,
 )
+from tutorial_atlas_control.sim.copy_plan import Copy, CopyPlan
 from tutorial_atlas_control.sim.link_transforms import LinkTransforms
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
 from tutorial_atlas_control.topics import PELVIS_FRAME, WORLD_FRAME
@@ -67,7 +67,7 @@ class SimMessages:
     stamp and return with the TCPROS length prefix. The IMU
     and contact messages are a fixed selection of `data.sensordata`
     (`imu_map`, `contact_maps`: float index in the message <- index in sensordata), so a
-    writer that keeps sensordata per step can build many messages at once (offline_run.py).
+    writer that keeps sensordata per step can build many messages at once (offline/player.py).
     """
 
     def __init__(self, sim: AtlasSimulator) -> None:

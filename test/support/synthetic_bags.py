@@ -1,7 +1,7 @@
 """Write synthetic ROS 1 bags with rosbags, shaped like the simulator's recordings.
 
 The unit tests' bags and the benchmark's 60 s run bag (bench/offline.py), with no
-simulator and no ROS installation: both need them, so they live in the package.
+simulator and no ROS installation: both import them from test/support.
 
 Tests describe a run as a list of :class:`Record` (topic, ROS 1 type, bag time, message)
 built with the helpers below and write it with :func:`write_bag`. Times are sim time in

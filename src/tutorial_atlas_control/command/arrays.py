@@ -1,4 +1,7 @@
-"""osrf_msgs/JointCommands: its arrays as numpy, decoding, checking and merging.
+"""The command the law reads: osrf_msgs/JointCommands' arrays as numpy, checked and merged.
+
+Below msgs/ (whose decoders produce it: joint_commands.py, atlas_command.py) and sim/
+(whose law reads it), so neither imports the other for it.
 
 DRCSim read the arrays by position and ignored `name`. We keep that for an empty
 `name` (the tutorial's joint order) and map by name otherwise, with or without the
@@ -10,7 +13,6 @@ the previous command stays.
 from __future__ import annotations
 
 import functools
-import struct
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, fields
 
@@ -18,7 +20,6 @@ import numpy as np
 
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import NUM_JOINTS, joint_index
-from tutorial_atlas_control.msgs.ros1_fields import FieldCursor
 
 #: The array fields of osrf_msgs/JointCommands, in message order.
 FIELD_NAMES: tuple[str, ...] = (
@@ -98,8 +99,8 @@ class CommandError(AtlasControlError):
 
 #: MAX_MAGNITUDE per field in LAW_FIELDS order (inf: no bound).
 _BOUNDS = np.array([MAX_MAGNITUDE.get(name, np.inf) for name in LAW_FIELDS])
-_ALL_JOINTS = np.arange(NUM_JOINTS)
-_ALL_JOINTS.setflags(write=False)
+ALL_JOINTS = np.arange(NUM_JOINTS)
+ALL_JOINTS.setflags(write=False)
 
 
 def joint_indices(names: Sequence[str]) -> np.ndarray:
@@ -112,7 +113,7 @@ def joint_indices(names: Sequence[str]) -> np.ndarray:
         CommandError: a name is unknown or appears twice.
     """
     if not names:
-        return _ALL_JOINTS
+        return ALL_JOINTS
     return _indices_of(tuple(names))
 
 
@@ -169,10 +170,11 @@ def command_update(names: Sequence[str],
         CommandError: wrong array length, NaN/Inf, a value beyond MAX_MAGNITUDE,
             unknown or duplicate joint name.
     """
-    return _checked_update(joint_indices(names), [arrays.get(name, ()) for name in FIELD_NAMES])
+    return checked_update(joint_indices(names), [arrays.get(name, ()) for name in FIELD_NAMES])
 
 
-def _checked_update(indices: np.ndarray, fields: Sequence[Sequence[float]]) -> CommandUpdate:
+def checked_update(indices: np.ndarray, fields: Sequence[Sequence[float]]) -> CommandUpdate:
+    """command_update for joints already mapped to `indices`, fields in FIELD_NAMES order."""
     expected = len(indices)
     rows, given = [], []
     for row, values in enumerate(fields):
@@ -226,35 +228,3 @@ def merge_command(previous: JointCommandArrays, names: Sequence[str],
     merged = previous.copy()
     update.apply_to(merged)
     return merged
-
-
-class CommandDecoder:
-    """Serialized osrf_msgs/JointCommands -> CommandUpdate, without genpy.
-
-    A controller sends the same joint names in every message: the decoder remembers the
-    last serialized `name` block and its joint indices, so a message with the same block
-    costs one bytes comparison instead of decoding and looking up 28 strings. Safe to
-    share between rospy's receiving threads (the memo is replaced as one tuple).
-    """
-
-    def __init__(self) -> None:
-        self._memo: tuple[bytes, np.ndarray] = (b'', _ALL_JOINTS)
-
-    def decode(self, raw: bytes) -> CommandUpdate:
-        """Raises CommandError: a malformed message, or one command_update refuses."""
-        try:
-            cursor = FieldCursor(raw)
-            cursor.header_stamp_ns()
-            start = cursor.pos
-            names_block, indices = self._memo
-            if names_block and raw.startswith(names_block, start):
-                cursor.pos = start + len(names_block)
-            else:
-                indices = joint_indices(cursor.strings())
-                self._memo = (raw[start:cursor.pos], indices)
-            fields = [cursor.f64s() for _ in FIELD_NAMES]
-            if cursor.pos != len(raw):
-                raise ValueError(f'{len(raw) - cursor.pos} bytes left after the last field')
-        except (ValueError, struct.error, UnicodeDecodeError) as err:
-            raise CommandError(f'malformed message ({err})') from None
-        return _checked_update(indices, fields)

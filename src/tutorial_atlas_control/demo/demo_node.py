@@ -134,13 +134,13 @@ def wait_sim_time(clock_type: type, seconds: float) -> None:
 
 
 def summarise(bag: Path, video_fps: float, video_size: tuple[int, int],
-              report: Report = _silent) -> None:
+              report: Report = _silent, table: bool = False) -> None:
     """Report the short summary; write the plot and (unless video_fps is 0) the video.
 
     The summary is reported before the (slower) plot and video are made.
     """
     analysis = analyze_bag(bag)
-    report('\n' + short_summary(analysis))
+    report('\n' + short_summary(analysis, table))
     foot = foot_line(analysis.data)
     if foot is not None:
         report(foot)

@@ -1,0 +1,112 @@
+"""The controller law applied to one simulator's joints: the one place that chooses how.
+
+Each step the mode's command (the user command in User mode, else the hold) gives the
+torque; outside User mode a user command with some k_effort not 0 is blended with that
+hold's torque (f_out). Whether the compiled kernel (law_kernel) or the numpy law
+(controller.compute_torque) computes it, JointLaw.apply() is the only call every kind of
+step makes (plain, under a cheat), so the two laws cannot take different branches.
+"""
+
+from __future__ import annotations
+
+import copy
+
+import mujoco
+import numpy as np
+
+from tutorial_atlas_control import native
+from tutorial_atlas_control.command.arrays import JointCommandArrays
+from tutorial_atlas_control.joints import NUM_JOINTS
+from tutorial_atlas_control.sim.controller import PidState, compute_torque
+from tutorial_atlas_control.sim.law_kernel import CompiledLaw, LawJoints
+from tutorial_atlas_control.sim.model import AtlasModel
+
+
+class JointLaw:
+    """The law's memory and output for one MjData: torque_nm (N m, (28,)), also written to
+    MjData.ctrl, from the mode's command and the blended user command.
+
+    `compiled`: run the law through law_kernel's C kernel when the library is built (the
+    same torques bit for bit, faster); False, or no library: controller.compute_torque.
+    """
+
+    def __init__(self, atlas: AtlasModel, data: mujoco.MjData, dt_s: float,
+                 compiled: bool = True) -> None:
+        self.joints = LawJoints(data.qpos, atlas.qpos_adr, data.qvel, atlas.dof_adr,
+                                atlas.lower_rad, atlas.upper_rad, atlas.effort_limit_nm, dt_s)
+        self.torque_nm = np.zeros(NUM_JOINTS)
+        #: The memory of the mode's command, and of the user command blended under a hold.
+        self.pid = PidState()
+        self.blend_pid = PidState()
+        self._hold_torque_nm = np.zeros(NUM_JOINTS)  # the hold's torque: f_out when blending
+        self._ctrl = data.ctrl
+        self._plain: CompiledLaw | None = None
+        self._hold: CompiledLaw | None = None
+        self._blend: CompiledLaw | None = None
+        library = native.load_library() if compiled else None
+        if library is not None and self._ctrl.shape == self.torque_nm.shape:
+            joints = self.joints
+            self._plain = CompiledLaw(library, joints, self.pid, self.torque_nm, self._ctrl)
+            self._hold = CompiledLaw(library, joints, self.pid, self._hold_torque_nm)
+            self._blend = CompiledLaw(library, joints, self.blend_pid, self.torque_nm,
+                                      self._ctrl, self._hold_torque_nm)
+        #: Every qpos and qvel finite? (the kernel's one C call when compiled)
+        self.state_is_finite = (self._numpy_state_is_finite if self._plain is None
+                                else self._plain.state_is_finite)
+
+    @property
+    def compiled(self) -> bool:
+        return self._plain is not None
+
+    def apply(self, command: JointCommandArrays, blended: JointCommandArrays | None) -> None:
+        """One step of the law: `command`'s torque, or, when `blended` is not None, its PID
+        torque blended by k_effort with `command`'s (the hold's); into torque_nm and ctrl."""
+        plain = self._plain
+        if plain is None:
+            self._numpy_torque(command, blended, self.pid, self.blend_pid, self.torque_nm)
+            self._ctrl[:] = self.torque_nm
+        elif blended is None:
+            plain(command)
+        else:
+            self._hold(command)  # type: ignore[misc]  # set with _plain
+            self._blend(blended)  # type: ignore[misc]
+
+    def set_torque(self, torque_nm: np.ndarray | float) -> None:
+        """Apply `torque_nm` instead of the law (a recorded torque; 0 while physics is off)."""
+        self.torque_nm[:] = torque_nm
+        self._ctrl[:] = self.torque_nm
+
+    def predict(self, command: JointCommandArrays,
+                blended: JointCommandArrays | None) -> np.ndarray:
+        """The torque (N m) apply() would give now; the law's memory is kept."""
+        return self._numpy_torque(command, blended, copy.deepcopy(self.pid),
+                                  copy.deepcopy(self.blend_pid), np.empty(NUM_JOINTS),
+                                  hold_nm=np.empty(NUM_JOINTS))
+
+    def reset(self) -> None:
+        """Forget the integrals and previous errors (ResetControls' reset_pid_controller); the
+        derivative restarts without a kick."""
+        self.pid.reset()
+        self.blend_pid.reset()
+
+    def restart_derivative(self) -> None:
+        """The target changed (a mode switch): the next step's derivative term is 0."""
+        self.pid.initialized = False
+        self.blend_pid.initialized = False
+
+    def _numpy_torque(self, command: JointCommandArrays, blended: JointCommandArrays | None,
+                      pid: PidState, blend_pid: PidState, out: np.ndarray,
+                      hold_nm: np.ndarray | None = None) -> np.ndarray:
+        joints = self.joints
+        q, v = joints.positions(), joints.velocities()
+        limits = (joints.lower, joints.upper, joints.effort_limit)
+        if blended is None:
+            return compute_torque(command, q, v, pid, joints.dt_s, *limits, out=out)
+        hold = compute_torque(command, q, v, pid, joints.dt_s, *limits,
+                              out=self._hold_torque_nm if hold_nm is None else hold_nm)
+        return compute_torque(blended, q, v, blend_pid, joints.dt_s, *limits, out=out,
+                              f_out=hold)
+
+    def _numpy_state_is_finite(self) -> bool:
+        joints = self.joints
+        return bool(np.isfinite(joints.qpos).all() and np.isfinite(joints.qvel).all())
