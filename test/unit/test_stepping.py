@@ -23,6 +23,7 @@ from tutorial_atlas_control.stepping.divergence import (
     MAX_DIVERGENCES_IN_A_ROW,
     DivergenceGuard,
 )
+from tutorial_atlas_control.stepping.inbox import CommandInbox
 from tutorial_atlas_control.stepping.loop import PAUSED_POLL_S, LoopSettings, SteppingLoop
 from tutorial_atlas_control.stepping.outputs import LoopOutputs
 from tutorial_atlas_control.stepping.pacing import Pacer
@@ -363,6 +364,35 @@ def test_commands_are_applied_while_paused_without_stepping(sim: AtlasSimulator)
     np.testing.assert_array_equal(sim.user_command.position, [0.1] * NUM_JOINTS)
     assert len(outbox.queued()[topics.JOINT_STATES]) == 1  # the initial state only
     assert loop.pacer.clock.slept_s == [PAUSED_POLL_S] * 3
+
+
+class CountingController:
+    """A StepController of its own: what users sent, then a note of the step it is for."""
+
+    def __init__(self, inbox: CommandInbox, sim: AtlasSimulator) -> None:
+        self.inbox, self.sim = inbox, sim
+        self.steps_ns: list[int] = []
+
+    def before_step(self) -> None:
+        self.inbox.apply_pending()
+        self.steps_ns.append(self.sim.sim_time_ns)
+
+
+def test_a_controller_plugs_in_and_is_called_once_before_each_step(sim: AtlasSimulator) -> None:
+    """Once per step, before it, never while paused; what users sent still acts."""
+    outbox = FakeOutbox(set(ALL_TOPICS))
+    made: list[CountingController] = []
+    loop = SteppingLoop(sim, LoopOutputs(outbox, {t: t for t in ALL_TOPICS}, FakeLog(),
+                                         lambda _text: None),
+                        LoopSettings(LAUNCH_RATES_HZ), CommandAgeStatistics(sim.dt_s),
+                        controller=lambda inbox: made.append(CountingController(inbox, sim))
+                        or made[-1])
+    loop.receive_command(complete_command(0.1))
+    loop.run(stops_after(5))
+    loop.pause()
+    loop.run(stops_after(3))
+    assert [controller.steps_ns for controller in made] == [[k * sim.step_ns for k in range(5)]]
+    np.testing.assert_array_equal(sim.user_command.position, [0.1] * NUM_JOINTS)
 
 
 # -- services ------------------------------------------------------------------------------

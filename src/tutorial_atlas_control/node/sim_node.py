@@ -192,7 +192,7 @@ class RawLatched:
 
 
 class RosLog:
-    """The stepping loop's log lines, into rospy's log (stepping.loop.LoopLog).
+    """The stepping loop's log lines, into rospy's log (stepping.outputs.LoopLog).
 
     Refusals are throttled per topic and kind (rospy's logwarn_throttle throttles per call
     site, so a refused JointCommands would hide a refused AtlasCommand for WARN_THROTTLE_S).

@@ -4,7 +4,8 @@ The default is the loop's CommandInbox: it hands the simulator what users sent (
 commands, AtlasCommands, Tests) and the simulator's law turns that into torques. A
 controller of its own (a balance or walking controller) implements before_step: it reads
 the simulator's state and gives it this step's command (AtlasSimulator.receive_updates),
-usually after applying what users sent (CommandInbox.apply_pending).
+usually after applying what users sent (CommandInbox.apply_pending). The loop makes it
+from its inbox (SteppingLoop's `controller` argument) and calls nothing else of it.
 """
 
 from __future__ import annotations

@@ -65,14 +65,15 @@ class SteppingLoop:
             tests give one with a fake clock).
         synchronization: DRCSim 2.6's synchronization window (default: DRCSim's budgets);
             its statistics go to the topics.SYNCHRONIZATION_STATISTICS outlet, if any.
-        controller: what gives the simulator each step's command (default: the inbox,
-            which applies the commands users sent).
+        controller: makes, from the loop's command inbox, what gives the simulator each
+            step's command (default: the inbox itself, which applies what users sent).
     """
 
     def __init__(self, sim: AtlasSimulator, outputs: LoopOutputs, settings: LoopSettings,
                  statistics: CommandAgeStatistics, pacer: Pacer | None = None,
                  synchronization: SynchronizationWindow | None = None,
-                 controller: StepController | None = None) -> None:
+                 controller: Callable[[CommandInbox], StepController] | None = None
+                 ) -> None:
         self.sim = sim
         self.lock = threading.Lock()
         self.outbox = outputs.outbox
@@ -84,7 +85,8 @@ class SteppingLoop:
                   else SynchronizationWindow(DelayBudgets()))
         self.watch = RunWatch(sim, outputs.log)
         self.inbox = CommandInbox(sim, outputs.log, statistics, self.watch, window.budgets)
-        self.controller: StepController = controller if controller is not None else self.inbox
+        self.controller: StepController = (controller(self.inbox) if controller is not None
+                                           else self.inbox)
         self.publisher = StepPublisher(sim, outputs, settings.rates_hz, statistics,
                                        settings.links)
         self.gate = SyncGate(sim, self.lock, self.inbox, outputs, self.pacer, window)
