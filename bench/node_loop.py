@@ -97,7 +97,7 @@ def unheard_topic_run(calls: int = 20000, rounds: int = 5) -> float:
     """µs per step that one published topic nobody subscribes to costs the node's loop.
 
     The node on fake rospy as launched (DRCSim's on-demand topics advertised, unheard:
-    support.fake_rospy.UNHEARD_TOPICS); its SteppingLoop.publish() is timed with those
+    support.fake_rospy.UNHEARD_TOPICS); its StepPublisher.publish() is timed with those
     topics' outlets and without them (interleaved rounds, best of each, the queued bytes
     dropped after each call), and the difference divided by their number. Those outlets
     are repeated UNHEARD_REPEAT times so that their cost stands out of publish()'s own
@@ -106,16 +106,17 @@ def unheard_topic_run(calls: int = 20000, rounds: int = 5) -> float:
     with fake_ros_node(0, warmup_steps=0) as node:
         loop = node.loop
         pending = loop.outbox.pending
-        publish = loop.publish
-        unheard = loop.demand_wires
+        publisher = loop.publisher
+        publish = publisher.publish
+        unheard = publisher.demand_wires
         if not unheard or any(loop.outbox.wanted(wire[3]) for wire in unheard):
             raise RuntimeError('expected the on-demand topics advertised and unheard')
 
         def timed(demand_wires: tuple[Any, ...]) -> float:
-            loop.demand_wires = demand_wires
+            publisher.demand_wires = demand_wires
             start = time.perf_counter()
             for _ in range(calls):
-                publish()
+                publish(0)
                 pending.clear()
             return time.perf_counter() - start
 
@@ -124,7 +125,7 @@ def unheard_topic_run(calls: int = 20000, rounds: int = 5) -> float:
         for _ in range(rounds):
             with_s.append(timed(repeated))
             without_s.append(timed(()))
-        loop.demand_wires = unheard
+        publisher.demand_wires = unheard
         return (min(with_s) - min(without_s)) / calls / len(repeated) * 1e6
 
 

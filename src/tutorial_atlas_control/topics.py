@@ -5,6 +5,9 @@ DRCSim's names, kept verbatim so that DRCSim-era clients and `rostopic` habits w
 
 from __future__ import annotations
 
+import enum
+from dataclasses import dataclass
+
 CLOCK = '/clock'
 JOINT_STATES = '/atlas/joint_states'
 JOINT_COMMANDS = '/atlas/joint_commands'
@@ -55,46 +58,158 @@ RESET_CONTROLS_SERVICE = '/atlas/reset_controls'
 #: The URDF of the simulated model (set by the simulator, or with
 #: tf_publisher:=robot_state_publisher by atlas.launch's state_publisher.py).
 ROBOT_DESCRIPTION_PARAM = '/robot_description'
+#: robot_state_publisher's latched topic of the fixed joints' transforms.
+TF_STATIC = '/tf_static'
 
-#: What scripts/record_run.sh records: the simulator's output, the commands and modes that
-#: drove it, the config replay needs, and the log. Analysis and replay read these.
-RECORDED_TOPICS: tuple[str, ...] = (
-    CLOCK, JOINT_STATES, GROUND_TRUTH_ODOM, IMU, L_FOOT_CONTACT, R_FOOT_CONTACT,
-    JOINT_COMMANDS, CONTROL_MODE, SIM_CONFIG, ROSOUT, CONTROLLER_STATISTICS, TF,
-    ATLAS_COMMAND, ATLAS_TEST,
-    MODE, SET_POSE, CMD_VEL, APPLY_PELVIS_FORCE, JOINT_TRAJECTORY, SIM_INPUTS,
+class Direction(enum.Enum):
+    """Who writes a topic: the simulator node, its users (commands, cheats), or every node."""
+
+    PUBLISHED = 'published'
+    SUBSCRIBED = 'subscribed'
+    LOG = 'every node'
+
+
+@dataclass(frozen=True)
+class Rate:
+    """How often a topic goes out: a rate parameter (Hz of sim time) with its default, or,
+    without one (`param` ''), `when` in words."""
+
+    param: str = ''
+    default_hz: float = 0.0
+    when: str = ''
+
+    @property
+    def key(self) -> str:
+        """The node's name for it (the stepping loop's `rates_hz` key): '~imu_rate' -> 'imu';
+        '' for a rate that is not one of the node's private parameters."""
+        if self.param.startswith('~') and self.param.endswith(RATE_SUFFIX):
+            return self.param[1:-len(RATE_SUFFIX)]
+        return ''
+
+    def text(self) -> str:
+        if not self.param:
+            return self.when
+        hz = f'{self.default_hz:g} Hz' if self.default_hz else 'every step'
+        return f'`{self.param}` ({hz}){"; " + self.when if self.when else ""}'
+
+
+@dataclass(frozen=True)
+class Delivery:
+    """How the simulator's side writes a topic.
+
+    Attributes:
+        message: the name of its wire message in sim.sim_messages.SimMessages ('' when
+            the loop builds it otherwise).
+        latched: a latched publisher (a bag connection marked latched).
+        offline: written by offline runs too (offline/player.py).
+        loop: sent by the stepping loop, serialized into its outbox (else the node
+            publishes it itself).
+    """
+
+    message: str = ''
+    latched: bool = False
+    offline: bool = False
+    loop: bool = False
+
+
+@dataclass(frozen=True)
+class Topic:
+    """One row of the simulator's ROS interface (INTERFACE)."""
+
+    name: str
+    msg_type: str
+    direction: Direction
+    rate: Rate = Rate()
+    on_demand: bool = False  # filled and sent only while someone subscribes
+    recorded: bool = False  # in scripts/record_run.sh's list
+    delivery: Delivery = Delivery()
+
+
+RATE_SUFFIX = '_rate'
+EVERY_STEP = Rate(when='every step')
+AS_SENT = Rate(when='as sent')
+_OUT, _IN = Direction.PUBLISHED, Direction.SUBSCRIBED
+
+#: The simulator's ROS interface, declared once: the stepping loop (what it fills and sends
+#: each step), the node (what it advertises and subscribes to), offline runs (what their
+#: bags hold), the recorder (RECORDED_TOPICS) and the README's table (markdown_table) read
+#: it. A test checks each of them against it.
+INTERFACE: tuple[Topic, ...] = (
+    Topic(CLOCK, 'rosgraph_msgs/Clock', _OUT, EVERY_STEP, recorded=True,
+          delivery=Delivery(offline=True, loop=True)),
+    Topic(JOINT_STATES, 'sensor_msgs/JointState', _OUT, Rate('~joint_states_rate', 1000.0),
+          recorded=True, delivery=Delivery('joint_state', offline=True, loop=True)),
+    Topic(GROUND_TRUTH_ODOM, 'nav_msgs/Odometry', _OUT, Rate('~odom_rate', 100.0),
+          recorded=True, delivery=Delivery(offline=True, loop=True)),
+    Topic(IMU, 'sensor_msgs/Imu', _OUT, Rate('~imu_rate', 1000.0), recorded=True,
+          delivery=Delivery('imu', offline=True, loop=True)),
+    Topic(L_FOOT_CONTACT, 'geometry_msgs/WrenchStamped', _OUT, Rate('~contact_rate', 1000.0),
+          recorded=True, delivery=Delivery('l', offline=True, loop=True)),
+    Topic(R_FOOT_CONTACT, 'geometry_msgs/WrenchStamped', _OUT, Rate('~contact_rate', 1000.0),
+          recorded=True, delivery=Delivery('r', offline=True, loop=True)),
+    Topic(TF, 'tf2_msgs/TFMessage', _OUT, Rate('~tf_rate', 100.0, (
+        'world -> pelvis, with `~tf`; the links at `~links_tf_rate` (50 Hz)')),
+          recorded=True, delivery=Delivery(offline=True, loop=True)),
+    Topic(CONTROLLER_STATISTICS, 'atlas_msgs/ControllerStatistics', _OUT,
+          Rate('/atlas/controller_statistics/update_rate'), on_demand=True, recorded=True,
+          delivery=Delivery(loop=True)),
+    Topic(ATLAS_STATE, 'atlas_msgs/AtlasState', _OUT, Rate('~atlas_state_rate', 1000.0),
+          on_demand=True, delivery=Delivery('atlas_state', loop=True)),
+    Topic(FORCE_TORQUE_SENSORS, 'atlas_msgs/ForceTorqueSensors', _OUT,
+          Rate('~force_torque_sensors_rate', 1000.0), on_demand=True,
+          delivery=Delivery('force_torque_sensors', loop=True)),
+    Topic(DEBUG_L_FOOT_CONTACT, 'geometry_msgs/WrenchStamped', _OUT,
+          Rate('~debug_contact_rate', 1000.0, 'while the foot touches'), on_demand=True,
+          delivery=Delivery('debug_l', loop=True)),
+    Topic(DEBUG_R_FOOT_CONTACT, 'geometry_msgs/WrenchStamped', _OUT,
+          Rate('~debug_contact_rate', 1000.0, 'while the foot touches'), on_demand=True,
+          delivery=Delivery('debug_r', loop=True)),
+    Topic(SYNCHRONIZATION_STATISTICS, 'atlas_msgs/SynchronizationStatistics', _OUT,
+          Rate(when='every step while the synchronization window is on'),
+          delivery=Delivery(latched=True, loop=True)),
+    Topic(SIM_CONFIG, 'std_msgs/String', _OUT, Rate(when='at start and after each reset'),
+          recorded=True, delivery=Delivery(latched=True, offline=True)),
+    Topic(SIM_INPUTS, 'std_msgs/String', _OUT, Rate(when='each applied cheat'), recorded=True),
+    Topic(CURRENT_CONTROL_MODE, 'std_msgs/String', _OUT, Rate(when='each mode switch'),
+          delivery=Delivery(latched=True)),
+    Topic(TF_STATIC, 'tf2_msgs/TFMessage', _OUT, Rate(when='once (`~tf_publisher` sim)'),
+          delivery=Delivery(latched=True)),
+    Topic(JOINT_COMMANDS, 'osrf_msgs/JointCommands', _IN, AS_SENT, recorded=True,
+          delivery=Delivery(offline=True)),
+    Topic(ATLAS_COMMAND, 'atlas_msgs/AtlasCommand', _IN, AS_SENT, recorded=True),
+    Topic(ATLAS_TEST, 'atlas_msgs/Test', _IN, AS_SENT, recorded=True),
+    Topic(CONTROL_MODE, 'std_msgs/String', _IN, AS_SENT, recorded=True,
+          delivery=Delivery(offline=True)),
+    Topic(MODE, 'std_msgs/String', _IN, AS_SENT, recorded=True),
+    Topic(SET_POSE, 'geometry_msgs/Pose', _IN, AS_SENT, recorded=True),
+    Topic(CMD_VEL, 'geometry_msgs/Twist', _IN, AS_SENT, recorded=True),
+    Topic(APPLY_PELVIS_FORCE, 'geometry_msgs/Wrench', _IN, AS_SENT, recorded=True),
+    Topic(JOINT_TRAJECTORY, 'trajectory_msgs/JointTrajectory', _IN, AS_SENT, recorded=True),
+    Topic(CONFIGURATION, 'sensor_msgs/JointState', _IN, AS_SENT),
+    Topic(SYNC_DELAY, 'std_msgs/String', _IN, AS_SENT),
+    Topic(ROSOUT, 'rosgraph_msgs/Log', Direction.LOG, Rate(when='each log line'), recorded=True,
+          delivery=Delivery(offline=True)),
 )
 
-#: The ROS 1 message type of each recorded topic, and of the simulator's other topics.
-MSG_TYPES: dict[str, str] = {
-    CLOCK: 'rosgraph_msgs/Clock',
-    JOINT_STATES: 'sensor_msgs/JointState',
-    GROUND_TRUTH_ODOM: 'nav_msgs/Odometry',
-    IMU: 'sensor_msgs/Imu',
-    L_FOOT_CONTACT: 'geometry_msgs/WrenchStamped',
-    R_FOOT_CONTACT: 'geometry_msgs/WrenchStamped',
-    JOINT_COMMANDS: 'osrf_msgs/JointCommands',
-    CONTROL_MODE: 'std_msgs/String',
-    SIM_CONFIG: 'std_msgs/String',
-    ROSOUT: 'rosgraph_msgs/Log',
-    CONTROLLER_STATISTICS: 'atlas_msgs/ControllerStatistics',
-    TF: 'tf2_msgs/TFMessage',
-    # Published, not recorded by default (README: the 1 kHz duplicates double a bag).
-    ATLAS_STATE: 'atlas_msgs/AtlasState',
-    FORCE_TORQUE_SENSORS: 'atlas_msgs/ForceTorqueSensors',
-    DEBUG_L_FOOT_CONTACT: 'geometry_msgs/WrenchStamped',
-    DEBUG_R_FOOT_CONTACT: 'geometry_msgs/WrenchStamped',
-    SYNCHRONIZATION_STATISTICS: 'atlas_msgs/SynchronizationStatistics',
-    SYNC_DELAY: 'std_msgs/String',
-    ATLAS_COMMAND: 'atlas_msgs/AtlasCommand',
-    ATLAS_TEST: 'atlas_msgs/Test',
-    MODE: 'std_msgs/String',
-    SET_POSE: 'geometry_msgs/Pose',
-    CMD_VEL: 'geometry_msgs/Twist',
-    APPLY_PELVIS_FORCE: 'geometry_msgs/Wrench',
-    JOINT_TRAJECTORY: 'trajectory_msgs/JointTrajectory',
-    SIM_INPUTS: 'std_msgs/String',
-}
+#: The table's rows by topic.
+BY_NAME: dict[str, Topic] = {topic.name: topic for topic in INTERFACE}
+#: What scripts/record_run.sh records: the simulator's output, the commands and modes that
+#: drove it, the config replay needs, and the log. Analysis and replay read these.
+RECORDED_TOPICS: tuple[str, ...] = tuple(topic.name for topic in INTERFACE if topic.recorded)
+#: The ROS 1 message type of each topic of the interface.
+MSG_TYPES: dict[str, str] = {topic.name: topic.msg_type for topic in INTERFACE}
+
+
+def markdown_table() -> str:
+    """INTERFACE as the README's markdown table (one row per topic, in the table's order)."""
+    yes = {True: 'yes', False: 'no'}
+    lines = ['| Topic | Type | Direction | Rate (parameter, default) | On demand | Recorded |',
+             '| --- | --- | --- | --- | --- | --- |']
+    lines += [f'| `{topic.name}` | `{topic.msg_type}` | {topic.direction.value} | '
+              f'{topic.rate.text()} | {yes[topic.on_demand]} | {yes[topic.recorded]} |'
+              for topic in INTERFACE]
+    return '\n'.join(lines) + '\n'
+
 
 #: Gazebo's services, as gazebo_ros offered them.
 RESET_WORLD_SERVICE = '/gazebo/reset_world'

@@ -18,8 +18,9 @@ from types import SimpleNamespace
 from typing import Any
 from unittest import mock
 
+from tutorial_atlas_control import topics
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
-from tutorial_atlas_control.stepping.loop import ON_DEMAND_MESSAGES
+from tutorial_atlas_control.stepping.loop import LoopSettings
 
 __all__ = ['LAUNCH_RATES_HZ', 'UNHEARD_TOPICS', 'FakePublisher', 'Sinks', 'fake_ros_node']
 
@@ -27,7 +28,8 @@ __all__ = ['LAUNCH_RATES_HZ', 'UNHEARD_TOPICS', 'FakePublisher', 'Sinks', 'fake_
 LAUNCH_RATES_HZ = {'joint_states': 1000.0, 'odom': 100.0, 'imu': 1000.0, 'contact': 1000.0}
 #: The topics no fake subscriber listens to: as in a live launch, where the recorder
 #: subscribes to what it records and DRCSim's 1 kHz duplicates are not recorded.
-UNHEARD_TOPICS = frozenset(topic for topic, _, _ in ON_DEMAND_MESSAGES)
+UNHEARD_TOPICS = frozenset(topic.name for topic in topics.INTERFACE
+                           if topic.delivery.loop and topic.on_demand and not topic.recorded)
 #: What the fake sockets report as their send timeout (s): set, so transport.py leaves it.
 SOCKET_TIMEOUT_S = 2.0
 
@@ -101,6 +103,8 @@ class FakePublisher:
     latched /atlas/sim_config)."""
 
     resolved_name = 'fake'
+    #: (ROS type, latched) as rospy.Publisher was given them.
+    advertised: tuple[str, bool] = ('', False)
 
     def __init__(self, sinks: Sinks, topic: str = '', heard: bool | None = None) -> None:
         self.topic = topic
@@ -135,8 +139,9 @@ def fake_ros_node(sim: AtlasSimulator, steps: int, tcp: bool = False,
         calls['left'] -= 1
         return calls['left'] < 0
 
-    def publisher(topic: str, *_args: object, **_kwargs: object) -> FakePublisher:
+    def publisher(topic: str, msg_class: type, *_args: object, **kwargs: object) -> FakePublisher:
         publishers[topic] = FakePublisher(sinks, topic)
+        publishers[topic].advertised = (msg_class._type, bool(kwargs.get('latch', False)))
         return publishers[topic]
 
     try:
@@ -150,8 +155,7 @@ def fake_ros_node(sim: AtlasSimulator, steps: int, tcp: bool = False,
                                  logerr=mock.DEFAULT, logerr_throttle=mock.DEFAULT,
                                  logfatal=mock.DEFAULT), \
                 mock.patch.object(sim_node, 'serve_udpros'):  # no rospy node to register with
-            node = sim_node.SimNode(sim, real_time_factor=0.0, paused=False,
-                                    rates_hz=dict(rates_hz), gui=False)
+            node = sim_node.SimNode(sim, LoopSettings(dict(rates_hz)), gui=False)
             node.fake_publishers = publishers
             yield node
     finally:

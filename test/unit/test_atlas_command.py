@@ -28,7 +28,8 @@ from tutorial_atlas_control.sim.controller import (
     load_gains_yaml,
 )
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode
-from tutorial_atlas_control.stepping.loop import ResetControlsRequest, SteppingLoop
+from tutorial_atlas_control.stepping.controls import ResetControlsRequest
+from tutorial_atlas_control.stepping.loop import SteppingLoop
 from tutorial_atlas_control.units import NS_PER_S
 
 CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
@@ -345,7 +346,7 @@ def test_refusals_and_left_out_fields_are_one_line_each(sim: AtlasSimulator) -> 
         'synchronization window on (/atlas/atlas_command desired_controller_period_ms = 10): '
         'each step waits for a command stamped no more than 10 ms before its end, at most '
         '0.025 s per step and 0.25 s per 5 s']
-    assert loop.desired_controller_period_ms == 20
+    assert loop.inbox.period_ms == 20
 
 
 # -- /atlas/reset_controls ------------------------------------------------------------------

@@ -28,7 +28,8 @@ from tutorial_atlas_control.sim.link_transforms import (
 )
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
 from tutorial_atlas_control.sim.urdf import UrdfJoint, read_joints
-from tutorial_atlas_control.stepping.loop import SteppingLoop
+from tutorial_atlas_control.stepping.loop import LoopSettings, SteppingLoop
+from tutorial_atlas_control.stepping.outputs import LoopOutputs
 from tutorial_atlas_control.stepping.pacing import Pacer
 from tutorial_atlas_control.units import NS_PER_S
 
@@ -209,15 +210,16 @@ def test_loop_publishes_links_at_robot_state_publishers_stamps(
         topics.CLOCK, topics.JOINT_STATES, topics.IMU, topics.L_FOOT_CONTACT,
         topics.R_FOOT_CONTACT, topics.GROUND_TRUTH_ODOM, topics.TF,
         topics.CONTROLLER_STATISTICS)}
-    loop = SteppingLoop(sim, outbox, outlets, rates, CommandAgeStatistics(sim.dt_s), Log(),
-                        lambda _json: None, pacer=Pacer(0.0), links=atlas_links())
+    loop = SteppingLoop(sim, LoopOutputs(outbox, outlets, Log(), lambda _json: None),
+                        LoopSettings(rates, links=atlas_links()), CommandAgeStatistics(sim.dt_s),
+                        pacer=Pacer(0.0))
     joint_states: dict[int, np.ndarray] = {}
-    original = loop.publish
+    original = loop.publisher.publish
 
-    def publish() -> None:
-        original()
+    def publish(count: int) -> None:
+        original(count)
         joint_states[sim.sim_time_ns] = sim.data.qpos[atlas.qpos_adr].copy()
-    loop.publish = publish
+    loop.publisher.publish = publish
     steps = [0]
     loop.run(lambda: (steps.__setitem__(0, steps[0] + 1) or steps[0] > 100))
     links_messages = [m for m in outbox.tf if len(m) > 200]

@@ -131,7 +131,7 @@ def test_the_node_hands_atlas_command_and_test_to_the_loop_in_order(sim: AtlasSi
         command, test = sim_node.RawAtlasCommand(), sim_node.RawTest()
         node.on_atlas_command(command.deserialize(encode_atlas_command(0, {})))
         node.on_test(test.deserialize(encode_test(0, {})))
-        assert [topic for topic, _raw in node.loop.pending_commands] == [
+        assert [topic for topic, _raw in node.loop.inbox.pending] == [
             topics.ATLAS_COMMAND, topics.ATLAS_TEST]
         assert sim_node.RawAtlasCommand._md5sum == '3a56dd1f50633ad975636160b665384a'
         assert sim_node.RawTest._md5sum == '62f63cd4b6db15007d8d3d4a23411c4c'
@@ -277,14 +277,14 @@ def test_tf_publisher_parameter_chooses_who_publishes_the_links(
     built: list[tuple[Any, ...]] = []
     monkeypatch.setattr(sim_node, 'SimNode', lambda *args: built.append(args))
     sim_node.build_node()
-    tf, links = built[-1][5], built[-1][7]
+    tf, links = built[-1][3], built[-1][1].links  # SimNode(sim, settings, gui, tf, ...)
     assert tf and links.frames[:2] == (('pelvis', 'ltorso'), ('ltorso', 'mtorso'))
     assert len(links) == 28 and links.static == ()
     assert params[topics.ROBOT_DESCRIPTION_PARAM].startswith('<?xml')
     del params[topics.ROBOT_DESCRIPTION_PARAM]
     params['~tf_publisher'] = 'robot_state_publisher'
     sim_node.build_node()
-    assert built[-1][5] and built[-1][7] is None
+    assert built[-1][3] and built[-1][1].links is None
     assert topics.ROBOT_DESCRIPTION_PARAM not in params
     params['~tf_publisher'] = 'rsp'
     with pytest.raises(sim_node.AtlasControlError,

@@ -18,17 +18,18 @@ from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistic
 from tutorial_atlas_control.sim.model import FALL_HEIGHT_M, pelvis_height_m
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode, PhysicsDivergenceError
 from tutorial_atlas_control.stepping import pacing
-from tutorial_atlas_control.stepping.loop import (
+from tutorial_atlas_control.stepping.divergence import (
     DIVERGENCE_REPEAT_S,
     MAX_DIVERGENCES_IN_A_ROW,
-    NOT_USER_WARN_PERIOD_S,
-    ON_DEMAND_MESSAGES,
-    PAUSED_POLL_S,
     DivergenceGuard,
-    SteppingLoop,
 )
+from tutorial_atlas_control.stepping.inbox import CommandInbox
+from tutorial_atlas_control.stepping.loop import PAUSED_POLL_S, LoopSettings, SteppingLoop
+from tutorial_atlas_control.stepping.outputs import LoopOutputs
 from tutorial_atlas_control.stepping.pacing import Pacer
+from tutorial_atlas_control.stepping.publication import DEMAND_TOPICS
 from tutorial_atlas_control.stepping.schedule import step_stamp, steps_between
+from tutorial_atlas_control.stepping.watch import NOT_USER_WARN_PERIOD_S
 from tutorial_atlas_control.units import NS_PER_S
 
 CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
@@ -130,9 +131,9 @@ def make_loop(sim: AtlasSimulator, listeners: set[str] | None = None,
     log = FakeLog()
     configs: list[str] = []
     clock = FakeClock()
-    loop = SteppingLoop(sim, outbox, {topic: topic for topic in ALL_TOPICS},
-                        rates_hz or LAUNCH_RATES_HZ, CommandAgeStatistics(sim.dt_s), log,
-                        configs.append, real_time_factor=real_time_factor, paused=paused,
+    outputs = LoopOutputs(outbox, {topic: topic for topic in ALL_TOPICS}, log, configs.append)
+    settings = LoopSettings(rates_hz or LAUNCH_RATES_HZ, real_time_factor, paused)
+    loop = SteppingLoop(sim, outputs, settings, CommandAgeStatistics(sim.dt_s),
                         pacer=Pacer(real_time_factor, clock, clock.sleep))
     return loop, outbox, log, configs
 
@@ -236,8 +237,8 @@ def test_nothing_is_serialized_for_topics_without_listeners(sim: AtlasSimulator)
 def test_without_a_tf_outlet_there_is_no_tf(sim: AtlasSimulator) -> None:
     outbox = FakeOutbox(set(ALL_TOPICS))
     outlets = {topic: topic for topic in ALL_TOPICS if topic != topics.TF}
-    loop = SteppingLoop(sim, outbox, outlets, LAUNCH_RATES_HZ, CommandAgeStatistics(sim.dt_s),
-                        FakeLog(), lambda _text: None)
+    loop = SteppingLoop(sim, LoopOutputs(outbox, outlets, FakeLog(), lambda _text: None),
+                        LoopSettings(LAUNCH_RATES_HZ), CommandAgeStatistics(sim.dt_s))
     loop.run(stops_after(20))
     queued = outbox.queued()
     assert topics.TF not in queued
@@ -246,15 +247,16 @@ def test_without_a_tf_outlet_there_is_no_tf(sim: AtlasSimulator) -> None:
 
 # -- DRCSim's messages, filled only when heard ------------------------------------------
 
-DRCSIM_TOPICS = tuple(topic for topic, _, _ in ON_DEMAND_MESSAGES)
+DRCSIM_TOPICS = tuple(topic.name for topic in DEMAND_TOPICS)
 
 
 def make_drcsim_loop(sim: AtlasSimulator, listeners: set[str],
                      rates_hz: dict[str, float] | None = None) -> tuple[SteppingLoop, FakeOutbox]:
     outbox = FakeOutbox(listeners)
     outlets = {topic: topic for topic in ALL_TOPICS + DRCSIM_TOPICS}
-    loop = SteppingLoop(sim, outbox, outlets, {**LAUNCH_RATES_HZ, **(rates_hz or {})},
-                        CommandAgeStatistics(sim.dt_s), FakeLog(), lambda _text: None)
+    loop = SteppingLoop(sim, LoopOutputs(outbox, outlets, FakeLog(), lambda _text: None),
+                        LoopSettings({**LAUNCH_RATES_HZ, **(rates_hz or {})}),
+                        CommandAgeStatistics(sim.dt_s))
     return loop, outbox
 
 
@@ -312,7 +314,7 @@ def test_commands_between_steps_merge_oldest_first(sim: AtlasSimulator) -> None:
     assert position[JOINT_INDEX['l_leg_kny']] == 0.1  # the complete one underneath
     assert log.of('info') == [
         'first /atlas/joint_commands since the start or last reset, at t=0.000 s (Stand mode)']
-    assert not loop.pending_commands
+    assert not loop.inbox.pending
 
 
 def test_a_complete_command_hides_older_ones_undecoded(sim: AtlasSimulator) -> None:
@@ -331,9 +333,9 @@ def test_of_complete_commands_only_the_newest_is_decoded(
     """A flood costs one decode per step: the newest complete command hides the rest."""
     loop, _, _, _ = make_loop(sim)
     decoded: list[bytes] = []
-    original = loop._decode
-    monkeypatch.setattr(loop, '_decode', lambda topic, raw: (decoded.append(raw),
-                                                             original(topic, raw))[1])
+    original = loop.inbox._decode
+    monkeypatch.setattr(loop.inbox, '_decode', lambda topic, raw: (decoded.append(raw),
+                                                                   original(topic, raw))[1])
     sent = [complete_command(0.1 * k, stamp_ns=k * NS_PER_S) for k in (1, 2, 3)]
     for raw in sent:
         loop.receive_command(raw)
@@ -362,6 +364,35 @@ def test_commands_are_applied_while_paused_without_stepping(sim: AtlasSimulator)
     np.testing.assert_array_equal(sim.user_command.position, [0.1] * NUM_JOINTS)
     assert len(outbox.queued()[topics.JOINT_STATES]) == 1  # the initial state only
     assert loop.pacer.clock.slept_s == [PAUSED_POLL_S] * 3
+
+
+class CountingController:
+    """A StepController of its own: what users sent, then a note of the step it is for."""
+
+    def __init__(self, inbox: CommandInbox, sim: AtlasSimulator) -> None:
+        self.inbox, self.sim = inbox, sim
+        self.steps_ns: list[int] = []
+
+    def before_step(self) -> None:
+        self.inbox.apply_pending()
+        self.steps_ns.append(self.sim.sim_time_ns)
+
+
+def test_a_controller_plugs_in_and_is_called_once_before_each_step(sim: AtlasSimulator) -> None:
+    """Once per step, before it, never while paused; what users sent still acts."""
+    outbox = FakeOutbox(set(ALL_TOPICS))
+    made: list[CountingController] = []
+    loop = SteppingLoop(sim, LoopOutputs(outbox, {t: t for t in ALL_TOPICS}, FakeLog(),
+                                         lambda _text: None),
+                        LoopSettings(LAUNCH_RATES_HZ), CommandAgeStatistics(sim.dt_s),
+                        controller=lambda inbox: made.append(CountingController(inbox, sim))
+                        or made[-1])
+    loop.receive_command(complete_command(0.1))
+    loop.run(stops_after(5))
+    loop.pause()
+    loop.run(stops_after(3))
+    assert [controller.steps_ns for controller in made] == [[k * sim.step_ns for k in range(5)]]
+    np.testing.assert_array_equal(sim.user_command.position, [0.1] * NUM_JOINTS)
 
 
 # -- services ------------------------------------------------------------------------------
@@ -459,9 +490,10 @@ def test_inputs_apply_between_steps_publish_their_event_and_log_once_a_second(
 
     outbox = FakeOutbox(set(ALL_TOPICS))
     log, events = FakeLog(), []
-    loop = SteppingLoop(sim, outbox, {topic: topic for topic in ALL_TOPICS}, LAUNCH_RATES_HZ,
-                        CommandAgeStatistics(sim.dt_s), log, lambda text: None,
-                        publish_input=events.append)
+    outputs = LoopOutputs(outbox, {topic: topic for topic in ALL_TOPICS}, log,
+                          lambda text: None, publish_input=events.append)
+    loop = SteppingLoop(sim, outputs, LoopSettings(LAUNCH_RATES_HZ),
+                        CommandAgeStatistics(sim.dt_s))
     loop.run(stops_after(3))
     for _ in range(5):  # a 1 kHz wrench stream
         loop.apply_input(wrench_input((1.0, 0.0, 0.0), (0.0, 0.0, 0.0)))

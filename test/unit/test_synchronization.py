@@ -28,7 +28,8 @@ from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistics
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
-from tutorial_atlas_control.stepping.loop import SteppingLoop
+from tutorial_atlas_control.stepping.loop import LoopSettings, SteppingLoop
+from tutorial_atlas_control.stepping.outputs import LoopOutputs
 from tutorial_atlas_control.stepping.pacing import Pacer
 from tutorial_atlas_control.stepping.synchronization import (
     MAX_PER_STEP_PARAM,
@@ -186,9 +187,10 @@ def make_sync_loop(sim: AtlasSimulator, budgets: DelayBudgets = BUDGETS
     outbox = FakeOutbox(set(SYNC_TOPICS))
     log = FakeLog()
     clock = FakeClock()
-    loop = SteppingLoop(sim, outbox, {topic: topic for topic in SYNC_TOPICS}, LAUNCH_RATES_HZ,
-                        CommandAgeStatistics(sim.dt_s), log, lambda _text: None,
-                        pacer=Pacer(0.0, clock, clock.sleep),
+    outputs = LoopOutputs(outbox, {topic: topic for topic in SYNC_TOPICS}, log,
+                          lambda _text: None)
+    loop = SteppingLoop(sim, outputs, LoopSettings(LAUNCH_RATES_HZ),
+                        CommandAgeStatistics(sim.dt_s), pacer=Pacer(0.0, clock, clock.sleep),
                         synchronization=SynchronizationWindow(budgets, clock))
     return loop, outbox, log, clock
 
@@ -229,7 +231,7 @@ def test_with_the_window_every_step_obeys_the_answer_to_the_state_before(
         sim: AtlasSimulator) -> None:
     loop, outbox, log, clock = make_sync_loop(sim)
     echo = EchoController(loop, outbox, clock)
-    loop.wait_for_command = echo.answer
+    loop.gate.wait_for_command = echo.answer
     # The first command, stamped 0, asks for the window and is applied at the first step;
     # from the second step on, each step waits for the answer to the last state.
     loop.receive_command(atlas_bytes(0, 1, k_effort=full(255), position=full(0.0)),
@@ -255,7 +257,7 @@ def test_the_state_is_sent_before_the_wait(sim: AtlasSimulator) -> None:
         seen.append(header_stamp_ns(outbox.sent[topics.JOINT_STATES][-1]))
         assert topics.JOINT_STATES not in outbox.pending
         return SilentController(clock)(timeout_s)
-    loop.wait_for_command = wait
+    loop.gate.wait_for_command = wait
     loop.receive_command(atlas_bytes(0, 1), topics.ATLAS_COMMAND)
     loop.run(stops_after(3))
     assert seen == [STEP_NS, 2 * STEP_NS]
@@ -264,7 +266,7 @@ def test_the_state_is_sent_before_the_wait(sim: AtlasSimulator) -> None:
 def test_a_silent_controller_is_waited_for_within_the_budgets(sim: AtlasSimulator) -> None:
     loop, outbox, log, clock = make_sync_loop(sim)
     silent = SilentController(clock)
-    loop.wait_for_command = silent
+    loop.gate.wait_for_command = silent
     loop.receive_command(atlas_bytes(0, 1), topics.ATLAS_COMMAND)
     loop.run(stops_after(6))
     assert sim.sim_time_ns == 6 * STEP_NS  # the simulation went on
@@ -286,7 +288,7 @@ def test_2_5_era_commands_never_wait(sim: AtlasSimulator, command: str) -> None:
 
     def no_wait(_timeout_s: float) -> bool:
         raise AssertionError('the loop waited')
-    loop.wait_for_command = no_wait
+    loop.gate.wait_for_command = no_wait
     if command == 'joint_commands':
         loop.receive_command(complete_command(0.1, stamp_ns=0))
     else:
@@ -306,7 +308,7 @@ def test_a_period_0_command_turns_the_window_off(sim: AtlasSimulator) -> None:
         waits.append(_timeout_s)
         loop.receive_command(atlas_bytes(0, 0, position=full(0.0)), topics.ATLAS_COMMAND)
         return True
-    loop.wait_for_command = turn_off
+    loop.gate.wait_for_command = turn_off
     loop.receive_command(atlas_bytes(0, 1), topics.ATLAS_COMMAND)
     loop.run(stops_after(4))
     assert len(waits) == 1  # at the second step; the third and fourth do not wait
@@ -318,11 +320,11 @@ def test_a_period_0_command_turns_the_window_off(sim: AtlasSimulator) -> None:
 def test_a_command_wakes_the_wait_only_while_the_window_is_on(sim: AtlasSimulator) -> None:
     loop, _, _, _ = make_sync_loop(sim)
     loop.receive_command(complete_command(0.1))
-    assert not loop._command_arrived.is_set()  # 2.5-era traffic costs no wake-up
+    assert not loop.inbox.arrived.is_set()  # 2.5-era traffic costs no wake-up
     loop.receive_command(atlas_bytes(0, 1), topics.ATLAS_COMMAND)
     loop.apply_pending_commands()
     loop.receive_command(atlas_bytes(0, 1), topics.ATLAS_COMMAND)
-    assert loop.wait_for_command(0.0)
+    assert loop.gate.wait_for_command(0.0)
 
 
 def test_shutdown_ends_the_wait(sim: AtlasSimulator) -> None:
@@ -337,7 +339,7 @@ def test_shutdown_ends_the_wait(sim: AtlasSimulator) -> None:
             return True
         clock.now_s += timeout_s  # (a wait that went on would wait out the step's 100 s)
         return False
-    loop.wait_for_command = wait
+    loop.gate.wait_for_command = wait
     loop.receive_command(atlas_bytes(0, 1), topics.ATLAS_COMMAND)
     turns = stops_after(3)
     loop.run(lambda: turns() or state['down'])
@@ -367,12 +369,12 @@ def test_the_latest_statistics_are_kept_for_later_subscribers(sim: AtlasSimulato
     outbox = FakeOutbox(set(ALL_TOPICS))  # nobody subscribes to the statistics
     clock = FakeClock()
     latched: list[bytes] = []
-    loop = SteppingLoop(sim, outbox, {topic: topic for topic in SYNC_TOPICS}, LAUNCH_RATES_HZ,
-                        CommandAgeStatistics(sim.dt_s), FakeLog(), lambda _text: None,
-                        pacer=Pacer(0.0, clock, clock.sleep),
-                        synchronization=SynchronizationWindow(BUDGETS, clock),
-                        latch_synchronization=latched.append)
-    loop.wait_for_command = SilentController(clock)
+    outputs = LoopOutputs(outbox, {topic: topic for topic in SYNC_TOPICS}, FakeLog(),
+                          lambda _text: None, latch_synchronization=latched.append)
+    loop = SteppingLoop(sim, outputs, LoopSettings(LAUNCH_RATES_HZ),
+                        CommandAgeStatistics(sim.dt_s), pacer=Pacer(0.0, clock, clock.sleep),
+                        synchronization=SynchronizationWindow(BUDGETS, clock))
+    loop.gate.wait_for_command = SilentController(clock)
     loop.receive_command(atlas_bytes(0, 1), topics.ATLAS_COMMAND)
     loop.run(stops_after(3))
     assert sync_statistics(outbox) == []

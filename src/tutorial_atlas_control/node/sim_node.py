@@ -56,14 +56,11 @@ Parameters (private unless noted):
 from __future__ import annotations
 
 import io
-import logging
-import os
-import threading
 import time
 import warnings
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
-from typing import Any
 
 import genpy
 import rospy
@@ -76,7 +73,7 @@ from atlas_msgs.msg import (
     Test,
 )
 from atlas_msgs.srv import ResetControls, ResetControlsResponse
-from geometry_msgs.msg import Pose, TransformStamped, Twist, Wrench, WrenchStamped
+from geometry_msgs.msg import TransformStamped, WrenchStamped
 from nav_msgs.msg import Odometry
 from osrf_msgs.msg import JointCommands
 from rosgraph_msgs.msg import Clock
@@ -84,19 +81,18 @@ from sensor_msgs.msg import Imu, JointState
 from std_msgs.msg import String
 from std_srvs.srv import Empty, EmptyResponse
 from tf2_msgs.msg import TFMessage
-from trajectory_msgs.msg import JointTrajectory
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags.bag_dir import unwritable_reason
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES
+from tutorial_atlas_control.node.cheats import WARN_THROTTLE_S, subscribe_cheats
 from tutorial_atlas_control.node.master_watch import start_master_watch
 from tutorial_atlas_control.node.recorder_watch import start_recorder_watch
 from tutorial_atlas_control.node.transport import WireBatch, widen_accept_queue
 from tutorial_atlas_control.node.udpros import serve as serve_udpros
-from tutorial_atlas_control.node.viewer import ViewerLink, ViewerRequest, display_problem
+from tutorial_atlas_control.node.viewer_window import open_viewer
 from tutorial_atlas_control.sim import model as atlas_model
-from tutorial_atlas_control.sim.camera import configure_viewer_camera, configure_viewer_scene
 from tutorial_atlas_control.sim.controller import GainsError, gains_from_params
 from tutorial_atlas_control.sim.controller_statistics import (
     DEFAULT_WINDOW_S,
@@ -104,7 +100,6 @@ from tutorial_atlas_control.sim.controller_statistics import (
     WINDOW_PARAM,
     CommandAgeStatistics,
 )
-from tutorial_atlas_control.sim.joint_trajectory import TrajectoryMessage, trajectory_input
 from tutorial_atlas_control.sim.link_transforms import LinkTransforms
 from tutorial_atlas_control.sim.simulator import (
     DEFAULT_TIME_TO_UNPIN_S,
@@ -116,47 +111,24 @@ from tutorial_atlas_control.sim.urdf import UrdfError, matching_urdf, read_joint
 from tutorial_atlas_control.sim.vrc import (
     DEFAULT_STARTUP_MODE,
     STARTUP_MODES,
-    InputError,
-    ModeInput,
-    SimInput,
     VrcMode,
-    cmd_vel_input,
-    input_notes,
-    parse_vrc_mode,
-    pose_input,
-    wrench_input,
 )
-from tutorial_atlas_control.stepping.loop import (
-    LINKS_TF_RATE_HZ,
-    ResetControlsRequest,
-    SteppingLoop,
-)
+from tutorial_atlas_control.stepping.controls import ResetControlsRequest
+from tutorial_atlas_control.stepping.loop import LoopSettings, SteppingLoop
+from tutorial_atlas_control.stepping.outputs import LoopOutputs
+from tutorial_atlas_control.stepping.publication import LINKS_TF_RATE_HZ, default_rates_hz
 from tutorial_atlas_control.stepping.synchronization import DelayBudgets, SynchronizationWindow
 from tutorial_atlas_control.units import finite_number
 
 NODE_NAME = 'atlas_sim'
-#: Seconds between repeats of the same refusal warning.
-WARN_THROTTLE_S = 2.0
-#: The viewer draws at most one frame per VIEWER_FRAME_PERIOD_S (s, wall): left alone, its
-#: render thread draws as fast as it can, and with software OpenGL (no GPU, Xvfb) that took
-#: the CPU the simulation needs. The pause is VIEWER_HOLD_S of it; the rest is its turn.
-VIEWER_FRAME_PERIOD_S = 1.0 / 30.0
-VIEWER_TURN_S = 0.005
-VIEWER_HOLD_S = VIEWER_FRAME_PERIOD_S - VIEWER_TURN_S
 #: Who publishes the links' transforms (~tf_publisher; the first is the default).
 TF_PUBLISHERS = ('sim', 'robot_state_publisher')
-#: robot_state_publisher's latched topic of the fixed joints' transforms.
-TF_STATIC = '/tf_static'
-
-#: What the stepping loop publishes through the node's publishers, with their types; /tf
-#: (world -> pelvis, and the links with ~tf_publisher sim) only with ~tf.
-LOOP_TOPICS = (
-    (topics.CLOCK, Clock), (topics.JOINT_STATES, JointState),
-    (topics.GROUND_TRUTH_ODOM, Odometry), (topics.IMU, Imu),
-    (topics.L_FOOT_CONTACT, WrenchStamped), (topics.R_FOOT_CONTACT, WrenchStamped),
-    (topics.CONTROLLER_STATISTICS, ControllerStatistics),
-    (topics.ATLAS_STATE, AtlasState), (topics.FORCE_TORQUE_SENSORS, ForceTorqueSensors),
-    (topics.DEBUG_L_FOOT_CONTACT, WrenchStamped), (topics.DEBUG_R_FOOT_CONTACT, WrenchStamped))
+#: The classes of the messages the node publishes, by ROS type (topics.INTERFACE's).
+MESSAGE_CLASSES: dict[str, type[genpy.Message]] = {cls._type: cls for cls in (
+    Clock, JointState, Odometry, Imu, WrenchStamped, ControllerStatistics, AtlasState,
+    ForceTorqueSensors, SynchronizationStatistics, TFMessage, String)}
+#: Queue size of the publishers the node itself calls publish() on (1 when not named).
+QUEUE_SIZES = {topics.SIM_INPUTS: 100}
 
 
 class RawMessage(genpy.Message):
@@ -220,7 +192,7 @@ class RawLatched:
 
 
 class RosLog:
-    """The stepping loop's log lines, into rospy's log (stepping.loop.LoopLog).
+    """The stepping loop's log lines, into rospy's log (stepping.outputs.LoopLog).
 
     Refusals are throttled per topic and kind (rospy's logwarn_throttle throttles per call
     site, so a refused JointCommands would hide a refused AtlasCommand for WARN_THROTTLE_S).
@@ -262,62 +234,65 @@ class RosLog:
 
 class SimNode:
     """The stepping loop (stepping/loop.py) behind ROS: publishers, subscriptions,
-    services, parameters and the viewer window."""
+    services, parameters and the viewer window.
 
-    def __init__(self, sim: AtlasSimulator, real_time_factor: float, paused: bool,
-                 rates_hz: dict[str, float], gui: bool, tf: bool = False,
-                 sync_budgets: DelayBudgets | None = None,
-                 links: LinkTransforms | None = None) -> None:
+    Args:
+        settings: the loop's rates, pace and pause, and the links' transforms to publish
+            (with `tf` only).
+        tf: publish /tf (and, with settings.links, the links and /tf_static).
+    """
+
+    def __init__(self, sim: AtlasSimulator, settings: LoopSettings, gui: bool,
+                 tf: bool = False, sync_budgets: DelayBudgets | None = None) -> None:
         self.sim = sim
         self.gui = gui
         # UDPROS for roscpp's unreliable() subscribers, before the master announces a topic.
         self.udpros = serve_udpros()
         widen_accept_queue()  # a dozen subscribers connect at once when it advertises
         self._advertise(tf)
-        statistics = self._controller_statistics()
         outbox = WireBatch()
         # Before rospy closes the connections: what a stalled-then-live subscriber (the
         # recorder) has not taken yet (transport.ConnectionWriter.drain).
         rospy.on_shutdown(outbox.drain)
-        self.loop = SteppingLoop(sim, outbox, self.publishers, rates_hz, statistics,
-                                 RosLog(), self._publish_config,
-                                 real_time_factor=real_time_factor, paused=paused,
-                                 publish_input=self._publish_input,
+        links = settings.links if tf else None
+        outputs = LoopOutputs(outbox, self.publishers, RosLog(), self._publish_config,
+                              self._publish_input, self._latch_synchronization)
+        self.loop = SteppingLoop(sim, outputs, replace(settings, links=links),
+                                 self._controller_statistics(),
                                  synchronization=SynchronizationWindow(
-                                     sync_budgets or DelayBudgets()),
-                                 latch_synchronization=self._latch_synchronization,
-                                 links=links if tf else None)
-        if tf and links is not None:
+                                     sync_budgets or DelayBudgets()))
+        if links is not None:
             self._publish_static_transforms(links)
         self.loop.publish_config()
-        self.mode_pub.publish(String(data=sim.mode.value))
+        self.node_publishers[topics.CURRENT_CONTROL_MODE].publish(String(data=sim.mode.value))
         self._subscribe()
 
     def _advertise(self, tf: bool) -> None:
-        """The publishers; the loop serializes their messages itself (msgs/wire.py).
+        """The publishers of topics.INTERFACE: the loop's (`publishers`), whose messages it
+        serializes itself (msgs/wire.py), and the node's own (`node_publishers`).
 
-        queue_size=None: plain synchronous connections, without rospy's per-message
-        writer-thread handoff. A subscriber that cannot keep up slows the loop (TCP
-        back-pressure) instead of losing messages; one that stops reading is not waited
-        for, and is dropped once it has accepted nothing for transport.SEND_TIMEOUT_S
-        (node/transport.py).
+        The loop's have queue_size=None: plain synchronous connections, without rospy's
+        per-message writer-thread handoff. A subscriber that cannot keep up slows the loop
+        (TCP back-pressure) instead of losing messages; one that stops reading is not
+        waited for, and is dropped once it has accepted nothing for
+        transport.SEND_TIMEOUT_S (node/transport.py).
         """
-        published = LOOP_TOPICS + (((topics.TF, TFMessage),) if tf else ())
+        self.publishers: dict[str, rospy.Publisher] = {}
+        self.node_publishers: dict[str, rospy.Publisher] = {}
         with warnings.catch_warnings():
             warnings.simplefilter('ignore', SyntaxWarning)  # rospy: "explicit queue_size"
-            self.publishers = {topic: rospy.Publisher(topic, msg_class, queue_size=None)
-                               for topic, msg_class in published}
-            # Latched, as DRCSim's: a new subscriber gets the latest step's delays at once.
-            self.publishers[topics.SYNCHRONIZATION_STATISTICS] = rospy.Publisher(
-                topics.SYNCHRONIZATION_STATISTICS, SynchronizationStatistics, queue_size=None,
-                latch=True)
-        # Latched, recorded in every bag: what offline replay needs to re-create the run.
-        self.config_pub = rospy.Publisher(topics.SIM_CONFIG, String, queue_size=1, latch=True)
-        # Each applied cheat, with the sim time it took effect: what replay re-applies.
-        self.inputs_pub = rospy.Publisher(topics.SIM_INPUTS, String, queue_size=100)
-        # Latched: the mode now, for traj_yaml.py's warning and `rostopic echo`.
-        self.mode_pub = rospy.Publisher(topics.CURRENT_CONTROL_MODE, String, queue_size=1,
-                                        latch=True)
+            for topic in topics.INTERFACE:
+                if topic.direction is not topics.Direction.PUBLISHED or (
+                        topic.name == topics.TF and not tf):
+                    continue
+                name, latch = topic.name, topic.delivery.latched
+                if topic.delivery.loop:
+                    self.publishers[name] = rospy.Publisher(
+                        name, MESSAGE_CLASSES[topic.msg_type], queue_size=None, latch=latch)
+                elif name != topics.TF_STATIC:  # only with the links (see __init__)
+                    self.node_publishers[name] = rospy.Publisher(
+                        name, MESSAGE_CLASSES[topic.msg_type],
+                        queue_size=QUEUE_SIZES.get(name, 1), latch=latch)
 
     def _publish_static_transforms(self, links: LinkTransforms) -> None:
         """The fixed joints once on latched /tf_static, as robot_state_publisher 1.15 does
@@ -332,8 +307,10 @@ class SimNode:
             t.x, t.y, t.z = (float(v) for v in fixed.translation_m)
             r.x, r.y, r.z, r.w = (float(v) for v in fixed.rotation_xyzw)
             message.transforms.append(transform)
-        self.static_tf_pub = rospy.Publisher(TF_STATIC, TFMessage, queue_size=1, latch=True)
-        self.static_tf_pub.publish(message)
+        self.node_publishers[topics.TF_STATIC] = rospy.Publisher(
+            topics.TF_STATIC, TFMessage, queue_size=1,
+            latch=topics.BY_NAME[topics.TF_STATIC].delivery.latched)
+        self.node_publishers[topics.TF_STATIC].publish(message)
 
     def _controller_statistics(self) -> CommandAgeStatistics:
         """DRCSim's command age statistics, from the parameters (fed and published by the
@@ -364,54 +341,7 @@ class SimNode:
             rospy.Service(topics.UNPAUSE_PHYSICS_SERVICE, Empty, self._service(loop.unpause)),
             rospy.Service(topics.RESET_MODELS_SERVICE, Empty, self._service(loop.reset_world)),
         ]
-        self._subscribe_cheats()
-
-    def _subscribe_cheats(self) -> None:
-        """VRCPlugin's, gazebo_ros_force's and gazebo_ros_joint_trajectory's topics."""
-        lower, upper = self.sim.atlas.lower_rad, self.sim.atlas.upper_rad
-        links = frozenset(self.sim.vrc.link_names)
-        cheats: tuple[tuple[str, type, Callable[[Any], SimInput]], ...] = (
-            (topics.MODE, String, lambda msg: ModeInput(parse_vrc_mode(msg.data))),
-            (topics.SET_POSE, Pose, lambda msg: pose_input(
-                (msg.position.x, msg.position.y, msg.position.z),
-                (msg.orientation.x, msg.orientation.y, msg.orientation.z, msg.orientation.w))),
-            (topics.CMD_VEL, Twist, lambda msg: cmd_vel_input(
-                (msg.linear.x, msg.linear.y, msg.linear.z),
-                (msg.angular.x, msg.angular.y, msg.angular.z))),
-            (topics.APPLY_PELVIS_FORCE, Wrench, lambda msg: wrench_input(
-                (msg.force.x, msg.force.y, msg.force.z),
-                (msg.torque.x, msg.torque.y, msg.torque.z))),
-            (topics.JOINT_TRAJECTORY, JointTrajectory, lambda msg: trajectory_input(
-                TrajectoryMessage.from_ros(msg), lower, upper, links)),
-        )
-        for topic, msg_class, decode in cheats:
-            rospy.Subscriber(topic, msg_class, self._cheat_handler(topic, decode),
-                             queue_size=100)
-        rospy.Subscriber(topics.CONFIGURATION, JointState, self.on_configuration, queue_size=10)
-
-    def _cheat_handler(self, topic: str,
-                       decode: Callable[[Any], SimInput]) -> Callable[[Any], None]:
-        """A callback that checks the message whole, then hands it to the loop."""
-        def handle(msg: Any) -> None:
-            try:
-                item = decode(msg)
-            except InputError as err:
-                # Per message text: rospy's plain throttle is per call site, and would
-                # hide a refusal on one topic behind another's.
-                rospy.logwarn_throttle_identical(WARN_THROTTLE_S,
-                                                 f'refused {topic}: {err}; nothing applied')
-                return
-            for note in input_notes(item):  # what the check changed, once per message
-                log = rospy.logwarn if note.level >= logging.WARNING else rospy.loginfo
-                log(f'{topic}: {note.text}')
-            self.loop.apply_input(item)
-        return handle
-
-    @staticmethod
-    def on_configuration(_msg: JointState) -> None:
-        """As VRCPlugin: planned but never implemented; said once per message."""
-        rospy.logerr_throttle(WARN_THROTTLE_S, f'{topics.CONFIGURATION} is not implemented '
-                              '(nor was it in DRCSim); nothing applied')
+        subscribe_cheats(self.sim, loop.apply_input)
 
     def _latch_synchronization(self, message: bytes) -> None:
         """The latest /atlas/synchronization_statistics (without its length prefix), for
@@ -420,11 +350,11 @@ class SimNode:
 
     def _publish_input(self, text: str) -> None:
         """/atlas/sim_inputs (recorded): one applied cheat."""
-        self.inputs_pub.publish(String(data=text))
+        self.node_publishers[topics.SIM_INPUTS].publish(String(data=text))
 
     def _publish_config(self, text: str) -> None:
         """/atlas/sim_config (latched, recorded in every bag): what replay needs."""
-        self.config_pub.publish(String(data=text))
+        self.node_publishers[topics.SIM_CONFIG].publish(String(data=text))
 
     # -- subscriptions and services ----------------------------------------------------
     def on_joint_commands(self, msg: RawJointCommands) -> None:
@@ -439,7 +369,7 @@ class SimNode:
 
     def on_reset_controls(self, request: ResetControls._request_class
                           ) -> ResetControlsResponse:
-        """atlas_msgs/ResetControls: the loop checks and applies it (stepping/loop.py)."""
+        """atlas_msgs/ResetControls: the loop checks and applies it (stepping/controls.py)."""
         gains = None
         if request.reload_pid_from_ros:
             try:
@@ -464,7 +394,7 @@ class SimNode:
             rospy.logwarn_throttle(WARN_THROTTLE_S, f'refused /atlas/control_mode: {err}')
             return
         previous = self.loop.set_mode(mode)
-        self.mode_pub.publish(String(data=mode.value))
+        self.node_publishers[topics.CURRENT_CONTROL_MODE].publish(String(data=mode.value))
         rospy.loginfo(f'control mode: {previous.value} -> {mode.value}')
 
     def _service(self, action: Callable[[], None]) -> Callable[[object], EmptyResponse]:
@@ -477,7 +407,7 @@ class SimNode:
     def spin(self) -> int:
         """Run the stepping loop until ROS shuts down (with the viewer, if asked); the exit
         status."""
-        viewer = self._open_viewer() if self.gui else None
+        viewer = open_viewer(self.sim, self.loop) if self.gui else None
         # One line if the recorder goes (killed, disk full) while the simulation goes on;
         # registered again with a restarted master.
         watch = start_recorder_watch(self.publishers[topics.JOINT_STATES],
@@ -490,60 +420,6 @@ class SimNode:
         if viewer is not None:
             viewer.close()
         return status
-
-    # -- the viewer ----------------------------------------------------------------------
-    def _open_viewer(self) -> ViewerLink | None:
-        """The viewer window, framing the whole robot and following the pelvis, kept up to
-        date by a thread of its own (_viewer_loop)."""
-        problem = display_problem(os.environ.get('DISPLAY'))
-        if problem is not None:
-            rospy.logwarn(f'cannot open the MuJoCo viewer: {problem}; running headless, '
-                          'recording on (gui:=false starts without trying)')
-            return None
-        try:
-            link = ViewerLink(self.sim.model)
-        except Exception as err:  # noqa: BLE001 - no display, no GL: run headless
-            rospy.logwarn(f'cannot open the MuJoCo viewer ({err}); running headless')
-            return None
-        with self.loop.lock:
-            link.copy_in(self.sim.data)
-        with link.handle.lock():
-            configure_viewer_camera(link.handle.cam, self.sim.model, link.shadow)
-            configure_viewer_scene(link.handle.user_scn)
-        threading.Thread(target=self._viewer_loop, args=(link,), name='viewer',
-                         daemon=True).start()
-        return link
-
-    def _viewer_loop(self, viewer: ViewerLink) -> None:
-        """Refresh the window and pace its drawing, outside the stepping loop."""
-        while not rospy.is_shutdown() and self._update_viewer(viewer):
-            viewer.hold(VIEWER_HOLD_S)  # its render thread waits at the top of its next frame
-            time.sleep(VIEWER_TURN_S)
-
-    def _update_viewer(self, viewer: ViewerLink) -> bool:
-        """Refresh the window and carry out what was asked in it; False once it is closed.
-
-        The lock is held only to copy the state in and the mouse forces out: the sync
-        itself waits for the viewer's thread, which must not stall services and commands.
-        """
-        if not viewer.is_running():
-            rospy.signal_shutdown('viewer closed')
-            return False
-        loop = self.loop
-        with loop.lock:
-            viewer.copy_in(self.sim.data)
-        viewer.sync()
-        with loop.lock:
-            viewer.copy_out(self.sim.data)
-        for request in viewer.take_requests():
-            if request is ViewerRequest.RESET_WORLD:
-                loop.reset_world(by=' (viewer)')
-            elif loop.paused:  # ViewerRequest.TOGGLE_PAUSE
-                loop.unpause()
-            else:
-                loop.pause()
-        viewer.show_paused(loop.paused)
-        return True
 
 
 def _float_param(name: str, default: float, minimum: float = 0.0) -> float:
@@ -560,17 +436,10 @@ def build_node() -> SimNode:
     _check_bag_dir()
     gains = gains_from_params(rospy.get_param(topics.GAINS_PARAM, {}))
     time_to_unpin_s = _float_param(topics.TIME_TO_UNPIN_PARAM, DEFAULT_TIME_TO_UNPIN_S)
-    rates_hz = {
-        'joint_states': _float_param('~joint_states_rate', 1000.0),
-        'odom': _float_param('~odom_rate', 100.0),
-        'imu': _float_param('~imu_rate', 1000.0),
-        'contact': _float_param('~contact_rate', 1000.0),
-        'tf': _float_param('~tf_rate', 100.0),
-        'atlas_state': _float_param('~atlas_state_rate', 1000.0),
-        'force_torque_sensors': _float_param('~force_torque_sensors_rate', 1000.0),
-        'debug_contact': _float_param('~debug_contact_rate', 1000.0),
-        'links_tf': _float_param('~links_tf_rate', LINKS_TF_RATE_HZ, minimum=1.0),
-    }
+    # Each rate of topics.INTERFACE from its parameter (~joint_states_rate, ...).
+    rates_hz = {key: _float_param(f'~{key}{topics.RATE_SUFFIX}', default_hz)
+                for key, default_hz in default_rates_hz().items()}
+    rates_hz['links_tf'] = _float_param('~links_tf_rate', LINKS_TF_RATE_HZ, minimum=1.0)
     tf_publisher = rospy.get_param('~tf_publisher', TF_PUBLISHERS[0])
     if tf_publisher not in TF_PUBLISHERS:
         raise AtlasControlError(f'parameter {rospy.resolve_name("~tf_publisher")} must be one '
@@ -586,11 +455,11 @@ def build_node() -> SimNode:
     sim = AtlasSimulator(atlas_model.load_model(Path(model_file)), gains, time_to_unpin_s,
                          startup_mode=VrcMode(startup_mode))
     description = _tf_wanted(Path(model_file), sim)
-    return SimNode(sim, _float_param('~real_time_factor', 1.0),
-                   bool(rospy.get_param('~paused', False)), rates_hz,
-                   bool(rospy.get_param('~gui', False)), description is not None,
-                   DelayBudgets.from_params(rospy.get_param),
-                   _links_publisher(description) if tf_publisher == 'sim' else None)
+    settings = LoopSettings(rates_hz, _float_param('~real_time_factor', 1.0),
+                            bool(rospy.get_param('~paused', False)),
+                            _links_publisher(description) if tf_publisher == 'sim' else None)
+    return SimNode(sim, settings, bool(rospy.get_param('~gui', False)),
+                   description is not None, DelayBudgets.from_params(rospy.get_param))
 
 
 def _check_bag_dir() -> None:

@@ -64,7 +64,7 @@ DEFAULT_SETTLE_S = 3.0
 #: step; nothing reads a bag's /clock at that rate, and it is a fifth of the records).
 CLOCK_PERIOD_NS = 10_000_000
 #: /ground_truth_odom's rate (Hz), the simulator's default (~odom_rate).
-ODOM_RATE_HZ = 100.0
+ODOM_RATE_HZ = topics.BY_NAME[topics.GROUND_TRUTH_ODOM].rate.default_hz
 #: Who published what in a live run: the bag's connections name them as callers.
 SIMULATOR_NODE = '/atlas_sim'
 PLAYER_NODE = '/tutorial_atlas_control'
@@ -78,25 +78,15 @@ CHUNK_BYTES = 768 * 1024
 #: step_and_fall run takes 8.8 MB instead of 16.3 MB, in no measurably longer time.
 CHUNK_COMPRESSION = 'lz4'
 
-#: Topic -> (publishing node, latched), as in a live run; this order is the bag's
-#: connections' order (their ids).
-PUBLISHERS: dict[str, tuple[str, bool]] = {
-    topics.SIM_CONFIG: (SIMULATOR_NODE, True),
-    topics.CLOCK: (SIMULATOR_NODE, False),
-    topics.JOINT_STATES: (SIMULATOR_NODE, False),
-    topics.GROUND_TRUTH_ODOM: (SIMULATOR_NODE, False),
-    topics.IMU: (SIMULATOR_NODE, False),
-    topics.L_FOOT_CONTACT: (SIMULATOR_NODE, False),
-    topics.R_FOOT_CONTACT: (SIMULATOR_NODE, False),
-    topics.CONTROL_MODE: (PLAYER_NODE, True),
-    topics.JOINT_COMMANDS: (PLAYER_NODE, False),
-    topics.ROSOUT: (PLAYER_NODE, True),
-    topics.TF: (SIMULATOR_NODE, False),
-}
-#: Topic -> its bag connection: type (topics.MSG_TYPES), publishing node, latched.
+#: Topic -> its bag connection: type, publishing node (the simulator for what it
+#: publishes, the player for the rest), latched; topics.INTERFACE's offline rows, in its
+#: order (the bag's connections' ids).
 TOPIC_TYPES: dict[str, TopicConnection] = {
-    topic: TopicConnection(rosbags_msgtype(topics.MSG_TYPES[topic]), node, latched)
-    for topic, (node, latched) in PUBLISHERS.items()}
+    topic.name: TopicConnection(
+        rosbags_msgtype(topic.msg_type),
+        SIMULATOR_NODE if topic.direction is topics.Direction.PUBLISHED else PLAYER_NODE,
+        topic.delivery.latched)
+    for topic in topics.INTERFACE if topic.delivery.offline}
 
 
 @dataclass(frozen=True)
@@ -155,31 +145,24 @@ def _serialized(message: StampedWire) -> np.ndarray:
     return np.frombuffer(message.buf, dtype=np.uint8)[TCPROS_PREFIX_BYTES:]
 
 
-class _OfflinePlayer:
-    """The simulator, traj_yaml's commands and the recorder, on one sim clock.
-
-    After each step it keeps what the simulator node would publish as rows of numbers
-    (qpos, qvel, torque, sensordata, stamps); every BLOCK_STEPS steps SimMessages' maps
-    turn them into messages, all at once (write_steps).
+class _StepRows:
+    """What the simulator node publishes after each step, kept as rows of numbers (qpos,
+    qvel, torque, sensordata, stamps); every BLOCK_STEPS steps they become messages, all
+    at once (write_steps): the joint states, and the table's sensor messages through
+    SimMessages.sensor_selection.
     """
 
-    def __init__(self, sim: AtlasSimulator, sink: BlockBagWriter,
-                 on_step: StepHook | None = None, latency: CommandLatency | None = None) -> None:
+    def __init__(self, sim: AtlasSimulator, sink: BlockBagWriter) -> None:
         self.sim = sim
-        self.latency = latency
-        self.latency_rng = np.random.default_rng(latency.seed if latency else 0)
-        #: Delayed commands: (the step count at which each takes effect, its update).
-        self.pending: list[tuple[int, CommandUpdate]] = []
         self.sink = sink
-        self.on_step = on_step
         self.messages = messages = SimMessages(sim)
         self.joint_states = self._block(topics.JOINT_STATES, messages.joint_state_wire)
         self.odometry = self._block(topics.GROUND_TRUTH_ODOM, messages.odometry_wire)
-        self.sensor_blocks = {
-            topics.IMU: (self._block(topics.IMU, messages.imu_wire), 'imu', messages.imu_map),
-            **{topic: (self._block(topic, messages.contact_wires[side]), side,
-                       messages.contact_maps[side])
-               for topic, side in ((topics.L_FOOT_CONTACT, 'l'), (topics.R_FOOT_CONTACT, 'r'))}}
+        selections = {topic.name: messages.sensor_selection(topic.delivery.message)
+                      for topic in topics.INTERFACE if topic.delivery.offline
+                      and topic.delivery.message in SimMessages.SENSOR_MESSAGES}
+        self.sensor_blocks = {topic: (self._block(topic, selection.wire), selection)
+                              for topic, selection in selections.items()}
         wire = messages.joint_state_wire
         self.joint_views = [self.joint_states.float_view(_offset_in(wire, view), len(view))
                             for view in (wire.position, wire.velocity, wire.effort)]
@@ -192,25 +175,15 @@ class _OfflinePlayer:
         self.sensed_ns = np.empty(BLOCK_STEPS, dtype=np.int64)
         self.count = 0
         self.odom_every = steps_between(ODOM_RATE_HZ, sim.dt_s)
-        self.steps = 0
         self.next_clock_ns = 0
-        self.decoder = CommandDecoder()
-        self.command = _command_wire(sim.gains)
-        self.commands_sent = 0
-        self._log_seq = 0
-        types = sink.typestore.types
-        self._string = types['std_msgs/msg/String']
-        self._log = types['rosgraph_msgs/msg/Log']
-        self._header = types['std_msgs/msg/Header']
-        self._time = types['builtin_interfaces/msg/Time']
 
     def _block(self, topic: str, message: StampedWire) -> RecordBlock:
         """Rows for BLOCK_STEPS records of `topic`, laid out like `message`."""
         return self.sink.record_block(topic, _serialized(message), BLOCK_STEPS)
 
-    # -- what the simulator publishes ---------------------------------------------------
-    def publish(self) -> None:
-        """Keep what the simulator node sends after a step, recorded at the time it sends it."""
+    def publish(self, steps: int) -> None:
+        """Keep what the simulator node sends after step `steps`, recorded at the time it
+        sends it."""
         sim = self.sim
         data = sim.data
         now_ns = sim.sim_time_ns
@@ -224,7 +197,7 @@ class _OfflinePlayer:
         self.qvel[k] = data.qvel
         self.torque[k] = sim.torque_nm
         self.sensordata[k] = data.sensordata
-        if self.steps % self.odom_every == 0:
+        if steps % self.odom_every == 0:
             self.messages.fill_odometry()
             self.odometry.add(now_ns, sim.state_time_ns)
             self.sink.write(topics.TF, now_ns,
@@ -246,26 +219,57 @@ class _OfflinePlayer:
             sink.write_rows(topics.JOINT_STATES, *self.joint_states.take(
                 now_ns, step_stamp(topics.JOINT_STATES, now_ns, sensed_ns)))
             sensors = self.sensordata[:count]
-            for topic, (block, name, (to, source)) in self.sensor_blocks.items():
-                floats = block.float_view(self.messages.float_offsets[name], max(to) + 1)
-                floats[:count, to] = sensors[:, source]
+            for topic, (block, selection) in self.sensor_blocks.items():
+                to = selection.to
+                floats = block.float_view(selection.float_offset, max(to) + 1)
+                floats[:count, to] = sensors[:, selection.source]
                 sink.write_rows(topic, *block.take(now_ns, step_stamp(topic, now_ns, sensed_ns)))
         sink.write_rows(topics.GROUND_TRUTH_ODOM, *self.odometry.take())
         self.count = 0
         sink.flush()
 
+
+class _OfflinePlayer:
+    """The simulator, traj_yaml's commands and the recorder, on one sim clock."""
+
+    def __init__(self, sim: AtlasSimulator, sink: BlockBagWriter,
+                 on_step: StepHook | None = None, latency: CommandLatency | None = None) -> None:
+        self.sim = sim
+        self.latency = latency
+        self.latency_rng = np.random.default_rng(latency.seed if latency else 0)
+        #: Delayed commands: (the step count at which each takes effect, its update).
+        self.pending: list[tuple[int, CommandUpdate]] = []
+        self.sink = sink
+        self.on_step = on_step
+        self.rows = _StepRows(sim, sink)
+        self.write_steps = self.rows.write_steps
+        self.steps = 0
+        self.decoder = CommandDecoder()
+        self.command = _command_wire(sim.gains)
+        self.commands_sent = 0
+        self._log_seq = 0
+        types = sink.typestore.types
+        self._string = types['std_msgs/msg/String']
+        self._log = types['rosgraph_msgs/msg/Log']
+        self._header = types['std_msgs/msg/Header']
+        self._time = types['builtin_interfaces/msg/Time']
+
+    def publish(self) -> None:
+        """Keep what the simulator node sends after a step (or before the first)."""
+        self.rows.publish(self.steps)
+
     def advance(self, duration_s: float) -> None:
         """Step and publish for `duration_s` of sim time (whole steps, rounded up)."""
         sim = self.sim
         until_ns = sim.sim_time_ns + int(round(duration_s * NS_PER_S))
-        step, publish, on_step = sim.step, self.publish, self.on_step
+        step, publish, on_step = sim.step, self.rows.publish, self.on_step
         try:
             while sim.sim_time_ns < until_ns:
                 if self.pending:
                     self._deliver()
                 step()
                 self.steps += 1
-                publish()
+                publish(self.steps)
                 if on_step is not None:
                     on_step(sim)
         except PhysicsDivergenceError as err:

@@ -1,15 +1,17 @@
 """The simulator's sensor messages, serialized from an AtlasSimulator's state.
 
 What each 1 kHz message holds (which array, which time, which quaternion order) is
-decided once, here, for both writers of those messages: the ROS node (sim_node.py),
-which sends the bytes over TCPROS, and offline runs (offline/player.py), which write them
-to a bag. The bytes come from wire.py's pre-laid-out messages: a step copies numbers in
-and stamps the header; nothing is serialized field by field.
+decided once, here, for both writers of those messages: the stepping loop
+(stepping/publication.py), which sends the bytes over TCPROS, and offline runs
+(offline/player.py), which write them to a bag. The bytes come from wire.py's
+pre-laid-out messages: a step copies numbers in and stamps the header; nothing is
+serialized field by field.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 
 import mujoco
 import numpy as np
@@ -32,7 +34,8 @@ from tutorial_atlas_control.sim.link_transforms import LinkTransforms
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
 from tutorial_atlas_control.topics import PELVIS_FRAME, WORLD_FRAME
 
-__all__ = ['DRCSIM_FOOT_COMPONENTS', 'HAND_BODIES', 'TCPROS_PREFIX_BYTES', 'SimMessages']
+__all__ = ['DRCSIM_FOOT_COMPONENTS', 'HAND_BODIES', 'TCPROS_PREFIX_BYTES', 'SensorSelection',
+           'SimMessages']
 
 #: wire.py's messages start with TCPROS's 4-byte length; a bag record holds what follows.
 TCPROS_PREFIX_BYTES = 4
@@ -59,16 +62,35 @@ def _float_offset(message: StampedWire) -> int:
     return message.floats.ctypes.data - base - TCPROS_PREFIX_BYTES
 
 
+@dataclass(frozen=True)
+class SensorSelection:
+    """A message whose floats are a fixed selection of `data.sensordata`:
+    floats[to] = sensordata[source].
+
+    Attributes:
+        wire: the message.
+        float_offset: byte offset of its float block in its serialization (without the
+            TCPROS prefix).
+    """
+
+    wire: StampedWire
+    float_offset: int
+    to: np.ndarray
+    source: np.ndarray
+
+
 class SimMessages:
     """One simulator's /atlas/joint_states, /ground_truth_odom, /atlas/imu and foot contacts.
 
     The per-step messages (joint state, IMU, feet) are filled through fill_plan; odometry
     and the pelvis transform by their fill_* methods, which odometry() and pelvis_tf() also
-    stamp and return with the TCPROS length prefix. The IMU
-    and contact messages are a fixed selection of `data.sensordata`
-    (`imu_map`, `contact_maps`: float index in the message <- index in sensordata), so a
-    writer that keeps sensordata per step can build many messages at once (offline/player.py).
+    stamp and return with the TCPROS length prefix. The IMU and contact messages are a
+    fixed selection of `data.sensordata` (sensor_selection), so a writer that keeps
+    sensordata per step can build many messages at once (offline/player.py).
     """
+
+    #: The per-step messages that are a selection of sensordata (sensor_selection).
+    SENSOR_MESSAGES = ('imu', 'l', 'r')
 
     def __init__(self, sim: AtlasSimulator) -> None:
         self.sim = sim
@@ -82,18 +104,15 @@ class SimMessages:
         adr = {name: int(model.sensor_adr[model.sensor(name).id]) for name in SENSOR_NAMES}
         orientation = adr['imu_orientation']
         # Orientation as ROS orders it (x y z w) from MuJoCo's (w x y z); covariances stay 0.
-        self.imu_map = (
+        self._imu_map = (
             np.r_[0:4, 13:16, 25:28],
             np.r_[orientation + 1:orientation + 4, orientation,
                   adr['imu_angular_velocity'] + np.arange(3),
                   adr['imu_linear_acceleration'] + np.arange(3)])
-        self.contact_maps = {
+        self._contact_maps = {
             side: (np.arange(6), np.r_[adr[f'{side}_foot_force'] + np.arange(3),
                                        adr[f'{side}_foot_torque'] + np.arange(3)])
             for side in 'lr'}
-        self.float_offsets = {name: _float_offset(wire) for name, wire in (
-            ('imu', self.imu_wire), ('odometry', self.odometry_wire),
-            ('l', self.contact_wires['l']), ('r', self.contact_wires['r']))}
         self._pelvis_velocity = np.zeros(6)
         # The per-step messages' numbers as CopyPlan copies (dst, to, src, from), by name.
         # joint_state: positions and velocities after the step, effort = the torque it
@@ -105,9 +124,9 @@ class SimMessages:
             'joint_state': [(wire.position, joints, data.qpos, sim.atlas.qpos_adr),
                             (wire.velocity, joints, data.qvel, sim.atlas.dof_adr),
                             (wire.effort, joints, sim.torque_nm, joints)],
-            'imu': [(self.imu_wire.floats, self.imu_map[0], data.sensordata, self.imu_map[1])],
+            'imu': [(self.imu_wire.floats, self._imu_map[0], data.sensordata, self._imu_map[1])],
             **{side: [(self.contact_wires[side].floats, to, data.sensordata, source)]
-               for side, (to, source) in self.contact_maps.items()}}
+               for side, (to, source) in self._contact_maps.items()}}
         #: The wire message of each per-step message, by the same names.
         self.step_wires: dict[str, StampedWire] = {
             'joint_state': self.joint_state_wire, 'imu': self.imu_wire, **self.contact_wires}
@@ -138,7 +157,7 @@ class SimMessages:
             (self._joint_rows[0], joints, data.qpos, sim.atlas.qpos_adr),
             (self._joint_rows[1], joints, data.qvel, sim.atlas.dof_adr),
             (self._joint_rows[2], joints, sim.torque_nm, joints),
-            (state.floats, np.arange(10), data.sensordata, self.imu_map[1]),
+            (state.floats, np.arange(10), data.sensordata, self._imu_map[1]),
             *((state.wrench_floats, k * WRENCH_FLOATS + foot_at, data.sensordata, feet[side])
               for k, side in enumerate('lr'))])
         self._force_torque_plan = CopyPlan([
@@ -206,6 +225,13 @@ class SimMessages:
             return False
         self.debug_contact_wires[side].floats[:] = self.body_wrench(external, body)
         return True
+
+    def sensor_selection(self, name: str) -> SensorSelection:
+        """How the per-step message `name` (one of SENSOR_MESSAGES) is filled from
+        `data.sensordata`."""
+        wire = self.imu_wire if name == 'imu' else self.contact_wires[name]
+        to, source = self._imu_map if name == 'imu' else self._contact_maps[name]
+        return SensorSelection(wire, _float_offset(wire), to, source)
 
     def fill_plan(self, names: Sequence[str]) -> CopyPlan:
         """One call that writes the current state into the named per-step messages.

@@ -1,16 +1,24 @@
-"""The simulator node's stepping loop without ROS: what is due, pacing, commands, divergence.
+"""The simulator node's stepping loop without ROS, one module per concern.
 
+loop: the loop itself (SteppingLoop), which node/sim_node.py wraps in rospy publishers,
+subscribers and services; controller: the StepController protocol a controller plugs in
+by; inbox: the commands waiting for the next step and their merge; publication: what is
+sent each step, as topics.INTERFACE declares it; sync_gate and synchronization: DRCSim's
+synchronization window; controls: resets, pause, modes, cheats; watch: the headless log
+lines; divergence: recovery from a diverged physics; outputs: where the loop writes;
 schedule: when each message is due and which time it carries (shared with offline runs);
-pacing: when to send and how long to wait against wall time; synchronization: the lockstep
-window; loop: the loop itself, which node/sim_node.py wraps in rospy publishers,
-subscribers and services. No rospy.
+pacing: when to send and how long to wait against wall time. No rospy.
 """
 
 from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
-    'loop': ['LINKS_TF_RATE_HZ', 'ON_DEMAND_MESSAGES', 'ResetControlsRequest', 'SteppingLoop'],
+    'controller': ['StepController'],
+    'controls': ['ResetControlsRequest'],
+    'loop': ['LoopSettings', 'SteppingLoop'],
+    'outputs': ['LoopLog', 'LoopOutputs', 'Outbox'],
     'pacing': ['Pacer'],
+    'publication': ['LINKS_TF_RATE_HZ', 'StepPublisher', 'default_rates_hz'],
     'schedule': ['step_stamp', 'steps_between'],
     'synchronization': ['DelayBudgets', 'SynchronizationWindow'],
 })

@@ -9,7 +9,7 @@ step, and at most `max_per_window_s` in each window of `window_size_s`; once a b
 spent the simulator steps on with the command it has.
 
 "Fresh" is DRCSim's test, `step time - stamp <= period`, at the time the coming step ends
-(the time /atlas/controller_statistics measures a command's age at, stepping/loop.py): with
+(the time /atlas/controller_statistics measures a command's age at, stepping/inbox.py): with
 a period of one step, only a command stamped with the last published state's time will do.
 
 The clock and the wait are parameters, so that tests drive the window with a fake clock.

@@ -1,0 +1,198 @@
+"""The commands waiting for the next step, and their merge into the simulator.
+
+Commands arrive on rospy's threads as undecoded bytes (receive); before each step the
+loop decodes, checks and merges them, newest first (apply_pending). The inbox also keeps
+what the commands say about the synchronization window: the latest AtlasCommand's
+desired_controller_period_ms and the stamp of the newest applied command.
+"""
+
+from __future__ import annotations
+
+import collections
+import threading
+
+from tutorial_atlas_control import topics
+from tutorial_atlas_control.command.arrays import (
+    FIELD_NAMES,
+    LAW_FIELDS,
+    CommandError,
+    CommandUpdate,
+)
+from tutorial_atlas_control.joints import NUM_JOINTS
+from tutorial_atlas_control.msgs.atlas_command import (
+    AtlasUpdate,
+    decode_atlas_command,
+    decode_test,
+)
+from tutorial_atlas_control.msgs.joint_commands import CommandDecoder
+from tutorial_atlas_control.msgs.ros1_fields import FieldCursor
+from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistics
+from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode
+from tutorial_atlas_control.stepping.outputs import LoopLog
+from tutorial_atlas_control.stepping.synchronization import DelayBudgets
+from tutorial_atlas_control.stepping.watch import RunWatch
+
+__all__ = ['CAN_SET', 'MAX_PENDING_COMMANDS', 'CommandInbox']
+
+#: Commands waiting for the next step, at most (a second of 10 kHz of them).
+MAX_PENDING_COMMANDS = 10_000
+#: Rows (arrays.LAW_FIELDS indices) each command topic can set; DAMPING_ROW stands for
+#: /atlas/debug/test's damping. An older message whose rows a newer one set for every
+#: joint is dropped undecoded (apply_pending).
+DAMPING_ROW = len(LAW_FIELDS)
+CAN_SET: dict[str, frozenset[int]] = {
+    topics.JOINT_COMMANDS: frozenset(range(len(FIELD_NAMES))),
+    topics.ATLAS_COMMAND: frozenset(range(len(LAW_FIELDS))),
+    topics.ATLAS_TEST: frozenset({DAMPING_ROW, *(LAW_FIELDS.index(name) for name in (
+        'kp_position', 'ki_position', 'kd_position', 'kp_velocity', 'i_effort_min',
+        'i_effort_max', 'k_effort'))}),
+}
+#: Where DRCSim takes the command's header stamp for /atlas/controller_statistics.
+STAMPED_COMMANDS = (topics.JOINT_COMMANDS, topics.ATLAS_COMMAND)
+
+
+class CommandInbox:
+    """The pending commands (bounded, emptied every step) and what the newest said.
+
+    It is also the loop's default StepController (controller.py): before each step it
+    hands the simulator what users sent, and the simulator's law does the rest.
+    """
+
+    def __init__(self, sim: AtlasSimulator, log: LoopLog, statistics: CommandAgeStatistics,
+                 watch: RunWatch, budgets: DelayBudgets) -> None:
+        self.sim = sim
+        self.log = log
+        self.statistics = statistics
+        self.watch = watch
+        self.budgets = budgets
+        self.decoder = CommandDecoder()
+        # Bounded, so that a stalled loop cannot make it grow without limit.
+        self.pending: collections.deque[tuple[str, bytes]] = collections.deque(
+            maxlen=MAX_PENDING_COMMANDS)
+        # DRCSim 2.6's synchronization window (synchronization.py): on while the latest
+        # AtlasCommand's desired_controller_period_ms is non-zero. A command wakes its wait.
+        self.period_ms = 0
+        self.command_stamp_ns = 0  # header.stamp of the newest applied command, as sent
+        self.arrived = threading.Event()
+
+    def receive(self, raw: bytes, topic: str = topics.JOINT_COMMANDS) -> None:
+        """Queue a serialized osrf_msgs/JointCommands (or, by `topic`, an
+        atlas_msgs/AtlasCommand or Test) for the next step, undecoded.
+
+        Nothing else happens in the receiving thread: decoding there would make several
+        fast publishers' threads and the loop fight over the GIL. One queue keeps the
+        topics' messages in the order they came: the newest sets the fields it carries.
+        """
+        self.pending.append((topic, raw))
+        if self.period_ms:
+            self.arrived.set()  # the window may be waiting for it
+
+    def _decode(self, topic: str, raw: bytes) -> CommandUpdate | AtlasUpdate:
+        if topic == topics.JOINT_COMMANDS:
+            return self.decoder.decode(raw)
+        if topic == topics.ATLAS_COMMAND:
+            return decode_atlas_command(raw)
+        return decode_test(raw)
+
+    def apply_pending(self) -> None:
+        """Decode, check and merge the commands received since the last step, in order.
+
+        Newest first: a message that sets some fields for every joint hides those fields
+        of all that came before it, so an older message with nothing else to set is
+        dropped undecoded (DRCSim, too, applied only the latest command at each step).
+        Controllers send such complete commands, so a flood costs one decode per step,
+        not one per message.
+        """
+        pending = self.pending
+        received = []
+        while pending:
+            received.append(pending.popleft())
+        hidden: set[int] = set()
+        decoded: list[tuple[str, CommandUpdate | AtlasUpdate]] = []
+        stamped = False
+        for topic, raw in reversed(received):
+            if CAN_SET[topic] <= hidden:
+                continue
+            try:
+                result = self._decode(topic, raw)
+            except CommandError as err:
+                self.log.refused_command(f'refused {topic}: {err}; previous command kept', topic)
+                continue
+            if not stamped and topic in STAMPED_COMMANDS:
+                self._note_command_stamp(raw)  # the newest applied command
+                stamped = True
+            decoded.append((topic, result))
+            update = result if isinstance(result, CommandUpdate) else result.update
+            if update.all_joints:
+                hidden.update(update.rows)
+            if isinstance(result, AtlasUpdate) and result.damping is not None:
+                hidden.add(DAMPING_ROW)
+        if decoded:
+            self._apply(decoded[::-1])
+
+    #: The default StepController: what users sent, for the simulator's law.
+    before_step = apply_pending
+
+    def _apply(self, decoded: list[tuple[str, CommandUpdate | AtlasUpdate]]) -> None:
+        """Apply decoded messages, oldest first."""
+        updates = []
+        for topic, result in decoded:
+            if isinstance(result, CommandUpdate):
+                updates.append(result)
+                continue
+            if result.ignored:
+                self.log.kept_fields(f'{topic}: {result.ignored_text()}', topic)
+            if result.damping is not None:
+                self.sim.set_joint_damping(result.damping)
+            if result.desired_controller_period_ms is not None:
+                self.store_period(result.desired_controller_period_ms)
+            updates.append(result.update)
+        first = self.sim.user_command is None
+        self.sim.receive_updates(updates)
+        if (self.sim.mode is not ControlMode.USER
+                and any(topic == topics.JOINT_COMMANDS for topic, _ in decoded)):
+            self.watch.warn_not_user()  # AtlasCommands with k_effort act in any mode
+        if first:
+            self.watch.first_command(decoded[0][0])
+
+    def _note_command_stamp(self, raw: bytes) -> None:
+        """The command in `raw` is applied from the coming step on: remember its stamp."""
+        stamp_ns = FieldCursor(raw).header_stamp_ns()
+        self.command_stamp_ns = stamp_ns
+        self.statistics.command_applied(stamp_ns, self.sim.sim_time_ns + self.sim.step_ns)
+
+    def forget_stamp(self) -> None:
+        """After reset_simulation: the newest command's stamp lies in the rewound future."""
+        self.statistics.forget_command()
+        self.command_stamp_ns = 0
+
+    def load_atlas_command(self, atlas: AtlasUpdate) -> list[str]:
+        """ResetControls' atlas_command applied as an AtlasCommand; what was done."""
+        done = []
+        if atlas.update.rows:
+            self.sim.receive_updates([atlas.update])
+            done.append('atlas_command loaded: ' + ', '.join(atlas.fields_set()))
+        else:
+            done.append(f'atlas_command has no array of {NUM_JOINTS}: no field loaded')
+        if atlas.ignored:
+            done.append(atlas.ignored_text())
+        assert atlas.desired_controller_period_ms is not None
+        self.store_period(atlas.desired_controller_period_ms)
+        return done
+
+    def store_period(self, period_ms: int) -> None:
+        """An AtlasCommand's desired_controller_period_ms; a line when the window turns
+        on or off."""
+        previous = self.period_ms
+        self.period_ms = period_ms
+        if bool(previous) == bool(period_ms):
+            return
+        if period_ms:
+            budgets = self.budgets
+            self.log.info(f'synchronization window on ({topics.ATLAS_COMMAND} '
+                          f'desired_controller_period_ms = {period_ms}): each step waits for '
+                          f'a command stamped no more than {period_ms} ms before its end, at '
+                          f'most {budgets.max_per_step_s:g} s per step and '
+                          f'{budgets.max_per_window_s:g} s per {budgets.window_size_s:g} s')
+        else:
+            self.log.info('synchronization window off (desired_controller_period_ms = 0)')
