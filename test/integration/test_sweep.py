@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from support.scripts import run_script
+from support.scripts import interrupt_script, run_script
 from tutorial_atlas_control.search.sweep import (
     SweepEngine,
     SweepInputs,
@@ -97,13 +97,28 @@ def test_push_topples_touchdown(tmp_path: Path, tiny_file: Path) -> None:
     assert rows[1]['fell'] is True and rows[1]['pelvis_dx_m'] > 0.3  # forward, the push's way
 
 
+def test_ctrl_c_keeps_the_finished_rows(tmp_path: Path, tiny_file: Path) -> None:
+    """Ctrl-C once the first of two runs has finished (the second plays 10000 times slower):
+    exit 130, one line saying how many rows were kept, and the table holds that row."""
+    result = interrupt_script('sweep.py', str(tiny_file), 'bend', '--time-scale', '1', '10000',
+                              '--settle', '0.3', '--workers', '2', '--out', 'table',
+                              ready=lambda err: '1/2' in err, cwd=tmp_path)
+    assert result.returncode == 130, result
+    assert 'Traceback' not in result.stderr
+    last = result.stderr.replace('\r', '\n').strip().splitlines()[-1]
+    assert last == ('sweep.py: interrupted: kept the 1 of 2 runs that finished in table.csv '
+                    'and table.json'), result.stderr
+    rows = json.loads((tmp_path / 'table.json').read_text())
+    assert [(row['index'], row['time_scale']) for row in rows] == [(0, 1.0)]
+    assert len((tmp_path / 'table.csv').read_text().splitlines()) == 2  # header, one row
+
+
 @pytest.mark.parametrize('args, message', [
     (['missing.yaml', 'bend'], 'missing.yaml'),
     (['{tiny}', 'nope'], 'nope'),
     (['{tiny}', 'bend', '--push', '1:300,0:0.2'], "push '1:300,0:0.2' is not AT_S:FX,FY,FZ"),
     (['{tiny}', 'bend', '--gains', 'no_gains.yaml'], 'gains file no_gains.yaml does not exist'),
     (['{tiny}', 'bend', '--latency-ms', '20:5'], "latency '20:5' is not LO:HI whole milliseconds"),
-    (['{tiny}', 'bend', '--repeat', '0'], '--repeat 0: give 1 or more'),
     (['{tiny}', 'bend', '--scheduler', 'tcp://127.0.0.1:9'],
      'cannot reach the Dask scheduler at tcp://127.0.0.1:9'),
 ])
