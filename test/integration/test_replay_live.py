@@ -63,16 +63,16 @@ def recorded_bag(demo_run) -> Path:  # demo_run: conftest.DemoRun
 
 @pytest.fixture()
 def fresh_simulator(tmp_path: Path) -> Iterator[AtlasLaunch]:
-    """atlas.launch (no recording) on its own master."""
-    with AtlasLaunch(tmp_path / 'atlas_launch.log', {'gui': 'false', 'record': 'false'},
+    """atlas.launch (no recording: record:=false) on its own master, bag_dir tmp_path/bags."""
+    with AtlasLaunch(tmp_path / 'atlas_launch.log',
+                     {'gui': 'false', 'record': 'false', 'bag_dir': str(tmp_path / 'bags')},
                      ros_log_dir=tmp_path / 'ros_log') as launch:
         launch.wait_master(STARTUP_TIMEOUT_S)
         yield launch
 
 
 def test_played_commands_make_the_robot_fall(
-        recorded_bag: Path,
-        fresh_simulator: AtlasLaunch) -> None:
+        recorded_bag: Path, fresh_simulator: AtlasLaunch, tmp_path: Path) -> None:
     from tutorial_atlas_control.bags.analysis import analyze_bag
 
     recorded = analyze_bag(recorded_bag)
@@ -99,6 +99,8 @@ def test_played_commands_make_the_robot_fall(
     print(f'\nlive replay of {recorded_bag.name}: {len(arrivals)} commands arrived over '
           f'{played_span_s:.2f} s of sim time (recorded over {recorded_span_s:.2f} s), '
           f'first at {arrivals[0]:.2f} s; lowest pelvis height {min_z_m:.2f} m')
+    # README: record:=false records nothing (the run is over; the launch still up).
+    assert not list((tmp_path / 'bags').glob('*')), 'record:=false wrote a bag'
     assert min_z_m < FALLEN_BELOW_M, (
         f'the replayed run did not fall (lowest pelvis {min_z_m:.2f} m); commands arrived over '
         f'{played_span_s:.2f} s of sim time vs {recorded_span_s:.2f} s recorded')

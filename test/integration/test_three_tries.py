@@ -43,7 +43,9 @@ SETTLE_S = 1.5
 AFTER_S = 4.0
 #: The commands' rate (50 Hz of sim time when the port keeps up) is a speed: make bench's
 #: tutorial_command_rate_hz. What holds at any speed: every scheduled command is sent (a
-#: late port restarts its schedule, it drops none) and recorded.
+#: late port restarts its schedule, it drops none) and recorded, but one per try whose
+#: hand-over to rospy timed out (test_recorded_run.py's allowance).
+MAX_COMMANDS_MISSED = 1
 TRAJECTORY_TIMEOUT_S = 180.0
 
 
@@ -94,8 +96,9 @@ def test_three_tries_are_analyzed_apart(session_bag: Path) -> None:
     assert [[p['name'] for p in each['trajectories']] for each in tries] == [
         [name] for name in SESSION], summary
     assert [each['fell'] for each in tries] == [True, False, True], summary
-    assert [each['command_count'] for each in tries] == [
-        scheduled_commands(name) for name in SESSION], summary
+    for each, name in zip(tries, SESSION):
+        expected = scheduled_commands(name)
+        assert expected - MAX_COMMANDS_MISSED <= each['command_count'] <= expected, summary
     assert tries[2]['sim_start'] == pytest.approx(0.0, abs=0.01), summary
     # The simulator's 1 kHz in sim time, over the whole run despite the rewind.
     assert analysis.data.topics['/atlas/joint_states'].rate_hz == pytest.approx(1000.0, rel=0.01)
