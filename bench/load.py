@@ -9,9 +9,11 @@ load run:     the node at real_time_factor:=1.0 with the launch's default record
               own window; the simulator's resident memory is read every second, from
               a baseline taken once every publisher has reported that its flood began.
 tutorial run: `run_demo.py step_and_fall --video-fps 0` (its own master), then the rate of
-              the port's commands in sim time, from the recorded bag, and the bag's size
-              per minute of sim time (its bytes / the span of its bag times, which are
-              sim times): MB are 10^6 bytes.
+              the port's commands in sim time, from the recorded bag, the share of the
+              recorded /atlas/controller_statistics windows whose command ages are at
+              their closed form (closed_form_share: a port that keeps up), and the bag's
+              size per minute of sim time (its bytes / the span of its bag times, which
+              are sim times): MB are 10^6 bytes.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ import subprocess
 import sys
 import threading
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -205,10 +208,13 @@ def tutorial_run(work_dir: Path, name: str) -> dict[str, float]:
         raise BenchError(f'run_demo.py failed ({completed.returncode}); see {log_path}')
     rate_hz = analyze_bag(bags[-1]).command_rate_hz
     mb_per_min = bag_mb_per_min(bags[-1])
+    age_share = bag_closed_form_share(bags[-1])
     shutil.rmtree(bag_dir, ignore_errors=True)
-    if rate_hz is None:
-        raise BenchError(f'the tutorial run recorded no commands; see {log_path}')
-    return {'tutorial_command_rate_hz': rate_hz, 'bag_mb_per_min': mb_per_min}
+    if rate_hz is None or age_share is None:
+        raise BenchError(f'the tutorial run recorded no commands or no controller statistics; '
+                         f'see {log_path}')
+    return {'tutorial_command_rate_hz': rate_hz, 'bag_mb_per_min': mb_per_min,
+            'tutorial_age_closed_form_share': age_share}
 
 
 def bag_mb_per_min(bag: Path) -> float:
@@ -220,3 +226,68 @@ def bag_mb_per_min(bag: Path) -> float:
     if span_s <= 0:
         raise BenchError(f'{bag} spans no sim time')
     return bag.stat().st_size / 1e6 / (span_s / 60.0)
+
+
+#: The 50 Hz port's command ages in closed form (test/rostest/test_command_age.py's
+#: docstring): each command applied one step after its stamp and held 20 steps, so the ages
+#: in a window of WINDOW_STEPS steps are 1..20 ms over and over (s, s^2).
+STEP_S = 0.001
+PERIOD_STEPS = 20
+WINDOW_STEPS = 1000
+CLOSED_FORM_MEAN_S = (1 + PERIOD_STEPS) / 2 * STEP_S
+CLOSED_FORM_VARIANCE_S2 = ((PERIOD_STEPS ** 2 - 1) / 12 * STEP_S ** 2
+                           * WINDOW_STEPS / (WINDOW_STEPS - 1))
+#: A window "at the closed form": its mean 10-12 ms (a command held 20 steps plus one, with
+#: room for one a step late now and then) and its variance within 10 %. A late command
+#: (a busy machine) shortens one hold and lengthens the next.
+CLOSED_FORM_MEAN_RANGE_S = (0.010, 0.012)
+CLOSED_FORM_VARIANCE_TOLERANCE = 0.10
+
+
+def closed_form_share(stamps_ns: Sequence[int], means_s: Sequence[float],
+                      variances_s2: Sequence[float], first_command_ns: int,
+                      last_command_ns: int) -> float | None:
+    """The share of /atlas/controller_statistics windows lying wholly within the port's
+    commands (from one window after its first) whose mean and variance are at the closed
+    form; None without such a window."""
+    start_ns = first_command_ns + int((WINDOW_STEPS + PERIOD_STEPS) * STEP_S * NS_PER_S)
+    inside = [(mean, variance) for stamp, mean, variance in zip(stamps_ns, means_s, variances_s2)
+              if start_ns <= stamp <= last_command_ns]
+    if not inside:
+        return None
+    good = [CLOSED_FORM_MEAN_RANGE_S[0] <= mean <= CLOSED_FORM_MEAN_RANGE_S[1]
+            and abs(variance / CLOSED_FORM_VARIANCE_S2 - 1.0) <= CLOSED_FORM_VARIANCE_TOLERANCE
+            for mean, variance in inside]
+    return sum(good) / len(good)
+
+
+def bag_closed_form_share(bag: Path) -> float | None:
+    """closed_form_share of a bag's /atlas/controller_statistics and /atlas/joint_commands
+    (their header stamps)."""
+    from rosbags.rosbag1 import Reader
+
+    from tutorial_atlas_control import topics
+    from tutorial_atlas_control.bags.typestore import load_typestore
+
+    commands: list[int] = []
+    stamps: list[int] = []
+    means: list[float] = []
+    variances: list[float] = []
+    with Reader(bag) as reader:
+        wanted = [c for c in reader.connections
+                  if c.topic in (topics.JOINT_COMMANDS, topics.CONTROLLER_STATISTICS)]
+        if not wanted:
+            return None
+        typestore = load_typestore(reader.connections)
+        for connection, _t, raw in reader.messages(connections=wanted):
+            message = typestore.deserialize_ros1(raw, connection.msgtype)
+            stamp_ns = message.header.stamp.sec * NS_PER_S + message.header.stamp.nanosec
+            if connection.topic == topics.JOINT_COMMANDS:
+                commands.append(stamp_ns)
+            else:
+                stamps.append(stamp_ns)
+                means.append(message.command_age_mean)
+                variances.append(message.command_age_variance)
+    if not commands:
+        return None
+    return closed_form_share(stamps, means, variances, min(commands), max(commands))

@@ -2,7 +2,9 @@
 
 A skip says a test did not check its claim. On a machine set up by `make setup` every test
 can run, so under TAC_REQUIRE_ALL=1 a skip means a broken workspace or a missing tool, and
-the run ends with one line naming the skipped tests and exit status 1. Only tests marked
+the run ends with one line naming the skipped tests and exit status 1. Without it (a local
+`make test`) the run ends with one loud line naming them too, so that a green local run
+never hides what CI would fail on. Only tests marked
 `@pytest.mark.optional(reason)` may skip there: they need something no clone carries (the
 DRCSim reference files beside the repository); their skips are listed, and allowed.
 """
@@ -61,6 +63,10 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
 
 def pytest_terminal_summary(terminalreporter: pytest.TerminalReporter) -> None:
     if not require_all():
+        if _unexpected:
+            terminalreporter.write_line(
+                f'SKIPPED, WHICH {REQUIRE_ALL_ENV}=1 (CI) WOULD FAIL: {len(_unexpected)} '
+                'test(s): ' + '; '.join(_unexpected), red=True, bold=True)
         return
     if _optional:
         terminalreporter.write_line(

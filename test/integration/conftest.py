@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -15,6 +16,24 @@ RUN_DEMO = REPO / 'scripts' / 'run_demo.py'
 #: Wall-clock guard against a hung recording (s): far beyond the ~30 s it takes, as the
 #: tests run niced beside other work (a niced process gets ~1/10 of a busy core's share).
 DEMO_TIMEOUT_S = 900
+
+
+#: The environment a ROS client reads its master from.
+ROS_ENVIRONMENT = ('ROS_MASTER_URI', 'ROS_HOSTNAME', 'ROS_IP')
+
+
+@pytest.fixture(autouse=True)
+def ros_state_left_as_found() -> Iterator[None]:
+    """Each test leaves this process's ROS state as it found it: no rospy node (one per
+    process, never shut down for good) and the same ROS environment, so that no later test
+    depends on the order the tests ran in. A test needing a node runs it in a subprocess."""
+    before = {name: os.environ.get(name) for name in ROS_ENVIRONMENT}
+    yield
+    after = {name: os.environ.get(name) for name in ROS_ENVIRONMENT}
+    assert after == before, f'the test changed this process\'s ROS environment: {after}'
+    rospy = sys.modules.get('rospy')
+    assert rospy is None or not rospy.core.is_initialized(), \
+        'the test started a rospy node in the pytest process'
 
 
 @dataclass(frozen=True)

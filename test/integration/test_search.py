@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from support.scripts import run_script
+from support.scripts import interrupt_script, run_script
 from tutorial_atlas_control.search.cmaes import LATENCY_SEED, runs_per_candidate
 from tutorial_atlas_control.search.sweep import SweepInputs, build_specs, run_sweep
 from tutorial_atlas_control.sim.controller import load_gains_yaml
@@ -93,6 +93,38 @@ def test_gain_search_writes_a_gains_file(tmp_path: Path, tiny: Path) -> None:
     changed = np.flatnonzero(gains.p != base.p)
     assert set(changed) <= {7, 13}  # l_leg_kny, r_leg_kny only
     assert 'gains_file:=' in (tmp_path / 'found.yaml').read_text()
+
+
+def _generations_logged(log: Path) -> int:
+    try:
+        text = log.read_text()
+    except FileNotFoundError:
+        return 0
+    return text.count('"kind": "generation"')
+
+
+def test_ctrl_c_keeps_the_finished_generations(tmp_path: Path, tiny: Path) -> None:
+    """Ctrl-C after two generations of a search that would run 1000: exit 130, one line, the
+    log whole (every line JSON) and resumable, the best so far written."""
+    log, found = tmp_path / 'log.jsonl', tmp_path / 'found.yaml'
+    args = [str(tiny), *TOY, '--log', str(log), '--yaml', str(found)]
+    result = interrupt_script('search.py', *args, '--generations', '1000',
+                              ready=lambda _err: _generations_logged(log) >= 2, cwd=tmp_path)
+    assert result.returncode == 130, result
+    generations = [r for r in _records(log) if r['kind'] == 'generation']
+    assert [r['gen'] for r in generations] == list(range(1, len(generations) + 1))
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1, result.stderr
+    # The signal lands while a generation runs (then its number is said), or, rarely, in the
+    # moment between two, which the log alone then tells.
+    assert lines[0] in (
+        f'search.py: interrupted after generation {len(generations)}; --resume continues it; '
+        f'best so far in {found}',
+        f'search.py: interrupted; the log {log} keeps the finished generations'), lines
+    assert load_trajectory(found, 'bend_found')
+    resumed = _search(*args, '--generations', str(len(generations) + 1), '--resume')
+    assert resumed.returncode == 0, resumed.stderr
+    assert f'resumed after generation {len(generations)}' in resumed.stdout
 
 
 @pytest.mark.parametrize('args, message', [

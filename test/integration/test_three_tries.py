@@ -4,7 +4,7 @@ One headless atlas.launch (recording on): User mode, step_and_fall; /gazebo/rese
 touchdown; /gazebo/reset_simulation (sim time back to 0), touchdown_exhausted; each with
 traj_yaml.py and trajectories/Traj_data2.yaml. The bag must then be analyzed as three
 tries with the right trajectories, the falls of step_and_fall and touchdown_exhausted, and
-the commands' real rate in each; and tries 2 and 3, which start at a mid-run reset_world
+every scheduled command in each; and tries 2 and 3, which start at a mid-run reset_world
 and at a reset_simulation, must replay offline bit for bit.
 
 Needs `make setup` and `source ./env.sh`; about 60 s of wall time (real_time_factor 1, as
@@ -31,6 +31,7 @@ from tutorial_atlas_control.bags.tries import (
     RUN_START,
 )
 from tutorial_atlas_control.offline.replay import replay_bag
+from tutorial_atlas_control.trajectories.trajectory import load_trajectory, sample_count
 
 REPO = Path(__file__).resolve().parents[2]
 TRAJ_YAML = REPO / 'scripts' / 'traj_yaml.py'
@@ -40,9 +41,18 @@ SESSION = ('step_and_fall', 'touchdown', 'touchdown_exhausted')
 SETTLE_S = 1.5
 #: Sim time (s) watched after each trajectory, for the fall.
 AFTER_S = 4.0
-#: traj_yaml.py sends the tutorial's 50 Hz; the band allows for commands it drops late.
-RATE_BAND_HZ = (45.0, 55.0)
+#: The commands' rate (50 Hz of sim time when the port keeps up) is a speed: make bench's
+#: tutorial_command_rate_hz. What holds at any speed: every scheduled command is sent (a
+#: late port restarts its schedule, it drops none) and recorded, but one per try whose
+#: hand-over to rospy timed out (test_recorded_run.py's allowance).
+MAX_COMMANDS_MISSED = 1
 TRAJECTORY_TIMEOUT_S = 180.0
+
+
+def scheduled_commands(trajectory: str) -> int:
+    """The commands traj_yaml.py sends for `trajectory`: the tutorial's per waypoint."""
+    return sum(sample_count(waypoint.duration_s)
+               for waypoint in load_trajectory(TRAJECTORY_FILE, trajectory))
 
 
 def play(launch: TestLaunch, trajectory: str) -> None:
@@ -86,13 +96,12 @@ def test_three_tries_are_analyzed_apart(session_bag: Path) -> None:
     assert [[p['name'] for p in each['trajectories']] for each in tries] == [
         [name] for name in SESSION], summary
     assert [each['fell'] for each in tries] == [True, False, True], summary
-    for each in tries:
-        assert RATE_BAND_HZ[0] <= each['command_rate'] <= RATE_BAND_HZ[1], summary
-        assert each['command_count'] > 100, summary
+    for each, name in zip(tries, SESSION):
+        expected = scheduled_commands(name)
+        assert expected - MAX_COMMANDS_MISSED <= each['command_count'] <= expected, summary
     assert tries[2]['sim_start'] == pytest.approx(0.0, abs=0.01), summary
     # The simulator's 1 kHz in sim time, over the whole run despite the rewind.
     assert analysis.data.topics['/atlas/joint_states'].rate_hz == pytest.approx(1000.0, rel=0.01)
-    assert RATE_BAND_HZ[0] <= analysis.command_rate_hz <= RATE_BAND_HZ[1]
     assert any('holds 3 tries' in warning for warning in analysis.warnings)
 
 

@@ -23,11 +23,19 @@ import pytest
 
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
-from tutorial_atlas_control.processes import RosMaster, default_sigint, stop_tree
+from tutorial_atlas_control.processes import (
+    RosMaster,
+    default_sigint,
+    stop_tree,
+    system_state,
+    wait_until,
+)
 
 REPO = Path(__file__).resolve().parents[2]
 TRAJ_YAML = REPO / 'scripts' / 'traj_yaml.py'
 FAKE_SIMULATOR = Path(__file__).resolve().parent / 'fake_simulator.py'
+COMMAND_LISTENER = Path(__file__).resolve().parent / 'command_listener.py'
+COMMAND_LISTENER_NODE = '/command_listener'
 TRAJECTORIES = REPO / 'trajectories' / 'Traj_data2.yaml'
 GAINS = REPO / 'config' / 'atlas_controller.yaml'
 MASTER_TIMEOUT_S = 60.0
@@ -39,8 +47,8 @@ FAKE_SIMULATOR_GUARD_S = 90.0
 PLAYING_TIMEOUT_S = 60.0
 #: The positive control's command: one joint position (rad) no trajectory of the file has.
 CONTROL_POSITION = 0.123456
-#: Wall-clock guard (s): rostopic echo polls the master for the topic, then gets the latched
-#: control message; seconds on a loaded machine.
+#: Wall-clock guard (s): for the listener to subscribe, and to get the latched control
+#: message; seconds on a loaded machine.
 CONTROL_TIMEOUT_S = 30.0
 
 
@@ -54,23 +62,34 @@ class Master(RosMaster):
         return subprocess.run(command, env=self.env, capture_output=True, text=True,
                               timeout=timeout_s, check=False)
 
+    def subscribed(self, node: str) -> bool:
+        """Whether the master lists `node` among /atlas/joint_commands' subscribers."""
+        try:
+            _, subscribers = system_state(self.uri)
+        except OSError:
+            return False
+        return node in subscribers.get('/atlas/joint_commands', [])
+
     def traj_yaml(self, *ros_args: str) -> tuple[subprocess.CompletedProcess, str]:
         """Run the port on step_and_fall; return its result and what was published meanwhile.
 
-        Positive control: after the port, a command published on purpose must reach the same
-        `rostopic echo`; else an echo that never connected would make "nothing was published"
-        pass whatever the port did.
+        The listener's subscription is on the master before the port starts (so the port,
+        once it advertises, is told of it). Positive control: after the port, a command
+        published on purpose must reach the same listener; else a listener that never
+        connected would make "nothing was published" pass whatever the port did.
         """
-        echo = subprocess.Popen(['rostopic', 'echo', '/atlas/joint_commands/position'],
-                                env=self.env, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
-                                text=True, start_new_session=True)
+        listener = subprocess.Popen([sys.executable, str(COMMAND_LISTENER)], env=self.env,
+                                    stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                                    text=True, start_new_session=True,
+                                    preexec_fn=default_sigint)
         lines: queue.Queue[str] = queue.Queue()
-        reader = threading.Thread(target=lambda: [lines.put(line) for line in echo.stdout or ()],
-                                  daemon=True)
+        reader = threading.Thread(
+            target=lambda: [lines.put(line) for line in listener.stdout or ()], daemon=True)
         reader.start()
         heard: list[str] = []
         try:
-            time.sleep(1.0)  # rostopic echo registered before the port starts
+            wait_until(lambda: self.subscribed(COMMAND_LISTENER_NODE), CONTROL_TIMEOUT_S,
+                       'the command listener did not subscribe to /atlas/joint_commands')
             result = self.run(sys.executable, str(TRAJ_YAML), str(TRAJECTORIES),
                               'step_and_fall', *ros_args)
             control = self.run('rostopic', 'pub', '-1', '/atlas/joint_commands',
@@ -79,12 +98,12 @@ class Master(RosMaster):
             deadline = time.monotonic() + CONTROL_TIMEOUT_S
             while not any(str(CONTROL_POSITION) in line for line in heard):
                 assert time.monotonic() < deadline, (
-                    f'rostopic echo did not show the control command within {CONTROL_TIMEOUT_S}'
-                    f' s: it would not have shown the port\'s either (heard {heard!r})')
+                    f'the listener did not hear the control command within {CONTROL_TIMEOUT_S}'
+                    f' s: it would not have heard the port\'s either (heard {heard!r})')
                 with contextlib.suppress(queue.Empty):
                     heard.append(lines.get(timeout=0.1))
         finally:
-            stop_tree(echo)
+            stop_tree(listener)
         before_control = heard[:next(k for k, line in enumerate(heard)
                                      if str(CONTROL_POSITION) in line)]
         return result, ''.join(before_control)

@@ -184,3 +184,15 @@ def bus_connections(node: str, caller_id: str = '/sim_probe') -> list[list]:
 def transports_to(peer: str, topic: str, node: str = '/atlas_sim') -> list[str]:
     """The transports (TCPROS, UDPROS) of `node`'s connections to `peer` on `topic`."""
     return [c[3] for c in bus_connections(node) if c[1] == peer and c[4] == topic]
+
+
+def messages_received(topic: str, node: str = '/atlas_sim', caller_id: str = '/sim_probe') -> int:
+    """How many `topic` messages `node` has read from this node's publisher (its getBusStats
+    and getBusInfo: rospy counts each message as it reads it, before its callback)."""
+    uri = xmlrpc.client.ServerProxy(rosgraph.Master(caller_id).lookupNode(node))
+    mine = rospy.get_node_uri()
+    ids = {c[0] for c in uri.getBusInfo(caller_id)[2]
+           if c[2] == 'i' and c[4] == topic and c[1] == mine}
+    _publish, subscribe, _services = uri.getBusStats(caller_id)[2]
+    return sum(connection[2] for name, connections in subscribe if name == topic
+               for connection in connections if connection[0] in ids)

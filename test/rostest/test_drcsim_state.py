@@ -56,6 +56,7 @@ class DrcsimStateTest(unittest.TestCase):
         rospy.init_node('test_drcsim_state')
         cls.lock = threading.Lock()
         cls.messages = {}
+        cls.latest_ns = {}
         cls.clock_ns = 0
         subscribers = [
             rospy.Subscriber(topic, msg_class, cls._keep, callback_args=topic, queue_size=20000)
@@ -70,8 +71,11 @@ class DrcsimStateTest(unittest.TestCase):
                   'the simulator\'s connections')
         rospy.wait_for_service(topics.UNPAUSE_PHYSICS_SERVICE, timeout=WALL_TIMEOUT_S)
         rospy.ServiceProxy(topics.UNPAUSE_PHYSICS_SERVICE, Empty)()
-        cls._wait(lambda: cls.clock_ns >= WATCH_S * 1e9 + 50 * STEP_NS, f'{WATCH_S} s of sim time')
-        time.sleep(0.5)  # what was sent before it arrives
+        # Each topic's messages come in order on its connection: once one stamped past the
+        # watch has arrived, every message of the watch has.
+        watched = [s.resolved_name for s in subscribers]
+        cls._wait(lambda: all(cls.latest_ns.get(topic, -1) > WATCH_S * 1e9 for topic in watched),
+                  f'a message stamped after {WATCH_S} s on each of {watched}')
 
     @classmethod
     def _wait(cls, predicate, what: str) -> None:
@@ -88,8 +92,9 @@ class DrcsimStateTest(unittest.TestCase):
     @classmethod
     def _keep(cls, msg, topic: str) -> None:
         stamp_ns = msg.header.stamp.to_nsec()
-        if stamp_ns <= WATCH_S * 1e9:
-            with cls.lock:
+        with cls.lock:
+            cls.latest_ns[topic] = max(stamp_ns, cls.latest_ns.get(topic, -1))
+            if stamp_ns <= WATCH_S * 1e9:
                 cls.messages.setdefault(topic, {})[stamp_ns] = msg
 
     def _standing(self, topic: str) -> list:

@@ -11,7 +11,7 @@ import rosgraph
 import rospy
 import rostest
 from rosgraph_msgs.msg import Clock
-from sim_probe import SimProbe  # beside this script, on its sys.path
+from sim_probe import SimProbe, messages_received  # beside this script, on its sys.path
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS
@@ -26,6 +26,11 @@ EXPECTED_TYPES = {topic: topics.MSG_TYPES[topic] for topic in (
 STEP_NS = 1_000_000
 #: A step command on the left elbow, with the tutorial's gains for that joint.
 ELBOW = 'l_arm_elx'
+MODE_TOPIC, COMMAND_TOPIC = '/atlas/control_mode', '/atlas/joint_commands'
+#: Wall time (s) without a /clock that says the pause took effect, and the window the paused
+#: clock must then stand still in.
+CLOCK_QUIET_S = 0.1
+PAUSE_WATCH_S = 0.5
 ELBOW_TARGET_RAD = 0.8
 
 
@@ -99,9 +104,13 @@ class SimInterfaceTest(unittest.TestCase):
                    'kd_position': [float(gains.d[index])]}
         probe.call('/gazebo/pause_physics')
         probe.call('/gazebo/reset_simulation')
+        modes, commands = (messages_received(topic) for topic in (MODE_TOPIC, COMMAND_TOPIC))
         probe.set_mode('User')
         probe.send(['atlas::' + ELBOW], **command)
-        time.sleep(0.5)  # let both messages arrive while physics is paused
+        # Both read by the simulator while physics is paused (then handed to its loop).
+        probe.wait_until(lambda: messages_received(MODE_TOPIC) > modes
+                         and messages_received(COMMAND_TOPIC) > commands,
+                         'the simulator to read the mode and the command')
         with probe.lock:
             probe.joint_states.clear()
             probe.keep_joint_states = True
@@ -210,9 +219,16 @@ class SimInterfaceTest(unittest.TestCase):
         self.assertAlmostEqual(probe.pelvis_z(), spawn_z, delta=0.002)
 
         probe.call('/gazebo/pause_physics')
-        time.sleep(0.2)
+        # The /clock sent before the pause arrives, then none: wait until it stops, then
+        # watch it stand still.
+        def clock_stopped() -> bool:
+            before_ns = probe.clock_ns
+            time.sleep(CLOCK_QUIET_S)
+            return probe.clock_ns == before_ns
+
+        probe.wait_until(clock_stopped, 'the clock to stop after pause_physics')
         paused_ns = probe.clock_ns
-        time.sleep(0.5)
+        time.sleep(PAUSE_WATCH_S)  # the window it must stand still in, not a wait
         self.assertEqual(probe.clock_ns, paused_ns, 'paused physics: clock stands still')
         probe.call('/gazebo/unpause_physics')
         probe.wait_sim(0.1)

@@ -16,11 +16,13 @@ import xml.etree.ElementTree as ET
 
 import mujoco
 import numpy as np
+import rosgraph
 import rospy
 import rostest
 import tf2_ros
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
+from rospy.impl.registration import get_topic_manager
 from std_srvs.srv import Empty
 from tf2_msgs.msg import TFMessage
 
@@ -60,14 +62,32 @@ class TfTest(unittest.TestCase):
         rospy.Subscriber('/ground_truth_odom', Odometry, cls._on_odom, queue_size=1000)
         rospy.Subscriber('/clock', Clock, cls._on_clock, queue_size=10)
         publishers = 2 if rospy.get_param('/atlas_sim/tf_publisher') != 'sim' else 1
+        # The listener's /tf subscription is tf_sub's (one per topic in a rospy node); its
+        # /tf_static one connects on its own, to every publisher the master lists.
         cls._wait(lambda: tf_sub.get_num_connections() >= publishers
-                  and cls.listener is not None and rospy.has_param('/robot_description'),
-                  f'{publishers} publishers of /tf')
-        time.sleep(1.0)  # the listener's own /tf subscription connects too
+                  and cls.tf_static_connected() and rospy.has_param('/robot_description'),
+                  f'{publishers} publishers of /tf, and /tf_static\'s')
         rospy.wait_for_service('/gazebo/unpause_physics', timeout=WALL_TIMEOUT_S)
         rospy.ServiceProxy('/gazebo/unpause_physics', Empty)()
-        cls._wait(lambda: cls.clock_s >= WATCH_S, f'{WATCH_S} s of sim time')
-        time.sleep(0.5)  # the messages stamped before it arrive
+        # Each topic's messages come in order on its connection: once one stamped past the
+        # watch has arrived, every message of the watch has.
+        cls._wait(lambda: cls.latest_s('/tf') > WATCH_S and cls.latest_s('/odom') > WATCH_S,
+                  f'/tf and /ground_truth_odom stamped after {WATCH_S} s')
+
+    @classmethod
+    def tf_static_connected(cls) -> bool:
+        """Whether the listener's /tf_static subscription is connected to every publisher."""
+        publishers, _subscribers, _services = rosgraph.Master('/test_tf').getSystemState()
+        expected = len(dict(publishers).get('/tf_static', []))
+        impl = get_topic_manager().get_subscriber_impl('/tf_static')
+        return expected == 0 or (impl is not None and impl.get_num_connections() >= expected)
+
+    @classmethod
+    def latest_s(cls, topic: str) -> float:
+        """The latest stamp (s) received on `topic` ('/tf': world -> pelvis; '/odom')."""
+        with cls.lock:
+            stamps = cls.pelvis_tf if topic == '/tf' else cls.pelvis_odom
+            return max(stamps, default=-1) / 1e9
 
     @classmethod
     def _wait(cls, predicate, what: str) -> None:

@@ -10,6 +10,8 @@ from __future__ import annotations
 import json
 import math
 
+import load
+import numpy as np
 import pytest
 import run_bench
 
@@ -76,6 +78,8 @@ def test_headline_command_latency_is_the_worse_rate() -> None:
     ('tutorial_command_rate_hz', 50.1, 'met'),
     ('tutorial_command_rate_hz', 44.9, 'MISSED'),
     ('tutorial_command_rate_hz', 51.1, 'MISSED'),
+    ('tutorial_age_closed_form_share', 0.8, 'met'),
+    ('tutorial_age_closed_form_share', 0.79, 'MISSED'),
     ('load_publish_rate_hz', 5900.0, 'met'),
     ('load_publish_rate_hz', 5800.0, 'MISSED'),
     ('unheard_topic_us_per_step', 1.0, 'MISSED'),
@@ -205,3 +209,33 @@ def test_command_age_is_read_from_the_wire_message() -> None:
     wire = ControllerStatisticsWire()
     wire.set_values(0.001, 0.002, 3e-7, 1.0)
     assert controller.command_age_s(bytes(wire.stamped(5_000_000))) == 0.001
+
+
+def sawtooth_window(hold_steps: list[int]) -> tuple[float, float]:
+    """A window's command-age mean (s) and variance (s^2, n - 1) when its commands are held
+    `hold_steps` steps each, each applied one step after its stamp."""
+    ages_s = np.concatenate([np.arange(1, hold + 1) for hold in hold_steps]) * load.STEP_S
+    return float(ages_s.mean()), float(ages_s.var(ddof=1))
+
+
+def test_the_closed_form_is_the_50_hz_ports_sawtooth() -> None:
+    mean_s, variance_s2 = sawtooth_window([20] * 50)  # 1000 steps
+    assert mean_s == pytest.approx(load.CLOSED_FORM_MEAN_S, rel=1e-12)
+    assert variance_s2 == pytest.approx(load.CLOSED_FORM_VARIANCE_S2, rel=1e-12)
+
+
+def test_closed_form_share_counts_the_windows_within_the_commands() -> None:
+    """Windows from one window after the first command to the last: a window of a port that
+    kept up counts, one whose command ages doubled (a 25 Hz port) does not."""
+    kept_up = sawtooth_window([20] * 50)
+    late = sawtooth_window([40] * 25)
+    first_ns, step_ns = 1_000_000_000, 1_000_000
+    start_ns = first_ns + 1020 * step_ns
+    stamps = [start_ns - step_ns, start_ns, start_ns + step_ns, start_ns + 2 * step_ns,
+              start_ns + 3 * step_ns]
+    windows = [late, kept_up, late, kept_up, late]  # the first before the span, the last after
+    last_ns = start_ns + 2 * step_ns
+    share = load.closed_form_share(stamps, [w[0] for w in windows], [w[1] for w in windows],
+                                   first_ns, last_ns)
+    assert share == pytest.approx(2 / 3)
+    assert load.closed_form_share(stamps[:1], [late[0]], [late[1]], first_ns, last_ns) is None

@@ -38,6 +38,14 @@ def test_help_works_from_anywhere(script: str) -> None:
      "argument --settle: '-1' must be a finite number of seconds >= 0"),
     ('plot_topics.py', ['/a/b', '--window', '0'],
      "argument --window: '0' must be a finite number of seconds > 0"),
+    ('sweep.py', ['Traj.yaml', 'bend', '--repeat', '0'], "argument --repeat: '0' must be at "
+     'least 1'),
+    ('sweep.py', ['Traj.yaml', 'bend', '--workers', '0'], "argument --workers: '0' must be at "
+     'least 1'),
+    ('search.py', ['Traj.yaml', 'bend', '--objective', 'stay_up', '--log', 'l', '--yaml', 'y',
+                   '--latency-draws', '-1'], "argument --latency-draws: '-1' must be at least 0"),
+    ('search.py', ['Traj.yaml', 'bend', '--objective', 'stay_up', '--log', 'l', '--yaml', 'y',
+                   '--popsize', '0'], "argument --popsize: '0' must be at least 1"),
     ('record_run.sh', [], 'expected BAG_DIR [atlas_recorder|rosbag [lz4|bz2|none]], got 0 '
      'argument(s)'),
     ('record_run.sh', ['/tmp', 'rosbag2'], "unknown recorder 'rosbag2'"),

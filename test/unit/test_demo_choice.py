@@ -3,6 +3,7 @@ before anything starts; and the summary's right-foot line (bags/feet.py)."""
 
 from __future__ import annotations
 
+import subprocess
 from pathlib import Path
 
 import mujoco
@@ -126,10 +127,15 @@ class Launched:
     def __init__(self, bag: Path) -> None:
         self.bag = bag
         self.calls: list[tuple[str, Path, GainsChoice | None]] = []
+        self.bag_dirs: list[Path] = []
+        self.real_time_factors: list[float] = []
 
-    def run_demo(self, trajectory: str, trajectory_file: Path, *_args: object,
-                 gains: GainsChoice | None = None, **_kwargs: object) -> Path:
+    def run_demo(self, trajectory: str, trajectory_file: Path, bag_dir: Path,
+                 real_time_factor: float, *_args: object, gains: GainsChoice | None = None,
+                 **_kwargs: object) -> Path:
         self.calls.append((trajectory, trajectory_file, gains))
+        self.bag_dirs.append(bag_dir)
+        self.real_time_factors.append(real_time_factor)
         return self.bag
 
     @staticmethod
@@ -249,3 +255,68 @@ def test_a_bad_real_time_factor_is_refused(launched: Launched, text: str,
     assert (f"argument --real-time-factor: real time factor '{text}' is not a finite number "
             '>= 0') in capsys.readouterr().err
     assert launched.calls == []
+
+
+# ------------------------------------------- `make demo RTF=...` and $TAC_BAG_DIR, end to end
+def test_make_demo_passes_rtf_to_run_demo() -> None:
+    """README: `make demo RTF=0.5` runs the simulator at half real time: the target's command
+    (make -n: printed, not run) gives run_demo.py --real-time-factor 0.5."""
+    result = subprocess.run(['make', '-n', '-C', str(REPO), 'demo', 'RTF=0.5', 'TRAJ=touchdown'],
+                            capture_output=True, text=True, check=False, timeout=60)
+    assert result.returncode == 0, result.stderr
+    assert 'scripts/run_demo.py "touchdown" --real-time-factor "0.5"' in result.stdout
+
+
+def test_run_demo_hands_the_factor_on(launched: Launched) -> None:
+    assert run_demo.main(['touchdown', '--real-time-factor', '0.5']) == 0
+    assert launched.real_time_factors == [0.5]
+
+
+class LaunchStarted(Exception):
+    """Raised by the fake AtlasLaunch: what demo.run_demo asked for is recorded, nothing runs."""
+
+
+def test_the_demo_launches_the_simulator_with_the_factor(monkeypatch: pytest.MonkeyPatch,
+                                                        tmp_path: Path) -> None:
+    """demo.run_demo gives atlas.launch real_time_factor:=0.5 (the fake run_demo of the tests
+    above would swallow it) and its bag_dir."""
+    asked: list[dict[str, object]] = []
+
+    def fake_launch(_log_path: Path, launch_args: dict[str, object], **_kwargs: object) -> None:
+        asked.append(launch_args)
+        raise LaunchStarted
+
+    monkeypatch.setattr(demo, 'AtlasLaunch', fake_launch)
+    with pytest.raises(LaunchStarted):
+        demo.run_demo('touchdown', TUTORIAL, tmp_path / 'bags', 0.5, tmp_path / 'logs')
+    assert asked[0]['real_time_factor'] == 0.5
+    assert asked[0]['bag_dir'] == tmp_path / 'bags'
+
+
+def test_the_demos_bag_dir_is_tac_bag_dir(launched: Launched, monkeypatch: pytest.MonkeyPatch,
+                                          tmp_path: Path) -> None:
+    """README: bags go to $TAC_BAG_DIR unless told otherwise (run_demo.py's default too)."""
+    monkeypatch.setenv('TAC_BAG_DIR', str(tmp_path / 'elsewhere'))
+    assert run_demo.main(['touchdown']) == 0
+    assert launched.bag_dirs == [(tmp_path / 'elsewhere').resolve()]
+
+
+@pytest.mark.parametrize(('env', 'expected'), [
+    ({'TAC_BAG_DIR': '/data/bags', 'HOME': '/home/u'}, '/data/bags'),
+    ({'HOME': '/home/u'}, '/home/u/.ros/tutorial_atlas_control/bags'),
+])
+def test_atlas_launch_bag_dir_default_is_tac_bag_dir(env: dict[str, str], expected: str,
+                                                    monkeypatch: pytest.MonkeyPatch) -> None:
+    """README: atlas.launch's bag_dir defaults to $TAC_BAG_DIR, else
+    ~/.ros/tutorial_atlas_control/bags: the launch file's own expression, evaluated by
+    roslaunch's substitution code."""
+    import xml.etree.ElementTree as ET
+
+    from roslaunch.substitution_args import resolve_args
+
+    root = ET.parse(REPO / 'launch' / 'atlas.launch').getroot()
+    default, = [arg.get('default') for arg in root.iter('arg') if arg.get('name') == 'bag_dir']
+    monkeypatch.delenv('TAC_BAG_DIR', raising=False)
+    for name, value in env.items():
+        monkeypatch.setenv(name, value)
+    assert resolve_args(default, context={'arg': {}}) == expected

@@ -30,7 +30,7 @@ from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistic
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
 from tutorial_atlas_control.stepping.loop import LoopSettings, SteppingLoop
 from tutorial_atlas_control.stepping.outputs import LoopOutputs
-from tutorial_atlas_control.stepping.pacing import Pacer
+from tutorial_atlas_control.stepping.pacing import MAX_LAG_S, Pacer
 from tutorial_atlas_control.stepping.synchronization import (
     MAX_PER_STEP_PARAM,
     DelayBudgets,
@@ -380,3 +380,60 @@ def test_the_latest_statistics_are_kept_for_later_subscribers(sim: AtlasSimulato
     assert sync_statistics(outbox) == []
     assert [struct.unpack('<3d', data)[:2] for data in latched] == [
         pytest.approx((0.025, 0.025)), pytest.approx((0.025, 0.05))]
+
+
+# -- the window at real_time_factor > 0: the factor a ceiling, waits caught up --------------
+#: Wall time (s) the physics of one step takes in these runs, and the steps run.
+PHYSICS_S = 0.0001
+PACED_STEPS = 1000
+
+
+def paced_run(real_time_factor: float, wait_s: dict[int, float]) -> tuple[FakeClock, Pacer,
+                                                                          list[float]]:
+    """PACED_STEPS steps of 1 ms as the loop paces them: the controller's wait (wait_s[k] at
+    step k, else none), the physics, then the pacer's wait. Returns the clock, the pacer and
+    how far ahead of wall time sim time was after each step (s; <= 0: never ahead)."""
+    clock = FakeClock()
+    pacer = Pacer(real_time_factor, clock, clock.sleep)
+    pacer.restart(0)
+    start_s, ahead_s = clock(), []
+    for step in range(1, PACED_STEPS + 1):
+        clock.now_s += wait_s.get(step, 0.0) + PHYSICS_S
+        sim_ns = step * 1_000_000
+        pacer.wait(sim_ns)
+        ahead_s.append(sim_ns / NS_PER_S / real_time_factor - (clock() - start_s))
+    return clock, pacer, ahead_s
+
+
+def test_a_controller_answering_within_the_step_costs_no_wait() -> None:
+    """README: at real_time_factor > 0 an answer within the step's share costs no wall time:
+    the pacer sleeps what is left of the step; the run takes its 1 s, not 1 s + the answers."""
+    answer_s = 0.0003
+    clock, _pacer, ahead_s = paced_run(1.0, dict.fromkeys(range(1, PACED_STEPS + 1), answer_s))
+    assert clock.now_s - 100.0 == pytest.approx(PACED_STEPS * 0.001, abs=1e-9)
+    assert clock.slept_s == pytest.approx([0.001 - answer_s - PHYSICS_S] * PACED_STEPS)
+    assert max(ahead_s) <= 1e-9
+
+
+def test_a_late_answer_is_caught_up_and_the_factor_stays_a_ceiling() -> None:
+    """README: a 20 ms wait (within the step's 25 ms budget) makes the loop late; it then
+    runs without sleeping until it is back on schedule (within MAX_LAG_S), and sim time is
+    never ahead of wall time x the factor."""
+    for factor in (0.5, 1.0):
+        clock, _pacer, ahead_s = paced_run(factor, {100: 0.020})
+        assert clock.now_s - 100.0 == pytest.approx(PACED_STEPS * 0.001 / factor, abs=1e-9)
+        assert max(ahead_s) <= 1e-9, 'sim time ran ahead of real time x the factor'
+        behind = [step for step, ahead in enumerate(ahead_s, 1) if ahead < -1e-9]
+        # Late from step 100 until the 20 ms are made up (a step's share less its physics
+        # each step): one stretch, then on schedule to the end.
+        assert behind and behind[0] == 100 and behind == list(range(100, behind[-1] + 1))
+        assert behind[-1] < PACED_STEPS
+
+
+def test_a_wait_beyond_the_lag_limit_restarts_the_schedule() -> None:
+    """Behind by more than MAX_LAG_S the pacer stops catching up: sim time due from then."""
+    wait_s = MAX_LAG_S + 0.5
+    clock, pacer, _ahead_s = paced_run(1.0, {100: wait_s})
+    assert pacer.sim0_ns == 100 * 1_000_000
+    # 99 steps on schedule, step 100 with its wait (the new reference), 900 steps of 1 ms.
+    assert clock.now_s - 100.0 == pytest.approx(0.099 + wait_s + PHYSICS_S + 0.900, abs=1e-9)

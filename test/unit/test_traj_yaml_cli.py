@@ -73,10 +73,11 @@ def assert_untouched(server: socket.socket) -> None:
         connection.close()
 
 
-def run_script(args: list[str], master_uri: str,
-               tmp_path: Path) -> subprocess.CompletedProcess[str]:
+def run_script(args: list[str], master_uri: str, tmp_path: Path,
+               first_on_path: Path | None = None) -> subprocess.CompletedProcess[str]:
     env = dict(os.environ)
-    env['PYTHONPATH'] = os.pathsep.join(filter(None, [str(REPO / 'src'), env.get('PYTHONPATH')]))
+    env['PYTHONPATH'] = os.pathsep.join(filter(None, [
+        str(first_on_path or ''), str(REPO / 'src'), env.get('PYTHONPATH')]))
     env['ROS_MASTER_URI'] = master_uri
     env['ROS_HOME'] = str(tmp_path / 'ros_home')
     env['ROS_LOG_DIR'] = str(tmp_path / 'ros_log')
@@ -188,19 +189,32 @@ def test_remapping_arguments_are_ignored(fake_master, tmp_path: Path) -> None:
     assert_untouched(server)
 
 
-def test_valid_file_without_master_fails_with_a_hint(tmp_path: Path) -> None:
-    """Nothing listens on the master port: one line, no hang, no traceback."""
+def free_master_uri() -> str:
+    """A master URI on a port nothing listens on."""
     with socket.socket() as probe:
         probe.bind(('127.0.0.1', 0))
-        port = probe.getsockname()[1]
-    result = run_script([str(TRAJECTORY_FILE), 'step_and_fall'], f'http://127.0.0.1:{port}',
-                        tmp_path)
-    if HAVE_OSRF_MSGS:
-        assert_one_line_error(result, f'no ROS master at http://127.0.0.1:{port}: '
-                                      'start the simulator with '
-                                      '`roslaunch tutorial_atlas_control atlas.launch`')
-    else:
-        assert_one_line_error(result, 'cannot import osrf_msgs.msg.JointCommands')
+        return f'http://127.0.0.1:{probe.getsockname()[1]}'
+
+
+@pytest.mark.skipif(not HAVE_OSRF_MSGS, reason='needs the catkin workspace: source ./env.sh')
+def test_valid_file_without_master_fails_with_a_hint(tmp_path: Path) -> None:
+    """Nothing listens on the master port: one line, no hang, no traceback."""
+    uri = free_master_uri()
+    result = run_script([str(TRAJECTORY_FILE), 'step_and_fall'], uri, tmp_path)
+    assert_one_line_error(result, f'no ROS master at {uri}: start the simulator with '
+                                  '`roslaunch tutorial_atlas_control atlas.launch`')
+
+
+def test_without_the_workspace_the_missing_messages_are_named(tmp_path: Path) -> None:
+    """osrf_msgs unimportable (a shell without the workspace, simulated by a package of that
+    name that refuses to import, first on the path): one line naming what is missing."""
+    shadow = tmp_path / 'shadow' / 'osrf_msgs'
+    shadow.mkdir(parents=True)
+    (shadow / '__init__.py').write_text(
+        "raise ImportError('osrf_msgs hidden by the test')\n", encoding='utf-8')
+    result = run_script([str(TRAJECTORY_FILE), 'step_and_fall'], free_master_uri(), tmp_path,
+                        first_on_path=shadow.parent)
+    assert_one_line_error(result, 'cannot import osrf_msgs.msg.JointCommands')
 
 
 # --- joint states by name ---------------------------------------------------------------

@@ -39,6 +39,21 @@ def argument_type(convert: Callable[[str], _T]) -> Callable[[str], _T]:
     return checked
 
 
+def whole_number(minimum: int) -> Callable[[str], int]:
+    """An argparse `type=` for a whole number >= `minimum`: out of range is a wrong command
+    line (exit 2), as a malformed value is."""
+    def checked(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f'{text!r} is not a whole number') from None
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f'{text!r} must be at least {minimum}')
+        return value
+    checked.__name__ = 'whole_number'
+    return checked
+
+
 def print_error(prog: str, message: object) -> None:
     """The one stderr line of a refused run."""
     print(f'{prog}: error: {message}', file=sys.stderr)

@@ -7,7 +7,12 @@ import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED, EXIT_REFUSED, print_error
+from tutorial_atlas_control.cli.convention import (
+    EXIT_INTERRUPTED,
+    EXIT_REFUSED,
+    print_error,
+    whole_number,
+)
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.search.cmaes import (
     SearchProblem,
@@ -30,16 +35,6 @@ from tutorial_atlas_control.search.sweep import (
 from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE
 
 PROG = 'search.py'
-
-
-def _count(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'{text!r} is not a whole number') from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f'{text!r} must be at least 1')
-    return value
 
 
 def _variant(text: str) -> tuple[float, float]:
@@ -76,9 +71,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument('--gains', default=str(DEFAULT_GAINS_FILE), metavar='FILE',
                         help='starting gains (default: config/atlas_controller.yaml)')
     parser.add_argument('--seed', type=int, default=0, help='CMA-ES seed (default: 0)')
-    parser.add_argument('--popsize', type=_count, default=6, metavar='N',
+    parser.add_argument('--popsize', type=whole_number(1), default=6, metavar='N',
                         help='candidates per generation (default: %(default)s)')
-    parser.add_argument('--generations', type=_count, default=10, metavar='N',
+    parser.add_argument('--generations', type=whole_number(1), default=10, metavar='N',
                         help='generations in all, counting resumed ones (default: %(default)s)')
     parser.add_argument('--step-scale', type=float, default=1.0, metavar='X',
                         help='factor on the initial steps (0.05 rad, 0.2 and 0.3 log-factors)')
@@ -88,7 +83,7 @@ def build_parser() -> argparse.ArgumentParser:
                              '(e.g. 0.9:1 1.1:1 1:0.9 1:1.1); its cost is the mean')
     parser.add_argument('--latency-ms', metavar='LO:HI',
                         help='with --latency-draws: each command delayed LO..HI ms, as live')
-    parser.add_argument('--latency-draws', type=int, default=0, metavar='N',
+    parser.add_argument('--latency-draws', type=whole_number(0), default=0, metavar='N',
                         help='also play each candidate N times with --latency-ms (the same N '
                              'draws for every candidate); its cost is the mean (default: 0)')
     parser.add_argument('--log', type=Path, required=True, metavar='FILE',
@@ -101,7 +96,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument('--gains-out', type=Path, metavar='FILE',
                         help='where the best gains are written (default: OUT_gains.yaml beside '
                              '--yaml, when gains are searched)')
-    parser.add_argument('--workers', type=int, default=None, metavar='N',
+    parser.add_argument('--workers', type=whole_number(1), default=None, metavar='N',
                         help='local cluster size (default: one per core)')
     parser.add_argument('--scheduler', metavar='ADDRESS', help='use this Dask scheduler')
     return parser
@@ -152,7 +147,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         gains_out = None
         if args.vary_gain:
             gains_out = args.gains_out or args.yaml.with_name(args.yaml.stem + '_gains.yaml')
-        if args.latency_draws < 0 or bool(args.latency_draws) != bool(args.latency_ms):
+        if bool(args.latency_draws) != bool(args.latency_ms):
             raise AtlasControlError('give --latency-ms LO:HI and --latency-draws N (N >= 1) '
                                     'together')
         lo, hi = parse_latency(args.latency_ms) if args.latency_ms else (0, 0)

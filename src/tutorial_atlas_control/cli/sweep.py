@@ -7,7 +7,12 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED, EXIT_REFUSED, print_error
+from tutorial_atlas_control.cli.convention import (
+    EXIT_INTERRUPTED,
+    EXIT_REFUSED,
+    print_error,
+    whole_number,
+)
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.search.runs import SweepError
 from tutorial_atlas_control.search.sweep import (
@@ -66,14 +71,14 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument('--latency-ms', metavar='LO:HI',
                         help='delay each command by LO..HI ms (1 ms steps, drawn from the row\'s '
                              'seed) as live delivery does (default: none: at once)')
-    parser.add_argument('--repeat', type=int, default=1, metavar='N',
+    parser.add_argument('--repeat', type=whole_number(1), default=1, metavar='N',
                         help='play each combination N times, seeds apart (with --latency-ms: '
                              'N draws of the latency; default: 1)')
     parser.add_argument('--settle', type=float, default=3.0, metavar='S',
                         help='sim time after the last waypoint (default: %(default)g)')
     parser.add_argument('--seed', type=int, default=0,
                         help='first row\'s seed; row k has SEED + k (default: 0)')
-    parser.add_argument('--workers', type=int, default=None, metavar='N',
+    parser.add_argument('--workers', type=whole_number(1), default=None, metavar='N',
                         help='local cluster size (default: one per core)')
     parser.add_argument('--scheduler', metavar='ADDRESS',
                         help='use this Dask scheduler (e.g. tcp://host:8786), not a local cluster')
@@ -89,8 +94,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         pushes = [None if text == 'none' else parse_push(text) for text in args.push or ['none']]
         latency = parse_latency(args.latency_ms) if args.latency_ms else (0, 0)
-        if args.repeat < 1:
-            raise SweepError(f'--repeat {args.repeat}: give 1 or more')
         inputs = SweepInputs(
             [(args.trajectory_file, name) for name in args.names] + args.trajectory,
             args.gains or [str(DEFAULT_GAINS_FILE)], args.gain_scale, args.time_scale,

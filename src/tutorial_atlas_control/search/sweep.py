@@ -8,6 +8,7 @@ order, so the table does not depend on the number of workers or on which finishe
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import itertools
@@ -15,7 +16,9 @@ import json
 import logging
 import math
 import os
-from collections.abc import Callable, Iterable, Sequence
+import signal
+import threading
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -141,9 +144,29 @@ def _client(scheduler: str | None, workers: int) -> Any:
             raise SweepError(f'cannot reach the Dask scheduler at {scheduler}: '
                              f'{str(err).splitlines()[0] if str(err) else type(err).__name__}'
                              ) from None
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                           dashboard_address=':0', silence_logs=logging.ERROR)
+    with _sigint_ignored():  # the workers inherit it: Ctrl-C is the client's alone
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                               dashboard_address=':0', silence_logs=logging.ERROR)
     return Client(cluster)
+
+
+@contextlib.contextmanager
+def _sigint_ignored() -> Iterator[None]:
+    """SIGINT ignored while local worker processes start.
+
+    A terminal's Ctrl-C goes to the whole process group: workers that did not ignore it
+    would each print a KeyboardInterrupt traceback while the client cancels the runs and
+    stops them itself. An ignored signal stays ignored in a started process, and Python
+    then installs no handler of its own.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 class SweepEngine:

@@ -1,0 +1,102 @@
+#!/usr/bin/env python3
+"""test_replay_live.py's ROS side, in its own process: waits for the fresh simulator to stand
+free, plays the bag's mode switch and commands with `rosbag play`, watches for the fall, and
+prints one JSON line: the pelvis height before, the sim times the commands arrived at, the
+lowest pelvis height, and rosbag play's outcome (or `error`).
+
+Its own process so that the test's pytest process never holds a rospy node (init_node is
+once per process) nor a ROS_MASTER_URI of its own: later tests do not depend on it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import threading
+import time
+
+import rospy
+from nav_msgs.msg import Odometry
+from osrf_msgs.msg import JointCommands
+from rosgraph_msgs.msg import Clock
+
+
+class Probe:
+    """Sim time, pelvis height, arrival of played commands."""
+
+    def __init__(self) -> None:
+        self.lock = threading.Lock()
+        self.clock_s = 0.0
+        self.min_z_m = float('inf')
+        self.z_m: float | None = None
+        self.command_arrivals_s: list[float] = []
+        rospy.Subscriber('/clock', Clock, self._on_clock, queue_size=10)
+        rospy.Subscriber('/ground_truth_odom', Odometry, self._on_odom, queue_size=10)
+        rospy.Subscriber('/atlas/joint_commands', JointCommands, self._on_command,
+                         queue_size=100)
+
+    def _on_clock(self, msg: Clock) -> None:
+        with self.lock:
+            self.clock_s = msg.clock.to_sec()
+
+    def _on_odom(self, msg: Odometry) -> None:
+        with self.lock:
+            self.z_m = msg.pose.pose.position.z
+            self.min_z_m = min(self.min_z_m, self.z_m)
+
+    def _on_command(self, _msg: JointCommands) -> None:
+        with self.lock:
+            self.command_arrivals_s.append(self.clock_s)
+
+    def wait_for(self, condition, timeout_s: float, what: str) -> None:
+        deadline = time.monotonic() + timeout_s
+        while True:
+            with self.lock:
+                if condition(self):
+                    return
+            if time.monotonic() > deadline:
+                raise TimeoutError(f'{what}: not reached within {timeout_s:g} s')
+            time.sleep(0.01)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument('bag')
+    parser.add_argument('--play-at', type=float, required=True, help='sim s to start playing')
+    parser.add_argument('--fallen-below', type=float, required=True, help='m')
+    parser.add_argument('--fall-window', type=float, required=True,
+                        help='sim s watched after the last played command')
+    parser.add_argument('--timeout', type=float, required=True, help='wall s per wait')
+    args = parser.parse_args()
+    rospy.init_node('replay_live_probe', anonymous=True)
+    probe = Probe()
+    result: dict[str, object] = {}
+    try:
+        probe.wait_for(lambda p: p.clock_s >= args.play_at and p.z_m is not None,
+                       args.timeout, 'simulator start')
+        result['z_before_m'] = probe.z_m
+        play = subprocess.run(
+            ['rosbag', 'play', '--quiet', '--wait-for-subscribers', args.bag,
+             '--topics', '/atlas/control_mode', '/atlas/joint_commands'],
+            capture_output=True, text=True, timeout=args.timeout, check=False)
+        result['play_returncode'] = play.returncode
+        result['play_output'] = play.stdout + play.stderr
+        with probe.lock:
+            played_until_s = probe.clock_s
+        probe.wait_for(lambda p: p.min_z_m < args.fallen_below
+                       or p.clock_s > played_until_s + args.fall_window,
+                       args.timeout, 'fall watch')
+    except (TimeoutError, subprocess.TimeoutExpired) as err:
+        result['error'] = str(err)
+    with probe.lock:
+        result['arrivals_s'] = list(probe.command_arrivals_s)
+        result['min_z_m'] = probe.min_z_m
+    print(json.dumps(result), flush=True)
+    rospy.signal_shutdown('done')
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
