@@ -110,3 +110,15 @@ def test_a_capture_point_ahead_moves_the_pressure_centre_further_ahead(
         reach = state.support_polygon[:, 0].max() - controller.gains.cop_margin_m
         assert cop[0] <= reach + 1e-9
         assert bool(cop[0] == pytest.approx(reach, abs=1e-4)) is beyond
+
+
+def test_the_polygon_is_kept_while_the_feet_stay_and_redone_when_they_move(
+        atlas: atlas_model.AtlasModel, placed: mujoco.MjData) -> None:
+    estimator = BalanceEstimator(atlas)
+    first = estimator.estimate(placed.qpos, placed.qvel).support_polygon
+    assert estimator.estimate(placed.qpos, placed.qvel).support_polygon is first
+    moved = placed.qpos.copy()
+    moved[0] += 0.01  # the whole robot 1 cm forward
+    again = estimator.estimate(moved, placed.qvel).support_polygon
+    assert again is not first
+    np.testing.assert_allclose(again, first + [0.01, 0.0])

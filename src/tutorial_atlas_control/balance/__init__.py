@@ -17,5 +17,5 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'push_trial': ['Push', 'TrialResult', 'push_survived', 'stand_trial'],
     'stand': ['StandController', 'StandGains', 'StandOutput', 'StandReference'],
     'stand_pose': ['STAND_POSE_RAD', 'place_in_stand_pose', 'sole_corners'],
-    'support': ['clamp_into', 'convex_hull', 'inside', 'shrink', 'signed_distance'],
+    'support': ['Region', 'clamp_into', 'convex_hull', 'inside', 'shrink', 'signed_distance'],
 })

@@ -4,9 +4,10 @@ The feet's contact wrenches (ground on foot, at each sole centre, [f (3), m (3)]
 right) must sum to the desired force F and moment M about the centre of mass. The moment
 about the axis between the feet is made by shifting vertical load from one foot to the
 other, as far as MIN_LOAD_SHARE left on the lighter foot (an unloaded foot would slide or
-lift and land elsewhere): each foot takes the same share of F as of the vertical load. What moment remains goes to the ankles in the same shares. Then each
-foot's share is made feasible: no pull (f_z >= 0) and the pressure centre inside the sole
-(|m_x| <= f_z w/2, |m_y| <= f_z l/2 in the sole's frame); friction is not modelled.
+lift and land elsewhere): each foot takes the same share of F as of the vertical load.
+What moment remains goes to the ankles in the same shares. Then each foot's share is made
+feasible: no pull (f_z >= 0) and the pressure centre inside the sole (|m_x| <= f_z w/2,
+|m_y| <= f_z l/2 in the sole's frame); friction is not modelled.
 In plain floats: this runs every 1 ms step.
 """
 

@@ -20,6 +20,8 @@ from tutorial_atlas_control.sim import model as atlas_model
 
 #: A sole whose lowest corner is within this of the ground (m) carries weight.
 CONTACT_HEIGHT_M = 0.01
+#: The support polygon is recomputed once a sole corner has moved this far (m).
+POLYGON_TOLERANCE_M = 5e-4
 #: The pendulum's height is taken as at least this (m), so omega stays finite in a fall.
 MIN_COM_HEIGHT_M = 0.05
 
@@ -63,6 +65,23 @@ class BalanceEstimator:
         signs = np.array([[1, 1, -1], [1, -1, -1], [-1, -1, -1], [-1, 1, -1]], dtype=np.float64)
         self._corner_offsets = np.array([signs * self.model.geom_size[g] for g in self._soles])
         self._half_thickness = self.model.geom_size[self._soles, 2][:, None]
+        self._last_polygon: tuple[tuple[bool, bool], np.ndarray, np.ndarray] | None = None
+
+    def _support_polygon(self, corners: np.ndarray, contact: tuple[bool, bool]) -> np.ndarray:
+        """The hull of the touching soles' corners; the same array as last time while the
+        contacts are the same and no corner moved POLYGON_TOLERANCE_M (standing feet do not
+        move: the hull is not recomputed every step, and the controller can cache on it)."""
+        corners_xy = corners[:, :, 0:2]
+        last = self._last_polygon
+        if (last is not None and last[0] == contact
+                and float(np.max(np.abs(corners_xy - last[1]))) < POLYGON_TOLERANCE_M):
+            return last[2]
+        touching = [foot for foot in (0, 1) if contact[foot]]
+        polygon = (support.convex_hull(corners_xy[touching].reshape(-1, 2)) if touching
+                   else np.zeros((0, 2)))
+        polygon.setflags(write=False)
+        self._last_polygon = (contact, corners_xy.copy(), polygon)
+        return polygon
 
     def estimate(self, qpos: np.ndarray, qvel: np.ndarray) -> BalanceState:
         """The state at (qpos, qvel) (the full MuJoCo vectors)."""
@@ -85,9 +104,7 @@ class BalanceEstimator:
                           self._sole_bodies[foot])
         lowest = corners[:, :, 2].min(axis=1).tolist()
         contact = (lowest[0] < CONTACT_HEIGHT_M, lowest[1] < CONTACT_HEIGHT_M)
-        touching = [foot for foot in (0, 1) if contact[foot]]
-        polygon = (support.convex_hull(corners[touching, :, 0:2].reshape(-1, 2)) if touching
-                   else np.zeros((0, 2)))
+        polygon = self._support_polygon(corners, contact)
         com = d.subtree_com[0].copy()
         com_velocity = d.subtree_linvel[0].copy()
         omega = lipm.natural_frequency(max(float(com[2]), MIN_COM_HEIGHT_M))

@@ -118,14 +118,19 @@ class StandController:
         self.reference = reference
         self.sole_half_size_m = sole_half_size_m
         self.gains = gains or StandGains()
+        self._region: tuple[np.ndarray, support.Region] | None = None
 
     def desired_cop(self, state: BalanceState) -> np.ndarray:
         """The capture-point law's pressure centre, inside the support polygon."""
         cop = lipm.dcm_feedback_cop(state.capture_point, self.reference.capture_point,
                                     self.gains.capture_gain)
-        if len(state.support_polygon) < 3:
+        polygon = state.support_polygon
+        if len(polygon) < 3:
             return cop
-        return support.clamp_into(state.support_polygon, cop, self.gains.cop_margin_m)
+        if self._region is None or self._region[0] is not polygon:
+            # The estimator hands over the same polygon while the feet stay put.
+            self._region = (polygon, support.Region(polygon, self.gains.cop_margin_m))
+        return self._region[1].clamp(cop)
 
     def centroidal_wrench(self, state: BalanceState,
                           cop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -90,21 +90,33 @@ def shrink(polygon: np.ndarray, margin_m: float) -> np.ndarray:
     return np.array(_shrunk(np.asarray(polygon).tolist(), margin_m), dtype=np.float64)
 
 
+class Region:
+    """A convex polygon shrunk by a margin, prepared once for clamping points into it."""
+
+    def __init__(self, polygon: np.ndarray, margin_m: float = 0.0) -> None:
+        self.vertices = _shrunk(np.asarray(polygon).tolist(), margin_m)
+        self._lines = _inward_lines(self.vertices) if len(self.vertices) >= 3 else []
+
+    def clamp(self, point_xy: np.ndarray) -> np.ndarray:
+        """`point_xy` if it is inside, else the region's nearest point."""
+        x, y = (float(v) for v in point_xy)
+        vertices = self.vertices
+        if len(vertices) < 3:
+            return np.array(vertices[0])
+        if _distance(self._lines, x, y) >= 0.0:
+            return np.array([x, y])
+        best, best_d2 = (x, y), math.inf
+        for (ax, ay), (bx, by) in zip(vertices, vertices[1:] + vertices[:1]):
+            ex, ey = bx - ax, by - ay
+            t = min(max(((x - ax) * ex + (y - ay) * ey) / (ex * ex + ey * ey), 0.0), 1.0)
+            px, py = ax + t * ex, ay + t * ey
+            d2 = (px - x) ** 2 + (py - y) ** 2
+            if d2 < best_d2:
+                best, best_d2 = (px, py), d2
+        return np.array(best)
+
+
 def clamp_into(polygon: np.ndarray, point_xy: np.ndarray, margin_m: float = 0.0) -> np.ndarray:
     """`point_xy` if it is inside the convex `polygon` shrunk by `margin_m`, else the
     nearest point of that shrunk polygon."""
-    x, y = (float(v) for v in point_xy)
-    shrunk = _shrunk(np.asarray(polygon).tolist(), margin_m)
-    if len(shrunk) < 3:
-        return np.array(shrunk[0])
-    if _distance(_inward_lines(shrunk), x, y) >= 0.0:
-        return np.array([x, y])
-    best, best_d2 = (x, y), math.inf
-    for (ax, ay), (bx, by) in zip(shrunk, shrunk[1:] + shrunk[:1]):
-        ex, ey = bx - ax, by - ay
-        t = min(max(((x - ax) * ex + (y - ay) * ey) / (ex * ex + ey * ey), 0.0), 1.0)
-        px, py = ax + t * ex, ay + t * ey
-        d2 = (px - x) ** 2 + (py - y) ** 2
-        if d2 < best_d2:
-            best, best_d2 = (px, py), d2
-    return np.array(best)
+    return Region(polygon, margin_m).clamp(point_xy)
