@@ -1,7 +1,7 @@
 """Stand balances, offline and deterministic: ten seconds in DRCSim's Stand pose, and
 0.2 s pelvis pushes (the /atlas/apply_pelvis_force input) forward, backward and sideways
 survived without a step. The figures are the largest impulses found in 5 N s steps (see
-docs/BALANCE.md); the planted defect (no capture-point correction) falls at the same pushes.
+docs/controllers.md); the planted defect (no capture-point correction) falls at the same pushes.
 
 About 1 s of CPU per simulated second: ~50 s in all.
 """
@@ -56,3 +56,10 @@ def test_without_capture_point_correction_the_same_push_is_not_survived(
     then stops but never returns."""
     unit, impulse = SURVIVED[direction]
     assert not push_survived(unit, impulse, StandGains(capture_gain=0.0)).stood
+
+
+def test_a_trial_is_deterministic() -> None:
+    """Offline runs replay: the same push gives the same motion, to the bit."""
+    first, second = (push_survived((0.0, 1.0), 30.0) for _ in range(2))
+    assert (first.lowest_pelvis_m, first.foot_travel_m, first.steps) == (
+        second.lowest_pelvis_m, second.foot_travel_m, second.steps)
