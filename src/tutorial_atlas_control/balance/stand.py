@@ -107,7 +107,8 @@ class StandOutput:
 
 
 class StandController:
-    """Capture-point balance on both feet; pure given the state (no memory between steps)."""
+    """Capture-point balance on both feet. Each step's torque depends on that step's state
+    alone; the only thing kept is the support region prepared for the estimator's polygon."""
 
     def __init__(self, mass_kg: float, effort_limit_nm: np.ndarray, reference: StandReference,
                  sole_half_size_m: tuple[float, float],
