@@ -65,22 +65,31 @@ class BalanceEstimator:
         signs = np.array([[1, 1, -1], [1, -1, -1], [-1, -1, -1], [-1, 1, -1]], dtype=np.float64)
         self._corner_offsets = np.array([signs * self.model.geom_size[g] for g in self._soles])
         self._half_thickness = self.model.geom_size[self._soles, 2][:, None]
-        self._last_polygon: tuple[tuple[bool, bool], np.ndarray, np.ndarray] | None = None
+        # The two soles are the same box.
+        self._half_size = self.model.geom_size[self._soles[0]].copy()
+        # A sole turned this much (rotation matrix entries) moves a corner the tolerance.
+        self._rotation_tolerance = POLYGON_TOLERANCE_M / float(np.linalg.norm(self._half_size))
+        self._last_polygon: (tuple[tuple[bool, bool], np.ndarray, np.ndarray, np.ndarray]
+                             | None) = None
 
-    def _support_polygon(self, corners: np.ndarray, contact: tuple[bool, bool]) -> np.ndarray:
+    def _support_polygon(self, positions: np.ndarray, rotations: np.ndarray,
+                         contact: tuple[bool, bool]) -> np.ndarray:
         """The hull of the touching soles' corners; the same array as last time while the
-        contacts are the same and no corner moved POLYGON_TOLERANCE_M (standing feet do not
-        move: the hull is not recomputed every step, and the controller can cache on it)."""
-        corners_xy = corners[:, :, 0:2]
+        contacts are the same and no sole moved POLYGON_TOLERANCE_M at its corners
+        (standing feet do not move: the hull is not recomputed every step, and the
+        controller can cache on it). `positions`, `rotations`: the sole boxes' poses."""
         last = self._last_polygon
         if (last is not None and last[0] == contact
-                and float(np.max(np.abs(corners_xy - last[1]))) < POLYGON_TOLERANCE_M):
-            return last[2]
+                and float(np.max(np.abs(positions - last[1]))) < POLYGON_TOLERANCE_M
+                and float(np.max(np.abs(rotations - last[2]))) < self._rotation_tolerance):
+            return last[3]
+        corners = positions[:, None, 0:2] + np.einsum(
+            'fcj,fij->fci', self._corner_offsets, rotations)[:, :, 0:2]
         touching = [foot for foot in (0, 1) if contact[foot]]
-        polygon = (support.convex_hull(corners_xy[touching].reshape(-1, 2)) if touching
+        polygon = (support.convex_hull(corners[touching].reshape(-1, 2)) if touching
                    else np.zeros((0, 2)))
         polygon.setflags(write=False)
-        self._last_polygon = (contact, corners_xy.copy(), polygon)
+        self._last_polygon = (contact, positions, rotations, polygon)
         return polygon
 
     def estimate(self, qpos: np.ndarray, qvel: np.ndarray) -> BalanceState:
@@ -93,18 +102,18 @@ class BalanceEstimator:
         mujoco.mj_comVel(m, d)
         mujoco.mj_subtreeVel(m, d)
         mujoco.mj_rne(m, d, 0, self._bias)
+        positions = d.geom_xpos[self._soles]
         rotations = d.geom_xmat[self._soles].reshape(2, 3, 3)
-        # Sole corners (2, 4, 3) and bottom-face centres (2, 3), world.
-        corners = d.geom_xpos[self._soles][:, None, :] + np.einsum(
-            'fcj,fij->fci', self._corner_offsets, rotations)
-        centres = d.geom_xpos[self._soles] - rotations[:, :, 2] * self._half_thickness
+        # Bottom-face centres (2, 3), world; a box's lowest corner is sum_j |R_zj| h_j
+        # below its centre.
+        centres = positions - rotations[:, :, 2] * self._half_thickness
+        lowest = (positions[:, 2] - np.abs(rotations[:, 2, :]) @ self._half_size).tolist()
         jac = self._jac
         for foot in (0, 1):
             mujoco.mj_jac(m, d, jac[foot, 0:3], jac[foot, 3:6], centres[foot],
                           self._sole_bodies[foot])
-        lowest = corners[:, :, 2].min(axis=1).tolist()
         contact = (lowest[0] < CONTACT_HEIGHT_M, lowest[1] < CONTACT_HEIGHT_M)
-        polygon = self._support_polygon(corners, contact)
+        polygon = self._support_polygon(positions, rotations, contact)
         com = d.subtree_com[0].copy()
         com_velocity = d.subtree_linvel[0].copy()
         omega = lipm.natural_frequency(max(float(com[2]), MIN_COM_HEIGHT_M))
