@@ -60,6 +60,21 @@ ATLAS_MSGS_MD5 = {
     'Test': '62f63cd4b6db15007d8d3d4a23411c4c',
     'ControllerStatistics': '628a0c6643f9fd5708402f085735e478',
     'SynchronizationStatistics': '27bc1701ef8ff889822573f985ebb2b6',
+    # The AtlasSimInterface set (2.6.0 = 2.7.0; ../shared/reference/drcsim_2.x/ASI.md).
+    'AtlasSimInterfaceCommand': 'afd78cf894b94df9f3ad71fa0e37286b',
+    'AtlasSimInterfaceState': 'cac8848356ecf29db9175b861bbf8e75',
+    'AtlasBehaviorFeedback': 'f7b1da61a8fcdd81f1e8d9a700d9d2bd',
+    'AtlasBehaviorStepFeedback': 'cff2fc0e568e03f6269567166d997b7c',
+    'AtlasBehaviorStandFeedback': 'db5aeaf3d00b862980dcbc6b5cfc70fc',
+    'AtlasBehaviorWalkFeedback': '4bd389e051b01f8e9b15c23ca6b58e8b',
+    'AtlasBehaviorManipulateFeedback': '81c353ff9e8def49f995ee851f13f670',
+    'AtlasBehaviorStepData': 'd310ca2045a49be1648d8958f198af57',
+    'AtlasBehaviorStepParams': 'fea683aa80fed08d9ec89dd950667373',
+    'AtlasBehaviorWalkParams': '0a5b4bccbb6f87ef4f591430c3499c4f',
+    'AtlasBehaviorStandParams': '569a10f839b2e1ce334950a722d388b4',
+    'AtlasBehaviorManipulateParams': 'c4e967ec87266f9e108243e7ac4b9614',
+    'AtlasBehaviorPelvisServoParams': '82f59d8aa26e61afaf2c8dbb7b4e7856',
+    'AtlasPositionData': '589dbd8c358d253de2ab5441acd36a2b',
 }
 
 

@@ -7,6 +7,7 @@ from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'atlas_command': ['AtlasUpdate', 'decode_atlas_command', 'decode_test'],
+    'atlas_sim_interface': ['AsiCommand', 'decode_asi_command', 'encode_asi_command'],
     'joint_commands': ['CommandDecoder'],
     'ros1_fields': ['FieldCursor', 'parse_names_arrays'],
     'wire': ['AtlasStateWire', 'ControllerStatisticsWire', 'ForceTorqueSensorsWire', 'ImuWire',

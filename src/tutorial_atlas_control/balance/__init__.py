@@ -1,0 +1,21 @@
+"""Whole-body balance without ROS, the ground the AtlasSimInterface behaviours stand on.
+
+lipm: the linear inverted pendulum and its capture point; support: the support polygon
+and keeping a pressure centre in it; contact_wrench: a wrench shared between the feet;
+stand_pose: DRCSim's Stand pose; estimator: the balance state from the model; stand: the
+Stand controller (capture-point feedback, inverse statics, joint PD); push_trial: offline
+trials of it on the simulator, standing and pushed.
+"""
+
+from tutorial_atlas_control.exports import lazy_exports
+
+__all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    'contact_wrench': ['make_feasible', 'split_wrench'],
+    'estimator': ['BalanceEstimator', 'BalanceState'],
+    'lipm': ['capture_point', 'com_acceleration', 'dcm_feedback_cop', 'lipm_state',
+             'natural_frequency'],
+    'push_trial': ['Push', 'TrialResult', 'push_survived', 'stand_trial'],
+    'stand': ['StandController', 'StandGains', 'StandOutput', 'StandReference'],
+    'stand_pose': ['STAND_POSE_RAD', 'place_in_stand_pose', 'sole_corners'],
+    'support': ['Region', 'clamp_into', 'convex_hull', 'inside', 'shrink', 'signed_distance'],
+})

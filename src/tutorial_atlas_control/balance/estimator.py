@@ -1,0 +1,130 @@
+"""What the balance needs to know, computed from the simulator's own state.
+
+The simulator knows its state exactly (no sensor noise), so the estimate is the model's
+kinematics at the current joint positions and velocities, computed in a scratch MjData:
+the stepping loop's MjData is not touched (after mj_step its body poses are those of the
+step's start). One `estimate` call runs kinematics, centre-of-mass and velocity passes and
+the bias forces (gravity and Coriolis) once.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from tutorial_atlas_control.balance import lipm, support
+from tutorial_atlas_control.balance.stand_pose import SOLE_GEOMS
+from tutorial_atlas_control.sim import model as atlas_model
+
+#: A sole whose lowest corner is within this of the ground (m) carries weight.
+CONTACT_HEIGHT_M = 0.01
+#: The support polygon is recomputed once a sole corner has moved this far (m).
+POLYGON_TOLERANCE_M = 5e-4
+#: The pendulum's height is taken as at least this (m), so omega stays finite in a fall.
+MIN_COM_HEIGHT_M = 0.05
+
+
+@dataclass(frozen=True)
+class BalanceState:
+    """The robot's balance-relevant state, world frame (m, m/s, rad/s)."""
+
+    com: np.ndarray               # (3,) centre of mass
+    com_velocity: np.ndarray      # (3,)
+    pelvis_position: np.ndarray   # (3,)
+    pelvis_rotation: np.ndarray   # (3, 3) pelvis frame to world
+    pelvis_velocity: np.ndarray   # (3,) linear, world
+    pelvis_angular_velocity: np.ndarray  # (3,) world
+    sole_centres: np.ndarray      # (2, 3) left, right: the middle of each sole's bottom face
+    sole_rotations: np.ndarray    # (2, 3, 3)
+    in_contact: tuple[bool, bool]
+    support_polygon: np.ndarray   # (k, 2) convex hull of the soles in contact (ccw)
+    omega: float                  # the LIPM's natural frequency at this CoM height (1/s)
+    capture_point: np.ndarray     # (2,)
+    bias_nm: np.ndarray           # (28,) joint part of qfrc_bias (gravity + Coriolis)
+    sole_jacobians: np.ndarray    # (2, 6, 28) [linear; angular] at each sole centre, joints
+
+
+class BalanceEstimator:
+    """Turns (qpos, qvel) into a BalanceState with a scratch MjData of its own."""
+
+    def __init__(self, atlas: atlas_model.AtlasModel) -> None:
+        self.atlas = atlas
+        self.model = atlas.model
+        self.scratch = mujoco.MjData(self.model)
+        self.mass_kg = float(self.model.body_subtreemass[0])
+        self._soles = [mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_GEOM, name)
+                       for name in SOLE_GEOMS]
+        self._sole_bodies = [int(self.model.geom_bodyid[g]) for g in self._soles]
+        self._pelvis = atlas.pelvis_body_id
+        self._jac = np.zeros((2, 6, self.model.nv))  # [linear; angular] per sole
+        self._dof_adr = atlas.dof_adr
+        self._bias = np.zeros(self.model.nv)
+        self._free_dof = int(self.model.jnt_dofadr[self.model.body_jntadr[self._pelvis]])
+        signs = np.array([[1, 1, -1], [1, -1, -1], [-1, -1, -1], [-1, 1, -1]], dtype=np.float64)
+        self._corner_offsets = np.array([signs * self.model.geom_size[g] for g in self._soles])
+        self._half_thickness = self.model.geom_size[self._soles, 2][:, None]
+        # The two soles are the same box.
+        self._half_size = self.model.geom_size[self._soles[0]].copy()
+        # A sole turned this much (rotation matrix entries) moves a corner the tolerance.
+        self._rotation_tolerance = POLYGON_TOLERANCE_M / float(np.linalg.norm(self._half_size))
+        self._last_polygon: (tuple[tuple[bool, bool], np.ndarray, np.ndarray, np.ndarray]
+                             | None) = None
+
+    def _support_polygon(self, positions: np.ndarray, rotations: np.ndarray,
+                         contact: tuple[bool, bool]) -> np.ndarray:
+        """The hull of the touching soles' corners; the same array as last time while the
+        contacts are the same and no sole moved POLYGON_TOLERANCE_M at its corners
+        (standing feet do not move: the hull is not recomputed every step, and the
+        controller can cache on it). `positions`, `rotations`: the sole boxes' poses."""
+        last = self._last_polygon
+        if (last is not None and last[0] == contact
+                and float(np.max(np.abs(positions - last[1]))) < POLYGON_TOLERANCE_M
+                and float(np.max(np.abs(rotations - last[2]))) < self._rotation_tolerance):
+            return last[3]
+        corners = positions[:, None, 0:2] + np.einsum(
+            'fcj,fij->fci', self._corner_offsets, rotations)[:, :, 0:2]
+        touching = [foot for foot in (0, 1) if contact[foot]]
+        polygon = (support.convex_hull(corners[touching].reshape(-1, 2)) if touching
+                   else np.zeros((0, 2)))
+        polygon.setflags(write=False)
+        self._last_polygon = (contact, positions, rotations, polygon)
+        return polygon
+
+    def estimate(self, qpos: np.ndarray, qvel: np.ndarray) -> BalanceState:
+        """The state at (qpos, qvel) (the full MuJoCo vectors)."""
+        m, d = self.model, self.scratch
+        d.qpos[:] = qpos
+        d.qvel[:] = qvel
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
+        mujoco.mj_comVel(m, d)
+        mujoco.mj_subtreeVel(m, d)
+        mujoco.mj_rne(m, d, 0, self._bias)
+        positions = d.geom_xpos[self._soles]
+        rotations = d.geom_xmat[self._soles].reshape(2, 3, 3)
+        # Bottom-face centres (2, 3), world; a box's lowest corner is sum_j |R_zj| h_j
+        # below its centre.
+        centres = positions - rotations[:, :, 2] * self._half_thickness
+        lowest = (positions[:, 2] - np.abs(rotations[:, 2, :]) @ self._half_size).tolist()
+        jac = self._jac
+        for foot in (0, 1):
+            mujoco.mj_jac(m, d, jac[foot, 0:3], jac[foot, 3:6], centres[foot],
+                          self._sole_bodies[foot])
+        contact = (lowest[0] < CONTACT_HEIGHT_M, lowest[1] < CONTACT_HEIGHT_M)
+        polygon = self._support_polygon(positions, rotations, contact)
+        com = d.subtree_com[0].copy()
+        com_velocity = d.subtree_linvel[0].copy()
+        omega = lipm.natural_frequency(max(float(com[2]), MIN_COM_HEIGHT_M))
+        free = self._free_dof
+        pelvis_rotation = d.xmat[self._pelvis].reshape(3, 3).copy()
+        return BalanceState(
+            com=com, com_velocity=com_velocity,
+            pelvis_position=d.xpos[self._pelvis].copy(), pelvis_rotation=pelvis_rotation,
+            pelvis_velocity=d.qvel[free:free + 3].copy(),
+            pelvis_angular_velocity=pelvis_rotation @ d.qvel[free + 3:free + 6],
+            sole_centres=centres, sole_rotations=rotations, in_contact=contact,
+            support_polygon=polygon, omega=omega,
+            capture_point=lipm.capture_point(com[:2], com_velocity[:2], omega),
+            bias_nm=self._bias[self._dof_adr], sole_jacobians=jac[:, :, self._dof_adr])

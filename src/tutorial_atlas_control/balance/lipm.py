@@ -1,0 +1,58 @@
+"""The linear inverted pendulum (LIPM) and its divergent component, the capture point.
+
+With the centre of mass c at constant height z over a flat ground and the centre of
+pressure p, the horizontal dynamics are c'' = omega^2 (c - p), omega = sqrt(g / z). The
+capture point (divergent component of motion, DCM) xi = c + c' / omega obeys
+xi' = omega (xi - p): it runs away from the centre of pressure, and the robot can stop
+without stepping exactly when the centre of pressure can be put on it, i.e. when xi is
+inside the support polygon. These are the textbook formulas (Pratt 2006, Englsberger 2011).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+#: Standard gravity (m/s^2), the model's |gravity|.
+GRAVITY_M_S2 = 9.81
+
+
+def natural_frequency(com_height_m: float, gravity_m_s2: float = GRAVITY_M_S2) -> float:
+    """omega = sqrt(g / z) (1/s) of a pendulum whose centre of mass is `com_height_m` up."""
+    if not com_height_m > 0.0:
+        raise ValueError(f'centre-of-mass height {com_height_m} m must be above the ground')
+    return math.sqrt(gravity_m_s2 / com_height_m)
+
+
+def capture_point(com_xy: np.ndarray, com_velocity_xy: np.ndarray, omega: float) -> np.ndarray:
+    """xi = c + c' / omega (m): where the centre of pressure must be to come to rest."""
+    return np.asarray(com_xy) + np.asarray(com_velocity_xy) / omega
+
+
+def lipm_state(com0: np.ndarray, velocity0: np.ndarray, cop: np.ndarray, omega: float,
+               t_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """The LIPM's exact (c, c') after `t_s` with the centre of pressure held at `cop`.
+
+    c(t) - p = (c0 - p) cosh(wt) + c0'/w sinh(wt); the reference for the tests.
+    """
+    offset = np.asarray(com0) - np.asarray(cop)
+    wt = omega * t_s
+    com = cop + offset * math.cosh(wt) + np.asarray(velocity0) / omega * math.sinh(wt)
+    velocity = offset * omega * math.sinh(wt) + np.asarray(velocity0) * math.cosh(wt)
+    return com, velocity
+
+
+def dcm_feedback_cop(xi: np.ndarray, xi_ref: np.ndarray, gain: float) -> np.ndarray:
+    """The centre of pressure that makes the capture point converge to `xi_ref`.
+
+    p = xi + gain (xi - xi_ref) gives xi' = -omega gain (xi - xi_ref): with gain > 0 the
+    error decays at rate omega * gain; with gain 0 the pressure centre sits on the
+    capture point and the capture point merely stops (no correction back).
+    """
+    return np.asarray(xi) + gain * (np.asarray(xi) - np.asarray(xi_ref))
+
+
+def com_acceleration(com_xy: np.ndarray, cop_xy: np.ndarray, omega: float) -> np.ndarray:
+    """c'' = omega^2 (c - p) (m/s^2): what a centre of pressure at `cop_xy` does."""
+    return omega * omega * (np.asarray(com_xy) - np.asarray(cop_xy))

@@ -1,0 +1,106 @@
+"""Offline trials of the Stand controller on the simulator: stand, get pushed, and say
+whether the robot stayed up without a step. Deterministic (the simulator is), so tests
+assert exact outcomes and the bench can search the largest push survived.
+
+The controller drives AtlasSimulator directly (its torque passed to step(), as offline
+replay passes recorded torques); pushes are the simulator's /atlas/apply_pelvis_force
+input (a force on the pelvis, held from one input to the next).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from tutorial_atlas_control.balance.estimator import BalanceEstimator
+from tutorial_atlas_control.balance.stand import StandController, StandGains, StandReference
+from tutorial_atlas_control.balance.stand_pose import place_in_stand_pose
+from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, load_gains_yaml
+from tutorial_atlas_control.sim.simulator import AtlasSimulator
+from tutorial_atlas_control.sim.vrc import VrcMode, wrench_input
+
+#: Sole box half sizes of sim/atlas_v1.xml (m): 0.26 x 0.125 m soles.
+SOLE_HALF_SIZE_M = (0.13, 0.0624435)
+#: The pushes of the robustness figures last this long (s), as the issue's bench does.
+PUSH_DURATION_S = 0.2
+#: Standing means the pelvis above this (m); Stand holds it at about 0.91 m.
+STANDING_PELVIS_M = 0.8
+#: A sole that moved more than this (m) in the horizontal plane has stepped or slid.
+FOOT_TRAVEL_LIMIT_M = 0.02
+
+
+@dataclass(frozen=True)
+class Push:
+    """A constant force (N, world) on the pelvis from `start_s` for `duration_s`."""
+
+    start_s: float
+    force_n: tuple[float, float, float]
+    duration_s: float = PUSH_DURATION_S
+
+    @property
+    def impulse_ns(self) -> float:
+        return float(np.linalg.norm(self.force_n)) * self.duration_s
+
+
+@dataclass(frozen=True)
+class TrialResult:
+    """What became of the robot: `stood` = the pelvis stayed above STANDING_PELVIS_M and
+    neither sole moved more than FOOT_TRAVEL_LIMIT_M."""
+
+    stood: bool
+    lowest_pelvis_m: float
+    foot_travel_m: float
+    steps: int
+    controller_cpu_s: float  # process time spent estimating and controlling
+
+    @property
+    def cost_per_step_us(self) -> float:
+        return self.controller_cpu_s / max(self.steps, 1) * 1e6
+
+
+def stand_trial(duration_s: float, pushes: Sequence[Push] = (),
+                gains: StandGains | None = None) -> TrialResult:
+    """Place the robot in the Stand pose on the ground and run Stand for `duration_s`
+    (s) with `pushes`; stop early once the pelvis is below the standing height."""
+    atlas = atlas_model.load_model()
+    sim = AtlasSimulator(atlas, load_gains_yaml(DEFAULT_GAINS_FILE), time_to_unpin_s=0.0,
+                         startup_mode=VrcMode.BDI_STAND)
+    place_in_stand_pose(sim.atlas, sim.data)
+    estimator = BalanceEstimator(sim.atlas)
+    state = estimator.estimate(sim.data.qpos, sim.data.qvel)
+    feet_start = state.sole_centres[:, :2].copy()
+    controller = StandController(estimator.mass_kg, sim.atlas.effort_limit_nm,
+                                 StandReference.from_state(state), SOLE_HALF_SIZE_M, gains)
+    events = sorted([(round(p.start_s / sim.dt_s), p.force_n) for p in pushes]
+                    + [(round((p.start_s + p.duration_s) / sim.dt_s), (0.0, 0.0, 0.0))
+                       for p in pushes], key=lambda event: event[0])
+    lowest, travel, cpu_s = np.inf, 0.0, 0.0
+    steps = round(duration_s / sim.dt_s)
+    for step in range(steps):
+        while events and events[0][0] == step:
+            sim.apply_input(wrench_input(events.pop(0)[1], (0.0, 0.0, 0.0)))
+        started = time.process_time()
+        state = estimator.estimate(sim.data.qpos, sim.data.qvel)
+        torque = controller.step(state, sim.joint_positions(), sim.joint_velocities()).torque_nm
+        cpu_s += time.process_time() - started
+        sim.step(torque)
+        lowest = min(lowest, atlas_model.pelvis_height_m(sim.atlas, sim.data))
+        travel = max(travel, float(np.max(np.linalg.norm(
+            state.sole_centres[:, :2] - feet_start, axis=1))))
+        if lowest < STANDING_PELVIS_M:
+            return TrialResult(False, lowest, travel, step + 1, cpu_s)
+    return TrialResult(travel <= FOOT_TRAVEL_LIMIT_M, lowest, travel, steps, cpu_s)
+
+
+def push_survived(direction_xy: tuple[float, float], impulse_ns: float,
+                  gains: StandGains | None = None, settle_s: float = 1.0,
+                  after_s: float = 2.5) -> TrialResult:
+    """A PUSH_DURATION_S push of `impulse_ns` (N s) along the unit `direction_xy` after
+    `settle_s` of standing; the robot must still stand `after_s` later."""
+    force = impulse_ns / PUSH_DURATION_S
+    push = Push(settle_s, (force * direction_xy[0], force * direction_xy[1], 0.0))
+    return stand_trial(settle_s + PUSH_DURATION_S + after_s, [push], gains)
