@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tutorial_atlas_control.command.arrays import LAW_FIELDS
+from tutorial_atlas_control.command import LAW_FIELDS
 
 __all__ = ['LIBRARY_ENV', 'LIBRARY_NAME', 'MIRRORED_STRUCTS', 'AtlasCopy', 'AtlasLawStep',
            'address', 'find_library', 'load_library', 'size_mismatches']

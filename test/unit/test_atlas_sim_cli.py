@@ -13,7 +13,7 @@ from tutorial_atlas_control.errors import AtlasControlError
 @pytest.fixture(autouse=True)
 def no_other_simulator(monkeypatch: pytest.MonkeyPatch) -> None:
     """No master to ask: the single-instance check passes (test_single_instance.py's)."""
-    monkeypatch.setattr(atlas_sim.single_instance, 'refuse_if_running', lambda *_: False)
+    monkeypatch.setattr(atlas_sim, 'refuse_if_running', lambda *_: False)
 
 
 def test_help_prints_the_parameters_and_starts_no_node(

@@ -21,7 +21,11 @@ from support.synthetic_bags import (
     write_bag,
 )
 from tutorial_atlas_control.bags.analysis import analyze_bag
-from tutorial_atlas_control.bags.compare import compare, compare_bags, first_applied_command_s
+from tutorial_atlas_control.bags.compare import (
+    compare_analyses,
+    compare_bags,
+    first_applied_command_s,
+)
 from tutorial_atlas_control.cli.analyze_bag import main
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
@@ -155,4 +159,4 @@ def test_runs_that_share_no_time_are_refused(tmp_path: Path) -> None:
                                            joint_state(0.5, np.zeros(NUM_JOINTS))])
     analysis = analyze_bag(short)
     with pytest.raises(BagAnalysisError, match='share no time'):
-        compare(analysis, analysis)
+        compare_analyses(analysis, analysis)

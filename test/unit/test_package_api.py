@@ -4,6 +4,7 @@ modules."""
 
 from __future__ import annotations
 
+import ast
 import importlib
 import subprocess
 import sys
@@ -73,3 +74,62 @@ def test_importing_a_subpackage_imports_none_of_its_modules() -> None:
     result = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
                             timeout=60, check=True)
     assert result.stdout.strip() == '[] False'
+
+
+def through_the_package_violations(source: str, current: str) -> list[str]:
+    """What module `current` (a dotted name) imports from another subpackage without going
+    through that subpackage's __init__: a module of it (`from pkg.sim.model import x`), or a
+    name its __all__ does not offer (`from pkg.sim import model`). A ROS-side `*_node`
+    module is imported by its path (it is no part of its package's API)."""
+    own = current.split('.')[1] if current.count('.') >= 2 else None
+    found = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            modules = [(node.module, [alias.name for alias in node.names])]
+        elif isinstance(node, ast.Import):
+            modules = [(alias.name, []) for alias in node.names]
+        else:
+            continue
+        for module, names in modules:
+            parts = module.split('.')
+            if parts[0] != PACKAGE or len(parts) < 2 or parts[1] not in SUBPACKAGES:
+                continue
+            if parts[1] == own or parts[-1].endswith('_node'):
+                continue
+            if len(parts) > 2:
+                found.append(f'{current}:{node.lineno}: imports {module}, not through '
+                             f'{PACKAGE}.{parts[1]}')
+                continue
+            offered = importlib.import_module(module).__all__
+            extra = [name for name in names if name not in offered and not name.endswith('_node')]
+            if extra:
+                found.append(f'{current}:{node.lineno}: {module} does not offer {extra}')
+    return found
+
+
+def test_other_packages_import_through_the_init() -> None:
+    violations = []
+    for path in sorted(PACKAGE_DIR.rglob('*.py')):
+        relative = path.relative_to(PACKAGE_DIR.parent).with_suffix('')
+        parts = relative.parts[:-1] if relative.name == '__init__' else relative.parts
+        violations += through_the_package_violations(path.read_text(), '.'.join(parts))
+    assert not violations, 'import through the subpackage:\n' + '\n'.join(violations)
+
+
+def test_the_through_check_catches_deep_imports() -> None:
+    source = textwrap.dedent(f'''
+        from {PACKAGE}.sim import AtlasSimulator
+        from {PACKAGE}.sim.model import load_model
+        import {PACKAGE}.bags.reader
+        from {PACKAGE}.sim import model
+        from {PACKAGE}.trajectories.traj_yaml_node import main
+        from {PACKAGE}.stepping.loop import SteppingLoop
+        from {PACKAGE} import joints
+    ''')
+    found = through_the_package_violations(source, f'{PACKAGE}.stepping.example')
+    assert found == [
+        f'{PACKAGE}.stepping.example:3: imports {PACKAGE}.sim.model, not through {PACKAGE}.sim',
+        f'{PACKAGE}.stepping.example:4: imports {PACKAGE}.bags.reader, not through '
+        f'{PACKAGE}.bags',
+        f"{PACKAGE}.stepping.example:5: {PACKAGE}.sim does not offer ['model']",
+    ]

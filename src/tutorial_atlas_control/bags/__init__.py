@@ -1,8 +1,7 @@
 """Recorded runs: bag records and reading, analysis, comparison, reports, videos, run logs.
 
 No ROS: bags are read and written with rosbags. Synthetic bags for the tests are
-test/support/synthetic_bags.py. compare.compare (the submodule's name) and the two to_json
-(compare's, report's) are imported from their modules.
+test/support/synthetic_bags.py.
 """
 
 from tutorial_atlas_control.exports import lazy_exports
@@ -10,15 +9,19 @@ from tutorial_atlas_control.exports import lazy_exports
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'analysis': ['Analysis', 'COMMAND_CHANGE_RAD', 'EFFORT_LIMIT_TOLERANCE_NM', 'FALL_HEIGHT_M',
                  'MOVED_RANGE_RAD', 'analyze', 'analyze_bag', 'analyze_try'],
-    'bag_dir': ['latest_bag', 'unwritable_reason'],
-    'compare': ['compare_bags', 'first_applied_command_s', 'format_comparison',
-                'plot_comparison'],
+    'bag_dir': ['default_bag_dir', 'latest_bag', 'newest_bag', 'unwritable_reason'],
+    'compare': ['compare_analyses', 'compare_bags', 'comparison_to_json',
+                'first_applied_command_s', 'format_comparison', 'plot_comparison'],
     'feet': ['foot_displacement', 'foot_line'],
+    'overview_plot': ['WORST_JOINTS'],
     'reader': ['BagData', 'JointStateSeries', 'read_bag'],
     'records': ['open_bag'],
     'render': ['DEFAULT_FPS', 'DEFAULT_SIZE', 'check_output_path', 'parse_fps', 'parse_size',
                'render_bag_video'],
-    'report': ['format_summary', 'plot_run', 'short_summary', 'write_csv'],
+    'report': ['analysis_to_json', 'format_summary', 'plot_joints', 'plot_run', 'short_summary',
+               'write_csv'],
+    'retention': ['BagFile', 'Retention', 'RetentionError', 'bag_files', 'bags_count', 'doomed',
+                  'retention_from_env', 'size_mb', 'usage_line'],
     'rosbag1_fast': ['BlockBagWriter', 'RecordBlock', 'TopicConnection'],
     'run_log': ['PlayedTrajectory'],
     'tries': ['RESET_SIMULATION', 'RESET_WORLD', 'RUN_START', 'Try', 'find_tries', 'pick_try',

@@ -33,8 +33,8 @@ from tutorial_atlas_control.bags.run_log import PlayedTrajectory
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_INDEX
 
-__all__ = ['ALIGNED_ON', 'Comparison', 'JointDifference', 'compare', 'compare_bags',
-           'format_comparison', 'plot_comparison', 'to_json']
+__all__ = ['ALIGNED_ON', 'Comparison', 'JointDifference', 'compare_analyses', 'compare_bags',
+           'format_comparison', 'plot_comparison', 'comparison_to_json']
 
 #: What the runs are aligned on, as the output says.
 ALIGNED_ON = 'first applied joint command'
@@ -136,7 +136,7 @@ def _max_abs(values: np.ndarray) -> float | None:
     return float(np.abs(values).max()) if len(values) else None
 
 
-def compare(a: Analysis, b: Analysis, trajectory_a: PlayedTrajectory | None = None,
+def compare_analyses(a: Analysis, b: Analysis, trajectory_a: PlayedTrajectory | None = None,
             trajectory_b: PlayedTrajectory | None = None) -> Comparison:
     """Align `a` and `b` on their first applied command and measure their differences.
 
@@ -197,7 +197,7 @@ def compare_bags(path_a: Path | str, path_b: Path | str, try_a: int = -1,
     """
     a, b = analyze_try(read_bag(path_a), try_a), analyze_try(read_bag(path_b), try_b)
     played_a, played_b = a.data.played, b.data.played
-    return compare(a, b, played_a[0][1] if played_a else None,
+    return compare_analyses(a, b, played_a[0][1] if played_a else None,
                    played_b[0][1] if played_b else None)
 
 
@@ -245,7 +245,7 @@ def format_comparison(comparison: Comparison) -> str:
     return '\n'.join(lines)
 
 
-def to_json(comparison: Comparison) -> str:
+def comparison_to_json(comparison: Comparison) -> str:
     """The comparison as one strict JSON document."""
     return json.dumps(json_safe(comparison.to_dict()), indent=2, allow_nan=False)
 

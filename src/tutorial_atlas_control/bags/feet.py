@@ -51,7 +51,7 @@ def foot_displacement(data: BagData, body: str = RIGHT_FOOT_BODY) -> FootDisplac
     prepare_gl()  # before mujoco's first import: a video may be rendered afterwards
     import mujoco  # noqa: PLC0415
 
-    from tutorial_atlas_control.sim.model import (  # noqa: PLC0415 - imports mujoco
+    from tutorial_atlas_control.sim import (  # noqa: PLC0415 - imports mujoco
         body_position_in_pose,
         load_model,
     )

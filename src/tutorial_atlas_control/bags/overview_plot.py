@@ -19,7 +19,7 @@ from tutorial_atlas_control.bags.tries import window
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.fall_report import fall_when
 from tutorial_atlas_control.joints import JOINT_NAMES
-from tutorial_atlas_control.trajectories.trajectory import load_trajectory
+from tutorial_atlas_control.trajectories import load_trajectory
 
 __all__ = ['WORST_JOINTS', 'axis_shift_s', 'draw_overview', 'tracking_errors', 'waypoint_times']
 

@@ -37,7 +37,7 @@ from tutorial_atlas_control.bags.typestore import (
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.fall_report import FALL_LINE_PREFIX, LoggedFall, parse_fall_line
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES, NUM_JOINTS, bare_joint_name
-from tutorial_atlas_control.msgs.ros1_fields import FieldCursor, parse_names_arrays
+from tutorial_atlas_control.msgs import FieldCursor, parse_names_arrays
 from tutorial_atlas_control.units import NS_PER_S
 
 __all__ = [

@@ -25,12 +25,12 @@ import numpy as np
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import NUM_JOINTS, joint_index
-from tutorial_atlas_control.sim.camera import CAMERA
+from tutorial_atlas_control.sim import CAMERA
 from tutorial_atlas_control.units import finite_number
 
 if TYPE_CHECKING:  # pragma: no cover - typing only; mujoco is imported lazily
     from tutorial_atlas_control.bags.reader import BagData
-    from tutorial_atlas_control.sim.model import AtlasModel
+    from tutorial_atlas_control.sim import AtlasModel
 
 __all__ = [
     'CAMERA',
@@ -228,7 +228,7 @@ class StateRenderer:
         # After prepare_gl(): MuJoCo picks its OpenGL back-end when first imported.
         import mujoco  # noqa: PLC0415
 
-        from tutorial_atlas_control.sim.model import load_model  # noqa: PLC0415 - imports mujoco
+        from tutorial_atlas_control.sim import load_model  # noqa: PLC0415 - imports mujoco
 
         self._mujoco = mujoco
         self.atlas = atlas if atlas is not None else load_model()

@@ -26,7 +26,7 @@ from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.fall_report import fall_line, fall_when
 from tutorial_atlas_control.joints import JOINT_NAMES
 
-__all__ = ['format_summary', 'plot_joints', 'plot_run', 'to_json', 'write_csv']
+__all__ = ['analysis_to_json', 'format_summary', 'plot_joints', 'plot_run', 'write_csv']
 
 #: Most points drawn per line; longer series are decimated (plots, not analysis).
 PLOT_MAX_POINTS = 4000
@@ -215,7 +215,7 @@ def json_safe(value: Any) -> Any:
     return value
 
 
-def to_json(analysis: Analysis, extra: dict[str, Any] | None = None) -> str:
+def analysis_to_json(analysis: Analysis, extra: dict[str, Any] | None = None) -> str:
     """The analysis as one JSON object (strict JSON: no NaN), plus the keys of `extra`."""
     return json.dumps(json_safe({**analysis.to_dict(), **(extra or {})}), indent=2,
                       allow_nan=False)

@@ -11,7 +11,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from tutorial_atlas_control.trajectories.schedule import (
+from tutorial_atlas_control.trajectories import (
     TRAJECTORY_LOG_PREFIX,
     parse_trajectory_log_line,
 )

@@ -16,7 +16,7 @@ import numpy as np
 
 from tutorial_atlas_control.balance import lipm, support
 from tutorial_atlas_control.balance.stand_pose import SOLE_GEOMS
-from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.sim import AtlasModel
 
 #: A sole whose lowest corner is within this of the ground (m) carries weight.
 CONTACT_HEIGHT_M = 0.01
@@ -49,7 +49,7 @@ class BalanceState:
 class BalanceEstimator:
     """Turns (qpos, qvel) into a BalanceState with a scratch MjData of its own."""
 
-    def __init__(self, atlas: atlas_model.AtlasModel) -> None:
+    def __init__(self, atlas: AtlasModel) -> None:
         self.atlas = atlas
         self.model = atlas.model
         self.scratch = mujoco.MjData(self.model)

@@ -18,10 +18,15 @@ import numpy as np
 from tutorial_atlas_control.balance.estimator import BalanceEstimator
 from tutorial_atlas_control.balance.stand import StandController, StandGains, StandReference
 from tutorial_atlas_control.balance.stand_pose import place_in_stand_pose
-from tutorial_atlas_control.sim import model as atlas_model
-from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, load_gains_yaml
-from tutorial_atlas_control.sim.simulator import AtlasSimulator
-from tutorial_atlas_control.sim.vrc import VrcMode, wrench_input
+from tutorial_atlas_control.sim import (
+    DEFAULT_GAINS_FILE,
+    AtlasSimulator,
+    VrcMode,
+    load_gains_yaml,
+    load_model,
+    pelvis_height_m,
+    wrench_input,
+)
 
 #: Sole box half sizes of sim/atlas_v1.xml (m): 0.26 x 0.125 m soles.
 SOLE_HALF_SIZE_M = (0.13, 0.0624435)
@@ -66,7 +71,7 @@ def stand_trial(duration_s: float, pushes: Sequence[Push] = (),
                 gains: StandGains | None = None) -> TrialResult:
     """Place the robot in the Stand pose on the ground and run Stand for `duration_s`
     (s) with `pushes`; stop early once the pelvis is below the standing height."""
-    atlas = atlas_model.load_model()
+    atlas = load_model()
     sim = AtlasSimulator(atlas, load_gains_yaml(DEFAULT_GAINS_FILE), time_to_unpin_s=0.0,
                          startup_mode=VrcMode.BDI_STAND)
     place_in_stand_pose(sim.atlas, sim.data)
@@ -88,7 +93,7 @@ def stand_trial(duration_s: float, pushes: Sequence[Push] = (),
         torque = controller.step(state, sim.joint_positions(), sim.joint_velocities()).torque_nm
         cpu_s += time.process_time() - started
         sim.step(torque)
-        lowest = min(lowest, atlas_model.pelvis_height_m(sim.atlas, sim.data))
+        lowest = min(lowest, pelvis_height_m(sim.atlas, sim.data))
         travel = max(travel, float(np.max(np.linalg.norm(
             state.sole_centres[:, :2] - feet_start, axis=1))))
         if lowest < STANDING_PELVIS_M:

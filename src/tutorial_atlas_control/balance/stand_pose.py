@@ -5,7 +5,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.sim import AtlasModel, reset_to_initial
 
 #: VRCPlugin::AtlasCommandController::SetPIDStand's "StandPrep end pose --> Stand pose"
 #: (DRCSim 2.7.0), the tutorial's joint order (rad): bent knees (0.518), arms down and out.
@@ -27,7 +27,7 @@ STAND_POSE_RAD.setflags(write=False)
 SOLE_GEOMS: tuple[str, str] = ('l_foot_sole', 'r_foot_sole')
 
 
-def place_in_stand_pose(atlas: atlas_model.AtlasModel, data: mujoco.MjData,
+def place_in_stand_pose(atlas: AtlasModel, data: mujoco.MjData,
                         joint_angles_rad: np.ndarray = STAND_POSE_RAD) -> float:
     """Set the joints to `joint_angles_rad` at rest with the pelvis upright, lowered so
     that the lowest sole corner touches z = 0; returns the pelvis height (m).
@@ -35,7 +35,7 @@ def place_in_stand_pose(atlas: atlas_model.AtlasModel, data: mujoco.MjData,
     DRCSim set the joints of a pinned robot; placing it on the ground instead lets an
     offline run start balancing at once.
     """
-    atlas_model.reset_to_initial(atlas, data)
+    reset_to_initial(atlas, data)
     data.qpos[atlas.qpos_adr] = joint_angles_rad
     mujoco.mj_kinematics(atlas.model, data)
     lowest = min(float(np.min(sole_corners(atlas.model, data, name)[:, 2]))

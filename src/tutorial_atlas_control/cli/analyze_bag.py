@@ -6,35 +6,33 @@ import argparse
 import sys
 from typing import Sequence
 
-from tutorial_atlas_control.bags.analysis import (
+from tutorial_atlas_control.bags import (
     COMMAND_CHANGE_RAD,
+    DEFAULT_FPS,
+    DEFAULT_SIZE,
     EFFORT_LIMIT_TOLERANCE_NM,
     FALL_HEIGHT_M,
     MOVED_RANGE_RAD,
+    WORST_JOINTS,
     Analysis,
+    PlayedTrajectory,
+    analysis_to_json,
     analyze,
     analyze_try,
-)
-from tutorial_atlas_control.bags.compare import compare, format_comparison, plot_comparison
-from tutorial_atlas_control.bags.compare import to_json as comparison_json
-from tutorial_atlas_control.bags.overview_plot import WORST_JOINTS
-from tutorial_atlas_control.bags.reader import read_bag
-from tutorial_atlas_control.bags.render import (
-    DEFAULT_FPS,
-    DEFAULT_SIZE,
     check_output_path,
+    compare_analyses,
+    comparison_to_json,
+    format_comparison,
+    format_summary,
     parse_fps,
     parse_size,
-    render_bag_video,
-)
-from tutorial_atlas_control.bags.report import (
-    format_summary,
+    plot_comparison,
     plot_joints,
     plot_run,
-    to_json,
+    read_bag,
+    render_bag_video,
     write_csv,
 )
-from tutorial_atlas_control.bags.run_log import PlayedTrajectory
 from tutorial_atlas_control.cli.convention import (
     EXIT_INTERRUPTED,
     EXIT_REFUSED,
@@ -200,7 +198,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             check_output_path(args.video, *args.size, args.fps)
         analysis = _chosen(args.bag, args)
         played = [p for _, p in analysis.data.played]
-        print(to_json(analysis, {'trajectory': _played_dict(played)}) if args.json
+        print(analysis_to_json(analysis, {'trajectory': _played_dict(played)}) if args.json
               else format_summary(analysis, trajectory=_played_text(played)))
         if args.csv:
             for path in write_csv(analysis.data, args.csv):
@@ -236,9 +234,9 @@ def _compare(args: argparse.Namespace) -> int:
         b = analyze_try(read_bag(args.compare), -1 if args.try_b is None else args.try_b)
         played_a = [p for _, p in a.data.played]
         played_b = [p for _, p in b.data.played]
-        comparison = compare(a, b, played_a[0] if played_a else None,
+        comparison = compare_analyses(a, b, played_a[0] if played_a else None,
                              played_b[0] if played_b else None)
-        print(comparison_json(comparison) if args.json else format_comparison(comparison))
+        print(comparison_to_json(comparison) if args.json else format_comparison(comparison))
         if args.plot:
             print(f'wrote {plot_comparison(comparison, args.plot)}', file=sys.stderr)
     except AtlasControlError as err:

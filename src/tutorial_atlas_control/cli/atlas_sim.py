@@ -20,7 +20,7 @@ import rospy
 from tutorial_atlas_control.cli.convention import EXIT_REFUSED
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.launch_args import unknown_arg_lines
-from tutorial_atlas_control.node import sim_node, single_instance
+from tutorial_atlas_control.node import refuse_if_running, sim_node
 from tutorial_atlas_control.node.sim_node import NODE_NAME, build_node
 from tutorial_atlas_control.processes import PACKAGE
 from tutorial_atlas_control.resources import package_path
@@ -75,7 +75,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if any(arg in HELP_OPTIONS for arg in args[1:]):
         print(sim_node.__doc__)
         return 0
-    if single_instance.refuse_if_running(NODE_NAME, NODE_NAME, full_argv):
+    if refuse_if_running(NODE_NAME, NODE_NAME, full_argv):
         return EXIT_REFUSED
     rospy.init_node(NODE_NAME)
     reason = ShutdownReason()

@@ -15,13 +15,13 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from tutorial_atlas_control.bags.bag_dir import default_bag_dir
-from tutorial_atlas_control.bags.retention import (
+from tutorial_atlas_control.bags import (
     BagFile,
     Retention,
     RetentionError,
     bag_files,
     bags_count,
+    default_bag_dir,
     doomed,
     retention_from_env,
     size_mb,

@@ -14,7 +14,7 @@ import sys
 from collections.abc import Callable
 from typing import TypeVar
 
-from tutorial_atlas_control.bags.bag_dir import newest_bag
+from tutorial_atlas_control.bags import newest_bag
 from tutorial_atlas_control.errors import AtlasControlError
 
 _T = TypeVar('_T')

@@ -23,8 +23,8 @@ from tutorial_atlas_control.cli.convention import (
     argument_type,
     print_error,
 )
+from tutorial_atlas_control.plotting import PlotError, expand_arguments, parse_field_path
 from tutorial_atlas_control.plotting import plot_topics_node as plot_topics
-from tutorial_atlas_control.plotting.fields import PlotError, expand_arguments, parse_field_path
 
 PROG = 'plot_topics.py'
 DEFAULT_WINDOW_S = 10.0

@@ -16,7 +16,7 @@ from tutorial_atlas_control.cli.convention import (
     print_error,
 )
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.offline.replay import (
+from tutorial_atlas_control.offline import (
     DEFAULT_TOLERANCE,
     ReplayError,
     format_report,

@@ -11,7 +11,7 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from tutorial_atlas_control.bags.render import parse_size
+from tutorial_atlas_control.bags import parse_size
 from tutorial_atlas_control.cli.convention import (
     EXIT_INTERRUPTED,
     EXIT_REFUSED,
@@ -20,9 +20,8 @@ from tutorial_atlas_control.cli.convention import (
 )
 from tutorial_atlas_control.demo import demo_node as demo
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.sim.controller import load_gains_yaml
-from tutorial_atlas_control.trajectories.catalog import find_trajectory, gains_for
-from tutorial_atlas_control.trajectories.trajectory import load_trajectory
+from tutorial_atlas_control.sim import load_gains_yaml
+from tutorial_atlas_control.trajectories import find_trajectory, gains_for, load_trajectory
 
 PROG = 'run_demo.py'
 

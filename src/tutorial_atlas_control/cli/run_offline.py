@@ -9,17 +9,16 @@ from pathlib import Path
 
 import numpy as np
 
-from tutorial_atlas_control.bags.analysis import analyze_bag
-from tutorial_atlas_control.bags.report import short_summary
+from tutorial_atlas_control.bags import analyze_bag, short_summary
 from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED, EXIT_REFUSED, print_error
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.offline.player import (
+from tutorial_atlas_control.offline import (
     DEFAULT_SETTLE_S,
     DEFAULT_START_AFTER_S,
     run_offline,
 )
-from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE
-from tutorial_atlas_control.trajectories.trajectory import locate_trajectory_file
+from tutorial_atlas_control.sim import DEFAULT_GAINS_FILE
+from tutorial_atlas_control.trajectories import locate_trajectory_file
 
 PROG = 'run_offline.py'
 

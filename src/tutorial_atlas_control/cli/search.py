@@ -14,25 +14,24 @@ from tutorial_atlas_control.cli.convention import (
     whole_number,
 )
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.search.cmaes import (
+from tutorial_atlas_control.search import (
+    OBJECTIVES,
+    RunSpec,
     SearchProblem,
     SearchResult,
-    gains_yaml,
-    parse_parameter,
-    run_search,
-    trajectory_yaml,
-)
-from tutorial_atlas_control.search.objectives import OBJECTIVES, parse_objective
-from tutorial_atlas_control.search.runs import RunSpec
-from tutorial_atlas_control.search.sweep import (
     SweepEngine,
     SweepInputs,
     atomic_write,
     build_specs,
     check_output,
+    gains_yaml,
     parse_latency,
+    parse_objective,
+    parse_parameter,
+    run_search,
+    trajectory_yaml,
 )
-from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE
+from tutorial_atlas_control.sim import DEFAULT_GAINS_FILE
 
 PROG = 'search.py'
 

@@ -14,9 +14,9 @@ from pathlib import Path
 import mujoco
 
 from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED, EXIT_REFUSED
-from tutorial_atlas_control.node import single_instance
+from tutorial_atlas_control.node import refuse_if_running
+from tutorial_atlas_control.sim import UrdfError, matching_urdf
 from tutorial_atlas_control.sim import state_publisher_node as state_publisher
-from tutorial_atlas_control.sim.urdf import UrdfError, matching_urdf
 
 PROG = 'state_publisher.py'
 HELP_OPTIONS = ('-h', '--help')
@@ -31,7 +31,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         asked = bool(plain) and plain[0] in HELP_OPTIONS
         print(state_publisher.__doc__.strip(), file=sys.stdout if asked else sys.stderr)
         return 0 if asked else EXIT_REFUSED
-    if single_instance.refuse_if_running(PROG, 'robot_state_publisher', argv, full=False):
+    if refuse_if_running(PROG, 'robot_state_publisher', argv, full=False):
         return EXIT_REFUSED
     try:
         return _start(Path(plain[0]), ros_args)

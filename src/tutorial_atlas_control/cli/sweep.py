@@ -14,8 +14,8 @@ from tutorial_atlas_control.cli.convention import (
     whole_number,
 )
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.search.runs import SweepError
-from tutorial_atlas_control.search.sweep import (
+from tutorial_atlas_control.search import (
+    SweepError,
     SweepInputs,
     build_specs,
     check_output,
@@ -24,7 +24,7 @@ from tutorial_atlas_control.search.sweep import (
     run_sweep,
     write_table,
 )
-from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE
+from tutorial_atlas_control.sim import DEFAULT_GAINS_FILE
 
 PROG = 'sweep.py'
 

@@ -19,13 +19,13 @@ import rospy
 
 from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED
 from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.trajectories import load_trajectory, locate_trajectory_file
 from tutorial_atlas_control.trajectories.traj_yaml_node import (
     NODE_NAME,
     joint_commands_type,
     play,
     require_master,
 )
-from tutorial_atlas_control.trajectories.trajectory import load_trajectory, locate_trajectory_file
 
 #: The tutorial's exit status for every refusal and failure.
 EXIT_FAILED = 1

@@ -15,13 +15,16 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from tutorial_atlas_control.bags.analysis import analyze_bag
-from tutorial_atlas_control.bags.feet import foot_line
-from tutorial_atlas_control.bags.render import render_bag_video
-from tutorial_atlas_control.bags.report import plot_run, short_summary
+from tutorial_atlas_control.bags import (
+    analyze_bag,
+    foot_line,
+    plot_run,
+    render_bag_video,
+    short_summary,
+)
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.processes import AtlasLaunch
-from tutorial_atlas_control.trajectories.catalog import GainsChoice
+from tutorial_atlas_control.trajectories import GainsChoice
 
 DEFAULT_BAG_DIR = Path.home() / '.ros' / 'tutorial_atlas_control' / 'bags'
 #: Sim time to wait before switching to User: the torso is pinned for 1 s after start.

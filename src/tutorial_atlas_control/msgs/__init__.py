@@ -10,6 +10,8 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'atlas_sim_interface': ['AsiCommand', 'decode_asi_command', 'encode_asi_command'],
     'joint_commands': ['CommandDecoder'],
     'ros1_fields': ['FieldCursor', 'parse_names_arrays'],
+    'udpros': ['HEADER', 'HEADER_SIZE', 'OP_DATA0', 'OP_DATAN', 'PROTOCOL', 'UdprosError',
+               'framed_messages', 'message_blocks', 'next_message_id', 'parse_request', 'reply'],
     'wire': ['AtlasStateWire', 'ControllerStatisticsWire', 'ForceTorqueSensorsWire', 'ImuWire',
              'JointCommandsWire', 'JointStateWire', 'OdometryWire', 'StampedWire', 'TransformWire',
              'TransformsWire', 'WRENCH_FLOATS', 'WrenchStampedWire', 'clock_bytes'],

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tutorial_atlas_control.command.arrays import (
+from tutorial_atlas_control.command import (
     ALL_JOINTS,
     K_EFFORT_ROW,
     LAW_FIELDS,

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tutorial_atlas_control.command.arrays import CommandError
+from tutorial_atlas_control.command import CommandError
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.msgs.ros1_fields import FieldCursor
 from tutorial_atlas_control.units import NS_PER_S

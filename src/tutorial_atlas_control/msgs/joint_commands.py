@@ -10,7 +10,7 @@ import struct
 
 import numpy as np
 
-from tutorial_atlas_control.command.arrays import (
+from tutorial_atlas_control.command import (
     ALL_JOINTS,
     FIELD_NAMES,
     CommandError,

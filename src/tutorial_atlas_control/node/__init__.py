@@ -8,5 +8,6 @@ from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'sim_node': ['NODE_NAME', 'build_node'],
+    'single_instance': ['refuse_if_running'],
     'transport': ['WireBatch', 'subscriber_names'],
 })

@@ -15,16 +15,17 @@ from std_msgs.msg import String
 from trajectory_msgs.msg import JointTrajectory
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.sim.joint_trajectory import TrajectoryMessage, trajectory_input
-from tutorial_atlas_control.sim.simulator import AtlasSimulator
-from tutorial_atlas_control.sim.vrc import (
+from tutorial_atlas_control.sim import (
+    AtlasSimulator,
     InputError,
     ModeInput,
     SimInput,
+    TrajectoryMessage,
     cmd_vel_input,
     input_notes,
     parse_vrc_mode,
     pose_input,
+    trajectory_input,
     wrench_input,
 )
 

@@ -83,7 +83,7 @@ from std_srvs.srv import Empty, EmptyResponse
 from tf2_msgs.msg import TFMessage
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.bags.bag_dir import unwritable_reason
+from tutorial_atlas_control.bags import unwritable_reason
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.node.cheats import WARN_THROTTLE_S, subscribe_cheats
@@ -92,32 +92,37 @@ from tutorial_atlas_control.node.recorder_watch import start_recorder_watch
 from tutorial_atlas_control.node.transport import WireBatch, widen_accept_queue
 from tutorial_atlas_control.node.udpros import serve as serve_udpros
 from tutorial_atlas_control.node.viewer_window import open_viewer
-from tutorial_atlas_control.sim import model as atlas_model
-from tutorial_atlas_control.sim.controller import GainsError, gains_from_params
-from tutorial_atlas_control.sim.controller_statistics import (
+from tutorial_atlas_control.sim import (
+    DEFAULT_STARTUP_MODE,
+    DEFAULT_TIME_TO_UNPIN_S,
     DEFAULT_WINDOW_S,
+    MODEL_PATH,
+    STARTUP_MODES,
     UPDATE_RATE_PARAM,
     WINDOW_PARAM,
-    CommandAgeStatistics,
-)
-from tutorial_atlas_control.sim.link_transforms import LinkTransforms
-from tutorial_atlas_control.sim.simulator import (
-    DEFAULT_TIME_TO_UNPIN_S,
     AtlasSimulator,
+    CommandAgeStatistics,
+    GainsError,
+    LinkTransforms,
     ModeError,
-    parse_mode,
-)
-from tutorial_atlas_control.sim.urdf import UrdfError, matching_urdf, read_joints
-from tutorial_atlas_control.sim.vrc import (
-    DEFAULT_STARTUP_MODE,
-    STARTUP_MODES,
+    UrdfError,
     VrcMode,
+    gains_from_params,
+    load_model,
+    matching_urdf,
+    parse_mode,
+    read_joints,
 )
-from tutorial_atlas_control.stepping.controls import ResetControlsRequest
-from tutorial_atlas_control.stepping.loop import LoopSettings, SteppingLoop
-from tutorial_atlas_control.stepping.outputs import LoopOutputs
-from tutorial_atlas_control.stepping.publication import LINKS_TF_RATE_HZ, default_rates_hz
-from tutorial_atlas_control.stepping.synchronization import DelayBudgets, SynchronizationWindow
+from tutorial_atlas_control.stepping import (
+    LINKS_TF_RATE_HZ,
+    DelayBudgets,
+    LoopOutputs,
+    LoopSettings,
+    ResetControlsRequest,
+    SteppingLoop,
+    SynchronizationWindow,
+    default_rates_hz,
+)
 from tutorial_atlas_control.units import finite_number
 
 NODE_NAME = 'atlas_sim'
@@ -444,7 +449,7 @@ def build_node() -> SimNode:
     if tf_publisher not in TF_PUBLISHERS:
         raise AtlasControlError(f'parameter {rospy.resolve_name("~tf_publisher")} must be one '
                                 f'of {", ".join(TF_PUBLISHERS)}, got {tf_publisher!r}')
-    model_file = rospy.get_param('~model_file', str(atlas_model.MODEL_PATH))
+    model_file = rospy.get_param('~model_file', str(MODEL_PATH))
     if not isinstance(model_file, str) or not model_file:
         raise AtlasControlError(f'parameter {rospy.resolve_name("~model_file")} must be the '
                                 f'path of an MJCF file, got {model_file!r}')
@@ -452,7 +457,7 @@ def build_node() -> SimNode:
     if startup_mode not in STARTUP_MODES:
         raise AtlasControlError(f'parameter {topics.STARTUP_MODE_PARAM} must be one of '
                                 f'{", ".join(STARTUP_MODES)}, got {startup_mode!r}')
-    sim = AtlasSimulator(atlas_model.load_model(Path(model_file)), gains, time_to_unpin_s,
+    sim = AtlasSimulator(load_model(Path(model_file)), gains, time_to_unpin_s,
                          startup_mode=VrcMode(startup_mode))
     description = _tf_wanted(Path(model_file), sim)
     settings = LoopSettings(rates_hz, _float_param('~real_time_factor', 1.0),

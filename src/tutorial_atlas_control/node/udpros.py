@@ -43,7 +43,19 @@ from rospy.impl.tcpros_base import TransportTerminated
 from rospy.impl.transport import OUTBOUND, ProtocolHandler, Transport
 
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.msgs import udpros
+from tutorial_atlas_control.msgs import (
+    HEADER,
+    HEADER_SIZE,
+    OP_DATA0,
+    OP_DATAN,
+    PROTOCOL,
+    UdprosError,
+    framed_messages,
+    message_blocks,
+    next_message_id,
+)
+from tutorial_atlas_control.msgs import parse_request as parse_udpros_request
+from tutorial_atlas_control.msgs import reply as udpros_reply
 from tutorial_atlas_control.node.transport import SEND_TIMEOUT_S
 
 __all__ = ['DatagramStream', 'UdprosConnection', 'UdprosHandler', 'serve']
@@ -65,7 +77,7 @@ class DatagramStream:
         self.sock = sock
         self.connection_id = connection_id
         self.max_datagram_size = max_datagram_size
-        self.max_payload = max_datagram_size - udpros.HEADER_SIZE
+        self.max_payload = max_datagram_size - HEADER_SIZE
         self.message_id = 0
         self.datagrams_sent = 0
         self._lock = threading.Lock()
@@ -85,20 +97,20 @@ class DatagramStream:
     def sendall(self, data: bytes | bytearray) -> None:
         """Send every message in `data`; OSError (ECONNREFUSED once the subscriber's port
         is closed, a timeout) as socket.sendall raises it."""
-        header, connection_id, sock = udpros.HEADER, self.connection_id, self.sock
+        header, connection_id, sock = HEADER, self.connection_id, self.sock
         with self._lock:
-            for frame in udpros.framed_messages(data):
-                message_id = self.message_id = udpros.next_message_id(self.message_id)
+            for frame in framed_messages(data):
+                message_id = self.message_id = next_message_id(self.message_id)
                 if len(frame) <= self.max_payload:  # the usual case: one datagram
-                    sock.sendmsg((header.pack(connection_id, udpros.OP_DATA0, message_id, 1),
+                    sock.sendmsg((header.pack(connection_id, OP_DATA0, message_id, 1),
                                   frame))
                     self.datagrams_sent += 1
                     continue
-                blocks = udpros.message_blocks(frame, self.max_datagram_size)
-                sock.sendmsg((header.pack(connection_id, udpros.OP_DATA0, message_id,
+                blocks = message_blocks(frame, self.max_datagram_size)
+                sock.sendmsg((header.pack(connection_id, OP_DATA0, message_id,
                                           len(blocks)), blocks[0]))
                 for index, block in enumerate(blocks[1:], start=1):
-                    sock.sendmsg((header.pack(connection_id, udpros.OP_DATAN, message_id,
+                    sock.sendmsg((header.pack(connection_id, OP_DATAN, message_id,
                                               index), block))
                 self.datagrams_sent += len(blocks)
 
@@ -110,7 +122,7 @@ class UdprosConnection(Transport):
     subscriber's node name, as for TCPROS (getBusInfo, transport.subscriber_names).
     """
 
-    transport_type = udpros.PROTOCOL
+    transport_type = PROTOCOL
 
     def __init__(self, topic: str, caller_id: str, stream: DatagramStream,
                  remote: tuple[str, int]) -> None:
@@ -168,7 +180,7 @@ class UdprosHandler(ProtocolHandler):
             self._warn(text)
 
     def supports(self, protocol: str) -> bool:
-        return protocol == udpros.PROTOCOL
+        return protocol == PROTOCOL
 
     def get_supported(self) -> list[list[str]]:
         return []
@@ -183,8 +195,8 @@ class UdprosHandler(ProtocolHandler):
     def init_publisher(self, topic: str, protocol: list[Any]) -> tuple[int, str, list[Any]]:
         """requestTopic's answer to an offered UDPROS: connect, or say why not."""
         try:
-            request = udpros.parse_request(protocol)
-        except udpros.UdprosError as err:
+            request = parse_udpros_request(protocol)
+        except UdprosError as err:
             return self._refuse('?', topic, str(err))
         caller_id = request.header.get('callerid', '?')
         impl = get_topic_manager().get_publisher_impl(topic)
@@ -209,7 +221,7 @@ class UdprosHandler(ProtocolHandler):
         connection = UdprosConnection(topic, caller_id, stream, (request.host, request.port))
         rospy.logdebug(f'{topic}: UDPROS subscriber {caller_id} at {request.host}:'
                        f'{request.port}, {request.max_datagram_size}-byte datagrams')
-        answer = udpros.reply(rosgraph.network.get_host_name(), connection.local_endpoint[1],
+        answer = udpros_reply(rosgraph.network.get_host_name(), connection.local_endpoint[1],
                               connection_id, request.max_datagram_size, {
                                   'callerid': rospy.get_name(),
                                   'md5sum': data_class._md5sum,

@@ -13,9 +13,12 @@ import time
 import rospy
 
 from tutorial_atlas_control.node.viewer import ViewerLink, ViewerRequest, display_problem
-from tutorial_atlas_control.sim.camera import configure_viewer_camera, configure_viewer_scene
-from tutorial_atlas_control.sim.simulator import AtlasSimulator
-from tutorial_atlas_control.stepping.loop import SteppingLoop
+from tutorial_atlas_control.sim import (
+    AtlasSimulator,
+    configure_viewer_camera,
+    configure_viewer_scene,
+)
+from tutorial_atlas_control.stepping import SteppingLoop
 
 __all__ = ['VIEWER_FRAME_PERIOD_S', 'open_viewer']
 

@@ -24,33 +24,40 @@ from pathlib import Path
 import numpy as np
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.bags.rosbag1_fast import BlockBagWriter, RecordBlock, TopicConnection
-from tutorial_atlas_control.bags.typestore import (
+from tutorial_atlas_control.bags import (
     JOINT_COMMANDS_TYPE,
+    BlockBagWriter,
+    RecordBlock,
+    TopicConnection,
     load_typestore,
     rosbags_msgtype,
 )
-from tutorial_atlas_control.command.arrays import CommandError, CommandUpdate
+from tutorial_atlas_control.command import CommandError, CommandUpdate
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES
-from tutorial_atlas_control.msgs.joint_commands import CommandDecoder
-from tutorial_atlas_control.msgs.wire import JointCommandsWire, StampedWire, clock_bytes
-from tutorial_atlas_control.sim import model as atlas_model
-from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, Gains, load_gains_yaml
-from tutorial_atlas_control.sim.sim_messages import TCPROS_PREFIX_BYTES, SimMessages
-from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode, PhysicsDivergenceError
-from tutorial_atlas_control.sim.vrc import SimInput
-from tutorial_atlas_control.stepping.schedule import step_stamp, steps_between
-from tutorial_atlas_control.trajectories.schedule import (
+from tutorial_atlas_control.msgs import CommandDecoder, JointCommandsWire, StampedWire, clock_bytes
+from tutorial_atlas_control.sim import (
+    DEFAULT_GAINS_FILE,
+    MODEL_PATH,
+    TCPROS_PREFIX_BYTES,
+    AtlasSimulator,
+    ControlMode,
+    Gains,
+    PhysicsDivergenceError,
+    SimInput,
+    SimMessages,
+    load_gains_yaml,
+    load_model,
+)
+from tutorial_atlas_control.stepping import step_stamp, steps_between
+from tutorial_atlas_control.trajectories import (
+    Waypoint,
     done_line,
+    load_trajectory,
+    locate_trajectory_file,
     playing_line,
     run_trajectory,
     trajectory_log_line,
-)
-from tutorial_atlas_control.trajectories.trajectory import (
-    Waypoint,
-    load_trajectory,
-    locate_trajectory_file,
 )
 from tutorial_atlas_control.units import NS_PER_S
 
@@ -357,7 +364,7 @@ def _command_wire(gains: Gains) -> JointCommandsWire:
 
 def write_offline_bag(bag: Path, trajectory_file: str, name: str, waypoints: Sequence[Waypoint],
                       gains: Gains, settle_s: float, start_after_s: float,
-                      model_path: Path = atlas_model.MODEL_PATH,
+                      model_path: Path = MODEL_PATH,
                       play_after_s: float = 0.0,
                       on_step: StepHook | None = None,
                       latency: CommandLatency | None = None) -> OfflineRun:
@@ -367,7 +374,7 @@ def write_offline_bag(bag: Path, trajectory_file: str, name: str, waypoints: Seq
     the sweep measures a run there, and applies its pushes, without reading the bag back.
     `latency`, if given, delays each command as a live run's delivery does (CommandLatency).
     """
-    sim = AtlasSimulator(atlas_model.load_model(model_path), gains)
+    sim = AtlasSimulator(load_model(model_path), gains)
     sink = _open_bag(bag)
     # The run's time, without loading the model and the message types (fixed costs).
     started_s = time.perf_counter()
@@ -395,7 +402,7 @@ def run_offline(trajectory_file: str, name: str, bag: Path | str,
                 settle_s: float = DEFAULT_SETTLE_S,
                 start_after_s: float = DEFAULT_START_AFTER_S,
                 gains_file: Path = DEFAULT_GAINS_FILE,
-                model_path: Path = atlas_model.MODEL_PATH,
+                model_path: Path = MODEL_PATH,
                 play_after_s: float = 0.0) -> OfflineRun:
     """Run trajectory `name` of `trajectory_file` offline into the bag `bag`.
 

@@ -37,19 +37,24 @@ from typing import Any
 import numpy as np
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.bags.reader import BagData, read_bag
-from tutorial_atlas_control.bags.tries import Try, find_tries, pick_try, window
+from tutorial_atlas_control.bags import BagData, Try, find_tries, pick_try, read_bag, window
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
-from tutorial_atlas_control.sim import model as atlas_model
-from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, load_gains_yaml
-from tutorial_atlas_control.sim.sim_config import SimConfig, SimConfigError, parse_sim_config
-from tutorial_atlas_control.sim.simulator import (
+from tutorial_atlas_control.sim import (
+    DEFAULT_GAINS_FILE,
     DEFAULT_TIME_TO_UNPIN_S,
+    STARTUP_MODES,
     AtlasSimulator,
+    InputError,
+    InputEvent,
     PhysicsDivergenceError,
+    SimConfig,
+    SimConfigError,
+    VrcMode,
+    load_gains_yaml,
+    load_model,
+    parse_sim_config,
 )
-from tutorial_atlas_control.sim.vrc import STARTUP_MODES, InputError, InputEvent, VrcMode
 from tutorial_atlas_control.units import NS_PER_S
 
 __all__ = [
@@ -548,7 +553,7 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
     if config.startup_mode not in STARTUP_MODES:
         raise ReplayError(f'{SIM_CONFIG_TOPIC} startup_mode {config.startup_mode!r} is not '
                           f'one of {", ".join(STARTUP_MODES)}.')
-    sim = AtlasSimulator(atlas_model.load_model(), load_gains_yaml(gains_file),
+    sim = AtlasSimulator(load_model(), load_gains_yaml(gains_file),
                          config.time_to_unpin_s, startup_mode=VrcMode(config.startup_mode))
     sha1_matches = _check_model(config, sim, warnings)
     step_ns = sim.step_ns

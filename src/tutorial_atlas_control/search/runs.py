@@ -19,15 +19,13 @@ import numpy as np
 
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import NUM_JOINTS
-from tutorial_atlas_control.offline.player import (
+from tutorial_atlas_control.offline import (
     CommandLatency,
     OfflineRunError,
     write_offline_bag,
 )
-from tutorial_atlas_control.sim.controller import Gains
-from tutorial_atlas_control.sim.simulator import AtlasSimulator
-from tutorial_atlas_control.sim.vrc import wrench_input
-from tutorial_atlas_control.trajectories.trajectory import Waypoint
+from tutorial_atlas_control.sim import AtlasSimulator, Gains, wrench_input
+from tutorial_atlas_control.trajectories import Waypoint
 from tutorial_atlas_control.units import NS_PER_S
 
 __all__ = ['FALL_HEIGHT_M', 'Push', 'RunSpec', 'SweepError', 'TABLE_COLUMNS', 'run_one']

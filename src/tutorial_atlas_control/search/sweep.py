@@ -36,8 +36,8 @@ from tutorial_atlas_control.search.runs import (
     spec_gains,
     spec_waypoints,
 )
-from tutorial_atlas_control.sim.controller import GainsError, load_gains_yaml
-from tutorial_atlas_control.trajectories.trajectory import (
+from tutorial_atlas_control.sim import GainsError, load_gains_yaml
+from tutorial_atlas_control.trajectories import (
     TrajectoryError,
     load_trajectory,
     locate_trajectory_file,

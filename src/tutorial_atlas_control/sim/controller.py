@@ -47,7 +47,7 @@ import numpy as np
 import yaml
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.command.arrays import JointCommandArrays
+from tutorial_atlas_control.command import JointCommandArrays
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.resources import package_path

@@ -15,7 +15,7 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control import native
-from tutorial_atlas_control.command.arrays import JointCommandArrays
+from tutorial_atlas_control.command import JointCommandArrays
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.sim.controller import PidState, compute_torque
 from tutorial_atlas_control.sim.law_kernel import CompiledLaw, LawJoints

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tutorial_atlas_control.command.arrays import LAW_FIELDS, JointCommandArrays
+from tutorial_atlas_control.command import LAW_FIELDS, JointCommandArrays
 from tutorial_atlas_control.native import AtlasLawStep, address
 from tutorial_atlas_control.sim.controller import PidState
 

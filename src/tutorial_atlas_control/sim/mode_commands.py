@@ -16,7 +16,7 @@ from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
-from tutorial_atlas_control.command.arrays import (
+from tutorial_atlas_control.command import (
     LAW_FIELDS,
     CommandUpdate,
     JointCommandArrays,

@@ -17,7 +17,7 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control.joints import JOINT_NAMES
-from tutorial_atlas_control.msgs.wire import (
+from tutorial_atlas_control.msgs import (
     WRENCH_FLOATS,
     AtlasStateWire,
     ForceTorqueSensorsWire,

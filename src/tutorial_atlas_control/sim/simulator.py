@@ -18,7 +18,7 @@ from collections.abc import Mapping, Sequence
 import mujoco
 import numpy as np
 
-from tutorial_atlas_control.command.arrays import CommandUpdate, JointCommandArrays
+from tutorial_atlas_control.command import CommandUpdate, JointCommandArrays
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import Gains
 from tutorial_atlas_control.sim.divergence import (

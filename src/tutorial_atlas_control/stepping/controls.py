@@ -8,11 +8,9 @@ import threading
 from dataclasses import dataclass
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.command.arrays import CommandError
-from tutorial_atlas_control.msgs.atlas_command import AtlasUpdate, decode_atlas_command
-from tutorial_atlas_control.sim.controller import Gains
-from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode
-from tutorial_atlas_control.sim.vrc import SimInput
+from tutorial_atlas_control.command import CommandError
+from tutorial_atlas_control.msgs import AtlasUpdate, decode_atlas_command
+from tutorial_atlas_control.sim import AtlasSimulator, ControlMode, Gains, SimInput
 from tutorial_atlas_control.stepping.inbox import CommandInbox
 from tutorial_atlas_control.stepping.outputs import LoopOutputs
 from tutorial_atlas_control.stepping.watch import RunWatch

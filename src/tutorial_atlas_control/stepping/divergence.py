@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from tutorial_atlas_control.sim.simulator import AtlasSimulator, PhysicsDivergenceError
+from tutorial_atlas_control.sim import AtlasSimulator, PhysicsDivergenceError
 from tutorial_atlas_control.stepping.outputs import LoopLog
 from tutorial_atlas_control.units import NS_PER_S
 

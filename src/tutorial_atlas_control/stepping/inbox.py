@@ -12,22 +12,21 @@ import collections
 import threading
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.command.arrays import (
+from tutorial_atlas_control.command import (
     FIELD_NAMES,
     LAW_FIELDS,
     CommandError,
     CommandUpdate,
 )
 from tutorial_atlas_control.joints import NUM_JOINTS
-from tutorial_atlas_control.msgs.atlas_command import (
+from tutorial_atlas_control.msgs import (
     AtlasUpdate,
+    CommandDecoder,
+    FieldCursor,
     decode_atlas_command,
     decode_test,
 )
-from tutorial_atlas_control.msgs.joint_commands import CommandDecoder
-from tutorial_atlas_control.msgs.ros1_fields import FieldCursor
-from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistics
-from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode
+from tutorial_atlas_control.sim import AtlasSimulator, CommandAgeStatistics, ControlMode
 from tutorial_atlas_control.stepping.outputs import LoopLog
 from tutorial_atlas_control.stepping.synchronization import DelayBudgets
 from tutorial_atlas_control.stepping.watch import RunWatch

@@ -18,9 +18,12 @@ import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
-from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistics
-from tutorial_atlas_control.sim.link_transforms import LinkTransforms
-from tutorial_atlas_control.sim.simulator import AtlasSimulator, PhysicsDivergenceError
+from tutorial_atlas_control.sim import (
+    AtlasSimulator,
+    CommandAgeStatistics,
+    LinkTransforms,
+    PhysicsDivergenceError,
+)
 from tutorial_atlas_control.stepping.controller import StepController
 from tutorial_atlas_control.stepping.controls import SimControls
 from tutorial_atlas_control.stepping.divergence import DivergenceRecovery

@@ -11,11 +11,14 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.msgs.wire import ControllerStatisticsWire, clock_bytes
-from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistics
-from tutorial_atlas_control.sim.link_transforms import LinkTransforms, RspSchedule
-from tutorial_atlas_control.sim.sim_messages import SimMessages
-from tutorial_atlas_control.sim.simulator import AtlasSimulator
+from tutorial_atlas_control.msgs import ControllerStatisticsWire, clock_bytes
+from tutorial_atlas_control.sim import (
+    AtlasSimulator,
+    CommandAgeStatistics,
+    LinkTransforms,
+    RspSchedule,
+    SimMessages,
+)
 from tutorial_atlas_control.stepping.outputs import LoopOutputs
 from tutorial_atlas_control.stepping.schedule import STAMPED_AT_STEP_END, steps_between
 

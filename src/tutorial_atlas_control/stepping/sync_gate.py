@@ -12,7 +12,7 @@ import threading
 from collections.abc import Callable
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.sim.simulator import AtlasSimulator
+from tutorial_atlas_control.sim import AtlasSimulator
 from tutorial_atlas_control.stepping.inbox import CommandInbox
 from tutorial_atlas_control.stepping.outputs import LoopOutputs
 from tutorial_atlas_control.stepping.pacing import Pacer

@@ -9,9 +9,7 @@ from __future__ import annotations
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.fall_report import fall_line
-from tutorial_atlas_control.sim.model import FALL_HEIGHT_M
-from tutorial_atlas_control.sim.simulator import AtlasSimulator
-from tutorial_atlas_control.sim.vrc import SimInput, describe_input
+from tutorial_atlas_control.sim import FALL_HEIGHT_M, AtlasSimulator, SimInput, describe_input
 from tutorial_atlas_control.stepping.outputs import LoopLog
 from tutorial_atlas_control.units import NS_PER_S
 

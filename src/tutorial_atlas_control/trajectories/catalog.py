@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE
+from tutorial_atlas_control.sim import DEFAULT_GAINS_FILE
 from tutorial_atlas_control.trajectories.trajectory import (
     TRAJECTORIES_DIR,
     TrajectoryError,

@@ -25,7 +25,7 @@ from std_msgs.msg import String
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES, NUM_JOINTS, joint_index
-from tutorial_atlas_control.sim.controller import LOAD_HINT, Gains, GainsError, gains_from_params
+from tutorial_atlas_control.sim import LOAD_HINT, Gains, GainsError, gains_from_params
 from tutorial_atlas_control.trajectories.schedule import (
     TimeWentBackError,
     done_line,
