@@ -69,8 +69,28 @@ class JointCommandArrays:
         return cls()
 
     def copy(self) -> JointCommandArrays:
-        """Deep copy (the arrays are copied, so the copy can be handed to another thread)."""
-        return JointCommandArrays(**{name: getattr(self, name).copy() for name in LAW_FIELDS})
+        """Deep copy (the arrays are copied, so the copy can be handed to another thread).
+
+        The copy's arrays are the rows of one (fields, joints) block, in LAW_FIELDS order:
+        the compiled law binds a new command by one address instead of ten (rows_block).
+        """
+        block = np.empty((len(LAW_FIELDS), NUM_JOINTS))
+        for row, name in enumerate(LAW_FIELDS):
+            block[row] = getattr(self, name)
+        copied = JointCommandArrays(*block)
+        copied._block = block
+        return copied
+
+    def rows_block(self) -> np.ndarray | None:
+        """The float64 block whose rows, in LAW_FIELDS order, are this command's arrays (a
+        copy() has one), or None: without one, or once a field was given another array."""
+        block = self.__dict__.get('_block')
+        if block is None:
+            return None
+        for name in LAW_FIELDS:
+            if getattr(self, name).base is not block:
+                return None
+        return block
 
 
 assert tuple(f.name for f in fields(JointCommandArrays)) == LAW_FIELDS
