@@ -245,7 +245,7 @@ def test_windows_and_search_by_flag(argv: list[str], budget: str, whole_search: 
 
 
 def test_default_search_is_a_short_fixed_budget_and_full_the_whole() -> None:
-    assert run_bench.BUDGETS['default'].search_generations == 2
+    assert run_bench.BUDGETS['default'].search_generations == 1
     assert run_bench.BUDGETS['quick'].search_generations == 1
     assert run_bench.BUDGETS['full'].search_generations is None
 
@@ -261,7 +261,7 @@ def test_quick_and_full_exclude_each_other(capsys: pytest.CaptureFixture[str]) -
     (['--only', 'search', '--runs', '1'], 'default', 'whole',
      'windows: the default (--full: the longer windows and the whole search); the whole search'),
     (['--runs', '1'], 'default', 'short', 'windows: the default (--full: the longer windows '
-     'and the whole search); the search for 2 generation(s)'),
+     'and the whole search); the search for 1 generation(s)'),
     (['--full', '--only', 'analysis', '--runs', '1'], 'full', None, 'windows: --full'),
 ])
 def test_json_and_table_say_which_windows_and_search(
@@ -297,3 +297,30 @@ def test_search_time_plays_the_generations_asked(monkeypatch: pytest.MonkeyPatch
     assert generations == '2'
     assert timed.reproduced is None  # a short search is not judged on the step it finds
     assert timed.runs == 9 * 9 and timed.generations == 1
+
+
+@pytest.mark.parametrize(('budget', 'runs', 'side'), [
+    ('default', 3, 1),   # the untargeted launches once, the targeted figures every run
+    ('default', 1, 1),
+    ('full', 3, 3),
+    ('quick', 2, 2),
+])
+def test_untargeted_launches_run_once_by_default(budget: str, runs: int, side: int) -> None:
+    assert run_bench.BUDGETS[budget].side(runs) == side
+
+
+def test_fast_variants_only_in_the_side_runs(monkeypatch: pytest.MonkeyPatch) -> None:
+    import online
+
+    launched: list[str] = []
+
+    def fast_run(*args: object, prefix: str, **kwargs: object) -> dict[str, float]:
+        launched.append(f'{prefix}{len(launched)}')
+        return {f'{prefix}_rtf': 1.0, f'{prefix}_master_cpu': 0.0}
+    monkeypatch.setattr(online, 'fast_run', fast_run)
+    monkeypatch.setattr(run_bench, 'log', lambda text: None)
+    samples: dict[str, list[float]] = {}
+    run_bench.run_fast(run_bench.parse_args(['--runs', '3']), samples, None, None, None)
+    assert [name.rstrip('0123456789') for name in launched] == [
+        'fast', 'fast_rosbag', 'fast_rsp', 'fast', 'fast']
+    assert len(samples['fast_rtf']) == 3 and len(samples['fast_rosbag_rtf']) == 1
