@@ -224,8 +224,9 @@ class Budget:
     load_s: float
     controller_window_s: float
     plot_window_s: float
-    #: Runs of the untargeted figures that need launches of their own (the fast section's
-    #: `rosbag record` and robot_state_publisher variants, the plot section); None: --runs.
+    #: Runs of the untargeted figures that need launches or clusters of their own (the fast
+    #: section's `rosbag record` and robot_state_publisher variants, the plot and sweep
+    #: sections); None: --runs.
     side_runs: int | None = None
 
     def side(self, runs: int) -> int:
@@ -444,7 +445,7 @@ def run_sweep(args: argparse.Namespace, samples: dict[str, list[float]],
     import sweep_rate
 
     with Section('sweep', loads):
-        for run in range(args.runs):
+        for run in range(args.budget.side(args.runs)):
             runs = args.budget.sweep_runs
             one, two = sweep_rate.runs_per_s(1, runs), sweep_rate.runs_per_s(2, runs)
             log(f'sweep run {run + 1}: {one:.3f} runs/s on 1 worker, {two:.3f} on 2')
