@@ -1,5 +1,8 @@
 """The benchmark's `controller` section: echo_controller (src/echo_controller.cpp) in the loop.
 
+floor:       real_time_factor:=1.0 before echo_controller starts (in the TCP age run's
+             launch): the simulator's CPU per step with no controller, the floor the
+             controller's cost sits on (`controller_none_node_us_per_step`).
 age run:     real_time_factor:=1.0, echo_controller answering every /atlas/atlas_state over
              TCP (then over UDP): the command age /atlas/controller_statistics reports at
              each step (1 ms: the answer to a state arrived before the next step), p50 and
@@ -101,15 +104,40 @@ def _wait_clock(launch: Launch, clock: RawRecorder) -> None:
 
 def age_run(master: Master, launch_file: str, clock: RawRecorder, statistics: RawRecorder,
             work_dir: Path, name: str, transport: str, warmup_s: float, window_s: float,
-            per_sim_s: float) -> dict[str, float] | None:
+            per_sim_s: float, floor: bool = False) -> dict[str, float] | None:
     """One run at real_time_factor:=1 with echo_controller over `transport` ('tcp' or
     'udp'): `controller_<transport>_age_p50_ms`, `_age_p99_ms`, `_node_us_per_step`; None
-    when the subscription never connected (no UDPROS)."""
+    when the subscription never connected (no UDPROS). With `floor`, first the same
+    window without the controller: `controller_none_node_us_per_step`."""
     with _launch(master, launch_file, work_dir, name, 1.0) as launch:
         _wait_clock(launch, clock)  # the gains are on the parameter server by then
+        figures = {}
+        if floor:
+            time.sleep(warmup_s)
+            figures['controller_none_node_us_per_step'] = _node_us_per_step(
+                launch, clock, name, window_s, per_sim_s)
         with EchoController(master, work_dir / f'{name}.echo.log', transport, 0) as echo:
-            return _age_window(master, launch, echo, clock, statistics, name, transport,
-                               warmup_s, window_s, per_sim_s)
+            served = _age_window(master, launch, echo, clock, statistics, name, transport,
+                                 warmup_s, window_s, per_sim_s)
+        return None if served is None else {**figures, **served}
+
+
+def _node_us_per_step(launch: Launch, clock: RawRecorder, name: str, window_s: float,
+                      per_sim_s: float) -> float:
+    """The simulator's CPU (µs) per simulated step over `window_s` of wall time."""
+    pid = launch.node_pid('atlas_sim')
+    if pid is None:
+        raise BenchError(f'{name}: no atlas_sim process')
+    cpu0 = cpu_seconds(pid)
+    clock.start()
+    time.sleep(window_s)
+    clocks = clock.stop()
+    cpu1 = cpu_seconds(pid)
+    launch.check_running()
+    if len(clocks) < 2:
+        raise BenchError(f'{name}: {len(clocks)} /clock messages in the window')
+    steps = (clock_ns(clocks[-1][1]) - clock_ns(clocks[0][1])) / NS_PER_S * per_sim_s
+    return (cpu1 - cpu0) * 1e6 / (steps * window_s / (clocks[-1][0] - clocks[0][0]))
 
 
 def _age_window(master: Master, launch: Launch, echo: EchoController, clock: RawRecorder,

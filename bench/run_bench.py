@@ -63,7 +63,8 @@ except ImportError as import_error:
 
 
 class Section:
-    """Records the load average, CPU busy and steal % while a section runs."""
+    """Records the load average, CPU busy and steal % while a section runs, and how long
+    it took (wall)."""
 
     def __init__(self, name: str, loads: dict[str, str]) -> None:
         self.name, self.loads = name, loads
@@ -71,10 +72,12 @@ class Section:
     def __enter__(self) -> None:
         self.load = load_average()
         self.stat = cpu_stat()
+        self.started_s = time.monotonic()
 
     def __exit__(self, *exc: object) -> None:
         busy, steal = busy_and_steal(self.stat, cpu_stat())
-        self.loads[self.name] = f'load {self.load}, busy {busy:.0f}%, steal {steal:.0f}%'
+        self.loads[self.name] = (f'load {self.load}, busy {busy:.0f}%, steal {steal:.0f}%, '
+                                 f'{time.monotonic() - self.started_s:.0f} s')
 
 
 #: The recorder's chunk compressions (atlas.launch's `compression` argument).
@@ -140,12 +143,15 @@ ROWS = (
     ('analysis_msgs_per_s', 'analyze_bag, 60 s bag', 'msgs/s', '', 0),
     ('rosbag_msgs_per_s', 'rosbag API, same topics', 'msgs/s', '', 0),
     ('analysis_speedup', 'analyze_bag / rosbag', 'x', '>= 5', 1),
+    ('controller_none_node_us_per_step', 'no controller, rtf:=1: node CPU/step', 'us', '', 1),
     ('controller_tcp_age_p50_ms', 'echo_controller TCP: command age p50', 'ms', '', 2),
-    ('controller_tcp_age_p99_ms', 'echo_controller TCP: command age p99', 'ms', '', 2),
-    ('controller_tcp_node_us_per_step', 'echo_controller TCP: node CPU/step', 'us', '', 1),
+    ('controller_tcp_age_p99_ms', 'echo_controller TCP: command age p99', 'ms', '1', 2),
+    ('controller_tcp_node_us_per_step', 'echo_controller TCP: node CPU/step', 'us', '<= 150',
+     1),
     ('controller_udp_age_p50_ms', 'echo_controller UDP: command age p50', 'ms', '', 2),
-    ('controller_udp_age_p99_ms', 'echo_controller UDP: command age p99', 'ms', '', 2),
-    ('controller_udp_node_us_per_step', 'echo_controller UDP: node CPU/step', 'us', '', 1),
+    ('controller_udp_age_p99_ms', 'echo_controller UDP: command age p99', 'ms', '1', 2),
+    ('controller_udp_node_us_per_step', 'echo_controller UDP: node CPU/step', 'us', '<= 150',
+     1),
     ('controller_window_steps_per_s', 'sync window, rtf:=0: steps/s of pair', 'steps/s', '', 0),
     ('controller_window_age_p99_ms', 'sync window, rtf:=0: command age p99', 'ms', '1', 2),
     ('plot_off_realtime_rtf', 'node rtf:=1, no plotter', 'x real time', '', 4),
@@ -200,6 +206,46 @@ class Target:
         return low <= value <= high
 
 
+@dataclass(frozen=True)
+class Budget:
+    """How long each section measures: `--quick` (a smoke test), the default (`make bench`,
+    about 11 minutes) or `--full` (the windows of the bench before it had a default, and
+    the whole search). Every figure is measured in each; only their windows differ."""
+
+    name: str
+    physics_steps: int
+    unheard_calls: int
+    analysis_bag_s: float
+    sweep_runs: int
+    #: The search's generations; None: the whole search (search_time.GENERATIONS), which
+    #: also says whether it found Stepping.yaml again.
+    search_generations: int | None
+    fast_window_s: float
+    realtime_window_s: float
+    latency_s: tuple[tuple[float, float], ...]  # (command rate Hz, seconds at it)
+    load_s: float
+    controller_window_s: float
+    plot_window_s: float
+    #: Runs of the untargeted figures that need launches or clusters of their own (the fast
+    #: section's `rosbag record` and robot_state_publisher variants, the plot and sweep
+    #: sections); None: --runs.
+    side_runs: int | None = None
+
+    def side(self, runs: int) -> int:
+        """How many of `runs` measure the untargeted launches too."""
+        return runs if self.side_runs is None else min(runs, self.side_runs)
+
+
+BUDGETS = {
+    'quick': Budget('quick', 2000, 5000, 10.0, 4, 1, 4.0, 8.0, ((50.0, 2.0), (1000.0, 1.0)),
+                    8.0, 4.0, 4.0),
+    'default': Budget('default', 5000, 20000, 60.0, 8, 1, 5.0, 15.0,
+                      ((50.0, 4.0), (1000.0, 2.0)), 15.0, 6.0, 6.0, side_runs=1),
+    'full': Budget('full', 5000, 20000, 60.0, 16, None, 10.0, 30.0,
+                   ((50.0, 6.0), (1000.0, 3.0)), 30.0, 15.0, 15.0),
+}
+
+
 #: The targets of issues 8, 18, 19 and 25 (bench/README.md), by JSON key.
 TARGETS = {
     'unheard_topic_us_per_step': Target(high=1.0, strict=True),
@@ -229,6 +275,11 @@ TARGETS = {
     'bag_mb_per_min': Target(high=80.0, lz4_only=True),
     'analysis_s': Target(high=2.0, strict=True),
     'analysis_speedup': Target(low=5.0),
+    # Serving a 1 kHz controller at real time: a fraction of a core, every step answered.
+    'controller_tcp_node_us_per_step': Target(high=150.0),
+    'controller_udp_node_us_per_step': Target(high=150.0),
+    'controller_tcp_age_p99_ms': Target(low=1.0, high=1.0),
+    'controller_udp_age_p99_ms': Target(low=1.0, high=1.0),
     # The window's promise: every step obeys the answer to the state before it.
     'controller_window_age_p99_ms': Target(low=1.0, high=1.0),
     # Issue 27: the search, run again whole, finds the committed step (one machine).
@@ -255,13 +306,14 @@ EXPECTED = {
              'load_recorded_fraction', 'load_rss_growth_mib', 'shutdown_s'),
     'tutorial': ('tutorial_command_rate_hz', 'bag_mb_per_min', 'tutorial_age_closed_form_share'),
     # The UDP keys only once the node serves UDPROS (else the JSON says NO_UDP).
-    'controller': ('controller_tcp_age_p50_ms', 'controller_tcp_age_p99_ms',
+    'controller': ('controller_none_node_us_per_step', 'controller_tcp_age_p50_ms',
+                   'controller_tcp_age_p99_ms',
                    'controller_tcp_node_us_per_step', 'controller_window_steps_per_s',
                    'controller_window_age_p99_ms'),
     'plot': ('plot_off_realtime_rtf', 'plot_on_realtime_rtf', 'plot_off_node_us_per_step',
              'plot_on_node_us_per_step', 'plot_on_plotter_cpu'),
     'sweep': ('sweep_runs_per_s_1', 'sweep_runs_per_s_2', 'sweep_scaling'),
-    # search_reproduced only from a whole search (not --quick's one generation).
+    # search_reproduced only from a whole search (--full, --only search).
     'search': ('search_wall_s', 'search_generations', 'search_runs_per_s'),
 }
 #: Keys computed from two sections, expected when both ran.
@@ -301,10 +353,14 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument('--runs', type=int, default=3, help='runs per figure (default 3)')
-    parser.add_argument('--only', default=','.join(SECTIONS),
-                        help=f'comma-separated sections to run (default: {",".join(SECTIONS)})')
-    parser.add_argument('--quick', action='store_true',
-                        help='short windows (a smoke test, not a measurement)')
+    parser.add_argument('--only',
+                        help=f'comma-separated sections to run (default: {",".join(SECTIONS)}); '
+                             'naming search runs the whole search (unless --quick)')
+    windows = parser.add_mutually_exclusive_group()
+    windows.add_argument('--quick', action='store_true',
+                         help='short windows (a smoke test, not a measurement)')
+    windows.add_argument('--full', action='store_true',
+                         help='the long windows and the whole search (about 30 minutes)')
     parser.add_argument('--launch-file', default='atlas.launch',
                         help='launch file to benchmark instead of the package\'s atlas.launch '
                              '(a path, or a file name in tutorial_atlas_control); it must take '
@@ -313,7 +369,8 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     parser.add_argument('--compression', choices=COMPRESSIONS,
                         help='chunk compression of every bag recorded (default: the launch\'s)')
     args = parser.parse_args(argv)
-    args.sections = [s.strip() for s in args.only.split(',') if s.strip()]
+    only = args.only if args.only is not None else ','.join(SECTIONS)
+    args.sections = [s.strip() for s in only.split(',') if s.strip()]
     unknown = set(args.sections) - set(SECTIONS)
     if unknown:
         parser.error(f'unknown section(s) {", ".join(sorted(unknown))}; choose from '
@@ -322,6 +379,10 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
         parser.error('--runs must be >= 1')
     if args.launch_file.endswith('.launch') and os.path.sep in args.launch_file:
         args.launch_file = str(Path(args.launch_file).resolve())
+    args.budget = BUDGETS['quick' if args.quick else 'full' if args.full else 'default']
+    # The whole search with --full, or when --only names it; else a short fixed budget.
+    args.whole_search = args.full or (args.only is not None and 'search' in args.sections
+                                      and not args.quick)
     return args
 
 
@@ -339,7 +400,7 @@ def run_offline(args: argparse.Namespace, samples: dict[str, list[float]],
 
         with Section('physics', loads):
             for run in range(max(args.runs, 5)):
-                steps = 2000 if args.quick else 5000
+                steps = args.budget.physics_steps
                 rates = {'bare_physics_steps_per_s': node_loop.bare_physics_run(steps),
                          'physics_limit_steps_per_s': offline.physics_run(steps=steps),
                          'physics_numpy_law_steps_per_s':
@@ -347,7 +408,7 @@ def run_offline(args: argparse.Namespace, samples: dict[str, list[float]],
                 log(f'physics run {run + 1}: ' + ', '.join(
                     f'{key} {rate:.0f}' for key, rate in rates.items()))
                 add(samples, rates)
-                unheard_us = node_loop.unheard_topic_run(5000 if args.quick else 20000)
+                unheard_us = node_loop.unheard_topic_run(args.budget.unheard_calls)
                 log(f'physics run {run + 1}: an unheard topic costs {unheard_us:.3f} us/step')
                 add(samples, {'unheard_topic_us_per_step': unheard_us})
     if 'offline' in args.sections:
@@ -355,7 +416,7 @@ def run_offline(args: argparse.Namespace, samples: dict[str, list[float]],
         with Section('offline', loads), tempfile.TemporaryDirectory(prefix='tac_bench_') as tmp:
             for run in range(max(args.runs, 5)):
                 # Interleaved with the plain loop: both see the same load.
-                physics = offline.physics_run(steps=2000 if args.quick else 5000)
+                physics = offline.physics_run(steps=args.budget.physics_steps)
                 rtf = offline.offline_run(Path(tmp))
                 log(f'offline run {run + 1}: {rtf:.2f}x real time; plain loop {physics:.0f} '
                     'steps/s')
@@ -363,7 +424,7 @@ def run_offline(args: argparse.Namespace, samples: dict[str, list[float]],
                               'offline_ratio': rtf * steps_per_s / physics})
     if 'analysis' in args.sections:
         path = offline.run_bag(Path(tempfile.gettempdir()) / 'tac_bench_cache',
-                               10.0 if args.quick else 60.0)
+                               args.budget.analysis_bag_s)
         count = offline.analysis_message_count(path)
         offline.analysis_run(path)  # warm the page cache and imports for both readers
         with Section('analysis', loads):
@@ -388,8 +449,8 @@ def run_sweep(args: argparse.Namespace, samples: dict[str, list[float]],
     import sweep_rate
 
     with Section('sweep', loads):
-        for run in range(args.runs):
-            runs = 4 if args.quick else 16
+        for run in range(args.budget.side(args.runs)):
+            runs = args.budget.sweep_runs
             one, two = sweep_rate.runs_per_s(1, runs), sweep_rate.runs_per_s(2, runs)
             log(f'sweep run {run + 1}: {one:.3f} runs/s on 1 worker, {two:.3f} on 2')
             add(samples, {'sweep_runs_per_s_1': one, 'sweep_runs_per_s_2': two,
@@ -398,14 +459,16 @@ def run_sweep(args: argparse.Namespace, samples: dict[str, list[float]],
 
 def run_search(args: argparse.Namespace, samples: dict[str, list[float]],
                loads: dict[str, str], work_dir: Path) -> None:
-    """The wall time of the search that found Stepping.yaml's step (issue 27): whole, once
-    (about ten minutes on 2 cores), whatever --runs says; --quick: one generation."""
+    """The wall time of the search that found Stepping.yaml's step (issue 27), once whatever
+    --runs says: whole (about ten minutes on 2 cores) with --full or `--only search`, else
+    the budget's few generations (the search's speed: search_runs_per_s)."""
     if 'search' not in args.sections:
         return
     import search_time
 
     with Section('search', loads):
-        timed = search_time.search_time(work_dir, args.quick)
+        timed = search_time.search_time(
+            work_dir, None if args.whole_search else args.budget.search_generations)
         figures = {'search_wall_s': timed.wall_s, 'search_generations': timed.generations,
                    'search_runs_per_s': timed.runs / timed.wall_s}
         if timed.reproduced is not None:
@@ -458,7 +521,7 @@ def run_load(args, samples, master, probes, work_dir) -> None:  # noqa: ANN001
 
     for run in range(args.runs):
         values = load.load_run(master, args.launch_file, probes, work_dir, f'load{run + 1}',
-                               duration_s=8.0 if args.quick else 30.0)
+                               duration_s=args.budget.load_s)
         log(f'load run {run + 1}: rtf {values["load_rtf"]:.4f}, '
             f'{values["load_commands_lost"]:.0f} commands lost, RSS growth '
             f'{values["load_rss_growth_mib"]:.2f} MiB, shutdown {values["shutdown_s"]:.2f} s')
@@ -479,14 +542,14 @@ def run_controller(args, samples, master, probes, work_dir) -> None:  # noqa: AN
 
     per_sim_s = offline.steps_per_sim_second()
     statistics = RawRecorder(topics.CONTROLLER_STATISTICS)
-    window_s = 4.0 if args.quick else 15.0
+    window_s = args.budget.controller_window_s
     for run in range(args.runs):
         values: dict[str, float] = {}
         for transport in ('tcp', 'udp'):
             figures = controller.age_run(
                 master, args.launch_file, probes.clock, statistics, work_dir,
                 f'controller_{transport}{run + 1}', transport, warmup_s=2.0,
-                window_s=window_s, per_sim_s=per_sim_s)
+                window_s=window_s, per_sim_s=per_sim_s, floor=transport == 'tcp')
             if figures is None:
                 log(f'controller run {run + 1}: {NO_UDP}: echo_controller --transport udp '
                     'never connected (the node serves no UDPROS)')
@@ -497,7 +560,9 @@ def run_controller(args, samples, master, probes, work_dir) -> None:  # noqa: AN
             master, args.launch_file, probes.clock, statistics, work_dir,
             f'controller_window{run + 1}', warmup_s=2.0, window_s=window_s,
             per_sim_s=per_sim_s))
-        log(f'controller run {run + 1}: TCP age p99 '
+        log(f'controller run {run + 1}: node '
+            f'{values["controller_none_node_us_per_step"]:.0f} us/step without a controller, '
+            f'{values["controller_tcp_node_us_per_step"]:.0f} with it over TCP; TCP age p99 '
             f'{values["controller_tcp_age_p99_ms"]:.2f} ms, UDP age p99 '
             + (f'{values["controller_udp_age_p99_ms"]:.2f} ms'
                if 'controller_udp_age_p99_ms' in values else NO_UDP)
@@ -509,9 +574,9 @@ def run_plot(args, samples, master, probes, work_dir) -> None:  # noqa: ANN001
     import offline
     import plot_cost
 
-    for run in range(args.runs):
+    for run in range(args.budget.side(args.runs)):
         values = plot_cost.plot_run(master, args.launch_file, probes, work_dir, f'plot{run + 1}',
-                                    warmup_s=2.0, window_s=4.0 if args.quick else 15.0,
+                                    warmup_s=2.0, window_s=args.budget.plot_window_s,
                                     steps_per_sim_s=offline.steps_per_sim_second())
         log(f'plot run {run + 1}: rtf {values["plot_off_realtime_rtf"]:.4f} without, '
             f'{values["plot_on_realtime_rtf"]:.4f} with the plotter; node '
@@ -541,34 +606,36 @@ def run_fast(args, samples, master, probes, work_dir) -> None:  # noqa: ANN001
     then `rosbag record` (fast_rosbag_*)."""
     import online
 
+    variants = (('atlas_recorder', 'fast', None), ('rosbag', 'fast_rosbag', None),
+                # Debian's robot_state_publisher publishing the links (issue 28: the
+                # master's and its CPU, beside the default's).
+                ('atlas_recorder', 'fast_rsp', {'tf_publisher': 'robot_state_publisher'}))
     for run in range(args.runs):
         values = {}
-        # Then with Debian's robot_state_publisher publishing the links (issue 28: the
-        # master's and its CPU, beside the default's).
-        for recorder, prefix, extra in (
-                ('atlas_recorder', 'fast', None), ('rosbag', 'fast_rosbag', None),
-                ('atlas_recorder', 'fast_rsp', {'tf_publisher': 'robot_state_publisher'})):
+        # The headline (atlas_recorder) every run; the variants in the budget's side runs.
+        for recorder, prefix, extra in variants[:3 if run < args.budget.side(args.runs) else 1]:
             values.update(online.fast_run(
                 master, args.launch_file, probes, work_dir, f'{prefix}{run + 1}',
-                warmup_s=2.0, window_s=4.0 if args.quick else 10.0, recorder=recorder,
+                warmup_s=2.0, window_s=args.budget.fast_window_s, recorder=recorder,
                 prefix=prefix, extra_args=extra))
-        log(f'fast run {run + 1}: rtf {values["fast_rtf"]:.3f} (atlas_recorder), '
-            f'{values["fast_rosbag_rtf"]:.3f} (rosbag record); master '
-            f'{values["fast_master_cpu"]:.4f} cores, with robot_state_publisher '
-            f'{values["fast_rsp_master_cpu"]:.4f} (it: '
-            f'{values.get("fast_rsp_state_publisher_cpu", 0.0):.3f})')
+        log(f'fast run {run + 1}: rtf {values["fast_rtf"]:.3f} (atlas_recorder), master '
+            f'{values["fast_master_cpu"]:.4f} cores' + (
+                '' if 'fast_rosbag_rtf' not in values else
+                f'; {values["fast_rosbag_rtf"]:.3f} (rosbag record), with '
+                f'robot_state_publisher master {values["fast_rsp_master_cpu"]:.4f} (it: '
+                f'{values.get("fast_rsp_state_publisher_cpu", 0.0):.3f})'))
         add(samples, values)
 
 
 def run_realtime(args, samples, master, probes, work_dir) -> None:  # noqa: ANN001
     import online
 
-    latency_s = {50.0: 2.0, 1000.0: 1.0} if args.quick else {50.0: 6.0, 1000.0: 3.0}
+    latency_s = dict(args.budget.latency_s)
     for run in range(args.runs):
         transport = online.js_transport(master, probes, work_dir)
         values = online.realtime_run(
             master, args.launch_file, probes, work_dir, f'realtime{run + 1}', warmup_s=2.0,
-            window_s=8.0 if args.quick else 30.0, latency_s=latency_s,
+            window_s=args.budget.realtime_window_s, latency_s=latency_s,
             transport_ms=transport['js_transport_p50_ms'])
         values.update(transport)
         log(f'realtime run {run + 1}: rtf {values["realtime_rtf"]:.4f}, lateness p99 '
@@ -621,10 +688,13 @@ def summarize(samples: dict[str, list[float]],
 
 
 def table(samples: dict[str, list[float]], loads: dict[str, str], runs: int,
-          compression: str, judged: dict[str, str], udp: str = '') -> str:
+          compression: str, judged: dict[str, str], udp: str = '', budget: str = '') -> str:
     lines = [f'tutorial_atlas_control benchmark, {os.cpu_count()} CPUs; per section: load '
-             'average (1/5/15 min) at its start, CPU busy and hypervisor steal % during it:']
+             'average (1/5/15 min) at its start, CPU busy and hypervisor steal % during it, '
+             'its wall time:']
     lines += [f'  {section:<9} {load}' for section, load in loads.items()]
+    if budget:
+        lines.append(f'windows: {budget}')
     lines += [f'bags: chunk compression {compression}',
               f'min / median / max over {runs} runs (physics: over >= 5 runs)', '']
     header = (f'{"figure":<38} {"min":>10} {"median":>10} {"max":>10}  {"unit":<12} '
@@ -645,6 +715,19 @@ def table(samples: dict[str, list[float]], loads: dict[str, str], runs: int,
     lines += ['', f'targets: {len(judged) - len(missed)} of {len(judged)} met'
               + (f'; MISSED: {", ".join(missed)}' if missed else '')]
     return '\n'.join(lines)
+
+
+def budget_text(budget: Budget, whole_search: bool | None) -> str:
+    """The table's line saying which windows were measured, and what --full adds
+    (`whole_search` None: no search section)."""
+    text = {'quick': '--quick (a smoke test, not a measurement)',
+            'default': 'the default (--full: the longer windows and the whole search)',
+            'full': '--full'}[budget.name]
+    if whole_search is None:
+        return text
+    search = ('the whole search' if whole_search
+              else f'the search for {budget.search_generations} generation(s)')
+    return f'{text}; {search}'
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -690,9 +773,12 @@ def main(argv: list[str] | None = None) -> int:
     judged = verdicts(medians, compression)
     invalid = invalid_figures(medians, args.sections)
     udp = getattr(args, 'udp', '')
-    print(table(samples, loads, args.runs, compression, judged, udp))
+    print(table(samples, loads, args.runs, compression, judged, udp,
+                budget_text(args.budget, args.whole_search if 'search' in args.sections
+                            else None)))
     result: dict[str, object] = {key: round(value, 4) for key, value in medians.items()}
-    result.update({'runs': args.runs, 'quick': args.quick, 'cpus': os.cpu_count(),
+    result.update({'runs': args.runs, 'quick': args.quick, 'budget': args.budget.name,
+                   'cpus': os.cpu_count(),
                    'compression': compression,
                    'load_avg': load_average(), 'wall_s': round(time.monotonic() - started, 1),
                    'missed': sorted(key for key, verdict in judged.items()
@@ -700,6 +786,8 @@ def main(argv: list[str] | None = None) -> int:
                    'invalid': invalid})
     if udp:
         result['controller_udp'] = udp
+    if 'search' in args.sections:
+        result['search'] = 'whole' if args.whole_search else 'short'
     print(json.dumps(result, sort_keys=True), flush=True)
     if invalid:  # a missed target is a figure; a missing or NaN one is a broken bench
         print(f'run_bench: missing or not finite: {", ".join(invalid)}', file=sys.stderr)

@@ -22,9 +22,9 @@ from tutorial_atlas_control.search.cmaes import runs_per_candidate
 SEARCH = REPO_DIR / 'scripts' / 'search.py'
 STEPPING = REPO_DIR / 'trajectories' / 'Stepping.yaml'
 STEPPING_GAINS = REPO_DIR / 'config' / 'stepping_gains.yaml'
-#: The search's own generations (Stepping.yaml); a quick bench runs GENERATIONS_QUICK.
+#: The search's own generations (Stepping.yaml): what a whole run plays. The default bench
+#: plays a few of them (run_bench.BUDGETS): the speed, not the step found.
 GENERATIONS = 25
-GENERATIONS_QUICK = 1
 ARGUMENTS = (
     str(REPO_DIR / 'trajectories' / 'QuickStep.yaml'), 'quick_step',
     '--gains', str(REPO_DIR / 'config' / 'quickstep_gains.yaml'),
@@ -52,9 +52,12 @@ def _data_lines(path: Path) -> list[str]:
     return [line for line in path.read_text().splitlines() if not line.lstrip().startswith('#')]
 
 
-def search_time(out_dir: Path, quick: bool) -> SearchTime:
-    """Run the search (GENERATIONS, or GENERATIONS_QUICK when quick) and time it."""
-    generations = GENERATIONS_QUICK if quick else GENERATIONS
+def search_time(out_dir: Path, generations: int | None) -> SearchTime:
+    """Run the search for `generations` (None: the whole search, GENERATIONS, which is
+    then judged on the step it writes) and time it."""
+    whole = generations is None
+    if generations is None:
+        generations = GENERATIONS
     log, found, gains = out_dir / 'search.jsonl', out_dir / 'found.yaml', out_dir / 'gains.yaml'
     for path in (log, found, gains):
         path.unlink(missing_ok=True)
@@ -70,7 +73,7 @@ def search_time(out_dir: Path, quick: bool) -> SearchTime:
     candidates = 1 + sum(len(r['x']) for r in records if r['kind'] == 'generation')
     done = sum(r['kind'] == 'generation' for r in records)
     reproduced = None
-    if not quick:
+    if whole:
         stepping = _data_lines(STEPPING)
         start = stepping.index('step_and_stand:')
         reproduced = (_data_lines(found) == stepping[start:start + len(_data_lines(found))]

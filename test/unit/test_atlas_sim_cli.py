@@ -6,8 +6,10 @@ import pytest
 
 pytest.importorskip('rospy', reason='needs ROS 1 (source ./env.sh)')
 
+from tutorial_atlas_control import topics
 from tutorial_atlas_control.cli import atlas_sim
 from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.node.transport import WireBatch
 
 
 @pytest.fixture(autouse=True)
@@ -44,7 +46,9 @@ class FakeNode:
         self.hooks = hooks
         self.reason = reason
         self.sim = type('Sim', (), {'dt_s': 0.001, 'time_to_unpin_s': 1.0})()
-        self.loop = type('Loop', (), {'real_time_factor': 1.0, 'paused': False})()
+        self.loop = type('Loop', (), {'real_time_factor': 1.0, 'paused': False,
+                                      'outbox': WireBatch()})()
+        self.publishers = {topics.CLOCK: 'clock'}
 
     def spin(self) -> int:
         for hook in self.hooks:

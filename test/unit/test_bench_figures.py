@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import load
 import numpy as np
@@ -239,3 +240,121 @@ def test_closed_form_share_counts_the_windows_within_the_commands() -> None:
                                    first_ns, last_ns)
     assert share == pytest.approx(2 / 3)
     assert load.closed_form_share(stamps[:1], [late[0]], [late[1]], first_ns, last_ns) is None
+
+
+@pytest.mark.parametrize(('key', 'value', 'verdict'), [
+    ('controller_tcp_node_us_per_step', 150.0, 'met'),      # <= 150: the bound meets it
+    ('controller_tcp_node_us_per_step', 150.1, 'MISSED'),
+    ('controller_udp_node_us_per_step', 149.0, 'met'),
+    ('controller_udp_node_us_per_step', 380.0, 'MISSED'),
+    ('controller_tcp_age_p99_ms', 1.0, 'met'),              # every state answered in time
+    ('controller_udp_age_p99_ms', 2.0, 'MISSED'),
+])
+def test_serving_a_controller_has_targets(key: str, value: float, verdict: str) -> None:
+    assert run_bench.verdicts({key: value}, 'lz4') == {key: verdict}
+
+
+def test_the_floor_without_a_controller_is_expected_and_unjudged() -> None:
+    assert 'controller_none_node_us_per_step' in run_bench.EXPECTED['controller']
+    assert run_bench.verdicts({'controller_none_node_us_per_step': 300.0}, 'lz4') == {}
+    figures = {key: 1.0 for key in run_bench.EXPECTED['controller']}
+    del figures['controller_none_node_us_per_step']
+    assert run_bench.invalid_figures(figures, ['controller']) == [
+        'controller_none_node_us_per_step']
+
+
+@pytest.mark.parametrize(('argv', 'budget', 'whole_search'), [
+    ([], 'default', False),                       # make bench: the search's speed only
+    (['--full'], 'full', True),
+    (['--only', 'search'], 'default', True),      # asked for by name: the whole search
+    (['--only', 'sweep,search'], 'default', True),
+    (['--only', 'search', '--quick'], 'quick', False),
+    (['--only', 'physics'], 'default', False),
+    (['--quick'], 'quick', False),
+])
+def test_windows_and_search_by_flag(argv: list[str], budget: str, whole_search: bool) -> None:
+    args = run_bench.parse_args(argv)
+    assert args.budget is run_bench.BUDGETS[budget]
+    assert args.whole_search is whole_search
+
+
+def test_default_search_is_a_short_fixed_budget_and_full_the_whole() -> None:
+    assert run_bench.BUDGETS['default'].search_generations == 1
+    assert run_bench.BUDGETS['quick'].search_generations == 1
+    assert run_bench.BUDGETS['full'].search_generations is None
+
+
+def test_quick_and_full_exclude_each_other(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as exit_info:
+        run_bench.parse_args(['--quick', '--full'])
+    assert exit_info.value.code == 2
+    assert 'not allowed with argument' in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(('argv', 'budget', 'search', 'line'), [
+    (['--only', 'search', '--runs', '1'], 'default', 'whole',
+     'windows: the default (--full: the longer windows and the whole search); the whole search'),
+    (['--runs', '1'], 'default', 'short', 'windows: the default (--full: the longer windows '
+     'and the whole search); the search for 1 generation(s)'),
+    (['--full', '--only', 'analysis', '--runs', '1'], 'full', None, 'windows: --full'),
+])
+def test_json_and_table_say_which_windows_and_search(
+        monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], argv: list[str],
+        budget: str, search: str | None, line: str) -> None:
+    monkeypatch.setattr(run_bench, 'run_search', lambda *args: None)
+    monkeypatch.setattr(run_bench, 'run_sweep', lambda *args: None)
+    monkeypatch.setattr(run_bench, 'invalid_figures', lambda medians, sections: [])
+    assert run_main_with(monkeypatch, {}, argv) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    result = json.loads(lines[-1])
+    assert result['budget'] == budget
+    assert result.get('search') == search
+    assert line in lines
+
+
+def test_search_time_plays_the_generations_asked(monkeypatch: pytest.MonkeyPatch,
+                                                 tmp_path: Path) -> None:
+    import search_time
+
+    commands = []
+
+    def fake_run(command: list[str], **kwargs: object) -> object:  # subprocess.run's shape
+        commands.append(command)
+        log = tmp_path / 'search.jsonl'
+        log.write_text(json.dumps({'kind': 'search', 'config': {}}) + '\n'
+                       + json.dumps({'kind': 'generation', 'x': [[0.0]] * 8}) + '\n')
+        return type('Done', (), {'returncode': 0, 'stderr': ''})()
+    monkeypatch.setattr(search_time.subprocess, 'run', fake_run)
+    monkeypatch.setattr(search_time, 'runs_per_candidate', lambda config: 9)
+    timed = search_time.search_time(tmp_path, 2)
+    generations = commands[-1][commands[-1].index('--generations') + 1]
+    assert generations == '2'
+    assert timed.reproduced is None  # a short search is not judged on the step it finds
+    assert timed.runs == 9 * 9 and timed.generations == 1
+
+
+@pytest.mark.parametrize(('budget', 'runs', 'side'), [
+    ('default', 3, 1),   # the untargeted launches once, the targeted figures every run
+    ('default', 1, 1),
+    ('full', 3, 3),
+    ('quick', 2, 2),
+])
+def test_untargeted_launches_run_once_by_default(budget: str, runs: int, side: int) -> None:
+    assert run_bench.BUDGETS[budget].side(runs) == side
+
+
+def test_fast_variants_only_in_the_side_runs(monkeypatch: pytest.MonkeyPatch) -> None:
+    import online
+
+    launched: list[str] = []
+
+    def fast_run(*args: object, prefix: str, **kwargs: object) -> dict[str, float]:
+        launched.append(f'{prefix}{len(launched)}')
+        return {f'{prefix}_rtf': 1.0, f'{prefix}_master_cpu': 0.0}
+    monkeypatch.setattr(online, 'fast_run', fast_run)
+    monkeypatch.setattr(run_bench, 'log', lambda text: None)
+    samples: dict[str, list[float]] = {}
+    run_bench.run_fast(run_bench.parse_args(['--runs', '3']), samples, None, None, None)
+    assert [name.rstrip('0123456789') for name in launched] == [
+        'fast', 'fast_rosbag', 'fast_rsp', 'fast', 'fast']
+    assert len(samples['fast_rtf']) == 3 and len(samples['fast_rosbag_rtf']) == 1

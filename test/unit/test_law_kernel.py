@@ -10,7 +10,7 @@ import pytest
 from test_controller import random_command
 
 from tutorial_atlas_control import native
-from tutorial_atlas_control.command.arrays import FIELD_NAMES, JointCommandArrays
+from tutorial_atlas_control.command.arrays import FIELD_NAMES, LAW_FIELDS, JointCommandArrays
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.msgs.atlas_command import decode_atlas_command, encode_atlas_command
 from tutorial_atlas_control.sim import law_kernel
@@ -68,6 +68,8 @@ def test_compiled_law_equals_the_numpy_law_on_random_inputs(library) -> None:
         for step in range(60):
             if rng.random() < 0.2:  # a new command object: ki and bounds change
                 command = random_command(rng)
+                if rng.random() < 0.5:  # a merged one: its rows in one block (rows_block)
+                    command = command.copy()
             elif rng.random() < 0.1:  # the same object, edited in place
                 command.ki_position[:] = -command.ki_position
             if step == 30 and rng.random() < 0.5:
@@ -224,3 +226,18 @@ def test_both_laws_blend_an_atlas_command_while_a_cheat_acts(library, cheat: Sim
         numpy_law.step()
     assert same_bits(compiled.data.qpos, numpy_law.data.qpos)
     assert same_bits(compiled.torque_nm, numpy_law.torque_nm)
+
+
+def test_a_copied_command_is_one_block_until_a_field_is_given_another_array() -> None:
+    rng = np.random.default_rng(3)
+    original = random_command(rng)
+    assert original.rows_block() is None
+    copied = original.copy()
+    block = copied.rows_block()
+    assert block is not None and block.shape == (len(LAW_FIELDS), NUM_JOINTS)
+    for row, name in enumerate(LAW_FIELDS):
+        assert same_bits(block[row], getattr(original, name))
+        getattr(copied, name)[0] += 1.0  # edited in place: still the block's row
+        assert block[row, 0] == getattr(original, name)[0] + 1.0
+    copied.kp_velocity = np.zeros(NUM_JOINTS)
+    assert copied.rows_block() is None

@@ -154,6 +154,24 @@ def test_clock_goes_out_after_the_messages_stamped_with_it(
     assert len(sent) == 3, 'a flush sent twice'
 
 
+
+def test_a_watcher_sees_what_each_flush_sent_after_it_was_written() -> None:
+    events: list[tuple[str, str, bytes]] = []
+
+    class Writer:
+        def write(self, pub, data):
+            events.append(('write', pub, bytes(data)))
+
+    batch = transport.WireBatch(Writer())
+    batch.watch('clock', lambda data: events.append(('seen', 'clock', bytes(data))))
+    batch.replace('clock', b'clock 1')
+    batch.add('imu', b'imu 1')
+    batch.flush()
+    batch.flush()  # nothing queued: nothing written, nothing seen
+    assert events == [('write', 'imu', b'imu 1'), ('write', 'clock', b'clock 1'),
+                      ('seen', 'clock', b'clock 1')]
+
+
 # -- TCP subscribers that read slowly, or stop reading (issue 29) ---------------------------
 class Clock:
     def __init__(self) -> None:

@@ -17,10 +17,11 @@ from pathlib import Path
 import rosgraph
 import rospy
 
+from tutorial_atlas_control import topics
 from tutorial_atlas_control.cli.convention import EXIT_REFUSED
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.launch_args import unknown_arg_lines
-from tutorial_atlas_control.node import refuse_if_running, sim_node
+from tutorial_atlas_control.node import follow_own_clock, refuse_if_running, sim_node
 from tutorial_atlas_control.node.sim_node import NODE_NAME, build_node
 from tutorial_atlas_control.processes import PACKAGE
 from tutorial_atlas_control.resources import package_path
@@ -85,6 +86,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except AtlasControlError as err:
         rospy.logfatal(f'{NODE_NAME}: {err}')
         return EXIT_REFUSED
+    # Its own /clock is not received back (node/own_clock.py).
+    follow_own_clock(node.loop.outbox, node.publishers[topics.CLOCK])
     rospy.loginfo(f'Atlas v1 simulator ready: dt={node.sim.dt_s * 1000:.1f} ms, '
                   f'real_time_factor={node.loop.real_time_factor}, paused={node.loop.paused}, '
                   f'torso pinned for {node.sim.time_to_unpin_s} s')

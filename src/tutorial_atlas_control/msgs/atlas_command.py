@@ -149,6 +149,25 @@ _FULL_ROWS = tuple(LAW_FIELDS.index(name) for name, _ in ATLAS_COMMAND_FIELDS)
 _K_EFFORT_INDEX = _FULL_ROWS.index(K_EFFORT_ROW)
 
 
+def _full_groups() -> tuple[tuple[int, int, np.dtype, int], ...]:
+    """Consecutive arrays of one type in the full body, each read as one strided view:
+    (first row, rows, type, offset of the first array's data after the header)."""
+    groups: list[list] = []
+    offset = 0
+    for row, (_, dtype) in enumerate(ATLAS_COMMAND_FIELDS):
+        offset += 4  # the array's count
+        if groups and groups[-1][2] == dtype:
+            groups[-1][1] += 1
+        else:
+            groups.append([row, 1, dtype, offset])
+        offset += dtype.itemsize * NUM_JOINTS
+    return tuple((first, count, dtype, start) for first, count, dtype, start in groups)
+
+
+#: The full body's arrays by group; one array's count and data make each group's row stride.
+_FULL_GROUPS = _full_groups()
+
+
 def _decode_full(raw: bytes) -> AtlasUpdate | None:
     """The fast path for an AtlasCommand whose arrays all have 28 entries; None otherwise."""
     try:
@@ -161,14 +180,15 @@ def _decode_full(raw: bytes) -> AtlasUpdate | None:
         return None
     if any(count != NUM_JOINTS for count in _FULL_COUNTS.unpack_from(raw, start)):
         return None
-    body = np.frombuffer(raw, dtype=_FULL_BODY, count=1, offset=start)[0]
     block = np.empty((len(_FULL_ROWS), NUM_JOINTS))
-    for row, (name, _) in enumerate(ATLAS_COMMAND_FIELDS):
-        block[row] = body[name]
+    for first, count, dtype, offset in _FULL_GROUPS:
+        row_bytes = 4 + dtype.itemsize * NUM_JOINTS
+        block[first:first + count] = np.ndarray((count, NUM_JOINTS), dtype, raw, start + offset,
+                                                (row_bytes, dtype.itemsize))
     check_values(_FULL_ROWS, block)
     block[_K_EFFORT_INDEX] /= K_EFFORT_FULL_SCALE
-    return AtlasUpdate(CommandUpdate(ALL_JOINTS, _FULL_ROWS, block), (), stamp_ns,
-                       int(body['desired_controller_period_ms']))
+    # The body's last byte: desired_controller_period_ms (uint8).
+    return AtlasUpdate(CommandUpdate(ALL_JOINTS, _FULL_ROWS, block), (), stamp_ns, raw[-1])
 
 
 def decode_atlas_command(raw: bytes) -> AtlasUpdate:

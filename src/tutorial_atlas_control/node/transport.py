@@ -277,6 +277,12 @@ class WireBatch:
         self.writer = writer if writer is not None else ConnectionWriter()
         self.pending: dict[rospy.Publisher, bytearray] = {}
         self.latest: dict[rospy.Publisher, bytearray] = {}
+        self.watchers: dict[rospy.Publisher, Callable[[bytearray], None]] = {}
+
+    def watch(self, pub: rospy.Publisher, sent: Callable[[bytearray], None]) -> None:
+        """Call `sent(data)` with what each flush has just written for `pub` (the node's
+        own time follows the /clock it sends: node/own_clock.py)."""
+        self.watchers[pub] = sent
 
     @staticmethod
     def wanted(pub: rospy.Publisher) -> bool:
@@ -299,10 +305,14 @@ class WireBatch:
     def flush(self) -> None:
         pending, self.pending = self.pending, {}
         latest, self.latest = self.latest, {}
-        write = self.writer.write
+        write, watchers = self.writer.write, self.watchers
         for batches in (pending, latest):
             for pub, data in batches.items():
                 write(pub, data)
+                if watchers:
+                    sent = watchers.get(pub)
+                    if sent is not None:
+                        sent(data)
 
     def drain(self) -> None:
         """Send what stalled connections still hold (rospy.on_shutdown: see ConnectionWriter)."""

@@ -109,6 +109,14 @@ class CompiledLaw:
         """Point the kernel at another command's arrays (a new command arrived)."""
         arrays = tuple(getattr(command, name) for name in LAW_FIELDS)
         count = self._step.n
+        block = command.rows_block()
+        if block is not None and block.shape == (len(LAW_FIELDS), count):
+            # One address for the ten rows (JointCommandArrays.copy: a new command's).
+            base, row_bytes = address(block, np.float64), block.strides[0]
+            for index in range(len(LAW_FIELDS)):
+                self._step.command[index] = base + index * row_bytes
+            self._command, self._command_arrays = command, arrays
+            return
         for index, (name, array) in enumerate(zip(LAW_FIELDS, arrays)):
             if array.shape != (count,):
                 raise ValueError(f'command.{name} has shape {array.shape}, expected ({count},)')
