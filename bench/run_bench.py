@@ -246,7 +246,7 @@ BUDGETS = {
 }
 
 
-#: The targets of issues 8, 18, 19 and 25 (bench/README.md), by JSON key.
+#: The targets (bench/README.md), by JSON key.
 TARGETS = {
     'unheard_topic_us_per_step': Target(high=1.0, strict=True),
     'offline_ratio': Target(low=0.8),
@@ -255,7 +255,7 @@ TARGETS = {
     'node_us_per_step': Target(high=1.5, per_bare='us'),
     'node_bare_ratio': Target(high=1.5),
     'fast_recorded_fraction': Target(low=1.0, high=1.0),
-    # Issue 28: with TF on (the simulator publishing the links), the master idles.
+    # With TF on (the simulator publishing the links), the master idles.
     'fast_master_cpu': Target(high=0.01, strict=True),
     'realtime_rtf': Target(low=0.99, high=1.01),
     'lateness_p99_ms': Target(high=2.0, strict=True),
@@ -282,7 +282,7 @@ TARGETS = {
     'controller_udp_age_p99_ms': Target(low=1.0, high=1.0),
     # The window's promise: every step obeys the answer to the state before it.
     'controller_window_age_p99_ms': Target(low=1.0, high=1.0),
-    # Issue 27: the search, run again whole, finds the committed step (one machine).
+    # The search, run again whole, finds the committed step (one machine).
     'search_reproduced': Target(low=1.0, high=1.0),
 }
 
@@ -443,7 +443,7 @@ def run_offline(args: argparse.Namespace, samples: dict[str, list[float]],
 
 def run_sweep(args: argparse.Namespace, samples: dict[str, list[float]],
               loads: dict[str, str]) -> None:
-    """Offline runs per second through sweep.py's Dask engine on 1 and 2 workers (issue 27)."""
+    """Offline runs per second through sweep.py's Dask engine on 1 and 2 workers."""
     if 'sweep' not in args.sections:
         return
     import sweep_rate
@@ -459,7 +459,7 @@ def run_sweep(args: argparse.Namespace, samples: dict[str, list[float]],
 
 def run_search(args: argparse.Namespace, samples: dict[str, list[float]],
                loads: dict[str, str], work_dir: Path) -> None:
-    """The wall time of the search that found Stepping.yaml's step (issue 27), once whatever
+    """The wall time of the search that found Stepping.yaml's step, once whatever
     --runs says: whole (about ten minutes on 2 cores) with --full or `--only search`, else
     the budget's few generations (the search's speed: search_runs_per_s)."""
     if 'search' not in args.sections:
@@ -607,7 +607,7 @@ def run_fast(args, samples, master, probes, work_dir) -> None:  # noqa: ANN001
     import online
 
     variants = (('atlas_recorder', 'fast', None), ('rosbag', 'fast_rosbag', None),
-                # Debian's robot_state_publisher publishing the links (issue 28: the
+                # Debian's robot_state_publisher publishing the links (the
                 # master's and its CPU, beside the default's).
                 ('atlas_recorder', 'fast_rsp', {'tf_publisher': 'robot_state_publisher'}))
     for run in range(args.runs):
@@ -672,7 +672,7 @@ def summarize(samples: dict[str, list[float]],
             sum(cpus) * 1e6 / (rtf * per_sim_s)
             for rtf, *cpus in zip(samples['fast_rtf'], *(samples[key] for key in cpu_keys))]
         medians['fast_cpu_us_per_step'] = statistics.median(samples['fast_cpu_us_per_step'])
-    if 'bare_physics_steps_per_s' in medians:  # issue 18's targets: ratios to bare mj_step
+    if 'bare_physics_steps_per_s' in medians:  # targets as ratios to bare mj_step
         bare = medians['bare_physics_steps_per_s']
         for key, ratio in (('fast_rtf', lambda rtf: rtf * per_sim_s / bare),
                            ('node_us_per_step', lambda us: us * bare / 1e6)):

@@ -1,4 +1,4 @@
-"""Wall time of the search that found Stepping.yaml's step_and_stand, run again (issue 27).
+"""Wall time of the search that found Stepping.yaml's step_and_stand, run again.
 
 The arguments are the ones Stepping.yaml's header gives; search.py runs on its default local
 cluster (one worker per core) and the wall time includes starting it, as a user's run does.

@@ -139,7 +139,7 @@ def test_the_tutorial_runs_from_an_install_space(tmp_path: Path) -> None:
     assert all(within(line, prefix / 'lib') for line in where.stdout.split()), where.stdout
     found = run(env, 'rospack', 'find', PACKAGE)
     assert found.stdout.strip() == str(share), found
-    # The installed controller (issue 26) runs from the prefix: its usage on stdout, exit 0.
+    # The installed echo_controller runs from the prefix: its usage on stdout, exit 0.
     echo = run(env, 'rosrun', PACKAGE, 'echo_controller', '--help')
     assert (echo.returncode, echo.stdout.splitlines()[0]) == (
         0, 'usage: echo_controller [--transport tcp|udp|udp-then-tcp] [--period-ms N]'), echo

@@ -1,6 +1,6 @@
 """rviz.launch beside atlas.launch, under a real X server (Xvfb) with software OpenGL: the
 robot model is drawn in the 3D view, and rviz reports no missing frame or robot_description.
-Also the bad inputs of issue 15: rviz without a display, and a model variant without a URDF.
+Also the bad inputs: rviz without a display, and a model variant without a URDF.
 
 Robot pixels are found from the model's material colours (support.xdisplay.material_mask)
 inside rviz's 3D view (the area of its background colour); rviz draws the URDF's colours,

@@ -1,4 +1,4 @@
-"""The ROS master killed and restarted under a running atlas.launch (issue 29).
+"""The ROS master killed and restarted under a running atlas.launch.
 
 The master runs apart from the launch (as `roscore` in a terminal of its own). It is
 killed (SIGKILL) mid-run: the simulator says so in one line and goes on stepping, and the

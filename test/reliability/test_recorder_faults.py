@@ -1,4 +1,4 @@
-"""The recorder's faults in a running atlas.launch (issue 29): killed, disk full, bag_dir.
+"""The recorder's faults in a running atlas.launch: killed, disk full, bag_dir.
 
 Each injects the fault from outside, then checks what the user sees (the simulator's and
 the recorder's one line, analyze_bag.py's one line and exit status) and what is recovered

@@ -1,4 +1,4 @@
-"""A subscriber to /atlas/joint_states that stops reading its socket (issue 29).
+"""A subscriber to /atlas/joint_states that stops reading its socket.
 
 It connects over TCPROS as any node does, then reads nothing. Once the socket buffers are
 full, the simulator (node/transport.py) waits for it one STALL_PROBE_S slice, then keeps

@@ -90,7 +90,7 @@ SERVICES = {
     '/gazebo/unpause_physics': 'std_srvs/Empty',
 }
 
-#: Being added on other branches (issue 25): absent is not (yet) a failure. Shrink this as
+#: Being added on other branches: absent is not (yet) a failure. Shrink this as
 #: they merge; the test prints the entries that are served and could leave it.
 NOT_YET_SERVED: frozenset[str] = frozenset()
 

@@ -2,7 +2,7 @@
 """rostest: trajectories/Stepping.yaml's step_and_stand, live, with the real traj_yaml.py.
 
 atlas.launch with config/stepping_gains.yaml, User mode, then traj_yaml.py, as Stepping.yaml's
-header says. The checks are issue 27's: the right foot lifts, lands at least 0.15 m further
+header says. The checks are the step's goals: the right foot lifts, lands at least 0.15 m further
 forward, and the robot stands the 5 s after with the pelvis above 0.8 m. The feet are placed
 by forward kinematics from /ground_truth_odom and the joint states of the same stamp.
 """

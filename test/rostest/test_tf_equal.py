@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """rostest: the simulator's links' transforms equal Debian's robot_state_publisher's on the
-same /atlas/joint_states (issue 28): same frames, same stamps, within 1e-9.
+same /atlas/joint_states: same frames, same stamps, within 1e-9.
 
 The launch (tf_equal.test) starts paused with a second robot_state_publisher on /tf_rsp;
 the test waits for both publishers, unpauses and watches WATCH_S of sim time.

@@ -2,7 +2,7 @@
 """rostest: one tutorial trajectory, run with the real traj_yaml.py, judged by what the robot did.
 
 Private parameters: ~trajectory (step_and_fall | touchdown | touchdown_exhausted | standing).
-The checks are the tutorial's promises (issue 6): step_and_fall lifts the right foot in its
+The checks are the tutorial's promises: step_and_fall lifts the right foot in its
 first waypoint and falls; touchdown tracks the arms and stays up; touchdown_exhausted tracks
 the arms and ends on the ground; the falls come when the README says; standing stands 20 s
 with no command.
@@ -30,7 +30,7 @@ from tutorial_atlas_control.trajectories.trajectory import load_trajectory, samp
 PKG = 'tutorial_atlas_control'
 TRAJECTORY_FILE = Path(__file__).resolve().parents[2] / 'trajectories' / 'Traj_data2.yaml'
 ARM_JOINTS = ('l_arm_shx', 'r_arm_shx', 'l_arm_elx', 'r_arm_elx')
-#: Acceptance thresholds (issue 6).
+#: Acceptance thresholds.
 ARM_TOLERANCE_RAD = 0.1
 FOOT_LIFT_M = 0.03
 FOOT_UNLOADED_N = 30.0  # the ankle sensor still carries the foot's own weight (16 N)

@@ -123,7 +123,7 @@ class UdprosTest(unittest.TestCase):
         for sock in receivers:
             sock.close()
         # /atlas/synchronization_statistics is sent only while an AtlasCommand asks for the
-        # synchronization window (issue 26), which none does here: served, never sent.
+        # synchronization window, which none does here: served, never sent.
         self.assertEqual(sorted(received), [topic for topic in published
                                             if topic != '/atlas/synchronization_statistics'])
         rospy.loginfo(f'UDPROS: one message from each of {len(published)} topics; blocks '

@@ -1,4 +1,4 @@
-"""Gravity stiffness of a stance joint: why single support needs stiffer gains (issue 27).
+"""Gravity stiffness of a stance joint: why single support needs stiffer gains.
 
 Standing on one foot, everything the stance leg carries above a roll joint is an inverted
 pendulum about that joint's axis: tipped by a small angle, gravity pulls it further with a

@@ -1,4 +1,4 @@
-"""Damaged bags given to analyze_bag.py, replay_bag.py and analyze_bag.py --compare (issue 29).
+"""Damaged bags given to analyze_bag.py, replay_bag.py and analyze_bag.py --compare.
 
 Each damage gives one line on stderr (`<prog>: error: ...`) and exit status 1, never a
 traceback: a truncated bag (cut in its header, a chunk or its index), a wrong MD5 on a

@@ -164,6 +164,23 @@ def test_no_page_cites_issue_numbers(page: Path) -> None:
     assert issue_citations(page) == []
 
 
+#: Source and build files whose comments and docstrings must not cite the tracker either: the
+#: tracker is not in the repository, so "issue 27" tells a reader nothing.
+CODE_SUFFIXES = ('.py', '.c', '.cpp', '.sh', '.launch', '.test', '.yaml', '.xml', '.txt')
+CODE_DIRS = ('src', 'scripts', 'test', 'bench', 'tools', 'launch', 'config', 'trajectories',
+             'msg', 'sim')
+
+
+def test_no_code_cites_issue_numbers() -> None:
+    files = [path for folder in CODE_DIRS for path in sorted((REPO / folder).rglob('*'))
+             if path.suffix in CODE_SUFFIXES and path.name != Path(__file__).name]
+    files += [REPO / name for name in ('Makefile', 'CMakeLists.txt', 'env.sh')]
+    assert len(files) > 100, 'the code was not found'
+    cited = [f'{path.relative_to(REPO)}: {match.group(0)!r}' for path in files
+             for match in ISSUE_NUMBER.finditer(path.read_text(errors='replace'))]
+    assert not cited, 'say what the code does, not which issue asked for it:\n' + '\n'.join(cited)
+
+
 # -- the checks themselves, on synthetic trees -----------------------------------------------
 
 @pytest.mark.parametrize(('heading', 'slug'), [

@@ -1,5 +1,5 @@
 """sim/link_transforms.py: the links' transforms the simulator publishes in
-robot_state_publisher's stead (issue 28), against MuJoCo's body poses and RSP 1.15's rules."""
+robot_state_publisher's stead, against MuJoCo's body poses and RSP 1.15's rules."""
 
 from __future__ import annotations
 

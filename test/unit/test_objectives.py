@@ -1,4 +1,4 @@
-"""search/objectives.py's steps_forward (issue 27's stretch goal: steps in a row): its cost is
+"""search/objectives.py's steps_forward (steps in a row): its cost is
 0 only when every goal holds, grows with each shortfall, and any fall costs more than any run
 that stands, whatever its shortfalls."""
 

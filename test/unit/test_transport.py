@@ -172,7 +172,7 @@ def test_a_watcher_sees_what_each_flush_sent_after_it_was_written() -> None:
                       ('seen', 'clock', b'clock 1')]
 
 
-# -- TCP subscribers that read slowly, or stop reading (issue 29) ---------------------------
+# -- TCP subscribers that read slowly, or stop reading --------------------------------
 class Clock:
     def __init__(self) -> None:
         self.now_s = 100.0
