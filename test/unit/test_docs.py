@@ -181,6 +181,17 @@ def test_no_code_cites_issue_numbers() -> None:
     assert not cited, 'say what the code does, not which issue asked for it:\n' + '\n'.join(cited)
 
 
+def test_the_layout_page_names_every_module() -> None:
+    """docs/layout.md is where a newcomer finds a module: a new one is named there."""
+    layout = (REPO / 'docs' / 'layout.md').read_text()
+    package = REPO / 'src' / PACKAGE
+    modules = [path for path in sorted(package.rglob('*.py')) if path.name != '__init__.py']
+    assert len(modules) > 50, 'the package was not found'
+    unnamed = [str(path.relative_to(package)) for path in modules
+               if f'`{path.name}`' not in layout and f'{path.parent.name}/{path.name}' not in layout]
+    assert not unnamed, f'docs/layout.md does not name: {unnamed}'
+
+
 # -- the checks themselves, on synthetic trees -----------------------------------------------
 
 @pytest.mark.parametrize(('heading', 'slug'), [
