@@ -1,15 +1,28 @@
-"""The strings /atlas/control_mode accepts (DRCSim's), for the tools that read bags.
+"""The strings /atlas/control_mode accepts (DRCSim's): the simulator's modes and the bag tools'.
 
-The simulator's ControlMode (sim/simulator.py) is the authority; this copy keeps the bag
-tools free of MuJoCo, and a unit test keeps the two equal. A bag records every string
-published, also those the simulator refused (`user`): the tools mark those as refused.
+Here, below every subpackage, so that the bag tools mark a refused string without importing
+the simulator. A bag records every string published, also those the simulator refused
+(`user`): the tools mark those as refused.
 """
 
 from __future__ import annotations
 
-__all__ = ['VALID_CONTROL_MODES', 'is_refused_mode']
+import enum
 
-VALID_CONTROL_MODES: tuple[str, ...] = ('Stand', 'StandPrep', 'Freeze', 'ragdoll', 'User')
+__all__ = ['ControlMode', 'VALID_CONTROL_MODES', 'is_refused_mode']
+
+
+class ControlMode(str, enum.Enum):
+    """The strings DRCSim accepted on /atlas/control_mode."""
+
+    STAND = 'Stand'
+    STAND_PREP = 'StandPrep'
+    FREEZE = 'Freeze'
+    RAGDOLL = 'ragdoll'
+    USER = 'User'
+
+
+VALID_CONTROL_MODES: tuple[str, ...] = tuple(mode.value for mode in ControlMode)
 
 
 def is_refused_mode(mode: str) -> bool:

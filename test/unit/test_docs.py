@@ -188,7 +188,8 @@ def test_the_layout_page_names_every_module() -> None:
     modules = [path for path in sorted(package.rglob('*.py')) if path.name != '__init__.py']
     assert len(modules) > 50, 'the package was not found'
     unnamed = [str(path.relative_to(package)) for path in modules
-               if f'`{path.name}`' not in layout and f'{path.parent.name}/{path.name}' not in layout]
+               if f'`{path.name}`' not in layout
+               and f'{path.parent.name}/{path.name}' not in layout]
     assert not unnamed, f'docs/layout.md does not name: {unnamed}'
 
 

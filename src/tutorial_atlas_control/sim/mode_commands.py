@@ -11,7 +11,6 @@ every k_effort to 1 (255) and any other switch sets them to 0.
 
 from __future__ import annotations
 
-import enum
 from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
@@ -22,6 +21,7 @@ from tutorial_atlas_control.command import (
     JointCommandArrays,
     command_update,
 )
+from tutorial_atlas_control.control_modes import VALID_CONTROL_MODES, ControlMode
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.sim.controller import Gains, hold_command
@@ -31,17 +31,7 @@ from tutorial_atlas_control.sim.controller import Gains, hold_command
 K_EFFORT_PID = 255
 
 
-class ControlMode(str, enum.Enum):
-    """The strings DRCSim accepted on /atlas/control_mode."""
-
-    STAND = 'Stand'
-    STAND_PREP = 'StandPrep'
-    FREEZE = 'Freeze'
-    RAGDOLL = 'ragdoll'
-    USER = 'User'
-
-
-VALID_MODES: tuple[str, ...] = tuple(mode.value for mode in ControlMode)
+VALID_MODES: tuple[str, ...] = VALID_CONTROL_MODES
 #: What ResetControls' reload_pid_from_ros sets in the user command (k_effort to 1).
 GAIN_FIELDS: tuple[str, ...] = ('kp_position', 'ki_position', 'kd_position', 'i_effort_min',
                                 'i_effort_max', 'k_effort')
