@@ -144,9 +144,12 @@ def _client(scheduler: str | None, workers: int) -> Any:
             raise SweepError(f'cannot reach the Dask scheduler at {scheduler}: '
                              f'{str(err).splitlines()[0] if str(err) else type(err).__name__}'
                              ) from None
+    # Workers log at CRITICAL only: a run's error reaches the client through its future, and
+    # a worker whose heartbeat meets the scheduler closing first (Ctrl-C, or any close)
+    # would print an ERROR traceback of distributed's that says nothing to the user.
     with _sigint_ignored():  # the workers inherit it: Ctrl-C is the client's alone
         cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                               dashboard_address=':0', silence_logs=logging.ERROR)
+                               dashboard_address=':0', silence_logs=logging.CRITICAL)
     return Client(cluster)
 
 
