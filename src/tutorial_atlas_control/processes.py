@@ -15,9 +15,10 @@ import os
 import signal
 import socket
 import subprocess
+import threading
 import time
 import xmlrpc.client
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import IO, Self
 
@@ -135,6 +136,45 @@ def default_sigint() -> None:
     cannot even trap a signal ignored at its start; stop_tree's Ctrl-C must reach it.
     """
     signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+def run_to_end(command: Sequence[str], env: Mapping[str, str], timeout_s: float,
+               stop_timeout_s: float = STOP_TIMEOUT_S) -> int:
+    """Run `command` (in a session of its own) to its end; its exit status.
+
+    On Ctrl-C or after `timeout_s` its tree is stopped (stop_tree) before the
+    KeyboardInterrupt or subprocess.TimeoutExpired goes on: the child must not outlive the
+    caller, who may be interrupted alone (`kill -INT`, not a terminal's Ctrl-C to the group).
+    A Ctrl-C arriving while the child is being started waits until its handle is held.
+    """
+    interrupted: list[int] = []
+    process: subprocess.Popen | None = None
+    try:
+        with _sigint_deferred(interrupted):
+            process = subprocess.Popen(list(command), env=dict(env), start_new_session=True,
+                                       preexec_fn=default_sigint)
+        if interrupted:
+            raise KeyboardInterrupt
+        return process.wait(timeout=timeout_s)
+    except BaseException:
+        if process is not None:
+            stop_tree(process, stop_timeout_s)
+        raise
+
+
+@contextlib.contextmanager
+def _sigint_deferred(caught: list[int]) -> Iterator[None]:
+    """Within: SIGINT is noted in `caught` instead of raising KeyboardInterrupt (only where
+    Python's default handler is installed, and only in the main thread, as signal requires)."""
+    deferring = (threading.current_thread() is threading.main_thread()
+                 and signal.getsignal(signal.SIGINT) is signal.default_int_handler)
+    if deferring:
+        signal.signal(signal.SIGINT, lambda signum, _frame: caught.append(signum))
+    try:
+        yield
+    finally:
+        if deferring:
+            signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def _signal_group(process: subprocess.Popen, sig: int) -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
+import threading
 from pathlib import Path
 
 import pytest
@@ -19,6 +20,7 @@ from tutorial_atlas_control.processes import (
     descendants,
     free_local_port,
     rss_kib,
+    run_to_end,
     stop_tree,
     wait_until,
 )
@@ -130,3 +132,53 @@ def test_a_missing_roslaunch_is_one_line(tmp_path: Path, monkeypatch: pytest.Mon
     monkeypatch.setenv('PATH', str(tmp_path))
     with pytest.raises(ProcessError, match=r'^roslaunch is not on PATH; run `make setup`'):
         AtlasLaunch(tmp_path / 'launch.log', {})
+
+
+def _pid_written_to(path: Path) -> int:
+    wait_until(lambda: path.exists() and path.read_text().strip() != '', GUARD_S,
+               f'the child did not write {path}')
+    return int(path.read_text())
+
+
+def test_run_to_end_returns_the_exit_status() -> None:
+    assert run_to_end(['bash', '-c', 'exit 3'], os.environ, GUARD_S) == 3
+
+
+def test_run_to_end_stops_the_child_when_its_caller_alone_gets_ctrl_c(tmp_path: Path) -> None:
+    pid_file = tmp_path / 'pid'
+    child = f'echo $$ > {pid_file}; exec sleep 300'
+
+    def interrupt_once_started() -> None:
+        _pid_written_to(pid_file)
+        os.kill(os.getpid(), signal.SIGINT)  # to this process only, as `kill -INT`
+
+    threading.Thread(target=interrupt_once_started, daemon=True).start()
+    with pytest.raises(KeyboardInterrupt):
+        run_to_end(['bash', '-c', child], os.environ, GUARD_S, stop_timeout_s=GUARD_S)
+    assert not alive([_pid_written_to(pid_file)])
+
+
+def test_run_to_end_stops_the_child_at_its_timeout(tmp_path: Path) -> None:
+    pid_file = tmp_path / 'pid'
+    with pytest.raises(subprocess.TimeoutExpired) as timeout:
+        run_to_end(['bash', '-c', f'echo $$ > {pid_file}; exec sleep 300'], os.environ, 1.0)
+    assert timeout.value.cmd[0] == 'bash'
+    assert not alive([_pid_written_to(pid_file)])
+
+
+def test_a_ctrl_c_while_the_child_starts_is_raised_once_it_can_be_stopped(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    real_popen = subprocess.Popen
+    started: list[int] = []
+
+    def popen_then_ctrl_c(*args: object, **kwargs: object) -> subprocess.Popen:
+        process = real_popen(*args, **kwargs)  # type: ignore[call-overload]
+        started.append(process.pid)
+        os.kill(os.getpid(), signal.SIGINT)  # lands before Popen has returned its handle
+        return process
+
+    monkeypatch.setattr(subprocess, 'Popen', popen_then_ctrl_c)
+    with pytest.raises(KeyboardInterrupt):
+        run_to_end(['sleep', '300'], os.environ, GUARD_S, stop_timeout_s=GUARD_S)
+    assert started
+    assert not alive(started)

@@ -10,7 +10,6 @@ a running one.
 from __future__ import annotations
 
 import os
-import subprocess
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -23,7 +22,7 @@ from tutorial_atlas_control.bags import (
     short_summary,
 )
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.processes import AtlasLaunch
+from tutorial_atlas_control.processes import AtlasLaunch, run_to_end
 from tutorial_atlas_control.trajectories import GainsChoice
 
 DEFAULT_BAG_DIR = Path.home() / '.ros' / 'tutorial_atlas_control' / 'bags'
@@ -39,6 +38,8 @@ DEMO_VIDEO_SIZE = '480x360'
 STARTUP_TIMEOUT_S = 60.0
 TRAJECTORY_TIMEOUT_S = 120.0
 SHUTDOWN_TIMEOUT_S = 20.0
+#: traj_yaml.py's time to leave after Ctrl-C before it is killed (s, wall).
+TRAJECTORY_STOP_TIMEOUT_S = 5.0
 
 
 class DemoError(AtlasControlError):
@@ -116,9 +117,10 @@ def drive(launch: AtlasLaunch, trajectory: str, trajectory_file: Path,
     command = ['rosrun', 'tutorial_atlas_control', 'traj_yaml.py', str(trajectory_file),
                trajectory]
     progress('demo: ' + ' '.join(command))
-    result = subprocess.run(command, env=launch.env, timeout=TRAJECTORY_TIMEOUT_S, check=False)
-    if result.returncode != 0:
-        raise DemoError(f'traj_yaml.py exited with status {result.returncode}')
+    # Stopped with its tree on Ctrl-C: run_demo may get the signal alone (`kill -INT`).
+    status = run_to_end(command, launch.env, TRAJECTORY_TIMEOUT_S, TRAJECTORY_STOP_TIMEOUT_S)
+    if status != 0:
+        raise DemoError(f'traj_yaml.py exited with status {status}')
     wait_sim_time(Clock, END_SETTLE_S)
 
 
