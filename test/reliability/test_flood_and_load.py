@@ -31,6 +31,9 @@ from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.node.transport import MAX_BACKLOG_BYTES
 from tutorial_atlas_control.processes import rss_kib
 
+#: Timing or memory claims: run alone, after make test's parallel part.
+pytestmark = pytest.mark.serial
+
 #: The issue's figures.
 FLOOD_S = 10.0
 LOAD_PUBLISHERS = 3

@@ -77,7 +77,8 @@ def test_master_killed_and_restarted(tmp_path: Path) -> None:
             assert master.getParam('/test', '/use_sim_time')[2] is True
             assert master.getParam('/test', '/atlas/time_to_unpin')[2] == 1.0
             assert master.getParam('/test', '/atlas_controller/gains/l_arm_elx/p')[0] == 1
-            after_s = launch.sim_time_s()  # a new client: `rostopic echo /clock`
+            launch.close_talker()  # the next reads and writes come from a new client
+            after_s = launch.sim_time_s()
             assert after_s > before_s
             launch.set_mode('User')  # a new publisher reaches the simulator's subscription
             launch.wait(lambda: 'control mode: Stand -> User' in launch.output(),

@@ -34,6 +34,9 @@ from support.launch import TestLaunch
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.stepping.schedule import steps_between
 
+#: Timing or memory claims: run alone, after make test's parallel part.
+pytestmark = pytest.mark.serial
+
 #: Sim time (s) recorded after the launch is ready.
 RUN_S = 4.0
 STEP_NS = 1_000_000

@@ -27,6 +27,9 @@ from tutorial_atlas_control.bags.reader import JOINT_STATE_MD5, read_bag
 from tutorial_atlas_control.node.transport import MAX_BACKLOG_BYTES
 from tutorial_atlas_control.processes import rss_kib
 
+#: Timing or memory claims: run alone, after make test's parallel part.
+pytestmark = pytest.mark.serial
+
 STALLED = '/stalled_subscriber'
 LIVE = '/live_subscriber'
 DROPPED = f'/atlas/joint_states: dropping subscriber {STALLED}: timed out'

@@ -18,6 +18,9 @@ import pytest
 
 from support.launch import SIM, TestLaunch, node_api
 
+#: Timing or memory claims: run alone, after make test's parallel part.
+pytestmark = pytest.mark.serial
+
 #: rospy's own backlog is 5; a dozen topics connect at once.
 MIN_BACKLOG = 64
 

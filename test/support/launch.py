@@ -10,12 +10,14 @@ with the launch's output; they are bounded in wall time only as guards against h
 from __future__ import annotations
 
 import json
+import select
 import subprocess
 import sys
 import time
 import xmlrpc.client
 from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -23,6 +25,7 @@ from tutorial_atlas_control import processes
 
 REPO = Path(__file__).resolve().parents[2]
 FLOOD = REPO / 'tools' / 'flood_commands.py'
+TALKER = Path(__file__).resolve().with_name('ros_talker.py')
 SIM, RECORDER = '/atlas_sim', '/recorder'
 #: Wall-clock guards (s): far beyond what any step takes on a loaded machine.
 STARTUP_TIMEOUT_S = 120.0
@@ -43,6 +46,41 @@ def node_api(master_uri: str, node: str, caller: str) -> xmlrpc.client.ServerPro
     return xmlrpc.client.ServerProxy(uri)
 
 
+class Talker:
+    """ros_talker.py against one master: publishes and reads topics in milliseconds."""
+
+    def __init__(self, env: Mapping[str, str], log_path: Path) -> None:
+        self.log_path = log_path
+        with log_path.open('a') as log:
+            self.process = subprocess.Popen(
+                [sys.executable, '-u', str(TALKER)], env=dict(env), stdin=subprocess.PIPE,
+                stdout=subprocess.PIPE, stderr=log, text=True)
+
+    def ask(self, answer_within_s: float, **request: Any) -> dict[str, Any]:
+        """One request, its reply; fails the test on an error or after `answer_within_s`."""
+        assert self.process.stdin is not None and self.process.stdout is not None
+        self.process.stdin.write(json.dumps(request) + '\n')
+        self.process.stdin.flush()
+        ready, _, _ = select.select([self.process.stdout], [], [], answer_within_s)
+        line = self.process.stdout.readline() if ready else ''
+        if not line:
+            pytest.fail(f'ros_talker.py did not answer {request} within {answer_within_s:.0f} s; '
+                        f'see {self.log_path}')
+        reply = json.loads(line)
+        if 'error' in reply:
+            pytest.fail(f'ros_talker.py: {request}: {reply["error"]}')
+        return reply
+
+    def close(self) -> None:
+        if self.process.stdin is not None and not self.process.stdin.closed:
+            self.process.stdin.close()
+        try:
+            self.process.wait(timeout=10.0)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            self.process.wait()
+
+
 class TestLaunch(processes.AtlasLaunch):
     """One `roslaunch tutorial_atlas_control atlas.launch` run, and what it left behind."""
 
@@ -58,6 +96,8 @@ class TestLaunch(processes.AtlasLaunch):
         super().__init__(tmp_path / 'atlas_launch.log', launch_args,
                          ros_log_dir=tmp_path / 'ros_log', base_env=base_env,
                          launch_file=launch_file, master=master)
+        self._talker: Talker | None = None
+        self._talker_log = tmp_path / 'ros_talker.log'
 
     # -- processes ------------------------------------------------------------------------
     def pid_of(self, fragment: str) -> int:
@@ -98,6 +138,14 @@ class TestLaunch(processes.AtlasLaunch):
         connected = {row[4] for row in bus if row[1] == RECORDER and row[2] == 'o'}
         return sorted(recorded - connected)
 
+    def interrupt(self, timeout_s: float = processes.STOP_TIMEOUT_S) -> float:
+        self.close_talker()  # not a node of the launch: it would outlive the master
+        return super().interrupt(timeout_s)
+
+    def close(self, timeout_s: float = processes.STOP_TIMEOUT_S) -> bool:
+        self.close_talker()
+        return super().close(timeout_s)
+
     def wait_exit(self, timeout_s: float = EXIT_TIMEOUT_S) -> int:
         try:
             return self.process.wait(timeout=timeout_s)
@@ -109,25 +157,43 @@ class TestLaunch(processes.AtlasLaunch):
         return subprocess.run(command, env=self.env, capture_output=True, text=True,
                               timeout=timeout_s, check=False)
 
+    @property
+    def talker(self) -> Talker:
+        """This launch's ros_talker.py, started at its first use."""
+        if self._talker is None:
+            self._talker = Talker(self.env, self._talker_log)
+        return self._talker
+
+    def close_talker(self) -> None:
+        """Stop the talker (the next use starts a new client, as a new `rostopic` would)."""
+        if self._talker is not None:
+            self._talker.close()
+            self._talker = None
+
+    def publish(self, topic: str, msg_type: str, yaml_text: str) -> None:
+        """`rostopic pub -1 topic msg_type -- yaml_text`, once every subscriber is connected."""
+        self.talker.ask(SIM_TIME_TIMEOUT_S, do='publish', topic=topic, type=msg_type,
+                        yaml=yaml_text)
+
+    def next_message(self, topic: str) -> dict[str, Any]:
+        """The next message on `topic`, as `rostopic echo -n 1` prints it (a YAML mapping)."""
+        return self.talker.ask(SIM_TIME_TIMEOUT_S + 5.0, do='next', topic=topic,
+                               timeout_s=SIM_TIME_TIMEOUT_S)['message']
+
     def set_mode(self, mode: str) -> None:
         """The tutorial's `rostopic pub /atlas/control_mode std_msgs/String -- User`."""
-        result = self.run('rostopic', 'pub', '-1', '/atlas/control_mode', 'std_msgs/String',
-                          '--', mode)
-        assert result.returncode == 0, result.stderr
+        self.publish('/atlas/control_mode', 'std_msgs/String', mode)
 
     def sim_time_s(self) -> float:
         """The simulator's clock now (s), from one /clock message."""
-        result = self.run('rostopic', 'echo', '-n', '1', '/clock')
-        fields = dict(line.strip().split(': ') for line in result.stdout.splitlines()
-                      if line.strip().startswith(('secs:', 'nsecs:')))
-        assert result.returncode == 0 and fields, f'no /clock: {result.stderr}'
-        return int(fields['secs']) + int(fields['nsecs']) * 1e-9
+        clock = self.next_message('/clock')['clock']
+        return int(clock['secs']) + int(clock['nsecs']) * 1e-9
 
     def wait_sim_until(self, until_s: float) -> None:
         """Until the simulator's clock reaches `until_s`: at any speed of the machine.
 
-        Sleeps the sim time still to go between readings (each is a `rostopic echo`):
-        at real_time_factor <= 1 a sim second takes at least a wall second.
+        Sleeps the sim time still to go between readings: at real_time_factor <= 1 a sim
+        second takes at least a wall second.
         """
         deadline = time.monotonic() + SIM_TIME_TIMEOUT_S
         while (now_s := self.sim_time_s()) < until_s:
@@ -135,7 +201,7 @@ class TestLaunch(processes.AtlasLaunch):
             if time.monotonic() > deadline:
                 pytest.fail(f'sim time {now_s:.1f} s did not reach {until_s:.1f} s within '
                             f'{SIM_TIME_TIMEOUT_S:.0f} s:\n{self.output()}')
-            time.sleep(max(0.2, until_s - now_s))
+            time.sleep(max(0.05, until_s - now_s))
 
     def wait_sim_s(self, seconds: float) -> None:
         """Until `seconds` of sim time have passed."""
