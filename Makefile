@@ -30,12 +30,10 @@ lint: setup
 rostest: setup
 	@$(IN_ENV) bash tools/run_rostests.sh
 
+# Lint, the rostests beside pytest on two workers, the serial tests, the quick bench
+# (tools/run_tests.sh; docs/TESTING.md).
 test: setup
-	@$(IN_ENV) python3 -m pytest test/unit test/integration test/reliability -q -rs
-	@$(IN_ENV) ruff check .
-	@$(IN_ENV) catkin_lint -W2 "$$TAC_WS/src"
-	@$(IN_ENV) bash tools/run_rostests.sh
-	@$(IN_ENV) python3 bench/run_bench.py --quick --runs 1 > /dev/null
+	@$(IN_ENV) bash tools/run_tests.sh
 
 # Every section once, short windows (~1.5 min): fails if the bench crashes or a figure is
 # missing or NaN; a MISSED target does not fail it (bench/README.md).

@@ -21,6 +21,9 @@ from tutorial_atlas_control.bags.typestore import JOINT_COMMANDS_TYPE, load_type
 from tutorial_atlas_control.joints import JOINT_NAMES, bare_joint_name
 from tutorial_atlas_control.sim.controller import load_gains_yaml
 
+#: Timing or memory claims: run alone, after make test's parallel part.
+pytestmark = pytest.mark.serial
+
 REPO = Path(__file__).resolve().parents[2]
 RUN_DEMO = REPO / 'scripts' / 'run_demo.py'
 STEPPING_GAINS = REPO / 'config' / 'stepping_gains.yaml'

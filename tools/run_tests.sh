@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# `make test`: every check of the project, in the order that takes least wall time on two
+# cores (docs/TESTING.md). Needs `source ./env.sh` (the Makefile does it).
+#   1. ruff and catkin_lint (seconds; a lint error is found before anything runs);
+#   2. pytest's independent tests on two xdist workers, and beside them, in the background,
+#      the rostests (mostly waiting on sim time) and the quick bench (it must run and give
+#      every figure; their values, measured under load here, are not judged);
+#   3. pytest's `serial` tests (timing and memory claims) with nothing else running.
+# Every part runs even if one before it failed; the exit status is 1 if any failed, and the
+# last lines name them with each part's wall time.
+set -uo pipefail
+: "${TAC_WS:?source ./env.sh first}"
+cd "$(dirname "$0")/.."
+
+failed=()
+timings=()
+
+timed() {  # timed NAME COMMAND...: run it, note its wall time and whether it failed
+  local name=$1 started=$SECONDS
+  shift
+  "$@" || failed+=("$name")
+  timings+=("$name $((SECONDS - started)) s")
+}
+
+timed ruff ruff check .
+timed catkin_lint catkin_lint -W2 "$TAC_WS/src"
+
+declare -A background_pid background_log background_started
+
+in_background() {  # in_background NAME COMMAND...: its output goes to a log shown later
+  local name=$1
+  shift
+  background_log[$name]=$(mktemp "${TMPDIR:-/tmp}/tac_${name}.XXXXXX")
+  background_started[$name]=$SECONDS
+  "$@" > "${background_log[$name]}" 2>&1 &
+  background_pid[$name]=$!
+}
+
+collect() {  # collect NAME: wait for it, show its output, note its time and status
+  local name=$1 status=0
+  wait "${background_pid[$name]}" || status=$?
+  cat "${background_log[$name]}"
+  rm -f "${background_log[$name]}"
+  [ "$status" -eq 0 ] || failed+=("$name")
+  timings+=("$name $((SECONDS - ${background_started[$name]})) s (beside pytest-parallel)")
+  unset "background_pid[$name]"
+}
+
+stop_background() {
+  local name
+  for name in "${!background_pid[@]}"; do
+    kill -- "${background_pid[$name]}" 2>/dev/null
+    rm -f "${background_log[$name]}"
+  done
+}
+trap stop_background EXIT
+
+in_background rostests bash tools/run_rostests.sh
+in_background bench-quick bash -c 'python3 bench/run_bench.py --quick --runs 1 > /dev/null'
+timed pytest-parallel python3 -m pytest test/unit test/integration test/reliability \
+  -q -rs -n 2 -m 'not serial' --durations=15
+collect rostests
+collect bench-quick
+
+timed pytest-serial python3 -m pytest test/integration test/reliability \
+  -q -rs -m serial --durations=5
+
+echo "make test: ${timings[*]/%/;} total $SECONDS s"
+if [ "${#failed[@]}" -gt 0 ]; then
+  echo "make test: FAILED: ${failed[*]}" >&2
+  exit 1
+fi
+echo 'make test: all passed'
