@@ -8,7 +8,7 @@ neck_ay moves). Keeping them in one table lets the unit tests compare the
 compiled MuJoCo model against the same numbers without the reference files.
 
 The URDF (for robot_state_publisher and rviz) has the same links, joints, limits, masses,
-inertias, shapes and colours; test/unit/test_urdf.py compares the two, kinematics included.
+inertias, shapes and colours; test/unit/sim/test_urdf.py compares the two, kinematics included.
 
 Usage: python3 tools/make_atlas_mjcf.py [OUTPUT]   (default: sim/atlas_v1.xml; the URDF
        is written beside it, same name, suffix .urdf)

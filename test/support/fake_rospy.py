@@ -3,7 +3,7 @@ faked, each publisher's one subscriber a socket to /dev/null or to a draining pr
 
 What is left is the node's own per-step work (commands, law, mj_step, serializing,
 batching and the writes), for the benchmark (bench/node_loop.py, which times it) and for
-tests of the node's shell (test/unit/test_sim_node.py).
+tests of the node's shell (test/unit/node/test_sim_node.py).
 """
 
 from __future__ import annotations

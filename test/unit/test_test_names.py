@@ -17,7 +17,7 @@ COLLECTED = ('unit', 'integration', 'reliability')
 
 def test_collected_test_files_have_distinct_names() -> None:
     names = Counter(path.name for folder in COLLECTED
-                    for path in (TEST_DIR / folder).glob('test_*.py'))
+                    for path in (TEST_DIR / folder).rglob('test_*.py'))
     assert sum(names.values()) > 50, 'the test folders were not found'
     twice = sorted(name for name, count in names.items() if count > 1)
     assert not twice, f'test files with the same name in {COLLECTED}: {twice}'

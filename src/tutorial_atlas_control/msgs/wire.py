@@ -9,7 +9,7 @@ Here each message is a bytearray laid out once (TCPROS length prefix, std_msgs/H
 constant strings) whose float fields are numpy views, so a step only copies numbers in
 and stamps the header. The node sends these bytes itself (node/transport.py); offline runs
 write them, without the TCPROS length prefix, to a bag. The layouts are checked against
-genpy in test/unit/test_wire.py.
+genpy in test/unit/msgs/test_wire.py.
 """
 
 from __future__ import annotations

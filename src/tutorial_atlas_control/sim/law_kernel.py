@@ -5,7 +5,7 @@ than its arithmetic; the C twin does the same arithmetic in one call, reading q 
 straight from MjData and writing MjData.ctrl. The same call tests the state for
 divergence (every qpos and qvel finite). The library is found and checked by
 tutorial_atlas_control.native; without it the simulator runs the numpy law, after one
-warning. Both give the same torques bit for bit (test/unit/test_law_kernel.py), so a run,
+warning. Both give the same torques bit for bit (test/unit/sim/test_law_kernel.py), so a run,
 its bag and its offline replay do not depend on which one ran.
 """
 

@@ -33,7 +33,7 @@ from tutorial_atlas_control.bags.render import (
 from tutorial_atlas_control.cli.analyze_bag import main as analyze_main
 from tutorial_atlas_control.joints import NUM_JOINTS
 
-SCRIPT = Path(__file__).resolve().parents[2] / 'scripts' / 'analyze_bag.py'
+SCRIPT = Path(__file__).resolve().parents[3] / 'scripts' / 'analyze_bag.py'
 UPRIGHT = np.array([1.0, 0.0, 0.0, 0.0])
 #: Lying face down: 90 degrees about the pelvis y axis.
 FACE_DOWN = np.array([math.cos(math.pi / 4), 0.0, math.sin(math.pi / 4), 0.0])

@@ -33,7 +33,7 @@ from tutorial_atlas_control.stepping.outputs import LoopOutputs
 from tutorial_atlas_control.stepping.pacing import Pacer
 from tutorial_atlas_control.units import NS_PER_S
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 URDF = ROOT / 'sim' / 'atlas_v1.urdf'
 CONFIG = ROOT / 'config' / 'atlas_controller.yaml'
 #: Double-precision agreement of two ways of composing the same few rotations.

@@ -19,7 +19,7 @@ from tutorial_atlas_control.sim.simulator import (
     parse_mode,
 )
 
-CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
+CONFIG = Path(__file__).resolve().parents[3] / 'config' / 'atlas_controller.yaml'
 
 
 @pytest.fixture(scope='module')

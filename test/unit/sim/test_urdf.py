@@ -15,7 +15,7 @@ from support.model_table import load_table
 from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.sim import model, urdf
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 #: The left knee's joint origin in the URDF, and the same 1 cm lower.
 KNEE_ORIGIN = '<child link="l_lleg"/>\n    <origin xyz="-0.05 0 -0.374"'
 KNEE_ORIGIN_MOVED = '<child link="l_lleg"/>\n    <origin xyz="-0.05 0 -0.384"'

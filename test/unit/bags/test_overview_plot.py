@@ -21,7 +21,7 @@ from tutorial_atlas_control.bags.report import plot_run
 from tutorial_atlas_control.trajectories.trajectory import load_trajectory
 
 matplotlib.use('Agg')
-TRAJECTORIES = Path(__file__).resolve().parents[2] / 'trajectories' / 'Traj_data2.yaml'
+TRAJECTORIES = Path(__file__).resolve().parents[3] / 'trajectories' / 'Traj_data2.yaml'
 
 
 def session(tmp_path: Path, specs: list[TrySpec]) -> Analysis:

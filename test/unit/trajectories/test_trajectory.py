@@ -26,7 +26,7 @@ from tutorial_atlas_control.trajectories.trajectory import (
     sample_count,
 )
 
-TRAJECTORY_FILE = Path(__file__).resolve().parents[2] / 'trajectories' / 'Traj_data2.yaml'
+TRAJECTORY_FILE = Path(__file__).resolve().parents[3] / 'trajectories' / 'Traj_data2.yaml'
 
 ZEROS = ' '.join(['0'] * NUM_JOINTS)
 

@@ -31,7 +31,7 @@ from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED
 from tutorial_atlas_control.demo import demo_node as demo
 from tutorial_atlas_control.plotting import plot_topics_node as plot_node
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 TRAJECTORY_FILE = REPO / 'trajectories' / 'Traj_data2.yaml'
 #: Long enough (s of sim time) that the run is still simulating when the signal comes.
 LONG_SETTLE_S = '10000'

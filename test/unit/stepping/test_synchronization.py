@@ -42,7 +42,7 @@ from tutorial_atlas_control.stepping.synchronization import (
 )
 from tutorial_atlas_control.units import NS_PER_S
 
-CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
+CONFIG = Path(__file__).resolve().parents[3] / 'config' / 'atlas_controller.yaml'
 BUDGETS = DelayBudgets(window_size_s=1.0, max_per_window_s=0.06, max_per_step_s=0.025)
 STEP_NS = NS_PER_S // 1000
 

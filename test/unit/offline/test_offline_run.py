@@ -22,7 +22,7 @@ from tutorial_atlas_control.offline.player import run_offline
 from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.trajectories.trajectory import TrajectoryError
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 SCRIPT = REPO / 'scripts' / 'run_offline.py'
 GAINS = REPO / 'config' / 'atlas_controller.yaml'
 ELX = JOINT_NAMES.index('l_arm_elx')

@@ -26,7 +26,7 @@ from tutorial_atlas_control.trajectories.catalog import (
 )
 from tutorial_atlas_control.trajectories.trajectory import TrajectoryError, load_trajectory_file
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 TUTORIAL = REPO / 'trajectories' / 'Traj_data2.yaml'
 STEPPING = REPO / 'trajectories' / 'Stepping.yaml'
 QUICK_STEP = REPO / 'trajectories' / 'QuickStep.yaml'

@@ -40,7 +40,7 @@ from tutorial_atlas_control.trajectories.traj_yaml_node import (
 )
 from tutorial_atlas_control.trajectories.trajectory import Waypoint, sample_count
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 SCRIPT = REPO / 'scripts' / 'traj_yaml.py'
 TRAJECTORY_FILE = REPO / 'trajectories' / 'Traj_data2.yaml'
 USAGE_LINES = ['usage: traj_yaml.py YAML_FILE TRAJECTORY_NAME',

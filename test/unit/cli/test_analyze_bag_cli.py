@@ -26,7 +26,7 @@ from support.synthetic_bags import (
 from tutorial_atlas_control.cli.analyze_bag import main
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 
-SCRIPT = Path(__file__).resolve().parents[2] / 'scripts' / 'analyze_bag.py'
+SCRIPT = Path(__file__).resolve().parents[3] / 'scripts' / 'analyze_bag.py'
 
 
 @pytest.fixture(scope='module')

@@ -15,7 +15,7 @@ from tutorial_atlas_control.command import arrays as commands
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.sim import controller, model
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 REFERENCE = REPO.parent / 'shared' / 'reference'
 GAINS_YAML = REPO / 'config' / 'atlas_controller.yaml'
 

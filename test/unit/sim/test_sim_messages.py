@@ -18,7 +18,7 @@ from tutorial_atlas_control.trajectories.schedule import (
     trajectory_log_line,
 )
 
-GAINS = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
+GAINS = Path(__file__).resolve().parents[3] / 'config' / 'atlas_controller.yaml'
 
 
 @pytest.fixture(scope='module')

@@ -29,7 +29,7 @@ from tutorial_atlas_control.sim.simulator import AtlasSimulator
 from tutorial_atlas_control.sim.vrc import InputError, TrajectoryInput, input_from_dict
 from tutorial_atlas_control.units import NS_PER_S
 
-CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
+CONFIG = Path(__file__).resolve().parents[3] / 'config' / 'atlas_controller.yaml'
 
 
 @pytest.fixture(scope='module')

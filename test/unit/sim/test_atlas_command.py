@@ -32,7 +32,7 @@ from tutorial_atlas_control.stepping.controls import ResetControlsRequest
 from tutorial_atlas_control.stepping.loop import SteppingLoop
 from tutorial_atlas_control.units import NS_PER_S
 
-CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
+CONFIG = Path(__file__).resolve().parents[3] / 'config' / 'atlas_controller.yaml'
 ELX = JOINT_INDEX['l_arm_elx']
 N = NUM_JOINTS
 

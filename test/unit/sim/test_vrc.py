@@ -18,7 +18,7 @@ from tutorial_atlas_control.sim.joint_trajectory import TrajectoryMessage, traje
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode
 from tutorial_atlas_control.sim.vrc import InputError, ModeInput, VrcMode
 
-CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
+CONFIG = Path(__file__).resolve().parents[3] / 'config' / 'atlas_controller.yaml'
 #: Standing, each ankle carries about half the robot's weight (N, foot z).
 STANDING_ANKLE_N = 430.0
 

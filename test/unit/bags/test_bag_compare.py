@@ -31,7 +31,7 @@ from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.trajectories.schedule import trajectory_log_line
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 ELX = JOINT_NAMES.index('l_arm_elx')
 
 

@@ -11,7 +11,7 @@ import pytest
 
 from tutorial_atlas_control.cli.environment import run_script
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 SYSTEM_PYTHON = '/usr/bin/python3'
 #: A shell as a new terminal has it before `source ./env.sh`.
 BARE_ENV = {'PATH': '/usr/bin:/bin', 'HOME': str(Path.home()), 'LANG': 'C.UTF-8'}

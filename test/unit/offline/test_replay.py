@@ -34,7 +34,7 @@ from tutorial_atlas_control.sim.joint_trajectory import TrajectoryMessage, traje
 from tutorial_atlas_control.sim.sim_config import SimConfig
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode
 
-SCRIPT = Path(__file__).resolve().parents[2] / 'scripts' / 'replay_bag.py'
+SCRIPT = Path(__file__).resolve().parents[3] / 'scripts' / 'replay_bag.py'
 #: Short pin so that unpinning happens inside the short synthetic runs (s).
 TIME_TO_UNPIN_S = 0.05
 #: Odometry every this many steps, as the simulator's 100 Hz default.

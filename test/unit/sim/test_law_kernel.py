@@ -19,7 +19,7 @@ from tutorial_atlas_control.sim.controller import PidState, compute_torque, load
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode
 from tutorial_atlas_control.sim.vrc import ModeInput, SimInput, VrcMode, WrenchInput
 
-CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
+CONFIG = Path(__file__).resolve().parents[3] / 'config' / 'atlas_controller.yaml'
 DT_S = 0.001
 
 

@@ -21,7 +21,7 @@ from tutorial_atlas_control.sim.vrc import ModeInput, VrcMode
 sim_node = pytest.importorskip('tutorial_atlas_control.node.sim_node',
                                reason='needs the catkin workspace: source ./env.sh')
 
-CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
+CONFIG = Path(__file__).resolve().parents[3] / 'config' / 'atlas_controller.yaml'
 
 
 def test_model_parameter_names_the_loaded_model_in_sim_config(

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-SCRIPTS = Path(__file__).resolve().parents[2] / 'scripts'
+SCRIPTS = Path(__file__).resolve().parents[3] / 'scripts'
 PYTHON_SCRIPTS = ('analyze_bag.py', 'replay_bag.py', 'run_demo.py', 'run_offline.py',
                   'traj_yaml.py', 'plot_topics.py', 'sweep.py', 'search.py')
 

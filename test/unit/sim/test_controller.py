@@ -24,7 +24,7 @@ from tutorial_atlas_control.sim.controller import (
     load_gains_yaml,
 )
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 GAINS_YAML = REPO / 'config' / 'atlas_controller.yaml'
 DT_S = 0.001
 LOWER = np.full(NUM_JOINTS, -1.0)

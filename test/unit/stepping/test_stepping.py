@@ -32,7 +32,7 @@ from tutorial_atlas_control.stepping.schedule import step_stamp, steps_between
 from tutorial_atlas_control.stepping.watch import NOT_USER_WARN_PERIOD_S
 from tutorial_atlas_control.units import NS_PER_S
 
-CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
+CONFIG = Path(__file__).resolve().parents[3] / 'config' / 'atlas_controller.yaml'
 #: One outlet per topic the loop publishes; the outlet is the topic's name.
 ALL_TOPICS = (topics.CLOCK, topics.JOINT_STATES, topics.IMU, topics.L_FOOT_CONTACT,
               topics.R_FOOT_CONTACT, topics.GROUND_TRUTH_ODOM, topics.TF,

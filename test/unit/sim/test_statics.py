@@ -13,7 +13,7 @@ from tutorial_atlas_control.joints import JOINT_INDEX
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import load_gains_yaml
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 
 
 @pytest.fixture(scope='module')
