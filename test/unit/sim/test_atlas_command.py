@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 from test_controller import DT_S, LIMIT, LOWER, UPPER, one_joint
-from test_stepping import command_bytes, complete_command, make_loop
 
+from support.stepping_fakes import atlas_bytes, command_bytes, complete_command, full, make_loop
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.command.arrays import CommandError
 from tutorial_atlas_control.joints import JOINT_INDEX, NUM_JOINTS
@@ -45,10 +45,6 @@ def atlas() -> atlas_model.AtlasModel:
 @pytest.fixture
 def sim(atlas: atlas_model.AtlasModel) -> AtlasSimulator:
     return AtlasSimulator(atlas, load_gains_yaml(CONFIG), time_to_unpin_s=0.0)
-
-
-def full(value: float) -> list[float]:
-    return [value] * N
 
 
 def run(sim: AtlasSimulator, steps: int) -> None:
@@ -280,10 +276,6 @@ def test_test_damping_sets_the_joint_damping(sim: AtlasSimulator) -> None:
 
 
 # -- merging in the loop ------------------------------------------------------------------
-
-def atlas_bytes(stamp_ns: int = 0, period_ms: int = 0, **arrays: list[float]) -> bytes:
-    return encode_atlas_command(stamp_ns, arrays, period_ms)
-
 
 def test_the_newest_message_sets_the_fields_it_carries(sim: AtlasSimulator) -> None:
     loop, _, log, _ = make_loop(sim)

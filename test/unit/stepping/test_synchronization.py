@@ -10,18 +10,19 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_atlas_command import atlas_bytes, full
-from test_stepping import (
+
+from support.stepping_fakes import (
     ALL_TOPICS,
     LAUNCH_RATES_HZ,
     FakeClock,
     FakeLog,
     FakeOutbox,
+    atlas_bytes,
     complete_command,
+    full,
     header_stamp_ns,
     stops_after,
 )
-
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.sim import model as atlas_model
