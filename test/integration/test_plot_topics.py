@@ -15,6 +15,7 @@ import os
 import signal
 import subprocess
 import sys
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -40,8 +41,13 @@ WINDOW_S = 4.0
 #: A screen wide enough for two plot windows (833 x 518) side by side; the second's corner.
 SCREEN = '1920x1200x24'
 EMPTY_WINDOW_AT = ('900', '600')
-#: Sim time (s) between the screenshots of the paused and of the resumed window.
-PAUSE_CHECK_S = 1.0
+#: Sim time (s) after the pause key for a draw already under way, then between the paused
+#: window's two screenshots: longer than a draw period of a loaded machine (the plot draws
+#: at most a quarter of the time, so a 0.5 s draw comes every 2 s).
+PAUSE_SETTLE_S = 1.0
+PAUSE_CHECK_S = 3.0
+#: Wall-clock guard for the resumed window's next picture.
+RESUME_TIMEOUT_S = 30.0
 #: Sim time (s) the reset test's --png run lasts; its reset comes after about 2 s.
 RESET_RUN_S = 10.0
 #: Wall-clock guard for a --png run of a few seconds of sim time on a loaded machine.
@@ -65,6 +71,16 @@ def sine_launch(tmp_path_factory: pytest.TempPathFactory) -> Iterator[TestLaunch
             yield launch
         finally:
             stop_tree(driver)
+
+
+def wait_for_new_picture(display: str, window: str, before: np.ndarray, path: Path) -> bool:
+    """Screenshots of `window` until one differs from `before` (True), or the guard passes."""
+    deadline = time.monotonic() + RESUME_TIMEOUT_S
+    while time.monotonic() < deadline:
+        if not np.array_equal(screenshot(display, window, path), before):
+            return True
+        time.sleep(0.1)
+    return False
 
 
 def key(display: str, window: str, name: str) -> None:
@@ -108,14 +124,16 @@ def test_the_window_shows_the_elbow_s_sine_and_an_empty_plot_does_not(
             sine_launch.wait_sim_s(WINDOW_S + 1.0)  # the window filled with samples
             images = {name: screenshot(display, ids[name], tmp_path / f'window_{name}.png')
                       for name in ids}
-            # space pauses: the picture stays while sim time goes on; space again resumes
-            pictures = []
-            for step in ('paused', 'resumed'):
-                key(display, ids['sine'], 'space')
-                for shot in range(2):
-                    sine_launch.wait_sim_s(PAUSE_CHECK_S)
-                    pictures.append(screenshot(display, ids['sine'],
-                                               tmp_path / f'window_{step}_{shot}.png'))
+            # space pauses: the picture stays while sim time goes on (a draw under way when
+            # the key came may land first); space again resumes: a new picture comes
+            key(display, ids['sine'], 'space')
+            sine_launch.wait_sim_s(PAUSE_SETTLE_S)
+            paused_a = screenshot(display, ids['sine'], tmp_path / 'window_paused_0.png')
+            sine_launch.wait_sim_s(PAUSE_CHECK_S)
+            paused_b = screenshot(display, ids['sine'], tmp_path / 'window_paused_1.png')
+            key(display, ids['sine'], 'space')
+            resumed = wait_for_new_picture(display, ids['sine'], paused_b,
+                                           tmp_path / 'window_resumed.png')
             for process in windows.values():
                 process.send_signal(signal.SIGINT)
             outcomes = {name: process.communicate(timeout=EXIT_TIMEOUT_S)
@@ -123,9 +141,8 @@ def test_the_window_shows_the_elbow_s_sine_and_an_empty_plot_does_not(
         finally:
             for process in windows.values():
                 stop_tree(process)
-    paused_a, paused_b, resumed_a, resumed_b = pictures
     assert np.array_equal(paused_a, paused_b), 'the paused window kept moving'
-    assert not np.array_equal(resumed_a, resumed_b), 'the resumed window does not move'
+    assert resumed, f'the resumed window did not move within {RESUME_TIMEOUT_S:.0f} s'
     sine, empty = curve_extent(images['sine']), curve_extent(images['empty'])
     print(f'sine window {sine}, empty window {empty}; screenshots in {tmp_path}')
     assert sine.shows_a_curve(), f'no curve in {tmp_path / "window_sine.png"}: {sine}'
