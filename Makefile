@@ -21,7 +21,7 @@ setup:
 	@bash tools/setup.sh
 
 unit-test: setup
-	@$(IN_ENV) python3 -m pytest test/unit -q -rs
+	@$(IN_ENV) python3 -m pytest test/unit -q -rs -n 2
 
 lint: setup
 	@$(IN_ENV) ruff check .
