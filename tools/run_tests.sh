@@ -32,7 +32,12 @@ in_background() {  # in_background NAME COMMAND...: its output goes to a log sho
   shift
   background_log[$name]=$(mktemp "${TMPDIR:-/tmp}/tac_${name}.XXXXXX")
   background_started[$name]=$SECONDS
-  "$@" > "${background_log[$name]}" 2>&1 &
+  (
+    "$@"
+    status=$?
+    echo "$name: finished after $((SECONDS - ${background_started[$name]})) s"
+    exit "$status"
+  ) > "${background_log[$name]}" 2>&1 &
   background_pid[$name]=$!
 }
 
@@ -40,9 +45,10 @@ collect() {  # collect NAME: wait for it, show its output, note its time and sta
   local name=$1 status=0
   wait "${background_pid[$name]}" || status=$?
   cat "${background_log[$name]}"
-  rm -f "${background_log[$name]}"
   [ "$status" -eq 0 ] || failed+=("$name")
-  timings+=("$name $((SECONDS - ${background_started[$name]})) s (beside pytest-parallel)")
+  timings+=("$name $(sed -n "s/^$name: finished after \\([0-9]*\\) s$/\\1/p" \
+    "${background_log[$name]}") s (beside pytest-parallel)")
+  rm -f "${background_log[$name]}"
   unset "background_pid[$name]"
 }
 
