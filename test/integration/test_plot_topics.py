@@ -41,12 +41,14 @@ WINDOW_S = 4.0
 #: A screen wide enough for two plot windows (833 x 518) side by side; the second's corner.
 SCREEN = '1920x1200x24'
 EMPTY_WINDOW_AT = ('900', '600')
-#: Sim time (s) after the pause key for a draw already under way, then between the paused
-#: window's two screenshots: longer than a draw period of a loaded machine (the plot draws
-#: at most a quarter of the time, so a 0.5 s draw comes every 2 s).
-PAUSE_SETTLE_S = 1.0
+#: Sim time (s) between the paused window's two screenshots, once its picture is steady:
+#: longer than a draw period of a loaded machine (the plot draws at most a quarter of the
+#: time, so a 0.5 s draw comes every 2 s).
 PAUSE_CHECK_S = 3.0
-#: Wall-clock guard for the resumed window's next picture.
+#: Wall time (s) the picture must stay the same to count as steady: the pause key reaches
+#: the window late on a busy machine, and a draw under way when it comes still lands.
+STEADY_S = 1.0
+#: Wall-clock guard for the paused window's steady picture and the resumed one's next.
 RESUME_TIMEOUT_S = 30.0
 #: Sim time (s) the reset test's --png run lasts; its reset comes after about 2 s.
 RESET_RUN_S = 10.0
@@ -71,6 +73,19 @@ def sine_launch(tmp_path_factory: pytest.TempPathFactory) -> Iterator[TestLaunch
             yield launch
         finally:
             stop_tree(driver)
+
+
+def wait_for_steady_picture(display: str, window: str, path: Path) -> np.ndarray:
+    """The picture of `window` once two screenshots STEADY_S apart agree (the guard fails)."""
+    deadline = time.monotonic() + RESUME_TIMEOUT_S
+    before = screenshot(display, window, path)
+    while time.monotonic() < deadline:
+        time.sleep(STEADY_S)
+        now = screenshot(display, window, path)
+        if np.array_equal(now, before):
+            return now
+        before = now
+    pytest.fail(f'the paused window kept changing for {RESUME_TIMEOUT_S:.0f} s')
 
 
 def wait_for_new_picture(display: str, window: str, before: np.ndarray, path: Path) -> bool:
@@ -127,8 +142,8 @@ def test_the_window_shows_the_elbow_s_sine_and_an_empty_plot_does_not(
             # space pauses: the picture stays while sim time goes on (a draw under way when
             # the key came may land first); space again resumes: a new picture comes
             key(display, ids['sine'], 'space')
-            sine_launch.wait_sim_s(PAUSE_SETTLE_S)
-            paused_a = screenshot(display, ids['sine'], tmp_path / 'window_paused_0.png')
+            paused_a = wait_for_steady_picture(display, ids['sine'],
+                                               tmp_path / 'window_paused_0.png')
             sine_launch.wait_sim_s(PAUSE_CHECK_S)
             paused_b = screenshot(display, ids['sine'], tmp_path / 'window_paused_1.png')
             key(display, ids['sine'], 'space')

@@ -33,6 +33,11 @@ from tutorial_atlas_control.bags.tries import (
 from tutorial_atlas_control.offline.replay import replay_bag
 from tutorial_atlas_control.trajectories.trajectory import load_trajectory, sample_count
 
+#: Serial: the tries are split on the recorder's own times, which lag the simulator's when the
+#: recorder is starved (seen beside a busy core: 440 ms, and 23 of try 3's commands counted in
+#: try 1; docs/TESTING.md, Known flakes: open).
+pytestmark = pytest.mark.serial
+
 REPO = Path(__file__).resolve().parents[2]
 TRAJ_YAML = REPO / 'scripts' / 'traj_yaml.py'
 TRAJECTORY_FILE = REPO / 'trajectories' / 'Traj_data2.yaml'

@@ -26,6 +26,10 @@ from tutorial_atlas_control.bags.analysis import analyze_bag
 from tutorial_atlas_control.bags.reader import BagData, read_bag
 from tutorial_atlas_control.bags.records import IndexedBag, PublicBag
 
+#: Serial: the replay's count of compared steps rests on `rosbag record`'s record times,
+#: which lag when it is starved (seen beside a busy core: 2618 of 5056 steps compared).
+pytestmark = pytest.mark.serial
+
 #: Sim time (s) recorded after the launch is ready.
 RUN_S = 3.0
 #: Wall-clock guard (s) for `rosbag play` of a few seconds of bag at 20 x (and its master).
