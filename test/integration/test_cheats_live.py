@@ -76,12 +76,24 @@ DRCSIM_ERA_LINES = (
     "as DRCSim 2.5.2 read it: each point's time_from_start added to the previous point's "
     'time; the 2 points play over 0.1 s',
 )
+#: The start of the simulator's line for each input it applies.
+APPLIED = 'applied at t='
 #: DRCSim-era push: 300 N forward on the pelvis, held about 0.5 s of sim time, then zero.
 PUSH = '{force: {x: 300.0}}'
 
 
 def publish(launch: TestLaunch, topic: str, msg_type: str, yaml_text: str) -> None:
     launch.publish(topic, msg_type, yaml_text)
+
+
+def apply(launch: TestLaunch, topic: str, msg_type: str, yaml_text: str) -> None:
+    """Publish a good input and wait for the simulator's line saying it applied it: inputs
+    on different topics travel over different connections, so only this keeps their order
+    (the line comes for the first input of a kind in a second: not for a repeat)."""
+    applied = launch.output().count(APPLIED)
+    launch.publish(topic, msg_type, yaml_text)
+    launch.wait(lambda: launch.output().count(APPLIED) > applied, 30.0,
+                f'{topic} {yaml_text} was not applied')
 
 
 def pelvis_position(launch: TestLaunch) -> tuple[float, float, float]:
@@ -107,10 +119,10 @@ def test_cheats_live_refusals_effects_reset_models_and_exact_replay(tmp_path: Pa
         after = pelvis_position(launch)
         # Standing, the robot sways by about a centimetre; a teleport or push moves it metres.
         assert after[2] > 0.9 and max(abs(a - b) for a, b in zip(before, after)) < 0.05
-        assert 'applied at t=' not in launch.output(), 'a refused input was applied'
+        assert APPLIED not in launch.output(), 'a refused input was applied'
 
         for topic, msg_type, yaml_text in GOOD_INPUTS[:2]:
-            publish(launch, topic, msg_type, yaml_text)
+            apply(launch, topic, msg_type, yaml_text)
         launch.wait_sim_s(0.5)
         x, y, z = pelvis_position(launch)  # pinned there: the teleport stays put
         assert abs(x - 0.5) < 1e-3 and abs(y + 0.25) < 1e-3 and abs(z - 1.0) < 1e-3
