@@ -35,7 +35,7 @@ rostest: setup
 test: setup
 	@$(IN_ENV) bash tools/run_tests.sh
 
-# Every section once, short windows (~1.5 min): fails if the bench crashes or a figure is
+# Every section once, short windows (about 3.5 min): fails if the bench crashes or a figure is
 # missing or NaN; a MISSED target does not fail it (bench/README.md).
 bench-quick: setup
 	@$(IN_ENV) python3 bench/run_bench.py --quick --runs 1

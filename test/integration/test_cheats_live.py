@@ -7,8 +7,8 @@ and the recorded bag, inputs and all, replays offline bit for bit and shows the 
 analyze_bag's timeline.
 
 Run with `python3 -m pytest test/integration/test_cheats_live.py -q -s` after `source
-env.sh` (needs roslaunch and the workspace's messages; skipped otherwise). Wall time about
-about 40 s.
+env.sh` (needs roslaunch and the workspace's messages; skipped otherwise). Wall time
+about 20 s (18 s measured on a quiet machine, 24 s beside the other tests).
 """
 
 from __future__ import annotations
@@ -82,10 +82,6 @@ APPLIED = 'applied at t='
 PUSH = '{force: {x: 300.0}}'
 
 
-def publish(launch: TestLaunch, topic: str, msg_type: str, yaml_text: str) -> None:
-    launch.publish(topic, msg_type, yaml_text)
-
-
 def apply(launch: TestLaunch, topic: str, msg_type: str, yaml_text: str) -> None:
     """Publish a good input and wait for the simulator's line saying it applied it: inputs
     on different topics travel over different connections, so only this keeps their order
@@ -109,10 +105,10 @@ def test_cheats_live_refusals_effects_reset_models_and_exact_replay(tmp_path: Pa
         launch.wait_sim_until(1.5)
         before = pelvis_position(launch)
         for topic, msg_type, yaml_text, refusal in BAD_INPUTS:
-            publish(launch, topic, msg_type, yaml_text)
+            launch.publish(topic, msg_type, yaml_text)
             launch.wait(lambda refusal=refusal: refusal in launch.output(), 30.0,
                         f'no refusal line {refusal!r}')
-        publish(launch, topics.CONFIGURATION, 'sensor_msgs/JointState',
+        launch.publish(topics.CONFIGURATION, 'sensor_msgs/JointState',
                 '{name: [l_arm_shx], position: [1.0]}')
         launch.wait(lambda: '/atlas/configuration is not implemented' in launch.output(),
                     30.0, 'no not-implemented line for /atlas/configuration')
@@ -127,7 +123,7 @@ def test_cheats_live_refusals_effects_reset_models_and_exact_replay(tmp_path: Pa
         x, y, z = pelvis_position(launch)  # pinned there: the teleport stays put
         assert abs(x - 0.5) < 1e-3 and abs(y + 0.25) < 1e-3 and abs(z - 1.0) < 1e-3
         for topic, msg_type, yaml_text in GOOD_INPUTS[2:]:
-            publish(launch, topic, msg_type, yaml_text)
+            launch.publish(topic, msg_type, yaml_text)
             launch.wait_sim_s(0.3)
         for line in DRCSIM_ERA_LINES:
             launch.wait(lambda line=line: line in launch.output(), 30.0, f'no line {line!r}')
@@ -136,9 +132,9 @@ def test_cheats_live_refusals_effects_reset_models_and_exact_replay(tmp_path: Pa
         launch.wait(lambda: 'reset_world: robot back to its initial pose' in launch.output(),
                     30.0, '/gazebo/reset_models did not reset the world')
         launch.wait_sim_s(1.5)  # unpinned, standing
-        publish(launch, topics.APPLY_PELVIS_FORCE, 'geometry_msgs/Wrench', PUSH)
+        launch.publish(topics.APPLY_PELVIS_FORCE, 'geometry_msgs/Wrench', PUSH)
         launch.wait_sim_s(0.5)
-        publish(launch, topics.APPLY_PELVIS_FORCE, 'geometry_msgs/Wrench', '{}')
+        launch.publish(topics.APPLY_PELVIS_FORCE, 'geometry_msgs/Wrench', '{}')
         launch.wait_sim_s(3.0)
         assert pelvis_position(launch)[2] < 0.5, 'the 300 N push toppled the robot'
         launch.interrupt(EXIT_TIMEOUT_S)
