@@ -50,6 +50,8 @@ PAUSE_CHECK_S = 3.0
 STEADY_S = 1.0
 #: Wall-clock guard for the paused window's steady picture and the resumed one's next.
 RESUME_TIMEOUT_S = 30.0
+#: Wall-clock guard for the sine window's first curve.
+CURVE_TIMEOUT_S = 60.0
 #: Sim time (s) the reset test's --png run lasts; its reset comes after about 2 s.
 RESET_RUN_S = 10.0
 #: Wall-clock guard for a --png run of a few seconds of sim time on a loaded machine.
@@ -86,6 +88,16 @@ def wait_for_steady_picture(display: str, window: str, path: Path) -> np.ndarray
             return now
         before = now
     pytest.fail(f'the paused window kept changing for {RESUME_TIMEOUT_S:.0f} s')
+
+
+def wait_for_curve(display: str, window: str, path: Path) -> np.ndarray:
+    """Screenshots of `window` until one shows a curve, or the guard passes: the last one."""
+    deadline = time.monotonic() + CURVE_TIMEOUT_S
+    picture = screenshot(display, window, path)
+    while not curve_extent(picture).shows_a_curve() and time.monotonic() < deadline:
+        time.sleep(0.2)
+        picture = screenshot(display, window, path)
+    return picture
 
 
 def wait_for_new_picture(display: str, window: str, before: np.ndarray, path: Path) -> bool:
@@ -137,8 +149,10 @@ def test_the_window_shows_the_elbow_s_sine_and_an_empty_plot_does_not(
             subprocess.run(['xdotool', 'windowmove', ids['empty'], *EMPTY_WINDOW_AT],
                            env=dict(env), check=True, timeout=EXIT_TIMEOUT_S)
             sine_launch.wait_sim_s(WINDOW_S + 1.0)  # the window filled with samples
-            images = {name: screenshot(display, ids[name], tmp_path / f'window_{name}.png')
-                      for name in ids}
+            # the sine's first samples come once the plotter's subscription is connected,
+            # which a loaded machine may take seconds longer than the window to do
+            images = {'sine': wait_for_curve(display, ids['sine'], tmp_path / 'window_sine.png')}
+            images['empty'] = screenshot(display, ids['empty'], tmp_path / 'window_empty.png')
             # space pauses: the picture stays while sim time goes on (a draw under way when
             # the key came may land first); space again resumes: a new picture comes
             key(display, ids['sine'], 'space')

@@ -129,8 +129,12 @@ def find_window(display: str, name: str, timeout_s: float = WINDOW_TIMEOUT_S) ->
     env = dict(os.environ, DISPLAY=display)
     deadline = time.monotonic() + timeout_s
     while True:
-        found = subprocess.run(['xdotool', 'search', '--name', name], env=env,
-                               capture_output=True, text=True, check=False).stdout.split()
+        try:
+            found = subprocess.run(['xdotool', 'search', '--name', name], env=env,
+                                   capture_output=True, text=True, check=False,
+                                   timeout=CAPTURE_TIMEOUT_S).stdout.split()
+        except subprocess.TimeoutExpired:  # a search stuck on a window being destroyed
+            found = []
         if found:
             return found[0]
         if time.monotonic() > deadline:
