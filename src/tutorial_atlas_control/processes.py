@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import random
 import signal
 import socket
 import subprocess
@@ -33,6 +34,13 @@ STOP_TIMEOUT_S = 20.0
 #: A master that accepts a connection but does not answer is not up (s).
 XMLRPC_TIMEOUT_S = 5.0
 POLL_PERIOD_S = 0.1
+#: Where masters' ports are picked (below); the kernel's own picks come from
+#: EPHEMERAL_RANGE_FILE's range (32768-60999 unless changed), which must not overlap.
+MASTER_PORTS = range(20000, 32768)
+EPHEMERAL_RANGE_FILE = Path('/proc/sys/net/ipv4/ip_local_port_range')
+DEFAULT_EPHEMERAL_PORTS = range(32768, 61000)
+#: Random candidates tried before falling back to a kernel-picked port.
+PORT_TRIES = 50
 
 
 class ProcessError(AtlasControlError):
@@ -188,9 +196,36 @@ def _signal_group(process: subprocess.Popen, sig: int) -> None:
 
 
 # ------------------------------------------------------------------------- a master
-def free_local_port() -> int:
-    """A TCP port free on the loopback interface now (the kernel's pick)."""
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
+def _ephemeral_ports(path: Path = EPHEMERAL_RANGE_FILE) -> range:
+    """The ports the kernel picks from for bind(0) and connect(): Linux's
+    ip_local_port_range (its default when unreadable)."""
+    try:
+        low, high = (int(field) for field in path.read_text().split())
+    except (OSError, ValueError):
+        return DEFAULT_EPHEMERAL_PORTS
+    return range(low, high + 1)
+
+
+def free_local_port(choose: Callable[[range], int] = random.choice) -> int:
+    """A TCP port free on the loopback interface now, for a master, picked below the
+    kernel's ephemeral range.
+
+    A port of that range that is free now may be a node's by the time roscore binds it
+    (every node's XML-RPC and TCPROS server binds port 0), and roslaunch takes any XML-RPC
+    server that answers getPid for a running master: it then starts no master and its
+    nodes never register. Below the range only other explicit picks compete.
+    """
+    ephemeral = _ephemeral_ports()
+    candidates = range(MASTER_PORTS.start, min(MASTER_PORTS.stop, ephemeral.start))
+    for _ in range(PORT_TRIES if len(candidates) > 0 else 0):
+        port = choose(candidates)
+        with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
+            try:
+                sock.bind(('127.0.0.1', port))
+            except OSError:
+                continue
+            return port
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:  # all taken: the kernel's
         sock.bind(('127.0.0.1', 0))
         return int(sock.getsockname()[1])
 

@@ -62,6 +62,14 @@ def node_exit_status(launch: TestLaunch) -> int | None:
     return None
 
 
+def wait_for_viewer(display: str, launch: TestLaunch) -> None:
+    """Until the viewer's window exists; failing, with what the launch printed."""
+    try:
+        xdisplay.find_window(display, WINDOW_NAME)
+    except pytest.fail.Exception as failure:
+        pytest.fail(f'{failure.msg}; the launch ({launch.log_path}) said:\n{launch.output()}')
+
+
 def rosnode_kill(launch: TestLaunch) -> None:
     result = launch.run('rosnode', 'kill', NODE)
     assert result.returncode == 0, result.stdout + result.stderr
@@ -85,7 +93,7 @@ def test_stopping_with_the_viewer_open_exits_cleanly(
         for round_ in range(ROUNDS):
             launch = TestLaunch(tmp_path / f'round{round_}', 'gui:=true', 'record:=false')
             try:
-                xdisplay.find_window(display, WINDOW_NAME)
+                wait_for_viewer(display, launch)
                 launch.wait_sim_until(STOP_AT_S)
                 stop(launch)
                 launch.wait_exit()

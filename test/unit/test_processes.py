@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import signal
+import socket
 import subprocess
 import threading
 from pathlib import Path
@@ -12,8 +13,10 @@ import pytest
 
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.processes import (
+    MASTER_PORTS,
     AtlasLaunch,
     ProcessError,
+    _ephemeral_ports,
     alive,
     command_line,
     default_sigint,
@@ -100,11 +103,32 @@ def test_command_line_and_memory_of_a_process() -> None:
     assert command_line(child.pid) == '' and rss_kib(child.pid) is None
 
 
-def test_free_local_port_can_be_bound() -> None:
-    import socket
-
+def test_free_local_port_can_be_bound_and_is_below_the_kernel_s_own_picks() -> None:
+    port = free_local_port()
+    assert MASTER_PORTS.start <= port < _ephemeral_ports().start
     with socket.socket() as sock:
-        sock.bind(('127.0.0.1', free_local_port()))
+        sock.bind(('127.0.0.1', port))
+
+
+def test_a_busy_port_in_the_range_is_passed_over() -> None:
+    with socket.socket() as taken:
+        for port in range(MASTER_PORTS.start, MASTER_PORTS.stop):
+            try:
+                taken.bind(('127.0.0.1', port))
+            except OSError:
+                continue
+            break
+        taken.listen()
+        picks = iter([port, port + 1 if port + 1 in MASTER_PORTS else port - 1])
+        picked = free_local_port(lambda ports: next(picks))
+    assert picked != port
+
+
+def test_the_ephemeral_range_is_read_from_proc_or_defaults(tmp_path: Path) -> None:
+    table = tmp_path / 'ip_local_port_range'
+    table.write_text('40000\t50000\n')
+    assert _ephemeral_ports(table) == range(40000, 50001)
+    assert _ephemeral_ports(tmp_path / 'missing') == range(32768, 61000)
 
 
 def test_wait_until_names_what_did_not_happen() -> None:
