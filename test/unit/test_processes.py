@@ -7,6 +7,7 @@ import signal
 import socket
 import subprocess
 import threading
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -158,6 +159,17 @@ def test_a_missing_roslaunch_is_one_line(tmp_path: Path, monkeypatch: pytest.Mon
         AtlasLaunch(tmp_path / 'launch.log', {})
 
 
+@pytest.fixture
+def python_ctrl_c() -> Iterator[None]:
+    """Python's own SIGINT handler (KeyboardInterrupt) for the test: a run started in the
+    background (`make test &`, nohup) inherits SIGINT ignored, and its Ctrl-C never comes."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 def _pid_written_to(path: Path) -> int:
     wait_until(lambda: path.exists() and path.read_text().strip() != '', GUARD_S,
                f'the child did not write {path}')
@@ -168,6 +180,7 @@ def test_run_to_end_returns_the_exit_status() -> None:
     assert run_to_end(['bash', '-c', 'exit 3'], os.environ, GUARD_S) == 3
 
 
+@pytest.mark.usefixtures('python_ctrl_c')
 def test_run_to_end_stops_the_child_when_its_caller_alone_gets_ctrl_c(tmp_path: Path) -> None:
     pid_file = tmp_path / 'pid'
     child = f'echo $$ > {pid_file}; exec sleep 300'
@@ -190,6 +203,7 @@ def test_run_to_end_stops_the_child_at_its_timeout(tmp_path: Path) -> None:
     assert not alive([_pid_written_to(pid_file)])
 
 
+@pytest.mark.usefixtures('python_ctrl_c')
 def test_a_ctrl_c_while_the_child_starts_is_raised_once_it_can_be_stopped(
         monkeypatch: pytest.MonkeyPatch) -> None:
     real_popen = subprocess.Popen

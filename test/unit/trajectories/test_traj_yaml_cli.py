@@ -504,6 +504,56 @@ def test_the_port_waits_until_rospy_has_taken_each_command() -> None:
             connection._cond_data_available.notify()
 
 
+def wait_until_drained(connection: object) -> None:
+    """Until the writer thread of rospy's `connection` has taken its queued message."""
+    deadline = time.monotonic() + THREAD_GUARD_S
+    while connection._queue and time.monotonic() < deadline:  # type: ignore[attr-defined]
+        time.sleep(0.001)
+
+
+def test_a_stalled_subscriber_delays_the_port_once_and_the_others_are_still_waited_for() -> None:
+    """A connection still queued at a wait's end is skipped by the next waits (a subscriber
+    that stopped reading), until its queue empties; the others are waited for throughout."""
+    from rospy.impl.tcpros_pubsub import QueuedConnection
+
+    stuck, slow = BlockingTransport(), BlockingTransport()
+    connections = [QueuedConnection(stuck, 1), QueuedConnection(slow, 1)]
+    publisher = SimpleNamespace(impl=SimpleNamespace(connections=connections))
+    stalled: set[int] = set()
+    try:
+        for connection in connections:
+            connection.write_data(b'first')  # each writer thread takes it, then blocks
+        assert wait_until_handed_over(publisher, THREAD_GUARD_S, stalled)
+        for connection in connections:
+            connection.write_data(b'second')  # queued behind the blocked writes
+        assert not wait_until_handed_over(publisher, 0.05, stalled)
+        assert stalled == {id(connection) for connection in connections}
+        slow.release.set()  # the slow one catches up; the stuck one never does
+        wait_until_drained(connections[1])
+        assert wait_until_handed_over(publisher, THREAD_GUARD_S, stalled)
+        assert stalled == {id(connections[0])}
+        slow.release.clear()
+        connections[1].write_data(b'third')  # taken, and its write blocks
+        assert wait_until_handed_over(publisher, THREAD_GUARD_S, stalled)
+        connections[1].write_data(b'fourth')  # the slow one is waited for again
+        assert not wait_until_handed_over(publisher, 0.05, stalled)
+        assert stalled == {id(connection) for connection in connections}
+        slow.release.set()
+        wait_until_drained(connections[1])
+        assert wait_until_handed_over(publisher, THREAD_GUARD_S, stalled)
+        assert stalled == {id(connections[0])}
+        started = time.monotonic()
+        connections[0].write_data(b'third')  # replaces 'second' in the stuck queue
+        assert wait_until_handed_over(publisher, 0.05, stalled), 'the stuck one was waited for'
+        assert time.monotonic() - started < 0.05
+    finally:
+        for transport, connection in zip((stuck, slow), connections, strict=True):
+            transport.release.set()
+            transport.done = True
+            with connection._lock:
+                connection._cond_data_available.notify()
+
+
 def test_handover_wait_without_connections_returns_at_once() -> None:
     assert wait_until_handed_over(SimpleNamespace(impl=None), 1.0)
     assert wait_until_handed_over(SimpleNamespace(impl=SimpleNamespace(connections=[])), 1.0)
