@@ -27,7 +27,8 @@ TUTORIAL_POINTS = 1500
 TUTORIAL_DT_NS = 10_000_000
 SINE_AMPLITUDE_RAD = 0.5
 SINE_HZ = 0.05
-#: Wall-clock guard (s) for the simulator's subscription.
+#: The node the trajectory is for, and the guard (s of ROS time) for its connection.
+SIMULATOR = '/atlas_sim'
 SUBSCRIBER_TIMEOUT_S = 60.0
 
 
@@ -54,9 +55,10 @@ def main() -> None:
     rospy.init_node('joint_control', anonymous=True)
     publisher = rospy.Publisher('/joint_trajectory', JointTrajectory, queue_size=1)
     deadline = rospy.get_rostime().to_sec() + SUBSCRIBER_TIMEOUT_S
-    while publisher.get_num_connections() == 0:
+    # the simulator's connection itself: the recorder subscribes too, and may connect first
+    while SIMULATOR not in {connection.endpoint_id for connection in publisher.impl.connections}:
         if rospy.is_shutdown() or rospy.get_rostime().to_sec() > deadline:
-            raise SystemExit('joint_animation: nobody subscribed to /joint_trajectory')
+            raise SystemExit(f'joint_animation: {SIMULATOR} did not connect to /joint_trajectory')
         rospy.sleep(0.1)
     msg = JointTrajectory(joint_names=['atlas::' + name for name in TUTORIAL_ORDER])
     msg.header.stamp, msg.header.frame_id = rospy.Time.now(), FRAME_ID
