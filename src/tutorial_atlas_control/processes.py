@@ -138,12 +138,16 @@ def stop_tree(process: subprocess.Popen, timeout_s: float = STOP_TIMEOUT_S,
 
 
 def default_sigint() -> None:
-    """`preexec_fn` for a child stopped with SIGINT: SIGINT back to its default action.
+    """`preexec_fn` for a child stopped with SIGINT: SIGINT back to its default action,
+    and unblocked.
 
     A child inherits an ignored SIGINT (e.g. from a shell's background job), and a shell
-    cannot even trap a signal ignored at its start; stop_tree's Ctrl-C must reach it.
+    cannot even trap a signal ignored at its start; it also inherits the starting thread's
+    signal mask, and a SIGINT blocked there stays pending forever (Python does not unblock
+    it). stop_tree's Ctrl-C must reach it.
     """
     signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 
 def run_to_end(command: Sequence[str], env: Mapping[str, str], timeout_s: float,

@@ -20,6 +20,8 @@ from typing import IO
 
 import pytest
 
+from tutorial_atlas_control.processes import default_sigint
+
 REPO = Path(__file__).resolve().parents[2]
 RUN_DEMO = REPO / 'scripts' / 'run_demo.py'
 #: Exit status on Ctrl-C (docs/troubleshooting.md, Script conventions).
@@ -31,13 +33,6 @@ EXIT_TIMEOUT_S = 120.0
 #: The progress line run_demo prints when it starts traj_yaml.py, and the one naming the port.
 PLAYING = 'demo: rosrun tutorial_atlas_control traj_yaml.py'
 MASTER_PORT = re.compile(r'master on port (\d+)')
-
-
-def default_sigint() -> None:
-    """In the child, before exec: SIGINT's default action, whatever this process inherited
-    (a shell without job control starts `make test &` with SIGINT ignored, and Python leaves
-    it ignored: run_demo.py would never see this Ctrl-C and play to the end, exit 0)."""
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def lines_of(stream: IO[str]) -> queue.Queue[str | None]:

@@ -30,6 +30,7 @@ from tutorial_atlas_control.cli import (
 from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED
 from tutorial_atlas_control.demo import demo_node as demo
 from tutorial_atlas_control.plotting import plot_topics_node as plot_node
+from tutorial_atlas_control.processes import default_sigint
 
 REPO = Path(__file__).resolve().parents[3]
 TRAJECTORY_FILE = REPO / 'trajectories' / 'Traj_data2.yaml'
@@ -67,15 +68,6 @@ def test_ctrl_c_exits_130_quietly(main: Callable[[list[str]], int], target: tupl
     assert status == EXIT_INTERRUPTED
     captured = capsys.readouterr()
     assert captured.err == '' and captured.out == ''
-
-
-def default_sigint() -> None:
-    """In the child, before exec: SIGINT's default action, whatever this process inherited.
-
-    A shell without job control starts background commands (`make test &`) with SIGINT
-    ignored, and Python then leaves it ignored: the script would never see this Ctrl-C.
-    """
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def test_sigint_stops_run_offline_with_130_and_leaves_no_bag(tmp_path: Path) -> None:
