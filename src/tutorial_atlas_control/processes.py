@@ -219,19 +219,23 @@ def free_local_port(choose: Callable[[range], int] = random.choice) -> int:
     server that answers getPid for a running master: it then starts no master and its
     nodes never register. Below the range only other explicit picks compete.
     """
-    ephemeral = _ephemeral_ports()
-    candidates = range(MASTER_PORTS.start, min(MASTER_PORTS.stop, ephemeral.start))
-    for _ in range(PORT_TRIES if len(candidates) > 0 else 0):
-        port = choose(candidates)
-        with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
-            try:
-                sock.bind(('127.0.0.1', port))
-            except OSError:
-                continue
+    candidates = range(MASTER_PORTS.start, min(MASTER_PORTS.stop, _ephemeral_ports().start))
+    for _ in range(PORT_TRIES if candidates else 0):
+        if _can_bind_local(port := choose(candidates)):
             return port
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:  # all taken: the kernel's
         sock.bind(('127.0.0.1', 0))
         return int(sock.getsockname()[1])
+
+
+def _can_bind_local(port: int) -> bool:
+    """Whether `port` can be bound on the loopback interface now."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
+        try:
+            sock.bind(('127.0.0.1', port))
+        except OSError:
+            return False
+        return True
 
 
 def ros_environment(port: int, ros_log_dir: Path | None = None,

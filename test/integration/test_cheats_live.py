@@ -109,7 +109,7 @@ def test_cheats_live_refusals_effects_reset_models_and_exact_replay(tmp_path: Pa
             launch.wait(lambda refusal=refusal: refusal in launch.output(), 30.0,
                         f'no refusal line {refusal!r}')
         launch.publish(topics.CONFIGURATION, 'sensor_msgs/JointState',
-                '{name: [l_arm_shx], position: [1.0]}')
+                       '{name: [l_arm_shx], position: [1.0]}')
         launch.wait(lambda: '/atlas/configuration is not implemented' in launch.output(),
                     30.0, 'no not-implemented line for /atlas/configuration')
         after = pelvis_position(launch)
