@@ -47,6 +47,7 @@ __all__ = [
     'require_master',
     'run_trajectory',
     'wait_for_joint_state',
+    'wait_for_log_readers',
     'wait_for_ros_time',
     'wait_for_subscribers',
     'wait_until_handed_over',
@@ -303,8 +304,13 @@ def play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], path
         wait_until_handed_over(publisher, HANDOVER_WAIT_S, stalled)
         publisher.publish(build_command(message_type, positions, gains, rospy.Time.now()))
 
-    # Logged once the recorder is connected (rospy's /rosout is latched, one message deep):
-    # how analyze_bag.py tells which trajectory a bag played.
+    # How analyze_bag.py tells which trajectory a bag played: logged once the recorder reads
+    # our /rosout (latched one message deep: a reader connecting later gets only the last).
+    late_readers = wait_for_log_readers(_log_readers_connected, _log_readers_registered,
+                                        subscriber_timeout_s)
+    if late_readers:
+        rospy.logwarn(f'not connected to {topics.ROSOUT} in time: '
+                      f'{", ".join(sorted(late_readers))} may miss the trajectory line below')
     rospy.loginfo(trajectory_log_line(os.path.abspath(path), name))
     rospy.loginfo(playing_line(name, waypoints))
     run_trajectory(waypoints, cache.positions, send, _sleep, rospy.loginfo, rospy.get_time)
@@ -358,13 +364,25 @@ def _timeout_param(name: str, default: float) -> float:
     return seconds
 
 
-def _registered_subscribers() -> set[str] | None:
-    """The nodes the master lists as subscribers of /atlas/joint_commands (None: it cannot tell)."""
+def _registered_subscribers(topic: str = JOINT_COMMANDS_TOPIC) -> set[str] | None:
+    """The nodes the master lists as subscribers of `topic` (None: it cannot tell)."""
     try:
         _publishers, subscribers, _services = rosgraph.Master(rospy.get_name()).getSystemState()
     except Exception:  # noqa: BLE001 - an unreachable master is asked again at the next poll
         return None
-    return next((set(nodes) for name, nodes in subscribers if name == JOINT_COMMANDS_TOPIC), set())
+    return next((set(nodes) for name, nodes in subscribers if name == topic), set())
+
+
+def _log_readers_registered() -> set[str] | None:
+    """The nodes the master lists as readers of /rosout, this node aside."""
+    nodes = _registered_subscribers(topics.ROSOUT)
+    return None if nodes is None else nodes - {rospy.get_name()}
+
+
+def _log_readers_connected() -> set[str]:
+    """The nodes connected to this node's /rosout publisher (rospy's own, made at init)."""
+    impl = rospy.topics.get_topic_manager().get_publisher_impl(topics.ROSOUT)
+    return {connection.endpoint_id for connection in list(impl.connections)} if impl else set()
 
 
 def _connections(publisher: rospy.Publisher) -> list[object]:
@@ -431,6 +449,41 @@ def wait_for_subscribers(
                     f'the simulator {simulator} subscribes to {JOINT_COMMANDS_TOPIC} but did not '
                     f'connect within {timeout_s:g} s; it would miss the start of the trajectory '
                     f'(a busy host? raise {SUBSCRIBER_TIMEOUT_PARAM})')
+            return missing
+        time.sleep(POLL_PERIOD_S)
+
+
+def wait_for_log_readers(
+    connected: Callable[[], set[str]],
+    registered: Callable[[], set[str] | None],
+    timeout_s: float,
+    is_shutdown: Callable[[], bool] = rospy.is_shutdown,
+) -> set[str]:
+    """Wait (wall clock, bounded) until every reader of /rosout (rosout, a recorder) is
+    connected to this node's /rosout publisher; return those that were not in time.
+
+    rospy latches /rosout one message deep: a reader that connects after two lines gets
+    only the second. The master tells a reader of a new publisher at once, but the reader
+    connects when it gets the CPU (the recorder runs niced), seconds later on a busy host.
+
+    Raises:
+        rospy.ROSInterruptException: the node was shut down while waiting.
+    """
+    deadline = time.monotonic() + timeout_s
+    listed: set[str] | None = None
+    next_master_poll = 0.0
+    while True:
+        if time.monotonic() >= next_master_poll:
+            answer = registered()
+            if answer is not None:  # else keep the last answer: the master did not reply
+                listed = answer
+            next_master_poll = time.monotonic() + MASTER_POLL_PERIOD_S
+        missing = (listed or set()) - connected()
+        if listed is not None and not missing:
+            return set()
+        if is_shutdown():
+            raise rospy.ROSInterruptException('shut down while waiting for /rosout readers')
+        if time.monotonic() >= deadline:
             return missing
         time.sleep(POLL_PERIOD_S)
 

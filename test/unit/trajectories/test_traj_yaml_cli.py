@@ -34,6 +34,7 @@ from tutorial_atlas_control.trajectories.traj_yaml_node import (
     read_gains,
     run_trajectory,
     wait_for_joint_state,
+    wait_for_log_readers,
     wait_for_ros_time,
     wait_for_subscribers,
     wait_until_handed_over,
@@ -716,3 +717,38 @@ def test_a_publish_racing_the_ctrl_c_shutdown_is_an_interrupt(
             cli.main([str(tmp_path / 'x.yaml'), 'step_and_fall'])
     else:
         assert cli.main([str(tmp_path / 'x.yaml'), 'step_and_fall']) == expected
+
+
+# --- waiting for the readers of /rosout -----------------------------------------------------
+
+ROSOUT_NODE = '/rosout'
+
+
+def test_a_recorder_that_reads_rosout_late_is_waited_for() -> None:
+    """The trajectory line goes out only once the recorder reads /rosout: latched one deep,
+    it would otherwise be replaced by the next line before the recorder connects."""
+    connected = Connecting({ROSOUT_NODE: 0, RECORDER: 20})
+    assert wait_for_log_readers(connected, lambda: {ROSOUT_NODE, RECORDER}, 5.0,
+                                never_shut_down) == set()
+    assert connected.polls == 21
+
+
+def test_a_reader_that_never_connects_is_returned_after_the_timeout() -> None:
+    started = time.monotonic()
+    missing = wait_for_log_readers(Connecting({ROSOUT_NODE: 0}),
+                                   lambda: {ROSOUT_NODE, RECORDER}, 0.2, never_shut_down)
+    assert missing == {RECORDER}
+    assert time.monotonic() - started >= 0.2
+
+
+def test_no_reader_of_rosout_needs_no_wait() -> None:
+    connected = Connecting({})
+    assert wait_for_log_readers(connected, set, 5.0, never_shut_down) == set()
+    assert connected.polls == 1
+
+
+def test_a_shutdown_ends_the_wait_for_rosout_readers() -> None:
+    import rospy
+
+    with pytest.raises(rospy.ROSInterruptException):
+        wait_for_log_readers(Connecting({}), lambda: {RECORDER}, 5.0, lambda: True)
