@@ -4,9 +4,12 @@ A recorder killed (SIGKILL, OOM) or stopped by a full disk leaves the simulator 
 with nobody recording, and nothing in the simulator's output would say so. The simulator
 sees the recorder's connection to /atlas/joint_states go. A killed recorder never
 unregisters: the master still lists it as a subscriber, and the line comes at once. One
-that unregistered stopped of itself: on Ctrl-C roslaunch stops the recorder first (reverse
-order) and the simulator seconds later, once the bag is closed, so the line comes only if
-the simulator is still running GRACE_S later (a full disk: the recorder has said why).
+that unregistered stopped of itself: on Ctrl-C roslaunch signals every node at once and the
+recorder may close its bag before the simulator is down, so the line comes only if the
+simulator is still running GRACE_S later (a full disk: the recorder has said why). Nothing
+is said once the simulator's own shutdown has begun: it unregisters its publishers before
+rospy reports it shut down, and the master then tells the recorder, which drops its
+connections while still listed as a subscriber, as a killed one would be.
 """
 
 from __future__ import annotations
@@ -80,19 +83,32 @@ def _registered(topic: str) -> bool:
     return any(name == topic and RECORDER_NODE in nodes for name, nodes in subscribers)
 
 
+def _shutting_down() -> bool:
+    """Has this node's shutdown begun? (rospy.is_shutdown() turns True only after the
+    shutdown hooks that unregister the node's topics and close its connections.)"""
+    return rospy.core.is_shutdown_requested() or rospy.is_shutdown()
+
+
 def start_recorder_watch(publisher: rospy.Publisher, sim_s: Callable[[], float],
-                         clock: Callable[[], float]) -> threading.Event:
+                         clock: Callable[[], float],
+                         registered: Callable[[], bool] | None = None,
+                         shutting_down: Callable[[], bool] = _shutting_down,
+                         say: Callable[[str], None] = rospy.logwarn,
+                         poll_s: float = POLL_S) -> threading.Event:
     """Watch `publisher`'s subscribers from a daemon thread until the returned event is set
-    (the node's spin() sets it when the loop ends)."""
+    (the node's spin() sets it when the loop ends) or the node's shutdown begins.
+
+    `registered` (default: ask the master): is the recorder still listed as a subscriber?
+    """
+    still_registered = registered or (lambda: _registered(topics.JOINT_STATES))
     watch = RecorderWatch()
     stop = threading.Event()
 
     def run() -> None:
-        while not stop.wait(POLL_S):
-            line = watch.update(subscriber_names(publisher), clock(), sim_s(),
-                                lambda: _registered(topics.JOINT_STATES))
-            if line is not None and not stop.is_set() and not rospy.is_shutdown():
-                rospy.logwarn(line)
+        while not stop.wait(poll_s) and not shutting_down():
+            line = watch.update(subscriber_names(publisher), clock(), sim_s(), still_registered)
+            if line is not None and not stop.is_set() and not shutting_down():
+                say(line)
 
     threading.Thread(target=run, name='recorder_watch', daemon=True).start()
     return stop

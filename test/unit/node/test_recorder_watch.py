@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import threading
+import time
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 
@@ -51,6 +54,75 @@ def test_nothing_is_said_before_a_recorder_came_or_when_it_comes_back() -> None:
     watch.update(OTHERS, 102.0, 2.0, unregistered)
     assert watch.update(BOTH, 102.5, 2.5, unregistered) is None, 'reconnected in the grace'
     assert watch.update(BOTH, 200.0, 100.0, unregistered) is None
+
+
+class WatchedPublisher:
+    """What start_recorder_watch reads of a rospy.Publisher: impl.connections."""
+
+    def __init__(self, *nodes: str) -> None:
+        self.impl = SimpleNamespace(connections=[SimpleNamespace(endpoint_id=node)
+                                                 for node in nodes])
+
+    def disconnect(self, node: str) -> None:
+        self.impl.connections = [c for c in self.impl.connections if c.endpoint_id != node]
+
+
+def watch_thread(shutting_down: threading.Event) -> tuple[WatchedPublisher, list[str],
+                                                          threading.Event, threading.Thread]:
+    """A watch over a publisher both nodes read, the master still listing the recorder.
+    Returns the publisher, the lines said, the watch's stop event and its thread."""
+    before = set(threading.enumerate())
+    publisher, said, polled = WatchedPublisher(*BOTH), [], threading.Event()
+
+    def sim_s() -> float:  # read at each poll
+        polled.set()
+        return 4.5
+
+    stop = recorder_watch.start_recorder_watch(publisher, sim_s, time.monotonic,
+                                               lambda: True, shutting_down.is_set,
+                                               said.append, 0.01)
+    thread, = (t for t in set(threading.enumerate()) - before if t.name == 'recorder_watch')
+    assert polled.wait(5.0), 'the recorder was seen'
+    return publisher, said, stop, thread
+
+
+def test_a_recorder_gone_while_the_simulator_runs_is_said_by_the_thread() -> None:
+    publisher, said, stop, _ = watch_thread(threading.Event())
+    try:
+        publisher.disconnect('/recorder')
+        deadline = time.monotonic() + 5.0
+        while not said and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert said == [stopped_line(4.5)]
+    finally:
+        stop.set()
+
+
+def test_the_watch_ends_when_the_simulators_own_shutdown_begins() -> None:
+    """Ctrl-C: the simulator unregisters its publishers before rospy.is_shutdown() turns
+    True; the master tells the recorder, which drops its connection while still listed,
+    as a killed recorder would be: nothing may be said from then on."""
+    shutting_down = threading.Event()
+    publisher, said, stop, thread = watch_thread(shutting_down)
+    try:
+        shutting_down.set()
+        thread.join(5.0)
+        publisher.disconnect('/recorder')
+        assert not thread.is_alive(), 'the watch goes on in a node shutting down'
+        assert said == []
+    finally:
+        stop.set()
+
+
+def test_shutdown_begins_with_rospy_s_request(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Requested (shutdown hooks running), not only done: rospy.is_shutdown() is still False
+    while they unregister the node's topics."""
+    import rospy
+
+    assert not recorder_watch._shutting_down()
+    monkeypatch.setattr(rospy.core, '_in_shutdown', True)
+    assert not rospy.is_shutdown()
+    assert recorder_watch._shutting_down()
 
 
 def test_bag_dir_check_creates_the_directory_and_names_the_reason(tmp_path: Path) -> None:
