@@ -33,9 +33,10 @@ from tutorial_atlas_control.bags.tries import (
 from tutorial_atlas_control.offline.replay import replay_bag
 from tutorial_atlas_control.trajectories.trajectory import load_trajectory, sample_count
 
-#: Serial: the tries are split on the recorder's own times, which lag the simulator's when the
-#: recorder is starved (seen beside a busy core: 440 ms, and 23 of try 3's commands counted in
-#: try 1; docs/TESTING.md, Known flakes: open).
+#: Serial: three tutorial trajectories played at real time, whose outcomes (two falls, one
+#: stand) hang on commands arriving in time (the rostests play them at 0.5x beside the
+#: parallel tests). A recorder lagging 440 ms once put 23 of try 3's commands in try 1; the
+#: reader now keeps each message in the try it was stamped in (test_bag_tries.py).
 pytestmark = pytest.mark.serial
 
 REPO = Path(__file__).resolve().parents[2]

@@ -28,7 +28,7 @@ from rosbags.interfaces import Connection
 from rosbags.rosbag1 import ReaderError
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.bags.records import EPOCH_GAP_NS, REWIND_NS, BagRecords, open_bag
+from tutorial_atlas_control.bags.records import EPOCH_GAP_NS, BagRecords, open_bag
 from tutorial_atlas_control.bags.run_log import PlayedTrajectory, trajectory_lines
 from tutorial_atlas_control.bags.typestore import (
     JOINT_COMMANDS_TYPE,
@@ -279,20 +279,26 @@ class _Reading:
                    connections: Sequence[Connection], zero_unset: bool) -> np.ndarray:
         """Header stamps (sim time, ns) moved to the run timeline, as the bag times are.
 
-        A message whose stamp is far from its record time around a reset_simulation (stamped
-        before it and recorded after it, or the other way round) keeps the epoch it was
-        stamped in. `zero_unset`: a zero stamp means "not stamped" (commands) and stays 0,
-        else it is sim time 0 (states).
+        Each message keeps the epoch, of the one it was recorded in and its two neighbours,
+        that puts its stamp nearest its record time: one stamped before a reset_simulation
+        and recorded after it (or the other way round) keeps the epoch it was stamped in,
+        and a starved recorder, whose clock lags the stamps, moves nothing (the
+        neighbours' stamps are the previous epoch's length plus EPOCH_GAP_NS away, the
+        lag a fraction of a second). `zero_unset`: a zero stamp means "not stamped"
+        (commands) and stays 0, else it is sim time 0 (states).
         """
         shifts_ns = np.asarray(self.records.epoch_shifts_ns, dtype=np.int64)
         if len(shifts_ns) == 1:
             return stamps_ns
         epochs = self.records.epochs(connections)
-        recorded_ns = bag_ns - shifts_ns[epochs]
         stamped = (stamps_ns > 0) | (not zero_unset)
-        late = stamped & (epochs > 0) & (stamps_ns > recorded_ns + REWIND_NS)
-        early = stamped & (epochs < len(shifts_ns) - 1) & (stamps_ns < recorded_ns - REWIND_NS)
-        epochs = np.where(late, epochs - 1, np.where(early, epochs + 1, epochs))
+        distance_ns = np.abs(stamps_ns + shifts_ns[epochs] - bag_ns)
+        for neighbour in (epochs - 1, epochs + 1):
+            neighbour = np.clip(neighbour, 0, len(shifts_ns) - 1)
+            neighbour_ns = np.abs(stamps_ns + shifts_ns[neighbour] - bag_ns)
+            nearer = stamped & (neighbour_ns < distance_ns)
+            epochs = np.where(nearer, neighbour, epochs)
+            distance_ns = np.where(nearer, neighbour_ns, distance_ns)
         shifted = stamps_ns + shifts_ns[epochs]
         return np.where(stamps_ns > 0, shifted, stamps_ns) if zero_unset else shifted
 

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import csv
+import dataclasses
 import json
 import os
 from pathlib import Path
@@ -97,6 +98,59 @@ def test_text_summary_lists_the_tries_and_resets(session_bag: Path) -> None:
     assert "try 2: 6.000 to 12.9" in text and "trajectory 'touchdown'" in text
     assert '6.000 s  reset_world: try 2 begins' in text
     assert "FELL at sim time 3.430 s, 2.430 s after the try's first command" in text
+
+
+#: How far a starved recorder's record times lagged the stamps of what it recorded (s), seen
+#: beside a busy core; twice that here.
+RECORDER_LAG_S = 0.88
+
+
+def test_a_lagging_recorder_keeps_each_message_in_the_try_it_was_stamped_in(
+        tmp_path: Path) -> None:
+    """A starved recorder's clock (its /clock thread) lags the simulator's: every record time
+    of the try after reset_simulation is behind its message's stamp. Nothing moves to another
+    try for it: the session reads as it does with a recorder on time."""
+    on_time = tries_records(SESSION)
+    after_reset = len(tries_records(SESSION[:2]))
+    lagging = on_time[:after_reset] + [
+        dataclasses.replace(record, t_s=max(record.t_s - RECORDER_LAG_S, 0.0))
+        for record in on_time[after_reset:]]
+    analysis = analyze_bag(write_bag(tmp_path / 'lagging.bag', lagging, in_given_order=True))
+    assert [each.window.cause for each in analysis.tries] == [RUN_START, RESET_WORLD,
+                                                              RESET_SIMULATION]
+    summary = [each.to_dict() for each in analysis.tries]
+    assert [each['command_count'] for each in summary] == [100, 100, 100]
+    assert [each['fell'] for each in summary] == [True, False, True]
+    assert summary[2]['fall_after_command'] == pytest.approx(3.0 + 0.43, abs=0.011)
+    states = analysis.tries[2].analysis.data.joint_states
+    assert len(states.t_s) == round(SESSION[2].duration_s / 0.01) - 1
+
+
+def test_messages_recorded_across_a_reset_from_their_stamps_keep_the_try_stamped_in(
+        tmp_path: Path) -> None:
+    """Around reset_simulation the recorder writes in arrival order: the last joint states
+    stamped before it can be written after the first ones stamped after it, and the other
+    way round. Each is counted in the try its stamp belongs to."""
+    records = tries_records(SESSION)
+    after_reset = len(tries_records(SESSION[:2]))
+    states = [i for i, record in enumerate(records) if record.topic == '/atlas/joint_states']
+    last_before = [i for i in states if i < after_reset][-3:]
+    first_after = [i for i in states if i >= after_reset][:2]
+    late = [dataclasses.replace(records[i], t_s=0.001 * (n + 1))  # stamped ~12.97-12.99 s
+            for n, i in enumerate(last_before)]
+    early = [dataclasses.replace(records[i], t_s=records[after_reset - 1].t_s)  # ~0.01 s
+             for i in first_after]
+    moved = set(last_before) | set(first_after)
+    kept = [record for i, record in enumerate(records) if i not in moved]
+    at = after_reset - len(last_before)
+    reordered = kept[:at] + early + kept[at:at + 1] + late + kept[at + 1:]
+    analysis = analyze_bag(write_bag(tmp_path / 'across.bag', reordered, in_given_order=True))
+    assert [each.window.cause for each in analysis.tries] == [RUN_START, RESET_WORLD,
+                                                              RESET_SIMULATION]
+    counts = [len(each.analysis.data.joint_states.t_s) for each in analysis.tries]
+    on_time = [len(each.analysis.data.joint_states.t_s) for each in analyze_bag(
+        write_bag(tmp_path / 'on_time.bag', records, in_given_order=True)).tries]
+    assert counts == on_time
 
 
 def test_single_run_is_one_try_without_warning(tmp_path: Path) -> None:
