@@ -27,7 +27,7 @@ from support.xdisplay import find_window, screenshot, skip_module_unless_launcha
 skip_module_unless_launchable()
 
 from support.launch import TestLaunch  # noqa: E402
-from support.plot_pixels import curve_extent  # noqa: E402
+from support.plot_pixels import curve_extent, shows_status_note  # noqa: E402
 from tutorial_atlas_control.processes import free_local_port, stop_tree  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
@@ -78,9 +78,16 @@ def sine_launch(tmp_path_factory: pytest.TempPathFactory) -> Iterator[TestLaunch
 
 
 def wait_for_steady_picture(display: str, window: str, path: Path) -> np.ndarray:
-    """The picture of `window` once two screenshots STEADY_S apart agree (the guard fails)."""
+    """The picture of `window` once it says PAUSED and two screenshots STEADY_S apart agree
+    (the guard fails). A window the machine starves draws nothing for seconds: two equal
+    screenshots alone were taken before the key had been handled."""
     deadline = time.monotonic() + RESUME_TIMEOUT_S
     before = screenshot(display, window, path)
+    while not shows_status_note(before):
+        if time.monotonic() > deadline:
+            pytest.fail(f'the window did not say PAUSED within {RESUME_TIMEOUT_S:.0f} s')
+        time.sleep(0.1)
+        before = screenshot(display, window, path)
     while time.monotonic() < deadline:
         time.sleep(STEADY_S)
         now = screenshot(display, window, path)

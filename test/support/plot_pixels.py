@@ -1,4 +1,5 @@
-"""Whether a picture of plot_topics.py (its window or its PNG) shows a curve, from its pixels.
+"""Whether a picture of plot_topics.py (its window or its PNG) shows a curve, or its status
+note (PAUSED), from its pixels.
 
 A curve in the first line colour (matplotlib's tab:blue, the first argument's) shows as
 pixels of that colour in most of the picture's columns (it runs across the time axis) and
@@ -23,6 +24,11 @@ COLOUR_TOLERANCE = 40
 #: the swatch are a few rows).
 MIN_COLUMNS_FRACTION = 0.6
 MIN_ROWS_FRACTION = 0.25
+#: The status note's colour (tab:red: PAUSED, autoscale off; nothing else is drawn in it),
+#: and the pixels of it that make a note: PAUSED at the window's size has about 110, none
+#: without it.
+STATUS_RGB = (214, 39, 40)
+MIN_STATUS_PIXELS = 40
 
 
 @dataclass(frozen=True)
@@ -44,3 +50,10 @@ def curve_extent(pixels: np.ndarray, rgb: tuple[int, int, int] = LINE_RGB) -> Cu
     height, width = line.shape
     return CurveExtent(float(line.any(axis=0).sum()) / width,
                        float(line.any(axis=1).sum()) / height)
+
+
+def shows_status_note(pixels: np.ndarray) -> bool:
+    """Whether the window shows its status note (PAUSED, or autoscale off)."""
+    distance = np.linalg.norm(pixels[..., :3].astype(float) - np.asarray(STATUS_RGB, float),
+                              axis=2)
+    return int(np.count_nonzero(distance <= COLOUR_TOLERANCE)) >= MIN_STATUS_PIXELS

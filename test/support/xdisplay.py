@@ -83,9 +83,39 @@ def _stop(process: subprocess.Popen) -> None:
             process.wait()
 
 
+def _lock_pid(number: int) -> int | None:
+    """The process holding display `number` (its lock file), None if none or unreadable."""
+    try:
+        return int(Path(f'/tmp/.X{number}-lock').read_text().strip())
+    except (OSError, ValueError):
+        return None
+
+
+def _answers(display: str) -> bool:
+    """Whether the X server at `display` accepts a client (xdotool opens it)."""
+    try:
+        return subprocess.run(['xdotool', 'getdisplaygeometry'],
+                              env=dict(os.environ, DISPLAY=display), capture_output=True,
+                              timeout=CAPTURE_TIMEOUT_S, check=False).returncode == 0
+    except subprocess.TimeoutExpired:
+        return False
+
+
+def _serving(process: subprocess.Popen, number: int) -> bool:
+    """Whether our Xvfb `process` holds display `number` and answers there.
+
+    Its socket file alone is not enough: another test's Xvfb may hold the number (ours then
+    exits, but may not have yet), and a viewer started on a display whose server did not
+    answer yet ran headless ("no X server answers").
+    """
+    return (process.poll() is None and _socket(number).exists()
+            and _lock_pid(number) == process.pid and _answers(f':{number}'))
+
+
 @contextmanager
 def xvfb(log_path: Path, screen: str = SCREEN) -> Iterator[str]:
-    """Yield the DISPLAY (':N') of a fresh Xvfb logging to `log_path`; stop it afterwards.
+    """Yield the DISPLAY (':N') of a fresh Xvfb logging to `log_path`, once it answers
+    there; stop it afterwards.
 
     Another test (or another checkout's tests) may take a free number between the check
     and Xvfb's start; Xvfb then exits at once and the next free number is tried.
@@ -101,7 +131,7 @@ def xvfb(log_path: Path, screen: str = SCREEN) -> Iterator[str]:
                 stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
             try:
                 deadline = time.monotonic() + START_TIMEOUT_S
-                while process.poll() is None and not _socket(number).exists():
+                while process.poll() is None and not _serving(process, number):
                     if time.monotonic() > deadline:
                         pytest.fail(f'Xvfb :{number} did not start within '
                                     f'{START_TIMEOUT_S:.0f} s; see {log_path}')

@@ -16,7 +16,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from support.plot_pixels import curve_extent
+from support.plot_pixels import curve_extent, shows_status_note
 from tutorial_atlas_control.plotting.fields import (
     FieldReader,
     FieldStep,
@@ -278,7 +278,7 @@ def test_the_y_range_of_flat_and_missing_data() -> None:
 
 
 # -- the drawing (the PNG's; the window's is the same code on Tk) -----------------------
-def draw(values_of_time: object, with_data: bool = True) -> np.ndarray:
+def draw(values_of_time: object, with_data: bool = True, paused: bool = False) -> np.ndarray:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -290,7 +290,7 @@ def draw(values_of_time: object, with_data: bool = True) -> np.ndarray:
     plot.advance(6.0)
     figure = Figure(figsize=(8.0, 4.5), dpi=100)
     canvas = FigureCanvasAgg(figure)
-    PlotFigure(figure, plot, 'sim time (s)').update()
+    PlotFigure(figure, plot, 'sim time (s)').update(paused=paused)
     canvas.draw()
     return np.asarray(canvas.buffer_rgba())[..., :3].copy()
 
@@ -303,6 +303,16 @@ def test_a_sine_shows_as_a_curve_and_flat_or_empty_plots_do_not() -> None:
     assert sine.shows_a_curve()
     assert not flat.shows_a_curve() and flat.columns_fraction > 0.6  # across, but flat
     assert not empty.shows_a_curve()
+
+
+def test_the_paused_note_is_seen_and_a_running_plot_has_none() -> None:
+    """What the window test waits for after the pause key (the plotter draws no other red)."""
+    def sine(t: float) -> float:
+        return 1.0 + 0.5 * math.sin(2.0 * math.pi * t)
+
+    assert shows_status_note(draw(sine, paused=True))
+    assert not shows_status_note(draw(sine))
+    assert not shows_status_note(draw(sine, with_data=False))
 
 
 def test_the_time_axis_follows_ros_time_from_0() -> None:
