@@ -15,8 +15,6 @@ import os
 
 import pytest
 
-from support.ordering import live_tests_first
-
 #: The environment variable that turns skips into a failed run.
 REQUIRE_ALL_ENV = 'TAC_REQUIRE_ALL'
 OPTIONAL_MARKER = 'optional'
@@ -50,10 +48,6 @@ def _note(report: pytest.TestReport | pytest.CollectReport, optional: bool) -> N
 def pytest_runtest_logreport(report: pytest.TestReport) -> None:
     if report.skipped and not hasattr(report, 'wasxfail'):
         _note(report, OPTIONAL_MARKER in report.keywords)
-
-
-def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    live_tests_first(items)  # the unit tests fill the parallel run's tail (support/ordering.py)
 
 
 def pytest_collectreport(report: pytest.CollectReport) -> None:
