@@ -396,6 +396,24 @@ def _connected_subscribers(publisher: rospy.Publisher) -> set[str]:
     return {connection.endpoint_id for connection in _connections(publisher)}
 
 
+class _MasterList:
+    """The master's subscribers of a topic, asked at most every MASTER_POLL_PERIOD_S; its
+    last answer is kept while it does not reply (None until it first does)."""
+
+    def __init__(self, registered: Callable[[], set[str] | None]) -> None:
+        self.registered = registered
+        self.listed: set[str] | None = None
+        self._next_poll_s = 0.0
+
+    def latest(self) -> set[str] | None:
+        if time.monotonic() >= self._next_poll_s:
+            answer = self.registered()
+            if answer is not None:
+                self.listed = answer
+            self._next_poll_s = time.monotonic() + MASTER_POLL_PERIOD_S
+        return self.listed
+
+
 def wait_for_subscribers(
     connected: Callable[[], set[str]],
     registered: Callable[[], set[str] | None],
@@ -425,14 +443,9 @@ def wait_for_subscribers(
         rospy.ROSInterruptException: the node was shut down while waiting.
     """
     deadline = time.monotonic() + timeout_s
-    listed: set[str] | None = None
-    next_master_poll = 0.0
+    master = _MasterList(registered)
     while True:
-        if time.monotonic() >= next_master_poll:
-            answer = registered()
-            if answer is not None:  # else keep the last answer: the master did not reply
-                listed = answer
-            next_master_poll = time.monotonic() + MASTER_POLL_PERIOD_S
+        listed = master.latest()
         now_connected = connected()
         missing = (listed or set()) - now_connected
         if now_connected and listed is not None and not missing:
@@ -470,14 +483,9 @@ def wait_for_log_readers(
         rospy.ROSInterruptException: the node was shut down while waiting.
     """
     deadline = time.monotonic() + timeout_s
-    listed: set[str] | None = None
-    next_master_poll = 0.0
+    master = _MasterList(registered)
     while True:
-        if time.monotonic() >= next_master_poll:
-            answer = registered()
-            if answer is not None:  # else keep the last answer: the master did not reply
-                listed = answer
-            next_master_poll = time.monotonic() + MASTER_POLL_PERIOD_S
+        listed = master.latest()
         missing = (listed or set()) - connected()
         if listed is not None and not missing:
             return set()
