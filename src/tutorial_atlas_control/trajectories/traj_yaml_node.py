@@ -41,6 +41,7 @@ __all__ = [
     'TrajYamlError',
     'build_command',
     'joint_commands_type',
+    'linger',
     'play',
     'positions_by_name',
     'read_gains',
@@ -82,6 +83,12 @@ MASTER_POLL_PERIOD_S = 0.1
 HANDOVER_WAIT_S = 0.5
 #: Polling interval (s, wall clock) of that wait.
 HANDOVER_POLL_S = 0.0005
+#: Wall time (s) the port stays up after its last command and line, so that a slow
+#: subscriber reads them. rospy's shutdown first tells the master the port is gone, and a
+#: roscpp subscriber then drops the connection at once, bytes it has not read included: a
+#: recorder starved for a moment (it runs niced) lost the last 3 commands and the done line
+#: of a fresh clone's demo while the simulator got them all. Cut short by Ctrl-C.
+EXIT_GRACE_S = 0.5
 #: Longest wait (s, wall clock) for the simulator's latched mode once it is connected; a
 #: simulator that does not publish it (an older one, a stand-in) gets no mode check.
 MODE_WAIT_S = 1.0
@@ -316,6 +323,16 @@ def play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], path
     run_trajectory(waypoints, cache.positions, send, _sleep, rospy.loginfo, rospy.get_time)
     wait_until_handed_over(publisher, HANDOVER_WAIT_S, stalled)  # the last, before shutdown
     rospy.loginfo(done_line(name))
+    linger(EXIT_GRACE_S)
+
+
+def linger(duration_s: float, shutting_down: Callable[[], bool] | None = None) -> None:
+    """Stay up `duration_s` of wall time (EXIT_GRACE_S), less once shutdown is requested."""
+    if shutting_down is None:
+        shutting_down = rospy.core.is_shutdown_requested
+    deadline = time.monotonic() + duration_s
+    while not shutting_down() and (left_s := deadline - time.monotonic()) > 0.0:
+        time.sleep(min(POLL_PERIOD_S, left_s))
 
 
 def _sleep(duration_s: float) -> None:

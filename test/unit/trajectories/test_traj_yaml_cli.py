@@ -29,6 +29,7 @@ from tutorial_atlas_control.trajectories.traj_yaml_node import (
     JointStateCache,
     TrajYamlError,
     build_command,
+    linger,
     mode_warning,
     positions_by_name,
     read_gains,
@@ -752,3 +753,24 @@ def test_a_shutdown_ends_the_wait_for_rosout_readers() -> None:
 
     with pytest.raises(rospy.ROSInterruptException):
         wait_for_log_readers(Connecting({}), lambda: {RECORDER}, 5.0, lambda: True)
+
+
+# --- staying up after the last command ------------------------------------------------------
+
+
+def test_the_port_stays_up_its_grace_after_the_last_command() -> None:
+    """Slow subscribers read the tail before rospy's shutdown makes roscpp drop them."""
+    started = time.monotonic()
+    linger(0.2, never_shut_down)
+    assert time.monotonic() - started >= 0.2
+
+
+def test_ctrl_c_cuts_the_grace_short() -> None:
+    asked = []
+
+    def shut_down_at_the_third_look() -> bool:
+        asked.append(True)
+        return len(asked) >= 3
+
+    linger(30.0, shut_down_at_the_third_look)
+    assert len(asked) == 3
