@@ -43,10 +43,15 @@ class CurveExtent:
                 and self.rows_fraction >= MIN_ROWS_FRACTION)
 
 
+def _of_colour(pixels: np.ndarray, rgb: tuple[int, int, int]) -> np.ndarray:
+    """Which of `pixels` ((height, width, 3) uint8 RGB) are within COLOUR_TOLERANCE of `rgb`."""
+    distance = np.linalg.norm(pixels[..., :3].astype(float) - np.asarray(rgb, float), axis=2)
+    return distance <= COLOUR_TOLERANCE
+
+
 def curve_extent(pixels: np.ndarray, rgb: tuple[int, int, int] = LINE_RGB) -> CurveExtent:
     """The extent of `rgb` in `pixels` ((height, width, 3) uint8 RGB)."""
-    distance = np.linalg.norm(pixels[..., :3].astype(float) - np.asarray(rgb, float), axis=2)
-    line = distance <= COLOUR_TOLERANCE
+    line = _of_colour(pixels, rgb)
     height, width = line.shape
     return CurveExtent(float(line.any(axis=0).sum()) / width,
                        float(line.any(axis=1).sum()) / height)
@@ -54,6 +59,4 @@ def curve_extent(pixels: np.ndarray, rgb: tuple[int, int, int] = LINE_RGB) -> Cu
 
 def shows_status_note(pixels: np.ndarray) -> bool:
     """Whether the window shows its status note (PAUSED, or autoscale off)."""
-    distance = np.linalg.norm(pixels[..., :3].astype(float) - np.asarray(STATUS_RGB, float),
-                              axis=2)
-    return int(np.count_nonzero(distance <= COLOUR_TOLERANCE)) >= MIN_STATUS_PIXELS
+    return int(np.count_nonzero(_of_colour(pixels, STATUS_RGB))) >= MIN_STATUS_PIXELS

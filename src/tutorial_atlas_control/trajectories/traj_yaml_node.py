@@ -326,10 +326,9 @@ def play(waypoints: Sequence[Waypoint], message_type: Callable[[], object], path
     linger(EXIT_GRACE_S)
 
 
-def linger(duration_s: float, shutting_down: Callable[[], bool] | None = None) -> None:
+def linger(duration_s: float,
+           shutting_down: Callable[[], bool] = rospy.core.is_shutdown_requested) -> None:
     """Stay up `duration_s` of wall time (EXIT_GRACE_S), less once shutdown is requested."""
-    if shutting_down is None:
-        shutting_down = rospy.core.is_shutdown_requested
     deadline = time.monotonic() + duration_s
     while not shutting_down() and (left_s := deadline - time.monotonic()) > 0.0:
         time.sleep(min(POLL_PERIOD_S, left_s))
@@ -349,9 +348,9 @@ def _wait_for_simulator(publisher: rospy.Publisher, first_state: JointState,
     """wait_for_subscribers for our publisher; the simulator is the sender of `first_state`."""
     simulator = (getattr(first_state, '_connection_header', None) or {}).get('callerid')
     started = time.monotonic()
-    missing = wait_for_subscribers(lambda: _connected_subscribers(publisher),
+    missing = wait_for_subscribers(lambda: _connected_subscribers(publisher.impl),
                                    _registered_subscribers, simulator, timeout_s)
-    connected = ', '.join(sorted(_connected_subscribers(publisher)))
+    connected = ', '.join(sorted(_connected_subscribers(publisher.impl)))
     rospy.loginfo(f'{JOINT_COMMANDS_TOPIC}: subscribers connected after '
                   f'{time.monotonic() - started:.2f} s: '
                   f'{connected} (simulator: {simulator or "unknown"})')
@@ -398,19 +397,19 @@ def _log_readers_registered() -> set[str] | None:
 
 def _log_readers_connected() -> set[str]:
     """The nodes connected to this node's /rosout publisher (rospy's own, made at init)."""
-    impl = rospy.topics.get_topic_manager().get_publisher_impl(topics.ROSOUT)
-    return {connection.endpoint_id for connection in list(impl.connections)} if impl else set()
+    return _connected_subscribers(rospy.topics.get_topic_manager().get_publisher_impl(
+        topics.ROSOUT))
 
 
-def _connections(publisher: rospy.Publisher) -> list[object]:
-    """A snapshot of `publisher`'s subscriber connections (none once it is closed)."""
-    impl = publisher.impl
+def _connections(impl: object | None) -> list[object]:
+    """A snapshot of a publisher's subscriber connections, from its rospy implementation
+    (`Publisher.impl`; none once it is closed)."""
     return list(impl.connections) if impl is not None else []
 
 
-def _connected_subscribers(publisher: rospy.Publisher) -> set[str]:
-    """The nodes connected to `publisher` (rospy names each connection by its subscriber)."""
-    return {connection.endpoint_id for connection in _connections(publisher)}
+def _connected_subscribers(impl: object | None) -> set[str]:
+    """The nodes connected to a publisher (rospy names each connection by its subscriber)."""
+    return {connection.endpoint_id for connection in _connections(impl)}
 
 
 class _MasterList:
@@ -531,7 +530,7 @@ def wait_until_handed_over(publisher: rospy.Publisher, timeout_s: float,
     skipped = stalled if stalled is not None else set()
     deadline = time.monotonic() + timeout_s
     while True:
-        queued = {id(connection) for connection in _connections(publisher)
+        queued = {id(connection) for connection in _connections(publisher.impl)
                   if getattr(connection, '_queue', None)}
         skipped.intersection_update(queued)  # one that caught up is waited for again
         if not queued - skipped:
