@@ -4,6 +4,11 @@ free, plays the bag's mode switch and commands with `rosbag play`, watches for t
 prints one JSON line: the pelvis height before, the sim times the commands arrived at, the
 lowest pelvis height, and rosbag play's outcome (or `error`).
 
+`rosbag play --wait-for-subscribers` starts once each topic has one subscriber: the
+simulator could be connected and this probe not yet, which would miss the first commands.
+So the player starts paused, and is resumed (its `pause_playback` service) once its
+getBusInfo lists a connection to every subscriber the master knows for each played topic.
+
 Its own process so that the test's pytest process never holds a rospy node (init_node is
 once per process) nor a ROS_MASTER_URI of its own: later tests do not depend on it.
 """
@@ -12,15 +17,24 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import subprocess
 import sys
 import threading
 import time
+import xmlrpc.client
 
 import rospy
 from nav_msgs.msg import Odometry
 from osrf_msgs.msg import JointCommands
 from rosgraph_msgs.msg import Clock
+from std_srvs.srv import SetBool
+
+from tutorial_atlas_control import processes
+
+PLAYED_TOPICS = ('/atlas/control_mode', '/atlas/joint_commands')
+#: rosbag play's node name: `play` made anonymous (`/play_<stamp>`), whatever __name says.
+PLAYER_PREFIX = '/play_'
 
 
 class Probe:
@@ -61,6 +75,62 @@ class Probe:
             time.sleep(0.01)
 
 
+def connected_player(master_uri: str, caller: str) -> str | None:
+    """rosbag play's node name once it is connected to every subscriber of every played
+    topic (the master's lists against the player's getBusInfo); None until then."""
+    try:
+        publishers, subscribers = processes.system_state(master_uri)
+        players = {node for topic in PLAYED_TOPICS for node in publishers.get(topic, [])
+                   if node.startswith(PLAYER_PREFIX)}
+        if len(players) != 1:
+            return None
+        player = players.pop()
+        code, _, uri = xmlrpc.client.ServerProxy(master_uri).lookupNode(caller, player)
+        if code != 1:
+            return None
+        code, _, bus = xmlrpc.client.ServerProxy(uri).getBusInfo(caller)
+    except OSError:
+        return None
+    if code != 1:
+        return None
+    for topic in PLAYED_TOPICS:
+        readers = set(subscribers.get(topic, []))
+        connected = {row[1] for row in bus if row[2] == 'o' and row[4] == topic}
+        if not readers or not readers <= connected:
+            return None
+    return player
+
+
+def play(bag: str, timeout_s: float) -> subprocess.CompletedProcess:
+    """`rosbag play --pause` of the played topics, resumed once every subscriber is connected.
+
+    Raises TimeoutError if the player is not connected, or has not ended, within `timeout_s`.
+    """
+    player = subprocess.Popen(
+        ['rosbag', 'play', '--quiet', '--pause', bag, '--topics', *PLAYED_TOPICS],
+        stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        deadline = time.monotonic() + timeout_s
+        while (name := connected_player(os.environ['ROS_MASTER_URI'], rospy.get_name())) is None:
+            if player.poll() is not None or time.monotonic() > deadline:
+                raise TimeoutError(f'rosbag play was not connected within {timeout_s:g} s')
+            time.sleep(0.05)
+        rospy.wait_for_service(f'{name}/pause_playback', timeout=timeout_s)
+        resumed = rospy.ServiceProxy(f'{name}/pause_playback', SetBool)(False)
+        if not resumed.success:
+            raise TimeoutError(f'rosbag play did not resume: {resumed.message}')
+        output, _ = player.communicate(timeout=timeout_s)
+    except subprocess.TimeoutExpired as err:
+        raise TimeoutError(f'rosbag play did not end within {timeout_s:g} s') from err
+    except rospy.ROSException as err:
+        raise TimeoutError(str(err)) from err
+    finally:
+        if player.poll() is None:
+            player.kill()
+            player.wait()
+    return subprocess.CompletedProcess(player.args, player.returncode, output, '')
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument('bag')
@@ -77,18 +147,15 @@ def main() -> int:
         probe.wait_for(lambda p: p.clock_s >= args.play_at and p.z_m is not None,
                        args.timeout, 'simulator start')
         result['z_before_m'] = probe.z_m
-        play = subprocess.run(
-            ['rosbag', 'play', '--quiet', '--wait-for-subscribers', args.bag,
-             '--topics', '/atlas/control_mode', '/atlas/joint_commands'],
-            capture_output=True, text=True, timeout=args.timeout, check=False)
-        result['play_returncode'] = play.returncode
-        result['play_output'] = play.stdout + play.stderr
+        played = play(args.bag, args.timeout)
+        result['play_returncode'] = played.returncode
+        result['play_output'] = played.stdout
         with probe.lock:
             played_until_s = probe.clock_s
         probe.wait_for(lambda p: p.min_z_m < args.fallen_below
                        or p.clock_s > played_until_s + args.fall_window,
                        args.timeout, 'fall watch')
-    except (TimeoutError, subprocess.TimeoutExpired) as err:
+    except TimeoutError as err:
         result['error'] = str(err)
     with probe.lock:
         result['arrivals_s'] = list(probe.command_arrivals_s)
