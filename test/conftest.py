@@ -7,11 +7,17 @@ the run ends with one line naming the skipped tests and exit status 1. Without i
 never hides what CI would fail on. Only tests marked
 `@pytest.mark.optional(reason)` may skip there: they need something no clone carries (the
 DRCSim reference files beside the repository); their skips are listed, and allowed.
+
+Also: Ctrl-C reaches the tests' children. A non-interactive shell starts its background
+jobs (make test's, a CI runner's) with SIGINT ignored, an ignored signal stays ignored
+across exec, and the tests stop their children with SIGINT as a terminal would.
 """
 
 from __future__ import annotations
 
 import os
+import signal
+import threading
 
 import pytest
 
@@ -27,7 +33,17 @@ def require_all() -> bool:
     return os.environ.get(REQUIRE_ALL_ENV, '') not in ('', '0')
 
 
+def ctrl_c_as_in_a_terminal() -> None:
+    """Python's SIGINT handler, SIGINT unblocked, in this process's main thread: each child
+    then starts with SIGINT at its default action (exec resets handled signals only). Without
+    it a started child ignores the SIGINT that stop_tree sends, and is killed 20 s later."""
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
 def pytest_configure(config: pytest.Config) -> None:
+    ctrl_c_as_in_a_terminal()
     config.addinivalue_line(
         'markers', f'{OPTIONAL_MARKER}(reason): may skip even with {REQUIRE_ALL_ENV}=1 '
                    '(it needs files no clone carries)')

@@ -6,31 +6,15 @@ loaded as a plugin, as `make test` loads it for the tree.
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
-TEST_DIR = Path(__file__).resolve().parents[1]
-#: Guard (s) against a hung pytest.
-PYTEST_GUARD_S = 120.0
+from support.pytest_runs import run_pytest
+
 SKIPPING = 'import pytest\n\n\ndef test_needs_a_tool():\n    pytest.skip("no such tool")\n'
 OPTIONAL = ('import pytest\n\n\n@pytest.mark.optional\ndef test_needs_reference_files():\n'
             '    pytest.skip("no reference files")\n')
-
-
-def run_pytest(tmp_path: Path, source: str, require_all: str) -> subprocess.CompletedProcess:
-    (tmp_path / 'test_sample.py').write_text(source, encoding='utf-8')
-    env = dict(os.environ, TAC_REQUIRE_ALL=require_all,
-               PYTHONPATH=os.pathsep.join(filter(None, [str(TEST_DIR),
-                                                        os.environ.get('PYTHONPATH')])))
-    return subprocess.run([sys.executable, '-m', 'pytest', '-p', 'conftest', '-q',
-                           '-p', 'no:cacheprovider', '--rootdir', str(tmp_path),
-                           str(tmp_path / 'test_sample.py')],
-                          cwd=tmp_path, env=env, capture_output=True, text=True,
-                          timeout=PYTEST_GUARD_S, check=False)
 
 
 def test_a_local_run_names_its_skips_loudly(tmp_path: Path) -> None:
