@@ -13,6 +13,7 @@ import os
 import shutil
 import subprocess
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -42,30 +43,74 @@ MIN_VIEW_SIDE_PX = 100
 #: at half the size still passes, an empty view never does.
 MIN_HEAD_PIXELS = 250
 MIN_LEG_PIXELS = 3000
-#: rviz has drawn its first frames of the robot after this long (s, wall; software GL).
-RVIZ_SETTLE_S = 20.0
+#: The grid's lines (rviz/atlas.rviz: 160, 160, 164 at half alpha) blend into the
+#: background as neutral greys between the two: in the view they mean rviz has rendered
+#: the scene. Measured: about 12 000 such pixels (62..125 grey); none before the first frame.
+GRID_GREY_RANGE = (55, 165)
+GRID_MAX_CHROMA = 4
+MIN_GRID_PIXELS = 2000
+#: Wall-clock guard (s) for rviz's first frames of the robot (software GL, a loaded machine).
+RVIZ_DRAW_TIMEOUT_S = 120.0
+#: Between two screenshots while waiting (s).
+SCREENSHOT_PERIOD_S = 1.0
 #: rviz messages that would mean it cannot place or build the robot.
 BAD_MESSAGES = ('robot_description', 'does not exist', 'No transform', 'Could not transform',
                 'Fixed Frame', 'URDF')
 
 
-def robot_pixels(image: np.ndarray) -> tuple[int, int]:
-    """(orange, blue) pixels inside the 3D view."""
+def view_of(image: np.ndarray) -> np.ndarray | None:
+    """rviz's 3D view in a screenshot (the area of its background colour); None if not shown."""
     background = np.all(image == BACKGROUND_RGB, axis=2)
     # Rows and columns mostly of background: the view, not the colour swatch in the panel.
     rows = np.nonzero(background.sum(axis=1) > MIN_VIEW_SIDE_PX)[0]
     cols = np.nonzero(background.sum(axis=0) > MIN_VIEW_SIDE_PX)[0]
-    assert len(rows) and len(cols), 'no rviz 3D view (background colour) on screen'
-    view = image[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1]
+    if not len(rows) or not len(cols):
+        return None
+    return image[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1]
+
+
+def robot_pixels(image: np.ndarray) -> tuple[int, int]:
+    """(orange, blue) pixels inside the 3D view."""
+    view = view_of(image)
+    assert view is not None, 'no rviz 3D view (background colour) on screen'
     m = atlas_model.load_model().model
     return tuple(int(material_mask(view, m.material(name).rgba, CHROMA_TOLERANCE,
                                    MIN_BRIGHTNESS).sum()) for name in ('orange', 'blue'))
 
 
+def shows_robot(image: np.ndarray) -> bool:
+    head, legs = robot_pixels(image)
+    return head >= MIN_HEAD_PIXELS and legs >= MIN_LEG_PIXELS
+
+
+def grid_pixels(view: np.ndarray) -> int:
+    """Pixels of the view in the grid's blended greys."""
+    pixels = view.astype(np.int16)
+    chroma = pixels.max(axis=2) - pixels.min(axis=2)
+    low, high = GRID_GREY_RANGE
+    return int(((chroma <= GRID_MAX_CHROMA) & (pixels[..., 0] >= low)
+                & (pixels[..., 0] <= high)).sum())
+
+
+def shows_grid(image: np.ndarray) -> bool:
+    view = view_of(image)
+    return view is not None and grid_pixels(view) >= MIN_GRID_PIXELS
+
+
+def screenshot_once(display: str, path: Path, drawn: Callable[[np.ndarray], bool]) -> np.ndarray:
+    """The screen once `drawn` says so of it, or the last one after RVIZ_DRAW_TIMEOUT_S."""
+    deadline = time.monotonic() + RVIZ_DRAW_TIMEOUT_S
+    while True:
+        image = screenshot(display, 'root', path)
+        if view_of(image) is not None and drawn(image) or time.monotonic() > deadline:
+            return image
+        time.sleep(SCREENSHOT_PERIOD_S)
+
+
 @pytest.mark.parametrize('tf', [True, False], ids=['tf', 'no_tf'])
 def test_rviz_shows_the_robot(tmp_path: Path, tf: bool) -> None:
     """With atlas.launch's TF, the robot in the 3D view; with tf:=false (no robot_description,
-    no TF: the check's bad frame), none of its colours."""
+    no TF: the check's bad frame), none of its colours once the view is drawn."""
     with xvfb(tmp_path / 'xvfb.log') as display:
         port = free_local_port()
         env = ros_environment(port, tmp_path / 'ros_log', base=display_env(display))
@@ -82,8 +127,10 @@ def test_rviz_shows_the_robot(tmp_path: Path, tf: bool) -> None:
                                     stdout=rviz_log, stderr=subprocess.STDOUT,
                                     start_new_session=True)
             find_window(display, 'RViz')
-            time.sleep(RVIZ_SETTLE_S)
-            image = screenshot(display, 'root', tmp_path / 'rviz.png')
+            # The robot once drawn; without TF (no robot_description) the view once rendered,
+            # grid and all: a frame the robot would be in.
+            image = screenshot_once(display, tmp_path / 'rviz.png',
+                                    shows_robot if tf else shows_grid)
         finally:
             if rviz is not None:
                 stop_tree(rviz)
@@ -95,6 +142,7 @@ def test_rviz_shows_the_robot(tmp_path: Path, tf: bool) -> None:
     print(f'rviz (tf:={tf}): {head} orange and {legs} blue pixels in the 3D view; '
           f'screenshot {tmp_path / "rviz.png"}')
     if not tf:
+        assert shows_grid(image), f'rviz drew no grid within {RVIZ_DRAW_TIMEOUT_S:.0f} s'
         assert head < MIN_HEAD_PIXELS and legs < MIN_LEG_PIXELS
         return
     assert head >= MIN_HEAD_PIXELS

@@ -180,8 +180,12 @@ def screenshot(display: str, window: str, path: Path | None = None) -> np.ndarra
     """
     from PIL import Image
 
-    png = subprocess.run(['import', '-display', display, '-window', window, 'png:-'],
-                         check=True, capture_output=True, timeout=CAPTURE_TIMEOUT_S).stdout
+    capture = subprocess.run(['import', '-display', display, '-window', window, 'png:-'],
+                             check=False, capture_output=True, timeout=CAPTURE_TIMEOUT_S)
+    if capture.returncode != 0:
+        raise AssertionError(f'import could not capture window {window} on {display} '
+                             f'(exit {capture.returncode}): {capture.stderr.decode().strip()}')
+    png = capture.stdout
     if path is not None:
         path.write_bytes(png)
     with Image.open(io.BytesIO(png)) as image:
