@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import struct
 import time
-import xmlrpc.client
 from pathlib import Path
 
 import numpy as np
@@ -32,7 +31,7 @@ from harness import READY_TIMEOUT_S, BenchError, Launch, Master, log
 from probes import RawRecorder, clock_ns
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.processes import _RosProcess, cpu_seconds, wait_until
+from tutorial_atlas_control.processes import _RosProcess, cpu_seconds, node_api, wait_until
 from tutorial_atlas_control.units import NS_PER_S
 
 #: How long (s, wall) a udp-only subscription may take to connect before the run says
@@ -64,15 +63,8 @@ def command_age_s(raw: bytes) -> float:
 def state_transport(master: Master) -> str | None:
     """The transport ('TCPROS'/'UDPROS') of the simulator's /atlas/atlas_state connection
     to echo_controller, from the simulator's getBusInfo; None while there is none."""
-    from tutorial_atlas_control.processes import _TimeoutTransport
-
     try:
-        server = xmlrpc.client.ServerProxy(master.uri, transport=_TimeoutTransport())
-        code, _, uri = server.lookupNode('/tac_bench', SIM_NODE)
-        if code != 1:
-            return None
-        node = xmlrpc.client.ServerProxy(uri, transport=_TimeoutTransport())
-        code, _, rows = node.getBusInfo('/tac_bench')
+        code, _, rows = node_api(master.uri, SIM_NODE, '/tac_bench').getBusInfo('/tac_bench')
     except OSError:
         return None
     if code != 1:

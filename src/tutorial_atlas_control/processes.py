@@ -268,6 +268,18 @@ def system_state(master_uri: str) -> tuple[dict[str, list[str]], dict[str, list[
     return dict(state[0]), dict(state[1])
 
 
+def node_api(master_uri: str, node: str, caller: str) -> xmlrpc.client.ServerProxy:
+    """`node`'s XML-RPC API (getBusInfo, requestTopic), looked up on the master as `caller`.
+
+    Raises OSError while the master does not answer or does not know `node`.
+    """
+    proxy = xmlrpc.client.ServerProxy(master_uri, transport=_TimeoutTransport())
+    code, message, uri = proxy.lookupNode(caller, node)
+    if code != 1:
+        raise OSError(f'{node}: {message}')
+    return xmlrpc.client.ServerProxy(uri, transport=_TimeoutTransport())
+
+
 def wait_until(condition: Callable[[], bool], timeout_s: float, failure: str,
                check: Callable[[], None] | None = None) -> None:
     """Poll `condition` until true, for at most `timeout_s` (wall).

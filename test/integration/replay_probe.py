@@ -22,7 +22,6 @@ import subprocess
 import sys
 import threading
 import time
-import xmlrpc.client
 
 import rospy
 from nav_msgs.msg import Odometry
@@ -85,10 +84,7 @@ def connected_player(master_uri: str, caller: str) -> str | None:
         if len(players) != 1:
             return None
         player = players.pop()
-        code, _, uri = xmlrpc.client.ServerProxy(master_uri).lookupNode(caller, player)
-        if code != 1:
-            return None
-        code, _, bus = xmlrpc.client.ServerProxy(uri).getBusInfo(caller)
+        code, _, bus = processes.node_api(master_uri, player, caller).getBusInfo(caller)
     except OSError:
         return None
     if code != 1:
@@ -110,11 +106,22 @@ def play(bag: str, timeout_s: float) -> subprocess.CompletedProcess:
         ['rosbag', 'play', '--quiet', '--pause', bag, '--topics', *PLAYED_TOPICS],
         stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
-        deadline = time.monotonic() + timeout_s
-        while (name := connected_player(os.environ['ROS_MASTER_URI'], rospy.get_name())) is None:
-            if player.poll() is not None or time.monotonic() > deadline:
-                raise TimeoutError(f'rosbag play was not connected within {timeout_s:g} s')
-            time.sleep(0.05)
+        def player_ended() -> None:
+            if player.poll() is not None:
+                raise TimeoutError(f'rosbag play ended before it was connected, '
+                                   f'exit status {player.returncode}')
+
+        found: list[str] = []
+
+        def connected() -> bool:
+            name = connected_player(os.environ['ROS_MASTER_URI'], rospy.get_name())
+            if name is not None:
+                found.append(name)
+            return name is not None
+
+        processes.wait_until(connected, timeout_s, 'rosbag play was not connected',
+                             check=player_ended)
+        name = found[0]
         rospy.wait_for_service(f'{name}/pause_playback', timeout=timeout_s)
         resumed = rospy.ServiceProxy(f'{name}/pause_playback', SetBool)(False)
         if not resumed.success:
@@ -122,7 +129,7 @@ def play(bag: str, timeout_s: float) -> subprocess.CompletedProcess:
         output, _ = player.communicate(timeout=timeout_s)
     except subprocess.TimeoutExpired as err:
         raise TimeoutError(f'rosbag play did not end within {timeout_s:g} s') from err
-    except rospy.ROSException as err:
+    except (rospy.ROSException, processes.ProcessError) as err:
         raise TimeoutError(str(err)) from err
     finally:
         if player.poll() is None:

@@ -22,10 +22,10 @@ import pytest
 pytest.importorskip('osrf_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
 
 from support.bag_checks import missing_steps
-from support.launch import SIM, TestLaunch, node_api
+from support.launch import SIM, TestLaunch
 from tutorial_atlas_control.bags.reader import JOINT_STATE_MD5, read_bag
 from tutorial_atlas_control.node.transport import MAX_BACKLOG_BYTES
-from tutorial_atlas_control.processes import rss_kib
+from tutorial_atlas_control.processes import node_api, rss_kib
 
 #: Timing or memory claims: run alone, after make test's parallel part.
 pytestmark = pytest.mark.serial

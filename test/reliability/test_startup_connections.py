@@ -16,7 +16,8 @@ import subprocess
 
 import pytest
 
-from support.launch import SIM, TestLaunch, node_api
+from support.launch import SIM, TestLaunch
+from tutorial_atlas_control.processes import node_api
 
 #: Timing or memory claims: run alone, after make test's parallel part.
 pytestmark = pytest.mark.serial

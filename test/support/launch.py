@@ -14,7 +14,6 @@ import select
 import subprocess
 import sys
 import time
-import xmlrpc.client
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -33,17 +32,6 @@ EXIT_TIMEOUT_S = 60.0
 SIM_TIME_TIMEOUT_S = 120.0
 #: wait_sim_time's guard (s): it also waits for the master and the simulator to start.
 WAIT_SIM_TIME_TIMEOUT_S = 180.0
-
-
-def node_api(master_uri: str, node: str, caller: str) -> xmlrpc.client.ServerProxy:
-    """`node`'s XML-RPC API (requestTopic, getBusInfo), looked up on the master as `caller`.
-
-    Raises OSError if the master does not know `node`.
-    """
-    code, message, uri = xmlrpc.client.ServerProxy(master_uri).lookupNode(caller, node)
-    if code != 1:
-        raise OSError(f'{node}: {message}')
-    return xmlrpc.client.ServerProxy(uri)
 
 
 class Talker:
@@ -128,7 +116,7 @@ class TestLaunch(processes.AtlasLaunch):
         caller = '/tutorial_atlas_control_tests'
         try:
             publishers, subscribers = processes.system_state(self.uri)
-            code, _, bus = node_api(self.uri, SIM, caller).getBusInfo(caller)
+            code, _, bus = processes.node_api(self.uri, SIM, caller).getBusInfo(caller)
         except OSError:
             return None
         recorded = {topic for topic, nodes in publishers.items()

@@ -7,6 +7,7 @@ import signal
 import socket
 import subprocess
 import threading
+import xmlrpc.server
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -23,6 +24,7 @@ from tutorial_atlas_control.processes import (
     default_sigint,
     descendants,
     free_local_port,
+    node_api,
     rss_kib,
     run_to_end,
     stop_tree,
@@ -160,17 +162,39 @@ def test_a_missing_roslaunch_is_one_line(tmp_path: Path, monkeypatch: pytest.Mon
 
 
 @pytest.fixture
-def python_ctrl_c() -> Iterator[None]:
-    """Python's own SIGINT handler (KeyboardInterrupt) for the test, with SIGINT unblocked
-    in this thread: a pytest worker was seen with it blocked (by what is not known), and its
-    Ctrl-C then never came."""
-    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
-    mask = signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+def fake_master() -> Iterator[str]:
+    """A master on localhost that knows one node, /known, itself an XML-RPC server whose
+    getBusInfo answers one connection row."""
+    servers = []
+    for _ in range(2):
+        server = xmlrpc.server.SimpleXMLRPCServer(('127.0.0.1', 0), logRequests=False)
+        threading.Thread(target=server.serve_forever, daemon=True).start()
+        servers.append(server)
+    master, node = servers
+    node_uri = f'http://127.0.0.1:{node.server_address[1]}/'
+    node.register_function(lambda caller: [1, '', [[1, '/sink', 'o', 'TCPROS', '/t']]],
+                           'getBusInfo')
+    master.register_function(
+        lambda caller, name: [1, '', node_uri] if name == '/known'
+        else [-1, f'unknown node [{name}]', ''], 'lookupNode')
     try:
-        yield
+        yield f'http://127.0.0.1:{master.server_address[1]}/'
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
-        signal.signal(signal.SIGINT, previous)
+        for server in servers:
+            server.shutdown()
+            server.server_close()
+
+
+def test_node_api_reaches_a_known_node_and_names_an_unknown_one(fake_master: str) -> None:
+    code, _, rows = node_api(fake_master, '/known', '/caller').getBusInfo('/caller')
+    assert (code, rows) == (1, [[1, '/sink', 'o', 'TCPROS', '/t']])
+    with pytest.raises(OSError, match=r'^/gone: unknown node \[/gone\]$'):
+        node_api(fake_master, '/gone', '/caller')
+
+
+def test_node_api_without_a_master_is_an_os_error() -> None:
+    with pytest.raises(OSError):
+        node_api(f'http://127.0.0.1:{free_local_port()}/', '/known', '/caller')
 
 
 def _pid_written_to(path: Path) -> int:
@@ -183,7 +207,6 @@ def test_run_to_end_returns_the_exit_status() -> None:
     assert run_to_end(['bash', '-c', 'exit 3'], os.environ, GUARD_S) == 3
 
 
-@pytest.mark.usefixtures('python_ctrl_c')
 def test_run_to_end_stops_the_child_when_its_caller_alone_gets_ctrl_c(tmp_path: Path) -> None:
     pid_file = tmp_path / 'pid'
     child = f'echo $$ > {pid_file}; exec sleep 300'
@@ -206,7 +229,6 @@ def test_run_to_end_stops_the_child_at_its_timeout(tmp_path: Path) -> None:
     assert not alive([_pid_written_to(pid_file)])
 
 
-@pytest.mark.usefixtures('python_ctrl_c')
 def test_a_ctrl_c_while_the_child_starts_is_raised_once_it_can_be_stopped(
         monkeypatch: pytest.MonkeyPatch) -> None:
     real_popen = subprocess.Popen
