@@ -40,6 +40,8 @@ class SimProbe:
         self.warnings: list[str] = []
         self.keep_joint_states = keep_joint_states
         self.joint_states: list[JointState] = []
+        #: time.monotonic() at each kept joint state's arrival (s).
+        self.joint_state_arrivals_s: list[float] = []
         self.configs: list[dict] = []
         rospy.Subscriber('/clock', Clock, self._on_clock, queue_size=1000)
         rospy.Subscriber('/atlas/joint_states', JointState, self._on_joint_state, queue_size=2000)
@@ -61,6 +63,7 @@ class SimProbe:
             self.joint_state = msg
             if self.keep_joint_states:
                 self.joint_states.append(msg)
+                self.joint_state_arrivals_s.append(time.monotonic())
 
     def _on_odom(self, msg: Odometry) -> None:
         self.odom = msg

@@ -67,6 +67,11 @@ ONE_OR_TWO_STEPS_SHARE = 0.8
 #: The client subscribes with queue_size 1, as DRCSim's did: when two states arrive
 #: together (the simulator sends in batches while it catches up) it answers the newer.
 ANSWERED_SHARE = 0.8
+#: Stalls (no new command for this many steps or more) are described in the log: how long
+#: their joint states took to reach this test in wall time tells a simulator that was held
+#: up and then caught up in a burst (much less than the schedule) from a client that was
+#: held up while the simulator stepped on (about the schedule).
+REPORTED_STALL_STEPS = 20
 
 
 class CommandAgeTest(unittest.TestCase):
@@ -174,6 +179,7 @@ class CommandAgeTest(unittest.TestCase):
             f'{errors.max():.4f} rad, mean {errors.mean():.4f} rad; command age (steps: count) '
             f'{counts}; mean of the window means '
             f'{np.mean([m.command_age_mean for m in statistics]) * 1e3:.2f} ms')
+        self.report_stalls(statistics)
         # Every command answers a joint state, stamped with its stamp, names prefixed.
         self.assertEqual(set(in_window) - state_stamps, set())
         self.assertGreater(len(answered), ANSWERED_SHARE * len(states))
@@ -186,6 +192,26 @@ class CommandAgeTest(unittest.TestCase):
         self.assertIn(int(np.median(ages)), ANSWER_AGES_STEPS)
         self.assertGreaterEqual(share, ONE_OR_TWO_STEPS_SHARE,
                                 f'command ages (steps: count) {counts}')
+
+    def report_stalls(self, statistics: list[ControllerStatistics]) -> None:
+        """Log each stall of REPORTED_STALL_STEPS or more: its end, its length, and the
+        wall time over which its joint states reached this test."""
+        with self.probe.lock:
+            arrivals = {s.header.stamp.to_nsec(): t for s, t in
+                        zip(self.probe.joint_states, self.probe.joint_state_arrivals_s)}
+        rate = rospy.get_param('/atlas_sim/real_time_factor', None)
+        ages = [round(m.command_age / STEP_S) for m in statistics]
+        for i, age in enumerate(ages):
+            ends = i + 1 == len(ages) or ages[i + 1] <= age
+            if age < REPORTED_STALL_STEPS or not ends:
+                continue
+            end_ns = statistics[i].header.stamp.to_nsec()
+            times = [arrivals[t] for t in range(end_ns - age * int(STEP_S * 1e9), end_ns + 1,
+                                                 int(STEP_S * 1e9)) if t in arrivals]
+            spread = f'{(max(times) - min(times)) * 1e3:.0f} ms' if times else 'unknown'
+            schedule = f'{age * STEP_S / rate * 1e3:.0f} ms' if rate else 'unknown'
+            rospy.loginfo(f'stall of {age} steps ending at t={end_ns / 1e9:.3f} s: its joint '
+                          f'states arrived over {spread} of wall time (schedule {schedule})')
 
 
 if __name__ == '__main__':
