@@ -428,6 +428,26 @@ def test_a_lagging_paced_run_flushes_less_until_it_has_caught_up() -> None:
     assert clock.slept_s == []  # still behind: no sleep
 
 
+def test_a_stalled_paced_run_catches_up_at_twice_the_factor_not_in_a_burst() -> None:
+    """After a 100 ms stall at real time, steps of 0.1 ms go no closer than half their 1 ms
+    share (a client's answer still has 0.4 ms to arrive), until the run is on schedule."""
+    clock = FakeClock()
+    pacer = Pacer(1.0, clock, clock.sleep)
+    pacer.restart(0)
+    clock.now_s += 0.100  # the stall, before the first step
+    released = []
+    for step in range(1, 301):
+        clock.now_s += 0.0001  # the step
+        pacer.wait(step * 1_000_000)
+        released.append(clock.now_s)
+    gaps_ms = np.diff(released) * 1e3
+    assert pacing.CATCH_UP_SPEEDUP == 2.0
+    # The lag shrinks by 0.5 ms a step: caught up after about 200 steps, then 1 ms a step.
+    assert gaps_ms[:190] == pytest.approx(np.full(190, 0.5))
+    assert gaps_ms[210:] == pytest.approx(np.full(89, 1.0))
+    assert clock.now_s == pytest.approx(pacer.due_s(300 * 1_000_000))
+
+
 def test_a_run_too_far_behind_gives_up_catching_up() -> None:
     clock = FakeClock()
     pacer = Pacer(1.0, clock, clock.sleep)
