@@ -127,7 +127,10 @@ def xvfb(log_path: Path, screen: str = SCREEN) -> Iterator[str]:
     with open(log_path, 'w') as log:
         for number in _free_displays():
             process = subprocess.Popen(
-                ['Xvfb', f':{number}', '-screen', '0', screen, '-nolisten', 'tcp'],
+                # -noreset: by default an X server resets when its last client leaves, and a
+                # client connecting meanwhile is refused ("Failed to open display"): a
+                # viewer starting while the test's xdotool polls the display.
+                ['Xvfb', f':{number}', '-screen', '0', screen, '-nolisten', 'tcp', '-noreset'],
                 stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
             try:
                 deadline = time.monotonic() + START_TIMEOUT_S
