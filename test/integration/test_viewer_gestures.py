@@ -118,7 +118,13 @@ def test_reset_button_is_reset_world(viewer: Viewer) -> None:
                    check=True)  # the left panel, hidden when the window opens
     deadline = time.monotonic() + UI_DRAWN_TIMEOUT_S
     while True:
-        pixels = xdisplay.screenshot(viewer.display, viewer.window)
+        try:  # while the panel appears, a capture may fail: not drawn yet, like no button
+            pixels = xdisplay.screenshot(viewer.display, viewer.window)
+        except xdisplay.CaptureError:
+            if time.monotonic() > deadline:
+                raise
+            time.sleep(1.0)
+            continue
         try:
             x, y = xdisplay.find_reset_button(pixels)
             break

@@ -175,19 +175,25 @@ def find_window(display: str, name: str, timeout_s: float = WINDOW_TIMEOUT_S) ->
         time.sleep(POLL_PERIOD_S)
 
 
+class CaptureError(AssertionError):
+    """`import` could not read a window's pixels (its exit status and stderr)."""
+
+
 def screenshot(display: str, window: str, path: Path | None = None) -> np.ndarray:
     """The pixels of `window` ('root': the whole screen), (height, width, 3) uint8 RGB.
 
     With `path`, the capture is also kept there as a PNG, for a person to look at when a
-    test fails.
+    test fails. Raises CaptureError when `import` fails: reading a window the X server is
+    changing (the viewer's panels appearing) fails now and then ("unable to read X window
+    image"), and a wait for what the window shows may take that as "not yet".
     """
     from PIL import Image
 
     capture = subprocess.run(['import', '-display', display, '-window', window, 'png:-'],
                              check=False, capture_output=True, timeout=CAPTURE_TIMEOUT_S)
     if capture.returncode != 0:
-        raise AssertionError(f'import could not capture window {window} on {display} '
-                             f'(exit {capture.returncode}): {capture.stderr.decode().strip()}')
+        raise CaptureError(f'import could not capture window {window} on {display} '
+                           f'(exit {capture.returncode}): {capture.stderr.decode().strip()}')
     png = capture.stdout
     if path is not None:
         path.write_bytes(png)
