@@ -9,6 +9,7 @@ which are the MJCF's.
 
 from __future__ import annotations
 
+import functools
 import os
 import shutil
 import subprocess
@@ -71,17 +72,21 @@ def view_of(image: np.ndarray) -> np.ndarray | None:
     return image[rows[0]:rows[-1] + 1, cols[0]:cols[-1] + 1]
 
 
-def robot_pixels(image: np.ndarray) -> tuple[int, int]:
-    """(orange, blue) pixels inside the 3D view."""
-    view = view_of(image)
-    assert view is not None, 'no rviz 3D view (background colour) on screen'
+@functools.cache
+def material_colours() -> tuple[np.ndarray, np.ndarray]:
+    """The model's orange and blue (rgba): compiled once, not at every screenshot."""
     m = atlas_model.load_model().model
-    return tuple(int(material_mask(view, m.material(name).rgba, CHROMA_TOLERANCE,
-                                   MIN_BRIGHTNESS).sum()) for name in ('orange', 'blue'))
+    return m.material('orange').rgba.copy(), m.material('blue').rgba.copy()
 
 
-def shows_robot(image: np.ndarray) -> bool:
-    head, legs = robot_pixels(image)
+def robot_pixels(view: np.ndarray) -> tuple[int, int]:
+    """(orange, blue) pixels in rviz's 3D view."""
+    return tuple(int(material_mask(view, rgba, CHROMA_TOLERANCE, MIN_BRIGHTNESS).sum())
+                 for rgba in material_colours())
+
+
+def shows_robot(view: np.ndarray) -> bool:
+    head, legs = robot_pixels(view)
     return head >= MIN_HEAD_PIXELS and legs >= MIN_LEG_PIXELS
 
 
@@ -94,30 +99,29 @@ def grid_pixels(view: np.ndarray) -> int:
                 & (pixels[..., 0] <= high)).sum())
 
 
-def shows_grid(image: np.ndarray) -> bool:
-    view = view_of(image)
-    return view is not None and grid_pixels(view) >= MIN_GRID_PIXELS
+def shows_grid(view: np.ndarray) -> bool:
+    return grid_pixels(view) >= MIN_GRID_PIXELS
 
 
 def log_tail(path: Path, lines: int = LOG_TAIL_LINES) -> str:
     return '\n'.join(path.read_text(errors='replace').splitlines()[-lines:])
 
 
-def screenshot_once(display: str, path: Path, drawn: Callable[[np.ndarray], bool],
+def drawn_view(display: str, path: Path, drawn: Callable[[np.ndarray], bool],
                     rviz: subprocess.Popen, rviz_log: Path) -> np.ndarray:
-    """The screen once `drawn` says so of it. Fails, with the end of rviz's output, if
+    """rviz's 3D view once `drawn` says so of it. Fails, with the end of rviz's output, if
     rviz.launch ends first or nothing is drawn within RVIZ_DRAW_TIMEOUT_S."""
     deadline = time.monotonic() + RVIZ_DRAW_TIMEOUT_S
     while True:
-        image = screenshot(display, 'root', path)
-        if view_of(image) is not None and drawn(image):
-            return image
+        view = view_of(screenshot(display, 'root', path))
+        if view is not None and drawn(view):
+            return view
         if rviz.poll() is not None:
             pytest.fail(f'rviz.launch ended (exit status {rviz.returncode}) before its view '
                         f'was drawn; screen {path}; its output ends:\n{log_tail(rviz_log)}')
         if time.monotonic() > deadline:
-            view = 'no 3D view' if view_of(image) is None else '3D view, not drawn'
-            pytest.fail(f'rviz did not draw within {RVIZ_DRAW_TIMEOUT_S:.0f} s ({view}); '
+            seen = 'no 3D view' if view is None else '3D view, not drawn'
+            pytest.fail(f'rviz did not draw within {RVIZ_DRAW_TIMEOUT_S:.0f} s ({seen}); '
                         f'screen {path}; its output ends:\n{log_tail(rviz_log)}')
         time.sleep(SCREENSHOT_PERIOD_S)
 
@@ -144,7 +148,7 @@ def test_rviz_shows_the_robot(tmp_path: Path, tf: bool) -> None:
             find_window(display, 'RViz')
             # The robot once drawn; without TF (no robot_description) the view once rendered,
             # grid and all: a frame the robot would be in.
-            image = screenshot_once(display, tmp_path / 'rviz.png',
+            view = drawn_view(display, tmp_path / 'rviz.png',
                                     shows_robot if tf else shows_grid, rviz, tmp_path / 'rviz.log')
         finally:
             if rviz is not None:
@@ -152,7 +156,7 @@ def test_rviz_shows_the_robot(tmp_path: Path, tf: bool) -> None:
             stop_tree(atlas)
             atlas_log.close()
             rviz_log.close()
-    head, legs = robot_pixels(image)
+    head, legs = robot_pixels(view)
     output = (tmp_path / 'rviz.log').read_text(errors='replace')
     print(f'rviz (tf:={tf}): {head} orange and {legs} blue pixels in the 3D view; '
           f'screenshot {tmp_path / "rviz.png"}')

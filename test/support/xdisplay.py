@@ -91,7 +91,7 @@ def _lock_pid(number: int) -> int | None:
         return None
 
 
-def _answers(display: str) -> bool:
+def answers(display: str) -> bool:
     """Whether the X server at `display` accepts a client (xdotool opens it)."""
     try:
         return subprocess.run(['xdotool', 'getdisplaygeometry'],
@@ -109,7 +109,7 @@ def _serving(process: subprocess.Popen, number: int) -> bool:
     answer yet ran headless ("no X server answers").
     """
     return (process.poll() is None and _socket(number).exists()
-            and _lock_pid(number) == process.pid and _answers(f':{number}'))
+            and _lock_pid(number) == process.pid and answers(f':{number}'))
 
 
 @contextmanager

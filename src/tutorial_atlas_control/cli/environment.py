@@ -62,4 +62,3 @@ def _import_without_ctrl_c(module: str) -> object:
         return importlib.import_module(module)
     finally:
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)
-
