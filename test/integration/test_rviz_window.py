@@ -56,6 +56,9 @@ RVIZ_DRAW_TIMEOUT_S = 120.0
 SCREENSHOT_PERIOD_S = 1.0
 #: Lines of rviz's output in a failure's message.
 LOG_TAIL_LINES = 30
+#: Frames of an rviz crash's backtrace in a failure's message.
+BACKTRACE_FRAMES = 25
+RVIZ_BINARY = '/usr/lib/rviz/rviz'
 #: rviz messages that would mean it cannot place or build the robot.
 BAD_MESSAGES = ('robot_description', 'does not exist', 'No transform', 'Could not transform',
                 'Fixed Frame', 'URDF')
@@ -107,8 +110,24 @@ def log_tail(path: Path, lines: int = LOG_TAIL_LINES) -> str:
     return '\n'.join(path.read_text(errors='replace').splitlines()[-lines:])
 
 
+def crash_backtrace(ros_home: Path) -> str:
+    """The backtrace of rviz's core dump under `ros_home` (roslaunch runs nodes there), or
+    why there is none: rviz's own start-up crashes are rare and need their stack to fix."""
+    cores = sorted(ros_home.glob('core*'))
+    if not cores:
+        return f'no core dump in {ros_home} (kernel.core_pattern is not "core"?)'
+    if shutil.which('gdb') is None:
+        return f'core dump {cores[0]}; install gdb for its backtrace'
+    result = subprocess.run(['gdb', '-batch', '-nx', '-ex', 'bt', RVIZ_BINARY, str(cores[0])],
+                            capture_output=True, text=True, timeout=120, check=False)
+    # gdb shows the crashing frame on loading the core, then the whole stack.
+    frames = list(dict.fromkeys(line for line in result.stdout.splitlines()
+                                if line.startswith('#')))
+    return f'core dump {cores[0]}, backtrace:\n' + '\n'.join(frames[:BACKTRACE_FRAMES])
+
+
 def drawn_view(display: str, path: Path, drawn: Callable[[np.ndarray], bool],
-                    rviz: subprocess.Popen, rviz_log: Path) -> np.ndarray:
+               rviz: subprocess.Popen, rviz_log: Path, ros_home: Path) -> np.ndarray:
     """rviz's 3D view once `drawn` says so of it. Fails, with the end of rviz's output, if
     rviz.launch ends first or nothing is drawn within RVIZ_DRAW_TIMEOUT_S."""
     deadline = time.monotonic() + RVIZ_DRAW_TIMEOUT_S
@@ -118,7 +137,8 @@ def drawn_view(display: str, path: Path, drawn: Callable[[np.ndarray], bool],
             return view
         if rviz.poll() is not None:
             pytest.fail(f'rviz.launch ended (exit status {rviz.returncode}) before its view '
-                        f'was drawn; screen {path}; its output ends:\n{log_tail(rviz_log)}')
+                        f'was drawn; screen {path}; its output ends:\n{log_tail(rviz_log)}\n'
+                        f'{crash_backtrace(ros_home)}')
         if time.monotonic() > deadline:
             seen = 'no 3D view' if view is None else '3D view, not drawn'
             pytest.fail(f'rviz did not draw within {RVIZ_DRAW_TIMEOUT_S:.0f} s ({seen}); '
@@ -142,14 +162,18 @@ def test_rviz_shows_the_robot(tmp_path: Path, tf: bool) -> None:
         rviz = None
         try:
             wait_sim_time(env, 1.0)
-            rviz = subprocess.Popen(['roslaunch', 'tutorial_atlas_control', 'rviz.launch'], env=env,
-                                    stdout=rviz_log, stderr=subprocess.STDOUT,
-                                    start_new_session=True)
+            # Core dumps on, in a ROS_HOME of the test's own: a crash of rviz leaves its stack.
+            ros_home = tmp_path / 'rviz_home'
+            ros_home.mkdir()
+            rviz = subprocess.Popen(['prlimit', '--core=unlimited', 'roslaunch',
+                                     'tutorial_atlas_control', 'rviz.launch'],
+                                    env=dict(env, ROS_HOME=str(ros_home)), stdout=rviz_log,
+                                    stderr=subprocess.STDOUT, start_new_session=True)
             find_window(display, 'RViz')
             # The robot once drawn; without TF (no robot_description) the view once rendered,
             # grid and all: a frame the robot would be in.
-            view = drawn_view(display, tmp_path / 'rviz.png',
-                                    shows_robot if tf else shows_grid, rviz, tmp_path / 'rviz.log')
+            view = drawn_view(display, tmp_path / 'rviz.png', shows_robot if tf else shows_grid,
+                              rviz, tmp_path / 'rviz.log', ros_home)
         finally:
             if rviz is not None:
                 stop_tree(rviz)
