@@ -3,7 +3,8 @@
 lipm: the linear inverted pendulum and its capture point; support: the support polygon
 and keeping a pressure centre in it; contact_wrench: a wrench shared between the feet;
 stand_pose: DRCSim's Stand pose; estimator: the balance state from the model; stand: the
-Stand controller (capture-point feedback, inverse statics, joint PD); push_trial: offline
+Stand controller (capture-point feedback, inverse statics, joint PD); stand_behaviour: that
+controller as the simulator's Stand behaviour; push_trial: offline
 trials of it on the simulator, standing and pushed.
 """
 
@@ -16,6 +17,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
              'natural_frequency'],
     'push_trial': ['Push', 'TrialResult', 'push_survived', 'stand_trial'],
     'stand': ['StandController', 'StandGains', 'StandOutput', 'StandReference'],
+    'stand_behaviour': ['StandBehaviour'],
     'stand_pose': ['STAND_POSE_RAD', 'place_in_stand_pose', 'sole_corners'],
     'support': ['Region', 'clamp_into', 'convex_hull', 'inside', 'shrink', 'signed_distance'],
 })

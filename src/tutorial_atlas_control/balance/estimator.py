@@ -72,6 +72,11 @@ class BalanceEstimator:
         self._last_polygon: (tuple[tuple[bool, bool], np.ndarray, np.ndarray, np.ndarray]
                              | None) = None
 
+    @property
+    def sole_half_size_m(self) -> tuple[float, float]:
+        """(half length, half width) of a sole box (m): the model's."""
+        return float(self._half_size[0]), float(self._half_size[1])
+
     def _support_polygon(self, positions: np.ndarray, rotations: np.ndarray,
                          contact: tuple[bool, bool]) -> np.ndarray:
         """The hull of the touching soles' corners; the same array as last time while the

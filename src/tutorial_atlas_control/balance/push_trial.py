@@ -2,9 +2,9 @@
 whether the robot stayed up without a step. Deterministic (the simulator is), so tests
 assert exact outcomes and the bench can search the largest push survived.
 
-The controller drives AtlasSimulator directly (its torque passed to step(), as offline
-replay passes recorded torques); pushes are the simulator's /atlas/apply_pelvis_force
-input (a force on the pelvis, held from one input to the next).
+The controller runs as the simulator's Stand behaviour (StandBehaviour installed, the
+Stand mode, its torque as f_out), the path the node steps; pushes are the simulator's
+/atlas/apply_pelvis_force input (a force on the pelvis, held from one input to the next).
 """
 
 from __future__ import annotations
@@ -13,10 +13,11 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import mujoco
 import numpy as np
 
-from tutorial_atlas_control.balance.estimator import BalanceEstimator
-from tutorial_atlas_control.balance.stand import StandController, StandGains, StandReference
+from tutorial_atlas_control.balance.stand import StandGains
+from tutorial_atlas_control.balance.stand_behaviour import StandBehaviour
 from tutorial_atlas_control.balance.stand_pose import place_in_stand_pose
 from tutorial_atlas_control.sim import (
     DEFAULT_GAINS_FILE,
@@ -28,8 +29,6 @@ from tutorial_atlas_control.sim import (
     wrench_input,
 )
 
-#: Sole box half sizes of sim/atlas_v1.xml (m): 0.26 x 0.125 m soles.
-SOLE_HALF_SIZE_M = (0.13, 0.0624435)
 #: The pushes of the robustness figures last this long (s), as the issue's bench does.
 PUSH_DURATION_S = 0.2
 #: Standing means the pelvis above this (m); Stand holds it at about 0.91 m.
@@ -75,30 +74,37 @@ def stand_trial(duration_s: float, pushes: Sequence[Push] = (),
     sim = AtlasSimulator(atlas, load_gains_yaml(DEFAULT_GAINS_FILE), time_to_unpin_s=0.0,
                          startup_mode=VrcMode.BDI_STAND)
     place_in_stand_pose(sim.atlas, sim.data)
-    estimator = BalanceEstimator(sim.atlas)
-    state = estimator.estimate(sim.data.qpos, sim.data.qvel)
-    feet_start = state.sole_centres[:, :2].copy()
-    controller = StandController(estimator.mass_kg, sim.atlas.effort_limit_nm,
-                                 StandReference.from_state(state), SOLE_HALF_SIZE_M, gains)
+    stand = _TimedStand(sim.atlas, gains)
+    sim.install_stand(stand)  # the simulator starts in Stand: it takes over at once
+    assert stand.last_state is not None
+    feet_start = stand.last_state.sole_centres[:, :2].copy()
     events = sorted([(round(p.start_s / sim.dt_s), p.force_n) for p in pushes]
                     + [(round((p.start_s + p.duration_s) / sim.dt_s), (0.0, 0.0, 0.0))
                        for p in pushes], key=lambda event: event[0])
-    lowest, travel, cpu_s = np.inf, 0.0, 0.0
+    lowest, travel = np.inf, 0.0
     steps = round(duration_s / sim.dt_s)
     for step in range(steps):
         while events and events[0][0] == step:
             sim.apply_input(wrench_input(events.pop(0)[1], (0.0, 0.0, 0.0)))
-        started = time.process_time()
-        state = estimator.estimate(sim.data.qpos, sim.data.qvel)
-        torque = controller.step(state, sim.joint_positions(), sim.joint_velocities()).torque_nm
-        cpu_s += time.process_time() - started
-        sim.step(torque)
+        sim.step()
         lowest = min(lowest, pelvis_height_m(sim.atlas, sim.data))
         travel = max(travel, float(np.max(np.linalg.norm(
-            state.sole_centres[:, :2] - feet_start, axis=1))))
+            stand.last_state.sole_centres[:, :2] - feet_start, axis=1))))
         if lowest < STANDING_PELVIS_M:
-            return TrialResult(False, lowest, travel, step + 1, cpu_s)
-    return TrialResult(travel <= FOOT_TRAVEL_LIMIT_M, lowest, travel, steps, cpu_s)
+            return TrialResult(False, lowest, travel, step + 1, stand.cpu_s)
+    return TrialResult(travel <= FOOT_TRAVEL_LIMIT_M, lowest, travel, steps, stand.cpu_s)
+
+
+class _TimedStand(StandBehaviour):
+    """StandBehaviour counting the process time its steps take."""
+
+    cpu_s = 0.0
+
+    def torque(self, data: mujoco.MjData) -> np.ndarray:
+        started = time.process_time()
+        torque = super().torque(data)
+        self.cpu_s += time.process_time() - started
+        return torque
 
 
 def push_survived(direction_xy: tuple[float, float], impulse_ns: float,

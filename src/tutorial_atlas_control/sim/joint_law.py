@@ -2,7 +2,8 @@
 
 Each step the mode's command (the user command in User mode, else the hold) gives the
 torque; outside User mode a user command with some k_effort not 0 is blended with that
-hold's torque (f_out). Whether the compiled kernel (law_kernel) or the numpy law
+hold's torque (f_out); under a behaviour (apply_behaviour) its torque is f_out instead.
+Whether the compiled kernel (law_kernel) or the numpy law
 (controller.compute_torque) computes it, JointLaw.apply() is the only call every kind of
 step makes (plain, under a cheat), so the two laws cannot take different branches.
 """
@@ -38,7 +39,8 @@ class JointLaw:
         #: The memory of the mode's command, and of the user command blended under a hold.
         self.pid = PidState()
         self.blend_pid = PidState()
-        self._hold_torque_nm = np.zeros(NUM_JOINTS)  # the hold's torque: f_out when blending
+        # f_out when blending: the hold's torque, or a behaviour's
+        self._hold_torque_nm = np.zeros(NUM_JOINTS)
         self._ctrl = data.ctrl
         self._plain: CompiledLaw | None = None
         self._hold: CompiledLaw | None = None
@@ -70,6 +72,37 @@ class JointLaw:
         else:
             self._hold(command)  # type: ignore[misc]  # set with _plain
             self._blend(blended)  # type: ignore[misc]
+
+    def apply_behaviour(self, f_out_nm: np.ndarray, blended: JointCommandArrays | None) -> None:
+        """One step under a behaviour (sim/behaviour.py): its torque `f_out_nm` (N m, (28,))
+        within the effort limits, or, when `blended` is not None, `blended`'s PID torque
+        blended with it by k_effort, as apply() blends a hold's; into torque_nm and ctrl."""
+        f_out = self._hold_torque_nm
+        limit = self.joints.effort_limit
+        np.clip(f_out_nm, -limit, limit, out=f_out)
+        if blended is None:
+            self.torque_nm[:] = f_out
+            self._ctrl[:] = f_out
+        elif self._blend is not None:
+            self._blend(blended)
+        else:
+            joints = self.joints
+            compute_torque(blended, joints.positions(), joints.velocities(), self.blend_pid,
+                           joints.dt_s, joints.lower, joints.upper, limit, out=self.torque_nm,
+                           f_out=f_out)
+            self._ctrl[:] = self.torque_nm
+
+    def predict_behaviour(self, f_out_nm: np.ndarray,
+                          blended: JointCommandArrays | None) -> np.ndarray:
+        """The torque (N m) apply_behaviour() would give now; the law's memory is kept."""
+        joints = self.joints
+        limit = joints.effort_limit
+        f_out = np.clip(f_out_nm, -limit, limit)
+        if blended is None:
+            return f_out
+        return compute_torque(blended, joints.positions(), joints.velocities(),
+                              copy.deepcopy(self.blend_pid), joints.dt_s, joints.lower,
+                              joints.upper, limit, f_out=f_out)
 
     def set_torque(self, torque_nm: np.ndarray | float) -> None:
         """Apply `torque_nm` instead of the law (a recorded torque; 0 while physics is off)."""

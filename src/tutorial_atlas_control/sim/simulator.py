@@ -20,6 +20,7 @@ import numpy as np
 
 from tutorial_atlas_control.command import CommandUpdate, JointCommandArrays
 from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.sim.behaviour import Behaviour, ModeBehaviours
 from tutorial_atlas_control.sim.controller import Gains
 from tutorial_atlas_control.sim.divergence import (
     DIVERGENCE_WARNINGS,
@@ -88,6 +89,7 @@ class AtlasSimulator:
         self.law = JointLaw(atlas, self.data, self.dt_s, compiled_law)
         self.torque_nm = self.law.torque_nm  # the law's output array, applied each step
         self.commands = ModeCommands(gains, self.joint_positions, self.torque_nm)
+        self.behaviours = ModeBehaviours()  # install_stand
         self._check_divergence = DivergenceCheck(self.data, self.law.state_is_finite).check
         self.sim_time_ns = 0
         # VRCPlugin's cheats (modes, teleport, cmd_vel, pelvis wrench, kinematic playback).
@@ -126,6 +128,7 @@ class AtlasSimulator:
         self._last_input = None
         self.startup_pin.start(self.sim_time_ns)
         self.commands.reset()
+        self.behaviours.select(self.mode, self.data)
 
     def config(self) -> SimConfig:
         """What re-creates this run offline: the model, its step, pinning and last reset."""
@@ -211,9 +214,15 @@ class AtlasSimulator:
         return self.commands.user_command
 
     def set_mode(self, mode: ControlMode) -> None:
-        """ModeCommands.set_mode; the target changed, so the derivative restarts (no kick)."""
+        """ModeCommands.set_mode; the derivative restarts (no kick); a behaviour starts."""
         self.commands.set_mode(mode)
         self.law.restart_derivative()
+        self.behaviours.select(mode, self.data)
+
+    def install_stand(self, behaviour: Behaviour | None) -> None:
+        """Stand runs `behaviour` (f_out: its torque), or the hold for None; at once."""
+        self.behaviours.stand = behaviour
+        self.behaviours.select(self.mode, self.data)
 
     def receive_command(self, names: Sequence[str],
                         arrays: Mapping[str, Sequence[float]]) -> None:
@@ -271,7 +280,11 @@ class AtlasSimulator:
             self.data.xfrc_applied += vrc.xfrc
         if torque_nm is None:
             commands = self.commands
-            self.law.apply(commands.law_command, commands.blend_command)
+            behaviour = self.behaviours.acting
+            if behaviour is None:
+                self.law.apply(commands.law_command, commands.blend_command)
+            else:
+                self.law.apply_behaviour(behaviour.torque(self.data), commands.blend_command)
         else:
             self.law.set_torque(torque_nm)
         mujoco.mj_step(self.model, self.data)
@@ -293,4 +306,8 @@ class AtlasSimulator:
 
     def next_law_torque(self) -> np.ndarray:
         """The torque (N m) the law would apply at the next step; the law's memory is kept."""
-        return self.law.predict(self.commands.law_command, self.commands.blend_command)
+        commands = self.commands
+        behaviour = self.behaviours.acting
+        if behaviour is not None:
+            return self.law.predict_behaviour(behaviour.torque(self.data), commands.blend_command)
+        return self.law.predict(commands.law_command, commands.blend_command)

@@ -12,6 +12,7 @@ import pytest
 from tutorial_atlas_control.balance import lipm, support
 from tutorial_atlas_control.balance.estimator import BalanceEstimator
 from tutorial_atlas_control.balance.stand import StandController, StandReference
+from tutorial_atlas_control.balance.stand_behaviour import StandBehaviour
 from tutorial_atlas_control.balance.stand_pose import STAND_POSE_RAD, place_in_stand_pose
 from tutorial_atlas_control.sim import model as atlas_model
 
@@ -122,3 +123,26 @@ def test_the_polygon_is_kept_while_the_feet_stay_and_redone_when_they_move(
     again = estimator.estimate(moved, placed.qvel).support_polygon
     assert again is not first
     np.testing.assert_allclose(again, first + [0.01, 0.0])
+
+
+def test_stand_behaviour_is_the_controller_held_where_it_started(
+        atlas: atlas_model.AtlasModel, placed: mujoco.MjData) -> None:
+    """The simulator's Stand behaviour: the controller's torque for the state in the
+    MjData, with the reference taken at start(); asked before start(), an error."""
+    behaviour = StandBehaviour(atlas)
+    with pytest.raises(RuntimeError, match='before start'):
+        behaviour.torque(placed)
+    behaviour.start(placed)
+    estimator = BalanceEstimator(atlas)
+    rest = estimator.estimate(placed.qpos, placed.qvel)
+    assert behaviour.estimator.sole_half_size_m == pytest.approx(SOLE_HALF_SIZE_M)
+    controller = StandController(estimator.mass_kg, atlas.effort_limit_nm,
+                                 StandReference.from_state(rest), SOLE_HALF_SIZE_M)
+    pushed = mujoco.MjData(atlas.model)
+    pushed.qpos[:], pushed.qvel[:] = placed.qpos, placed.qvel
+    pushed.qvel[0] = 0.2  # moving forward: the capture point ahead of where it started
+    expected = controller.step(estimator.estimate(pushed.qpos, pushed.qvel),
+                               pushed.qpos[atlas.qpos_adr], pushed.qvel[atlas.dof_adr])
+    np.testing.assert_array_equal(behaviour.torque(pushed), expected.torque_nm)
+    assert behaviour.last_output is not None
+    assert behaviour.last_output.desired_cop[0] > rest.capture_point[0] + 0.01

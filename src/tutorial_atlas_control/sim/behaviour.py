@@ -1,0 +1,51 @@
+"""Where a behaviour of the open AtlasSimInterface hands the simulator its torque, f_out.
+
+DRCSim's AtlasPlugin blended each joint's PID torque with the output of BDI's behaviour
+library (f_out) by k_effort. Here a Behaviour computes f_out from the simulator's state
+once per step, and the simulator blends it exactly as it blends its hold's torque. The
+behaviours themselves (balance/) sit above the simulator and are installed into it: the
+simulator knows only this protocol, so it stays free of the controllers' imports.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+import mujoco
+import numpy as np
+
+from tutorial_atlas_control.control_modes import ControlMode
+
+__all__ = ['Behaviour', 'ModeBehaviours']
+
+
+class Behaviour(Protocol):
+    """A controller giving f_out, the 28 joint torques of one behaviour, each step."""
+
+    def start(self, data: mujoco.MjData) -> None:
+        """Take over the robot as it is in `data` now (e.g. stand where it stands)."""
+
+    def torque(self, data: mujoco.MjData) -> np.ndarray:
+        """This step's f_out (N m, (28,), the tutorial's joint order) from `data`'s joint
+        positions and velocities; `data` is read, never written."""
+
+
+class ModeBehaviours:
+    """The behaviours installed for the control modes, and the one acting now.
+
+    Only Stand takes one so far; a mode without one keeps the simulator's law on its
+    command (the hold, the user's PID, ragdoll's zeros).
+    """
+
+    def __init__(self) -> None:
+        #: What Stand runs; None: Stand is the hold.
+        self.stand: Behaviour | None = None
+        #: The behaviour acting now (the mode's, started), or None.
+        self.acting: Behaviour | None = None
+
+    def select(self, mode: ControlMode, data: mujoco.MjData) -> None:
+        """`mode`'s behaviour, started from the robot in `data`, becomes the acting one."""
+        behaviour = self.stand if mode is ControlMode.STAND else None
+        if behaviour is not None:
+            behaviour.start(data)
+        self.acting = behaviour
