@@ -195,6 +195,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ('msgs', 'plotting'),
     ('sim',),
     ('balance',),
+    ('asi',),
     ('stepping', 'trajectories'),
     ('bags',),
     ('offline', 'demo'),
@@ -305,9 +306,9 @@ def test_the_layer_check_catches_upward_imports() -> None:
     found = layer_order_violations(source, f'{PACKAGE}.msgs.example')
     assert found == [
         f'{PACKAGE}.msgs.example:7: imports {PACKAGE}.sim.simulator (layer 4 above layer 3)',
-        f'{PACKAGE}.msgs.example:9: imports {PACKAGE}.offline (layer 8 above layer 3)',
-        f'{PACKAGE}.msgs.example:10: imports {PACKAGE}.bags (layer 7 above layer 3)',
-        f'{PACKAGE}.msgs.example:11: imports {PACKAGE}.stepping (layer 6 above layer 3)',
+        f'{PACKAGE}.msgs.example:9: imports {PACKAGE}.offline (layer 9 above layer 3)',
+        f'{PACKAGE}.msgs.example:10: imports {PACKAGE}.bags (layer 8 above layer 3)',
+        f'{PACKAGE}.msgs.example:11: imports {PACKAGE}.stepping (layer 7 above layer 3)',
         f'{PACKAGE}.msgs.example:12: imports {PACKAGE}.nowhere (in no layer)',
     ]
 

@@ -57,6 +57,14 @@ class JointLaw:
                                 else self._plain.state_is_finite)
 
     @property
+    def f_out_nm(self) -> np.ndarray:
+        """The f_out of the last blended step (N m, (28,)): the hold's or the behaviour's
+        torque the user's PID was blended with (read-only view)."""
+        view = self._hold_torque_nm.view()
+        view.setflags(write=False)
+        return view
+
+    @property
     def compiled(self) -> bool:
         return self._plain is not None
 

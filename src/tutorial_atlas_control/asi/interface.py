@@ -1,0 +1,145 @@
+"""The open AtlasSimInterface over one simulator: requests applied between steps, the state
+reported after each step. ROS-free: the node hands it decoded commands and publishes the
+bytes of its states.
+
+What it does with a command (DRCSim 2.7's AtlasPlugin::SetASICommand): the behaviour is
+requested (AsiSession decides), then k_effort, at exactly 28 entries, becomes the blend of
+every joint; a behaviour switch itself never changes k_effort. Stand runs the balancing
+StandBehaviour, installed into the simulator here.
+"""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+
+from tutorial_atlas_control.asi.behaviors import BEHAVIOR_OF_MODE, Behavior
+from tutorial_atlas_control.asi.session import STANDING_BEHAVIORS, AsiSession
+from tutorial_atlas_control.balance import StandBehaviour, signed_distance
+from tutorial_atlas_control.command import LAW_FIELDS, CommandUpdate
+from tutorial_atlas_control.control_modes import ControlMode
+from tutorial_atlas_control.joints import NUM_JOINTS
+from tutorial_atlas_control.msgs import AsiCommand, AsiState, BehaviorFeedback
+from tutorial_atlas_control.sim import AtlasSimulator
+
+__all__ = ['FALLING_PELVIS_M', 'FALLING_TILT_RAD', 'AtlasSimInterface']
+
+#: A standing behaviour is falling once the pelvis is below this (m; Stand holds it at
+#: about 0.91 m) ...
+FALLING_PELVIS_M = 0.7
+#: ... or tilted more than this from upright (rad).
+FALLING_TILT_RAD = 0.5
+#: Stand is refused while the centre of mass is further than this outside the feet (m).
+COM_OUTSIDE_TOLERANCE_M = 0.0
+FOOT_BODIES = ('l_foot', 'r_foot')
+_K_EFFORT_ROW = (LAW_FIELDS.index('k_effort'),)
+_ALL_JOINTS = np.arange(NUM_JOINTS)
+_NO_TORQUE = np.zeros(NUM_JOINTS)
+_NO_TORQUE.setflags(write=False)
+_NO_BLEND = np.zeros(NUM_JOINTS, np.uint8)
+_NO_BLEND.setflags(write=False)
+
+
+class AtlasSimInterface:
+    """Behaviour requests and state reports for `sim`, whose Stand it makes the balancing
+    one."""
+
+    def __init__(self, sim: AtlasSimulator) -> None:
+        self.sim = sim
+        self.session = AsiSession()
+        self.stand = StandBehaviour(sim.atlas)
+        sim.install_stand(self.stand)
+        model = sim.model
+        self._feet = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name)
+                      for name in FOOT_BODIES]
+        free_joint = int(model.body_jntadr[sim.atlas.pelvis_body_id])
+        self._free_dof = int(model.jnt_dofadr[free_joint])
+
+    @property
+    def current_behavior(self) -> Behavior:
+        return BEHAVIOR_OF_MODE[self.sim.mode]
+
+    def apply(self, command: AsiCommand) -> None:
+        """One checked AtlasSimInterfaceCommand, between two steps."""
+        sim = self.sim
+        current = self.current_behavior
+        feet_under_com = True
+        if command.behavior != current:
+            feet_under_com = self.com_over_feet()
+        mode = self.session.request(command.behavior, current, feet_under_com)
+        if mode is not None:
+            kept = None if sim.user_command is None else sim.user_command.k_effort.copy()
+            sim.set_mode(mode)
+            if kept is not None:
+                self._set_k_effort(kept)
+        if command.k_effort is not None:
+            self._set_k_effort(command.k_effort)
+
+    def mode_switched(self, previous: ControlMode) -> None:
+        """The control mode changed outside the interface (/atlas/control_mode)."""
+        current = self.current_behavior
+        if current != BEHAVIOR_OF_MODE[previous]:
+            self.session.switched(current, BEHAVIOR_OF_MODE[previous])
+
+    def _set_k_effort(self, fractions: np.ndarray) -> None:
+        self.sim.receive_updates([CommandUpdate(_ALL_JOINTS, _K_EFFORT_ROW,
+                                                np.asarray(fractions, dtype=float)[None, :])])
+
+    def com_over_feet(self) -> bool:
+        """The centre of mass over the support polygon of the soles touching the ground."""
+        state = self.stand.estimator.estimate(self.sim.data.qpos, self.sim.data.qvel)
+        polygon = state.support_polygon
+        if len(polygon) < 3:
+            return False
+        return signed_distance(polygon, state.com[:2]) >= -COM_OUTSIDE_TOLERANCE_M
+
+    def falling(self) -> bool:
+        """The pelvis low or tilted (FALLING_PELVIS_M, FALLING_TILT_RAD)."""
+        data, pelvis = self.sim.data, self.sim.atlas.pelvis_body_id
+        upright = float(data.xmat[pelvis][8])  # the pelvis z axis's world z component
+        tilt = math.acos(max(-1.0, min(1.0, upright)))
+        return float(data.xpos[pelvis][2]) < FALLING_PELVIS_M or tilt > FALLING_TILT_RAD
+
+    def f_out(self) -> np.ndarray:
+        """The behaviour's joint torques this step (N m): the Stand behaviour's or a hold's;
+        none in User and ragdoll."""
+        sim = self.sim
+        if sim.mode in (ControlMode.USER, ControlMode.RAGDOLL):
+            return _NO_TORQUE
+        return sim.torque_nm if sim.blended_command() is None else sim.law.f_out_nm
+
+    def k_effort(self) -> np.ndarray:
+        """The blend in use (uint8, (28,)): the user command's in User; elsewhere the
+        blended user command's, 0 on every joint when the behaviour alone acts."""
+        sim = self.sim
+        if sim.mode is ControlMode.USER or sim.blended_command() is not None:
+            return sim.active_k_effort()
+        return _NO_BLEND
+
+    def state(self) -> AsiState:
+        """The AtlasSimInterfaceState of the step just taken."""
+        sim, data, session = self.sim, self.sim.data, self.session
+        current = self.current_behavior
+        falling = current in STANDING_BEHAVIORS and self.falling()
+        adr, dof = sim.atlas.free_qpos_adr, self._free_dof
+        feet = np.empty((2, 7))
+        for row, body in enumerate(self._feet):
+            feet[row, 0:3] = data.xpos[body]
+            w, x, y, z = data.xquat[body]
+            feet[row, 3:7] = (x, y, z, w)
+        return AsiState(
+            stamp_ns=sim.state_time_ns, error_code=int(session.error_code),
+            current_behavior=int(current), desired_behavior=session.desired_behavior,
+            f_out_nm=self.f_out().copy(),
+            pelvis_position_m=tuple(data.qpos[adr:adr + 3]),
+            pelvis_velocity_m_s=tuple(data.qvel[dof:dof + 3]), foot_poses=feet,
+            behavior_feedback=BehaviorFeedback(session.status_flags(current, falling),
+                                               session.trans_from_behavior,
+                                               session.trans_to_behavior),
+            k_effort=self.k_effort())
+
+    def end_step(self) -> None:
+        """After each step, whether or not a state was built."""
+        self.session.end_step()

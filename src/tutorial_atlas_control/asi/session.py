@@ -1,0 +1,86 @@
+"""The behaviour library's decisions and what it reports: requests taken or refused, the
+feedback status, the error code. Pure: the caller applies the control mode it returns.
+
+Our choices where BDI's library published none (docs/controllers.md): a request of the
+running behaviour changes nothing, so a client may stream it at 1 kHz; an accepted switch
+reports TRANSITION_SUCCESS in the state of that step, then OK; a refusal (unknown or not yet
+served behaviour, Stand with the centre of mass outside the feet) reports its FAILED_TRANS_*
+until the next accepted switch and keeps the running behaviour; ERROR_FALLING is reported
+while a standing behaviour is falling, ahead of any other value (one value at a time).
+"""
+
+from __future__ import annotations
+
+from tutorial_atlas_control.asi.behaviors import (
+    MODE_OF_BEHAVIOR,
+    AsiError,
+    Behavior,
+    Status,
+)
+from tutorial_atlas_control.control_modes import ControlMode
+
+__all__ = ['STANDING_BEHAVIORS', 'AsiSession']
+
+#: Behaviours that keep the robot on its feet: only they can be falling, and entering one
+#: needs the centre of mass over the feet.
+STANDING_BEHAVIORS = frozenset({Behavior.STAND, Behavior.MANIPULATE})
+_KNOWN = frozenset(int(b) for b in Behavior)
+
+
+class AsiSession:
+    """Requests in, feedback values out, for one simulator."""
+
+    def __init__(self) -> None:
+        self.desired_behavior = int(Behavior.STAND)
+        self.error_code = AsiError.NO_ERRORS
+        self.trans_from_behavior = int(Behavior.STAND)
+        self.trans_to_behavior = int(Behavior.STAND)
+        self._status = Status.OK
+
+    def status_flags(self, current: Behavior, falling: bool) -> int:
+        """behavior_feedback.status_flags: ERROR_FALLING while a standing behaviour is
+        falling, else the outcome of the last request that changed something."""
+        if falling and current in STANDING_BEHAVIORS:
+            return int(Status.ERROR_FALLING)
+        return int(self._status)
+
+    def request(self, behavior: int, current: Behavior,
+                feet_under_com: bool) -> ControlMode | None:
+        """A requested behaviour number; returns the control mode to switch to, or None
+        (the running behaviour stays). `feet_under_com`: the centre of mass is over the
+        support polygon (else Stand is refused)."""
+        self.desired_behavior = behavior
+        if behavior == current:
+            return None
+        if behavior not in _KNOWN:
+            return self._refuse(behavior, current, Status.FAILED_TRANS_UNKNOWN_BEHAVIOR,
+                                AsiError.NO_SUCH_BEHAVIOR)
+        wanted = Behavior(behavior)
+        if wanted not in MODE_OF_BEHAVIOR:
+            return self._refuse(behavior, current, Status.FAILED_TRANS_ILLEGAL_BEHAVIOR,
+                                AsiError.BEHAVIOR_NOT_IMPLEMENTED)
+        if wanted in STANDING_BEHAVIORS and not feet_under_com:
+            return self._refuse(behavior, current, Status.FAILED_TRANS_COM_POS,
+                                AsiError.FAILED_TO_START_BEHAVIOR)
+        self._status = Status.TRANSITION_SUCCESS
+        self.error_code = AsiError.NO_ERRORS
+        self.trans_from_behavior, self.trans_to_behavior = int(current), behavior
+        return MODE_OF_BEHAVIOR[wanted]
+
+    def switched(self, current: Behavior, previous: Behavior) -> None:
+        """The mode changed another way (/atlas/control_mode, /atlas/mode bdi_stand): the
+        library saw a successful transition."""
+        self.desired_behavior = int(current)
+        self._status = Status.TRANSITION_SUCCESS
+        self.error_code = AsiError.NO_ERRORS
+        self.trans_from_behavior, self.trans_to_behavior = int(previous), int(current)
+
+    def end_step(self) -> None:
+        """A step has passed: a success has been reported (or was not listened to)."""
+        if self._status is Status.TRANSITION_SUCCESS:
+            self._status = Status.OK
+
+    def _refuse(self, behavior: int, current: Behavior, status: Status,
+                error: AsiError) -> None:
+        self._status, self.error_code = status, error
+        self.trans_from_behavior, self.trans_to_behavior = int(current), behavior

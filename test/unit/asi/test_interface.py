@@ -1,0 +1,151 @@
+"""AtlasSimInterface over a simulator: Stand is the balancing behaviour, requests switch
+behaviours without touching k_effort, k_effort taken at 28 entries only, and the state
+reports Freeze and StandPrep truly, f_out, the pelvis, the feet and falling."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tutorial_atlas_control.asi import AsiError, AtlasSimInterface, Behavior, Status
+from tutorial_atlas_control.balance import place_in_stand_pose
+from tutorial_atlas_control.control_modes import ControlMode
+from tutorial_atlas_control.joints import NUM_JOINTS
+from tutorial_atlas_control.msgs.atlas_sim_interface import (
+    AsiCommand,
+    ManipulateParams,
+    StepData,
+)
+from tutorial_atlas_control.msgs.atlas_sim_interface_state import encode_asi_state
+from tutorial_atlas_control.sim import AtlasSimulator, VrcMode, load_gains_yaml, load_model
+from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.sim.vrc import WrenchInput
+
+CONFIG = Path(__file__).resolve().parents[3] / 'config' / 'atlas_controller.yaml'
+
+
+@pytest.fixture(scope='module')
+def atlas() -> atlas_model.AtlasModel:
+    return load_model()
+
+
+@pytest.fixture
+def interface(atlas: atlas_model.AtlasModel) -> AtlasSimInterface:
+    """Standing in DRCSim's Stand pose, free, in Stand."""
+    sim = AtlasSimulator(atlas, load_gains_yaml(CONFIG), time_to_unpin_s=0.0,
+                         startup_mode=VrcMode.BDI_STAND)
+    place_in_stand_pose(sim.atlas, sim.data)
+    return AtlasSimInterface(sim)
+
+
+def command(behavior: int, k_effort: np.ndarray | None = None,
+            length: int | None = None) -> AsiCommand:
+    return AsiCommand(0, behavior, (StepData(),) * 4, False, StepData(), False,
+                      ManipulateParams(), k_effort,
+                      NUM_JOINTS if length is None else length)
+
+
+def run(interface: AtlasSimInterface, steps: int) -> None:
+    for _ in range(steps):
+        interface.sim.step()
+        interface.end_step()
+
+
+def test_stand_is_the_balancing_behaviour_and_reported(interface: AtlasSimInterface) -> None:
+    run(interface, 200)
+    sim = interface.sim
+    assert sim.behaviours.acting is interface.stand
+    state = interface.state()
+    assert (state.current_behavior, state.desired_behavior) == (Behavior.STAND, Behavior.STAND)
+    assert state.behavior_feedback.status_flags == Status.OK
+    np.testing.assert_array_equal(state.f_out_nm, sim.torque_nm)  # no user joints
+    np.testing.assert_array_equal(state.k_effort, np.zeros(NUM_JOINTS, np.uint8))
+    assert state.pelvis_position_m[2] == pytest.approx(0.91, abs=0.01)
+    left, right = state.foot_poses
+    assert left[1] > 0.05 and right[1] < -0.05  # left foot on the left (y > 0)
+    np.testing.assert_allclose(np.linalg.norm(state.foot_poses[:, 3:], axis=1), 1.0)
+    assert len(encode_asi_state(state)) > 0
+
+
+@pytest.mark.parametrize(('behavior', 'mode'), [(Behavior.FREEZE, ControlMode.FREEZE),
+                                                (Behavior.STAND_PREP, ControlMode.STAND_PREP),
+                                                (Behavior.USER, ControlMode.USER)])
+def test_each_served_behaviour_is_reported_as_itself(interface: AtlasSimInterface,
+                                                     behavior: Behavior,
+                                                     mode: ControlMode) -> None:
+    """DRCSim reported Freeze and StandPrep as 0: not copied."""
+    interface.apply(command(behavior))
+    assert interface.sim.mode is mode
+    state = interface.state()
+    assert state.current_behavior == behavior != 0
+    assert state.behavior_feedback.status_flags == Status.TRANSITION_SUCCESS
+    interface.end_step()
+    assert interface.state().behavior_feedback.status_flags == Status.OK
+
+
+def test_k_effort_is_taken_at_28_entries_and_a_switch_keeps_it(
+        interface: AtlasSimInterface) -> None:
+    arms = np.zeros(NUM_JOINTS)
+    arms[16:] = 1.0
+    interface.apply(command(Behavior.STAND, arms))
+    expected = (arms * 255).astype(np.uint8)
+    np.testing.assert_array_equal(interface.sim.active_k_effort(), expected)
+    interface.apply(command(Behavior.STAND, None, length=27))
+    np.testing.assert_array_equal(interface.sim.active_k_effort(), expected)  # kept
+    interface.apply(command(Behavior.FREEZE))
+    assert interface.sim.mode is ControlMode.FREEZE
+    np.testing.assert_array_equal(interface.sim.active_k_effort(), expected)  # not reset
+
+
+def test_streaming_the_running_stand_changes_nothing(atlas: atlas_model.AtlasModel) -> None:
+    """A client requesting STAND every step: the run is bit for bit a run without it."""
+    twins = []
+    for _ in range(2):
+        sim = AtlasSimulator(atlas, load_gains_yaml(CONFIG), time_to_unpin_s=0.0,
+                             startup_mode=VrcMode.BDI_STAND)
+        place_in_stand_pose(sim.atlas, sim.data)
+        twins.append(AtlasSimInterface(sim))
+    streamed, quiet = twins
+    for _ in range(300):
+        streamed.apply(command(Behavior.STAND))
+        for twin in twins:
+            twin.sim.step()
+            twin.end_step()
+    assert streamed.sim.data.qpos.tobytes() == quiet.sim.data.qpos.tobytes()
+    assert streamed.state().behavior_feedback.status_flags == Status.OK
+
+
+def test_stand_is_refused_for_a_fallen_robot_which_reports_falling_in_stand(
+        interface: AtlasSimInterface) -> None:
+    sim = interface.sim
+    sim.set_mode(ControlMode.RAGDOLL)
+    run(interface, 3000)  # limp: it falls
+    assert interface.state().current_behavior == Behavior.USER
+    interface.apply(command(Behavior.STAND))
+    assert sim.mode is ControlMode.RAGDOLL
+    state = interface.state()
+    assert state.behavior_feedback.status_flags == Status.FAILED_TRANS_COM_POS
+    assert state.error_code == AsiError.FAILED_TO_START_BEHAVIOR
+    sim.set_mode(ControlMode.STAND)  # /atlas/control_mode Stand is not refused
+    assert interface.falling()
+    assert interface.state().behavior_feedback.status_flags == Status.ERROR_FALLING
+
+
+def test_a_push_beyond_what_stand_survives_is_reported_falling(
+        interface: AtlasSimInterface) -> None:
+    sim = interface.sim
+    run(interface, 500)
+    assert not interface.falling()
+    sim.apply_input(WrenchInput((1000.0, 0.0, 0.0), (0.0, 0.0, 0.0)))  # 200 N s
+    run(interface, 200)
+    sim.apply_input(WrenchInput((0.0, 0.0, 0.0), (0.0, 0.0, 0.0)))
+    flags = []
+    for _ in range(3000):
+        run(interface, 1)
+        flags.append(interface.state().behavior_feedback.status_flags)
+    assert flags[0] == Status.OK and flags[-1] == Status.ERROR_FALLING
+    pelvis = sim.data.xpos[sim.atlas.pelvis_body_id]
+    assert pelvis[2] < 0.7 or math.acos(sim.data.xmat[sim.atlas.pelvis_body_id][8]) > 0.5
