@@ -3,13 +3,16 @@
 survived without a step. The figures are the largest impulses found in 5 N s steps (see
 docs/controllers.md); the planted defect (no capture-point correction) falls at the same pushes.
 
-About 1 s of CPU per simulated second: ~50 s in all.
+About 1 s of CPU per simulated second. Also the take-over from the hold's straight legs
+(the Stand pose reached over TRANSITION_S; at once, the planted defect, it falls).
 """
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
+from tutorial_atlas_control.balance import STAND_POSE_RAD, TRANSITION_S, StandBehaviour
 from tutorial_atlas_control.balance.push_trial import (
     FOOT_TRAVEL_LIMIT_M,
     STANDING_PELVIS_M,
@@ -17,6 +20,16 @@ from tutorial_atlas_control.balance.push_trial import (
     stand_trial,
 )
 from tutorial_atlas_control.balance.stand import StandGains
+from tutorial_atlas_control.joints import JOINT_INDEX
+from tutorial_atlas_control.sim import (
+    DEFAULT_GAINS_FILE,
+    AtlasSimulator,
+    load_gains_yaml,
+    load_model,
+    pelvis_height_m,
+)
+
+KNEES = [JOINT_INDEX['l_leg_kny'], JOINT_INDEX['r_leg_kny']]
 
 #: The largest impulses (N s) survived, per direction (unit vector), found in 5 N s steps.
 SURVIVED = {'forward': ((1.0, 0.0), 45.0), 'backward': ((-1.0, 0.0), 45.0),
@@ -63,3 +76,35 @@ def test_a_trial_is_deterministic() -> None:
     first, second = (push_survived((0.0, 1.0), 30.0) for _ in range(2))
     assert (first.lowest_pelvis_m, first.foot_travel_m, first.steps) == (
         second.lowest_pelvis_m, second.foot_travel_m, second.steps)
+
+
+def stand_after_the_hold(transition_s: float) -> tuple[AtlasSimulator, float]:
+    """The port's start-up (pinned 1 s, then the hold's straight legs) for 2 s, then the
+    balancing Stand taking over for 4 s; (the simulator, how far a sole moved (m))."""
+    atlas = load_model()
+    sim = AtlasSimulator(atlas, load_gains_yaml(DEFAULT_GAINS_FILE), time_to_unpin_s=1.0)
+    for _ in range(2000):
+        sim.step()
+    stand = StandBehaviour(atlas, transition_s=transition_s)
+    sim.install_stand(stand)
+    assert stand.last_state is not None
+    feet = stand.last_state.sole_centres[:, :2].copy()
+    for _ in range(4000):
+        sim.step()
+    travel = float(np.max(np.linalg.norm(stand.last_state.sole_centres[:, :2] - feet, axis=1)))
+    return sim, travel
+
+
+def test_stand_takes_over_from_the_hold_and_bends_to_the_stand_pose() -> None:
+    """From the hold's straight legs, within TRANSITION_S, to DRCSim's Stand pose: knees
+    0.518 rad, the pelvis about 0.91 m, the feet where they were."""
+    sim, travel = stand_after_the_hold(TRANSITION_S)
+    np.testing.assert_allclose(sim.joint_positions()[KNEES], STAND_POSE_RAD[KNEES], atol=0.01)
+    assert pelvis_height_m(sim.atlas, sim.data) == pytest.approx(0.912, abs=0.01)
+    assert travel < 0.001
+
+
+def test_without_the_transition_stand_does_not_take_over() -> None:
+    """The planted defect: the Stand pose's reference at once, from straight legs, falls."""
+    sim, _ = stand_after_the_hold(0.0)
+    assert pelvis_height_m(sim.atlas, sim.data) < STANDING_PELVIS_M

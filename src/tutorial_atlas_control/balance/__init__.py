@@ -17,7 +17,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
              'natural_frequency'],
     'push_trial': ['Push', 'TrialResult', 'push_survived', 'stand_trial'],
     'stand': ['StandController', 'StandGains', 'StandOutput', 'StandReference'],
-    'stand_behaviour': ['StandBehaviour'],
+    'stand_behaviour': ['TRANSITION_S', 'StandBehaviour', 'stand_pose_com_height_m'],
     'stand_pose': ['STAND_POSE_RAD', 'place_in_stand_pose', 'sole_corners'],
     'support': ['Region', 'clamp_into', 'convex_hull', 'inside', 'shrink', 'signed_distance'],
 })
