@@ -6,6 +6,7 @@ from setuptools import setup
 setup(**generate_distutils_setup(
     packages=[
         'tutorial_atlas_control',
+        'tutorial_atlas_control.asi',
         'tutorial_atlas_control.balance',
         'tutorial_atlas_control.bags',
         'tutorial_atlas_control.cli',

@@ -47,6 +47,10 @@ SIM_INPUTS = '/atlas/sim_inputs'
 TF = '/tf'
 #: atlas_msgs/AtlasCommand (2.7.0): commands with k_effort, beside JointCommands.
 ATLAS_COMMAND = '/atlas/atlas_command'
+#: DRCSim 2.6/2.7's AtlasSimInterface (the behaviour library's): behaviour requests and
+#: k_effort in; each step's behaviour, its torques (f_out) and feedback out.
+ASI_COMMAND = '/atlas/atlas_sim_interface_command'
+ASI_STATE = '/atlas/atlas_sim_interface_state'
 #: atlas_msgs/Test: DRCSim's testing hook (joint damping, gains, k_effort).
 ATLAS_TEST = '/atlas/debug/test'
 #: atlas_msgs/SynchronizationStatistics (DRCSim 2.6+): the synchronization window's delays.
@@ -164,6 +168,8 @@ INTERFACE: tuple[Topic, ...] = (
     Topic(DEBUG_R_FOOT_CONTACT, 'geometry_msgs/WrenchStamped', _OUT,
           Rate('~debug_contact_rate', 1000.0, 'while the foot touches'), on_demand=True,
           delivery=Delivery('debug_r', loop=True)),
+    Topic(ASI_STATE, 'atlas_msgs/AtlasSimInterfaceState', _OUT, EVERY_STEP, on_demand=True,
+          delivery=Delivery(loop=True)),
     Topic(SYNCHRONIZATION_STATISTICS, 'atlas_msgs/SynchronizationStatistics', _OUT,
           Rate(when='every step while the synchronization window is on'),
           delivery=Delivery(latched=True, loop=True)),
@@ -178,6 +184,7 @@ INTERFACE: tuple[Topic, ...] = (
           delivery=Delivery(offline=True)),
     Topic(ATLAS_COMMAND, 'atlas_msgs/AtlasCommand', _IN, AS_SENT, recorded=True),
     Topic(ATLAS_TEST, 'atlas_msgs/Test', _IN, AS_SENT, recorded=True),
+    Topic(ASI_COMMAND, 'atlas_msgs/AtlasSimInterfaceCommand', _IN, AS_SENT, recorded=True),
     Topic(CONTROL_MODE, 'std_msgs/String', _IN, AS_SENT, recorded=True,
           delivery=Delivery(offline=True)),
     Topic(MODE, 'std_msgs/String', _IN, AS_SENT, recorded=True),

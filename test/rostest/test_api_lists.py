@@ -74,10 +74,12 @@ DRCSIM_2_5_2 = (
 )
 
 #: Beyond the 2.5.2 lists, from DRCSim's sources: AtlasPlugin 2.7.0's synchronization
-#: topics (the publisher latched, the subscriber a cheat).
+#: topics (the publisher latched, the subscriber a cheat) and its AtlasSimInterface topics.
 DRCSIM_2_7_0 = (
     Entry('/atlas/synchronization_statistics', 'atlas_msgs/SynchronizationStatistics', 1, ANY),
     Entry('/atlas/debug/sync_delay', 'std_msgs/String', ANY, 1),
+    Entry('/atlas/atlas_sim_interface_state', 'atlas_msgs/AtlasSimInterfaceState', 1, ANY),
+    Entry('/atlas/atlas_sim_interface_command', 'atlas_msgs/AtlasSimInterfaceCommand', ANY, 1),
 )
 
 #: Services (not in the yaml lists; AtlasPlugin 2.5.2 and DRCSim's gazebo_ros_api_plugin,

@@ -5,7 +5,9 @@ bytes of its states.
 What it does with a command (DRCSim 2.7's AtlasPlugin::SetASICommand): the behaviour is
 requested (AsiSession decides), then k_effort, at exactly 28 entries, becomes the blend of
 every joint; a behaviour switch itself never changes k_effort. Stand runs the balancing
-StandBehaviour, installed into the simulator here.
+StandBehaviour, installed into the simulator here (or, without `balance`, the simulator's
+hold, DRCSim 2.5.2's stand-in). A switch made elsewhere (/atlas/control_mode, /atlas/mode
+bdi_stand) is seen at the next state or step and reported as a successful transition.
 """
 
 from __future__ import annotations
@@ -43,14 +45,16 @@ _NO_BLEND.setflags(write=False)
 
 
 class AtlasSimInterface:
-    """Behaviour requests and state reports for `sim`, whose Stand it makes the balancing
-    one."""
+    """Behaviour requests and state reports for `sim`; with `balance`, Stand is the
+    balancing StandBehaviour, else the simulator's hold."""
 
-    def __init__(self, sim: AtlasSimulator) -> None:
+    def __init__(self, sim: AtlasSimulator, balance: bool = True) -> None:
         self.sim = sim
         self.session = AsiSession()
-        self.stand = StandBehaviour(sim.atlas)
-        sim.install_stand(self.stand)
+        self.stand = StandBehaviour(sim.atlas)  # its estimator also checks the CoM
+        if balance:
+            sim.install_stand(self.stand)
+        self._mode = sim.mode
         model = sim.model
         self._feet = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name)
                       for name in FOOT_BODIES]
@@ -63,6 +67,7 @@ class AtlasSimInterface:
 
     def apply(self, command: AsiCommand) -> None:
         """One checked AtlasSimInterfaceCommand, between two steps."""
+        self._observe()
         sim = self.sim
         current = self.current_behavior
         feet_under_com = True
@@ -72,16 +77,20 @@ class AtlasSimInterface:
         if mode is not None:
             kept = None if sim.user_command is None else sim.user_command.k_effort.copy()
             sim.set_mode(mode)
+            self._mode = mode
             if kept is not None:
                 self._set_k_effort(kept)
         if command.k_effort is not None:
             self._set_k_effort(command.k_effort)
 
-    def mode_switched(self, previous: ControlMode) -> None:
-        """The control mode changed outside the interface (/atlas/control_mode)."""
-        current = self.current_behavior
-        if current != BEHAVIOR_OF_MODE[previous]:
-            self.session.switched(current, BEHAVIOR_OF_MODE[previous])
+    def _observe(self) -> None:
+        """A control mode switched outside the interface is the library's transition."""
+        mode = self.sim.mode
+        if mode is not self._mode:
+            current, previous = BEHAVIOR_OF_MODE[mode], BEHAVIOR_OF_MODE[self._mode]
+            self._mode = mode
+            if current != previous:
+                self.session.switched(current, previous)
 
     def _set_k_effort(self, fractions: np.ndarray) -> None:
         self.sim.receive_updates([CommandUpdate(_ALL_JOINTS, _K_EFFORT_ROW,
@@ -120,6 +129,7 @@ class AtlasSimInterface:
 
     def state(self) -> AsiState:
         """The AtlasSimInterfaceState of the step just taken."""
+        self._observe()
         sim, data, session = self.sim, self.sim.data, self.session
         current = self.current_behavior
         falling = current in STANDING_BEHAVIORS and self.falling()
@@ -142,4 +152,5 @@ class AtlasSimInterface:
 
     def end_step(self) -> None:
         """After each step, whether or not a state was built."""
+        self._observe()
         self.session.end_step()

@@ -8,7 +8,9 @@ time, /atlas/controller_statistics (command age, while subscribed), DRCSim's
 subscribed), and a latched
 /atlas/sim_config (JSON: timestep, time_to_unpin, model file and checksum, time of the last
 reset) for offline replay; obeys /atlas/joint_commands, /atlas/atlas_command,
-/atlas/debug/test and /atlas/control_mode; offers /atlas/reset_controls and gazebo_ros's
+/atlas/debug/test and /atlas/control_mode; serves DRCSim 2.7's AtlasSimInterface
+(/atlas/atlas_sim_interface_command in, /atlas/atlas_sim_interface_state out every step while
+subscribed; asi/); offers /atlas/reset_controls and gazebo_ros's
 reset and pause services (and DRCSim's /gazebo/reset_models). VRCPlugin's
 /atlas/mode, set_pose, cmd_vel, gazebo_ros_force's /atlas/apply_pelvis_force and
 gazebo_ros_joint_trajectory's /joint_trajectory are checked here and applied by the loop
@@ -39,6 +41,9 @@ Parameters (private unless noted):
         robot_state_publisher: atlas.launch's state_publisher.py does both.
     ~bag_dir (str, unset): where the launch's recorder writes; if set and no file can be
         written there, the node refuses to start (one line).
+    ~stand (str, hold): what Stand does. hold: the port's stand-in for BDI's behaviour, a
+        joint hold with the parameter gains (DRCSim 2.5.2's tutorial behaves as measured);
+        balance: the open AtlasSimInterface's balancing Stand (balance/, docs/controllers.md).
     ~model_file (str, the package's sim/atlas_v1.xml): the MJCF to simulate; it must have
         Atlas v1's joints, actuators and sensors (a variant of the package's model).
     /atlas/time_to_unpin (float, 1.0): seconds the torso stays pinned after start/reset.
@@ -66,6 +71,8 @@ import genpy
 import rospy
 from atlas_msgs.msg import (
     AtlasCommand,
+    AtlasSimInterfaceCommand,
+    AtlasSimInterfaceState,
     AtlasState,
     ControllerStatistics,
     ForceTorqueSensors,
@@ -131,7 +138,9 @@ TF_PUBLISHERS = ('sim', 'robot_state_publisher')
 #: The classes of the messages the node publishes, by ROS type (topics.INTERFACE's).
 MESSAGE_CLASSES: dict[str, type[genpy.Message]] = {cls._type: cls for cls in (
     Clock, JointState, Odometry, Imu, WrenchStamped, ControllerStatistics, AtlasState,
-    ForceTorqueSensors, SynchronizationStatistics, TFMessage, String)}
+    ForceTorqueSensors, SynchronizationStatistics, TFMessage, String, AtlasSimInterfaceState)}
+#: What ~stand chooses Stand to be (the first is the default).
+STAND_CHOICES = ('hold', 'balance')
 #: Queue size of the publishers the node itself calls publish() on (1 when not named).
 QUEUE_SIZES = {topics.SIM_INPUTS: 100}
 
@@ -180,6 +189,15 @@ class RawTest(RawMessage):
     _type = Test._type
     _md5sum = Test._md5sum
     _full_text = Test._full_text
+    __slots__: list[str] = []
+
+
+class RawAsiCommand(RawMessage):
+    """atlas_msgs/AtlasSimInterfaceCommand, undecoded (through the loop's queue, in order)."""
+
+    _type = AtlasSimInterfaceCommand._type
+    _md5sum = AtlasSimInterfaceCommand._md5sum
+    _full_text = AtlasSimInterfaceCommand._full_text
     __slots__: list[str] = []
 
 
@@ -331,6 +349,8 @@ class SimNode:
         rospy.Subscriber(topics.ATLAS_COMMAND, RawAtlasCommand, self.on_atlas_command,
                          queue_size=10, tcp_nodelay=True)
         rospy.Subscriber(topics.ATLAS_TEST, RawTest, self.on_test, queue_size=10)
+        rospy.Subscriber(topics.ASI_COMMAND, RawAsiCommand, self.on_asi_command, queue_size=1,
+                         tcp_nodelay=True)
         rospy.Subscriber(topics.CONTROL_MODE, String, self.on_control_mode, queue_size=10)
         # DRCSim 2.6's cheat: any message ends the synchronization window's wait early.
         rospy.Subscriber(topics.SYNC_DELAY, String, lambda _msg: self.loop.wake(), queue_size=1,
@@ -371,6 +391,9 @@ class SimNode:
 
     def on_test(self, msg: RawTest) -> None:
         self.loop.receive_command(msg.raw, topics.ATLAS_TEST)
+
+    def on_asi_command(self, msg: RawAsiCommand) -> None:
+        self.loop.receive_command(msg.raw, topics.ASI_COMMAND)
 
     def on_reset_controls(self, request: ResetControls._request_class
                           ) -> ResetControlsResponse:
@@ -457,12 +480,17 @@ def build_node() -> SimNode:
     if startup_mode not in STARTUP_MODES:
         raise AtlasControlError(f'parameter {topics.STARTUP_MODE_PARAM} must be one of '
                                 f'{", ".join(STARTUP_MODES)}, got {startup_mode!r}')
+    stand = rospy.get_param('~stand', STAND_CHOICES[0])
+    if stand not in STAND_CHOICES:
+        raise AtlasControlError(f'parameter {rospy.resolve_name("~stand")} must be one of '
+                                f'{", ".join(STAND_CHOICES)}, got {stand!r}')
     sim = AtlasSimulator(load_model(Path(model_file)), gains, time_to_unpin_s,
                          startup_mode=VrcMode(startup_mode))
     description = _tf_wanted(Path(model_file), sim)
     settings = LoopSettings(rates_hz, _float_param('~real_time_factor', 1.0),
                             bool(rospy.get_param('~paused', False)),
-                            _links_publisher(description) if tf_publisher == 'sim' else None)
+                            _links_publisher(description) if tf_publisher == 'sim' else None,
+                            balance_stand=stand == 'balance')
     return SimNode(sim, settings, bool(rospy.get_param('~gui', False)),
                    description is not None, DelayBudgets.from_params(rospy.get_param))
 

@@ -12,6 +12,7 @@ import collections
 import threading
 
 from tutorial_atlas_control import topics
+from tutorial_atlas_control.asi import AtlasSimInterface
 from tutorial_atlas_control.command import (
     FIELD_NAMES,
     LAW_FIELDS,
@@ -20,9 +21,11 @@ from tutorial_atlas_control.command import (
 )
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.msgs import (
+    AsiCommand,
     AtlasUpdate,
     CommandDecoder,
     FieldCursor,
+    decode_asi_command,
     decode_atlas_command,
     decode_test,
 )
@@ -46,6 +49,9 @@ CAN_SET: dict[str, frozenset[int]] = {
         'kp_position', 'ki_position', 'kd_position', 'kp_velocity', 'i_effort_min',
         'i_effort_max', 'k_effort'))}),
 }
+#: The AtlasSimInterface's commands: only the newest of a step's is applied (DRCSim's queue
+#: of 1); another topic's message never hides its behaviour request.
+ASI_TOPIC = topics.ASI_COMMAND
 #: Where DRCSim takes the command's header stamp for /atlas/controller_statistics.
 STAMPED_COMMANDS = (topics.JOINT_COMMANDS, topics.ATLAS_COMMAND)
 
@@ -58,8 +64,10 @@ class CommandInbox:
     """
 
     def __init__(self, sim: AtlasSimulator, log: LoopLog, statistics: CommandAgeStatistics,
-                 watch: RunWatch, budgets: DelayBudgets) -> None:
+                 watch: RunWatch, budgets: DelayBudgets,
+                 asi: AtlasSimInterface | None = None) -> None:
         self.sim = sim
+        self.asi = asi
         self.log = log
         self.statistics = statistics
         self.watch = watch
@@ -86,11 +94,13 @@ class CommandInbox:
         if self.period_ms:
             self.arrived.set()  # the window may be waiting for it
 
-    def _decode(self, topic: str, raw: bytes) -> CommandUpdate | AtlasUpdate:
+    def _decode(self, topic: str, raw: bytes) -> CommandUpdate | AtlasUpdate | AsiCommand:
         if topic == topics.JOINT_COMMANDS:
             return self.decoder.decode(raw)
         if topic == topics.ATLAS_COMMAND:
             return decode_atlas_command(raw)
+        if topic == ASI_TOPIC:
+            return decode_asi_command(raw)
         return decode_test(raw)
 
     def apply_pending(self) -> None:
@@ -107,10 +117,14 @@ class CommandInbox:
         while pending:
             received.append(pending.popleft())
         hidden: set[int] = set()
-        decoded: list[tuple[str, CommandUpdate | AtlasUpdate]] = []
-        stamped = False
+        decoded: list[tuple[str, CommandUpdate | AtlasUpdate | AsiCommand]] = []
+        stamped = asi_seen = False
         for topic, raw in reversed(received):
-            if CAN_SET[topic] <= hidden:
+            if topic == ASI_TOPIC:
+                if asi_seen or self.asi is None:
+                    continue
+                asi_seen = True
+            elif CAN_SET[topic] <= hidden:
                 continue
             try:
                 result = self._decode(topic, raw)
@@ -121,6 +135,8 @@ class CommandInbox:
                 self._note_command_stamp(raw)  # the newest applied command
                 stamped = True
             decoded.append((topic, result))
+            if isinstance(result, AsiCommand):
+                continue  # its k_effort may not apply (length); it hides nothing
             update = result if isinstance(result, CommandUpdate) else result.update
             if update.all_joints:
                 hidden.update(update.rows)
@@ -132,12 +148,18 @@ class CommandInbox:
     #: The default StepController: what users sent, for the simulator's law.
     before_step = apply_pending
 
-    def _apply(self, decoded: list[tuple[str, CommandUpdate | AtlasUpdate]]) -> None:
+    def _apply(self, decoded: list[tuple[str, CommandUpdate | AtlasUpdate | AsiCommand]]
+               ) -> None:
         """Apply decoded messages, oldest first."""
-        updates = []
+        first = self.sim.user_command is None
+        updates: list[CommandUpdate] = []
         for topic, result in decoded:
             if isinstance(result, CommandUpdate):
                 updates.append(result)
+                continue
+            if isinstance(result, AsiCommand):
+                self._apply_asi(result, updates)
+                updates = []
                 continue
             if result.ignored:
                 self.log.kept_fields(f'{topic}: {result.ignored_text()}', topic)
@@ -146,13 +168,22 @@ class CommandInbox:
             if result.desired_controller_period_ms is not None:
                 self.store_period(result.desired_controller_period_ms)
             updates.append(result.update)
-        first = self.sim.user_command is None
         self.sim.receive_updates(updates)
         if (self.sim.mode is not ControlMode.USER
                 and any(topic == topics.JOINT_COMMANDS for topic, _ in decoded)):
             self.watch.warn_not_user()  # AtlasCommands with k_effort act in any mode
         if first:
             self.watch.first_command(decoded[0][0])
+
+    def _apply_asi(self, command: AsiCommand, before: list[CommandUpdate]) -> None:
+        """The commands before it, then the AtlasSimInterfaceCommand (in that order: its
+        k_effort overrides theirs)."""
+        assert self.asi is not None  # not decoded without one
+        if before:
+            self.sim.receive_updates(before)
+        if command.ignored_text():
+            self.log.kept_fields(f'{ASI_TOPIC}: {command.ignored_text()}', ASI_TOPIC)
+        self.asi.apply(command)
 
     def _note_command_stamp(self, raw: bytes) -> None:
         """The command in `raw` is applied from the coming step on: remember its stamp."""

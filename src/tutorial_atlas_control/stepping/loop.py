@@ -18,6 +18,7 @@ import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
+from tutorial_atlas_control.asi import AtlasSimInterface
 from tutorial_atlas_control.sim import (
     AtlasSimulator,
     CommandAgeStatistics,
@@ -52,12 +53,15 @@ class LoopSettings:
         paused: start with physics paused.
         links: with a /tf outlet, the links' transforms published in robot_state_publisher's
             stead (link_transforms.py); None: not.
+        balance_stand: Stand is the open AtlasSimInterface's balancing Stand; False: the
+            simulator's hold (DRCSim 2.5.2's stand-in).
     """
 
     rates_hz: Mapping[str, float] = field(default_factory=dict)
     real_time_factor: float = 0.0
     paused: bool = False
     links: LinkTransforms | None = None
+    balance_stand: bool = False
 
 
 class SteppingLoop:
@@ -87,11 +91,14 @@ class SteppingLoop:
         window = (synchronization if synchronization is not None
                   else SynchronizationWindow(DelayBudgets()))
         self.watch = RunWatch(sim, outputs.log)
-        self.inbox = CommandInbox(sim, outputs.log, statistics, self.watch, window.budgets)
+        #: The AtlasSimInterface: its commands come through the inbox, its state is published.
+        self.asi = AtlasSimInterface(sim, settings.balance_stand)
+        self.inbox = CommandInbox(sim, outputs.log, statistics, self.watch, window.budgets,
+                                  self.asi)
         self.controller: StepController = (controller(self.inbox) if controller is not None
                                            else self.inbox)
         self.publisher = StepPublisher(sim, outputs, settings.rates_hz, statistics,
-                                       settings.links)
+                                       settings.links, self.asi)
         self.gate = SyncGate(sim, self.lock, self.inbox, outputs, self.pacer, window)
         self.controls = SimControls(sim, self.lock, self.inbox, self.watch, outputs,
                                     settings.paused)

@@ -2,8 +2,8 @@
 
 The table's rows with a SimMessages wire are filled by plans and sent at their rate; the
 on-demand ones are filled only when due and someone listens (an unheard one costs a test
-per step). /clock, /ground_truth_odom, /tf and /atlas/controller_statistics have builders
-of their own.
+per step). /clock, /ground_truth_odom, /tf, /atlas/controller_statistics and the AtlasSimInterface's
+state have builders of their own.
 """
 
 from __future__ import annotations
@@ -11,7 +11,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.msgs import ControllerStatisticsWire, clock_bytes
+from tutorial_atlas_control.asi import AtlasSimInterface
+from tutorial_atlas_control.msgs import ControllerStatisticsWire, clock_bytes, encode_asi_state
 from tutorial_atlas_control.sim import (
     AtlasSimulator,
     CommandAgeStatistics,
@@ -51,11 +52,17 @@ class StepPublisher:
             takes the table's default.
         links: with a /tf outlet, the links' transforms published in robot_state_publisher's
             stead (link_transforms.py), at rates_hz['links_tf']; None: not.
+        asi: the AtlasSimInterface whose state goes out every step while someone listens
+            (its end_step is called after every step); None: no such state.
     """
 
     def __init__(self, sim: AtlasSimulator, outputs: LoopOutputs, rates_hz: Mapping[str, float],
-                 statistics: CommandAgeStatistics, links: LinkTransforms | None) -> None:
+                 statistics: CommandAgeStatistics, links: LinkTransforms | None,
+                 asi: AtlasSimInterface | None = None) -> None:
         self.sim = sim
+        self.asi = asi
+        self.asi_outlet = outputs.outlets.get(topics.ASI_STATE) if asi is not None else None
+        self.asi_seq = 0
         self.outbox = outputs.outbox
         outlets = outputs.outlets
         rates_hz = {**default_rates_hz(), **rates_hz}
@@ -123,11 +130,19 @@ class StepPublisher:
         if (links is not None and count % self.every['joint_states'] == 0
                 and links.due(now_ns) and wanted(tf_outlet)):
             outbox.add(tf_outlet, messages.links_tf(now_ns))
+        asi_outlet = self.asi_outlet
+        if asi_outlet is not None and wanted(asi_outlet):
+            self.asi_seq += 1
+            assert self.asi is not None  # an outlet only with one
+            body = encode_asi_state(self.asi.state(), self.asi_seq)
+            outbox.add(asi_outlet, len(body).to_bytes(4, 'little') + body)
 
     def publish_step(self, count: int) -> None:
         """After step `count`: its messages, and the command age into the statistics'
         window and, when due, out."""
         self.publish(count)
+        if self.asi is not None:
+            self.asi.end_step()
         if not self.outbox.wanted(self.statistics_outlet):
             return
         now_ns = self.sim.sim_time_ns

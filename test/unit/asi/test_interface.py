@@ -149,3 +149,26 @@ def test_a_push_beyond_what_stand_survives_is_reported_falling(
     assert flags[0] == Status.OK and flags[-1] == Status.ERROR_FALLING
     pelvis = sim.data.xpos[sim.atlas.pelvis_body_id]
     assert pelvis[2] < 0.7 or math.acos(sim.data.xmat[sim.atlas.pelvis_body_id][8]) > 0.5
+
+
+def test_a_switch_made_elsewhere_is_reported_once(interface: AtlasSimInterface) -> None:
+    """/atlas/control_mode Freeze: the next state says Stand -> Freeze succeeded, then OK."""
+    run(interface, 10)
+    interface.sim.set_mode(ControlMode.FREEZE)
+    interface.sim.step()
+    state = interface.state()
+    assert state.current_behavior == Behavior.FREEZE == state.desired_behavior
+    feedback = state.behavior_feedback
+    assert feedback.status_flags == Status.TRANSITION_SUCCESS
+    assert (feedback.trans_from_behavior_index, feedback.trans_to_behavior_index) == (0, 2)
+    interface.end_step()
+    run(interface, 1)
+    assert interface.state().behavior_feedback.status_flags == Status.OK
+
+
+def test_without_balance_stand_is_the_hold(atlas: atlas_model.AtlasModel) -> None:
+    sim = AtlasSimulator(atlas, load_gains_yaml(CONFIG))
+    interface = AtlasSimInterface(sim, balance=False)
+    assert sim.behaviours.acting is None and sim.behaviours.stand is None
+    run(interface, 5)
+    np.testing.assert_array_equal(interface.state().f_out_nm, sim.torque_nm)  # the hold's

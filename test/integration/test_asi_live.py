@@ -1,0 +1,60 @@
+"""The open AtlasSimInterface over ROS, against a running, recording atlas.launch with
+stand:=balance: /atlas/atlas_sim_interface_state says Stand with the pelvis at the balancing
+Stand's height (the hold's straight legs stand 15 mm higher), a FREEZE request on
+/atlas/atlas_sim_interface_command is reported as Freeze (2, not DRCSim's 0), and the
+command is in the bag (the state, a 1 kHz duplicate, is not).
+
+Run with `python3 -m pytest test/integration/test_asi_live.py -q -s` after `source env.sh`.
+Wall time about 20 s.
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip('atlas_msgs.msg', reason='needs the catkin workspace: source ./env.sh')
+if shutil.which('roslaunch') is None:
+    pytest.skip('roslaunch is not on PATH (source env.sh)', allow_module_level=True)
+
+from support.bag_checks import count
+from support.launch import EXIT_TIMEOUT_S, TestLaunch
+from tutorial_atlas_control import topics
+from tutorial_atlas_control.asi import Behavior, Status
+
+pytestmark = pytest.mark.filterwarnings('ignore::DeprecationWarning')
+
+SIM = '/atlas_sim'
+#: The balancing Stand's pelvis height (m, offline: 0.912-0.913); the hold's is 0.927.
+STAND_PELVIS_M = 0.912
+PELVIS_TOLERANCE_M = 0.006
+
+
+def test_asi_live_balancing_stand_a_freeze_request_and_its_record(tmp_path: Path) -> None:
+    with TestLaunch(tmp_path, 'stand:=balance') as launch:
+        launch.wait_ready()
+        launch.wait(lambda: SIM in launch.subscribers(topics.ASI_COMMAND), 120.0,
+                    f'{SIM} did not subscribe to {topics.ASI_COMMAND}')
+        launch.wait_sim_until(3.0)  # pinned 1 s, then the Stand pose reached
+        state = launch.next_message(topics.ASI_STATE)
+        assert state['current_behavior'] == Behavior.STAND
+        assert state['behavior_feedback']['status_flags'] == Status.OK
+        pelvis_z = state['pos_est']['position']['z']
+        assert abs(pelvis_z - STAND_PELVIS_M) < PELVIS_TOLERANCE_M, state['pos_est']
+        assert state['k_effort'] == [0] * 28
+        launch.publish(topics.ASI_COMMAND, 'atlas_msgs/AtlasSimInterfaceCommand',
+                       f'{{behavior: {int(Behavior.FREEZE)}}}')
+        launch.wait(lambda: launch.next_message(topics.ASI_STATE)['current_behavior']
+                    == Behavior.FREEZE, 30.0, 'the FREEZE request was not reported')
+        state = launch.next_message(topics.ASI_STATE)
+        assert state['desired_behavior'] == Behavior.FREEZE
+        feedback = state['behavior_feedback']
+        assert feedback['trans_from_behavior_index'] == Behavior.STAND
+        assert feedback['trans_to_behavior_index'] == Behavior.FREEZE
+        print(f'figures: balancing Stand pelvis {pelvis_z:.4f} m at 3 s; then Freeze')
+        launch.interrupt(EXIT_TIMEOUT_S)
+        bag = launch.bag()
+    assert count(bag, topics.ASI_COMMAND) == 1
+    assert count(bag, topics.ASI_STATE) == 0
