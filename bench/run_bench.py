@@ -95,6 +95,7 @@ ROWS = (
     ('physics_limit_steps_per_s', 'physics + law, plain loop', 'steps/s', '', 0),
     ('physics_numpy_law_steps_per_s', 'physics + numpy law, plain loop', 'steps/s', '', 0),
     ('unheard_topic_us_per_step', 'a topic nobody subscribes to', 'us/step', '< 1', 3),
+    ('stand_us_per_step', 'balancing Stand: estimate + control', 'us/step', '<= 100', 1),
     ('offline_rtf', 'run_offline.py to a bag', 'x real time', '', 2),
     ('offline_ratio', 'offline_rtf*1000 / physics limit', '', '>= 0.8', 3),
     ('fast_rtf', 'node rtf:=0 + recorder', 'x real time', '>= 0.6 x bare/1000', 2),
@@ -249,6 +250,8 @@ BUDGETS = {
 #: The targets (bench/README.md), by JSON key.
 TARGETS = {
     'unheard_topic_us_per_step': Target(high=1.0, strict=True),
+    # The open AtlasSimInterface's Stand at 1 kHz beside a recorder and a client.
+    'stand_us_per_step': Target(high=100.0),
     'offline_ratio': Target(low=0.8),
     'fast_rtf': Target(low=0.6, per_bare='rtf'),
     'fast_bare_ratio': Target(low=0.6),
@@ -289,7 +292,8 @@ TARGETS = {
 #: The keys each section must produce (a crash or an empty window shows as a missing key).
 EXPECTED = {
     'physics': ('bare_physics_steps_per_s', 'physics_limit_steps_per_s',
-                'physics_numpy_law_steps_per_s', 'unheard_topic_us_per_step'),
+                'physics_numpy_law_steps_per_s', 'unheard_topic_us_per_step',
+                'stand_us_per_step'),
     'offline': ('offline_rtf', 'offline_ratio'),
     'analysis': ('analysis_s', 'rosbag_s', 'analysis_msgs_per_s', 'rosbag_msgs_per_s',
                  'analysis_speedup'),
@@ -411,6 +415,9 @@ def run_offline(args: argparse.Namespace, samples: dict[str, list[float]],
                 unheard_us = node_loop.unheard_topic_run(args.budget.unheard_calls)
                 log(f'physics run {run + 1}: an unheard topic costs {unheard_us:.3f} us/step')
                 add(samples, {'unheard_topic_us_per_step': unheard_us})
+                stand_us = offline.stand_run(steps=steps)
+                log(f'physics run {run + 1}: the balancing Stand costs {stand_us:.1f} us/step')
+                add(samples, {'stand_us_per_step': stand_us})
     if 'offline' in args.sections:
         steps_per_s = offline.steps_per_sim_second()
         with Section('offline', loads), tempfile.TemporaryDirectory(prefix='tac_bench_') as tmp:
