@@ -59,27 +59,17 @@ def stand_run(warmup_steps: int = 2500, steps: int = 5000) -> float:
     the node steps it; the warm-up passes the 1 s torso pin and the 1 s take-over to the
     Stand pose, so the timed steps are the robot balancing on both feet.
     """
-    from tutorial_atlas_control.balance import StandBehaviour
+    from tutorial_atlas_control.balance import TimedStand
 
     sim = make_simulator()
-    stand = StandBehaviour(sim.atlas)
+    stand = TimedStand(sim.atlas, clock=time.perf_counter)
     sim.install_stand(stand)
     for _ in range(warmup_steps):
         sim.step()
-    torque = stand.torque
-    spent_s = 0.0
-
-    def timed(data: object) -> object:
-        nonlocal spent_s
-        started = time.perf_counter()
-        result = torque(data)
-        spent_s += time.perf_counter() - started
-        return result
-
-    stand.torque = timed  # the instance's, which the simulator calls
+    stand.spent_s = 0.0
     for _ in range(steps):
         sim.step()
-    return spent_s / steps * 1e6
+    return stand.spent_s / steps * 1e6
 
 
 def steps_per_sim_second() -> float:

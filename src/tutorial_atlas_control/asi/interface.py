@@ -19,7 +19,7 @@ import numpy as np
 
 from tutorial_atlas_control.asi.behaviors import BEHAVIOR_OF_MODE, Behavior
 from tutorial_atlas_control.asi.session import STANDING_BEHAVIORS, AsiSession
-from tutorial_atlas_control.balance import StandBehaviour, signed_distance
+from tutorial_atlas_control.balance import BalanceEstimator, StandBehaviour, signed_distance
 from tutorial_atlas_control.command import LAW_FIELDS, CommandUpdate
 from tutorial_atlas_control.control_modes import ControlMode
 from tutorial_atlas_control.joints import NUM_JOINTS
@@ -51,9 +51,13 @@ class AtlasSimInterface:
     def __init__(self, sim: AtlasSimulator, balance: bool = True) -> None:
         self.sim = sim
         self.session = AsiSession()
-        self.stand = StandBehaviour(sim.atlas)  # its estimator also checks the CoM
-        if balance:
+        #: The balancing Stand installed (None: Stand is the hold); its estimator, or one of
+        #: the interface's own, checks the centre of mass before Stand is entered.
+        self.stand = StandBehaviour(sim.atlas) if balance else None
+        if self.stand is not None:
             sim.install_stand(self.stand)
+        self._estimator = (self.stand.estimator if self.stand is not None
+                           else BalanceEstimator(sim.atlas))
         self._mode = sim.mode
         model = sim.model
         self._feet = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name)
@@ -98,7 +102,7 @@ class AtlasSimInterface:
 
     def com_over_feet(self) -> bool:
         """The centre of mass over the support polygon of the soles touching the ground."""
-        state = self.stand.estimator.estimate(self.sim.data.qpos, self.sim.data.qvel)
+        state = self._estimator.estimate(self.sim.data.qpos, self.sim.data.qvel)
         polygon = state.support_polygon
         if len(polygon) < 3:
             return False

@@ -15,7 +15,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'estimator': ['BalanceEstimator', 'BalanceState'],
     'lipm': ['capture_point', 'com_acceleration', 'dcm_feedback_cop', 'lipm_state',
              'natural_frequency'],
-    'push_trial': ['Push', 'TrialResult', 'push_survived', 'stand_trial'],
+    'push_trial': ['Push', 'TimedStand', 'TrialResult', 'push_survived', 'stand_trial'],
     'stand': ['StandController', 'StandGains', 'StandOutput', 'StandReference'],
     'stand_behaviour': ['TRANSITION_S', 'StandBehaviour', 'stand_pose_com_height_m'],
     'stand_pose': ['STAND_POSE_RAD', 'place_in_stand_pose', 'sole_corners'],

@@ -22,7 +22,7 @@ from tutorial_atlas_control.msgs.ros1_fields import FieldCursor
 from tutorial_atlas_control.units import NS_PER_S
 
 __all__ = ['BEHAVIORS', 'MAX_ABS_VALUE', 'STEP_QUEUE_LENGTH', 'AsiCommand', 'ManipulateParams',
-           'StepData', 'decode_asi_command', 'encode_asi_command']
+           'StepData', 'decode_asi_command', 'encode_asi_command', 'step_data_bytes']
 
 #: AtlasSimInterfaceCommand's behaviour constants, by value.
 BEHAVIORS: dict[int, str] = {0: 'STAND', 1: 'USER', 2: 'FREEZE', 3: 'STAND_PREP', 4: 'WALK',
@@ -158,7 +158,8 @@ def decode_asi_command(raw: bytes) -> AsiCommand:
         raise CommandError(f'malformed AtlasSimInterfaceCommand ({err})') from None
 
 
-def _step_bytes(step: StepData) -> bytes:
+def step_data_bytes(step: StepData) -> bytes:
+    """An atlas_msgs/AtlasBehaviorStepData's wire bytes (the command's and the state's)."""
     return _STEP.pack(step.step_index, step.foot_index, step.duration_s, *step.position_m,
                       *step.orientation_xyzw, step.swing_height_m)
 
@@ -172,9 +173,9 @@ def encode_asi_command(command: AsiCommand, k_effort_bytes: bytes = b'',
     out = bytearray(struct.pack('<III', 0, secs, nsecs) + struct.pack('<I', len(frame)) + frame)
     out += _I32.pack(command.behavior)
     for step in command.step_queue:
-        out += _step_bytes(step)
+        out += step_data_bytes(step)
     out += _BOOL.pack(command.use_demo_walk)
-    out += _step_bytes(command.desired_step) + _BOOL.pack(command.step_use_demo_walk)
+    out += step_data_bytes(command.desired_step) + _BOOL.pack(command.step_use_demo_walk)
     out += _I32.pack(0)
     m = command.manipulate
     out += _MANIPULATE.pack(m.use_desired, m.pelvis_height_m, m.pelvis_yaw_rad, m.pelvis_lat_m,

@@ -14,7 +14,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tutorial_atlas_control.joints import NUM_JOINTS
-from tutorial_atlas_control.msgs.atlas_sim_interface import STEP_QUEUE_LENGTH, StepData
+from tutorial_atlas_control.msgs.atlas_sim_interface import (
+    STEP_QUEUE_LENGTH,
+    StepData,
+    step_data_bytes,
+)
 from tutorial_atlas_control.units import NS_PER_S
 
 __all__ = ['AsiState', 'BehaviorFeedback', 'ManipulateFeedback', 'StepFeedback',
@@ -22,7 +26,6 @@ __all__ = ['AsiState', 'BehaviorFeedback', 'ManipulateFeedback', 'StepFeedback',
 
 _HEADER = struct.Struct('<III')           # seq, secs, nsecs (then frame_id)
 _CODES = struct.Struct('<iii')            # error_code, current_behavior, desired_behavior
-_STEP = struct.Struct('<II9d')            # AtlasBehaviorStepData
 _BEHAVIOR_FEEDBACK = struct.Struct('<Iii')
 _STEP_FEEDBACK = struct.Struct('<IdII')   # status_flags, t_step_rem, current, next needed
 _WALK_FEEDBACK = struct.Struct('<dIII')   # t_step_rem, current, next needed, status_flags
@@ -108,11 +111,6 @@ class AsiState:
     k_effort: np.ndarray = field(default_factory=lambda: np.zeros(NUM_JOINTS, np.uint8))
 
 
-def _step_bytes(step: StepData) -> bytes:
-    return _STEP.pack(step.step_index, step.foot_index, step.duration_s, *step.position_m,
-                      *step.orientation_xyzw, step.swing_height_m)
-
-
 def encode_asi_state(state: AsiState, seq: int = 0, frame_id: str = '') -> bytes:
     """The wire bytes of `state` (header seq `seq`)."""
     secs, nsecs = divmod(state.stamp_ns, NS_PER_S)
@@ -129,14 +127,14 @@ def encode_asi_state(state: AsiState, seq: int = 0, frame_id: str = '') -> bytes
     step = state.step_feedback
     parts += [_STEP_FEEDBACK.pack(step.status_flags, step.t_step_rem_s, step.current_step_index,
                                   step.next_step_index_needed),
-              _step_bytes(step.desired_step_saturated), _U32.pack(state.stand_status_flags)]
+              step_data_bytes(step.desired_step_saturated), _U32.pack(state.stand_status_flags)]
     walk = state.walk_feedback
     if len(walk.step_queue_saturated) != STEP_QUEUE_LENGTH:
         raise ValueError(f'walk_feedback.step_queue_saturated has '
                          f'{len(walk.step_queue_saturated)} steps, not {STEP_QUEUE_LENGTH}')
     parts.append(_WALK_FEEDBACK.pack(walk.t_step_rem_s, walk.current_step_index,
                                      walk.next_step_index_needed, walk.status_flags))
-    parts += [_step_bytes(s) for s in walk.step_queue_saturated]
+    parts += [step_data_bytes(s) for s in walk.step_queue_saturated]
     manipulate = state.manipulate_feedback
     parts += [_U32.pack(manipulate.status_flags),
               _PELVIS_SERVO.pack(manipulate.pelvis_height_m, manipulate.pelvis_yaw_rad,
