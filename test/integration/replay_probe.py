@@ -8,6 +8,8 @@ lowest pelvis height, and rosbag play's outcome (or `error`).
 simulator could be connected and this probe not yet, which would miss the first commands.
 So the player starts paused, and is resumed (its `pause_playback` service) once its
 getBusInfo lists a connection to every subscriber the master knows for each played topic.
+When the player has ended, the probe waits for every command in the bag (`--commands`) to
+have been read before it reports.
 
 Its own process so that the test's pytest process never holds a rospy node (init_node is
 once per process) nor a ROS_MASTER_URI of its own: later tests do not depend on it.
@@ -34,6 +36,8 @@ from tutorial_atlas_control import processes
 PLAYED_TOPICS = ('/atlas/control_mode', '/atlas/joint_commands')
 #: rosbag play's node name: `play` made anonymous (`/play_<stamp>`), whatever __name says.
 PLAYER_PREFIX = '/play_'
+#: Wall s to wait, once rosbag play has ended, for its last commands to be read here.
+ARRIVAL_TIMEOUT_S = 30.0
 
 
 class Probe:
@@ -146,6 +150,8 @@ def main() -> int:
     parser.add_argument('--fall-window', type=float, required=True,
                         help='sim s watched after the last played command')
     parser.add_argument('--timeout', type=float, required=True, help='wall s per wait')
+    parser.add_argument('--commands', type=int, required=True,
+                        help='joint commands in the bag: waited for after playing')
     args = parser.parse_args()
     rospy.init_node('replay_live_probe', anonymous=True)
     probe = Probe()
@@ -157,6 +163,10 @@ def main() -> int:
         played = play(args.bag, args.timeout)
         result['play_returncode'] = played.returncode
         result['play_output'] = played.stdout
+        # rosbag play has sent everything when it ends, but this node's receive thread may
+        # not have read the last commands yet (the robot has usually fallen by then).
+        probe.wait_for(lambda p: len(p.command_arrivals_s) >= args.commands,
+                       ARRIVAL_TIMEOUT_S, f'all {args.commands} played commands to arrive')
         with probe.lock:
             played_until_s = probe.clock_s
         probe.wait_for(lambda p: p.min_z_m < args.fallen_below

@@ -84,7 +84,8 @@ def test_played_commands_make_the_robot_fall(
     probe = subprocess.run(
         [sys.executable, str(REPLAY_PROBE), str(recorded_bag), '--play-at',
          str(1.0 + PLAY_AFTER_S), '--fallen-below', str(FALLEN_BELOW_M), '--fall-window',
-         str(FALL_WINDOW_S), '--timeout', str(PLAY_TIMEOUT_S)],
+         str(FALL_WINDOW_S), '--timeout', str(PLAY_TIMEOUT_S),
+         '--commands', str(len(recorded.data.commands.t_s))],
         env=fresh_simulator.env, capture_output=True, text=True,
         timeout=STARTUP_TIMEOUT_S + 2 * PLAY_TIMEOUT_S, check=False)
     assert probe.returncode == 0 and probe.stdout.strip(), probe
