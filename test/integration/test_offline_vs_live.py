@@ -1,11 +1,13 @@
 """An offline run (run_offline.py) reaches the outcome of the live run (`make demo`) it stands for.
 
-The live runs are run_demo.py's, at LIVE_REAL_TIME_FACTOR (step_and_fall, touchdown and
-touchdown_exhausted, the README's slow sway that ends on the ground); each is
-compared with the offline run of the same trajectory, aligned on the first applied command
+The live runs are run_demo.py's, at LIVE_REAL_TIME_FACTOR (step_and_fall and
+touchdown_exhausted, the README's slow sway that ends on the ground); each is compared with
+the offline run of the same trajectory, aligned on the first applied command
 (bags/compare.py). Transport and scheduling move a live run a little (the trajectory starts from
 a pose the robot held longer, commands arrive 1-2 ms late), so only the outcome must agree:
-the robot falls in both or in neither, within FALL_TOLERANCE_S.
+the robot falls in both, within FALL_TOLERANCE_S. The falls are the comparison that can
+disagree; touchdown, which stands, is held to that live (the touchdown rostest, the three
+tries) and offline (test_sweep.py, test_arm_tracking.py) apart, at a live run's cost less.
 """
 
 from __future__ import annotations
@@ -66,16 +68,11 @@ def step_and_fall_run(tmp_path_factory: pytest.TempPathFactory) -> LiveRun:
 
 
 @pytest.fixture(scope='module')
-def touchdown_run(tmp_path_factory: pytest.TempPathFactory) -> LiveRun:
-    return run_live(tmp_path_factory.mktemp('touchdown'), 'touchdown')
-
-
-@pytest.fixture(scope='module')
 def touchdown_exhausted_run(tmp_path_factory: pytest.TempPathFactory) -> LiveRun:
     return run_live(tmp_path_factory.mktemp('touchdown_exhausted'), 'touchdown_exhausted')
 
 
-@pytest.mark.parametrize(('trajectory', 'falls'), [('step_and_fall', True), ('touchdown', False),
+@pytest.mark.parametrize(('trajectory', 'falls'), [('step_and_fall', True),
                                                    ('touchdown_exhausted', True)])
 def test_offline_run_reaches_the_live_outcome(trajectory: str, falls: bool,
                                               request: pytest.FixtureRequest,
