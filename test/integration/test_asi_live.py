@@ -1,8 +1,10 @@
-"""The open AtlasSimInterface over ROS, against a running, recording atlas.launch with
-stand:=balance: /atlas/atlas_sim_interface_state says Stand with the pelvis at the balancing
-Stand's height (the hold's straight legs stand 15 mm higher), a FREEZE request on
-/atlas/atlas_sim_interface_command is reported as Freeze (2, not DRCSim's 0), and the
-command is in the bag (the state, a 1 kHz duplicate, is not).
+"""The open AtlasSimInterface over ROS, against a running, recording atlas.launch started as
+DRCSim 2.6/2.7 started (startup_mode:=bdi_stand, whose default Stand is the balancing one):
+pinned in the Stand pose under the user's PID (User, k_effort 255) at 0.5 s; then
+/atlas/atlas_sim_interface_state says Stand with the pelvis at the balancing Stand's height
+(the hold's straight legs stand 15 mm higher) and AtlasState's k_effort is 0 (the behaviour
+alone); a FREEZE request on /atlas/atlas_sim_interface_command is reported as Freeze (2, not
+DRCSim's 0), and the command is in the bag (the state, a 1 kHz duplicate, is not).
 
 Run with `python3 -m pytest test/integration/test_asi_live.py -q -s` after `source env.sh`.
 Wall time about 20 s.
@@ -32,18 +34,24 @@ STAND_PELVIS_M = 0.912
 PELVIS_TOLERANCE_M = 0.006
 
 
-def test_asi_live_balancing_stand_a_freeze_request_and_its_record(tmp_path: Path) -> None:
-    with TestLaunch(tmp_path, 'stand:=balance') as launch:
+def test_asi_live_drcsim_start_balancing_stand_a_freeze_request_and_its_record(
+        tmp_path: Path) -> None:
+    with TestLaunch(tmp_path, 'startup_mode:=bdi_stand') as launch:
         launch.wait_ready()
         launch.wait(lambda: SIM in launch.subscribers(topics.ASI_COMMAND), 120.0,
                     f'{SIM} did not subscribe to {topics.ASI_COMMAND}')
-        launch.wait_sim_until(3.0)  # pinned 1 s, then the Stand pose reached
+        launch.wait_sim_until(0.5)  # pinned in the Stand pose, the user's PID holding it
+        state = launch.next_message(topics.ASI_STATE)
+        assert state['current_behavior'] == Behavior.USER
+        assert state['k_effort'] == [255] * 28
+        launch.wait_sim_until(3.5)  # released at 1 s, Stand from 2 s
         state = launch.next_message(topics.ASI_STATE)
         assert state['current_behavior'] == Behavior.STAND
         assert state['behavior_feedback']['status_flags'] == Status.OK
         pelvis_z = state['pos_est']['position']['z']
         assert abs(pelvis_z - STAND_PELVIS_M) < PELVIS_TOLERANCE_M, state['pos_est']
         assert state['k_effort'] == [0] * 28
+        assert launch.next_message(topics.ATLAS_STATE)['k_effort'] == [0] * 28
         launch.publish(topics.ASI_COMMAND, 'atlas_msgs/AtlasSimInterfaceCommand',
                        f'{{behavior: {int(Behavior.FREEZE)}}}')
         launch.wait(lambda: launch.next_message(topics.ASI_STATE)['current_behavior']
@@ -53,7 +61,7 @@ def test_asi_live_balancing_stand_a_freeze_request_and_its_record(tmp_path: Path
         feedback = state['behavior_feedback']
         assert feedback['trans_from_behavior_index'] == Behavior.STAND
         assert feedback['trans_to_behavior_index'] == Behavior.FREEZE
-        print(f'figures: balancing Stand pelvis {pelvis_z:.4f} m at 3 s; then Freeze')
+        print(f'figures: balancing Stand pelvis {pelvis_z:.4f} m at 3.5 s; then Freeze')
         launch.interrupt(EXIT_TIMEOUT_S)
         bag = launch.bag()
     assert count(bag, topics.ASI_COMMAND) == 1

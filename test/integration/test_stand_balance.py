@@ -24,6 +24,8 @@ from tutorial_atlas_control.joints import JOINT_INDEX
 from tutorial_atlas_control.sim import (
     DEFAULT_GAINS_FILE,
     AtlasSimulator,
+    ControlMode,
+    VrcMode,
     load_gains_yaml,
     load_model,
     pelvis_height_m,
@@ -108,3 +110,29 @@ def test_without_the_transition_stand_does_not_take_over() -> None:
     """The planted defect: the Stand pose's reference at once, from straight legs, falls."""
     sim, _ = stand_after_the_hold(0.0)
     assert pelvis_height_m(sim.atlas, sim.data) < STANDING_PELVIS_M
+
+
+def test_drcsim_2_7_start_lands_and_balances() -> None:
+    """startup_mode bdi_stand (DRCSim 2.6/2.7's start): pinned in the Stand pose, dropped at
+    1 s, the balancing Stand from 2 s with every k_effort 0: standing at the Stand's height,
+    the feet still, at 8 s."""
+    atlas = load_model()
+    sim = AtlasSimulator(atlas, load_gains_yaml(DEFAULT_GAINS_FILE),
+                         startup_mode=VrcMode.BDI_STAND)
+    stand = StandBehaviour(atlas)
+    sim.install_stand(stand)
+    for _ in range(2500):
+        sim.step()
+    assert sim.mode is ControlMode.STAND and stand.last_state is not None
+    np.testing.assert_array_equal(sim.active_k_effort(), 0)  # AtlasState: f_out alone
+    feet = stand.last_state.sole_centres[:, :2].copy()
+    lowest = np.inf
+    for _ in range(5500):
+        sim.step()
+        lowest = min(lowest, pelvis_height_m(sim.atlas, sim.data))
+    travel = float(np.max(np.linalg.norm(stand.last_state.sole_centres[:, :2] - feet, axis=1)))
+    print(f'\nbdi_stand start: pelvis {pelvis_height_m(sim.atlas, sim.data):.4f} m at 8 s, '
+          f'lowest {lowest:.4f} m from 2.5 s, feet moved {travel * 1000:.2f} mm')
+    assert pelvis_height_m(sim.atlas, sim.data) == pytest.approx(0.912, abs=0.01)
+    assert lowest > STANDING_PELVIS_M
+    assert travel < 0.001

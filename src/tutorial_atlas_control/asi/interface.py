@@ -121,13 +121,13 @@ class AtlasSimInterface:
         sim = self.sim
         if sim.mode in (ControlMode.USER, ControlMode.RAGDOLL):
             return _NO_TORQUE
-        return sim.torque_nm if sim.blended_command() is None else sim.law.f_out_nm
+        return sim.torque_nm if sim.commands.blend_command is None else sim.law.f_out_nm
 
     def k_effort(self) -> np.ndarray:
         """The blend in use (uint8, (28,)): the user command's in User; elsewhere the
         blended user command's, 0 on every joint when the behaviour alone acts."""
         sim = self.sim
-        if sim.mode is ControlMode.USER or sim.blended_command() is not None:
+        if sim.mode is ControlMode.USER or sim.commands.blend_command is not None:
             return sim.active_k_effort()
         return _NO_BLEND
 

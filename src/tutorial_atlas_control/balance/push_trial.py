@@ -23,7 +23,6 @@ from tutorial_atlas_control.sim import (
     DEFAULT_GAINS_FILE,
     AtlasModel,
     AtlasSimulator,
-    VrcMode,
     load_gains_yaml,
     load_model,
     pelvis_height_m,
@@ -72,8 +71,7 @@ def stand_trial(duration_s: float, pushes: Sequence[Push] = (),
     """Place the robot in the Stand pose on the ground and run Stand for `duration_s`
     (s) with `pushes`; stop early once the pelvis is below the standing height."""
     atlas = load_model()
-    sim = AtlasSimulator(atlas, load_gains_yaml(DEFAULT_GAINS_FILE), time_to_unpin_s=0.0,
-                         startup_mode=VrcMode.BDI_STAND)
+    sim = AtlasSimulator(atlas, load_gains_yaml(DEFAULT_GAINS_FILE), time_to_unpin_s=0.0)
     place_in_stand_pose(sim.atlas, sim.data)
     stand = TimedStand(sim.atlas, gains)
     sim.install_stand(stand)  # the simulator starts in Stand: it takes over at once

@@ -5,23 +5,10 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from tutorial_atlas_control.sim import AtlasModel, reset_to_initial
+from tutorial_atlas_control.sim import STAND_POSE_RAD, AtlasModel, reset_to_initial
 
-#: VRCPlugin::AtlasCommandController::SetPIDStand's "StandPrep end pose --> Stand pose"
-#: (DRCSim 2.7.0), the tutorial's joint order (rad): bent knees (0.518), arms down and out.
-STAND_POSE_RAD: np.ndarray = np.array([
-    2.438504816382192e-05, 0.0015186156379058957, 9.983908967114985e-06,
-    -0.0010675729718059301,
-    -0.0003740221436601132, 0.06201673671603203, -0.2333149015903473,
-    0.5181407332420349, -0.27610817551612854, -0.062101610004901886,
-    0.00035181696875952184, -0.06218484416604042, -0.2332201600074768,
-    0.51811283826828, -0.2762000858783722, 0.06211360543966293,
-    0.29983898997306824, -1.303462266921997, 2.0007927417755127,
-    0.49823325872421265, 0.0003098883025813848, -0.0044272784143686295,
-    0.29982614517211914, 1.3034454584121704, 2.000779867172241,
-    -0.498238742351532, 0.0003156556049361825, 0.004448802210390568,
-])
-STAND_POSE_RAD.setflags(write=False)
+__all__ = ['STAND_POSE_RAD', 'place_in_stand_pose', 'sole_corners']
+
 
 #: The sole boxes of the model (sim/atlas_v1.xml), left then right.
 SOLE_GEOMS: tuple[str, str] = ('l_foot_sole', 'r_foot_sole')

@@ -164,7 +164,7 @@ class RunProbe:
         self.l_lift_max_m = max(self.l_lift_max_m,
                                 float(poses['l_foot'][2] - self.start['l_foot'][2]))
         if now_ns <= self.end_ns:
-            error = sim.joint_positions() - sim.active_command().position
+            error = sim.joint_positions() - sim.commands.law_command.position
             self.sq_error += float(error @ error)
             self.error_count += NUM_JOINTS
 

@@ -28,6 +28,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'startup_pin': ['StartupPin'],
     'urdf': ['UrdfError', 'matching_urdf', 'read_joints'],
     'vrc': ['DEFAULT_STARTUP_MODE', 'InputError', 'InputEvent', 'InputNote', 'ModeInput',
-            'STARTUP_MODES', 'SimInput', 'TrajectoryInput', 'VrcMode', 'cmd_vel_input',
-            'describe_input', 'input_notes', 'parse_vrc_mode', 'pose_input', 'wrench_input'],
+            'STAND_POSE_RAD', 'STARTUP_MODES', 'SimInput', 'TrajectoryInput', 'VrcMode',
+            'cmd_vel_input', 'describe_input', 'input_notes', 'parse_vrc_mode', 'pose_input',
+            'wrench_input'],
 })

@@ -197,7 +197,7 @@ class SimMessages:
         """AtlasState: joints after the step (as joint_state), the active gains and
         k_effort, IMU and wrenches from the step's start. Always sent."""
         self._atlas_state_plan()
-        rows, command = self._joint_rows, self.sim.pid_command()
+        rows, command = self._joint_rows, self.sim.commands.pid_command()
         rows[3] = command.kp_position
         rows[4] = command.ki_position
         rows[5] = command.kd_position

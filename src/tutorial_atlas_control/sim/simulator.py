@@ -19,9 +19,10 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control.command import CommandUpdate, JointCommandArrays
+from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.behaviour import Behaviour, ModeBehaviours
-from tutorial_atlas_control.sim.controller import Gains
+from tutorial_atlas_control.sim.controller import Gains, hold_command
 from tutorial_atlas_control.sim.divergence import (
     DIVERGENCE_WARNINGS,
     DivergenceCheck,
@@ -38,9 +39,10 @@ from tutorial_atlas_control.sim.mode_commands import (
     parse_mode,
 )
 from tutorial_atlas_control.sim.sim_config import SimConfig
-from tutorial_atlas_control.sim.startup_pin import StartupPin
+from tutorial_atlas_control.sim.startup_pin import StartupEvent, StartupPin
 from tutorial_atlas_control.sim.vrc import (
     DEFAULT_STARTUP_MODE,
+    STAND_POSE_RAD,
     CmdVelInput,
     InputEvent,
     ModeInput,
@@ -57,6 +59,9 @@ __all__ = ['DEFAULT_TIME_TO_UNPIN_S', 'DIVERGENCE_WARNINGS', 'GAIN_FIELDS', 'K_E
            'VALID_MODES', 'AtlasSimulator', 'ControlMode', 'ModeError', 'PhysicsDivergenceError',
            'parse_mode']
 
+#: AtlasState's k_effort while a behaviour alone drives every joint.
+_NO_PID = np.zeros(NUM_JOINTS, np.uint8)
+_NO_PID.setflags(write=False)
 #: DRCSim released the pinned torso after this long (s); `/atlas/time_to_unpin` overrides it.
 DEFAULT_TIME_TO_UNPIN_S = 1.0
 
@@ -128,7 +133,18 @@ class AtlasSimulator:
         self._last_input = None
         self.startup_pin.start(self.sim_time_ns)
         self.commands.reset()
-        self.behaviours.select(self.mode, self.data)
+        if self.startup_mode is VrcMode.BDI_STAND:
+            self._begin_bdi_stand()
+        else:
+            self.behaviours.select(self.mode, self.data)
+
+    def _begin_bdi_stand(self) -> None:
+        """VRCPlugin's `bdi_stand` (SetPIDStand): pinned without gravity, the joints set to
+        the Stand pose and held by the user's PID (User, k_effort 1) until the pin's Stand."""
+        self.startup_pin.begin_bdi_stand(self.sim_time_ns)
+        self.vrc.set_joint_positions(STAND_POSE_RAD)
+        self.set_mode(ControlMode.USER)
+        self.commands.user_command = hold_command(self.gains, STAND_POSE_RAD)  # k_effort 1
 
     def config(self) -> SimConfig:
         """What re-creates this run offline: the model, its step, pinning and last reset."""
@@ -175,15 +191,16 @@ class AtlasSimulator:
         """Apply one checked input now, between two steps, and log it for replay.
 
         An explicit /atlas/mode cancels the start-up release (the user's mode stays);
-        `bdi_stand` also switches the control mode to Stand (the port's stand-in for BDI's
-        stand behaviour).
+        `bdi_stand` starts VRCPlugin's sequence from here: pinned in the Stand pose, released
+        after 1 s, the Stand behaviour after 2 s.
         """
         vrc = self.vrc
         if isinstance(item, ModeInput):
             self.startup_pin.cancel()
-            vrc.set_mode(item.mode)
             if item.mode is VrcMode.BDI_STAND:
-                self.set_mode(ControlMode.STAND)
+                self._begin_bdi_stand()
+            else:
+                vrc.set_mode(item.mode)
         elif isinstance(item, PoseInput):
             vrc.set_pose(item)
         elif isinstance(item, CmdVelInput):
@@ -233,26 +250,11 @@ class AtlasSimulator:
         """ModeCommands.receive_updates: apply checked command messages, in order."""
         self.commands.receive_updates(updates)
 
-    def load_gains(self, gains: Gains) -> None:
-        """ModeCommands.load_gains: ResetControls' reload_pid_from_ros."""
-        self.commands.load_gains(gains)
-
-    def reset_pid(self) -> None:
-        """JointLaw.reset: ResetControls' reset_pid_controller."""
-        self.law.reset()
-
-    def active_command(self) -> JointCommandArrays:
-        """ModeCommands.law_command: the mode's command the law applies this step."""
-        return self.commands.law_command
-
-    def blended_command(self) -> JointCommandArrays | None:
-        """ModeCommands.blend_command: the user command blended under a hold, or None."""
-        return self.commands.blend_command
-
-    def pid_command(self) -> JointCommandArrays:
-        return self.commands.pid_command()
-
     def active_k_effort(self) -> np.ndarray:
+        """AtlasState's k_effort (uint8, (28,)): 0 while a behaviour alone drives (its f_out,
+        as DRCSim 2.7 said), else the PID command's (255: the PID alone, a hold's too)."""
+        if self.behaviours.acting is not None and self.commands.blend_command is None:
+            return _NO_PID
         return self.commands.active_k_effort()
 
     # -- stepping ----------------------------------------------------------------------
@@ -267,8 +269,9 @@ class AtlasSimulator:
             PhysicsDivergenceError: the new state is not finite (the caller resets).
         """
         pin = self.startup_pin
-        if pin.pending and self.sim_time_ns >= pin.release_ns:
-            pin.release()
+        if pin.pending and self.sim_time_ns >= pin.release_ns \
+                and pin.release() is StartupEvent.STAND:
+            self.set_mode(ControlMode.STAND)  # bdi_stand's end: every k_effort 0
         vrc = self.vrc
         viewer_xfrc = None
         if vrc.active:

@@ -36,7 +36,8 @@ from tutorial_atlas_control.sim import model as atlas_model
 
 __all__ = [
     'DEFAULT_STARTUP_MODE', 'STARTUP_MODES', 'VALID_VRC_MODES', 'CmdVelInput', 'InputError',
-    'InputEvent', 'InputNote', 'describe_input', 'finite_values', 'input_notes',
+    'InputEvent', 'InputNote', 'STAND_POSE_RAD', 'describe_input', 'finite_values',
+    'input_notes',
     'ModeInput', 'PoseInput', 'SimInput', 'TrajectoryInput', 'VrcMode', 'VrcState',
     'WrenchInput', 'cmd_vel_input', 'input_from_dict', 'parse_vrc_mode', 'pose_input',
     'wrench_input',
@@ -62,6 +63,22 @@ VALID_VRC_MODES: tuple[str, ...] = tuple(mode.value for mode in VrcMode)
 STARTUP_MODES: tuple[str, ...] = (VrcMode.PINNED_WITH_GRAVITY.value, VrcMode.PINNED.value,
                                   VrcMode.BDI_STAND.value)
 DEFAULT_STARTUP_MODE = VrcMode.PINNED_WITH_GRAVITY
+
+#: VRCPlugin::AtlasCommandController::SetPIDStand's "StandPrep end pose --> Stand pose"
+#: (DRCSim 2.7.0), the tutorial's joint order (rad): bent knees (0.518), arms down and out.
+STAND_POSE_RAD: np.ndarray = np.array([
+    2.438504816382192e-05, 0.0015186156379058957, 9.983908967114985e-06,
+    -0.0010675729718059301,
+    -0.0003740221436601132, 0.06201673671603203, -0.2333149015903473,
+    0.5181407332420349, -0.27610817551612854, -0.062101610004901886,
+    0.00035181696875952184, -0.06218484416604042, -0.2332201600074768,
+    0.51811283826828, -0.2762000858783722, 0.06211360543966293,
+    0.29983898997306824, -1.303462266921997, 2.0007927417755127,
+    0.49823325872421265, 0.0003098883025813848, -0.0044272784143686295,
+    0.29982614517211914, 1.3034454584121704, 2.000779867172241,
+    -0.498238742351532, 0.0003156556049361825, 0.004448802210390568,
+])
+STAND_POSE_RAD.setflags(write=False)
 
 #: `harnessed` lifts the robot upright with DRCSim's pin link (utorso) this high (m) above
 #: the ground (the port's ground is the plane z = 0): the pelvis ends 4.3 cm above standing.
@@ -418,12 +435,15 @@ class VrcState:
 
     # -- inputs ----------------------------------------------------------------------------
     def set_mode(self, mode: VrcMode) -> None:
-        """VRCPlugin::SetRobotMode (bdi_stand's Stand hold is the simulator's part)."""
-        if mode in (VrcMode.PINNED, VrcMode.PINNED_WITH_GRAVITY):
+        """VRCPlugin::SetRobotMode: the pin and gravity. `bdi_stand` pins without gravity, as
+        `pinned` does; its Stand pose and timed sequence are the simulator's part."""
+        if mode in (VrcMode.PINNED, VrcMode.PINNED_WITH_GRAVITY, VrcMode.BDI_STAND):
             pos, quat = self.pelvis_pose()
             if not self.is_pinned():
                 self.pin_at(pos, quat)
             self.warp_z_m = float(pos[2])
+            if mode is VrcMode.BDI_STAND:
+                self.warp = None  # as the free modes: bdi_stand stops cmd_vel
             self.set_gravity(mode is VrcMode.PINNED_WITH_GRAVITY)
             return
         if mode is VrcMode.HARNESSED:
@@ -436,11 +456,17 @@ class VrcState:
             self.warp_z_m = float(pos[2])
             self.set_gravity(False)
             return
-        # nominal, feet, no_gravity, bdi_stand: free, warp stopped
+        # nominal, feet, no_gravity: free, warp stopped
         self.unpin()
         self.warp = None
-        self.set_gravity(mode in (VrcMode.NOMINAL, VrcMode.BDI_STAND),
-                         except_feet=mode is VrcMode.FEET)
+        self.set_gravity(mode is VrcMode.NOMINAL, except_feet=mode is VrcMode.FEET)
+
+    def set_joint_positions(self, positions_rad: np.ndarray) -> None:
+        """Gazebo's Model::SetJointPositions, as VRCPlugin's SetPIDStand calls it: the joints
+        at `positions_rad` (tutorial order), at rest; the pelvis stays where it is."""
+        self.data.qpos[self.atlas.qpos_adr] = positions_rad
+        self.data.qvel[self.atlas.dof_adr] = 0.0
+        mujoco.mj_forward(self.model, self.data)
 
     def set_pose(self, item: PoseInput) -> None:
         """Teleport the pelvis; a pinned robot takes its pin along (velocities kept)."""

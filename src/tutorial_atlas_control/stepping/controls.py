@@ -72,11 +72,11 @@ class SimControls:
                 done.append('reset_bdi_controller: there is no BDI controller in this '
                             'simulator, nothing to reset')
             if request.reset_pid_controller:
-                self.sim.reset_pid()
+                self.sim.law.reset()
                 done.append('PID state reset (integral terms and previous errors)')
             if atlas is None:
                 assert isinstance(request.gains, Gains)
-                self.sim.load_gains(request.gains)
+                self.sim.commands.load_gains(request.gains)
                 done.append(f'gains reloaded from {topics.GAINS_PARAM}, k_effort 255 on every '
                             'joint (atlas_command ignored)')
             else:

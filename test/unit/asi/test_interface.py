@@ -20,7 +20,7 @@ from tutorial_atlas_control.msgs.atlas_sim_interface import (
     StepData,
 )
 from tutorial_atlas_control.msgs.atlas_sim_interface_state import encode_asi_state
-from tutorial_atlas_control.sim import AtlasSimulator, VrcMode, load_gains_yaml, load_model
+from tutorial_atlas_control.sim import AtlasSimulator, load_gains_yaml, load_model
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.vrc import WrenchInput
 
@@ -35,8 +35,7 @@ def atlas() -> atlas_model.AtlasModel:
 @pytest.fixture
 def interface(atlas: atlas_model.AtlasModel) -> AtlasSimInterface:
     """Standing in DRCSim's Stand pose, free, in Stand."""
-    sim = AtlasSimulator(atlas, load_gains_yaml(CONFIG), time_to_unpin_s=0.0,
-                         startup_mode=VrcMode.BDI_STAND)
+    sim = AtlasSimulator(atlas, load_gains_yaml(CONFIG), time_to_unpin_s=0.0)
     place_in_stand_pose(sim.atlas, sim.data)
     return AtlasSimInterface(sim)
 
@@ -104,8 +103,7 @@ def test_streaming_the_running_stand_changes_nothing(atlas: atlas_model.AtlasMod
     """A client requesting STAND every step: the run is bit for bit a run without it."""
     twins = []
     for _ in range(2):
-        sim = AtlasSimulator(atlas, load_gains_yaml(CONFIG), time_to_unpin_s=0.0,
-                             startup_mode=VrcMode.BDI_STAND)
+        sim = AtlasSimulator(atlas, load_gains_yaml(CONFIG), time_to_unpin_s=0.0)
         place_in_stand_pose(sim.atlas, sim.data)
         twins.append(AtlasSimInterface(sim))
     streamed, quiet = twins

@@ -26,7 +26,7 @@ def _elbow_targets(tmp_path: Path, latency: CommandLatency | None) -> np.ndarray
     targets: list[float] = []
 
     def on_step(sim: AtlasSimulator) -> None:
-        targets.append(float(sim.active_command().position[ELBOW]))
+        targets.append(float(sim.commands.law_command.position[ELBOW]))
 
     write_offline_bag(tmp_path / f'run{len(list(tmp_path.iterdir()))}.bag', 'ramp.yaml', 'ramp',
                       RAMP, load_gains_yaml(DEFAULT_GAINS_FILE), settle_s=0.05,

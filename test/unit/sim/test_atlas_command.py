@@ -252,7 +252,7 @@ def test_in_stand_mode_k_effort_hands_one_joint_to_the_user(
     sim.set_mode(ControlMode.USER)
     assert (sim.user_command.k_effort == 1.0).all()
     sim.set_mode(ControlMode.FREEZE)
-    assert not sim.user_command.k_effort.any() and sim.blended_command() is None
+    assert not sim.user_command.k_effort.any() and sim.commands.blend_command is None
 
 
 def test_joint_commands_in_stand_mode_stay_ineffective_as_in_drcsim(
@@ -439,7 +439,7 @@ def test_a_mode_switch_comes_after_the_commands_received_before_it(
                          topics.ATLAS_COMMAND)
     loop.set_mode(ControlMode.STAND)  # AtlasPlugin::OnRobotMode zeroes k_effort after it
     np.testing.assert_array_equal(sim.user_command.position, full(0.1))
-    assert not sim.user_command.k_effort.any() and sim.blended_command() is None
+    assert not sim.user_command.k_effort.any() and sim.commands.blend_command is None
 
 
 def test_the_fast_path_for_full_commands_agrees_with_the_general_one() -> None:

@@ -76,7 +76,7 @@ def test_freeze_is_bumpless(sim: AtlasSimulator) -> None:
     sim.step()
     # The same torque keeps the robot where it is; only the dynamics of one step differ.
     assert np.max(np.abs(sim.torque_nm - before)) < 5.0
-    frozen = sim.active_command().position.copy()
+    frozen = sim.commands.law_command.position.copy()
     run(sim, 1.0)
     assert np.max(np.abs(sim.joint_positions() - frozen)) < 0.05
 
@@ -84,9 +84,9 @@ def test_freeze_is_bumpless(sim: AtlasSimulator) -> None:
 def test_user_mode_holds_until_the_first_command_then_merges_subsets(sim: AtlasSimulator) -> None:
     run(sim, 0.6)
     sim.set_mode(ControlMode.USER)
-    held = sim.active_command().position.copy()
+    held = sim.commands.law_command.position.copy()
     sim.receive_command(['atlas::l_arm_elx'], {'position': [0.8]})
-    command = sim.active_command()
+    command = sim.commands.law_command
     elbow = JOINT_INDEX['l_arm_elx']
     assert command.position[elbow] == 0.8
     others = np.arange(NUM_JOINTS) != elbow
@@ -100,7 +100,7 @@ def test_refused_command_keeps_the_previous_one(sim: AtlasSimulator) -> None:
     sim.receive_command(['neck_ay'], {'position': [0.3]})
     with pytest.raises(CommandError):
         sim.receive_command(['neck_ay'], {'position': [float('inf')]})
-    assert sim.active_command().position[JOINT_INDEX['neck_ay']] == 0.3
+    assert sim.commands.law_command.position[JOINT_INDEX['neck_ay']] == 0.3
 
 
 def test_reset_world_keeps_time_and_forgets_commands(sim: AtlasSimulator) -> None:

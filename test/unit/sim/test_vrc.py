@@ -119,13 +119,51 @@ def test_feet_mode_standing_unloads_the_ankles(atlas) -> None:
     assert np.linalg.norm(atlas_model.sensor(sim.atlas, sim.data, 'l_foot_force')) < 20.0
 
 
-def test_bdi_stand_frees_the_robot_in_the_stand_hold(atlas) -> None:
-    sim = make(atlas)
+def check_bdi_stand_sequence(sim: AtlasSimulator, started_s: float) -> None:
+    """VRCPlugin's bdi_stand from `started_s` (sim time): pinned without gravity in the
+    Stand pose under the user's PID, `nominal` at +1 s, Stand with k_effort 0 at +2 s."""
+    def run_until(t_s: float) -> None:
+        run(sim, t_s - sim.sim_time_ns / 1e9)
+
+    pinned_at = pelvis(sim)[0].copy()
+    run_until(started_s + 0.9)
+    assert sim.pinned and sim.vrc.gravity_off.all()
+    np.testing.assert_allclose(pelvis(sim)[0], pinned_at, atol=1e-4)  # a weld: soft
+    np.testing.assert_allclose(sim.joint_positions(), vrc.STAND_POSE_RAD, atol=0.01)
+    assert sim.mode is ControlMode.USER
+    np.testing.assert_array_equal(sim.active_k_effort(), 255)
+    run_until(started_s + 1.1)
+    assert not sim.pinned and not sim.vrc.gravity_off.any()
+    assert sim.mode is ControlMode.USER
+    run_until(started_s + 1.999)
+    assert sim.mode is ControlMode.USER
+    run_until(started_s + 2.001)
+    assert sim.mode is ControlMode.STAND  # the hold here: AtlasState says its PID, 255
+    assert sim.user_command is not None and not sim.user_command.k_effort.any()
+
+
+def test_startup_mode_bdi_stand_is_drcsim_2_7s_start(atlas) -> None:
+    sim = make(atlas, startup_mode=VrcMode.BDI_STAND)
+    check_bdi_stand_sequence(sim, 0.0)
+    sim.reset_simulation()  # and again after each reset
+    check_bdi_stand_sequence(sim, 0.0)
+
+
+def test_bdi_stand_on_atlas_mode_runs_the_sequence_from_then(atlas) -> None:
+    sim = standing(atlas)
     sim.set_mode(ControlMode.USER)
+    sim.apply_input(vrc.cmd_vel_input((0.1, 0.0, 0.0), (0.0, 0.0, 0.0)))
     sim.apply_input(ModeInput(VrcMode.BDI_STAND))
-    assert sim.mode is ControlMode.STAND and not sim.pinned
+    assert sim.vrc.warp is None, 'bdi_stand stops cmd_vel'
+    check_bdi_stand_sequence(sim, 1.5)
+
+
+def test_another_mode_cancels_the_bdi_stand_sequence(atlas) -> None:
+    sim = make(atlas, startup_mode=VrcMode.BDI_STAND)
+    run(sim, 0.5)
+    sim.apply_input(ModeInput(VrcMode.NOMINAL))
     run(sim, 2.0)
-    assert pelvis(sim)[0][2] > 0.9
+    assert sim.mode is ControlMode.USER and not sim.pinned
 
 
 def push(atlas, force_n: float) -> float:
@@ -264,5 +302,5 @@ def test_startup_mode_pinned_is_drcsims_gravity_off_then_nominal(atlas) -> None:
     assert not sim.pinned and not sim.vrc.gravity_off.any()
     assert sim.config().to_dict()['startup_mode'] == 'pinned'
     bdi = make(atlas, startup_mode=VrcMode.BDI_STAND)
-    assert not bdi.pinned
+    assert bdi.pinned and bdi.config().to_dict()['startup_mode'] == 'bdi_stand'
     assert 'startup_mode' not in make(atlas).config().to_dict()  # the default's text unchanged
