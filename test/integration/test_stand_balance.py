@@ -3,8 +3,10 @@
 survived without a step. The figures are the largest impulses found in 5 N s steps (see
 docs/controllers.md); the planted defect (no capture-point correction) falls at the same pushes.
 
-About 1 s of CPU per simulated second. Also the take-over from the hold's straight legs
-(the Stand pose reached over TRANSITION_S; at once, the planted defect, it falls).
+About 0.2 s of CPU per simulated second. Also the take-over from the hold's straight legs
+(the Stand pose reached over TRANSITION_S; at once, the planted defect, it falls), DRCSim
+2.7's start, the harness drop of DRCSim's scripts, and the arms swung under the user's PID
+while Stand balances the rest.
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.balance import STAND_POSE_RAD, TRANSITION_S, StandBehaviour
+from tutorial_atlas_control.balance import TRANSITION_S, StandBehaviour
 from tutorial_atlas_control.balance.push_trial import (
     FOOT_TRAVEL_LIMIT_M,
     STANDING_PELVIS_M,
@@ -20,11 +22,15 @@ from tutorial_atlas_control.balance.push_trial import (
     stand_trial,
 )
 from tutorial_atlas_control.balance.stand import StandGains
-from tutorial_atlas_control.joints import JOINT_INDEX
+from tutorial_atlas_control.command import K_EFFORT_ROW, CommandUpdate, command_update
+from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES
 from tutorial_atlas_control.sim import (
     DEFAULT_GAINS_FILE,
+    STAND_POSE_RAD,
     AtlasSimulator,
     ControlMode,
+    Gains,
+    ModeInput,
     VrcMode,
     load_gains_yaml,
     load_model,
@@ -136,3 +142,86 @@ def test_drcsim_2_7_start_lands_and_balances() -> None:
     assert pelvis_height_m(sim.atlas, sim.data) == pytest.approx(0.912, abs=0.01)
     assert lowest > STANDING_PELVIS_M
     assert travel < 0.001
+
+
+def run_for(sim: AtlasSimulator, seconds: float) -> float:
+    """Step `seconds`; the lowest pelvis height (m) on the way."""
+    lowest = np.inf
+    for _ in range(int(round(seconds / sim.dt_s))):
+        sim.step()
+        lowest = min(lowest, pelvis_height_m(sim.atlas, sim.data))
+    return lowest
+
+
+def balancing_simulator() -> AtlasSimulator:
+    """The port's start (pinned 1 s), Stand the balancing one."""
+    atlas = load_model()
+    sim = AtlasSimulator(atlas, load_gains_yaml(DEFAULT_GAINS_FILE))
+    sim.install_stand(StandBehaviour(atlas))
+    return sim
+
+
+def test_harness_drop_lands_and_stands() -> None:
+    """DRCSim's scripts: /atlas/mode harnessed, StandPrep, 5 s, nominal, 0.3 s, Stand: the
+    robot lands (feet 4.3 cm above the ground in the harness) and stands 10 s."""
+    sim = balancing_simulator()
+    run_for(sim, 1.5)
+    sim.apply_input(ModeInput(VrcMode.HARNESSED))
+    sim.set_mode(ControlMode.STAND_PREP)
+    run_for(sim, 5.0)
+    assert pelvis_height_m(sim.atlas, sim.data) == pytest.approx(0.97, abs=0.005)
+    sim.apply_input(ModeInput(VrcMode.NOMINAL))
+    landing = run_for(sim, 0.3)
+    sim.set_mode(ControlMode.STAND)
+    standing = run_for(sim, 10.0)
+    end = pelvis_height_m(sim.atlas, sim.data)
+    print(f'\nharness drop: lowest {landing:.4f} m landing, {standing:.4f} m over 10 s of Stand, '
+          f'{end:.4f} m at the end')
+    assert standing > STANDING_PELVIS_M
+    assert end == pytest.approx(0.912, abs=0.01)
+
+
+ARMS = [name for name in JOINT_NAMES if '_arm_' in name]
+#: The arms swing through this range (rad), about the Stand pose, at SWING_HZ.
+SWING_RAD = 1.5
+SWING_HZ = 0.5
+#: Mixed control's goal: the pelvis moves less than this (m) while the arms swing.
+PELVIS_MOVE_M = 0.05
+
+
+def arm_command(positions: np.ndarray, gains: Gains) -> list[CommandUpdate]:
+    """A JointCommands for the arms with the parameter gains, and k_effort 255 on them (as
+    an AtlasCommand would set): the user's PID drives the arms, Stand the rest."""
+    arms = np.array([JOINT_INDEX[name] for name in ARMS])
+    zeros = np.zeros(len(arms))
+    return [command_update(ARMS, {
+        'position': positions[arms], 'velocity': zeros, 'effort': zeros,
+        'kp_position': gains.p[arms], 'ki_position': gains.i[arms], 'kd_position': gains.d[arms],
+        'kp_velocity': zeros, 'i_effort_min': -gains.i_clamp[arms],
+        'i_effort_max': gains.i_clamp[arms]}),
+        CommandUpdate(arms, (K_EFFORT_ROW,), np.ones((1, len(arms))))]
+
+
+@pytest.mark.parametrize('joint', ['usy', 'shx'])
+def test_arms_swung_under_the_users_pid_while_stand_balances(joint: str) -> None:
+    """Both arms swung through SWING_RAD (shoulder pitch or roll, 4 s) under the user's PID:
+    Stand keeps the robot up with the pelvis within PELVIS_MOVE_M of where it stood."""
+    sim = balancing_simulator()
+    run_for(sim, 3.0)
+    adr = sim.atlas.free_qpos_adr
+    start = sim.data.qpos[adr:adr + 3].copy()
+    moved = 0.0
+    for k in range(4000):
+        if k % 20 == 0:  # the tutorial's 50 Hz
+            target = STAND_POSE_RAD.copy()
+            for side in 'lr':
+                target[JOINT_INDEX[f'{side}_arm_{joint}']] += (
+                    SWING_RAD / 2 * np.sin(2 * np.pi * SWING_HZ * k * sim.dt_s))
+            sim.receive_updates(arm_command(target, sim.gains))
+        sim.step()
+        moved = max(moved, float(np.linalg.norm(sim.data.qpos[adr:adr + 3] - start)))
+    arms = [JOINT_INDEX[name] for name in ARMS]
+    assert (sim.active_k_effort()[arms] == 255).all()
+    print(f'\narm swing ({joint}): the pelvis moved at most {moved * 100:.2f} cm')
+    assert moved < PELVIS_MOVE_M
+    assert pelvis_height_m(sim.atlas, sim.data) > STANDING_PELVIS_M
