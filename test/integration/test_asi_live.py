@@ -3,7 +3,8 @@ DRCSim 2.6/2.7 started (startup_mode:=bdi_stand, whose default Stand is the bala
 pinned in the Stand pose under the user's PID (User, k_effort 255) at 0.5 s; then
 /atlas/atlas_sim_interface_state says Stand with the pelvis at the balancing Stand's height
 (the hold's straight legs stand 15 mm higher) and AtlasState's k_effort is 0 (the behaviour
-alone); a FREEZE request on /atlas/atlas_sim_interface_command is reported as Freeze (2, not
+alone); a MANIPULATE request for a pelvis at 0.85 m is reported and reached within 2 s; a
+FREEZE request on /atlas/atlas_sim_interface_command is reported as Freeze (2, not
 DRCSim's 0), and the command is in the bag (the state, a 1 kHz duplicate, is not).
 
 Run with `python3 -m pytest test/integration/test_asi_live.py -q -s` after `source env.sh`.
@@ -32,6 +33,8 @@ SIM = '/atlas_sim'
 #: The balancing Stand's pelvis height (m, offline: 0.912-0.913); the hold's is 0.927.
 STAND_PELVIS_M = 0.912
 PELVIS_TOLERANCE_M = 0.006
+#: A Manipulate pelvis height within reach (m).
+MANIPULATE_PELVIS_M = 0.85
 
 
 def test_asi_live_drcsim_start_balancing_stand_a_freeze_request_and_its_record(
@@ -53,16 +56,27 @@ def test_asi_live_drcsim_start_balancing_stand_a_freeze_request_and_its_record(
         assert state['k_effort'] == [0] * 28
         assert launch.next_message(topics.ATLAS_STATE)['k_effort'] == [0] * 28
         launch.publish(topics.ASI_COMMAND, 'atlas_msgs/AtlasSimInterfaceCommand',
+                       f'{{behavior: {int(Behavior.MANIPULATE)}, manipulate_params: {{use_desired: '
+                       f'true, desired: {{pelvis_height: {MANIPULATE_PELVIS_M}}}}}}}')
+        launch.wait(lambda: launch.next_message(topics.ASI_STATE)['current_behavior']
+                    == Behavior.MANIPULATE, 30.0, 'the MANIPULATE request was not reported')
+        launch.wait_sim_until(launch.sim_time_s() + 2.0)
+        state = launch.next_message(topics.ASI_STATE)
+        assert state['manipulate_feedback']['clamped']['pelvis_height'] == MANIPULATE_PELVIS_M
+        manipulated_z = state['pos_est']['position']['z']
+        assert abs(manipulated_z - MANIPULATE_PELVIS_M) < PELVIS_TOLERANCE_M, state['pos_est']
+        launch.publish(topics.ASI_COMMAND, 'atlas_msgs/AtlasSimInterfaceCommand',
                        f'{{behavior: {int(Behavior.FREEZE)}}}')
         launch.wait(lambda: launch.next_message(topics.ASI_STATE)['current_behavior']
                     == Behavior.FREEZE, 30.0, 'the FREEZE request was not reported')
         state = launch.next_message(topics.ASI_STATE)
         assert state['desired_behavior'] == Behavior.FREEZE
         feedback = state['behavior_feedback']
-        assert feedback['trans_from_behavior_index'] == Behavior.STAND
+        assert feedback['trans_from_behavior_index'] == Behavior.MANIPULATE
         assert feedback['trans_to_behavior_index'] == Behavior.FREEZE
-        print(f'figures: balancing Stand pelvis {pelvis_z:.4f} m at 3.5 s; then Freeze')
+        print(f'figures: balancing Stand pelvis {pelvis_z:.4f} m at 3.5 s; Manipulate '
+              f'{manipulated_z:.4f} m 2 s after asking {MANIPULATE_PELVIS_M} m; then Freeze')
         launch.interrupt(EXIT_TIMEOUT_S)
         bag = launch.bag()
-    assert count(bag, topics.ASI_COMMAND) == 1
+    assert count(bag, topics.ASI_COMMAND) == 2
     assert count(bag, topics.ASI_STATE) == 0

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from tutorial_atlas_control.asi import AtlasSimInterface, Behavior
 from tutorial_atlas_control.balance import TRANSITION_S, StandBehaviour
 from tutorial_atlas_control.balance.push_trial import (
     FOOT_TRAVEL_LIMIT_M,
@@ -22,8 +23,10 @@ from tutorial_atlas_control.balance.push_trial import (
     stand_trial,
 )
 from tutorial_atlas_control.balance.stand import StandGains
+from tutorial_atlas_control.balance.stand_behaviour import yaw_of
 from tutorial_atlas_control.command import K_EFFORT_ROW, CommandUpdate, command_update
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES
+from tutorial_atlas_control.msgs.atlas_sim_interface import AsiCommand, ManipulateParams, StepData
 from tutorial_atlas_control.sim import (
     DEFAULT_GAINS_FILE,
     STAND_POSE_RAD,
@@ -225,3 +228,36 @@ def test_arms_swung_under_the_users_pid_while_stand_balances(joint: str) -> None
     print(f'\narm swing ({joint}): the pelvis moved at most {moved * 100:.2f} cm')
     assert moved < PELVIS_MOVE_M
     assert pelvis_height_m(sim.atlas, sim.data) > STANDING_PELVIS_M
+
+
+#: Manipulate's goal: the pelvis within these of its target 2 s after a request (m, rad).
+SERVO_HEIGHT_M = 0.02
+SERVO_YAW_RAD = 0.05
+
+
+def test_manipulate_tracks_pelvis_height_and_yaw() -> None:
+    """Through the AtlasSimInterface: Manipulate with use_desired, 2 s per target. 0.75 m is
+    below what the legs reach with the pelvis level and the feet flat (the ankles' 0.698 rad):
+    clamped to 0.81 m, reported so, and tracked there."""
+    sim = balancing_simulator()
+    interface = AtlasSimInterface(sim)  # installs its own balancing Stand
+    stand = interface.stand
+    assert stand is not None
+    run_for(sim, 3.0)
+    for height, yaw in ((0.75, 0.0), (0.85, 0.0), (0.85, 0.3), (0.85, -0.3)):
+        interface.apply(AsiCommand(0, Behavior.MANIPULATE, (StepData(),) * 4, False,
+                                   StepData(), False, ManipulateParams(True, height, yaw, 0.0),
+                                   None, 0))
+        clamped = interface.state().manipulate_feedback
+        assert run_for(sim, 2.0) > STANDING_PELVIS_M
+        state = stand.last_state
+        assert state is not None
+        pelvis_m = pelvis_height_m(sim.atlas, sim.data) - float(state.sole_centres[:, 2].mean())
+        headings = state.sole_rotations[:, 0:2, 0].sum(axis=0)
+        turned = yaw_of(state.pelvis_rotation) - float(np.arctan2(headings[1], headings[0]))
+        print(f'\nmanipulate {height} m, {yaw} rad: clamped to {clamped.pelvis_height_m:.4f} m, '
+              f'{clamped.pelvis_yaw_rad:.3f} rad; after 2 s {pelvis_m:.4f} m, {turned:.4f} rad')
+        assert clamped.pelvis_yaw_rad == yaw
+        assert abs(pelvis_m - clamped.pelvis_height_m) < SERVO_HEIGHT_M
+        assert abs(turned - yaw) < SERVO_YAW_RAD
+    assert clamped.pelvis_height_m == 0.85

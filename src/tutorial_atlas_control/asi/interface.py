@@ -6,8 +6,10 @@ What it does with a command (DRCSim 2.7's AtlasPlugin::SetASICommand): the behav
 requested (AsiSession decides), then k_effort, at exactly 28 entries, becomes the blend of
 every joint; a behaviour switch itself never changes k_effort. Stand runs the balancing
 StandBehaviour, installed into the simulator here (or, without `balance`, the simulator's
-hold, DRCSim 2.5.2's stand-in). A switch made elsewhere (/atlas/control_mode, /atlas/mode
-bdi_stand) is seen at the next state or step and reported as a successful transition.
+hold, DRCSim 2.5.2's stand-in). Manipulate, served with the balancing Stand only, is that
+Stand with its pelvis servoed to `manipulate_params.desired` (the Stand pose without
+use_desired). A switch made elsewhere (/atlas/control_mode, /atlas/mode bdi_stand) is seen
+at the next state or step and reported as a successful transition.
 """
 
 from __future__ import annotations
@@ -17,13 +19,24 @@ import math
 import mujoco
 import numpy as np
 
-from tutorial_atlas_control.asi.behaviors import BEHAVIOR_OF_MODE, Behavior
+from tutorial_atlas_control.asi.behaviors import BEHAVIOR_OF_MODE, MODE_OF_BEHAVIOR, Behavior
 from tutorial_atlas_control.asi.session import STANDING_BEHAVIORS, AsiSession
-from tutorial_atlas_control.balance import BalanceEstimator, StandBehaviour, signed_distance
+from tutorial_atlas_control.balance import (
+    BalanceEstimator,
+    PelvisServo,
+    StandBehaviour,
+    signed_distance,
+)
 from tutorial_atlas_control.command import LAW_FIELDS, CommandUpdate
 from tutorial_atlas_control.control_modes import ControlMode
 from tutorial_atlas_control.joints import NUM_JOINTS
-from tutorial_atlas_control.msgs import AsiCommand, AsiState, BehaviorFeedback
+from tutorial_atlas_control.msgs import (
+    AsiCommand,
+    AsiState,
+    BehaviorFeedback,
+    ManipulateFeedback,
+    ManipulateParams,
+)
 from tutorial_atlas_control.sim import AtlasSimulator
 
 __all__ = ['FALLING_PELVIS_M', 'FALLING_TILT_RAD', 'AtlasSimInterface']
@@ -44,18 +57,30 @@ _NO_BLEND = np.zeros(NUM_JOINTS, np.uint8)
 _NO_BLEND.setflags(write=False)
 
 
+def servo_of(params: ManipulateParams) -> PelvisServo | None:
+    """Manipulate's pelvis target: `desired` when use_desired, else None (the Stand pose)."""
+    if not params.use_desired:
+        return None
+    return PelvisServo(params.pelvis_height_m, params.pelvis_yaw_rad, params.pelvis_lat_m)
+
+
 class AtlasSimInterface:
     """Behaviour requests and state reports for `sim`; with `balance`, Stand is the
     balancing StandBehaviour, else the simulator's hold."""
 
     def __init__(self, sim: AtlasSimulator, balance: bool = True) -> None:
         self.sim = sim
-        self.session = AsiSession()
         #: The balancing Stand installed (None: Stand is the hold); its estimator, or one of
         #: the interface's own, checks the centre of mass before Stand is entered.
         self.stand = StandBehaviour(sim.atlas) if balance else None
+        served = dict(MODE_OF_BEHAVIOR)
         if self.stand is not None:
             sim.install_stand(self.stand)
+            served[Behavior.MANIPULATE] = ControlMode.STAND
+        self.session = AsiSession(served)
+        #: Manipulate runs: Stand, started `_stand_starts`-th, with its pelvis servoed.
+        self.manipulating = False
+        self._stand_starts = 0
         self._estimator = (self.stand.estimator if self.stand is not None
                            else BalanceEstimator(sim.atlas))
         self._mode = sim.mode
@@ -67,7 +92,7 @@ class AtlasSimInterface:
 
     @property
     def current_behavior(self) -> Behavior:
-        return BEHAVIOR_OF_MODE[self.sim.mode]
+        return Behavior.MANIPULATE if self.manipulating else BEHAVIOR_OF_MODE[self.sim.mode]
 
     def apply(self, command: AsiCommand) -> None:
         """One checked AtlasSimInterfaceCommand, between two steps."""
@@ -79,17 +104,38 @@ class AtlasSimInterface:
             feet_under_com = self.com_over_feet()
         mode = self.session.request(command.behavior, current, feet_under_com)
         if mode is not None:
-            kept = None if sim.user_command is None else sim.user_command.k_effort.copy()
-            sim.set_mode(mode)
-            self._mode = mode
-            if kept is not None:
-                self._set_k_effort(kept)
+            if mode is not sim.mode:
+                kept = None if sim.user_command is None else sim.user_command.k_effort.copy()
+                sim.set_mode(mode)
+                self._mode = mode
+                if kept is not None:
+                    self._set_k_effort(kept)
+            self._set_manipulating(command.behavior == Behavior.MANIPULATE)
+        if self.manipulating:
+            assert self.stand is not None  # served only with it
+            self.stand.servo(servo_of(command.manipulate), float(sim.data.time))
         if command.k_effort is not None:
             self._set_k_effort(command.k_effort)
 
+    def _set_manipulating(self, manipulating: bool) -> None:
+        """Enter Manipulate (in a started Stand), or leave it for Stand's own pose."""
+        stand = self.stand
+        if stand is not None and self.manipulating and not manipulating \
+                and self.sim.mode is ControlMode.STAND:
+            stand.servo(None, float(self.sim.data.time))
+        self.manipulating = manipulating
+        if stand is not None:
+            self._stand_starts = stand.starts
+
     def _observe(self) -> None:
-        """A control mode switched outside the interface is the library's transition."""
-        mode = self.sim.mode
+        """A control mode switched outside the interface is the library's transition; so is
+        Stand restarted under Manipulate (/atlas/control_mode Stand)."""
+        mode, stand = self.sim.mode, self.stand
+        if self.manipulating and stand is not None and (
+                mode is not ControlMode.STAND or stand.starts != self._stand_starts):
+            self.manipulating = False
+            if mode is ControlMode.STAND:
+                self.session.switched(Behavior.STAND, Behavior.MANIPULATE)
         if mode is not self._mode:
             current, previous = BEHAVIOR_OF_MODE[mode], BEHAVIOR_OF_MODE[self._mode]
             self._mode = mode
@@ -152,7 +198,17 @@ class AtlasSimInterface:
             behavior_feedback=BehaviorFeedback(session.status_flags(current, falling),
                                                session.trans_from_behavior,
                                                session.trans_to_behavior),
+            manipulate_feedback=self.manipulate_feedback(),
             k_effort=self.k_effort())
+
+    def manipulate_feedback(self) -> ManipulateFeedback:
+        """The pelvis target in use, as clamped, while Manipulate runs (the Stand pose's
+        without use_desired); zeros otherwise."""
+        stand = self.stand
+        if not self.manipulating or stand is None:
+            return ManipulateFeedback()
+        target = stand.servo_target or PelvisServo(stand.squats.stand_height_m)
+        return ManipulateFeedback(0, target.height_m, target.yaw_rad, target.lateral_m)
 
     def end_step(self) -> None:
         """After each step, whether or not a state was built."""

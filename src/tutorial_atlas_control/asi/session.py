@@ -11,6 +11,8 @@ while a standing behaviour is falling, ahead of any other value (one value at a 
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 from tutorial_atlas_control.asi.behaviors import (
     MODE_OF_BEHAVIOR,
     AsiError,
@@ -30,7 +32,10 @@ _KNOWN = frozenset(int(b) for b in Behavior)
 class AsiSession:
     """Requests in, feedback values out, for one simulator."""
 
-    def __init__(self) -> None:
+    def __init__(self, served: Mapping[Behavior, ControlMode] = MODE_OF_BEHAVIOR) -> None:
+        """`served`: the behaviours this library runs, each with the control mode it runs
+        in; the others are refused as not implemented."""
+        self.served = dict(served)
         self.desired_behavior = int(Behavior.STAND)
         self.error_code = AsiError.NO_ERRORS
         self.trans_from_behavior = int(Behavior.STAND)
@@ -56,7 +61,7 @@ class AsiSession:
             return self._refuse(behavior, current, Status.FAILED_TRANS_UNKNOWN_BEHAVIOR,
                                 AsiError.NO_SUCH_BEHAVIOR)
         wanted = Behavior(behavior)
-        if wanted not in MODE_OF_BEHAVIOR:
+        if wanted not in self.served:
             return self._refuse(behavior, current, Status.FAILED_TRANS_ILLEGAL_BEHAVIOR,
                                 AsiError.BEHAVIOR_NOT_IMPLEMENTED)
         if wanted in STANDING_BEHAVIORS and not feet_under_com:
@@ -65,7 +70,7 @@ class AsiSession:
         self._status = Status.TRANSITION_SUCCESS
         self.error_code = AsiError.NO_ERRORS
         self.trans_from_behavior, self.trans_to_behavior = int(current), behavior
-        return MODE_OF_BEHAVIOR[wanted]
+        return self.served[wanted]
 
     def switched(self, current: Behavior, previous: Behavior) -> None:
         """The mode changed another way (/atlas/control_mode, /atlas/mode bdi_stand): the

@@ -2,10 +2,11 @@
 
 lipm: the linear inverted pendulum and its capture point; support: the support polygon
 and keeping a pressure centre in it; contact_wrench: a wrench shared between the feet;
-stand_pose: DRCSim's Stand pose; estimator: the balance state from the model; stand: the
-Stand controller (capture-point feedback, inverse statics, joint PD); stand_behaviour: that
-controller as the simulator's Stand behaviour; push_trial: offline
-trials of it on the simulator, standing and pushed.
+stand_pose: DRCSim's Stand pose placed on the ground; manipulate: Manipulate's pelvis servo
+(targets clamped, the posture that reaches them); estimator: the balance state from the
+model; stand: the Stand controller (capture-point feedback, inverse statics, joint PD);
+stand_behaviour: that controller as the simulator's Stand behaviour, with the servo;
+push_trial: offline trials of it on the simulator, standing and pushed.
 """
 
 from tutorial_atlas_control.exports import lazy_exports
@@ -13,6 +14,7 @@ from tutorial_atlas_control.exports import lazy_exports
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'contact_wrench': ['make_feasible', 'split_wrench'],
     'estimator': ['BalanceEstimator', 'BalanceState'],
+    'manipulate': ['PelvisServo', 'SquatTable', 'bent_posture', 'clamp_servo'],
     'lipm': ['capture_point', 'com_acceleration', 'dcm_feedback_cop', 'lipm_state',
              'natural_frequency'],
     'push_trial': ['Push', 'TimedStand', 'TrialResult', 'push_survived', 'stand_trial'],

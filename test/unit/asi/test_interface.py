@@ -170,3 +170,58 @@ def test_without_balance_stand_is_the_hold(atlas: atlas_model.AtlasModel) -> Non
     assert sim.behaviours.acting is None and sim.behaviours.stand is None
     run(interface, 5)
     np.testing.assert_array_equal(interface.state().f_out_nm, sim.torque_nm)  # the hold's
+
+
+def manipulate(height_m: float, yaw_rad: float = 0.0, lateral_m: float = 0.0,
+               use_desired: bool = True) -> AsiCommand:
+    return AsiCommand(0, Behavior.MANIPULATE, (StepData(),) * 4, False, StepData(), False,
+                      ManipulateParams(use_desired, height_m, yaw_rad, lateral_m), None, 0)
+
+
+def test_manipulate_servoes_stand_and_reports_the_clamped_targets(
+        interface: AtlasSimInterface) -> None:
+    run(interface, 10)
+    interface.apply(manipulate(0.5, 1.0, -0.2))  # beyond reach every way
+    assert interface.sim.mode is ControlMode.STAND and interface.manipulating
+    state = interface.state()
+    assert state.current_behavior == Behavior.MANIPULATE == state.desired_behavior
+    assert state.behavior_feedback.status_flags == Status.TRANSITION_SUCCESS
+    clamped = state.manipulate_feedback
+    squats = interface.stand.squats
+    assert (clamped.pelvis_height_m, clamped.pelvis_yaw_rad, clamped.pelvis_lat_m) == (
+        squats.height_range_m[0], squats.yaw_limit_rad, -0.05)
+    target = interface.stand.servo_target
+    interface.end_step()
+    run(interface, 5)
+    interface.apply(manipulate(0.5, 1.0, -0.2))  # streamed: the same target, no restart
+    assert interface.stand.servo_target is target
+    assert interface.state().behavior_feedback.status_flags == Status.OK
+    interface.apply(manipulate(0.0, use_desired=False))  # Stand's own pose
+    assert interface.stand.servo_target is None
+    assert interface.state().manipulate_feedback.pelvis_height_m == pytest.approx(
+        squats.stand_height_m)
+    interface.apply(command(Behavior.STAND))
+    state = interface.state()
+    assert state.current_behavior == Behavior.STAND and not interface.manipulating
+    assert state.manipulate_feedback.pelvis_height_m == 0.0
+
+
+def test_control_mode_stand_ends_manipulate(interface: AtlasSimInterface) -> None:
+    interface.apply(manipulate(0.85))
+    interface.end_step()
+    interface.sim.set_mode(ControlMode.STAND)  # /atlas/control_mode Stand: Stand restarts
+    interface.sim.step()
+    state = interface.state()
+    assert state.current_behavior == Behavior.STAND
+    assert (state.behavior_feedback.trans_from_behavior_index,
+            state.behavior_feedback.trans_to_behavior_index) == (Behavior.MANIPULATE,
+                                                                 Behavior.STAND)
+
+
+def test_without_balance_manipulate_is_not_served(atlas: atlas_model.AtlasModel) -> None:
+    interface = AtlasSimInterface(AtlasSimulator(atlas, load_gains_yaml(CONFIG)), balance=False)
+    interface.apply(manipulate(0.85))
+    state = interface.state()
+    assert state.current_behavior == Behavior.STAND and not interface.manipulating
+    assert state.behavior_feedback.status_flags == Status.FAILED_TRANS_ILLEGAL_BEHAVIOR
+    assert state.error_code == AsiError.BEHAVIOR_NOT_IMPLEMENTED
