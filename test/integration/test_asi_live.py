@@ -3,9 +3,10 @@ DRCSim 2.6/2.7 started (startup_mode:=bdi_stand, whose default Stand is the bala
 pinned in the Stand pose under the user's PID (User, k_effort 255) at 0.5 s; then
 /atlas/atlas_sim_interface_state says Stand with the pelvis at the balancing Stand's height
 (the hold's straight legs stand 15 mm higher) and AtlasState's k_effort is 0 (the behaviour
-alone); a MANIPULATE request for a pelvis at 0.85 m is reported and reached within 2 s; a
-FREEZE request on /atlas/atlas_sim_interface_command is reported as Freeze (2, not
-DRCSim's 0), and the command is in the bag (the state, a 1 kHz duplicate, is not).
+alone); a sideways pelvis push the stiff hold falls at is stood (its impulse read back from
+/atlas/sim_inputs); a MANIPULATE request for a pelvis at 0.85 m is reported and reached
+within 2 s; a FREEZE request on /atlas/atlas_sim_interface_command is reported as Freeze (2,
+not DRCSim's 0), and the commands are in the bag (the state, a 1 kHz duplicate, is not).
 
 Run with `python3 -m pytest test/integration/test_asi_live.py -q -s` after `source env.sh`.
 Wall time about 20 s.
@@ -22,10 +23,11 @@ pytest.importorskip('atlas_msgs.msg', reason='needs the catkin workspace: source
 if shutil.which('roslaunch') is None:
     pytest.skip('roslaunch is not on PATH (source env.sh)', allow_module_level=True)
 
-from support.bag_checks import count
+from support.bag_checks import count, messages
 from support.launch import EXIT_TIMEOUT_S, TestLaunch
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.asi import Behavior, Status
+from tutorial_atlas_control.sim.vrc import InputEvent, WrenchInput
 
 pytestmark = pytest.mark.filterwarnings('ignore::DeprecationWarning')
 
@@ -35,6 +37,21 @@ STAND_PELVIS_M = 0.912
 PELVIS_TOLERANCE_M = 0.006
 #: A Manipulate pelvis height within reach (m).
 MANIPULATE_PELVIS_M = 0.85
+#: A sideways push (N) held at least PUSH_AT_LEAST_S of sim time: more than the stiff hold
+#: survives sideways (it falls at HOLD_FALLS_SIDEWAYS_N_S), and below the balancing Stand's
+#: 60 N s even if a loaded machine ends it 0.9 s late.
+PUSH_N = 40.0
+PUSH_AT_LEAST_S = 0.6
+HOLD_FALLS_SIDEWAYS_N_S = 20.0
+
+
+def pushed_impulse_n_s(bag: Path) -> float:
+    """The sideways impulse the simulator applied (N s), from the bag's /atlas/sim_inputs:
+    each wrench held from its step until the next one's."""
+    events = [InputEvent.from_json(text.data) for text in messages(bag, topics.SIM_INPUTS)]
+    wrenches = [e for e in events if isinstance(e.item, WrenchInput)]
+    return sum(a.item.force_n[1] * (b.time_ns - a.time_ns) / 1e9
+               for a, b in zip(wrenches, wrenches[1:]))
 
 
 def test_asi_live_drcsim_start_balancing_stand_a_freeze_request_and_its_record(
@@ -55,6 +72,15 @@ def test_asi_live_drcsim_start_balancing_stand_a_freeze_request_and_its_record(
         assert abs(pelvis_z - STAND_PELVIS_M) < PELVIS_TOLERANCE_M, state['pos_est']
         assert state['k_effort'] == [0] * 28
         assert launch.next_message(topics.ATLAS_STATE)['k_effort'] == [0] * 28
+        launch.publish(topics.APPLY_PELVIS_FORCE, 'geometry_msgs/Wrench',  # a sideways push
+                       f'{{force: {{y: {PUSH_N}}}}}')
+        launch.wait_sim_until(launch.sim_time_s() + PUSH_AT_LEAST_S)  # sent: acting by now
+        launch.publish(topics.APPLY_PELVIS_FORCE, 'geometry_msgs/Wrench', '{}')
+        launch.wait_sim_until(launch.sim_time_s() + 2.0)
+        state = launch.next_message(topics.ASI_STATE)
+        assert state['behavior_feedback']['status_flags'] == Status.OK, 'falling after the push'
+        pushed_z = state['pos_est']['position']['z']
+        assert abs(pushed_z - STAND_PELVIS_M) < PELVIS_TOLERANCE_M, state['pos_est']
         launch.publish(topics.ASI_COMMAND, 'atlas_msgs/AtlasSimInterfaceCommand',
                        f'{{behavior: {int(Behavior.MANIPULATE)}, manipulate_params: {{use_desired: '
                        f'true, desired: {{pelvis_height: {MANIPULATE_PELVIS_M}}}}}}}')
@@ -79,4 +105,7 @@ def test_asi_live_drcsim_start_balancing_stand_a_freeze_request_and_its_record(
         launch.interrupt(EXIT_TIMEOUT_S)
         bag = launch.bag()
     assert count(bag, topics.ASI_COMMAND) == 2
+    impulse = pushed_impulse_n_s(bag)
+    print(f'figures: the push stood was {impulse:.1f} N s sideways (recorded)')
+    assert impulse > HOLD_FALLS_SIDEWAYS_N_S
     assert count(bag, topics.ASI_STATE) == 0
