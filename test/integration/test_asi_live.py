@@ -6,7 +6,8 @@ pinned in the Stand pose under the user's PID (User, k_effort 255) at 0.5 s; the
 alone); a sideways pelvis push the stiff hold falls at is stood (its impulse read back from
 /atlas/sim_inputs); a MANIPULATE request for a pelvis at 0.85 m is reported and reached
 within 2 s; a FREEZE request on /atlas/atlas_sim_interface_command is reported as Freeze (2,
-not DRCSim's 0), and the commands are in the bag (the state, a 1 kHz duplicate, is not).
+not DRCSim's 0), and the commands are in the bag (the state, a 1 kHz duplicate, is not),
+which replays offline bit for bit.
 
 Run with `python3 -m pytest test/integration/test_asi_live.py -q -s` after `source env.sh`.
 Wall time about 20 s.
@@ -27,6 +28,7 @@ from support.bag_checks import count, messages
 from support.launch import EXIT_TIMEOUT_S, TestLaunch
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.asi import Behavior, Status
+from tutorial_atlas_control.offline.replay import replay_bag
 from tutorial_atlas_control.sim.vrc import InputEvent, WrenchInput
 
 pytestmark = pytest.mark.filterwarnings('ignore::DeprecationWarning')
@@ -108,4 +110,7 @@ def test_asi_live_drcsim_start_balancing_stand_a_freeze_request_and_its_record(
     impulse = pushed_impulse_n_s(bag)
     print(f'figures: the push stood was {impulse:.1f} N s sideways (recorded)')
     assert impulse > HOLD_FALLS_SIDEWAYS_N_S
+    replayed = replay_bag(bag)  # the recorded torques, the behaviour's included
+    assert replayed.joint_position.max_abs == 0.0 and replayed.joint_velocity.max_abs == 0.0
+    assert replayed.pelvis_position is not None and replayed.pelvis_position.max_abs == 0.0
     assert count(bag, topics.ASI_STATE) == 0
