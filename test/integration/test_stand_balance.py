@@ -167,7 +167,8 @@ def balancing_simulator() -> AtlasSimulator:
 def test_harness_drop_lands_and_stands() -> None:
     """DRCSim's scripts: /atlas/mode harnessed, StandPrep, 5 s, nominal, 0.3 s, Stand: the
     robot lands (feet 4.3 cm above the ground in the harness) and stands 10 s."""
-    sim = balancing_simulator()
+    sim = AtlasSimulator(load_model(), load_gains_yaml(DEFAULT_GAINS_FILE))
+    AtlasSimInterface(sim)  # installs the balancing Stand and StandPrep
     run_for(sim, 1.5)
     sim.apply_input(ModeInput(VrcMode.HARNESSED))
     sim.set_mode(ControlMode.STAND_PREP)

@@ -5,11 +5,12 @@ bytes of its states.
 What it does with a command (DRCSim 2.7's AtlasPlugin::SetASICommand): the behaviour is
 requested (AsiSession decides), then k_effort, at exactly 28 entries, becomes the blend of
 every joint; a behaviour switch itself never changes k_effort. Stand runs the balancing
-StandBehaviour, installed into the simulator here (or, without `balance`, the simulator's
-hold, DRCSim 2.5.2's stand-in). Manipulate, served with the balancing Stand only, is that
-Stand with its pelvis servoed to `manipulate_params.desired` (the Stand pose without
-use_desired). A switch made elsewhere (/atlas/control_mode, /atlas/mode bdi_stand) is seen
-at the next state or step and reported as a successful transition.
+StandBehaviour and StandPrep the StandPrepBehaviour, installed into the simulator here
+(or, without `balance`, the simulator's holds, DRCSim 2.5.2's stand-in). Manipulate, served
+with the balancing Stand only, is that Stand with its pelvis servoed to
+`manipulate_params.desired` (the Stand pose without use_desired). A switch made elsewhere
+(/atlas/control_mode, /atlas/mode bdi_stand) is seen at the next state or step and reported
+as a successful transition.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ from tutorial_atlas_control.balance import (
     BalanceEstimator,
     PelvisServo,
     StandBehaviour,
+    StandPrepBehaviour,
     signed_distance,
 )
 from tutorial_atlas_control.command import LAW_FIELDS, CommandUpdate
@@ -76,6 +78,7 @@ class AtlasSimInterface:
         served = dict(MODE_OF_BEHAVIOR)
         if self.stand is not None:
             sim.install_stand(self.stand)
+            sim.install_stand(StandPrepBehaviour(sim.atlas, sim.gains), ControlMode.STAND_PREP)
             served[Behavior.MANIPULATE] = ControlMode.STAND
         self.session = AsiSession(served)
         #: Manipulate runs: Stand, started `_stand_starts`-th, with its pelvis servoed.

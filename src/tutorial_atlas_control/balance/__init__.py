@@ -6,6 +6,7 @@ stand_pose: DRCSim's Stand pose placed on the ground; manipulate: Manipulate's p
 (targets clamped, the posture that reaches them); estimator: the balance state from the
 model; stand: the Stand controller (capture-point feedback, inverse statics, joint PD);
 stand_behaviour: that controller as the simulator's Stand behaviour, with the servo;
+stand_prep: StandPrep, the harnessed robot brought to the Stand pose;
 push_trial: offline trials of it on the simulator, standing and pushed.
 """
 
@@ -21,5 +22,6 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'stand': ['StandController', 'StandGains', 'StandOutput', 'StandReference'],
     'stand_behaviour': ['TRANSITION_S', 'StandBehaviour', 'stand_pose_com_height_m'],
     'stand_pose': ['STAND_POSE_RAD', 'place_in_stand_pose', 'sole_corners'],
+    'stand_prep': ['PREP_S', 'StandPrepBehaviour'],
     'support': ['Region', 'clamp_into', 'convex_hull', 'inside', 'shrink', 'signed_distance'],
 })

@@ -33,19 +33,31 @@ class Behaviour(Protocol):
 class ModeBehaviours:
     """The behaviours installed for the control modes, and the one acting now.
 
-    Only Stand takes one so far; a mode without one keeps the simulator's law on its
+    Stand and StandPrep take one; a mode without one keeps the simulator's law on its
     command (the hold, the user's PID, ragdoll's zeros).
     """
 
     def __init__(self) -> None:
-        #: What Stand runs; None: Stand is the hold.
-        self.stand: Behaviour | None = None
+        #: What each mode runs; a mode absent: its hold (or the law's command).
+        self.installed: dict[ControlMode, Behaviour] = {}
         #: The behaviour acting now (the mode's, started), or None.
         self.acting: Behaviour | None = None
 
+    @property
+    def stand(self) -> Behaviour | None:
+        """What Stand runs; None: Stand is the hold."""
+        return self.installed.get(ControlMode.STAND)
+
+    def install(self, mode: ControlMode, behaviour: Behaviour | None) -> None:
+        """`mode` runs `behaviour` from its next selection (None: the hold again)."""
+        if behaviour is None:
+            self.installed.pop(mode, None)
+        else:
+            self.installed[mode] = behaviour
+
     def select(self, mode: ControlMode, data: mujoco.MjData) -> None:
         """`mode`'s behaviour, started from the robot in `data`, becomes the acting one."""
-        behaviour = self.stand if mode is ControlMode.STAND else None
+        behaviour = self.installed.get(mode)
         if behaviour is not None:
             behaviour.start(data)
         self.acting = behaviour

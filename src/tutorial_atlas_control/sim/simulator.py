@@ -236,10 +236,12 @@ class AtlasSimulator:
         self.law.restart_derivative()
         self.behaviours.select(mode, self.data)
 
-    def install_stand(self, behaviour: Behaviour | None) -> None:
-        """Stand runs `behaviour` (f_out: its torque), or the hold for None; at once."""
-        self.behaviours.stand = behaviour
-        self.behaviours.select(self.mode, self.data)
+    def install_stand(self, behaviour: Behaviour | None,
+                      mode: ControlMode = ControlMode.STAND) -> None:
+        """`mode` (Stand, StandPrep) runs `behaviour` (f_out), or its hold for None."""
+        self.behaviours.install(mode, behaviour)
+        if mode is self.mode:
+            self.behaviours.select(mode, self.data)
 
     def receive_command(self, names: Sequence[str],
                         arrays: Mapping[str, Sequence[float]]) -> None:
