@@ -112,6 +112,11 @@ def _drop_bags(launch: Launch) -> None:
     shutil.rmtree(launch.args['bag_dir'], ignore_errors=True)
 
 
+#: Wall time (s) after the first /clock before a bdi_stand start is balancing in Stand (its
+#: Stand begins at 2 s of sim time; a loaded machine may run a little slow).
+STAND_STARTED_S = 3.0
+
+
 def _wait_ready(master: Master, launch: Launch, probes: Probes) -> None:
     """/clock arriving and the recorder subscribed to the simulator's topics."""
     start_count = probes.clock.count
@@ -232,6 +237,32 @@ def js_transport(master: Master, probes: Probes, work_dir: Path, count: int = 20
     transport = np.array([t - header_stamp_ns(raw) / NS_PER_S for t, raw in samples]) * 1000.0
     return {'js_transport_p50_ms': float(np.percentile(transport, 50)),
             'js_transport_p99_ms': float(np.percentile(transport, 99))}
+
+
+def stand_realtime_run(master: Master, launch_file: str, probes: Probes, work_dir: Path,
+                       name: str, window_s: float) -> dict[str, float]:
+    """atlas.launch as DRCSim 2.7 started (startup_mode:=bdi_stand: the balancing Stand from
+    2 s of sim time) at real_time_factor:=1 with the recorder: the pace it keeps
+    (`stand_realtime_rtf`), its step lateness p99 and the node's CPU per step, in Stand."""
+    with _launch(master, launch_file, work_dir, name, 1.0,
+                 extra_args={'startup_mode': 'bdi_stand'}) as launch:
+        _wait_ready(master, launch, probes)
+        time.sleep(STAND_STARTED_S)
+        node = launch.node_pid('atlas_sim')
+        cpu0 = cpu_seconds(node) if node else 0.0
+        probes.clock.start()
+        time.sleep(window_s)
+        samples = probes.clock.stop()
+        cpu1 = cpu_seconds(node) if node else 0.0
+        launch.check_running()
+    _drop_bags(launch)
+    wall, sim = _clock_series(samples)
+    steps = (sim[-1] - sim[0]) * 1000.0
+    result = {'stand_realtime_rtf': float((sim[-1] - sim[0]) / (wall[-1] - wall[0])),
+              'stand_lateness_p99_ms': float(np.percentile(_lateness(wall, sim), 99))}
+    if node:
+        result['stand_node_us_per_step'] = (cpu1 - cpu0) / max(steps, 1.0) * 1e6
+    return result
 
 
 def realtime_run(master: Master, launch_file: str, probes: Probes, work_dir: Path, name: str,

@@ -116,6 +116,10 @@ ROWS = (
     ('fast_rosbag_rtf', 'same, `rosbag record` recording', 'x real time', '', 2),
     ('fast_rosbag_recorded_fraction', 'joint_states recorded (rosbag)', 'fraction', '', 4),
     ('realtime_rtf', 'node rtf:=1, achieved', 'x real time', '1.00 +- 0.01', 4),
+    ('stand_realtime_rtf', 'same, balancing Stand (bdi_stand)', 'x real time', '1.00 +- 0.01',
+     4),
+    ('stand_lateness_p99_ms', 'its step lateness p99', 'ms', '< 2', 2),
+    ('stand_node_us_per_step', 'its node CPU per step', 'us', '', 0),
     ('lateness_p50_ms', 'step lateness p50', 'ms', '', 2),
     ('lateness_p99_ms', 'step lateness p99', 'ms', '< 2', 2),
     ('lateness_max_ms', 'step lateness max', 'ms', '', 2),
@@ -261,6 +265,9 @@ TARGETS = {
     # With TF on (the simulator publishing the links), the master idles.
     'fast_master_cpu': Target(high=0.01, strict=True),
     'realtime_rtf': Target(low=0.99, high=1.01),
+    # Real time holds with the balancing Stand in the loop and the recorder.
+    'stand_realtime_rtf': Target(low=0.99, high=1.01),
+    'stand_lateness_p99_ms': Target(high=2.0, strict=True),
     'lateness_p99_ms': Target(high=2.0, strict=True),
     'cmd_latency_p99_ms_50hz': Target(high=2.0, strict=True),
     'cmd_latency_p99_ms_1khz': Target(high=2.0, strict=True),
@@ -302,6 +309,7 @@ EXPECTED = {
              'fast_rosbag_rtf', 'fast_rosbag_recorded_fraction', 'fast_master_cpu',
              'fast_rsp_rtf', 'fast_rsp_master_cpu', 'fast_rsp_state_publisher_cpu'),
     'realtime': ('realtime_rtf', 'lateness_p50_ms', 'lateness_p99_ms', 'lateness_max_ms',
+                 'stand_realtime_rtf', 'stand_lateness_p99_ms',
                  'js_transport_p50_ms', 'js_transport_p99_ms', 'cmd_latency_p50_ms',
                  'cmd_latency_p99_ms', 'cmd_applied_1khz',
                  *(f'cmd_latency_p{pct}_ms{raw}_{rate}' for pct in (50, 99)
@@ -650,6 +658,13 @@ def run_realtime(args, samples, master, probes, work_dir) -> None:  # noqa: ANN0
             f'{values["cmd_latency_p99_ms_50hz"]:.2f} ms at 50 Hz, '
             f'{values["cmd_latency_p99_ms_1khz"]:.2f} ms at 1 kHz')
         add(samples, values)
+        stand = online.stand_realtime_run(master, args.launch_file, probes, work_dir,
+                                          f'stand{run + 1}', args.budget.realtime_window_s)
+        log(f'realtime run {run + 1}: in the balancing Stand rtf '
+            f'{stand["stand_realtime_rtf"]:.4f}, lateness p99 '
+            f'{stand["stand_lateness_p99_ms"]:.2f} ms, node '
+            f'{stand.get("stand_node_us_per_step", float("nan")):.0f} us/step')
+        add(samples, stand)
 
 
 def summarize(samples: dict[str, list[float]],
