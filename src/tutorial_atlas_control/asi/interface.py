@@ -68,30 +68,36 @@ def servo_of(params: ManipulateParams) -> PelvisServo | None:
 
 class AtlasSimInterface:
     """Behaviour requests and state reports for `sim`; with `balance`, Stand is the
-    balancing StandBehaviour, else the simulator's hold."""
+    balancing StandBehaviour, else the simulator's hold until a bdi_stand sequence (the
+    start-up mode or /atlas/mode) asks for BDI's Stand, which loads the balancing one."""
 
     def __init__(self, sim: AtlasSimulator, balance: bool = True) -> None:
         self.sim = sim
         #: The balancing Stand installed (None: Stand is the hold); its estimator, or one of
         #: the interface's own, checks the centre of mass before Stand is entered.
-        self.stand = StandBehaviour(sim.atlas) if balance else None
-        served = dict(MODE_OF_BEHAVIOR)
-        if self.stand is not None:
-            sim.install_stand(self.stand)
-            sim.install_stand(StandPrepBehaviour(sim.atlas, sim.gains), ControlMode.STAND_PREP)
-            served[Behavior.MANIPULATE] = ControlMode.STAND
-        self.session = AsiSession(served)
+        self.stand: StandBehaviour | None = None
+        self.session = AsiSession(MODE_OF_BEHAVIOR)
+        self._estimator = BalanceEstimator(sim.atlas)
+        if balance:
+            self._load_balance()
         #: Manipulate runs: Stand, started `_stand_starts`-th, with its pelvis servoed.
         self.manipulating = False
         self._stand_starts = 0
-        self._estimator = (self.stand.estimator if self.stand is not None
-                           else BalanceEstimator(sim.atlas))
         self._mode = sim.mode
         model = sim.model
         self._feet = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name)
                       for name in FOOT_BODIES]
         free_joint = int(model.body_jntadr[sim.atlas.pelvis_body_id])
         self._free_dof = int(model.jnt_dofadr[free_joint])
+
+    def _load_balance(self) -> None:
+        """Stand and StandPrep become the balancing behaviours; Manipulate is served."""
+        sim = self.sim
+        self.stand = StandBehaviour(sim.atlas)
+        sim.install_stand(self.stand)
+        sim.install_stand(StandPrepBehaviour(sim.atlas, sim.gains), ControlMode.STAND_PREP)
+        self.session.served[Behavior.MANIPULATE] = ControlMode.STAND
+        self._estimator = self.stand.estimator
 
     @property
     def current_behavior(self) -> Behavior:
@@ -133,6 +139,8 @@ class AtlasSimInterface:
     def _observe(self) -> None:
         """A control mode switched outside the interface is the library's transition; so is
         Stand restarted under Manipulate (/atlas/control_mode Stand)."""
+        if self.stand is None and self.sim.startup_pin.bdi_stand:
+            self._load_balance()  # BDI's Stand asked for: the library is there
         mode, stand = self.sim.mode, self.stand
         if self.manipulating and stand is not None and (
                 mode is not ControlMode.STAND or stand.starts != self._stand_starts):

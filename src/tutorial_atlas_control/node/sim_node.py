@@ -42,8 +42,9 @@ Parameters (private unless noted):
     ~bag_dir (str, unset): where the launch's recorder writes; if set and no file can be
         written there, the node refuses to start (one line).
     ~stand (str, hold): what Stand does. hold: the port's stand-in for BDI's behaviour, a
-        joint hold with the parameter gains (DRCSim 2.5.2's tutorial behaves as measured);
-        balance: the open AtlasSimInterface's balancing Stand (balance/, docs/controllers.md).
+        joint hold with the parameter gains (DRCSim 2.5.2's tutorial behaves as measured),
+        until a bdi_stand sequence asks for BDI's Stand; balance: the open AtlasSimInterface's
+        balancing Stand from the start (balance/, docs/controllers.md).
     ~model_file (str, the package's sim/atlas_v1.xml): the MJCF to simulate; it must have
         Atlas v1's joints, actuators and sensors (a variant of the package's model).
     /atlas/time_to_unpin (float, 1.0): seconds the torso stays pinned after start/reset.

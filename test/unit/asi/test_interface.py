@@ -22,7 +22,7 @@ from tutorial_atlas_control.msgs.atlas_sim_interface import (
 from tutorial_atlas_control.msgs.atlas_sim_interface_state import encode_asi_state
 from tutorial_atlas_control.sim import AtlasSimulator, load_gains_yaml, load_model
 from tutorial_atlas_control.sim import model as atlas_model
-from tutorial_atlas_control.sim.vrc import WrenchInput
+from tutorial_atlas_control.sim.vrc import ModeInput, VrcMode, WrenchInput
 
 CONFIG = Path(__file__).resolve().parents[3] / 'config' / 'atlas_controller.yaml'
 
@@ -225,3 +225,17 @@ def test_without_balance_manipulate_is_not_served(atlas: atlas_model.AtlasModel)
     assert state.current_behavior == Behavior.STAND and not interface.manipulating
     assert state.behavior_feedback.status_flags == Status.FAILED_TRANS_ILLEGAL_BEHAVIOR
     assert state.error_code == AsiError.BEHAVIOR_NOT_IMPLEMENTED
+
+
+def test_bdi_stand_loads_the_balancing_stand_into_a_hold_session(
+        atlas: atlas_model.AtlasModel) -> None:
+    """stand:=hold, then /atlas/mode bdi_stand: its Stand at 2 s is the balancing one."""
+    sim = AtlasSimulator(atlas, load_gains_yaml(CONFIG))
+    interface = AtlasSimInterface(sim, balance=False)
+    run(interface, 1500)
+    assert interface.stand is None and sim.behaviours.acting is None
+    sim.apply_input(ModeInput(VrcMode.BDI_STAND))
+    run(interface, 2100)
+    assert sim.mode is ControlMode.STAND
+    assert interface.stand is not None and sim.behaviours.acting is interface.stand
+    assert interface.session.served[Behavior.MANIPULATE] is ControlMode.STAND
