@@ -235,6 +235,8 @@ class Budget:
     #: section's `rosbag record` and robot_state_publisher variants, the plot and sweep
     #: sections); None: --runs.
     side_runs: int | None = None
+    #: The search's population in its few generations (None: Stepping.yaml's 8).
+    search_popsize: int | None = None
 
     def side(self, runs: int) -> int:
         """How many of `runs` measure the untargeted launches too."""
@@ -243,7 +245,7 @@ class Budget:
 
 BUDGETS = {
     'quick': Budget('quick', 2000, 5000, 10.0, 4, 1, 4.0, 8.0, ((50.0, 2.0), (1000.0, 1.0)),
-                    8.0, 4.0, 4.0),
+                    8.0, 4.0, 4.0, search_popsize=2),
     'default': Budget('default', 5000, 20000, 60.0, 8, 1, 5.0, 15.0,
                       ((50.0, 4.0), (1000.0, 2.0)), 15.0, 6.0, 6.0, side_runs=1),
     'full': Budget('full', 5000, 20000, 60.0, 16, None, 10.0, 30.0,
@@ -483,7 +485,8 @@ def run_search(args: argparse.Namespace, samples: dict[str, list[float]],
 
     with Section('search', loads):
         timed = search_time.search_time(
-            work_dir, None if args.whole_search else args.budget.search_generations)
+            work_dir, None if args.whole_search else args.budget.search_generations,
+            args.budget.search_popsize)
         figures = {'search_wall_s': timed.wall_s, 'search_generations': timed.generations,
                    'search_runs_per_s': timed.runs / timed.wall_s}
         if timed.reproduced is not None:

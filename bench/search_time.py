@@ -52,16 +52,21 @@ def _data_lines(path: Path) -> list[str]:
     return [line for line in path.read_text().splitlines() if not line.lstrip().startswith('#')]
 
 
-def search_time(out_dir: Path, generations: int | None) -> SearchTime:
+def search_time(out_dir: Path, generations: int | None,
+                popsize: int | None = None) -> SearchTime:
     """Run the search for `generations` (None: the whole search, GENERATIONS, which is
-    then judged on the step it writes) and time it."""
+    then judged on the step it writes) and time it; `popsize` (a smoke test's) replaces
+    the search's own population of 8 in a partial run."""
     whole = generations is None
+    arguments = list(ARGUMENTS)
+    if popsize is not None and not whole:
+        arguments[arguments.index('--popsize') + 1] = str(popsize)
     if generations is None:
         generations = GENERATIONS
     log, found, gains = out_dir / 'search.jsonl', out_dir / 'found.yaml', out_dir / 'gains.yaml'
     for path in (log, found, gains):
         path.unlink(missing_ok=True)
-    command = [sys.executable, str(SEARCH), *ARGUMENTS, '--generations', str(generations),
+    command = [sys.executable, str(SEARCH), *arguments, '--generations', str(generations),
                '--log', str(log), '--yaml', str(found), '--gains-out', str(gains)]
     started = time.perf_counter()
     result = subprocess.run(command, capture_output=True, text=True, check=False)
