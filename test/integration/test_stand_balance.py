@@ -22,8 +22,7 @@ from tutorial_atlas_control.balance.push_trial import (
     push_survived,
     stand_trial,
 )
-from tutorial_atlas_control.balance.stand import StandGains
-from tutorial_atlas_control.balance.stand_behaviour import yaw_of
+from tutorial_atlas_control.balance.stand import StandGains, yaw_of
 from tutorial_atlas_control.command import K_EFFORT_ROW, CommandUpdate, command_update
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES
 from tutorial_atlas_control.msgs.atlas_sim_interface import AsiCommand, ManipulateParams, StepData

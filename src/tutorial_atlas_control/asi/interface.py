@@ -77,9 +77,10 @@ class AtlasSimInterface:
         #: the interface's own, checks the centre of mass before Stand is entered.
         self.stand: StandBehaviour | None = None
         self.session = AsiSession(MODE_OF_BEHAVIOR)
-        self._estimator = BalanceEstimator(sim.atlas)
         if balance:
             self._load_balance()
+        else:
+            self._estimator = BalanceEstimator(sim.atlas)
         #: Manipulate runs: Stand, started `_stand_starts`-th, with its pelvis servoed.
         self.manipulating = False
         self._stand_starts = 0

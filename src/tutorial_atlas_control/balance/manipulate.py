@@ -22,15 +22,15 @@ from tutorial_atlas_control.balance.stand_pose import STAND_POSE_RAD, place_in_s
 from tutorial_atlas_control.joints import JOINT_INDEX
 from tutorial_atlas_control.sim import AtlasModel
 
-__all__ = ['HIP_SHARE', 'LATERAL_LIMIT_M', 'PelvisServo', 'SquatTable', 'clamp_servo']
+__all__ = ['HIP_SHARE', 'LATERAL_LIMIT_M', 'PelvisServo', 'SquatTable', 'bent_posture',
+           'clamp_servo']
 
 _LEGS = ('l', 'r')
 _PITCH = {side: (JOINT_INDEX[f'{side}_leg_lhy'], JOINT_INDEX[f'{side}_leg_kny'],
                  JOINT_INDEX[f'{side}_leg_uay']) for side in _LEGS}
 _HIP_YAW = tuple(JOINT_INDEX[f'{side}_leg_uhz'] for side in _LEGS)
-_hip, _knee, _ankle = (STAND_POSE_RAD[i] for i in _PITCH['l'])
 #: The hip's share of the knee's bend in the Stand pose (the ankle takes the rest).
-HIP_SHARE = float(-_hip / (_knee - 0.0)) if _knee else 0.5
+HIP_SHARE = float(-STAND_POSE_RAD[_PITCH['l'][0]] / STAND_POSE_RAD[_PITCH['l'][1]])
 #: How far (rad) from a joint limit the servo's knee bend and yaw stay.
 LIMIT_MARGIN_RAD = 0.05
 YAW_MARGIN_RAD = 0.02

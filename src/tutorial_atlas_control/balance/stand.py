@@ -80,11 +80,20 @@ class StandReference:
         heading = state.pelvis_rotation[:, 0].copy()
         heading[2] = 0.0
         heading /= np.linalg.norm(heading)
-        yaw = np.arctan2(heading[1], heading[0])
-        upright = np.array([[np.cos(yaw), -np.sin(yaw), 0.0],
-                            [np.sin(yaw), np.cos(yaw), 0.0], [0.0, 0.0, 1.0]])
+        upright = yaw_rotation(np.arctan2(heading[1], heading[0]))
         middle = state.sole_centres[:, :2].mean(axis=0) + forward_offset_m * heading[:2]
         return cls(middle, float(state.com[2]), upright, np.array(posture_rad, dtype=float))
+
+
+def yaw_of(rotation: np.ndarray) -> float:
+    """The heading (rad) of a frame's x axis about the world z axis."""
+    return float(np.arctan2(rotation[1, 0], rotation[0, 0]))
+
+
+def yaw_rotation(yaw_rad: float) -> np.ndarray:
+    """An upright frame turned by `yaw_rad` about z."""
+    c, s = np.cos(yaw_rad), np.sin(yaw_rad)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 def orientation_error(rotation: np.ndarray, reference: np.ndarray) -> np.ndarray:

@@ -15,6 +15,7 @@ blends with the user's PID by k_effort as f_out.
 from __future__ import annotations
 
 import dataclasses
+import functools
 
 import mujoco
 import numpy as np
@@ -31,6 +32,8 @@ from tutorial_atlas_control.balance.stand import (
     StandGains,
     StandOutput,
     StandReference,
+    yaw_of,
+    yaw_rotation,
 )
 from tutorial_atlas_control.balance.stand_pose import STAND_POSE_RAD, place_in_stand_pose
 from tutorial_atlas_control.sim import AtlasModel
@@ -49,17 +52,6 @@ def stand_pose_com_height_m(atlas: AtlasModel) -> float:
     return float(data.subtree_com[0][2])
 
 
-def yaw_of(rotation: np.ndarray) -> float:
-    """The heading (rad) of a frame's x axis about the world z axis."""
-    return float(np.arctan2(rotation[1, 0], rotation[0, 0]))
-
-
-def yaw_rotation(yaw_rad: float) -> np.ndarray:
-    """An upright frame turned by `yaw_rad` about z."""
-    c, s = np.cos(yaw_rad), np.sin(yaw_rad)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
 def smoothstep(fraction: float) -> float:
     """0 at 0, 1 at 1 and beyond, with zero slope at both ends."""
     s = min(max(fraction, 0.0), 1.0)
@@ -76,7 +68,6 @@ class StandBehaviour:
         self.transition_s = transition_s
         self.estimator = BalanceEstimator(atlas)
         self.com_height_m = stand_pose_com_height_m(atlas)
-        self.squats = SquatTable(atlas)
         self.controller: StandController | None = None
         #: The last step's state and decision (None before the first), for feedback.
         self.last_state: BalanceState | None = None
@@ -87,6 +78,11 @@ class StandBehaviour:
         self.starts = 0
         #: The reference moving on: (start time, from, to); None once it has arrived.
         self._transition: tuple[float, StandReference, StandReference] | None = None
+
+    @functools.cached_property
+    def squats(self) -> SquatTable:
+        """Manipulate's reach and postures, built when first servoed (not every Stand is)."""
+        return SquatTable(self.atlas)
 
     def start(self, data: mujoco.MjData) -> None:
         """Stand where the robot stands now, going to the Stand pose over transition_s."""
