@@ -62,9 +62,12 @@ stop_background() {
 trap stop_background EXIT
 
 in_background rostests bash tools/run_rostests.sh
-# Niced: at equal priority its rtf-20 runs and searches took the tests' CPU and live tutorial
-# runs lost commands; at nice 19 it takes what the tests leave idle.
-in_background bench-quick nice -n 19 bash -c 'python3 bench/run_bench.py --quick --runs 1 > /dev/null'
+# At the lowest priority: at equal priority its rtf-20 runs and searches took the tests' CPU
+# and live tutorial runs lost commands. `nice` alone is not enough: its simulators run in
+# sessions of their own (roslaunch), which the scheduler served like any test's
+# (tools/lowest_priority.py); niced with their sessions, it takes what the tests leave idle.
+in_background bench-quick python3 tools/lowest_priority.py \
+  bash -c 'python3 bench/run_bench.py --quick --runs 1 > /dev/null'
 timed pytest-parallel python3 -m pytest test/unit test/integration test/reliability \
   -q -rs -n 2 -m 'not serial' --durations=15
 collect rostests
