@@ -65,7 +65,11 @@ create_virtualenv() {
   fi
   [ -x "$TAC_VENV/bin/python" ] || { log "creating virtualenv $TAC_VENV"; /usr/bin/python3 -m venv --system-site-packages "$TAC_VENV"; }
   log "installing pinned requirements"
-  "$TAC_VENV/bin/python" -m pip install --disable-pip-version-check -q -r "$repo_dir/requirements.txt"
+  # Without PYTHONPATH: in a shell that sourced another clone's env.sh, pip would find the
+  # requirements in that clone's virtualenv (on PYTHONPATH), install nothing here, and the
+  # stamp below would call this empty virtualenv up to date.
+  env -u PYTHONPATH -u VIRTUAL_ENV "$TAC_VENV/bin/python" -m pip install \
+    --disable-pip-version-check -q -r "$repo_dir/requirements.txt"
   echo "$want" > "$stamp"
 }
 
