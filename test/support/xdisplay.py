@@ -150,16 +150,8 @@ def xvfb(log_path: Path, screen: str = SCREEN) -> Iterator[str]:
 
 def display_env(display: str) -> dict[str, str]:
     """This environment for a GUI process on `display`: software OpenGL (Xvfb has no GPU),
-    and without env.sh's headless OSMesa choice, which would keep MuJoCo off the display.
-
-    llvmpipe rasterizes in the drawing thread (LP_NUM_THREADS=0), not in worker threads:
-    rviz once aborted at start-up on a loaded host with the heap corrupted inside Mesa's
-    buffer swap ("free(): invalid next size", docs/TESTING.md's known flakes), a race that
-    valgrind's one-thread-at-a-time run of rviz did not show (no invalid access in minutes
-    of drawing). Without rasterizer threads that race cannot happen; on two busy cores it
-    costs no time (the window tests took as long).
-    """
-    env = dict(os.environ, DISPLAY=display, LIBGL_ALWAYS_SOFTWARE='1', LP_NUM_THREADS='0')
+    and without env.sh's headless OSMesa choice, which would keep MuJoCo off the display."""
+    env = dict(os.environ, DISPLAY=display, LIBGL_ALWAYS_SOFTWARE='1')
     for name in ('MUJOCO_GL', 'PYOPENGL_PLATFORM'):
         env.pop(name, None)
     return env
