@@ -182,11 +182,11 @@ def test_the_import_check_catches_a_module_that_needs_rospy(tmp_path: Path) -> N
 #: msgs' decoders produce and sim's law reads, so it sits below both; native (the compiled
 #: library's binding) mirrors the command's fields for the compiled law; msgs are the wire
 #: formats, plotting reads messages; sim fills messages from the simulator; balance (the
-#: behaviours' controllers) computes torques over the model sim loads; stepping (the live
-#: loop) and trajectories run the simulation; bags read recorded runs, of trajectories;
-#: offline runs write and replay bags, demo runs the tutorial and reads its bag; search
-#: sweeps offline runs; node is the simulator node over all of these; cli, each script's
-#: command line, over everything.
+#: behaviours' controllers) computes torques over the model sim loads; walking plans steps
+#: on the balance's pendulum; stepping (the live loop) and trajectories run the simulation;
+#: bags read recorded runs, of trajectories; offline runs write and replay bags, demo runs
+#: the tutorial and reads its bag; search sweeps offline runs; node is the simulator node
+#: over all of these; cli, each script's command line, over everything.
 LAYERS: tuple[tuple[str, ...], ...] = (
     ('', 'control_modes', 'errors', 'exports', 'fall_report', 'joints', 'launch_args',
      'processes', 'resources', 'topics', 'units', 'yaml_errors'),
@@ -195,6 +195,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ('msgs', 'plotting'),
     ('sim',),
     ('balance',),
+    ('walking',),
     ('asi',),
     ('stepping', 'trajectories'),
     ('bags',),
@@ -306,9 +307,9 @@ def test_the_layer_check_catches_upward_imports() -> None:
     found = layer_order_violations(source, f'{PACKAGE}.msgs.example')
     assert found == [
         f'{PACKAGE}.msgs.example:7: imports {PACKAGE}.sim.simulator (layer 4 above layer 3)',
-        f'{PACKAGE}.msgs.example:9: imports {PACKAGE}.offline (layer 9 above layer 3)',
-        f'{PACKAGE}.msgs.example:10: imports {PACKAGE}.bags (layer 8 above layer 3)',
-        f'{PACKAGE}.msgs.example:11: imports {PACKAGE}.stepping (layer 7 above layer 3)',
+        f'{PACKAGE}.msgs.example:9: imports {PACKAGE}.offline (layer 10 above layer 3)',
+        f'{PACKAGE}.msgs.example:10: imports {PACKAGE}.bags (layer 9 above layer 3)',
+        f'{PACKAGE}.msgs.example:11: imports {PACKAGE}.stepping (layer 8 above layer 3)',
         f'{PACKAGE}.msgs.example:12: imports {PACKAGE}.nowhere (in no layer)',
     ]
 

@@ -44,6 +44,7 @@ class BalanceState:
     capture_point: np.ndarray     # (2,)
     bias_nm: np.ndarray           # (28,) joint part of qfrc_bias (gravity + Coriolis)
     sole_jacobians: np.ndarray    # (2, 6, 28) [linear; angular] at each sole centre, joints
+    sole_velocities: np.ndarray   # (2, 6) [linear; angular] of each sole centre, world
 
 
 class BalanceEstimator:
@@ -132,4 +133,5 @@ class BalanceEstimator:
             sole_centres=centres, sole_rotations=rotations, in_contact=contact,
             support_polygon=polygon, omega=omega,
             capture_point=lipm.capture_point(com[:2], com_velocity[:2], omega),
-            bias_nm=self._bias[self._dof_adr], sole_jacobians=jac[:, :, self._dof_adr])
+            bias_nm=self._bias[self._dof_adr], sole_jacobians=jac[:, :, self._dof_adr],
+            sole_velocities=jac @ d.qvel)

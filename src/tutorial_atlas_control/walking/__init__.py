@@ -1,0 +1,19 @@
+"""Walking without ROS: the footsteps Walk and Step take and the plan they follow.
+
+footsteps: a step as the AtlasSimInterface names it, DRCSim's fixed queue, straight and
+circular plans, a streaming client's window; step_queue: Walk's queue of steps merged by
+index, clamped to what the legs reach, and its feedback flags; dcm_plan: the capture
+point's plan over the steps and the law that tracks it; swing: the swing foot's path.
+"""
+
+from tutorial_atlas_control.exports import lazy_exports
+
+__all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    'dcm_plan': ['DcmPlan', 'tracking_cop'],
+    'footsteps': ['DRCSIM_WALK_QUEUE', 'LEFT', 'QUEUE_LENGTH', 'RIGHT', 'STANCE_WIDTH_M',
+                  'STEP_DURATION_S', 'Footstep', 'circle_steps', 'side_sign', 'straight_steps',
+                  'window', 'wrap_angle'],
+    'step_queue': ['CATCHING', 'ERROR_INCONSISTENT_STEPS', 'OKAY', 'STEPPING', 'SWAYING',
+                   'WARNING_INSUFFICIENT_STEP_DATA', 'StepLimits', 'StepQueue', 'clamp_step'],
+    'swing': ['SWING_HEIGHT_M', 'SwingPath', 'bump', 'quintic'],
+})

@@ -1,0 +1,124 @@
+"""Walk's queue of footsteps: what clients send, merged by index, and what Walk reports.
+
+Clients send WALK commands carrying up to four steps, some on every state message (1 kHz),
+some once. The queue keeps every step by its index, a later copy of an index replacing the
+earlier one (re-sending the same steps changes nothing), and forgets the steps already
+taken. Walk takes step `current_step_index + 1` next and looks ahead to
+`current_step_index + QUEUE_LENGTH`; `next_step_index_needed` is that last index, the
+window a streaming client sends from. A step is clamped to what the legs reach from the
+foot before it (`step_queue_saturated`); two steps in a row with the same foot are
+inconsistent (ERROR_INCONSISTENT_STEPS, latched: Walk returns to Stand).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass, replace
+
+from tutorial_atlas_control.walking.footsteps import (
+    QUEUE_LENGTH,
+    Footstep,
+    side_sign,
+    wrap_angle,
+)
+
+#: walk_feedback.status_flags (ASI.md): one of the first three, plus the warnings.
+OKAY, SWAYING, STEPPING, CATCHING = 0, 1, 2, 4
+WARNING_INSUFFICIENT_STEP_DATA = 8
+ERROR_INCONSISTENT_STEPS = 16
+
+
+@dataclass(frozen=True)
+class StepLimits:
+    """What one step may do, in the frame of the foot it steps from (ours: BDI's library
+    never published its own). Forward and back along that foot's heading (m), the distance
+    across it, on the stepping foot's own side (m), and the turn (rad)."""
+
+    forward_m: float = 0.40
+    back_m: float = 0.20
+    min_width_m: float = 0.16
+    max_width_m: float = 0.40
+    turn_rad: float = 0.40
+
+
+#: The limits Walk uses unless told otherwise.
+DEFAULT_LIMITS = StepLimits()
+
+
+def clamp_step(step: Footstep, stance: Footstep,
+               limits: StepLimits = DEFAULT_LIMITS) -> Footstep:
+    """`step` moved to the nearest pose the legs reach from the stance foot `stance`."""
+    c, s = math.cos(stance.yaw_rad), math.sin(stance.yaw_rad)
+    dx, dy = step.x_m - stance.x_m, step.y_m - stance.y_m
+    ahead, across = c * dx + s * dy, -s * dx + c * dy
+    ahead = min(max(ahead, -limits.back_m), limits.forward_m)
+    # The stepping foot lies on its own side of the stance foot: +y for the left one.
+    width = side_sign(step.foot_index) * across
+    across = side_sign(step.foot_index) * min(max(width, limits.min_width_m), limits.max_width_m)
+    turn = min(max(wrap_angle(step.yaw_rad - stance.yaw_rad), -limits.turn_rad), limits.turn_rad)
+    return replace(step, x_m=stance.x_m + c * ahead - s * across,
+                   y_m=stance.y_m + s * ahead + c * across,
+                   yaw_rad=wrap_angle(stance.yaw_rad + turn))
+
+
+class StepQueue:
+    """The steps Walk knows, from the feet where it began (`start`: index 0 of each foot)."""
+
+    def __init__(self, start_left: Footstep, start_right: Footstep,
+                 limits: StepLimits = DEFAULT_LIMITS) -> None:
+        self.limits = limits
+        self.current_step_index = 0
+        self.inconsistent = False
+        #: The last pose of each foot: where it stands now (left, right).
+        self.feet = [start_left, start_right]
+        self._last_foot: int | None = None
+        self._steps: dict[int, Footstep] = {}
+
+    @property
+    def next_step_index_needed(self) -> int:
+        return self.current_step_index + QUEUE_LENGTH
+
+    def offer(self, steps: Iterable[Footstep]) -> None:
+        """Merge a command's steps; those already taken are ignored."""
+        for step in steps:
+            if step.step_index > self.current_step_index:
+                self._steps[step.step_index] = step
+
+    def preview(self) -> list[Footstep]:
+        """The known steps from the next one on without a gap, up to QUEUE_LENGTH, each
+        clamped from the foot it steps from. Two in a row with the same foot (or the next
+        one with the foot that took the last) end the preview before the second and set
+        `inconsistent`."""
+        feet = list(self.feet)
+        last_foot = self._last_foot
+        planned = []
+        for index in range(self.current_step_index + 1,
+                           self.current_step_index + QUEUE_LENGTH + 1):
+            step = self._steps.get(index)
+            if step is None:
+                break
+            if step.foot_index == last_foot:
+                self.inconsistent = True
+                break
+            clamped = clamp_step(step, feet[1 - step.foot_index], self.limits)
+            planned.append(clamped)
+            feet[step.foot_index] = clamped
+            last_foot = step.foot_index
+        return planned
+
+    def touchdown(self, landed: Footstep) -> None:
+        """Step `current_step_index + 1` is down, where `landed` says."""
+        self.current_step_index += 1
+        self.feet[landed.foot_index] = landed
+        self._last_foot = landed.foot_index
+        self._steps = {k: v for k, v in self._steps.items() if k > self.current_step_index}
+
+    def status_flags(self, phase: int) -> int:
+        """walk_feedback.status_flags for the walk's `phase` (SWAYING, STEPPING, CATCHING)."""
+        flags = phase
+        if len(self.preview()) < QUEUE_LENGTH:
+            flags |= WARNING_INSUFFICIENT_STEP_DATA
+        if self.inconsistent:
+            flags |= ERROR_INCONSISTENT_STEPS
+        return flags

@@ -1,0 +1,242 @@
+"""Walk: dynamic walking over the step queue, on the Stand's whole-body balance.
+
+A walk is a row of phases: a sway (both feet down, the capture point moved over towards
+the first stance foot), then one single-support phase per step (the stance foot carries
+the whole wrench, the other foot swings to its target along swing.SwingPath), then a
+catch (both feet down, the capture point brought to rest between them), after which
+Stand takes over. At each touchdown the capture point's plan (dcm_plan) is made again
+over the steps the queue then holds, so a streaming client's new steps enter it as
+they come.
+
+Each 1 ms step: the pressure centre p = p_ref + (1 + k)(xi - xi_ref) is kept inside the
+support polygon (the stance sole alone while a foot swings), the Stand's centroidal
+wrench and contact split turn it into torques by inverse statics, and the swing foot's
+task-space PD force, mapped through its Jacobian, moves the swing leg; the legs' posture
+PD of Stand is off (in single support the stance leg's joints follow from the pelvis
+and the foot, the swing leg's from its task).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from tutorial_atlas_control.balance import (
+    BalanceState,
+    StandController,
+    clamp_into,
+    convex_hull,
+    make_feasible,
+    orientation_error,
+    split_wrench,
+    yaw_rotation,
+)
+from tutorial_atlas_control.walking.dcm_plan import DcmPlan, tracking_cop
+from tutorial_atlas_control.walking.footsteps import Footstep
+from tutorial_atlas_control.walking.step_queue import (
+    CATCHING,
+    STEPPING,
+    SWAYING,
+    StepQueue,
+)
+from tutorial_atlas_control.walking.swing import SwingPath
+
+#: The leg joints (tutorial order): their Stand posture PD is off while walking.
+LEG_JOINTS = slice(4, 16)
+
+
+@dataclass(frozen=True)
+class WalkGains:
+    """The walk's numbers (ours)."""
+
+    #: k of p = p_ref + (1 + k)(xi - xi_ref): the capture point's error decays at omega k.
+    dcm_gain: float = 1.5
+    #: How long the first sway and the last catch take (s).
+    sway_s: float = 0.6
+    catch_s: float = 0.6
+    #: The swing foot's task-space PD: position (N/m, N s/m), orientation (N m/rad, N m s/rad).
+    swing_kp: float = 2500.0
+    swing_kd: float = 80.0
+    swing_rotation_kp: float = 200.0
+    swing_rotation_kd: float = 10.0
+    #: Damping on the leg joints (N m s/rad) in place of Stand's posture PD.
+    leg_kd: float = 2.0
+
+
+@dataclass(frozen=True)
+class WalkOutput:
+    """One step's decision, for feedback and tests."""
+
+    torque_nm: np.ndarray         # (28,)
+    desired_cop: np.ndarray       # (2,)
+    capture_point_ref: np.ndarray  # (2,)
+    phase: int                    # SWAYING, STEPPING or CATCHING
+    swing_foot: int | None
+
+
+def foot_pose(state: BalanceState, foot: int, step_index: int = 0) -> Footstep:
+    """Where a foot is now, as a step (sole centre and heading)."""
+    rotation = state.sole_rotations[foot]
+    centre = state.sole_centres[foot]
+    return Footstep(step_index, foot, float(centre[0]), float(centre[1]),
+                    math.atan2(rotation[1, 0], rotation[0, 0]))
+
+
+def sway_cop(xi_now: np.ndarray, xi_target: np.ndarray, omega: float,
+             duration_s: float) -> np.ndarray:
+    """The constant pressure centre that takes the capture point from `xi_now` to
+    `xi_target` in `duration_s` (xi(T) = p + (xi0 - p) exp(omega T), solved for p)."""
+    growth = math.exp(omega * duration_s)
+    return (np.asarray(xi_target) - growth * np.asarray(xi_now)) / (1.0 - growth)
+
+
+class WalkController:
+    """Walks the queue's steps from a standing start; `done` once it stands again."""
+
+    def __init__(self, stand: StandController, queue: StepQueue, state: BalanceState,
+                 time_s: float, gains: WalkGains | None = None) -> None:
+        self.stand = stand
+        self.queue = queue
+        self.gains = gains or WalkGains()
+        self.phase = SWAYING
+        self.done = False
+        self.phase_start_s = time_s
+        #: The step being taken (None while swaying or catching) and its swing path.
+        self.step: Footstep | None = None
+        self.swing: SwingPath | None = None
+        self._plan: DcmPlan | None = None
+        self._sway_cop = np.zeros(2)
+        self._begin_sway(state, time_s)
+
+    # -- the phases ---------------------------------------------------------------------------
+
+    def _plan_steps(self, state: BalanceState) -> DcmPlan | None:
+        """The capture point's plan over the queue's preview, from the feet as they are."""
+        preview = self.queue.preview()
+        if not preview:
+            return None
+        feet = [self.queue.feet[0], self.queue.feet[1]]
+        cops, durations = [], []
+        for step in preview:
+            stance = feet[1 - step.foot_index]
+            cops.append((stance.x_m, stance.y_m))
+            durations.append(step.duration_s)
+            feet[step.foot_index] = step
+        final = 0.5 * np.array([feet[0].x_m + feet[1].x_m, feet[0].y_m + feet[1].y_m])
+        return DcmPlan.plan(np.array(cops), np.array(durations), final, state.omega)
+
+    def _begin_sway(self, state: BalanceState, time_s: float) -> None:
+        self.phase, self.phase_start_s = SWAYING, time_s
+        self._plan = self._plan_steps(state)
+        target = (self._plan.start if self._plan is not None
+                  else state.sole_centres[:, :2].mean(axis=0))
+        self._sway_cop = sway_cop(state.capture_point, target, state.omega, self.gains.sway_s)
+        self._sway_from = state.capture_point.copy()
+        self._sway_target = target
+
+    def _begin_step(self, state: BalanceState, time_s: float) -> None:
+        self._plan = self._plan_steps(state)
+        preview = self.queue.preview()
+        if self._plan is None or not preview:
+            self._begin_catch(state, time_s)
+            return
+        step = preview[0]
+        lift = state.sole_centres[step.foot_index]
+        self.step = step
+        self.swing = SwingPath(lift.copy(), np.array([step.x_m, step.y_m, 0.0]),
+                               foot_pose(state, step.foot_index).yaw_rad, step.yaw_rad,
+                               step.duration_s)
+        self.phase, self.phase_start_s = STEPPING, time_s
+
+    def _begin_catch(self, state: BalanceState, time_s: float) -> None:
+        self.step, self.swing, self._plan = None, None, None
+        self.phase, self.phase_start_s = CATCHING, time_s
+
+    def _advance(self, state: BalanceState, time_s: float) -> None:
+        """Move on to the next phase when this one's time is up."""
+        elapsed = time_s - self.phase_start_s
+        if self.phase == SWAYING and elapsed >= self.gains.sway_s:
+            self._begin_step(state, time_s)
+        elif self.phase == STEPPING and self.step is not None \
+                and elapsed >= self.step.duration_s:
+            self.queue.touchdown(foot_pose(state, self.step.foot_index, self.step.step_index))
+            self._begin_step(state, time_s)
+        elif self.phase == CATCHING and elapsed >= self.gains.catch_s:
+            self.done = True
+
+    # -- the references -----------------------------------------------------------------------
+
+    def _capture_reference(self, state: BalanceState,
+                           time_s: float) -> tuple[np.ndarray, np.ndarray]:
+        """(xi_ref, p_ref) now."""
+        elapsed = time_s - self.phase_start_s
+        if self.phase == SWAYING:
+            growth = math.exp(state.omega * min(elapsed, self.gains.sway_s))
+            xi = self._sway_cop + (self._sway_from - self._sway_cop) * growth
+            return xi, self._sway_cop
+        if self.phase == STEPPING and self._plan is not None:
+            return self._plan.reference(0, elapsed)
+        middle = state.sole_centres[:, :2].mean(axis=0)
+        return middle, middle
+
+    def _swing_torque(self, state: BalanceState, time_s: float) -> np.ndarray:
+        """The swing leg's torques (28,) from its foot's task-space PD."""
+        assert self.swing is not None and self.step is not None
+        foot = self.step.foot_index
+        gains = self.gains
+        position, velocity, yaw, yaw_rate = self.swing.at(time_s - self.phase_start_s)
+        twist = state.sole_velocities[foot]
+        force = (gains.swing_kp * (position - state.sole_centres[foot])
+                 + gains.swing_kd * (velocity - twist[0:3]))
+        moment = (gains.swing_rotation_kp
+                  * orientation_error(state.sole_rotations[foot], yaw_rotation(yaw))
+                  + gains.swing_rotation_kd * (np.array([0.0, 0.0, yaw_rate]) - twist[3:6]))
+        return state.sole_jacobians[foot].T @ np.concatenate([force, moment])
+
+    # -- one step -----------------------------------------------------------------------------
+
+    def step_torque(self, state: BalanceState, joint_positions: np.ndarray,
+                    joint_velocities: np.ndarray, time_s: float) -> WalkOutput:
+        """The 28 joint torques (N m) for this 1 ms step, within the effort limits."""
+        self._advance(state, time_s)
+        stand, gains = self.stand, self.gains
+        xi_ref, cop_ref = self._capture_reference(state, time_s)
+        cop = tracking_cop(state.capture_point, xi_ref, cop_ref, gains.dcm_gain)
+        swinging = self.phase == STEPPING and self.step is not None
+        contact = ((self.step.foot_index != 0, self.step.foot_index != 1)  # type: ignore[union-attr]
+                   if swinging else (True, True))
+        stance = [foot for foot in (0, 1) if contact[foot]]
+        corners = np.concatenate([_sole_corners(state, foot, stand.sole_half_size_m)
+                                  for foot in stance])
+        cop = clamp_into(convex_hull(corners), cop, stand.gains.cop_margin_m)
+        force, moment = stand.centroidal_wrench(state, cop)
+        wrenches = split_wrench(force, moment, state.sole_centres, state.com,
+                                               contact)
+        half_length, half_width = stand.sole_half_size_m
+        for foot in stance:
+            wrenches[foot] = make_feasible(
+                wrenches[foot], state.sole_rotations[foot], half_length, half_width)
+        torque = state.bias_nm - state.sole_jacobians.reshape(12, -1).T @ wrenches.reshape(12)
+        joint_kp = stand.gains.joint_kp.copy()
+        joint_kd = stand.gains.joint_kd.copy()
+        joint_kp[LEG_JOINTS] = 0.0
+        joint_kd[LEG_JOINTS] = gains.leg_kd
+        torque += (joint_kp * (stand.reference.posture_rad - joint_positions)
+                   - joint_kd * joint_velocities)
+        if swinging:
+            torque += self._swing_torque(state, time_s)
+        np.clip(torque, -stand.effort_limit_nm, stand.effort_limit_nm, out=torque)
+        return WalkOutput(torque, cop, xi_ref, self.phase,
+                          self.step.foot_index if swinging else None)  # type: ignore[union-attr]
+
+
+def _sole_corners(state: BalanceState, foot: int,
+                  half_size_m: tuple[float, float]) -> np.ndarray:
+    """The four corners (4, 2) of a sole's bottom face, world x, y."""
+    half_length, half_width = half_size_m
+    offsets = np.array([[half_length, half_width], [half_length, -half_width],
+                        [-half_length, -half_width], [-half_length, half_width]])
+    rotation = state.sole_rotations[foot][0:2, 0:2]
+    return state.sole_centres[foot][0:2] + offsets @ rotation.T

@@ -1,0 +1,109 @@
+"""Walk's queue: merging by index, re-requests, clamping, the feedback flags."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import pytest
+
+from tutorial_atlas_control.walking.footsteps import (
+    DRCSIM_WALK_QUEUE,
+    LEFT,
+    RIGHT,
+    Footstep,
+    straight_steps,
+    window,
+)
+from tutorial_atlas_control.walking.step_queue import (
+    ERROR_INCONSISTENT_STEPS,
+    STEPPING,
+    SWAYING,
+    WARNING_INSUFFICIENT_STEP_DATA,
+    StepLimits,
+    StepQueue,
+    clamp_step,
+)
+
+START_LEFT = Footstep(0, LEFT, 0.0, 0.12, 0.0)
+START_RIGHT = Footstep(0, RIGHT, 0.0, -0.12, 0.0)
+
+
+def new_queue() -> StepQueue:
+    return StepQueue(START_LEFT, START_RIGHT)
+
+
+def test_re_sending_the_same_window_changes_nothing() -> None:
+    queue = new_queue()
+    queue.offer(DRCSIM_WALK_QUEUE)
+    first = queue.preview()
+    for _ in range(1000):
+        queue.offer(DRCSIM_WALK_QUEUE)
+    assert queue.preview() == first == list(DRCSIM_WALK_QUEUE)
+    assert queue.status_flags(SWAYING) == SWAYING
+
+
+def test_a_streaming_client_keeps_the_queue_full_to_the_end() -> None:
+    plan = straight_steps(10, 0.25)
+    queue = new_queue()
+    taken = []
+    while queue.current_step_index < len(plan):
+        queue.offer(window(plan, queue.next_step_index_needed - 3))
+        preview = queue.preview()
+        remaining = len(plan) - queue.current_step_index
+        assert len(preview) == min(4, remaining)
+        flags = queue.status_flags(STEPPING)
+        assert bool(flags & WARNING_INSUFFICIENT_STEP_DATA) == (remaining < 4)
+        queue.touchdown(preview[0])
+        taken.append(preview[0])
+    assert taken == plan
+    assert queue.next_step_index_needed == 14
+
+
+def test_a_one_shot_queue_runs_out_and_says_so() -> None:
+    queue = new_queue()
+    queue.offer(DRCSIM_WALK_QUEUE)
+    queue.touchdown(queue.preview()[0])
+    assert [s.step_index for s in queue.preview()] == [2, 3, 4]
+    assert queue.status_flags(STEPPING) == STEPPING | WARNING_INSUFFICIENT_STEP_DATA
+    for _ in range(3):
+        queue.touchdown(queue.preview()[0])
+    assert queue.preview() == []
+
+
+def test_a_later_copy_of_an_index_replaces_it_and_taken_steps_are_ignored() -> None:
+    queue = new_queue()
+    queue.offer(DRCSIM_WALK_QUEUE)
+    queue.touchdown(DRCSIM_WALK_QUEUE[0])
+    moved = replace(DRCSIM_WALK_QUEUE[1], x_m=0.35)
+    queue.offer([replace(DRCSIM_WALK_QUEUE[0], x_m=9.0), moved])
+    assert queue.preview()[0] == moved
+
+
+def test_two_steps_with_the_same_foot_are_inconsistent_and_latched() -> None:
+    queue = new_queue()
+    queue.offer([DRCSIM_WALK_QUEUE[0], replace(DRCSIM_WALK_QUEUE[1], foot_index=LEFT)])
+    assert len(queue.preview()) == 1
+    assert queue.status_flags(SWAYING) & ERROR_INCONSISTENT_STEPS
+    queue.offer(DRCSIM_WALK_QUEUE)
+    assert queue.status_flags(SWAYING) & ERROR_INCONSISTENT_STEPS
+
+
+@pytest.mark.parametrize('target, expected', [
+    ((1.0, 0.2, 0.0), (0.40, 0.2, 0.0)),      # too far ahead: the stride limit
+    ((-0.5, 0.2, 0.0), (-0.20, 0.2, 0.0)),    # too far back
+    ((0.1, 0.02, 0.0), (0.1, 0.16, 0.0)),     # too narrow: the minimum width
+    ((0.1, -0.3, 0.0), (0.1, 0.16, 0.0)),     # across the stance foot: back to its side
+    ((0.1, 0.2, 1.0), (0.1, 0.2, 0.40)),      # too sharp a turn
+])
+def test_clamp_step_in_the_stance_foots_frame(target: tuple, expected: tuple) -> None:
+    stance = Footstep(0, RIGHT, 0.0, 0.0, 0.0)
+    step = clamp_step(Footstep(1, LEFT, *target), stance, StepLimits())
+    assert (step.x_m, step.y_m, step.yaw_rad) == pytest.approx(expected)
+
+
+def test_clamp_step_turns_with_the_stance_foot() -> None:
+    stance = Footstep(0, RIGHT, 1.0, 1.0, math.pi / 2)
+    # 1 m ahead along the stance foot's heading (+y) is clamped to 0.4 m; left is -x.
+    step = clamp_step(Footstep(1, LEFT, 0.8, 2.0, math.pi / 2), stance)
+    assert (step.x_m, step.y_m, step.yaw_rad) == pytest.approx((0.8, 1.4, math.pi / 2))
