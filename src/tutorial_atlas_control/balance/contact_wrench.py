@@ -80,9 +80,12 @@ def split_wrench(force_n: np.ndarray, moment_nm: np.ndarray, sole_centres: np.nd
 
 
 def make_feasible(wrench: np.ndarray, sole_rotation: np.ndarray,
-                  half_length_m: float, half_width_m: float) -> np.ndarray:
+                  half_length_m: float, half_width_m: float,
+                  torsion_m: float | None = None) -> np.ndarray:
     """`wrench` [f, m] (world) with f_z >= 0 and its pressure centre kept inside a sole of
-    half sizes (half_length_m, half_width_m) (along the sole's x and y)."""
+    half sizes (half_length_m, half_width_m) (along the sole's x and y); with `torsion_m`,
+    its moment about the sole's normal within torsion_m * f_z too (MuJoCo's torsional
+    friction: more turns the foot on the ground)."""
     fx, fy, fz, mx, my, mz = wrench.tolist()
     fz = max(fz, 0.0)
     (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = sole_rotation.tolist()
@@ -92,5 +95,7 @@ def make_feasible(wrench: np.ndarray, sole_rotation: np.ndarray,
     lz = r02 * mx + r12 * my + r22 * mz
     lx = min(max(lx, -fz * half_width_m), fz * half_width_m)
     ly = min(max(ly, -fz * half_length_m), fz * half_length_m)
+    if torsion_m is not None:
+        lz = min(max(lz, -fz * torsion_m), fz * torsion_m)
     return np.array([fx, fy, fz, r00 * lx + r01 * ly + r02 * lz,
                      r10 * lx + r11 * ly + r12 * lz, r20 * lx + r21 * ly + r22 * lz])

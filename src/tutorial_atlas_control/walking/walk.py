@@ -19,7 +19,7 @@ and the foot, the swing leg's from its task).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -34,7 +34,7 @@ from tutorial_atlas_control.balance import (
     yaw_rotation,
 )
 from tutorial_atlas_control.walking.dcm_plan import DcmPlan, tracking_cop
-from tutorial_atlas_control.walking.footsteps import Footstep
+from tutorial_atlas_control.walking.footsteps import Footstep, wrap_angle
 from tutorial_atlas_control.walking.step_queue import (
     CATCHING,
     STEPPING,
@@ -56,13 +56,32 @@ class WalkGains:
     #: How long the first sway and the last catch take (s).
     sway_s: float = 0.6
     catch_s: float = 0.6
+    #: The catch ends once the capture point is this near the feet's midpoint (m), or
+    #: after longest_catch_s (s).
+    at_rest_m: float = 0.01
+    longest_catch_s: float = 3.0
     #: The swing foot's task-space PD: position (N/m, N s/m), orientation (N m/rad, N m s/rad).
-    swing_kp: float = 2500.0
-    swing_kd: float = 80.0
-    swing_rotation_kp: float = 200.0
-    swing_rotation_kd: float = 10.0
+    #: At 2500 N/m and 200 N m/rad the first swing foot lagged its path by 3 cm and landed
+    #: late; these walk DRCSim's queue and 20 straight steps.
+    swing_kp: float = 6000.0
+    swing_kd: float = 150.0
+    swing_rotation_kp: float = 600.0
+    swing_rotation_kd: float = 30.0
     #: Damping on the leg joints (N m s/rad) in place of Stand's posture PD.
     leg_kd: float = 2.0
+    #: A swing foot not down when its step's time is up keeps going down at this speed
+    #: (m/s), for at most late_touchdown_s (s), before the next step begins anyway.
+    touchdown_speed_m_s: float = 0.2
+    late_touchdown_s: float = 0.4
+    #: The yaw moment a stance sole may take, per newton it bears (m): the model's
+    #: torsional friction is 0.02 m (sim/atlas_v1.xml); beyond it the foot turns.
+    torsion_m: float = 0.015
+    #: A foot put back down aims this far below the ground (m), so that it lands.
+    press_m: float = 0.005
+    #: A sole is flat on the ground with its centre below flat_height_m (m) and its normal
+    #: within acos(flat_cos) of vertical (0.05 rad).
+    flat_height_m: float = 0.005
+    flat_cos: float = 0.99875
 
 
 @dataclass(frozen=True)
@@ -145,14 +164,22 @@ class WalkController:
         step = preview[0]
         lift = state.sole_centres[step.foot_index]
         self.step = step
+        stance = self.queue.feet[1 - step.foot_index]
+        self._face(stance.yaw_rad, step.yaw_rad)
         self.swing = SwingPath(lift.copy(), np.array([step.x_m, step.y_m, 0.0]),
                                foot_pose(state, step.foot_index).yaw_rad, step.yaw_rad,
                                step.duration_s)
         self.phase, self.phase_start_s = STEPPING, time_s
 
     def _begin_catch(self, state: BalanceState, time_s: float) -> None:
+        self._face(self.queue.feet[0].yaw_rad, self.queue.feet[1].yaw_rad)
         self.step, self.swing, self._plan = None, None, None
         self.phase, self.phase_start_s = CATCHING, time_s
+
+    def _face(self, first_yaw_rad: float, second_yaw_rad: float) -> None:
+        """Hold the pelvis upright, facing halfway between two feet's headings."""
+        yaw = first_yaw_rad + 0.5 * wrap_angle(second_yaw_rad - first_yaw_rad)
+        self.stand.reference = replace(self.stand.reference, pelvis_rotation=yaw_rotation(yaw))
 
     def _advance(self, state: BalanceState, time_s: float) -> None:
         """Move on to the next phase when this one's time is up."""
@@ -160,10 +187,14 @@ class WalkController:
         if self.phase == SWAYING and elapsed >= self.gains.sway_s:
             self._begin_step(state, time_s)
         elif self.phase == STEPPING and self.step is not None \
-                and elapsed >= self.step.duration_s:
+                and elapsed >= self.step.duration_s \
+                and (state.in_contact[self.step.foot_index]
+                     or elapsed >= self.step.duration_s + self.gains.late_touchdown_s):
             self.queue.touchdown(foot_pose(state, self.step.foot_index, self.step.step_index))
             self._begin_step(state, time_s)
-        elif self.phase == CATCHING and elapsed >= self.gains.catch_s:
+        elif self.phase == CATCHING and elapsed >= self.gains.catch_s and (
+                np.linalg.norm(state.capture_point - state.sole_centres[:, :2].mean(axis=0))
+                < self.gains.at_rest_m or elapsed >= self.gains.longest_catch_s):
             self.done = True
 
     # -- the references -----------------------------------------------------------------------
@@ -186,7 +217,18 @@ class WalkController:
         assert self.swing is not None and self.step is not None
         foot = self.step.foot_index
         gains = self.gains
-        position, velocity, yaw, yaw_rate = self.swing.at(time_s - self.phase_start_s)
+        elapsed = time_s - self.phase_start_s
+        position, velocity, yaw, yaw_rate = self.swing.at(elapsed)
+        late = elapsed - self.swing.duration_s
+        if late > 0.0:  # not down yet: on down
+            position[2] -= gains.touchdown_speed_m_s * late
+            velocity[2] = -gains.touchdown_speed_m_s
+        return self._foot_pd(state, foot, position, velocity, yaw, yaw_rate)
+
+    def _foot_pd(self, state: BalanceState, foot: int, position: np.ndarray,
+                 velocity: np.ndarray, yaw: float, yaw_rate: float) -> np.ndarray:
+        """The leg's torques (28,) moving a sole towards a pose (task-space PD)."""
+        gains = self.gains
         twist = state.sole_velocities[foot]
         force = (gains.swing_kp * (position - state.sole_centres[foot])
                  + gains.swing_kd * (velocity - twist[0:3]))
@@ -194,6 +236,17 @@ class WalkController:
                   * orientation_error(state.sole_rotations[foot], yaw_rotation(yaw))
                   + gains.swing_rotation_kd * (np.array([0.0, 0.0, yaw_rate]) - twist[3:6]))
         return state.sole_jacobians[foot].T @ np.concatenate([force, moment])
+
+    def _flat_down(self, state: BalanceState, foot: int) -> bool:
+        """Whether a sole lies flat on the ground (not up, not on an edge)."""
+        return (float(state.sole_centres[foot][2]) < self.gains.flat_height_m
+                and float(state.sole_rotations[foot][2, 2]) > self.gains.flat_cos)
+
+    def _put_down_torque(self, state: BalanceState, foot: int) -> np.ndarray:
+        """A foot off the ground while both should be down: back onto its last pose."""
+        pose = self.queue.feet[foot]
+        target = np.array([pose.x_m, pose.y_m, -self.gains.press_m])
+        return self._foot_pd(state, foot, target, np.zeros(3), pose.yaw_rad, 0.0)
 
     # -- one step -----------------------------------------------------------------------------
 
@@ -205,8 +258,10 @@ class WalkController:
         xi_ref, cop_ref = self._capture_reference(state, time_s)
         cop = tracking_cop(state.capture_point, xi_ref, cop_ref, gains.dcm_gain)
         swinging = self.phase == STEPPING and self.step is not None
-        contact = ((self.step.foot_index != 0, self.step.foot_index != 1)  # type: ignore[union-attr]
-                   if swinging else (True, True))
+        if swinging:
+            contact = (self.step.foot_index != 0, self.step.foot_index != 1)  # type: ignore[union-attr]
+        else:  # swaying or catching: the feet that are down (both, unless a landing is late)
+            contact = state.in_contact if any(state.in_contact) else (True, True)
         stance = [foot for foot in (0, 1) if contact[foot]]
         corners = np.concatenate([_sole_corners(state, foot, stand.sole_half_size_m)
                                   for foot in stance])
@@ -217,7 +272,8 @@ class WalkController:
         half_length, half_width = stand.sole_half_size_m
         for foot in stance:
             wrenches[foot] = make_feasible(
-                wrenches[foot], state.sole_rotations[foot], half_length, half_width)
+                wrenches[foot], state.sole_rotations[foot], half_length, half_width,
+                gains.torsion_m if swinging else None)
         torque = state.bias_nm - state.sole_jacobians.reshape(12, -1).T @ wrenches.reshape(12)
         joint_kp = stand.gains.joint_kp.copy()
         joint_kd = stand.gains.joint_kd.copy()
@@ -227,6 +283,10 @@ class WalkController:
                    - joint_kd * joint_velocities)
         if swinging:
             torque += self._swing_torque(state, time_s)
+        else:
+            for foot in (0, 1):
+                if not contact[foot] or not self._flat_down(state, foot):
+                    torque += self._put_down_torque(state, foot)
         np.clip(torque, -stand.effort_limit_nm, stand.effort_limit_nm, out=torque)
         return WalkOutput(torque, cop, xi_ref, self.phase,
                           self.step.foot_index if swinging else None)  # type: ignore[union-attr]

@@ -1,0 +1,153 @@
+"""Offline walking trials: the robot placed standing, Stand for a moment, then a plan of
+footsteps walked, then Stand again; what happened, step by step.
+
+The figures the tests and the bench judge: whether it fell (pelvis below
+STANDING_PELVIS_M), how many steps it took, where each foot came down against its
+target, the lowest pelvis, where the pelvis ended, and the controller's CPU per step.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import mujoco
+import numpy as np
+
+from tutorial_atlas_control.balance import BalanceState, StandBehaviour, place_in_stand_pose
+from tutorial_atlas_control.sim import (
+    DEFAULT_GAINS_FILE,
+    AtlasModel,
+    AtlasSimulator,
+    load_gains_yaml,
+    load_model,
+    pelvis_height_m,
+)
+from tutorial_atlas_control.walking.footsteps import Footstep, wrap_angle
+from tutorial_atlas_control.walking.step_queue import StepQueue
+from tutorial_atlas_control.walking.walk import WalkController, WalkGains, foot_pose
+
+#: Standing means the pelvis above this (m); Stand holds it at about 0.91 m.
+STANDING_PELVIS_M = 0.8
+#: Stand before the walk begins (s).
+SETTLE_S = 1.0
+
+
+@dataclass(frozen=True)
+class Landing:
+    """Where a step came down against where it was sent (m, rad)."""
+
+    step_index: int
+    foot_index: int
+    error_m: float
+    yaw_error_rad: float
+
+
+@dataclass
+class WalkTrial:
+    """What a walking trial did."""
+
+    fell: bool = False
+    steps: int = 0
+    landings: list[Landing] = field(default_factory=list)
+    lowest_pelvis_m: float = math.inf
+    pelvis_end: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    walk_ended_s: float | None = None
+    controller_cpu_s: float = 0.0
+    control_steps: int = 0
+
+    @property
+    def worst_landing_m(self) -> float:
+        return max((landing.error_m for landing in self.landings), default=0.0)
+
+    @property
+    def cost_per_step_us(self) -> float:
+        return self.controller_cpu_s / max(self.control_steps, 1) * 1e6
+
+
+class WalkingStand:
+    """Stand, then the plan walked from `walk_at_s`, then Stand where the walk ended; the
+    simulator's Stand behaviour for a trial."""
+
+    def __init__(self, atlas: AtlasModel, plan: Sequence[Footstep], walk_at_s: float,
+                 gains: WalkGains | None = None) -> None:
+        self.stand = StandBehaviour(atlas)
+        self.plan = list(plan)
+        self.walk_at_s = walk_at_s
+        self.gains = gains
+        self.walk: WalkController | None = None
+        self.trial = WalkTrial()
+        self._stood_again = False
+
+    def start(self, data: mujoco.MjData) -> None:
+        self.stand.start(data)
+
+    def torque(self, data: mujoco.MjData) -> np.ndarray:
+        started = time.process_time()
+        try:
+            return self._torque(data)
+        finally:
+            self.trial.controller_cpu_s += time.process_time() - started
+            self.trial.control_steps += 1
+
+    def _torque(self, data: mujoco.MjData) -> np.ndarray:
+        time_s = float(data.time)
+        stand = self.stand
+        if self.walk is None and time_s >= self.walk_at_s:
+            state = stand.last_state
+            assert state is not None and stand.controller is not None
+            queue = StepQueue(foot_pose(state, 0), foot_pose(state, 1))
+            queue.offer(self.plan)
+            self.walk = WalkController(stand.controller, queue, state, time_s, self.gains)
+        walk = self.walk
+        if walk is None or self._stood_again:
+            return stand.torque(data)
+        if walk.done:
+            self.trial.walk_ended_s = time_s
+            self._stood_again = True
+            stand.start(data)
+            return stand.torque(data)
+        atlas = stand.atlas
+        state = stand.estimator.estimate(data.qpos, data.qvel)
+        taken = walk.queue.current_step_index
+        output = walk.step_torque(state, data.qpos[atlas.qpos_adr], data.qvel[atlas.dof_adr],
+                                  time_s)
+        stand.last_state = state
+        if walk.queue.current_step_index > taken:
+            self._landed(walk, state)
+        return output.torque_nm
+
+    def _landed(self, walk: WalkController, state: BalanceState) -> None:
+        """Note the step just down against its target."""
+        index = walk.queue.current_step_index
+        target = next((s for s in self.plan if s.step_index == index), None)
+        if target is None:
+            return
+        down = foot_pose(state, target.foot_index)
+        self.trial.steps = index
+        self.trial.landings.append(Landing(
+            index, target.foot_index, math.hypot(down.x_m - target.x_m, down.y_m - target.y_m),
+            abs(wrap_angle(down.yaw_rad - target.yaw_rad))))
+
+
+def walk_trial(plan: Sequence[Footstep], duration_s: float,
+               gains: WalkGains | None = None) -> WalkTrial:
+    """Place the robot in the Stand pose, stand SETTLE_S, walk `plan`, stand; run for
+    `duration_s` (s) of sim time or until it falls."""
+    atlas = load_model()
+    sim = AtlasSimulator(atlas, load_gains_yaml(DEFAULT_GAINS_FILE), time_to_unpin_s=0.0)
+    place_in_stand_pose(sim.atlas, sim.data)
+    behaviour = WalkingStand(sim.atlas, plan, SETTLE_S, gains)
+    sim.install_stand(behaviour)
+    trial = behaviour.trial
+    for _ in range(round(duration_s / sim.dt_s)):
+        sim.step()
+        height = pelvis_height_m(sim.atlas, sim.data)
+        trial.lowest_pelvis_m = min(trial.lowest_pelvis_m, height)
+        if height < STANDING_PELVIS_M:
+            trial.fell = True
+            break
+    trial.pelvis_end = sim.data.xpos[sim.atlas.pelvis_body_id].copy()
+    return trial
