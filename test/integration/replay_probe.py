@@ -36,6 +36,8 @@ from tutorial_atlas_control import processes
 PLAYED_TOPICS = ('/atlas/control_mode', '/atlas/joint_commands')
 #: rosbag play's node name: `play` made anonymous (`/play_<stamp>`), whatever __name says.
 PLAYER_PREFIX = '/play_'
+#: rosbag play's outgoing queue per topic (messages): more than a tutorial bag holds.
+PLAYER_QUEUE = 10000
 #: Wall s to wait, once rosbag play has ended, for its last commands to be read here.
 ARRIVAL_TIMEOUT_S = 30.0
 
@@ -51,8 +53,10 @@ class Probe:
         self.command_arrivals_s: list[float] = []
         rospy.Subscriber('/clock', Clock, self._on_clock, queue_size=10)
         rospy.Subscriber('/ground_truth_odom', Odometry, self._on_odom, queue_size=10)
+        # Unbounded: with 100, a probe starved on a loaded host (its /clock and odometry
+        # callbacks at 1 kHz each) dropped played commands from its own queue.
         rospy.Subscriber('/atlas/joint_commands', JointCommands, self._on_command,
-                         queue_size=100)
+                         queue_size=None)
 
     def _on_clock(self, msg: Clock) -> None:
         with self.lock:
@@ -107,7 +111,10 @@ def play(bag: str, timeout_s: float) -> subprocess.CompletedProcess:
     Raises TimeoutError if the player is not connected, or has not ended, within `timeout_s`.
     """
     player = subprocess.Popen(
-        ['rosbag', 'play', '--quiet', '--pause', bag, '--topics', *PLAYED_TOPICS],
+        # --queue beyond the bag's commands: a slow reader backs the player up, never
+        # makes it drop (its default queue is 100).
+        ['rosbag', 'play', '--quiet', '--pause', f'--queue={PLAYER_QUEUE}', bag,
+         '--topics', *PLAYED_TOPICS],
         stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
         def player_ended() -> None:
