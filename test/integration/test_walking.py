@@ -4,7 +4,8 @@ of footsteps (walking/walk.py on the Stand's whole-body balance), then stands ag
 DRCSim's fixed `control_mode Walk` queue (four steps of 0.2 m) and then 10 s of Stand; 20
 straight steps of 0.25 m at 0.63 s each (about 0.4 m/s). The issue's bounds: every landing
 within 5 cm and 0.1 rad of its target, no fall, the pelvis at least 4 m ahead after the
-straight walk; and the exact figures of these runs. The planted defect: without the limit
+straight walk; and the exact figures of these runs. A client streaming its window every
+step walks the same walk as one sending the plan once. The planted defect: without the limit
 on the yaw moment a stance sole can take (its torsional friction) the stance foot turns
 and the straight walk falls at its fifth step. About 13 s of CPU in all.
 """
@@ -58,6 +59,17 @@ def test_twenty_straight_steps_of_a_quarter_metre() -> None:
     assert round(trial.worst_landing_m, 3) == 0.036
     assert round(trial.lowest_pelvis_m, 3) == 0.898
     assert round(float(trial.pelvis_end[0]), 2) == 4.76
+
+
+def test_a_client_streaming_its_window_every_step_walks_the_same_walk() -> None:
+    """The window [next_step_index_needed, +3] sent at 1 kHz: the same landings and the
+    same end, to the bit, as the plan sent once (re-requests change nothing)."""
+    plan = straight_steps(6, STRIDE_M)
+    once = walk_trial(plan, 7.0)
+    streamed = walk_trial(plan, 7.0, streaming=True)
+    assert not once.fell and once.steps == 6
+    assert streamed.landings == once.landings
+    assert streamed.pelvis_end.tolist() == once.pelvis_end.tolist()
 
 
 def test_without_the_torsion_limit_the_stance_foot_turns_and_it_falls() -> None:

@@ -4,10 +4,11 @@ Clients send WALK commands carrying up to four steps, some on every state messag
 some once. The queue keeps every step by its index, a later copy of an index replacing the
 earlier one (re-sending the same steps changes nothing), and forgets the steps already
 taken. Walk takes step `current_step_index + 1` next and looks ahead to
-`current_step_index + QUEUE_LENGTH`; `next_step_index_needed` is that last index, the
-window a streaming client sends from. A step is clamped to what the legs reach from the
-foot before it (`step_queue_saturated`); two steps in a row with the same foot are
-inconsistent (ERROR_INCONSISTENT_STEPS, latched: Walk returns to Stand).
+`current_step_index + QUEUE_LENGTH`; `next_step_index_needed`, the window a streaming
+client sends from, is the first step of those not known (that last one once all are).
+A step is clamped to what the legs reach from the foot before it (`step_queue_saturated`);
+two steps in a row with the same foot are inconsistent (ERROR_INCONSISTENT_STEPS,
+latched: Walk returns to Stand).
 """
 
 from __future__ import annotations
@@ -77,7 +78,13 @@ class StepQueue:
 
     @property
     def next_step_index_needed(self) -> int:
-        return self.current_step_index + QUEUE_LENGTH
+        """The first step not known after the current one, at most QUEUE_LENGTH ahead:
+        1 before anything is sent, current_step_index + QUEUE_LENGTH while a client keeps
+        the queue full. A streaming client sends the window from it."""
+        index = self.current_step_index + 1
+        while index in self._steps and index < self.current_step_index + QUEUE_LENGTH:
+            index += 1
+        return index
 
     def offer(self, steps: Iterable[Footstep]) -> None:
         """Merge a command's steps; those already taken are ignored."""

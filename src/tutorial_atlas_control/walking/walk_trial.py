@@ -25,7 +25,7 @@ from tutorial_atlas_control.sim import (
     load_model,
     pelvis_height_m,
 )
-from tutorial_atlas_control.walking.footsteps import Footstep, wrap_angle
+from tutorial_atlas_control.walking.footsteps import Footstep, window, wrap_angle
 from tutorial_atlas_control.walking.step_queue import StepQueue
 from tutorial_atlas_control.walking.walk import WalkController, WalkGains, foot_pose
 
@@ -72,9 +72,12 @@ class WalkingStand:
     simulator's Stand behaviour for a trial."""
 
     def __init__(self, atlas: AtlasModel, plan: Sequence[Footstep], walk_at_s: float,
-                 gains: WalkGains | None = None) -> None:
+                 gains: WalkGains | None = None, streaming: bool = False) -> None:
         self.stand = StandBehaviour(atlas)
         self.plan = list(plan)
+        #: Sent as a streaming client does: the window from next_step_index_needed, every
+        #: step (1 kHz); else the whole plan once.
+        self.streaming = streaming
         self.walk_at_s = walk_at_s
         self.gains = gains
         self.walk: WalkController | None = None
@@ -99,9 +102,12 @@ class WalkingStand:
             state = stand.last_state
             assert state is not None and stand.controller is not None
             queue = StepQueue(foot_pose(state, 0), foot_pose(state, 1))
-            queue.offer(self.plan)
+            queue.offer(window(self.plan, queue.next_step_index_needed) if self.streaming
+                        else self.plan)
             self.walk = WalkController(stand.controller, queue, state, time_s, self.gains)
         walk = self.walk
+        if walk is not None and self.streaming:
+            walk.queue.offer(window(self.plan, walk.queue.next_step_index_needed))
         if walk is None or self._stood_again:
             return stand.torque(data)
         if walk.done:
@@ -132,14 +138,15 @@ class WalkingStand:
             abs(wrap_angle(down.yaw_rad - target.yaw_rad))))
 
 
-def walk_trial(plan: Sequence[Footstep], duration_s: float,
-               gains: WalkGains | None = None) -> WalkTrial:
-    """Place the robot in the Stand pose, stand SETTLE_S, walk `plan`, stand; run for
-    `duration_s` (s) of sim time or until it falls."""
+def walk_trial(plan: Sequence[Footstep], duration_s: float, gains: WalkGains | None = None,
+               streaming: bool = False) -> WalkTrial:
+    """Place the robot in the Stand pose, stand SETTLE_S, walk `plan` (sent once, or
+    `streaming` its window every step), stand; run for `duration_s` (s) of sim time or
+    until it falls."""
     atlas = load_model()
     sim = AtlasSimulator(atlas, load_gains_yaml(DEFAULT_GAINS_FILE), time_to_unpin_s=0.0)
     place_in_stand_pose(sim.atlas, sim.data)
-    behaviour = WalkingStand(sim.atlas, plan, SETTLE_S, gains)
+    behaviour = WalkingStand(sim.atlas, plan, SETTLE_S, gains, streaming)
     sim.install_stand(behaviour)
     trial = behaviour.trial
     for _ in range(round(duration_s / sim.dt_s)):

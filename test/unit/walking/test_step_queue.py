@@ -46,9 +46,12 @@ def test_re_sending_the_same_window_changes_nothing() -> None:
 def test_a_streaming_client_keeps_the_queue_full_to_the_end() -> None:
     plan = straight_steps(10, 0.25)
     queue = new_queue()
+    assert queue.next_step_index_needed == 1
     taken = []
     while queue.current_step_index < len(plan):
-        queue.offer(window(plan, queue.next_step_index_needed - 3))
+        # What a client streaming the window [next_step_index_needed, +3] keeps sending.
+        for _ in range(3):
+            queue.offer(window(plan, queue.next_step_index_needed))
         preview = queue.preview()
         remaining = len(plan) - queue.current_step_index
         assert len(preview) == min(4, remaining)
@@ -57,7 +60,17 @@ def test_a_streaming_client_keeps_the_queue_full_to_the_end() -> None:
         queue.touchdown(preview[0])
         taken.append(preview[0])
     assert taken == plan
-    assert queue.next_step_index_needed == 14
+    assert queue.next_step_index_needed == 11
+
+
+def test_next_step_index_needed_is_the_first_unknown_step_up_to_four_ahead() -> None:
+    queue = new_queue()
+    queue.offer(DRCSIM_WALK_QUEUE[:2])
+    assert queue.next_step_index_needed == 3
+    queue.offer(DRCSIM_WALK_QUEUE)
+    assert queue.next_step_index_needed == 4
+    queue.touchdown(DRCSIM_WALK_QUEUE[0])
+    assert queue.next_step_index_needed == 5
 
 
 def test_a_one_shot_queue_runs_out_and_says_so() -> None:
