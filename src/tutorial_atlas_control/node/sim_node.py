@@ -97,7 +97,7 @@ from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.node.cheats import WARN_THROTTLE_S, subscribe_cheats
 from tutorial_atlas_control.node.master_watch import start_master_watch
 from tutorial_atlas_control.node.recorder_watch import start_recorder_watch
-from tutorial_atlas_control.node.transport import WireBatch, widen_accept_queue
+from tutorial_atlas_control.node.transport import WireBatch, flush_rosout, widen_accept_queue
 from tutorial_atlas_control.node.udpros import serve as serve_udpros
 from tutorial_atlas_control.node.viewer_window import open_viewer
 from tutorial_atlas_control.sim import (
@@ -445,6 +445,7 @@ class SimNode:
         status = self.loop.run(rospy.is_shutdown)
         watch.set()
         if status:
+            flush_rosout()  # the line saying why reaches the recorder before the shutdown
             rospy.signal_shutdown('physics diverges after every reset')
         if viewer is not None:
             viewer.close()

@@ -23,11 +23,11 @@ import time
 from collections.abc import Callable
 
 import rospy
-from rospy.impl import tcpros_base
+from rospy.impl import rosout, tcpros_base
 from rospy.impl.tcpros_base import TransportTerminated
 
 __all__ = ['MAX_BACKLOG_BYTES', 'SEND_TIMEOUT_S', 'STALL_PROBE_S', 'ConnectionWriter',
-           'WireBatch', 'subscriber_names', 'widen_accept_queue']
+           'WireBatch', 'flush_rosout', 'subscriber_names', 'widen_accept_queue']
 
 #: A subscriber that accepts nothing for this long (s) is dropped: slow subscribers lose
 #: nothing, stalled ones do not hold their bytes (and the node's memory) forever.
@@ -53,6 +53,37 @@ def widen_accept_queue() -> None:
     server = tcpros_base._tcpros_server  # rospy offers no setter
     if server is not None and server.tcp_ros_server is not None:  # else rospy has logged why
         server.tcp_ros_server.server_sock.listen(socket.SOMAXCONN)  # Linux: updates the backlog
+
+
+def flush_rosout(timeout_s: float = 2.0) -> None:
+    """Return once rospy has written every /rosout message logged so far (or after
+    `timeout_s`): its /rosout publisher hands each line to a writer thread per subscriber,
+    and a shutdown right after a log call closed the connection before the simulator's last
+    line (why it stopped) reached the recorder (a forced-divergence run beside a busy core).
+
+    Per connection, two empty barriers in turn: the writer takes its queue as one batch, so
+    once the second barrier is taken the batch holding the first, and every line before it,
+    has been written. rospy offers no flush; its QueuedConnection is used as it is.
+    """
+    publisher = rosout._rosout_pub
+    if publisher is None:
+        return
+    deadline = time.monotonic() + timeout_s
+    for connection in list(publisher.impl.connections):
+        lock = getattr(connection, '_lock', None)
+        queue = getattr(connection, '_queue', None)
+        wake = getattr(connection, '_cond_data_available', None)
+        if lock is None or queue is None or wake is None:  # a synchronous connection
+            continue
+        for _barrier in range(2):
+            with lock:
+                queue.append(b'')
+                wake.notify()
+            while time.monotonic() < deadline and not connection.done:
+                with lock:
+                    if not connection._queue:
+                        break
+                time.sleep(0.001)
 
 
 def wait_writable(sock: socket.socket, timeout_s: float) -> bool:
