@@ -14,9 +14,10 @@ from __future__ import annotations
 
 import pytest
 
+from tutorial_atlas_control.balance import STANDING_PELVIS_M
 from tutorial_atlas_control.walking import DRCSIM_WALK_QUEUE, straight_steps
 from tutorial_atlas_control.walking.walk import WalkGains
-from tutorial_atlas_control.walking.walk_trial import SETTLE_S, STANDING_PELVIS_M, walk_trial
+from tutorial_atlas_control.walking.walk_trial import SETTLE_S, walk_trial
 
 #: The issue's bounds on each landing (m, rad).
 LANDING_WITHIN_M = 0.05

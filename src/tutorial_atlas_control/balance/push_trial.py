@@ -66,13 +66,19 @@ class TrialResult:
         return self.controller_cpu_s / max(self.steps, 1) * 1e6
 
 
+def standing_simulator() -> AtlasSimulator:
+    """A simulator (the parameter gains, no pin) whose robot stands on the ground in the
+    Stand pose: where the offline trials start."""
+    sim = AtlasSimulator(load_model(), load_gains_yaml(DEFAULT_GAINS_FILE), time_to_unpin_s=0.0)
+    place_in_stand_pose(sim.atlas, sim.data)
+    return sim
+
+
 def stand_trial(duration_s: float, pushes: Sequence[Push] = (),
                 gains: StandGains | None = None) -> TrialResult:
     """Place the robot in the Stand pose on the ground and run Stand for `duration_s`
     (s) with `pushes`; stop early once the pelvis is below the standing height."""
-    atlas = load_model()
-    sim = AtlasSimulator(atlas, load_gains_yaml(DEFAULT_GAINS_FILE), time_to_unpin_s=0.0)
-    place_in_stand_pose(sim.atlas, sim.data)
+    sim = standing_simulator()
     stand = TimedStand(sim.atlas, gains)
     sim.install_stand(stand)  # the simulator starts in Stand: it takes over at once
     assert stand.last_state is not None

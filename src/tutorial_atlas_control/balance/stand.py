@@ -159,17 +159,29 @@ class StandController:
     def step(self, state: BalanceState, joint_positions: np.ndarray,
              joint_velocities: np.ndarray) -> StandOutput:
         """The 28 joint torques (N m) for this step, clamped to the effort limits."""
-        cop = self.desired_cop(state)
+        output = self.whole_body(state, self.desired_cop(state), state.in_contact,
+                                 joint_positions, joint_velocities)
+        np.clip(output.torque_nm, -self.effort_limit_nm, self.effort_limit_nm,
+                out=output.torque_nm)
+        return output
+
+    def whole_body(self, state: BalanceState, cop: np.ndarray, contact: tuple[bool, bool],
+                   joint_positions: np.ndarray, joint_velocities: np.ndarray,
+                   joint_gains: tuple[np.ndarray, np.ndarray] | None = None,
+                   torsion_m: float | None = None) -> StandOutput:
+        """The torques that make the soles in `contact` press the centroidal wrench for
+        `cop` (inverse statics, each sole's wrench made feasible: `torsion_m`, its yaw
+        moment too), plus the joint PD to the posture (`joint_gains` (kp, kd), else the
+        Stand's); not yet clamped to the effort limits (Walk adds its swing leg's first)."""
         force, moment = self.centroidal_wrench(state, cop)
         wrenches = contact_wrench.split_wrench(force, moment, state.sole_centres, state.com,
-                                               state.in_contact)
+                                               contact)
         half_length, half_width = self.sole_half_size_m
         for foot in (0, 1):
             wrenches[foot] = contact_wrench.make_feasible(
-                wrenches[foot], state.sole_rotations[foot], half_length, half_width)
+                wrenches[foot], state.sole_rotations[foot], half_length, half_width, torsion_m)
         torque = state.bias_nm - state.sole_jacobians.reshape(12, -1).T @ wrenches.reshape(12)
-        gains = self.gains
-        torque += (gains.joint_kp * (self.reference.posture_rad - joint_positions)
-                   - gains.joint_kd * joint_velocities)
-        np.clip(torque, -self.effort_limit_nm, self.effort_limit_nm, out=torque)
+        joint_kp, joint_kd = joint_gains or (self.gains.joint_kp, self.gains.joint_kd)
+        torque += (joint_kp * (self.reference.posture_rad - joint_positions)
+                   - joint_kd * joint_velocities)
         return StandOutput(torque, cop, force, moment, wrenches)

@@ -28,9 +28,8 @@ from tutorial_atlas_control.balance import (
     StandController,
     clamp_into,
     convex_hull,
-    make_feasible,
     orientation_error,
-    split_wrench,
+    yaw_of,
     yaw_rotation,
 )
 from tutorial_atlas_control.walking.dcm_plan import DcmPlan, tracking_cop
@@ -97,10 +96,9 @@ class WalkOutput:
 
 def foot_pose(state: BalanceState, foot: int, step_index: int = 0) -> Footstep:
     """Where a foot is now, as a step (sole centre and heading)."""
-    rotation = state.sole_rotations[foot]
     centre = state.sole_centres[foot]
     return Footstep(step_index, foot, float(centre[0]), float(centre[1]),
-                    math.atan2(rotation[1, 0], rotation[0, 0]))
+                    yaw_of(state.sole_rotations[foot]))
 
 
 def sway_cop(xi_now: np.ndarray, xi_target: np.ndarray, omega: float,
@@ -126,14 +124,18 @@ class WalkController:
         self.step: Footstep | None = None
         self.swing: SwingPath | None = None
         self._plan: DcmPlan | None = None
+        #: The Stand's joint PD with the legs' posture gains off (damping leg_kd instead).
+        joint_kp, joint_kd = stand.gains.joint_kp.copy(), stand.gains.joint_kd.copy()
+        joint_kp[LEG_JOINTS] = 0.0
+        joint_kd[LEG_JOINTS] = self.gains.leg_kd
+        self._joint_gains = (joint_kp, joint_kd)
         self._sway_cop = np.zeros(2)
         self._begin_sway(state, time_s)
 
     # -- the phases ---------------------------------------------------------------------------
 
-    def _plan_steps(self, state: BalanceState) -> DcmPlan | None:
-        """The capture point's plan over the queue's preview, from the feet as they are."""
-        preview = self.queue.preview()
+    def _plan_steps(self, preview: list[Footstep], omega: float) -> DcmPlan | None:
+        """The capture point's plan over the queue's `preview`, from the feet as they are."""
         if not preview:
             return None
         feet = [self.queue.feet[0], self.queue.feet[1]]
@@ -144,21 +146,20 @@ class WalkController:
             durations.append(step.duration_s)
             feet[step.foot_index] = step
         final = 0.5 * np.array([feet[0].x_m + feet[1].x_m, feet[0].y_m + feet[1].y_m])
-        return DcmPlan.plan(np.array(cops), np.array(durations), final, state.omega)
+        return DcmPlan.plan(np.array(cops), np.array(durations), final, omega)
 
     def _begin_sway(self, state: BalanceState, time_s: float) -> None:
         self.phase, self.phase_start_s = SWAYING, time_s
-        self._plan = self._plan_steps(state)
+        self._plan = self._plan_steps(self.queue.preview(), state.omega)
         target = (self._plan.start if self._plan is not None
                   else state.sole_centres[:, :2].mean(axis=0))
         self._sway_cop = sway_cop(state.capture_point, target, state.omega, self.gains.sway_s)
         self._sway_from = state.capture_point.copy()
-        self._sway_target = target
 
     def _begin_step(self, state: BalanceState, time_s: float) -> None:
-        self._plan = self._plan_steps(state)
         preview = self.queue.preview()
-        if self._plan is None or not preview:
+        self._plan = self._plan_steps(preview, state.omega)
+        if self._plan is None:
             self._begin_catch(state, time_s)
             return
         step = preview[0]
@@ -262,25 +263,12 @@ class WalkController:
             contact = (self.step.foot_index != 0, self.step.foot_index != 1)  # type: ignore[union-attr]
         else:  # swaying or catching: the feet that are down (both, unless a landing is late)
             contact = state.in_contact if any(state.in_contact) else (True, True)
-        stance = [foot for foot in (0, 1) if contact[foot]]
         corners = np.concatenate([_sole_corners(state, foot, stand.sole_half_size_m)
-                                  for foot in stance])
+                                  for foot in (0, 1) if contact[foot]])
         cop = clamp_into(convex_hull(corners), cop, stand.gains.cop_margin_m)
-        force, moment = stand.centroidal_wrench(state, cop)
-        wrenches = split_wrench(force, moment, state.sole_centres, state.com,
-                                               contact)
-        half_length, half_width = stand.sole_half_size_m
-        for foot in stance:
-            wrenches[foot] = make_feasible(
-                wrenches[foot], state.sole_rotations[foot], half_length, half_width,
-                gains.torsion_m if swinging else None)
-        torque = state.bias_nm - state.sole_jacobians.reshape(12, -1).T @ wrenches.reshape(12)
-        joint_kp = stand.gains.joint_kp.copy()
-        joint_kd = stand.gains.joint_kd.copy()
-        joint_kp[LEG_JOINTS] = 0.0
-        joint_kd[LEG_JOINTS] = gains.leg_kd
-        torque += (joint_kp * (stand.reference.posture_rad - joint_positions)
-                   - joint_kd * joint_velocities)
+        torque = stand.whole_body(state, cop, contact, joint_positions, joint_velocities,
+                                  self._joint_gains, gains.torsion_m if swinging else None
+                                  ).torque_nm
         if swinging:
             torque += self._swing_torque(state, time_s)
         else:

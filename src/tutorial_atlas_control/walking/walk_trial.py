@@ -2,7 +2,7 @@
 footsteps walked, then Stand again; what happened, step by step.
 
 The figures the tests and the bench judge: whether it fell (pelvis below
-STANDING_PELVIS_M), how many steps it took, where each foot came down against its
+balance's STANDING_PELVIS_M), how many steps it took, where each foot came down against its
 target, the lowest pelvis, where the pelvis ended, and the controller's CPU per step.
 """
 
@@ -16,21 +16,17 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
-from tutorial_atlas_control.balance import BalanceState, StandBehaviour, place_in_stand_pose
-from tutorial_atlas_control.sim import (
-    DEFAULT_GAINS_FILE,
-    AtlasModel,
-    AtlasSimulator,
-    load_gains_yaml,
-    load_model,
-    pelvis_height_m,
+from tutorial_atlas_control.balance import (
+    STANDING_PELVIS_M,
+    BalanceState,
+    StandBehaviour,
+    standing_simulator,
 )
+from tutorial_atlas_control.sim import AtlasModel, pelvis_height_m
 from tutorial_atlas_control.walking.footsteps import Footstep, window, wrap_angle
 from tutorial_atlas_control.walking.step_queue import StepQueue
 from tutorial_atlas_control.walking.walk import WalkController, WalkGains, foot_pose
 
-#: Standing means the pelvis above this (m); Stand holds it at about 0.91 m.
-STANDING_PELVIS_M = 0.8
 #: Stand before the walk begins (s).
 SETTLE_S = 1.0
 
@@ -143,9 +139,7 @@ def walk_trial(plan: Sequence[Footstep], duration_s: float, gains: WalkGains | N
     """Place the robot in the Stand pose, stand SETTLE_S, walk `plan` (sent once, or
     `streaming` its window every step), stand; run for `duration_s` (s) of sim time or
     until it falls."""
-    atlas = load_model()
-    sim = AtlasSimulator(atlas, load_gains_yaml(DEFAULT_GAINS_FILE), time_to_unpin_s=0.0)
-    place_in_stand_pose(sim.atlas, sim.data)
+    sim = standing_simulator()
     behaviour = WalkingStand(sim.atlas, plan, SETTLE_S, gains, streaming)
     sim.install_stand(behaviour)
     trial = behaviour.trial
