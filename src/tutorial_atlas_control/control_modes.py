@@ -20,6 +20,7 @@ class ControlMode(str, enum.Enum):
     FREEZE = 'Freeze'
     RAGDOLL = 'ragdoll'
     USER = 'User'
+    WALK = 'Walk'
 
 
 VALID_CONTROL_MODES: tuple[str, ...] = tuple(mode.value for mode in ControlMode)

@@ -7,7 +7,7 @@ within 5 cm and 0.1 rad of its target, no fall, the pelvis at least 4 m ahead af
 straight walk; and the exact figures of these runs. A client streaming its window every
 step walks the same walk as one sending the plan once. The planted defect: without the limit
 on the yaw moment a stance sole can take (its torsional friction) the stance foot turns
-and the straight walk falls at its fifth step. About 13 s of CPU in all.
+and the straight walk falls at its third step. About 13 s of CPU in all.
 """
 
 from __future__ import annotations
@@ -41,9 +41,9 @@ def test_drcsim_s_walk_queue_is_walked_and_then_stood_on() -> None:
     assert SETTLE_S + 3.8 + STAND_AFTER_S - trial.walk_ended_s >= STAND_AFTER_S
     assert trial.lowest_pelvis_m > STANDING_PELVIS_M
     # This run's figures (deterministic).
-    assert round(trial.worst_landing_m, 3) == 0.037
+    assert round(trial.worst_landing_m, 3) == 0.014
     assert round(trial.lowest_pelvis_m, 3) == 0.902
-    assert round(float(trial.pelvis_end[0]), 3) == 0.655
+    assert float(trial.pelvis_end[0]) == pytest.approx(0.6465, abs=1e-4)
     assert trial.walk_ended_s == pytest.approx(4.726)
 
 
@@ -57,9 +57,9 @@ def test_twenty_straight_steps_of_a_quarter_metre() -> None:
     assert float(trial.pelvis_end[0]) >= STRAIGHT_AHEAD_M
     assert trial.walk_ended_s is not None
     # This run's figures (deterministic).
-    assert round(trial.worst_landing_m, 3) == 0.036
+    assert round(trial.worst_landing_m, 3) == 0.029
     assert round(trial.lowest_pelvis_m, 3) == 0.898
-    assert round(float(trial.pelvis_end[0]), 2) == 4.76
+    assert round(float(trial.pelvis_end[0]), 2) == 4.75
 
 
 def test_a_client_streaming_its_window_every_step_walks_the_same_walk() -> None:
@@ -76,4 +76,4 @@ def test_a_client_streaming_its_window_every_step_walks_the_same_walk() -> None:
 def test_without_the_torsion_limit_the_stance_foot_turns_and_it_falls() -> None:
     trial = walk_trial(straight_steps(STRAIGHT_STEPS, STRIDE_M), 20.0, WalkGains(torsion_m=None))
     assert trial.fell
-    assert trial.steps == 5
+    assert trial.steps == 3

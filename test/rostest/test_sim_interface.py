@@ -179,7 +179,7 @@ class SimInterfaceTest(unittest.TestCase):
         probe.send([ELBOW], position=[0.0])  # stored, not applied while frozen
         probe.set_mode('Dance')
         probe.wait_until(lambda: probe.warnings_containing('valid modes: Stand, StandPrep, '
-                                                           'Freeze, ragdoll, User'),
+                                                           'Freeze, ragdoll, User, Walk'),
                          'the unknown-mode warning')
         probe.wait_sim(1.0)
         # Held near where it was frozen (the body still sways), not sent to the stored 0.

@@ -65,4 +65,5 @@ MODE_OF_BEHAVIOR: dict[Behavior, ControlMode] = {
 BEHAVIOR_OF_MODE: dict[ControlMode, Behavior] = {
     **{mode: behavior for behavior, mode in MODE_OF_BEHAVIOR.items()},
     ControlMode.RAGDOLL: Behavior.USER,
+    ControlMode.WALK: Behavior.WALK,  # served with the balancing Stand only
 }

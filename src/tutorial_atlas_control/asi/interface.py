@@ -8,7 +8,10 @@ every joint; a behaviour switch itself never changes k_effort. Stand runs the ba
 StandBehaviour and StandPrep the StandPrepBehaviour, installed into the simulator here
 (or, without `balance`, the simulator's holds, DRCSim 2.5.2's stand-in). Manipulate, served
 with the balancing Stand only, is that Stand with its pelvis servoed to
-`manipulate_params.desired` (the Stand pose without use_desired). A switch made elsewhere
+`manipulate_params.desired` (the Stand pose without use_desired). Walk, also served with
+the balancing Stand only, is walking.WalkBehaviour over the command's step queue (DRCSim's
+fixed queue when started by /atlas/control_mode Walk); once it has caught itself after its
+last step the interface hands the robot back to Stand (WARNING_AUTO_TRANS). A switch made elsewhere
 (/atlas/control_mode, /atlas/mode bdi_stand) is seen at the next state or step and reported
 as a successful transition.
 """
@@ -22,6 +25,7 @@ import numpy as np
 
 from tutorial_atlas_control.asi.behaviors import BEHAVIOR_OF_MODE, MODE_OF_BEHAVIOR, Behavior
 from tutorial_atlas_control.asi.session import STANDING_BEHAVIORS, AsiSession
+from tutorial_atlas_control.asi.walk_params import footsteps_of, walk_feedback
 from tutorial_atlas_control.balance import (
     BalanceEstimator,
     PelvisServo,
@@ -38,8 +42,10 @@ from tutorial_atlas_control.msgs import (
     BehaviorFeedback,
     ManipulateFeedback,
     ManipulateParams,
+    WalkFeedback,
 )
 from tutorial_atlas_control.sim import AtlasSimulator
+from tutorial_atlas_control.walking import WalkBehaviour
 
 __all__ = ['FALLING_PELVIS_M', 'FALLING_TILT_RAD', 'AtlasSimInterface']
 
@@ -76,6 +82,8 @@ class AtlasSimInterface:
         #: The balancing Stand installed (None: Stand is the hold); its estimator, or one of
         #: the interface's own, checks the centre of mass before Stand is entered.
         self.stand: StandBehaviour | None = None
+        #: Walk, installed with the balancing Stand.
+        self.walking: WalkBehaviour | None = None
         self.session = AsiSession(MODE_OF_BEHAVIOR)
         if balance:
             self._load_balance()
@@ -98,6 +106,9 @@ class AtlasSimInterface:
         sim.install_stand(self.stand)
         sim.install_stand(StandPrepBehaviour(sim.atlas, sim.gains), ControlMode.STAND_PREP)
         self.session.served[Behavior.MANIPULATE] = ControlMode.STAND
+        self.walking = WalkBehaviour(self.stand)
+        sim.install_stand(self.walking, ControlMode.WALK)
+        self.session.served[Behavior.WALK] = ControlMode.WALK
         self._estimator = self.stand.estimator
 
     @property
@@ -109,23 +120,40 @@ class AtlasSimInterface:
         self._observe()
         sim = self.sim
         current = self.current_behavior
-        feet_under_com = True
-        if command.behavior != current:
-            feet_under_com = self.com_over_feet()
-        mode = self.session.request(command.behavior, current, feet_under_com)
-        if mode is not None:
-            if mode is not sim.mode:
-                kept = None if sim.user_command is None else sim.user_command.k_effort.copy()
-                sim.set_mode(mode)
-                self._mode = mode
-                if kept is not None:
-                    self._set_k_effort(kept)
-            self._set_manipulating(command.behavior == Behavior.MANIPULATE)
+        self._request(command, current)
         if self.manipulating:
             assert self.stand is not None  # served only with it
             self.stand.servo(servo_of(command.manipulate), float(sim.data.time))
         if command.k_effort is not None:
             self._set_k_effort(command.k_effort)
+
+    def _request(self, command: AsiCommand, current: Behavior) -> None:
+        """The command's behaviour requested; a WALK's steps to the walk, running or starting.
+        A WALK without steps starts nothing: it is a streaming client's last, empty window,
+        sent after its walk ended."""
+        steps = footsteps_of(command.step_queue) if command.behavior == Behavior.WALK else []
+        if command.behavior == Behavior.WALK != current and not steps:
+            return
+        feet_under_com = command.behavior == current or self.com_over_feet()
+        mode = self.session.request(command.behavior, current, feet_under_com)
+        walking = self.walking
+        if mode is not None:
+            if mode is ControlMode.WALK and walking is not None:
+                walking.next_steps = steps
+            self._switch(mode)
+            self._set_manipulating(command.behavior == Behavior.MANIPULATE)
+        elif current == Behavior.WALK == command.behavior and walking is not None:
+            walking.offer(steps)
+
+    def _switch(self, mode: ControlMode) -> None:
+        """The simulator into `mode`; a behaviour switch never changes k_effort."""
+        sim = self.sim
+        if mode is not sim.mode:
+            kept = None if sim.user_command is None else sim.user_command.k_effort.copy()
+            sim.set_mode(mode)
+            self._mode = mode
+            if kept is not None:
+                self._set_k_effort(kept)
 
     def _set_manipulating(self, manipulating: bool) -> None:
         """Enter Manipulate (in a started Stand), or leave it for Stand's own pose."""
@@ -211,6 +239,9 @@ class AtlasSimInterface:
                                                session.trans_from_behavior,
                                                session.trans_to_behavior),
             manipulate_feedback=self.manipulate_feedback(),
+            walk_feedback=(walk_feedback(self.walking.status(float(data.time)))
+                           if current == Behavior.WALK and self.walking is not None
+                           else WalkFeedback()),
             k_effort=self.k_effort())
 
     def manipulate_feedback(self) -> ManipulateFeedback:
@@ -226,3 +257,7 @@ class AtlasSimInterface:
         """After each step, whether or not a state was built."""
         self._observe()
         self.session.end_step()
+        if self.sim.mode is ControlMode.WALK and self.walking is not None \
+                and self.walking.done:
+            self._switch(ControlMode.STAND)
+            self.session.auto_switched(Behavior.STAND, Behavior.WALK)

@@ -5,8 +5,10 @@ Our choices where BDI's library published none (docs/controllers.md): a request 
 running behaviour changes nothing, so a client may stream it at 1 kHz; an accepted switch
 reports TRANSITION_SUCCESS in the state of that step, then OK; a refusal (unknown or not yet
 served behaviour, Stand with the centre of mass outside the feet) reports its FAILED_TRANS_*
-until the next accepted switch and keeps the running behaviour; ERROR_FALLING is reported
-while a standing behaviour is falling, ahead of any other value (one value at a time).
+until the next accepted switch and keeps the running behaviour; Walk's return to Stand
+after its last step reports WARNING_AUTO_TRANS until the next switch or refusal;
+ERROR_FALLING is reported while a standing behaviour (Walk included) is falling, ahead of
+any other value (one value at a time).
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ __all__ = ['STANDING_BEHAVIORS', 'AsiSession']
 
 #: Behaviours that keep the robot on its feet: only they can be falling, and entering one
 #: needs the centre of mass over the feet.
-STANDING_BEHAVIORS = frozenset({Behavior.STAND, Behavior.MANIPULATE})
+STANDING_BEHAVIORS = frozenset({Behavior.STAND, Behavior.MANIPULATE, Behavior.WALK})
 _KNOWN = frozenset(int(b) for b in Behavior)
 
 
@@ -79,6 +81,12 @@ class AsiSession:
         self._status = Status.TRANSITION_SUCCESS
         self.error_code = AsiError.NO_ERRORS
         self.trans_from_behavior, self.trans_to_behavior = int(previous), int(current)
+
+    def auto_switched(self, current: Behavior, previous: Behavior) -> None:
+        """The library left `previous` by itself (Walk, its steps done, to Stand):
+        WARNING_AUTO_TRANS until the next accepted switch or refusal."""
+        self.switched(current, previous)
+        self._status = Status.WARNING_AUTO_TRANS
 
     def end_step(self) -> None:
         """A step has passed: a success has been reported (or was not listened to)."""

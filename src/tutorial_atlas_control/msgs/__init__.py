@@ -7,8 +7,8 @@ from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'atlas_command': ['AtlasUpdate', 'decode_atlas_command', 'decode_test'],
-    'atlas_sim_interface': ['AsiCommand', 'ManipulateParams', 'decode_asi_command',
-                            'encode_asi_command'],
+    'atlas_sim_interface': ['STEP_QUEUE_LENGTH', 'AsiCommand', 'ManipulateParams', 'StepData',
+                            'decode_asi_command', 'encode_asi_command'],
     'atlas_sim_interface_state': ['AsiState', 'BehaviorFeedback', 'ManipulateFeedback',
                                   'StepFeedback', 'WalkFeedback', 'encode_asi_state'],
     'joint_commands': ['CommandDecoder'],

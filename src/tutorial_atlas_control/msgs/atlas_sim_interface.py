@@ -27,6 +27,7 @@ __all__ = ['BEHAVIORS', 'MAX_ABS_VALUE', 'STEP_QUEUE_LENGTH', 'AsiCommand', 'Man
 #: AtlasSimInterfaceCommand's behaviour constants, by value.
 BEHAVIORS: dict[int, str] = {0: 'STAND', 1: 'USER', 2: 'FREEZE', 3: 'STAND_PREP', 4: 'WALK',
                              5: 'STEP', 6: 'MANIPULATE'}
+WALK, STEP = 4, 5
 #: walk_params.step_queue's fixed length.
 STEP_QUEUE_LENGTH = 4
 #: Larger floats (m, s, rad) are refused as absurd: no step or pelvis target is that far.
@@ -118,6 +119,13 @@ def _read_step(cursor: FieldCursor, prefix: str) -> StepData:
                     fields[10])
 
 
+def _check_foot(step: StepData, prefix: str) -> None:
+    """A step the behaviour will take (step_index > 0: 0 marks an unused slot) names a foot."""
+    if step.step_index > 0 and step.foot_index not in (0, 1):
+        raise CommandError(f'{prefix}foot_index is {step.foot_index}, not 0 (left) or '
+                           '1 (right)')
+
+
 def _read_bool(cursor: FieldCursor) -> bool:
     (value,) = _BOOL.unpack_from(cursor.data, cursor.pos)
     cursor.pos += 1
@@ -141,6 +149,11 @@ def _read(raw: bytes) -> AsiCommand:
     k_effort = cursor.array(np.dtype('u1'))
     if cursor.pos != len(raw):
         raise ValueError(f'{len(raw) - cursor.pos} bytes left after the last field')
+    if behavior == WALK:
+        for i, queued in enumerate(queue):
+            _check_foot(queued, f'walk_params.step_queue[{i}].')
+    elif behavior == STEP:
+        _check_foot(step, 'step_params.desired_step.')
     fractions = (k_effort / K_EFFORT_FULL_SCALE if len(k_effort) == NUM_JOINTS else None)
     return AsiCommand(stamp_ns, behavior, queue, use_demo_walk, step, step_demo,
                       ManipulateParams(*manipulate), fractions, len(k_effort))

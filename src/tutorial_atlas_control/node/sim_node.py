@@ -92,6 +92,7 @@ from tf2_msgs.msg import TFMessage
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags import unwritable_reason
+from tutorial_atlas_control.control_modes import ControlMode
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.node.cheats import WARN_THROTTLE_S, subscribe_cheats
@@ -421,6 +422,11 @@ class SimNode:
             mode = parse_mode(msg.data)
         except ModeError as err:
             rospy.logwarn_throttle(WARN_THROTTLE_S, f'refused /atlas/control_mode: {err}')
+            return
+        if mode is ControlMode.WALK and self.loop.asi.walking is None:
+            rospy.logwarn_throttle(WARN_THROTTLE_S, 'refused /atlas/control_mode: Walk needs '
+                                   'the balancing Stand (stand:=balance, or /atlas/mode '
+                                   'bdi_stand first)')
             return
         previous = self.loop.set_mode(mode)
         self.node_publishers[topics.CURRENT_CONTROL_MODE].publish(String(data=mode.value))

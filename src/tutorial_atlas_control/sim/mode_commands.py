@@ -124,7 +124,7 @@ class ModeCommands:
         The user command's k_effort becomes 1 in User, 0 otherwise (AtlasPlugin::OnRobotMode:
         LoadPIDGainsFromParameter, ZeroAtlasCommand); its other fields are kept.
         """
-        if mode in (ControlMode.STAND, ControlMode.STAND_PREP):
+        if mode in (ControlMode.STAND, ControlMode.STAND_PREP, ControlMode.WALK):
             self._mode_command = self._stand_command
         elif mode in HOLD_AT_SWITCH:
             self._mode_command = self.hold_current_pose()

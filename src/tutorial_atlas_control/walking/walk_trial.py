@@ -24,8 +24,8 @@ from tutorial_atlas_control.balance import (
 )
 from tutorial_atlas_control.sim import AtlasModel, pelvis_height_m
 from tutorial_atlas_control.walking.footsteps import Footstep, window, wrap_angle
-from tutorial_atlas_control.walking.step_queue import StepQueue
 from tutorial_atlas_control.walking.walk import WalkController, WalkGains, foot_pose
+from tutorial_atlas_control.walking.walk_behaviour import WalkBehaviour
 
 #: Stand before the walk begins (s).
 SETTLE_S = 1.0
@@ -64,21 +64,24 @@ class WalkTrial:
 
 
 class WalkingStand:
-    """Stand, then the plan walked from `walk_at_s`, then Stand where the walk ended; the
-    simulator's Stand behaviour for a trial."""
+    """Stand, then the plan walked from `walk_at_s` (WalkBehaviour), then Stand where the
+    walk ended; the simulator's Stand behaviour for a trial."""
 
     def __init__(self, atlas: AtlasModel, plan: Sequence[Footstep], walk_at_s: float,
                  gains: WalkGains | None = None, streaming: bool = False) -> None:
         self.stand = StandBehaviour(atlas)
+        self.walking = WalkBehaviour(self.stand, gains)
         self.plan = list(plan)
         #: Sent as a streaming client does: the window from next_step_index_needed, every
         #: step (1 kHz); else the whole plan once.
         self.streaming = streaming
         self.walk_at_s = walk_at_s
-        self.gains = gains
-        self.walk: WalkController | None = None
         self.trial = WalkTrial()
-        self._stood_again = False
+        self._phase = 'stand'  # then 'walk', then 'stand again'
+
+    @property
+    def walk(self) -> WalkController | None:
+        return self.walking.walk
 
     def start(self, data: mujoco.MjData) -> None:
         self.stand.start(data)
@@ -93,33 +96,29 @@ class WalkingStand:
 
     def _torque(self, data: mujoco.MjData) -> np.ndarray:
         time_s = float(data.time)
-        stand = self.stand
-        if self.walk is None and time_s >= self.walk_at_s:
-            state = stand.last_state
-            assert state is not None and stand.controller is not None
-            queue = StepQueue(foot_pose(state, 0), foot_pose(state, 1))
-            queue.offer(window(self.plan, queue.next_step_index_needed) if self.streaming
-                        else self.plan)
-            self.walk = WalkController(stand.controller, queue, state, time_s, self.gains)
-        walk = self.walk
-        if walk is not None and self.streaming:
-            walk.queue.offer(window(self.plan, walk.queue.next_step_index_needed))
-        if walk is None or self._stood_again:
-            return stand.torque(data)
+        walking = self.walking
+        if self._phase == 'stand' and time_s >= self.walk_at_s:
+            walking.next_steps = window(self.plan, 1) if self.streaming else self.plan
+            walking.start(data)
+            self._phase = 'walk'
+        if self._phase != 'walk':
+            return self.stand.torque(data)
+        walk = walking.walk
+        assert walk is not None  # started above
         if walk.done:
             self.trial.walk_ended_s = time_s
-            self._stood_again = True
-            stand.start(data)
-            return stand.torque(data)
-        atlas = stand.atlas
-        state = stand.estimator.estimate(data.qpos, data.qvel)
+            self._phase = 'stand again'
+            self.stand.start(data)
+            return self.stand.torque(data)
+        if self.streaming:
+            walking.offer(window(self.plan, walk.queue.next_step_index_needed))
         taken = walk.queue.current_step_index
-        output = walk.step_torque(state, data.qpos[atlas.qpos_adr], data.qvel[atlas.dof_adr],
-                                  time_s)
-        stand.last_state = state
+        torque = walking.torque(data)
         if walk.queue.current_step_index > taken:
+            state = self.stand.last_state
+            assert state is not None  # set by the torque call
             self._landed(walk, state)
-        return output.torque_nm
+        return torque
 
     def _landed(self, walk: WalkController, state: BalanceState) -> None:
         """Note the step just down against its target."""

@@ -12,7 +12,7 @@ from tutorial_atlas_control.control_modes import VALID_CONTROL_MODES, is_refused
 
 
 def test_the_modes_are_drcsims() -> None:
-    assert VALID_CONTROL_MODES == ('Stand', 'StandPrep', 'Freeze', 'ragdoll', 'User')
+    assert VALID_CONTROL_MODES == ('Stand', 'StandPrep', 'Freeze', 'ragdoll', 'User', 'Walk')
     assert is_refused_mode('user') and not is_refused_mode('User')
 
 

@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import io
 import math
+import re
 import struct
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -107,3 +109,23 @@ def test_a_truncated_or_padded_message_is_malformed() -> None:
     assert str(refused.value) == ('malformed AtlasSimInterfaceCommand '
                                   '(1 bytes left after the last field)')
     assert struct.calcsize('<II9d') == 80  # AtlasBehaviorStepData on the wire
+
+
+@pytest.mark.parametrize(('behavior', 'slot', 'field'), [
+    (4, 2, 'walk_params.step_queue[2].foot_index'),
+    (5, None, 'step_params.desired_step.foot_index')])
+def test_a_step_to_take_with_no_such_foot_is_refused(behavior: int, slot: int | None,
+                                                     field: str) -> None:
+    queue = list(command().step_queue)
+    bad = StepData(3, 2, 0.63)
+    if slot is not None:
+        queue[slot] = bad
+    changed = command(behavior, step_queue=tuple(queue),
+                      desired_step=bad if slot is None else command().desired_step)
+    with pytest.raises(CommandError, match=rf'{re.escape(field)} is 2, not 0 \(left\) or 1'):
+        decode_asi_command(encode_asi_command(changed))
+    # An unused slot (step_index 0) and another behaviour's parameters are not looked at.
+    unused = replace(bad, step_index=0)
+    queue[2] = unused
+    assert decode_asi_command(encode_asi_command(command(4, step_queue=tuple(queue)))).behavior == 4
+    assert decode_asi_command(encode_asi_command(command(0, desired_step=bad))).behavior == 0

@@ -45,7 +45,7 @@ def test_parse_mode_accepts_drcsim_modes_and_lists_them_otherwise() -> None:
     assert parse_mode('User') is ControlMode.USER
     assert parse_mode('ragdoll') is ControlMode.RAGDOLL
     with pytest.raises(ModeError, match="unknown control mode 'user'; valid modes: Stand, "
-                                        'StandPrep, Freeze, ragdoll, User'):
+                                        'StandPrep, Freeze, ragdoll, User, Walk'):
         parse_mode('user')
     with pytest.raises(ModeError, match=r"'x{40}\.\.\.'"):
         parse_mode('x' * 10_000)

@@ -1,0 +1,103 @@
+"""Walk as the simulator's behaviour for control mode Walk (sim/behaviour.py's protocol).
+
+It shares the balancing Stand's estimator and whole-body controller. On start it takes the
+robot over where it stands (the Stand's reference made from the present state, as Stand
+itself does), builds a step queue from the feet as they are, and walks `next_steps` (set
+before the start from an AtlasSimInterfaceCommand's queue) or, without them, DRCSim's fixed
+queue (/atlas/control_mode Walk). Steps offered while it walks join the queue by index.
+Once the walk has caught itself after its last step it is `done`: the interface then
+hands the robot back to Stand.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from tutorial_atlas_control.balance import StandBehaviour
+from tutorial_atlas_control.walking.footsteps import DRCSIM_WALK_QUEUE, QUEUE_LENGTH, Footstep
+from tutorial_atlas_control.walking.step_queue import (
+    DEFAULT_LIMITS,
+    STEPPING,
+    StepLimits,
+    StepQueue,
+)
+from tutorial_atlas_control.walking.walk import WalkController, WalkGains, foot_pose
+
+__all__ = ['WalkBehaviour', 'WalkStatus']
+
+
+@dataclass(frozen=True)
+class WalkStatus:
+    """What walk_feedback reports (ASI.md): the time left in the step being taken (s), the
+    steps taken, the first step the queue needs, the flags, and the next steps as clamped."""
+
+    t_step_rem_s: float
+    current_step_index: int
+    next_step_index_needed: int
+    status_flags: int
+    steps_saturated: tuple[Footstep, ...]
+
+
+class WalkBehaviour:
+    """Walk on `stand`'s balance; steps come through `offer`."""
+
+    def __init__(self, stand: StandBehaviour, gains: WalkGains | None = None,
+                 limits: StepLimits = DEFAULT_LIMITS) -> None:
+        self.stand = stand
+        self.gains = gains
+        self.limits = limits
+        #: The walk under way (None before the first start).
+        self.walk: WalkController | None = None
+        #: The steps the next start walks (None: DRCSim's fixed queue).
+        self.next_steps: list[Footstep] | None = None
+
+    @property
+    def done(self) -> bool:
+        """The walk has ended: its steps taken and the robot caught at rest."""
+        return self.walk is not None and self.walk.done
+
+    def offer(self, steps: Iterable[Footstep]) -> None:
+        """A client's steps for the walk under way: into its queue by index."""
+        if self.walk is None:
+            raise RuntimeError('WalkBehaviour.offer before start()')
+        self.walk.queue.offer(steps)
+
+    def start(self, data: mujoco.MjData) -> None:
+        """Begin a walk from where the robot stands, over the steps offered so far (DRCSim's
+        fixed queue if none were)."""
+        stand = self.stand
+        stand.start(data)
+        controller, state = stand.controller, stand.last_state
+        assert controller is not None and state is not None  # set by start
+        queue = StepQueue(foot_pose(state, 0), foot_pose(state, 1), self.limits)
+        queue.offer(DRCSIM_WALK_QUEUE if self.next_steps is None else self.next_steps)
+        self.next_steps = None
+        self.walk = WalkController(controller, queue, state, float(data.time), self.gains)
+
+    def torque(self, data: mujoco.MjData) -> np.ndarray:
+        """This step's f_out (N m, (28,)), within the effort limits."""
+        walk = self.walk
+        if walk is None:
+            raise RuntimeError('WalkBehaviour.torque before start()')
+        stand, atlas = self.stand, self.stand.atlas
+        state = stand.estimator.estimate(data.qpos, data.qvel)
+        stand.last_state = state
+        return walk.step_torque(state, data.qpos[atlas.qpos_adr], data.qvel[atlas.dof_adr],
+                                float(data.time)).torque_nm
+
+    def status(self, time_s: float) -> WalkStatus:
+        """walk_feedback's values now."""
+        walk = self.walk
+        if walk is None:
+            return WalkStatus(0.0, 0, 1, 0, ())
+        queue = walk.queue
+        remaining = 0.0
+        if walk.phase == STEPPING and walk.step is not None:
+            remaining = max(0.0, walk.step.duration_s - (time_s - walk.phase_start_s))
+        return WalkStatus(remaining, queue.current_step_index, queue.next_step_index_needed,
+                          queue.status_flags(walk.phase),
+                          tuple(queue.preview()[:QUEUE_LENGTH]))

@@ -1,0 +1,178 @@
+"""Walk through the open AtlasSimInterface, offline and deterministic: a WALK command's
+queue walked with walk_feedback as ASI.md says, then Stand by itself (WARNING_AUTO_TRANS);
+a client streaming its window at 1 kHz walks the same walk; /atlas/control_mode Walk walks
+DRCSim's fixed queue; two steps with one foot end the walk (ERROR_INCONSISTENT_STEPS);
+without the balancing Stand, Walk is not served. About 12 s of CPU.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tutorial_atlas_control.asi import AsiError, AtlasSimInterface, Behavior, Status
+from tutorial_atlas_control.balance import place_in_stand_pose
+from tutorial_atlas_control.control_modes import ControlMode
+from tutorial_atlas_control.joints import NUM_JOINTS
+from tutorial_atlas_control.msgs.atlas_sim_interface import AsiCommand, ManipulateParams, StepData
+from tutorial_atlas_control.sim import AtlasSimulator, load_gains_yaml, load_model
+from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.walking import DRCSIM_WALK_QUEUE, Footstep, window
+from tutorial_atlas_control.walking.step_queue import (
+    CATCHING,
+    ERROR_INCONSISTENT_STEPS,
+    STEPPING,
+    SWAYING,
+    WARNING_INSUFFICIENT_STEP_DATA,
+)
+
+CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
+#: Stand before the walk, and the run's whole length (s).
+STAND_FIRST_S = 1.0
+RUN_S = 7.0
+#: A standing or walking pelvis stays above this (m; falling is below 0.7).
+PELVIS_ABOVE_M = 0.85
+LANDING_WITHIN_M = 0.05
+
+
+@pytest.fixture(scope='module')
+def atlas() -> atlas_model.AtlasModel:
+    return load_model()
+
+
+def standing(atlas: atlas_model.AtlasModel, balance: bool = True) -> AtlasSimInterface:
+    """In DRCSim's Stand pose, free, in Stand, for STAND_FIRST_S."""
+    sim = AtlasSimulator(atlas, load_gains_yaml(CONFIG), time_to_unpin_s=0.0)
+    place_in_stand_pose(sim.atlas, sim.data)
+    interface = AtlasSimInterface(sim, balance)
+    for _ in range(round(STAND_FIRST_S / sim.dt_s)):
+        sim.step()
+        interface.end_step()
+    return interface
+
+
+def step_data(step: Footstep) -> StepData:
+    half = 0.5 * step.yaw_rad
+    return StepData(step.step_index, step.foot_index, step.duration_s, (step.x_m, step.y_m, 0.1),
+                    (0.0, 0.0, np.sin(half), np.cos(half)), 0.2)
+
+
+def walk_command(steps: list[Footstep]) -> AsiCommand:
+    queue = [step_data(step) for step in steps] + [StepData()] * (4 - len(steps))
+    return AsiCommand(0, Behavior.WALK, tuple(queue), False, StepData(), False,
+                      ManipulateParams(), None, 0)
+
+
+@dataclass
+class Run:
+    """What the state said, step by step."""
+
+    behaviors: list[int] = field(default_factory=list)
+    status: list[int] = field(default_factory=list)
+    walk_flags: list[int] = field(default_factory=list)
+    current_steps: list[int] = field(default_factory=list)
+    lowest_pelvis_m: float = np.inf
+
+
+def run(interface: AtlasSimInterface, seconds: float, plan: list[Footstep] | None = None
+        ) -> Run:
+    """Step for `seconds`, building the state each step; with `plan`, a streaming client
+    sends a WALK with its window from next_step_index_needed before each step until the
+    walk has returned to Stand."""
+    sim, seen = interface.sim, Run()
+    needed = 1
+    for _ in range(round(seconds / sim.dt_s)):
+        if plan is not None and Behavior.STAND not in seen.behaviors:
+            interface.apply(walk_command(window(plan, needed)))
+        sim.step()
+        state = interface.state()
+        interface.end_step()
+        seen.behaviors.append(state.current_behavior)
+        seen.status.append(state.behavior_feedback.status_flags)
+        seen.walk_flags.append(state.walk_feedback.status_flags)
+        seen.current_steps.append(state.walk_feedback.current_step_index)
+        seen.lowest_pelvis_m = min(seen.lowest_pelvis_m, state.pelvis_position_m[2])
+        needed = state.walk_feedback.next_step_index_needed
+    return seen
+
+
+def feet(interface: AtlasSimInterface) -> np.ndarray:
+    """The feet's x, y now (left, right)."""
+    return interface.state().foot_poses[:, 0:2]
+
+
+def changes(values: list[int]) -> list[int]:
+    """`values` without repeats in a row."""
+    return [v for i, v in enumerate(values) if i == 0 or v != values[i - 1]]
+
+
+def test_a_walk_command_walks_its_queue_and_returns_to_stand_by_itself(
+        atlas: atlas_model.AtlasModel) -> None:
+    interface = standing(atlas)
+    interface.apply(walk_command(list(DRCSIM_WALK_QUEUE)))
+    assert interface.sim.mode is ControlMode.WALK
+    seen = run(interface, RUN_S)
+    assert seen.lowest_pelvis_m > PELVIS_ABOVE_M
+    # Walk, then Stand by itself, warning so once it is there.
+    assert changes(seen.behaviors) == [Behavior.WALK, Behavior.STAND]
+    assert changes(seen.status) == [Status.TRANSITION_SUCCESS, Status.OK,
+                                    Status.WARNING_AUTO_TRANS]
+    assert seen.status[seen.behaviors.index(Behavior.STAND)] == Status.WARNING_AUTO_TRANS
+    # Sway, four steps (the queue running short from the second), catch; zeros in Stand.
+    insufficient = STEPPING | WARNING_INSUFFICIENT_STEP_DATA
+    assert changes(seen.walk_flags) == [SWAYING, STEPPING, insufficient,
+                                        CATCHING | WARNING_INSUFFICIENT_STEP_DATA, 0]
+    assert changes(seen.current_steps) == [0, 1, 2, 3, 4, 0]
+    state = interface.state()
+    assert state.behavior_feedback.trans_from_behavior_index == Behavior.WALK
+    assert state.behavior_feedback.trans_to_behavior_index == Behavior.STAND
+    np.testing.assert_allclose(feet(interface), [[0.6, 0.12], [0.8, -0.12]],
+                               atol=LANDING_WITHIN_M)
+
+
+def test_a_client_streaming_its_window_at_1khz_walks_the_same_walk(
+        atlas: atlas_model.AtlasModel) -> None:
+    plan = list(DRCSIM_WALK_QUEUE)
+    once, streamed = standing(atlas), standing(atlas)
+    once.apply(walk_command(plan))
+    run(once, RUN_S)
+    seen = run(streamed, RUN_S, plan)
+    assert changes(seen.behaviors) == [Behavior.WALK, Behavior.STAND]
+    assert streamed.sim.data.qpos.tobytes() == once.sim.data.qpos.tobytes()
+
+
+def test_control_mode_walk_walks_drcsims_queue(atlas: atlas_model.AtlasModel) -> None:
+    interface = standing(atlas)
+    interface.sim.set_mode(ControlMode.WALK)  # what /atlas/control_mode Walk does
+    seen = run(interface, RUN_S)
+    assert seen.lowest_pelvis_m > PELVIS_ABOVE_M
+    assert changes(seen.behaviors) == [Behavior.WALK, Behavior.STAND]
+    assert max(seen.current_steps) == 4
+    np.testing.assert_allclose(feet(interface), [[0.6, 0.12], [0.8, -0.12]],
+                               atol=LANDING_WITHIN_M)
+
+
+def test_two_steps_with_one_foot_end_the_walk_inconsistent(
+        atlas: atlas_model.AtlasModel) -> None:
+    interface = standing(atlas)
+    plan = [Footstep(1, 0, 0.2, 0.12, 0.0), Footstep(2, 0, 0.4, 0.12, 0.0)]
+    interface.apply(walk_command(plan))
+    seen = run(interface, 4.0)
+    assert seen.lowest_pelvis_m > PELVIS_ABOVE_M
+    assert max(seen.current_steps) == 1  # the first step only
+    assert any(flags & ERROR_INCONSISTENT_STEPS for flags in seen.walk_flags)
+    assert seen.behaviors[-1] == Behavior.STAND
+
+
+def test_without_the_balancing_stand_walk_is_not_served(
+        atlas: atlas_model.AtlasModel) -> None:
+    interface = standing(atlas, balance=False)
+    interface.apply(walk_command(list(DRCSIM_WALK_QUEUE)))
+    state = interface.state()
+    assert state.current_behavior == Behavior.STAND
+    assert state.behavior_feedback.status_flags == Status.FAILED_TRANS_ILLEGAL_BEHAVIOR
+    assert state.error_code == AsiError.BEHAVIOR_NOT_IMPLEMENTED
+    assert len(state.k_effort) == NUM_JOINTS
