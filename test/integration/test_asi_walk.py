@@ -2,7 +2,10 @@
 queue walked with walk_feedback as ASI.md says, then Stand by itself (WARNING_AUTO_TRANS);
 a client streaming its window at 1 kHz walks the same walk; /atlas/control_mode Walk walks
 DRCSim's fixed queue; two steps with one foot end the walk (ERROR_INCONSISTENT_STEPS);
-without the balancing Stand, Walk is not served. About 12 s of CPU.
+without the balancing Stand, Walk is not served. DRCSim's scripts' sequence from the
+harness (harnessed, StandPrep, 5 s, nominal, 0.3 s, Stand, 1 s, Walk) lands, stands, walks
+and stands; eight steps walked with the arms swung slowly under the user's PID (mixed
+control). About 25 s of CPU.
 """
 
 from __future__ import annotations
@@ -13,14 +16,22 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from support.arm_swing import ARMS, arm_command, swung
 from tutorial_atlas_control.asi import AsiError, AtlasSimInterface, Behavior, Status
 from tutorial_atlas_control.balance import place_in_stand_pose
 from tutorial_atlas_control.control_modes import ControlMode
-from tutorial_atlas_control.joints import NUM_JOINTS
+from tutorial_atlas_control.joints import JOINT_INDEX, NUM_JOINTS
 from tutorial_atlas_control.msgs.atlas_sim_interface import AsiCommand, ManipulateParams, StepData
-from tutorial_atlas_control.sim import AtlasSimulator, load_gains_yaml, load_model
+from tutorial_atlas_control.sim import (
+    AtlasSimulator,
+    ModeInput,
+    VrcMode,
+    load_gains_yaml,
+    load_model,
+    pelvis_height_m,
+)
 from tutorial_atlas_control.sim import model as atlas_model
-from tutorial_atlas_control.walking import DRCSIM_WALK_QUEUE, Footstep, window
+from tutorial_atlas_control.walking import DRCSIM_WALK_QUEUE, Footstep, straight_steps, window
 from tutorial_atlas_control.walking.step_queue import (
     CATCHING,
     ERROR_INCONSISTENT_STEPS,
@@ -176,3 +187,58 @@ def test_without_the_balancing_stand_walk_is_not_served(
     assert state.behavior_feedback.status_flags == Status.FAILED_TRANS_ILLEGAL_BEHAVIOR
     assert state.error_code == AsiError.BEHAVIOR_NOT_IMPLEMENTED
     assert len(state.k_effort) == NUM_JOINTS
+
+
+def test_from_the_harness_it_lands_stands_walks_and_stands(
+        atlas: atlas_model.AtlasModel) -> None:
+    """DRCSim's scripts: /atlas/mode harnessed, StandPrep, 5 s, nominal, 0.3 s, Stand, 1 s,
+    /atlas/control_mode Walk."""
+    sim = AtlasSimulator(atlas, load_gains_yaml(CONFIG))
+    interface = AtlasSimInterface(sim)
+    run(interface, 1.5)
+    sim.apply_input(ModeInput(VrcMode.HARNESSED))
+    sim.set_mode(ControlMode.STAND_PREP)
+    run(interface, 5.0)
+    sim.apply_input(ModeInput(VrcMode.NOMINAL))
+    landing = run(interface, 0.3)
+    sim.set_mode(ControlMode.STAND)
+    standing = run(interface, 1.0)
+    sim.set_mode(ControlMode.WALK)
+    walking = run(interface, RUN_S)
+    assert min(landing.lowest_pelvis_m, standing.lowest_pelvis_m,
+               walking.lowest_pelvis_m) > PELVIS_ABOVE_M
+    assert changes(walking.behaviors) == [Behavior.WALK, Behavior.STAND]
+    assert max(walking.current_steps) == 4
+    assert pelvis_height_m(sim.atlas, sim.data) == pytest.approx(0.912, abs=0.01)
+    np.testing.assert_allclose(feet(interface), [[0.6, 0.12], [0.8, -0.12]],
+                               atol=LANDING_WITHIN_M)
+
+
+#: Mixed control while walking: both arms' shoulder pitch through this range (rad) at
+#: this frequency (Hz), slowly, under the user's PID.
+ARM_SWING_RAD = 0.5
+ARM_SWING_HZ = 0.25
+
+
+def test_eight_steps_with_the_arms_swung_under_the_users_pid(
+        atlas: atlas_model.AtlasModel) -> None:
+    """k_effort 255 on the arm joints, the Walk's balance treating them as a disturbance."""
+    interface = standing(atlas)
+    sim = interface.sim
+    assert interface.walking is not None
+    interface.walking.next_steps = straight_steps(8, 0.25)
+    sim.set_mode(ControlMode.WALK)
+    lowest, steps = np.inf, 0
+    for k in range(round(8 * 0.63 / sim.dt_s) + 4000):
+        if k % 20 == 0:  # the tutorial's 50 Hz
+            sim.receive_updates(arm_command(swung('usy', ARM_SWING_RAD, ARM_SWING_HZ,
+                                                  k * sim.dt_s), sim.gains))
+        sim.step()
+        state = interface.state()
+        interface.end_step()
+        lowest = min(lowest, state.pelvis_position_m[2])
+        steps = max(steps, state.walk_feedback.current_step_index)
+    assert lowest > PELVIS_ABOVE_M
+    assert steps == 8
+    assert sim.mode is ControlMode.STAND
+    assert (sim.active_k_effort()[[JOINT_INDEX[name] for name in ARMS]] == 255).all()

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from support.arm_swing import ARMS, arm_command, swung
 from tutorial_atlas_control.asi import AtlasSimInterface, Behavior
 from tutorial_atlas_control.balance import TRANSITION_S, StandBehaviour
 from tutorial_atlas_control.balance.push_trial import (
@@ -23,15 +24,13 @@ from tutorial_atlas_control.balance.push_trial import (
     stand_trial,
 )
 from tutorial_atlas_control.balance.stand import StandGains, yaw_of
-from tutorial_atlas_control.command import K_EFFORT_ROW, CommandUpdate, command_update
-from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES
+from tutorial_atlas_control.joints import JOINT_INDEX
 from tutorial_atlas_control.msgs.atlas_sim_interface import AsiCommand, ManipulateParams, StepData
 from tutorial_atlas_control.sim import (
     DEFAULT_GAINS_FILE,
     STAND_POSE_RAD,
     AtlasSimulator,
     ControlMode,
-    Gains,
     ModeInput,
     VrcMode,
     load_gains_yaml,
@@ -184,25 +183,11 @@ def test_harness_drop_lands_and_stands() -> None:
     assert end == pytest.approx(0.912, abs=0.01)
 
 
-ARMS = [name for name in JOINT_NAMES if '_arm_' in name]
 #: The arms swing through this range (rad), about the Stand pose, at SWING_HZ.
 SWING_RAD = 1.5
 SWING_HZ = 0.5
 #: Mixed control's goal: the pelvis moves less than this (m) while the arms swing.
 PELVIS_MOVE_M = 0.05
-
-
-def arm_command(positions: np.ndarray, gains: Gains) -> list[CommandUpdate]:
-    """A JointCommands for the arms with the parameter gains, and k_effort 255 on them (as
-    an AtlasCommand would set): the user's PID drives the arms, Stand the rest."""
-    arms = np.array([JOINT_INDEX[name] for name in ARMS])
-    zeros = np.zeros(len(arms))
-    return [command_update(ARMS, {
-        'position': positions[arms], 'velocity': zeros, 'effort': zeros,
-        'kp_position': gains.p[arms], 'ki_position': gains.i[arms], 'kd_position': gains.d[arms],
-        'kp_velocity': zeros, 'i_effort_min': -gains.i_clamp[arms],
-        'i_effort_max': gains.i_clamp[arms]}),
-        CommandUpdate(arms, (K_EFFORT_ROW,), np.ones((1, len(arms))))]
 
 
 @pytest.mark.parametrize('joint', ['usy', 'shx'])
@@ -216,11 +201,8 @@ def test_arms_swung_under_the_users_pid_while_stand_balances(joint: str) -> None
     moved = 0.0
     for k in range(4000):
         if k % 20 == 0:  # the tutorial's 50 Hz
-            target = STAND_POSE_RAD.copy()
-            for side in 'lr':
-                target[JOINT_INDEX[f'{side}_arm_{joint}']] += (
-                    SWING_RAD / 2 * np.sin(2 * np.pi * SWING_HZ * k * sim.dt_s))
-            sim.receive_updates(arm_command(target, sim.gains))
+            sim.receive_updates(arm_command(swung(joint, SWING_RAD, SWING_HZ, k * sim.dt_s),
+                                            sim.gains))
         sim.step()
         moved = max(moved, float(np.linalg.norm(sim.data.qpos[adr:adr + 3] - start)))
     arms = [JOINT_INDEX[name] for name in ARMS]

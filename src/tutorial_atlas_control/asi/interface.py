@@ -25,7 +25,7 @@ import numpy as np
 
 from tutorial_atlas_control.asi.behaviors import BEHAVIOR_OF_MODE, MODE_OF_BEHAVIOR, Behavior
 from tutorial_atlas_control.asi.session import STANDING_BEHAVIORS, AsiSession
-from tutorial_atlas_control.asi.walk_params import footsteps_of, walk_feedback
+from tutorial_atlas_control.asi.walk_params import footsteps_of, sole_step, walk_feedback
 from tutorial_atlas_control.balance import (
     BalanceEstimator,
     PelvisServo,
@@ -45,7 +45,7 @@ from tutorial_atlas_control.msgs import (
     WalkFeedback,
 )
 from tutorial_atlas_control.sim import AtlasSimulator
-from tutorial_atlas_control.walking import WalkBehaviour
+from tutorial_atlas_control.walking import DRCSIM_WALK_QUEUE, WalkBehaviour
 
 __all__ = ['FALLING_PELVIS_M', 'FALLING_TILT_RAD', 'AtlasSimInterface']
 
@@ -106,7 +106,9 @@ class AtlasSimInterface:
         sim.install_stand(self.stand)
         sim.install_stand(StandPrepBehaviour(sim.atlas, sim.gains), ControlMode.STAND_PREP)
         self.session.served[Behavior.MANIPULATE] = ControlMode.STAND
-        self.walking = WalkBehaviour(self.stand)
+        ahead = self.stand.estimator.sole_ahead_m
+        self.walking = WalkBehaviour(self.stand, default_steps=[
+            sole_step(step, ahead) for step in DRCSIM_WALK_QUEUE])
         sim.install_stand(self.walking, ControlMode.WALK)
         self.session.served[Behavior.WALK] = ControlMode.WALK
         self._estimator = self.stand.estimator
@@ -131,7 +133,8 @@ class AtlasSimInterface:
         """The command's behaviour requested; a WALK's steps to the walk, running or starting.
         A WALK without steps starts nothing: it is a streaming client's last, empty window,
         sent after its walk ended."""
-        steps = footsteps_of(command.step_queue) if command.behavior == Behavior.WALK else []
+        steps = (footsteps_of(command.step_queue, self._estimator.sole_ahead_m)
+                 if command.behavior == Behavior.WALK else [])
         if command.behavior == Behavior.WALK != current and not steps:
             return
         feet_under_com = command.behavior == current or self.com_over_feet()
@@ -239,7 +242,8 @@ class AtlasSimInterface:
                                                session.trans_from_behavior,
                                                session.trans_to_behavior),
             manipulate_feedback=self.manipulate_feedback(),
-            walk_feedback=(walk_feedback(self.walking.status(float(data.time)))
+            walk_feedback=(walk_feedback(self.walking.status(float(data.time)),
+                                         self._estimator.sole_ahead_m)
                            if current == Behavior.WALK and self.walking is not None
                            else WalkFeedback()),
             k_effort=self.k_effort())

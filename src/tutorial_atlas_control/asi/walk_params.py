@@ -2,7 +2,10 @@
 walk_feedback from the walk's status.
 
 Poses are taken as ASI.md says: x, y and the yaw of the orientation, in the frame of
-pos_est (the world's here); z and swing_height are ignored on flat ground. A slot with
+pos_est (the world's here); z and swing_height are ignored on flat ground. A step's pose is
+the foot link's, the point foot_pos_est reports (so a step to where foot_pos_est says a
+foot is steps in place, and DRCSim's fixed queue's 0.2 m are the ankles' strides); the
+walk places sole centres, `sole_ahead_m` ahead of it along the foot. A slot with
 step_index 0 is unused (a default message's queue is four of them).
 """
 
@@ -10,30 +13,42 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
+from dataclasses import replace
 
 from tutorial_atlas_control.msgs import STEP_QUEUE_LENGTH, StepData, WalkFeedback
 from tutorial_atlas_control.walking import SWING_HEIGHT_M, Footstep, WalkStatus
 
-__all__ = ['footsteps_of', 'step_data_of', 'walk_feedback']
+__all__ = ['footsteps_of', 'sole_step', 'step_data_of', 'walk_feedback']
 
 
-def footsteps_of(queue: Iterable[StepData]) -> list[Footstep]:
-    """The used slots of walk_params.step_queue (foot indices checked by the decoder)."""
-    return [Footstep(step.step_index, step.foot_index, step.position_m[0], step.position_m[1],
-                     step.yaw_rad(), step.duration_s)
+def sole_step(step: Footstep, sole_ahead_m: float) -> Footstep:
+    """A step of the foot link as the step of its sole's centre."""
+    return replace(step, x_m=step.x_m + sole_ahead_m * math.cos(step.yaw_rad),
+                   y_m=step.y_m + sole_ahead_m * math.sin(step.yaw_rad))
+
+
+def footsteps_of(queue: Iterable[StepData], sole_ahead_m: float) -> list[Footstep]:
+    """The used slots of walk_params.step_queue (foot indices checked by the decoder), as
+    the soles' steps."""
+    return [sole_step(Footstep(step.step_index, step.foot_index, step.position_m[0],
+                               step.position_m[1], step.yaw_rad(), step.duration_s),
+                      sole_ahead_m)
             for step in queue if step.step_index > 0]
 
 
-def step_data_of(step: Footstep) -> StepData:
-    """A footstep as AtlasBehaviorStepData: on the ground, our swing height."""
+def step_data_of(step: Footstep, sole_ahead_m: float) -> StepData:
+    """A sole's step as the foot link's AtlasBehaviorStepData: on the ground, our swing
+    height."""
+    link = sole_step(step, -sole_ahead_m)
     half = 0.5 * step.yaw_rad
-    return StepData(step.step_index, step.foot_index, step.duration_s, (step.x_m, step.y_m, 0.0),
+    return StepData(step.step_index, step.foot_index, step.duration_s, (link.x_m, link.y_m, 0.0),
                     (0.0, 0.0, math.sin(half), math.cos(half)), SWING_HEIGHT_M)
 
 
-def walk_feedback(status: WalkStatus) -> WalkFeedback:
+def walk_feedback(status: WalkStatus, sole_ahead_m: float) -> WalkFeedback:
     """AtlasBehaviorWalkFeedback; step_queue_saturated padded with empty slots to four."""
-    saturated = [step_data_of(step) for step in status.steps_saturated[:STEP_QUEUE_LENGTH]]
+    saturated = [step_data_of(step, sole_ahead_m)
+                 for step in status.steps_saturated[:STEP_QUEUE_LENGTH]]
     saturated += [StepData()] * (STEP_QUEUE_LENGTH - len(saturated))
     return WalkFeedback(status.t_step_rem_s, status.current_step_index,
                         status.next_step_index_needed, status.status_flags, tuple(saturated))

@@ -22,7 +22,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                    'stand_trial', 'standing_simulator'],
     'stand': ['StandController', 'StandGains', 'StandOutput', 'StandReference',
               'orientation_error', 'yaw_of', 'yaw_rotation'],
-    'stand_behaviour': ['TRANSITION_S', 'StandBehaviour', 'stand_pose_com_height_m'],
+    'stand_behaviour': ['TRANSITION_S', 'StandBehaviour', 'smoothstep', 'stand_pose_com_height_m'],
     'stand_pose': ['STAND_POSE_RAD', 'place_in_stand_pose', 'sole_corners'],
     'stand_prep': ['PREP_S', 'StandPrepBehaviour'],
     'support': ['Region', 'clamp_into', 'convex_hull', 'inside', 'shrink', 'signed_distance'],

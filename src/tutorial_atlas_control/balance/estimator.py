@@ -74,6 +74,12 @@ class BalanceEstimator:
                              | None) = None
 
     @property
+    def sole_ahead_m(self) -> float:
+        """How far ahead of its foot link's origin (the ankle) a sole's centre lies (m),
+        along the foot: the model's."""
+        return float(self.model.geom_pos[self._soles[0]][0])
+
+    @property
     def sole_half_size_m(self) -> tuple[float, float]:
         """(half length, half width) of a sole box (m): the model's."""
         return float(self._half_size[0]), float(self._half_size[1])

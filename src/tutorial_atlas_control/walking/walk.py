@@ -29,6 +29,7 @@ from tutorial_atlas_control.balance import (
     clamp_into,
     convex_hull,
     orientation_error,
+    smoothstep,
     yaw_of,
     yaw_rotation,
 )
@@ -130,6 +131,8 @@ class WalkController:
         joint_kd[LEG_JOINTS] = self.gains.leg_kd
         self._joint_gains = (joint_kp, joint_kd)
         self._sway_cop = np.zeros(2)
+        #: The pelvis's heading moving on: (start time, duration, from, turn) (s, rad).
+        self._facing = (time_s, 1.0, yaw_of(stand.reference.pelvis_rotation), 0.0)
         self._begin_sway(state, time_s)
 
     # -- the phases ---------------------------------------------------------------------------
@@ -166,21 +169,32 @@ class WalkController:
         lift = state.sole_centres[step.foot_index]
         self.step = step
         stance = self.queue.feet[1 - step.foot_index]
-        self._face(stance.yaw_rad, step.yaw_rad)
+        self._face(stance.yaw_rad, step.yaw_rad, time_s, step.duration_s)
         self.swing = SwingPath(lift.copy(), np.array([step.x_m, step.y_m, 0.0]),
                                foot_pose(state, step.foot_index).yaw_rad, step.yaw_rad,
                                step.duration_s)
         self.phase, self.phase_start_s = STEPPING, time_s
 
     def _begin_catch(self, state: BalanceState, time_s: float) -> None:
-        self._face(self.queue.feet[0].yaw_rad, self.queue.feet[1].yaw_rad)
+        self._face(self.queue.feet[0].yaw_rad, self.queue.feet[1].yaw_rad, time_s,
+                   self.gains.catch_s)
         self.step, self.swing, self._plan = None, None, None
         self.phase, self.phase_start_s = CATCHING, time_s
 
-    def _face(self, first_yaw_rad: float, second_yaw_rad: float) -> None:
-        """Hold the pelvis upright, facing halfway between two feet's headings."""
-        yaw = first_yaw_rad + 0.5 * wrap_angle(second_yaw_rad - first_yaw_rad)
-        self.stand.reference = replace(self.stand.reference, pelvis_rotation=yaw_rotation(yaw))
+    def _face(self, first_yaw_rad: float, second_yaw_rad: float, time_s: float,
+              duration_s: float) -> None:
+        """Turn the pelvis, upright, to face halfway between two feet's headings over
+        `duration_s` (a smoothstep from where its heading is now: a jump in the heading's
+        reference at each step kicked the pelvis, which the stance sole's little yaw
+        moment could not stop)."""
+        now = self._heading(time_s)
+        goal = first_yaw_rad + 0.5 * wrap_angle(second_yaw_rad - first_yaw_rad)
+        self._facing = (time_s, duration_s, now, wrap_angle(goal - now))
+
+    def _heading(self, time_s: float) -> float:
+        """The pelvis heading's reference at `time_s` (rad)."""
+        started_s, duration_s, start, turn = self._facing
+        return start + smoothstep((time_s - started_s) / duration_s) * turn
 
     def _advance(self, state: BalanceState, time_s: float) -> None:
         """Move on to the next phase when this one's time is up."""
@@ -256,6 +270,8 @@ class WalkController:
         """The 28 joint torques (N m) for this 1 ms step, within the effort limits."""
         self._advance(state, time_s)
         stand, gains = self.stand, self.gains
+        stand.reference = replace(stand.reference,
+                                  pelvis_rotation=yaw_rotation(self._heading(time_s)))
         xi_ref, cop_ref = self._capture_reference(state, time_s)
         cop = tracking_cop(state.capture_point, xi_ref, cop_ref, gains.dcm_gain)
         swinging = self.phase == STEPPING and self.step is not None

@@ -3,10 +3,10 @@
 It shares the balancing Stand's estimator and whole-body controller. On start it takes the
 robot over where it stands (the Stand's reference made from the present state, as Stand
 itself does), builds a step queue from the feet as they are, and walks `next_steps` (set
-before the start from an AtlasSimInterfaceCommand's queue) or, without them, DRCSim's fixed
-queue (/atlas/control_mode Walk). Steps offered while it walks join the queue by index.
-Once the walk has caught itself after its last step it is `done`: the interface then
-hands the robot back to Stand.
+before the start from an AtlasSimInterfaceCommand's queue) or, without them, its default
+steps (DRCSim's fixed queue: /atlas/control_mode Walk). Steps offered while it walks
+join the queue by index. Once the walk has caught itself after its last step it is
+`done`: the interface then hands the robot back to Stand.
 """
 
 from __future__ import annotations
@@ -46,13 +46,16 @@ class WalkBehaviour:
     """Walk on `stand`'s balance; steps come through `offer`."""
 
     def __init__(self, stand: StandBehaviour, gains: WalkGains | None = None,
-                 limits: StepLimits = DEFAULT_LIMITS) -> None:
+                 limits: StepLimits = DEFAULT_LIMITS,
+                 default_steps: Iterable[Footstep] = DRCSIM_WALK_QUEUE) -> None:
+        """`default_steps`: what a start without next_steps walks."""
         self.stand = stand
+        self.default_steps = tuple(default_steps)
         self.gains = gains
         self.limits = limits
         #: The walk under way (None before the first start).
         self.walk: WalkController | None = None
-        #: The steps the next start walks (None: DRCSim's fixed queue).
+        #: The steps the next start walks (None: default_steps).
         self.next_steps: list[Footstep] | None = None
 
     @property
@@ -74,7 +77,7 @@ class WalkBehaviour:
         controller, state = stand.controller, stand.last_state
         assert controller is not None and state is not None  # set by start
         queue = StepQueue(foot_pose(state, 0), foot_pose(state, 1), self.limits)
-        queue.offer(DRCSIM_WALK_QUEUE if self.next_steps is None else self.next_steps)
+        queue.offer(self.default_steps if self.next_steps is None else self.next_steps)
         self.next_steps = None
         self.walk = WalkController(controller, queue, state, float(data.time), self.gains)
 
