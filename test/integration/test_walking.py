@@ -16,6 +16,7 @@ import pytest
 
 from tutorial_atlas_control.balance import STANDING_PELVIS_M
 from tutorial_atlas_control.walking import DRCSIM_WALK_QUEUE, straight_steps
+from tutorial_atlas_control.walking.leg_tasks import LegGains
 from tutorial_atlas_control.walking.walk import WalkGains
 from tutorial_atlas_control.walking.walk_trial import SETTLE_S, walk_trial
 
@@ -74,6 +75,7 @@ def test_a_client_streaming_its_window_every_step_walks_the_same_walk() -> None:
 
 
 def test_without_the_torsion_limit_the_stance_foot_turns_and_it_falls() -> None:
-    trial = walk_trial(straight_steps(STRAIGHT_STEPS, STRIDE_M), 20.0, WalkGains(torsion_m=None))
+    trial = walk_trial(straight_steps(STRAIGHT_STEPS, STRIDE_M), 20.0,
+                       WalkGains(legs=LegGains(torsion_m=None)))
     assert trial.fell
     assert trial.steps == 3

@@ -4,7 +4,8 @@ footsteps: a step as the AtlasSimInterface names it, DRCSim's fixed queue, strai
 circular plans, a streaming client's window; step_queue: Walk's queue of steps merged by
 index, clamped to what the legs reach, and its feedback flags; dcm_plan: the capture
 point's plan over the steps and the law that tracks it; swing: the swing foot's path;
-walk: the walk's phases on the Stand's whole-body balance; walk_behaviour: Walk as the
+leg_tasks: what Walk and Step do alike each step (the whole-body law on the carrying
+soles, the swing foot, the pelvis's heading); walk: the walk's phases; walk_behaviour: Walk as the
 simulator's behaviour; walk_trial: offline walking trials, landing by landing.
 """
 
@@ -18,7 +19,8 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'step_queue': ['CATCHING', 'ERROR_INCONSISTENT_STEPS', 'OKAY', 'STEPPING', 'SWAYING',
                    'WARNING_INSUFFICIENT_STEP_DATA', 'StepLimits', 'StepQueue', 'clamp_step'],
     'swing': ['SWING_HEIGHT_M', 'SwingPath', 'bump', 'quintic'],
-    'walk': ['WalkController', 'WalkGains', 'WalkOutput', 'foot_pose', 'sway_cop'],
+    'leg_tasks': ['LEG_JOINTS', 'LegGains', 'LegTasks', 'foot_pose'],
+    'walk': ['WalkController', 'WalkGains', 'WalkOutput', 'sway_cop'],
     'walk_behaviour': ['WalkBehaviour', 'WalkStatus'],
     'walk_trial': ['Landing', 'WalkTrial', 'WalkingStand', 'walk_trial'],
 })

@@ -8,33 +8,22 @@ Stand takes over. At each touchdown the capture point's plan (dcm_plan) is made 
 over the steps the queue then holds, so a streaming client's new steps enter it as
 they come.
 
-Each 1 ms step: the pressure centre p = p_ref + (1 + k)(xi - xi_ref) is kept inside the
-support polygon (the stance sole alone while a foot swings), the Stand's centroidal
-wrench and contact split turn it into torques by inverse statics, and the swing foot's
-task-space PD force, mapped through its Jacobian, moves the swing leg; the legs' posture
-PD of Stand is off (in single support the stance leg's joints follow from the pelvis
-and the foot, the swing leg's from its task).
+Each 1 ms step: the pressure centre p = p_ref + (1 + k)(xi - xi_ref), and leg_tasks
+turns it into torques (the Stand's whole-body law on the carrying soles, the swing foot's
+task-space PD, feet put back down).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from tutorial_atlas_control.balance import (
-    BalanceState,
-    StandController,
-    clamp_into,
-    convex_hull,
-    orientation_error,
-    smoothstep,
-    yaw_of,
-    yaw_rotation,
-)
+from tutorial_atlas_control.balance import BalanceState, StandController
 from tutorial_atlas_control.walking.dcm_plan import DcmPlan, tracking_cop
-from tutorial_atlas_control.walking.footsteps import Footstep, wrap_angle
+from tutorial_atlas_control.walking.footsteps import Footstep
+from tutorial_atlas_control.walking.leg_tasks import LegGains, LegTasks, foot_pose
 from tutorial_atlas_control.walking.step_queue import (
     CATCHING,
     STEPPING,
@@ -42,9 +31,6 @@ from tutorial_atlas_control.walking.step_queue import (
     StepQueue,
 )
 from tutorial_atlas_control.walking.swing import SwingPath
-
-#: The leg joints (tutorial order): their Stand posture PD is off while walking.
-LEG_JOINTS = slice(4, 16)
 
 
 @dataclass(frozen=True)
@@ -60,28 +46,8 @@ class WalkGains:
     #: after longest_catch_s (s).
     at_rest_m: float = 0.01
     longest_catch_s: float = 3.0
-    #: The swing foot's task-space PD: position (N/m, N s/m), orientation (N m/rad, N m s/rad).
-    #: At 2500 N/m and 200 N m/rad the first swing foot lagged its path by 3 cm and landed
-    #: late; these walk DRCSim's queue and 20 straight steps.
-    swing_kp: float = 6000.0
-    swing_kd: float = 150.0
-    swing_rotation_kp: float = 600.0
-    swing_rotation_kd: float = 30.0
-    #: Damping on the leg joints (N m s/rad) in place of Stand's posture PD.
-    leg_kd: float = 2.0
-    #: A swing foot not down when its step's time is up keeps going down at this speed
-    #: (m/s), for at most late_touchdown_s (s), before the next step begins anyway.
-    touchdown_speed_m_s: float = 0.2
-    late_touchdown_s: float = 0.4
-    #: The yaw moment a stance sole may take, per newton it bears (m): the model's
-    #: torsional friction is 0.02 m (sim/atlas_v1.xml); beyond it the foot turns.
-    torsion_m: float = 0.015
-    #: A foot put back down aims this far below the ground (m), so that it lands.
-    press_m: float = 0.005
-    #: A sole is flat on the ground with its centre below flat_height_m (m) and its normal
-    #: within acos(flat_cos) of vertical (0.05 rad).
-    flat_height_m: float = 0.005
-    flat_cos: float = 0.99875
+    #: The legs' gains and limits (leg_tasks).
+    legs: LegGains = field(default_factory=LegGains)
 
 
 @dataclass(frozen=True)
@@ -93,13 +59,6 @@ class WalkOutput:
     capture_point_ref: np.ndarray  # (2,)
     phase: int                    # SWAYING, STEPPING or CATCHING
     swing_foot: int | None
-
-
-def foot_pose(state: BalanceState, foot: int, step_index: int = 0) -> Footstep:
-    """Where a foot is now, as a step (sole centre and heading)."""
-    centre = state.sole_centres[foot]
-    return Footstep(step_index, foot, float(centre[0]), float(centre[1]),
-                    yaw_of(state.sole_rotations[foot]))
 
 
 def sway_cop(xi_now: np.ndarray, xi_target: np.ndarray, omega: float,
@@ -118,6 +77,7 @@ class WalkController:
         self.stand = stand
         self.queue = queue
         self.gains = gains or WalkGains()
+        self.legs = LegTasks(stand, self.gains.legs, time_s)
         self.phase = SWAYING
         self.done = False
         self.phase_start_s = time_s
@@ -125,14 +85,7 @@ class WalkController:
         self.step: Footstep | None = None
         self.swing: SwingPath | None = None
         self._plan: DcmPlan | None = None
-        #: The Stand's joint PD with the legs' posture gains off (damping leg_kd instead).
-        joint_kp, joint_kd = stand.gains.joint_kp.copy(), stand.gains.joint_kd.copy()
-        joint_kp[LEG_JOINTS] = 0.0
-        joint_kd[LEG_JOINTS] = self.gains.leg_kd
-        self._joint_gains = (joint_kp, joint_kd)
         self._sway_cop = np.zeros(2)
-        #: The pelvis's heading moving on: (start time, duration, from, turn) (s, rad).
-        self._facing = (time_s, 1.0, yaw_of(stand.reference.pelvis_rotation), 0.0)
         self._begin_sway(state, time_s)
 
     # -- the phases ---------------------------------------------------------------------------
@@ -169,32 +122,17 @@ class WalkController:
         lift = state.sole_centres[step.foot_index]
         self.step = step
         stance = self.queue.feet[1 - step.foot_index]
-        self._face(stance.yaw_rad, step.yaw_rad, time_s, step.duration_s)
+        self.legs.face(stance.yaw_rad, step.yaw_rad, time_s, step.duration_s)
         self.swing = SwingPath(lift.copy(), np.array([step.x_m, step.y_m, 0.0]),
                                foot_pose(state, step.foot_index).yaw_rad, step.yaw_rad,
                                step.duration_s)
         self.phase, self.phase_start_s = STEPPING, time_s
 
     def _begin_catch(self, state: BalanceState, time_s: float) -> None:
-        self._face(self.queue.feet[0].yaw_rad, self.queue.feet[1].yaw_rad, time_s,
+        self.legs.face(self.queue.feet[0].yaw_rad, self.queue.feet[1].yaw_rad, time_s,
                    self.gains.catch_s)
         self.step, self.swing, self._plan = None, None, None
         self.phase, self.phase_start_s = CATCHING, time_s
-
-    def _face(self, first_yaw_rad: float, second_yaw_rad: float, time_s: float,
-              duration_s: float) -> None:
-        """Turn the pelvis, upright, to face halfway between two feet's headings over
-        `duration_s` (a smoothstep from where its heading is now: a jump in the heading's
-        reference at each step kicked the pelvis, which the stance sole's little yaw
-        moment could not stop)."""
-        now = self._heading(time_s)
-        goal = first_yaw_rad + 0.5 * wrap_angle(second_yaw_rad - first_yaw_rad)
-        self._facing = (time_s, duration_s, now, wrap_angle(goal - now))
-
-    def _heading(self, time_s: float) -> float:
-        """The pelvis heading's reference at `time_s` (rad)."""
-        started_s, duration_s, start, turn = self._facing
-        return start + smoothstep((time_s - started_s) / duration_s) * turn
 
     def _advance(self, state: BalanceState, time_s: float) -> None:
         """Move on to the next phase when this one's time is up."""
@@ -204,7 +142,7 @@ class WalkController:
         elif self.phase == STEPPING and self.step is not None \
                 and elapsed >= self.step.duration_s \
                 and (state.in_contact[self.step.foot_index]
-                     or elapsed >= self.step.duration_s + self.gains.late_touchdown_s):
+                     or elapsed >= self.step.duration_s + self.gains.legs.late_touchdown_s):
             self.queue.touchdown(foot_pose(state, self.step.foot_index, self.step.step_index))
             self._begin_step(state, time_s)
         elif self.phase == CATCHING and elapsed >= self.gains.catch_s and (
@@ -227,80 +165,27 @@ class WalkController:
         middle = state.sole_centres[:, :2].mean(axis=0)
         return middle, middle
 
-    def _swing_torque(self, state: BalanceState, time_s: float) -> np.ndarray:
-        """The swing leg's torques (28,) from its foot's task-space PD."""
-        assert self.swing is not None and self.step is not None
-        foot = self.step.foot_index
-        gains = self.gains
-        elapsed = time_s - self.phase_start_s
-        position, velocity, yaw, yaw_rate = self.swing.at(elapsed)
-        late = elapsed - self.swing.duration_s
-        if late > 0.0:  # not down yet: on down
-            position[2] -= gains.touchdown_speed_m_s * late
-            velocity[2] = -gains.touchdown_speed_m_s
-        return self._foot_pd(state, foot, position, velocity, yaw, yaw_rate)
-
-    def _foot_pd(self, state: BalanceState, foot: int, position: np.ndarray,
-                 velocity: np.ndarray, yaw: float, yaw_rate: float) -> np.ndarray:
-        """The leg's torques (28,) moving a sole towards a pose (task-space PD)."""
-        gains = self.gains
-        twist = state.sole_velocities[foot]
-        force = (gains.swing_kp * (position - state.sole_centres[foot])
-                 + gains.swing_kd * (velocity - twist[0:3]))
-        moment = (gains.swing_rotation_kp
-                  * orientation_error(state.sole_rotations[foot], yaw_rotation(yaw))
-                  + gains.swing_rotation_kd * (np.array([0.0, 0.0, yaw_rate]) - twist[3:6]))
-        return state.sole_jacobians[foot].T @ np.concatenate([force, moment])
-
-    def _flat_down(self, state: BalanceState, foot: int) -> bool:
-        """Whether a sole lies flat on the ground (not up, not on an edge)."""
-        return (float(state.sole_centres[foot][2]) < self.gains.flat_height_m
-                and float(state.sole_rotations[foot][2, 2]) > self.gains.flat_cos)
-
-    def _put_down_torque(self, state: BalanceState, foot: int) -> np.ndarray:
-        """A foot off the ground while both should be down: back onto its last pose."""
-        pose = self.queue.feet[foot]
-        target = np.array([pose.x_m, pose.y_m, -self.gains.press_m])
-        return self._foot_pd(state, foot, target, np.zeros(3), pose.yaw_rad, 0.0)
-
     # -- one step -----------------------------------------------------------------------------
 
     def step_torque(self, state: BalanceState, joint_positions: np.ndarray,
                     joint_velocities: np.ndarray, time_s: float) -> WalkOutput:
         """The 28 joint torques (N m) for this 1 ms step, within the effort limits."""
         self._advance(state, time_s)
-        stand, gains = self.stand, self.gains
-        stand.reference = replace(stand.reference,
-                                  pelvis_rotation=yaw_rotation(self._heading(time_s)))
         xi_ref, cop_ref = self._capture_reference(state, time_s)
-        cop = tracking_cop(state.capture_point, xi_ref, cop_ref, gains.dcm_gain)
-        swinging = self.phase == STEPPING and self.step is not None
-        if swinging:
-            contact = (self.step.foot_index != 0, self.step.foot_index != 1)  # type: ignore[union-attr]
-        else:  # swaying or catching: the feet that are down (both, unless a landing is late)
-            contact = state.in_contact if any(state.in_contact) else (True, True)
-        corners = np.concatenate([_sole_corners(state, foot, stand.sole_half_size_m)
-                                  for foot in (0, 1) if contact[foot]])
-        cop = clamp_into(convex_hull(corners), cop, stand.gains.cop_margin_m)
-        torque = stand.whole_body(state, cop, contact, joint_positions, joint_velocities,
-                                  self._joint_gains, gains.torsion_m if swinging else None
-                                  ).torque_nm
-        if swinging:
-            torque += self._swing_torque(state, time_s)
+        cop = tracking_cop(state.capture_point, xi_ref, cop_ref, self.gains.dcm_gain)
+        step = self.step if self.phase == STEPPING else None
+        swing_foot = None if step is None else step.foot_index
+        legs = self.legs
+        torque, cop, contact = legs.torque(state, joint_positions, joint_velocities, time_s,
+                                           cop, swing_foot)
+        if step is not None:
+            assert self.swing is not None  # set with the step
+            torque += legs.swing_torque(state, step.foot_index, self.swing,
+                                        time_s - self.phase_start_s)
         else:
             for foot in (0, 1):
-                if not contact[foot] or not self._flat_down(state, foot):
-                    torque += self._put_down_torque(state, foot)
-        np.clip(torque, -stand.effort_limit_nm, stand.effort_limit_nm, out=torque)
-        return WalkOutput(torque, cop, xi_ref, self.phase,
-                          self.step.foot_index if swinging else None)  # type: ignore[union-attr]
-
-
-def _sole_corners(state: BalanceState, foot: int,
-                  half_size_m: tuple[float, float]) -> np.ndarray:
-    """The four corners (4, 2) of a sole's bottom face, world x, y."""
-    half_length, half_width = half_size_m
-    offsets = np.array([[half_length, half_width], [half_length, -half_width],
-                        [-half_length, -half_width], [-half_length, half_width]])
-    rotation = state.sole_rotations[foot][0:2, 0:2]
-    return state.sole_centres[foot][0:2] + offsets @ rotation.T
+                if not contact[foot] or not legs.flat_down(state, foot):
+                    torque += legs.put_down_torque(state, foot, self.queue.feet[foot])
+        limit = self.stand.effort_limit_nm
+        np.clip(torque, -limit, limit, out=torque)
+        return WalkOutput(torque, cop, xi_ref, self.phase, swing_foot)

@@ -24,7 +24,8 @@ from tutorial_atlas_control.balance import (
 )
 from tutorial_atlas_control.sim import AtlasModel, pelvis_height_m
 from tutorial_atlas_control.walking.footsteps import Footstep, window, wrap_angle
-from tutorial_atlas_control.walking.walk import WalkController, WalkGains, foot_pose
+from tutorial_atlas_control.walking.leg_tasks import foot_pose
+from tutorial_atlas_control.walking.walk import WalkController, WalkGains
 from tutorial_atlas_control.walking.walk_behaviour import WalkBehaviour
 
 #: Stand before the walk begins (s).

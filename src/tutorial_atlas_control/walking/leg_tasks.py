@@ -1,0 +1,165 @@
+"""What Walk and Step do alike each 1 ms step: the Stand's whole-body law on the feet that
+carry the robot, a swing foot moved by a task-space PD along its path, a foot that should
+be down put back flat on its last pose, and the pelvis turned towards the feet's heading.
+
+The Stand's joint PD keeps the arms and the back; the legs' posture gains are off (leg_kd
+of damping instead): in single support the stance leg's joints follow from the pelvis and
+the foot, the swing leg's from its task. While a foot swings, the stance sole's yaw moment
+is held within torsion_m times its load (beyond the model's torsional friction the foot
+turns).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from tutorial_atlas_control.balance import (
+    BalanceState,
+    StandController,
+    clamp_into,
+    convex_hull,
+    orientation_error,
+    smoothstep,
+    yaw_of,
+    yaw_rotation,
+)
+from tutorial_atlas_control.walking.footsteps import Footstep, wrap_angle
+from tutorial_atlas_control.walking.swing import SwingPath
+
+__all__ = ['LEG_JOINTS', 'LegGains', 'LegTasks', 'foot_pose']
+
+#: The leg joints (tutorial order): their Stand posture PD is off while stepping.
+LEG_JOINTS = slice(4, 16)
+
+
+@dataclass(frozen=True)
+class LegGains:
+    """The legs' numbers while stepping (ours)."""
+
+    #: The swing foot's task-space PD: position (N/m, N s/m), orientation (N m/rad, N m s/rad).
+    #: At 2500 N/m and 200 N m/rad the first swing foot lagged its path by 3 cm and landed
+    #: late; these walk DRCSim's queue and 20 straight steps.
+    swing_kp: float = 6000.0
+    swing_kd: float = 150.0
+    swing_rotation_kp: float = 600.0
+    swing_rotation_kd: float = 30.0
+    #: Damping on the leg joints (N m s/rad) in place of Stand's posture PD.
+    leg_kd: float = 2.0
+    #: A swing foot not down when its step's time is up keeps going down at this speed
+    #: (m/s), for at most late_touchdown_s (s), before the next step begins anyway.
+    touchdown_speed_m_s: float = 0.2
+    late_touchdown_s: float = 0.4
+    #: The yaw moment a stance sole may take, per newton it bears (m): the model's
+    #: torsional friction is 0.02 m (sim/atlas_v1.xml); beyond it the foot turns.
+    torsion_m: float | None = 0.015
+    #: A foot put back down aims this far below the ground (m), so that it lands.
+    press_m: float = 0.005
+    #: A sole is flat on the ground with its centre below flat_height_m (m) and its normal
+    #: within acos(flat_cos) of vertical (0.05 rad).
+    flat_height_m: float = 0.005
+    flat_cos: float = 0.99875
+
+
+def foot_pose(state: BalanceState, foot: int, step_index: int = 0) -> Footstep:
+    """Where a foot is now, as a step (sole centre and heading)."""
+    centre = state.sole_centres[foot]
+    return Footstep(step_index, foot, float(centre[0]), float(centre[1]),
+                    yaw_of(state.sole_rotations[foot]))
+
+
+class LegTasks:
+    """The shared torques over one StandController, whose reference's heading it turns."""
+
+    def __init__(self, stand: StandController, gains: LegGains, time_s: float) -> None:
+        self.stand = stand
+        self.gains = gains
+        #: The Stand's joint PD with the legs' posture gains off (damping leg_kd instead).
+        joint_kp, joint_kd = stand.gains.joint_kp.copy(), stand.gains.joint_kd.copy()
+        joint_kp[LEG_JOINTS] = 0.0
+        joint_kd[LEG_JOINTS] = gains.leg_kd
+        self._joint_gains = (joint_kp, joint_kd)
+        #: The pelvis's heading moving on: (start time, duration, from, turn) (s, rad).
+        self._facing = (time_s, 1.0, yaw_of(stand.reference.pelvis_rotation), 0.0)
+
+    def face(self, first_yaw_rad: float, second_yaw_rad: float, time_s: float,
+             duration_s: float) -> None:
+        """Turn the pelvis, upright, to face halfway between two feet's headings over
+        `duration_s` (a smoothstep from where its heading is now: a jump in the heading's
+        reference at each step kicked the pelvis, which the stance sole's little yaw
+        moment could not stop)."""
+        now = self.heading(time_s)
+        goal = first_yaw_rad + 0.5 * wrap_angle(second_yaw_rad - first_yaw_rad)
+        self._facing = (time_s, duration_s, now, wrap_angle(goal - now))
+
+    def heading(self, time_s: float) -> float:
+        """The pelvis heading's reference at `time_s` (rad)."""
+        started_s, duration_s, start, turn = self._facing
+        return start + smoothstep((time_s - started_s) / duration_s) * turn
+
+    def swing_torque(self, state: BalanceState, foot: int, swing: SwingPath,
+                     elapsed_s: float) -> np.ndarray:
+        """The swing leg's torques (28,) along `swing`, `elapsed_s` into it; past its end
+        the foot goes on down at touchdown_speed_m_s."""
+        gains = self.gains
+        position, velocity, yaw, yaw_rate = swing.at(elapsed_s)
+        late = elapsed_s - swing.duration_s
+        if late > 0.0:  # not down yet: on down
+            position[2] -= gains.touchdown_speed_m_s * late
+            velocity[2] = -gains.touchdown_speed_m_s
+        return self.foot_pd(state, foot, position, velocity, yaw, yaw_rate)
+
+    def foot_pd(self, state: BalanceState, foot: int, position: np.ndarray,
+                velocity: np.ndarray, yaw: float, yaw_rate: float) -> np.ndarray:
+        """The leg's torques (28,) moving a sole towards a pose (task-space PD)."""
+        gains = self.gains
+        twist = state.sole_velocities[foot]
+        force = (gains.swing_kp * (position - state.sole_centres[foot])
+                 + gains.swing_kd * (velocity - twist[0:3]))
+        moment = (gains.swing_rotation_kp
+                  * orientation_error(state.sole_rotations[foot], yaw_rotation(yaw))
+                  + gains.swing_rotation_kd * (np.array([0.0, 0.0, yaw_rate]) - twist[3:6]))
+        return state.sole_jacobians[foot].T @ np.concatenate([force, moment])
+
+    def flat_down(self, state: BalanceState, foot: int) -> bool:
+        """Whether a sole lies flat on the ground (not up, not on an edge)."""
+        return (float(state.sole_centres[foot][2]) < self.gains.flat_height_m
+                and float(state.sole_rotations[foot][2, 2]) > self.gains.flat_cos)
+
+    def put_down_torque(self, state: BalanceState, foot: int, pose: Footstep) -> np.ndarray:
+        """A foot off the ground while both should be down: back onto `pose`."""
+        target = np.array([pose.x_m, pose.y_m, -self.gains.press_m])
+        return self.foot_pd(state, foot, target, np.zeros(3), pose.yaw_rad, 0.0)
+
+    def torque(self, state: BalanceState, joint_positions: np.ndarray,
+               joint_velocities: np.ndarray, time_s: float, cop: np.ndarray,
+               swing_foot: int | None) -> tuple[np.ndarray, np.ndarray, tuple[bool, bool]]:
+        """The whole-body torques (28,) for the pressure centre `cop` kept inside the
+        carrying soles (the stance sole alone while `swing_foot` swings, else the feet
+        that are down, both if none is), the pressure centre as kept, and which soles
+        carry. The caller adds the swing or put-down torques; nothing is clipped yet."""
+        stand = self.stand
+        stand.reference = replace(stand.reference,
+                                  pelvis_rotation=yaw_rotation(self.heading(time_s)))
+        if swing_foot is not None:
+            contact = (swing_foot != 0, swing_foot != 1)
+        else:  # swaying or catching: the feet that are down (both, unless a landing is late)
+            contact = state.in_contact if any(state.in_contact) else (True, True)
+        corners = np.concatenate([_sole_corners(state, foot, stand.sole_half_size_m)
+                                  for foot in (0, 1) if contact[foot]])
+        cop = clamp_into(convex_hull(corners), cop, stand.gains.cop_margin_m)
+        torsion = self.gains.torsion_m if swing_foot is not None else None
+        torque = stand.whole_body(state, cop, contact, joint_positions, joint_velocities,
+                                  self._joint_gains, torsion).torque_nm
+        return torque, cop, contact
+
+
+def _sole_corners(state: BalanceState, foot: int,
+                  half_size_m: tuple[float, float]) -> np.ndarray:
+    """The four corners (4, 2) of a sole's bottom face, world x, y."""
+    half_length, half_width = half_size_m
+    offsets = np.array([[half_length, half_width], [half_length, -half_width],
+                        [-half_length, -half_width], [-half_length, half_width]])
+    rotation = state.sole_rotations[foot][0:2, 0:2]
+    return state.sole_centres[foot][0:2] + offsets @ rotation.T
