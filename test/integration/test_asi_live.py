@@ -4,11 +4,12 @@ pinned in the Stand pose under the user's PID (User, k_effort 255) at 0.5 s; the
 /atlas/atlas_sim_interface_state says Stand with the pelvis at the balancing Stand's height
 (the hold's straight legs stand 15 mm higher) and AtlasState's k_effort is 0 (the behaviour
 alone); a sideways pelvis push the stiff hold falls at is stood (its impulse read back from
-/atlas/sim_inputs); a WALK request of DRCSim's fixed queue is walked and ends back in Stand by
-itself (WARNING_AUTO_TRANS) with the feet where the queue put them; a MANIPULATE request for a
-pelvis at 0.85 m is reported and reached within 2 s; a FREEZE request on
-/atlas/atlas_sim_interface_command is reported as Freeze (2, not DRCSim's 0), and the commands
-are in the bag (the state, a 1 kHz duplicate, is not), which replays offline bit for bit.
+/atlas/sim_inputs); walk_client.py, streaming a WALK on every state, walks four steps and the
+walk ends back in Stand by itself (WARNING_AUTO_TRANS) with the feet where it sent them; a
+MANIPULATE request for a pelvis at 0.85 m is reported and reached within 2 s; a FREEZE request
+on /atlas/atlas_sim_interface_command is reported as Freeze (2, not DRCSim's 0), and the
+commands are in the bag (the state, a 1 kHz duplicate, is not), which replays offline bit for
+bit.
 
 Run with `python3 -m pytest test/integration/test_asi_live.py -q -s` after `source env.sh`.
 Wall time about 30 s.
@@ -17,6 +18,7 @@ Wall time about 30 s.
 from __future__ import annotations
 
 import shutil
+import sys
 from pathlib import Path
 
 import pytest
@@ -31,7 +33,6 @@ from tutorial_atlas_control import topics
 from tutorial_atlas_control.asi import Behavior, Status
 from tutorial_atlas_control.offline.replay import replay_bag
 from tutorial_atlas_control.sim.vrc import InputEvent, WrenchInput
-from tutorial_atlas_control.walking import DRCSIM_WALK_QUEUE
 
 pytestmark = pytest.mark.filterwarnings('ignore::DeprecationWarning')
 
@@ -48,20 +49,17 @@ MANIPULATE_PELVIS_M = 0.85
 PUSH_N = 40.0
 PUSH_AT_LEAST_S = 0.75
 HOLD_FALLS_SIDEWAYS_N_S = 20.0
-#: DRCSim's fixed Walk queue: where the left and the right foot end (m), within a landing's
-#: tolerance, the pelvis above a walking height throughout (m).
-WALKED_FEET = ((0.6, 0.12), (0.8, -0.12))
+#: walk_client.py's walk: four steps of 0.2 m from where the feet stand (the feet end side by
+#: side 0.6 m ahead, 0.24 m apart), each foot within a landing's tolerance (m).
+CLIENT_ARGS = ('--steps', '4', '--stride', '0.2')
+WALKED_AHEAD_M = 0.6
+WALKED_WIDTH_M = 0.24
 LANDING_WITHIN_M = 0.05
-WALKED_PELVIS_ABOVE_M = 0.85
+WALK_CLIENT = Path(__file__).resolve().parents[2] / 'scripts' / 'walk_client.py'
 
 
-def walk_queue_yaml() -> str:
-    """walk_params for DRCSim's fixed queue, as rostopic pub's YAML."""
-    steps = ', '.join(
-        f'{{step_index: {s.step_index}, foot_index: {s.foot_index}, duration: {s.duration_s}, '
-        f'pose: {{position: {{x: {s.x_m}, y: {s.y_m}}}, orientation: {{w: 1.0}}}}}}'
-        for s in DRCSIM_WALK_QUEUE)
-    return f'{{step_queue: [{steps}]}}'
+def feet_xy(state: dict) -> list[tuple[float, float]]:
+    return [(foot['position']['x'], foot['position']['y']) for foot in state['foot_pos_est']]
 
 
 def pushed_impulse_n_s(bag: Path) -> float:
@@ -100,20 +98,20 @@ def test_asi_live_drcsim_start_balancing_stand_a_freeze_request_and_its_record(
         assert state['behavior_feedback']['status_flags'] == Status.OK, 'falling after the push'
         pushed_z = state['pos_est']['position']['z']
         assert abs(pushed_z - STAND_PELVIS_M) < PELVIS_TOLERANCE_M, state['pos_est']
-        launch.publish(topics.ASI_COMMAND, 'atlas_msgs/AtlasSimInterfaceCommand',
-                       f'{{behavior: {int(Behavior.WALK)}, walk_params: {walk_queue_yaml()}}}')
-        launch.wait(lambda: launch.next_message(topics.ASI_STATE)['current_behavior']
-                    == Behavior.WALK, 30.0, 'the WALK request was not reported')
-        launch.wait(lambda: launch.next_message(topics.ASI_STATE)['behavior_feedback']
-                    ['status_flags'] == Status.WARNING_AUTO_TRANS, 60.0,
-                    'the walk did not return to Stand by itself')
+        (left_x, left_y), (right_x, right_y) = feet_xy(state)
+        walked = launch.run(sys.executable, str(WALK_CLIENT), *CLIENT_ARGS, timeout_s=120.0)
+        assert walked.returncode == 0, walked.stdout + walked.stderr
+        assert 'walked 4 of 4 steps (streamed), back in Stand' in walked.stdout
         state = launch.next_message(topics.ASI_STATE)
         assert state['current_behavior'] == Behavior.STAND
-        feet = [(foot['position']['x'], foot['position']['y']) for foot in state['foot_pos_est']]
-        for (x, y), (x_sent, y_sent) in zip(feet, WALKED_FEET):
-            assert abs(x - x_sent) < LANDING_WITHIN_M and abs(y - y_sent) < LANDING_WITHIN_M, feet
-        walked_z = state['pos_est']['position']['z']
-        assert walked_z > WALKED_PELVIS_ABOVE_M, state['pos_est']
+        assert state['behavior_feedback']['status_flags'] == Status.WARNING_AUTO_TRANS
+        start_x, middle_y = 0.5 * (left_x + right_x), 0.5 * (left_y + right_y)
+        feet = feet_xy(state)
+        ends = [(start_x + WALKED_AHEAD_M, middle_y + WALKED_WIDTH_M / 2),
+                (start_x + WALKED_AHEAD_M, middle_y - WALKED_WIDTH_M / 2)]
+        for (x, y), (x_sent, y_sent) in zip(feet, ends):
+            assert abs(x - x_sent) < LANDING_WITHIN_M and abs(y - y_sent) < LANDING_WITHIN_M, \
+                (feet, ends)
         launch.publish(topics.ASI_COMMAND, 'atlas_msgs/AtlasSimInterfaceCommand',
                        f'{{behavior: {int(Behavior.MANIPULATE)}, manipulate_params: {{use_desired: '
                        f'true, desired: {{pelvis_height: {MANIPULATE_PELVIS_M}}}}}}}')
@@ -133,12 +131,12 @@ def test_asi_live_drcsim_start_balancing_stand_a_freeze_request_and_its_record(
         feedback = state['behavior_feedback']
         assert feedback['trans_from_behavior_index'] == Behavior.MANIPULATE
         assert feedback['trans_to_behavior_index'] == Behavior.FREEZE
-        print(f'figures: balancing Stand pelvis {pelvis_z:.4f} m at 3.5 s; walked DRCSim\'s '
-              f'queue, feet at {feet}; Manipulate {manipulated_z:.4f} m 2 s after asking '
-              f'{MANIPULATE_PELVIS_M} m; then Freeze')
+        print(f'figures: balancing Stand pelvis {pelvis_z:.4f} m at 3.5 s; walk_client '
+              f'{" ".join(CLIENT_ARGS)}: feet at {feet}; Manipulate {manipulated_z:.4f} m 2 s '
+              f'after asking {MANIPULATE_PELVIS_M} m; then Freeze')
         launch.interrupt(EXIT_TIMEOUT_S)
         bag = launch.bag()
-    assert count(bag, topics.ASI_COMMAND) == 3
+    assert count(bag, topics.ASI_COMMAND) > 100  # the client's stream, Manipulate, Freeze
     impulse = pushed_impulse_n_s(bag)
     print(f'figures: the push stood was {impulse:.1f} N s sideways (recorded)')
     assert impulse > HOLD_FALLS_SIDEWAYS_N_S

@@ -1,7 +1,8 @@
 """The open AtlasSimInterface, ROS-free: DRCSim 2.7's behaviour library contract (ASI.md)
 over the simulator and the balance. behaviors: its numbers and which control mode runs
-each behaviour; session: requests taken or refused and the feedback status; interface:
-one simulator's requests applied and its states built.
+each behaviour; session: requests taken or refused and the feedback status; walk_params:
+a WALK's steps and walk_feedback; interface: one simulator's requests applied and its
+states built; walk_client: what a walking client does with each state.
 """
 
 from tutorial_atlas_control.exports import lazy_exports
@@ -10,4 +11,6 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'behaviors': ['BEHAVIOR_OF_MODE', 'MODE_OF_BEHAVIOR', 'AsiError', 'Behavior', 'Status'],
     'interface': ['FALLING_PELVIS_M', 'FALLING_TILT_RAD', 'AtlasSimInterface'],
     'session': ['STANDING_BEHAVIORS', 'AsiSession'],
+    'walk_client': ['Outcome', 'WalkClient'],
+    'walk_params': ['footsteps_of', 'sole_step', 'step_data_of', 'walk_feedback'],
 })

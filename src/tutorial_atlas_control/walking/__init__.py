@@ -14,8 +14,8 @@ from tutorial_atlas_control.exports import lazy_exports
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'dcm_plan': ['DcmPlan', 'tracking_cop'],
     'footsteps': ['DRCSIM_WALK_QUEUE', 'LEFT', 'QUEUE_LENGTH', 'RIGHT', 'STANCE_WIDTH_M',
-                  'STEP_DURATION_S', 'Footstep', 'circle_steps', 'side_sign', 'straight_steps',
-                  'window', 'wrap_angle'],
+                  'STEP_DURATION_S', 'Footstep', 'circle_steps', 'placed', 'side_sign',
+                  'straight_steps', 'window', 'wrap_angle'],
     'step_queue': ['CATCHING', 'ERROR_INCONSISTENT_STEPS', 'OKAY', 'STEPPING', 'SWAYING',
                    'WARNING_INSUFFICIENT_STEP_DATA', 'StepLimits', 'StepQueue', 'clamp_step'],
     'swing': ['SWING_HEIGHT_M', 'SwingPath', 'bump', 'quintic'],

@@ -10,7 +10,7 @@ issue's: DRCSim's fixed `control_mode Walk` queue, a straight line and a circle.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 LEFT, RIGHT = 0, 1
 #: How many steps a WALK command carries (`walk_params.step_queue`).
@@ -91,6 +91,16 @@ def circle_steps(radius_m: float, steps_per_circle: int, circles: int = 1,
         y = radius_m - foot_radius * math.cos(heading)
         steps.append(Footstep(k, foot, x, y, wrap_angle(heading), duration_s))
     return steps
+
+
+def placed(plan: list[Footstep], origin_xy: tuple[float, float],
+           yaw_rad: float) -> list[Footstep]:
+    """`plan` (made from the origin facing +x) for a walker at `origin_xy` facing `yaw_rad`."""
+    c, s = math.cos(yaw_rad), math.sin(yaw_rad)
+    x0, y0 = origin_xy
+    return [replace(step, x_m=x0 + c * step.x_m - s * step.y_m,
+                    y_m=y0 + s * step.x_m + c * step.y_m,
+                    yaw_rad=wrap_angle(step.yaw_rad + yaw_rad)) for step in plan]
 
 
 def wrap_angle(angle_rad: float) -> float:

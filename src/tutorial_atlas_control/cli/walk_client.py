@@ -1,0 +1,175 @@
+"""Command line of walk_client.py: a DRC-era walking client of the AtlasSimInterface.
+
+It reads where the feet are from the first /atlas/atlas_sim_interface_state, lays a plan of
+footsteps from there (straight ahead, or round a circle on the left), and sends WALK
+commands as DRCSim's walking clients did: streamed, a new WALK with the window
+[next_step_index_needed, +3] on every state message (1 kHz), or the first four steps once
+(--once). It ends when the walk has returned to Stand (exit 0), or on a fall, a refused
+request or the timeout (exit 1).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import threading
+from collections.abc import Sequence
+
+import rosgraph
+import rospy
+from atlas_msgs.msg import AtlasSimInterfaceCommand, AtlasSimInterfaceState
+
+from tutorial_atlas_control import topics
+from tutorial_atlas_control.asi import Outcome, WalkClient
+from tutorial_atlas_control.cli.convention import (
+    EXIT_INTERRUPTED,
+    EXIT_REFUSED,
+    print_error,
+    whole_number,
+)
+from tutorial_atlas_control.walking import (
+    STEP_DURATION_S,
+    Footstep,
+    circle_steps,
+    placed,
+    straight_steps,
+    wrap_angle,
+)
+
+PROG = 'walk_client.py'
+#: How long (s, wall time) to wait for the first state, and for the simulator to subscribe.
+CONNECT_TIMEOUT_S = 30.0
+
+
+def _positive(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'{text!r} is not a number') from None
+    if not math.isfinite(value) or value <= 0.0:
+        raise argparse.ArgumentTypeError(f'{text!r} must be a positive number')
+    return value
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog=PROG, description=__doc__.split('\n\n')[1].replace('\n', ' '),
+        epilog='Start the simulator with the balancing Stand first: roslaunch '
+               'tutorial_atlas_control atlas.launch startup_mode:=bdi_stand')
+    parser.add_argument('--steps', type=whole_number(1), default=6,
+                        help='how many steps (default 6)')
+    parser.add_argument('--stride', type=_positive, default=0.25, metavar='M',
+                        help='each foot this far ahead of the other (m, default 0.25)')
+    parser.add_argument('--width', type=_positive, default=0.24, metavar='M',
+                        help='the feet this far apart (m, default 0.24)')
+    parser.add_argument('--duration', type=_positive, default=STEP_DURATION_S, metavar='S',
+                        help=f'each step\'s duration (s, default {STEP_DURATION_S})')
+    parser.add_argument('--circle', type=_positive, metavar='RADIUS',
+                        help='walk round a circle of RADIUS (m) on the left, 60 steps a turn, '
+                             'instead of straight ahead')
+    parser.add_argument('--once', action='store_true',
+                        help='send the first four steps once instead of streaming')
+    parser.add_argument('--timeout', type=_positive, default=120.0, metavar='S',
+                        help='give up after this long (s, wall time; default 120)')
+    return parser
+
+
+def plan_for(args: argparse.Namespace) -> list[Footstep]:
+    """The plan from the origin facing +x (foot links' poses)."""
+    if args.circle is not None:
+        return circle_steps(args.circle, 60, 1, args.width, args.duration)[:args.steps]
+    return straight_steps(args.steps, args.stride, args.width, args.duration)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of scripts/walk_client.py (`argv` without the program name)."""
+    parser = _parser()
+    args = parser.parse_args(sys.argv[1:] if argv is None else argv)
+    try:
+        plan = plan_for(args)
+    except ValueError as err:
+        parser.error(str(err))
+    try:
+        return _walk(plan, args)
+    except KeyboardInterrupt:
+        return EXIT_INTERRUPTED
+    except _Refused as err:
+        print_error(PROG, err)
+        return EXIT_REFUSED
+
+
+class _Refused(Exception):
+    """No master, no simulator, or a walk that did not end well."""
+
+
+def _walk(plan: list[Footstep], args: argparse.Namespace) -> int:
+    uri = rosgraph.get_master_uri()
+    if not rosgraph.is_master_online(uri):
+        raise _Refused(f'no ROS master at {uri}: start the simulator first')
+    rospy.init_node('walk_client', anonymous=True, disable_signals=True)
+    try:
+        first = rospy.wait_for_message(topics.ASI_STATE, AtlasSimInterfaceState,
+                                       timeout=CONNECT_TIMEOUT_S)
+    except rospy.ROSException:
+        raise _Refused(f'no {topics.ASI_STATE} within {CONNECT_TIMEOUT_S:.0f} s: is the '
+                       'simulator running?') from None
+    feet = first.foot_pos_est
+    left_yaw, right_yaw = (_yaw(foot.orientation) for foot in feet)
+    yaw = left_yaw + 0.5 * wrap_angle(right_yaw - left_yaw)
+    origin = (0.5 * (feet[0].position.x + feet[1].position.x),
+              0.5 * (feet[0].position.y + feet[1].position.y))
+    client = WalkClient(placed(plan, origin, yaw), streaming=not args.once)
+    publisher = rospy.Publisher(topics.ASI_COMMAND, AtlasSimInterfaceCommand, queue_size=1,
+                                tcp_nodelay=True)
+    ended = threading.Event()
+    last: list[AtlasSimInterfaceState] = [first]
+
+    def on_state(state: AtlasSimInterfaceState) -> None:
+        last[0] = state
+        steps = client.on_state(state.current_behavior, state.behavior_feedback.status_flags,
+                                state.walk_feedback.current_step_index,
+                                state.walk_feedback.next_step_index_needed)
+        if client.outcome is not None:
+            ended.set()
+        elif steps is not None:
+            publisher.publish(_command(steps))
+
+    deadline = rospy.get_time() + CONNECT_TIMEOUT_S
+    while publisher.get_num_connections() == 0:
+        if rospy.get_time() > deadline or rospy.is_shutdown():
+            raise _Refused(f'the simulator did not subscribe to {topics.ASI_COMMAND}')
+        rospy.sleep(0.01)
+    rospy.Subscriber(topics.ASI_STATE, AtlasSimInterfaceState, on_state, queue_size=1,
+                     tcp_nodelay=True)
+    if not ended.wait(args.timeout):
+        raise _Refused(f'the walk did not end within {args.timeout:g} s '
+                       f'({client.steps_taken} of {len(plan)} steps taken)')
+    state = last[0]
+    feet = ', '.join(f'({foot.position.x:.3f}, {foot.position.y:.3f})'
+                     for foot in state.foot_pos_est)
+    if client.outcome is not Outcome.WALKED:
+        raise _Refused(f'the walk {client.outcome.value} after {client.steps_taken} of '
+                       f'{len(plan)} steps (status {state.behavior_feedback.status_flags})')
+    print(f'{PROG}: walked {client.steps_taken} of {len(plan)} steps '
+          f'({"once" if args.once else "streamed"}), back in Stand; feet at {feet}')
+    rospy.signal_shutdown('walked')
+    return 0
+
+
+def _yaw(q: object) -> float:
+    x, y, z, w = q.x, q.y, q.z, q.w  # type: ignore[attr-defined]
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def _command(steps: list[Footstep]) -> AtlasSimInterfaceCommand:
+    """An AtlasSimInterfaceCommand WALK of `steps` (empty slots after them)."""
+    command = AtlasSimInterfaceCommand()
+    command.behavior = command.WALK
+    for slot, step in zip(command.walk_params.step_queue, steps):
+        slot.step_index, slot.foot_index, slot.duration = (step.step_index, step.foot_index,
+                                                           step.duration_s)
+        slot.pose.position.x, slot.pose.position.y = step.x_m, step.y_m
+        slot.pose.orientation.z = math.sin(0.5 * step.yaw_rad)
+        slot.pose.orientation.w = math.cos(0.5 * step.yaw_rad)
+    return command
