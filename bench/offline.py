@@ -72,6 +72,22 @@ def stand_run(warmup_steps: int = 2500, steps: int = 5000) -> float:
     return stand.spent_s / steps * 1e6
 
 
+def walk_run(steps: int = 6) -> tuple[float, float]:
+    """(controller CPU µs per step, offline real-time factor) of a walking trial: Stand
+    1 s, `steps` straight steps of 0.25 m at 0.63 s, the catch, Stand again (walk_trial:
+    the robot placed standing, the controller in lockstep with the physics, no bag)."""
+    from tutorial_atlas_control.walking import straight_steps
+    from tutorial_atlas_control.walking.walk_trial import SETTLE_S, walk_trial
+
+    sim_s = SETTLE_S + 0.6 + steps * 0.63 + 0.8
+    start = time.perf_counter()
+    trial = walk_trial(straight_steps(steps, 0.25), sim_s)
+    wall_s = time.perf_counter() - start
+    if trial.fell or trial.steps != steps:
+        raise RuntimeError(f'the bench\'s walk fell or took {trial.steps} of {steps} steps')
+    return trial.cost_per_step_us, sim_s / wall_s
+
+
 def steps_per_sim_second() -> float:
     from tutorial_atlas_control.sim import model
 

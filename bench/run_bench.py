@@ -96,6 +96,8 @@ ROWS = (
     ('physics_numpy_law_steps_per_s', 'physics + numpy law, plain loop', 'steps/s', '', 0),
     ('unheard_topic_us_per_step', 'a topic nobody subscribes to', 'us/step', '< 1', 3),
     ('stand_us_per_step', 'balancing Stand: estimate + control', 'us/step', '<= 100', 1),
+    ('walk_us_per_step', 'Walk, 6 steps: estimate + control (CPU)', 'us/step', '<= 150', 1),
+    ('walk_offline_rtf', 'the same walk offline (no bag)', 'x real time', '>= 10', 2),
     ('offline_rtf', 'run_offline.py to a bag', 'x real time', '', 2),
     ('offline_ratio', 'offline_rtf*1000 / physics limit', '', '>= 0.8', 3),
     ('fast_rtf', 'node rtf:=0 + recorder', 'x real time', '>= 0.6 x bare/1000', 2),
@@ -258,6 +260,9 @@ TARGETS = {
     'unheard_topic_us_per_step': Target(high=1.0, strict=True),
     # The open AtlasSimInterface's Stand at 1 kHz beside a recorder and a client.
     'stand_us_per_step': Target(high=100.0),
+    # Walking: the controller in the 1 ms loop, and offline runs of it (issue's goals).
+    'walk_us_per_step': Target(high=150.0),
+    'walk_offline_rtf': Target(low=10.0),
     'offline_ratio': Target(low=0.8),
     'fast_rtf': Target(low=0.6, per_bare='rtf'),
     'fast_bare_ratio': Target(low=0.6),
@@ -302,7 +307,7 @@ TARGETS = {
 EXPECTED = {
     'physics': ('bare_physics_steps_per_s', 'physics_limit_steps_per_s',
                 'physics_numpy_law_steps_per_s', 'unheard_topic_us_per_step',
-                'stand_us_per_step'),
+                'stand_us_per_step', 'walk_us_per_step', 'walk_offline_rtf'),
     'offline': ('offline_rtf', 'offline_ratio'),
     'analysis': ('analysis_s', 'rosbag_s', 'analysis_msgs_per_s', 'rosbag_msgs_per_s',
                  'analysis_speedup'),
@@ -428,6 +433,10 @@ def run_offline(args: argparse.Namespace, samples: dict[str, list[float]],
                 stand_us = offline.stand_run(steps=steps)
                 log(f'physics run {run + 1}: the balancing Stand costs {stand_us:.1f} us/step')
                 add(samples, {'stand_us_per_step': stand_us})
+                walk_us, walk_rtf = offline.walk_run()
+                log(f'physics run {run + 1}: Walk costs {walk_us:.1f} us/step, walks offline '
+                    f'at {walk_rtf:.2f}x real time')
+                add(samples, {'walk_us_per_step': walk_us, 'walk_offline_rtf': walk_rtf})
     if 'offline' in args.sections:
         steps_per_s = offline.steps_per_sim_second()
         with Section('offline', loads), tempfile.TemporaryDirectory(prefix='tac_bench_') as tmp:
