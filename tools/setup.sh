@@ -28,7 +28,7 @@ APT_PACKAGES=(
   # package.xml files that let rospack, rosmsg and a client's manifest find tf,
   # tf_conversions and trajectory_msgs (Debian ships them in the -dev packages).
   python3-tf python3-tf-conversions python3-pykdl python3-actionlib python3-actionlib-msgs
-  ros-actionlib-msgs python3-roslib python3-tf2-geometry-msgs python3-tf2-kdl python3-angles
+  ros-actionlib-msgs libactionlib-msgs-dev python3-roslib python3-tf2-geometry-msgs python3-tf2-kdl python3-angles
   libtf-dev libtf-conversions-dev libtrajectory-msgs-dev
   xvfb xdotool x11-apps imagemagick iproute2
   python3-tk

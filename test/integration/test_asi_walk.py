@@ -242,3 +242,28 @@ def test_eight_steps_with_the_arms_swung_under_the_users_pid(
     assert steps == 8
     assert sim.mode is ControlMode.STAND
     assert (sim.active_k_effort()[[JOINT_INDEX[name] for name in ARMS]] == 255).all()
+
+
+def test_stand_asked_for_mid_walk_ends_it_after_the_step_under_way(
+        atlas: atlas_model.AtlasModel) -> None:
+    """DRCSim's actionlib server sends STAND once the last step has begun: the walk ends
+    with that step, caught, and then Stand (TRANSITION_IN_PROGRESS until then)."""
+    interface = standing(atlas)
+    plan = straight_steps(8, 0.25)
+    interface.apply(walk_command(plan[:4]))
+    first = run(interface, 1.5)  # the sway, and into the second step
+    taking = max(first.current_steps) + 1
+    assert first.behaviors[-1] == Behavior.WALK and first.walk_flags[-1] & STEPPING
+    for _ in range(3):  # asked for again and again: the same
+        interface.apply(command_of(Behavior.STAND))
+    rest = run(interface, RUN_S)
+    assert first.lowest_pelvis_m > PELVIS_ABOVE_M and rest.lowest_pelvis_m > PELVIS_ABOVE_M
+    assert max(rest.current_steps) == taking  # the step under way, no more
+    assert changes(rest.behaviors) == [Behavior.WALK, Behavior.STAND]
+    assert changes(rest.status) == [Status.TRANSITION_IN_PROGRESS, Status.TRANSITION_SUCCESS,
+                                    Status.OK]
+
+
+def command_of(behavior: Behavior) -> AsiCommand:
+    return AsiCommand(0, behavior, (StepData(),) * 4, False, StepData(), False,
+                      ManipulateParams(), None, 0)

@@ -5,15 +5,16 @@ bytes of its states.
 What it does with a command (DRCSim 2.7's AtlasPlugin::SetASICommand): the behaviour is
 requested (AsiSession decides), then k_effort, at exactly 28 entries, becomes the blend of
 every joint; a behaviour switch itself never changes k_effort. Stand runs the balancing
-StandBehaviour and StandPrep the StandPrepBehaviour, installed into the simulator here
-(or, without `balance`, the simulator's holds, DRCSim 2.5.2's stand-in). Manipulate, served
-with the balancing Stand only, is that Stand with its pelvis servoed to
+StandBehaviour and StandPrep the StandPrepBehaviour, installed into the simulator here (or,
+without `balance`, the simulator's holds, DRCSim 2.5.2's stand-in). Manipulate, served with
+the balancing Stand only, is that Stand with its pelvis servoed to
 `manipulate_params.desired` (the Stand pose without use_desired). Walk, also served with
 the balancing Stand only, is walking.WalkBehaviour over the command's step queue (DRCSim's
 fixed queue when started by /atlas/control_mode Walk); once it has caught itself after its
-last step the interface hands the robot back to Stand (WARNING_AUTO_TRANS). A switch made elsewhere
-(/atlas/control_mode, /atlas/mode bdi_stand) is seen at the next state or step and reported
-as a successful transition.
+last step the interface hands the robot back to Stand (WARNING_AUTO_TRANS); Stand asked for
+during a walk ends it after the step under way (TRANSITION_IN_PROGRESS until then). A
+switch made elsewhere (/atlas/control_mode, /atlas/mode bdi_stand) is seen at the next
+state or step and reported as a successful transition.
 """
 
 from __future__ import annotations
@@ -82,8 +83,9 @@ class AtlasSimInterface:
         #: The balancing Stand installed (None: Stand is the hold); its estimator, or one of
         #: the interface's own, checks the centre of mass before Stand is entered.
         self.stand: StandBehaviour | None = None
-        #: Walk, installed with the balancing Stand.
+        #: Walk, installed with the balancing Stand; Stand asked for during it.
         self.walking: WalkBehaviour | None = None
+        self._stand_after_walk = False
         self.session = AsiSession(MODE_OF_BEHAVIOR)
         if balance:
             self._load_balance()
@@ -137,9 +139,16 @@ class AtlasSimInterface:
                  if command.behavior == Behavior.WALK else [])
         if command.behavior == Behavior.WALK != current and not steps:
             return
+        walking = self.walking
+        if current == Behavior.WALK and command.behavior == Behavior.STAND \
+                and walking is not None and not walking.done:
+            if not self._stand_after_walk:
+                walking.finish()
+                self.session.defer(Behavior.STAND, Behavior.WALK)
+                self._stand_after_walk = True
+            return
         feet_under_com = command.behavior == current or self.com_over_feet()
         mode = self.session.request(command.behavior, current, feet_under_com)
-        walking = self.walking
         if mode is not None:
             if mode is ControlMode.WALK and walking is not None:
                 walking.next_steps = steps
@@ -264,4 +273,9 @@ class AtlasSimInterface:
         if self.sim.mode is ControlMode.WALK and self.walking is not None \
                 and self.walking.done:
             self._switch(ControlMode.STAND)
-            self.session.auto_switched(Behavior.STAND, Behavior.WALK)
+            if self._stand_after_walk:
+                self.session.switched(Behavior.STAND, Behavior.WALK)
+            else:
+                self.session.auto_switched(Behavior.STAND, Behavior.WALK)
+        if self.sim.mode is not ControlMode.WALK:
+            self._stand_after_walk = False

@@ -5,8 +5,10 @@ Our choices where BDI's library published none (docs/controllers.md): a request 
 running behaviour changes nothing, so a client may stream it at 1 kHz; an accepted switch
 reports TRANSITION_SUCCESS in the state of that step, then OK; a refusal (unknown or not yet
 served behaviour, Stand with the centre of mass outside the feet) reports its FAILED_TRANS_*
-until the next accepted switch and keeps the running behaviour; Walk's return to Stand
-after its last step reports WARNING_AUTO_TRANS until the next switch or refusal;
+until the next accepted switch and keeps the running behaviour; Stand requested during Walk is
+taken once the step under way is down and the robot caught (TRANSITION_IN_PROGRESS until
+then, TRANSITION_SUCCESS after); Walk's return to Stand by itself after its last step
+reports WARNING_AUTO_TRANS until the next switch or refusal;
 ERROR_FALLING is reported while a standing behaviour (Walk included) is falling, ahead of
 any other value (one value at a time).
 """
@@ -81,6 +83,14 @@ class AsiSession:
         self._status = Status.TRANSITION_SUCCESS
         self.error_code = AsiError.NO_ERRORS
         self.trans_from_behavior, self.trans_to_behavior = int(previous), int(current)
+
+    def defer(self, behavior: Behavior, current: Behavior) -> None:
+        """`behavior` asked for, taken once `current` has ended (Stand during Walk, after its
+        step under way): TRANSITION_IN_PROGRESS until then."""
+        self.desired_behavior = int(behavior)
+        self._status = Status.TRANSITION_IN_PROGRESS
+        self.error_code = AsiError.NO_ERRORS
+        self.trans_from_behavior, self.trans_to_behavior = int(current), int(behavior)
 
     def auto_switched(self, current: Behavior, previous: Behavior) -> None:
         """The library left `previous` by itself (Walk, its steps done, to Stand):

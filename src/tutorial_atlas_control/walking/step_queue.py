@@ -71,6 +71,8 @@ class StepQueue:
         self.limits = limits
         self.current_step_index = 0
         self.inconsistent = False
+        #: Stopped: no more steps are taken than the one under way (a request for Stand).
+        self.stopped = False
         #: The last pose of each foot: where it stands now (left, right).
         self.feet = [start_left, start_right]
         self._last_foot: int | None = None
@@ -87,10 +89,18 @@ class StepQueue:
         return index
 
     def offer(self, steps: Iterable[Footstep]) -> None:
-        """Merge a command's steps; those already taken are ignored."""
+        """Merge a command's steps; those already taken are ignored, and all once stopped."""
+        if self.stopped:
+            return
         for step in steps:
             if step.step_index > self.current_step_index:
                 self._steps[step.step_index] = step
+
+    def stop(self, taking: int | None) -> None:
+        """No step after `taking` (the index of the step under way; None: none is): the walk
+        ends with it, and steps offered later are ignored."""
+        self.stopped = True
+        self._steps = {k: v for k, v in self._steps.items() if taking is not None and k <= taking}
 
     def preview(self) -> list[Footstep]:
         """The known steps from the next one on without a gap, up to QUEUE_LENGTH, each

@@ -70,6 +70,15 @@ class WalkBehaviour:
             raise RuntimeError('WalkBehaviour.offer before start()')
         self.walk.queue.offer(steps)
 
+    def finish(self) -> None:
+        """End the walk with the step under way (none if it is swaying): then it catches
+        itself and is done."""
+        walk = self.walk
+        if walk is None:
+            raise RuntimeError('WalkBehaviour.finish before start()')
+        taking = walk.step.step_index if walk.phase == STEPPING and walk.step else None
+        walk.queue.stop(taking)
+
     def start(self, data: mujoco.MjData) -> None:
         """Begin a walk from where the robot stands, over the steps offered so far (DRCSim's
         fixed queue if none were)."""

@@ -75,6 +75,15 @@ ATLAS_MSGS_MD5 = {
     'AtlasBehaviorManipulateParams': 'c4e967ec87266f9e108243e7ac4b9614',
     'AtlasBehaviorPelvisServoParams': '82f59d8aa26e61afaf2c8dbb7b4e7856',
     'AtlasPositionData': '589dbd8c358d253de2ab5441acd36a2b',
+    # DRCSim's actionlib server's action, through actionlib_msgs' genaction (ASI.md gives
+    # the first 8 digits of all but the first; the rest are genmsg's of the same text).
+    'WalkDemoAction': 'abe30eb264997de30b2841a700221184',
+    'WalkDemoGoal': '9f688523db1280090d872cabed20d25b',
+    'WalkDemoResult': '9acd5105e8aac35c60f292ff9a681629',
+    'WalkDemoFeedback': 'dbaa9607b44a2efe654c751e0bae6116',
+    'WalkDemoActionGoal': 'be276040800453fdc072cc2f7f7dbc6a',
+    'WalkDemoActionResult': 'e62dca2bf26ccbf63139e15689379528',
+    'WalkDemoActionFeedback': '27ff4207512409473fc0e40ce6d1c140',
 }
 
 
