@@ -120,15 +120,20 @@ def test_without_the_transition_stand_does_not_take_over() -> None:
 
 
 def test_drcsim_2_7_start_lands_and_balances() -> None:
-    """startup_mode bdi_stand (DRCSim 2.6/2.7's start): pinned in the Stand pose, dropped at
-    1 s, the balancing Stand from 2 s with every k_effort 0: standing at the Stand's height,
+    """startup_mode bdi_stand (DRCSim 2.6/2.7's start): pinned in the Stand pose under the
+    user's PID (User, k_effort 255) at 0.5 s, dropped at 1 s, the balancing Stand from 2 s
+    with every k_effort 0: standing at the Stand's height,
     the feet still, at 8 s."""
     atlas = load_model()
     sim = AtlasSimulator(atlas, load_gains_yaml(DEFAULT_GAINS_FILE),
                          startup_mode=VrcMode.BDI_STAND)
     stand = StandBehaviour(atlas)
     sim.install_stand(stand)
-    for _ in range(2500):
+    for _ in range(500):
+        sim.step()
+    assert sim.mode is ControlMode.USER  # pinned in the Stand pose under the user's PID
+    np.testing.assert_array_equal(sim.active_k_effort(), 255)
+    for _ in range(2000):
         sim.step()
     assert sim.mode is ControlMode.STAND and stand.last_state is not None
     np.testing.assert_array_equal(sim.active_k_effort(), 0)  # AtlasState: f_out alone

@@ -2,7 +2,8 @@
 over the simulator and the balance. behaviors: its numbers and which control mode runs
 each behaviour; session: requests taken or refused and the feedback status; walk_params:
 a WALK's steps and walk_feedback; interface: one simulator's requests applied and its
-states built; walk_client: what a walking client does with each state.
+states built; walk_client: what a walking client does with each state; walk_demo: DRCSim's
+actionlib server's decisions.
 """
 
 from tutorial_atlas_control.exports import lazy_exports
@@ -12,5 +13,6 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'interface': ['FALLING_PELVIS_M', 'FALLING_TILT_RAD', 'AtlasSimInterface'],
     'session': ['STANDING_BEHAVIORS', 'AsiSession'],
     'walk_client': ['Outcome', 'WalkClient'],
+    'walk_demo': ['Decision', 'WalkDemoServer'],
     'walk_params': ['footsteps_of', 'sole_step', 'step_data_of', 'walk_feedback'],
 })

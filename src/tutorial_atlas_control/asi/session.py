@@ -8,7 +8,8 @@ served behaviour, Stand with the centre of mass outside the feet) reports its FA
 until the next accepted switch and keeps the running behaviour; Stand requested during Walk is
 taken once the step under way is down and the robot caught (TRANSITION_IN_PROGRESS until
 then, TRANSITION_SUCCESS after); Walk's return to Stand by itself after its last step
-reports WARNING_AUTO_TRANS until the next switch or refusal;
+reports WARNING_AUTO_TRANS in the state of that step, then OK (DRCSim's actionlib server
+does nothing while it is reported: latched, it would wait forever);
 ERROR_FALLING is reported while a standing behaviour (Walk included) is falling, ahead of
 any other value (one value at a time).
 """
@@ -94,13 +95,13 @@ class AsiSession:
 
     def auto_switched(self, current: Behavior, previous: Behavior) -> None:
         """The library left `previous` by itself (Walk, its steps done, to Stand):
-        WARNING_AUTO_TRANS until the next accepted switch or refusal."""
+        WARNING_AUTO_TRANS in the state of that step, then OK."""
         self.switched(current, previous)
         self._status = Status.WARNING_AUTO_TRANS
 
     def end_step(self) -> None:
         """A step has passed: a success has been reported (or was not listened to)."""
-        if self._status is Status.TRANSITION_SUCCESS:
+        if self._status in (Status.TRANSITION_SUCCESS, Status.WARNING_AUTO_TRANS):
             self._status = Status.OK
 
     def _refuse(self, behavior: int, current: Behavior, status: Status,
