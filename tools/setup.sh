@@ -30,7 +30,7 @@ APT_PACKAGES=(
   python3-tf python3-tf-conversions python3-pykdl python3-actionlib python3-actionlib-msgs
   ros-actionlib-msgs libactionlib-msgs-dev python3-roslib python3-tf2-geometry-msgs python3-tf2-kdl python3-angles
   libtf-dev libtf-conversions-dev libtrajectory-msgs-dev
-  xvfb xdotool x11-apps imagemagick iproute2
+  xvfb xdotool x11-apps imagemagick iproute2 tmux
   python3-tk
 )
 

@@ -3,7 +3,7 @@ over the simulator and the balance. behaviors: its numbers and which control mod
 each behaviour; session: requests taken or refused and the feedback status; walk_params:
 a WALK's steps and walk_feedback; interface: one simulator's requests applied and its
 states built; walk_client: what a walking client does with each state; walk_demo: DRCSim's
-actionlib server's decisions.
+actionlib server's decisions; teleop: the keyboard teleop's keys and steps.
 """
 
 from tutorial_atlas_control.exports import lazy_exports
@@ -12,6 +12,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'behaviors': ['BEHAVIOR_OF_MODE', 'MODE_OF_BEHAVIOR', 'AsiError', 'Behavior', 'Status'],
     'interface': ['FALLING_PELVIS_M', 'FALLING_TILT_RAD', 'AtlasSimInterface'],
     'session': ['STANDING_BEHAVIORS', 'AsiSession'],
+    'teleop': ['MOVES', 'Settings', 'ego_steps', 'key_action'],
     'walk_client': ['Outcome', 'WalkClient'],
     'walk_demo': ['Decision', 'WalkDemoServer'],
     'walk_params': ['footsteps_of', 'sole_step', 'step_data_of', 'walk_feedback'],

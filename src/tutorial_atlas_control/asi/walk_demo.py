@@ -12,7 +12,9 @@ STEPPING; STAND and STAND_PREP goals send their behaviour and succeed when it is
 USER and FREEZE goals send nothing. An error code or a FAILED_TRANS_* or ERROR_FALLING
 status aborts the goal; while WARNING_AUTO_TRANS is reported nothing else happens. A new goal
 while one runs sends STAND first. Ours: a WALK goal of fewer than two steps is aborted (DRCSim
-left it active forever), and MANIPULATE goals are sent (DRCSim only logged "not yet
+left it active forever); a walk that returns to Stand before its last step (the padded copies
+of a short walk repeat a foot: the walk stops there) ends the goal as the last step would
+(DRCSim's waited for ever); MANIPULATE goals are sent (DRCSim only logged "not yet
 implemented").
 
 The messages are the node's (atlas_msgs' genpy classes): this module reads their fields and
@@ -78,6 +80,8 @@ class WalkDemoServer:
         self.executing = False
         self.current_step_index = 0
         self.stepping = False
+        #: The walk of the goal has been reported (ours: to see it end early).
+        self.walk_seen = False
         #: The pelvis's estimated position (pos_est) and the IMU's yaw.
         self.robot_xy = (0.0, 0.0)
         self.robot_yaw = 0.0
@@ -105,6 +109,7 @@ class WalkDemoServer:
         elif goal.behavior == Behavior.STEP:
             self.stepping = False
             self._to_world(goal.step_params.desired_step.pose)
+        self.walk_seen = False
         return Decision()
 
     def preempted(self) -> None:
@@ -119,6 +124,8 @@ class WalkDemoServer:
             decision = self._abort(f'ActionServer: ERROR_CODE: {_error_name(state.error_code)}',
                                    state)
         status = state.behavior_feedback.status_flags
+        if decision.aborted is not None and status not in _PASSING_STATUS:
+            return decision  # aborted once, for the error code
         if status in _ABORTING_STATUS:
             return self._abort('ActionServer: AtlasBehaviorFeedback error: '
                                f'STATUS_{Status(status).name}', state)
@@ -164,6 +171,11 @@ class WalkDemoServer:
         goal = self.goal
         if goal.behavior == Behavior.WALK:
             walk = state.walk_feedback
+            if state.current_behavior == Behavior.WALK:
+                self.walk_seen = True
+            elif self.walk_seen:  # ours: the walk ended before its last step (Stand by itself)
+                self.executing = False
+                return
             if walk.current_step_index >= len(goal.steps) - 1:
                 decision.commands.append(self._command(Behavior.STAND))
                 self.executing = False

@@ -28,26 +28,24 @@ from atlas_msgs.msg import (
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.asi import Decision, WalkDemoServer
-from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED, EXIT_REFUSED, print_error
+from tutorial_atlas_control.cli.convention import (
+    EXIT_INTERRUPTED,
+    EXIT_REFUSED,
+    node_arguments,
+    print_error,
+)
 
 PROG = 'bdi_control.py'
 NODE_NAME = 'atlas_bdi_control'
 ACTION = 'atlas/bdi_control'
-HELP_OPTIONS = ('-h', '--help')
-#: A wrong command line, as argparse's.
-EXIT_USAGE = 2
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of scripts/bdi_control.py (`argv` with the program name first)."""
     argv = list(sys.argv if argv is None else argv)
-    plain = rospy.myargv(argv)[1:]
-    if plain:
-        if plain[0] in HELP_OPTIONS:
-            print(__doc__.strip())
-            return 0
-        print_error(PROG, f'unexpected argument {plain[0]!r} (see --help)')
-        return EXIT_USAGE
+    refused = node_arguments(PROG, __doc__, rospy.myargv(argv)[1:])
+    if refused is not None:
+        return refused
     try:
         return _serve(argv)
     except KeyboardInterrupt:

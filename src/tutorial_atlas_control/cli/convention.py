@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import argparse
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import TypeVar
 
 from tutorial_atlas_control.bags import newest_bag
@@ -52,6 +52,24 @@ def whole_number(minimum: int) -> Callable[[str], int]:
         return value
     checked.__name__ = 'whole_number'
     return checked
+
+
+#: A wrong command line (argparse's status).
+EXIT_USAGE = 2
+HELP_OPTIONS = ('-h', '--help')
+
+
+def node_arguments(prog: str, doc: str, plain: Sequence[str]) -> int | None:
+    """A node script's command line without its ROS arguments (`plain`): none, else
+    -h/--help (the docstring `doc`, exit 0) or one line for anything else (exit 2); None
+    when the node may start."""
+    if not plain:
+        return None
+    if plain[0] in HELP_OPTIONS:
+        print(doc.strip())
+        return 0
+    print_error(prog, f'unexpected argument {plain[0]!r} (see --help)')
+    return EXIT_USAGE
 
 
 def print_error(prog: str, message: object) -> None:

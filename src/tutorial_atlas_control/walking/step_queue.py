@@ -89,12 +89,16 @@ class StepQueue:
         return index
 
     def offer(self, steps: Iterable[Footstep]) -> None:
-        """Merge a command's steps; those already taken are ignored, and all once stopped."""
+        """Merge a command's steps; those already taken are ignored, and all once stopped.
+        Within one command the first copy of an index counts (DRCSim's actionlib server
+        pads a short walk with copies of earlier steps under indices already used)."""
         if self.stopped:
             return
+        merged: set[int] = set()
         for step in steps:
-            if step.step_index > self.current_step_index:
+            if step.step_index > self.current_step_index and step.step_index not in merged:
                 self._steps[step.step_index] = step
+                merged.add(step.step_index)
 
     def stop(self, taking: int | None) -> None:
         """No step after `taking` (the index of the step under way; None: none is): the walk

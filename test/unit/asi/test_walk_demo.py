@@ -82,7 +82,10 @@ def test_steps_are_turned_by_the_imu_and_moved_by_pos_est_and_a_short_walk_padde
     (state_of(status=Status.ERROR_FALLING), 'STATUS_ERROR_FALLING'),
     (state_of(status=Status.FAILED_TRANS_COM_POS), 'STATUS_FAILED_TRANS_COM_POS'),
     (state_of(error=-7), 'ERROR_CODE: ERROR_BEHAVIOR_NOT_IMPLEMENTED'),
-    (state_of(status=3), 'UNDOCUMENTED STATUS STATE')])
+    (state_of(status=3), 'UNDOCUMENTED STATUS STATE'),
+    # A refused STEP (Step is not served yet): the error code's reason, once.
+    (state_of(status=Status.FAILED_TRANS_ILLEGAL_BEHAVIOR, error=-7),
+     'ERROR_CODE: ERROR_BEHAVIOR_NOT_IMPLEMENTED')])
 def test_errors_abort_the_goal(state: atlas.AtlasSimInterfaceState, reason: str) -> None:
     server = WalkDemoServer(atlas.AtlasSimInterfaceCommand)
     server.accept(goal_of(WALK, 4))
@@ -130,3 +133,16 @@ def test_a_stand_goal_and_a_new_goal_while_one_runs() -> None:
     (again,) = server.on_state(state_of(WALK, current=1, needed=5)).commands
     assert again.behavior == STAND
     assert server.on_state(state_of(STAND, Status.TRANSITION_SUCCESS)).succeeded
+
+
+def test_a_walk_back_in_stand_before_its_last_step_ends_the_goal() -> None:
+    """Ours: DRCSim's padding of a short walk repeats a foot, so our Walk stops there and
+    returns to Stand; DRCSim's server would have waited for ever."""
+    server = WalkDemoServer(atlas.AtlasSimInterfaceCommand)
+    server.accept(goal_of(WALK, 2))
+    server.on_state(state_of())
+    assert server.on_state(state_of(STAND)).commands == []  # not walking yet: waits
+    server.on_state(state_of(WALK, current=2, needed=3))
+    assert not server.on_state(state_of(STAND, Status.WARNING_AUTO_TRANS)).succeeded
+    assert not server.on_state(state_of(STAND)).succeeded  # the walk seen ending
+    assert server.on_state(state_of(STAND)).succeeded

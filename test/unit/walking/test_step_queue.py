@@ -120,3 +120,13 @@ def test_clamp_step_turns_with_the_stance_foot() -> None:
     # 1 m ahead along the stance foot's heading (+y) is clamped to 0.4 m; left is -x.
     step = clamp_step(Footstep(1, LEFT, 0.8, 2.0, math.pi / 2), stance)
     assert (step.x_m, step.y_m, step.yaw_rad) == pytest.approx((0.8, 1.4, math.pi / 2))
+
+
+def test_within_one_command_the_first_copy_of_an_index_counts() -> None:
+    """DRCSim's actionlib server pads a two-step walk to [1, 2, 2, 3] with copies of the
+    steps two before: the walk takes 1, 2, then 3 (a copy of 2, the same foot: it ends)."""
+    first, second = Footstep(1, LEFT, 0.2, 0.12, 0.0), Footstep(2, RIGHT, 0.4, -0.12, 0.0)
+    queue = StepQueue(Footstep(0, LEFT, 0.0, 0.12, 0.0), Footstep(0, RIGHT, 0.0, -0.12, 0.0))
+    queue.offer([first, second, replace(first, step_index=2), replace(second, step_index=3)])
+    assert [step.step_index for step in queue.preview()] == [1, 2]
+    assert queue.preview()[1].foot_index == RIGHT and queue.inconsistent
