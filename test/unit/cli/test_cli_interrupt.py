@@ -78,6 +78,22 @@ def sigint_blocked(pid: int, tid: str) -> bool:
     return bool(mask >> (signal.SIGINT - 1) & 1)
 
 
+def signal_masks(pid: int) -> str:
+    """Each thread's pending, blocked, ignored and caught signal masks (/proc), one line
+    each: what a SIGINT that was not acted on became."""
+    lines = []
+    for tid in sorted(os.listdir(f'/proc/{pid}/task')):
+        try:
+            status = Path(f'/proc/{pid}/task/{tid}/status').read_text()
+        except OSError:
+            continue
+        fields = dict(line.split(':', 1) for line in status.splitlines() if ':' in line)
+        lines.append(f'{tid} {fields.get("Name", "").strip()}: ' + ' '.join(
+            f'{key} {fields.get(key, "").strip()}'
+            for key in ('SigPnd', 'ShdPnd', 'SigBlk', 'SigIgn', 'SigCgt')))
+    return '\n'.join(lines)
+
+
 def test_sigint_stops_run_offline_with_130_and_leaves_no_bag(tmp_path: Path) -> None:
     """A real Ctrl-C while the offline run simulates: exit 130, no traceback, no bag left;
     only the main thread can take it."""
@@ -105,11 +121,13 @@ def test_sigint_stops_run_offline_with_130_and_leaves_no_bag(tmp_path: Path) -> 
         process.send_signal(signal.SIGINT)
         try:
             out, err = process.communicate(timeout=EXIT_TIMEOUT_S)
-        except subprocess.TimeoutExpired:  # the stacks say where it was
+        except subprocess.TimeoutExpired:  # the masks and stacks say where it went
+            masks = signal_masks(process.pid)
             process.send_signal(signal.SIGABRT)
             _out, err = process.communicate(timeout=EXIT_TIMEOUT_S)
             pytest.fail(f'run_offline.py did not exit within {EXIT_TIMEOUT_S:g} s of SIGINT; '
-                        f'its threads:\n{err}')
+                        f'its threads\' signal masks (SIGINT is 0x2):\n{masks}\nits threads:'
+                        f'\n{err}')
     finally:
         if process.poll() is None:
             process.kill()
