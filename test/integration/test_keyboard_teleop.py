@@ -28,6 +28,8 @@ pytestmark = pytest.mark.filterwarnings('ignore::DeprecationWarning')
 SIM = '/atlas_sim'
 TELEOP = Path(__file__).resolve().parents[2] / 'scripts' / 'keyboard_teleop.py'
 SCREEN_TIMEOUT_S = 90.0
+#: The terminal's width: the longest status line fits.
+COLUMNS = 140
 
 
 class Terminal:
@@ -36,8 +38,14 @@ class Terminal:
     def __init__(self, command: str, env: dict[str, str]) -> None:
         self.socket = f'tac_teleop_{os.getpid()}'
         self.env = env
-        self._tmux('new-session', '-d', '-s', 'teleop', '-x', '100', '-y', '20',
+        self._tmux('new-session', '-d', '-s', 'teleop', '-x', str(COLUMNS), '-y', '20',
                    f'{command}; echo EXITED $?; sleep 600')
+        # A detached session's size is not always the one asked for (a fresh clone's CI
+        # run got 80 columns): set it, so that the longest line shows whole.
+        self._tmux('set-option', '-t', 'teleop', 'window-size', 'manual')
+        self._tmux('resize-window', '-t', 'teleop', '-x', str(COLUMNS), '-y', '20')
+        assert self._tmux('display-message', '-p', '-t', 'teleop',
+                          '#{window_width}').strip() == str(COLUMNS)
 
     def _tmux(self, *args: str) -> str:
         return subprocess.run(['tmux', '-L', self.socket, *args], env=self.env, check=True,
