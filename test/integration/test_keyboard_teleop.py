@@ -37,15 +37,11 @@ class Terminal:
 
     def __init__(self, command: str, env: dict[str, str]) -> None:
         self.socket = f'tac_teleop_{os.getpid()}'
-        self.env = env
+        # With $COLUMNS and $LINES in its environment (a fresh clone's CI run had
+        # COLUMNS=80), the teleop still sizes its screen by the window.
+        self.env = {**env, 'COLUMNS': '80', 'LINES': '24'}
         self._tmux('new-session', '-d', '-s', 'teleop', '-x', str(COLUMNS), '-y', '20',
                    f'{command}; echo EXITED $?; sleep 600')
-        # A detached session's size is not always the one asked for (a fresh clone's CI
-        # run got 80 columns): set it, so that the longest line shows whole.
-        self._tmux('set-option', '-t', 'teleop', 'window-size', 'manual')
-        self._tmux('resize-window', '-t', 'teleop', '-x', str(COLUMNS), '-y', '20')
-        assert self._tmux('display-message', '-p', '-t', 'teleop',
-                          '#{window_width}').strip() == str(COLUMNS)
 
     def _tmux(self, *args: str) -> str:
         return subprocess.run(['tmux', '-L', self.socket, *args], env=self.env, check=True,

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import curses
 import math
+import os
 import sys
 import threading
 from collections.abc import Sequence
@@ -64,6 +65,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         print_error(PROG, f'no {ACTION} server within {SERVER_TIMEOUT_S:.0f} s: start the '
                           'simulator with bdi_control:=true')
         return EXIT_REFUSED
+    for stale in ('COLUMNS', 'LINES'):  # curses takes the terminal's own size, not these
+        os.environ.pop(stale, None)
     try:
         curses.wrapper(Teleop(client).run)
     except KeyboardInterrupt:
@@ -124,9 +127,10 @@ class Teleop:
                  f'{self.settings.stride_m:.2f} m',
                  '  R stand up from the harness   H harness   Q quit',
                  '', self.robot, f'last: {self.last}']
+        rows, columns = screen.getmaxyx()  # the terminal as it is now (resizes included)
         screen.erase()
-        for row, line in enumerate(lines):
-            screen.addnstr(row, 0, line, max(1, curses.COLS - 1))
+        for row, line in enumerate(lines[:rows]):
+            screen.addnstr(row, 0, line, max(1, columns - 1))
         screen.refresh()
 
     def _start(self, work: object, what: str) -> None:
