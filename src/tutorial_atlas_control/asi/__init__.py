@@ -14,6 +14,6 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'session': ['STANDING_BEHAVIORS', 'AsiSession'],
     'teleop': ['MOVES', 'Settings', 'ego_steps', 'key_action'],
     'walk_client': ['Outcome', 'WalkClient'],
-    'walk_demo': ['Decision', 'WalkDemoServer'],
+    'walk_demo': ['Decision', 'WalkDemoServer', 'yaw_of_quaternion'],
     'walk_params': ['footsteps_of', 'sole_step', 'step_data_of', 'walk_feedback'],
 })

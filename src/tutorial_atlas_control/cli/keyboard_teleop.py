@@ -12,7 +12,6 @@ from the harness; H harness; Q quit. Options: -h/--help; ROS remapping arguments
 from __future__ import annotations
 
 import curses
-import math
 import os
 import sys
 import threading
@@ -23,7 +22,6 @@ import rosgraph
 import rospy
 from actionlib_msgs.msg import GoalStatus
 from atlas_msgs.msg import (
-    AtlasBehaviorStepData,
     AtlasSimInterfaceState,
     WalkDemoAction,
     WalkDemoGoal,
@@ -38,7 +36,7 @@ from tutorial_atlas_control.cli.convention import (
     node_arguments,
     print_error,
 )
-from tutorial_atlas_control.walking import Footstep
+from tutorial_atlas_control.cli.walk_client import step_message
 
 PROG = 'keyboard_teleop.py'
 ACTION = 'atlas/bdi_control'
@@ -149,14 +147,14 @@ class Teleop:
     def _walk(self, move: str) -> None:
         steps = ego_steps(move, self.settings)
         goal = WalkDemoGoal(behavior=WalkDemoGoal.WALK,
-                            steps=[_step_data(step) for step in steps])
+                            steps=[step_message(step) for step in steps])
         self._send(goal, f'{move}, {len(steps)} steps')
 
     def _step(self, move: str) -> None:
         steps = ego_steps(move, self.settings)
         for number, step in enumerate(steps, 1):
             goal = WalkDemoGoal(behavior=WalkDemoGoal.STEP)
-            goal.step_params.desired_step = _step_data(step)
+            goal.step_params.desired_step = step_message(step)
             if not self._send(goal, f'{move} step by step, step {number} of {len(steps)}'):
                 return
 
@@ -183,13 +181,4 @@ class Teleop:
         rospy.sleep(LANDING_S)
         self.control_modes.publish(String(data='Stand'))
         self.last = f'{what}: Stand'
-
-
-def _step_data(step: Footstep) -> AtlasBehaviorStepData:
-    data = AtlasBehaviorStepData(step_index=step.step_index, foot_index=step.foot_index,
-                                 duration=step.duration_s)
-    data.pose.position.x, data.pose.position.y = step.x_m, step.y_m
-    half = 0.5 * step.yaw_rad
-    data.pose.orientation.z, data.pose.orientation.w = math.sin(half), math.cos(half)
-    return data
 

@@ -18,10 +18,14 @@ from collections.abc import Sequence
 
 import rosgraph
 import rospy
-from atlas_msgs.msg import AtlasSimInterfaceCommand, AtlasSimInterfaceState
+from atlas_msgs.msg import (
+    AtlasBehaviorStepData,
+    AtlasSimInterfaceCommand,
+    AtlasSimInterfaceState,
+)
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.asi import Outcome, WalkClient
+from tutorial_atlas_control.asi import Outcome, WalkClient, yaw_of_quaternion
 from tutorial_atlas_control.cli.convention import (
     EXIT_INTERRUPTED,
     EXIT_REFUSED,
@@ -115,7 +119,8 @@ def _walk(plan: list[Footstep], args: argparse.Namespace) -> int:
         raise _Refused(f'no {topics.ASI_STATE} within {CONNECT_TIMEOUT_S:.0f} s: is the '
                        'simulator running?') from None
     feet = first.foot_pos_est
-    left_yaw, right_yaw = (_yaw(foot.orientation) for foot in feet)
+    left_yaw, right_yaw = (yaw_of_quaternion(o.x, o.y, o.z, o.w)
+                           for o in (foot.orientation for foot in feet))
     yaw = left_yaw + 0.5 * wrap_angle(right_yaw - left_yaw)
     origin = (0.5 * (feet[0].position.x + feet[1].position.x),
               0.5 * (feet[0].position.y + feet[1].position.y))
@@ -157,19 +162,20 @@ def _walk(plan: list[Footstep], args: argparse.Namespace) -> int:
     return 0
 
 
-def _yaw(q: object) -> float:
-    x, y, z, w = q.x, q.y, q.z, q.w  # type: ignore[attr-defined]
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+def step_message(step: Footstep) -> AtlasBehaviorStepData:
+    """A footstep as atlas_msgs/AtlasBehaviorStepData (x, y, yaw; z and swing height 0)."""
+    data = AtlasBehaviorStepData(step_index=step.step_index, foot_index=step.foot_index,
+                                 duration=step.duration_s)
+    data.pose.position.x, data.pose.position.y = step.x_m, step.y_m
+    half = 0.5 * step.yaw_rad
+    data.pose.orientation.z, data.pose.orientation.w = math.sin(half), math.cos(half)
+    return data
 
 
 def _command(steps: list[Footstep]) -> AtlasSimInterfaceCommand:
     """An AtlasSimInterfaceCommand WALK of `steps` (empty slots after them)."""
     command = AtlasSimInterfaceCommand()
     command.behavior = command.WALK
-    for slot, step in zip(command.walk_params.step_queue, steps):
-        slot.step_index, slot.foot_index, slot.duration = (step.step_index, step.foot_index,
-                                                           step.duration_s)
-        slot.pose.position.x, slot.pose.position.y = step.x_m, step.y_m
-        slot.pose.orientation.z = math.sin(0.5 * step.yaw_rad)
-        slot.pose.orientation.w = math.cos(0.5 * step.yaw_rad)
+    for slot, step in enumerate(steps[:len(command.walk_params.step_queue)]):
+        command.walk_params.step_queue[slot] = step_message(step)
     return command

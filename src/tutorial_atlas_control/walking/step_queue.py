@@ -135,10 +135,11 @@ class StepQueue:
         self._last_foot = landed.foot_index
         self._steps = {k: v for k, v in self._steps.items() if k > self.current_step_index}
 
-    def status_flags(self, phase: int) -> int:
-        """walk_feedback.status_flags for the walk's `phase` (SWAYING, STEPPING, CATCHING)."""
+    def status_flags(self, phase: int, preview: list[Footstep] | None = None) -> int:
+        """walk_feedback.status_flags for the walk's `phase` (SWAYING, STEPPING, CATCHING);
+        `preview`: this queue's preview() if the caller has just made it."""
         flags = phase
-        if len(self.preview()) < QUEUE_LENGTH:
+        if len(self.preview() if preview is None else preview) < QUEUE_LENGTH:
             flags |= WARNING_INSUFFICIENT_STEP_DATA
         if self.inconsistent:
             flags |= ERROR_INCONSISTENT_STEPS

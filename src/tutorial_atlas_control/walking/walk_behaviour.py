@@ -18,7 +18,7 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control.balance import StandBehaviour
-from tutorial_atlas_control.walking.footsteps import DRCSIM_WALK_QUEUE, QUEUE_LENGTH, Footstep
+from tutorial_atlas_control.walking.footsteps import DRCSIM_WALK_QUEUE, Footstep
 from tutorial_atlas_control.walking.leg_tasks import foot_pose
 from tutorial_atlas_control.walking.step_queue import (
     DEFAULT_LIMITS,
@@ -111,6 +111,6 @@ class WalkBehaviour:
         remaining = 0.0
         if walk.phase == STEPPING and walk.step is not None:
             remaining = max(0.0, walk.step.duration_s - (time_s - walk.phase_start_s))
+        preview = queue.preview()
         return WalkStatus(remaining, queue.current_step_index, queue.next_step_index_needed,
-                          queue.status_flags(walk.phase),
-                          tuple(queue.preview()[:QUEUE_LENGTH]))
+                          queue.status_flags(walk.phase, preview), tuple(preview))
