@@ -109,3 +109,13 @@ def test_help_and_a_wrong_argument() -> None:
     assert done.returncode == 2
     assert done.stderr.strip() == ("keyboard_teleop.py: error: unexpected argument 'forward' "
                                    '(see --help)')
+
+
+def test_without_a_terminal_one_line_and_status_1() -> None:
+    """Through a pipe (no tty) curses cannot start: one line, before any ROS connection."""
+    done = subprocess.run([sys.executable, str(TELEOP)], capture_output=True, text=True,
+                          stdin=subprocess.DEVNULL, timeout=60, check=False)
+    assert (done.returncode, done.stdout) == (1, '')
+    assert done.stderr.strip() == (
+        'keyboard_teleop.py: error: needs a terminal: its standard input and output must be a '
+        'tty (run it in a terminal, not through a pipe or roslaunch)')

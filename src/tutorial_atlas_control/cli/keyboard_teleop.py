@@ -53,6 +53,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     refused = node_arguments(PROG, __doc__, rospy.myargv(argv)[1:])
     if refused is not None:
         return refused
+    if not (sys.stdin.isatty() and sys.stdout.isatty()):
+        print_error(PROG, 'needs a terminal: its standard input and output must be a tty '
+                          '(run it in a terminal, not through a pipe or roslaunch)')
+        return EXIT_REFUSED
     uri = rosgraph.get_master_uri()
     if not rosgraph.is_master_online(uri):
         print_error(PROG, f'no ROS master at {uri}: start the simulator first')
@@ -69,6 +73,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         curses.wrapper(Teleop(client).run)
     except KeyboardInterrupt:
         return EXIT_INTERRUPTED
+    except curses.error as error:  # a terminal curses cannot drive (TERM unknown, too small)
+        print_error(PROG, f'cannot draw in this terminal (TERM={os.environ.get("TERM", "")}): '
+                          f'{error}')
+        return EXIT_REFUSED
     finally:
         rospy.signal_shutdown('teleop closed')
     return 0
