@@ -37,7 +37,7 @@ export ROS_HOSTNAME="${ROS_HOSTNAME:-localhost}"
 export ROS_MASTER_URI="${ROS_MASTER_URI:-http://localhost:11311}"
 # Offscreen rendering without a GPU or display: software OSMesa unless the user chose otherwise.
 if [ -z "${DISPLAY:-}" ] && [ -z "${MUJOCO_GL:-}" ]; then export MUJOCO_GL=osmesa PYOPENGL_PLATFORM=osmesa; fi
-export TAC_REPO_DIR="$repo_dir" TAC_HOME TAC_WS TAC_VENV
+export TAC_REPO_DIR="$repo_dir" TAC_HOME TAC_WS TAC_VENV TAC_INSTALL_WS TAC_INSTALL_PREFIX
 unset repo_dir
 # The tutorial's roscd, rosls, rosed, roscp and the ROS commands' tab completion: shell
 # functions from Debian's rosbash package, for bash only (nothing else sources them).

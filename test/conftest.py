@@ -8,9 +8,11 @@ never hides what CI would fail on. Only tests marked
 `@pytest.mark.optional(reason)` may skip there: they need something no clone carries (the
 DRCSim reference files beside the repository); their skips are listed, and allowed.
 
-Also: Ctrl-C reaches the tests' children. A non-interactive shell starts its background
-jobs (make test's, a CI runner's) with SIGINT ignored, an ignored signal stays ignored
-across exec, and the tests stop their children with SIGINT as a terminal would.
+Also: make test's two xdist workers take whole modules (support/xdist_scheduling.py), so
+that a module-scoped launch starts once. And Ctrl-C reaches the tests' children. A
+non-interactive shell starts its background jobs (make test's, a CI runner's) with SIGINT
+ignored, an ignored signal stays ignored across exec, and the tests stop their children
+with SIGINT as a terminal would.
 """
 
 from __future__ import annotations
@@ -92,3 +94,10 @@ def pytest_terminal_summary(terminalreporter: pytest.TerminalReporter) -> None:
         terminalreporter.write_line(
             f'{REQUIRE_ALL_ENV}=1: {len(_unexpected)} test(s) skipped, which fails the run: '
             + '; '.join(_unexpected), red=True, bold=True)
+
+
+def pytest_xdist_make_scheduler(config: pytest.Config, log: object) -> object:
+    """Whole modules to a worker (support/xdist_scheduling.py); `-n` without `--dist` too."""
+    from support.xdist_scheduling import ModuleScheduling
+
+    return ModuleScheduling(config, log)

@@ -6,4 +6,7 @@ TAC_CACHE_DIR=${TAC_CACHE_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/tutorial_atlas_co
 TAC_HOME="$TAC_CACHE_DIR/$(printf '%s' "$_tac_repo" | sha1sum | cut -c1-12)"
 TAC_VENV="$TAC_HOME/venv"
 TAC_WS="$TAC_HOME/ws"
+# An install space as a user builds it, checked by test_install_space.py.
+TAC_INSTALL_WS="$TAC_HOME/install_ws"
+TAC_INSTALL_PREFIX="$TAC_HOME/install"
 unset _tac_repo

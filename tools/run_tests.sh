@@ -68,6 +68,7 @@ in_background rostests bash tools/run_rostests.sh
 # (tools/lowest_priority.py); niced with their sessions, it takes what the tests leave idle.
 in_background bench-quick python3 tools/lowest_priority.py \
   bash -c 'python3 bench/run_bench.py --quick --runs 1 > /dev/null'
+# Each worker takes whole modules (test/conftest.py's scheduler): a module's launch starts once.
 timed pytest-parallel python3 -m pytest test/unit test/integration test/reliability \
   -q -rs -n 2 -m 'not serial' --durations=15
 collect rostests

@@ -3,7 +3,9 @@
 #   1. Debian packages (ROS 1 from Debian 12, catkin, software GL) via apt-get;
 #   2. a virtualenv from /usr/bin/python3 with --system-site-packages and the pinned PyPI requirements;
 #   3. a catkin workspace OUTSIDE the repository (a workspace inside the tree makes rosrun loop),
-#      whose src/ holds symlinks to this package and to the vendored message packages under msg/.
+#      whose src/ holds symlinks to this package and to the vendored message packages under msg/;
+#   4. beside it, an install space built as a user would (`catkin_make install`), which
+#      test_install_space.py runs the tutorial from (tools/build_install_space.sh).
 # Each step is skipped when its inputs have not changed since the last run.
 set -euo pipefail
 
@@ -95,7 +97,19 @@ build_workspace() {
   echo "$want" > "$stamp"
 }
 
+build_install_space() {
+  local stamp="$TAC_INSTALL_WS/.build-inputs.sha1" want
+  want=$(cat "$TAC_WS/.build-inputs.sha1")
+  if [ -f "$TAC_INSTALL_PREFIX/setup.bash" ] && [ "$(cat "$stamp" 2>/dev/null)" = "$want" ]; then
+    log "install space up to date ($TAC_INSTALL_PREFIX)"; return
+  fi
+  log "building the install space $TAC_INSTALL_PREFIX (for test_install_space.py)"
+  bash "$repo_dir/tools/build_install_space.sh" "$TAC_INSTALL_WS" "$TAC_INSTALL_PREFIX"
+  echo "$want" > "$stamp"
+}
+
 install_debian_packages
 create_virtualenv
 build_workspace
+build_install_space
 log "done; now: source ./env.sh"

@@ -1,9 +1,11 @@
 """The tutorial from a catkin install space: built, installed, run, and its bag read.
 
-The workspace is a new one in tmp_path (src/ holds symlinks to this repository and its two
-message packages, as tools/setup.sh lays out the developer's), built from a bare
-environment, so nothing of the developer's workspace (devel space, build directory) can
-hide a missing install rule. The commands, as a user would type them:
+The workspace is not the developer's: `make setup` builds one beside it
+(tools/build_install_space.sh: src/ holds symlinks to this repository and its two message
+packages), from a bare environment, so nothing of the developer's workspace (devel space,
+build directory) can hide a missing install rule. Here it is rebuilt (only what changed
+compiles) and installed into an emptied prefix, so that a file no install rule names any
+more cannot linger there. The commands, as a user would type them:
 
     mkdir -p WS/src && cd WS/src && ln -s REPO tutorial_atlas_control \\
         && ln -s REPO/msg/osrf_msgs osrf_msgs && ln -s REPO/msg/atlas_msgs atlas_msgs
@@ -24,21 +26,23 @@ hide a missing install rule. The commands, as a user would type them:
 Judged: the robot stays up through touchdown, whose arm joints moved; and what ran came
 from PREFIX (the environment names neither the repository nor the developer's workspace,
 the package's Python, its data, its node and its compiled library are PREFIX's).
-Needs `make setup` (Debian's catkin and ROS, the virtualenv).
+Needs `make setup` (Debian's catkin and ROS, the virtualenv, the install workspace).
 """
 
 from __future__ import annotations
 
+import fcntl
 import json
 import os
 import shutil
 import subprocess
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
 if shutil.which('roslaunch') is None or shutil.which('catkin_make') is None \
-        or 'TAC_VENV' not in os.environ:
+        or 'TAC_INSTALL_WS' not in os.environ:
     pytest.skip('needs the project environment (make setup, source env.sh)',
                 allow_module_level=True)
 
@@ -48,10 +52,7 @@ from tutorial_atlas_control.native import LIBRARY_NAME
 REPO = Path(__file__).resolve().parents[2]
 PACKAGE = 'tutorial_atlas_control'
 MESSAGE_PACKAGES = ('osrf_msgs', 'atlas_msgs')
-#: As tools/setup.sh builds: catkin on Debian's Python, where ROS lives. No test targets
-#: (the roscpp test client), which an install does not hold.
-CATKIN_MAKE_ARGS = ('-DPYTHON_EXECUTABLE=/usr/bin/python3', '-DPython3_EXECUTABLE=/usr/bin/python3',
-                    '-DCATKIN_ENABLE_TESTING=OFF')
+BUILD_SCRIPT = REPO / 'tools' / 'build_install_space.sh'
 #: A bare shell's PATH: ROS's commands are Debian's, in /usr/bin.
 BARE_PATH = '/usr/local/bin:/usr/bin:/bin'
 #: Variables whose entries must not lead back to the source tree or the developer's workspace.
@@ -83,22 +84,11 @@ def venv_site_packages() -> str:
         capture_output=True, text=True, check=True).stdout.strip()
 
 
-def build_install_space(root: Path, home: Path) -> Path:
-    """catkin_make install of a new workspace under `root`; the install prefix."""
-    workspace, prefix = root / 'ws', root / 'install'
-    (workspace / 'src').mkdir(parents=True)
-    (workspace / 'src' / PACKAGE).symlink_to(REPO)
-    for name in MESSAGE_PACKAGES:
-        (workspace / 'src' / name).symlink_to(REPO / 'msg' / name)
-    log = root / 'catkin_make.log'
-    with log.open('w') as out:
-        result = subprocess.run(
-            ['catkin_make', *CATKIN_MAKE_ARGS, f'-DCMAKE_INSTALL_PREFIX={prefix}', 'install'],
-            cwd=workspace, env=bare_env(home), stdout=out, stderr=subprocess.STDOUT,
-            timeout=BUILD_TIMEOUT_S, check=False)
-    tail = '\n'.join(log.read_text(errors='replace').splitlines()[-40:])
-    assert result.returncode == 0, f'catkin_make install failed ({log}):\n{tail}'
-    return prefix
+def build_install_space(workspace: Path, prefix: Path) -> None:
+    """tools/build_install_space.sh: `catkin_make install` into an emptied `prefix`."""
+    result = subprocess.run(['bash', str(BUILD_SCRIPT), str(workspace), str(prefix)],
+                            capture_output=True, text=True, timeout=BUILD_TIMEOUT_S, check=False)
+    assert result.returncode == 0, f'catkin_make install failed:\n{result.stderr}'
 
 
 def install_env(prefix: Path, home: Path) -> dict[str, str]:
@@ -121,15 +111,27 @@ def within(path: str | Path, directory: Path) -> bool:
     return Path(path).resolve().is_relative_to(directory.resolve())
 
 
-def test_the_tutorial_runs_from_an_install_space(tmp_path: Path) -> None:
+@pytest.fixture()
+def install_space() -> Iterator[tuple[Path, Path]]:
+    """The install workspace and its prefix, rebuilt, held against any other pytest's use."""
+    workspace, prefix = Path(os.environ['TAC_INSTALL_WS']), Path(os.environ['TAC_INSTALL_PREFIX'])
+    workspace.mkdir(parents=True, exist_ok=True)
+    with (workspace.parent / 'install_ws.lock').open('w') as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        build_install_space(workspace, prefix)
+        yield workspace, prefix
+
+
+def test_the_tutorial_runs_from_an_install_space(
+        tmp_path: Path, install_space: tuple[Path, Path]) -> None:
     home = tmp_path / 'home'
     home.mkdir()
-    prefix = build_install_space(tmp_path, home)
+    workspace, prefix = install_space
     env = install_env(prefix, home)
     share = prefix / 'share' / PACKAGE
 
     # Nothing in the environment leads to the source tree or the developer's workspace.
-    developer = [REPO, Path(os.environ.get('TAC_WS', REPO)), tmp_path / 'ws']
+    developer = [REPO, Path(os.environ.get('TAC_WS', REPO)), workspace]
     leaks = [entry for name in PATH_VARIABLES for entry in env.get(name, '').split(':')
              if entry and any(within(entry, place) for place in developer)]
     assert leaks == []

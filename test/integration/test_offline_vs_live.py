@@ -1,7 +1,8 @@
 """An offline run (run_offline.py) reaches the outcome of the live run (`make demo`) it stands for.
 
-The live runs are run_demo.py's, at LIVE_REAL_TIME_FACTOR (step_and_fall and
-touchdown_exhausted, the README's slow sway that ends on the ground); each is compared with
+The live runs are run_demo.py's, at LIVE_REAL_TIME_FACTOR (step_and_fall: the demo_run every
+test of the demo shares, conftest.py; and touchdown_exhausted, the README's slow sway that
+ends on the ground); each is compared with
 the offline run of the same trajectory, aligned on the first applied command
 (bags/compare.py). Transport and scheduling move a live run a little (the trajectory starts from
 a pose the robot held longer, commands arrive 1-2 ms late), so only the outcome must agree:
@@ -63,8 +64,8 @@ def run_live(bag_dir: Path, trajectory: str) -> LiveRun:
 
 
 @pytest.fixture(scope='module')
-def step_and_fall_run(tmp_path_factory: pytest.TempPathFactory) -> LiveRun:
-    return run_live(tmp_path_factory.mktemp('step_and_fall'), 'step_and_fall')
+def step_and_fall_run(demo_run) -> LiveRun:  # demo_run: conftest.DemoRun, at 0.5x as here
+    return LiveRun(demo_run.result, demo_run.bag)
 
 
 @pytest.fixture(scope='module')
