@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from support.scripts import interrupt_script, run_script
+from tutorial_atlas_control.cli import search as search_cli
 from tutorial_atlas_control.search.cmaes import LATENCY_SEED, runs_per_candidate
 from tutorial_atlas_control.search.sweep import SweepInputs, build_specs, run_sweep
 from tutorial_atlas_control.sim.controller import load_gains_yaml
@@ -136,14 +137,18 @@ def test_ctrl_c_keeps_the_finished_generations(tmp_path: Path, tiny: Path) -> No
       '--latency-draws', '2'], "latency 'x' is not LO:HI"),
 ])
 def test_bad_input_one_line_exit_1_nothing_written(tmp_path: Path, tiny: Path,
-                                                    args: list[str], message: str) -> None:
+                                                    args: list[str], message: str,
+                                                    capsys: pytest.CaptureFixture[str]) -> None:
+    """The command line's main in this process (each refusal comes before any run; the
+    script's wrapper and exit status are test_missing_file_and_unknown_name's)."""
     out = tmp_path / 'out'
     out.mkdir()
-    result = _search(str(tiny), 'bend', *args, '--log', str(out / 'log.jsonl'),
-                     '--yaml', str(out / 'found.yaml'), '--workers', '1')
-    assert result.returncode == 1
-    lines = result.stderr.splitlines()
-    assert len(lines) == 1, result.stderr
+    status = search_cli.main([str(tiny), 'bend', *args, '--log', str(out / 'log.jsonl'),
+                              '--yaml', str(out / 'found.yaml'), '--workers', '1'])
+    captured = capsys.readouterr()
+    assert (status, captured.out) == (1, '')
+    lines = captured.err.splitlines()
+    assert len(lines) == 1, captured.err
     assert lines[0].startswith('search.py: error: ') and message in lines[0]
     assert list(out.iterdir()) == []
 

@@ -7,8 +7,8 @@ tries with the right trajectories, the falls of step_and_fall and touchdown_exha
 every scheduled command in each; and tries 2 and 3, which start at a mid-run reset_world
 and at a reset_simulation, must replay offline bit for bit.
 
-Needs `make setup` and `source ./env.sh`; about 90 s of wall time (at REAL_TIME_FACTOR:
-traj_yaml.py paces its commands in sim time either way).
+Needs `make setup` and `source ./env.sh`; about 60 s of wall time (real_time_factor 1, as
+the demo: traj_yaml.py paces its commands in sim time either way).
 """
 
 from __future__ import annotations
@@ -33,12 +33,12 @@ from tutorial_atlas_control.bags.tries import (
 from tutorial_atlas_control.offline.replay import replay_bag
 from tutorial_atlas_control.trajectories.trajectory import load_trajectory, sample_count
 
-#: The simulator's pace. The outcomes (two falls, one stand) hang on commands arriving in
-#: time: at half real time a busy machine's delays are half as long in sim time, as in the
-#: tutorial rostests, which play them so beside the parallel tests (this test ran serial at
-#: 1.0 before). A recorder lagging 440 ms once put 23 of try 3's commands in try 1; the
-#: reader keeps each message in the try it was stamped in (test_bag_tries.py).
-REAL_TIME_FACTOR = 0.5
+#: Serial: three tutorial trajectories played at real time, whose outcomes (two falls, one
+#: stand) hang on commands arriving in time (the rostests play them at 0.5x beside the
+#: parallel tests). A recorder lagging 440 ms once put 23 of try 3's commands in try 1; the
+#: reader now keeps each message in the try it was stamped in (test_bag_tries.py).
+pytestmark = pytest.mark.serial
+
 REPO = Path(__file__).resolve().parents[2]
 TRAJ_YAML = REPO / 'scripts' / 'traj_yaml.py'
 TRAJECTORY_FILE = REPO / 'trajectories' / 'Traj_data2.yaml'
@@ -74,8 +74,7 @@ def reset(launch: TestLaunch, service: str) -> None:
 
 @pytest.fixture(scope='module')
 def session_bag(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    with TestLaunch(tmp_path_factory.mktemp('three_tries'),
-                    f'real_time_factor:={REAL_TIME_FACTOR}') as launch:
+    with TestLaunch(tmp_path_factory.mktemp('three_tries')) as launch:
         launch.wait_ready()
         launch.wait_sim_until(SETTLE_S)
         launch.set_mode('User')

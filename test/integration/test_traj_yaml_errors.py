@@ -92,16 +92,23 @@ class Master(RosMaster):
                        'the command listener did not subscribe to /atlas/joint_commands')
             result = self.run(sys.executable, str(TRAJ_YAML), str(TRAJECTORIES),
                               'step_and_fall', *ros_args)
-            control = self.run('rostopic', 'pub', '-1', '/atlas/joint_commands',
-                               'osrf_msgs/JointCommands', f'{{position: [{CONTROL_POSITION}]}}')
-            assert control.returncode == 0, control.stderr
-            deadline = time.monotonic() + CONTROL_TIMEOUT_S
-            while not any(str(CONTROL_POSITION) in line for line in heard):
-                assert time.monotonic() < deadline, (
-                    f'the listener did not hear the control command within {CONTROL_TIMEOUT_S}'
-                    f' s: it would not have heard the port\'s either (heard {heard!r})')
-                with contextlib.suppress(queue.Empty):
-                    heard.append(lines.get(timeout=0.1))
+            # Stopped once heard: `rostopic pub -1` would latch 3 s more before exiting.
+            control = subprocess.Popen(
+                ['rostopic', 'pub', '-1', '/atlas/joint_commands', 'osrf_msgs/JointCommands',
+                 f'{{position: [{CONTROL_POSITION}]}}'], env=self.env,
+                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
+                preexec_fn=default_sigint)
+            try:
+                deadline = time.monotonic() + CONTROL_TIMEOUT_S
+                while not any(str(CONTROL_POSITION) in line for line in heard):
+                    assert time.monotonic() < deadline, (
+                        f'the listener did not hear the control command within '
+                        f'{CONTROL_TIMEOUT_S} s: it would not have heard the port\'s either '
+                        f'(heard {heard!r}; rostopic pub exit status {control.poll()})')
+                    with contextlib.suppress(queue.Empty):
+                        heard.append(lines.get(timeout=0.1))
+            finally:
+                stop_tree(control)
         finally:
             stop_tree(listener)
         before_control = heard[:next(k for k, line in enumerate(heard)

@@ -26,10 +26,9 @@ from tutorial_atlas_control.bags.analysis import analyze_bag
 from tutorial_atlas_control.bags.reader import BagData, read_bag
 from tutorial_atlas_control.bags.records import IndexedBag, PublicBag
 
-#: `rosbag record`'s case is serial: the replay's count of compared steps rests on its record
-#: times, which lag when it is starved (seen beside a busy core: 2618 of 5056 steps
-#: compared). atlas_recorder loses nothing however busy the machine (node/transport.py).
-ROSBAG_SERIAL = pytest.mark.serial
+#: Serial: the replay's count of compared steps rests on `rosbag record`'s record times,
+#: which lag when it is starved (seen beside a busy core: 2618 of 5056 steps compared).
+pytestmark = pytest.mark.serial
 
 #: Sim time (s) recorded after the launch is ready.
 RUN_S = 3.0
@@ -58,7 +57,7 @@ def record(tmp_path: Path, recorder: str, compression: str) -> Path:
 
 @pytest.mark.parametrize(('recorder', 'compression'), [
     ('atlas_recorder', 'none'), ('atlas_recorder', 'lz4'), ('atlas_recorder', 'bz2'),
-    pytest.param('rosbag', 'lz4', marks=ROSBAG_SERIAL),
+    ('rosbag', 'lz4'),
 ])
 def test_bag_is_compressed_as_asked_and_reads_back(tmp_path: Path, recorder: str,
                                                    compression: str) -> None:
