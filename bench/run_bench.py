@@ -239,6 +239,9 @@ class Budget:
     side_runs: int | None = None
     #: The search's population in its few generations (None: Stepping.yaml's 8).
     search_popsize: int | None = None
+    #: The least runs of the physics and offline sections, whose medians need a few even
+    #: when --runs is 1; the smoke test's one is enough to produce each figure.
+    min_offline_runs: int = 5
 
     def side(self, runs: int) -> int:
         """How many of `runs` measure the untargeted launches too."""
@@ -247,7 +250,7 @@ class Budget:
 
 BUDGETS = {
     'quick': Budget('quick', 2000, 5000, 10.0, 4, 1, 4.0, 8.0, ((50.0, 2.0), (1000.0, 1.0)),
-                    8.0, 4.0, 4.0, search_popsize=2),
+                    8.0, 4.0, 4.0, search_popsize=2, min_offline_runs=1),
     'default': Budget('default', 5000, 20000, 60.0, 8, 1, 5.0, 15.0,
                       ((50.0, 4.0), (1000.0, 2.0)), 15.0, 6.0, 6.0, side_runs=1),
     'full': Budget('full', 5000, 20000, 60.0, 16, None, 10.0, 30.0,
@@ -418,7 +421,7 @@ def run_offline(args: argparse.Namespace, samples: dict[str, list[float]],
         import node_loop
 
         with Section('physics', loads):
-            for run in range(max(args.runs, 5)):
+            for run in range(max(args.runs, args.budget.min_offline_runs)):
                 steps = args.budget.physics_steps
                 rates = {'bare_physics_steps_per_s': node_loop.bare_physics_run(steps),
                          'physics_limit_steps_per_s': offline.physics_run(steps=steps),
@@ -441,7 +444,7 @@ def run_offline(args: argparse.Namespace, samples: dict[str, list[float]],
     if 'offline' in args.sections:
         steps_per_s = offline.steps_per_sim_second()
         with Section('offline', loads), tempfile.TemporaryDirectory(prefix='tac_bench_') as tmp:
-            for run in range(max(args.runs, 5)):
+            for run in range(max(args.runs, args.budget.min_offline_runs)):
                 # Interleaved with the plain loop: both see the same load.
                 physics = offline.physics_run(steps=args.budget.physics_steps)
                 rtf = offline.offline_run(Path(tmp))
