@@ -51,7 +51,6 @@ from tutorial_atlas_control.native import LIBRARY_NAME
 
 REPO = Path(__file__).resolve().parents[2]
 PACKAGE = 'tutorial_atlas_control'
-MESSAGE_PACKAGES = ('osrf_msgs', 'atlas_msgs')
 BUILD_SCRIPT = REPO / 'tools' / 'build_install_space.sh'
 #: A bare shell's PATH: ROS's commands are Debian's, in /usr/bin.
 BARE_PATH = '/usr/local/bin:/usr/bin:/bin'
