@@ -200,6 +200,45 @@ def _send_commands(probes: Probes, rate_hz: float, duration_s: float,
     return sent
 
 
+def _wait_effort_seen(probes: Probes, value: float, launch: Launch, failure: str,
+                      resend: object | None = None) -> None:
+    """Until /atlas/joint_states (being recorded) shows `value` as LATENCY_JOINT's effort.
+
+    Waiting for the condition, not a fixed time: beside the test suite both the simulator
+    and this process can be starved of CPU for seconds, and a sample not yet read off the
+    socket when recording stops would read as a command lost. `resend` is published at
+    every poll (a command that may have been ignored).
+    """
+    scanned = 0
+
+    def seen() -> bool:
+        nonlocal scanned
+        if resend is not None:
+            probes.command_pub.publish(resend)
+        with probes.joint_states.lock:
+            fresh = probes.joint_states.samples[scanned:]
+        scanned += len(fresh)
+        return any(joint_state_effort(raw, LATENCY_JOINT) == value for _, raw in fresh)
+
+    wait_until(seen, READY_TIMEOUT_S, failure, launch.check_running)
+
+
+def _wait_user_mode(probes: Probes, launch: Launch) -> None:
+    """Until a command shows up in /atlas/joint_states: User mode is in effect (commands
+    sent before the simulator acts on the mode change are ignored, not late)."""
+    from osrf_msgs.msg import JointCommands
+
+    value = 0.25  # outside the measured commands' values
+    msg = JointCommands(name=[LATENCY_JOINT], kp_position=[0.0], ki_position=[0.0],
+                        kd_position=[0.0], kp_velocity=[0.0], effort=[value])
+    probes.joint_states.start()
+    try:
+        _wait_effort_seen(probes, value, launch, 'no command showed up in '
+                          '/atlas/joint_states after the switch to User', resend=msg)
+    finally:
+        probes.joint_states.stop()
+
+
 def _match_latencies(sent: list[tuple[float, float]],
                      states: list[tuple[float, bytes]]) -> tuple[np.ndarray, int]:
     """(latencies in ms of the commands that were applied, count sent)."""
@@ -294,15 +333,19 @@ def realtime_run(master: Master, launch_file: str, probes: Probes, work_dir: Pat
                        and probes.mode_pub.get_num_connections() > 0, READY_TIMEOUT_S,
                        'the simulator did not subscribe to the commands', launch.check_running)
             probes.mode_pub.publish(String(data='User'))
-            time.sleep(0.5)
+            _wait_user_mode(probes, launch)
         key = 0
         for rate_hz, duration_s in latency_s.items():
             label = f'{rate_hz:g}hz' if rate_hz < 1000 else f'{rate_hz / 1000:g}khz'
             probes.joint_states.start()
             sent = _send_commands(probes, rate_hz, duration_s, key)
             key += len(sent) + 1
-            time.sleep(0.2)
-            states = probes.joint_states.stop()
+            try:
+                _wait_effort_seen(probes, sent[-1][0], launch,
+                                  f'the last command at {label} did not show up in '
+                                  '/atlas/joint_states')
+            finally:
+                states = probes.joint_states.stop()
             launch.check_running()
             latencies, count = _match_latencies(sent, states)
             if len(latencies) < 10:
