@@ -266,6 +266,12 @@ def js_transport(master: Master, probes: Probes, work_dir: Path, count: int = 20
              JS_PROBE_TOPIC, str(count), str(rate_hz)],
             env=master.env, stdout=probe_log, stderr=subprocess.STDOUT,
             stdin=subprocess.DEVNULL, timeout=count / rate_hz + 60, check=False)
+        if completed.returncode == 0:
+            # Its sends are synchronous, so all `count` arrive; this process, niced beside
+            # the test suite, may still be reading them.
+            deadline = time.monotonic() + READY_TIMEOUT_S
+            while len(probes.js_probe.samples) < count and time.monotonic() < deadline:
+                time.sleep(0.05)
     except subprocess.TimeoutExpired as err:
         raise BenchError('js_transport_probe.py did not finish in time') from err
     finally:
