@@ -249,7 +249,7 @@ class Budget:
 
 
 BUDGETS = {
-    'quick': Budget('quick', 2000, 5000, 10.0, 4, 1, 4.0, 8.0, ((50.0, 2.0), (1000.0, 1.0)),
+    'quick': Budget('quick', 2000, 5000, 10.0, 2, 1, 4.0, 8.0, ((50.0, 2.0), (1000.0, 1.0)),
                     8.0, 4.0, 4.0, search_popsize=2, min_offline_runs=1),
     'default': Budget('default', 5000, 20000, 60.0, 8, 1, 5.0, 15.0,
                       ((50.0, 4.0), (1000.0, 2.0)), 15.0, 6.0, 6.0, side_runs=1),

@@ -52,15 +52,29 @@ def _data_lines(path: Path) -> list[str]:
     return [line for line in path.read_text().splitlines() if not line.lstrip().startswith('#')]
 
 
+def _smoke_arguments(arguments: list[str], popsize: int) -> list[str]:
+    """ARGUMENTS for a smoke test: population `popsize`, one robustness variant and one
+    late-command draw (3 runs a candidate instead of 9; each option is still used)."""
+    arguments = list(arguments)
+    arguments[arguments.index('--popsize') + 1] = str(popsize)
+    arguments[arguments.index('--latency-draws') + 1] = '1'
+    robust = arguments.index('--robust')
+    end = robust + 1
+    while end < len(arguments) and not arguments[end].startswith('--'):
+        end += 1
+    return arguments[:robust + 2] + arguments[end:]
+
+
 def search_time(out_dir: Path, generations: int | None,
                 popsize: int | None = None) -> SearchTime:
     """Run the search for `generations` (None: the whole search, GENERATIONS, which is
     then judged on the step it writes) and time it; `popsize` (a smoke test's) replaces
-    the search's own population of 8 in a partial run."""
+    the search's own population of 8 in a partial run, which then also tries one
+    robustness variant and one late-command draw a candidate."""
     whole = generations is None
     arguments = list(ARGUMENTS)
     if popsize is not None and not whole:
-        arguments[arguments.index('--popsize') + 1] = str(popsize)
+        arguments = _smoke_arguments(arguments, popsize)
     if generations is None:
         generations = GENERATIONS
     log, found, gains = out_dir / 'search.jsonl', out_dir / 'found.yaml', out_dir / 'gains.yaml'
