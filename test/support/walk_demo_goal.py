@@ -1,7 +1,7 @@
 """Send DRCSim's actionlib server (atlas/bdi_control) one WALK goal of N ego-centric steps of
-0.2 m (the last beside the one before, the feet 0.24 m apart), as its keyboard teleop did,
+STRIDE m (the last beside the one before, the feet 0.24 m apart), as its keyboard teleop did,
 and print one JSON line: the pelvis's x, y when sent, the goal's final status and result,
-and where the feet ended. Usage: walk_demo_goal.py N"""
+and where the feet ended. Usage: walk_demo_goal.py N STRIDE"""
 
 from __future__ import annotations
 
@@ -18,11 +18,11 @@ from atlas_msgs.msg import (
     WalkDemoGoal,
 )
 
-STRIDE_M, HALF_WIDTH_M = 0.2, 0.12
+HALF_WIDTH_M = 0.12
 
 
 def main() -> int:
-    count = int(sys.argv[1])
+    count, stride_m = int(sys.argv[1]), float(sys.argv[2])
     rospy.init_node('walk_demo_goal', anonymous=True)
     client = actionlib.SimpleActionClient('atlas/bdi_control', WalkDemoAction)
     if not client.wait_for_server(rospy.Duration(60.0)):
@@ -33,7 +33,7 @@ def main() -> int:
     goal = WalkDemoGoal(behavior=WalkDemoGoal.WALK)
     for k in range(1, count + 1):
         step = AtlasBehaviorStepData(step_index=k, foot_index=(k + 1) % 2, duration=0.63)
-        step.pose.position.x = STRIDE_M * (k if k < count else k - 1)
+        step.pose.position.x = stride_m * (k if k < count else k - 1)
         step.pose.position.y = HALF_WIDTH_M if k % 2 else -HALF_WIDTH_M
         step.pose.orientation.w = 1.0
         goal.steps.append(step)
