@@ -31,7 +31,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from harness import READY_TIMEOUT_S, BenchError, Launch, Master
+from harness import READY_TIMEOUT_S, BenchError, Launch, Master, log
 from probes import RawRecorder, clock_ns, header_stamp_ns, joint_state_effort
 
 from tutorial_atlas_control import topics
@@ -39,6 +39,8 @@ from tutorial_atlas_control.processes import cpu_seconds, wait_until
 from tutorial_atlas_control.units import NS_PER_S
 
 LATENCY_JOINT = 'neck_ay'
+#: Fewer applied commands than this in a latency window are logged as few.
+FEW_LATENCIES = 10
 JS_PROBE_TOPIC = '/tac_bench/js_probe'
 
 
@@ -354,9 +356,11 @@ def realtime_run(master: Master, launch_file: str, probes: Probes, work_dir: Pat
                 states = probes.joint_states.stop()
             launch.check_running()
             latencies, count = _match_latencies(sent, states)
-            if len(latencies) < 10:
-                raise BenchError(f'only {len(latencies)} of {count} commands at {label} '
-                                 'showed up in /atlas/joint_states')
+            # At least the last one (waited for). Few more: a starved simulator stepped in
+            # bursts, each applying only the newest command; cmd_applied_* says so.
+            if len(latencies) < FEW_LATENCIES:
+                log(f'only {len(latencies)} of {count} commands at {label} showed up in '
+                    '/atlas/joint_states: its latency figures rest on them')
             for pct in (50, 99):
                 raw_ms = float(np.percentile(latencies, pct))
                 result[f'cmd_latency_p{pct}_ms_raw_{label}'] = raw_ms
