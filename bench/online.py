@@ -174,13 +174,18 @@ def _lateness(wall: np.ndarray, sim: np.ndarray) -> np.ndarray:
     return (offset - offset.min()) * 1000.0
 
 
+def _latency_command(effort: float) -> object:
+    """JointCommands for LATENCY_JOINT alone, every gain 0: the law's torque is `effort`."""
+    from osrf_msgs.msg import JointCommands
+
+    return JointCommands(name=[LATENCY_JOINT], kp_position=[0.0], ki_position=[0.0],
+                         kd_position=[0.0], kp_velocity=[0.0], effort=[effort])
+
+
 def _send_commands(probes: Probes, rate_hz: float, duration_s: float,
                    first_key: int) -> list[tuple[float, float]]:
     """Publish neck_ay feed-forward commands; return (effort value, publish time) pairs."""
-    from osrf_msgs.msg import JointCommands
-
-    msg = JointCommands(name=[LATENCY_JOINT], kp_position=[0.0], ki_position=[0.0],
-                        kd_position=[0.0], kp_velocity=[0.0])
+    msg = _latency_command(0.0)
     sent = []
     period = 1.0 / rate_hz
     count = int(round(rate_hz * duration_s))
@@ -228,11 +233,8 @@ def _wait_effort_seen(probes: Probes, value: float, launch: Launch, failure: str
 def _wait_user_mode(probes: Probes, launch: Launch) -> None:
     """Until a command shows up in /atlas/joint_states: User mode is in effect (commands
     sent before the simulator acts on the mode change are ignored, not late)."""
-    from osrf_msgs.msg import JointCommands
-
     value = 0.25  # outside the measured commands' values
-    msg = JointCommands(name=[LATENCY_JOINT], kp_position=[0.0], ki_position=[0.0],
-                        kd_position=[0.0], kp_velocity=[0.0], effort=[value])
+    msg = _latency_command(value)
     probes.joint_states.start()
     try:
         _wait_effort_seen(probes, value, launch, 'no command showed up in '

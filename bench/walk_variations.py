@@ -193,8 +193,10 @@ def _parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     parser = _parser()
     args = parser.parse_args(argv)
-    if args.runs < 1 or args.workers < 1 or not 0.0 < args.stride <= 0.4:
-        parser.error('--runs and --workers are at least 1, --stride in (0, 0.4] m')
+    if args.runs < 1 or args.workers < 1 or args.first_seed < 0 \
+            or not 0.0 < args.stride <= 0.4:
+        parser.error('--runs and --workers are at least 1, --first-seed at least 0, '
+                     '--stride in (0, 0.4] m')
     seeds = range(args.first_seed, args.first_seed + args.runs)
     with ProcessPoolExecutor(args.workers) as pool:
         outcomes = []

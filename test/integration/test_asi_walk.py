@@ -194,11 +194,11 @@ def test_two_steps_with_one_foot_end_the_walk_inconsistent(
 
 def test_a_late_window_of_an_ended_walk_starts_nothing(
         atlas: atlas_model.AtlasModel) -> None:
-    """A window without step 1 (the actionlib server's, re-sent as its walk ended, arriving
-    after Walk's return to Stand) leaves Stand: a walk from it could take no step."""
+    """A window without step 1 (a streaming client's answer to a state it read late,
+    arriving after Walk's return to Stand) leaves Stand: a walk from it could take no step."""
     interface = standing(atlas)
     late = straight_steps(4, 0.25)[2:]
-    interface.apply(walk_command(late + late))  # padded with copies, as the server does
+    interface.apply(walk_command(late + late))  # old steps, some repeated
     seen = run(interface, 0.2)
     assert changes(seen.behaviors) == [Behavior.STAND]
     assert changes(seen.status) == [Status.OK]

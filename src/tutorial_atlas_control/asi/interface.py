@@ -135,8 +135,8 @@ class AtlasSimInterface:
         """The command's behaviour requested; a WALK's steps to the walk, running or starting.
         A WALK without step 1 (a new walk's first) starts nothing: it is a window of a walk
         that has ended, sent before the client saw the end (a streaming client's last, empty
-        one, or the actionlib server's re-sent window arriving after its STAND). Started, it
-        could take no step and would only catch itself from standing."""
+        one, or one answering a state read late, from before the walk's first touchdown).
+        Started, it could take no step and would only catch itself from standing."""
         steps = (footsteps_of(command.step_queue, self._estimator.sole_ahead_m)
                  if command.behavior == Behavior.WALK else [])
         if command.behavior == Behavior.WALK != current \
