@@ -6,10 +6,12 @@ Debian's default): the scheduler first shares the CPU between sessions, equally,
 process's nice value only ranks it within its own session. roslaunch starts every node in a
 session of its own (setsid), so a niced bench's simulators took as much CPU as a test's
 (measured: a nice-19 busy loop in its own session 64 % of a core beside a nice-0 one; 2 %
-once its session's autogroup was niced too). This wrapper runs the command at nice 19 and,
-every POLL_PERIOD_S, sets the autogroup nice of each of its descendants to 19
-(/proc/PID/autogroup, sched(7)) when it runs in a session other than ours; raising a
-nice value needs no privilege.
+once its session's autogroup was niced too). This wrapper runs the command at nice 19 in a
+session of its own and, every POLL_PERIOD_S, sets the autogroup nice of that session and of
+every other session its descendants start to 19 (/proc/PID/autogroup, sched(7)); raising a
+nice value needs no privilege. In the caller's session the command would share the caller's
+autogroup, and whenever the caller waits (make test's pytest, waiting on a launch) take that
+whole autogroup's share.
 
     python3 tools/lowest_priority.py COMMAND [ARG...]
 
@@ -62,8 +64,7 @@ def descendants(root: int, links: dict[int, int]) -> set[int]:
 
 def lower_autogroup(pid: int) -> bool:
     """Set the autogroup nice of `pid`'s session to LOWEST_NICE; False if it was already,
-    or if that session is ours: within it the process's own nice value already ranks it,
-    and our session's other processes (make test's pytest) must keep their share."""
+    or if that session is ours (the caller's processes keep their share)."""
     path = Path(f'/proc/{pid}/autogroup')
     try:
         if os.getsid(pid) == os.getsid(0):
@@ -81,14 +82,15 @@ def main(argv: list[str]) -> int:
         print(USAGE, file=sys.stdout if argv else sys.stderr)
         return 0 if argv else 2
     try:
-        child = subprocess.Popen(argv, preexec_fn=lambda: os.nice(LOWEST_NICE))
+        child = subprocess.Popen(argv, preexec_fn=lambda: os.nice(LOWEST_NICE),
+                                 start_new_session=True)
     except OSError as error:
         print(f'lowest_priority.py: cannot run {argv[0]}: {error.strerror}', file=sys.stderr)
         return 127
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda received, _frame: child.send_signal(received))
     while child.poll() is None:
-        for pid in descendants(child.pid, parent_links()):
+        for pid in {child.pid} | descendants(child.pid, parent_links()):
             lower_autogroup(pid)
         time.sleep(POLL_PERIOD_S)
     return child.returncode

@@ -2,10 +2,12 @@
 # `make test`: every check of the project, in the order that takes least wall time on two
 # cores (docs/TESTING.md). Needs `source ./env.sh` (the Makefile does it).
 #   1. ruff and catkin_lint (seconds; a lint error is found before anything runs);
-#   2. pytest's independent tests on two xdist workers, and beside them, in the background,
-#      the rostests (mostly waiting on sim time) and, niced, the quick bench (it must run
-#      and give every figure; their values, measured under load here, are not judged);
-#   3. pytest's `serial` tests (timing and memory claims) with nothing else running.
+#   2. pytest's live tests on two xdist workers, and beside them, in the background, the
+#      rostests (mostly waiting on sim time) and, at the lowest priority, the quick bench (it
+#      must run and give every figure; their values, measured under load here, are not judged);
+#   3. pytest's `serial` tests (timing and memory claims), and beside them, at the lowest
+#      priority, the `offline` ones (no ROS, no timing claim: the unit tests and the offline
+#      runs) on the CPU the serial tests leave idle (about one core of two).
 # Every part runs even if one before it failed; the exit status is 1 if any failed, and the
 # last lines name them with each part's wall time.
 set -uo pipefail
@@ -41,13 +43,13 @@ in_background() {  # in_background NAME COMMAND...: its output goes to a log sho
   background_pid[$name]=$!
 }
 
-collect() {  # collect NAME: wait for it, show its output, note its time and status
-  local name=$1 status=0
+collect() {  # collect NAME BESIDE: wait for it, show its output, note its time and status
+  local name=$1 beside=$2 status=0
   wait "${background_pid[$name]}" || status=$?
   cat "${background_log[$name]}"
   [ "$status" -eq 0 ] || failed+=("$name")
   timings+=("$name $(sed -n "s/^$name: finished after \\([0-9]*\\) s$/\\1/p" \
-    "${background_log[$name]}") s (beside pytest-parallel)")
+    "${background_log[$name]}") s (beside $beside)")
   rm -f "${background_log[$name]}"
   unset "background_pid[$name]"
 }
@@ -69,13 +71,19 @@ in_background rostests bash tools/run_rostests.sh
 in_background bench-quick python3 tools/lowest_priority.py \
   bash -c 'python3 bench/run_bench.py --quick --runs 1 > /dev/null'
 # Each worker takes whole modules (test/conftest.py's scheduler): a module's launch starts once.
-timed pytest-parallel python3 -m pytest test/unit test/integration test/reliability \
-  -q -rs -n 2 -m 'not serial' --durations=15
-collect rostests
-collect bench-quick
+timed pytest-parallel python3 -m pytest test/integration test/reliability \
+  -q -rs -n 2 -m 'not serial and not offline' --durations=15
+collect rostests pytest-parallel
+collect bench-quick pytest-parallel
 
+# The serial tests take about one core of the two; the offline tests, at the lowest priority
+# in sessions of their own, take only what the serial ones leave (measured: the serial part's
+# test times unchanged beside the whole quick bench run so).
+in_background pytest-offline python3 tools/lowest_priority.py \
+  python3 -m pytest test/unit test/integration -q -rs -n 2 -m offline --durations=10
 timed pytest-serial python3 -m pytest test/integration test/reliability \
   -q -rs -m serial --durations=5
+collect pytest-offline pytest-serial
 
 echo "make test: ${timings[*]/%/;} total $SECONDS s"
 if [ "${#failed[@]}" -gt 0 ]; then

@@ -20,6 +20,10 @@ from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, load_gains
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
 from tutorial_atlas_control.trajectories.trajectory import load_trajectory, sample_count
 
+#: Offline (no ROS, no claim about time): `make test` runs it at the lowest priority beside
+#: the serial tests, on the CPU they leave idle.
+pytestmark = pytest.mark.offline
+
 REPO = Path(__file__).resolve().parents[2]
 TRAJ_DATA2 = REPO / 'trajectories' / 'Traj_data2.yaml'
 ARM_JOINTS = ('l_arm_shx', 'r_arm_shx', 'l_arm_elx', 'r_arm_elx')

@@ -40,6 +40,10 @@ from tutorial_atlas_control.walking.step_queue import (
     WARNING_INSUFFICIENT_STEP_DATA,
 )
 
+#: Offline (no ROS, no claim about time): `make test` runs it at the lowest priority beside
+#: the serial tests, on the CPU they leave idle.
+pytestmark = pytest.mark.offline
+
 CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
 #: Stand before the walk, and the run's whole length (s).
 STAND_FIRST_S = 1.0

@@ -18,6 +18,10 @@ from tutorial_atlas_control.search.sweep import SweepInputs, build_specs, run_sw
 from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.trajectories.trajectory import load_trajectory
 
+#: Offline (no ROS, no claim about time): `make test` runs it at the lowest priority beside
+#: the serial tests, on the CPU they leave idle.
+pytestmark = pytest.mark.offline
+
 REPO = Path(__file__).resolve().parents[2]
 _search = partial(run_script, 'search.py')
 #: A squat held briefly: the toy problem is to end with the pelvis 0.80 m high (it starts

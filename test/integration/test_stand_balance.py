@@ -38,6 +38,10 @@ from tutorial_atlas_control.sim import (
     pelvis_height_m,
 )
 
+#: Offline (no ROS, no claim about time): `make test` runs it at the lowest priority beside
+#: the serial tests, on the CPU they leave idle.
+pytestmark = pytest.mark.offline
+
 KNEES = [JOINT_INDEX['l_leg_kny'], JOINT_INDEX['r_leg_kny']]
 
 #: The largest impulses (N s) survived, per direction (unit vector), found in 5 N s steps.

@@ -7,8 +7,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from tutorial_atlas_control.search.runs import run_one
 from tutorial_atlas_control.search.sweep import SweepInputs, build_specs, run_sweep
+
+#: Offline (no ROS, no claim about time): `make test` runs it at the lowest priority beside
+#: the serial tests, on the CPU they leave idle.
+pytestmark = pytest.mark.offline
 
 REPO = Path(__file__).resolve().parents[2]
 STEPPING = REPO / 'trajectories' / 'Stepping.yaml'

@@ -17,6 +17,10 @@ from tutorial_atlas_control.search.sweep import (
     table_texts,
 )
 
+#: Offline (no ROS, no claim about time): `make test` runs it at the lowest priority beside
+#: the serial tests, on the CPU they leave idle.
+pytestmark = pytest.mark.offline
+
 REPO = Path(__file__).resolve().parents[2]
 _sweep = partial(run_script, 'sweep.py')
 TRAJ_DATA2 = REPO / 'trajectories' / 'Traj_data2.yaml'

@@ -10,10 +10,16 @@ About 10 s of CPU in all.
 
 from __future__ import annotations
 
+import pytest
+
 from tutorial_atlas_control.walking import straight_steps
 from tutorial_atlas_control.walking.leg_tasks import LegGains
 from tutorial_atlas_control.walking.walk import WalkGains
 from tutorial_atlas_control.walking.walk_trial import walk_trial
+
+#: Offline (no ROS, no claim about time): `make test` runs it at the lowest priority beside
+#: the serial tests, on the CPU they leave idle.
+pytestmark = pytest.mark.offline
 
 #: The issue's bounds on each landing (m, rad).
 LANDING_WITHIN_M = 0.05

@@ -3,10 +3,21 @@
 from __future__ import annotations
 
 import ctypes
+from pathlib import Path
 
 import pytest
 
 from tutorial_atlas_control import native
+
+UNIT_DIR = Path(__file__).resolve().parent
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Every unit test is `offline` (pytest.ini): ROS-free and with no claim about time, so
+    `make test` runs them at the lowest priority beside the serial tests."""
+    for item in items:
+        if UNIT_DIR in item.path.parents:
+            item.add_marker(pytest.mark.offline)
 
 
 @pytest.fixture(scope='module')
