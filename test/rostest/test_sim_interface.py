@@ -32,6 +32,8 @@ MODE_TOPIC, COMMAND_TOPIC = '/atlas/control_mode', '/atlas/joint_commands'
 CLOCK_QUIET_S = 0.1
 PAUSE_WATCH_S = 0.5
 ELBOW_TARGET_RAD = 0.8
+#: Sim time (s) Stand is watched for from a reset: the 1 s pin, its release, and 4 s after.
+STAND_WATCHED_S = 5.0
 
 
 class SimInterfaceTest(unittest.TestCase):
@@ -82,17 +84,20 @@ class SimInterfaceTest(unittest.TestCase):
         on_states = np.isin(clocks_in_window, stamps)
         self.assertGreater(on_states.mean(), 0.95, '/clock times stamp joint states')
 
-    def test_03_stands_20_s_without_commands(self) -> None:
+    def test_03_stands_without_commands(self) -> None:
+        """Stand through the ROS path: the pin's release at 1 s and after it. How long it
+        stands is judged offline (test_model.py: 30 s, the pelvis within 2 cm)."""
         probe = self.probe
         self.restart('Stand')
         start_z = probe.pelvis_z()
         heights = []
-        end_ns = probe.clock_ns + 20 * 10**9
+        end_ns = probe.clock_ns + round(STAND_WATCHED_S * 1e9)
         while probe.clock_ns < end_ns:
             heights.append(probe.pelvis_z())
             probe.wait_sim(0.05)
         drift = float(np.max(np.abs(np.array(heights) - start_z)))
-        rospy.loginfo(f'standing: max pelvis drift over 20 s = {drift * 100:.2f} cm')
+        rospy.loginfo(f'standing: max pelvis drift over {STAND_WATCHED_S:g} s = '
+                      f'{drift * 100:.2f} cm')
         self.assertLess(drift, 0.02)
 
     def test_04_step_command_follows_the_law(self) -> None:

@@ -104,10 +104,14 @@ class UdprosTest(unittest.TestCase):
         # /atlas/sim_inputs and /rosout carry events: an applied cheat gives one of each.
         force = rospy.Publisher('/atlas/apply_pelvis_force', Wrench, queue_size=1, latch=True)
         force.publish(Wrench())
+        # /atlas/synchronization_statistics is sent only while an AtlasCommand asks for the
+        # synchronization window, which none does here: served, never sent.
+        expected = [topic for topic in published
+                    if topic != '/atlas/synchronization_statistics']
         received: dict[str, object] = {}
         blocks: dict[str, set[int]] = {}
         deadline = time.monotonic() + WALL_TIMEOUT_S
-        while len(received) < len(published) and time.monotonic() < deadline:
+        while len(received) < len(expected) and time.monotonic() < deadline:
             ready, _, _ = select.select(list(receivers), [], [], 0.5)
             for sock in ready:
                 datagram = sock.recv(65536)
@@ -122,10 +126,7 @@ class UdprosTest(unittest.TestCase):
                     received[topic] = msg_class().deserialize(payload)
         for sock in receivers:
             sock.close()
-        # /atlas/synchronization_statistics is sent only while an AtlasCommand asks for the
-        # synchronization window, which none does here: served, never sent.
-        self.assertEqual(sorted(received), [topic for topic in published
-                                            if topic != '/atlas/synchronization_statistics'])
+        self.assertEqual(sorted(received), expected)
         rospy.loginfo(f'UDPROS: one message from each of {len(published)} topics; blocks '
                       f'per message (DATA0 counts): {blocks}')
         self.assertEqual(len(received['/atlas/joint_states'].name), 28)
