@@ -40,6 +40,10 @@ UDP_CONNECT_S = 10.0
 #: The node that serves /atlas/atlas_state.
 SIM_NODE = '/atlas_sim'
 CONTROLLER_NODE = '/echo_controller'
+#: The fewest messages a window's figures rest on: a starved simulator's window is recorded
+#: past its length until they have come (within READY_TIMEOUT_S more), not failed.
+MIN_STATISTICS = 100
+MIN_CLOCKS = 2
 #: ControllerStatistics ends with four float64: command_age, mean, variance, window.
 _AGE_FROM_END = 32
 
@@ -116,20 +120,49 @@ def age_run(master: Master, launch_file: str, clock: RawRecorder, statistics: Ra
 
 def _node_us_per_step(launch: Launch, clock: RawRecorder, name: str, window_s: float,
                       per_sim_s: float) -> float:
-    """The simulator's CPU (µs) per simulated step over `window_s` of wall time."""
+    """The simulator's CPU (µs) per simulated step over at least `window_s` of wall time."""
     pid = launch.node_pid('atlas_sim')
     if pid is None:
         raise BenchError(f'{name}: no atlas_sim process')
     cpu0 = cpu_seconds(pid)
-    clock.start()
-    time.sleep(window_s)
-    clocks = clock.stop()
+    clocks, _, recorded_s = _record(launch, name, window_s, clock, None)
     cpu1 = cpu_seconds(pid)
-    launch.check_running()
-    if len(clocks) < 2:
-        raise BenchError(f'{name}: {len(clocks)} /clock messages in the window')
     steps = (clock_ns(clocks[-1][1]) - clock_ns(clocks[0][1])) / NS_PER_S * per_sim_s
-    return (cpu1 - cpu0) * 1e6 / (steps * window_s / (clocks[-1][0] - clocks[0][0]))
+    return (cpu1 - cpu0) * 1e6 / (steps * recorded_s / (clocks[-1][0] - clocks[0][0]))
+
+
+def _record(launch: Launch, name: str, window_s: float, clock: RawRecorder,
+            statistics: RawRecorder | None,
+            echo: EchoController | None = None,
+            ) -> tuple[list[tuple[float, bytes]], list[tuple[float, bytes]], float]:
+    """Record /clock (and the controller statistics) for `window_s` of wall time, and on
+    until MIN_CLOCKS (and MIN_STATISTICS) have come: the /clock and statistics samples and
+    the wall time recorded (s)."""
+
+    def check() -> None:
+        launch.check_running()
+        if echo is not None:
+            echo.check_running()
+
+    def enough() -> bool:
+        return (clock.recorded() >= MIN_CLOCKS
+                and (statistics is None or statistics.recorded() >= MIN_STATISTICS))
+
+    started = time.monotonic()
+    clock.start()
+    if statistics is not None:
+        statistics.start()
+    try:
+        time.sleep(window_s)
+        wait_until(enough, READY_TIMEOUT_S,
+                   f'{name}: fewer than {MIN_CLOCKS} /clock messages'
+                   + ('' if statistics is None else
+                      f' or {MIN_STATISTICS} controller statistics') + ' in the window',
+                   check)
+    finally:
+        ages = [] if statistics is None else statistics.stop()
+        clocks = clock.stop()
+    return clocks, ages, time.monotonic() - started
 
 
 def _age_window(master: Master, launch: Launch, echo: EchoController, clock: RawRecorder,
@@ -149,34 +182,26 @@ def _age_window(master: Master, launch: Launch, echo: EchoController, clock: Raw
     time.sleep(warmup_s)
     pid = launch.node_pid('atlas_sim')
     cpu0 = cpu_seconds(pid) if pid else 0.0
-    age_ms, steps, span_s = _record_window(launch, echo, clock, statistics, name, window_s,
-                                           per_sim_s)
+    age_ms, steps, span_s, recorded_s = _record_window(launch, echo, clock, statistics, name,
+                                                       window_s, per_sim_s)
     cpu1 = cpu_seconds(pid) if pid else 0.0
     log(f'{name}: /atlas/atlas_state over {connected}')
     return {f'controller_{transport}_age_p50_ms': float(np.percentile(age_ms, 50)),
             f'controller_{transport}_age_p99_ms': float(np.percentile(age_ms, 99)),
             f'controller_{transport}_node_us_per_step':
-                (cpu1 - cpu0) * 1e6 / (steps * window_s / span_s)}
+                (cpu1 - cpu0) * 1e6 / (steps * recorded_s / span_s)}
 
 
 def _record_window(launch: Launch, echo: EchoController, clock: RawRecorder,
                    statistics: RawRecorder, name: str, window_s: float,
-                   per_sim_s: float) -> tuple[np.ndarray, float, float]:
-    """Record /clock and the controller statistics for `window_s` (wall): the command ages
-    (ms), the steps simulated and the wall time (s) between the first and last /clock."""
-    clock.start()
-    statistics.start()
-    time.sleep(window_s)
-    ages = statistics.stop()
-    clocks = clock.stop()
-    launch.check_running()
-    echo.check_running()
-    if len(ages) < 100 or len(clocks) < 2:
-        raise BenchError(f'{name}: {len(ages)} controller statistics, {len(clocks)} /clock '
-                         'messages in the window')
+                   per_sim_s: float) -> tuple[np.ndarray, float, float, float]:
+    """Record /clock and the controller statistics for at least `window_s` (wall): the
+    command ages (ms), the steps simulated and the wall time (s) between the first and last
+    /clock, and the wall time recorded (s)."""
+    clocks, ages, recorded_s = _record(launch, name, window_s, clock, statistics, echo)
     age_ms = np.array([command_age_s(raw) for _, raw in ages]) * 1000.0
     steps = (clock_ns(clocks[-1][1]) - clock_ns(clocks[0][1])) / NS_PER_S * per_sim_s
-    return age_ms, steps, clocks[-1][0] - clocks[0][0]
+    return age_ms, steps, clocks[-1][0] - clocks[0][0], recorded_s
 
 
 def window_run(master: Master, launch_file: str, clock: RawRecorder, statistics: RawRecorder,
@@ -198,7 +223,7 @@ def _window_window(master: Master, launch: Launch, echo: EchoController, clock: 
     wait_until(lambda: state_transport(master) is not None, READY_TIMEOUT_S,
                'echo_controller did not connect', launch.check_running)
     time.sleep(warmup_s)
-    age_ms, steps, span_s = _record_window(launch, echo, clock, statistics, name, window_s,
-                                           per_sim_s)
+    age_ms, steps, span_s, _ = _record_window(launch, echo, clock, statistics, name, window_s,
+                                              per_sim_s)
     return {'controller_window_steps_per_s': steps / span_s,
             'controller_window_age_p99_ms': float(np.percentile(age_ms, 99))}

@@ -42,6 +42,10 @@ class RawRecorder:
             self.samples = []
             self.recording = True
 
+    def recorded(self) -> int:
+        """How many messages the recording holds so far."""
+        return len(self.samples)
+
     def stop(self) -> list[tuple[float, bytes]]:
         with self.lock:
             self.recording = False
