@@ -26,8 +26,9 @@ from tutorial_atlas_control.bags.analysis import analyze_bag
 from tutorial_atlas_control.bags.reader import BagData, read_bag
 from tutorial_atlas_control.bags.records import IndexedBag, PublicBag
 
-#: Serial: the replay's count of compared steps rests on `rosbag record`'s record times,
-#: which lag when it is starved (seen beside a busy core: 2618 of 5056 steps compared).
+#: Serial: `rosbag record` drops joint states when it is starved (seen beside a busy core:
+#: 56 of 4803 dropped, the replay compared the 953 steps before the first); the check
+#: follows the bag it got, but a standing run of 3 s must come out whole when not starved.
 pytestmark = pytest.mark.serial
 
 #: Sim time (s) recorded after the launch is ready.
@@ -118,8 +119,15 @@ def check_user_tools(bag: Path, data: BagData) -> None:
     assert steps, replayed.stdout
     total, before, compared = (int(n) for n in steps.groups())
     assert total == before + compared
+    # rosbag record drops messages when it is starved (its subscription's queue of 100):
+    # the replay then stops at the first missing joint state and says so.
     stamps_ms = np.rint((data.joint_states.t_s + data.start_time_s) * 1000).astype(int)
-    assert compared == np.count_nonzero(stamps_ms > before) > (RUN_S - 0.5) * 1000
+    after = stamps_ms[stamps_ms > before]
+    gaps = np.flatnonzero(np.diff(after) != 1)
+    assert compared == (int(gaps[0]) + 1 if len(gaps) else len(after)) > 0
+    assert ('joint state(s) missing after' in replayed.stdout) is bool(len(gaps)), replayed.stdout
+    if not len(gaps):
+        assert compared > (RUN_S - 0.5) * 1000
     # Same model, same MuJoCo: the replay is exact (replay_bag.py --help).
     for label, unit in (('joint positions', 'rad'), ('joint velocities', 'rad/s')):
         assert re.search(rf'^  {label} +max \|diff\| 0 {unit}, {compared} samples$',
