@@ -97,6 +97,10 @@ class SynchronizationTest(unittest.TestCase):
                 raise AssertionError(f'timed out after {WALL_TIMEOUT_S} s waiting for {what}')
             time.sleep(0.01)
 
+    def largest_age_ns(self) -> int:
+        with self.lock:
+            return max((age for _, age in self.ages_ns), default=-1)
+
     def last_stamp_ns(self) -> int:
         with self.lock:
             return self.states[-1][0] if self.states else -1
@@ -199,18 +203,21 @@ class SynchronizationTest(unittest.TestCase):
         self.wait_until(renewed, 'the window budget spent, then a new window')
         with self.lock:
             sync = list(self.sync)
-            ages = list(self.ages_ns)
-            last_ns = self.states[-1][0]
         waited = [msg.delay_in_step for msg in sync if msg.delay_in_step > 0.0]
         self.assertTrue(waited)
         # Each silent step waits its whole step budget (or what is left of the window's):
         # never more than a step's budget plus a loaded host's oversleep.
         self.assertTrue(all(step <= MAX_PER_STEP_S + 1.0 for step in waited), waited)
-        # The simulator went on: far more sim time than budget-limited waits could hold up.
-        self.assertGreater(last_ns - silent_from_ns,
-                           (MAX_PER_WINDOW_S / MAX_PER_STEP_S + 100) * STEP_NS)
-        # And the command it obeys grew stale (the statistics show it).
-        self.assertGreater(max(age for _, age in ages), 100 * STEP_NS)
+        # The simulator went on: far more sim time than budget-limited waits could hold up;
+        # and the command it obeys grew stale (the statistics show it). The joint states and
+        # the statistics come over connections of their own, behind the synchronization
+        # statistics on a loaded host (a sample of them once showed no step since the
+        # silence): waited for, within the test's timeout.
+        went_on_ns = (MAX_PER_WINDOW_S / MAX_PER_STEP_S + 100) * STEP_NS
+        self.wait_until(lambda: self.last_stamp_ns() - silent_from_ns > went_on_ns,
+                        f'{went_on_ns / 1e9:.3f} s of sim time after the silence')
+        self.wait_until(lambda: self.largest_age_ns() > 100 * STEP_NS,
+                        'a command age of more than 100 steps')
 
 
 if __name__ == '__main__':
