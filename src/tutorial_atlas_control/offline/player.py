@@ -23,6 +23,11 @@ from pathlib import Path
 
 import numpy as np
 
+# numpy (2.x) imports numpy.random at its first use; imported here with the module, before
+# the run begins: a Ctrl-C landing in that import's compiled part was lost, and the run went
+# on simulating.
+from numpy.random import default_rng
+
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags import (
     JOINT_COMMANDS_TYPE,
@@ -243,7 +248,7 @@ class _OfflinePlayer:
                  on_step: StepHook | None = None, latency: CommandLatency | None = None) -> None:
         self.sim = sim
         self.latency = latency
-        self.latency_rng = np.random.default_rng(latency.seed if latency else 0)
+        self.latency_rng = default_rng(latency.seed if latency else 0)
         #: Delayed commands: (the step count at which each takes effect, its update).
         self.pending: list[tuple[int, CommandUpdate]] = []
         self.sink = sink

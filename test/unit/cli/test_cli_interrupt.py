@@ -8,6 +8,7 @@ interrupted for real, with SIGINT, while it simulates.
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
@@ -136,6 +137,33 @@ def test_sigint_stops_run_offline_with_130_and_leaves_no_bag(tmp_path: Path) -> 
     assert 'Traceback' not in err and err == '', err
     assert out == ''
     assert list(tmp_path.iterdir()) == [], 'a partial or complete bag was left behind'
+
+
+#: Run in a fresh interpreter: the compiled modules (extension files) that run_offline's main
+#: imports only once it runs.
+LATE_EXTENSIONS = """
+import json, sys
+from tutorial_atlas_control.cli import run_offline
+before = set(sys.modules)
+status = run_offline.main(sys.argv[1:])
+late = sorted(name for name in set(sys.modules) - before
+              if str(getattr(sys.modules[name], '__file__', '') or '').endswith('.so'))
+print(json.dumps([status, late]))
+"""
+
+
+def test_run_offline_imports_no_compiled_module_once_it_runs(tmp_path: Path) -> None:
+    """A Ctrl-C landing in a compiled module's import can be lost there (numpy 2.x imports
+    numpy.random at its first use, and its Cython part swallowed the KeyboardInterrupt: the
+    run went on simulating). The script imports them all before it runs, with SIGINT
+    blocked (cli/environment.py)."""
+    result = subprocess.run(
+        [sys.executable, '-c', LATE_EXTENSIONS, str(TRAJECTORY_FILE), 'touchdown',
+         '--settle', '0.1', '--bag', str(tmp_path / 'run.bag')],
+        capture_output=True, text=True, check=True, timeout=START_TIMEOUT_S)
+    status, late = json.loads(result.stdout.splitlines()[-1])
+    assert status == 0
+    assert late == [], f'imported while running: {late}'
 
 
 def test_ctrl_c_during_the_demo_names_the_bag_recorded_so_far(
