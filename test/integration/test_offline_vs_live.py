@@ -45,6 +45,7 @@ FALL_TOLERANCE_S = 0.3
 #: (conftest.py), its quick fall moving less.
 TOUCHDOWN_EXHAUSTED_REAL_TIME_FACTOR = 0.25
 
+
 @dataclass(frozen=True)
 class LiveRun:
     result: subprocess.CompletedProcess
