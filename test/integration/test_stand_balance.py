@@ -23,7 +23,7 @@ from tutorial_atlas_control.balance.push_trial import (
     push_survived,
     stand_trial,
 )
-from tutorial_atlas_control.balance.stand import StandGains, yaw_of
+from tutorial_atlas_control.balance.stand import StandGains, pitch_of, yaw_of
 from tutorial_atlas_control.joints import JOINT_INDEX
 from tutorial_atlas_control.msgs.atlas_sim_interface import AsiCommand, ManipulateParams, StepData
 from tutorial_atlas_control.sim import (
@@ -227,28 +227,33 @@ SERVO_YAW_RAD = 0.05
 
 
 def test_manipulate_tracks_pelvis_height_and_yaw() -> None:
-    """Through the AtlasSimInterface: Manipulate with use_desired, 2 s per target. 0.75 m is
-    below what the legs reach with the pelvis level and the feet flat (the ankles' 0.698 rad):
-    clamped to 0.81 m, reported so, and tracked there."""
+    """Through the AtlasSimInterface: Manipulate with use_desired, 2 s per target, down into
+    the tipped squat (0.75 m: below what the legs reach with the pelvis level, the ankles'
+    0.698 rad), up out of it, and turned both ways; on the way, never lower than the lower
+    of the two targets less the goal's 2 cm."""
     sim = balancing_simulator()
     interface = AtlasSimInterface(sim)  # installs its own balancing Stand
     stand = interface.stand
     assert stand is not None
     run_for(sim, 3.0)
-    for height, yaw in ((0.75, 0.0), (0.85, 0.0), (0.85, 0.3), (0.85, -0.3)):
+    previous_m = STANDING_PELVIS_M
+    for height, yaw in ((0.75, 0.0), (0.85, 0.0), (0.85, 0.3), (0.75, -0.3), (0.85, 0.3)):
         interface.apply(AsiCommand(0, Behavior.MANIPULATE, (StepData(),) * 4, False,
                                    StepData(), False, ManipulateParams(True, height, yaw, 0.0),
                                    None, 0))
         clamped = interface.state().manipulate_feedback
-        assert run_for(sim, 2.0) > STANDING_PELVIS_M
+        assert (clamped.pelvis_height_m, clamped.pelvis_yaw_rad) == (height, yaw)
+        lowest = run_for(sim, 2.0)
         state = stand.last_state
         assert state is not None
-        pelvis_m = pelvis_height_m(sim.atlas, sim.data) - float(state.sole_centres[:, 2].mean())
+        soles_m = float(state.sole_centres[:, 2].mean())
+        pelvis_m = pelvis_height_m(sim.atlas, sim.data) - soles_m
         headings = state.sole_rotations[:, 0:2, 0].sum(axis=0)
         turned = yaw_of(state.pelvis_rotation) - float(np.arctan2(headings[1], headings[0]))
-        print(f'\nmanipulate {height} m, {yaw} rad: clamped to {clamped.pelvis_height_m:.4f} m, '
-              f'{clamped.pelvis_yaw_rad:.3f} rad; after 2 s {pelvis_m:.4f} m, {turned:.4f} rad')
-        assert clamped.pelvis_yaw_rad == yaw
-        assert abs(pelvis_m - clamped.pelvis_height_m) < SERVO_HEIGHT_M
+        print(f'\nmanipulate {height} m, {yaw} rad: after 2 s {pelvis_m:.4f} m, '
+              f'{turned:.4f} rad, pitched {pitch_of(state.pelvis_rotation):.3f} rad; lowest '
+              f'{lowest - soles_m:.4f} m')
+        assert lowest - soles_m > min(height, previous_m) - SERVO_HEIGHT_M
+        previous_m = height
+        assert abs(pelvis_m - height) < SERVO_HEIGHT_M
         assert abs(turned - yaw) < SERVO_YAW_RAD
-    assert clamped.pelvis_height_m == 0.85

@@ -70,6 +70,12 @@ class StandReference:
     com_height_m: float
     pelvis_rotation: np.ndarray  # (3, 3)
     posture_rad: np.ndarray = field(default_factory=lambda: STAND_POSE_RAD.copy())
+    #: How fast a moving reference moves (the PDs' damping is about these, so that a
+    #: reference on its way is followed rather than dragged behind): the CoM height's rate
+    #: (m/s), the pelvis frame's angular velocity (rad/s, world) and the posture's (rad/s).
+    com_height_rate_m_s: float = 0.0
+    pelvis_angular_velocity: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    posture_rate_rad_s: np.ndarray = field(default_factory=lambda: np.zeros(28))
 
     @classmethod
     def from_state(cls, state: BalanceState, posture_rad: np.ndarray = STAND_POSE_RAD,
@@ -94,6 +100,17 @@ def yaw_rotation(yaw_rad: float) -> np.ndarray:
     """An upright frame turned by `yaw_rad` about z."""
     c, s = np.cos(yaw_rad), np.sin(yaw_rad)
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def pitch_of(rotation: np.ndarray) -> float:
+    """The pitch (rad, + leaning forward) of a frame's x axis below the horizontal."""
+    return float(np.arctan2(-rotation[2, 0], np.hypot(rotation[0, 0], rotation[1, 0])))
+
+
+def pelvis_frame(yaw_rad: float, pitch_rad: float = 0.0) -> np.ndarray:
+    """A frame turned by `yaw_rad` about z, then pitched by `pitch_rad` about its own y."""
+    c, s = np.cos(pitch_rad), np.sin(pitch_rad)
+    return yaw_rotation(yaw_rad) @ np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
 def orientation_error(rotation: np.ndarray, reference: np.ndarray) -> np.ndarray:
@@ -149,11 +166,13 @@ class StandController:
         acceleration = np.empty(3)
         acceleration[0:2] = lipm.com_acceleration(state.com[:2], cop, state.omega)
         acceleration[2] = (gains.height_kp * (reference.com_height_m - state.com[2])
-                           - gains.height_kd * state.com_velocity[2])
+                           + gains.height_kd * (reference.com_height_rate_m_s
+                                                - state.com_velocity[2]))
         force = self.mass_kg * (acceleration + np.array([0.0, 0.0, lipm.GRAVITY_M_S2]))
         error = orientation_error(state.pelvis_rotation, reference.pelvis_rotation)
         moment = (gains.orientation_kp * error
-                  - gains.orientation_kd * state.pelvis_angular_velocity)
+                  + gains.orientation_kd * (reference.pelvis_angular_velocity
+                                            - state.pelvis_angular_velocity))
         return force, moment
 
     def step(self, state: BalanceState, joint_positions: np.ndarray,
@@ -182,6 +201,7 @@ class StandController:
                 wrenches[foot], state.sole_rotations[foot], half_length, half_width, torsion_m)
         torque = state.bias_nm - state.sole_jacobians.reshape(12, -1).T @ wrenches.reshape(12)
         joint_kp, joint_kd = joint_gains or (self.gains.joint_kp, self.gains.joint_kd)
-        torque += (joint_kp * (self.reference.posture_rad - joint_positions)
-                   - joint_kd * joint_velocities)
+        reference = self.reference
+        torque += (joint_kp * (reference.posture_rad - joint_positions)
+                   + joint_kd * (reference.posture_rate_rad_s - joint_velocities))
         return StandOutput(torque, cop, force, moment, wrenches)

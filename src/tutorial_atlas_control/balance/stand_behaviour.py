@@ -24,7 +24,6 @@ from tutorial_atlas_control.balance.estimator import BalanceEstimator, BalanceSt
 from tutorial_atlas_control.balance.manipulate import (
     PelvisServo,
     SquatTable,
-    bent_posture,
     clamp_servo,
 )
 from tutorial_atlas_control.balance.stand import (
@@ -32,6 +31,8 @@ from tutorial_atlas_control.balance.stand import (
     StandGains,
     StandOutput,
     StandReference,
+    pelvis_frame,
+    pitch_of,
     yaw_of,
     yaw_rotation,
 )
@@ -58,6 +59,44 @@ def smoothstep(fraction: float) -> float:
     return s * s * (3.0 - 2.0 * s)
 
 
+_UP = np.array([0.0, 0.0, 1.0])
+
+
+def _as_vector(reference: StandReference) -> np.ndarray:
+    """A reference's posture (28,), pelvis pitch and CoM height as one (30,) vector, the
+    squat table's row layout."""
+    return np.concatenate([reference.posture_rad,
+                           (pitch_of(reference.pelvis_rotation), reference.com_height_m)])
+
+
+@dataclasses.dataclass(frozen=True)
+class _Transition:
+    """The reference moving from `start` to `goal` over transition_s from `started_s`; with
+    `table` (the pelvis heights from and to, and the squat table's rows there), along the
+    squat table between those heights. Once there, the reference is the table's posture at
+    `end_height_m` (None: off the table)."""
+
+    started_s: float
+    start: StandReference
+    goal: StandReference
+    table: tuple[float, float, np.ndarray, np.ndarray] | None = None
+    end_height_m: float | None = None
+    #: Whether the reference carries its rates (Manipulate's moves; not start()'s, whose
+    #: slow straightening the walking figures were measured from).
+    with_rates: bool = True
+
+    @functools.cached_property
+    def vectors(self) -> tuple[np.ndarray, np.ndarray]:
+        return _as_vector(self.start), _as_vector(self.goal)
+
+    @functools.cached_property
+    def yaws(self) -> tuple[float, float]:
+        """(the start's yaw, the shorter turn to the goal's) (rad)."""
+        start_yaw = yaw_of(self.start.pelvis_rotation)
+        turn = (yaw_of(self.goal.pelvis_rotation) - start_yaw + np.pi) % (2 * np.pi) - np.pi
+        return start_yaw, turn
+
+
 class StandBehaviour:
     """Capture-point Stand for one simulator's robot."""
 
@@ -76,8 +115,16 @@ class StandBehaviour:
         self.servo_target: PelvisServo | None = None
         #: How many times Stand has started (a restart drops the servo target).
         self.starts = 0
-        #: The reference moving on: (start time, from, to); None once it has arrived.
-        self._transition: tuple[float, StandReference, StandReference] | None = None
+        #: The reference moving on; None once it has arrived.
+        self._transition: _Transition | None = None
+        #: The pelvis height (m) of the squat table's posture the reference is at or passing
+        #: through (None: off the table, as after start()).
+        self._table_height_m: float | None = None
+
+    @functools.cached_property
+    def stand_height_m(self) -> float:
+        """The pelvis height (m) of the Stand pose on flat ground."""
+        return place_in_stand_pose(self.atlas, mujoco.MjData(self.atlas.model))
 
     @functools.cached_property
     def squats(self) -> SquatTable:
@@ -93,8 +140,10 @@ class StandBehaviour:
             self.estimator.sole_half_size_m, self.gains)
         self.servo_target = None
         self.starts += 1
-        self._transition = (float(data.time), held, dataclasses.replace(
-            held, com_height_m=self.com_height_m, posture_rad=STAND_POSE_RAD))
+        self._transition = _Transition(float(data.time), held, dataclasses.replace(
+            held, com_height_m=self.com_height_m, posture_rad=STAND_POSE_RAD),
+            end_height_m=self.stand_height_m, with_rates=False)
+        self._table_height_m = None
         self.last_state = state
         self.last_output = None
 
@@ -113,6 +162,8 @@ class StandBehaviour:
         feet_yaw = float(np.arctan2(headings[1], headings[0]))
         left = feet[0] - feet[1]
         left /= np.linalg.norm(left)
+        table = self.squats
+        goal_height = table.stand_height_m if target is None else target.height_m
         if target is None:
             goal = StandReference(feet.mean(axis=0), self.com_height_m, yaw_rotation(feet_yaw),
                                   STAND_POSE_RAD.copy())
@@ -120,29 +171,56 @@ class StandBehaviour:
             goal = StandReference(
                 feet.mean(axis=0) + target.lateral_m * left,
                 self.squats.com_for(target.height_m),
-                yaw_rotation(feet_yaw + target.yaw_rad),
-                bent_posture(self.squats.knee_for(target.height_m), target.yaw_rad))
-        self._transition = (time_s, controller.reference, goal)
+                pelvis_frame(feet_yaw + target.yaw_rad, self.squats.pitch_for(target.height_m)),
+                self.squats.posture_for(target.height_m, target.yaw_rad))
+        table_path = None
+        if self._table_height_m is not None:
+            table_path = (self._table_height_m, goal_height,
+                          table.row(self._table_height_m)[0], table.row(goal_height)[0])
+        self._transition = _Transition(time_s, controller.reference, goal, table_path,
+                                       goal_height)
         self.servo_target = target
         return target
 
     def _reference_at(self, time_s: float) -> StandReference:
-        """The moving reference at `time_s`; its goal once transition_s has passed."""
-        assert self._transition is not None
-        started_s, start, goal = self._transition
-        fraction = ((time_s - started_s) / self.transition_s if self.transition_s > 0.0
-                    else 1.0)
+        """The moving reference at `time_s`, with its rates; its goal once the transition's
+        duration has passed."""
+        transition = self._transition
+        assert transition is not None
+        duration = self.transition_s
+        fraction = (time_s - transition.started_s) / duration if duration > 0.0 else 1.0
         if fraction >= 1.0:
             self._transition = None
-            return goal
+            self._table_height_m = transition.end_height_m
+            return transition.goal
         s = smoothstep(fraction)
-        start_yaw = yaw_of(start.pelvis_rotation)
-        turn = (yaw_of(goal.pelvis_rotation) - start_yaw + np.pi) % (2 * np.pi) - np.pi
+        start, goal = transition.vectors
+        vector = (1.0 - s) * start + s * goal
+        per_s = goal - start  # d(vector)/ds
+        self._table_height_m = None
+        if transition.table is not None:
+            # Along the squat table rather than straight across it, so that the posture,
+            # the pelvis pitch and the CoM height stay those of one squat all the way.
+            low, high, low_row, high_row = transition.table
+            height = (1.0 - s) * low + s * high
+            row, slope = self.squats.row(height)
+            vector += row - ((1.0 - s) * low_row + s * high_row)
+            per_s += slope * (high - low) - (high_row - low_row)
+            self._table_height_m = height
+        start_yaw, turn = transition.yaws
+        yaw, pitch = start_yaw + s * turn, float(vector[28])
+        capture_point = ((1.0 - s) * transition.start.capture_point
+                         + s * transition.goal.capture_point)
+        if not transition.with_rates:
+            return StandReference(capture_point, float(vector[29]), pelvis_frame(yaw, pitch),
+                                  vector[:28])
+        rate = per_s * (6.0 * fraction * (1.0 - fraction) / duration)  # ds/dt: smoothstep's
+        yaw_rate = turn * 6.0 * fraction * (1.0 - fraction) / duration
         return StandReference(
-            (1.0 - s) * start.capture_point + s * goal.capture_point,
-            (1.0 - s) * start.com_height_m + s * goal.com_height_m,
-            yaw_rotation(start_yaw + s * turn),
-            (1.0 - s) * start.posture_rad + s * goal.posture_rad)
+            capture_point, float(vector[29]), pelvis_frame(yaw, pitch), vector[:28],
+            com_height_rate_m_s=float(rate[29]),
+            pelvis_angular_velocity=yaw_rate * _UP + rate[28] * yaw_rotation(yaw)[:, 1],
+            posture_rate_rad_s=rate[:28])
 
     def torque(self, data: mujoco.MjData) -> np.ndarray:
         """This step's f_out (N m, (28,)), within the effort limits."""

@@ -11,7 +11,8 @@ import pytest
 
 from tutorial_atlas_control.balance import lipm, support
 from tutorial_atlas_control.balance.estimator import BalanceEstimator
-from tutorial_atlas_control.balance.stand import StandController, StandReference
+from tutorial_atlas_control.balance.manipulate import PelvisServo
+from tutorial_atlas_control.balance.stand import StandController, StandReference, pitch_of
 from tutorial_atlas_control.balance.stand_behaviour import StandBehaviour
 from tutorial_atlas_control.balance.stand_pose import STAND_POSE_RAD, place_in_stand_pose
 from tutorial_atlas_control.sim import model as atlas_model
@@ -167,3 +168,71 @@ def test_stand_behaviour_is_the_controller_held_where_it_started(
     np.testing.assert_array_equal(behaviour.torque(pushed), expected.torque_nm)
     assert behaviour.last_output is not None
     assert behaviour.last_output.desired_cop[0] > rest.capture_point[0] + 0.01
+
+
+def _rotation_rate(before: np.ndarray, after: np.ndarray, seconds: float) -> np.ndarray:
+    """The angular velocity (rad/s, world) that turns `before` into `after` in `seconds`."""
+    turn = after @ before.T
+    return 0.5 * np.array([turn[2, 1] - turn[1, 2], turn[0, 2] - turn[2, 0],
+                           turn[1, 0] - turn[0, 1]]) / seconds
+
+
+def test_a_moving_reference_carries_its_own_rates(atlas: atlas_model.AtlasModel,
+                                                  placed: mujoco.MjData) -> None:
+    """Manipulate's squat from the Stand pose down into the tipped range: the reference's
+    rates are its time derivative (so the PDs damp about them), and zero once arrived."""
+    behaviour = StandBehaviour(atlas)
+    behaviour.start(placed)
+    data = mujoco.MjData(atlas.model)
+    data.qpos[:], data.qvel[:] = placed.qpos, placed.qvel
+
+    def reference_at(time_s: float) -> StandReference:
+        data.time = time_s
+        behaviour.torque(data)
+        assert behaviour.controller is not None
+        return behaviour.controller.reference
+
+    reference_at(1.5)  # the start's transition over: the reference on the squat table
+    behaviour.servo(PelvisServo(0.76, yaw_rad=0.2), 1.5)
+    h = 1e-4
+    for time_s in (1.8, 2.0, 2.3):
+        before, middle, after = (reference_at(time_s + d) for d in (-h, 0.0, h))
+        assert middle.com_height_rate_m_s == pytest.approx(
+            (after.com_height_m - before.com_height_m) / (2 * h), rel=1e-3, abs=1e-5)
+        np.testing.assert_allclose(
+            middle.pelvis_angular_velocity,
+            _rotation_rate(before.pelvis_rotation, after.pelvis_rotation, 2 * h),
+            rtol=1e-3, atol=1e-4)
+        np.testing.assert_allclose(middle.posture_rate_rad_s,
+                                   (after.posture_rad - before.posture_rad) / (2 * h),
+                                   rtol=1e-3, atol=1e-4)
+    assert reference_at(2.3).pelvis_angular_velocity[1] > 0.3  # leaning forward, fast
+    arrived = reference_at(2.6)
+    assert pitch_of(arrived.pelvis_rotation) == pytest.approx(
+        behaviour.squats.pitch_for(0.76), abs=1e-12)
+    assert arrived.com_height_rate_m_s == 0.0 and not arrived.posture_rate_rad_s.any()
+
+
+def test_the_pds_damp_about_the_reference_s_rates(atlas: atlas_model.AtlasModel,
+                                                   placed: mujoco.MjData) -> None:
+    """A robot moving as its reference moves feels no damping: the height and orientation
+    PDs act on the error alone."""
+    estimator = BalanceEstimator(atlas)
+    moving = placed.qvel.copy()
+    moving[2], moving[4] = 0.1, 0.3  # rising, pitching (the free joint's local y)
+    state = estimator.estimate(placed.qpos, moving)
+    held = StandReference.from_state(state)
+    following = dataclasses.replace(held, com_height_rate_m_s=float(state.com_velocity[2]),
+                                    pelvis_angular_velocity=state.pelvis_angular_velocity)
+    gains = StandController(estimator.mass_kg, atlas.effort_limit_nm, held,
+                            SOLE_HALF_SIZE_M).gains
+    for reference, damped in ((held, True), (following, False)):
+        controller = StandController(estimator.mass_kg, atlas.effort_limit_nm, reference,
+                                     SOLE_HALF_SIZE_M)
+        force, moment = controller.centroidal_wrench(state, state.com[:2])
+        weight_n = estimator.mass_kg * lipm.GRAVITY_M_S2
+        drag = estimator.mass_kg * gains.height_kd * state.com_velocity[2]
+        assert force[2] == pytest.approx(weight_n - drag if damped else weight_n)
+        expected = (-gains.orientation_kd * state.pelvis_angular_velocity if damped
+                    else np.zeros(3))
+        np.testing.assert_allclose(moment, expected, atol=1e-9)
