@@ -19,6 +19,7 @@ from tutorial_atlas_control.cli.convention import (
     print_error,
 )
 from tutorial_atlas_control.demo import demo_node as demo
+from tutorial_atlas_control.demo import walk_demo_node as walk_demo
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.sim import load_gains_yaml
 from tutorial_atlas_control.trajectories import find_trajectory, gains_for, load_trajectory
@@ -29,10 +30,13 @@ PROG = 'run_demo.py'
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser (its --help is the documentation)."""
     parser = argparse.ArgumentParser(prog=PROG, description=demo.__doc__.split('\n\n')[0])
+    walks = '; '.join(f'{name}: {what}' for name, (what, _) in walk_demo.WALKS.items())
     parser.add_argument('trajectory', nargs='?', default='step_and_fall',
                         help='trajectory name (default: step_and_fall); without --file it '
                              "must be in exactly one of the package's trajectories/*.yaml, "
-                             'e.g. step_and_stand (trajectories/Stepping.yaml)')
+                             'e.g. step_and_stand (trajectories/Stepping.yaml); or a walk '
+                             'through the AtlasSimInterface (startup_mode:=bdi_stand and '
+                             f'walk_client.py; the summary adds the footprints): {walks}')
     parser.add_argument('--file', type=Path,
                         help="trajectory YAML file (default: the one of the package's "
                              'trajectories/*.yaml that holds TRAJECTORY, e.g. Traj_data2.yaml '
@@ -78,26 +82,48 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status."""
     args = build_parser().parse_args(argv)
     started_s = time.time()
+    walk = args.trajectory in walk_demo.WALKS and args.file is None
+    if walk and (args.gains_file is not None or args.table):
+        print_error(PROG, f'{args.trajectory} is a walk: --gains-file and --table apply to '
+                          'trajectories only')
+        return EXIT_REFUSED
     try:
-        # Everything is checked before anything starts.
-        trajectory_file = args.file or find_trajectory(args.trajectory)
-        load_trajectory(trajectory_file, args.trajectory)
-        gains = gains_for(trajectory_file, args.gains_file)
-        load_gains_yaml(gains.path)
-        bag = demo.run_demo(args.trajectory, trajectory_file, args.bag_dir.expanduser().resolve(),
-                            args.real_time_factor, args.bag_dir.expanduser() / 'logs',
-                            progress=print, warn=_warn, gains=gains)
-        demo.summarise(bag, args.video_fps, args.video_size, report=print, table=args.table)
+        if walk:
+            _walk(args)
+        else:
+            _play(args)
     except AtlasControlError as err:
         print_error(PROG, err)
         return EXIT_REFUSED
     except subprocess.TimeoutExpired as err:
         print_error(PROG, f'{err.cmd[2] if len(err.cmd) > 2 else err.cmd} timed out')
         return EXIT_REFUSED
-    except KeyboardInterrupt:  # run_demo has stopped roslaunch on the way out
+    except KeyboardInterrupt:  # the demo has stopped roslaunch on the way out
         _name_partial_bag(args.bag_dir.expanduser().resolve(), started_s)
         return EXIT_INTERRUPTED
     return 0
+
+
+def _play(args: argparse.Namespace) -> None:
+    """run_demo.py TRAJECTORY: the tutorial's way, User mode and traj_yaml.py."""
+    # Everything is checked before anything starts.
+    trajectory_file = args.file or find_trajectory(args.trajectory)
+    load_trajectory(trajectory_file, args.trajectory)
+    gains = gains_for(trajectory_file, args.gains_file)
+    load_gains_yaml(gains.path)
+    bag = demo.run_demo(args.trajectory, trajectory_file, args.bag_dir.expanduser().resolve(),
+                        args.real_time_factor, args.bag_dir.expanduser() / 'logs',
+                        progress=print, warn=_warn, gains=gains)
+    demo.summarise(bag, args.video_fps, args.video_size, report=print, table=args.table)
+
+
+def _walk(args: argparse.Namespace) -> None:
+    """run_demo.py WALK: a walk through the AtlasSimInterface (the balancing Stand walks;
+    the tutorial's gains are the user's PID's)."""
+    bag = walk_demo.run_walk_demo(args.trajectory, args.bag_dir.expanduser().resolve(),
+                                  args.real_time_factor, args.bag_dir.expanduser() / 'logs',
+                                  progress=print, warn=_warn)
+    demo.summarise(bag, args.video_fps, args.video_size, report=print, walk=True)
 
 
 def _name_partial_bag(bag_dir: Path, started_s: float) -> None:

@@ -44,6 +44,10 @@ from tutorial_atlas_control.walking import (
 PROG = 'walk_client.py'
 #: How long (s, wall time) to wait for the first state, and for the simulator to subscribe.
 CONNECT_TIMEOUT_S = 30.0
+#: Steps per turn of --circle.
+STEPS_PER_TURN = 60
+#: How long (s, wall time) to wait for the other subscribers the master lists (a recorder).
+LISTED_CONNECT_TIMEOUT_S = 2.0
 
 
 def _positive(text: str) -> float:
@@ -82,7 +86,9 @@ def _parser() -> argparse.ArgumentParser:
 def plan_for(args: argparse.Namespace) -> list[Footstep]:
     """The plan from the origin facing +x (foot links' poses)."""
     if args.circle is not None:
-        return circle_steps(args.circle, 60, 1, args.width, args.duration)[:args.steps]
+        turns = math.ceil(args.steps / STEPS_PER_TURN)
+        return circle_steps(args.circle, STEPS_PER_TURN, turns, args.width,
+                            args.duration)[:args.steps]
     return straight_steps(args.steps, args.stride, args.width, args.duration)
 
 
@@ -145,6 +151,12 @@ def _walk(plan: list[Footstep], args: argparse.Namespace) -> int:
         if rospy.get_time() > deadline or rospy.is_shutdown():
             raise _Refused(f'the simulator did not subscribe to {topics.ASI_COMMAND}')
         rospy.sleep(0.01)
+    # A recorder subscribed too gets the first commands (the only ones that carry the
+    # first steps) if it is connected before they go.
+    deadline = rospy.get_time() + LISTED_CONNECT_TIMEOUT_S
+    while publisher.get_num_connections() < _listed_subscribers(topics.ASI_COMMAND) \
+            and rospy.get_time() < deadline and not rospy.is_shutdown():
+        rospy.sleep(0.01)
     rospy.Subscriber(topics.ASI_STATE, AtlasSimInterfaceState, on_state, queue_size=1,
                      tcp_nodelay=True)
     if not ended.wait(args.timeout):
@@ -160,6 +172,15 @@ def _walk(plan: list[Footstep], args: argparse.Namespace) -> int:
           f'({"once" if args.once else "streamed"}), back in Stand; feet at {feet}')
     rospy.signal_shutdown('walked')
     return 0
+
+
+def _listed_subscribers(topic: str) -> int:
+    """How many nodes the master lists as subscribers of `topic` (0 if it cannot say)."""
+    try:
+        _, subscribers, _ = rosgraph.Master(rospy.get_name()).getSystemState()
+    except (rosgraph.MasterException, OSError):
+        return 0
+    return next((len(nodes) for name, nodes in subscribers if name == topic), 0)
 
 
 def step_message(step: Footstep) -> AtlasBehaviorStepData:

@@ -1,6 +1,7 @@
-"""The tutorial end to end, headless, in one command (run_demo.py): demo_node.py.
+"""The tutorial end to end, headless, in one command (run_demo.py): demo_node.py; and
+Atlas walking the same way: walk_demo_node.py.
 
-ROS side only (demo_node.py imports rospy once a launch runs): import it by its module.
+ROS side only (both import rospy once a launch runs): import them by their modules.
 """
 
 __all__: list[str] = []

@@ -17,9 +17,12 @@ from pathlib import Path
 from tutorial_atlas_control.bags import (
     analyze_bag,
     foot_line,
+    plot_footprints,
     plot_run,
     render_bag_video,
     short_summary,
+    summarise_walk,
+    walk_lines,
 )
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.processes import AtlasLaunch, run_to_end
@@ -60,12 +63,12 @@ def newest_bag(bag_dir: Path, since_s: float) -> Path:
 Report = Callable[[str], None]
 
 
-def _silent(_line: str) -> None:
+def silent(_line: str) -> None:
     """The default Report: say nothing."""
 
 
 def run_demo(trajectory: str, trajectory_file: Path, bag_dir: Path, real_time_factor: float,
-             log_dir: Path, progress: Report = _silent, warn: Report = _silent,
+             log_dir: Path, progress: Report = silent, warn: Report = silent,
              gains: GainsChoice | None = None) -> Path:
     """Run the tutorial once; return the closed bag's path.
 
@@ -93,23 +96,13 @@ def run_demo(trajectory: str, trajectory_file: Path, bag_dir: Path, real_time_fa
 
 
 def drive(launch: AtlasLaunch, trajectory: str, trajectory_file: Path,
-          progress: Report = _silent) -> None:
+          progress: Report = silent) -> None:
     """What the tutorial's user does in the other terminals: User mode, then traj_yaml.py."""
     import rospy  # noqa: PLC0415 - rospy loads only once a launch runs
     from rosgraph_msgs.msg import Clock  # noqa: PLC0415
-    from sensor_msgs.msg import JointState  # noqa: PLC0415
     from std_msgs.msg import String  # noqa: PLC0415
 
-    os.environ.update(ROS_MASTER_URI=launch.uri, ROS_HOSTNAME=launch.env['ROS_HOSTNAME'])
-    # The master first: init_node would print "Unable to register with master node ... Will
-    # keep trying" while it starts.
-    launch.wait_master(STARTUP_TIMEOUT_S)
-    rospy.init_node('tutorial_demo', anonymous=True, disable_signals=True)
-    try:
-        rospy.wait_for_message('/atlas/joint_states', JointState, timeout=STARTUP_TIMEOUT_S)
-    except rospy.ROSException:
-        raise DemoError('the simulator did not publish /atlas/joint_states within '
-                        f'{STARTUP_TIMEOUT_S:.0f} s; see {launch.log_path}') from None
+    join(launch, 'tutorial_demo')
     wait_sim_time(Clock, START_SETTLE_S)
     mode_pub = rospy.Publisher('/atlas/control_mode', String, queue_size=1, latch=True)
     mode_pub.publish(String(data='User'))
@@ -122,6 +115,24 @@ def drive(launch: AtlasLaunch, trajectory: str, trajectory_file: Path,
     if status != 0:
         raise DemoError(f'traj_yaml.py exited with status {status}')
     wait_sim_time(Clock, END_SETTLE_S)
+
+
+def join(launch: AtlasLaunch, node_name: str) -> None:
+    """Become a node (`node_name`, anonymous) of `launch`'s master once its simulator
+    publishes."""
+    import rospy  # noqa: PLC0415 - rospy loads only once a launch runs
+    from sensor_msgs.msg import JointState  # noqa: PLC0415
+
+    os.environ.update(ROS_MASTER_URI=launch.uri, ROS_HOSTNAME=launch.env['ROS_HOSTNAME'])
+    # The master first: init_node would print "Unable to register with master node ... Will
+    # keep trying" while it starts.
+    launch.wait_master(STARTUP_TIMEOUT_S)
+    rospy.init_node(node_name, anonymous=True, disable_signals=True)
+    try:
+        rospy.wait_for_message('/atlas/joint_states', JointState, timeout=STARTUP_TIMEOUT_S)
+    except rospy.ROSException:
+        raise DemoError('the simulator did not publish /atlas/joint_states within '
+                        f'{STARTUP_TIMEOUT_S:.0f} s; see {launch.log_path}') from None
 
 
 def wait_sim_time(clock_type: type, seconds: float) -> None:
@@ -139,16 +150,28 @@ def wait_sim_time(clock_type: type, seconds: float) -> None:
 
 
 def summarise(bag: Path, video_fps: float, video_size: tuple[int, int],
-              report: Report = _silent, table: bool = False) -> None:
+              report: Report = silent, table: bool = False, walk: bool = False) -> None:
     """Report the short summary; write the plot and (unless video_fps is 0) the video.
+    `walk`: a walk's bag: the walk's figures and its footprints (<bag>.footprints.png)
+    instead of the right foot's displacement.
 
     The summary is reported before the (slower) plot and video are made.
     """
     analysis = analyze_bag(bag)
     report('\n' + short_summary(analysis, table))
-    foot = foot_line(analysis.data)
-    if foot is not None:
-        report(foot)
+    footprints = None
+    if walk:
+        summary = summarise_walk(analysis.data)
+        if summary is None:
+            report('walk: the bag holds no WALK command')
+        else:
+            for line in walk_lines(summary):
+                report(line)
+            footprints = plot_footprints(summary, bag.with_suffix('.footprints.png'))
+    else:
+        foot = foot_line(analysis.data)
+        if foot is not None:
+            report(foot)
     plot = plot_run(analysis, bag.with_suffix('.png'))
     video = None
     if video_fps > 0:
@@ -156,5 +179,7 @@ def summarise(bag: Path, video_fps: float, video_size: tuple[int, int],
                                  video_size).path
     report(f'bag:   {bag}')
     report(f'plot:  {plot}')
+    if footprints is not None:
+        report(f'footprints: {footprints}')
     if video is not None:
         report(f'video: {video}')
