@@ -38,7 +38,14 @@ TF_MSG_DEFINITION = 'geometry_msgs/TransformStamped[] transforms'
 
 #: The vendored atlas_msgs messages (msg/atlas_msgs), registered from their .msg files.
 ATLAS_MSGS = ('AtlasCommand', 'AtlasState', 'ControllerStatistics', 'ForceTorqueSensors',
-              'SynchronizationStatistics', 'Test')
+              'SynchronizationStatistics', 'Test',
+              # the AtlasSimInterface's, each after the ones it holds
+              'AtlasBehaviorStepData', 'AtlasBehaviorStepParams', 'AtlasBehaviorStandParams',
+              'AtlasBehaviorPelvisServoParams', 'AtlasBehaviorManipulateParams',
+              'AtlasBehaviorWalkParams', 'AtlasSimInterfaceCommand', 'AtlasPositionData',
+              'AtlasBehaviorFeedback', 'AtlasBehaviorStepFeedback',
+              'AtlasBehaviorWalkFeedback', 'AtlasBehaviorStandFeedback',
+              'AtlasBehaviorManipulateFeedback', 'AtlasSimInterfaceState')
 #: A constant as genmsg reads it: `TYPE NAME = VALUE`, any case, spaces around '=' or not.
 _CONSTANT = re.compile(r'^\s*([a-z][a-z0-9]*)\s+([A-Za-z][A-Za-z0-9_]*)\s*=\s*(.*)$')
 _INTEGER_TYPES = frozenset({'byte', 'char', 'int8', 'uint8', 'int16', 'uint16', 'int32',

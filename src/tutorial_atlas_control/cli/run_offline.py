@@ -1,4 +1,5 @@
-"""Command line of run_offline.py: play a trajectory offline (no ROS) and summarize the run."""
+"""Command line of run_offline.py: play a trajectory, or a recorded AtlasSimInterface
+session, offline (no ROS) and summarize the run."""
 
 from __future__ import annotations
 
@@ -9,12 +10,13 @@ from pathlib import Path
 
 import numpy as np
 
-from tutorial_atlas_control.bags import analyze_bag, short_summary
+from tutorial_atlas_control.bags import analyze_bag, short_summary, summarise_walk, walk_lines
 from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED, EXIT_REFUSED, print_error
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.offline import (
     DEFAULT_SETTLE_S,
     DEFAULT_START_AFTER_S,
+    run_asi_offline,
     run_offline,
 )
 from tutorial_atlas_control.sim import DEFAULT_GAINS_FILE
@@ -42,8 +44,15 @@ def build_parser() -> argparse.ArgumentParser:
             'the gains of --gains, then --settle s), deterministically and faster than real '
             'time. Prints the demo\'s summary; with --bag, also keeps the run as a ROS 1 bag '
             'that analyze_bag.py, replay_bag.py and rosbag read as a recorded run.'))
-    parser.add_argument('trajectory_file', metavar='YAML_FILE', help='trajectory file')
-    parser.add_argument('name', metavar='NAME', help='trajectory name in YAML_FILE')
+    parser.add_argument('trajectory_file', metavar='YAML_FILE', nargs='?',
+                        help='trajectory file')
+    parser.add_argument('name', metavar='NAME', nargs='?', help='trajectory name in YAML_FILE')
+    parser.add_argument('--asi-from', type=Path, metavar='IN.bag',
+                        help='instead of a trajectory, play the AtlasSimInterface commands '
+                             'recorded in IN.bag (a walking client\'s, say) into a simulator '
+                             'started as that run was, each at the sim time it was recorded '
+                             'at, then --settle s; the summary adds the walk\'s steps, '
+                             'distance, worst placement and falls')
     parser.add_argument('--bag', type=Path, metavar='OUT.bag',
                         help='write the run to this bag (replaced if it exists)')
     parser.add_argument('--table', action='store_true',
@@ -64,23 +73,36 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """The command line; returns the exit status (1: bad input or failed run, nothing written)."""
-    args = build_parser().parse_args(argv)
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.asi_from is not None and args.trajectory_file is not None:
+        parser.error('--asi-from plays a recorded session: give no YAML_FILE and NAME')
+    if args.asi_from is None and args.name is None:
+        parser.error('give YAML_FILE and NAME (or --asi-from IN.bag)')
     try:
         with tempfile.TemporaryDirectory(prefix='tac_offline_') as scratch:
             # Without --bag the summary is read from a bag that is deleted afterwards.
-            bag = args.bag if args.bag is not None else Path(scratch) / f'{args.name}.bag'
-            trajectory_file = locate_trajectory_file(args.trajectory_file, announce=print)
-            run = run_offline(trajectory_file, args.name, bag, args.settle,
-                              args.start_after, args.gains, play_after_s=args.play_after)
+            bag = args.bag if args.bag is not None else Path(scratch) / 'offline.bag'
+            if args.asi_from is not None:
+                run = run_asi_offline(args.asi_from, bag, args.settle, args.gains)
+                what = f'{args.asi_from}: {run.commands} AtlasSimInterface commands applied'
+            else:
+                trajectory_file = locate_trajectory_file(args.trajectory_file, announce=print)
+                run = run_offline(trajectory_file, args.name, bag, args.settle,
+                                  args.start_after, args.gains, play_after_s=args.play_after)
+                what = f'{args.name}: {run.commands} commands'
             analysis = analyze_bag(run.bag)
+            walk = summarise_walk(analysis.data) if args.asi_from is not None else None
     except AtlasControlError as err:
         print_error(PROG, err)
         return EXIT_REFUSED
-    except KeyboardInterrupt:  # run_offline leaves no partial bag behind
+    except KeyboardInterrupt:  # the run leaves no partial bag behind
         return EXIT_INTERRUPTED
-    print(f'offline: {args.name}: {run.commands} commands, {run.sim_time_s:.3f} s of sim time '
-          f'in {run.wall_s:.2f} s ({run.real_time_factor:.1f}x real time)')
+    print(f'offline: {what}, {run.sim_time_s:.3f} s of sim time in {run.wall_s:.2f} s '
+          f'({run.real_time_factor:.1f}x real time)')
     print(short_summary(analysis, args.table))
+    for line in walk_lines(walk) if walk is not None else ():
+        print(line)
     if args.bag is not None:
         print(f'bag:   {run.bag}')
     return 0

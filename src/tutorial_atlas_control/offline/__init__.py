@@ -1,8 +1,10 @@
-"""Runs without ROS: the offline trajectory player and the replay of a recorded run."""
+"""Runs without ROS: the offline trajectory player, an AtlasSimInterface session played again,
+and the replay of a recorded run."""
 
 from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    'asi_playback': ['AsiStream', 'read_asi_stream', 'run_asi_offline'],
     'player': ['CommandLatency', 'DEFAULT_SETTLE_S', 'DEFAULT_START_AFTER_S', 'OfflineRunError',
                'run_offline', 'write_offline_bag'],
     'replay': ['DEFAULT_TOLERANCE', 'ReplayError', 'format_report', 'replay_bag'],

@@ -66,7 +66,8 @@ from tutorial_atlas_control.trajectories import (
 )
 from tutorial_atlas_control.units import NS_PER_S
 
-__all__ = ['CommandLatency', 'OfflineRunError', 'OfflineRun', 'run_offline', 'write_offline_bag']
+__all__ = ['CommandLatency', 'OfflinePlayer', 'OfflineRunError', 'OfflineRun', 'open_offline_bag',
+           'run_offline', 'write_offline_bag', 'write_whole']
 
 #: Sim time (s) before the switch to User, as `make demo`: past the 1 s torso pin.
 DEFAULT_START_AFTER_S = 1.5
@@ -143,7 +144,7 @@ class OfflineRun:
 BLOCK_STEPS = 500
 
 
-def _open_bag(path: Path) -> BlockBagWriter:
+def open_offline_bag(path: Path) -> BlockBagWriter:
     """A new bag at `path` with a live run's connections (TOPIC_TYPES)."""
     typestore = load_typestore()
     if JOINT_COMMANDS_TYPE not in typestore.fielddefs:
@@ -241,7 +242,7 @@ class _StepRows:
         sink.flush()
 
 
-class _OfflinePlayer:
+class OfflinePlayer:
     """The simulator, traj_yaml's commands and the recorder, on one sim clock."""
 
     def __init__(self, sim: AtlasSimulator, sink: BlockBagWriter,
@@ -380,11 +381,11 @@ def write_offline_bag(bag: Path, trajectory_file: str, name: str, waypoints: Seq
     `latency`, if given, delays each command as a live run's delivery does (CommandLatency).
     """
     sim = AtlasSimulator(load_model(model_path), gains)
-    sink = _open_bag(bag)
+    sink = open_offline_bag(bag)
     # The run's time, without loading the model and the message types (fixed costs).
     started_s = time.perf_counter()
     try:
-        player = _OfflinePlayer(sim, sink, on_step, latency)
+        player = OfflinePlayer(sim, sink, on_step, latency)
         player.write_config()
         player.publish()  # the initial state, before the first step, as the node does
         player.advance(start_after_s)
@@ -425,15 +426,26 @@ def run_offline(trajectory_file: str, name: str, bag: Path | str,
     path = locate_trajectory_file(trajectory_file)
     waypoints = load_trajectory(path, name)
     gains = load_gains_yaml(gains_file)
-    target = Path(bag)
+    return write_whole(Path(bag), lambda partial: write_offline_bag(
+        partial, os.path.abspath(path), name, waypoints, gains, settle_s, start_after_s,
+        model_path, play_after_s))
+
+
+def write_whole(target: Path, write: Callable[[Path], OfflineRun]) -> OfflineRun:
+    """`write` the run to a temporary name beside `target`, renamed to it when complete
+    (replacing an existing file): a failed run leaves nothing.
+
+    Raises:
+        OfflineRunError: `target`'s directory does not exist, it is a directory, or it
+            cannot be written.
+    """
     if not target.parent.is_dir():
         raise OfflineRunError(f'{target}: directory {target.parent} does not exist')
     if target.is_dir():
         raise OfflineRunError(f'{target} is a directory; give a .bag file name')
     partial = target.parent / f'.{target.name}.{os.getpid()}.partial'
     try:
-        run = write_offline_bag(partial, os.path.abspath(path), name, waypoints, gains,
-                                settle_s, start_after_s, model_path, play_after_s)
+        run = write(partial)
         os.replace(partial, target)
     except OSError as err:
         raise OfflineRunError(f'cannot write {target}: {err.strerror or err}') from err
