@@ -199,3 +199,23 @@ def messages_received(topic: str, node: str = '/atlas_sim', caller_id: str = '/s
     _publish, subscribe, _services = uri.getBusStats(caller_id)[2]
     return sum(connection[2] for name, connections in subscribe if name == topic
                for connection in connections if connection[0] in ids)
+
+
+#: A client that left this many steps of joint states unanswered or more was held up (a
+#: loaded host starves it; how often is a speed, make bench's controller ages) ...
+STALL_STEPS = 20
+#: ... and its joint lags its commands for about this long after (s of sim time): the arm's
+#: PD (200 N m/rad) takes up the difference in a few tens of ms.
+STALL_RECOVERY_S = 0.2
+
+
+def after_stalls(answered_ns: Sequence[int], step_ns: int) -> set[int]:
+    """Of the sorted stamps of the answered joint states, those in a client's stall (a gap of
+    STALL_STEPS steps or more between two answers) or in the STALL_RECOVERY_S after it:
+    there the joint tracks the last command the client could send, not the current one."""
+    recovery_ns = int(STALL_RECOVERY_S * 1e9)
+    stalled: set[int] = set()
+    for before, after in zip(answered_ns, answered_ns[1:]):
+        if after - before >= STALL_STEPS * step_ns:
+            stalled.update(t for t in answered_ns if after <= t <= after + recovery_ns)
+    return stalled

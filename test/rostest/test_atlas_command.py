@@ -20,7 +20,7 @@ import rospy
 import rostest
 from atlas_msgs.msg import AtlasCommand, Test
 from atlas_msgs.srv import ResetControls, ResetControlsRequest
-from sim_probe import SimProbe
+from sim_probe import SimProbe, after_stalls
 
 PKG = 'tutorial_atlas_control'
 N = 28
@@ -33,6 +33,8 @@ HELD_RAD = 0.05
 #: The arm joint reset_controls' atlas_command moves, and where to.
 MOVED_JOINT, MOVED_TARGET_RAD = 'l_arm_elx', 0.8
 TRACKING_TOLERANCE_RAD = 0.1
+#: The simulator's step (ns).
+STEP_NS = 1_000_000
 
 # -- the roscpp client (as test_command_age.py's) ----------------------------------------------
 SINE_JOINT = 'l_arm_elx'
@@ -228,13 +230,19 @@ class AtlasCommandTest(unittest.TestCase):
         index = self.index(SINE_JOINT)
         answered = [(s, commands[s.header.stamp.to_nsec()]) for s in states
                     if s.header.stamp.to_nsec() in commands]
-        errors = np.array([abs(s.position[index] - c.position[index]) for s, c in answered])
+        # Tracking is judged where the client kept up: after a stall (a loaded host starved
+        # it) the joint follows the last command it could send, a speed, not the law's doing.
+        stalled = after_stalls([s.header.stamp.to_nsec() for s, _c in answered],
+                               STEP_NS)
+        timely = [(s, c) for s, c in answered if s.header.stamp.to_nsec() not in stalled]
+        errors = np.array([abs(s.position[index] - c.position[index]) for s, c in timely])
         targets = np.array([c.position[index] for _s, c in answered])
         measured = np.array([s.position[index] for s, _c in answered])
-        rospy.loginfo(f'AtlasCommand client: answered {len(answered)} of {len(states)} states; '
-                      f'{SINE_JOINT} target {targets.min():.2f}..{targets.max():.2f} rad, '
-                      f'tracking error max {errors.max():.4f} rad, mean {errors.mean():.4f}')
-        self.assertGreater(len(answered), ANSWERED_SHARE * len(states))
+        rospy.loginfo(f'AtlasCommand client: answered {len(answered)} of {len(states)} states '
+                      f'({len(stalled)} in or just after a stall); {SINE_JOINT} target '
+                      f'{targets.min():.2f}..{targets.max():.2f} rad, tracking error max '
+                      f'{errors.max():.4f} rad, mean {errors.mean():.4f}')
+        self.assertGreater(len(timely), ANSWERED_SHARE * len(states))
         self.assertEqual(set(answered[0][1].k_effort), {255})
         self.assertGreater(targets.max() - targets.min(), 0.7, 'the sine spans its 0.8 rad')
         self.assertGreater(measured.max() - measured.min(), 0.6, 'the joint moves with it')

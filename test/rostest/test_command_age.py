@@ -28,7 +28,7 @@ import rospy
 import rostest
 from atlas_msgs.msg import ControllerStatistics
 from osrf_msgs.msg import JointCommands
-from sim_probe import SimProbe, bus_connections, transports_to
+from sim_probe import SimProbe, after_stalls, bus_connections, transports_to
 
 PKG = 'tutorial_atlas_control'
 TOPIC = '/atlas/controller_statistics'
@@ -170,22 +170,28 @@ class CommandAgeTest(unittest.TestCase):
         in_window = {t: c for t, c in commands.items() if start_ns <= t <= end_ns}
         answered = [(s, commands[s.header.stamp.to_nsec()]) for s in states
                     if s.header.stamp.to_nsec() in commands]
-        errors = np.array([abs(s.position[index] - c.position[index]) for s, c in answered])
+        # Tracking is judged where the client kept up: after a stall (a loaded host starved
+        # it) the joint follows the last command it could send, a speed, not the law's doing.
+        stalled = after_stalls([s.header.stamp.to_nsec() for s, _c in answered],
+                               int(STEP_S * 1e9))
+        timely = [(s, c) for s, c in answered if s.header.stamp.to_nsec() not in stalled]
+        errors = np.array([abs(s.position[index] - c.position[index]) for s, c in timely])
         targets = np.array([c.position[index] for _s, c in answered])
         statistics = self.statistics_between(start_ns, end_ns)
         ages = np.rint(np.array([m.command_age for m in statistics]) / STEP_S).astype(int)
         share = np.isin(ages, ANSWER_AGES_STEPS).mean() if len(ages) else 0.0
         counts = {int(a): int(n) for a, n in zip(*np.unique(ages, return_counts=True))}
         rospy.loginfo(
-            f'roscpp client: answered {len(answered)} of {len(states)} states; {SINE_JOINT} '
-            f'target {targets.min():.2f}..{targets.max():.2f} rad, tracking error max '
+            f'roscpp client: answered {len(answered)} of {len(states)} states ({len(stalled)} '
+            f'in or just after a stall); {SINE_JOINT} target {targets.min():.2f}..'
+            f'{targets.max():.2f} rad, tracking error max '
             f'{errors.max():.4f} rad, mean {errors.mean():.4f} rad; command age (steps: count) '
             f'{counts}; mean of the window means '
             f'{np.mean([m.command_age_mean for m in statistics]) * 1e3:.2f} ms')
         self.report_stalls(statistics)
         # Every command answers a joint state, stamped with its stamp, names prefixed.
         self.assertEqual(set(in_window) - state_stamps, set())
-        self.assertGreater(len(answered), ANSWERED_SHARE * len(states))
+        self.assertGreater(len(timely), ANSWERED_SHARE * len(states))
         self.assertEqual(answered[0][1].name[index], 'atlas::' + SINE_JOINT)
         self.assertGreater(targets.max() - targets.min(), 0.7, 'the sine spans its 0.8 rad')
         self.assertLess(errors.max(), TRACKING_TOLERANCE_RAD)
