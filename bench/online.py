@@ -117,6 +117,11 @@ def _drop_bags(launch: Launch) -> None:
 #: Wall time (s) after the first /clock before a bdi_stand start is balancing in Stand (its
 #: Stand begins at 2 s of sim time; a loaded machine may run a little slow).
 STAND_STARTED_S = 3.0
+#: The longest a bench walk may take (s, wall; walk_client.py gives up at 120 s itself):
+#: eight steps take about 8 s.
+WALK_TIMEOUT_S = 180.0
+#: The bench's walk: walk_straight's eight steps of 0.25 m.
+WALK_STEPS = 8
 
 
 def _wait_ready(master: Master, launch: Launch, probes: Probes) -> None:
@@ -311,6 +316,47 @@ def stand_realtime_run(master: Master, launch_file: str, probes: Probes, work_di
               'stand_lateness_p99_ms': float(np.percentile(_lateness(wall, sim), 99))}
     if node:
         result['stand_node_us_per_step'] = (cpu1 - cpu0) / max(steps, 1.0) * 1e6
+    return result
+
+
+def walk_realtime_run(master: Master, launch_file: str, probes: Probes, work_dir: Path,
+                      name: str, steps: int) -> dict[str, float]:
+    """As stand_realtime_run, over a walk: `walk_client.py --steps STEPS` streaming a WALK on
+    every AtlasSimInterfaceState (1 kHz) from STAND_STARTED_S until it ends: the pace kept
+    (`walk_realtime_rtf`), the step lateness p99, the node's CPU per step, and whether the
+    walk ended back in Stand (`walk_realtime_walked`, 1 or 0: a fall is the walk's, not
+    the pace's)."""
+    log_path = work_dir / f'{name}_walk_client.log'
+    with _launch(master, launch_file, work_dir, name, 1.0,
+                 extra_args={'startup_mode': 'bdi_stand'}) as launch:
+        _wait_ready(master, launch, probes)
+        time.sleep(STAND_STARTED_S)
+        node = launch.node_pid('atlas_sim')
+        cpu0 = cpu_seconds(node) if node else 0.0
+        probes.clock.start()
+        with log_path.open('w') as client_log:
+            try:
+                status = subprocess.run(
+                    ['rosrun', 'tutorial_atlas_control', 'walk_client.py', '--steps',
+                     str(steps)], env=master.env, stdout=client_log,
+                    stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+                    timeout=WALK_TIMEOUT_S, check=False).returncode
+            except subprocess.TimeoutExpired as err:
+                raise BenchError(f'walk_client.py did not end in time; see {log_path}') from err
+            finally:
+                samples = probes.clock.stop()
+        cpu1 = cpu_seconds(node) if node else 0.0
+        launch.check_running()
+    _drop_bags(launch)
+    if status not in (0, 1):  # 1: the walk fell or was refused; 2 and more: it never ran
+        raise BenchError(f'walk_client.py exited with {status}; see {log_path}')
+    wall, sim = _clock_series(samples)
+    steps_simulated = (sim[-1] - sim[0]) * 1000.0
+    result = {'walk_realtime_rtf': float((sim[-1] - sim[0]) / (wall[-1] - wall[0])),
+              'walk_lateness_p99_ms': float(np.percentile(_lateness(wall, sim), 99)),
+              'walk_realtime_walked': 1.0 if status == 0 else 0.0}
+    if node:
+        result['walk_node_us_per_step'] = (cpu1 - cpu0) / max(steps_simulated, 1.0) * 1e6
     return result
 
 

@@ -122,6 +122,11 @@ ROWS = (
      4),
     ('stand_lateness_p99_ms', 'its step lateness p99', 'ms', '< 2', 2),
     ('stand_node_us_per_step', 'its node CPU per step', 'us', '', 0),
+    ('walk_realtime_rtf', 'same, walking: a 1 kHz streaming client', 'x real time',
+     '1.00 +- 0.01', 4),
+    ('walk_lateness_p99_ms', 'its step lateness p99', 'ms', '< 2', 2),
+    ('walk_node_us_per_step', 'its node CPU per step', 'us', '', 0),
+    ('walk_realtime_walked', 'that walk ended in Stand (1) or fell (0)', '', '', 0),
     ('lateness_p50_ms', 'step lateness p50', 'ms', '', 2),
     ('lateness_p99_ms', 'step lateness p99', 'ms', '< 2', 2),
     ('lateness_max_ms', 'step lateness max', 'ms', '', 2),
@@ -278,6 +283,9 @@ TARGETS = {
     # Real time holds with the balancing Stand in the loop and the recorder.
     'stand_realtime_rtf': Target(low=0.99, high=1.01),
     'stand_lateness_p99_ms': Target(high=2.0, strict=True),
+    # ... and walking, with a client streaming a WALK on every state.
+    'walk_realtime_rtf': Target(low=0.99, high=1.01),
+    'walk_lateness_p99_ms': Target(high=2.0, strict=True),
     'lateness_p99_ms': Target(high=2.0, strict=True),
     'cmd_latency_p99_ms_50hz': Target(high=2.0, strict=True),
     'cmd_latency_p99_ms_1khz': Target(high=2.0, strict=True),
@@ -319,7 +327,8 @@ EXPECTED = {
              'fast_rosbag_rtf', 'fast_rosbag_recorded_fraction', 'fast_master_cpu',
              'fast_rsp_rtf', 'fast_rsp_master_cpu', 'fast_rsp_state_publisher_cpu'),
     'realtime': ('realtime_rtf', 'lateness_p50_ms', 'lateness_p99_ms', 'lateness_max_ms',
-                 'stand_realtime_rtf', 'stand_lateness_p99_ms',
+                 'stand_realtime_rtf', 'stand_lateness_p99_ms', 'walk_realtime_rtf',
+                 'walk_lateness_p99_ms', 'walk_realtime_walked',
                  'js_transport_p50_ms', 'js_transport_p99_ms', 'cmd_latency_p50_ms',
                  'cmd_latency_p99_ms', 'cmd_applied_1khz',
                  *(f'cmd_latency_p{pct}_ms{raw}_{rate}' for pct in (50, 99)
@@ -681,6 +690,14 @@ def run_realtime(args, samples, master, probes, work_dir) -> None:  # noqa: ANN0
             f'{stand["stand_lateness_p99_ms"]:.2f} ms, node '
             f'{stand.get("stand_node_us_per_step", float("nan")):.0f} us/step')
         add(samples, stand)
+        walk = online.walk_realtime_run(master, args.launch_file, probes, work_dir,
+                                        f'walk{run + 1}', online.WALK_STEPS)
+        log(f'realtime run {run + 1}: walking (a 1 kHz streaming client) rtf '
+            f'{walk["walk_realtime_rtf"]:.4f}, lateness p99 '
+            f'{walk["walk_lateness_p99_ms"]:.2f} ms, node '
+            f'{walk.get("walk_node_us_per_step", float("nan")):.0f} us/step, '
+            f'{"walked" if walk["walk_realtime_walked"] else "fell"}')
+        add(samples, walk)
 
 
 def summarize(samples: dict[str, list[float]],
