@@ -4,7 +4,7 @@ AtlasSimInterface, and the summary's figures are the bag's: every step asked for
 (the recorder had connected before the client's first WALK, the only one carrying steps 1-3),
 each landing is matched with its step, and the footprints are drawn. The summary must agree
 with what the client saw; a walk that ends in Stand places every foot within the issue's
-5 cm and 0.1 rad and goes about 1.75 m. (Live, the eight steps fall now and then: 1 of 8
+5 cm and 0.1 rad and goes about 1.75 m. (Live, the eight steps fall now and then: 3 of 13
 runs here; the test then checks the summary against the client's count only.)"""
 
 from __future__ import annotations
