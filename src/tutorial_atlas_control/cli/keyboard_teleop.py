@@ -12,6 +12,7 @@ from the harness; H harness; Q quit. Options: -h/--help; ROS remapping arguments
 from __future__ import annotations
 
 import curses
+import logging
 import os
 import sys
 import threading
@@ -26,6 +27,7 @@ from atlas_msgs.msg import (
     WalkDemoAction,
     WalkDemoGoal,
 )
+from rosgraph.roslogging import RosStreamHandler
 from std_msgs.msg import String
 
 from tutorial_atlas_control import topics
@@ -69,6 +71,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_REFUSED
     for stale in ('COLUMNS', 'LINES'):  # curses takes the terminal's own size, not these
         os.environ.pop(stale, None)
+    keep_logs_off_the_screen()
     try:
         curses.wrapper(Teleop(client).run)
     except KeyboardInterrupt:
@@ -80,6 +83,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     finally:
         rospy.signal_shutdown('teleop closed')
     return 0
+
+
+def keep_logs_off_the_screen(logger: logging.Logger | None = None) -> int:
+    """Stop rospy's terminal output (the `rosout` logger's RosStreamHandler): the screen is
+    curses'. A log line there (actionlib's "Got a transition callback on a goal handle that
+    we're not tracking", for a finished goal's late status) broke a screen line in two. The
+    lines still go to the node's log file and /rosout. Returns how many handlers went."""
+    logger = logger or logging.getLogger('rosout')
+    streams = [h for h in logger.handlers if isinstance(h, RosStreamHandler)]
+    for handler in streams:
+        logger.removeHandler(handler)
+    return len(streams)
 
 
 class Teleop:
