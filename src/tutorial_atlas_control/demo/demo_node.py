@@ -75,20 +75,34 @@ def run_demo(trajectory: str, trajectory_file: Path, bag_dir: Path, real_time_fa
     `gains` is atlas.launch's gains_file (None: the launch's default, the tutorial's).
     `progress` gets a line at each phase, `warn` one if roslaunch had to be killed.
     """
-    started_s = time.time()
-    gui = 'true' if os.environ.get('DISPLAY') else 'false'
-    args: dict[str, object] = {'gui': gui, 'bag_dir': bag_dir,
-                               'real_time_factor': real_time_factor}
+    args: dict[str, object] = {}
     if gains is not None:
         # Absolute: roslaunch's rosparam loader must not depend on its working directory.
         args['gains_file'] = gains.path.resolve()
-    launch = AtlasLaunch(log_dir / 'atlas_launch.log', args)
-    try:
-        progress(f'demo: atlas.launch started (master on port {launch.port}, '
-                 f'log {launch.log_path})')
+
+    def play(launch: AtlasLaunch) -> None:
         if gains is not None:
             progress(f'demo: gains {gains.describe()}')
         drive(launch, trajectory, trajectory_file, progress)
+
+    return run_launched('atlas.launch', args, bag_dir, real_time_factor, log_dir, play,
+                        progress, warn)
+
+
+def run_launched(label: str, args: dict[str, object], bag_dir: Path, real_time_factor: float,
+                 log_dir: Path, drive: Callable[[AtlasLaunch], None],
+                 progress: Report = silent, warn: Report = silent) -> Path:
+    """atlas.launch with `args` (headless unless there is a display, recording to `bag_dir`)
+    on a private master, `drive` with it, then stopped; the closed bag's path. `label` names
+    the launch in the progress line; `warn` gets a line if roslaunch had to be killed."""
+    started_s = time.time()
+    gui = 'true' if os.environ.get('DISPLAY') else 'false'
+    launch = AtlasLaunch(log_dir / 'atlas_launch.log',
+                         {'gui': gui, 'bag_dir': bag_dir, 'real_time_factor': real_time_factor,
+                          **args})
+    try:
+        progress(f'demo: {label} started (master on port {launch.port}, log {launch.log_path})')
+        drive(launch)
     finally:
         if not launch.close(SHUTDOWN_TIMEOUT_S):
             warn(f'demo: roslaunch did not stop within {SHUTDOWN_TIMEOUT_S:.0f} s; killed it')

@@ -9,17 +9,14 @@ worst placement against the steps asked for, falls, and the footprints seen from
 
 from __future__ import annotations
 
-import os
-import time
 from pathlib import Path
 
 from tutorial_atlas_control.demo.demo_node import (
     END_SETTLE_S,
-    SHUTDOWN_TIMEOUT_S,
     TRAJECTORY_STOP_TIMEOUT_S,
     Report,
     join,
-    newest_bag,
+    run_launched,
     silent,
     wait_sim_time,
 )
@@ -49,19 +46,9 @@ def run_walk_demo(walk: str, bag_dir: Path, real_time_factor: float, log_dir: Pa
                   progress: Report = silent, warn: Report = silent) -> Path:
     """Walk `walk` (a WALKS name) once; return the closed bag's path. A walk that falls
     is a result, not an error: walk_client.py's exit status is reported through `warn`."""
-    started_s = time.time()
-    gui = 'true' if os.environ.get('DISPLAY') else 'false'
-    launch = AtlasLaunch(log_dir / 'atlas_launch.log',
-                         {'gui': gui, 'bag_dir': bag_dir, 'real_time_factor': real_time_factor,
-                          'startup_mode': 'bdi_stand'})
-    try:
-        progress(f'demo: atlas.launch startup_mode:=bdi_stand started (master on port '
-                 f'{launch.port}, log {launch.log_path})')
-        _drive(launch, walk, progress, warn)
-    finally:
-        if not launch.close(SHUTDOWN_TIMEOUT_S):
-            warn(f'demo: roslaunch did not stop within {SHUTDOWN_TIMEOUT_S:.0f} s; killed it')
-    return newest_bag(bag_dir, started_s)
+    return run_launched('atlas.launch startup_mode:=bdi_stand', {'startup_mode': 'bdi_stand'},
+                        bag_dir, real_time_factor, log_dir,
+                        lambda launch: _drive(launch, walk, progress, warn), progress, warn)
 
 
 def _drive(launch: AtlasLaunch, walk: str, progress: Report, warn: Report) -> None:
