@@ -8,6 +8,7 @@ to show a step: the right foot's displacement from the first applied command to 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -16,7 +17,7 @@ from tutorial_atlas_control.bags.reader import BagData
 from tutorial_atlas_control.bags.render import prepare_gl
 from tutorial_atlas_control.joints import NUM_JOINTS, joint_index
 
-__all__ = ['FootDisplacement', 'foot_displacement', 'foot_line']
+__all__ = ['FootDisplacement', 'RecordedKinematics', 'foot_displacement', 'foot_line']
 
 #: The MJCF body of the right foot (the swing foot of the package's steps).
 RIGHT_FOOT_BODY = 'r_foot'
@@ -37,6 +38,46 @@ def _row_at(t_s: np.ndarray, at_s: float) -> int:
     return int(np.clip(np.searchsorted(t_s, at_s, side='right') - 1, 0, len(t_s) - 1))
 
 
+class RecordedKinematics:
+    """The model placed as the bag recorded it, at any time of the run: the pelvis pose
+    (/ground_truth_odom) and the joint angles (/atlas/joint_states; a joint the bag lacks at
+    0), each the last sample at or before that time; forward kinematics only."""
+
+    def __init__(self, data: BagData) -> None:
+        pelvis, states = data.pelvis, data.joint_states
+        if pelvis is None or states is None:
+            raise ValueError('the bag has no pelvis pose or no joint states')
+        prepare_gl()  # before mujoco's first import: a video may be rendered afterwards
+        import mujoco  # noqa: PLC0415
+
+        from tutorial_atlas_control.sim import load_model  # noqa: PLC0415 - imports mujoco
+
+        self._mujoco = mujoco
+        self.atlas = load_model()
+        self.data = mujoco.MjData(self.atlas.model)
+        self._pelvis, self._states = pelvis, states
+        self._columns = [(column, index) for column, name in enumerate(states.names)
+                         if (index := joint_index(name)) is not None]
+        self._angles = np.zeros(NUM_JOINTS)
+
+    def body_id(self, name: str) -> int:
+        """The model's body `name` (-1 if it has none)."""
+        return self._mujoco.mj_name2id(self.atlas.model, self._mujoco.mjtObj.mjOBJ_BODY, name)
+
+    def place(self, at_s: float) -> Any:
+        """The MjData (kinematics computed) as recorded at `at_s` (s from the bag's start)."""
+        pelvis, states, atlas, data = self._pelvis, self._states, self.atlas, self.data
+        pose_row, joint_row = _row_at(pelvis.t_s, at_s), _row_at(states.t_s, at_s)
+        for column, index in self._columns:
+            self._angles[index] = states.position[joint_row, column]
+        adr = atlas.free_qpos_adr
+        data.qpos[adr:adr + 3] = pelvis.position_m[pose_row]
+        data.qpos[adr + 3:adr + 7] = pelvis.orientation_xyzw[pose_row, [3, 0, 1, 2]]
+        data.qpos[atlas.qpos_adr] = self._angles
+        self._mujoco.mj_kinematics(atlas.model, data)
+        return data
+
+
 def foot_displacement(data: BagData, body: str = RIGHT_FOOT_BODY) -> FootDisplacement | None:
     """`body`'s displacement from the first applied command (else the first pose) to the
     last pose both topics cover; None without pelvis pose or joint states."""
@@ -48,29 +89,13 @@ def foot_displacement(data: BagData, body: str = RIGHT_FOOT_BODY) -> FootDisplac
     start_s = max(first_s, first_applied_command_s(data) or first_s)
     if end_s < start_s:
         return None
-    prepare_gl()  # before mujoco's first import: a video may be rendered afterwards
-    import mujoco  # noqa: PLC0415
-
-    from tutorial_atlas_control.sim import (  # noqa: PLC0415 - imports mujoco
-        body_position_in_pose,
-        load_model,
-    )
-
-    atlas = load_model()
-    body_id = mujoco.mj_name2id(atlas.model, mujoco.mjtObj.mjOBJ_BODY, body)
+    kinematics = RecordedKinematics(data)
+    body_id = kinematics.body_id(body)
     if body_id < 0:
         return None
-    kinematics = mujoco.MjData(atlas.model)
-    columns = [(column, index) for column, name in enumerate(states.names)
-               if (index := joint_index(name)) is not None]
 
     def position_at(at_s: float) -> np.ndarray:
-        pose_row, joint_row = _row_at(pelvis.t_s, at_s), _row_at(states.t_s, at_s)
-        angles = np.zeros(NUM_JOINTS)  # a joint the bag lacks stays at 0
-        for column, index in columns:
-            angles[index] = states.position[joint_row, column]
-        return body_position_in_pose(atlas, kinematics, body_id, pelvis.position_m[pose_row],
-                                     pelvis.orientation_xyzw[pose_row, [3, 0, 1, 2]], angles)
+        return kinematics.place(at_s).xpos[body_id].copy()
 
     return FootDisplacement(body, start_s, end_s, position_at(end_s) - position_at(start_s))
 

@@ -21,12 +21,11 @@ from typing import Any
 import numpy as np
 
 from tutorial_atlas_control import topics
+from tutorial_atlas_control.bags.feet import RecordedKinematics
 from tutorial_atlas_control.bags.reader import BagData
 from tutorial_atlas_control.bags.records import open_bag
-from tutorial_atlas_control.bags.render import prepare_gl
 from tutorial_atlas_control.bags.typestore import load_typestore
 from tutorial_atlas_control.errors import BagAnalysisError
-from tutorial_atlas_control.joints import NUM_JOINTS, joint_index
 
 __all__ = ['FOOT_BODIES', 'Landing', 'StepTarget', 'WalkSummary', 'landings', 'match_landings',
            'plot_footprints', 'read_step_targets', 'summarise_walk', 'walk_lines']
@@ -195,39 +194,22 @@ def _foot_poses(data: BagData, since_s: float) -> tuple[np.ndarray, list[np.ndar
     flat on the ground (the Stand pose placed on it)."""
     pelvis, states = data.pelvis, data.joint_states
     assert pelvis is not None and states is not None
-    prepare_gl()  # before mujoco's first import: a video may be rendered afterwards
-    import mujoco  # noqa: PLC0415
+    kinematics = RecordedKinematics(data)
+    from tutorial_atlas_control.balance import place_in_stand_pose  # noqa: PLC0415 - mujoco
 
-    from tutorial_atlas_control.balance import place_in_stand_pose  # noqa: PLC0415
-    from tutorial_atlas_control.sim import load_model  # noqa: PLC0415 - imports mujoco
-
-    atlas = load_model()
-    kinematics = mujoco.MjData(atlas.model)
-    bodies = [mujoco.mj_name2id(atlas.model, mujoco.mjtObj.mjOBJ_BODY, name)
-              for name in FOOT_BODIES]
-    place_in_stand_pose(atlas, kinematics)
-    standing_m = float(kinematics.xpos[bodies[0]][2])
-    columns = [(column, index) for column, name in enumerate(states.names)
-               if (index := joint_index(name)) is not None]
+    bodies = [kinematics.body_id(name) for name in FOOT_BODIES]
+    place_in_stand_pose(kinematics.atlas, kinematics.data)  # the soles flat on the ground
+    standing_m = float(kinematics.data.xpos[bodies[0]][2])
     end_s = min(float(pelvis.t_s[-1]), float(states.t_s[-1]))
     t_s = np.arange(max(since_s, float(pelvis.t_s[0]), float(states.t_s[0])), end_s,
                     1.0 / KINEMATICS_RATE_HZ)
     positions = [np.empty((len(t_s), 3)) for _ in bodies]
     yaws = [np.empty(len(t_s)) for _ in bodies]
-    pose_rows = np.clip(np.searchsorted(pelvis.t_s, t_s, side='right') - 1, 0, None)
-    joint_rows = np.clip(np.searchsorted(states.t_s, t_s, side='right') - 1, 0, None)
-    adr = atlas.free_qpos_adr
-    angles = np.zeros(NUM_JOINTS)  # a joint the bag lacks stays at 0
-    for row, (pose_row, joint_row) in enumerate(zip(pose_rows, joint_rows)):
-        for column, index in columns:
-            angles[index] = states.position[joint_row, column]
-        kinematics.qpos[adr:adr + 3] = pelvis.position_m[pose_row]
-        kinematics.qpos[adr + 3:adr + 7] = pelvis.orientation_xyzw[pose_row, [3, 0, 1, 2]]
-        kinematics.qpos[atlas.qpos_adr] = angles
-        mujoco.mj_kinematics(atlas.model, kinematics)
+    for row, at_s in enumerate(t_s):
+        placed = kinematics.place(float(at_s))
         for foot, body in enumerate(bodies):
-            positions[foot][row] = kinematics.xpos[body]
-            xmat = kinematics.xmat[body]
+            positions[foot][row] = placed.xpos[body]
+            xmat = placed.xmat[body]
             yaws[foot][row] = np.arctan2(xmat[3], xmat[0])
     return t_s, positions, yaws, standing_m
 
