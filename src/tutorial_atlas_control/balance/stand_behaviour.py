@@ -214,12 +214,12 @@ class StandBehaviour:
         if not transition.with_rates:
             return StandReference(capture_point, float(vector[29]), pelvis_frame(yaw, pitch),
                                   vector[:28])
-        rate = per_s * (6.0 * fraction * (1.0 - fraction) / duration)  # ds/dt: smoothstep's
-        yaw_rate = turn * 6.0 * fraction * (1.0 - fraction) / duration
+        s_rate = 6.0 * fraction * (1.0 - fraction) / duration  # ds/dt: smoothstep's
+        rate = per_s * s_rate
         return StandReference(
             capture_point, float(vector[29]), pelvis_frame(yaw, pitch), vector[:28],
             com_height_rate_m_s=float(rate[29]),
-            pelvis_angular_velocity=yaw_rate * _UP + rate[28] * yaw_rotation(yaw)[:, 1],
+            pelvis_angular_velocity=turn * s_rate * _UP + rate[28] * yaw_rotation(yaw)[:, 1],
             posture_rate_rad_s=rate[:28])
 
     def torque(self, data: mujoco.MjData) -> np.ndarray:
