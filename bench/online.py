@@ -27,8 +27,10 @@ import struct
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 from harness import READY_TIMEOUT_S, BenchError, Launch, Master, log
@@ -39,6 +41,9 @@ from tutorial_atlas_control.processes import cpu_seconds, wait_until
 from tutorial_atlas_control.units import NS_PER_S
 
 LATENCY_JOINT = 'neck_ay'
+#: What the action during a paced window returns.
+T = TypeVar('T')
+
 #: Fewer applied commands than this in a latency window are logged as few.
 FEW_LATENCIES = 10
 JS_PROBE_TOPIC = '/tac_bench/js_probe'
@@ -293,11 +298,13 @@ def js_transport(master: Master, probes: Probes, work_dir: Path, count: int = 20
             'js_transport_p99_ms': float(np.percentile(transport, 99))}
 
 
-def stand_realtime_run(master: Master, launch_file: str, probes: Probes, work_dir: Path,
-                       name: str, window_s: float) -> dict[str, float]:
+def _bdi_stand_pace(master: Master, launch_file: str, probes: Probes, work_dir: Path,
+                    name: str, prefix: str, during: Callable[[], T]) -> tuple[dict[str, float], T]:
     """atlas.launch as DRCSim 2.7 started (startup_mode:=bdi_stand: the balancing Stand from
-    2 s of sim time) at real_time_factor:=1 with the recorder: the pace it keeps
-    (`stand_realtime_rtf`), its step lateness p99 and the node's CPU per step, in Stand."""
+    2 s of sim time) at real_time_factor:=1 with the recorder, and from STAND_STARTED_S on,
+    while `during` runs: the pace kept (`<prefix>_realtime_rtf`), the step lateness p99
+    (`<prefix>_lateness_p99_ms`) and the node's CPU per step (`<prefix>_node_us_per_step`);
+    and what `during` returned."""
     with _launch(master, launch_file, work_dir, name, 1.0,
                  extra_args={'startup_mode': 'bdi_stand'}) as launch:
         _wait_ready(master, launch, probes)
@@ -305,17 +312,28 @@ def stand_realtime_run(master: Master, launch_file: str, probes: Probes, work_di
         node = launch.node_pid('atlas_sim')
         cpu0 = cpu_seconds(node) if node else 0.0
         probes.clock.start()
-        time.sleep(window_s)
-        samples = probes.clock.stop()
+        try:
+            outcome = during()
+        finally:
+            samples = probes.clock.stop()
         cpu1 = cpu_seconds(node) if node else 0.0
         launch.check_running()
     _drop_bags(launch)
     wall, sim = _clock_series(samples)
     steps = (sim[-1] - sim[0]) * 1000.0
-    result = {'stand_realtime_rtf': float((sim[-1] - sim[0]) / (wall[-1] - wall[0])),
-              'stand_lateness_p99_ms': float(np.percentile(_lateness(wall, sim), 99))}
+    result = {f'{prefix}_realtime_rtf': float((sim[-1] - sim[0]) / (wall[-1] - wall[0])),
+              f'{prefix}_lateness_p99_ms': float(np.percentile(_lateness(wall, sim), 99))}
     if node:
-        result['stand_node_us_per_step'] = (cpu1 - cpu0) / max(steps, 1.0) * 1e6
+        result[f'{prefix}_node_us_per_step'] = (cpu1 - cpu0) / max(steps, 1.0) * 1e6
+    return result, outcome
+
+
+def stand_realtime_run(master: Master, launch_file: str, probes: Probes, work_dir: Path,
+                       name: str, window_s: float) -> dict[str, float]:
+    """The pace (`stand_realtime_rtf`), step lateness p99 and node CPU per step in the
+    balancing Stand, over `window_s` (_bdi_stand_pace)."""
+    result, _ = _bdi_stand_pace(master, launch_file, probes, work_dir, name, 'stand',
+                                lambda: time.sleep(window_s))
     return result
 
 
@@ -327,36 +345,22 @@ def walk_realtime_run(master: Master, launch_file: str, probes: Probes, work_dir
     walk ended back in Stand (`walk_realtime_walked`, 1 or 0: a fall is the walk's, not
     the pace's)."""
     log_path = work_dir / f'{name}_walk_client.log'
-    with _launch(master, launch_file, work_dir, name, 1.0,
-                 extra_args={'startup_mode': 'bdi_stand'}) as launch:
-        _wait_ready(master, launch, probes)
-        time.sleep(STAND_STARTED_S)
-        node = launch.node_pid('atlas_sim')
-        cpu0 = cpu_seconds(node) if node else 0.0
-        probes.clock.start()
+
+    def walk() -> int:
         with log_path.open('w') as client_log:
             try:
-                status = subprocess.run(
+                return subprocess.run(
                     ['rosrun', 'tutorial_atlas_control', 'walk_client.py', '--steps',
                      str(steps)], env=master.env, stdout=client_log,
                     stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
                     timeout=WALK_TIMEOUT_S, check=False).returncode
             except subprocess.TimeoutExpired as err:
                 raise BenchError(f'walk_client.py did not end in time; see {log_path}') from err
-            finally:
-                samples = probes.clock.stop()
-        cpu1 = cpu_seconds(node) if node else 0.0
-        launch.check_running()
-    _drop_bags(launch)
+
+    result, status = _bdi_stand_pace(master, launch_file, probes, work_dir, name, 'walk', walk)
     if status not in (0, 1):  # 1: the walk fell or was refused; 2 and more: it never ran
         raise BenchError(f'walk_client.py exited with {status}; see {log_path}')
-    wall, sim = _clock_series(samples)
-    steps_simulated = (sim[-1] - sim[0]) * 1000.0
-    result = {'walk_realtime_rtf': float((sim[-1] - sim[0]) / (wall[-1] - wall[0])),
-              'walk_lateness_p99_ms': float(np.percentile(_lateness(wall, sim), 99)),
-              'walk_realtime_walked': 1.0 if status == 0 else 0.0}
-    if node:
-        result['walk_node_us_per_step'] = (cpu1 - cpu0) / max(steps_simulated, 1.0) * 1e6
+    result['walk_realtime_walked'] = 1.0 if status == 0 else 0.0
     return result
 
 
