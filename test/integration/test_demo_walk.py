@@ -3,8 +3,9 @@
 AtlasSimInterface, and the summary's figures are the bag's: every step asked for is in it
 (the recorder had connected before the client's first WALK, the only one carrying steps 1-3),
 each landing is matched with its step, and the footprints are drawn. The summary must agree
-with what the client saw: the steps taken, and, for a walk back in Stand, each foot's last
-landing where the simulator reported the feet at the end. Physical figures (placement within
+with what the client saw: the steps taken (a foot's landings given to the other foot make
+them differ). A foot's last landing against the feet the client reports at the end is no
+check: run 249 saw a sole slide 3.6 cm after landing. Physical figures (placement within
 5 cm, distance) are judged offline (test_asi_offline.py, test_walking.py): live, the eight
 steps fell in 3 of 13 runs here, and one walk that stood placed a foot 6.0 cm off."""
 
@@ -18,7 +19,7 @@ from pathlib import Path
 
 import pytest
 
-from tutorial_atlas_control.bags.footprints import read_step_targets, summarise_walk
+from tutorial_atlas_control.bags.footprints import read_step_targets
 from tutorial_atlas_control.bags.reader import read_bag
 
 #: Live at real time: run alone, after make test's parallel part.
@@ -29,9 +30,6 @@ RUN_DEMO = REPO / 'scripts' / 'run_demo.py'
 #: Wall-clock guard against a hung run (s), as conftest's DEMO_TIMEOUT_S.
 DEMO_TIMEOUT_S = 900
 STEPS = 8
-#: Each foot's last landing (read 50 ms after touchdown) against where the simulator said
-#: it was at the end (m): the sole may settle or slip a little after landing.
-FEET_WITHIN_M = 0.03
 
 
 def test_walk_demo_reports_the_bags_steps_landings_and_footprints(tmp_path: Path) -> None:
@@ -69,16 +67,3 @@ def test_walk_demo_reports_the_bags_steps_landings_and_footprints(tmp_path: Path
     if walked:
         assert int(taken.group(2)) == STEPS
         assert 'walk: no fall' in result.stdout
-        # The landings, found by forward kinematics of the recorded pose, against where the
-        # simulator said the feet were at the end (foot_pos_est, printed by the client).
-        feet = re.search(r'feet at \(([-\d.]+), ([-\d.]+)\), \(([-\d.]+), ([-\d.]+)\)', out)
-        assert feet is not None, out
-        reported = [(float(feet.group(1)), float(feet.group(2))),
-                    (float(feet.group(3)), float(feet.group(4)))]
-        summary = summarise_walk(read_bag(bag))
-        assert summary is not None
-        for foot in (0, 1):
-            last = [landing for target, landing in summary.placements
-                    if target.foot_index == foot and landing is not None][-1]
-            assert abs(last.x_m - reported[foot][0]) < FEET_WITHIN_M, (foot, last, reported)
-            assert abs(last.y_m - reported[foot][1]) < FEET_WITHIN_M, (foot, last, reported)
