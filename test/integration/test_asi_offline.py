@@ -99,9 +99,9 @@ def test_a_session_played_again_is_the_same_run(session: Path, tmp_path: Path) -
     lines = result.stdout.splitlines()
     taken = next(line for line in lines if line.startswith('walk: 4 of 4 steps taken, '))
     assert 0.55 < float(taken.split(', ')[1].split()[0]) < 0.7  # measured 0.64 m (the sway)
-    assert any(line.startswith('walk: no fall (lowest pelvis 0.9') for line in lines), lines
+    assert any(line.startswith('walk: no fall (lowest pelvis 0.8') for line in lines), lines
     worst = next(line for line in lines if line.startswith('walk: worst placement '))
-    assert float(worst.split()[3]) < 5.0  # cm, the goal; measured 3.5 cm
+    assert float(worst.split()[3]) < 5.0  # cm, the goal; measured 2.6 cm
     played = read_bag(again).joint_states
     assert played is not None
     np.testing.assert_array_equal(played.position, _direct_run(len(played.t_s)))

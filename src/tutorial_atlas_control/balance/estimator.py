@@ -9,6 +9,7 @@ the bias forces (gravity and Coriolis) once.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import mujoco
@@ -45,6 +46,9 @@ class BalanceState:
     bias_nm: np.ndarray           # (28,) joint part of qfrc_bias (gravity + Coriolis)
     sole_jacobians: np.ndarray    # (2, 6, 28) [linear; angular] at each sole centre, joints
     sole_velocities: np.ndarray   # (2, 6) [linear; angular] of each sole centre, world
+    #: The joint-space inertia block (k, k) of some joints (a slice, tutorial order) at this
+    #: state, computed on first use; valid until the estimator's next estimate.
+    joint_inertia: Callable[[slice], np.ndarray]
 
 
 class BalanceEstimator:
@@ -72,6 +76,8 @@ class BalanceEstimator:
         self._rotation_tolerance = POLYGON_TOLERANCE_M / float(np.linalg.norm(self._half_size))
         self._last_polygon: (tuple[tuple[bool, bool], np.ndarray, np.ndarray, np.ndarray]
                              | None) = None
+        self._inertia = np.zeros((self.model.nv, self.model.nv))
+        self._inertia_current = False
 
     @property
     def sole_ahead_m(self) -> float:
@@ -104,11 +110,22 @@ class BalanceEstimator:
         self._last_polygon = (contact, positions, rotations, polygon)
         return polygon
 
+    def _joint_inertia(self, joints: slice) -> np.ndarray:
+        """The inertia block of `joints` at the last estimate's state (mj_crb once per
+        estimate, only when asked: Walk's swing leg needs it, Stand does not)."""
+        if not self._inertia_current:
+            mujoco.mj_crb(self.model, self.scratch)
+            mujoco.mj_fullM(self.model, self.scratch, self._inertia)
+            self._inertia_current = True
+        dofs = self._dof_adr[joints]
+        return self._inertia[np.ix_(dofs, dofs)]
+
     def estimate(self, qpos: np.ndarray, qvel: np.ndarray) -> BalanceState:
         """The state at (qpos, qvel) (the full MuJoCo vectors)."""
         m, d = self.model, self.scratch
         d.qpos[:] = qpos
         d.qvel[:] = qvel
+        self._inertia_current = False
         mujoco.mj_kinematics(m, d)
         mujoco.mj_comPos(m, d)
         mujoco.mj_comVel(m, d)
@@ -140,4 +157,4 @@ class BalanceEstimator:
             support_polygon=polygon, omega=omega,
             capture_point=lipm.capture_point(com[:2], com_velocity[:2], omega),
             bias_nm=self._bias[self._dof_adr], sole_jacobians=jac[:, :, self._dof_adr],
-            sole_velocities=jac @ d.qvel)
+            sole_velocities=jac @ d.qvel, joint_inertia=self._joint_inertia)

@@ -1,12 +1,20 @@
 """What Walk and Step do alike each 1 ms step: the Stand's whole-body law on the feet that
-carry the robot, a swing foot moved by a task-space PD along its path, a foot that should
-be down put back flat on its last pose, and the pelvis turned towards the feet's heading.
+carry the robot, a swing foot servoed along its path, a foot that should be down put back
+flat on its last pose, the pelvis turned towards the feet's heading and lowered to the
+walking height.
 
 The Stand's joint PD keeps the arms and the back; the legs' posture gains are off (leg_kd
 of damping instead): in single support the stance leg's joints follow from the pelvis and
 the foot, the swing leg's from its task. While a foot swings, the stance sole's yaw moment
 is held within torsion_m times its load (beyond the model's torsional friction the foot
 turns).
+
+A foot is servoed in the leg's joint space: its pose error turned into joint errors by
+the leg's damped least-squares inverse, then a joint PD scaled by the leg's inertia, so
+that every joint has the same bandwidth. The task-space PD it replaced (6000 N/m on the
+sole, 600 N m/rad and 30 N m s/rad on its turn) was unstable at 1 kHz on the light foot:
+the legs' torques flipped between their effort limits every millisecond (280 N m per
+step on the hip pitch), and that shaking decided, chaotically, which walks stood.
 """
 
 from __future__ import annotations
@@ -32,19 +40,22 @@ __all__ = ['LEG_JOINTS', 'LegGains', 'LegTasks', 'foot_pose']
 
 #: The leg joints (tutorial order): their Stand posture PD is off while stepping.
 LEG_JOINTS = slice(4, 16)
+#: Each foot's leg joints, uhz to lax (tutorial order).
+LEG_OF_FOOT = (slice(4, 10), slice(10, 16))
 
 
 @dataclass(frozen=True)
 class LegGains:
     """The legs' numbers while stepping (ours)."""
 
-    #: The swing foot's task-space PD: position (N/m, N s/m), orientation (N m/rad, N m s/rad).
-    #: At 2500 N/m and 200 N m/rad the first swing foot lagged its path by 3 cm and landed
-    #: late; these walk DRCSim's queue and 20 straight steps.
-    swing_kp: float = 6000.0
-    swing_kd: float = 150.0
-    swing_rotation_kp: float = 600.0
-    swing_rotation_kd: float = 30.0
+    #: The foot servo's joint PD, per unit of the leg's inertia (1/s^2, 1/s): 20 rad/s of
+    #: bandwidth. A damping of 20/s and more chattered again (period 2 ms, on both legs);
+    #: at 10/s the 20 straight steps and the circles stand.
+    swing_kp: float = 400.0
+    swing_kd: float = 10.0
+    #: The damping of the leg's least-squares inverse (m): bounded joint errors with the
+    #: knee nearly straight.
+    ik_damping_m: float = 0.02
     #: Damping on the leg joints (N m s/rad) in place of Stand's posture PD.
     leg_kd: float = 2.0
     #: A swing foot not down when its step's time is up keeps going down at this speed
@@ -82,6 +93,22 @@ class LegTasks:
         self._joint_gains = (joint_kp, joint_kd)
         #: The pelvis's heading moving on: (start time, duration, from, turn) (s, rad).
         self._facing = (time_s, 1.0, yaw_of(stand.reference.pelvis_rotation), 0.0)
+        #: The CoM height moving on: (start time, duration, from, change) (s, m).
+        self._height = (time_s, 1.0, stand.reference.com_height_m, 0.0)
+
+    def move_height(self, height_m: float, time_s: float, duration_s: float) -> None:
+        """Take the CoM's reference height from where it is now to `height_m` over
+        `duration_s` (a smoothstep)."""
+        now, _ = self.height(time_s)
+        self._height = (time_s, duration_s, now, height_m - now)
+
+    def height(self, time_s: float) -> tuple[float, float]:
+        """The CoM height's reference and its rate at `time_s` (m, m/s)."""
+        started_s, duration_s, start, change = self._height
+        fraction = (time_s - started_s) / duration_s
+        rate = (6.0 * fraction * (1.0 - fraction) * change / duration_s
+                if 0.0 < fraction < 1.0 else 0.0)
+        return start + smoothstep(fraction) * change, rate
 
     def face(self, first_yaw_rad: float, second_yaw_rad: float, time_s: float,
              duration_s: float) -> None:
@@ -98,8 +125,8 @@ class LegTasks:
         started_s, duration_s, start, turn = self._facing
         return start + smoothstep((time_s - started_s) / duration_s) * turn
 
-    def swing_torque(self, state: BalanceState, foot: int, swing: SwingPath,
-                     elapsed_s: float) -> np.ndarray:
+    def swing_torque(self, state: BalanceState, joint_velocities: np.ndarray, foot: int,
+                     swing: SwingPath, elapsed_s: float) -> np.ndarray:
         """The swing leg's torques (28,) along `swing`, `elapsed_s` into it; past its end
         the foot goes on down at touchdown_speed_m_s."""
         gains = self.gains
@@ -108,29 +135,41 @@ class LegTasks:
         if late > 0.0:  # not down yet: on down
             position[2] -= gains.touchdown_speed_m_s * late
             velocity[2] = -gains.touchdown_speed_m_s
-        return self.foot_pd(state, foot, position, velocity, yaw, yaw_rate)
+        return self.foot_servo(state, joint_velocities, foot, position, velocity, yaw,
+                               yaw_rate)
 
-    def foot_pd(self, state: BalanceState, foot: int, position: np.ndarray,
-                velocity: np.ndarray, yaw: float, yaw_rate: float) -> np.ndarray:
-        """The leg's torques (28,) moving a sole towards a pose (task-space PD)."""
+    def foot_servo(self, state: BalanceState, joint_velocities: np.ndarray, foot: int,
+                   position: np.ndarray, velocity: np.ndarray, yaw: float,
+                   yaw_rate: float) -> np.ndarray:
+        """The leg's torques (28,) moving a sole towards a pose at a velocity (the module's
+        joint-space servo)."""
         gains = self.gains
-        twist = state.sole_velocities[foot]
-        force = (gains.swing_kp * (position - state.sole_centres[foot])
-                 + gains.swing_kd * (velocity - twist[0:3]))
-        moment = (gains.swing_rotation_kp
-                  * orientation_error(state.sole_rotations[foot], yaw_rotation(yaw))
-                  + gains.swing_rotation_kd * (np.array([0.0, 0.0, yaw_rate]) - twist[3:6]))
-        return state.sole_jacobians[foot].T @ np.concatenate([force, moment])
+        leg = LEG_OF_FOOT[foot]
+        jacobian = state.sole_jacobians[foot][:, leg]
+        targets = np.empty((6, 2))  # the pose's error, and the velocity asked for
+        targets[0:3, 0] = position - state.sole_centres[foot]
+        targets[3:6, 0] = orientation_error(state.sole_rotations[foot], yaw_rotation(yaw))
+        targets[0:3, 1] = velocity
+        targets[3:6, 1] = (0.0, 0.0, yaw_rate)
+        damped = jacobian @ jacobian.T + gains.ik_damping_m ** 2 * np.eye(6)
+        joint_error, joint_rate = (jacobian.T @ np.linalg.solve(damped, targets)).T
+        acceleration = (gains.swing_kp * joint_error
+                        + gains.swing_kd * (joint_rate - joint_velocities[leg]))
+        torque = np.zeros(len(joint_velocities))
+        torque[leg] = state.joint_inertia(leg) @ acceleration
+        return torque
 
     def flat_down(self, state: BalanceState, foot: int) -> bool:
         """Whether a sole lies flat on the ground (not up, not on an edge)."""
         return (float(state.sole_centres[foot][2]) < self.gains.flat_height_m
                 and float(state.sole_rotations[foot][2, 2]) > self.gains.flat_cos)
 
-    def put_down_torque(self, state: BalanceState, foot: int, pose: Footstep) -> np.ndarray:
+    def put_down_torque(self, state: BalanceState, joint_velocities: np.ndarray, foot: int,
+                        pose: Footstep) -> np.ndarray:
         """A foot off the ground while both should be down: back onto `pose`."""
         target = np.array([pose.x_m, pose.y_m, -self.gains.press_m])
-        return self.foot_pd(state, foot, target, np.zeros(3), pose.yaw_rad, 0.0)
+        return self.foot_servo(state, joint_velocities, foot, target, np.zeros(3),
+                               pose.yaw_rad, 0.0)
 
     def torque(self, state: BalanceState, joint_positions: np.ndarray,
                joint_velocities: np.ndarray, time_s: float, cop: np.ndarray,
@@ -140,8 +179,10 @@ class LegTasks:
         that are down, both if none is), the pressure centre as kept, and which soles
         carry. The caller adds the swing or put-down torques; nothing is clipped yet."""
         stand = self.stand
+        height, height_rate = self.height(time_s)
         stand.reference = replace(stand.reference,
-                                  pelvis_rotation=yaw_rotation(self.heading(time_s)))
+                                  pelvis_rotation=yaw_rotation(self.heading(time_s)),
+                                  com_height_m=height, com_height_rate_m_s=height_rate)
         if swing_foot is not None:
             contact = (swing_foot != 0, swing_foot != 1)
         else:  # swaying or catching: the feet that are down (both, unless a landing is late)

@@ -10,7 +10,7 @@ they come.
 
 Each 1 ms step: the pressure centre p = p_ref + (1 + k)(xi - xi_ref), and leg_tasks
 turns it into torques (the Stand's whole-body law on the carrying soles, the swing foot's
-task-space PD, feet put back down).
+joint-space servo, feet put back down). The CoM walks 5 cm lower than it stands.
 """
 
 from __future__ import annotations
@@ -39,6 +39,10 @@ class WalkGains:
 
     #: k of p = p_ref + (1 + k)(xi - xi_ref): the capture point's error decays at omega k.
     dcm_gain: float = 1.5
+    #: How far the CoM is lowered while walking (m): over the sway, back up over the catch.
+    #: At the Stand's height the trailing leg of a 0.25 m stride lifts off with its hip
+    #: pitch, knee and ankle pitch on their limits, and the servo cannot lift it.
+    walk_lowering_m: float = 0.05
     #: How long the first sway and the last catch take (s).
     sway_s: float = 0.6
     catch_s: float = 0.6
@@ -86,6 +90,8 @@ class WalkController:
         self.swing: SwingPath | None = None
         self._plan: DcmPlan | None = None
         self._sway_cop = np.zeros(2)
+        #: The CoM height the walk starts from and returns to (m).
+        self.stand_height_m = stand.reference.com_height_m
         self._begin_sway(state, time_s)
 
     # -- the phases ---------------------------------------------------------------------------
@@ -106,6 +112,8 @@ class WalkController:
 
     def _begin_sway(self, state: BalanceState, time_s: float) -> None:
         self.phase, self.phase_start_s = SWAYING, time_s
+        self.legs.move_height(self.stand_height_m - self.gains.walk_lowering_m, time_s,
+                              self.gains.sway_s)
         self._plan = self._plan_steps(self.queue.preview(), state.omega)
         target = (self._plan.start if self._plan is not None
                   else state.sole_centres[:, :2].mean(axis=0))
@@ -130,7 +138,8 @@ class WalkController:
 
     def _begin_catch(self, state: BalanceState, time_s: float) -> None:
         self.legs.face(self.queue.feet[0].yaw_rad, self.queue.feet[1].yaw_rad, time_s,
-                   self.gains.catch_s)
+                       self.gains.catch_s)
+        self.legs.move_height(self.stand_height_m, time_s, self.gains.catch_s)
         self.step, self.swing, self._plan = None, None, None
         self.phase, self.phase_start_s = CATCHING, time_s
 
@@ -180,12 +189,13 @@ class WalkController:
                                            cop, swing_foot)
         if step is not None:
             assert self.swing is not None  # set with the step
-            torque += legs.swing_torque(state, step.foot_index, self.swing,
+            torque += legs.swing_torque(state, joint_velocities, step.foot_index, self.swing,
                                         time_s - self.phase_start_s)
         else:
             for foot in (0, 1):
                 if not contact[foot] or not legs.flat_down(state, foot):
-                    torque += legs.put_down_torque(state, foot, self.queue.feet[foot])
+                    torque += legs.put_down_torque(state, joint_velocities, foot,
+                                                   self.queue.feet[foot])
         limit = self.stand.effort_limit_nm
         np.clip(torque, -limit, limit, out=torque)
         return WalkOutput(torque, cop, xi_ref, self.phase, swing_foot)

@@ -3,7 +3,9 @@ footsteps walked, then Stand again; what happened, step by step.
 
 The figures the tests and the bench judge: whether it fell (pelvis below
 balance's STANDING_PELVIS_M), how many steps it took, where each foot came down against its
-target, the lowest pelvis, where the pelvis ended, and the controller's CPU per step.
+target and where the pelvis was then, the lowest pelvis, where the pelvis ended, how much
+the legs' torques jump from one 1 ms step to the next while walking (a controller unstable
+at 1 kHz chatters between the effort limits), and the controller's CPU per step.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ from tutorial_atlas_control.balance import (
 )
 from tutorial_atlas_control.sim import AtlasModel, pelvis_height_m
 from tutorial_atlas_control.walking.footsteps import Footstep, window, wrap_angle
-from tutorial_atlas_control.walking.leg_tasks import foot_pose
+from tutorial_atlas_control.walking.leg_tasks import LEG_JOINTS, foot_pose
 from tutorial_atlas_control.walking.walk import WalkController, WalkGains
 from tutorial_atlas_control.walking.walk_behaviour import WalkBehaviour
 
@@ -40,6 +42,8 @@ class Landing:
     foot_index: int
     error_m: float
     yaw_error_rad: float
+    #: Where the pelvis was (world x, y, m).
+    pelvis_xy: tuple[float, float] = (0.0, 0.0)
 
 
 @dataclass
@@ -52,6 +56,11 @@ class WalkTrial:
     lowest_pelvis_m: float = math.inf
     pelvis_end: np.ndarray = field(default_factory=lambda: np.zeros(3))
     walk_ended_s: float | None = None
+    #: Where the pelvis was when the walk began (world x, y, m).
+    pelvis_start_xy: tuple[float, float] = (0.0, 0.0)
+    #: The largest, over the leg joints, of a joint's mean |torque change| per 1 ms step
+    #: while walking (N m).
+    leg_torque_jump_nm: float = 0.0
     controller_cpu_s: float = 0.0
     control_steps: int = 0
 
@@ -79,6 +88,10 @@ class WalkingStand:
         self.walk_at_s = walk_at_s
         self.trial = WalkTrial()
         self._phase = 'stand'  # then 'walk', then 'stand again'
+        #: The last walking torque, and the legs' |torque changes| summed, with their count.
+        self._last_torque: np.ndarray | None = None
+        self._jumps = np.zeros(LEG_JOINTS.stop - LEG_JOINTS.start)
+        self._jump_count = 0
 
     @property
     def walk(self) -> WalkController | None:
@@ -102,6 +115,8 @@ class WalkingStand:
             walking.next_steps = window(self.plan, 1) if self.streaming else self.plan
             walking.start(data)
             self._phase = 'walk'
+            pelvis = data.xpos[self.stand.atlas.pelvis_body_id]
+            self.trial.pelvis_start_xy = (float(pelvis[0]), float(pelvis[1]))
         if self._phase != 'walk':
             return self.stand.torque(data)
         walk = walking.walk
@@ -115,11 +130,20 @@ class WalkingStand:
             walking.offer(window(self.plan, walk.queue.next_step_index_needed))
         taken = walk.queue.current_step_index
         torque = walking.torque(data)
+        self._note_jump(torque)
         if walk.queue.current_step_index > taken:
             state = self.stand.last_state
             assert state is not None  # set by the torque call
             self._landed(walk, state)
         return torque
+
+    def _note_jump(self, torque: np.ndarray) -> None:
+        """Add this walking step's leg torque changes to the trial's figure."""
+        if self._last_torque is not None:
+            self._jumps += np.abs(torque[LEG_JOINTS] - self._last_torque[LEG_JOINTS])
+            self._jump_count += 1
+            self.trial.leg_torque_jump_nm = float(np.max(self._jumps)) / self._jump_count
+        self._last_torque = torque.copy()
 
     def _landed(self, walk: WalkController, state: BalanceState) -> None:
         """Note the step just down against its target."""
@@ -131,7 +155,8 @@ class WalkingStand:
         self.trial.steps = index
         self.trial.landings.append(Landing(
             index, target.foot_index, math.hypot(down.x_m - target.x_m, down.y_m - target.y_m),
-            abs(wrap_angle(down.yaw_rad - target.yaw_rad))))
+            abs(wrap_angle(down.yaw_rad - target.yaw_rad)),
+            (float(state.pelvis_position[0]), float(state.pelvis_position[1]))))
 
 
 def walk_trial(plan: Sequence[Footstep], duration_s: float, gains: WalkGains | None = None,

@@ -1,0 +1,98 @@
+"""The legs' shared tasks on the Atlas model placed in DRCSim's Stand pose: the foot servo
+asks of the leg the sole's acceleration its PD means, with the leg's inertia (so its gains
+are per unit of inertia), and the CoM height's reference moves smoothly with its rate."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+
+from tutorial_atlas_control.balance.stand import orientation_error
+from tutorial_atlas_control.balance.stand_behaviour import StandBehaviour
+from tutorial_atlas_control.balance.stand_pose import place_in_stand_pose
+from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.walking.leg_tasks import LEG_OF_FOOT, LegGains, LegTasks
+
+LEFT, RIGHT = 0, 1
+
+
+@pytest.fixture(scope='module')
+def standing() -> tuple[StandBehaviour, mujoco.MjData]:
+    atlas = atlas_model.load_model()
+    data = mujoco.MjData(atlas.model)
+    place_in_stand_pose(atlas, data)
+    behaviour = StandBehaviour(atlas)
+    behaviour.start(data)
+    return behaviour, data
+
+
+def _legs(standing: tuple[StandBehaviour, mujoco.MjData],
+          gains: LegGains | None = None) -> LegTasks:
+    behaviour, _ = standing
+    assert behaviour.controller is not None
+    return LegTasks(behaviour.controller, gains or LegGains(), 0.0)
+
+
+@pytest.mark.parametrize('foot', [LEFT, RIGHT])
+def test_the_foot_servo_asks_the_soles_pd_acceleration_of_that_leg_alone(
+        standing: tuple[StandBehaviour, mujoco.MjData], foot: int) -> None:
+    behaviour, data = standing
+    gains = LegGains(ik_damping_m=0.0)  # undamped: exactly the PD's acceleration
+    legs = _legs(standing, gains)
+    state = behaviour.estimator.estimate(data.qpos, data.qvel)
+    sole = state.sole_centres[foot]
+    offset = np.array([0.01, -0.005, 0.02])  # 2.3 cm off, nothing moving
+    joint_velocities = np.zeros(28)
+    torque = legs.foot_servo(state, joint_velocities, foot, sole + offset, np.zeros(3),
+                             0.0, 0.0)
+    leg = LEG_OF_FOOT[foot]
+    untouched = np.ones(28, dtype=bool)
+    untouched[leg] = False
+    assert not torque[untouched].any()
+    # The leg's joint acceleration under that torque alone, and the sole's acceleration.
+    acceleration = np.linalg.solve(state.joint_inertia(leg), torque[leg])
+    sole_acceleration = state.sole_jacobians[foot][:, leg] @ acceleration
+    np.testing.assert_allclose(sole_acceleration[0:3], gains.swing_kp * offset, rtol=1e-6)
+    # Its turn: towards level, heading 0 (the placed sole is a little off both).
+    turn = orientation_error(state.sole_rotations[foot], np.eye(3))
+    np.testing.assert_allclose(sole_acceleration[3:6], gains.swing_kp * turn, atol=1e-6)
+    # Damped (the walk's 2 cm), the nearly straight leg's up and down gives a little.
+    damped = _legs(standing).foot_servo(state, joint_velocities, foot, sole + offset,
+                                        np.zeros(3), 0.0, 0.0)
+    acceleration = np.linalg.solve(state.joint_inertia(leg), damped[leg])
+    sole_acceleration = state.sole_jacobians[foot][:, leg] @ acceleration
+    np.testing.assert_allclose(sole_acceleration[0:3], gains.swing_kp * offset, rtol=0.1)
+
+
+def test_the_foot_servo_damps_the_legs_joint_velocities(
+        standing: tuple[StandBehaviour, mujoco.MjData]) -> None:
+    behaviour, data = standing
+    legs = _legs(standing)
+    state = behaviour.estimator.estimate(data.qpos, data.qvel)
+    leg = LEG_OF_FOOT[LEFT]
+    joint_velocities = np.zeros(28)
+    joint_velocities[leg] = 0.1
+    sole, yaw = state.sole_centres[LEFT], 0.0
+    torque = legs.foot_servo(state, joint_velocities, LEFT, sole, np.zeros(3), yaw, 0.0)
+    at_rest = legs.foot_servo(state, np.zeros(28), LEFT, sole, np.zeros(3), yaw, 0.0)
+    damping = np.linalg.solve(state.joint_inertia(leg), (torque - at_rest)[leg])
+    np.testing.assert_allclose(damping, -LegGains().swing_kd * 0.1, rtol=1e-9)
+
+
+def test_the_height_moves_by_a_smoothstep_whose_rate_is_its_derivative(
+        standing: tuple[StandBehaviour, mujoco.MjData]) -> None:
+    legs = _legs(standing)
+    start, _ = legs.height(0.0)
+    legs.move_height(start - 0.05, 1.0, 0.6)
+    assert legs.height(1.0) == (start, 0.0)
+    assert legs.height(1.6) == (pytest.approx(start - 0.05), 0.0)
+    for t in (1.1, 1.3, 1.5):
+        (before, _), (now, rate), (after, _) = (legs.height(t + dt) for dt in (-1e-6, 0, 1e-6))
+        assert rate == pytest.approx((after - before) / 2e-6, rel=1e-5)
+        assert start - 0.05 < now < start
+    # Moved again halfway: on from where it is, without a jump.
+    halfway, _ = legs.height(1.3)
+    legs.move_height(start, 1.3, 0.6)
+    assert legs.height(1.3) == (pytest.approx(halfway), 0.0)
+    assert legs.height(1.9)[0] == pytest.approx(start)
