@@ -28,10 +28,10 @@ __all__ = ['WALKS', 'run_walk_demo']
 WALKS: dict[str, tuple[str, tuple[str, ...]]] = {
     'walk_straight': ('8 steps of 0.25 m straight ahead at 0.63 s a step',
                       ('--steps', '8', '--stride', '0.25')),
-    'walk_twenty': ("the issue's 20 steps of 0.25 m (live, it falls after 10-13 steps: see "
-                    'docs/controllers.md)', ('--steps', '20', '--stride', '0.25')),
-    'walk_circle': ('two turns of a circle of radius 2 m, 60 steps a turn (it falls: see '
-                    'docs/controllers.md)', ('--circle', '2', '--steps', '120')),
+    'walk_twenty': ("the issue's 20 steps of 0.25 m (about 0.4 m/s)",
+                    ('--steps', '20', '--stride', '0.25')),
+    'walk_circle': ('two turns of a circle of radius 2 m, 60 steps a turn',
+                    ('--circle', '2', '--steps', '120')),
 }
 #: Sim time (s) before the client starts: Stand balances from 2 s (DRCSim 2.7's start). Live,
 #: rosrun's start-up puts the first WALK later still; from 4 s the eight steps walked 3 of 5
