@@ -78,6 +78,9 @@ class BalanceEstimator:
                              | None) = None
         self._inertia = np.zeros((self.model.nv, self.model.nv))
         self._inertia_current = False
+        #: Each joint slice's dof indices: a slice where they run on (a leg's do), else
+        #: an index array.
+        self._inertia_index: dict[tuple[int, int], tuple[slice, slice] | tuple] = {}
 
     @property
     def sole_ahead_m(self) -> float:
@@ -117,8 +120,15 @@ class BalanceEstimator:
             mujoco.mj_crb(self.model, self.scratch)
             mujoco.mj_fullM(self.model, self.scratch, self._inertia)
             self._inertia_current = True
-        dofs = self._dof_adr[joints]
-        return self._inertia[np.ix_(dofs, dofs)]
+        key = (joints.start, joints.stop)
+        index = self._inertia_index.get(key)
+        if index is None:
+            dofs = self._dof_adr[joints]
+            runs_on = bool(np.all(np.diff(dofs) == 1))
+            index = ((slice(int(dofs[0]), int(dofs[-1]) + 1),) * 2 if runs_on
+                     else np.ix_(dofs, dofs))
+            self._inertia_index[key] = index
+        return self._inertia[index]
 
     def estimate(self, qpos: np.ndarray, qvel: np.ndarray) -> BalanceState:
         """The state at (qpos, qvel) (the full MuJoCo vectors)."""

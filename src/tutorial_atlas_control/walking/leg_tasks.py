@@ -91,6 +91,7 @@ class LegTasks:
         joint_kp[LEG_JOINTS] = 0.0
         joint_kd[LEG_JOINTS] = gains.leg_kd
         self._joint_gains = (joint_kp, joint_kd)
+        self._ik_damping = gains.ik_damping_m ** 2 * np.eye(6)
         #: The pelvis's heading moving on: (start time, duration, from, turn) (s, rad).
         self._facing = (time_s, 1.0, yaw_of(stand.reference.pelvis_rotation), 0.0)
         #: The CoM height moving on: (start time, duration, from, change) (s, m).
@@ -151,7 +152,7 @@ class LegTasks:
         targets[3:6, 0] = orientation_error(state.sole_rotations[foot], yaw_rotation(yaw))
         targets[0:3, 1] = velocity
         targets[3:6, 1] = (0.0, 0.0, yaw_rate)
-        damped = jacobian @ jacobian.T + gains.ik_damping_m ** 2 * np.eye(6)
+        damped = jacobian @ jacobian.T + self._ik_damping
         joint_error, joint_rate = (jacobian.T @ np.linalg.solve(damped, targets)).T
         acceleration = (gains.swing_kp * joint_error
                         + gains.swing_kd * (joint_rate - joint_velocities[leg]))

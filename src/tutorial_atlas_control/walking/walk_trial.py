@@ -103,10 +103,13 @@ class WalkingStand:
     def torque(self, data: mujoco.MjData) -> np.ndarray:
         started = time.process_time()
         try:
-            return self._torque(data)
+            torque = self._torque(data)
         finally:
             self.trial.controller_cpu_s += time.process_time() - started
             self.trial.control_steps += 1
+        if self._phase == 'walk':
+            self._note_jump(torque)  # the trial's own figure: not the controller's cost
+        return torque
 
     def _torque(self, data: mujoco.MjData) -> np.ndarray:
         time_s = float(data.time)
@@ -130,7 +133,6 @@ class WalkingStand:
             walking.offer(window(self.plan, walk.queue.next_step_index_needed))
         taken = walk.queue.current_step_index
         torque = walking.torque(data)
-        self._note_jump(torque)
         if walk.queue.current_step_index > taken:
             state = self.stand.last_state
             assert state is not None  # set by the torque call
