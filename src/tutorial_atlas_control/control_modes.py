@@ -21,9 +21,14 @@ class ControlMode(str, enum.Enum):
     RAGDOLL = 'ragdoll'
     USER = 'User'
     WALK = 'Walk'
+    #: Step runs in a mode of its own, entered only through the AtlasSimInterface's STEP:
+    #: /atlas/control_mode does not take it (DRCSim's did not), but /atlas/current_control_mode
+    #: says it.
+    STEP = 'Step'
 
 
-VALID_CONTROL_MODES: tuple[str, ...] = tuple(mode.value for mode in ControlMode)
+VALID_CONTROL_MODES: tuple[str, ...] = tuple(mode.value for mode in ControlMode
+                                             if mode is not ControlMode.STEP)
 
 
 def is_refused_mode(mode: str) -> bool:

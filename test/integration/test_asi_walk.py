@@ -5,7 +5,10 @@ DRCSim's fixed queue and stands 10 s after (with this run's exact figures); two 
 one foot end the walk (ERROR_INCONSISTENT_STEPS); without the balancing Stand, Walk is not
 served. DRCSim's scripts' sequence from the harness (harnessed, StandPrep, 5 s, nominal, 0.3
 s, Stand, 1 s, Walk) lands, stands, walks and stands; eight steps walked with the arms swung
-slowly under the user's PID (mixed control). About 25 s of CPU.
+slowly under the user's PID (mixed control). Step: a client sending STEP with its next
+target, advancing when it first sees SWAYING after STEPPING, steps statically round 20 steps
+of the 2 m circle (flags 1, 2, 1, ...); a target already reached is not stepped again; Stand
+asked for during a step waits for the foot to be down. About 60 s of CPU.
 """
 
 from __future__ import annotations
@@ -31,7 +34,13 @@ from tutorial_atlas_control.sim import (
     pelvis_height_m,
 )
 from tutorial_atlas_control.sim import model as atlas_model
-from tutorial_atlas_control.walking import DRCSIM_WALK_QUEUE, Footstep, straight_steps, window
+from tutorial_atlas_control.walking import (
+    DRCSIM_WALK_QUEUE,
+    Footstep,
+    circle_steps,
+    straight_steps,
+    window,
+)
 from tutorial_atlas_control.walking.step_queue import (
     CATCHING,
     ERROR_INCONSISTENT_STEPS,
@@ -298,3 +307,120 @@ def test_stand_asked_for_mid_walk_ends_it_after_the_step_under_way(
 def command_of(behavior: Behavior) -> AsiCommand:
     return AsiCommand(0, behavior, (StepData(),) * 4, False, StepData(), False,
                       ManipulateParams(), None, 0)
+
+
+# -- Step --------------------------------------------------------------------------------------
+
+#: step_feedback.status_flags (ASI.md: the library's values).
+STEP_SWAYING, STEP_STEPPING = 1, 2
+#: The issue's circle: radius (m), steps a turn.
+CIRCLE_RADIUS_M = 2.0
+CIRCLE_STEPS = 60
+#: The static steps round the circle (the issue's: 20), and how long one may take (s).
+STATIC_STEPS = 20
+LONGEST_STATIC_STEP_S = 6.0
+
+
+def step_command(step: Footstep | None) -> AsiCommand:
+    desired = StepData() if step is None else step_data(replace_index(step, 1))
+    return AsiCommand(0, Behavior.STEP, (StepData(),) * 4, False, desired, False,
+                      ManipulateParams(), None, 0)
+
+
+def replace_index(step: Footstep, index: int) -> Footstep:
+    """A desired step's step_index is 1 (ASI.md)."""
+    return Footstep(index, step.foot_index, step.x_m, step.y_m, step.yaw_rad, step.duration_s)
+
+
+@dataclass
+class Stepped:
+    """What a stepping client saw: the flags, the steps taken, where each foot came down
+    against its target (m, rad), the lowest pelvis."""
+
+    flags: list[int] = field(default_factory=list)
+    behaviors: list[int] = field(default_factory=list)
+    status: list[int] = field(default_factory=list)
+    taken: int = 0
+    errors: list[tuple[float, float]] = field(default_factory=list)
+    lowest_pelvis_m: float = np.inf
+
+
+def step_through(interface: AtlasSimInterface, plan: list[Footstep], seconds: float,
+                 seen: Stepped | None = None) -> Stepped:
+    """A client streaming STEP with its next target on every state, advancing when it first
+    sees SWAYING after STEPPING (noting where that step's foot came down), for `seconds`
+    or until the plan is walked."""
+    sim, seen = interface.sim, seen or Stepped()
+    previous = 0
+    for _ in range(round(seconds / sim.dt_s)):
+        if seen.taken < len(plan):
+            interface.apply(step_command(plan[seen.taken]))
+        sim.step()
+        state = interface.state()
+        interface.end_step()
+        flags = state.step_feedback.status_flags
+        seen.flags.append(flags)
+        seen.behaviors.append(state.current_behavior)
+        seen.status.append(state.behavior_feedback.status_flags)
+        seen.lowest_pelvis_m = min(seen.lowest_pelvis_m, state.pelvis_position_m[2])
+        if previous == STEP_STEPPING and flags == STEP_SWAYING:
+            target = plan[seen.taken]
+            x, y, z, w = state.foot_poses[target.foot_index, 3:7]
+            yaw = np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+            seen.errors.append((
+                float(np.hypot(*(state.foot_poses[target.foot_index, 0:2]
+                                 - (target.x_m, target.y_m)))),
+                abs(float(np.angle(np.exp(1j * (yaw - target.yaw_rad)))))))
+            seen.taken += 1
+        previous = flags
+        if seen.taken == len(plan) and flags == STEP_SWAYING \
+                and interface.stepping is not None and interface.stepping.stepping is None:
+            break
+    return seen
+
+
+def test_static_steps_round_twenty_steps_of_the_circle(atlas: atlas_model.AtlasModel) -> None:
+    interface = standing(atlas)
+    plan = circle_steps(CIRCLE_RADIUS_M, CIRCLE_STEPS, 1, width_m=0.3)[:STATIC_STEPS]
+    seen = step_through(interface, plan, STATIC_STEPS * LONGEST_STATIC_STEP_S)
+    assert seen.taken == STATIC_STEPS
+    assert seen.lowest_pelvis_m > PELVIS_ABOVE_M
+    assert changes(seen.behaviors) == [Behavior.STEP]
+    assert changes(seen.flags) == [STEP_SWAYING, STEP_STEPPING] * STATIC_STEPS + [STEP_SWAYING]
+    assert all(error_m < LANDING_WITHIN_M and yaw_rad < 0.1 for error_m, yaw_rad in seen.errors)
+    state = interface.state()
+    assert state.step_feedback.current_step_index == STATIC_STEPS
+    assert state.step_feedback.next_step_index_needed == STATIC_STEPS + 1
+
+
+def test_a_target_already_reached_is_not_stepped_again(atlas: atlas_model.AtlasModel) -> None:
+    interface = standing(atlas)
+    plan = straight_steps(1, 0.1)
+    seen = step_through(interface, plan, LONGEST_STATIC_STEP_S)
+    assert seen.taken == 1
+    for _ in range(round(3.0 / interface.sim.dt_s)):  # the same STEP streamed on
+        interface.apply(step_command(plan[0]))
+        interface.sim.step()
+        state = interface.state()
+        interface.end_step()
+        assert state.step_feedback.status_flags == STEP_SWAYING
+    assert state.step_feedback.current_step_index == 1
+    assert state.current_behavior == Behavior.STEP
+
+
+def test_stand_asked_for_during_a_step_waits_for_the_foot_to_be_down(
+        atlas: atlas_model.AtlasModel) -> None:
+    interface = standing(atlas)
+    plan = straight_steps(1, 0.1)
+    seen = Stepped()
+    sim = interface.sim
+    while not seen.flags or seen.flags[-1] != STEP_STEPPING:
+        step_through(interface, plan, sim.dt_s, seen)
+    interface.apply(AsiCommand(0, Behavior.STAND, (StepData(),) * 4, False, StepData(), False,
+                               ManipulateParams(), None, 0))
+    rest = run(interface, 4.0)
+    assert changes(rest.behaviors) == [Behavior.STEP, Behavior.STAND]
+    assert changes(rest.status) == [Status.TRANSITION_IN_PROGRESS, Status.TRANSITION_SUCCESS,
+                                    Status.OK]
+    assert rest.lowest_pelvis_m > PELVIS_ABOVE_M
+    assert interface.stepping is not None and interface.stepping.steps_taken == 1

@@ -66,4 +66,5 @@ BEHAVIOR_OF_MODE: dict[ControlMode, Behavior] = {
     **{mode: behavior for behavior, mode in MODE_OF_BEHAVIOR.items()},
     ControlMode.RAGDOLL: Behavior.USER,
     ControlMode.WALK: Behavior.WALK,  # served with the balancing Stand only
+    ControlMode.STEP: Behavior.STEP,  # the same
 }

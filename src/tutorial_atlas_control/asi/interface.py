@@ -12,7 +12,10 @@ the balancing Stand only, is that Stand with its pelvis servoed to
 the balancing Stand only, is walking.WalkBehaviour over the command's step queue (DRCSim's
 fixed queue when started by /atlas/control_mode Walk); once it has caught itself after its
 last step the interface hands the robot back to Stand (WARNING_AUTO_TRANS); Stand asked for
-during a walk ends it after the step under way (TRANSITION_IN_PROGRESS until then). A
+during a walk ends it after the step under way (TRANSITION_IN_PROGRESS until then). Step,
+served with the balancing Stand too, is walking.StepBehaviour: one quasi-static step to each
+new `step_params.desired_step` (a STEP streamed for a target already reached does not step
+again), standing between steps; Stand asked for during a step is taken once it is down. A
 switch made elsewhere (/atlas/control_mode, /atlas/mode bdi_stand) is seen at the next
 state or step and reported as a successful transition.
 """
@@ -26,7 +29,12 @@ import numpy as np
 
 from tutorial_atlas_control.asi.behaviors import BEHAVIOR_OF_MODE, MODE_OF_BEHAVIOR, Behavior
 from tutorial_atlas_control.asi.session import STANDING_BEHAVIORS, AsiSession
-from tutorial_atlas_control.asi.walk_params import footsteps_of, sole_step, walk_feedback
+from tutorial_atlas_control.asi.walk_params import (
+    footsteps_of,
+    sole_step,
+    step_feedback,
+    walk_feedback,
+)
 from tutorial_atlas_control.balance import (
     BalanceEstimator,
     PelvisServo,
@@ -43,10 +51,16 @@ from tutorial_atlas_control.msgs import (
     BehaviorFeedback,
     ManipulateFeedback,
     ManipulateParams,
+    StepFeedback,
     WalkFeedback,
 )
 from tutorial_atlas_control.sim import AtlasSimulator
-from tutorial_atlas_control.walking import DRCSIM_WALK_QUEUE, WalkBehaviour
+from tutorial_atlas_control.walking import (
+    DRCSIM_WALK_QUEUE,
+    Footstep,
+    StepBehaviour,
+    WalkBehaviour,
+)
 
 __all__ = ['FALLING_PELVIS_M', 'FALLING_TILT_RAD', 'AtlasSimInterface']
 
@@ -86,6 +100,9 @@ class AtlasSimInterface:
         #: Walk, installed with the balancing Stand; Stand asked for during it.
         self.walking: WalkBehaviour | None = None
         self._stand_after_walk = False
+        #: Step, installed with the balancing Stand; Stand asked for during a step.
+        self.stepping: StepBehaviour | None = None
+        self._stand_after_step = False
         self.session = AsiSession(MODE_OF_BEHAVIOR)
         if balance:
             self._load_balance()
@@ -113,6 +130,9 @@ class AtlasSimInterface:
             sole_step(step, ahead) for step in DRCSIM_WALK_QUEUE])
         sim.install_stand(self.walking, ControlMode.WALK)
         self.session.served[Behavior.WALK] = ControlMode.WALK
+        self.stepping = StepBehaviour(self.stand)
+        sim.install_stand(self.stepping, ControlMode.STEP)
+        self.session.served[Behavior.STEP] = ControlMode.STEP
         self._estimator = self.stand.estimator
 
     @property
@@ -142,6 +162,16 @@ class AtlasSimInterface:
         if command.behavior == Behavior.WALK != current \
                 and not any(step.step_index == 1 for step in steps):
             return
+        stepping = self.stepping
+        if command.behavior == Behavior.STEP and stepping is not None:
+            # The target before the switch: Step's start keeps it.
+            stepping.desire(self._desired_step(command))
+        if current == Behavior.STEP and command.behavior == Behavior.STAND \
+                and stepping is not None and stepping.stepping is not None:
+            if not self._stand_after_step:
+                self.session.defer(Behavior.STAND, Behavior.STEP)
+                self._stand_after_step = True
+            return
         walking = self.walking
         if current == Behavior.WALK and command.behavior == Behavior.STAND \
                 and walking is not None and not walking.done:
@@ -159,6 +189,11 @@ class AtlasSimInterface:
             self._set_manipulating(command.behavior == Behavior.MANIPULATE)
         elif current == Behavior.WALK == command.behavior and walking is not None:
             walking.offer(steps)
+
+    def _desired_step(self, command: AsiCommand) -> Footstep | None:
+        """step_params.desired_step as a sole's step (None: an empty one, no step wanted)."""
+        steps = footsteps_of([command.desired_step], self._estimator.sole_ahead_m)
+        return steps[0] if steps else None
 
     def _switch(self, mode: ControlMode) -> None:
         """The simulator into `mode`; a behaviour switch never changes k_effort."""
@@ -258,6 +293,10 @@ class AtlasSimInterface:
                                          self._estimator.sole_ahead_m)
                            if current == Behavior.WALK and self.walking is not None
                            else WalkFeedback()),
+            step_feedback=(step_feedback(self.stepping.status(float(data.time)),
+                                         self._estimator.sole_ahead_m)
+                           if current == Behavior.STEP and self.stepping is not None
+                           else StepFeedback()),
             k_effort=self.k_effort())
 
     def manipulate_feedback(self) -> ManipulateFeedback:
@@ -282,3 +321,9 @@ class AtlasSimInterface:
                 self.session.auto_switched(Behavior.STAND, Behavior.WALK)
         if self.sim.mode is not ControlMode.WALK:
             self._stand_after_walk = False
+        if self._stand_after_step and self.stepping is not None \
+                and self.stepping.stepping is None:
+            self._switch(ControlMode.STAND)
+            self.session.switched(Behavior.STAND, Behavior.STEP)
+        if self.sim.mode is not ControlMode.STEP:
+            self._stand_after_step = False

@@ -30,7 +30,8 @@ __all__ = ['STANDING_BEHAVIORS', 'AsiSession']
 
 #: Behaviours that keep the robot on its feet: only they can be falling, and entering one
 #: needs the centre of mass over the feet.
-STANDING_BEHAVIORS = frozenset({Behavior.STAND, Behavior.MANIPULATE, Behavior.WALK})
+STANDING_BEHAVIORS = frozenset({Behavior.STAND, Behavior.MANIPULATE, Behavior.WALK,
+                                Behavior.STEP})
 _KNOWN = frozenset(int(b) for b in Behavior)
 
 

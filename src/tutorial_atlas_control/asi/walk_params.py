@@ -1,5 +1,5 @@
-"""Walk's side of the AtlasSimInterface's messages: a command's step queue as footsteps, and
-walk_feedback from the walk's status.
+"""Walk's and Step's side of the AtlasSimInterface's messages: a command's step queue or
+desired step as footsteps, and walk_feedback and step_feedback from their status.
 
 Poses are taken as ASI.md says: x, y and the yaw of the orientation, in the frame of
 pos_est (the world's here); z and swing_height are ignored on flat ground. A step's pose is
@@ -15,10 +15,10 @@ import math
 from collections.abc import Iterable
 from dataclasses import replace
 
-from tutorial_atlas_control.msgs import STEP_QUEUE_LENGTH, StepData, WalkFeedback
-from tutorial_atlas_control.walking import SWING_HEIGHT_M, Footstep, WalkStatus
+from tutorial_atlas_control.msgs import STEP_QUEUE_LENGTH, StepData, StepFeedback, WalkFeedback
+from tutorial_atlas_control.walking import SWING_HEIGHT_M, Footstep, StepStatus, WalkStatus
 
-__all__ = ['footsteps_of', 'sole_step', 'step_data_of', 'walk_feedback']
+__all__ = ['footsteps_of', 'sole_step', 'step_data_of', 'step_feedback', 'walk_feedback']
 
 
 def sole_step(step: Footstep, sole_ahead_m: float) -> Footstep:
@@ -52,3 +52,11 @@ def walk_feedback(status: WalkStatus, sole_ahead_m: float) -> WalkFeedback:
     saturated += [StepData()] * (STEP_QUEUE_LENGTH - len(saturated))
     return WalkFeedback(status.t_step_rem_s, status.current_step_index,
                         status.next_step_index_needed, status.status_flags, tuple(saturated))
+
+
+def step_feedback(status: StepStatus, sole_ahead_m: float) -> StepFeedback:
+    """AtlasBehaviorStepFeedback; desired_step_saturated empty before the first step."""
+    saturated = (StepData() if status.step_saturated is None
+                 else step_data_of(status.step_saturated, sole_ahead_m))
+    return StepFeedback(status.status_flags, status.t_step_rem_s, status.current_step_index,
+                        status.next_step_index_needed, saturated)

@@ -49,12 +49,10 @@ def parse_mode(text: str) -> ControlMode:
     Raises:
         ModeError: the string is not one of VALID_MODES (the message lists them).
     """
-    try:
+    if text in VALID_MODES:
         return ControlMode(text)
-    except ValueError:
-        shown = text if len(text) <= 40 else text[:40] + '...'
-        raise ModeError(f'unknown control mode {shown!r}; valid modes: '
-                        + ', '.join(VALID_MODES)) from None
+    shown = text if len(text) <= 40 else text[:40] + '...'
+    raise ModeError(f'unknown control mode {shown!r}; valid modes: ' + ', '.join(VALID_MODES))
 
 
 class ModeCommands:
@@ -124,7 +122,8 @@ class ModeCommands:
         The user command's k_effort becomes 1 in User, 0 otherwise (AtlasPlugin::OnRobotMode:
         LoadPIDGainsFromParameter, ZeroAtlasCommand); its other fields are kept.
         """
-        if mode in (ControlMode.STAND, ControlMode.STAND_PREP, ControlMode.WALK):
+        if mode in (ControlMode.STAND, ControlMode.STAND_PREP, ControlMode.WALK,
+                    ControlMode.STEP):
             self._mode_command = self._stand_command
         elif mode in HOLD_AT_SWITCH:
             self._mode_command = self.hold_current_pose()

@@ -6,7 +6,8 @@ index, clamped to what the legs reach, and its feedback flags; dcm_plan: the cap
 point's plan over the steps and the law that tracks it; swing: the swing foot's path;
 leg_tasks: what Walk and Step do alike each step (the whole-body law on the carrying
 soles, the swing foot, the pelvis's heading); walk: the walk's phases; walk_behaviour: Walk as the
-simulator's behaviour; walk_trial: offline walking trials, landing by landing.
+simulator's behaviour; walk_trial: offline walking trials, landing by landing; static_step:
+one quasi-static step; step_behaviour: Step as the simulator's behaviour.
 """
 
 from tutorial_atlas_control.exports import lazy_exports
@@ -23,4 +24,6 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'walk': ['WalkController', 'WalkGains', 'WalkOutput', 'sway_cop'],
     'walk_behaviour': ['WalkBehaviour', 'WalkStatus'],
     'walk_trial': ['Landing', 'WalkTrial', 'WalkingStand', 'walk_trial'],
+    'static_step': ['StaticStep', 'StepGains'],
+    'step_behaviour': ['StepBehaviour', 'StepStatus'],
 })

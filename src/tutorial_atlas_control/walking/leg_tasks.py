@@ -19,6 +19,7 @@ step on the hip pitch), and that shaking decided, chaotically, which walks stood
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -176,9 +177,10 @@ class LegTasks:
                joint_velocities: np.ndarray, time_s: float, cop: np.ndarray,
                swing_foot: int | None) -> tuple[np.ndarray, np.ndarray, tuple[bool, bool]]:
         """The whole-body torques (28,) for the pressure centre `cop` kept inside the
-        carrying soles (the stance sole alone while `swing_foot` swings, else the feet
-        that are down, both if none is), the pressure centre as kept, and which soles
-        carry. The caller adds the swing or put-down torques; nothing is clipped yet."""
+        carrying soles (the stance sole alone while `swing_foot` swings or is being
+        unloaded, else the feet that are down, both if none is), the pressure centre as
+        kept, and which soles carry. `finish` adds the swing or put-down torques; nothing
+        is clipped yet."""
         stand = self.stand
         height, height_rate = self.height(time_s)
         stand.reference = replace(stand.reference,
@@ -195,6 +197,24 @@ class LegTasks:
         torque = stand.whole_body(state, cop, contact, joint_positions, joint_velocities,
                                   self._joint_gains, torsion).torque_nm
         return torque, cop, contact
+
+
+    def finish(self, state: BalanceState, joint_velocities: np.ndarray, torque: np.ndarray,
+               contact: tuple[bool, bool], swing: tuple[int, SwingPath, float] | None,
+               feet: Sequence[Footstep]) -> np.ndarray:
+        """`torque` (from torque()) with the swing leg's servo added (`swing`: the foot, its
+        path and the time into it), or else with each foot that should carry but is not
+        flat down put back on its pose in `feet`; clipped to the effort limits, in place."""
+        if swing is not None:
+            foot, path, elapsed_s = swing
+            torque += self.swing_torque(state, joint_velocities, foot, path, elapsed_s)
+        else:
+            for foot in (0, 1):
+                if not contact[foot] or not self.flat_down(state, foot):
+                    torque += self.put_down_torque(state, joint_velocities, foot, feet[foot])
+        limit = self.stand.effort_limit_nm
+        np.clip(torque, -limit, limit, out=torque)
+        return torque
 
 
 def _sole_corners(state: BalanceState, foot: int,

@@ -187,15 +187,9 @@ class WalkController:
         legs = self.legs
         torque, cop, contact = legs.torque(state, joint_positions, joint_velocities, time_s,
                                            cop, swing_foot)
+        swing = None
         if step is not None:
             assert self.swing is not None  # set with the step
-            torque += legs.swing_torque(state, joint_velocities, step.foot_index, self.swing,
-                                        time_s - self.phase_start_s)
-        else:
-            for foot in (0, 1):
-                if not contact[foot] or not legs.flat_down(state, foot):
-                    torque += legs.put_down_torque(state, joint_velocities, foot,
-                                                   self.queue.feet[foot])
-        limit = self.stand.effort_limit_nm
-        np.clip(torque, -limit, limit, out=torque)
+            swing = (step.foot_index, self.swing, time_s - self.phase_start_s)
+        legs.finish(state, joint_velocities, torque, contact, swing, self.queue.feet)
         return WalkOutput(torque, cop, xi_ref, self.phase, swing_foot)

@@ -1,5 +1,6 @@
 """A WALK's queue as the soles' footsteps and walk_feedback back as the foot links' poses:
-unused slots skipped, the sole's offset along each step's heading, four slots reported."""
+unused slots skipped, the sole's offset along each step's heading, four slots reported;
+step_feedback alike, empty before the first step."""
 
 from __future__ import annotations
 
@@ -7,9 +8,14 @@ import math
 
 import pytest
 
-from tutorial_atlas_control.asi.walk_params import footsteps_of, step_data_of, walk_feedback
+from tutorial_atlas_control.asi.walk_params import (
+    footsteps_of,
+    step_data_of,
+    step_feedback,
+    walk_feedback,
+)
 from tutorial_atlas_control.msgs.atlas_sim_interface import StepData
-from tutorial_atlas_control.walking import SWING_HEIGHT_M, Footstep, WalkStatus
+from tutorial_atlas_control.walking import SWING_HEIGHT_M, Footstep, StepStatus, WalkStatus
 
 AHEAD_M = 0.048
 
@@ -36,3 +42,14 @@ def test_feedback_gives_the_foot_links_back_in_four_slots() -> None:
     assert first.swing_height_m == SWING_HEIGHT_M
     assert rest == [StepData()] * 3
     assert footsteps_of([first], AHEAD_M) == [sole]
+
+
+def test_step_feedback_gives_the_step_as_clamped_as_its_foot_link() -> None:
+    sole = Footstep(1, 1, 0.3 + AHEAD_M, -0.12, 0.0, 0.63)
+    feedback = step_feedback(StepStatus(2, 0.4, 3, 4, sole), AHEAD_M)
+    assert (feedback.status_flags, feedback.t_step_rem_s, feedback.current_step_index,
+            feedback.next_step_index_needed) == (2, 0.4, 3, 4)
+    assert feedback.desired_step_saturated == step_data_of(sole, AHEAD_M)
+    assert feedback.desired_step_saturated.position_m == pytest.approx((0.3, -0.12, 0.0))
+    assert step_feedback(StepStatus(1, 0.0, 0, 1, None), AHEAD_M).desired_step_saturated \
+        == StepData()

@@ -51,6 +51,9 @@ def test_parse_mode_accepts_drcsim_modes_and_lists_them_otherwise() -> None:
         parse_mode('x' * 10_000)
     with pytest.raises(ModeError):
         parse_mode('')
+    # Step is entered through the AtlasSimInterface only, as in DRCSim.
+    with pytest.raises(ModeError, match="unknown control mode 'Step'"):
+        parse_mode('Step')
 
 
 def test_torso_pinned_until_time_to_unpin_then_ragdoll_falls(sim: AtlasSimulator) -> None:

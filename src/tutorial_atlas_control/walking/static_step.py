@@ -1,0 +1,145 @@
+"""Step: one quasi-static step, on the Stand's whole-body balance.
+
+Three phases: the weight shifted over the stance foot (the capture point's reference,
+with the pressure centre on it, moved there by a smoothstep; once the capture point is near
+it the other foot, still down, carries nothing: SWAYING), the other foot lifted
+and placed along swing.SwingPath with the capture point held over the stance sole
+(STEPPING), then the weight brought back between the feet (SWAYING again); `done` once it
+is there and at rest. Nothing is dynamic: at any instant the robot could stop and stand.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tutorial_atlas_control.balance import BalanceState, StandController, smoothstep
+from tutorial_atlas_control.walking.dcm_plan import tracking_cop
+from tutorial_atlas_control.walking.footsteps import Footstep
+from tutorial_atlas_control.walking.leg_tasks import LegGains, LegTasks, foot_pose
+from tutorial_atlas_control.walking.swing import SwingPath
+
+__all__ = ['StaticStep', 'StepGains']
+
+#: step_feedback.status_flags (ASI.md: the library's values, not the message's constants).
+SWAYING, STEPPING = 1, 2
+
+
+@dataclass(frozen=True)
+class StepGains:
+    """The quasi-static step's numbers (ours)."""
+
+    #: k of p = p_ref + (1 + k)(xi - xi_ref), as Walk's.
+    dcm_gain: float = 1.5
+    #: How long the weight takes to shift onto the stance foot, and back (s).
+    shift_s: float = 1.0
+    #: The other foot carries nothing (the Stand's split gives each foot in contact a
+    #: share) once the capture point is this near the stance sole's centre (m) ...
+    unload_m: float = 0.04
+    #: ... and lifts once it is this near (m) ...
+    over_stance_m: float = 0.02
+    #: ... or this long after the shift began anyway (s).
+    longest_shift_s: float = 2.0
+    #: The shortest swing (s): a step's duration below it is lengthened.
+    shortest_swing_s: float = 0.6
+    #: The step is over once the capture point is this near the feet's midpoint (m), or
+    #: this long after the weight began to shift back (s).
+    at_rest_m: float = 0.01
+    longest_settle_s: float = 2.0
+    integral_gain: float = 0.0
+    #: How far below the Stand's CoM height the step is taken (m), as Walk's: at the
+    #: Stand's height a trailing leg lifts off with its hip pitch, knee and ankle pitch on
+    #: their limits and the servo cannot lift it.
+    lowering_m: float = 0.05
+    legs: LegGains = field(default_factory=LegGains)
+
+
+class StaticStep:
+    """One quasi-static step of `step` (a sole's target, already clamped) from the feet
+    where they stand (`feet`: left, right)."""
+
+    def __init__(self, stand: StandController, feet: tuple[Footstep, Footstep],
+                 step: Footstep, state: BalanceState, time_s: float, stand_com_height_m: float,
+                 gains: StepGains | None = None) -> None:
+        self.gains = gains or StepGains()
+        self.step = step
+        self.feet = list(feet)
+        self.legs = LegTasks(stand, self.gains.legs, time_s)
+        self.legs.move_height(stand_com_height_m - self.gains.lowering_m, time_s,
+                              self.gains.shift_s)
+        self.stand = stand
+        self.status = SWAYING
+        self.done = False
+        self.landed: Footstep | None = None
+        self.swing_s = max(step.duration_s, self.gains.shortest_swing_s)
+        stance = self.feet[1 - step.foot_index]
+        self._shift = (time_s, state.capture_point.copy(), np.array([stance.x_m, stance.y_m]))
+        self._swing: SwingPath | None = None
+        self._integral = np.zeros(2)
+        self._swing_start_s = 0.0
+
+    def remaining_s(self, time_s: float) -> float:
+        """The time left in the swing (s; 0 outside it)."""
+        if self.status != STEPPING:
+            return 0.0
+        return max(0.0, self.swing_s - (time_s - self._swing_start_s))
+
+    def _capture_reference(self, time_s: float) -> np.ndarray:
+        started_s, start, goal = self._shift
+        s = smoothstep((time_s - started_s) / self.gains.shift_s)
+        return (1.0 - s) * start + s * goal
+
+    def _advance(self, state: BalanceState, time_s: float) -> None:
+        gains, step = self.gains, self.step
+        started_s, _, goal = self._shift
+        elapsed = time_s - started_s
+        if self.landed is None and self.status == SWAYING and elapsed >= gains.shift_s and (
+                np.linalg.norm(state.capture_point - goal) < gains.over_stance_m
+                or elapsed >= gains.longest_shift_s):
+            lift = state.sole_centres[step.foot_index].copy()
+            self._swing = SwingPath(lift, np.array([step.x_m, step.y_m, 0.0]),
+                                    foot_pose(state, step.foot_index).yaw_rad, step.yaw_rad,
+                                    self.swing_s)
+            stance = self.feet[1 - step.foot_index]
+            self.legs.face(stance.yaw_rad, step.yaw_rad, time_s, self.swing_s)
+            self.status, self._swing_start_s = STEPPING, time_s
+        elif self.status == STEPPING:
+            swung = time_s - self._swing_start_s
+            if swung >= self.swing_s and (state.in_contact[step.foot_index] or
+                                          swung >= self.swing_s + gains.legs.late_touchdown_s):
+                self.landed = foot_pose(state, step.foot_index, step.step_index)
+                self.feet[step.foot_index] = self.landed
+                left, right = self.feet
+                middle = np.array([0.5 * (left.x_m + right.x_m), 0.5 * (left.y_m + right.y_m)])
+                self._shift = (time_s, state.capture_point.copy(), middle)
+                self.legs.face(left.yaw_rad, right.yaw_rad, time_s, gains.shift_s)
+                self.status = SWAYING
+        elif self.landed is not None and elapsed >= gains.shift_s and (
+                np.linalg.norm(state.capture_point - goal) < gains.at_rest_m
+                or elapsed >= gains.longest_settle_s):
+            self.done = True
+
+    def step_torque(self, state: BalanceState, joint_positions: np.ndarray,
+                    joint_velocities: np.ndarray, time_s: float) -> np.ndarray:
+        """The 28 joint torques (N m) for this 1 ms step, within the effort limits."""
+        self._advance(state, time_s)
+        xi_ref = self._capture_reference(time_s)
+        if self.status == SWAYING and self.landed is None:
+            self._integral += (state.capture_point - xi_ref) * 0.001
+        else:
+            self._integral[:] = 0.0
+        cop = tracking_cop(state.capture_point, xi_ref, xi_ref, self.gains.dcm_gain) \
+            + self.gains.integral_gain * self._integral
+        swinging = self.status == STEPPING
+        unloading = self.landed is None and not swinging and float(
+            np.linalg.norm(state.capture_point - self._shift[2])) < self.gains.unload_m
+        unloaded = self.step.foot_index if swinging or unloading else None
+        legs = self.legs
+        torque, _, contact = legs.torque(state, joint_positions, joint_velocities, time_s, cop,
+                                         unloaded)
+        swing = None
+        if swinging:
+            assert self._swing is not None  # set with STEPPING
+            swing = (self.step.foot_index, self._swing, time_s - self._swing_start_s)
+        return legs.finish(state, joint_velocities, torque, contact, swing, self.feet)

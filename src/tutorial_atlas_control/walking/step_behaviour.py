@@ -1,0 +1,100 @@
+"""Step as the simulator's behaviour for control mode Step (sim/behaviour.py's protocol).
+
+It stands (the balancing Stand, taken over where the robot stands) until a client desires a
+step, takes it quasi-statically (static_step), and stands again where it landed. The
+desired step is the latest one sent: a target equal to the one last taken is not taken
+again (a client may stream its STEP at 1 kHz), and one sent while a step is under way is
+taken after it. Each target is clamped from the stance foot (step_queue's limits) and
+reported as `desired_step_saturated`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from tutorial_atlas_control.balance import StandBehaviour
+from tutorial_atlas_control.walking.footsteps import Footstep
+from tutorial_atlas_control.walking.leg_tasks import foot_pose
+from tutorial_atlas_control.walking.static_step import SWAYING, StaticStep, StepGains
+from tutorial_atlas_control.walking.step_queue import DEFAULT_LIMITS, StepLimits, clamp_step
+
+__all__ = ['StepBehaviour', 'StepStatus']
+
+
+@dataclass(frozen=True)
+class StepStatus:
+    """What step_feedback reports: SWAYING 1 or STEPPING 2, the swing's time left (s), the
+    steps taken, the next index wanted, and the step under way or last taken, clamped."""
+
+    status_flags: int
+    t_step_rem_s: float
+    current_step_index: int
+    next_step_index_needed: int
+    step_saturated: Footstep | None
+
+
+class StepBehaviour:
+    """Quasi-static steps on `stand`'s balance, one per new desired target."""
+
+    def __init__(self, stand: StandBehaviour, gains: StepGains | None = None,
+                 limits: StepLimits = DEFAULT_LIMITS) -> None:
+        self.stand = stand
+        self.gains = gains
+        self.limits = limits
+        #: The latest target a client sent (a sole's step), None before any.
+        self.desired: Footstep | None = None
+        #: The step under way (None while standing).
+        self.stepping: StaticStep | None = None
+        self.steps_taken = 0
+        self._taken: Footstep | None = None
+        self._saturated: Footstep | None = None
+
+    def desire(self, step: Footstep | None) -> None:
+        """A client's target (None: no step wanted)."""
+        self.desired = step
+
+    def start(self, data: mujoco.MjData) -> None:
+        """Stand where the robot stands; the count of steps starts again."""
+        self.stand.start(data)
+        self.stepping, self.steps_taken = None, 0
+        self._taken = self._saturated = None
+
+    def torque(self, data: mujoco.MjData) -> np.ndarray:
+        """This step's f_out (N m, (28,)), within the effort limits."""
+        stand = self.stand
+        if self.stepping is not None and self.stepping.done:
+            self.stepping = None
+            self.steps_taken += 1
+            stand.start(data)  # stand where it landed
+        if self.stepping is None and self.desired is not None and self.desired != self._taken:
+            self._begin(data)
+        if self.stepping is None:
+            return stand.torque(data)
+        atlas = stand.atlas
+        state = stand.estimator.estimate(data.qpos, data.qvel)
+        stand.last_state = state
+        return self.stepping.step_torque(state, data.qpos[atlas.qpos_adr],
+                                         data.qvel[atlas.dof_adr], float(data.time))
+
+    def _begin(self, data: mujoco.MjData) -> None:
+        stand, wanted = self.stand, self.desired
+        assert wanted is not None and stand.controller is not None  # started
+        stand.start(data)  # the reference from where it stands now
+        state = stand.last_state
+        assert state is not None and stand.controller is not None  # set by start
+        feet = (foot_pose(state, 0), foot_pose(state, 1))
+        step = clamp_step(wanted, feet[1 - wanted.foot_index], self.limits)
+        self.stepping = StaticStep(stand.controller, feet, step, state, float(data.time),
+                                   stand.com_height_m, self.gains)
+        self._taken, self._saturated = wanted, step
+
+    def status(self, time_s: float) -> StepStatus:
+        """step_feedback's values now."""
+        stepping = self.stepping
+        flags = SWAYING if stepping is None else stepping.status
+        remaining = 0.0 if stepping is None else stepping.remaining_s(time_s)
+        return StepStatus(flags, remaining, self.steps_taken, self.steps_taken + 1,
+                          self._saturated)
