@@ -13,6 +13,7 @@ asked for during a step waits for the foot to be down. About 60 s of CPU.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -321,8 +322,12 @@ STATIC_STEPS = 20
 LONGEST_STATIC_STEP_S = 6.0
 
 
-def step_command(step: Footstep | None) -> AsiCommand:
+def step_command(step: Footstep | None, timed: bool = True) -> AsiCommand:
+    """STEP to `step` (its duration left 0 unless `timed`, as DRCSim's actionlib server
+    sent it)."""
     desired = StepData() if step is None else step_data(replace_index(step, 1))
+    if not timed:
+        desired = dataclasses.replace(desired, duration_s=0.0)
     return AsiCommand(0, Behavior.STEP, (StepData(),) * 4, False, desired, False,
                       ManipulateParams(), None, 0)
 
@@ -330,6 +335,7 @@ def step_command(step: Footstep | None) -> AsiCommand:
 def replace_index(step: Footstep, index: int) -> Footstep:
     """A desired step's step_index is 1 (ASI.md)."""
     return Footstep(index, step.foot_index, step.x_m, step.y_m, step.yaw_rad, step.duration_s)
+
 
 
 @dataclass
@@ -346,7 +352,7 @@ class Stepped:
 
 
 def step_through(interface: AtlasSimInterface, plan: list[Footstep], seconds: float,
-                 seen: Stepped | None = None) -> Stepped:
+                 seen: Stepped | None = None, timed: bool = True) -> Stepped:
     """A client streaming STEP with its next target on every state, advancing when it first
     sees SWAYING after STEPPING (noting where that step's foot came down), for `seconds`
     or until the plan is walked."""
@@ -354,7 +360,7 @@ def step_through(interface: AtlasSimInterface, plan: list[Footstep], seconds: fl
     previous = 0
     for _ in range(round(seconds / sim.dt_s)):
         if seen.taken < len(plan):
-            interface.apply(step_command(plan[seen.taken]))
+            interface.apply(step_command(plan[seen.taken], timed))
         sim.step()
         state = interface.state()
         interface.end_step()
@@ -396,10 +402,11 @@ def test_static_steps_round_twenty_steps_of_the_circle(atlas: atlas_model.AtlasM
 def test_a_target_already_reached_is_not_stepped_again(atlas: atlas_model.AtlasModel) -> None:
     interface = standing(atlas)
     plan = straight_steps(1, 0.1)
-    seen = step_through(interface, plan, LONGEST_STATIC_STEP_S)
+    # Without a duration, as DRCSim's actionlib server sends a STEP: ours, 0.63 s.
+    seen = step_through(interface, plan, LONGEST_STATIC_STEP_S, timed=False)
     assert seen.taken == 1
     for _ in range(round(3.0 / interface.sim.dt_s)):  # the same STEP streamed on
-        interface.apply(step_command(plan[0]))
+        interface.apply(step_command(plan[0], timed=False))
         interface.sim.step()
         state = interface.state()
         interface.end_step()

@@ -22,6 +22,7 @@ state or step and reported as a successful transition.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import mujoco
@@ -57,6 +58,7 @@ from tutorial_atlas_control.msgs import (
 from tutorial_atlas_control.sim import AtlasSimulator
 from tutorial_atlas_control.walking import (
     DRCSIM_WALK_QUEUE,
+    STEP_DURATION_S,
     Footstep,
     StepBehaviour,
     WalkBehaviour,
@@ -191,8 +193,13 @@ class AtlasSimInterface:
             walking.offer(steps)
 
     def _desired_step(self, command: AsiCommand) -> Footstep | None:
-        """step_params.desired_step as a sole's step (None: an empty one, no step wanted)."""
-        steps = footsteps_of([command.desired_step], self._estimator.sole_ahead_m)
+        """step_params.desired_step as a sole's step (None: an empty one, no step wanted);
+        without a duration (DRCSim's actionlib server sends none) it swings for
+        STEP_DURATION_S."""
+        desired = command.desired_step
+        if desired.duration_s <= 0.0:
+            desired = dataclasses.replace(desired, duration_s=STEP_DURATION_S)
+        steps = footsteps_of([desired], self._estimator.sole_ahead_m)
         return steps[0] if steps else None
 
     def _switch(self, mode: ControlMode) -> None:

@@ -152,6 +152,9 @@ def _read(raw: bytes) -> AsiCommand:
     if behavior == WALK:
         for i, queued in enumerate(queue):
             _check_foot(queued, f'walk_params.step_queue[{i}].')
+            if queued.step_index > 0 and not queued.duration_s > 0.0:
+                raise CommandError(f'walk_params.step_queue[{i}].duration is '
+                                   f'{queued.duration_s:g}, not positive')
     elif behavior == STEP:
         _check_foot(step, 'step_params.desired_step.')
     fractions = (k_effort / K_EFFORT_FULL_SCALE if len(k_effort) == NUM_JOINTS else None)

@@ -129,3 +129,15 @@ def test_a_step_to_take_with_no_such_foot_is_refused(behavior: int, slot: int | 
     queue[2] = unused
     assert decode_asi_command(encode_asi_command(command(4, step_queue=tuple(queue)))).behavior == 4
     assert decode_asi_command(encode_asi_command(command(0, desired_step=bad))).behavior == 0
+
+
+@pytest.mark.parametrize('duration_s', [0.0, -0.5])
+def test_a_walk_step_without_a_duration_is_refused(duration_s: float) -> None:
+    queue = list(command().step_queue)
+    queue[1] = StepData(2, 1, duration_s)
+    with pytest.raises(CommandError, match=re.escape(
+            f'walk_params.step_queue[1].duration is {duration_s:g}, not positive')):
+        decode_asi_command(encode_asi_command(command(4, step_queue=tuple(queue))))
+    # Step's desired step may come without one (DRCSim's actionlib server sends none).
+    step = decode_asi_command(encode_asi_command(command(5, desired_step=StepData(1, 0, 0.0))))
+    assert step.desired_step.duration_s == 0.0
