@@ -190,9 +190,13 @@ class LegTasks:
             contact = (swing_foot != 0, swing_foot != 1)
         else:  # swaying or catching: the feet that are down (both, unless a landing is late)
             contact = state.in_contact if any(state.in_contact) else (True, True)
-        corners = np.concatenate([_sole_corners(state, foot, stand.sole_half_size_m)
-                                  for foot in (0, 1) if contact[foot]])
-        cop = clamp_into(convex_hull(corners), cop, stand.gains.cop_margin_m)
+        if swing_foot is not None:
+            cop = _clamp_to_sole(state, 1 - swing_foot, stand.sole_half_size_m,
+                                 stand.gains.cop_margin_m, cop)
+        else:
+            corners = np.concatenate([_sole_corners(state, foot, stand.sole_half_size_m)
+                                      for foot in (0, 1) if contact[foot]])
+            cop = clamp_into(convex_hull(corners), cop, stand.gains.cop_margin_m)
         torsion = self.gains.torsion_m if swing_foot is not None else None
         torque = stand.whole_body(state, cop, contact, joint_positions, joint_velocities,
                                   self._joint_gains, torsion).torque_nm
@@ -215,6 +219,22 @@ class LegTasks:
         limit = self.stand.effort_limit_nm
         np.clip(torque, -limit, limit, out=torque)
         return torque
+
+
+def _clamp_to_sole(state: BalanceState, foot: int, half_size_m: tuple[float, float],
+                   margin_m: float, point_xy: np.ndarray) -> np.ndarray:
+    """`point_xy` moved to the nearest point of one sole's rectangle shrunk by `margin_m`
+    (in the sole's frame a clamp of each coordinate: the rectangle's hull and a general
+    polygon's clamp, every step of single support, cost more than the rest of the step's
+    pressure-centre work)."""
+    half_length, half_width = half_size_m
+    rotation = state.sole_rotations[foot][0:2, 0:2]
+    centre = state.sole_centres[foot][0:2]
+    local = rotation.T @ (np.asarray(point_xy, dtype=np.float64) - centre)
+    reach_x, reach_y = max(half_length - margin_m, 0.0), max(half_width - margin_m, 0.0)
+    local[0] = min(max(local[0], -reach_x), reach_x)
+    local[1] = min(max(local[1], -reach_y), reach_y)
+    return centre + rotation @ local
 
 
 def _sole_corners(state: BalanceState, foot: int,

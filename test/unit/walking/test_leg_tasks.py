@@ -1,6 +1,7 @@
 """The legs' shared tasks on the Atlas model placed in DRCSim's Stand pose: the foot servo
 asks of the leg the sole's acceleration its PD means, with the leg's inertia (so its gains
-are per unit of inertia), and the CoM height's reference moves smoothly with its rate."""
+are per unit of inertia), the CoM height's reference moves smoothly with its rate, and a
+stance sole's pressure-centre clamp is the support polygon's."""
 
 from __future__ import annotations
 
@@ -11,8 +12,15 @@ import pytest
 from tutorial_atlas_control.balance.stand import orientation_error
 from tutorial_atlas_control.balance.stand_behaviour import StandBehaviour
 from tutorial_atlas_control.balance.stand_pose import place_in_stand_pose
+from tutorial_atlas_control.balance.support import clamp_into, convex_hull
 from tutorial_atlas_control.sim import model as atlas_model
-from tutorial_atlas_control.walking.leg_tasks import LEG_OF_FOOT, LegGains, LegTasks
+from tutorial_atlas_control.walking.leg_tasks import (
+    LEG_OF_FOOT,
+    LegGains,
+    LegTasks,
+    _clamp_to_sole,
+    _sole_corners,
+)
 
 LEFT, RIGHT = 0, 1
 
@@ -96,3 +104,20 @@ def test_the_height_moves_by_a_smoothstep_whose_rate_is_its_derivative(
     legs.move_height(start, 1.3, 0.6)
     assert legs.height(1.3) == (pytest.approx(halfway), 0.0)
     assert legs.height(1.9)[0] == pytest.approx(start)
+
+
+@pytest.mark.parametrize('foot', [LEFT, RIGHT])
+def test_a_stance_soles_clamp_is_the_polygon_clamp_of_its_rectangle(
+        standing: tuple[StandBehaviour, mujoco.MjData], foot: int) -> None:
+    behaviour, data = standing
+    state = behaviour.estimator.estimate(data.qpos, data.qvel)
+    half_size = behaviour.estimator.sole_half_size_m
+    polygon = convex_hull(_sole_corners(state, foot, half_size))
+    centre = state.sole_centres[foot][0:2]
+    rng = np.random.default_rng(7)
+    for offset in rng.uniform(-0.3, 0.3, size=(200, 2)):
+        point = centre + offset
+        # The placed sole tilts a little: its corners' projection is a rectangle only to
+        # some microns.
+        np.testing.assert_allclose(_clamp_to_sole(state, foot, half_size, 0.015, point),
+                                   clamp_into(polygon, point, 0.015), atol=2e-5)
