@@ -188,12 +188,10 @@ class LegTasks:
                                   com_height_m=height, com_height_rate_m_s=height_rate)
         if swing_foot is not None:
             contact = (swing_foot != 0, swing_foot != 1)
-        else:  # swaying or catching: the feet that are down (both, unless a landing is late)
-            contact = state.in_contact if any(state.in_contact) else (True, True)
-        if swing_foot is not None:
             cop = _clamp_to_sole(state, 1 - swing_foot, stand.sole_half_size_m,
                                  stand.gains.cop_margin_m, cop)
-        else:
+        else:  # swaying or catching: the feet that are down (both, unless a landing is late)
+            contact = state.in_contact if any(state.in_contact) else (True, True)
             corners = np.concatenate([_sole_corners(state, foot, stand.sole_half_size_m)
                                       for foot in (0, 1) if contact[foot]])
             cop = clamp_into(convex_hull(corners), cop, stand.gains.cop_margin_m)
@@ -201,7 +199,6 @@ class LegTasks:
         torque = stand.whole_body(state, cop, contact, joint_positions, joint_velocities,
                                   self._joint_gains, torsion).torque_nm
         return torque, cop, contact
-
 
     def finish(self, state: BalanceState, joint_velocities: np.ndarray, torque: np.ndarray,
                contact: tuple[bool, bool], swing: tuple[int, SwingPath, float] | None,

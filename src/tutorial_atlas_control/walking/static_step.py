@@ -47,7 +47,6 @@ class StepGains:
     #: this long after the weight began to shift back (s).
     at_rest_m: float = 0.01
     longest_settle_s: float = 2.0
-    integral_gain: float = 0.0
     #: How far below the Stand's CoM height the step is taken (m), as Walk's: at the
     #: Stand's height a trailing leg lifts off with its hip pitch, knee and ankle pitch on
     #: their limits and the servo cannot lift it.
@@ -68,7 +67,6 @@ class StaticStep:
         self.legs = LegTasks(stand, self.gains.legs, time_s)
         self.legs.move_height(stand_com_height_m - self.gains.lowering_m, time_s,
                               self.gains.shift_s)
-        self.stand = stand
         self.status = SWAYING
         self.done = False
         self.landed: Footstep | None = None
@@ -76,7 +74,6 @@ class StaticStep:
         stance = self.feet[1 - step.foot_index]
         self._shift = (time_s, state.capture_point.copy(), np.array([stance.x_m, stance.y_m]))
         self._swing: SwingPath | None = None
-        self._integral = np.zeros(2)
         self._swing_start_s = 0.0
 
     def remaining_s(self, time_s: float) -> float:
@@ -125,12 +122,7 @@ class StaticStep:
         """The 28 joint torques (N m) for this 1 ms step, within the effort limits."""
         self._advance(state, time_s)
         xi_ref = self._capture_reference(time_s)
-        if self.status == SWAYING and self.landed is None:
-            self._integral += (state.capture_point - xi_ref) * 0.001
-        else:
-            self._integral[:] = 0.0
-        cop = tracking_cop(state.capture_point, xi_ref, xi_ref, self.gains.dcm_gain) \
-            + self.gains.integral_gain * self._integral
+        cop = tracking_cop(state.capture_point, xi_ref, xi_ref, self.gains.dcm_gain)
         swinging = self.status == STEPPING
         unloading = self.landed is None and not swinging and float(
             np.linalg.norm(state.capture_point - self._shift[2])) < self.gains.unload_m
