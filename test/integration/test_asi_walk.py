@@ -35,6 +35,7 @@ from tutorial_atlas_control.sim import (
     pelvis_height_m,
 )
 from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.sim.vrc import WrenchInput
 from tutorial_atlas_control.walking import (
     DRCSIM_WALK_QUEUE,
     Footstep,
@@ -283,6 +284,55 @@ def test_eight_steps_with_the_arms_swung_under_the_users_pid(
     assert steps == 8
     assert sim.mode is ControlMode.STAND
     assert (sim.active_k_effort()[[JOINT_INDEX[name] for name in ARMS]] == 255).all()
+
+
+#: The issue's push while walking: 150 N sideways on the pelvis for 0.1 s (15 N s); a step
+#: adjusted for it is reported at least this far from where it was sent (m).
+PUSH_N = 150.0
+PUSH_S = 0.1
+ADJUSTED_BY_M = 0.08
+
+
+def test_a_push_while_walking_moves_the_step_and_step_queue_saturated_says_so(
+        atlas: atlas_model.AtlasModel) -> None:
+    """A client streams eight steps; as the right foot lifts for step 4, 150 N pushes the
+    pelvis to the right for 0.1 s: walk_feedback's step_queue_saturated reports step 4 moved
+    out to the right, the foot lands there, and the walk goes on to Stand."""
+    interface = standing(atlas)
+    sim = interface.sim
+    plan = straight_steps(8, 0.25)
+    sent = {step.step_index: step for step in plan}
+    pushed_at, reported, landed, walked = None, [], None, False
+    state = interface.state()
+    for k in range(round(8 * 0.63 / sim.dt_s) + 4000):
+        feedback = state.walk_feedback
+        walked = walked or state.current_behavior == Behavior.WALK
+        if not walked or state.current_behavior == Behavior.WALK:  # as run() streams
+            interface.apply(walk_command(window(plan, feedback.next_step_index_needed)))
+        if pushed_at is None and feedback.current_step_index == 3 \
+                and feedback.status_flags & STEPPING:
+            sim.apply_input(WrenchInput((0.0, -PUSH_N, 0.0), (0.0, 0.0, 0.0)))
+            pushed_at = k
+        elif pushed_at is not None and k == pushed_at + round(PUSH_S / sim.dt_s):
+            sim.apply_input(WrenchInput((0.0, 0.0, 0.0), (0.0, 0.0, 0.0)))
+        if feedback.current_step_index == 3 and feedback.status_flags & STEPPING:
+            under_way = feedback.step_queue_saturated[0]
+            assert under_way.step_index == 4
+            reported.append(under_way.position_m)
+        if landed is None and feedback.current_step_index == 4:
+            landed = feet(interface)[1]
+        sim.step()
+        state = interface.state()
+        interface.end_step()
+        assert state.pelvis_position_m[2] > PELVIS_ABOVE_M
+    assert pushed_at is not None and landed is not None
+    assert state.current_behavior == Behavior.STAND
+    target = sent[4]
+    moved = [target.y_m - position[1] for position in reported]
+    assert moved[0] == pytest.approx(0.0, abs=0.01)  # before the push: as sent
+    assert moved[-1] > ADJUSTED_BY_M                  # after: out to the right
+    # The foot came down where step_queue_saturated said last (the link ahead of the sole).
+    assert landed[1] == pytest.approx(reported[-1][1], abs=LANDING_WITHIN_M)
 
 
 def test_stand_asked_for_mid_walk_ends_it_after_the_step_under_way(

@@ -29,6 +29,8 @@ from tutorial_atlas_control.sim import (
     wrench_input,
 )
 
+Vector = tuple[float, float, float]
+
 #: The pushes of the robustness figures last this long (s), as the issue's bench does.
 PUSH_DURATION_S = 0.2
 #: Standing means the pelvis above this (m); Stand holds it at about 0.91 m.
@@ -42,7 +44,7 @@ class Push:
     """A constant force (N, world) on the pelvis from `start_s` for `duration_s`."""
 
     start_s: float
-    force_n: tuple[float, float, float]
+    force_n: Vector
     duration_s: float = PUSH_DURATION_S
 
     @property
@@ -74,6 +76,21 @@ def standing_simulator() -> AtlasSimulator:
     return sim
 
 
+def push_events(pushes: Sequence[Push], dt_s: float) -> list[tuple[int, Vector]]:
+    """The pelvis force to set at each step where it changes, (step, force (N)) in order:
+    each push's force at its start, none at its end."""
+    return sorted([(round(p.start_s / dt_s), p.force_n) for p in pushes]
+                  + [(round((p.start_s + p.duration_s) / dt_s), (0.0, 0.0, 0.0))
+                     for p in pushes], key=lambda event: event[0])
+
+
+def apply_pushes(sim: AtlasSimulator, events: list[tuple[int, Vector]], step: int) -> None:
+    """Set the pelvis force of the `events` (push_events) due at `step`, taking them off the
+    list: the simulator's /atlas/apply_pelvis_force input, as a live push."""
+    while events and events[0][0] == step:
+        sim.apply_input(wrench_input(events.pop(0)[1], (0.0, 0.0, 0.0)))
+
+
 def stand_trial(duration_s: float, pushes: Sequence[Push] = (),
                 gains: StandGains | None = None) -> TrialResult:
     """Place the robot in the Stand pose on the ground and run Stand for `duration_s`
@@ -83,14 +100,11 @@ def stand_trial(duration_s: float, pushes: Sequence[Push] = (),
     sim.install_stand(stand)  # the simulator starts in Stand: it takes over at once
     assert stand.last_state is not None
     feet_start = stand.last_state.sole_centres[:, :2].copy()
-    events = sorted([(round(p.start_s / sim.dt_s), p.force_n) for p in pushes]
-                    + [(round((p.start_s + p.duration_s) / sim.dt_s), (0.0, 0.0, 0.0))
-                       for p in pushes], key=lambda event: event[0])
+    events = push_events(pushes, sim.dt_s)
     lowest, travel = np.inf, 0.0
     steps = round(duration_s / sim.dt_s)
     for step in range(steps):
-        while events and events[0][0] == step:
-            sim.apply_input(wrench_input(events.pop(0)[1], (0.0, 0.0, 0.0)))
+        apply_pushes(sim, events, step)
         sim.step()
         lowest = min(lowest, pelvis_height_m(sim.atlas, sim.data))
         travel = max(travel, float(np.max(np.linalg.norm(

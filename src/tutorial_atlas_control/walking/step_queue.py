@@ -50,17 +50,24 @@ DEFAULT_LIMITS = StepLimits()
 def clamp_step(step: Footstep, stance: Footstep,
                limits: StepLimits = DEFAULT_LIMITS) -> Footstep:
     """`step` moved to the nearest pose the legs reach from the stance foot `stance`."""
+    x, y, yaw = clamp_pose(step.foot_index, step.x_m, step.y_m, step.yaw_rad, stance, limits)
+    return replace(step, x_m=x, y_m=y, yaw_rad=yaw)
+
+
+def clamp_pose(foot_index: int, x_m: float, y_m: float, yaw_rad: float, stance: Footstep,
+               limits: StepLimits = DEFAULT_LIMITS) -> tuple[float, float, float]:
+    """clamp_step on a pose (x, y, yaw) of foot `foot_index`, without making a Footstep
+    (Walk's step adjustment clamps its landing every 1 ms of a step)."""
     c, s = math.cos(stance.yaw_rad), math.sin(stance.yaw_rad)
-    dx, dy = step.x_m - stance.x_m, step.y_m - stance.y_m
+    dx, dy = x_m - stance.x_m, y_m - stance.y_m
     ahead, across = c * dx + s * dy, -s * dx + c * dy
     ahead = min(max(ahead, -limits.back_m), limits.forward_m)
     # The stepping foot lies on its own side of the stance foot: +y for the left one.
-    width = side_sign(step.foot_index) * across
-    across = side_sign(step.foot_index) * min(max(width, limits.min_width_m), limits.max_width_m)
-    turn = min(max(wrap_angle(step.yaw_rad - stance.yaw_rad), -limits.turn_rad), limits.turn_rad)
-    return replace(step, x_m=stance.x_m + c * ahead - s * across,
-                   y_m=stance.y_m + s * ahead + c * across,
-                   yaw_rad=wrap_angle(stance.yaw_rad + turn))
+    width = side_sign(foot_index) * across
+    across = side_sign(foot_index) * min(max(width, limits.min_width_m), limits.max_width_m)
+    turn = min(max(wrap_angle(yaw_rad - stance.yaw_rad), -limits.turn_rad), limits.turn_rad)
+    return (stance.x_m + c * ahead - s * across, stance.y_m + s * ahead + c * across,
+            wrap_angle(stance.yaw_rad + turn))
 
 
 class StepQueue:
@@ -77,6 +84,8 @@ class StepQueue:
         self.feet = [start_left, start_right]
         self._last_foot: int | None = None
         self._steps: dict[int, Footstep] = {}
+        #: The step under way as Walk moved it after a push (None: as sent).
+        self._adjusted: Footstep | None = None
 
     @property
     def next_step_index_needed(self) -> int:
@@ -122,14 +131,25 @@ class StepQueue:
             if step.foot_index == last_foot:
                 self.inconsistent = True
                 break
-            clamped = clamp_step(step, feet[1 - step.foot_index], self.limits)
+            adjusted = self._adjusted
+            clamped = (adjusted if adjusted is not None and index == adjusted.step_index
+                       else clamp_step(step, feet[1 - step.foot_index], self.limits))
             planned.append(clamped)
             feet[step.foot_index] = clamped
             last_foot = step.foot_index
         return planned
 
+    def adjust(self, step: Footstep) -> None:
+        """The step under way (`current_step_index + 1`) lands at `step` instead, already
+        within the limits: the queue's preview says so until it is down."""
+        if step.step_index != self.current_step_index + 1:
+            raise ValueError(f'step {step.step_index} is not the one under way '
+                             f'({self.current_step_index + 1})')
+        self._adjusted = step
+
     def touchdown(self, landed: Footstep) -> None:
         """Step `current_step_index + 1` is down, where `landed` says."""
+        self._adjusted = None
         self.current_step_index += 1
         self.feet[landed.foot_index] = landed
         self._last_foot = landed.foot_index

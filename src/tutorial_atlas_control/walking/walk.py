@@ -10,13 +10,16 @@ they come.
 
 Each 1 ms step: the pressure centre p = p_ref + (1 + k)(xi - xi_ref), and leg_tasks
 turns it into torques (the Stand's whole-body law on the carrying soles, the swing foot's
-joint-space servo, feet put back down). The CoM walks 5 cm lower than it stands.
+joint-space servo, feet put back down). The CoM walks 5 cm lower than it stands. While a
+foot swings, its landing moves with the capture point's error predicted at touchdown
+(step_adjustment): a push that the stance sole cannot take back is caught by where the foot
+comes down, within the step limits, and the queue reports the step so moved.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -24,11 +27,13 @@ from tutorial_atlas_control.balance import BalanceState, StandController
 from tutorial_atlas_control.walking.dcm_plan import DcmPlan, tracking_cop
 from tutorial_atlas_control.walking.footsteps import Footstep
 from tutorial_atlas_control.walking.leg_tasks import LegGains, LegTasks, foot_pose
+from tutorial_atlas_control.walking.step_adjustment import foothold_shift
 from tutorial_atlas_control.walking.step_queue import (
     CATCHING,
     STEPPING,
     SWAYING,
     StepQueue,
+    clamp_pose,
 )
 from tutorial_atlas_control.walking.swing import SwingPath
 
@@ -50,6 +55,10 @@ class WalkGains:
     #: after longest_catch_s (s).
     at_rest_m: float = 0.01
     longest_catch_s: float = 3.0
+    #: Whether the swing foot's landing follows the capture point (step_adjustment), and
+    #: the least change (m) that moves its path.
+    adjust_steps: bool = True
+    adjust_tolerance_m: float = 0.001
     #: The legs' gains and limits (leg_tasks).
     legs: LegGains = field(default_factory=LegGains)
 
@@ -88,10 +97,17 @@ class WalkController:
         #: The step being taken (None while swaying or catching) and its swing path.
         self.step: Footstep | None = None
         self.swing: SwingPath | None = None
+        #: The step under way as the queue planned it, before any adjustment.
+        self._planned_step: Footstep | None = None
         self._plan: DcmPlan | None = None
         self._sway_cop = np.zeros(2)
         #: The CoM height the walk starts from and returns to (m).
         self.stand_height_m = stand.reference.com_height_m
+        #: How far the pressure centre may go from the stance sole's centre (m): along it,
+        #: across it.
+        half_length, half_width = stand.sole_half_size_m
+        margin = stand.gains.cop_margin_m
+        self._reach_xy = (half_length - margin, half_width - margin)
         self._begin_sway(state, time_s)
 
     # -- the phases ---------------------------------------------------------------------------
@@ -128,7 +144,7 @@ class WalkController:
             return
         step = preview[0]
         lift = state.sole_centres[step.foot_index]
-        self.step = step
+        self.step = self._planned_step = step
         stance = self.queue.feet[1 - step.foot_index]
         self.legs.face(stance.yaw_rad, step.yaw_rad, time_s, step.duration_s)
         self.swing = SwingPath(lift.copy(), np.array([step.x_m, step.y_m, 0.0]),
@@ -174,6 +190,30 @@ class WalkController:
         middle = state.sole_centres[:, :2].mean(axis=0)
         return middle, middle
 
+    def _adjust(self, state: BalanceState, xi_ref: np.ndarray, cop_ref: np.ndarray,
+                time_s: float) -> None:
+        """Move the swing foot's landing by where the capture point will be at touchdown
+        (step_adjustment), within the step limits from the stance foot."""
+        step, planned, plan, swing = self.step, self._planned_step, self._plan, self.swing
+        assert step is not None and planned is not None and plan is not None \
+            and swing is not None  # set with the step
+        stance = 1 - step.foot_index
+        sole = state.sole_rotations[stance]
+        error_x, error_y = (state.capture_point - xi_ref).tolist()
+        offset_x, offset_y = (cop_ref - state.sole_centres[stance][0:2]).tolist()
+        shift_x, shift_y = foothold_shift(
+            (error_x, error_y), (float(sole[0, 0]), float(sole[1, 0])), (offset_x, offset_y),
+            self._reach_xy, self.gains.dcm_gain, state.omega,
+            step.duration_s - (time_s - self.phase_start_s),
+            float(plan.durations_s[1]) if len(plan.durations_s) > 1 else None)
+        x, y, _ = clamp_pose(step.foot_index, planned.x_m + shift_x, planned.y_m + shift_y,
+                             planned.yaw_rad, self.queue.feet[stance], self.queue.limits)
+        if math.hypot(x - step.x_m, y - step.y_m) < self.gains.adjust_tolerance_m:
+            return
+        self.step = replace(planned, x_m=x, y_m=y)
+        self.swing = replace(swing, end=np.array([x, y, 0.0]))
+        self.queue.adjust(self.step)
+
     # -- one step -----------------------------------------------------------------------------
 
     def step_torque(self, state: BalanceState, joint_positions: np.ndarray,
@@ -181,6 +221,8 @@ class WalkController:
         """The 28 joint torques (N m) for this 1 ms step, within the effort limits."""
         self._advance(state, time_s)
         xi_ref, cop_ref = self._capture_reference(state, time_s)
+        if self.phase == STEPPING and self.gains.adjust_steps:
+            self._adjust(state, xi_ref, cop_ref, time_s)
         cop = tracking_cop(state.capture_point, xi_ref, cop_ref, self.gains.dcm_gain)
         step = self.step if self.phase == STEPPING else None
         swing_foot = None if step is None else step.foot_index

@@ -21,7 +21,10 @@ import numpy as np
 from tutorial_atlas_control.balance import (
     STANDING_PELVIS_M,
     BalanceState,
+    Push,
     StandBehaviour,
+    apply_pushes,
+    push_events,
     standing_simulator,
 )
 from tutorial_atlas_control.sim import AtlasModel, pelvis_height_m
@@ -44,6 +47,9 @@ class Landing:
     yaw_error_rad: float
     #: Where the pelvis was (world x, y, m).
     pelvis_xy: tuple[float, float] = (0.0, 0.0)
+    #: How far it came down from the step as Walk took it (after the clamp to the step
+    #: limits and any step adjustment: what step_queue_saturated said) (m).
+    taken_error_m: float = 0.0
 
 
 @dataclass
@@ -131,12 +137,12 @@ class WalkingStand:
             return self.stand.torque(data)
         if self.streaming:
             walking.offer(window(self.plan, walk.queue.next_step_index_needed))
-        taken = walk.queue.current_step_index
+        taken, taking = walk.queue.current_step_index, walk.step
         torque = walking.torque(data)
         if walk.queue.current_step_index > taken:
             state = self.stand.last_state
-            assert state is not None  # set by the torque call
-            self._landed(walk, state)
+            assert state is not None and taking is not None  # set by the torque call
+            self._landed(walk, state, taking)
         return torque
 
     def _note_jump(self, torque: np.ndarray) -> None:
@@ -147,8 +153,9 @@ class WalkingStand:
             self.trial.leg_torque_jump_nm = float(np.max(self._jumps)) / self._jump_count
         self._last_torque = torque.copy()
 
-    def _landed(self, walk: WalkController, state: BalanceState) -> None:
-        """Note the step just down against its target."""
+    def _landed(self, walk: WalkController, state: BalanceState, taken: Footstep) -> None:
+        """Note the step just down against its target and against `taken`, the step as
+        Walk took it."""
         index = walk.queue.current_step_index
         target = next((s for s in self.plan if s.step_index == index), None)
         if target is None:
@@ -158,19 +165,22 @@ class WalkingStand:
         self.trial.landings.append(Landing(
             index, target.foot_index, math.hypot(down.x_m - target.x_m, down.y_m - target.y_m),
             abs(wrap_angle(down.yaw_rad - target.yaw_rad)),
-            (float(state.pelvis_position[0]), float(state.pelvis_position[1]))))
+            (float(state.pelvis_position[0]), float(state.pelvis_position[1])),
+            math.hypot(down.x_m - taken.x_m, down.y_m - taken.y_m)))
 
 
 def walk_trial(plan: Sequence[Footstep], duration_s: float, gains: WalkGains | None = None,
-               streaming: bool = False) -> WalkTrial:
+               streaming: bool = False, pushes: Sequence[Push] = ()) -> WalkTrial:
     """Place the robot in the Stand pose, stand SETTLE_S, walk `plan` (sent once, or
-    `streaming` its window every step), stand; run for `duration_s` (s) of sim time or
-    until it falls."""
+    `streaming` its window every step), stand; with `pushes` on the pelvis (their times
+    in sim time from the start); run for `duration_s` (s) of sim time or until it falls."""
     sim = standing_simulator()
     behaviour = WalkingStand(sim.atlas, plan, SETTLE_S, gains, streaming)
     sim.install_stand(behaviour)
     trial = behaviour.trial
-    for _ in range(round(duration_s / sim.dt_s)):
+    events = push_events(pushes, sim.dt_s)
+    for step in range(round(duration_s / sim.dt_s)):
+        apply_pushes(sim, events, step)
         sim.step()
         height = pelvis_height_m(sim.atlas, sim.data)
         trial.lowest_pelvis_m = min(trial.lowest_pelvis_m, height)

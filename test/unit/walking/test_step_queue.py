@@ -130,3 +130,27 @@ def test_within_one_command_the_first_copy_of_an_index_counts() -> None:
     queue.offer([first, second, replace(first, step_index=2), replace(second, step_index=3)])
     assert [step.step_index for step in queue.preview()] == [1, 2]
     assert queue.preview()[1].foot_index == RIGHT and queue.inconsistent
+
+
+def test_an_adjusted_step_is_what_the_preview_reports_until_it_is_down() -> None:
+    queue = new_queue()
+    queue.offer(DRCSIM_WALK_QUEUE)
+    moved = replace(DRCSIM_WALK_QUEUE[0], y_m=0.35)
+    queue.adjust(moved)
+    preview = queue.preview()
+    assert preview[0] == moved
+    # The next step is clamped from where the adjusted one lands: 0.40 m across at most.
+    assert preview[1].y_m == pytest.approx(0.35 - 0.40)
+    # A client re-sending the step under way does not undo the adjustment.
+    queue.offer(DRCSIM_WALK_QUEUE)
+    assert queue.preview()[0] == moved
+    queue.touchdown(moved)
+    assert queue.feet[LEFT] == moved
+    assert queue.preview()[0] == preview[1]
+
+
+def test_only_the_step_under_way_is_adjusted() -> None:
+    queue = new_queue()
+    queue.offer(DRCSIM_WALK_QUEUE)
+    with pytest.raises(ValueError, match='step 2 is not the one under way \\(1\\)'):
+        queue.adjust(DRCSIM_WALK_QUEUE[1])
