@@ -9,6 +9,7 @@ the bias forces (gravity and Coriolis) once.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -35,20 +36,24 @@ class BalanceState:
     com_velocity: np.ndarray      # (3,)
     pelvis_position: np.ndarray   # (3,)
     pelvis_rotation: np.ndarray   # (3, 3) pelvis frame to world
-    pelvis_velocity: np.ndarray   # (3,) linear, world
     pelvis_angular_velocity: np.ndarray  # (3,) world
     sole_centres: np.ndarray      # (2, 3) left, right: the middle of each sole's bottom face
     sole_rotations: np.ndarray    # (2, 3, 3)
     in_contact: tuple[bool, bool]
-    support_polygon: np.ndarray   # (k, 2) convex hull of the soles in contact (ccw)
     omega: float                  # the LIPM's natural frequency at this CoM height (1/s)
     capture_point: np.ndarray     # (2,)
     bias_nm: np.ndarray           # (28,) joint part of qfrc_bias (gravity + Coriolis)
     sole_jacobians: np.ndarray    # (2, 6, 28) [linear; angular] at each sole centre, joints
-    sole_velocities: np.ndarray   # (2, 6) [linear; angular] of each sole centre, world
     #: The joint-space inertia block (k, k) of some joints (a slice, tutorial order) at this
     #: state, computed on first use; valid until the estimator's next estimate.
     joint_inertia: Callable[[slice], np.ndarray]
+    #: Makes support_polygon, on first use (Walk's single support never asks).
+    polygon_of: Callable[[], np.ndarray]
+
+    @functools.cached_property
+    def support_polygon(self) -> np.ndarray:
+        """(k, 2) the convex hull of the soles in contact, counter-clockwise."""
+        return self.polygon_of()
 
 
 class BalanceEstimator:
@@ -152,7 +157,6 @@ class BalanceEstimator:
             mujoco.mj_jac(m, d, jac[foot, 0:3], jac[foot, 3:6], centres[foot],
                           self._sole_bodies[foot])
         contact = (lowest[0] < CONTACT_HEIGHT_M, lowest[1] < CONTACT_HEIGHT_M)
-        polygon = self._support_polygon(positions, rotations, contact)
         com = d.subtree_com[0].copy()
         com_velocity = d.subtree_linvel[0].copy()
         omega = lipm.natural_frequency(max(float(com[2]), MIN_COM_HEIGHT_M))
@@ -161,10 +165,9 @@ class BalanceEstimator:
         return BalanceState(
             com=com, com_velocity=com_velocity,
             pelvis_position=d.xpos[self._pelvis].copy(), pelvis_rotation=pelvis_rotation,
-            pelvis_velocity=d.qvel[free:free + 3].copy(),
             pelvis_angular_velocity=pelvis_rotation @ d.qvel[free + 3:free + 6],
-            sole_centres=centres, sole_rotations=rotations, in_contact=contact,
-            support_polygon=polygon, omega=omega,
+            sole_centres=centres, sole_rotations=rotations, in_contact=contact, omega=omega,
             capture_point=lipm.capture_point(com[:2], com_velocity[:2], omega),
             bias_nm=self._bias[self._dof_adr], sole_jacobians=jac[:, :, self._dof_adr],
-            sole_velocities=jac @ d.qvel, joint_inertia=self._joint_inertia)
+            joint_inertia=self._joint_inertia,
+            polygon_of=lambda: self._support_polygon(positions, rotations, contact))
