@@ -57,6 +57,7 @@ def test_walk_demo_reports_the_bags_steps_landings_and_footprints(tmp_path: Path
     footprints = bag.with_suffix('.footprints.png')
     assert footprints.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
     assert f'footprints: {footprints}' in result.stdout.splitlines()
+    assert 'tracking' not in result.stdout  # no joint was under a command: nothing to track
 
     targets, _ = read_step_targets(read_bag(bag))
     assert [t.step_index for t in targets][:4] == [1, 2, 3, 4], 'the first WALK is recorded'

@@ -88,3 +88,12 @@ def test_the_demo_summary_is_a_few_lines_the_table_on_request(tmp_path: Path) ->
     table = short_summary(analysis, table=True).splitlines()
     assert [row.split()[0] for row in table[3:]] == [name for _, name in tracked]
     assert len(table) == 3 + len(tracked)
+
+
+def test_a_walks_summary_has_no_tracking_line(tmp_path: Path) -> None:
+    from support.synthetic_bags import write_run_bag
+
+    analysis = analyze_bag(write_run_bag(tmp_path / 'run.bag', 3.0, with_imu=False,
+                                         fall_time_s=1.5))
+    short = short_summary(analysis, tracking=False).splitlines()
+    assert short == ['=== summary ===', short_summary(analysis).splitlines()[1]]

@@ -172,9 +172,10 @@ def format_summary(analysis: Analysis, trajectory: str | None = None) -> str:
     return '\n'.join(lines)
 
 
-def short_summary(analysis: Analysis, table: bool = False) -> str:
+def short_summary(analysis: Analysis, table: bool = False, tracking: bool = True) -> str:
     """The demo's summary of a run (make demo, run_offline.py), a few lines: the fall, then
-    the joints that tracked worst; with `table`, every joint that moved, a row each."""
+    the joints that tracked worst; with `table`, every joint that moved, a row each; without
+    `tracking` (a walk: the behaviours drove every joint, no command did), the fall alone."""
     lines = ['=== summary ===']
     first = analysis.first_fall()
     if analysis.fell is None:
@@ -184,6 +185,8 @@ def short_summary(analysis: Analysis, table: bool = False) -> str:
     else:
         lines.append('the robot did not fall (lowest pelvis height '
                      f'{analysis.min_pelvis_height_m:.2f} m)')
+    if not tracking:
+        return '\n'.join(lines)
     tracked = sorted(((joint.rms_error_rad, joint.max_error_rad, name)
                       for name, joint in analysis.joints.items()
                       if joint.rms_error_rad is not None), reverse=True)

@@ -172,7 +172,7 @@ def summarise(bag: Path, video_fps: float, video_size: tuple[int, int],
     The summary is reported before the (slower) plot and video are made.
     """
     analysis = analyze_bag(bag)
-    report('\n' + short_summary(analysis, table))
+    report('\n' + short_summary(analysis, table, tracking=not walk))
     footprints = None
     if walk:
         summary = summarise_walk(analysis.data)
