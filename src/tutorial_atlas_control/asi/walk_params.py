@@ -11,6 +11,7 @@ step_index 0 is unused (a default message's queue is four of them).
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Iterable
 from dataclasses import replace
@@ -30,15 +31,23 @@ def sole_step(step: Footstep, sole_ahead_m: float) -> Footstep:
 def footsteps_of(queue: Iterable[StepData], sole_ahead_m: float) -> list[Footstep]:
     """The used slots of walk_params.step_queue (foot indices checked by the decoder), as
     the soles' steps."""
-    return [sole_step(Footstep(step.step_index, step.foot_index, step.position_m[0],
-                               step.position_m[1], step.yaw_rad(), step.duration_s),
-                      sole_ahead_m)
-            for step in queue if step.step_index > 0]
+    steps = []
+    for step in queue:
+        if step.step_index > 0:
+            x, y, _ = step.position_m
+            yaw = step.yaw_rad()
+            # sole_step's, without a Footstep of the link first: a streaming client sends
+            # four steps at every state.
+            steps.append(Footstep(step.step_index, step.foot_index,
+                                  x + sole_ahead_m * math.cos(yaw),
+                                  y + sole_ahead_m * math.sin(yaw), yaw, step.duration_s))
+    return steps
 
 
+@functools.lru_cache(maxsize=64)
 def step_data_of(step: Footstep, sole_ahead_m: float) -> StepData:
     """A sole's step as the foot link's AtlasBehaviorStepData: on the ground, our swing
-    height."""
+    height. Cached: walk_feedback reports the same four steps at every state."""
     link = sole_step(step, -sole_ahead_m)
     half = 0.5 * step.yaw_rad
     return StepData(step.step_index, step.foot_index, step.duration_s, (link.x_m, link.y_m, 0.0),

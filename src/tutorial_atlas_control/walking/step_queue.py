@@ -86,6 +86,9 @@ class StepQueue:
         self._steps: dict[int, Footstep] = {}
         #: The step under way as Walk moved it after a push (None: as sent).
         self._adjusted: Footstep | None = None
+        #: preview()'s steps until the queue changes (walk_feedback asks at every state, a
+        #: streaming client re-sends the same steps at every state).
+        self._preview: list[Footstep] | None = None
 
     @property
     def next_step_index_needed(self) -> int:
@@ -105,21 +108,31 @@ class StepQueue:
             return
         merged: set[int] = set()
         for step in steps:
-            if step.step_index > self.current_step_index and step.step_index not in merged:
-                self._steps[step.step_index] = step
-                merged.add(step.step_index)
+            index = step.step_index
+            if index > self.current_step_index and index not in merged:
+                if self._steps.get(index) != step:
+                    self._steps[index] = step
+                    self._preview = None
+                merged.add(index)
 
     def stop(self, taking: int | None) -> None:
         """No step after `taking` (the index of the step under way; None: none is): the walk
         ends with it, and steps offered later are ignored."""
         self.stopped = True
         self._steps = {k: v for k, v in self._steps.items() if taking is not None and k <= taking}
+        self._preview = None
 
     def preview(self) -> list[Footstep]:
         """The known steps from the next one on without a gap, up to QUEUE_LENGTH, each
         clamped from the foot it steps from. Two in a row with the same foot (or the next
         one with the foot that took the last) end the preview before the second and set
         `inconsistent`."""
+        if self._preview is None:
+            self._preview = self._planned()
+        return list(self._preview)
+
+    def _planned(self) -> list[Footstep]:
+        """preview() made anew."""
         feet = list(self.feet)
         last_foot = self._last_foot
         planned = []
@@ -146,10 +159,12 @@ class StepQueue:
             raise ValueError(f'step {step.step_index} is not the one under way '
                              f'({self.current_step_index + 1})')
         self._adjusted = step
+        self._preview = None
 
     def touchdown(self, landed: Footstep) -> None:
         """Step `current_step_index + 1` is down, where `landed` says."""
         self._adjusted = None
+        self._preview = None
         self.current_step_index += 1
         self.feet[landed.foot_index] = landed
         self._last_foot = landed.foot_index

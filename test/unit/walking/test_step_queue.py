@@ -154,3 +154,13 @@ def test_only_the_step_under_way_is_adjusted() -> None:
     queue.offer(DRCSIM_WALK_QUEUE)
     with pytest.raises(ValueError, match='step 2 is not the one under way \\(1\\)'):
         queue.adjust(DRCSIM_WALK_QUEUE[1])
+
+
+def test_stopped_the_preview_ends_with_the_step_under_way() -> None:
+    queue = new_queue()
+    queue.offer(DRCSIM_WALK_QUEUE)
+    assert len(queue.preview()) == 4
+    queue.stop(1)
+    assert queue.preview() == [DRCSIM_WALK_QUEUE[0]]
+    queue.offer(DRCSIM_WALK_QUEUE)  # ignored once stopped
+    assert queue.preview() == [DRCSIM_WALK_QUEUE[0]]
