@@ -93,6 +93,11 @@ class LegTasks:
         joint_kd[LEG_JOINTS] = gains.leg_kd
         self._joint_gains = (joint_kp, joint_kd)
         self._ik_damping = gains.ik_damping_m ** 2 * np.eye(6)
+        #: How far a lone stance sole's pressure centre may go from the sole's centre (m),
+        #: along it and across it: the sole's half size less the Stand's margin.
+        half_length, half_width = stand.sole_half_size_m
+        margin = stand.gains.cop_margin_m
+        self.sole_reach_m = (max(half_length - margin, 0.0), max(half_width - margin, 0.0))
         #: The pelvis's heading moving on: (start time, duration, from, turn) (s, rad).
         self._facing = (time_s, 1.0, yaw_of(stand.reference.pelvis_rotation), 0.0)
         #: The CoM height moving on: (start time, duration, from, change) (s, m).
@@ -188,8 +193,7 @@ class LegTasks:
                                   com_height_m=height, com_height_rate_m_s=height_rate)
         if swing_foot is not None:
             contact = (swing_foot != 0, swing_foot != 1)
-            cop = _clamp_to_sole(state, 1 - swing_foot, stand.sole_half_size_m,
-                                 stand.gains.cop_margin_m, cop)
+            cop = _clamp_to_sole(state, 1 - swing_foot, self.sole_reach_m, cop)
         else:  # swaying or catching: the feet that are down (both, unless a landing is late)
             contact = state.in_contact if any(state.in_contact) else (True, True)
             corners = np.concatenate([_sole_corners(state, foot, stand.sole_half_size_m)
@@ -218,17 +222,16 @@ class LegTasks:
         return torque
 
 
-def _clamp_to_sole(state: BalanceState, foot: int, half_size_m: tuple[float, float],
-                   margin_m: float, point_xy: np.ndarray) -> np.ndarray:
-    """`point_xy` moved to the nearest point of one sole's rectangle shrunk by `margin_m`
-    (in the sole's frame a clamp of each coordinate: the rectangle's hull and a general
-    polygon's clamp, every step of single support, cost more than the rest of the step's
-    pressure-centre work)."""
-    half_length, half_width = half_size_m
+def _clamp_to_sole(state: BalanceState, foot: int, reach_m: tuple[float, float],
+                   point_xy: np.ndarray) -> np.ndarray:
+    """`point_xy` moved to the nearest point of one sole's rectangle reaching `reach_m`
+    from its centre along and across it (in the sole's frame a clamp of each coordinate:
+    the rectangle's hull and a general polygon's clamp, every step of single support, cost
+    more than the rest of the step's pressure-centre work)."""
     rotation = state.sole_rotations[foot][0:2, 0:2]
     centre = state.sole_centres[foot][0:2]
     local = rotation.T @ (np.asarray(point_xy, dtype=np.float64) - centre)
-    reach_x, reach_y = max(half_length - margin_m, 0.0), max(half_width - margin_m, 0.0)
+    reach_x, reach_y = reach_m
     local[0] = min(max(local[0], -reach_x), reach_x)
     local[1] = min(max(local[1], -reach_y), reach_y)
     return centre + rotation @ local

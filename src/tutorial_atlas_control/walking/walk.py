@@ -103,11 +103,6 @@ class WalkController:
         self._sway_cop = np.zeros(2)
         #: The CoM height the walk starts from and returns to (m).
         self.stand_height_m = stand.reference.com_height_m
-        #: How far the pressure centre may go from the stance sole's centre (m): along it,
-        #: across it.
-        half_length, half_width = stand.sole_half_size_m
-        margin = stand.gains.cop_margin_m
-        self._reach_xy = (half_length - margin, half_width - margin)
         self._begin_sway(state, time_s)
 
     # -- the phases ---------------------------------------------------------------------------
@@ -203,7 +198,7 @@ class WalkController:
         offset_x, offset_y = (cop_ref - state.sole_centres[stance][0:2]).tolist()
         shift_x, shift_y = foothold_shift(
             (error_x, error_y), (float(sole[0, 0]), float(sole[1, 0])), (offset_x, offset_y),
-            self._reach_xy, self.gains.dcm_gain, state.omega,
+            self.legs.sole_reach_m, self.gains.dcm_gain, state.omega,
             step.duration_s - (time_s - self.phase_start_s),
             float(plan.durations_s[1]) if len(plan.durations_s) > 1 else None)
         x, y, _ = clamp_pose(step.foot_index, planned.x_m + shift_x, planned.y_m + shift_y,
