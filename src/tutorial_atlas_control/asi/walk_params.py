@@ -22,10 +22,15 @@ from tutorial_atlas_control.walking import SWING_HEIGHT_M, Footstep, StepStatus,
 __all__ = ['footsteps_of', 'sole_step', 'step_data_of', 'step_feedback', 'walk_feedback']
 
 
+def _ahead(x_m: float, y_m: float, yaw_rad: float, ahead_m: float) -> tuple[float, float]:
+    """The point `ahead_m` ahead of (x, y) along the heading `yaw_rad`."""
+    return x_m + ahead_m * math.cos(yaw_rad), y_m + ahead_m * math.sin(yaw_rad)
+
+
 def sole_step(step: Footstep, sole_ahead_m: float) -> Footstep:
     """A step of the foot link as the step of its sole's centre."""
-    return replace(step, x_m=step.x_m + sole_ahead_m * math.cos(step.yaw_rad),
-                   y_m=step.y_m + sole_ahead_m * math.sin(step.yaw_rad))
+    x, y = _ahead(step.x_m, step.y_m, step.yaw_rad, sole_ahead_m)
+    return replace(step, x_m=x, y_m=y)
 
 
 def footsteps_of(queue: Iterable[StepData], sole_ahead_m: float) -> list[Footstep]:
@@ -34,13 +39,11 @@ def footsteps_of(queue: Iterable[StepData], sole_ahead_m: float) -> list[Footste
     steps = []
     for step in queue:
         if step.step_index > 0:
-            x, y, _ = step.position_m
-            yaw = step.yaw_rad()
-            # sole_step's, without a Footstep of the link first: a streaming client sends
+            # sole_step, without a Footstep of the link first: a streaming client sends
             # four steps at every state.
-            steps.append(Footstep(step.step_index, step.foot_index,
-                                  x + sole_ahead_m * math.cos(yaw),
-                                  y + sole_ahead_m * math.sin(yaw), yaw, step.duration_s))
+            yaw = step.yaw_rad()
+            x, y = _ahead(step.position_m[0], step.position_m[1], yaw, sole_ahead_m)
+            steps.append(Footstep(step.step_index, step.foot_index, x, y, yaw, step.duration_s))
     return steps
 
 
