@@ -21,7 +21,13 @@ import numpy as np
 import pytest
 
 from support.arm_swing import ARMS, arm_command, swung
-from tutorial_atlas_control.asi import AsiError, AtlasSimInterface, Behavior, Status
+from tutorial_atlas_control.asi import (
+    DOWN_PELVIS_M,
+    AsiError,
+    AtlasSimInterface,
+    Behavior,
+    Status,
+)
 from tutorial_atlas_control.balance import place_in_stand_pose
 from tutorial_atlas_control.control_modes import ControlMode
 from tutorial_atlas_control.joints import JOINT_INDEX, NUM_JOINTS
@@ -333,6 +339,45 @@ def test_a_push_while_walking_moves_the_step_and_step_queue_saturated_says_so(
     assert moved[-1] > ADJUSTED_BY_M                  # after: out to the right
     # The foot came down where step_queue_saturated said last (the link ahead of the sole).
     assert landed[1] == pytest.approx(reported[-1][1], abs=LANDING_WITHIN_M)
+
+
+#: A push that knocks a walking robot down: 700 N sideways for 0.2 s (140 N s).
+KNOCK_N = 700.0
+KNOCK_S = 0.2
+
+
+def test_knocked_down_while_walking_it_freezes_instead_of_crawling(
+        atlas: atlas_model.AtlasModel) -> None:
+    """Pushed over mid-walk, the state says ERROR_FALLING while it falls; once the pelvis is
+    below DOWN_PELVIS_M the library gives up: Freeze (WARNING_AUTO_TRANS once, from Walk),
+    and the robot lies still (without it, the walk stepped on and dragged the fallen robot
+    1.4 m in 2 s)."""
+    interface = standing(atlas)
+    sim = interface.sim
+    interface.apply(walk_command(straight_steps(8, 0.25)[:4]))
+    behaviors, status, pelvis = [], [], []
+    for k in range(7000):
+        if k == 1500:
+            sim.apply_input(WrenchInput((0.0, KNOCK_N, 0.0), (0.0, 0.0, 0.0)))
+        elif k == 1500 + round(KNOCK_S / sim.dt_s):
+            sim.apply_input(WrenchInput((0.0, 0.0, 0.0), (0.0, 0.0, 0.0)))
+        sim.step()
+        state = interface.state()
+        interface.end_step()
+        behaviors.append(state.current_behavior)
+        status.append(state.behavior_feedback.status_flags)
+        pelvis.append(state.pelvis_position_m)
+    assert changes(behaviors) == [Behavior.WALK, Behavior.FREEZE]
+    frozen = behaviors.index(Behavior.FREEZE)
+    assert Status.ERROR_FALLING in status[:frozen]
+    assert status[frozen] == Status.WARNING_AUTO_TRANS
+    assert set(status[frozen + 1:]) == {Status.OK}
+    state = interface.state()
+    assert state.behavior_feedback.trans_from_behavior_index == Behavior.WALK
+    assert state.behavior_feedback.trans_to_behavior_index == Behavior.FREEZE
+    assert pelvis[frozen][2] < DOWN_PELVIS_M
+    last = np.array(pelvis[-2000:])
+    assert np.linalg.norm(last[-1, 0:2] - last[0, 0:2]) < 0.01  # lying still
 
 
 def test_stand_asked_for_mid_walk_ends_it_after_the_step_under_way(

@@ -64,13 +64,17 @@ from tutorial_atlas_control.walking import (
     WalkBehaviour,
 )
 
-__all__ = ['FALLING_PELVIS_M', 'FALLING_TILT_RAD', 'AtlasSimInterface']
+__all__ = ['DOWN_PELVIS_M', 'FALLING_PELVIS_M', 'FALLING_TILT_RAD', 'AtlasSimInterface']
 
 #: A standing behaviour is falling once the pelvis is below this (m; Stand holds it at
 #: about 0.91 m) ...
 FALLING_PELVIS_M = 0.7
 #: ... or tilted more than this from upright (rad).
 FALLING_TILT_RAD = 0.5
+#: Walk or Step with the pelvis below this (m) has fallen for good: the library gives up
+#: and Freezes the joints where they are (else the walk goes on stepping on the ground and
+#: drags the fallen robot across the floor). A stumble that the walk catches stays above.
+DOWN_PELVIS_M = 0.5
 #: Stand is refused while the centre of mass is further than this outside the feet (m).
 COM_OUTSIDE_TOLERANCE_M = 0.0
 FOOT_BODIES = ('l_foot', 'r_foot')
@@ -258,6 +262,10 @@ class AtlasSimInterface:
         tilt = math.acos(max(-1.0, min(1.0, upright)))
         return float(data.xpos[pelvis][2]) < FALLING_PELVIS_M or tilt > FALLING_TILT_RAD
 
+    def down(self) -> bool:
+        """The pelvis below DOWN_PELVIS_M: fallen for good."""
+        return float(self.sim.data.xpos[self.sim.atlas.pelvis_body_id][2]) < DOWN_PELVIS_M
+
     def f_out(self) -> np.ndarray:
         """The behaviour's joint torques this step (N m): the Stand behaviour's or a hold's;
         none in User and ragdoll."""
@@ -319,6 +327,12 @@ class AtlasSimInterface:
         """After each step, whether or not a state was built."""
         self._observe()
         self.session.end_step()
+        mode = self.sim.mode
+        if mode in (ControlMode.WALK, ControlMode.STEP) and self.down():
+            self._switch(ControlMode.FREEZE)
+            self.session.auto_switched(Behavior.FREEZE, BEHAVIOR_OF_MODE[mode])
+            self._stand_after_walk = self._stand_after_step = False
+            return
         if self.sim.mode is ControlMode.WALK and self.walking is not None \
                 and self.walking.done:
             self._switch(ControlMode.STAND)
