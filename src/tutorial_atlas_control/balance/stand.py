@@ -17,6 +17,7 @@ stops but never returns: that is the planted defect the tests show falling.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -98,7 +99,7 @@ def yaw_of(rotation: np.ndarray) -> float:
 
 def yaw_rotation(yaw_rad: float) -> np.ndarray:
     """An upright frame turned by `yaw_rad` about z."""
-    c, s = np.cos(yaw_rad), np.sin(yaw_rad)
+    c, s = math.cos(yaw_rad), math.sin(yaw_rad)
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
@@ -115,10 +116,8 @@ def pelvis_frame(yaw_rad: float, pitch_rad: float = 0.0) -> np.ndarray:
 
 def orientation_error(rotation: np.ndarray, reference: np.ndarray) -> np.ndarray:
     """The small rotation (rad, world axis) that takes `rotation` to `reference`."""
-    difference = reference @ rotation.T
-    return 0.5 * np.array([difference[2, 1] - difference[1, 2],
-                           difference[0, 2] - difference[2, 0],
-                           difference[1, 0] - difference[0, 1]])
+    (d00, d01, d02), (d10, d11, d12), (d20, d21, d22) = (reference @ rotation.T).tolist()
+    return np.array([0.5 * (d21 - d12), 0.5 * (d02 - d20), 0.5 * (d10 - d01)])
 
 
 @dataclass(frozen=True)
@@ -162,17 +161,22 @@ class StandController:
     def centroidal_wrench(self, state: BalanceState,
                           cop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(force (3,) N, moment about the CoM (3,) N m) the contacts should exert."""
-        gains, reference = self.gains, self.reference
-        acceleration = np.empty(3)
-        acceleration[0:2] = lipm.com_acceleration(state.com[:2], cop, state.omega)
-        acceleration[2] = (gains.height_kp * (reference.com_height_m - state.com[2])
-                           + gains.height_kd * (reference.com_height_rate_m_s
-                                                - state.com_velocity[2]))
-        force = self.mass_kg * (acceleration + np.array([0.0, 0.0, lipm.GRAVITY_M_S2]))
-        error = orientation_error(state.pelvis_rotation, reference.pelvis_rotation)
-        moment = (gains.orientation_kp * error
-                  + gains.orientation_kd * (reference.pelvis_angular_velocity
-                                            - state.pelvis_angular_velocity))
+        gains, reference, mass = self.gains, self.reference, self.mass_kg
+        # In plain floats (every 1 ms step), in numpy's order of operations: the same bits.
+        com_x, com_y, com_z = state.com.tolist()
+        cop_x, cop_y = np.asarray(cop, dtype=np.float64).tolist()
+        stiffness = state.omega * state.omega  # lipm.com_acceleration's omega^2 (c - p)
+        vertical = (gains.height_kp * (reference.com_height_m - com_z)
+                    + gains.height_kd * (reference.com_height_rate_m_s
+                                         - float(state.com_velocity[2])))
+        force = np.array([mass * (stiffness * (com_x - cop_x) + 0.0),
+                          mass * (stiffness * (com_y - cop_y) + 0.0),
+                          mass * (vertical + lipm.GRAVITY_M_S2)])
+        error = orientation_error(state.pelvis_rotation, reference.pelvis_rotation).tolist()
+        kp, kd = gains.orientation_kp, gains.orientation_kd
+        moment = np.array([kp * e + kd * (w_ref - w) for e, w_ref, w in zip(
+            error, reference.pelvis_angular_velocity.tolist(),
+            state.pelvis_angular_velocity.tolist())])
         return force, moment
 
     def step(self, state: BalanceState, joint_positions: np.ndarray,
