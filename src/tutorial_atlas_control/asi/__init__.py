@@ -10,7 +10,8 @@ from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'behaviors': ['BEHAVIOR_OF_MODE', 'MODE_OF_BEHAVIOR', 'AsiError', 'Behavior', 'Status'],
-    'interface': ['DOWN_PELVIS_M', 'FALLING_PELVIS_M', 'FALLING_TILT_RAD', 'AtlasSimInterface'],
+    'interface': ['DOWN_PELVIS_M', 'FALLING_PELVIS_M', 'FALLING_TILT_RAD', 'AtlasSimInterface',
+                  'fallen_robot', 'falling_robot'],
     'session': ['STANDING_BEHAVIORS', 'AsiSession'],
     'teleop': ['MOVES', 'Settings', 'ego_steps', 'key_action'],
     'walk_client': ['Outcome', 'WalkClient'],

@@ -64,7 +64,8 @@ from tutorial_atlas_control.walking import (
     WalkBehaviour,
 )
 
-__all__ = ['DOWN_PELVIS_M', 'FALLING_PELVIS_M', 'FALLING_TILT_RAD', 'AtlasSimInterface']
+__all__ = ['DOWN_PELVIS_M', 'FALLING_PELVIS_M', 'FALLING_TILT_RAD', 'AtlasSimInterface',
+           'fallen_robot', 'falling_robot']
 
 #: A standing behaviour is falling once the pelvis is below this (m; Stand holds it at
 #: about 0.91 m) ...
@@ -91,6 +92,19 @@ def servo_of(params: ManipulateParams) -> PelvisServo | None:
     if not params.use_desired:
         return None
     return PelvisServo(params.pelvis_height_m, params.pelvis_yaw_rad, params.pelvis_lat_m)
+
+
+def falling_robot(sim: AtlasSimulator) -> bool:
+    """The pelvis low or tilted (FALLING_PELVIS_M, FALLING_TILT_RAD)."""
+    data, pelvis = sim.data, sim.atlas.pelvis_body_id
+    upright = float(data.xmat[pelvis][8])  # the pelvis z axis's world z component
+    tilt = math.acos(max(-1.0, min(1.0, upright)))
+    return float(data.xpos[pelvis][2]) < FALLING_PELVIS_M or tilt > FALLING_TILT_RAD
+
+
+def fallen_robot(sim: AtlasSimulator) -> bool:
+    """The pelvis below DOWN_PELVIS_M: fallen for good."""
+    return float(sim.data.xpos[sim.atlas.pelvis_body_id][2]) < DOWN_PELVIS_M
 
 
 class AtlasSimInterface:
@@ -255,17 +269,6 @@ class AtlasSimInterface:
             return False
         return signed_distance(polygon, state.com[:2]) >= -COM_OUTSIDE_TOLERANCE_M
 
-    def falling(self) -> bool:
-        """The pelvis low or tilted (FALLING_PELVIS_M, FALLING_TILT_RAD)."""
-        data, pelvis = self.sim.data, self.sim.atlas.pelvis_body_id
-        upright = float(data.xmat[pelvis][8])  # the pelvis z axis's world z component
-        tilt = math.acos(max(-1.0, min(1.0, upright)))
-        return float(data.xpos[pelvis][2]) < FALLING_PELVIS_M or tilt > FALLING_TILT_RAD
-
-    def down(self) -> bool:
-        """The pelvis below DOWN_PELVIS_M: fallen for good."""
-        return float(self.sim.data.xpos[self.sim.atlas.pelvis_body_id][2]) < DOWN_PELVIS_M
-
     def f_out(self) -> np.ndarray:
         """The behaviour's joint torques this step (N m): the Stand behaviour's or a hold's;
         none in User and ragdoll."""
@@ -287,7 +290,7 @@ class AtlasSimInterface:
         self._observe()
         sim, data, session = self.sim, self.sim.data, self.session
         current = self.current_behavior
-        falling = current in STANDING_BEHAVIORS and self.falling()
+        falling = current in STANDING_BEHAVIORS and falling_robot(sim)
         adr, dof = sim.atlas.free_qpos_adr, self._free_dof
         feet = np.empty((2, 7))
         for row, body in enumerate(self._feet):
@@ -328,7 +331,7 @@ class AtlasSimInterface:
         self._observe()
         self.session.end_step()
         mode = self.sim.mode
-        if mode in (ControlMode.WALK, ControlMode.STEP) and self.down():
+        if mode in (ControlMode.WALK, ControlMode.STEP) and fallen_robot(self.sim):
             self._switch(ControlMode.FREEZE)
             self.session.auto_switched(Behavior.FREEZE, BEHAVIOR_OF_MODE[mode])
             self._stand_after_walk = self._stand_after_step = False

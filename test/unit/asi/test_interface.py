@@ -10,7 +10,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.asi import AsiError, AtlasSimInterface, Behavior, Status
+from tutorial_atlas_control.asi import (
+    AsiError,
+    AtlasSimInterface,
+    Behavior,
+    Status,
+    falling_robot,
+)
 from tutorial_atlas_control.balance import place_in_stand_pose
 from tutorial_atlas_control.control_modes import ControlMode
 from tutorial_atlas_control.joints import NUM_JOINTS
@@ -128,7 +134,7 @@ def test_stand_is_refused_for_a_fallen_robot_which_reports_falling_in_stand(
     assert state.behavior_feedback.status_flags == Status.FAILED_TRANS_COM_POS
     assert state.error_code == AsiError.FAILED_TO_START_BEHAVIOR
     sim.set_mode(ControlMode.STAND)  # /atlas/control_mode Stand is not refused
-    assert interface.falling()
+    assert falling_robot(sim)
     assert interface.state().behavior_feedback.status_flags == Status.ERROR_FALLING
 
 
@@ -136,7 +142,7 @@ def test_a_push_beyond_what_stand_survives_is_reported_falling(
         interface: AtlasSimInterface) -> None:
     sim = interface.sim
     run(interface, 500)
-    assert not interface.falling()
+    assert not falling_robot(sim)
     sim.apply_input(WrenchInput((1000.0, 0.0, 0.0), (0.0, 0.0, 0.0)))  # 200 N s
     run(interface, 200)
     sim.apply_input(WrenchInput((0.0, 0.0, 0.0), (0.0, 0.0, 0.0)))
