@@ -55,7 +55,7 @@ from tutorial_atlas_control.msgs import (
     StepFeedback,
     WalkFeedback,
 )
-from tutorial_atlas_control.sim import AtlasSimulator
+from tutorial_atlas_control.sim import AtlasSimulator, pelvis_height_m
 from tutorial_atlas_control.walking import (
     DRCSIM_WALK_QUEUE,
     STEP_DURATION_S,
@@ -103,8 +103,9 @@ def falling_robot(sim: AtlasSimulator) -> bool:
 
 
 def fallen_robot(sim: AtlasSimulator) -> bool:
-    """The pelvis below DOWN_PELVIS_M: fallen for good."""
-    return float(sim.data.xpos[sim.atlas.pelvis_body_id][2]) < DOWN_PELVIS_M
+    """The pelvis below DOWN_PELVIS_M (as the state's pelvis_position reports it): fallen
+    for good."""
+    return pelvis_height_m(sim.atlas, sim.data) < DOWN_PELVIS_M
 
 
 class AtlasSimInterface:
