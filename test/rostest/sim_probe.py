@@ -43,6 +43,8 @@ class SimProbe:
         #: time.monotonic() at each kept joint state's arrival (s).
         self.joint_state_arrivals_s: list[float] = []
         self.configs: list[dict] = []
+        #: Each /atlas/current_control_mode the simulator said, in order.
+        self.modes: list[str] = []
         rospy.Subscriber('/clock', Clock, self._on_clock, queue_size=1000)
         rospy.Subscriber('/atlas/joint_states', JointState, self._on_joint_state, queue_size=2000)
         rospy.Subscriber('/ground_truth_odom', Odometry, self._on_odom, queue_size=100)
@@ -51,6 +53,7 @@ class SimProbe:
                              self._on_contact, callback_args=side, queue_size=100)
         rospy.Subscriber('/rosout', Log, self._on_log, queue_size=100)
         rospy.Subscriber('/atlas/sim_config', String, self._on_config, queue_size=10)
+        rospy.Subscriber('/atlas/current_control_mode', String, self._on_mode, queue_size=10)
         self.mode_pub = rospy.Publisher('/atlas/control_mode', String, queue_size=10, latch=True)
         self.command_pub = rospy.Publisher('/atlas/joint_commands', JointCommands, queue_size=10)
 
@@ -74,6 +77,10 @@ class SimProbe:
     def _on_config(self, msg: String) -> None:
         with self.lock:
             self.configs.append(json.loads(msg.data))
+
+    def _on_mode(self, msg: String) -> None:
+        with self.lock:
+            self.modes.append(msg.data)
 
     def _on_log(self, msg: Log) -> None:
         if msg.level >= Log.WARN:
@@ -165,6 +172,19 @@ class SimProbe:
 
     def set_mode(self, mode: str) -> None:
         self.mode_pub.publish(String(data=mode))
+
+    def set_mode_applied(self, mode: str) -> None:
+        """set_mode, and wait until the simulator says it switched."""
+        with self.lock:
+            seen = len(self.modes)
+        self.set_mode(mode)
+        self.wait_until(lambda: mode in self.modes[seen:], f'/atlas/current_control_mode {mode}')
+
+    def restart_held(self, service: str = '/gazebo/reset_world') -> int:
+        """The robot at its initial pose in the start's hold (Stand's mode, no behaviour:
+        the tutorial's start): Stand, then a reset in it. Returns reset()'s sim time."""
+        self.set_mode_applied('Stand')
+        return self.reset(service)
 
     def send(self, names: Sequence[str], **arrays: Sequence[float]) -> None:
         self.command_pub.publish(JointCommands(name=list(names), **arrays))

@@ -97,8 +97,7 @@ class AtlasCommandTest(unittest.TestCase):
     # -- interface ---------------------------------------------------------------------------
     def scenario_interface(self) -> None:
         self.k_effort_zero_in_user_mode()
-        self.probe.reset('/gazebo/reset_world')
-        self.probe.set_mode('Stand')
+        self.probe.restart_held()
         self.probe.wait_sim(UNPIN_WAIT_S)
         self.reset_controls_forms()
         self.bad_inputs()

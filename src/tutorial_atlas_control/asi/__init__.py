@@ -12,7 +12,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'behaviors': ['BEHAVIOR_OF_MODE', 'MODE_OF_BEHAVIOR', 'AsiError', 'Behavior', 'Status'],
     'interface': ['DOWN_PELVIS_M', 'FALLING_PELVIS_M', 'FALLING_TILT_RAD', 'AtlasSimInterface',
                   'fallen_robot', 'falling_robot'],
-    'session': ['STANDING_BEHAVIORS', 'AsiSession'],
+    'session': ['REFUSAL_REPORTED_STEPS', 'STANDING_BEHAVIORS', 'AsiSession', 'Refusal'],
     'teleop': ['MOVES', 'Settings', 'ego_steps', 'key_action'],
     'walk_client': ['Outcome', 'WalkClient'],
     'walk_demo': ['Decision', 'WalkDemoServer', 'yaw_of_quaternion'],

@@ -18,6 +18,11 @@ new `step_params.desired_step` (a STEP streamed for a target already reached doe
 again), standing between steps; Stand asked for during a step is taken once it is down. A
 switch made elsewhere (/atlas/control_mode, /atlas/mode bdi_stand) is seen at the next
 state or step and reported as a successful transition.
+
+With `hold_at_start` (atlas.launch's default start) the library is loaded but waits: the
+start holds the robot with the parameter gains, the tutorial's hold, reported as User (the
+PID holds it, k_effort 255) until a Stand is asked for (an ASI STAND, /atlas/control_mode
+Stand); after reset_world in Stand, the start's hold again.
 """
 
 from __future__ import annotations
@@ -29,7 +34,7 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control.asi.behaviors import BEHAVIOR_OF_MODE, MODE_OF_BEHAVIOR, Behavior
-from tutorial_atlas_control.asi.session import STANDING_BEHAVIORS, AsiSession
+from tutorial_atlas_control.asi.session import STANDING_BEHAVIORS, AsiSession, behavior_name
 from tutorial_atlas_control.asi.walk_params import (
     footsteps_of,
     sole_step,
@@ -111,10 +116,19 @@ def fallen_robot(sim: AtlasSimulator) -> bool:
 class AtlasSimInterface:
     """Behaviour requests and state reports for `sim`; with `balance`, Stand is the
     balancing StandBehaviour, else the simulator's hold until a bdi_stand sequence (the
-    start-up mode or /atlas/mode) asks for BDI's Stand, which loads the balancing one."""
+    start-up mode or /atlas/mode) asks for BDI's Stand, which loads the balancing one.
+    `hold_at_start`: a (re)start in Stand holds the robot as the tutorial's start did until
+    Stand is asked for."""
 
-    def __init__(self, sim: AtlasSimulator, balance: bool = True) -> None:
+    def __init__(self, sim: AtlasSimulator, balance: bool = True,
+                 hold_at_start: bool = False) -> None:
         self.sim = sim
+        if balance and hold_at_start:
+            sim.hold_stand_at_start = True
+            if sim.mode is ControlMode.STAND:
+                sim.behaviours.hold_start()
+        #: Why the last request was not carried out, for the log (take_refusal).
+        self._refusal: str | None = None
         #: The balancing Stand installed (None: Stand is the hold); its estimator, or one of
         #: the interface's own, checks the centre of mass before Stand is entered.
         self.stand: StandBehaviour | None = None
@@ -132,7 +146,8 @@ class AtlasSimInterface:
         #: Manipulate runs: Stand, started `_stand_starts`-th, with its pelvis servoed.
         self.manipulating = False
         self._stand_starts = 0
-        self._mode = sim.mode
+        #: The behaviour the mode was last seen running (Manipulate apart).
+        self._seen = self._mode_behavior()
         model = sim.model
         self._feet = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name)
                       for name in FOOT_BODIES]
@@ -158,7 +173,20 @@ class AtlasSimInterface:
 
     @property
     def current_behavior(self) -> Behavior:
-        return Behavior.MANIPULATE if self.manipulating else BEHAVIOR_OF_MODE[self.sim.mode]
+        return Behavior.MANIPULATE if self.manipulating else self._mode_behavior()
+
+    def _mode_behavior(self) -> Behavior:
+        """The behaviour the control mode runs: User during the start's hold (the PID with
+        the parameter gains holds the robot; no behaviour of the library acts)."""
+        if self.sim.behaviours.holding_start:
+            return Behavior.USER
+        return BEHAVIOR_OF_MODE[self.sim.mode]
+
+    def take_refusal(self) -> str | None:
+        """The log line of the last request's refusal, once (None: it was not refused)."""
+        refusal = self.session.take_refusal()
+        line, self._refusal = self._refusal, None
+        return refusal.line() if refusal is not None else line
 
     def apply(self, command: AsiCommand) -> None:
         """One checked AtlasSimInterfaceCommand, between two steps."""
@@ -182,6 +210,10 @@ class AtlasSimInterface:
                  if command.behavior == Behavior.WALK else [])
         if command.behavior == Behavior.WALK != current \
                 and not any(step.step_index == 1 for step in steps):
+            indices = [step.step_index for step in steps]
+            self._refusal = (f'ignored AtlasSimInterfaceCommand behavior 4 (WALK) in '
+                             f'{behavior_name(current)}: its step_queue has step_index '
+                             f'{indices or "none"}, and a new walk starts with step_index 1')
             return
         stepping = self.stepping
         if command.behavior == Behavior.STEP and stepping is not None:
@@ -224,10 +256,10 @@ class AtlasSimInterface:
     def _switch(self, mode: ControlMode) -> None:
         """The simulator into `mode`; a behaviour switch never changes k_effort."""
         sim = self.sim
-        if mode is not sim.mode:
+        if mode is not sim.mode or sim.behaviours.holding_start:
             kept = None if sim.user_command is None else sim.user_command.k_effort.copy()
             sim.set_mode(mode)
-            self._mode = mode
+            self._seen = self._mode_behavior()
             if kept is not None:
                 self._set_k_effort(kept)
 
@@ -252,11 +284,10 @@ class AtlasSimInterface:
             self.manipulating = False
             if mode is ControlMode.STAND:
                 self.session.switched(Behavior.STAND, Behavior.MANIPULATE)
-        if mode is not self._mode:
-            current, previous = BEHAVIOR_OF_MODE[mode], BEHAVIOR_OF_MODE[self._mode]
-            self._mode = mode
-            if current != previous:
-                self.session.switched(current, previous)
+        current = self._mode_behavior()
+        if current is not self._seen:
+            previous, self._seen = self._seen, current
+            self.session.switched(current, previous)
 
     def _set_k_effort(self, fractions: np.ndarray) -> None:
         self.sim.receive_updates([CommandUpdate(_ALL_JOINTS, _K_EFFORT_ROW,
@@ -274,15 +305,17 @@ class AtlasSimInterface:
         """The behaviour's joint torques this step (N m): the Stand behaviour's or a hold's;
         none in User and ragdoll."""
         sim = self.sim
-        if sim.mode in (ControlMode.USER, ControlMode.RAGDOLL):
+        if sim.mode in (ControlMode.USER, ControlMode.RAGDOLL) or sim.behaviours.holding_start:
             return _NO_TORQUE
         return sim.torque_nm if sim.commands.blend_command is None else sim.law.f_out_nm
 
     def k_effort(self) -> np.ndarray:
-        """The blend in use (uint8, (28,)): the user command's in User; elsewhere the
-        blended user command's, 0 on every joint when the behaviour alone acts."""
+        """The blend in use (uint8, (28,)): the user command's in User; the hold's PID
+        during the start's hold; elsewhere the blended user command's, 0 on every joint when
+        the behaviour alone acts."""
         sim = self.sim
-        if sim.mode is ControlMode.USER or sim.commands.blend_command is not None:
+        if sim.mode is ControlMode.USER or sim.behaviours.holding_start \
+                or sim.commands.blend_command is not None:
             return sim.active_k_effort()
         return _NO_BLEND
 

@@ -41,10 +41,12 @@ Parameters (private unless noted):
         robot_state_publisher: atlas.launch's state_publisher.py does both.
     ~bag_dir (str, unset): where the launch's recorder writes; if set and no file can be
         written there, the node refuses to start (one line).
-    ~stand (str, hold): what Stand does. hold: the port's stand-in for BDI's behaviour, a
-        joint hold with the parameter gains (DRCSim 2.5.2's tutorial behaves as measured),
-        until a bdi_stand sequence asks for BDI's Stand; balance: the open AtlasSimInterface's
-        balancing Stand from the start (balance/, docs/controllers.md).
+    ~stand (str, balance): what Stand does. balance: the open AtlasSimInterface's balancing
+        Stand (balance/, docs/controllers.md) whenever Stand is asked for (an ASI STAND,
+        /atlas/control_mode Stand, bdi_stand's sequence); a (re)start in Stand holds the robot
+        with the parameter gains, the tutorial's start, until then. hold: Stand is that joint
+        hold (DRCSim 2.5.2's stand-in for BDI's behaviour) until a bdi_stand sequence asks for
+        BDI's Stand.
     ~model_file (str, the package's sim/atlas_v1.xml): the MJCF to simulate; it must have
         Atlas v1's joints, actuators and sensors (a variant of the package's model).
     /atlas/time_to_unpin (float, 1.0): seconds the torso stays pinned after start/reset.
@@ -142,7 +144,7 @@ MESSAGE_CLASSES: dict[str, type[genpy.Message]] = {cls._type: cls for cls in (
     Clock, JointState, Odometry, Imu, WrenchStamped, ControllerStatistics, AtlasState,
     ForceTorqueSensors, SynchronizationStatistics, TFMessage, String, AtlasSimInterfaceState)}
 #: What ~stand chooses Stand to be (the first is the default).
-STAND_CHOICES = ('hold', 'balance')
+STAND_CHOICES = ('balance', 'hold')
 #: Queue size of the publishers the node itself calls publish() on (1 when not named).
 QUEUE_SIZES = {topics.SIM_INPUTS: 100}
 
@@ -425,8 +427,8 @@ class SimNode:
             return
         if mode is ControlMode.WALK and self.loop.asi.walking is None:
             rospy.logwarn_throttle(WARN_THROTTLE_S, 'refused /atlas/control_mode: Walk needs '
-                                   'the balancing Stand (stand:=balance, or /atlas/mode '
-                                   'bdi_stand first)')
+                                   'the balancing Stand (stand:=balance, the default, '
+                                   'or /atlas/mode bdi_stand first)')
             return
         previous = self.loop.set_mode(mode)
         self.node_publishers[topics.CURRENT_CONTROL_MODE].publish(String(data=mode.value))
@@ -498,7 +500,8 @@ def build_node() -> SimNode:
     settings = LoopSettings(rates_hz, _float_param('~real_time_factor', 1.0),
                             bool(rospy.get_param('~paused', False)),
                             _links_publisher(description) if tf_publisher == 'sim' else None,
-                            balance_stand=stand == 'balance')
+                            balance_stand=stand == 'balance',
+                            hold_at_start=stand == 'balance')
     return SimNode(sim, settings, bool(rospy.get_param('~gui', False)),
                    description is not None, DelayBudgets.from_params(rospy.get_param))
 

@@ -34,7 +34,9 @@ class ModeBehaviours:
     """The behaviours installed for the control modes, and the one acting now.
 
     Stand and StandPrep take one; a mode without one keeps the simulator's law on its
-    command (the hold, the user's PID, ragdoll's zeros).
+    command (the hold, the user's PID, ragdoll's zeros). The port's start holds the robot
+    with that law even where Stand has a behaviour (`holding_start`): the behaviour library
+    is there, waiting to be asked, as DRCSim 3.x's library waited in User.
     """
 
     def __init__(self) -> None:
@@ -42,6 +44,9 @@ class ModeBehaviours:
         self.installed: dict[ControlMode, Behaviour] = {}
         #: The behaviour acting now (the mode's, started), or None.
         self.acting: Behaviour | None = None
+        #: The start's hold acts although the mode's behaviour is installed: until a mode
+        #: is selected (set_mode), no behaviour acts.
+        self.holding_start = False
 
     @property
     def stand(self) -> Behaviour | None:
@@ -55,8 +60,14 @@ class ModeBehaviours:
         else:
             self.installed[mode] = behaviour
 
+    def hold_start(self) -> None:
+        """The start's hold acts, whatever is installed, until the next select."""
+        self.acting = None
+        self.holding_start = True
+
     def select(self, mode: ControlMode, data: mujoco.MjData) -> None:
         """`mode`'s behaviour, started from the robot in `data`, becomes the acting one."""
+        self.holding_start = False
         behaviour = self.installed.get(mode)
         if behaviour is not None:
             behaviour.start(data)

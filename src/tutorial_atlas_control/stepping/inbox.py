@@ -184,6 +184,9 @@ class CommandInbox:
         if command.ignored_text():
             self.log.kept_fields(f'{ASI_TOPIC}: {command.ignored_text()}', ASI_TOPIC)
         self.asi.apply(command)
+        refusal = self.asi.take_refusal()
+        if refusal is not None:
+            self.log.refused_command(refusal, ASI_TOPIC)
 
     def _note_command_stamp(self, raw: bytes) -> None:
         """The command in `raw` is applied from the coming step on: remember its stamp."""

@@ -55,6 +55,9 @@ class LoopSettings:
             stead (link_transforms.py); None: not.
         balance_stand: Stand is the open AtlasSimInterface's balancing Stand; False: the
             simulator's hold (DRCSim 2.5.2's stand-in).
+        hold_at_start: with balance_stand, a (re)start in Stand holds the robot with the
+            parameter gains (the tutorial's start, reported as User) until Stand is asked
+            for; False: the balancing Stand acts from the start.
     """
 
     rates_hz: Mapping[str, float] = field(default_factory=dict)
@@ -62,6 +65,7 @@ class LoopSettings:
     paused: bool = False
     links: LinkTransforms | None = None
     balance_stand: bool = False
+    hold_at_start: bool = False
 
 
 class SteppingLoop:
@@ -92,7 +96,7 @@ class SteppingLoop:
                   else SynchronizationWindow(DelayBudgets()))
         self.watch = RunWatch(sim, outputs.log)
         #: The AtlasSimInterface: its commands come through the inbox, its state is published.
-        self.asi = AtlasSimInterface(sim, settings.balance_stand)
+        self.asi = AtlasSimInterface(sim, settings.balance_stand, settings.hold_at_start)
         self.inbox = CommandInbox(sim, outputs.log, statistics, self.watch, window.budgets,
                                   self.asi)
         self.controller: StepController = (controller(self.inbox) if controller is not None

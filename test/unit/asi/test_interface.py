@@ -245,3 +245,86 @@ def test_bdi_stand_loads_the_balancing_stand_into_a_hold_session(
     assert sim.mode is ControlMode.STAND
     assert interface.stand is not None and sim.behaviours.acting is interface.stand
     assert interface.session.served[Behavior.MANIPULATE] is ControlMode.STAND
+
+
+@pytest.fixture
+def waiting(atlas: atlas_model.AtlasModel) -> AtlasSimInterface:
+    """atlas.launch's default start: pinned for 1 s, the library loaded but waiting."""
+    sim = AtlasSimulator(atlas, load_gains_yaml(CONFIG))
+    return AtlasSimInterface(sim, hold_at_start=True)
+
+
+def test_the_default_start_holds_as_the_tutorial_did_and_says_user(
+        waiting: AtlasSimInterface) -> None:
+    sim = waiting.sim
+    run(waiting, 1500)  # past the pin's release at 1 s
+    assert sim.mode is ControlMode.STAND and sim.behaviours.acting is None
+    state = waiting.state()
+    assert state.current_behavior == Behavior.USER
+    np.testing.assert_array_equal(state.k_effort, np.full(NUM_JOINTS, 255, np.uint8))
+    np.testing.assert_array_equal(state.f_out_nm, np.zeros(NUM_JOINTS))
+    # The tutorial's hold: the initial pose, straight legs, the pelvis where it started.
+    assert state.pelvis_position_m[2] == pytest.approx(0.927, abs=0.005)
+
+
+def test_an_asi_stand_from_the_default_start_hands_the_robot_to_the_balancing_stand(
+        waiting: AtlasSimInterface) -> None:
+    sim = waiting.sim
+    run(waiting, 1500)
+    waiting.apply(command(Behavior.STAND, np.zeros(NUM_JOINTS)))
+    assert waiting.take_refusal() is None
+    assert sim.behaviours.acting is waiting.stand
+    state = waiting.state()
+    assert (state.current_behavior, state.behavior_feedback.status_flags) == (
+        Behavior.STAND, Status.TRANSITION_SUCCESS)
+    assert (state.behavior_feedback.trans_from_behavior_index,
+            state.behavior_feedback.trans_to_behavior_index) == (Behavior.USER, Behavior.STAND)
+    run(waiting, 2000)
+    state = waiting.state()
+    assert state.current_behavior == Behavior.STAND
+    np.testing.assert_array_equal(state.k_effort, np.zeros(NUM_JOINTS, np.uint8))
+    assert state.pelvis_position_m[2] == pytest.approx(0.91, abs=0.01)  # the Stand's height
+
+
+def test_control_mode_stand_gets_the_balancing_stand_and_a_reset_the_hold_again(
+        waiting: AtlasSimInterface) -> None:
+    sim = waiting.sim
+    run(waiting, 10)
+    sim.set_mode(ControlMode.STAND)  # /atlas/control_mode Stand
+    assert sim.behaviours.acting is waiting.stand
+    state = waiting.state()
+    assert (state.current_behavior, state.behavior_feedback.status_flags) == (
+        Behavior.STAND, Status.TRANSITION_SUCCESS)
+    run(waiting, 10)
+    sim.reset_world()
+    assert sim.behaviours.acting is None
+    assert waiting.state().current_behavior == Behavior.USER
+
+
+def test_walk_from_the_default_start_is_refused_in_one_line_naming_stand(
+        waiting: AtlasSimInterface) -> None:
+    run(waiting, 10)
+    step = StepData(1, 0, 0.63, (0.2, 0.12, 0.0), (0.0, 0.0, 0.0, 1.0), 0.1)
+    walk = AsiCommand(0, Behavior.WALK, (step,) + (StepData(),) * 3, False, StepData(), False,
+                      ManipulateParams(), None, 0)
+    waiting.apply(walk)
+    assert waiting.take_refusal() == (
+        'refused AtlasSimInterfaceCommand behavior 4 (WALK) in USER: '
+        'FAILED_TRANS_ILLEGAL_BEHAVIOR, WALK needs Stand: send STAND (behavior 0) first')
+    assert waiting.take_refusal() is None
+    assert waiting.state().behavior_feedback.status_flags == Status.FAILED_TRANS_ILLEGAL_BEHAVIOR
+    waiting.apply(command(Behavior.STAND))  # the remedy: taken at once
+    assert waiting.take_refusal() is None
+    assert waiting.state().current_behavior == Behavior.STAND
+
+
+def test_a_walk_without_its_first_step_outside_walk_is_said_aloud(
+        interface: AtlasSimInterface) -> None:
+    step = StepData(3, 0, 0.63, (0.2, 0.12, 0.0), (0.0, 0.0, 0.0, 1.0), 0.1)
+    walk = AsiCommand(0, Behavior.WALK, (step,) + (StepData(),) * 3, False, StepData(), False,
+                      ManipulateParams(), None, 0)
+    interface.apply(walk)
+    assert interface.take_refusal() == (
+        'ignored AtlasSimInterfaceCommand behavior 4 (WALK) in STAND: its step_queue has '
+        'step_index [3], and a new walk starts with step_index 1')
+    assert interface.current_behavior == Behavior.STAND

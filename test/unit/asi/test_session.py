@@ -5,7 +5,14 @@ from __future__ import annotations
 
 import pytest
 
-from tutorial_atlas_control.asi import AsiError, AsiSession, Behavior, Status
+from tutorial_atlas_control.asi import (
+    MODE_OF_BEHAVIOR,
+    REFUSAL_REPORTED_STEPS,
+    AsiError,
+    AsiSession,
+    Behavior,
+    Status,
+)
 from tutorial_atlas_control.control_modes import ControlMode
 
 STAND, USER = Behavior.STAND, Behavior.USER
@@ -42,7 +49,8 @@ def test_the_running_behaviour_requested_again_changes_nothing() -> None:
 ])
 def test_a_refused_request_keeps_the_behaviour_and_says_why_until_a_switch(
         behavior: int, status: Status, error: AsiError) -> None:
-    session = AsiSession()
+    session = AsiSession({Behavior.STAND: ControlMode.STAND, Behavior.USER: ControlMode.USER,
+                          Behavior.FREEZE: ControlMode.FREEZE})
     assert session.request(behavior, USER, True) is None
     for _ in range(3):
         session.end_step()
@@ -80,3 +88,64 @@ def test_a_switch_made_elsewhere_is_reported_as_the_library_s() -> None:
 
 def test_every_status_is_a_single_value() -> None:
     assert all(status == 0 or status & (status - 1) == 0 for status in Status)
+
+
+def test_walk_step_and_manipulate_need_a_standing_behaviour_first() -> None:
+    served = {**MODE_OF_BEHAVIOR, Behavior.WALK: ControlMode.WALK,
+              Behavior.STEP: ControlMode.STEP, Behavior.MANIPULATE: ControlMode.STAND}
+    for current in (USER, Behavior.FREEZE, Behavior.STAND_PREP):
+        for wanted in (Behavior.WALK, Behavior.STEP, Behavior.MANIPULATE):
+            session = AsiSession(served)
+            assert session.request(wanted, current, feet_under_com=True) is None
+            assert session.status_flags(current, False) == Status.FAILED_TRANS_ILLEGAL_BEHAVIOR
+            assert session.error_code == AsiError.FAILED_TO_START_BEHAVIOR
+            refusal = session.take_refusal()
+            assert refusal is not None and session.take_refusal() is None
+            assert refusal.line() == (
+                f'refused AtlasSimInterfaceCommand behavior {int(wanted)} ({wanted.name}) in '
+                f'{current.name}: FAILED_TRANS_ILLEGAL_BEHAVIOR, {wanted.name} needs Stand: '
+                'send STAND (behavior 0) first')
+    session = AsiSession(served)
+    assert session.request(Behavior.WALK, STAND, True) is ControlMode.WALK
+    assert session.take_refusal() is None
+
+
+@pytest.mark.parametrize(('behavior', 'feet', 'reason'), [
+    (9, True, 'not a behaviour (0 STAND, 1 USER, 2 FREEZE, 3 STAND_PREP, 4 WALK, 5 STEP, '
+              '6 MANIPULATE)'),
+    (Behavior.WALK, True, 'WALK is not served with the stiff hold as Stand (atlas.launch '
+                          'stand:=hold): launch with stand:=balance, the default'),
+    (Behavior.STAND, False, 'STAND needs the centre of mass over the feet: the robot is down '
+                            'or off balance (reset_world, or StandPrep from the harness)'),
+])
+def test_each_refusal_says_why_and_what_to_do(behavior: int, feet: bool, reason: str) -> None:
+    session = AsiSession()
+    session.request(behavior, USER, feet_under_com=feet)
+    refusal = session.take_refusal()
+    assert refusal is not None and refusal.reason == reason
+    assert refusal.line().startswith(f'refused AtlasSimInterfaceCommand behavior {behavior} (')
+
+
+def test_a_refusal_is_answered_by_the_next_request_and_never_latched() -> None:
+    session = AsiSession()
+    session.request(Behavior.WALK, STAND, True)  # not served here
+    session.end_step()
+    assert session.status_flags(STAND, False) == Status.FAILED_TRANS_ILLEGAL_BEHAVIOR
+    assert session.request(Behavior.STAND, STAND, True) is None  # the running one: fine
+    assert session.status_flags(STAND, False) == Status.OK
+    assert session.error_code == AsiError.NO_ERRORS
+    # Unanswered, it is reported for REFUSAL_REPORTED_STEPS steps, then no more.
+    session.request(Behavior.WALK, STAND, True)
+    for _ in range(REFUSAL_REPORTED_STEPS - 1):
+        session.end_step()
+    assert session.status_flags(STAND, False) == Status.FAILED_TRANS_ILLEGAL_BEHAVIOR
+    session.end_step()
+    assert session.status_flags(STAND, False) == Status.OK
+    assert session.error_code == AsiError.NO_ERRORS
+
+
+def test_a_new_request_leaves_a_transition_under_way_reported() -> None:
+    session = AsiSession()
+    session.defer(Behavior.STAND, Behavior.WALK)
+    assert session.request(Behavior.WALK, Behavior.WALK, True) is None
+    assert session.status_flags(Behavior.WALK, False) == Status.TRANSITION_IN_PROGRESS

@@ -47,12 +47,13 @@ def sim(atlas: atlas_model.AtlasModel) -> AtlasSimulator:
     return AtlasSimulator(atlas, load_gains_yaml(CONFIG))
 
 
-def make_loop(sim: AtlasSimulator, listeners: set[str],
-              balance: bool = False) -> tuple[SteppingLoop, FakeOutbox, FakeLog]:
+def make_loop(sim: AtlasSimulator, listeners: set[str], balance: bool = False,
+              hold_at_start: bool = False) -> tuple[SteppingLoop, FakeOutbox, FakeLog]:
     outbox, log = FakeOutbox(listeners), FakeLog()
     outlets = {topic: topic for topic in (*ALL_TOPICS, topics.ASI_STATE)}
     loop = SteppingLoop(sim, LoopOutputs(outbox, outlets, log, lambda _text: None),
-                        LoopSettings(LAUNCH_RATES_HZ, balance_stand=balance),
+                        LoopSettings(LAUNCH_RATES_HZ, balance_stand=balance,
+                                     hold_at_start=hold_at_start),
                         CommandAgeStatistics(sim.dt_s))
     return loop, outbox, log
 
@@ -132,3 +133,23 @@ def test_balance_stand_makes_stand_the_balancing_behaviour(sim: AtlasSimulator) 
     assert sim.behaviours.acting is loop.asi.stand
     loop, _, _ = make_loop(AtlasSimulator(sim.atlas, sim.gains), set())
     assert loop.sim.behaviours.acting is None
+
+
+def test_a_refused_request_is_said_in_one_line_and_the_remedy_is_taken(
+        sim: AtlasSimulator) -> None:
+    loop, _, log = make_loop(sim, set(), balance=True, hold_at_start=True)
+    assert loop.asi.current_behavior == Behavior.USER  # the start's hold
+    loop.receive_command(asi_bytes(Behavior.MANIPULATE), topics.ASI_COMMAND)
+    loop.apply_pending_commands()
+    assert log.of('refused') == [
+        'refused AtlasSimInterfaceCommand behavior 6 (MANIPULATE) in USER: '
+        'FAILED_TRANS_ILLEGAL_BEHAVIOR, MANIPULATE needs Stand: send STAND (behavior 0) first']
+    loop.receive_command(asi_bytes(Behavior.STAND), topics.ASI_COMMAND)
+    loop.receive_command(asi_bytes(Behavior.MANIPULATE), topics.ASI_COMMAND)
+    loop.apply_pending_commands()  # the newest of a step's only: MANIPULATE, still refused
+    loop.receive_command(asi_bytes(Behavior.STAND), topics.ASI_COMMAND)
+    loop.apply_pending_commands()
+    assert len(log.of('refused')) == 2 and sim.behaviours.acting is loop.asi.stand
+    loop.receive_command(asi_bytes(Behavior.MANIPULATE), topics.ASI_COMMAND)
+    loop.apply_pending_commands()
+    assert len(log.of('refused')) == 2 and loop.asi.current_behavior == Behavior.MANIPULATE
