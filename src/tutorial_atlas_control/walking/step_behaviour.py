@@ -4,8 +4,11 @@ It stands (the balancing Stand, taken over where the robot stands) until a clien
 step, takes it quasi-statically (static_step), and stands again where it landed. The
 desired step is the latest one sent: a target equal to the one last taken is not taken
 again (a client may stream its STEP at 1 kHz), and one sent while a step is under way is
-taken after it. Each target is clamped from the stance foot (step_queue's limits) and
-reported as `desired_step_saturated`.
+taken after it. Where the target desired as a step touched down differs from that step's,
+it is the next one (as BDI's library went on at once, before clients answered the
+SWAYING that touchdown reports: the walking tutorial's client, counting its steps on that
+SWAYING, already sends the step after it). Each target is clamped from the stance foot
+(step_queue's limits) and reported as `desired_step_saturated`.
 """
 
 from __future__ import annotations
@@ -51,6 +54,8 @@ class StepBehaviour:
         self.steps_taken = 0
         self._taken: Footstep | None = None
         self._saturated: Footstep | None = None
+        #: The target desired when the step under way touched down (None: not yet down).
+        self._desired_at_touchdown: Footstep | None = None
 
     def desire(self, step: Footstep | None) -> None:
         """A client's target (None: no step wanted)."""
@@ -60,7 +65,7 @@ class StepBehaviour:
         """Stand where the robot stands; the count of steps starts again."""
         self.stand.start(data)
         self.stepping, self.steps_taken = None, 0
-        self._taken = self._saturated = None
+        self._taken = self._saturated = self._desired_at_touchdown = None
 
     def torque(self, data: mujoco.MjData) -> np.ndarray:
         """This step's f_out (N m, (28,)), within the effort limits."""
@@ -69,19 +74,35 @@ class StepBehaviour:
             self.stepping = None
             self.steps_taken += 1
             stand.start(data)  # stand where it landed
-        if self.stepping is None and self.desired is not None and self.desired != self._taken:
-            self._begin(data)
         if self.stepping is None:
+            wanted = self._next_target()
+            if wanted is not None:
+                self._begin(data, wanted)
+        stepping = self.stepping
+        if stepping is None:
             return stand.torque(data)
         atlas = stand.atlas
         state = stand.estimator.estimate(data.qpos, data.qvel)
         stand.last_state = state
-        return self.stepping.step_torque(state, data.qpos[atlas.qpos_adr],
-                                         data.qvel[atlas.dof_adr], float(data.time))
+        was_down = stepping.landed is not None
+        torque = stepping.step_torque(state, data.qpos[atlas.qpos_adr],
+                                      data.qvel[atlas.dof_adr], float(data.time))
+        if not was_down and stepping.landed is not None:
+            self._desired_at_touchdown = self.desired
+        return torque
 
-    def _begin(self, data: mujoco.MjData) -> None:
-        stand, wanted = self.stand, self.desired
-        assert wanted is not None and stand.controller is not None  # started
+    def _next_target(self) -> Footstep | None:
+        """The step to take now, if any: the one desired at the last touchdown when that
+        was new, else the newest one sent when it is not the one last taken."""
+        at_touchdown, self._desired_at_touchdown = self._desired_at_touchdown, None
+        for wanted in (at_touchdown, self.desired):
+            if wanted is not None and wanted != self._taken:
+                return wanted
+        return None
+
+    def _begin(self, data: mujoco.MjData, wanted: Footstep) -> None:
+        stand = self.stand
+        assert stand.controller is not None  # started
         stand.start(data)  # the reference from where it stands now
         state = stand.last_state
         assert state is not None and stand.controller is not None  # set by start
