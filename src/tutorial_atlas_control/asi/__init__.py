@@ -14,7 +14,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                   'fallen_robot', 'falling_robot'],
     'session': ['REFUSAL_REPORTED_STEPS', 'STANDING_BEHAVIORS', 'AsiSession', 'Refusal'],
     'teleop': ['MOVES', 'Settings', 'ego_steps', 'key_action'],
-    'walk_client': ['Outcome', 'WalkClient'],
+    'walk_client': ['Outcome', 'WalkClient', 'refusal_hint'],
     'walk_demo': ['Decision', 'WalkDemoServer', 'yaw_of_quaternion'],
     'walk_params': ['footsteps_of', 'sole_step', 'step_data_of', 'walk_feedback'],
 })

@@ -25,7 +25,7 @@ from atlas_msgs.msg import (
 )
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.asi import Outcome, WalkClient, yaw_of_quaternion
+from tutorial_atlas_control.asi import Outcome, WalkClient, refusal_hint, yaw_of_quaternion
 from tutorial_atlas_control.cli.convention import (
     EXIT_INTERRUPTED,
     EXIT_REFUSED,
@@ -166,8 +166,9 @@ def _walk(plan: list[Footstep], args: argparse.Namespace) -> int:
     feet = ', '.join(f'({foot.position.x:.3f}, {foot.position.y:.3f})'
                      for foot in state.foot_pos_est)
     if client.outcome is not Outcome.WALKED:
+        hint = refusal_hint(state.behavior_feedback.status_flags, state.current_behavior)
         raise _Refused(f'the walk {client.outcome.value} after {client.steps_taken} of '
-                       f'{len(plan)} steps (status {state.behavior_feedback.status_flags})')
+                       f'{len(plan)} steps ({hint})')
     print(f'{PROG}: walked {client.steps_taken} of {len(plan)} steps '
           f'({"once" if args.once else "streamed"}), back in Stand; feet at {feet}')
     rospy.signal_shutdown('walked')

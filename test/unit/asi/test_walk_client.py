@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from tutorial_atlas_control.asi.behaviors import Behavior, Status
-from tutorial_atlas_control.asi.walk_client import Outcome, WalkClient
+from tutorial_atlas_control.asi.walk_client import Outcome, WalkClient, refusal_hint
 from tutorial_atlas_control.walking import Footstep, straight_steps
 
 PLAN = straight_steps(6, 0.25)
@@ -44,8 +44,26 @@ def test_a_one_shot_client_sends_four_steps_once() -> None:
     (Status.FAILED_TRANS_COM_POS, Outcome.REFUSED)])
 def test_a_fall_or_a_refusal_ends_the_walk(status: Status, outcome: Outcome) -> None:
     client = WalkClient(PLAN)
+    assert client.on_state(STAND, Status.OK, 0, 0) is not None  # its request
     assert client.on_state(STAND, status, 0, 0) is None
     assert client.outcome is outcome
+
+
+def test_a_refusal_before_its_own_request_is_somebody_elses() -> None:
+    client = WalkClient(PLAN)
+    assert indices(client.on_state(STAND, Status.FAILED_TRANS_ILLEGAL_BEHAVIOR, 0, 0)) == [
+        1, 2, 3, 4]
+    assert client.outcome is None
+
+
+@pytest.mark.parametrize(('status', 'behavior', 'hint'), [
+    (Status.FAILED_TRANS_ILLEGAL_BEHAVIOR, Behavior.USER, 'WALK needs Stand; send STAND first'),
+    (Status.FAILED_TRANS_ILLEGAL_BEHAVIOR, Behavior.STAND, 'stand:=hold'),
+    (Status.FAILED_TRANS_COM_POS, Behavior.STAND, '/gazebo/reset_world'),
+    (Status.ERROR_FALLING, Behavior.WALK, 'the robot fell'),
+    (999, Behavior.STAND, 'status 999')])
+def test_a_refusal_is_said_with_what_to_do(status: int, behavior: Behavior, hint: str) -> None:
+    assert hint in refusal_hint(status, behavior)
 
 
 def test_a_plan_must_number_its_steps_from_one() -> None:
