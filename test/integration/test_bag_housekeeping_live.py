@@ -28,8 +28,8 @@ def test_keep_bags_deletes_the_oldest_as_the_launch_starts(tmp_path: Path) -> No
         launch.interrupt(EXIT_TIMEOUT_S)
         output = launch.output()
     assert f'record_run.sh: bag directory {bag_dir}: 3 bags, 15 MB\n' in output, output
-    assert (f'record_run.sh: deleted 2 old bags (10 MB) in {bag_dir} to keep keep_bags=2 '
-            "(counting this run's)") in output, output
+    assert (f'record_run.sh: deleted 2 old bags (10 MB) in {bag_dir} to keep keep_bags=2, '
+            "max_bags_mb=4000 (counting this run's)") in output, output
     left = sorted(path.name for path in bag_dir.iterdir())
     assert len(left) == 2 and left[0] == old[2].name, left  # the newest old one, and the run's
     assert left[1] not in {path.name for path in old}, left
