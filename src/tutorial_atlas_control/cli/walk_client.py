@@ -4,8 +4,10 @@ It reads where the feet are from the first /atlas/atlas_sim_interface_state, lay
 footsteps from there (straight ahead, or round a circle on the left), and sends WALK
 commands as DRCSim's walking clients did: streamed, a new WALK with the window
 [next_step_index_needed, +3] on every state message (1 kHz), or the first four steps once
-(--once). It ends when the walk has returned to Stand (exit 0), or on a fall, a refused
-request or the timeout (exit 1).
+(--once). From the default start (the tutorial's hold, which the interface reports as User)
+it sends a STAND first, and says so. It ends when the walk has returned to Stand (exit 0),
+or on a fall, a refused request, states that stop coming for STATE_SILENCE_S or the timeout
+(exit 1); Ctrl-C says how many steps were taken (exit 130).
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ import argparse
 import math
 import sys
 import threading
+import time
 from collections.abc import Sequence
 
 import rosgraph
@@ -25,7 +28,13 @@ from atlas_msgs.msg import (
 )
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.asi import Outcome, WalkClient, refusal_hint, yaw_of_quaternion
+from tutorial_atlas_control.asi import (
+    Behavior,
+    Outcome,
+    WalkClient,
+    refusal_hint,
+    yaw_of_quaternion,
+)
 from tutorial_atlas_control.cli.convention import (
     EXIT_INTERRUPTED,
     EXIT_REFUSED,
@@ -48,6 +57,11 @@ CONNECT_TIMEOUT_S = 30.0
 STEPS_PER_TURN = 60
 #: How long (s, wall time) to wait for the other subscribers the master lists (a recorder).
 LISTED_CONNECT_TIMEOUT_S = 2.0
+#: The walk is given up when no state came for this long (s, wall time): the simulator
+#: stopped, died or was paused.
+STATE_SILENCE_S = 2.0
+#: How long (s, wall time) the STAND sent from the start's hold may take to be reported.
+STAND_TIMEOUT_S = 10.0
 
 
 def _positive(text: str) -> float:
@@ -63,8 +77,9 @@ def _positive(text: str) -> float:
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog=PROG, description=__doc__.split('\n\n')[1].replace('\n', ' '),
-        epilog='Start the simulator with the balancing Stand first: roslaunch '
-               'tutorial_atlas_control atlas.launch startup_mode:=bdi_stand')
+        epilog='Start the simulator first: roslaunch tutorial_atlas_control atlas.launch '
+               '(the tutorial\'s hold: a STAND is sent first) or atlas.launch '
+               'startup_mode:=bdi_stand (Stand from 2 s)')
     parser.add_argument('--steps', type=whole_number(1), default=6,
                         help='how many steps (default 6)')
     parser.add_argument('--stride', type=_positive, default=0.25, metavar='M',
@@ -157,11 +172,31 @@ def _walk(plan: list[Footstep], args: argparse.Namespace) -> int:
     while publisher.get_num_connections() < _listed_subscribers(topics.ASI_COMMAND) \
             and rospy.get_time() < deadline and not rospy.is_shutdown():
         rospy.sleep(0.01)
-    rospy.Subscriber(topics.ASI_STATE, AtlasSimInterfaceState, on_state, queue_size=1,
+    if first.current_behavior == Behavior.USER:
+        _stand_first(publisher, len(plan))
+    heard = [time.monotonic()]
+
+    def on_heard(state: AtlasSimInterfaceState) -> None:
+        heard[0] = time.monotonic()
+        on_state(state)
+
+    rospy.Subscriber(topics.ASI_STATE, AtlasSimInterfaceState, on_heard, queue_size=1,
                      tcp_nodelay=True)
-    if not ended.wait(args.timeout):
-        raise _Refused(f'the walk did not end within {args.timeout:g} s '
-                       f'({client.steps_taken} of {len(plan)} steps taken)')
+    deadline = time.monotonic() + args.timeout
+    try:
+        while not ended.wait(0.05):
+            now = time.monotonic()
+            if now - heard[0] > STATE_SILENCE_S:
+                raise _Refused(f'no {topics.ASI_STATE} for {STATE_SILENCE_S:g} s: the '
+                               'simulator stopped or is paused '
+                               f'({client.steps_taken} of {len(plan)} steps taken)')
+            if now > deadline:
+                raise _Refused(f'the walk did not end within {args.timeout:g} s '
+                               f'({client.steps_taken} of {len(plan)} steps taken)')
+    except KeyboardInterrupt:
+        print(f'{PROG}: interrupted after {client.steps_taken} of {len(plan)} steps',
+              file=sys.stderr)
+        raise
     state = last[0]
     feet = ', '.join(f'({foot.position.x:.3f}, {foot.position.y:.3f})'
                      for foot in state.foot_pos_est)
@@ -173,6 +208,30 @@ def _walk(plan: list[Footstep], args: argparse.Namespace) -> int:
           f'({"once" if args.once else "streamed"}), back in Stand; feet at {feet}')
     rospy.signal_shutdown('walked')
     return 0
+
+
+def _stand_first(publisher: rospy.Publisher, planned: int) -> None:
+    """The start's hold (User): STAND, then wait until the state says Stand."""
+    print(f'{PROG}: the robot is in User (the tutorial\'s hold): sending STAND first',
+          flush=True)
+    command = AtlasSimInterfaceCommand()
+    command.header.stamp = rospy.Time.now()
+    command.behavior = Behavior.STAND
+    publisher.publish(command)
+    try:
+        state = rospy.wait_for_message(topics.ASI_STATE, AtlasSimInterfaceState,
+                                       timeout=CONNECT_TIMEOUT_S)
+        deadline = time.monotonic() + STAND_TIMEOUT_S
+        while state.current_behavior != Behavior.STAND:
+            if time.monotonic() > deadline:
+                hint = refusal_hint(state.behavior_feedback.status_flags,
+                                    state.current_behavior)
+                raise _Refused(f'STAND was not taken within {STAND_TIMEOUT_S:g} s ({hint}); '
+                               f'0 of {planned} steps taken')
+            state = rospy.wait_for_message(topics.ASI_STATE, AtlasSimInterfaceState,
+                                           timeout=CONNECT_TIMEOUT_S)
+    except rospy.ROSException:
+        raise _Refused(f'no {topics.ASI_STATE} after STAND: is the simulator running?') from None
 
 
 def _listed_subscribers(topic: str) -> int:
