@@ -1,6 +1,7 @@
 """keyboard_teleop.py as a person uses it: in a terminal (tmux), against a running
-atlas.launch with DRCSim's actionlib server (startup_mode:=bdi_stand bdi_control:=true).
-Keys are sent and the screen is read: 2 steps, a longer stride, `i` walks them forward (the
+atlas.launch with DRCSim's actionlib server (bdi_control:=true, the default start). Keys are
+sent and the screen is read: in the tutorial's hold `i` aborts and the screen says to press
+S, which stands; then 2 steps, a longer stride, `i` walks them forward (the
 robot's x on the screen grows), a capital steps the same two steps statically, one STEP goal
 each (the x grows again), `Q` quits with status 0. Wall time about 50 s."""
 
@@ -75,15 +76,21 @@ def robot_x(screen: str) -> float:
 
 
 def test_keys_walk_the_robot_and_the_screen_says_how_it_went(tmp_path: Path) -> None:
-    with TestLaunch(tmp_path, 'startup_mode:=bdi_stand', 'bdi_control:=true',
-                    'record:=false') as launch:
+    with TestLaunch(tmp_path, 'bdi_control:=true', 'record:=false') as launch:
         launch.wait(lambda: SIM in launch.subscribers(topics.ASI_COMMAND), 120.0,
                     f'{SIM} did not subscribe to {topics.ASI_COMMAND}')
-        launch.wait_sim_until(3.5)  # the balancing Stand from 2 s
+        launch.wait_sim_until(1.5)  # the default start: the tutorial's hold, past the pin
         terminal = Terminal(f'{sys.executable} {TELEOP}', dict(launch.env))
         try:
             terminal.wait_for('last: ready')
-            start = robot_x(terminal.wait_for('robot: x'))
+            terminal.wait_for('behaviour USER')
+            terminal.keys('i')  # in the hold: the goal aborts, and the screen says what to do
+            terminal.wait_for('the robot is in USER: press S for Stand first')
+            # Past the refusal's report (0.05 s): DRCSim's server would abort a goal on it.
+            launch.wait_sim_until(launch.sim_time_s() + 0.1)
+            terminal.keys('S')
+            terminal.wait_for('stand: succeeded')
+            start = robot_x(terminal.wait_for('behaviour STAND'))
             terminal.keys('2')
             terminal.wait_for('1-9 steps: 2')
             terminal.keys('=')

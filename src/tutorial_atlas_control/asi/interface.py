@@ -22,7 +22,9 @@ state or step and reported as a successful transition.
 With `hold_at_start` (atlas.launch's default start) the library is loaded but waits: the
 start holds the robot with the parameter gains, the tutorial's hold, reported as User (the
 PID holds it, k_effort 255) until a Stand is asked for (an ASI STAND, /atlas/control_mode
-Stand); after reset_world in Stand, the start's hold again.
+Stand); after reset_world in Stand, the start's hold again. A WALK or STEP asked for while
+Stand is still taking the robot over (bringing it to the Stand pose, 1 s) waits for it,
+TRANSITION_IN_PROGRESS meanwhile: a walk does not start from the hold's straight legs.
 """
 
 from __future__ import annotations
@@ -30,11 +32,11 @@ from __future__ import annotations
 import dataclasses
 import math
 
-import mujoco
 import numpy as np
 
 from tutorial_atlas_control.asi.behaviors import BEHAVIOR_OF_MODE, MODE_OF_BEHAVIOR, Behavior
 from tutorial_atlas_control.asi.session import STANDING_BEHAVIORS, AsiSession, behavior_name
+from tutorial_atlas_control.asi.state_report import StateReport
 from tutorial_atlas_control.asi.walk_params import (
     footsteps_of,
     sole_step,
@@ -54,7 +56,6 @@ from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.msgs import (
     AsiCommand,
     AsiState,
-    BehaviorFeedback,
     ManipulateFeedback,
     ManipulateParams,
     StepFeedback,
@@ -83,13 +84,8 @@ FALLING_TILT_RAD = 0.5
 DOWN_PELVIS_M = 0.5
 #: Stand is refused while the centre of mass is further than this outside the feet (m).
 COM_OUTSIDE_TOLERANCE_M = 0.0
-FOOT_BODIES = ('l_foot', 'r_foot')
 _K_EFFORT_ROW = (LAW_FIELDS.index('k_effort'),)
 _ALL_JOINTS = np.arange(NUM_JOINTS)
-_NO_TORQUE = np.zeros(NUM_JOINTS)
-_NO_TORQUE.setflags(write=False)
-_NO_BLEND = np.zeros(NUM_JOINTS, np.uint8)
-_NO_BLEND.setflags(write=False)
 
 
 def servo_of(params: ManipulateParams) -> PelvisServo | None:
@@ -124,11 +120,13 @@ class AtlasSimInterface:
                  hold_at_start: bool = False) -> None:
         self.sim = sim
         if balance and hold_at_start:
-            sim.hold_stand_at_start = True
+            sim.behaviours.hold_stand_at_start = True
             if sim.mode is ControlMode.STAND:
                 sim.behaviours.hold_start()
         #: Why the last request was not carried out, for the log (take_refusal).
         self._refusal: str | None = None
+        #: A WALK or STEP asked for while Stand takes the robot over, taken once it has.
+        self._deferred: AsiCommand | None = None
         #: The balancing Stand installed (None: Stand is the hold); its estimator, or one of
         #: the interface's own, checks the centre of mass before Stand is entered.
         self.stand: StandBehaviour | None = None
@@ -148,11 +146,7 @@ class AtlasSimInterface:
         self._stand_starts = 0
         #: The behaviour the mode was last seen running (Manipulate apart).
         self._seen = self._mode_behavior()
-        model = sim.model
-        self._feet = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name)
-                      for name in FOOT_BODIES]
-        free_joint = int(model.body_jntadr[sim.atlas.pelvis_body_id])
-        self._free_dof = int(model.jnt_dofadr[free_joint])
+        self._report = StateReport(sim)
 
     def _load_balance(self) -> None:
         """Stand and StandPrep become the balancing behaviours; Manipulate is served."""
@@ -206,6 +200,7 @@ class AtlasSimInterface:
         that has ended, sent before the client saw the end (a streaming client's last, empty
         one, or one answering a state read late, from before the walk's first touchdown).
         Started, it could take no step and would only catch itself from standing."""
+        self._deferred = None
         steps = (footsteps_of(command.step_queue, self._estimator.sole_ahead_m)
                  if command.behavior == Behavior.WALK else [])
         if command.behavior == Behavior.WALK != current \
@@ -214,6 +209,12 @@ class AtlasSimInterface:
             self._refusal = (f'ignored AtlasSimInterfaceCommand behavior 4 (WALK) in '
                              f'{behavior_name(current)}: its step_queue has step_index '
                              f'{indices or "none"}, and a new walk starts with step_index 1')
+            return
+        stand = self.stand
+        if command.behavior in (Behavior.WALK, Behavior.STEP) and current == Behavior.STAND \
+                and stand is not None and stand.taking_over:
+            self._deferred = command  # the newest one: a streaming client's window
+            self.session.defer(Behavior(command.behavior), current)
             return
         stepping = self.stepping
         if command.behavior == Behavior.STEP and stepping is not None:
@@ -301,55 +302,20 @@ class AtlasSimInterface:
             return False
         return signed_distance(polygon, state.com[:2]) >= -COM_OUTSIDE_TOLERANCE_M
 
-    def f_out(self) -> np.ndarray:
-        """The behaviour's joint torques this step (N m): the Stand behaviour's or a hold's;
-        none in User and ragdoll."""
-        sim = self.sim
-        if sim.mode in (ControlMode.USER, ControlMode.RAGDOLL) or sim.behaviours.holding_start:
-            return _NO_TORQUE
-        return sim.torque_nm if sim.commands.blend_command is None else sim.law.f_out_nm
-
-    def k_effort(self) -> np.ndarray:
-        """The blend in use (uint8, (28,)): the user command's in User; the hold's PID
-        during the start's hold; elsewhere the blended user command's, 0 on every joint when
-        the behaviour alone acts."""
-        sim = self.sim
-        if sim.mode is ControlMode.USER or sim.behaviours.holding_start \
-                or sim.commands.blend_command is not None:
-            return sim.active_k_effort()
-        return _NO_BLEND
-
     def state(self) -> AsiState:
         """The AtlasSimInterfaceState of the step just taken."""
         self._observe()
-        sim, data, session = self.sim, self.sim.data, self.session
+        sim, session = self.sim, self.session
         current = self.current_behavior
         falling = current in STANDING_BEHAVIORS and falling_robot(sim)
-        adr, dof = sim.atlas.free_qpos_adr, self._free_dof
-        feet = np.empty((2, 7))
-        for row, body in enumerate(self._feet):
-            feet[row, 0:3] = data.xpos[body]
-            w, x, y, z = data.xquat[body]
-            feet[row, 3:7] = (x, y, z, w)
-        return AsiState(
-            stamp_ns=sim.state_time_ns, error_code=int(session.error_code),
-            current_behavior=int(current), desired_behavior=session.desired_behavior,
-            f_out_nm=self.f_out().copy(),
-            pelvis_position_m=tuple(data.qpos[adr:adr + 3]),
-            pelvis_velocity_m_s=tuple(data.qvel[dof:dof + 3]), foot_poses=feet,
-            behavior_feedback=BehaviorFeedback(session.status_flags(current, falling),
-                                               session.trans_from_behavior,
-                                               session.trans_to_behavior),
-            manipulate_feedback=self.manipulate_feedback(),
-            walk_feedback=(walk_feedback(self.walking.status(float(data.time)),
-                                         self._estimator.sole_ahead_m)
-                           if current == Behavior.WALK and self.walking is not None
-                           else WalkFeedback()),
-            step_feedback=(step_feedback(self.stepping.status(float(data.time)),
-                                         self._estimator.sole_ahead_m)
-                           if current == Behavior.STEP and self.stepping is not None
-                           else StepFeedback()),
-            k_effort=self.k_effort())
+        time_s, ahead_m = float(sim.data.time), self._estimator.sole_ahead_m
+        walking, stepping = self.walking, self.stepping
+        return self._report.state(
+            current, session, falling, self.manipulate_feedback(),
+            (walk_feedback(walking.status(time_s), ahead_m)
+             if current == Behavior.WALK and walking is not None else WalkFeedback()),
+            (step_feedback(stepping.status(time_s), ahead_m)
+             if current == Behavior.STEP and stepping is not None else StepFeedback()))
 
     def manipulate_feedback(self) -> ManipulateFeedback:
         """The pelvis target in use, as clamped, while Manipulate runs (the Stand pose's
@@ -364,6 +330,12 @@ class AtlasSimInterface:
         """After each step, whether or not a state was built."""
         self._observe()
         self.session.end_step()
+        deferred, stand = self._deferred, self.stand
+        if deferred is not None and stand is not None and not stand.taking_over:
+            current = self.current_behavior
+            if current == Behavior.STAND:
+                self._request(deferred, current)
+            self._deferred = None
         mode = self.sim.mode
         if mode in (ControlMode.WALK, ControlMode.STEP) and fallen_robot(self.sim):
             self._switch(ControlMode.FREEZE)

@@ -39,9 +39,10 @@ STANDING_BEHAVIORS = frozenset({Behavior.STAND, Behavior.MANIPULATE, Behavior.WA
 #: Behaviours entered only from a standing one (BDI's library: Stand first).
 NEEDS_STANDING = frozenset({Behavior.MANIPULATE, Behavior.WALK, Behavior.STEP})
 #: How many steps (1 ms each) a refusal stays reported without a new request: long enough
-#: for a client reading every tenth state to see it, short enough that the next client's
-#: first state is not about somebody else's request.
-REFUSAL_REPORTED_STEPS = 250
+#: for a client reading every tenth state to see it, short enough that the next goal's first
+#: state is not about somebody else's request (DRCSim's actionlib server aborts a new goal
+#: on the error code of the first state it reads, before it sends anything).
+REFUSAL_REPORTED_STEPS = 50
 _KNOWN = frozenset(int(b) for b in Behavior)
 _REFUSALS = frozenset({Status.FAILED_TRANS_UNKNOWN_BEHAVIOR, Status.FAILED_TRANS_ILLEGAL_BEHAVIOR,
                        Status.FAILED_TRANS_COM_POS, Status.FAILED_TRANS_COM_VEL,

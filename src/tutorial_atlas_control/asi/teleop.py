@@ -4,7 +4,8 @@ DRCSim's key map: lower case walks dynamically (one WALK goal of the steps), cap
 statically (one STEP goal per step); `i` and `,` forward and back, `j` and `l` turn left and
 right in place, `u` and `o` curve forward to the left and right, `m` and `.` step sideways
 to the left and right; `1`-`9` how many steps, `-` and `=` a shorter and longer stride;
-`R` stands the robot up from the harness, `H` puts it in the harness, `Q` quits. Our
+`R` stands the robot up from the harness, `H` puts it in the harness, `Q` quits; ours, `S`
+asks for Stand (a STAND goal: the default start's hold needs one before walking). Our
 numbers: feet 0.24 m apart, 0.63 s a step, a stride of 0.2 m to start (0.05-0.40 m in
 steps of 0.05), a turn of 0.1 rad a step, curves of radius 2 m, a side step of half the
 stride. Steps are in the pelvis's frame (x ahead, y left), as the actionlib server expects.
@@ -49,7 +50,7 @@ class Settings:
 
 def key_action(key: str, settings: Settings) -> tuple[str, Settings | str | None]:
     """('walk' | 'step', move) for a walking key, ('settings', new Settings) for 1-9, - and
-    =, ('stand up' | 'harness' | 'quit', None), or ('unknown', None)."""
+    =, ('stand up' | 'stand' | 'harness' | 'quit', None), or ('unknown', None)."""
     if key in MOVES:
         return 'walk', MOVES[key]
     if key in _CAPITALS:
@@ -61,7 +62,7 @@ def key_action(key: str, settings: Settings) -> tuple[str, Settings | str | None
         change = STRIDE_STEP_M if key == '=' else -STRIDE_STEP_M
         stride = min(max(round(settings.stride_m + change, 2), low), high)
         return 'settings', replace(settings, stride_m=stride)
-    return {'R': ('stand up', None), 'H': ('harness', None),
+    return {'R': ('stand up', None), 'S': ('stand', None), 'H': ('harness', None),
             'Q': ('quit', None)}.get(key, ('unknown', None))
 
 

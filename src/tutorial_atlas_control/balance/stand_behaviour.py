@@ -37,12 +37,17 @@ from tutorial_atlas_control.balance.stand import (
     yaw_rotation,
 )
 from tutorial_atlas_control.balance.stand_pose import STAND_POSE_RAD, place_in_stand_pose
+from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.sim import AtlasModel
 
 __all__ = ['TRANSITION_S', 'StandBehaviour', 'stand_pose_com_height_m']
 
 #: How long Stand takes to bring the robot from where it starts to the Stand pose (s).
 TRANSITION_S = 1.0
+#: A start whose legs are further than this from the Stand pose's on some joint (rad) is a
+#: take-over (the hold's straight legs: the knees 0.52 rad off), which Walk and Step wait for.
+TAKE_OVER_RAD = 0.1
+_LEGS = np.array([index for index, name in enumerate(JOINT_NAMES) if '_leg_' in name])
 
 
 def stand_pose_com_height_m(atlas: AtlasModel) -> float:
@@ -117,6 +122,9 @@ class StandBehaviour:
         self.starts = 0
         #: The reference moving on; None once it has arrived.
         self._transition: _Transition | None = None
+        #: Since a start() with the legs far from the Stand pose (TAKE_OVER_RAD), bringing
+        #: them there: Walk and Step wait for it.
+        self.taking_over = False
         #: The pelvis height (m) of the squat table's posture the reference is at or passing
         #: through (None: off the table, as after start()).
         self._table_height_m: float | None = None
@@ -146,6 +154,8 @@ class StandBehaviour:
         self._table_height_m = None
         self.last_state = state
         self.last_output = None
+        self.taking_over = bool(np.max(np.abs(held.posture_rad[_LEGS] - STAND_POSE_RAD[_LEGS]))
+                                > TAKE_OVER_RAD)
 
     def servo(self, desired: PelvisServo | None, time_s: float) -> PelvisServo | None:
         """Move the pelvis to `desired` (clamped to what the legs reach; None: back to the
@@ -179,6 +189,7 @@ class StandBehaviour:
                           table.row(self._table_height_m)[0], table.row(goal_height)[0])
         self._transition = _Transition(time_s, controller.reference, goal, table_path,
                                        goal_height)
+        self.taking_over = False
         self.servo_target = target
         return target
 
@@ -191,6 +202,7 @@ class StandBehaviour:
         fraction = (time_s - transition.started_s) / duration if duration > 0.0 else 1.0
         if fraction >= 1.0:
             self._transition = None
+            self.taking_over = False
             self._table_height_m = transition.end_height_m
             return transition.goal
         s = smoothstep(fraction)

@@ -1,12 +1,12 @@
 """Command line of keyboard_teleop.py: DRCSim's keyboard teleop for Atlas, in a terminal.
 
 Each walking key sends a goal to DRCSim's actionlib server atlas/bdi_control (start the
-simulator with `roslaunch tutorial_atlas_control atlas.launch startup_mode:=bdi_stand
-bdi_control:=true`): lower case one WALK goal of the steps, capitals one STEP goal per
-step. The screen shows the key map, the settings, where the robot is and how the last goal
-ended. Keys (asi/teleop.py): u i o / j l / m , . walk; 1-9 steps; - = stride; R stand up
-from the harness; H harness; Q quit. Options: -h/--help; ROS remapping arguments
-(name:=value) are accepted.
+simulator with `roslaunch tutorial_atlas_control atlas.launch bdi_control:=true`, then press
+S for Stand; or with startup_mode:=bdi_stand, standing from 2 s): lower case one WALK goal of
+the steps, capitals one STEP goal per step. The screen shows what every key does, the
+settings, where the robot is and how the last goal ended. Keys (asi/teleop.py):
+u i o / j l / m , . walk; 1-9 steps; - = stride; S stand; R stand up from the harness;
+H harness; Q quit. Options: -h/--help; ROS remapping arguments (name:=value) are accepted.
 """
 
 from __future__ import annotations
@@ -65,6 +65,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_REFUSED
     rospy.init_node('keyboard_teleop', anonymous=True, argv=argv, disable_signals=True)
     client = actionlib.SimpleActionClient(ACTION, WalkDemoAction)
+    print(f'{PROG}: waiting for {ACTION} (up to {SERVER_TIMEOUT_S:.0f} s; atlas.launch '
+          'bdi_control:=true serves it)', flush=True)
     if not client.wait_for_server(rospy.Duration(SERVER_TIMEOUT_S)):
         print_error(PROG, f'no {ACTION} server within {SERVER_TIMEOUT_S:.0f} s: start the '
                           'simulator with bdi_control:=true')
@@ -105,6 +107,8 @@ class Teleop:
         self.settings = Settings()
         self.last = 'ready: press a walking key'
         self.robot = 'robot: (no state yet)'
+        #: The behaviour the last state said (None before one).
+        self.behavior: int | None = None
         self.busy = threading.Lock()
         self.modes = rospy.Publisher(topics.MODE, String, queue_size=10)
         self.control_modes = rospy.Publisher(topics.CONTROL_MODE, String, queue_size=10)
@@ -113,6 +117,7 @@ class Teleop:
 
     def _on_state(self, state: AtlasSimInterfaceState) -> None:
         position = state.pos_est.position
+        self.behavior = state.current_behavior
         try:
             behaviour = Behavior(state.current_behavior).name
         except ValueError:
@@ -137,16 +142,21 @@ class Teleop:
                 self._start(self._walk if action == 'walk' else self._step, str(value))
             elif action == 'stand up':
                 self._start(self._stand_up, 'stand up from the harness')
+            elif action == 'stand':
+                self._start(self._stand, 'stand')
             elif action == 'harness':
                 self.modes.publish(String(data='harnessed'))
                 self.last = 'in the harness (/atlas/mode harnessed)'
 
     def _draw(self, screen: curses.window) -> None:
         lines = [f'Atlas keyboard teleop (DRCSim\'s key map) -- {ACTION}',
-                 '  walk:  u i o   j l   m , .     capitals: the same, step by step',
-                 f'  1-9 steps: {self.settings.steps}    - = stride: '
+                 '  walk:  u i o  curve left, forward, curve right',
+                 '         j   l  turn left, turn right      , back',
+                 '         m   .  side step left, right',
+                 '  capitals (U I O J L M < >): the same, one static step at a time',
+                 f'  1-9 steps: {self.settings.steps}    - = shorter, longer stride: '
                  f'{self.settings.stride_m:.2f} m',
-                 '  R stand up from the harness   H harness   Q quit',
+                 '  S stand   R stand up from the harness   H harness   Q quit',
                  '', self.robot, f'last: {self.last}']
         rows, columns = screen.getmaxyx()  # the terminal as it is now (resizes included)
         screen.erase()
@@ -191,8 +201,17 @@ class Teleop:
             return True
         text = self.client.get_goal_status_text()
         self.last = f'{what}: {"aborted" if state == GoalStatus.ABORTED else "ended"}' + (
-            f' ({text})' if text else '')
+            f' ({text})' if text else '') + self._remedy()
         return False
+
+    def _remedy(self) -> str:
+        """What to do when the library is not in a behaviour a goal can start from."""
+        if self.behavior in (Behavior.USER, Behavior.FREEZE, Behavior.STAND_PREP):
+            return f'; the robot is in {Behavior(self.behavior).name}: press S for Stand first'
+        return ''
+
+    def _stand(self, what: str) -> None:
+        self._send(WalkDemoGoal(behavior=WalkDemoGoal.STAND), what)
 
     def _stand_up(self, what: str) -> None:
         """DRCSim's scripts: harnessed, StandPrep, 5 s, nominal, 0.3 s, Stand."""

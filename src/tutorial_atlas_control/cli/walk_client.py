@@ -161,17 +161,7 @@ def _walk(plan: list[Footstep], args: argparse.Namespace) -> int:
         elif steps is not None:
             publisher.publish(_command(steps))
 
-    deadline = rospy.get_time() + CONNECT_TIMEOUT_S
-    while publisher.get_num_connections() == 0:
-        if rospy.get_time() > deadline or rospy.is_shutdown():
-            raise _Refused(f'the simulator did not subscribe to {topics.ASI_COMMAND}')
-        rospy.sleep(0.01)
-    # A recorder subscribed too gets the first commands (the only ones that carry the
-    # first steps) if it is connected before they go.
-    deadline = rospy.get_time() + LISTED_CONNECT_TIMEOUT_S
-    while publisher.get_num_connections() < _listed_subscribers(topics.ASI_COMMAND) \
-            and rospy.get_time() < deadline and not rospy.is_shutdown():
-        rospy.sleep(0.01)
+    _wait_for_subscribers(publisher)
     if first.current_behavior == Behavior.USER:
         _stand_first(publisher, len(plan))
     heard = [time.monotonic()]
@@ -182,21 +172,7 @@ def _walk(plan: list[Footstep], args: argparse.Namespace) -> int:
 
     rospy.Subscriber(topics.ASI_STATE, AtlasSimInterfaceState, on_heard, queue_size=1,
                      tcp_nodelay=True)
-    deadline = time.monotonic() + args.timeout
-    try:
-        while not ended.wait(0.05):
-            now = time.monotonic()
-            if now - heard[0] > STATE_SILENCE_S:
-                raise _Refused(f'no {topics.ASI_STATE} for {STATE_SILENCE_S:g} s: the '
-                               'simulator stopped or is paused '
-                               f'({client.steps_taken} of {len(plan)} steps taken)')
-            if now > deadline:
-                raise _Refused(f'the walk did not end within {args.timeout:g} s '
-                               f'({client.steps_taken} of {len(plan)} steps taken)')
-    except KeyboardInterrupt:
-        print(f'{PROG}: interrupted after {client.steps_taken} of {len(plan)} steps',
-              file=sys.stderr)
-        raise
+    _wait_for_the_end(ended, heard, client, args.timeout)
     state = last[0]
     feet = ', '.join(f'({foot.position.x:.3f}, {foot.position.y:.3f})'
                      for foot in state.foot_pos_est)
@@ -208,6 +184,43 @@ def _walk(plan: list[Footstep], args: argparse.Namespace) -> int:
           f'({"once" if args.once else "streamed"}), back in Stand; feet at {feet}')
     rospy.signal_shutdown('walked')
     return 0
+
+
+def _wait_for_subscribers(publisher: rospy.Publisher) -> None:
+    """Until the simulator is subscribed to the commands, and (for a while) every other
+    subscriber the master lists: a recorder connected before the first commands go gets
+    them (the only ones that carry the first steps)."""
+    deadline = rospy.get_time() + CONNECT_TIMEOUT_S
+    while publisher.get_num_connections() == 0:
+        if rospy.get_time() > deadline or rospy.is_shutdown():
+            raise _Refused(f'the simulator did not subscribe to {topics.ASI_COMMAND}')
+        rospy.sleep(0.01)
+    deadline = rospy.get_time() + LISTED_CONNECT_TIMEOUT_S
+    while publisher.get_num_connections() < _listed_subscribers(topics.ASI_COMMAND) \
+            and rospy.get_time() < deadline and not rospy.is_shutdown():
+        rospy.sleep(0.01)
+
+
+def _wait_for_the_end(ended: threading.Event, heard: list[float], client: WalkClient,
+                      timeout_s: float) -> None:
+    """Until the walk ends; _Refused when the states stop for STATE_SILENCE_S or at the
+    timeout; Ctrl-C says how many steps were taken."""
+    planned = len(client.plan)
+    deadline = time.monotonic() + timeout_s
+    try:
+        while not ended.wait(0.05):
+            now = time.monotonic()
+            if now - heard[0] > STATE_SILENCE_S:
+                raise _Refused(f'no {topics.ASI_STATE} for {STATE_SILENCE_S:g} s: the '
+                               'simulator stopped or is paused '
+                               f'({client.steps_taken} of {planned} steps taken)')
+            if now > deadline:
+                raise _Refused(f'the walk did not end within {timeout_s:g} s '
+                               f'({client.steps_taken} of {planned} steps taken)')
+    except KeyboardInterrupt:
+        print(f'{PROG}: interrupted after {client.steps_taken} of {planned} steps',
+              file=sys.stderr)
+        raise
 
 
 def _stand_first(publisher: rospy.Publisher, planned: int) -> None:

@@ -47,6 +47,10 @@ class ModeBehaviours:
         #: The start's hold acts although the mode's behaviour is installed: until a mode
         #: is selected (set_mode), no behaviour acts.
         self.holding_start = False
+        #: A restart in Stand holds the start pose with the parameter gains (the tutorial's
+        #: start) even when Stand has a behaviour installed: the AtlasSimInterface sets it
+        #: when its library waits to be asked (atlas.launch).
+        self.hold_stand_at_start = False
 
     @property
     def stand(self) -> Behaviour | None:
@@ -64,6 +68,14 @@ class ModeBehaviours:
         """The start's hold acts, whatever is installed, until the next select."""
         self.acting = None
         self.holding_start = True
+
+    def restart(self, mode: ControlMode, data: mujoco.MjData) -> None:
+        """After a reset in `mode`: the start's hold (hold_stand_at_start, in Stand), else
+        `mode`'s behaviour started from the robot in `data`."""
+        if self.hold_stand_at_start and mode is ControlMode.STAND:
+            self.hold_start()
+        else:
+            self.select(mode, data)
 
     def select(self, mode: ControlMode, data: mujoco.MjData) -> None:
         """`mode`'s behaviour, started from the robot in `data`, becomes the acting one."""

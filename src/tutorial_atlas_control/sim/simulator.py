@@ -95,10 +95,6 @@ class AtlasSimulator:
         self.torque_nm = self.law.torque_nm  # the law's output array, applied each step
         self.commands = ModeCommands(gains, self.joint_positions, self.torque_nm)
         self.behaviours = ModeBehaviours()  # install_stand
-        #: A reset in Stand holds the start pose with the parameter gains (the tutorial's
-        #: start) even when Stand has a behaviour installed, until a mode is set: the
-        #: AtlasSimInterface sets it when its library waits to be asked (atlas.launch).
-        self.hold_stand_at_start = False
         self._check_divergence = DivergenceCheck(self.data, self.law.state_is_finite).check
         self.sim_time_ns = 0
         # VRCPlugin's cheats (modes, teleport, cmd_vel, pelvis wrench, kinematic playback).
@@ -139,10 +135,8 @@ class AtlasSimulator:
         self.commands.reset()
         if self.startup_mode is VrcMode.BDI_STAND:
             self._begin_bdi_stand()
-        elif self.hold_stand_at_start and self.mode is ControlMode.STAND:
-            self.behaviours.hold_start()
         else:
-            self.behaviours.select(self.mode, self.data)
+            self.behaviours.restart(self.mode, self.data)
 
     def _begin_bdi_stand(self) -> None:
         """VRCPlugin's `bdi_stand` (SetPIDStand): pinned without gravity, the joints set to
@@ -244,8 +238,7 @@ class AtlasSimulator:
 
     def install_stand(self, behaviour: Behaviour | None,
                       mode: ControlMode = ControlMode.STAND) -> None:
-        """`mode` (Stand, StandPrep) runs `behaviour` (f_out), or its hold for None; during
-        the start's hold, from the next switch."""
+        """`mode` runs `behaviour` (f_out), or its hold for None (the start's hold: later)."""
         self.behaviours.install(mode, behaviour)
         if mode is self.mode and not self.behaviours.holding_start:
             self.behaviours.select(mode, self.data)

@@ -328,3 +328,26 @@ def test_a_walk_without_its_first_step_outside_walk_is_said_aloud(
         'ignored AtlasSimInterfaceCommand behavior 4 (WALK) in STAND: its step_queue has '
         'step_index [3], and a new walk starts with step_index 1')
     assert interface.current_behavior == Behavior.STAND
+
+
+def test_a_walk_asked_for_while_stand_takes_over_waits_for_it(
+        waiting: AtlasSimInterface) -> None:
+    run(waiting, 1500)
+    waiting.apply(command(Behavior.STAND))
+    assert waiting.stand is not None and waiting.stand.taking_over
+    step = StepData(1, 0, 0.63, (0.2, 0.12, 0.0), (0.0, 0.0, 0.0, 1.0), 0.1)
+    walk = AsiCommand(0, Behavior.WALK, (step,) + (StepData(),) * 3, False, StepData(), False,
+                      ManipulateParams(), None, 0)
+    waiting.apply(walk)  # DRCSim's actionlib server: STAND succeeded, then its WALK, once
+    run(waiting, 1)
+    state = waiting.state()
+    assert (state.current_behavior, state.behavior_feedback.status_flags) == (
+        Behavior.STAND, Status.TRANSITION_IN_PROGRESS)
+    taken_at = None
+    for k in range(1500):
+        run(waiting, 1)
+        if waiting.current_behavior == Behavior.WALK:
+            taken_at = k
+            break
+    assert taken_at is not None
+    assert 900 <= taken_at <= 1000  # the Stand's take-over: 1 s from the STAND

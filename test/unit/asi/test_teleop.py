@@ -18,8 +18,8 @@ def test_keys_walk_step_set_and_quit() -> None:
     assert key_action('=', Settings(4, 0.40)) == ('settings', Settings(4, 0.40))  # at most
     assert key_action('-', Settings(4, 0.05)) == ('settings', Settings(4, 0.05))  # at least
     assert key_action('-', settings) == ('settings', Settings(4, 0.15))
-    assert [key_action(k, settings)[0] for k in 'RHQx'] == ['stand up', 'harness', 'quit',
-                                                          'unknown']
+    assert [key_action(k, settings)[0] for k in 'RSHQx'] == ['stand up', 'stand', 'harness',
+                                                           'quit', 'unknown']
 
 
 @pytest.mark.parametrize('move', sorted(MOVES.values()))
