@@ -288,8 +288,8 @@ def _frames(states: RunStates, width: int, height: int, progress: bool,
     from tqdm import tqdm  # noqa: PLC0415 - only videos need it
 
     with StateRenderer(width, height) as renderer, \
-            tqdm(total=len(states), unit='frame', desc='rendering', file=sys.stderr,
-                 disable=not progress, leave=False, mininterval=0.5) as bar:
+            tqdm(total=len(states), unit='frame', desc='rendering', file=sys.stderr,  # a tty's
+                 disable=None if progress else True, leave=False, mininterval=0.5) as bar:
         for row in range(len(states)):
             frame = renderer.render(states.pelvis_position_m[row], states.pelvis_quat_wxyz[row],
                                     states.joint_position_rad[row])

@@ -107,7 +107,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _play(args: argparse.Namespace) -> None:
     """run_demo.py TRAJECTORY: the tutorial's way, User mode and traj_yaml.py."""
     # Everything is checked before anything starts.
-    trajectory_file = args.file or find_trajectory(args.trajectory)
+    trajectory_file = args.file or find_trajectory(args.trajectory,
+                                                   walks=tuple(walk_demo.WALKS))
     load_trajectory(trajectory_file, args.trajectory)
     gains = gains_for(trajectory_file, args.gains_file)
     load_gains_yaml(gains.path)

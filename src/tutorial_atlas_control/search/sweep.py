@@ -224,7 +224,9 @@ def run_sweep(specs: Sequence[RunSpec], workers: int | None = None, scheduler: s
 
 
 def _bar(total: int, enabled: bool) -> Any:
-    return tqdm(total=total, unit='run', desc='sweep', disable=not enabled, leave=False)
+    # disable=None: tqdm draws only on a terminal (a log file gets no bars).
+    return tqdm(total=total, unit='run', desc='sweep', disable=None if enabled else True,
+                leave=False)
 
 
 def _csv_value(value: Any) -> str:

@@ -13,6 +13,8 @@ gains, ``config/atlas_controller.yaml`` (atlas.launch's default).
 
 from __future__ import annotations
 
+import difflib
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -38,12 +40,17 @@ def trajectory_files(directory: Path = TRAJECTORIES_DIR) -> list[Path]:
     return sorted(files, key=lambda path: path.name != TUTORIAL_FILE_NAME)
 
 
-def find_trajectory(name: str, directory: Path = TRAJECTORIES_DIR) -> Path:
+def find_trajectory(name: str, directory: Path = TRAJECTORIES_DIR,
+                    walks: Sequence[str] = ()) -> Path:
     """The one file of `directory` (see :func:`trajectory_files`) that holds trajectory `name`.
+
+    `walks`: the other names the caller takes (run_demo.py's walks), listed and suggested
+    beside the trajectories when `name` is none of them.
 
     Raises:
         TrajectoryError: no file, or more than one, holds `name` (one line listing the files
-            searched), or a file cannot be read (its own one-line error).
+            searched and, for a name close to a valid one, "did you mean"), or a file cannot
+            be read (its own one-line error).
     """
     files = trajectory_files(directory)
     docs = {path: load_trajectory_file(path) for path in files}
@@ -54,8 +61,14 @@ def find_trajectory(name: str, directory: Path = TRAJECTORIES_DIR) -> Path:
     if not holding:
         names = '; '.join(f'{path.name}: ' + ', '.join(str(key) for key in docs[path])
                           for path in files) or f'none: no *.yaml in {directory}'
-        raise TrajectoryError(f'no trajectory named {name} in the package\'s trajectory files '
-                              f'(valid names: {names}); give its file with --file')
+        valid = [str(key) for path in files for key in docs[path]] + list(walks)
+        close = difflib.get_close_matches(name, valid, n=1)
+        guess = f'did you mean {close[0]}? ' if close else ''
+        what = 'trajectory or walk' if walks else 'trajectory'
+        listed = f'walks: {", ".join(walks)}; ' if walks else ''
+        raise TrajectoryError(f'no {what} named {name} in the package\'s trajectory files: '
+                              f'{guess}({listed}valid names: {names}); give its file with '
+                              '--file')
     both = ' and '.join(path.name for path in holding)
     raise TrajectoryError(f'trajectory {name} is in {both} (searched {searched}); '
                           'choose one with --file')

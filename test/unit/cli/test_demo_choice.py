@@ -71,8 +71,20 @@ def test_a_name_in_no_file_is_refused_listing_the_files(tmp_path: Path) -> None:
     with pytest.raises(TrajectoryError) as caught:
         find_trajectory('jump', folder)
     assert str(caught.value) == (
-        "no trajectory named jump in the package's trajectory files (valid names: "
+        "no trajectory named jump in the package's trajectory files: (valid names: "
         'Traj_data2.yaml: t; Other.yaml: o); give its file with --file')
+
+
+def test_a_misspelled_name_gets_a_guess_among_trajectories_and_walks(tmp_path: Path) -> None:
+    folder = write_trajectories(tmp_path, {'Traj_data2.yaml': ['step_and_fall']})
+    with pytest.raises(TrajectoryError) as caught:
+        find_trajectory('walk_circl', folder, walks=('walk_straight', 'walk_circle'))
+    assert str(caught.value) == (
+        "no trajectory or walk named walk_circl in the package's trajectory files: did you mean "
+        'walk_circle? (walks: walk_straight, walk_circle; valid names: Traj_data2.yaml: '
+        'step_and_fall); give its file with --file')
+    with pytest.raises(TrajectoryError, match='did you mean step_and_fall'):
+        find_trajectory('step_and_fal', folder)
 
 
 def test_the_package_names_are_where_the_readme_says() -> None:
@@ -172,7 +184,8 @@ def test_main_runs_the_name_with_its_gains(launched: Launched, argv: list[str], 
      'Could not read gains from {tmp}/missing.yaml: No such file or directory'),
     (['--gains-file', '{tmp}/bad.yaml'],
      "{tmp}/bad.yaml: atlas_controller/gains/back_lbz/p is 'x', not a finite number"),
-    (['jump'], "no trajectory named jump in the package's trajectory files (valid names: "
+    (['jump'], "no trajectory or walk named jump in the package's trajectory files: (walks: "
+               'walk_straight, walk_twenty, walk_circle; valid names: '
                'Traj_data2.yaml: step_and_fall, touchdown, touchdown_exhausted; '
                f'{QUICK_STEP.name}: {", ".join(load_trajectory_file(QUICK_STEP))}; Stepping.yaml: '
                f'{", ".join(load_trajectory_file(STEPPING))}); give its file with --file'),
