@@ -97,11 +97,15 @@ def test_a_session_played_again_is_the_same_run(session: Path, tmp_path: Path) -
     result = _run('--asi-from', str(session), '--bag', str(again), '--settle', '0')
     assert result.returncode == 0, result.stdout + result.stderr
     lines = result.stdout.splitlines()
-    taken = next(line for line in lines if line.startswith('walk: 4 of 4 steps taken, '))
-    assert 0.55 < float(taken.split(', ')[1].split()[0]) < 0.7  # measured 0.64 m (the sway)
+    taken = next(line for line in lines if line.startswith('walk: 4 of 4 steps taken; '))
+    walked = float(taken.split('walked ')[1].split()[0])
+    ended = float(taken.split('ended ')[1].split()[0])
+    assert 0.55 < walked < 0.7 and 0.55 < ended < 0.7, taken  # four steps of 0.2 m
     assert any(line.startswith('walk: no fall (lowest pelvis 0.8') for line in lines), lines
-    worst = next(line for line in lines if line.startswith('walk: worst placement '))
-    assert float(worst.split()[3]) < 5.0  # cm, the issue's goal; measured 2.6 cm
+    assert not any('did not fall' in line for line in lines), lines  # one no-fall line
+    placed = next(line for line in lines if line.startswith('walk: landings '))
+    worst = float(placed.split('worst placement ')[1].split()[0])
+    assert worst < 5.0  # cm, the issue's goal; measured 2.6 cm
     played = read_bag(again).joint_states
     assert played is not None
     np.testing.assert_array_equal(played.position, _direct_run(len(played.t_s)))
@@ -123,3 +127,23 @@ def test_a_bag_without_the_interface_s_commands_is_refused(tmp_path: Path) -> No
     assert both.returncode == 2
     assert both.stderr.splitlines()[-1] == ('run_offline.py: error: --asi-from plays a '
                                             'recorded session: give no YAML_FILE and NAME')
+
+
+ANALYZE = Path(__file__).resolve().parents[2] / 'scripts' / 'analyze_bag.py'
+
+
+def test_analyze_bag_reads_a_walk_as_a_walk(session: Path, tmp_path: Path) -> None:
+    plot = tmp_path / 'walk.png'
+    result = subprocess.run([sys.executable, str(ANALYZE), str(session), '--plot', str(plot)],
+                            capture_output=True, text=True, timeout=300, check=False)
+    assert result.returncode == 0, result.stderr
+    lines = result.stdout.splitlines()
+    assert 'Tracking: no joint command to track (what moved the joints was a behaviour or a ' \
+           'cheat)' in lines
+    assert not any('never commanded' in line for line in lines), lines
+    assert any(line.startswith('walk: 4 of 4 steps taken; walked ') for line in lines), lines
+    assert any(line.startswith('walk: landings ') for line in lines), lines
+    assert any(line.startswith('walk: no fall') for line in lines), lines
+    footprints = tmp_path / 'walk.footprints.png'
+    assert footprints.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
+    assert f'wrote {footprints}' in result.stderr

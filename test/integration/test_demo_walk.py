@@ -46,10 +46,10 @@ def test_walk_demo_reports_the_bags_steps_landings_and_footprints(tmp_path: Path
     assert client is not None, out
     walked = client.group(1) is not None
     client_steps = int(client.group(1) or client.group(2))
-    taken = re.search(r'^walk: (\d+) of (\d+) steps taken, ([\d.]+) m from where the walk '
-                      r'began$', result.stdout, re.MULTILINE)
-    worst = re.search(r'^walk: worst placement ([\d.]+) cm and ([\d.]+) rad from the step '
-                      r'asked for$', result.stdout, re.MULTILINE)
+    taken = re.search(r'^walk: (\d+) of (\d+) steps taken; walked ([\d.]+) m, ended ([\d.]+) m '
+                      r'from where the walk began$', result.stdout, re.MULTILINE)
+    worst = re.search(r'^walk: landings .* worst placement ([\d.]+) cm and ([\d.]+) rad from '
+                      r'the step asked for$', result.stdout, re.MULTILINE)
     assert taken is not None and worst is not None, result.stdout
     print(f'\nwalk demo live: {taken.group(0)}; {worst.group(0)}; the client: '
           f'{client.group(0)}')
@@ -68,3 +68,4 @@ def test_walk_demo_reports_the_bags_steps_landings_and_footprints(tmp_path: Path
     if walked:
         assert int(taken.group(2)) == STEPS
         assert 'walk: no fall' in result.stdout
+        assert 'did not fall' not in result.stdout  # one no-fall line

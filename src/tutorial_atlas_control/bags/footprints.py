@@ -83,6 +83,9 @@ class WalkSummary:
     fell: bool
     lowest_pelvis_m: float | None
     pelvis_xy: np.ndarray  # (n, 2), for the plot
+    #: How far the feet went, landing to landing, the two feet's mean (m): the path walked
+    #: (a circle walked round is long; its distance from the start is short).
+    path_m: float | None = None
 
     @property
     def steps_taken(self) -> int:
@@ -97,6 +100,34 @@ class WalkSummary:
         if not errors:
             return None
         return max(e[0] for e in errors), max(e[1] for e in errors)
+
+
+    def placement_errors(self) -> np.ndarray:
+        """Each landing's position error in its step's frame (m, (n, 2)): ahead of the
+        step asked for along its heading, and to its left."""
+        rows = []
+        for target, landing in self.placements:
+            if landing is None:
+                continue
+            dx, dy = landing.x_m - target.x_m, landing.y_m - target.y_m
+            c, s = np.cos(target.yaw_rad), np.sin(target.yaw_rad)
+            rows.append((c * dx + s * dy, -s * dx + c * dy))
+        return np.array(rows).reshape(-1, 2)
+
+    @property
+    def placement_bias_m(self) -> tuple[float, float] | None:
+        """The landings' mean error ahead and to the left of the steps asked for (m)."""
+        errors = self.placement_errors()
+        return None if not len(errors) else (float(errors[:, 0].mean()),
+                                              float(errors[:, 1].mean()))
+
+    @property
+    def placement_scatter_m(self) -> float | None:
+        """The landings' RMS distance from the steps asked for plus the bias (m)."""
+        errors = self.placement_errors()
+        if not len(errors):
+            return None
+        return float(np.sqrt(np.mean(np.sum((errors - errors.mean(axis=0)) ** 2, axis=1))))
 
 
 def _wrap(angle_rad: float) -> float:
@@ -228,24 +259,45 @@ def summarise_walk(data: BagData) -> WalkSummary | None:
     path = pelvis.position_m[walking]
     distance = float(np.hypot(*(path[-1, :2] - path[0, :2]))) if len(path) else None
     lowest = float(path[:, 2].min()) if len(path) else None
+    travel = [_travel(positions[foot][0, :2] if len(t_s) else None, by_foot[foot])
+              for foot in (0, 1)]
     return WalkSummary(placements, distance, lowest is not None and lowest < FALL_HEIGHT_M,
-                       lowest, path[:, :2].copy())
+                       lowest, path[:, :2].copy(), path_m=float(np.mean(travel)))
+
+
+def _travel(start_xy: np.ndarray | None, landed: list[Landing]) -> float:
+    """How far a foot went from `start_xy` through its landings (m)."""
+    points = ([start_xy] if start_xy is not None else []) + [
+        np.array([landing.x_m, landing.y_m]) for landing in landed]
+    return float(sum(np.hypot(*(b - a)) for a, b in zip(points, points[1:])))
 
 
 def walk_lines(summary: WalkSummary) -> list[str]:
-    """The demo's lines on a walk: steps, distance, worst placement, falls."""
+    """The lines on a walk: steps and how far, placement as bias and scatter, falls."""
     asked = len(summary.placements)
+    went = []
+    if summary.path_m is not None:
+        went.append(f'walked {summary.path_m:.2f} m')
+    if summary.distance_m is not None:
+        went.append(f'ended {summary.distance_m:.2f} m from where the walk began')
     lines = [f'walk: {summary.steps_taken} of {asked} steps taken'
-             + (f', {summary.distance_m:.2f} m from where the walk began'
-                if summary.distance_m is not None else '')]
-    worst = summary.worst_placement
-    if worst is not None:
-        lines.append(f'walk: worst placement {worst[0] * 100:.1f} cm and {worst[1]:.3f} rad '
-                     'from the step asked for')
+             + (f'; {", ".join(went)}' if went else '')]
+    bias, scatter, worst = (summary.placement_bias_m, summary.placement_scatter_m,
+                            summary.worst_placement)
+    if bias is not None and scatter is not None and worst is not None:
+        ahead, left = bias
+        lines.append(f'walk: landings {_signed_cm(ahead, "ahead", "behind")} and '
+                     f'{_signed_cm(left, "left", "right")} of the steps asked for on average, '
+                     f'scatter {scatter * 100:.1f} cm; worst placement {worst[0] * 100:.1f} cm '
+                     f'and {worst[1]:.3f} rad from the step asked for')
     lowest = '' if summary.lowest_pelvis_m is None else \
         f' (lowest pelvis {summary.lowest_pelvis_m:.3f} m)'
     lines.append(f'walk: {"FELL" if summary.fell else "no fall"}{lowest}')
     return lines
+
+
+def _signed_cm(value_m: float, positive: str, negative: str) -> str:
+    return f'{abs(value_m) * 100:.1f} cm {positive if value_m >= 0 else negative}'
 
 
 def plot_footprints(summary: WalkSummary, path: Path) -> Path:

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import argparse
 import sys
-from typing import Sequence
+from pathlib import Path
+from typing import Any, Sequence
 
 from tutorial_atlas_control.bags import (
     COMMAND_CHANGE_RAD,
@@ -16,6 +17,7 @@ from tutorial_atlas_control.bags import (
     WORST_JOINTS,
     Analysis,
     PlayedTrajectory,
+    WalkSummary,
     analysis_to_json,
     analyze,
     analyze_try,
@@ -27,10 +29,13 @@ from tutorial_atlas_control.bags import (
     parse_fps,
     parse_size,
     plot_comparison,
+    plot_footprints,
     plot_joints,
     plot_run,
     read_bag,
     render_bag_video,
+    summarise_walk,
+    walk_lines,
     write_csv,
 )
 from tutorial_atlas_control.cli.convention import (
@@ -198,13 +203,19 @@ def main(argv: Sequence[str] | None = None) -> int:
             check_output_path(args.video, *args.size, args.fps)
         analysis = _chosen(args.bag, args)
         played = [p for _, p in analysis.data.played]
-        print(analysis_to_json(analysis, {'trajectory': _played_dict(played)}) if args.json
-              else format_summary(analysis, trajectory=_played_text(played)))
+        walk = summarise_walk(analysis.data)
+        print(analysis_to_json(analysis, {'trajectory': _played_dict(played),
+                                          'walk': _walk_dict(walk)}) if args.json
+              else format_summary(analysis, trajectory=_played_text(played))
+              + ''.join(f'\n{line}' for line in (walk_lines(walk) if walk else ())))
         if args.csv:
             for path in write_csv(analysis.data, args.csv):
                 print(f'wrote {path}', file=sys.stderr)
         if args.plot:
             print(f'wrote {plot_run(analysis, args.plot)}', file=sys.stderr)
+            if walk is not None:  # and the walk seen from above, beside it
+                footprints = Path(args.plot).with_suffix('.footprints.png')
+                print(f'wrote {plot_footprints(walk, footprints)}', file=sys.stderr)
         if args.plot_joints:
             print(f'wrote {plot_joints(analysis, args.plot_joints)}', file=sys.stderr)
         if args.video:
@@ -217,6 +228,22 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         return EXIT_INTERRUPTED
     return 0
+
+
+def _walk_dict(walk: WalkSummary | None) -> dict[str, Any] | None:
+    """The walk's figures for --json (None: the run had no WALK)."""
+    if walk is None:
+        return None
+    bias = walk.placement_bias_m
+    worst = walk.worst_placement
+    return {'steps_asked': len(walk.placements), 'steps_taken': walk.steps_taken,
+            'path_m': walk.path_m, 'displacement_m': walk.distance_m, 'fell': walk.fell,
+            'lowest_pelvis_m': walk.lowest_pelvis_m,
+            'placement_bias_ahead_m': None if bias is None else bias[0],
+            'placement_bias_left_m': None if bias is None else bias[1],
+            'placement_scatter_m': walk.placement_scatter_m,
+            'worst_placement_m': None if worst is None else worst[0],
+            'worst_placement_rad': None if worst is None else worst[1]}
 
 
 def _played_dict(played: list[PlayedTrajectory]) -> dict[str, str] | None:

@@ -100,9 +100,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_INTERRUPTED
     print(f'offline: {what}, {run.sim_time_s:.3f} s of sim time in {run.wall_s:.2f} s '
           f'({run.real_time_factor:.1f}x real time)')
-    print(short_summary(analysis, args.table))
-    for line in walk_lines(walk) if walk is not None else ():
-        print(line)
+    if walk is None:
+        print(short_summary(analysis, args.table))
+    else:  # the walk's lines say whether it fell
+        print('=== summary ===')
+        for line in walk_lines(walk):
+            print(line)
     if args.bag is not None:
         print(f'bag:   {run.bag}')
     return 0

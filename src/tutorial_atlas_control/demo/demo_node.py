@@ -172,17 +172,19 @@ def summarise(bag: Path, video_fps: float, video_size: tuple[int, int],
     The summary is reported before the (slower) plot and video are made.
     """
     analysis = analyze_bag(bag)
-    report('\n' + short_summary(analysis, table, tracking=not walk))
     footprints = None
     if walk:
         summary = summarise_walk(analysis.data)
         if summary is None:
+            report('\n' + short_summary(analysis, table, tracking=False))
             report('walk: the bag holds no WALK command')
-        else:
+        else:  # the walk's lines say whether it fell: one line, not two
+            report('\n=== summary ===')
             for line in walk_lines(summary):
                 report(line)
             footprints = plot_footprints(summary, bag.with_suffix('.footprints.png'))
     else:
+        report('\n' + short_summary(analysis, table))
         foot = foot_line(analysis.data)
         if foot is not None:
             report(foot)

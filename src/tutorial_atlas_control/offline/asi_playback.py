@@ -132,7 +132,7 @@ def write_asi_bag(stream: AsiStream, bag: Path, settle_s: float,
     """Play `stream` offline and write the run to `bag` (a new file)."""
     sim = AtlasSimulator(load_model(), load_gains_yaml(gains_file),
                          startup_mode=stream.startup_mode)
-    interface = AtlasSimInterface(sim)
+    interface = AtlasSimInterface(sim, hold_at_start=True)  # atlas.launch's default start
     sink = open_offline_bag(bag)
     started_s = time.perf_counter()
     try:

@@ -81,18 +81,33 @@ def _summary(fell: bool = False) -> WalkSummary:
         (StepTarget(3, 0, 0.75, 0.12, 0.0), None),
     ]
     return WalkSummary(placements, 0.61, fell, 0.35 if fell else 0.88,
-                       np.array([[0.0, 0.0], [0.3, 0.01], [0.61, 0.0]]))
+                       np.array([[0.0, 0.0], [0.3, 0.01], [0.61, 0.0]]), path_m=0.63)
 
 
-def test_the_lines_say_steps_distance_worst_placement_and_falls() -> None:
+def test_the_lines_say_steps_path_placement_and_falls() -> None:
     summary = _summary()
     assert summary.steps_taken == 2
     assert summary.worst_placement == pytest.approx((0.03, 0.05))
+    # In each step's frame: (+2 cm ahead, 0) and (0, +3 cm left): the mean (1, 1.5) cm, each
+    # 1.80 cm from it.
+    assert summary.placement_bias_m == pytest.approx((0.01, 0.015))
+    assert summary.placement_scatter_m == pytest.approx(np.hypot(0.01, 0.015))
     assert walk_lines(summary) == [
-        'walk: 2 of 3 steps taken, 0.61 m from where the walk began',
-        'walk: worst placement 3.0 cm and 0.050 rad from the step asked for',
+        'walk: 2 of 3 steps taken; walked 0.63 m, ended 0.61 m from where the walk began',
+        'walk: landings 1.0 cm ahead and 1.5 cm left of the steps asked for on average, '
+        'scatter 1.8 cm; worst placement 3.0 cm and 0.050 rad from the step asked for',
         'walk: no fall (lowest pelvis 0.880 m)']
     assert walk_lines(_summary(fell=True))[-1] == 'walk: FELL (lowest pelvis 0.350 m)'
+
+
+def test_the_bias_is_taken_in_each_steps_frame() -> None:
+    """Round a circle a world-frame mean cancels out; in each step's frame it does not."""
+    placements = [(StepTarget(k, k % 2, 0.0, 0.0, yaw),
+                   Landing(k % 2, float(k), 0.02 * np.cos(yaw), 0.02 * np.sin(yaw), yaw))
+                  for k, yaw in enumerate(np.linspace(0.0, 2 * np.pi, 8, endpoint=False))]
+    summary = WalkSummary(placements, 0.0, False, 0.88, np.zeros((1, 2)))
+    assert summary.placement_bias_m == pytest.approx((0.02, 0.0), abs=1e-12)
+    assert summary.placement_scatter_m == pytest.approx(0.0, abs=1e-12)
 
 
 def test_the_footprints_are_plotted(tmp_path: Path) -> None:
