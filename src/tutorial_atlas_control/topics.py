@@ -51,6 +51,10 @@ ATLAS_COMMAND = '/atlas/atlas_command'
 #: k_effort in; each step's behaviour, its torques (f_out) and feedback out.
 ASI_COMMAND = '/atlas/atlas_sim_interface_command'
 ASI_STATE = '/atlas/atlas_sim_interface_state'
+#: atlas_msgs/AtlasSimInterfaceState for the bag: the same state at ~asi_state_recorded_rate
+#: (50 Hz) and at each change of behaviour or status, so that a recorded run keeps every
+#: transition without the 1 kHz duplicate.
+ASI_STATE_RECORDED = '/atlas/asi_state_recorded'
 #: atlas_msgs/Test: DRCSim's testing hook (joint damping, gains, k_effort).
 ATLAS_TEST = '/atlas/debug/test'
 #: atlas_msgs/SynchronizationStatistics (DRCSim 2.6+): the synchronization window's delays.
@@ -170,6 +174,9 @@ INTERFACE: tuple[Topic, ...] = (
           delivery=Delivery('debug_r', loop=True)),
     Topic(ASI_STATE, 'atlas_msgs/AtlasSimInterfaceState', _OUT, EVERY_STEP, on_demand=True,
           delivery=Delivery(loop=True)),
+    Topic(ASI_STATE_RECORDED, 'atlas_msgs/AtlasSimInterfaceState', _OUT,
+          Rate('~asi_state_recorded_rate', 50.0, 'and at each change of behaviour or status'),
+          on_demand=True, recorded=True, delivery=Delivery(loop=True)),
     Topic(SYNCHRONIZATION_STATISTICS, 'atlas_msgs/SynchronizationStatistics', _OUT,
           Rate(when='every step while the synchronization window is on'),
           delivery=Delivery(latched=True, loop=True)),

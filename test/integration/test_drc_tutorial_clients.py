@@ -3,7 +3,9 @@ is the tutorial's hold and the AtlasSimInterface says User (k_effort 255); a WAL
 refused in one log line naming the remedy, and reported, but not latched: an ASI STAND
 then hands the robot to the balancing Stand, walk_client.py walks and DRCSim's actionlib
 server's WALK goal succeeds; the gazebo_tutorials walking tutorial's static client steps
-round its 2 m circle and its dynamic client walks on round it, no fall. Where each of the
+round its 2 m circle and its dynamic client walks on round it, no fall; analyze_bag.py reads
+the run's behaviours back from the bag in order (the refusal, Stand, Walk, the return to
+Stand, Step). Where each of the
 60 static steps lands, and the dynamic client's turn, are judged offline
 (test_walking_tutorial.py), where a loaded host cannot starve the client.
 
@@ -15,6 +17,7 @@ from __future__ import annotations
 
 import json
 import shutil
+import subprocess
 import sys
 from pathlib import Path
 
@@ -35,6 +38,7 @@ HERE = Path(__file__).resolve().parent
 WALK_CLIENT = HERE.parents[1] / 'scripts' / 'walk_client.py'
 WALK_DEMO_GOAL = HERE.parent / 'support' / 'walk_demo_goal.py'
 TUTORIAL_CLIENT = HERE / 'walking_tutorial_client.py'
+ANALYZE = HERE.parents[1] / 'scripts' / 'analyze_bag.py'
 #: The tutorial's hold: straight legs, the pelvis 15 mm above the balancing Stand's.
 HOLD_PELVIS_M = 0.927
 STAND_PELVIS_M = 0.912
@@ -109,3 +113,16 @@ def test_drc_era_clients_on_the_default_launch(tmp_path: Path) -> None:
               f'{static["lowest_pelvis_m"]:.3f} m; dynamic {dynamic["taken"]} steps, lowest '
               f'pelvis {dynamic["lowest_pelvis_m"]:.3f} m')
         launch.interrupt(EXIT_TIMEOUT_S)
+        bag = launch.bag()
+    analyzed = subprocess.run([sys.executable, str(ANALYZE), str(bag)], capture_output=True,
+                              text=True, timeout=300, check=False)
+    assert analyzed.returncode == 0, analyzed.stderr
+    timeline = analyzed.stdout.split('Behaviours (')[1].split('\nWalk 1 ')[0]
+    at = [timeline.find(text) for text in (
+        'USER  FAILED_TRANS_ILLEGAL_BEHAVIOR (WALK asked for)',
+        'STAND  TRANSITION_SUCCESS (STAND asked for)', 'WALK  TRANSITION_SUCCESS',
+        'STAND  WARNING_AUTO_TRANS', 'STEP  TRANSITION_SUCCESS')]
+    assert -1 not in at and at == sorted(at), timeline
+    # Each client's walk summarised on its own (their step indices start at 1 again).
+    assert 'Walk 1 (from ' in analyzed.stdout and 'Walk 2 (from ' in analyzed.stdout
+    assert analyzed.stdout.count('walk: 4 of 4 steps taken') >= 2, analyzed.stdout

@@ -36,7 +36,7 @@ import numpy as np
 
 from tutorial_atlas_control.asi.behaviors import BEHAVIOR_OF_MODE, MODE_OF_BEHAVIOR, Behavior
 from tutorial_atlas_control.asi.session import STANDING_BEHAVIORS, AsiSession, behavior_name
-from tutorial_atlas_control.asi.state_report import StateReport
+from tutorial_atlas_control.asi.state_report import StateReport, manipulate_feedback
 from tutorial_atlas_control.asi.walk_params import (
     footsteps_of,
     sole_step,
@@ -56,7 +56,6 @@ from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.msgs import (
     AsiCommand,
     AsiState,
-    ManipulateFeedback,
     ManipulateParams,
     StepFeedback,
     WalkFeedback,
@@ -302,6 +301,14 @@ class AtlasSimInterface:
             return False
         return signed_distance(polygon, state.com[:2]) >= -COM_OUTSIDE_TOLERANCE_M
 
+    def status_key(self) -> tuple[int, int]:
+        """(current behaviour, behavior_feedback.status_flags) now, without a whole state:
+        what a recorded state's change is judged by."""
+        self._observe()
+        current = self.current_behavior
+        falling = current in STANDING_BEHAVIORS and falling_robot(self.sim)
+        return int(current), self.session.status_flags(current, falling)
+
     def state(self) -> AsiState:
         """The AtlasSimInterfaceState of the step just taken."""
         self._observe()
@@ -311,20 +318,12 @@ class AtlasSimInterface:
         time_s, ahead_m = float(sim.data.time), self._estimator.sole_ahead_m
         walking, stepping = self.walking, self.stepping
         return self._report.state(
-            current, session, falling, self.manipulate_feedback(),
+            current, session, falling,
+            manipulate_feedback(self.stand if self.manipulating else None),
             (walk_feedback(walking.status(time_s), ahead_m)
              if current == Behavior.WALK and walking is not None else WalkFeedback()),
             (step_feedback(stepping.status(time_s), ahead_m)
              if current == Behavior.STEP and stepping is not None else StepFeedback()))
-
-    def manipulate_feedback(self) -> ManipulateFeedback:
-        """The pelvis target in use, as clamped, while Manipulate runs (the Stand pose's
-        without use_desired); zeros otherwise."""
-        stand = self.stand
-        if not self.manipulating or stand is None:
-            return ManipulateFeedback()
-        target = stand.servo_target or PelvisServo(stand.squats.stand_height_m)
-        return ManipulateFeedback(0, target.height_m, target.yaw_rad, target.lateral_m)
 
     def end_step(self) -> None:
         """After each step, whether or not a state was built."""

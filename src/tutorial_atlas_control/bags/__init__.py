@@ -13,6 +13,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'compare': ['compare_analyses', 'compare_bags', 'comparison_to_json',
                 'first_applied_command_s', 'format_comparison', 'plot_comparison'],
     'feet': ['foot_displacement', 'foot_line'],
+    'behaviours': ['BehaviourChange', 'behaviour_lines', 'read_behaviours', 'walk_windows'],
     'footprints': ['Landing', 'StepTarget', 'WalkSummary', 'plot_footprints',
                    'read_step_targets', 'summarise_walk', 'walk_lines'],
     'overview_plot': ['WORST_JOINTS'],

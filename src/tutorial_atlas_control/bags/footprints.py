@@ -138,10 +138,12 @@ def _yaw_of_xyzw(x: float, y: float, z: float, w: float) -> float:
     return float(np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)))
 
 
-def read_step_targets(data: BagData) -> tuple[list[StepTarget], float | None]:
+def read_step_targets(data: BagData, window_s: tuple[float, float] | None = None
+                      ) -> tuple[list[StepTarget], float | None]:
     """The steps the WALK commands in `data`'s bag asked for, by step index (the last pose
     sent for each index), and when the first WALK came (s from the bag's start; None: no
-    WALK did)."""
+    WALK did); with `window_s` (from, to), only the commands sent in it (one walk of
+    several: their step indices start again at 1)."""
     records = open_bag(data.path)
     try:
         connections = [c for c in records.connections if c.topic == topics.ASI_COMMAND]
@@ -153,10 +155,12 @@ def read_step_targets(data: BagData) -> tuple[list[StepTarget], float | None]:
         first_walk_s = None
         for t_ns, raw in zip(bag_ns.tolist(), raws):
             command = typestore.deserialize_ros1(raw, _COMMAND_TYPE)
-            if command.behavior != WALK_BEHAVIOR:
+            sent_s = t_ns / 1e9 - data.start_time_s
+            if command.behavior != WALK_BEHAVIOR or (
+                    window_s is not None and not window_s[0] <= sent_s <= window_s[1]):
                 continue
             if first_walk_s is None:
-                first_walk_s = t_ns / 1e9 - data.start_time_s
+                first_walk_s = sent_s
             for step in command.walk_params.step_queue:
                 if step.step_index == 0:  # a padding entry
                     continue
@@ -218,8 +222,8 @@ def match_landings(targets: list[StepTarget],
     return placements
 
 
-def _foot_poses(data: BagData, since_s: float) -> tuple[np.ndarray, list[np.ndarray],
-                                                        list[np.ndarray], float]:
+def _foot_poses(data: BagData, since_s: float, until_s: float = np.inf
+                ) -> tuple[np.ndarray, list[np.ndarray], list[np.ndarray], float]:
     """Times (n,) at KINEMATICS_RATE_HZ from `since_s`, per foot its link's world positions
     (n, 3) and yaws (n,) from the recorded pose, and the links' height (m) with the soles
     flat on the ground (the Stand pose placed on it)."""
@@ -231,7 +235,7 @@ def _foot_poses(data: BagData, since_s: float) -> tuple[np.ndarray, list[np.ndar
     bodies = [kinematics.body_id(name) for name in FOOT_BODIES]
     place_in_stand_pose(kinematics.atlas, kinematics.data)  # the soles flat on the ground
     standing_m = float(kinematics.data.xpos[bodies[0]][2])
-    end_s = min(float(pelvis.t_s[-1]), float(states.t_s[-1]))
+    end_s = min(float(pelvis.t_s[-1]), float(states.t_s[-1]), until_s)
     t_s = np.arange(max(since_s, float(pelvis.t_s[0]), float(states.t_s[0])), end_s,
                     1.0 / KINEMATICS_RATE_HZ)
     positions = [np.empty((len(t_s), 3)) for _ in bodies]
@@ -245,17 +249,20 @@ def _foot_poses(data: BagData, since_s: float) -> tuple[np.ndarray, list[np.ndar
     return t_s, positions, yaws, standing_m
 
 
-def summarise_walk(data: BagData) -> WalkSummary | None:
-    """The walk in `data`'s bag; None when it holds no WALK command or no recorded pose."""
-    targets, first_walk_s = read_step_targets(data)
+def summarise_walk(data: BagData, window_s: tuple[float, float] | None = None
+                   ) -> WalkSummary | None:
+    """The walk in `data`'s bag (with `window_s`, the one in that window, s from the bag's
+    start); None when it holds no WALK command or no recorded pose."""
+    targets, first_walk_s = read_step_targets(data, window_s)
     pelvis = data.pelvis
     if first_walk_s is None or pelvis is None or data.joint_states is None \
             or not len(pelvis.t_s) or not len(data.joint_states.t_s):
         return None
-    t_s, positions, yaws, standing_m = _foot_poses(data, first_walk_s)
+    until_s = np.inf if window_s is None else window_s[1]
+    t_s, positions, yaws, standing_m = _foot_poses(data, first_walk_s, until_s)
     by_foot = [landings(foot, t_s, positions[foot], yaws[foot], standing_m) for foot in (0, 1)]
     placements = match_landings(targets, by_foot)
-    walking = pelvis.t_s >= first_walk_s
+    walking = (pelvis.t_s >= first_walk_s) & (pelvis.t_s <= until_s)
     path = pelvis.position_m[walking]
     distance = float(np.hypot(*(path[-1, :2] - path[0, :2]))) if len(path) else None
     lowest = float(path[:, 2].min()) if len(path) else None

@@ -16,11 +16,13 @@ from tutorial_atlas_control.bags import (
     MOVED_RANGE_RAD,
     WORST_JOINTS,
     Analysis,
+    BehaviourChange,
     PlayedTrajectory,
     WalkSummary,
     analysis_to_json,
     analyze,
     analyze_try,
+    behaviour_lines,
     check_output_path,
     compare_analyses,
     comparison_to_json,
@@ -33,9 +35,11 @@ from tutorial_atlas_control.bags import (
     plot_joints,
     plot_run,
     read_bag,
+    read_behaviours,
     render_bag_video,
     summarise_walk,
     walk_lines,
+    walk_windows,
     write_csv,
 )
 from tutorial_atlas_control.cli.convention import (
@@ -204,10 +208,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         analysis = _chosen(args.bag, args)
         played = [p for _, p in analysis.data.played]
         walk = summarise_walk(analysis.data)
-        print(analysis_to_json(analysis, {'trajectory': _played_dict(played),
-                                          'walk': _walk_dict(walk)}) if args.json
-              else format_summary(analysis, trajectory=_played_text(played))
-              + ''.join(f'\n{line}' for line in (walk_lines(walk) if walk else ())))
+        changes = read_behaviours(analysis.data)
+        walks = _walks(analysis, changes)
+        extra = (behaviour_lines(changes) if changes is not None else []) + [
+            line for title, each in walks for line in [title, *walk_lines(each)]]
+        print(analysis_to_json(analysis, {
+            'trajectory': _played_dict(played), 'walk': _walk_dict(walk),
+            'walks': [_walk_dict(each) for _, each in walks],
+            'behaviours': None if changes is None else [vars(c) for c in changes]})
+              if args.json else format_summary(analysis, trajectory=_played_text(played))
+              + ''.join(f'\n{line}' for line in extra))
         if args.csv:
             for path in write_csv(analysis.data, args.csv):
                 print(f'wrote {path}', file=sys.stderr)
@@ -228,6 +238,22 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         return EXIT_INTERRUPTED
     return 0
+
+
+def _walks(analysis: Analysis, changes: list[BehaviourChange] | None
+           ) -> list[tuple[str, WalkSummary]]:
+    """Each walk of the run, titled: by the recorded behaviours' walk windows (a client's
+    step indices start at 1 again each walk), else the bag's WALK commands as one."""
+    if changes is not None:
+        found = []
+        for number, window in enumerate(walk_windows(changes), 1):
+            each = summarise_walk(analysis.data, window)
+            if each is not None:
+                end = 'the end' if window[1] == float('inf') else f'{window[1]:.1f} s'
+                found.append((f'Walk {number} (from {window[0]:.1f} s to {end}):', each))
+        return found
+    walk = summarise_walk(analysis.data)
+    return [] if walk is None else [('Walk (the bag\'s WALK commands):', walk)]
 
 
 def _walk_dict(walk: WalkSummary | None) -> dict[str, Any] | None:

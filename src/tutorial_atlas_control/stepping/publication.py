@@ -3,7 +3,7 @@
 The table's rows with a SimMessages wire are filled by plans and sent at their rate; the
 on-demand ones are filled only when due and someone listens (an unheard one costs a test
 per step). /clock, /ground_truth_odom, /tf, /atlas/controller_statistics and the AtlasSimInterface's
-state have builders of their own.
+state (and the bag's copy of it) have builders of their own.
 """
 
 from __future__ import annotations
@@ -12,7 +12,12 @@ from collections.abc import Mapping
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.asi import AtlasSimInterface
-from tutorial_atlas_control.msgs import ControllerStatisticsWire, clock_bytes, encode_asi_state
+from tutorial_atlas_control.msgs import (
+    AsiState,
+    ControllerStatisticsWire,
+    clock_bytes,
+    encode_asi_state,
+)
 from tutorial_atlas_control.sim import (
     AtlasSimulator,
     CommandAgeStatistics,
@@ -63,6 +68,11 @@ class StepPublisher:
         self.asi = asi
         self.asi_outlet = outputs.outlets.get(topics.ASI_STATE) if asi is not None else None
         self.asi_seq = 0
+        #: The bag's copy of the state: at its rate and at each change of (behaviour, status).
+        self.asi_recorded_outlet = (outputs.outlets.get(topics.ASI_STATE_RECORDED)
+                                    if asi is not None else None)
+        self.asi_recorded_seq = 0
+        self.asi_recorded_key: tuple[int, int] | None = None
         self.outbox = outputs.outbox
         outlets = outputs.outlets
         rates_hz = {**default_rates_hz(), **rates_hz}
@@ -131,11 +141,28 @@ class StepPublisher:
                 and links.due(now_ns) and wanted(tf_outlet)):
             outbox.add(tf_outlet, messages.links_tf(now_ns))
         asi_outlet = self.asi_outlet
+        state = None
         if asi_outlet is not None and wanted(asi_outlet):
             self.asi_seq += 1
             assert self.asi is not None  # an outlet only with one
-            body = encode_asi_state(self.asi.state(), self.asi_seq)
+            state = self.asi.state()
+            body = encode_asi_state(state, self.asi_seq)
             outbox.add(asi_outlet, len(body).to_bytes(4, 'little') + body)
+        recorded = self.asi_recorded_outlet
+        if recorded is not None and wanted(recorded):
+            self._record_asi_state(count, recorded, state)
+
+    def _record_asi_state(self, count: int, outlet: object, state: AsiState | None) -> None:
+        """The bag's copy of the state, when due or changed (`state`: built already)."""
+        asi = self.asi
+        assert asi is not None  # an outlet only with one
+        key = asi.status_key()
+        if count % self.every['asi_state_recorded'] and key == self.asi_recorded_key:
+            return
+        self.asi_recorded_key = key
+        self.asi_recorded_seq += 1
+        body = encode_asi_state(state or asi.state(), self.asi_recorded_seq)
+        self.outbox.add(outlet, len(body).to_bytes(4, 'little') + body)
 
     def publish_step(self, count: int) -> None:
         """After step `count`: its messages, and the command age into the statistics'

@@ -50,7 +50,8 @@ def sim(atlas: atlas_model.AtlasModel) -> AtlasSimulator:
 def make_loop(sim: AtlasSimulator, listeners: set[str], balance: bool = False,
               hold_at_start: bool = False) -> tuple[SteppingLoop, FakeOutbox, FakeLog]:
     outbox, log = FakeOutbox(listeners), FakeLog()
-    outlets = {topic: topic for topic in (*ALL_TOPICS, topics.ASI_STATE)}
+    outlets = {topic: topic
+               for topic in (*ALL_TOPICS, topics.ASI_STATE, topics.ASI_STATE_RECORDED)}
     loop = SteppingLoop(sim, LoopOutputs(outbox, outlets, log, lambda _text: None),
                         LoopSettings(LAUNCH_RATES_HZ, balance_stand=balance,
                                      hold_at_start=hold_at_start),
@@ -153,3 +154,29 @@ def test_a_refused_request_is_said_in_one_line_and_the_remedy_is_taken(
     loop.receive_command(asi_bytes(Behavior.MANIPULATE), topics.ASI_COMMAND)
     loop.apply_pending_commands()
     assert len(log.of('refused')) == 2 and loop.asi.current_behavior == Behavior.MANIPULATE
+
+
+def test_the_bags_copy_of_the_state_comes_at_50_hz_and_at_each_change(
+        sim: AtlasSimulator) -> None:
+    atlas_msgs = pytest.importorskip('atlas_msgs.msg', reason='needs the catkin workspace')
+    loop, outbox, _ = make_loop(sim, {topics.ASI_STATE_RECORDED})
+    turns = [0]
+
+    def is_shutdown() -> bool:
+        turns[0] += 1
+        if turns[0] == 31:  # FREEZE before step 30: TRANSITION_SUCCESS in its state, then OK
+            loop.receive_command(asi_bytes(Behavior.FREEZE), topics.ASI_COMMAND)
+        return turns[0] > 45
+    loop.run(is_shutdown)
+    seen = []
+    for framed in outbox.queued()[topics.ASI_STATE_RECORDED]:
+        message = atlas_msgs.AtlasSimInterfaceState()
+        message.deserialize(bytes(framed[4:]))
+        seen.append((header_stamp_ns(framed) // sim.step_ns, message.current_behavior,
+                     message.behavior_feedback.status_flags))
+    # Stamped as the state (the step's start, ms): every 20th step, and the switch's
+    # TRANSITION_SUCCESS and the OK after it, which a 50 Hz sample alone would miss.
+    assert seen == [(0, Behavior.STAND, Status.OK), (19, Behavior.STAND, Status.OK),
+                    (30, Behavior.FREEZE, Status.TRANSITION_SUCCESS),
+                    (31, Behavior.FREEZE, Status.OK), (39, Behavior.FREEZE, Status.OK)]
+    assert topics.ASI_STATE not in outbox.queued()  # the 1 kHz state: nobody listens

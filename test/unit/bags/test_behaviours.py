@@ -1,0 +1,37 @@
+"""bags/behaviours.py: a recorded state's change as a line of the timeline."""
+
+from __future__ import annotations
+
+from tutorial_atlas_control.bags.behaviours import (
+    WALK_ENDS_AFTER_S,
+    BehaviourChange,
+    behaviour_lines,
+    walk_windows,
+)
+
+
+def test_each_change_says_the_behaviour_its_status_and_what_was_asked() -> None:
+    lines = behaviour_lines([BehaviourChange(1.5, 1, 0, 0), BehaviourChange(2.25, 1, 8, 4),
+                             BehaviourChange(3.0, 0, 2, 0), BehaviourChange(9.0, 0, 128, 0),
+                             BehaviourChange(9.5, 9, 0, 0)])
+    assert lines == [
+        "Behaviours (the AtlasSimInterface's state; times from bag start):",
+        '      1.500 s  USER',
+        '      2.250 s  USER  FAILED_TRANS_ILLEGAL_BEHAVIOR (WALK asked for)',
+        '      3.000 s  STAND  TRANSITION_SUCCESS (STAND asked for)',
+        '      9.000 s  STAND  WARNING_AUTO_TRANS',
+        '      9.500 s  9']
+
+
+def test_a_recorded_topic_without_states_says_so() -> None:
+    assert behaviour_lines([]) == [
+        'Behaviours: /atlas/asi_state_recorded recorded, but no state in it']
+
+
+def test_each_walk_has_its_window_from_the_change_before_it() -> None:
+    changes = [BehaviourChange(0.1, 1, 0, 0), BehaviourChange(2.0, 0, 2, 0),
+               BehaviourChange(5.0, 4, 2, 4), BehaviourChange(5.001, 4, 0, 0),
+               BehaviourChange(8.0, 0, 128, 0), BehaviourChange(9.0, 0, 1, 4),
+               BehaviourChange(10.0, 4, 2, 4)]
+    assert walk_windows(changes) == [(2.0, 8.0 + WALK_ENDS_AFTER_S),
+                                     (9.0, float('inf'))]
