@@ -104,6 +104,7 @@ PORT_OWN_TOPICS = {
     '/atlas/sim_config': 'std_msgs/String',
     '/atlas/sim_inputs': 'std_msgs/String',
     '/atlas/current_control_mode': 'std_msgs/String',
+    '/atlas/asi_state_recorded': 'atlas_msgs/AtlasSimInterfaceState',
 }
 
 EXPECTED = DRCSIM_2_5_2 + DRCSIM_2_7_0

@@ -98,12 +98,12 @@ def _commands_line(analysis: Analysis) -> str:
 
 
 def _tracking_lines(analysis: Analysis) -> list[str]:
+    if 'joints' in analysis.unavailable:
+        return [f'Tracking: unavailable ({analysis.unavailable["joints"]})']
     commands = analysis.data.commands
     if commands is None or not len(commands.t_s):
         return ['Tracking: no joint command to track (what moved the joints was a behaviour '
                 'or a cheat)']
-    if 'joints' in analysis.unavailable:
-        return [f'Tracking: unavailable ({analysis.unavailable["joints"]})']
     if not analysis.joints:
         return [f'Tracking: no joint moved (measured range <= {MOVED_RANGE_RAD} rad, '
                 'constant commands)']
