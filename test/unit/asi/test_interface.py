@@ -247,6 +247,13 @@ def test_bdi_stand_loads_the_balancing_stand_into_a_hold_session(
     assert interface.session.served[Behavior.MANIPULATE] is ControlMode.STAND
 
 
+def one_step_walk(step_index: int) -> AsiCommand:
+    """A WALK of one left step 0.2 m ahead with `step_index`."""
+    step = StepData(step_index, 0, 0.63, (0.2, 0.12, 0.0), (0.0, 0.0, 0.0, 1.0), 0.1)
+    return AsiCommand(0, Behavior.WALK, (step,) + (StepData(),) * 3, False, StepData(), False,
+                      ManipulateParams(), None, 0)
+
+
 @pytest.fixture
 def waiting(atlas: atlas_model.AtlasModel) -> AtlasSimInterface:
     """atlas.launch's default start: pinned for 1 s, the library loaded but waiting."""
@@ -304,9 +311,7 @@ def test_control_mode_stand_gets_the_balancing_stand_and_a_reset_the_hold_again(
 def test_walk_from_the_default_start_is_refused_in_one_line_naming_stand(
         waiting: AtlasSimInterface) -> None:
     run(waiting, 10)
-    step = StepData(1, 0, 0.63, (0.2, 0.12, 0.0), (0.0, 0.0, 0.0, 1.0), 0.1)
-    walk = AsiCommand(0, Behavior.WALK, (step,) + (StepData(),) * 3, False, StepData(), False,
-                      ManipulateParams(), None, 0)
+    walk = one_step_walk(1)
     waiting.apply(walk)
     assert waiting.take_refusal() == (
         'refused AtlasSimInterfaceCommand behavior 4 (WALK) in USER: '
@@ -320,9 +325,7 @@ def test_walk_from_the_default_start_is_refused_in_one_line_naming_stand(
 
 def test_a_walk_without_its_first_step_outside_walk_is_said_aloud(
         interface: AtlasSimInterface) -> None:
-    step = StepData(3, 0, 0.63, (0.2, 0.12, 0.0), (0.0, 0.0, 0.0, 1.0), 0.1)
-    walk = AsiCommand(0, Behavior.WALK, (step,) + (StepData(),) * 3, False, StepData(), False,
-                      ManipulateParams(), None, 0)
+    walk = one_step_walk(3)
     interface.apply(walk)
     assert interface.take_refusal() == (
         'ignored AtlasSimInterfaceCommand behavior 4 (WALK) in STAND: its step_queue has '
@@ -335,9 +338,7 @@ def test_a_walk_asked_for_while_stand_takes_over_waits_for_it(
     run(waiting, 1500)
     waiting.apply(command(Behavior.STAND))
     assert waiting.stand is not None and waiting.stand.taking_over
-    step = StepData(1, 0, 0.63, (0.2, 0.12, 0.0), (0.0, 0.0, 0.0, 1.0), 0.1)
-    walk = AsiCommand(0, Behavior.WALK, (step,) + (StepData(),) * 3, False, StepData(), False,
-                      ManipulateParams(), None, 0)
+    walk = one_step_walk(1)
     waiting.apply(walk)  # DRCSim's actionlib server: STAND succeeded, then its WALK, once
     run(waiting, 1)
     state = waiting.state()
