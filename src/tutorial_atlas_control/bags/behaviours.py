@@ -5,6 +5,9 @@ as a timeline of changes: Stand, Walk, Step, Manipulate, auto-transitions and re
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags.reader import BagData
@@ -12,7 +15,8 @@ from tutorial_atlas_control.bags.records import open_bag
 from tutorial_atlas_control.bags.typestore import load_typestore
 from tutorial_atlas_control.errors import BagAnalysisError
 
-__all__ = ['BehaviourChange', 'behaviour_lines', 'read_behaviours', 'walk_windows']
+__all__ = ['BehaviourChange', 'behaviour_lines', 'plot_behaviours', 'read_behaviours',
+           'walk_windows']
 
 _STATE_TYPE = 'atlas_msgs/msg/AtlasSimInterfaceState'
 WALK = 4
@@ -99,3 +103,45 @@ def walk_windows(changes: list[BehaviourChange]) -> list[tuple[float, float]]:
                    float('inf'))
         windows.append((start, end + WALK_ENDS_AFTER_S))
     return windows
+
+
+#: Each behaviour's colour in the plot.
+_COLOURS = {0: 'tab:green', 1: '0.75', 2: 'tab:cyan', 3: 'tab:olive', 4: 'tab:blue',
+            5: 'tab:purple', 6: 'tab:orange'}
+#: Statuses marked on the plot: refusals, the library's own switches, falling.
+_MARKED = {4, 8, 16, 32, 64, 128, 256}
+
+
+def plot_behaviours(changes: list[BehaviourChange], t_s: np.ndarray,
+                    pelvis_height_m: np.ndarray, path: Path) -> Path:
+    """The pelvis height over the run, each behaviour's span shaded in its colour, and
+    refusals, auto-transitions and ERROR_FALLING marked and named; written to `path`."""
+    import matplotlib  # noqa: PLC0415 - only the plot needs it
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    figure, ax = plt.subplots(figsize=(10.0, 4.0))
+    ax.plot(t_s, pelvis_height_m, color='black', lw=1, label='pelvis height')
+    end_s = float(t_s[-1]) if len(t_s) else (changes[-1].t_s if changes else 1.0)
+    spans = [change for k, change in enumerate(changes)
+             if k == 0 or change.behaviour != changes[k - 1].behaviour]
+    shown: set[int] = set()
+    for span, after in zip(spans, [*spans[1:], None]):
+        colour = _COLOURS.get(span.behaviour, '0.9')
+        label = None if span.behaviour in shown else _name(span.behaviour, BEHAVIOURS)
+        shown.add(span.behaviour)
+        ax.axvspan(span.t_s, end_s if after is None else after.t_s, color=colour, alpha=0.25,
+                   lw=0, label=label)
+    for number, change in enumerate(c for c in changes if c.status in _MARKED):
+        ax.axvline(change.t_s, color='tab:red', lw=0.8, ls=':')
+        ax.annotate(_name(change.status, STATUSES), (change.t_s, 1.0),
+                    xycoords=('data', 'axes fraction'), xytext=(2, -10 - 9 * (number % 3)),
+                    textcoords='offset points', fontsize=7, color='tab:red')
+    ax.set_xlabel('time from the bag\'s start (s)')
+    ax.set_ylabel('pelvis height (m)')
+    ax.set_title('the AtlasSimInterface\'s behaviours')
+    ax.legend(loc='lower left', fontsize='small', ncol=4)
+    figure.tight_layout()
+    figure.savefig(path, dpi=100)
+    plt.close(figure)
+    return path

@@ -30,6 +30,7 @@ from tutorial_atlas_control.bags import (
     format_summary,
     parse_fps,
     parse_size,
+    plot_behaviours,
     plot_comparison,
     plot_footprints,
     plot_joints,
@@ -226,6 +227,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             if walk is not None:  # and the walk seen from above, beside it
                 footprints = Path(args.plot).with_suffix('.footprints.png')
                 print(f'wrote {plot_footprints(walk, footprints)}', file=sys.stderr)
+            pelvis = analysis.data.pelvis
+            if changes and pelvis is not None:  # and the behaviours over time
+                behaviours = plot_behaviours(changes, pelvis.t_s, pelvis.position_m[:, 2],
+                                             Path(args.plot).with_suffix('.behaviours.png'))
+                print(f'wrote {behaviours}', file=sys.stderr)
         if args.plot_joints:
             print(f'wrote {plot_joints(analysis, args.plot_joints)}', file=sys.stderr)
         if args.video:

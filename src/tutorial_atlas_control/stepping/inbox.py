@@ -151,7 +151,7 @@ class CommandInbox:
     def _apply(self, decoded: list[tuple[str, CommandUpdate | AtlasUpdate | AsiCommand]]
                ) -> None:
         """Apply decoded messages, oldest first."""
-        first = self.sim.user_command is None
+        first = self.watch.first_command_ns is None  # since the start or last reset
         updates: list[CommandUpdate] = []
         for topic, result in decoded:
             if isinstance(result, CommandUpdate):

@@ -180,3 +180,17 @@ def test_the_bags_copy_of_the_state_comes_at_50_hz_and_at_each_change(
                     (30, Behavior.FREEZE, Status.TRANSITION_SUCCESS),
                     (31, Behavior.FREEZE, Status.OK), (39, Behavior.FREEZE, Status.OK)]
     assert topics.ASI_STATE not in outbox.queued()  # the 1 kHz state: nobody listens
+
+
+def test_a_client_streaming_its_requests_gets_one_first_command_line(
+        sim: AtlasSimulator) -> None:
+    """An AtlasSimInterfaceCommand without k_effort leaves the user command unset: the first
+    command is the watch's own record, not the user command's absence (a 1 kHz client made
+    one line per command, 5906 in a live minute)."""
+    loop, _, log = make_loop(sim, set(), balance=True, hold_at_start=True)
+    for _ in range(3):
+        loop.receive_command(asi_bytes(Behavior.STAND), topics.ASI_COMMAND)
+        loop.apply_pending_commands()
+    firsts = [line for line in log.of('info') if line.startswith('first ')]
+    assert firsts == ['first /atlas/atlas_sim_interface_command since the start or last '
+                      'reset, at t=0.000 s (Stand mode)']
