@@ -2,10 +2,15 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
+import numpy as np
+
 from tutorial_atlas_control.bags.behaviours import (
     WALK_ENDS_AFTER_S,
     BehaviourChange,
     behaviour_lines,
+    plot_behaviours,
     walk_windows,
 )
 
@@ -35,3 +40,13 @@ def test_each_walk_has_its_window_from_the_change_before_it() -> None:
                BehaviourChange(10.0, 4, 2, 4)]
     assert walk_windows(changes) == [(2.0, 8.0 + WALK_ENDS_AFTER_S),
                                      (9.0, float('inf'))]
+
+
+def test_the_behaviours_are_plotted_over_the_pelvis_height(tmp_path: Path) -> None:
+    changes = [BehaviourChange(0.0, 1, 0, 0), BehaviourChange(1.0, 1, 8, 4),
+               BehaviourChange(2.0, 0, 2, 0), BehaviourChange(3.0, 4, 2, 4),
+               BehaviourChange(6.0, 0, 128, 0)]
+    t_s = np.linspace(0.0, 8.0, 801)
+    path = plot_behaviours(changes, t_s, 0.9 - 0.05 * (t_s > 3.0), tmp_path / 'b.png')
+    assert path.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
+    assert path.stat().st_size > 10_000
