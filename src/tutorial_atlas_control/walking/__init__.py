@@ -29,7 +29,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'walk_behaviour': ['WalkBehaviour', 'WalkStatus'],
     'start_noise': ['DEFAULT_START_NOISE', 'StartNoise', 'perturb_start'],
     'walk_trial': ['Landing', 'WalkTrial', 'WalkingStand', 'pushed_walk_trial',
-                   'random_pushes', 'walk_started_s', 'walk_trial'],
+                   'random_pushes', 'straight_walk_trial', 'walk_started_s', 'walk_trial'],
     'static_step': ['StaticStep', 'StepGains'],
     'step_behaviour': ['StepBehaviour', 'StepStatus'],
 })

@@ -233,6 +233,14 @@ def walk_started_s(gains: WalkGains | None = None) -> float:
     return SETTLE_S + (gains or WalkGains()).sway_s
 
 
+def straight_walk_trial(steps: int, stride_m: float, step_duration_s: float = STEP_DURATION_S,
+                        seed: int | None = None, after_s: float = 1.5) -> WalkTrial:
+    """`steps` straight steps of `stride_m` (m) at `step_duration_s` (s), sent once, from
+    a start perturbed by `seed`, then `after_s` (s) to catch and stand."""
+    plan = straight_steps(steps, stride_m, duration_s=step_duration_s)
+    return walk_trial(plan, walk_started_s() + steps * step_duration_s + after_s, seed=seed)
+
+
 def pushed_walk_trial(seed: int | None, steps: int = 20, stride_m: float = 0.25,
                       force_n: float = 150.0, push_s: float = 0.1, every_s: float = 5.0,
                       gains: WalkGains | None = None, after_s: float = 2.5
