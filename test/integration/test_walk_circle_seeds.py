@@ -3,7 +3,8 @@
 test_walking.py keeps one deterministic run of the README's two turns; this holds the
 circle over seeds (walking/start_noise.py: 5 mrad and 5 mrad/s on every joint), the
 assertions on the fractions, their messages naming the seeds that failed. One turn, not two,
-for the budget: 8 one-turn runs cost about as much as 4 two-turn runs. About 200 CPU s.
+for the budget: 8 one-turn runs cost about as much as 4 two-turn runs. About 220 CPU s
+(at load 7-10).
 """
 
 from __future__ import annotations
