@@ -7,7 +7,7 @@ pushed, drawing the pushes' phases and sides. The assertions are on the fraction
 messages name the seeds that failed. The seeds must perturb: 8 seeds, 8 different walks.
 Planted once: the noise at 0.1 rad and 0.1 rad/s: 6 of 8 straight walks, the test fails
 naming seeds 0 and 3. The circle over seeds: test_walk_circle_seeds.py; the static steps:
-test_asi_walk.py. About 160 CPU s (at load 7-10).
+test_asi_walk.py. About 130 CPU s at load 4.5, 160 at load 7-10.
 """
 
 from __future__ import annotations
