@@ -25,6 +25,9 @@ Sections (see bench/README.md for what each figure means and how it is measured)
             2.6's synchronization window on (--period-ms 1) at real_time_factor:=0
   plot      realtime_rtf and node_us_per_step without and with plot_topics.py plotting
             three 1 kHz fields (bench/plot_cost.py)
+  walking   the fractions of seeds whose walks fall: pushed every 5 s (walk_pushes.py), one
+            push at each phase of a step, test_asi_live's walks varied (walk_variations.py);
+            once, whatever --runs says (bench/walking.py)
 
 --compression sets the bags' chunk compression for every launch (TAC_BAG_COMPRESSION, which
 atlas.launch's `compression` argument defaults to); without it, the launch's default (lz4).
@@ -85,7 +88,7 @@ COMPRESSIONS = ('lz4', 'bz2', 'none')
 #: What the table and the JSON call the launch's own compression (lz4, atlas.launch).
 DEFAULT_COMPRESSION = 'the launch\'s default'
 SECTIONS = ('physics', 'offline', 'analysis', 'fast', 'realtime', 'load', 'tutorial',
-            'controller', 'plot', 'sweep', 'search')
+            'controller', 'plot', 'sweep', 'search', 'walking')
 #: What the table and the JSON say for the UDP figures while no UDP connection is made.
 NO_UDP = 'n/a (no UDP connection)'
 
@@ -178,6 +181,18 @@ ROWS = (
     ('search_generations', 'search.py: its generations', 'count', '', 0),
     ('search_runs_per_s', 'search.py: offline runs per second', 'runs/s', '', 3),
     ('search_reproduced', 'search.py: found Stepping.yaml again', 'yes=1', '1', 0),
+    ('walk_pushes_runs', 'walks pushed every 5 s: seeds', 'count', '', 0),
+    ('walk_pushes_fell_fraction_150n', 'of them fell, 150 N x 0.1 s', 'fraction', '0', 3),
+    ('walk_pushes_fell_fraction_175n', 'of them fell, 175 N x 0.1 s', 'fraction', '', 3),
+    ('walk_pushes_fell_fraction_200n', 'of them fell, 200 N x 0.1 s', 'fraction', '', 3),
+    ('walk_phase_pushes_runs', 'one push at a phase of a step: runs', 'count', '', 0),
+    ('walk_phase_pushes_fell_fraction_150n', 'of them fell, 150 N', 'fraction', '0', 3),
+    ('walk_phase_pushes_fell_fraction_150n_unadjusted', 'same, no step adjustment', 'fraction',
+     '', 3),
+    ('walk_phase_pushes_fell_fraction_200n', 'of them fell, 200 N', 'fraction', '', 3),
+    ('walk_phase_pushes_fell_fraction_250n', 'of them fell, 250 N', 'fraction', '', 3),
+    ('walk_variations_runs', 'test_asi_live\'s walks varied: seeds', 'count', '', 0),
+    ('walk_variations_fell_fraction', 'of them fell', 'fraction', '0', 3),
 )
 #: Rows shown as NO_UDP when the controller section ran without a UDP connection.
 UDP_ROWS = ('controller_udp_age_p50_ms', 'controller_udp_age_p99_ms',
@@ -312,6 +327,10 @@ TARGETS = {
     'controller_window_age_p99_ms': Target(low=1.0, high=1.0),
     # The search, run again whole, finds the committed step (one machine).
     'search_reproduced': Target(low=1.0, high=1.0),
+    # The issue's push while walking (15 N s) and the live test's walks: no seed falls.
+    'walk_pushes_fell_fraction_150n': Target(low=0.0, high=0.0),
+    'walk_phase_pushes_fell_fraction_150n': Target(low=0.0, high=0.0),
+    'walk_variations_fell_fraction': Target(low=0.0, high=0.0),
 }
 
 #: The keys each section must produce (a crash or an empty window shows as a missing key).
@@ -346,6 +365,10 @@ EXPECTED = {
     'sweep': ('sweep_runs_per_s_1', 'sweep_runs_per_s_2', 'sweep_scaling'),
     # search_reproduced only from a whole search (--full, --only search).
     'search': ('search_wall_s', 'search_generations', 'search_runs_per_s'),
+    # The other forces only in the budgets that push harder (bench/walking.BUDGETS).
+    'walking': ('walk_pushes_runs', 'walk_pushes_fell_fraction_150n', 'walk_phase_pushes_runs',
+                'walk_phase_pushes_fell_fraction_150n', 'walk_variations_runs',
+                'walk_variations_fell_fraction'),
 }
 #: Keys computed from two sections, expected when both ran.
 EXPECTED_ACROSS = {('physics', 'fast'): ('fast_ratio', 'fast_bare_ratio', 'node_bare_ratio')}
@@ -517,6 +540,18 @@ def run_search(args: argparse.Namespace, samples: dict[str, list[float]],
             f'{timed.wall_s:.1f} s' + ('' if timed.reproduced is None else
                                       f'; found Stepping.yaml again: {timed.reproduced}'))
         add(samples, figures)
+
+
+def run_walking(args: argparse.Namespace, samples: dict[str, list[float]],
+                loads: dict[str, str]) -> None:
+    """How often pushed and varied walks fall, over seeds: once, whatever --runs says (the
+    figures are fractions of seeds, not medians of runs)."""
+    if 'walking' not in args.sections:
+        return
+    import walking
+
+    with Section('walking', loads):
+        add(samples, walking.walking_figures(walking.BUDGETS[args.budget.name], log=log))
 
 
 def run_online(args: argparse.Namespace, samples: dict[str, list[float]],
@@ -804,6 +839,7 @@ def main(argv: list[str] | None = None) -> int:
         run_offline(args, samples, loads)
         run_sweep(args, samples, loads)
         run_search(args, samples, loads, work_dir)
+        run_walking(args, samples, loads)
         run_online(args, samples, loads, work_dir)
         run_tutorial(args, samples, loads, work_dir)
         ok = True

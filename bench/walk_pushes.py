@@ -5,8 +5,10 @@ Each run plays, without ROS: DRCSim 2.7's start (bdi_stand), then from 3 s a cli
 streaming a WALK of `--steps` straight steps of 0.25 m at 0.63 s on every state (as
 walk_client.py), and every `--every` seconds of the walk a push of `--force` N for `--push`
 s through the simulator's pelvis wrench (as /atlas/apply_pelvis_force), at a phase and to a
-side drawn from the run's seed. A run falls when the state says ERROR_FALLING. With
-`--search`, the force is raised in 25 N steps until a run of the seeds falls.
+side drawn from the run's seed (walk_trial.random_pushes), which also perturbs the start
+(start_noise: the joints' angles and rates). A run falls when the state says ERROR_FALLING.
+With `--search`, the force is raised in 25 N steps until a run of the seeds falls.
+`run_bench.py` runs it as its `walking` section (bench/walking.py).
 
 usage: python3 bench/walk_pushes.py [--steps N] [--force N] [--push S] [--every S]
        [--runs N] [--first-seed K] [--workers W] [--search]
@@ -18,7 +20,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import random
 import sys
 from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor
@@ -29,7 +30,7 @@ from walk_variations import CONFIG, DURATION_S, STEP_S, WIDTH_M, walk_command
 from tutorial_atlas_control.asi import AtlasSimInterface, Status, WalkClient
 from tutorial_atlas_control.sim import AtlasSimulator, VrcMode, load_gains_yaml, load_model
 from tutorial_atlas_control.sim.vrc import WrenchInput
-from tutorial_atlas_control.walking import placed, straight_steps
+from tutorial_atlas_control.walking import perturb_start, placed, random_pushes, straight_steps
 
 #: The walk starts at this sim time (s): Stand balances from 2 s and settles (a walk sent at
 #: 3.0 s, as its transition ends, fell at step 5 of 20 here, one at 4 s walks).
@@ -51,20 +52,19 @@ class Outcome:
     pushes: tuple[tuple[float, float], ...]
 
 
-def run(seed: int, steps: int, force_n: float, push_s: float, every_s: float) -> Outcome:
-    """One pushed walk (see the module docstring)."""
-    rng = random.Random(seed)
+def run(seed: int | None, steps: int, force_n: float, push_s: float, every_s: float
+        ) -> Outcome:
+    """One pushed walk (see the module docstring); seed None: the start unperturbed, the
+    pushes drawn from seed 0."""
     sim = AtlasSimulator(load_model(), load_gains_yaml(CONFIG), startup_mode=VrcMode.BDI_STAND)
+    perturb_start(sim.atlas, sim.data, seed, on_ground=False)  # pinned in the air at first
     interface = AtlasSimInterface(sim, True)
     walk_at = round(WALK_AT_S / STEP_S)
     duration = steps * DURATION_S + SETTLE_S
-    pushes = []  # (start step, end step, signed force)
-    t = WALK_AT_S
-    while t + every_s < WALK_AT_S + steps * DURATION_S:
-        start_s = t + rng.uniform(0.0, every_s)
-        pushes.append((round(start_s / STEP_S), round((start_s + push_s) / STEP_S),
-                       force_n * rng.choice((-1.0, 1.0))))
-        t += every_s
+    pushes = [(round(p.start_s / STEP_S), round((p.start_s + p.duration_s) / STEP_S),
+               p.force_n[1])  # (start step, end step, signed force)
+              for p in random_pushes(0 if seed is None else seed, WALK_AT_S,
+                                     WALK_AT_S + steps * DURATION_S, force_n, push_s, every_s)]
     client: WalkClient | None = None
     taken = 0
     state = interface.state()
@@ -92,10 +92,10 @@ def run(seed: int, steps: int, force_n: float, push_s: float, every_s: float) ->
         interface.end_step()
         taken = max(taken, state.walk_feedback.current_step_index)
         if state.behavior_feedback.status_flags == Status.ERROR_FALLING:
-            return Outcome(seed, force_n, True, taken,
+            return Outcome(-1 if seed is None else seed, force_n, True, taken,
                            tuple((round(s * STEP_S, 3), f) for s, _, f in pushes
                                  if s <= k))
-    return Outcome(seed, force_n, False, taken,
+    return Outcome(-1 if seed is None else seed, force_n, False, taken,
                    tuple((round(s * STEP_S, 3), f) for s, _, f in pushes))
 
 

@@ -3,13 +3,15 @@
 A live run differs from the deterministic offline tests in small things: how long the push
 before the walk lasts, when each walk starts, which states a streaming client answers and
 how late, and where the physics stands to the last bit. Each run here draws those from its
-seed and plays the live test's sequence through the AtlasSimInterface, without ROS:
-DRCSim 2.7's start (bdi_stand), a 40 N sideways push, walk_client's streamed walk of four
-steps, then the actionlib server's (four ego-centric steps placed by the pelvis's x, y and
-yaw, STAND once the last step has begun). A run falls when the state says ERROR_FALLING.
+seed, perturbs its start with it (start_noise: the joints' angles and rates) and plays
+the live test's sequence through the AtlasSimInterface, without ROS: DRCSim 2.7's start
+(bdi_stand), a 40 N sideways push, walk_client's streamed walk of four steps, then the
+actionlib server's (four ego-centric steps placed by the pelvis's x, y and yaw, STAND once
+the last step has begun). A run falls when the state says ERROR_FALLING.
 
 usage: python3 bench/walk_variations.py [--stride M] [--runs N] [--first-seed K] [--workers W]
-(after `source ./env.sh`; about 30 CPU s a run). Figures: bench/README.md.
+(after `source ./env.sh`; about 30 CPU s a run). Figures: bench/README.md; `run_bench.py` runs
+it in its `walking` section (bench/walking.py).
 """
 
 from __future__ import annotations
@@ -30,7 +32,7 @@ from tutorial_atlas_control.asi import AtlasSimInterface, Behavior, Status, Walk
 from tutorial_atlas_control.msgs.atlas_sim_interface import AsiCommand, ManipulateParams, StepData
 from tutorial_atlas_control.sim import AtlasSimulator, VrcMode, load_gains_yaml, load_model
 from tutorial_atlas_control.sim.vrc import WrenchInput
-from tutorial_atlas_control.walking import Footstep, placed, straight_steps
+from tutorial_atlas_control.walking import Footstep, perturb_start, placed, straight_steps
 
 CONFIG = Path(__file__).resolve().parents[1] / 'config' / 'atlas_controller.yaml'
 #: The live test's push (N, sideways) and the 1 ms step.
@@ -55,14 +57,13 @@ class Variation:
     client_lag_steps: int    # it answers the state of 1-30 steps before
     client_answers: float    # the fraction of states it answers (0.6)
     demo_delay_s: float      # the actionlib goal 0.5-2 s after the first walk's end
-    joint_noise_rad: float   # normal noise on the initial joint angles (none for seed 0)
 
     @classmethod
     def draw(cls, seed: int) -> Variation:
         rng = random.Random(seed)
         return cls(seed, 3.5 + rng.uniform(0.0, 0.4), 0.75 + rng.uniform(0.0, 0.75),
                    2.0 + rng.uniform(0.0, 1.0), rng.randint(1, 30), 0.6,
-                   rng.uniform(0.5, 2.0), 1e-6 if seed else 0.0)
+                   rng.uniform(0.5, 2.0))
 
 
 @dataclass(frozen=True)
@@ -110,16 +111,14 @@ def demo_steps(stride_m: float, origin_xy: tuple[float, float], yaw_rad: float) 
     return placed(ego, origin_xy, yaw_rad)
 
 
-def run(seed: int, stride_m: float) -> Outcome:
-    """The live test's sequence under the variation of `seed`."""
-    variation = Variation.draw(seed)
-    rng = random.Random(seed + 1_000_003)
+def run(seed: int | None, stride_m: float) -> Outcome:
+    """The live test's sequence under the variation of `seed`, its start perturbed by the
+    seed too (start_noise); seed None: seed 0's variation from an unperturbed start."""
+    variation = Variation.draw(0 if seed is None else seed)
+    rng = random.Random(variation.seed + 1_000_003)
     sim = AtlasSimulator(load_model(), load_gains_yaml(CONFIG), startup_mode=VrcMode.BDI_STAND)
     interface = AtlasSimInterface(sim, True)
-    if variation.joint_noise_rad:
-        noise = np.random.default_rng(seed).normal(0.0, variation.joint_noise_rad,
-                                                   sim.data.qpos[7:].shape)
-        sim.data.qpos[7:] += noise
+    perturb_start(sim.atlas, sim.data, seed, on_ground=False)  # pinned in the air at first
     push_start = round(variation.push_start_s / STEP_S)
     push_end = push_start + round(variation.push_s / STEP_S)
     walk_start = push_end + round(variation.walk_delay_s / STEP_S)
@@ -169,12 +168,13 @@ def run(seed: int, stride_m: float) -> Outcome:
         worst_tilt, lowest = max(worst_tilt, tilt), min(lowest, float(sim.data.qpos[2]))
         if state.behavior_feedback.status_flags == Status.ERROR_FALLING \
                 or sim.data.qpos[2] < DOWN_M:
-            return Outcome(seed, stride_m, phase, (taken['walk_client'], taken['actionlib']),
-                           round(k * STEP_S, 3), round(worst_tilt, 1), round(lowest, 3))
+            return Outcome(variation.seed, stride_m, phase,
+                           (taken['walk_client'], taken['actionlib']), round(k * STEP_S, 3),
+                           round(worst_tilt, 1), round(lowest, 3))
         if stand_sent and state.current_behavior == Behavior.STAND and len(seen) > lag \
                 and k > demo_start + round(3.0 / STEP_S):
             break
-    return Outcome(seed, stride_m, None, (taken['walk_client'], taken['actionlib']),
+    return Outcome(variation.seed, stride_m, None, (taken['walk_client'], taken['actionlib']),
                    round(k * STEP_S, 3), round(worst_tilt, 1), round(lowest, 3))
 
 
@@ -185,7 +185,7 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument('--stride', type=float, default=0.2, help='stride (m; default 0.2)')
     parser.add_argument('--runs', type=int, default=12, help='runs (default 12)')
     parser.add_argument('--first-seed', type=int, default=1,
-                        help='the first run\'s seed (default 1; seed 0 draws no joint noise)')
+                        help='the first run\'s seed (default 1)')
     parser.add_argument('--workers', type=int, default=2, help='processes (default 2)')
     return parser
 

@@ -1,16 +1,18 @@
-"""Walking offline, deterministic: the robot standing in DRCSim's Stand pose walks 20
-straight steps of 0.25 m at 0.63 s each (about 0.4 m/s; walking/walk.py on the Stand's
-whole-body balance), then stands again; and the issue's two turns of a 2 m circle, streamed.
-The issue's bounds: every landing within 5 cm and 0.1 rad of its target, no fall, the
-pelvis at least 4 m ahead (straight), back within 0.3 m of the start after each turn (the
-circle); the legs' torques without chatter; and the exact figures of these runs. Pushed
-sideways by the issue's 15 N s four times during the 20 steps, the walk moves the pushed
-steps' landings (step adjustment) and walks on. Defects kept as tests: the same pushes
-without step adjustment fall at the fifth step; the walk at the Stand's height (the
-trailing leg cannot lift) falls within its first three steps. Planted once: a swing servo
+"""Walking offline, deterministic (seed None): the robot standing in DRCSim's Stand pose
+walks the issue's two turns of a 2 m circle, streamed (walking/walk.py on the Stand's
+whole-body balance), then stands again. The issue's bounds: every landing within 5 cm and
+0.1 rad of its target, no fall, back within 0.3 m of the start after each turn; the legs'
+torques without chatter; and the exact figures of this run. Defects kept as tests: pushed
+sideways by the issue's 15 N s four times during 20 straight steps, at phases chosen so,
+a walk without step adjustment falls at the fifth step (with it, seeded pushed walks walk
+on: test_walk_seeds.py; the moved step's landing and step_queue_saturated:
+test_asi_walk.py); the walk at the Stand's height (the trailing leg cannot lift) falls
+within its first three steps. Planted once: a swing servo
 damped at 40/s chatters (107 N m of mean torque change per 1 ms step), misses the landing
-bounds and falls round the circle at its ninth step. DRCSim's queue, streaming and
-one-shot clients: test_asi_walk.py, through the interface. About 45 s of CPU in all.
+bounds and falls round the circle at its ninth step. The same walks over 8 perturbed
+starts each (the 20 straight steps, pushed or not; one turn of the circle):
+test_walk_seeds.py and test_walk_circle_seeds.py. DRCSim's queue, streaming and one-shot
+clients: test_asi_walk.py, through the interface. About 50 s of CPU in all.
 """
 
 from __future__ import annotations
@@ -30,10 +32,9 @@ pytestmark = pytest.mark.offline
 #: The issue's bounds on each landing (m, rad).
 LANDING_WITHIN_M = 0.05
 LANDING_YAW_WITHIN_RAD = 0.1
-#: The straight walk: steps, stride (m), and how far ahead the pelvis must end (m).
+#: The straight walk: steps and stride (m).
 STRAIGHT_STEPS = 20
 STRIDE_M = 0.25
-STRAIGHT_AHEAD_M = 4.0
 #: The circle: radius (m), steps a turn, turns, feet apart (m); how near the start the pelvis
 #: is after each turn (m); a walking pelvis stays above this (m).
 CIRCLE_RADIUS_M = 2.0
@@ -45,9 +46,6 @@ PELVIS_ABOVE_M = 0.7
 #: The issue's push while walking: 150 N sideways on the pelvis for 0.1 s (15 N s).
 PUSH_N = 150.0
 PUSH_S = 0.1
-#: A step adjusted for a push lands at least this far from where it was sent (m), and
-#: within LANDING_WITHIN_M of where Walk moved it.
-ADJUSTED_BY_M = 0.08
 #: The legs' torques change by at most this much per 1 ms step, on average (N m): the
 #: chattering servo's was 107, the smooth one's is 1.4.
 TORQUE_JUMP_BELOW_NM = 10.0
@@ -57,21 +55,6 @@ def _landings_within_bounds(trial: WalkTrial) -> bool:
     return (all(landing.error_m < LANDING_WITHIN_M for landing in trial.landings)
             and all(landing.yaw_error_rad < LANDING_YAW_WITHIN_RAD
                     for landing in trial.landings))
-
-
-def test_twenty_straight_steps_of_a_quarter_metre() -> None:
-    plan = straight_steps(STRAIGHT_STEPS, STRIDE_M)
-    trial = walk_trial(plan, 20.0)
-    assert not trial.fell
-    assert trial.steps == STRAIGHT_STEPS
-    assert _landings_within_bounds(trial)
-    assert float(trial.pelvis_end[0]) >= STRAIGHT_AHEAD_M
-    assert trial.leg_torque_jump_nm < TORQUE_JUMP_BELOW_NM
-    assert trial.walk_ended_s is not None
-    # This run's figures (deterministic).
-    assert round(trial.worst_landing_m, 3) == 0.027
-    assert round(trial.lowest_pelvis_m, 3) == 0.839
-    assert round(float(trial.pelvis_end[0]), 2) == 4.75
 
 
 def test_two_turns_of_a_two_metre_circle_streamed() -> None:
@@ -104,21 +87,6 @@ def _pushed_walk(adjust_steps: bool) -> WalkTrial:
                                            (16, 0.9, 1.0))]
     return walk_trial(straight_steps(STRAIGHT_STEPS, STRIDE_M), 17.0,
                       WalkGains(adjust_steps=adjust_steps), streaming=True, pushes=pushes)
-
-
-def test_pushed_while_walking_the_robot_steps_where_the_capture_point_goes() -> None:
-    trial = _pushed_walk(adjust_steps=True)
-    assert not trial.fell
-    assert trial.steps == STRAIGHT_STEPS
-    assert trial.lowest_pelvis_m > PELVIS_ABOVE_M
-    assert float(trial.pelvis_end[0]) >= STRAIGHT_AHEAD_M
-    moved = [landing.step_index for landing in trial.landings
-             if landing.error_m > ADJUSTED_BY_M]
-    assert moved == [4, 9]
-    # Every step lands where Walk took it (step_queue_saturated), the moved ones too.
-    assert all(landing.taken_error_m < LANDING_WITHIN_M for landing in trial.landings)
-    # This run's figures (deterministic).
-    assert round(trial.worst_landing_m, 3) == 0.116
 
 
 def test_pushed_while_walking_without_step_adjustment_it_falls() -> None:

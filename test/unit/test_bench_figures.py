@@ -141,6 +141,7 @@ def run_main_with(monkeypatch: pytest.MonkeyPatch, figures: dict[str, list[float
                         lambda args, samples, loads: samples.update(figures))
     monkeypatch.setattr(run_bench, 'run_online', lambda *args: None)
     monkeypatch.setattr(run_bench, 'run_tutorial', lambda *args: None)
+    monkeypatch.setattr(run_bench, 'run_walking', lambda *args: None)
     return run_bench.main(argv)
 
 
@@ -190,6 +191,7 @@ def test_controller_section_without_udp_says_so_and_passes(
     monkeypatch.setattr(run_bench, 'run_offline', lambda *args: None)
     monkeypatch.setattr(run_bench, 'run_online', online)
     monkeypatch.setattr(run_bench, 'run_tutorial', lambda *args: None)
+    monkeypatch.setattr(run_bench, 'run_walking', lambda *args: None)
     monkeypatch.setattr(run_bench, 'summarize', lambda samples: {
         key: values[0] for key, values in samples.items()})
     assert run_bench.main(['--only', 'controller', '--runs', '1']) == 0
@@ -358,3 +360,59 @@ def test_fast_variants_only_in_the_side_runs(monkeypatch: pytest.MonkeyPatch) ->
     assert [name.rstrip('0123456789') for name in launched] == [
         'fast', 'fast_rosbag', 'fast_rsp', 'fast', 'fast']
     assert len(samples['fast_rtf']) == 3 and len(samples['fast_rosbag_rtf']) == 1
+
+
+def test_walking_fractions_are_falls_over_runs() -> None:
+    import walking
+
+    assert walking.fell_fraction([False] * 8) == 0.0
+    assert walking.fell_fraction([True, False, False, False, False, False, False, False]) == 0.125
+    assert walking.fell_fraction([True, True]) == 1.0
+    with pytest.raises(ValueError):
+        walking.fell_fraction([])
+    assert walking.force_key('walk_pushes', 175.0) == 'walk_pushes_fell_fraction_175n'
+    assert walking.force_key('walk_phase_pushes', 150.0, adjust=False) == (
+        'walk_phase_pushes_fell_fraction_150n_unadjusted')
+
+
+def test_phase_pushes_are_every_step_phase_and_side_each_its_own_seed() -> None:
+    import walking
+
+    cases = walking.phase_pushes((4, 5), 7, 150.0, True)
+    assert len(cases) == 28  # the docs' "0 of 28": 2 steps x 7 phases x 2 sides
+    assert [case.index for case in cases] == list(range(28))
+    assert {(case.step, round(case.phase * 7), case.side) for case in cases} == {
+        (step, k, side) for step in (4, 5) for k in range(7) for side in (1.0, -1.0)}
+
+
+def test_walking_section_figures_from_synthetic_runs(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The section's arithmetic with the runs replaced: seed 3 of the pushed walks falls at
+    every force, phase case 0 falls, variation seed 2 falls."""
+    import walking
+
+    monkeypatch.setattr(walking, '_pushed_fell', lambda job: job[0] == 3)
+    monkeypatch.setattr(walking, 'phase_push_fell', lambda case: case.index == 0)
+    monkeypatch.setattr(walking, '_varied_fell', lambda seed: seed == 2)
+    figures = walking.walking_figures(walking.BUDGETS['default'], log=lambda text: None,
+                                      pool_map=lambda function, jobs: map(function, jobs))
+    assert figures == {
+        'walk_pushes_runs': 8.0, 'walk_pushes_fell_fraction_150n': 0.125,
+        'walk_pushes_fell_fraction_175n': 0.125, 'walk_phase_pushes_runs': 28.0,
+        'walk_phase_pushes_fell_fraction_150n': 1 / 28, 'walk_variations_runs': 8.0,
+        'walk_variations_fell_fraction': 0.125}
+    assert run_bench.invalid_figures(figures, ['walking']) == []
+    quick = walking.walking_figures(walking.BUDGETS['quick'], log=lambda text: None,
+                                    pool_map=lambda function, jobs: map(function, jobs))
+    assert run_bench.invalid_figures(quick, ['walking']) == []  # --quick: every key too
+    assert quick['walk_phase_pushes_runs'] == 2.0 and quick['walk_variations_runs'] == 1.0
+
+
+@pytest.mark.parametrize(('key', 'value', 'verdict'), [
+    ('walk_pushes_fell_fraction_150n', 0.0, 'met'),   # the issue's push: no seed falls
+    ('walk_pushes_fell_fraction_150n', 0.125, 'MISSED'),
+    ('walk_phase_pushes_fell_fraction_150n', 1 / 28, 'MISSED'),
+    ('walk_variations_fell_fraction', 0.0, 'met'),
+])
+def test_walking_targets_are_no_fall(key: str, value: float, verdict: str) -> None:
+    assert run_bench.verdicts({key: value}, 'lz4') == {key: verdict}
+    assert run_bench.verdicts({'walk_pushes_fell_fraction_175n': 0.5}, 'lz4') == {}

@@ -1,4 +1,5 @@
-"""Sweeps of many offline runs on Dask, and the CMA-ES search over them. No ROS."""
+"""Sweeps of many offline runs on Dask (trajectories; walks: the walk map), and the CMA-ES
+search over them. No ROS."""
 
 from tutorial_atlas_control.exports import lazy_exports
 
@@ -9,4 +10,6 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'runs': ['RunSpec', 'SweepError', 'run_one'],
     'sweep': ['SweepEngine', 'SweepInputs', 'atomic_write', 'build_specs', 'check_output',
               'parse_latency', 'parse_push', 'run_sweep', 'table_texts', 'write_table'],
+    'walk_map': ['MapCell', 'WalkMapInputs', 'WalkSpec', 'fastest_walking', 'map_cells',
+                 'map_csv', 'plot_map', 'run_walk', 'run_walk_map', 'walk_specs', 'write_map'],
 })

@@ -7,7 +7,8 @@ point's plan over the steps and the law that tracks it; step_adjustment: where a
 swing foot must land instead; swing: the swing foot's path;
 leg_tasks: what Walk and Step do alike each step (the whole-body law on the carrying
 soles, the swing foot, the pelvis's heading); walk: the walk's phases; walk_behaviour: Walk as the
-simulator's behaviour; walk_trial: offline walking trials, landing by landing; static_step:
+simulator's behaviour; start_noise: a trial's start perturbed by a seed; walk_trial: offline
+walking trials, landing by landing, pushed or not; static_step:
 one quasi-static step; step_behaviour: Step as the simulator's behaviour.
 """
 
@@ -26,7 +27,9 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'leg_tasks': ['LEG_JOINTS', 'LegGains', 'LegTasks', 'foot_pose'],
     'walk': ['WalkController', 'WalkGains', 'WalkOutput', 'sway_cop'],
     'walk_behaviour': ['WalkBehaviour', 'WalkStatus'],
-    'walk_trial': ['Landing', 'WalkTrial', 'WalkingStand', 'walk_trial'],
+    'start_noise': ['DEFAULT_START_NOISE', 'StartNoise', 'perturb_start'],
+    'walk_trial': ['Landing', 'WalkTrial', 'WalkingStand', 'pushed_walk_trial',
+                   'random_pushes', 'straight_walk_trial', 'walk_started_s', 'walk_trial'],
     'static_step': ['StaticStep', 'StepGains'],
     'step_behaviour': ['StepBehaviour', 'StepStatus'],
 })

@@ -6,6 +6,10 @@ balance's STANDING_PELVIS_M), how many steps it took, where each foot came down 
 target and where the pelvis was then, the lowest pelvis, where the pelvis ended, how much
 the legs' torques jump from one 1 ms step to the next while walking (a controller unstable
 at 1 kHz chatters between the effort limits), and the controller's CPU per step.
+
+A trial's `seed` perturbs its start (start_noise: the joints' angles and rates) and, for
+pushed walks, draws the pushes' phases and sides: a figure is then a fraction of seeds.
+Seed None is today's deterministic run.
 """
 
 from __future__ import annotations
@@ -28,8 +32,19 @@ from tutorial_atlas_control.balance import (
     standing_simulator,
 )
 from tutorial_atlas_control.sim import AtlasModel, pelvis_height_m
-from tutorial_atlas_control.walking.footsteps import Footstep, window, wrap_angle
+from tutorial_atlas_control.walking.footsteps import (
+    STEP_DURATION_S,
+    Footstep,
+    straight_steps,
+    window,
+    wrap_angle,
+)
 from tutorial_atlas_control.walking.leg_tasks import LEG_JOINTS, foot_pose
+from tutorial_atlas_control.walking.start_noise import (
+    DEFAULT_START_NOISE,
+    StartNoise,
+    perturb_start,
+)
 from tutorial_atlas_control.walking.walk import WalkController, WalkGains
 from tutorial_atlas_control.walking.walk_behaviour import WalkBehaviour
 
@@ -170,11 +185,14 @@ class WalkingStand:
 
 
 def walk_trial(plan: Sequence[Footstep], duration_s: float, gains: WalkGains | None = None,
-               streaming: bool = False, pushes: Sequence[Push] = ()) -> WalkTrial:
-    """Place the robot in the Stand pose, stand SETTLE_S, walk `plan` (sent once, or
-    `streaming` its window every step), stand; with `pushes` on the pelvis (their times
-    in sim time from the start); run for `duration_s` (s) of sim time or until it falls."""
+               streaming: bool = False, pushes: Sequence[Push] = (), seed: int | None = None,
+               noise: StartNoise = DEFAULT_START_NOISE) -> WalkTrial:
+    """Place the robot in the Stand pose (perturbed by `noise` drawn from `seed`; None:
+    not), stand SETTLE_S, walk `plan` (sent once, or `streaming` its window every step),
+    stand; with `pushes` on the pelvis (their times in sim time from the start); run for
+    `duration_s` (s) of sim time or until it falls."""
     sim = standing_simulator()
+    perturb_start(sim.atlas, sim.data, seed, noise)
     behaviour = WalkingStand(sim.atlas, plan, SETTLE_S, gains, streaming)
     sim.install_stand(behaviour)
     trial = behaviour.trial
@@ -189,3 +207,51 @@ def walk_trial(plan: Sequence[Footstep], duration_s: float, gains: WalkGains | N
             break
     trial.pelvis_end = sim.data.xpos[sim.atlas.pelvis_body_id].copy()
     return trial
+
+
+#: The pushes' stream of a seed (its start noise is default_rng(seed) itself).
+PUSH_STREAM = 1
+
+
+def random_pushes(seed: int, start_s: float, end_s: float, force_n: float, push_s: float,
+                  every_s: float) -> list[Push]:
+    """One sideways pelvis push of `force_n` (N) for `push_s` (s) in each `every_s` (s)
+    from `start_s` that ends before `end_s`, at a phase within it and to a side drawn from
+    default_rng((seed, PUSH_STREAM))."""
+    rng = np.random.default_rng((seed, PUSH_STREAM))
+    pushes, t = [], start_s
+    while t + every_s <= end_s:
+        at = t + float(rng.uniform(0.0, every_s - push_s))
+        side = 1.0 if rng.random() < 0.5 else -1.0
+        pushes.append(Push(at, (0.0, side * force_n, 0.0), push_s))
+        t += every_s
+    return pushes
+
+
+def walk_started_s(gains: WalkGains | None = None) -> float:
+    """Sim time (s) at which a trial's first step begins: after SETTLE_S and the sway."""
+    return SETTLE_S + (gains or WalkGains()).sway_s
+
+
+def straight_walk_trial(steps: int, stride_m: float, step_duration_s: float = STEP_DURATION_S,
+                        seed: int | None = None, after_s: float = 1.5) -> WalkTrial:
+    """`steps` straight steps of `stride_m` (m) at `step_duration_s` (s), sent once, from
+    a start perturbed by `seed`, then `after_s` (s) to catch and stand."""
+    plan = straight_steps(steps, stride_m, duration_s=step_duration_s)
+    return walk_trial(plan, walk_started_s() + steps * step_duration_s + after_s, seed=seed)
+
+
+def pushed_walk_trial(seed: int | None, steps: int = 20, stride_m: float = 0.25,
+                      force_n: float = 150.0, push_s: float = 0.1, every_s: float = 5.0,
+                      gains: WalkGains | None = None, after_s: float = 2.5
+                      ) -> tuple[WalkTrial, list[Push]]:
+    """`steps` straight steps of `stride_m` at STEP_DURATION_S, streamed, pushed by
+    random_pushes over the steps (seed None: drawn from seed 0, the start unperturbed),
+    then `after_s` (s) to catch and stand; the trial and its pushes."""
+    start_s = walk_started_s(gains)
+    walk_s = steps * STEP_DURATION_S
+    pushes = random_pushes(0 if seed is None else seed, start_s, start_s + walk_s, force_n,
+                           push_s, every_s)
+    trial = walk_trial(straight_steps(steps, stride_m), start_s + walk_s + after_s, gains,
+                       streaming=True, pushes=pushes, seed=seed)
+    return trial, pushes
