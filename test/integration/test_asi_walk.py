@@ -74,7 +74,7 @@ PELVIS_ABOVE_M = 0.80
 #: the pelvis went (m): this run's figures.
 STAND_AFTER_S = 10.0
 WALKED_S = 3.726
-LOWEST_PELVIS_M = 0.838
+LOWEST_PELVIS_M = 0.840
 LANDING_WITHIN_M = 0.05
 
 
@@ -301,7 +301,7 @@ def test_eight_steps_with_the_arms_swung_under_the_users_pid(
 #: adjusted for it is reported at least this far from where it was sent (m).
 PUSH_N = 150.0
 PUSH_S = 0.1
-ADJUSTED_BY_M = 0.08
+ADJUSTED_BY_M = 0.05
 
 
 def test_a_push_while_walking_moves_the_step_and_step_queue_saturated_says_so(

@@ -43,6 +43,7 @@ from tutorial_atlas_control.sim import (
 pytestmark = pytest.mark.offline
 
 KNEES = [JOINT_INDEX['l_leg_kny'], JOINT_INDEX['r_leg_kny']]
+HIP_ROLLS = [JOINT_INDEX['l_leg_mhx'], JOINT_INDEX['r_leg_mhx']]
 
 #: The largest impulses (N s) survived, per direction (unit vector), found in 5 N s steps.
 SURVIVED = {'forward': ((1.0, 0.0), 45.0), 'backward': ((-1.0, 0.0), 45.0),
@@ -109,10 +110,16 @@ def stand_after_the_hold(transition_s: float) -> tuple[AtlasSimulator, float]:
 
 
 def test_stand_takes_over_from_the_hold_and_bends_to_the_stand_pose() -> None:
-    """From the hold's straight legs, within TRANSITION_S, to DRCSim's Stand pose: knees
-    0.518 rad, the pelvis about 0.91 m, the feet where they were."""
+    """From the hold's straight legs, within TRANSITION_S, to DRCSim's Stand pose carried to
+    the hold's stance: its feet are 0.18 m apart where the Stand pose's are 0.28 m, so the
+    hips stay unrolled (the Stand pose's 0.062 rad would push the soles apart) and the knees
+    bend to 0.529 rad (the Stand pose's 0.518); the pelvis about 0.91 m, the feet where
+    they were."""
     sim, travel = stand_after_the_hold(TRANSITION_S)
-    np.testing.assert_allclose(sim.joint_positions()[KNEES], STAND_POSE_RAD[KNEES], atol=0.01)
+    joints = sim.joint_positions()
+    np.testing.assert_allclose(joints[KNEES], 0.529, atol=0.002)
+    np.testing.assert_allclose(joints[HIP_ROLLS], 0.0, atol=0.002)
+    np.testing.assert_allclose(joints[KNEES], STAND_POSE_RAD[KNEES], atol=0.015)
     assert pelvis_height_m(sim.atlas, sim.data) == pytest.approx(0.912, abs=0.01)
     assert travel < 0.001
 

@@ -2,7 +2,8 @@
 
 lipm: the linear inverted pendulum and its capture point; support: the support polygon
 and keeping a pressure centre in it; contact_wrench: a wrench shared between the feet;
-stand_pose: DRCSim's Stand pose placed on the ground; manipulate: Manipulate's pelvis servo
+stand_pose: DRCSim's Stand pose placed on the ground; stance_posture: that pose's legs
+solved for the stance the feet are in; manipulate: Manipulate's pelvis servo
 (targets clamped, the posture that reaches them); estimator: the balance state from the
 model; stand: the Stand controller (capture-point feedback, inverse statics, joint PD);
 stand_behaviour: that controller as the simulator's Stand behaviour, with the servo;
@@ -20,6 +21,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
              'natural_frequency'],
     'push_trial': ['STANDING_PELVIS_M', 'Push', 'TimedStand', 'TrialResult', 'apply_pushes',
                    'push_events', 'push_survived', 'stand_trial', 'standing_simulator'],
+    'stance_posture': ['Stance', 'StancePosture'],
     'stand': ['StandController', 'StandGains', 'StandOutput', 'StandReference',
               'orientation_error', 'yaw_of', 'yaw_rotation'],
     'stand_behaviour': ['TRANSITION_S', 'StandBehaviour', 'smoothstep', 'stand_pose_com_height_m'],

@@ -44,6 +44,9 @@ class BalanceState:
     capture_point: np.ndarray     # (2,)
     bias_nm: np.ndarray           # (28,) joint part of qfrc_bias (gravity + Coriolis)
     sole_jacobians: np.ndarray    # (2, 6, 28) [linear; angular] at each sole centre, joints
+    #: (2, 6) [linear; angular] velocity of each sole centre, world: the joints' and the
+    #: floating base's motion both.
+    sole_velocities: np.ndarray
     #: The joint-space inertia block (k, k) of some joints (a slice, tutorial order) at this
     #: state, computed on first use; valid until the estimator's next estimate.
     joint_inertia: Callable[[slice], np.ndarray]
@@ -156,6 +159,7 @@ class BalanceEstimator:
         for foot in (0, 1):
             mujoco.mj_jac(m, d, jac[foot, 0:3], jac[foot, 3:6], centres[foot],
                           self._sole_bodies[foot])
+        sole_velocities = jac @ d.qvel
         contact = (lowest[0] < CONTACT_HEIGHT_M, lowest[1] < CONTACT_HEIGHT_M)
         com = d.subtree_com[0].copy()
         com_velocity = d.subtree_linvel[0].copy()
@@ -169,5 +173,6 @@ class BalanceEstimator:
             sole_centres=centres, sole_rotations=rotations, in_contact=contact, omega=omega,
             capture_point=lipm.capture_point(com[:2], com_velocity[:2], omega),
             bias_nm=self._bias[self._dof_adr], sole_jacobians=jac[:, :, self._dof_adr],
+            sole_velocities=sole_velocities,
             joint_inertia=self._joint_inertia,
             polygon_of=lambda: self._support_polygon(positions, rotations, contact))

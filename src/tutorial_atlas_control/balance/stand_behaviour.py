@@ -3,11 +3,15 @@ Manipulate's pelvis servo on top of it.
 
 On start it holds the robot where it stands (StandReference.from_state: the capture point
 over the soles' midpoint, the pelvis upright at its yaw) and, over TRANSITION_S, brings the
-posture and the centre-of-mass height from where they are to DRCSim's Stand pose (a
-smoothstep: no jump in the reference, none in the torque). A robot taken over standing
-straight under the hold thus bends its knees to the Stand pose instead of fighting it.
+posture and the centre-of-mass height from where they are to DRCSim's Stand pose carried to
+the stance the feet are in (stance_posture: the legs that reach the soles where they lie; the
+Stand pose's own, pulled to by the legs' posture PD in a staggered or turned stance, pushed
+the soles against each other and turned one on the ground) (a smoothstep: no jump in the
+reference, none in the torque). A robot taken over standing straight under the hold thus
+bends its knees instead of fighting it.
 `servo` moves the reference the same way to a pelvis height, yaw and lateral offset
-(Manipulate, balance/manipulate.py), or back to the Stand pose. Each step it estimates the
+(Manipulate, balance/manipulate.py), or back to the Stand pose (carried to the stance).
+Each step it estimates the
 state from the simulator's MjData and returns the controller's torque, which the simulator
 blends with the user's PID by k_effort as f_out.
 """
@@ -26,6 +30,7 @@ from tutorial_atlas_control.balance.manipulate import (
     SquatTable,
     clamp_servo,
 )
+from tutorial_atlas_control.balance.stance_posture import StancePosture
 from tutorial_atlas_control.balance.stand import (
     StandController,
     StandGains,
@@ -36,7 +41,7 @@ from tutorial_atlas_control.balance.stand import (
     yaw_of,
     yaw_rotation,
 )
-from tutorial_atlas_control.balance.stand_pose import STAND_POSE_RAD, place_in_stand_pose
+from tutorial_atlas_control.balance.stand_pose import place_in_stand_pose
 from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.sim import AtlasModel
 
@@ -135,6 +140,21 @@ class StandBehaviour:
         return place_in_stand_pose(self.atlas, mujoco.MjData(self.atlas.model))
 
     @functools.cached_property
+    def stance(self) -> StancePosture:
+        """The Stand pose's legs solved for the stance the feet are in."""
+        return StancePosture(self.atlas)
+
+    def stance_reference(self, state: BalanceState, pelvis_yaw_rad: float
+                         ) -> tuple[np.ndarray, float]:
+        """(posture (28,), CoM height (m)): DRCSim's Stand pose with its legs where they
+        are with the soles as they lie and the pelvis upright at `pelvis_yaw_rad`, lowered
+        where they do not reach: the Stand pose itself with the feet side by side as it
+        puts them; staggered or turned, legs that reach the soles (the Stand pose's would
+        push them against each other, and turn one on the ground)."""
+        stance = self.stance.stance(state.sole_centres, state.sole_rotations, pelvis_yaw_rad)
+        return stance.posture_rad, self.com_height_m - stance.com_lowered_m
+
+    @functools.cached_property
     def squats(self) -> SquatTable:
         """Manipulate's reach and postures, built when first servoed (not every Stand is)."""
         return SquatTable(self.atlas)
@@ -148,13 +168,14 @@ class StandBehaviour:
             self.estimator.sole_half_size_m, self.gains)
         self.servo_target = None
         self.starts += 1
+        posture, com_height = self.stance_reference(state, yaw_of(held.pelvis_rotation))
         self._transition = _Transition(float(data.time), held, dataclasses.replace(
-            held, com_height_m=self.com_height_m, posture_rad=STAND_POSE_RAD),
+            held, com_height_m=com_height, posture_rad=posture),
             end_height_m=self.stand_height_m, with_rates=False)
         self._table_height_m = None
         self.last_state = state
         self.last_output = None
-        self.taking_over = bool(np.max(np.abs(held.posture_rad[_LEGS] - STAND_POSE_RAD[_LEGS]))
+        self.taking_over = bool(np.max(np.abs(held.posture_rad[_LEGS] - posture[_LEGS]))
                                 > TAKE_OVER_RAD)
 
     def servo(self, desired: PelvisServo | None, time_s: float) -> PelvisServo | None:
@@ -175,8 +196,9 @@ class StandBehaviour:
         table = self.squats
         goal_height = table.stand_height_m if target is None else target.height_m
         if target is None:
-            goal = StandReference(feet.mean(axis=0), self.com_height_m, yaw_rotation(feet_yaw),
-                                  STAND_POSE_RAD.copy())
+            posture, com_height = self.stance_reference(state, feet_yaw)
+            goal = StandReference(feet.mean(axis=0), com_height, yaw_rotation(feet_yaw),
+                                  posture)
         else:
             goal = StandReference(
                 feet.mean(axis=0) + target.lateral_m * left,

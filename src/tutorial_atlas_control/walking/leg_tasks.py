@@ -11,7 +11,10 @@ turns).
 
 A foot is servoed in the leg's joint space: its pose error turned into joint errors by
 the leg's damped least-squares inverse, then a joint PD scaled by the leg's inertia, so
-that every joint has the same bandwidth. The task-space PD it replaced (6000 N/m on the
+that every joint has the same bandwidth; a swing foot's path has its acceleration fed
+forward and its velocity compared with the sole's in the world (without either the foot ran
+ahead of its path as it slowed down and with the pelvis's speed, and every landing sat
+2.5 cm ahead of its step). The task-space PD it replaced (6000 N/m on the
 sole, 600 N m/rad and 30 N m s/rad on its turn) was unstable at 1 kHz on the light foot:
 the legs' torques flipped between their effort limits every millisecond (280 N m per
 step on the hip pitch), and that shaking decided, chaotically, which walks stood.
@@ -54,6 +57,14 @@ class LegGains:
     #: at 10/s the 20 straight steps and the circles stand.
     swing_kp: float = 400.0
     swing_kd: float = 10.0
+    #: Whether the swing path's acceleration is fed forward. Without it the servo's error
+    #: is the path's acceleration over swing_kp: the foot lagged as it sped up and ran ahead
+    #: as it slowed down, and came down 2.5 cm ahead of every step (heel first, toes up).
+    swing_feedforward: bool = True
+    #: Whether the swing servo damps the sole's velocity in the world (the pelvis's motion
+    #: too) rather than the leg's joint velocities: the path's velocity is in the world,
+    #: and the foot ran ahead of it by the pelvis's speed (1 cm at 0.4 m/s).
+    world_velocity: bool = True
     #: The damping of the leg's least-squares inverse (m): bounded joint errors with the
     #: knee nearly straight.
     ik_damping_m: float = 0.02
@@ -134,36 +145,54 @@ class LegTasks:
 
     def swing_torque(self, state: BalanceState, joint_velocities: np.ndarray, foot: int,
                      swing: SwingPath, elapsed_s: float) -> np.ndarray:
-        """The swing leg's torques (28,) along `swing`, `elapsed_s` into it; past its end
-        the foot goes on down at touchdown_speed_m_s."""
+        """The swing leg's torques (28,) along `swing`, `elapsed_s` into it, the path's
+        acceleration fed forward; past its end the foot goes on down at
+        touchdown_speed_m_s."""
         gains = self.gains
         position, velocity, yaw, yaw_rate = swing.at(elapsed_s)
+        acceleration, yaw_acceleration = (swing.acceleration(elapsed_s)
+                                          if gains.swing_feedforward else (None, 0.0))
         late = elapsed_s - swing.duration_s
         if late > 0.0:  # not down yet: on down
             position[2] -= gains.touchdown_speed_m_s * late
             velocity[2] = -gains.touchdown_speed_m_s
         return self.foot_servo(state, joint_velocities, foot, position, velocity, yaw,
-                               yaw_rate)
+                               yaw_rate, acceleration, yaw_acceleration,
+                               world=gains.world_velocity)
 
     def foot_servo(self, state: BalanceState, joint_velocities: np.ndarray, foot: int,
                    position: np.ndarray, velocity: np.ndarray, yaw: float,
-                   yaw_rate: float) -> np.ndarray:
+                   yaw_rate: float, acceleration: np.ndarray | None = None,
+                   yaw_acceleration: float = 0.0, world: bool = False) -> np.ndarray:
         """The leg's torques (28,) moving a sole towards a pose at a velocity (the module's
-        joint-space servo)."""
+        joint-space servo), with `acceleration` (the sole's, and its yaw's) fed forward
+        through the same inverse; `world`: damping the sole's velocity in the world (a
+        swing foot's path is in the world, the pelvis's motion adds to it) rather than the
+        leg's joint velocities (a foot put back down: its pelvis moves over it)."""
         gains = self.gains
         leg = LEG_OF_FOOT[foot]
         jacobian = state.sole_jacobians[foot][:, leg]
-        targets = np.empty((6, 2))  # the pose's error, and the velocity asked for
+        columns = 2 if acceleration is None else 3
+        targets = np.zeros((6, columns))  # the pose's error, the velocity asked for, ...
         targets[0:3, 0] = position - state.sole_centres[foot]
         targets[3:6, 0] = orientation_error(state.sole_rotations[foot], yaw_rotation(yaw))
         targets[0:3, 1] = velocity
-        targets[3:6, 1] = (0.0, 0.0, yaw_rate)
+        targets[5, 1] = yaw_rate
+        if world:
+            targets[:, 1] -= state.sole_velocities[foot]
+        if acceleration is not None:  # ... and the acceleration
+            targets[0:3, 2] = acceleration
+            targets[5, 2] = yaw_acceleration
         damped = jacobian @ jacobian.T + self._ik_damping
-        joint_error, joint_rate = (jacobian.T @ np.linalg.solve(damped, targets)).T
-        acceleration = (gains.swing_kp * joint_error
-                        + gains.swing_kd * (joint_rate - joint_velocities[leg]))
+        joint_targets = (jacobian.T @ np.linalg.solve(damped, targets)).T
+        joint_error, joint_rate = joint_targets[0], joint_targets[1]
+        if not world:
+            joint_rate = joint_rate - joint_velocities[leg]
+        accel = gains.swing_kp * joint_error + gains.swing_kd * joint_rate
+        if acceleration is not None:
+            accel += joint_targets[2]
         torque = np.zeros(len(joint_velocities))
-        torque[leg] = state.joint_inertia(leg) @ acceleration
+        torque[leg] = state.joint_inertia(leg) @ accel
         return torque
 
     def flat_down(self, state: BalanceState, foot: int) -> bool:

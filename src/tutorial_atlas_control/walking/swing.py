@@ -67,3 +67,17 @@ class SwingPath:
         yaw_rate = rate * turn / self.duration_s if 0.0 < s < 1.0 else 0.0
         return position, velocity, yaw, yaw_rate
 
+    def acceleration(self, t_s: float) -> tuple[np.ndarray, float]:
+        """(acceleration (3,), yaw acceleration) of the sole at `t_s` after lift-off; zero
+        outside (0, duration)."""
+        s = t_s / self.duration_s
+        if not 0.0 < s < 1.0:
+            return np.zeros(3), 0.0
+        per_s2 = 1.0 / (self.duration_s * self.duration_s)
+        _, _, curve = quintic(s)
+        _, _, lift_curve = bump(s)
+        acceleration = curve * per_s2 * (self.end - self.start)
+        acceleration[2] += self.height_m * lift_curve * per_s2
+        turn = wrap_angle(self.end_yaw_rad - self.start_yaw_rad)
+        return acceleration, curve * per_s2 * turn
+

@@ -65,6 +65,9 @@ class Landing:
     #: How far it came down from the step as Walk took it (after the clamp to the step
     #: limits and any step adjustment: what step_queue_saturated said) (m).
     taken_error_m: float = 0.0
+    #: How far ahead of its target it came down, along the target's heading (m; negative:
+    #: short of it): a bias here is the swing servo's, not scatter.
+    ahead_m: float = 0.0
 
 
 @dataclass
@@ -92,6 +95,12 @@ class WalkTrial:
     @property
     def cost_per_step_us(self) -> float:
         return self.controller_cpu_s / max(self.control_steps, 1) * 1e6
+
+    @property
+    def mean_ahead_m(self) -> float:
+        """The landings' mean error along their steps (m; + ahead): their bias."""
+        return (sum(landing.ahead_m for landing in self.landings)
+                / max(len(self.landings), 1))
 
 
 class WalkingStand:
@@ -177,11 +186,13 @@ class WalkingStand:
             return
         down = foot_pose(state, target.foot_index)
         self.trial.steps = index
+        dx, dy = down.x_m - target.x_m, down.y_m - target.y_m
         self.trial.landings.append(Landing(
-            index, target.foot_index, math.hypot(down.x_m - target.x_m, down.y_m - target.y_m),
+            index, target.foot_index, math.hypot(dx, dy),
             abs(wrap_angle(down.yaw_rad - target.yaw_rad)),
             (float(state.pelvis_position[0]), float(state.pelvis_position[1])),
-            math.hypot(down.x_m - taken.x_m, down.y_m - taken.y_m)))
+            math.hypot(down.x_m - taken.x_m, down.y_m - taken.y_m),
+            math.cos(target.yaw_rad) * dx + math.sin(target.yaw_rad) * dy))
 
 
 def walk_trial(plan: Sequence[Footstep], duration_s: float, gains: WalkGains | None = None,

@@ -1,6 +1,7 @@
 """The legs' shared tasks on the Atlas model placed in DRCSim's Stand pose: the foot servo
 asks of the leg the sole's acceleration its PD means, with the leg's inertia (so its gains
-are per unit of inertia), the CoM height's reference moves smoothly with its rate, and a
+are per unit of inertia), damps the sole's velocity in the world and feeds the path's
+acceleration forward, the CoM height's reference moves smoothly with its rate, and a
 stance sole's pressure-centre clamp is the support polygon's."""
 
 from __future__ import annotations
@@ -9,6 +10,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from tutorial_atlas_control.balance.estimator import BalanceState
 from tutorial_atlas_control.balance.stand import orientation_error
 from tutorial_atlas_control.balance.stand_behaviour import StandBehaviour
 from tutorial_atlas_control.balance.stand_pose import place_in_stand_pose
@@ -73,19 +75,66 @@ def test_the_foot_servo_asks_the_soles_pd_acceleration_of_that_leg_alone(
     np.testing.assert_allclose(sole_acceleration[0:3], gains.swing_kp * offset, rtol=0.1)
 
 
-def test_the_foot_servo_damps_the_legs_joint_velocities(
-        standing: tuple[StandBehaviour, mujoco.MjData]) -> None:
+def _moving(standing: tuple[StandBehaviour, mujoco.MjData], dofs: slice | np.ndarray,
+            speed: float) -> BalanceState:
+    """The estimate with these velocities (qvel indices) at `speed`, the rest at rest."""
     behaviour, data = standing
-    legs = _legs(standing)
-    state = behaviour.estimator.estimate(data.qpos, data.qvel)
+    qvel = np.zeros_like(data.qvel)
+    qvel[dofs] = speed
+    return behaviour.estimator.estimate(data.qpos, qvel)
+
+
+def test_the_swing_servo_damps_the_soles_velocity_in_the_world(
+        standing: tuple[StandBehaviour, mujoco.MjData]) -> None:
+    """The leg's own joints moving: damped as they move (undamped inverse: exactly). The
+    pelvis moving, the leg still: the sole moves with it, and a swing foot's servo damps
+    that too (damping the joints alone let the foot run ahead of its path by the pelvis's
+    speed: 1 cm at 0.4 m/s)."""
+    behaviour, data = standing
+    legs = _legs(standing, LegGains(ik_damping_m=0.0))
     leg = LEG_OF_FOOT[LEFT]
+    dofs = behaviour.atlas.dof_adr[leg]
+    state = _moving(standing, dofs, 0.1)
+    sole, yaw = state.sole_centres[LEFT], 0.0
+    at_rest_state = behaviour.estimator.estimate(data.qpos, np.zeros_like(data.qvel))
     joint_velocities = np.zeros(28)
     joint_velocities[leg] = 0.1
-    sole, yaw = state.sole_centres[LEFT], 0.0
-    torque = legs.foot_servo(state, joint_velocities, LEFT, sole, np.zeros(3), yaw, 0.0)
-    at_rest = legs.foot_servo(state, np.zeros(28), LEFT, sole, np.zeros(3), yaw, 0.0)
+    torque = legs.foot_servo(state, joint_velocities, LEFT, sole, np.zeros(3), yaw, 0.0,
+                             world=True)
+    at_rest = legs.foot_servo(at_rest_state, np.zeros(28), LEFT, sole, np.zeros(3), yaw, 0.0,
+                              world=True)
     damping = np.linalg.solve(state.joint_inertia(leg), (torque - at_rest)[leg])
-    np.testing.assert_allclose(damping, -LegGains().swing_kd * 0.1, rtol=1e-9)
+    np.testing.assert_allclose(damping, -LegGains().swing_kd * 0.1, rtol=1e-6)
+    # The pelvis moving forward at 0.4 m/s, every joint still.
+    free = int(behaviour.atlas.model.jnt_dofadr[
+        behaviour.atlas.model.body_jntadr[behaviour.atlas.pelvis_body_id]])
+    carried = _moving(standing, slice(free, free + 1), 0.4)
+    torque = legs.foot_servo(carried, np.zeros(28), LEFT, sole, np.zeros(3), yaw, 0.0,
+                             world=True)
+    acceleration = np.linalg.solve(state.joint_inertia(leg), (torque - at_rest)[leg])
+    sole_acceleration = state.sole_jacobians[LEFT][:, leg] @ acceleration
+    np.testing.assert_allclose(sole_acceleration, [-LegGains().swing_kd * 0.4, 0, 0, 0, 0, 0],
+                               atol=1e-6)
+    # A foot put back down damps its leg's joints: the pelvis moving over it, none.
+    held = legs.foot_servo(carried, np.zeros(28), LEFT, sole, np.zeros(3), yaw, 0.0)
+    np.testing.assert_allclose(held, at_rest, atol=1e-9)
+
+
+def test_the_foot_servo_feeds_the_paths_acceleration_forward(
+        standing: tuple[StandBehaviour, mujoco.MjData]) -> None:
+    behaviour, data = standing
+    legs = _legs(standing, LegGains(ik_damping_m=0.0))
+    state = behaviour.estimator.estimate(data.qpos, np.zeros_like(data.qvel))
+    leg = LEG_OF_FOOT[RIGHT]
+    sole, zeros = state.sole_centres[RIGHT], np.zeros(28)
+    turn = orientation_error(state.sole_rotations[RIGHT], np.eye(3))
+    asked = np.array([2.0, -0.5, 1.0])
+    torque = legs.foot_servo(state, zeros, RIGHT, sole, np.zeros(3), 0.0, 0.0, asked, 3.0)
+    acceleration = np.linalg.solve(state.joint_inertia(leg), torque[leg])
+    sole_acceleration = state.sole_jacobians[RIGHT][:, leg] @ acceleration
+    # The placed sole is a little off level: the PD's part on top of what was asked.
+    expected = np.concatenate([asked, LegGains().swing_kp * turn + [0.0, 0.0, 3.0]])
+    np.testing.assert_allclose(sole_acceleration, expected, atol=1e-6)
 
 
 def test_the_height_moves_by_a_smoothstep_whose_rate_is_its_derivative(

@@ -1,4 +1,5 @@
-"""The swing foot's path: at rest at both ends, lifted to its height at mid-swing."""
+"""The swing foot's path: at rest at both ends, lifted to its height at mid-swing, its
+velocity and acceleration the rates of its position and velocity."""
 
 from __future__ import annotations
 
@@ -45,6 +46,20 @@ def test_the_foot_is_highest_at_mid_swing_and_its_velocity_is_its_rate() -> None
         assert PATH.at(t)[1] == pytest.approx(rate, rel=1e-5)
         assert PATH.at(t)[3] == pytest.approx((PATH.at(t + h)[2] - PATH.at(t - h)[2]) / (2 * h))
     assert turn_rate == pytest.approx(0.3 * 1.875 / 0.6)
+
+
+def test_the_acceleration_is_the_velocitys_rate_and_zero_at_rest() -> None:
+    """The servo feeds it forward: without it the foot ran 2.5 cm ahead at touchdown."""
+    h = 1e-6
+    for t in (0.05, 0.2, 0.3, 0.52):
+        acceleration, yaw_acceleration = PATH.acceleration(t)
+        rate = (PATH.at(t + h)[1] - PATH.at(t - h)[1]) / (2 * h)
+        assert acceleration == pytest.approx(rate, rel=1e-4, abs=1e-6)
+        assert yaw_acceleration == pytest.approx(
+            (PATH.at(t + h)[3] - PATH.at(t - h)[3]) / (2 * h), rel=1e-4, abs=1e-6)
+    for t in (-0.1, 0.0, 0.6, 1.0):
+        acceleration, yaw_acceleration = PATH.acceleration(t)
+        assert not acceleration.any() and yaw_acceleration == 0.0
 
 
 def test_the_turn_takes_the_short_way_round() -> None:
