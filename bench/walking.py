@@ -47,7 +47,7 @@ class WalkingBudget:
 
 
 BUDGETS = {
-    'quick': WalkingBudget(1, 8, (150.0,), (4,), 1, ((150.0, True),), 1),
+    'quick': WalkingBudget(1, 4, (150.0,), (4,), 1, ((150.0, True),), 1),
     'default': WalkingBudget(8, 60, (150.0, 175.0), PHASE_STEPS, PHASES, ((150.0, True),), 8),
     'full': WalkingBudget(8, 60, (150.0, 175.0, 200.0), PHASE_STEPS, PHASES,
                           ((150.0, True), (150.0, False), (200.0, True), (250.0, True)), 8),

@@ -1,10 +1,12 @@
-"""The 2 m circle over perturbed starts: one turn (60 streamed steps) from each of 8 seeds.
+"""The 2 m circle over perturbed starts: its first sixth (10 of a turn's 60 streamed steps,
+turning 1.05 rad) from each of 8 seeds.
 
 test_walking.py keeps one deterministic run of the README's two turns; this holds the
 circle over seeds (walking/start_noise.py: 5 mrad and 5 mrad/s on every joint), the
-assertions on the fractions, their messages naming the seeds that failed. One turn, not two,
-for the budget: 8 one-turn runs cost about as much as 4 two-turn runs. About 220 CPU s
-(at load 7-10).
+assertions on the fractions, their messages naming the seeds that failed. A sixth of a turn,
+not a turn, for make test's 15 minutes: a whole turn over 8 seeds (measured once 8 of 8
+within 2.5 cm, 0.034 rad, back within 0.3 m of the start) cost 221 CPU s, a third of the
+offline part. About 25 CPU s.
 """
 
 from __future__ import annotations
@@ -20,12 +22,13 @@ from tutorial_atlas_control.walking.walk_trial import WalkTrial, walk_started_s,
 pytestmark = pytest.mark.offline
 
 SEEDS = range(8)
-#: The circle: radius (m), steps a turn, feet apart (m); how near the start the pelvis is
-#: after the turn (m).
+#: The circle: radius (m), steps a turn, feet apart (m); the steps walked (a sixth of it) and
+#: how far round the pelvis must turn (rad).
 RADIUS_M = 2.0
-STEPS = 60
+STEPS_A_TURN = 60
 WIDTH_M = 0.3
-BACK_WITHIN_M = 0.3
+STEPS = 10
+TURNED_AT_LEAST_RAD = 0.8
 #: The README's "every landing within about 3 cm" (m), the issue's 0.1 rad.
 LANDING_WITHIN_M = 0.03
 LANDING_YAW_WITHIN_RAD = 0.1
@@ -36,7 +39,7 @@ AFTER_S = 1.5
 
 @pytest.fixture(scope='module')
 def turns() -> dict[int, WalkTrial]:
-    plan = circle_steps(RADIUS_M, STEPS, 1, width_m=WIDTH_M)
+    plan = circle_steps(RADIUS_M, STEPS_A_TURN, 1, width_m=WIDTH_M)[:STEPS]
     duration_s = walk_started_s() + len(plan) * plan[0].duration_s + AFTER_S
     trials = {seed: walk_trial(plan, duration_s, streaming=True, seed=seed) for seed in SEEDS}
     print(f'circle: worst landing {max(t.worst_landing_m for t in trials.values()):.4f} m, '
@@ -45,23 +48,24 @@ def turns() -> dict[int, WalkTrial]:
     return trials
 
 
-def back_at_start(trial: WalkTrial) -> bool:
-    after = next((landing for landing in trial.landings if landing.step_index == STEPS), None)
-    return after is not None and float(np.linalg.norm(
-        np.array(after.pelvis_xy) - np.array(trial.pelvis_start_xy))) < BACK_WITHIN_M
+def turned_round(trial: WalkTrial) -> bool:
+    """The pelvis turned a sixth of the way round: its heading at the end (from its path
+    round the centre at (0, R)) at least TURNED_AT_LEAST_RAD from the start's."""
+    x, y = float(trial.pelvis_end[0]), float(trial.pelvis_end[1])
+    return float(np.arctan2(x, RADIUS_M - y)) % (2 * np.pi) >= TURNED_AT_LEAST_RAD
 
 
-def test_eight_of_eight_seeds_walk_a_turn_of_the_circle_landing_within_3_cm(
+def test_eight_of_eight_seeds_walk_a_sixth_of_the_circle_landing_within_3_cm(
         turns: dict[int, WalkTrial]) -> None:
     def ok(trial: WalkTrial) -> bool:
         return (not trial.fell and trial.steps == STEPS and trial.walk_ended_s is not None
-                and trial.lowest_pelvis_m > PELVIS_ABOVE_M and back_at_start(trial)
+                and trial.lowest_pelvis_m > PELVIS_ABOVE_M and turned_round(trial)
                 and all(landing.error_m < LANDING_WITHIN_M
                         and landing.yaw_error_rad < LANDING_YAW_WITHIN_RAD
                         for landing in trial.landings))
     bad = [seed for seed, trial in turns.items() if not ok(trial)]
     assert len(turns) - len(bad) == 8, (
-        f'{len(turns) - len(bad)} of {len(turns)} seeds walked the turn within 3 cm; failed: '
+        f'{len(turns) - len(bad)} of {len(turns)} seeds walked the sixth within 3 cm; failed: '
         + ', '.join(f'seed {seed} (fell={turns[seed].fell}, {turns[seed].steps} steps, worst '
                     f'landing {turns[seed].worst_landing_m:.3f} m)' for seed in bad))
     ends = {tuple(round(float(v), 9) for v in trial.pelvis_end) for trial in turns.values()}

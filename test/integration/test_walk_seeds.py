@@ -7,7 +7,7 @@ pushed, drawing the pushes' phases and sides. The assertions are on the fraction
 messages name the seeds that failed. The seeds must perturb: 8 seeds, 8 different walks.
 Planted once: the noise at 0.1 rad and 0.1 rad/s: 6 of 8 straight walks, the test fails
 naming seeds 0 and 3. The circle over seeds: test_walk_circle_seeds.py; the static steps:
-test_asi_walk.py. About 130 CPU s at load 4.5, 160 at load 7-10.
+test_asi_walk.py. About 60 CPU s.
 """
 
 from __future__ import annotations
@@ -30,9 +30,11 @@ pytestmark = pytest.mark.offline
 
 SEEDS = range(8)
 #: The straight walk: steps, stride (m), the pelvis at least this far ahead at the end (m).
-STEPS = 20
+#: Ten, not the README's twenty, for make test's 15 minutes (twenty over 8 seeds, measured
+#: once: 8 of 8 within 2.7 cm; pushed, 8 of 8 within 4.4 cm of where Walk took them).
+STEPS = 10
 STRIDE_M = 0.25
-AHEAD_M = 4.0
+AHEAD_M = 2.0
 #: The landings' mean error along the step (m), the issue's bound on their bias.
 LANDING_BIAS_BELOW_M = 0.005
 #: The README's "every landing within about 3 cm" (m), the issue's 0.1 rad.
@@ -46,7 +48,7 @@ PELVIS_ABOVE_M = 0.8
 #: chattering servo's was 107, the smooth one's is 1.4).
 TORQUE_JUMP_BELOW_NM = 10.0
 #: The issue's push while walking: 150 N sideways for 0.1 s (15 N s), one at a random phase
-#: and side in every 5 steps (4 in the 20).
+#: and side in every 5 steps (2 in the 10).
 PUSH_N = 150.0
 PUSH_S = 0.1
 PUSH_EVERY_S = 5 * STEP_DURATION_S

@@ -71,7 +71,7 @@ def test_two_turns_of_a_two_metre_circle_streamed() -> None:
         assert np.linalg.norm(np.array(after.pelvis_xy) - start) < BACK_WITHIN_M
     assert trial.leg_torque_jump_nm < TORQUE_JUMP_BELOW_NM
     # This run's figures (deterministic).
-    assert round(trial.worst_landing_m, 3) == 0.025
+    assert round(trial.worst_landing_m, 3) == 0.006
 
 
 def _pushed_walk(adjust_steps: bool) -> WalkTrial:

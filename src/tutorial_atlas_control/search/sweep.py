@@ -17,6 +17,7 @@ import logging
 import math
 import os
 import signal
+import sys
 import threading
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
@@ -203,10 +204,15 @@ class SweepEngine:
         interrupted = False
         futures = [self.client.submit(run, spec, pure=False) for spec in specs]
         bar = _bar(len(futures), progress)
+        # Not on a terminal (a log): a plain line per finished run instead of the bar.
+        lines = progress and bar.disable
         try:
             for future in as_completed(futures):
                 rows.append(future.result())
                 bar.update(1)
+                if lines:
+                    print(f'sweep: {len(rows)}/{len(futures)} runs done', file=sys.stderr,
+                          flush=True)
         except KeyboardInterrupt:
             interrupted = True
             self.client.cancel(futures)

@@ -71,7 +71,7 @@ def run_walk(spec: WalkSpec) -> dict[str, Any]:
                                 AFTER_WALK_S)
     return {**asdict(spec), 'walked': not trial.fell and trial.steps == spec.steps,
             'fell': trial.fell, 'steps_taken': trial.steps,
-            'worst_landing_m': round(trial.worst_landing_m, 4)}
+            'worst_landing_m': round(trial.worst_landing_m, 6)}
 
 
 def run_walk_map(specs: Sequence[WalkSpec], workers: int | None = None,
