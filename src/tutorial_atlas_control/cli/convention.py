@@ -54,6 +54,17 @@ def whole_number(minimum: int) -> Callable[[str], int]:
     return checked
 
 
+def positive_number(text: str) -> float:
+    """An argparse `type=` for a finite number > 0 (a stride, a duration, a time scale)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'{text!r} is not a number') from None
+    if not 0.0 < value < float('inf'):
+        raise argparse.ArgumentTypeError(f'{text!r} must be a finite number > 0')
+    return value
+
+
 #: A wrong command line (argparse's status).
 EXIT_USAGE = 2
 HELP_OPTIONS = ('-h', '--help')

@@ -10,6 +10,7 @@ from pathlib import Path
 from tutorial_atlas_control.cli.convention import (
     EXIT_INTERRUPTED,
     EXIT_REFUSED,
+    positive_number,
     print_error,
     whole_number,
 )
@@ -27,16 +28,6 @@ from tutorial_atlas_control.search import (
 from tutorial_atlas_control.sim import DEFAULT_GAINS_FILE
 
 PROG = 'sweep.py'
-
-
-def _positive(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'{text!r} is not a number') from None
-    if not 0.0 < value < float('inf'):
-        raise argparse.ArgumentTypeError(f'{text!r} must be a finite number > 0')
-    return value
 
 
 def _trajectory(text: str) -> tuple[str, str]:
@@ -61,9 +52,9 @@ def build_parser() -> argparse.ArgumentParser:
                         metavar='FILE:NAME', help='one more trajectory (repeatable)')
     parser.add_argument('--gains', action='append', metavar='FILE',
                         help='gains YAML (repeatable; default: config/atlas_controller.yaml)')
-    parser.add_argument('--gain-scale', type=_positive, nargs='+', default=[1.0], metavar='X',
+    parser.add_argument('--gain-scale', type=positive_number, nargs='+', default=[1.0], metavar='X',
                         help='factors on every p, i, d (default: 1)')
-    parser.add_argument('--time-scale', type=_positive, nargs='+', default=[1.0], metavar='X',
+    parser.add_argument('--time-scale', type=positive_number, nargs='+', default=[1.0], metavar='X',
                         help='factors on every waypoint duration (default: 1)')
     parser.add_argument('--push', action='append', metavar='AT_S:FX,FY,FZ:DURATION_S',
                         help='a world-frame force (N) on the pelvis, AT_S s after the first '

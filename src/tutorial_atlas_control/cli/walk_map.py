@@ -11,6 +11,7 @@ from pathlib import Path
 from tutorial_atlas_control.cli.convention import (
     EXIT_INTERRUPTED,
     EXIT_REFUSED,
+    positive_number,
     print_error,
     whole_number,
 )
@@ -27,16 +28,6 @@ from tutorial_atlas_control.search import (
 PROG = 'walk_map.py'
 
 
-def _positive(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'{text!r} is not a number') from None
-    if not 0.0 < value < float('inf'):
-        raise argparse.ArgumentTypeError(f'{text!r} must be a finite number > 0')
-    return value
-
-
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser (its --help is the documentation)."""
     parser = argparse.ArgumentParser(
@@ -47,9 +38,9 @@ def build_parser() -> argparse.ArgumentParser:
             'duration, the fraction of seeds that took every step without a fall), '
             'OUT_runs.csv (every run) and OUT.png (the map). Rows are in input order; the '
             'same inputs give the same map on any number of workers.'))
-    parser.add_argument('--strides', type=_positive, nargs='+', default=[0.25], metavar='M',
+    parser.add_argument('--strides', type=positive_number, nargs='+', default=[0.25], metavar='M',
                         help='strides (m, at most 0.40; default: 0.25)')
-    parser.add_argument('--durations', type=_positive, nargs='+', default=[0.63], metavar='S',
+    parser.add_argument('--durations', type=positive_number, nargs='+', default=[0.63], metavar='S',
                         help='step durations (s; default: 0.63)')
     parser.add_argument('--seeds', type=whole_number(1), default=8, metavar='N',
                         help='seeds per cell (default: 8)')
