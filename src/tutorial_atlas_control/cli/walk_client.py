@@ -152,6 +152,8 @@ def _walk(plan: list[Footstep], args: argparse.Namespace) -> int:
     last: list[AtlasSimInterfaceState] = [first]
 
     def on_state(state: AtlasSimInterfaceState) -> None:
+        if ended.is_set():  # given up, interrupted or walked: the client answers no more
+            return
         last[0] = state
         steps = client.on_state(state.current_behavior, state.behavior_feedback.status_flags,
                                 state.walk_feedback.current_step_index,
@@ -159,7 +161,7 @@ def _walk(plan: list[Footstep], args: argparse.Namespace) -> int:
         if client.outcome is not None:
             ended.set()
         elif steps is not None:
-            publisher.publish(_command(steps))
+            _send(publisher, _command(steps), ended)
 
     _wait_for_subscribers(publisher)
     if first.current_behavior == Behavior.USER:
@@ -201,6 +203,17 @@ def _wait_for_subscribers(publisher: rospy.Publisher) -> None:
         rospy.sleep(0.01)
 
 
+def _send(publisher: rospy.Publisher, command: AtlasSimInterfaceCommand,
+          ended: threading.Event) -> None:
+    """Publish from the state callback; a state read just as the client stopped (rospy
+    closing its topics on the way out) sends nothing and says nothing."""
+    try:
+        publisher.publish(command)
+    except rospy.ROSException:
+        if not ended.is_set():
+            raise
+
+
 def _wait_for_the_end(ended: threading.Event, heard: list[float], client: WalkClient,
                       timeout_s: float) -> None:
     """Until the walk ends; _Refused when the states stop for STATE_SILENCE_S or at the
@@ -208,19 +221,27 @@ def _wait_for_the_end(ended: threading.Event, heard: list[float], client: WalkCl
     planned = len(client.plan)
     deadline = time.monotonic() + timeout_s
     try:
-        while not ended.wait(0.05):
-            now = time.monotonic()
-            if now - heard[0] > STATE_SILENCE_S:
-                raise _Refused(f'no {topics.ASI_STATE} for {STATE_SILENCE_S:g} s: the '
-                               'simulator stopped or is paused '
-                               f'({client.steps_taken} of {planned} steps taken)')
-            if now > deadline:
-                raise _Refused(f'the walk did not end within {timeout_s:g} s '
-                               f'({client.steps_taken} of {planned} steps taken)')
+        _wait_or_give_up(ended, heard, client, deadline, timeout_s)
     except KeyboardInterrupt:
         print(f'{PROG}: interrupted after {client.steps_taken} of {planned} steps',
               file=sys.stderr)
         raise
+    finally:
+        ended.set()  # however it ended, the state callback sends nothing more
+
+
+def _wait_or_give_up(ended: threading.Event, heard: list[float], client: WalkClient,
+                     deadline: float, timeout_s: float) -> None:
+    planned = len(client.plan)
+    while not ended.wait(0.05):
+        now = time.monotonic()
+        if now - heard[0] > STATE_SILENCE_S:
+            raise _Refused(f'no {topics.ASI_STATE} for {STATE_SILENCE_S:g} s: the '
+                           'simulator stopped or is paused '
+                           f'({client.steps_taken} of {planned} steps taken)')
+        if now > deadline:
+            raise _Refused(f'the walk did not end within {timeout_s:g} s '
+                           f'({client.steps_taken} of {planned} steps taken)')
 
 
 def _stand_first(publisher: rospy.Publisher, planned: int) -> None:
