@@ -93,16 +93,19 @@ def behaviour_lines(changes: list[BehaviourChange]) -> list[str]:
 
 def walk_windows(changes: list[BehaviourChange]) -> list[tuple[float, float]]:
     """Each walk's window (s from the bag's start): from the change before Walk began (its
-    WALK commands were sent then) to WALK_ENDS_AFTER_S past the change that ended it."""
-    windows = []
+    WALK commands were sent then) to WALK_ENDS_AFTER_S past the change that ended it, or to
+    the next walk's window if that begins sooner: a client's step indices start at 1 again
+    each walk, so one walk's window must not hold the next one's steps."""
+    spans = []
     for k, change in enumerate(changes):
         if change.behaviour != WALK or (k and changes[k - 1].behaviour == WALK):
             continue
         start = changes[k - 1].t_s if k else 0.0
         end = next((later.t_s for later in changes[k + 1:] if later.behaviour != WALK),
                    float('inf'))
-        windows.append((start, end + WALK_ENDS_AFTER_S))
-    return windows
+        spans.append((start, end + WALK_ENDS_AFTER_S))
+    return [(start, min(end, spans[n + 1][0]) if n + 1 < len(spans) else end)
+            for n, (start, end) in enumerate(spans)]
 
 
 #: Each behaviour's colour in the plot.

@@ -42,6 +42,13 @@ def test_each_walk_has_its_window_from_the_change_before_it() -> None:
                                      (9.0, float('inf'))]
 
 
+def test_a_walk_soon_after_another_ends_the_first_ones_window() -> None:
+    changes = [BehaviourChange(1.7, 0, 2, 0), BehaviourChange(4.49, 4, 2, 4),
+               BehaviourChange(8.212, 0, 128, 0), BehaviourChange(9.067, 4, 2, 4),
+               BehaviourChange(12.794, 0, 2, 0)]
+    assert walk_windows(changes) == [(1.7, 8.212), (8.212, 12.794 + WALK_ENDS_AFTER_S)]
+
+
 def test_the_behaviours_are_plotted_over_the_pelvis_height(tmp_path: Path) -> None:
     changes = [BehaviourChange(0.0, 1, 0, 0), BehaviourChange(1.0, 1, 8, 4),
                BehaviourChange(2.0, 0, 2, 0), BehaviourChange(3.0, 4, 2, 4),
