@@ -181,6 +181,14 @@ ROWS = (
     ('search_generations', 'search.py: its generations', 'count', '', 0),
     ('search_runs_per_s', 'search.py: offline runs per second', 'runs/s', '', 3),
     ('search_reproduced', 'search.py: found Stepping.yaml again', 'yes=1', '1', 0),
+    ('walk_straight_runs', 'README\'s 20 straight steps: seeds', 'count', '', 0),
+    ('walk_straight_within_fraction', 'of them walked, landings within 3 cm', 'fraction', '1',
+     3),
+    ('walk_straight_worst_landing_m', 'their worst landing', 'm', '', 4),
+    ('walk_circle_runs', 'README\'s turn of the 2 m circle: seeds', 'count', '', 0),
+    ('walk_circle_within_fraction', 'of them walked, landings within 3 cm', 'fraction', '1',
+     3),
+    ('walk_circle_worst_landing_m', 'their worst landing', 'm', '', 4),
     ('walk_pushes_runs', 'walks pushed every 5 s: seeds', 'count', '', 0),
     ('walk_pushes_fell_fraction_150n', 'of them fell, 150 N x 0.1 s', 'fraction', '0', 3),
     ('walk_pushes_fell_fraction_175n', 'of them fell, 175 N x 0.1 s', 'fraction', '', 3),
@@ -269,8 +277,8 @@ class Budget:
 
 
 BUDGETS = {
-    'quick': Budget('quick', 2000, 5000, 10.0, 2, 1, 4.0, 8.0, ((50.0, 2.0), (1000.0, 1.0)),
-                    8.0, 4.0, 4.0, search_popsize=2, min_offline_runs=1),
+    'quick': Budget('quick', 2000, 5000, 10.0, 2, 1, 2.0, 4.0, ((50.0, 1.0), (1000.0, 0.5)),
+                    4.0, 2.0, 2.0, search_popsize=2, min_offline_runs=1),
     'default': Budget('default', 5000, 20000, 60.0, 8, 1, 5.0, 15.0,
                       ((50.0, 4.0), (1000.0, 2.0)), 15.0, 6.0, 6.0, side_runs=1),
     'full': Budget('full', 5000, 20000, 60.0, 16, None, 10.0, 30.0,
@@ -327,6 +335,9 @@ TARGETS = {
     'controller_window_age_p99_ms': Target(low=1.0, high=1.0),
     # The search, run again whole, finds the committed step (one machine).
     'search_reproduced': Target(low=1.0, high=1.0),
+    # The README's walks: every seed walks them, each landing within 3 cm.
+    'walk_straight_within_fraction': Target(low=1.0, high=1.0),
+    'walk_circle_within_fraction': Target(low=1.0, high=1.0),
     # The issue's push while walking (15 N s) and the live test's walks: no seed falls.
     'walk_pushes_fell_fraction_150n': Target(low=0.0, high=0.0),
     'walk_phase_pushes_fell_fraction_150n': Target(low=0.0, high=0.0),
@@ -366,7 +377,10 @@ EXPECTED = {
     # search_reproduced only from a whole search (--full, --only search).
     'search': ('search_wall_s', 'search_generations', 'search_runs_per_s'),
     # The other forces only in the budgets that push harder (bench/walking.BUDGETS).
-    'walking': ('walk_pushes_runs', 'walk_pushes_fell_fraction_150n', 'walk_phase_pushes_runs',
+    'walking': ('walk_straight_runs', 'walk_straight_within_fraction',
+                'walk_straight_worst_landing_m', 'walk_circle_runs',
+                'walk_circle_within_fraction', 'walk_circle_worst_landing_m',
+                'walk_pushes_runs', 'walk_pushes_fell_fraction_150n', 'walk_phase_pushes_runs',
                 'walk_phase_pushes_fell_fraction_150n', 'walk_variations_runs',
                 'walk_variations_fell_fraction'),
 }

@@ -1,10 +1,12 @@
 """The `walking` section: how often pushed and varied walks fall, as fractions of seeds.
 
-Three kinds of run, each perturbed by its seed (walking/start_noise.py), on a pool of
-processes: walk_pushes.py's streamed straight walks through the AtlasSimInterface, pushed
-sideways at a random phase in every 5 s; one push at each of 7 phases of a right and a
-left step, to either side (walk_trial, an 8-step streamed walk: the phase pushes); and
-walk_variations.py's live test sequences. A figure is the fraction of runs that fell.
+Four kinds of run, each perturbed by its seed (walking/start_noise.py), on a pool of
+processes: the README's two walks unpushed (20 straight steps sent once, a turn of the 2 m
+circle streamed), each landing to be within 3 cm; walk_pushes.py's streamed straight walks
+through the AtlasSimInterface, pushed sideways at a random phase in every 5 s; one push at
+each of 7 phases of a right and a left step, to either side (walk_trial, an 8-step streamed
+walk: the phase pushes); and walk_variations.py's live test sequences. A figure is the
+fraction of runs that walked, or that fell.
 """
 
 from __future__ import annotations
@@ -17,7 +19,12 @@ import walk_pushes
 import walk_variations
 
 from tutorial_atlas_control.balance import Push
-from tutorial_atlas_control.walking import STEP_DURATION_S, WalkGains, straight_steps
+from tutorial_atlas_control.walking import (
+    STEP_DURATION_S,
+    WalkGains,
+    circle_steps,
+    straight_steps,
+)
 from tutorial_atlas_control.walking.walk_trial import walk_started_s, walk_trial
 
 #: The pushes' length (s) and period (s), walk_pushes.py's defaults (the issue's 0.1 s).
@@ -30,12 +37,23 @@ PHASES = 7
 PHASE_STEPS = (4, 5)
 #: The variations' stride (m): test_asi_live's.
 VARIATION_STRIDE_M = 0.2
+#: The README's walks: the straight one's stride (m); the circle's radius (m), steps a turn
+#: and feet apart (m); every landing within this of its step (m, rad); sim time after the
+#: last step (s: the catch, then Stand).
+COURSE_STRIDE_M = 0.25
+CIRCLE_RADIUS_M = 2.0
+CIRCLE_STEPS_A_TURN = 60
+CIRCLE_WIDTH_M = 0.3
+LANDING_WITHIN_M = 0.03
+LANDING_YAW_WITHIN_RAD = 0.1
+AFTER_S = 1.5
 
 
 @dataclass(frozen=True)
 class WalkingBudget:
     """What the section runs: pushed walks (seeds, steps, forces in N), phase pushes (the
-    steps pushed, phases of each, (force N, step adjustment on) cases), variations (seeds)."""
+    steps pushed, phases of each, (force N, step adjustment on) cases), variations (seeds),
+    the README's walks (seeds, the straight walk's steps, the circle's steps)."""
 
     push_seeds: int
     push_steps: int
@@ -44,13 +62,18 @@ class WalkingBudget:
     phases: int
     phase_cases: tuple[tuple[float, bool], ...]
     variation_seeds: int
+    course_seeds: int
+    straight_steps: int
+    circle_steps: int
 
 
 BUDGETS = {
-    'quick': WalkingBudget(1, 4, (150.0,), (4,), 1, ((150.0, True),), 1),
-    'default': WalkingBudget(8, 60, (150.0, 175.0), PHASE_STEPS, PHASES, ((150.0, True),), 8),
+    'quick': WalkingBudget(1, 4, (150.0,), (4,), 1, ((150.0, True),), 1, 1, 4, 4),
+    'default': WalkingBudget(8, 60, (150.0, 175.0), PHASE_STEPS, PHASES, ((150.0, True),), 8,
+                             8, 20, CIRCLE_STEPS_A_TURN),
     'full': WalkingBudget(8, 60, (150.0, 175.0, 200.0), PHASE_STEPS, PHASES,
-                          ((150.0, True), (150.0, False), (200.0, True), (250.0, True)), 8),
+                          ((150.0, True), (150.0, False), (200.0, True), (250.0, True)), 8,
+                          8, 20, CIRCLE_STEPS_A_TURN),
 }
 
 
@@ -98,6 +121,26 @@ def phase_push_fell(case: PhasePush) -> bool:
     return trial.fell
 
 
+def course_walk(job: tuple[str, int, int]) -> tuple[bool, float]:
+    """One of the README's walks, ('straight' or 'circle', steps, seed): whether it walked
+    every step, caught itself and landed each within LANDING_WITHIN_M and
+    LANDING_YAW_WITHIN_RAD of its step; and its worst landing (m)."""
+    kind, steps, seed = job
+    if kind == 'straight':
+        plan, streaming = straight_steps(steps, COURSE_STRIDE_M), False
+    else:
+        plan = circle_steps(CIRCLE_RADIUS_M, CIRCLE_STEPS_A_TURN, 1,
+                            width_m=CIRCLE_WIDTH_M)[:steps]
+        streaming = True
+    duration_s = walk_started_s() + len(plan) * plan[0].duration_s + AFTER_S
+    trial = walk_trial(plan, duration_s, streaming=streaming, seed=seed)
+    within = (not trial.fell and trial.steps == steps and trial.walk_ended_s is not None
+              and all(landing.error_m < LANDING_WITHIN_M
+                      and landing.yaw_error_rad < LANDING_YAW_WITHIN_RAD
+                      for landing in trial.landings))
+    return within, trial.worst_landing_m
+
+
 def _pushed_fell(job: tuple[int, int, float]) -> bool:
     seed, steps, force_n = job
     return walk_pushes.run(seed, steps, force_n, PUSH_S, PUSH_EVERY_S).fell
@@ -111,11 +154,25 @@ def walking_figures(budget: WalkingBudget, workers: int = 2,
                     log: Callable[[str], None] = print,
                     pool_map: Callable[[Callable, Iterable], Iterable] | None = None
                     ) -> dict[str, float]:
-    """The section's figures: per force, the fraction of pushed walks (seeds 0..) and of
-    phase pushes that fell; the fraction of variations (seeds 1..) that fell; the runs."""
+    """The section's figures: the fraction of the README's walks (seeds 0..) that walked
+    within 3 cm and their worst landing; per force, the fraction of pushed walks (seeds 0..)
+    and of phase pushes that fell; the fraction of variations (seeds 1..) that fell; the
+    runs."""
     with ProcessPoolExecutor(workers) as pool:
         run = pool_map or pool.map
-        figures: dict[str, float] = {'walk_pushes_runs': float(budget.push_seeds)}
+        figures: dict[str, float] = {}
+        for kind, steps in (('straight', budget.straight_steps),
+                            ('circle', budget.circle_steps)):
+            walks = list(run(course_walk, [(kind, steps, seed)
+                                           for seed in range(budget.course_seeds)]))
+            within = sum(ok for ok, _ in walks)
+            worst = max(landing for _, landing in walks)
+            figures.update({f'walk_{kind}_runs': float(len(walks)),
+                            f'walk_{kind}_within_fraction': within / len(walks),
+                            f'walk_{kind}_worst_landing_m': worst})
+            log(f'walking: {kind}, {steps} steps: {within} of {len(walks)} seeds walked '
+                f'within {LANDING_WITHIN_M * 100:g} cm (worst landing {worst * 100:.1f} cm)')
+        figures['walk_pushes_runs'] = float(budget.push_seeds)
         for force in budget.push_forces_n:
             fell = list(run(_pushed_fell, [(seed, budget.push_steps, force)
                                            for seed in range(budget.push_seeds)]))

@@ -93,7 +93,7 @@ def straight() -> dict[int, WalkTrial]:
     return trials
 
 
-def test_eight_of_eight_seeds_walk_twenty_straight_steps(
+def test_eight_of_eight_seeds_walk_ten_straight_steps(
         straight: dict[int, WalkTrial]) -> None:
     def ok(trial: WalkTrial) -> bool:
         return (walked(trial) and float(trial.pelvis_end[0]) >= AHEAD_M
