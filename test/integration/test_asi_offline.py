@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from tutorial_atlas_control.asi import AtlasSimInterface, Behavior
-from tutorial_atlas_control.bags import read_bag
+from tutorial_atlas_control.bags import capture_trace, read_bag
 from tutorial_atlas_control.msgs.atlas_sim_interface import (
     AsiCommand,
     ManipulateParams,
@@ -43,6 +43,8 @@ SCRIPT = Path(__file__).resolve().parents[2] / 'scripts' / 'run_offline.py'
 WALK_AT_S = 3.0
 #: The session lasts this long (s of sim time): the walk and its return to Stand.
 SESSION_S = 7.0
+#: Standing, the capture point is at least this far inside the feet (m).
+STANDING_MARGIN_M = 0.03
 
 
 def _walk_bytes(stamp_ns: int, behavior: int = Behavior.WALK) -> bytes:
@@ -147,3 +149,22 @@ def test_analyze_bag_reads_a_walk_as_a_walk(session: Path, tmp_path: Path) -> No
     footprints = tmp_path / 'walk.footprints.png'
     assert footprints.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
     assert f'wrote {footprints}' in result.stderr
+    capture = tmp_path / 'walk.capture.png'
+    assert capture.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
+    assert f'wrote {capture}' in result.stderr
+
+
+def test_the_capture_point_leaves_the_support_polygon_only_while_it_steps(
+        session: Path) -> None:
+    """Standing before the walk and after it, both soles down and the capture point well
+    inside them; walking, one sole down at times and the capture point outside its polygon,
+    caught by the next step."""
+    trace = capture_trace(read_bag(session))
+    assert trace is not None
+    for during in ((trace.t_s > WALK_AT_S - 0.5) & (trace.t_s < WALK_AT_S),
+                   trace.t_s > SESSION_S - 0.5):
+        assert (trace.soles_down[during] == 2).all()
+        assert trace.margin_m[during].min() > STANDING_MARGIN_M, trace.margin_m[during].min()
+    walking = trace.t_s > WALK_AT_S
+    assert (trace.soles_down[walking] == 1).any()
+    assert np.nanmin(trace.margin_m[walking]) < 0.0

@@ -23,6 +23,7 @@ from tutorial_atlas_control.bags import (
     analyze,
     analyze_try,
     behaviour_lines,
+    capture_trace,
     check_output_path,
     compare_analyses,
     comparison_to_json,
@@ -31,6 +32,7 @@ from tutorial_atlas_control.bags import (
     parse_fps,
     parse_size,
     plot_behaviours,
+    plot_capture,
     plot_comparison,
     plot_footprints,
     plot_joints,
@@ -232,6 +234,10 @@ def main(argv: Sequence[str] | None = None) -> int:
                 behaviours = plot_behaviours(changes, pelvis.t_s, pelvis.position_m[:, 2],
                                              Path(args.plot).with_suffix('.behaviours.png'))
                 print(f'wrote {behaviours}', file=sys.stderr)
+            trace = capture_trace(analysis.data) if walk is not None or changes else None
+            if trace is not None:  # and the capture point against the support polygon
+                capture = plot_capture(trace, Path(args.plot).with_suffix('.capture.png'))
+                print(f'wrote {capture}', file=sys.stderr)
         if args.plot_joints:
             print(f'wrote {plot_joints(analysis, args.plot_joints)}', file=sys.stderr)
         if args.video:
