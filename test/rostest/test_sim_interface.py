@@ -35,6 +35,53 @@ PAUSE_WATCH_S = 0.5
 ELBOW_TARGET_RAD = 0.8
 #: Sim time (s) Stand is watched for from a reset: the 1 s pin, its release, and 4 s after.
 STAND_WATCHED_S = 5.0
+#: The AtlasSimInterface's behaviours (ASI.md).
+ASI_STAND, ASI_WALK = 0, 4
+#: control_mode Walk's feet: Stand takes the robot over (s of sim time), the walk's wall-time
+#: bound (s), the stance after it watched (s of sim time); the issue's bounds on how far a
+#: foot may slide (m) or turn (rad) there; a standing pelvis stays above this (m).
+STAND_TAKE_OVER_S = 2.0
+WALK_WALL_TIMEOUT_S = 60.0
+STANCE_WATCHED_S = 10.0
+FOOT_SLIDES_BELOW_M = 0.01
+FOOT_TURNS_BELOW_RAD = 0.02
+PELVIS_ABOVE_M = 0.8
+
+
+class AsiStates:
+    """The newest AtlasSimInterfaceState, and the lowest pelvis it reported since
+    `watch_pelvis` (the recorder's copy of the state: 50 Hz and each change, not 1 kHz)."""
+
+    def __init__(self) -> None:
+        from atlas_msgs.msg import AtlasSimInterfaceState
+
+        self.state: AtlasSimInterfaceState | None = None
+        self.lowest_pelvis_m = float('inf')
+        self._subscriber = rospy.Subscriber(topics.ASI_STATE_RECORDED, AtlasSimInterfaceState,
+                                            self._on_state, queue_size=1)
+
+    def _on_state(self, state: object) -> None:
+        self.state = state
+        self.lowest_pelvis_m = min(self.lowest_pelvis_m, state.pos_est.position.z)
+
+    def watch_pelvis(self) -> None:
+        self.lowest_pelvis_m = float('inf')
+
+    def behaviour(self) -> int | None:
+        return None if self.state is None else self.state.current_behavior
+
+    def feet(self) -> np.ndarray:
+        """Each foot's (x, y, yaw) from foot_pos_est (2, 3)."""
+        assert self.state is not None
+        rows = []
+        for pose in self.state.foot_pos_est:
+            q = pose.orientation
+            yaw = np.arctan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+            rows.append((pose.position.x, pose.position.y, yaw))
+        return np.array(rows)
+
+    def close(self) -> None:
+        self._subscriber.unregister()
 
 
 class SimInterfaceTest(unittest.TestCase):
@@ -243,6 +290,40 @@ class SimInterfaceTest(unittest.TestCase):
         probe.wait_sim(0.1)
         self.assertGreater(probe.clock_ns, paused_ns)
         probe.set_mode('Stand')
+
+    def test_09_control_mode_walk_then_the_feet_stay_put_in_stand(self) -> None:
+        """DRCSim's control_mode Walk from the balancing Stand: its queue walked without a
+        fall and, back in Stand, each foot where the walk put it for STANCE_WATCHED_S."""
+        probe = self.probe
+        states = AsiStates()
+        try:
+            probe.reset('/gazebo/reset_simulation')
+            probe.set_mode('Stand')  # from the default start's hold: the balancing Stand
+            probe.wait_until(lambda: states.behaviour() == ASI_STAND
+                             and not any(states.state.k_effort), 'the balancing Stand')
+            states.watch_pelvis()
+            probe.wait_sim(STAND_TAKE_OVER_S)
+            probe.set_mode('Walk')
+            probe.wait_until(lambda: states.behaviour() == ASI_WALK, 'Walk')
+            probe.wait_until(lambda: states.behaviour() == ASI_STAND, 'Walk back to Stand',
+                             timeout_s=WALK_WALL_TIMEOUT_S)
+            probe.wait_sim(1.0)  # the last foot down and settled
+            before = states.feet()
+            probe.wait_sim(STANCE_WATCHED_S)
+            after = states.feet()
+            self.assertEqual(states.behaviour(), ASI_STAND)
+            slid = np.hypot(*(after[:, :2] - before[:, :2]).T)
+            turned = np.abs(np.angle(np.exp(1j * (after[:, 2] - before[:, 2]))))
+            rospy.loginfo(f'control_mode Walk, then Stand: in {STANCE_WATCHED_S:g} s the feet '
+                          f'slid {slid} m and turned {turned} rad; lowest pelvis '
+                          f'{states.lowest_pelvis_m:.3f} m')
+            self.assertTrue((slid < FOOT_SLIDES_BELOW_M).all(), f'the feet slid {slid} m')
+            self.assertTrue((turned < FOOT_TURNS_BELOW_RAD).all(), f'the feet turned {turned}')
+            self.assertGreater(float(before[0, 0] + before[1, 0]) / 2.0, 0.5,
+                               f'the feet walked ahead: {before}')
+            self.assertGreater(states.lowest_pelvis_m, PELVIS_ABOVE_M, 'a fall')
+        finally:
+            states.close()
 
 
 if __name__ == '__main__':
