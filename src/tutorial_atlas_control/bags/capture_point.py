@@ -130,23 +130,23 @@ def plot_capture(trace: CaptureTrace, path: Path) -> Path:
     import matplotlib.pyplot as plt  # noqa: PLC0415
 
     margin_cm = trace.margin_m * 100.0
-    figure, ax = plt.subplots(figsize=(10.0, 3.6))
+    figure, ax = plt.subplots(figsize=(10.0, 4.0))
+    single = trace.soles_down == 1
+    if single.any():  # underneath what is drawn over it
+        ax.fill_between(trace.t_s, 0.0, 1.0, where=single, transform=ax.get_xaxis_transform(),
+                        color='0.88', lw=0, zorder=0, label='one foot down')
     ax.axhline(0.0, color='black', lw=0.8)
+    outside = np.nan_to_num(margin_cm, nan=0.0) < 0.0
+    ax.fill_between(trace.t_s, margin_cm, 0.0, where=outside, color='tab:red', alpha=0.35,
+                    lw=0, label='outside: a step must catch it')
     ax.plot(trace.t_s, margin_cm, color='tab:blue', lw=1,
             label='capture point inside the support polygon (cm)')
-    outside = np.nan_to_num(margin_cm, nan=0.0) < 0.0
-    ax.fill_between(trace.t_s, margin_cm, 0.0, where=outside, color='tab:red', alpha=0.3,
-                    lw=0, label='outside: a step must catch it')
-    single = trace.soles_down == 1
-    if single.any():
-        ax.fill_between(trace.t_s, 0.0, 1.0, where=single, transform=ax.get_xaxis_transform(),
-                        color='0.85', lw=0, label='one foot down')
     ax.set_xlabel('time from the bag\'s start (s)')
     ax.set_ylabel('margin (cm)')
     ax.set_title(f'the capture point against the support polygon: outside '
                  f'{trace.outside_fraction:.0%} of the time a foot was down')
-    ax.legend(loc='lower left', fontsize='small', ncol=3)
-    figure.tight_layout()
+    figure.legend(loc='lower center', fontsize='small', ncol=3)
+    figure.tight_layout(rect=(0.0, 0.08, 1.0, 1.0))
     figure.savefig(path, dpi=100)
     plt.close(figure)
     return path
