@@ -27,11 +27,6 @@ from tutorial_atlas_control.balance.lipm import GRAVITY_M_S2
 CAPTURE_RATE_HZ = 100.0
 #: The pendulum's height is taken as at least this (m), so omega stays finite in a fall.
 MIN_COM_HEIGHT_M = 0.05
-#: A box's corners as signs of its half sizes.
-_CORNER_SIGNS = np.array([[1, 1, -1], [1, -1, -1], [-1, -1, -1], [-1, 1, -1],
-                          [1, 1, 1], [1, -1, 1], [-1, -1, 1], [-1, 1, 1]], dtype=np.float64)
-
-
 @dataclass(frozen=True)
 class CaptureTrace:
     """The capture point over a run: times (s from the bag's start), the centre of mass
@@ -64,8 +59,8 @@ def capture_points(com_m: np.ndarray, dt_s: float) -> np.ndarray:
 
 
 def support_polygon(corners_m: np.ndarray, contact_height_m: float) -> np.ndarray:
-    """The hull (k, 2) of the corners (2, 8, 3) of the soles that touch, their lowest
-    corner within `contact_height_m` of the ground; (0, 2) if none does."""
+    """The hull (k, 2) of the bottom corners (2, 4, 3) of the soles that touch, their
+    lowest corner within `contact_height_m` of the ground; (0, 2) if none does."""
     touching = touching_soles(corners_m, contact_height_m)
     if not touching:
         return np.zeros((0, 2))
@@ -73,7 +68,7 @@ def support_polygon(corners_m: np.ndarray, contact_height_m: float) -> np.ndarra
 
 
 def touching_soles(corners_m: np.ndarray, contact_height_m: float) -> list[int]:
-    """The soles (0 left, 1 right) whose lowest corner (of (2, 8, 3)) is within
+    """The soles (0 left, 1 right) whose lowest bottom corner (of (2, 4, 3)) is within
     `contact_height_m` of the ground."""
     return [foot for foot in (0, 1) if float(corners_m[foot, :, 2].min()) < contact_height_m]
 
@@ -97,11 +92,12 @@ def capture_trace(data: BagData, since_s: float = 0.0, until_s: float = np.inf
     import mujoco  # noqa: PLC0415 - after RecordedKinematics has prepared GL
 
     from tutorial_atlas_control.balance.estimator import CONTACT_HEIGHT_M  # noqa: PLC0415
-    from tutorial_atlas_control.balance.stand_pose import SOLE_GEOMS  # noqa: PLC0415
+    from tutorial_atlas_control.balance.stand_pose import (  # noqa: PLC0415
+        SOLE_GEOMS,
+        sole_corners,
+    )
 
     model = kinematics.atlas.model
-    soles = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name) for name in SOLE_GEOMS]
-    offsets = np.array([_CORNER_SIGNS * model.geom_size[geom] for geom in soles])
     start_s = max(since_s, float(pelvis.t_s[0]), float(states.t_s[0]))
     end_s = min(until_s, float(pelvis.t_s[-1]), float(states.t_s[-1]))
     dt_s = 1.0 / CAPTURE_RATE_HZ
@@ -113,8 +109,7 @@ def capture_trace(data: BagData, since_s: float = 0.0, until_s: float = np.inf
         placed = kinematics.place(float(at_s))
         mujoco.mj_comPos(model, placed)
         com[row] = placed.subtree_com[0]
-        corners = np.array([placed.geom_xpos[geom] + offsets[foot] @ placed.geom_xmat[geom]
-                            .reshape(3, 3).T for foot, geom in enumerate(soles)])
+        corners = np.array([sole_corners(model, placed, name) for name in SOLE_GEOMS])
         polygons.append(support_polygon(corners, CONTACT_HEIGHT_M))
         soles_down[row] = len(touching_soles(corners, CONTACT_HEIGHT_M))
     capture = capture_points(com, dt_s)

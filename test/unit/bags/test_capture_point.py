@@ -17,10 +17,9 @@ from tutorial_atlas_control.bags.capture_point import (
     support_polygon,
 )
 
-#: A sole as a box's 8 corners: 0.26 x 0.125 m, 0.05 m thick, its centre at (x, y, z).
+#: A sole box's 4 bottom corners: 0.26 x 0.125 m, 0.05 m thick, its centre at (x, y, z).
 HALF = np.array([0.13, 0.0625, 0.025])
-SIGNS = np.array([[1, 1, -1], [1, -1, -1], [-1, -1, -1], [-1, 1, -1],
-                  [1, 1, 1], [1, -1, 1], [-1, -1, 1], [-1, 1, 1]], dtype=np.float64)
+SIGNS = np.array([[1, 1, -1], [1, -1, -1], [-1, -1, -1], [-1, 1, -1]], dtype=np.float64)
 CONTACT_M = 0.01
 
 
