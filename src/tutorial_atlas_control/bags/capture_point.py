@@ -20,8 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from tutorial_atlas_control.bags.reader import BagData
-from tutorial_atlas_control.balance import support
-from tutorial_atlas_control.balance.lipm import GRAVITY_M_S2
+from tutorial_atlas_control.balance import convex_hull, natural_frequency, signed_distance
 
 #: How often the recorded pose is sampled (Hz): /ground_truth_odom's rate.
 CAPTURE_RATE_HZ = 100.0
@@ -54,7 +53,7 @@ def capture_points(com_m: np.ndarray, dt_s: float) -> np.ndarray:
     if len(com_m) < 2:
         return com_m[:, :2].copy()
     velocity = np.gradient(com_m[:, :2], dt_s, axis=0)
-    omega = np.sqrt(GRAVITY_M_S2 / np.maximum(com_m[:, 2], MIN_COM_HEIGHT_M))
+    omega = np.array([natural_frequency(max(float(z), MIN_COM_HEIGHT_M)) for z in com_m[:, 2]])
     return com_m[:, :2] + velocity / omega[:, None]
 
 
@@ -64,7 +63,7 @@ def support_polygon(corners_m: np.ndarray, contact_height_m: float) -> np.ndarra
     touching = touching_soles(corners_m, contact_height_m)
     if not touching:
         return np.zeros((0, 2))
-    return support.convex_hull(corners_m[touching, :, :2].reshape(-1, 2))
+    return convex_hull(corners_m[touching, :, :2].reshape(-1, 2))
 
 
 def touching_soles(corners_m: np.ndarray, contact_height_m: float) -> list[int]:
@@ -75,7 +74,7 @@ def touching_soles(corners_m: np.ndarray, contact_height_m: float) -> list[int]:
 
 def margins(capture_xy: np.ndarray, polygons: list[np.ndarray]) -> np.ndarray:
     """Each capture point's signed distance inside its polygon (m); NaN without one."""
-    return np.array([support.signed_distance(polygon, point) if len(polygon) >= 3 else np.nan
+    return np.array([signed_distance(polygon, point) if len(polygon) >= 3 else np.nan
                      for point, polygon in zip(capture_xy, polygons)], dtype=np.float64)
 
 
@@ -91,8 +90,8 @@ def capture_trace(data: BagData, since_s: float = 0.0, until_s: float = np.inf
     kinematics = RecordedKinematics(data)
     import mujoco  # noqa: PLC0415 - after RecordedKinematics has prepared GL
 
-    from tutorial_atlas_control.balance.estimator import CONTACT_HEIGHT_M  # noqa: PLC0415
-    from tutorial_atlas_control.balance.stand_pose import (  # noqa: PLC0415
+    from tutorial_atlas_control.balance import (  # noqa: PLC0415 - they import mujoco
+        CONTACT_HEIGHT_M,
         SOLE_GEOMS,
         sole_corners,
     )

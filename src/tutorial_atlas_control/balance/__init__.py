@@ -15,7 +15,7 @@ from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'contact_wrench': ['make_feasible', 'split_wrench'],
-    'estimator': ['BalanceEstimator', 'BalanceState'],
+    'estimator': ['CONTACT_HEIGHT_M', 'BalanceEstimator', 'BalanceState'],
     'manipulate': ['PelvisServo', 'SquatTable', 'bent_posture', 'clamp_servo'],
     'lipm': ['capture_point', 'com_acceleration', 'dcm_feedback_cop', 'lipm_state',
              'natural_frequency'],
@@ -25,7 +25,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'stand': ['StandController', 'StandGains', 'StandOutput', 'StandReference',
               'orientation_error', 'yaw_of', 'yaw_rotation'],
     'stand_behaviour': ['TRANSITION_S', 'StandBehaviour', 'smoothstep', 'stand_pose_com_height_m'],
-    'stand_pose': ['STAND_POSE_RAD', 'place_in_stand_pose', 'sole_corners'],
+    'stand_pose': ['SOLE_GEOMS', 'STAND_POSE_RAD', 'place_in_stand_pose', 'sole_corners'],
     'stand_prep': ['PREP_S', 'StandPrepBehaviour'],
     'support': ['Region', 'clamp_into', 'convex_hull', 'inside', 'shrink', 'signed_distance'],
 })
