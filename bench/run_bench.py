@@ -189,6 +189,8 @@ ROWS = (
     ('walk_circle_within_fraction', 'of them walked, landings within 3 cm', 'fraction', '1',
      3),
     ('walk_circle_worst_landing_m', 'their worst landing', 'm', '', 4),
+    ('mode_switching_runs', 'DRCSim\'s mode-switching demo: seeds', 'count', '', 0),
+    ('mode_switching_fell_fraction', 'of them fell', 'fraction', '0', 3),
     ('walk_pushes_runs', 'walks pushed every 5 s: seeds', 'count', '', 0),
     ('walk_pushes_fell_fraction_150n', 'of them fell, 150 N x 0.1 s', 'fraction', '0', 3),
     ('walk_pushes_fell_fraction_175n', 'of them fell, 175 N x 0.1 s', 'fraction', '', 3),
@@ -338,6 +340,8 @@ TARGETS = {
     # The README's walks: every seed walks them, each landing within 3 cm.
     'walk_straight_within_fraction': Target(low=1.0, high=1.0),
     'walk_circle_within_fraction': Target(low=1.0, high=1.0),
+    # Mixed control as DRC-era demos used it: no seed falls.
+    'mode_switching_fell_fraction': Target(low=0.0, high=0.0),
     # The issue's push while walking (15 N s) and the live test's walks: no seed falls.
     'walk_pushes_fell_fraction_150n': Target(low=0.0, high=0.0),
     'walk_phase_pushes_fell_fraction_150n': Target(low=0.0, high=0.0),
@@ -380,6 +384,7 @@ EXPECTED = {
     'walking': ('walk_straight_runs', 'walk_straight_within_fraction',
                 'walk_straight_worst_landing_m', 'walk_circle_runs',
                 'walk_circle_within_fraction', 'walk_circle_worst_landing_m',
+                'mode_switching_runs', 'mode_switching_fell_fraction',
                 'walk_pushes_runs', 'walk_pushes_fell_fraction_150n', 'walk_phase_pushes_runs',
                 'walk_phase_pushes_fell_fraction_150n', 'walk_variations_runs',
                 'walk_variations_fell_fraction'),

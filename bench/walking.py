@@ -11,13 +11,17 @@ fraction of runs that walked, or that fell.
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
+from pathlib import Path
 
 import walk_pushes
 import walk_variations
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / 'test'))
+from support.mode_switching_run import run_mode_switching
 from tutorial_atlas_control.balance import Push
 from tutorial_atlas_control.walking import (
     STEP_DURATION_S,
@@ -65,15 +69,16 @@ class WalkingBudget:
     course_seeds: int
     straight_steps: int
     circle_steps: int
+    mode_switching_seeds: int
 
 
 BUDGETS = {
-    'quick': WalkingBudget(1, 4, (150.0,), (4,), 1, ((150.0, True),), 1, 1, 4, 4),
+    'quick': WalkingBudget(1, 4, (150.0,), (4,), 1, ((150.0, True),), 1, 1, 4, 4, 1),
     'default': WalkingBudget(8, 60, (150.0, 175.0), PHASE_STEPS, PHASES, ((150.0, True),), 8,
-                             8, 20, CIRCLE_STEPS_A_TURN),
+                             8, 20, CIRCLE_STEPS_A_TURN, 8),
     'full': WalkingBudget(8, 60, (150.0, 175.0, 200.0), PHASE_STEPS, PHASES,
                           ((150.0, True), (150.0, False), (200.0, True), (250.0, True)), 8,
-                          8, 20, CIRCLE_STEPS_A_TURN),
+                          8, 20, CIRCLE_STEPS_A_TURN, 8),
 }
 
 
@@ -141,6 +146,11 @@ def course_walk(job: tuple[str, int, int]) -> tuple[bool, float]:
     return within, trial.worst_landing_m
 
 
+def mode_switching_fell(seed: int) -> bool:
+    """DRCSim's mode-switching demo offline from the default start perturbed by `seed`."""
+    return run_mode_switching(seed).fell_at_s is not None
+
+
 def _pushed_fell(job: tuple[int, int, float]) -> bool:
     seed, steps, force_n = job
     return walk_pushes.run(seed, steps, force_n, PUSH_S, PUSH_EVERY_S).fell
@@ -155,9 +165,9 @@ def walking_figures(budget: WalkingBudget, workers: int = 2,
                     pool_map: Callable[[Callable, Iterable], Iterable] | None = None
                     ) -> dict[str, float]:
     """The section's figures: the fraction of the README's walks (seeds 0..) that walked
-    within 3 cm and their worst landing; per force, the fraction of pushed walks (seeds 0..)
-    and of phase pushes that fell; the fraction of variations (seeds 1..) that fell; the
-    runs."""
+    within 3 cm and their worst landing; the fraction of mode-switching demos that fell
+    (seeds 0..); per force, the fraction of pushed walks (seeds 0..) and of phase pushes
+    that fell; the fraction of variations (seeds 1..) that fell; the runs."""
     with ProcessPoolExecutor(workers) as pool:
         run = pool_map or pool.map
         figures: dict[str, float] = {}
@@ -172,6 +182,10 @@ def walking_figures(budget: WalkingBudget, workers: int = 2,
                             f'walk_{kind}_worst_landing_m': worst})
             log(f'walking: {kind}, {steps} steps: {within} of {len(walks)} seeds walked '
                 f'within {LANDING_WITHIN_M * 100:g} cm (worst landing {worst * 100:.1f} cm)')
+        fell = list(run(mode_switching_fell, range(budget.mode_switching_seeds)))
+        figures.update({'mode_switching_runs': float(len(fell)),
+                        'mode_switching_fell_fraction': fell_fraction(fell)})
+        log(f'walking: DRCSim\'s mode-switching demo: {sum(fell)} of {len(fell)} seeds fell')
         figures['walk_pushes_runs'] = float(budget.push_seeds)
         for force in budget.push_forces_n:
             fell = list(run(_pushed_fell, [(seed, budget.push_steps, force)

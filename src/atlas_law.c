@@ -68,7 +68,7 @@ void atlas_law_step(AtlasLawStep *s) {
     double u = c[KP_POSITION][j] * error;
     u += integral;
     u += ((error - previous) / dt_s) * c[KD_POSITION][j];
-    u += (c[VELOCITY][j] - s->qvel[s->dof_adr[j]]) * c[KP_VELOCITY][j];
+    u += c[VELOCITY][j] * c[KP_VELOCITY][j]; /* its damping is the joint's (2.7) */
     u += c[EFFORT][j];
     s->previous_error[j] = error;
 

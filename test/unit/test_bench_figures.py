@@ -387,12 +387,13 @@ def test_phase_pushes_are_every_step_phase_and_side_each_its_own_seed() -> None:
 
 def test_walking_section_figures_from_synthetic_runs(monkeypatch: pytest.MonkeyPatch) -> None:
     """The section's arithmetic with the runs replaced: seed 5 of the README's circle lands
-    4 cm off, seed 3 of the pushed walks falls at every force, phase case 0 falls,
-    variation seed 2 falls."""
+    4 cm off, seed 7's mode-switching demo falls, seed 3 of the pushed walks falls at every
+    force, phase case 0 falls, variation seed 2 falls."""
     import walking
 
     monkeypatch.setattr(walking, 'course_walk', lambda job: (
         (False, 0.04) if job[0] == 'circle' and job[2] == 5 else (True, 0.01 + job[2] / 1000)))
+    monkeypatch.setattr(walking, 'mode_switching_fell', lambda seed: seed == 7)
     monkeypatch.setattr(walking, '_pushed_fell', lambda job: job[0] == 3)
     monkeypatch.setattr(walking, 'phase_push_fell', lambda case: case.index == 0)
     monkeypatch.setattr(walking, '_varied_fell', lambda seed: seed == 2)
@@ -402,6 +403,7 @@ def test_walking_section_figures_from_synthetic_runs(monkeypatch: pytest.MonkeyP
         'walk_straight_runs': 8.0, 'walk_straight_within_fraction': 1.0,
         'walk_straight_worst_landing_m': 0.017, 'walk_circle_runs': 8.0,
         'walk_circle_within_fraction': 0.875, 'walk_circle_worst_landing_m': 0.04,
+        'mode_switching_runs': 8.0, 'mode_switching_fell_fraction': 0.125,
         'walk_pushes_runs': 8.0, 'walk_pushes_fell_fraction_150n': 0.125,
         'walk_pushes_fell_fraction_175n': 0.125, 'walk_phase_pushes_runs': 28.0,
         'walk_phase_pushes_fell_fraction_150n': 1 / 28, 'walk_variations_runs': 8.0,

@@ -5,9 +5,8 @@ Per joint, each 1 ms step (AtlasPlugin::UpdateStates in DRCSim 2.5.2):
     q_target = clamp(position, lower, upper)
     e        = q_target - q
     de/dt    = (e - e_prev) / dt ;  e_prev = e
-    qd_p     = velocity - v
     I        = clamp(I + dt * ki_position * e, i_effort_min, i_effort_max)   # a torque (N m)
-    u        = kp_position * e + I + kd_position * de/dt + kp_velocity * qd_p + effort
+    u        = kp_position * e + I + kd_position * de/dt + kp_velocity * velocity + effort
     if k_effort != 1:                                  # AtlasCommand's k_effort / 255
         u    = k_effort * u + (1 - k_effort) * f_out
     tau      = clamp(u, -effort_limit, effort_limit)
@@ -19,6 +18,15 @@ with Gazebo's clamp(x, lo, hi) = max(min(x, hi), lo) (so lo wins when lo > hi) a
 Gazebo's math::equal tolerance (1e-6) deciding "saturated" and "ki is on". The integral
 holds a torque, so a change of ki between commands keeps what was accumulated, and while
 the torque saturates the integral is pulled back by the excess (anti-windup).
+
+The velocity gain is DRCSim 2.7's, not 2.5.2's: 2.5.2 added kp_velocity * (velocity - v)
+as an explicit torque, which on Atlas's light links (wrists, elbows, neck, feet) is past the
+1 ms step's stability limit (gain * dt / inertia > 2) and shakes the robot; 2.7 passes
+kp_velocity through to the joint's damping (clamped to [the model's damping, effort limit /
+velocity limit * 50]), which the physics integrates implicitly, and keeps only
+kp_velocity * velocity in the torque. Here the law gives that torque and
+joint_law.JointLaw sets the damping (velocity_damping.py). With kp_velocity 0 (the
+tutorial's commands, every hold) both laws are the same.
 
 Where this differs from 2.5.2, on purpose:
 * First step after a reset: e_prev := e, so the derivative term starts at 0.
@@ -137,7 +145,8 @@ def compute_torque(command: JointCommandArrays, q: np.ndarray, v: np.ndarray, st
     integral += term
     _clamp(integral, command.i_effort_min, command.i_effort_max, out=integral)
 
-    # u = kp * e + I + kd * de/dt + kp_velocity * (velocity - v) + effort, summed in that order
+    # u = kp * e + I + kd * de/dt + kp_velocity * velocity + effort, summed in that order (the
+    # velocity gain's damping, - kp_velocity * v, is the joint's: velocity_damping.py)
     np.multiply(command.kp_position, error, out=unclamped)
     unclamped += integral
     np.subtract(error, state.previous_error, out=term)
@@ -145,8 +154,7 @@ def compute_torque(command: JointCommandArrays, q: np.ndarray, v: np.ndarray, st
     term *= command.kd_position
     unclamped += term
     state.previous_error[:] = error
-    np.subtract(command.velocity, v, out=term)
-    term *= command.kp_velocity
+    np.multiply(command.velocity, command.kp_velocity, out=term)
     unclamped += term
     unclamped += command.effort
     k_effort = command.k_effort

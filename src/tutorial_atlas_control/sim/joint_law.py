@@ -21,6 +21,7 @@ from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.sim.controller import PidState, compute_torque
 from tutorial_atlas_control.sim.law_kernel import CompiledLaw, LawJoints
 from tutorial_atlas_control.sim.model import AtlasModel
+from tutorial_atlas_control.sim.velocity_damping import VelocityDamping
 
 
 class JointLaw:
@@ -52,6 +53,9 @@ class JointLaw:
             self._hold = CompiledLaw(library, joints, self.pid, self._hold_torque_nm)
             self._blend = CompiledLaw(library, joints, self.blend_pid, self.torque_nm,
                                       self._ctrl, self._hold_torque_nm)
+        #: The velocity gain of the command in force, as the joints' damping (DRCSim 2.7).
+        self.velocity_damping = VelocityDamping(atlas.model.dof_damping, atlas.dof_adr,
+                                                atlas.effort_limit_nm, atlas.velocity_limit_rad_s)
         #: Every qpos and qvel finite? (the kernel's one C call when compiled)
         self.state_is_finite = (self._numpy_state_is_finite if self._plain is None
                                 else self._plain.state_is_finite)
@@ -70,7 +74,10 @@ class JointLaw:
 
     def apply(self, command: JointCommandArrays, blended: JointCommandArrays | None) -> None:
         """One step of the law: `command`'s torque, or, when `blended` is not None, its PID
-        torque blended by k_effort with `command`'s (the hold's); into torque_nm and ctrl."""
+        torque blended by k_effort with `command`'s (the hold's); into torque_nm and ctrl;
+        the velocity gain of the user's command (`blended`, else `command`) into the joints'
+        damping."""
+        self.velocity_damping.apply(command if blended is None else blended)
         plain = self._plain
         if plain is None:
             self._numpy_torque(command, blended, self.pid, self.blend_pid, self.torque_nm)
@@ -84,7 +91,9 @@ class JointLaw:
     def apply_behaviour(self, f_out_nm: np.ndarray, blended: JointCommandArrays | None) -> None:
         """One step under a behaviour (sim/behaviour.py): its torque `f_out_nm` (N m, (28,))
         within the effort limits, or, when `blended` is not None, `blended`'s PID torque
-        blended with it by k_effort, as apply() blends a hold's; into torque_nm and ctrl."""
+        blended with it by k_effort, as apply() blends a hold's; into torque_nm and ctrl;
+        `blended`'s velocity gain into the joints' damping."""
+        self.velocity_damping.apply(blended)
         f_out = self._hold_torque_nm
         limit = self.joints.effort_limit
         np.clip(f_out_nm, -limit, limit, out=f_out)
@@ -114,6 +123,7 @@ class JointLaw:
 
     def set_torque(self, torque_nm: np.ndarray | float) -> None:
         """Apply `torque_nm` instead of the law (a recorded torque; 0 while physics is off)."""
+        self.velocity_damping.apply(None)
         self.torque_nm[:] = torque_nm
         self._ctrl[:] = self.torque_nm
 

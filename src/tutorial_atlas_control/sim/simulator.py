@@ -178,13 +178,13 @@ class AtlasSimulator:
         return atlas_model.joint_velocities(self.atlas, self.data)
 
     def joint_damping(self) -> np.ndarray:
-        """The joints' viscous damping (N m s/rad), tutorial order."""
-        return self.model.dof_damping[self.atlas.dof_adr].copy()
+        """The joints' own viscous damping (N m s/rad), under a velocity gain's."""
+        return self.law.velocity_damping.model_nm_s.copy()
 
     def set_joint_damping(self, damping: np.ndarray) -> None:
         """Set the joints' viscous damping (N m s/rad, (28,)), as /atlas/debug/test does
         (Gazebo's Joint::SetDamping); kept across resets, as in Gazebo."""
-        self.model.dof_damping[self.atlas.dof_adr] = damping
+        self.law.velocity_damping.set_model(damping)
 
     # -- VRCPlugin's inputs ----------------------------------------------------------------
     def apply_input(self, item: SimInput) -> None:

@@ -95,8 +95,11 @@ def test_derivative_is_of_the_error_and_has_no_first_step_kick() -> None:
 
 
 def test_velocity_term_and_feed_forward() -> None:
+    """DRCSim 2.7's velocity gain: the torque holds kp_velocity * velocity, whatever the
+    joint's velocity (its - kp_velocity * v is the joint's damping, velocity_damping.py)."""
     command = one_joint(velocity=1.5, kp_velocity=4.0, effort=-7.0)
-    assert torque(command, q=0.0, v=0.5) == pytest.approx(4.0 * (1.5 - 0.5) - 7.0)
+    assert torque(command, q=0.0, v=0.5) == pytest.approx(4.0 * 1.5 - 7.0)
+    assert torque(command, q=0.0, v=-3.0) == pytest.approx(4.0 * 1.5 - 7.0)
 
 
 def test_integral_accumulates_dt_times_ki_times_error_as_a_torque() -> None:
@@ -218,11 +221,10 @@ class ScalarJoint:
             self.previous_error, self.initialized = e, True
         de = (e - self.previous_error) / dt
         self.previous_error = e
-        qd_p = c['velocity'] - v
         self.integral = gazebo_clamp(self.integral + dt * c['ki_position'] * e,
                                      c['i_effort_min'], c['i_effort_max'])
         u = (c['kp_position'] * e + self.integral + c['kd_position'] * de
-             + c['kp_velocity'] * qd_p + c['effort'])
+             + c['kp_velocity'] * c['velocity'] + c['effort'])
         tau = gazebo_clamp(u, -limit, limit)
         self.tied_back = math.fabs(tau - u) > 1e-6 and math.fabs(c['ki_position']) > 1e-6
         if self.tied_back:  # !math::equal(tau, u) && !math::equal(ki, 0)
