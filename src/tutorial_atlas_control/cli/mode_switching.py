@@ -111,17 +111,16 @@ def _run(kp_velocity: float) -> int:
         while (state := latest[0]) is not None and _sim_s(state) < due_s:
             lowest = min(lowest, state.pos_est.position.z)
             if state.pos_est.position.z < FALLEN_M:
-                raise _Refused(f'the robot fell at sim time {_sim_s(state):.2f} s, after '
-                               f'{cue.name if cue else "the last command"} was due')
+                raise _Refused(f'the robot fell at sim time {_sim_s(state):.2f} s, '
+                               + (f'before {cue.name} was sent' if cue else
+                                  'after the last command'))
             if time.monotonic() - heard[0] > STATE_SILENCE_S:
                 raise _Refused(f'no state for {STATE_SILENCE_S:g} s: the simulator stopped')
             time.sleep(0.002)
         if cue is None:
             break
         position = state.pos_est.position
-        orientation = state.pos_est.orientation
-        pose = (position.x, position.y, yaw_of_quaternion(orientation.x, orientation.y,
-                                                          orientation.z, orientation.w))
+        pose = (position.x, position.y, _heading(state))
         if cue.name == 'WALK':
             walked_from = (position.x, position.y)
         for topic, raw in cue_messages(cue, int(_sim_s(state) * 1e9), kp_position, pose,
@@ -137,6 +136,14 @@ def _run(kp_velocity: float) -> int:
           f'{Behavior(latest[0].current_behavior).name}')
     rospy.signal_shutdown('done')
     return 0
+
+
+def _heading(state: AtlasSimInterfaceState) -> float:
+    """The feet's mean yaw (rad): pos_est carries no orientation (DRCSim's demo took the
+    IMU's)."""
+    left, right = (yaw_of_quaternion(o.x, o.y, o.z, o.w)
+                   for o in (foot.orientation for foot in state.foot_pos_est))
+    return left + 0.5 * math.remainder(right - left, math.tau)
 
 
 def _sim_s(state: AtlasSimInterfaceState) -> float:
