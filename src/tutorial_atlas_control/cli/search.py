@@ -96,7 +96,8 @@ def build_parser() -> argparse.ArgumentParser:
                         help='where the best gains are written (default: OUT_gains.yaml beside '
                              '--yaml, when gains are searched)')
     parser.add_argument('--workers', type=whole_number(1), default=None, metavar='N',
-                        help='local cluster size (default: one per core)')
+                        help='local cluster size (default: one per core; 1: the runs in this '
+                             'process, no cluster)')
     parser.add_argument('--scheduler', metavar='ADDRESS', help='use this Dask scheduler')
     return parser
 

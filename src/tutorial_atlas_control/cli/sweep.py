@@ -70,7 +70,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument('--seed', type=int, default=0,
                         help='first row\'s seed; row k has SEED + k (default: 0)')
     parser.add_argument('--workers', type=whole_number(1), default=None, metavar='N',
-                        help='local cluster size (default: one per core)')
+                        help='local cluster size (default: one per core; 1: the runs in this '
+                             'process, no cluster)')
     parser.add_argument('--scheduler', metavar='ADDRESS',
                         help='use this Dask scheduler (e.g. tcp://host:8786), not a local cluster')
     parser.add_argument('--out', type=Path, default=Path('sweep'), metavar='OUT',

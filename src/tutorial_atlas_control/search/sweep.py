@@ -175,12 +175,16 @@ def _sigint_ignored() -> Iterator[None]:
 
 class SweepEngine:
     """A Dask client for one or more sweeps: on `scheduler`, or a local cluster of `workers`
-    processes (default: one per core). A context manager; close() stops a local cluster."""
+    processes (default: one per core); one worker and no scheduler run in this process, as
+    the same tasks one after another (a cluster of one would add only its start-up: a
+    process importing MuJoCo, seconds). A context manager; close() stops a local cluster."""
 
     def __init__(self, workers: int | None = None, scheduler: str | None = None) -> None:
         self.workers = workers or os.cpu_count() or 1
         self.scheduler = scheduler
-        self.client = _client(scheduler, self.workers)
+        #: None: the runs go in this process.
+        self.client = (None if self.workers == 1 and scheduler is None
+                       else _client(scheduler, self.workers))
 
     def __enter__(self) -> SweepEngine:
         return self
@@ -189,6 +193,8 @@ class SweepEngine:
         self.close()
 
     def close(self) -> None:
+        if self.client is None:
+            return
         cluster = self.client.cluster if self.scheduler is None else None
         self.client.close()
         if cluster is not None:
@@ -202,20 +208,25 @@ class SweepEngine:
         """
         rows: list[dict[str, Any]] = []
         interrupted = False
-        futures = [self.client.submit(run, spec, pure=False) for spec in specs]
-        bar = _bar(len(futures), progress)
+        client = self.client
+        futures = [] if client is None else [client.submit(run, spec, pure=False)
+                                             for spec in specs]
+        finished = ((run(spec) for spec in specs) if client is None
+                    else (future.result() for future in as_completed(futures)))
+        bar = _bar(len(specs), progress)
         # Not on a terminal (a log): a plain line per finished run instead of the bar.
         lines = progress and bar.disable
         try:
-            for future in as_completed(futures):
-                rows.append(future.result())
+            for row in finished:
+                rows.append(row)
                 bar.update(1)
                 if lines:
-                    print(f'sweep: {len(rows)}/{len(futures)} runs done', file=sys.stderr,
+                    print(f'sweep: {len(rows)}/{len(specs)} runs done', file=sys.stderr,
                           flush=True)
         except KeyboardInterrupt:
             interrupted = True
-            self.client.cancel(futures)
+            if client is not None:
+                client.cancel(futures)
         finally:
             bar.close()
         rows.sort(key=lambda row: row['index'])
