@@ -9,8 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from support.stepping_fakes import ALL_TOPICS, LAUNCH_RATES_HZ, FakeLog, FakeOutbox
-from tutorial_atlas_control import topics
+from support.stepping_fakes import make_loop
 from tutorial_atlas_control.asi.mode_switching import (
     AFTER_LAST_S,
     CUES,
@@ -19,10 +18,7 @@ from tutorial_atlas_control.asi.mode_switching import (
 )
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import load_gains_yaml
-from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistics
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
-from tutorial_atlas_control.stepping.loop import LoopSettings, SteppingLoop
-from tutorial_atlas_control.stepping.outputs import LoopOutputs
 from tutorial_atlas_control.walking.start_noise import perturb_start
 
 CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
@@ -46,17 +42,13 @@ class ModeSwitchingRun:
     refused: list[str] = field(default_factory=list)
 
 
-def run_mode_switching(seed: int | None = None, kp_velocity: float | None = None
+def run_mode_switching(seed: int | None = None, kp_velocity: float = KP_VELOCITY
                        ) -> ModeSwitchingRun:
-    """The demo from a start perturbed by `seed` (None: not); `kp_velocity` replaces the
-    demo's velocity gain (None: keep it)."""
+    """The demo from a start perturbed by `seed` (None: not), its AtlasCommands with the
+    velocity gain `kp_velocity`."""
     gains = load_gains_yaml(CONFIG)
     sim = AtlasSimulator(atlas_model.load_model(), gains)
-    log = FakeLog()
-    outlets = {topic: topic for topic in (*ALL_TOPICS, topics.ASI_STATE)}
-    loop = SteppingLoop(sim, LoopOutputs(FakeOutbox(set()), outlets, log, lambda _text: None),
-                        LoopSettings(LAUNCH_RATES_HZ, balance_stand=True, hold_at_start=True),
-                        CommandAgeStatistics(sim.dt_s))
+    loop, _, log, _ = make_loop(sim, listeners=set(), balance_stand=True, hold_at_start=True)
     perturb_start(sim.atlas, sim.data, seed, on_ground=False)
     pelvis = sim.atlas.pelvis_body_id
     pending = list(CUES)
@@ -77,8 +69,7 @@ def run_mode_switching(seed: int | None = None, kp_velocity: float | None = None
             pose = (float(position[0]), float(position[1]), float(np.arctan2(xmat[3], xmat[0])))
             if cue.name == 'WALK':
                 run.at_walk = position.copy()
-            for topic, raw in cue_messages(cue, sim.sim_time_ns, gains.p, pose,
-                                           KP_VELOCITY if kp_velocity is None else kp_velocity):
+            for topic, raw in cue_messages(cue, sim.sim_time_ns, gains.p, pose, kp_velocity):
                 loop.receive_command(raw, topic)
         if position[2] < FALLEN_M:
             run.fell_at_s = t_s

@@ -99,14 +99,16 @@ class FakeClock:
 
 def make_loop(sim: AtlasSimulator, listeners: set[str] | None = None,
               rates_hz: dict[str, float] | None = None, paused: bool = False,
-              real_time_factor: float = 0.0) -> tuple[SteppingLoop, FakeOutbox, FakeLog,
-                                                       list[str]]:
+              real_time_factor: float = 0.0, balance_stand: bool = False,
+              hold_at_start: bool = False) -> tuple[SteppingLoop, FakeOutbox, FakeLog,
+                                                    list[str]]:
     outbox = FakeOutbox(set(ALL_TOPICS) if listeners is None else listeners)
     log = FakeLog()
     configs: list[str] = []
     clock = FakeClock()
     outputs = LoopOutputs(outbox, {topic: topic for topic in ALL_TOPICS}, log, configs.append)
-    settings = LoopSettings(rates_hz or LAUNCH_RATES_HZ, real_time_factor, paused)
+    settings = LoopSettings(rates_hz or LAUNCH_RATES_HZ, real_time_factor, paused,
+                            balance_stand=balance_stand, hold_at_start=hold_at_start)
     loop = SteppingLoop(sim, outputs, settings, CommandAgeStatistics(sim.dt_s),
                         pacer=Pacer(real_time_factor, clock, clock.sleep))
     return loop, outbox, log, configs

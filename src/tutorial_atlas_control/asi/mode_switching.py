@@ -114,7 +114,7 @@ def cue_messages(cue: Cue, stamp_ns: int, kp_position: Sequence[float],
     if cue.name == 'STAND':
         return [(topics.ASI_COMMAND, _asi_command(stamp_ns, Behavior.STAND,
                                                   bytes(NUM_JOINTS)))]
-    if cue.name.startswith('STAND, '):
+    if cue.name == 'STAND, arms and neck to the PID':
         return [(topics.ASI_COMMAND, _asi_command(stamp_ns, Behavior.STAND, mixed_k_effort()))]
     if cue.name == 'WALK':
         return [(topics.ASI_COMMAND, _asi_command(stamp_ns, Behavior.WALK, mixed_k_effort(),

@@ -20,12 +20,17 @@ from pathlib import Path
 import numpy as np
 
 from tutorial_atlas_control.bags.reader import BagData
-from tutorial_atlas_control.balance import convex_hull, natural_frequency, signed_distance
+from tutorial_atlas_control.balance import (
+    capture_point,
+    convex_hull,
+    natural_frequency,
+    signed_distance,
+)
 
 #: How often the recorded pose is sampled (Hz): /ground_truth_odom's rate.
 CAPTURE_RATE_HZ = 100.0
-#: The pendulum's height is taken as at least this (m), so omega stays finite in a fall.
-MIN_COM_HEIGHT_M = 0.05
+
+
 @dataclass(frozen=True)
 class CaptureTrace:
     """The capture point over a run: times (s from the bag's start), the centre of mass
@@ -52,15 +57,16 @@ def capture_points(com_m: np.ndarray, dt_s: float) -> np.ndarray:
     `dt_s`: xi = c + c' / omega, c' by central differences (one-sided at the ends)."""
     if len(com_m) < 2:
         return com_m[:, :2].copy()
+    from tutorial_atlas_control.balance import MIN_COM_HEIGHT_M  # noqa: PLC0415 - mujoco
+
     velocity = np.gradient(com_m[:, :2], dt_s, axis=0)
     omega = np.array([natural_frequency(max(float(z), MIN_COM_HEIGHT_M)) for z in com_m[:, 2]])
-    return com_m[:, :2] + velocity / omega[:, None]
+    return capture_point(com_m[:, :2], velocity, omega[:, None])
 
 
-def support_polygon(corners_m: np.ndarray, contact_height_m: float) -> np.ndarray:
-    """The hull (k, 2) of the bottom corners (2, 4, 3) of the soles that touch, their
-    lowest corner within `contact_height_m` of the ground; (0, 2) if none does."""
-    touching = touching_soles(corners_m, contact_height_m)
+def support_polygon(corners_m: np.ndarray, touching: list[int]) -> np.ndarray:
+    """The hull (k, 2) of the bottom corners (2, 4, 3) of the `touching` soles
+    (touching_soles); (0, 2) if none does."""
     if not touching:
         return np.zeros((0, 2))
     return convex_hull(corners_m[touching, :, :2].reshape(-1, 2))
@@ -109,8 +115,9 @@ def capture_trace(data: BagData, since_s: float = 0.0, until_s: float = np.inf
         mujoco.mj_comPos(model, placed)
         com[row] = placed.subtree_com[0]
         corners = np.array([sole_corners(model, placed, name) for name in SOLE_GEOMS])
-        polygons.append(support_polygon(corners, CONTACT_HEIGHT_M))
-        soles_down[row] = len(touching_soles(corners, CONTACT_HEIGHT_M))
+        touching = touching_soles(corners, CONTACT_HEIGHT_M)
+        polygons.append(support_polygon(corners, touching))
+        soles_down[row] = len(touching)
     capture = capture_points(com, dt_s)
     return CaptureTrace(t_s, com[:, :2].copy(), capture, polygons, soles_down,
                         margins(capture, polygons))
@@ -144,4 +151,3 @@ def plot_capture(trace: CaptureTrace, path: Path) -> Path:
     figure.savefig(path, dpi=100)
     plt.close(figure)
     return path
-

@@ -54,14 +54,26 @@ def whole_number(minimum: int) -> Callable[[str], int]:
     return checked
 
 
-def positive_number(text: str) -> float:
-    """An argparse `type=` for a finite number > 0 (a stride, a duration, a time scale)."""
+def _number(text: str) -> float:
     try:
-        value = float(text)
+        return float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f'{text!r} is not a number') from None
+
+
+def positive_number(text: str) -> float:
+    """An argparse `type=` for a finite number > 0 (a stride, a duration, a time scale)."""
+    value = _number(text)
     if not 0.0 < value < float('inf'):
         raise argparse.ArgumentTypeError(f'{text!r} must be a finite number > 0')
+    return value
+
+
+def non_negative_number(text: str) -> float:
+    """An argparse `type=` for a finite number >= 0 (a gain that may be off)."""
+    value = _number(text)
+    if not 0.0 <= value < float('inf'):
+        raise argparse.ArgumentTypeError(f'{text!r} must be a number >= 0')
     return value
 
 

@@ -28,7 +28,12 @@ from tutorial_atlas_control.asi import (
     cue_messages,
     yaw_of_quaternion,
 )
-from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED, EXIT_REFUSED, print_error
+from tutorial_atlas_control.cli.convention import (
+    EXIT_INTERRUPTED,
+    EXIT_REFUSED,
+    non_negative_number,
+    print_error,
+)
 from tutorial_atlas_control.sim import GainsError, gains_from_params
 
 PROG = 'mode_switching_demo.py'
@@ -46,21 +51,12 @@ class _Refused(Exception):
     """No master, no simulator, a fall or a silence."""
 
 
-def _gain(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'{text!r} is not a number') from None
-    if not math.isfinite(value) or value < 0.0:
-        raise argparse.ArgumentTypeError(f'{text!r} must be a number >= 0')
-    return value
-
-
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog=PROG, description=__doc__.split('\n\n')[1].replace('\n', ' '),
         epilog='Start the simulator first: roslaunch tutorial_atlas_control atlas.launch')
-    parser.add_argument('--kp-velocity', type=_gain, default=KP_VELOCITY, metavar='GAIN',
+    parser.add_argument('--kp-velocity', type=non_negative_number, default=KP_VELOCITY,
+                        metavar='GAIN',
                         help='the AtlasCommands\' velocity gain, N m s/rad (default: '
                              f'{KP_VELOCITY:g}, the demo\'s; 0 shows why it needs one)')
     return parser

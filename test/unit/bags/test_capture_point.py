@@ -15,6 +15,7 @@ from tutorial_atlas_control.bags.capture_point import (
     margins,
     plot_capture,
     support_polygon,
+    touching_soles,
 )
 
 #: A sole box's 4 bottom corners: 0.26 x 0.125 m, 0.05 m thick, its centre at (x, y, z).
@@ -37,20 +38,24 @@ def test_a_com_moving_at_constant_speed_has_its_capture_point_ahead_by_v_over_om
     assert still == pytest.approx(np.zeros((len(t_s), 2)))
 
 
+def polygon(*soles: np.ndarray) -> np.ndarray:
+    corners = np.array(soles)
+    return support_polygon(corners, touching_soles(corners, CONTACT_M))
+
+
 def test_the_polygon_holds_the_soles_that_touch() -> None:
-    both = support_polygon(np.array([sole(0.0, 0.12), sole(0.0, -0.12)]), CONTACT_M)
+    both = polygon(sole(0.0, 0.12), sole(0.0, -0.12))
     assert np.ptp(both, axis=0) == pytest.approx([0.26, 0.365])
-    left_only = support_polygon(np.array([sole(0.0, 0.12), sole(0.2, -0.12, 0.05)]),
-                                CONTACT_M)
+    left_only = polygon(sole(0.0, 0.12), sole(0.2, -0.12, 0.05))
     assert np.ptp(left_only, axis=0) == pytest.approx([0.26, 0.125])
-    assert len(support_polygon(np.array([sole(0.0, 0.12, 0.3), sole(0.0, -0.12, 0.3)]),
-                               CONTACT_M)) == 0
+    assert touching_soles(np.array([sole(0.0, 0.12), sole(0.2, -0.12, 0.05)]), CONTACT_M) == [0]
+    assert len(polygon(sole(0.0, 0.12, 0.3), sole(0.0, -0.12, 0.3))) == 0
 
 
 def test_the_margin_is_signed_and_nan_in_the_air() -> None:
-    polygon = support_polygon(np.array([sole(0.0, 0.12), sole(0.0, -0.12)]), CONTACT_M)
+    both = polygon(sole(0.0, 0.12), sole(0.0, -0.12))
     found = margins(np.array([[0.0, 0.0], [0.23, 0.0], [0.0, 0.0]]),
-                    [polygon, polygon, np.zeros((0, 2))])
+                    [both, both, np.zeros((0, 2))])
     assert found[0] == pytest.approx(0.13)  # the heels and toes are nearer than the sides
     assert found[1] == pytest.approx(-0.10)
     assert math.isnan(found[2])
