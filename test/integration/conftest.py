@@ -50,9 +50,11 @@ class DemoRun:
         return bags[-1]
 
 
-#: The demo's pace: at half real time a busy machine's late commands matter half as much in
-#: sim time (test_offline_vs_live.py compares its fall with the offline run's).
-DEMO_REAL_TIME_FACTOR = 0.5
+#: The demo's pace: at a quarter of real time a busy machine's late commands matter a quarter
+#: as much in sim time (test_offline_vs_live.py compares its fall with the offline run's: at
+#: half real time, beside make test's parallel part, the live fall came 0.32 s before the
+#: offline one, past its 0.3 s; touchdown_exhausted's run is at a quarter for the same reason).
+DEMO_REAL_TIME_FACTOR = 0.25
 
 
 @pytest.fixture(scope='session')

@@ -1,7 +1,7 @@
 """An offline run (run_offline.py) reaches the outcome of the live run (`make demo`) it stands for.
 
 The live runs are run_demo.py's (step_and_fall: the demo_run every test of the demo shares,
-conftest.py, at 0.5x; and touchdown_exhausted, the README's slow sway that ends on the ground,
+conftest.py, at 0.25x; and touchdown_exhausted, the README's slow sway that ends on the ground,
 at TOUCHDOWN_EXHAUSTED_REAL_TIME_FACTOR); each is compared with
 the offline run of the same trajectory, aligned on the first applied command
 (bags/compare.py). Transport and scheduling move a live run a little (the trajectory starts from
@@ -41,7 +41,7 @@ FALL_TOLERANCE_S = 0.3
 #: touchdown_exhausted's live run's pace. Late commands move a live fall: at 1.0, beside the
 #: parallel tests, touchdown_exhausted's came 0.8 s after the offline one (step_and_fall's,
 #: the demo's own run, 0.39 s before it); at 0.5x, beside a busy core, 0.31 s after. Slower,
-#: the same starvation is less delay in sim time; step_and_fall's demo_run is at 0.5x
+#: the same starvation is less delay in sim time; step_and_fall's demo_run is at 0.25x
 #: (conftest.py), its quick fall moving less.
 TOUCHDOWN_EXHAUSTED_REAL_TIME_FACTOR = 0.25
 
@@ -65,7 +65,7 @@ def run_live(bag_dir: Path, trajectory: str, real_time_factor: float) -> LiveRun
 
 
 @pytest.fixture(scope='module')
-def step_and_fall_run(demo_run) -> LiveRun:  # demo_run: conftest.DemoRun, at 0.5x as here
+def step_and_fall_run(demo_run) -> LiveRun:  # demo_run: conftest.DemoRun, at 0.25x as here
     return LiveRun(demo_run.result, demo_run.bag)
 
 
