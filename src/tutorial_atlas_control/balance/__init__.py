@@ -15,7 +15,8 @@ from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'contact_wrench': ['make_feasible', 'split_wrench'],
-    'estimator': ['CONTACT_HEIGHT_M', 'MIN_COM_HEIGHT_M', 'BalanceEstimator', 'BalanceState'],
+    'estimator': ['CONTACT_HEIGHT_M', 'MIN_COM_HEIGHT_M', 'BalanceEstimator', 'BalanceState',
+                  'SoleContacts'],
     'manipulate': ['PelvisServo', 'SquatTable', 'bent_posture', 'clamp_servo'],
     'lipm': ['capture_point', 'com_acceleration', 'dcm_feedback_cop', 'lipm_state',
              'natural_frequency'],
