@@ -3,8 +3,10 @@
 A step (`atlas_msgs/AtlasBehaviorStepData`) names its foot (0 left, 1 right), its index in the
 walk (1 is the first step; 0 stands for where the feet were when Walk began), how long it
 takes and where the sole lands: x, y and yaw in the frame of `pos_est`, which starts where
-the robot starts. Its z and swing height are ignored on flat ground. The plans here are the
-issue's: DRCSim's fixed `control_mode Walk` queue, a straight line and a circle.
+the robot starts. Here a step is the sole's whole pose: its centre's height too (the surface it
+lands on, 0 on the ground the robot starts on) and the surface's normal where known; swings end
+on it. The plans here are DRCSim's fixed `control_mode Walk` queue, a straight line and a
+circle, on flat ground.
 """
 
 from __future__ import annotations
@@ -22,7 +24,9 @@ STANCE_WIDTH_M = 0.24
 
 @dataclass(frozen=True)
 class Footstep:
-    """Where and when one foot lands: the sole's centre (m) and heading (rad), world frame."""
+    """Where and when one foot lands: the sole's centre (m) and heading (rad), world frame;
+    `z_m` the height of the sole's bottom face there (the surface it lands on), `normal` that
+    surface's unit normal (upright unless known)."""
 
     step_index: int
     foot_index: int
@@ -30,14 +34,20 @@ class Footstep:
     y_m: float
     yaw_rad: float
     duration_s: float = STEP_DURATION_S
+    z_m: float = 0.0
+    normal: tuple[float, float, float] = (0.0, 0.0, 1.0)
 
     def __post_init__(self) -> None:
         if self.foot_index not in (LEFT, RIGHT):
             raise ValueError(f'step {self.step_index}: foot_index {self.foot_index} is not '
                              '0 (left) or 1 (right)')
-        values = (self.x_m, self.y_m, self.yaw_rad, self.duration_s)
+        values = (self.x_m, self.y_m, self.z_m, self.yaw_rad, self.duration_s, *self.normal)
         if not all(math.isfinite(value) for value in values):
             raise ValueError(f'step {self.step_index}: a pose or duration is not finite')
+        if len(self.normal) != 3 or abs(math.hypot(*self.normal) - 1.0) > 1e-6 \
+                or self.normal[2] <= 0.0:
+            raise ValueError(f'step {self.step_index}: surface normal {self.normal} is not '
+                             'a unit vector pointing up')
         if self.duration_s <= 0.0:
             raise ValueError(f'step {self.step_index}: duration {self.duration_s} s is not '
                              'positive')

@@ -86,10 +86,10 @@ class LegGains:
 
 
 def foot_pose(state: BalanceState, foot: int, step_index: int = 0) -> Footstep:
-    """Where a foot is now, as a step (sole centre and heading)."""
+    """Where a foot is now, as a step (sole centre, its height, and heading)."""
     centre = state.sole_centres[foot]
     return Footstep(step_index, foot, float(centre[0]), float(centre[1]),
-                    yaw_of(state.sole_rotations[foot]))
+                    yaw_of(state.sole_rotations[foot]), z_m=float(centre[2]))
 
 
 class LegTasks:
@@ -195,15 +195,16 @@ class LegTasks:
         torque[leg] = state.joint_inertia(leg) @ accel
         return torque
 
-    def flat_down(self, state: BalanceState, foot: int) -> bool:
-        """Whether a sole lies flat on the ground (not up, not on an edge)."""
-        return (float(state.sole_centres[foot][2]) < self.gains.flat_height_m
-                and float(state.sole_rotations[foot][2, 2]) > self.gains.flat_cos)
+    def flat_down(self, state: BalanceState, foot: int, pose: Footstep) -> bool:
+        """Whether a sole lies flat on the surface of `pose` (not up, not on an edge)."""
+        sole_normal = state.sole_rotations[foot][:, 2]
+        return (float(state.sole_centres[foot][2]) - pose.z_m < self.gains.flat_height_m
+                and float(sole_normal @ np.asarray(pose.normal)) > self.gains.flat_cos)
 
     def put_down_torque(self, state: BalanceState, joint_velocities: np.ndarray, foot: int,
                         pose: Footstep) -> np.ndarray:
         """A foot off the ground while both should be down: back onto `pose`."""
-        target = np.array([pose.x_m, pose.y_m, -self.gains.press_m])
+        target = np.array([pose.x_m, pose.y_m, pose.z_m - self.gains.press_m])
         return self.foot_servo(state, joint_velocities, foot, target, np.zeros(3),
                                pose.yaw_rad, 0.0)
 
@@ -244,7 +245,7 @@ class LegTasks:
             torque += self.swing_torque(state, joint_velocities, foot, path, elapsed_s)
         else:
             for foot in (0, 1):
-                if not contact[foot] or not self.flat_down(state, foot):
+                if not contact[foot] or not self.flat_down(state, foot, feet[foot]):
                     torque += self.put_down_torque(state, joint_velocities, foot, feet[foot])
         limit = self.stand.effort_limit_nm
         np.clip(torque, -limit, limit, out=torque)

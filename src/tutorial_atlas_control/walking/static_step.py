@@ -95,7 +95,7 @@ class StaticStep:
                 np.linalg.norm(state.capture_point - goal) < gains.over_stance_m
                 or elapsed >= gains.longest_shift_s):
             lift = state.sole_centres[step.foot_index].copy()
-            self._swing = SwingPath(lift, np.array([step.x_m, step.y_m, 0.0]),
+            self._swing = SwingPath(lift, np.array([step.x_m, step.y_m, step.z_m]),
                                     foot_pose(state, step.foot_index).yaw_rad, step.yaw_rad,
                                     self.swing_s)
             stance = self.feet[1 - step.foot_index]

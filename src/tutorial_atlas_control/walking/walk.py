@@ -142,7 +142,7 @@ class WalkController:
         self.step = self._planned_step = step
         stance = self.queue.feet[1 - step.foot_index]
         self.legs.face(stance.yaw_rad, step.yaw_rad, time_s, step.duration_s)
-        self.swing = SwingPath(lift.copy(), np.array([step.x_m, step.y_m, 0.0]),
+        self.swing = SwingPath(lift.copy(), np.array([step.x_m, step.y_m, step.z_m]),
                                foot_pose(state, step.foot_index).yaw_rad, step.yaw_rad,
                                step.duration_s)
         self.phase, self.phase_start_s = STEPPING, time_s
@@ -206,7 +206,7 @@ class WalkController:
         if math.hypot(x - step.x_m, y - step.y_m) < self.gains.adjust_tolerance_m:
             return
         self.step = replace(planned, x_m=x, y_m=y)
-        self.swing = replace(swing, end=np.array([x, y, 0.0]))
+        self.swing = replace(swing, end=np.array([x, y, planned.z_m]))
         self.queue.adjust(self.step)
 
     # -- one step -----------------------------------------------------------------------------

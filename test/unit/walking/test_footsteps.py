@@ -31,10 +31,25 @@ def test_drcsim_walk_queue_is_atlas_plugins() -> None:
     ((1, 0, math.nan, 0.0, 0.0), 'not finite'),
     ((1, 0, 0.0, 0.0, math.inf), 'not finite'),
     ((1, 0, 0.0, 0.0, 0.0, 0.0), 'duration 0.0 s is not positive'),
+    ((1, 0, 0.0, 0.0, 0.0, 0.63, math.nan), 'not finite'),
+    ((3, 0, 0.0, 0.0, 0.0, 0.63, 0.0, (0.0, 0.0, 2.0)),
+     'step 3: surface normal (0.0, 0.0, 2.0) is not a unit vector pointing up'),
+    ((3, 0, 0.0, 0.0, 0.0, 0.63, 0.0, (0.0, 0.0, -1.0)), 'pointing up'),
 ])
 def test_a_bad_step_is_refused_naming_it(fields: tuple, message: str) -> None:
     with pytest.raises(ValueError, match=re.escape(message)):
         Footstep(*fields)
+
+
+def test_a_step_is_on_the_ground_unless_it_says_otherwise() -> None:
+    """A DRC-era client's step (x, y, yaw) lands on the ground the robot starts on; a step
+    onto a 16 degree slope 0.2 m up keeps its height and the slope's normal."""
+    flat = Footstep(1, LEFT, 0.3, 0.12, 0.0)
+    assert (flat.z_m, flat.normal) == (0.0, (0.0, 0.0, 1.0))
+    tilt = math.radians(16.0)
+    normal = (-math.sin(tilt), 0.0, math.cos(tilt))
+    up = Footstep(2, RIGHT, 0.6, -0.12, 0.0, z_m=0.2, normal=normal)
+    assert (up.z_m, up.normal) == (0.2, normal)
 
 
 def test_straight_steps_alternate_and_end_side_by_side() -> None:

@@ -16,12 +16,14 @@ from tutorial_atlas_control.balance.stand_behaviour import StandBehaviour
 from tutorial_atlas_control.balance.stand_pose import place_in_stand_pose
 from tutorial_atlas_control.balance.support import clamp_into, convex_hull
 from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.walking.footsteps import Footstep
 from tutorial_atlas_control.walking.leg_tasks import (
     LEG_OF_FOOT,
     LegGains,
     LegTasks,
     _clamp_to_sole,
     _sole_corners,
+    foot_pose,
 )
 
 LEFT, RIGHT = 0, 1
@@ -171,3 +173,39 @@ def test_a_stance_soles_clamp_is_the_polygon_clamp_of_its_rectangle(
         reach = (half_size[0] - 0.015, half_size[1] - 0.015)
         np.testing.assert_allclose(_clamp_to_sole(state, foot, reach, point),
                                    clamp_into(polygon, point, 0.015), atol=2e-5)
+
+
+def test_a_foot_is_flat_down_on_the_surface_of_its_pose(
+        standing: tuple[StandBehaviour, mujoco.MjData]) -> None:
+    """Flat down is judged against the surface the foot should stand on: on the ground the
+    standing soles are; on a pose 5 cm up, or one tilted 0.1 rad, they are not; and a foot's
+    pose carries its sole's height."""
+    behaviour, data = standing
+    legs = _legs(standing)
+    state = behaviour.estimator.estimate(data.qpos, data.qvel)
+    pose = foot_pose(state, LEFT)
+    assert pose.z_m == pytest.approx(0.0, abs=2e-3)
+    assert legs.flat_down(state, LEFT, pose)
+    assert not legs.flat_down(state, LEFT, Footstep(0, LEFT, pose.x_m, pose.y_m, pose.yaw_rad,
+                                                    z_m=pose.z_m - 0.05))
+    tilted = (float(np.sin(0.1)), 0.0, float(np.cos(0.1)))
+    assert not legs.flat_down(state, LEFT, Footstep(0, LEFT, pose.x_m, pose.y_m, pose.yaw_rad,
+                                                    z_m=pose.z_m, normal=tilted))
+
+
+def test_a_foot_put_down_aims_just_below_its_poses_surface(
+        standing: tuple[StandBehaviour, mujoco.MjData]) -> None:
+    """The put-down servo's target is the pose's height less press_m: a pose 0.1 m up asks
+    the sole up, one on the ground asks it (slightly) down."""
+    behaviour, data = standing
+    gains = LegGains(ik_damping_m=0.0)
+    legs = _legs(standing, gains)
+    state = behaviour.estimator.estimate(data.qpos, data.qvel)
+    pose = foot_pose(state, RIGHT)
+    leg = LEG_OF_FOOT[RIGHT]
+    jacobian = state.sole_jacobians[RIGHT][:, leg]
+    for height_m, sign in ((0.1, 1.0), (pose.z_m, -1.0)):
+        target = Footstep(0, RIGHT, pose.x_m, pose.y_m, pose.yaw_rad, z_m=height_m)
+        torque = legs.put_down_torque(state, np.zeros(28), RIGHT, target)
+        acceleration = np.linalg.solve(state.joint_inertia(leg), torque[leg])
+        assert sign * float((jacobian @ acceleration)[2]) > 0.0
