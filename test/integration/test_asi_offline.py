@@ -131,6 +131,22 @@ def test_a_bag_without_the_interface_s_commands_is_refused(tmp_path: Path) -> No
                                             'recorded session: give no YAML_FILE and NAME')
 
 
+def test_a_behaviour_of_ones_own_that_does_not_load_is_one_line(session: Path,
+                                                                 tmp_path: Path) -> None:
+    out = tmp_path / 'out.bag'
+    missing = tmp_path / 'mine.py'
+    result = _run('--asi-from', str(session), '--bag', str(out), '--behaviour',
+                  f'{missing}:Mine')
+    assert result.returncode == 1
+    assert result.stderr.strip() == (f"run_offline.py: error: behaviour '{missing}:Mine': "
+                                     f'no file {missing}')
+    assert not out.exists()
+    alone = _run('Traj_data2.yaml', 'step_and_fall', '--behaviour', f'{missing}:Mine')
+    assert alone.returncode == 2
+    assert alone.stderr.splitlines()[-1] == ('run_offline.py: error: --behaviour serves the '
+                                             'AtlasSimInterface: it needs --asi-from')
+
+
 ANALYZE = Path(__file__).resolve().parents[2] / 'scripts' / 'analyze_bag.py'
 
 

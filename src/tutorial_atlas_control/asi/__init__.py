@@ -1,6 +1,8 @@
 """The open AtlasSimInterface, ROS-free: DRCSim 2.7's behaviour library contract (ASI.md)
 over the simulator and the balance. behaviors: its numbers and which control mode runs
-each behaviour; session: requests taken or refused and the feedback status; walk_params:
+each behaviour; library: what the interface asks of a behaviour beyond Stand (Walk, Step,
+a user's own); user_behaviour: a user's class named by a launch argument, loaded; session:
+requests taken or refused and the feedback status; walk_params:
 a WALK's steps and walk_feedback; interface: one simulator's requests applied and its
 states built; walk_client: what a walking client does with each state; walk_demo: DRCSim's
 actionlib server's decisions; teleop: the keyboard teleop's keys and steps; mode_switching:
@@ -13,9 +15,11 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'behaviors': ['BEHAVIOR_OF_MODE', 'MODE_OF_BEHAVIOR', 'AsiError', 'Behavior', 'Status'],
     'interface': ['DOWN_PELVIS_M', 'FALLING_PELVIS_M', 'FALLING_TILT_RAD', 'AtlasSimInterface',
                   'fallen_robot', 'falling_robot'],
+    'library': ['BehaviourBase', 'Handover', 'LibraryBehaviour', 'StepEntry', 'WalkEntry'],
     'mode_switching': ['AFTER_LAST_S', 'CUES', 'KP_VELOCITY', 'Cue', 'cue_messages'],
     'session': ['REFUSAL_REPORTED_STEPS', 'STANDING_BEHAVIORS', 'AsiSession', 'Refusal'],
     'teleop': ['MOVES', 'Settings', 'ego_steps', 'key_action'],
+    'user_behaviour': ['USER_BEHAVIORS', 'UserBehaviourError', 'load_user_behaviour'],
     'walk_client': ['Outcome', 'WalkClient', 'refusal_hint'],
     'walk_demo': ['Decision', 'WalkDemoServer', 'yaw_of_quaternion'],
     'walk_params': ['footsteps_of', 'sole_step', 'step_data_of', 'walk_feedback'],

@@ -29,20 +29,15 @@ TRANSITION_IN_PROGRESS meanwhile: a walk does not start from the hold's straight
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
 import numpy as np
 
 from tutorial_atlas_control.asi.behaviors import BEHAVIOR_OF_MODE, MODE_OF_BEHAVIOR, Behavior
+from tutorial_atlas_control.asi.library import LibraryBehaviour, StepEntry, WalkEntry
 from tutorial_atlas_control.asi.session import STANDING_BEHAVIORS, AsiSession, behavior_name
 from tutorial_atlas_control.asi.state_report import StateReport, manipulate_feedback
-from tutorial_atlas_control.asi.walk_params import (
-    footsteps_of,
-    sole_step,
-    step_feedback,
-    walk_feedback,
-)
+from tutorial_atlas_control.asi.walk_params import sole_step
 from tutorial_atlas_control.balance import (
     BalanceEstimator,
     PelvisServo,
@@ -61,13 +56,7 @@ from tutorial_atlas_control.msgs import (
     WalkFeedback,
 )
 from tutorial_atlas_control.sim import AtlasSimulator, pelvis_height_m
-from tutorial_atlas_control.walking import (
-    DRCSIM_WALK_QUEUE,
-    STEP_DURATION_S,
-    Footstep,
-    StepBehaviour,
-    WalkBehaviour,
-)
+from tutorial_atlas_control.walking import DRCSIM_WALK_QUEUE, StepBehaviour, WalkBehaviour
 
 __all__ = ['DOWN_PELVIS_M', 'FALLING_PELVIS_M', 'FALLING_TILT_RAD', 'AtlasSimInterface',
            'fallen_robot', 'falling_robot']
@@ -113,11 +102,14 @@ class AtlasSimInterface:
     balancing StandBehaviour, else the simulator's hold until a bdi_stand sequence (the
     start-up mode or /atlas/mode) asks for BDI's Stand, which loads the balancing one.
     `hold_at_start`: a (re)start in Stand holds the robot as the tutorial's start did until
-    Stand is asked for."""
+    Stand is asked for. `user_behaviour`: a behaviour of the user's own, registered over the
+    library's (with `balance` only; one answering Stand leaves Manipulate unserved)."""
 
     def __init__(self, sim: AtlasSimulator, balance: bool = True,
-                 hold_at_start: bool = False) -> None:
+                 hold_at_start: bool = False,
+                 user_behaviour: LibraryBehaviour | None = None) -> None:
         self.sim = sim
+        self.user_behaviour = user_behaviour
         if balance and hold_at_start:
             sim.behaviours.hold_stand_at_start = True
             if sim.mode is ControlMode.STAND:
@@ -129,12 +121,10 @@ class AtlasSimInterface:
         #: The balancing Stand installed (None: Stand is the hold); its estimator, or one of
         #: the interface's own, checks the centre of mass before Stand is entered.
         self.stand: StandBehaviour | None = None
-        #: Walk, installed with the balancing Stand; Stand asked for during it.
-        self.walking: WalkBehaviour | None = None
-        self._stand_after_walk = False
-        #: Step, installed with the balancing Stand; Stand asked for during a step.
-        self.stepping: StepBehaviour | None = None
-        self._stand_after_step = False
+        #: The library's behaviours beyond Stand (registered with the balancing Stand), and
+        #: the one that deferred a Stand asked for while it runs.
+        self.library: dict[Behavior, LibraryBehaviour] = {}
+        self._stand_deferred_by: Behavior | None = None
         self.session = AsiSession(MODE_OF_BEHAVIOR)
         if balance:
             self._load_balance()
@@ -155,14 +145,37 @@ class AtlasSimInterface:
         sim.install_stand(StandPrepBehaviour(sim.atlas, sim.gains), ControlMode.STAND_PREP)
         self.session.served[Behavior.MANIPULATE] = ControlMode.STAND
         ahead = self.stand.estimator.sole_ahead_m
-        self.walking = WalkBehaviour(self.stand, default_steps=[
-            sole_step(step, ahead) for step in DRCSIM_WALK_QUEUE])
-        sim.install_stand(self.walking, ControlMode.WALK)
-        self.session.served[Behavior.WALK] = ControlMode.WALK
-        self.stepping = StepBehaviour(self.stand)
-        sim.install_stand(self.stepping, ControlMode.STEP)
-        self.session.served[Behavior.STEP] = ControlMode.STEP
+        self.register(WalkEntry(WalkBehaviour(self.stand, default_steps=[
+            sole_step(step, ahead) for step in DRCSIM_WALK_QUEUE]), ahead))
+        self.register(StepEntry(StepBehaviour(self.stand), ahead))
         self._estimator = self.stand.estimator
+        if self.user_behaviour is not None:
+            self.register(self.user_behaviour)
+            if self.user_behaviour.behavior == Behavior.STAND:
+                del self.session.served[Behavior.MANIPULATE]  # the library's Stand, servoed
+
+    def register(self, behaviour: LibraryBehaviour) -> None:
+        """Serve `behaviour`: installed in the simulator for its control mode, requested by
+        its ASI behaviour number."""
+        self.sim.install_stand(behaviour, behaviour.mode)
+        self.session.served[behaviour.behavior] = behaviour.mode
+        self.library[behaviour.behavior] = behaviour
+
+    def serves(self, mode: ControlMode) -> bool:
+        """Whether a library behaviour runs control mode `mode`."""
+        return any(entry.mode is mode for entry in self.library.values())
+
+    @property
+    def walking(self) -> WalkBehaviour | None:
+        """Walk's behaviour (None: not served)."""
+        entry = self.library.get(Behavior.WALK)
+        return entry.walking if isinstance(entry, WalkEntry) else None
+
+    @property
+    def stepping(self) -> StepBehaviour | None:
+        """Step's behaviour (None: not served)."""
+        entry = self.library.get(Behavior.STEP)
+        return entry.stepping if isinstance(entry, StepEntry) else None
 
     @property
     def current_behavior(self) -> Behavior:
@@ -194,64 +207,43 @@ class AtlasSimInterface:
             self._set_k_effort(command.k_effort)
 
     def _request(self, command: AsiCommand, current: Behavior) -> None:
-        """The command's behaviour requested; a WALK's steps to the walk, running or starting.
-        A WALK without step 1 (a new walk's first) starts nothing: it is a window of a walk
-        that has ended, sent before the client saw the end (a streaming client's last, empty
-        one, or one answering a state read late, from before the walk's first touchdown).
-        Started, it could take no step and would only catch itself from standing."""
+        """The command's behaviour requested, the library behaviour asked for given its
+        parameters (for its start, or while it runs); Stand asked for while a library
+        behaviour runs waits if that behaviour first finishes what is under way."""
         self._deferred = None
-        steps = (footsteps_of(command.step_queue, self._estimator.sole_ahead_m)
-                 if command.behavior == Behavior.WALK else [])
-        if command.behavior == Behavior.WALK != current \
-                and not any(step.step_index == 1 for step in steps):
-            indices = [step.step_index for step in steps]
-            self._refusal = (f'ignored AtlasSimInterfaceCommand behavior 4 (WALK) in '
-                             f'{behavior_name(current)}: its step_queue has step_index '
-                             f'{indices or "none"}, and a new walk starts with step_index 1')
-            return
+        target = self.library.get(command.behavior)
+        running = command.behavior == current
+        if target is not None:
+            reason = target.refusal(command, running)
+            if reason is not None:
+                self._refusal = (f'ignored AtlasSimInterfaceCommand behavior '
+                                 f'{int(command.behavior)} ({behavior_name(command.behavior)}) '
+                                 f'in {behavior_name(current)}: {reason}')
+                return
         stand = self.stand
-        if command.behavior in (Behavior.WALK, Behavior.STEP) and current == Behavior.STAND \
+        if target is not None and target.waits_for_stand and current == Behavior.STAND \
                 and stand is not None and stand.taking_over:
             self._deferred = command  # the newest one: a streaming client's window
             self.session.defer(Behavior(command.behavior), current)
             return
-        stepping = self.stepping
-        if command.behavior == Behavior.STEP and stepping is not None:
-            # The target before the switch: Step's start keeps it.
-            stepping.desire(self._desired_step(command))
-        if current == Behavior.STEP and command.behavior == Behavior.STAND \
-                and stepping is not None and stepping.stepping is not None:
-            if not self._stand_after_step:
-                self.session.defer(Behavior.STAND, Behavior.STEP)
-                self._stand_after_step = True
+        if target is not None:
+            target.prepare(command)
+        acting = self.library.get(current)
+        if acting is not None and command.behavior == Behavior.STAND and not running \
+                and acting.stop():
+            if self._stand_deferred_by is not current:
+                self.session.defer(Behavior.STAND, current)
+                self._stand_deferred_by = current
             return
-        walking = self.walking
-        if current == Behavior.WALK and command.behavior == Behavior.STAND \
-                and walking is not None and not walking.done:
-            if not self._stand_after_walk:
-                walking.finish()
-                self.session.defer(Behavior.STAND, Behavior.WALK)
-                self._stand_after_walk = True
-            return
-        feet_under_com = command.behavior == current or self.com_over_feet()
+        feet_under_com = running or self.com_over_feet()
         mode = self.session.request(command.behavior, current, feet_under_com)
         if mode is not None:
-            if mode is ControlMode.WALK and walking is not None:
-                walking.next_steps = steps
+            if target is not None:
+                target.take(command, running=False)
             self._switch(mode)
             self._set_manipulating(command.behavior == Behavior.MANIPULATE)
-        elif current == Behavior.WALK == command.behavior and walking is not None:
-            walking.offer(steps)
-
-    def _desired_step(self, command: AsiCommand) -> Footstep | None:
-        """step_params.desired_step as a sole's step (None: an empty one, no step wanted);
-        without a duration (DRCSim's actionlib server sends none) it swings for
-        STEP_DURATION_S."""
-        desired = command.desired_step
-        if desired.duration_s <= 0.0:
-            desired = dataclasses.replace(desired, duration_s=STEP_DURATION_S)
-        steps = footsteps_of([desired], self._estimator.sole_ahead_m)
-        return steps[0] if steps else None
+        elif running and target is not None:
+            target.take(command, running=True)
 
     def _switch(self, mode: ControlMode) -> None:
         """The simulator into `mode`; a behaviour switch never changes k_effort."""
@@ -315,15 +307,14 @@ class AtlasSimInterface:
         sim, session = self.sim, self.session
         current = self.current_behavior
         falling = current in STANDING_BEHAVIORS and falling_robot(sim)
-        time_s, ahead_m = float(sim.data.time), self._estimator.sole_ahead_m
-        walking, stepping = self.walking, self.stepping
+        acting = self.library.get(current)
+        feedback = ({} if acting is None else
+                    acting.feedback(float(sim.data.time), self._estimator.sole_ahead_m))
         return self._report.state(
             current, session, falling,
             manipulate_feedback(self.stand if self.manipulating else None),
-            (walk_feedback(walking.status(time_s), ahead_m)
-             if current == Behavior.WALK and walking is not None else WalkFeedback()),
-            (step_feedback(stepping.status(time_s), ahead_m)
-             if current == Behavior.STEP and stepping is not None else StepFeedback()))
+            feedback.get('walk_feedback', WalkFeedback()),
+            feedback.get('step_feedback', StepFeedback()))
 
     def end_step(self) -> None:
         """After each step, whether or not a state was built."""
@@ -335,24 +326,15 @@ class AtlasSimInterface:
             if current == Behavior.STAND:
                 self._request(deferred, current)
             self._deferred = None
-        mode = self.sim.mode
-        if mode in (ControlMode.WALK, ControlMode.STEP) and fallen_robot(self.sim):
-            self._switch(ControlMode.FREEZE)
-            self.session.auto_switched(Behavior.FREEZE, BEHAVIOR_OF_MODE[mode])
-            self._stand_after_walk = self._stand_after_step = False
-            return
-        if self.sim.mode is ControlMode.WALK and self.walking is not None \
-                and self.walking.done:
-            self._switch(ControlMode.STAND)
-            if self._stand_after_walk:
-                self.session.switched(Behavior.STAND, Behavior.WALK)
+        acting = self.library.get(BEHAVIOR_OF_MODE.get(self.sim.mode, Behavior.USER))
+        handover = None if acting is None else acting.handover(fallen_robot(self.sim))
+        if handover is not None:
+            assert acting is not None
+            self._switch(MODE_OF_BEHAVIOR[handover.behavior])
+            if handover.automatic:
+                self.session.auto_switched(handover.behavior, acting.behavior)
             else:
-                self.session.auto_switched(Behavior.STAND, Behavior.WALK)
-        if self.sim.mode is not ControlMode.WALK:
-            self._stand_after_walk = False
-        if self._stand_after_step and self.stepping is not None \
-                and self.stepping.stepping is None:
-            self._switch(ControlMode.STAND)
-            self.session.switched(Behavior.STAND, Behavior.STEP)
-        if self.sim.mode is not ControlMode.STEP:
-            self._stand_after_step = False
+                self.session.switched(handover.behavior, acting.behavior)
+        if self._stand_deferred_by is not None \
+                and BEHAVIOR_OF_MODE.get(self.sim.mode) is not self._stand_deferred_by:
+            self._stand_deferred_by = None

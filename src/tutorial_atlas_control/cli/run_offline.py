@@ -53,6 +53,10 @@ def build_parser() -> argparse.ArgumentParser:
                              'started as that run was, each at the sim time it was recorded '
                              'at, then --settle s; the summary adds the walk\'s steps, '
                              'distance, worst placement and falls')
+    parser.add_argument('--behaviour', default='', metavar='MODULE:CLASS',
+                        help='with --asi-from: a behaviour of your own in the library, as '
+                             'atlas.launch\'s behaviour argument had it (module:Class or '
+                             'path/to/file.py:Class)')
     parser.add_argument('--bag', type=Path, metavar='OUT.bag',
                         help='write the run to this bag (replaced if it exists)')
     parser.add_argument('--table', action='store_true',
@@ -79,12 +83,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.error('--asi-from plays a recorded session: give no YAML_FILE and NAME')
     if args.asi_from is None and args.name is None:
         parser.error('give YAML_FILE and NAME (or --asi-from IN.bag)')
+    if args.behaviour and args.asi_from is None:
+        parser.error('--behaviour serves the AtlasSimInterface: it needs --asi-from')
     try:
         with tempfile.TemporaryDirectory(prefix='tac_offline_') as scratch:
             # Without --bag the summary is read from a bag that is deleted afterwards.
             bag = args.bag if args.bag is not None else Path(scratch) / 'offline.bag'
             if args.asi_from is not None:
-                run = run_asi_offline(args.asi_from, bag, args.settle, args.gains)
+                run = run_asi_offline(args.asi_from, bag, args.settle, args.gains,
+                                      args.behaviour)
                 what = f'{args.asi_from}: {run.commands} AtlasSimInterface commands applied'
             else:
                 trajectory_file = locate_trajectory_file(args.trajectory_file, announce=print)

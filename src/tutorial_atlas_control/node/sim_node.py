@@ -47,6 +47,9 @@ Parameters (private unless noted):
         with the parameter gains, the tutorial's start, until then. hold: Stand is that joint
         hold (DRCSim 2.5.2's stand-in for BDI's behaviour) until a bdi_stand sequence asks for
         BDI's Stand.
+    ~behaviour (str, ''): a behaviour of the user's own (module:Class or file.py:Class,
+        asi/user_behaviour.py), registered over the library's Stand, Walk or Step; needs
+        ~stand balance.
     ~model_file (str, the package's sim/atlas_v1.xml): the MJCF to simulate; it must have
         Atlas v1's joints, actuators and sensors (a variant of the package's model).
     /atlas/time_to_unpin (float, 1.0): seconds the torso stays pinned after start/reset.
@@ -93,6 +96,7 @@ from std_srvs.srv import Empty, EmptyResponse
 from tf2_msgs.msg import TFMessage
 
 from tutorial_atlas_control import topics
+from tutorial_atlas_control.asi import load_user_behaviour
 from tutorial_atlas_control.bags import unwritable_reason
 from tutorial_atlas_control.control_modes import ControlMode
 from tutorial_atlas_control.errors import AtlasControlError
@@ -425,7 +429,7 @@ class SimNode:
         except ModeError as err:
             rospy.logwarn_throttle(WARN_THROTTLE_S, f'refused /atlas/control_mode: {err}')
             return
-        if mode is ControlMode.WALK and self.loop.asi.walking is None:
+        if mode is ControlMode.WALK and not self.loop.asi.serves(ControlMode.WALK):
             rospy.logwarn_throttle(WARN_THROTTLE_S, 'refused /atlas/control_mode: Walk needs '
                                    'the balancing Stand (stand:=balance, the default, '
                                    'or /atlas/mode bdi_stand first)')
@@ -496,12 +500,22 @@ def build_node() -> SimNode:
                                 f'{", ".join(STAND_CHOICES)}, got {stand!r}')
     sim = AtlasSimulator(load_model(Path(model_file)), gains, time_to_unpin_s,
                          startup_mode=VrcMode(startup_mode))
+    behaviour_spec = rospy.get_param('~behaviour', '')
+    if not isinstance(behaviour_spec, str):
+        raise AtlasControlError(f'parameter {rospy.resolve_name("~behaviour")} must be '
+                                f'module:Class or file.py:Class, got {behaviour_spec!r}')
+    if behaviour_spec and stand != 'balance':
+        raise AtlasControlError(f'parameter {rospy.resolve_name("~behaviour")} needs '
+                                f'~stand balance (the library it joins), got {stand!r}')
+    user_behaviour = (load_user_behaviour(behaviour_spec, sim.atlas) if behaviour_spec
+                      else None)
     description = _tf_wanted(Path(model_file), sim)
     settings = LoopSettings(rates_hz, _float_param('~real_time_factor', 1.0),
                             bool(rospy.get_param('~paused', False)),
                             _links_publisher(description) if tf_publisher == 'sim' else None,
                             balance_stand=stand == 'balance',
-                            hold_at_start=stand == 'balance')
+                            hold_at_start=stand == 'balance',
+                            user_behaviour=user_behaviour)
     return SimNode(sim, settings, bool(rospy.get_param('~gui', False)),
                    description is not None, DelayBudgets.from_params(rospy.get_param))
 

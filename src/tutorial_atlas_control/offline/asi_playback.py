@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.asi import AtlasSimInterface
+from tutorial_atlas_control.asi import AtlasSimInterface, load_user_behaviour
 from tutorial_atlas_control.bags import open_bag, read_bag
 from tutorial_atlas_control.command import CommandError
 from tutorial_atlas_control.msgs import decode_asi_command
@@ -128,11 +128,14 @@ class _AsiFeed:
 
 
 def write_asi_bag(stream: AsiStream, bag: Path, settle_s: float,
-                  gains_file: Path = DEFAULT_GAINS_FILE) -> OfflineRun:
-    """Play `stream` offline and write the run to `bag` (a new file)."""
+                  gains_file: Path = DEFAULT_GAINS_FILE, behaviour: str = '') -> OfflineRun:
+    """Play `stream` offline and write the run to `bag` (a new file); `behaviour`: a user's
+    own (`module:Class` or `file.py:Class`), as atlas.launch's argument."""
     sim = AtlasSimulator(load_model(), load_gains_yaml(gains_file),
                          startup_mode=stream.startup_mode)
-    interface = AtlasSimInterface(sim, hold_at_start=True)  # atlas.launch's default start
+    user = load_user_behaviour(behaviour, sim.atlas) if behaviour else None
+    # atlas.launch's default start
+    interface = AtlasSimInterface(sim, hold_at_start=True, user_behaviour=user)
     sink = open_offline_bag(bag)
     started_s = time.perf_counter()
     try:
@@ -151,19 +154,23 @@ def write_asi_bag(stream: AsiStream, bag: Path, settle_s: float,
 
 
 def run_asi_offline(source: Path | str, bag: Path | str, settle_s: float = DEFAULT_SETTLE_S,
-                    gains_file: Path = DEFAULT_GAINS_FILE) -> OfflineRun:
+                    gains_file: Path = DEFAULT_GAINS_FILE, behaviour: str = '') -> OfflineRun:
     """Play the AtlasSimInterface session recorded in `source` offline into the bag `bag`
     (written under a temporary name beside it and renamed when complete: a failed run
-    leaves nothing); `settle_s` of sim time after the recording's end.
+    leaves nothing); `settle_s` of sim time after the recording's end; `behaviour`: a
+    user's own, as the live run had it (atlas.launch's `behaviour`).
 
     Raises:
-        BagAnalysisError, OfflineRunError, GainsError: bad inputs (checked before
-            simulating), a bag that cannot be written, or physics that diverged.
+        BagAnalysisError, OfflineRunError, GainsError, UserBehaviourError: bad inputs
+            (checked before simulating), a bag that cannot be written, or physics that
+            diverged.
     """
     stream = read_asi_stream(source)
     load_gains_yaml(gains_file)
+    if behaviour:
+        load_user_behaviour(behaviour, load_model())
     target = Path(bag)
     if target.exists() and target.resolve() == stream.source.resolve():
         raise OfflineRunError(f'{target} is the bag played: give another file name')
     return write_whole(target, lambda partial: write_asi_bag(stream, partial, settle_s,
-                                                             gains_file))
+                                                             gains_file, behaviour))

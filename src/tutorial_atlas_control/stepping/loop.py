@@ -18,7 +18,7 @@ import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
-from tutorial_atlas_control.asi import AtlasSimInterface
+from tutorial_atlas_control.asi import AtlasSimInterface, LibraryBehaviour
 from tutorial_atlas_control.sim import (
     AtlasSimulator,
     CommandAgeStatistics,
@@ -58,6 +58,8 @@ class LoopSettings:
         hold_at_start: with balance_stand, a (re)start in Stand holds the robot with the
             parameter gains (the tutorial's start, reported as User) until Stand is asked
             for; False: the balancing Stand acts from the start.
+        user_behaviour: a behaviour of the user's own for the AtlasSimInterface (with
+            balance_stand), registered over the library's; None: the library's own.
     """
 
     rates_hz: Mapping[str, float] = field(default_factory=dict)
@@ -66,6 +68,7 @@ class LoopSettings:
     links: LinkTransforms | None = None
     balance_stand: bool = False
     hold_at_start: bool = False
+    user_behaviour: LibraryBehaviour | None = None
 
 
 class SteppingLoop:
@@ -96,7 +99,8 @@ class SteppingLoop:
                   else SynchronizationWindow(DelayBudgets()))
         self.watch = RunWatch(sim, outputs.log)
         #: The AtlasSimInterface: its commands come through the inbox, its state is published.
-        self.asi = AtlasSimInterface(sim, settings.balance_stand, settings.hold_at_start)
+        self.asi = AtlasSimInterface(sim, settings.balance_stand, settings.hold_at_start,
+                                     settings.user_behaviour)
         self.inbox = CommandInbox(sim, outputs.log, statistics, self.watch, window.budgets,
                                   self.asi)
         self.controller: StepController = (controller(self.inbox) if controller is not None

@@ -1,0 +1,234 @@
+"""The behaviour library's contract: what the AtlasSimInterface asks of a behaviour it serves
+beyond Stand, so that the interface has no branch per behaviour.
+
+A library behaviour is a simulator Behaviour (sim/behaviour.py: `start`, `torque`) that also
+says which ASI behaviour it answers to and which control mode runs it, takes its command's
+parameters, answers Stand asked for while it runs, reports its feedback, and says after each
+tick what it hands the robot over to (a walk done: Stand; fallen: Freeze). Adding one is a
+class with these members and an entry in `library_of` (or the interface's `register`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Protocol
+
+import mujoco
+import numpy as np
+
+from tutorial_atlas_control.asi.behaviors import Behavior
+from tutorial_atlas_control.asi.walk_params import footsteps_of, step_feedback, walk_feedback
+from tutorial_atlas_control.control_modes import ControlMode
+from tutorial_atlas_control.msgs import AsiCommand
+from tutorial_atlas_control.walking import (
+    STEP_DURATION_S,
+    Footstep,
+    StepBehaviour,
+    WalkBehaviour,
+)
+
+__all__ = ['BehaviourBase', 'Handover', 'LibraryBehaviour', 'StepEntry', 'WalkEntry']
+
+
+@dataclasses.dataclass(frozen=True)
+class Handover:
+    """The behaviour a library behaviour hands the robot to, and whether the library did it
+    by itself (WARNING_AUTO_TRANS) rather than as the client asked (a Stand it deferred)."""
+
+    behavior: Behavior
+    automatic: bool
+
+
+class LibraryBehaviour(Protocol):
+    """A behaviour of the open AtlasSimInterface, beyond the simulator's `start`/`torque`."""
+
+    #: The ASI behaviour it answers to and the control mode that runs it.
+    behavior: Behavior
+    mode: ControlMode
+    #: A request for it waits while Stand is still taking the robot over (a walk does not
+    #: start from the hold's straight legs).
+    waits_for_stand: bool
+
+    def start(self, data: mujoco.MjData) -> None:
+        """Take the robot over as it is."""
+
+    def torque(self, data: mujoco.MjData) -> np.ndarray:
+        """This tick's f_out (N m, (28,))."""
+
+    def refusal(self, command: AsiCommand, running: bool) -> str | None:
+        """Why `command` cannot be taken (a log line's reason), None if it can."""
+
+    def prepare(self, command: AsiCommand) -> None:
+        """`command`'s parameters before the interface requests the behaviour (whether or
+        not the request is granted)."""
+
+    def take(self, command: AsiCommand, running: bool) -> None:
+        """`command`'s parameters once granted: for the next start, or (`running`) for the
+        behaviour under way."""
+
+    def stop(self) -> bool:
+        """Stand is asked for while it runs: True if it first finishes what is under way
+        (it then hands over itself), False if Stand may take over at once."""
+
+    def handover(self, fallen: bool) -> Handover | None:
+        """After a tick it ran: what it hands the robot to now (`fallen`: the robot is down
+        for good), None to go on."""
+
+    def feedback(self, time_s: float, sole_ahead_m: float) -> dict[str, object]:
+        """Its fields of AtlasSimInterfaceState (e.g. walk_feedback), now."""
+
+
+class BehaviourBase:
+    """The contract's quiet defaults, for a behaviour of one's own: it takes every command,
+    needs none of its parameters, lets Stand in at once, never hands over by itself (a
+    fallen robot is the client's to handle) and reports no feedback of its own. A subclass
+    sets `behavior` and `mode` and writes `start` and `torque`."""
+
+    behavior: Behavior
+    mode: ControlMode
+    waits_for_stand = False
+
+    def start(self, data: mujoco.MjData) -> None:
+        raise NotImplementedError
+
+    def torque(self, data: mujoco.MjData) -> np.ndarray:
+        raise NotImplementedError
+
+    def refusal(self, command: AsiCommand, running: bool) -> str | None:
+        return None
+
+    def prepare(self, command: AsiCommand) -> None:
+        """Nothing to take before the request."""
+
+    def take(self, command: AsiCommand, running: bool) -> None:
+        """Nothing to take from the command."""
+
+    def stop(self) -> bool:
+        return False
+
+    def handover(self, fallen: bool) -> Handover | None:
+        return None
+
+    def feedback(self, time_s: float, sole_ahead_m: float) -> dict[str, object]:
+        return {}
+
+
+class WalkEntry:
+    """Walk in the library: a WALK's step queue, Stand deferred to the end of the step under
+    way, Stand again once the walk has caught itself, Freeze once fallen."""
+
+    behavior = Behavior.WALK
+    mode = ControlMode.WALK
+    waits_for_stand = True
+
+    def __init__(self, walking: WalkBehaviour, sole_ahead_m: float) -> None:
+        self.walking = walking
+        self.sole_ahead_m = sole_ahead_m
+        self._stand_asked = False
+        self._decoded: tuple[AsiCommand, list[Footstep]] | None = None
+
+    def start(self, data: mujoco.MjData) -> None:
+        self._stand_asked = False
+        self.walking.start(data)
+
+    def torque(self, data: mujoco.MjData) -> np.ndarray:
+        return self.walking.torque(data)
+
+    def _steps(self, command: AsiCommand) -> list[Footstep]:
+        """The command's step queue as the soles' steps (kept for the same command: the
+        refusal and the take read it once)."""
+        if self._decoded is None or self._decoded[0] is not command:
+            self._decoded = (command, footsteps_of(command.step_queue, self.sole_ahead_m))
+        return self._decoded[1]
+
+    def refusal(self, command: AsiCommand, running: bool) -> str | None:
+        """A WALK without step 1 (a new walk's first) starts nothing: it is a window of a
+        walk that has ended, sent before the client saw the end. Started, it could take no
+        step and would only catch itself from standing."""
+        if running:
+            return None
+        indices = [step.step_index for step in self._steps(command)]
+        if 1 in indices:
+            return None
+        return (f'its step_queue has step_index {indices or "none"}, and a new walk starts '
+                'with step_index 1')
+
+    def prepare(self, command: AsiCommand) -> None:
+        """Nothing before the request: a refused WALK leaves the next start's steps alone."""
+
+    def take(self, command: AsiCommand, running: bool) -> None:
+        if running:
+            self.walking.offer(self._steps(command))
+        else:
+            self.walking.next_steps = self._steps(command)
+
+    def stop(self) -> bool:
+        if self.walking.done:
+            return False
+        if not self._stand_asked:
+            self.walking.finish()
+            self._stand_asked = True
+        return True
+
+    def handover(self, fallen: bool) -> Handover | None:
+        if fallen:
+            return Handover(Behavior.FREEZE, True)
+        if self.walking.done:
+            return Handover(Behavior.STAND, not self._stand_asked)
+        return None
+
+    def feedback(self, time_s: float, sole_ahead_m: float) -> dict[str, object]:
+        return {'walk_feedback': walk_feedback(self.walking.status(time_s), sole_ahead_m)}
+
+
+class StepEntry:
+    """Step in the library: each STEP's desired step (kept even before the switch: Step's
+    start keeps it), Stand deferred until the step under way is down, Freeze once fallen."""
+
+    behavior = Behavior.STEP
+    mode = ControlMode.STEP
+    waits_for_stand = True
+
+    def __init__(self, stepping: StepBehaviour, sole_ahead_m: float) -> None:
+        self.stepping = stepping
+        self.sole_ahead_m = sole_ahead_m
+        self._stand_asked = False
+
+    def start(self, data: mujoco.MjData) -> None:
+        self._stand_asked = False
+        self.stepping.start(data)
+
+    def torque(self, data: mujoco.MjData) -> np.ndarray:
+        return self.stepping.torque(data)
+
+    def refusal(self, command: AsiCommand, running: bool) -> str | None:
+        return None
+
+    def prepare(self, command: AsiCommand) -> None:
+        """step_params.desired_step as a sole's step (None: an empty one, no step wanted);
+        without a duration (DRCSim's actionlib server sends none) it swings for
+        STEP_DURATION_S."""
+        desired = command.desired_step
+        if desired.duration_s <= 0.0:
+            desired = dataclasses.replace(desired, duration_s=STEP_DURATION_S)
+        steps = footsteps_of([desired], self.sole_ahead_m)
+        self.stepping.desire(steps[0] if steps else None)
+
+    def take(self, command: AsiCommand, running: bool) -> None:
+        """The desired step was taken by `prepare`."""
+
+    def stop(self) -> bool:
+        if self.stepping.stepping is None:
+            return False
+        self._stand_asked = True
+        return True
+
+    def handover(self, fallen: bool) -> Handover | None:
+        if fallen:
+            return Handover(Behavior.FREEZE, True)
+        if self._stand_asked and self.stepping.stepping is None:
+            return Handover(Behavior.STAND, False)
+        return None
+
+    def feedback(self, time_s: float, sole_ahead_m: float) -> dict[str, object]:
+        return {'step_feedback': step_feedback(self.stepping.status(time_s), sole_ahead_m)}
