@@ -24,6 +24,7 @@ import functools
 import mujoco
 import numpy as np
 
+from tutorial_atlas_control.balance.blend import smoothstep, smoothstep_rate
 from tutorial_atlas_control.balance.estimator import BalanceEstimator, BalanceState
 from tutorial_atlas_control.balance.manipulate import (
     PelvisServo,
@@ -61,12 +62,6 @@ def stand_pose_com_height_m(atlas: AtlasModel) -> float:
     place_in_stand_pose(atlas, data)
     mujoco.mj_comPos(atlas.model, data)
     return float(data.subtree_com[0][2])
-
-
-def smoothstep(fraction: float) -> float:
-    """0 at 0, 1 at 1 and beyond, with zero slope at both ends."""
-    s = min(max(fraction, 0.0), 1.0)
-    return s * s * (3.0 - 2.0 * s)
 
 
 _UP = np.array([0.0, 0.0, 1.0])
@@ -248,7 +243,7 @@ class StandBehaviour:
         if not transition.with_rates:
             return StandReference(capture_point, float(vector[29]), pelvis_frame(yaw, pitch),
                                   vector[:28])
-        s_rate = 6.0 * fraction * (1.0 - fraction) / duration  # ds/dt: smoothstep's
+        s_rate = smoothstep_rate(fraction, duration)  # ds/dt
         rate = per_s * s_rate
         return StandReference(
             capture_point, float(vector[29]), pelvis_frame(yaw, pitch), vector[:28],

@@ -12,7 +12,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from tutorial_atlas_control.balance.stand_behaviour import smoothstep
+from tutorial_atlas_control.balance.blend import smoothstep
 from tutorial_atlas_control.balance.stand_pose import STAND_POSE_RAD
 from tutorial_atlas_control.sim import AtlasModel, Gains
 

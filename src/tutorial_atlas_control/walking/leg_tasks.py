@@ -34,6 +34,7 @@ from tutorial_atlas_control.balance import (
     convex_hull,
     orientation_error,
     smoothstep,
+    smoothstep_rate,
     yaw_of,
     yaw_rotation,
 )
@@ -124,9 +125,8 @@ class LegTasks:
         """The CoM height's reference and its rate at `time_s` (m, m/s)."""
         started_s, duration_s, start, change = self._height
         fraction = (time_s - started_s) / duration_s
-        rate = (6.0 * fraction * (1.0 - fraction) * change / duration_s
-                if 0.0 < fraction < 1.0 else 0.0)
-        return start + smoothstep(fraction) * change, rate
+        return (start + smoothstep(fraction) * change,
+                smoothstep_rate(fraction, duration_s) * change)
 
     def face(self, first_yaw_rad: float, second_yaw_rad: float, time_s: float,
              duration_s: float) -> None:
