@@ -43,14 +43,19 @@ def lipm_state(com0: np.ndarray, velocity0: np.ndarray, cop: np.ndarray, omega: 
     return com, velocity
 
 
-def dcm_feedback_cop(xi: np.ndarray, xi_ref: np.ndarray, gain: float) -> np.ndarray:
+def dcm_feedback_cop(xi: np.ndarray, xi_ref: np.ndarray, gain: float,
+                     cop_ref: np.ndarray | None = None) -> np.ndarray:
     """The centre of pressure that makes the capture point converge to `xi_ref`.
 
-    p = xi + gain (xi - xi_ref) gives xi' = -omega gain (xi - xi_ref): with gain > 0 the
-    error decays at rate omega * gain; with gain 0 the pressure centre sits on the
-    capture point and the capture point merely stops (no correction back).
+    p = p_ref + (1 + gain) (xi - xi_ref) gives (xi - xi_ref)' = -omega gain (xi - xi_ref)
+    for a reference moving as xi_ref' = omega (xi_ref - p_ref): with gain > 0 the error
+    decays at rate omega * gain; with gain 0 it merely stops growing. Stand's reference is
+    at rest (p_ref = xi_ref, the default: p = xi + gain (xi - xi_ref)); the walk's moves
+    with its plan's pressure centre `cop_ref`.
     """
-    return np.asarray(xi) + gain * (np.asarray(xi) - np.asarray(xi_ref))
+    xi_ref = np.asarray(xi_ref)
+    reference = xi_ref if cop_ref is None else np.asarray(cop_ref)
+    return reference + (1.0 + gain) * (np.asarray(xi) - xi_ref)
 
 
 def com_acceleration(com_xy: np.ndarray, cop_xy: np.ndarray, omega: float) -> np.ndarray:

@@ -3,7 +3,7 @@
 footsteps: a step as the AtlasSimInterface names it, DRCSim's fixed queue, straight and
 circular plans, a streaming client's window; step_queue: Walk's queue of steps merged by
 index, clamped to what the legs reach, and its feedback flags; dcm_plan: the capture
-point's plan over the steps and the law that tracks it; step_adjustment: where a pushed
+point's plan over the steps; step_adjustment: where a pushed
 swing foot must land instead; swing: the swing foot's path;
 leg_tasks: what Walk and Step do alike each step (the whole-body law on the carrying
 soles, the swing foot, the pelvis's heading); walk: the walk's phases; walk_behaviour: Walk as the
@@ -15,7 +15,7 @@ one quasi-static step; step_behaviour: Step as the simulator's behaviour.
 from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
-    'dcm_plan': ['DcmPlan', 'tracking_cop'],
+    'dcm_plan': ['DcmPlan'],
     'footsteps': ['DRCSIM_WALK_QUEUE', 'LEFT', 'QUEUE_LENGTH', 'RIGHT', 'STANCE_WIDTH_M',
                   'STEP_DURATION_S', 'Footstep', 'circle_steps', 'placed', 'side_sign',
                   'straight_steps', 'window', 'wrap_angle'],

@@ -4,9 +4,9 @@ With the pressure centre held at the stance foot's centre p_i during step i (dur
 the capture point moves as xi(t) = p_i + (xi_i,end - p_i) exp(omega (t - T_i)). Ending the
 walk with the capture point between the last two feet fixes every step's end point by
 backward recursion, xi_i,end = p_(i+1) + (xi_(i+1),end - p_(i+1)) exp(-omega T_(i+1))
-(Englsberger, Ott and Albu-Schaeffer 2015, with constant pressure centres). Tracking it with
-p = p_ref + (1 + k) (xi - xi_ref) makes the error decay at omega k, the Stand's law with a
-moving reference.
+(Englsberger, Ott and Albu-Schaeffer 2015, with constant pressure centres). The walk tracks
+it with the Stand's law, lipm.dcm_feedback_cop with the plan's pressure centre as p_ref:
+p = p_ref + (1 + k) (xi - xi_ref), the error decaying at omega k.
 """
 
 from __future__ import annotations
@@ -58,8 +58,3 @@ class DcmPlan:
             self.omega * (t - float(self.durations_s[step])))
         return xi, cop
 
-
-def tracking_cop(xi: np.ndarray, xi_ref: np.ndarray, cop_ref: np.ndarray,
-                 gain: float) -> np.ndarray:
-    """p = p_ref + (1 + gain) (xi - xi_ref): the error xi - xi_ref decays at omega * gain."""
-    return np.asarray(cop_ref) + (1.0 + gain) * (np.asarray(xi) - np.asarray(xi_ref))

@@ -23,8 +23,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from tutorial_atlas_control.balance import BalanceState, StandController
-from tutorial_atlas_control.walking.dcm_plan import DcmPlan, tracking_cop
+from tutorial_atlas_control.balance import BalanceState, StandController, dcm_feedback_cop
+from tutorial_atlas_control.walking.dcm_plan import DcmPlan
 from tutorial_atlas_control.walking.footsteps import Footstep
 from tutorial_atlas_control.walking.leg_tasks import LegGains, LegTasks, foot_pose
 from tutorial_atlas_control.walking.step_adjustment import foothold_shift
@@ -218,7 +218,7 @@ class WalkController:
         xi_ref, cop_ref = self._capture_reference(state, time_s)
         if self.phase == STEPPING and self.gains.adjust_steps:
             self._adjust(state, xi_ref, cop_ref, time_s)
-        cop = tracking_cop(state.capture_point, xi_ref, cop_ref, self.gains.dcm_gain)
+        cop = dcm_feedback_cop(state.capture_point, xi_ref, self.gains.dcm_gain, cop_ref)
         step = self.step if self.phase == STEPPING else None
         swing_foot = None if step is None else step.foot_index
         legs = self.legs
