@@ -11,8 +11,12 @@ inside the support polygon. These are the textbook formulas (Pratt 2006, Englsbe
 from __future__ import annotations
 
 import math
+from typing import TypeVar
 
 import numpy as np
+
+#: A point on one axis (float: step_adjustment's per-axis arithmetic) or in the plane (m).
+Point = TypeVar('Point', float, np.ndarray)
 
 #: Standard gravity (m/s^2), the model's |gravity|.
 GRAVITY_M_S2 = 9.81
@@ -41,6 +45,24 @@ def lipm_state(com0: np.ndarray, velocity0: np.ndarray, cop: np.ndarray, omega: 
     com = cop + offset * math.cosh(wt) + np.asarray(velocity0) / omega * math.sinh(wt)
     velocity = offset * omega * math.sinh(wt) + np.asarray(velocity0) * math.cosh(wt)
     return com, velocity
+
+
+def capture_point_after(xi0: Point, cop: Point, omega: float, t_s: float) -> Point:
+    """The capture point `t_s` after `xi0` with the pressure centre held at `cop` (m).
+
+    xi(t) = p + (xi0 - p) exp(omega t), xi' = omega (xi - p) solved; a negative `t_s` runs
+    it back: where the capture point must have been to reach `xi0` after -t_s.
+    """
+    return cop + (xi0 - cop) * math.exp(omega * t_s)
+
+
+def cop_reaching(xi0: np.ndarray, xi_target: np.ndarray, omega: float,
+                 t_s: float) -> np.ndarray:
+    """The pressure centre that, held, takes the capture point from `xi0` to `xi_target` in
+    `t_s` (m): capture_point_after solved for p, p = (xi_T - g xi0) / (1 - g),
+    g = exp(omega t_s)."""
+    growth = math.exp(omega * t_s)
+    return (np.asarray(xi_target) - growth * np.asarray(xi0)) / (1.0 - growth)
 
 
 def dcm_feedback_cop(xi: np.ndarray, xi_ref: np.ndarray, gain: float,

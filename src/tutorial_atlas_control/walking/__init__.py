@@ -25,7 +25,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'step_adjustment': ['foothold_shift', 'predicted_error'],
     'swing': ['SWING_HEIGHT_M', 'SwingPath', 'bump', 'quintic'],
     'leg_tasks': ['LEG_JOINTS', 'LegGains', 'LegTasks', 'foot_pose'],
-    'walk': ['WalkController', 'WalkGains', 'WalkOutput', 'sway_cop'],
+    'walk': ['WalkController', 'WalkGains', 'WalkOutput'],
     'walk_behaviour': ['WalkBehaviour', 'WalkStatus'],
     'start_noise': ['DEFAULT_START_NOISE', 'StartNoise', 'perturb_start'],
     'walk_trial': ['Landing', 'WalkTrial', 'WalkingStand', 'pushed_walk_trial',

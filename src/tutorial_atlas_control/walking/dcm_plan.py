@@ -11,10 +11,11 @@ p = p_ref + (1 + k) (xi - xi_ref), the error decaying at omega k.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
+
+from tutorial_atlas_control.balance import capture_point_after
 
 
 @dataclass(frozen=True)
@@ -41,20 +42,20 @@ class DcmPlan:
         after = np.asarray(final, dtype=float)
         for i in range(len(cops) - 1, -1, -1):
             ends[i] = after
-            after = cops[i] + (after - cops[i]) * math.exp(-omega * durations[i])
+            after = capture_point_after(after, cops[i], omega, -float(durations[i]))
         return cls(cops, durations, ends, omega)
 
     @property
     def start(self) -> np.ndarray:
         """Where the capture point must be as step 0 begins."""
-        return self.cops[0] + (self.ends[0] - self.cops[0]) * math.exp(
-            -self.omega * self.durations_s[0])
+        return capture_point_after(self.ends[0], self.cops[0], self.omega,
+                                   -float(self.durations_s[0]))
 
     def reference(self, step: int, t_s: float) -> tuple[np.ndarray, np.ndarray]:
         """(xi_ref, p_ref) at `t_s` into step `step` (clamped to the step's duration)."""
         t = min(max(t_s, 0.0), float(self.durations_s[step]))
         cop = self.cops[step]
-        xi = cop + (self.ends[step] - cop) * math.exp(
-            self.omega * (t - float(self.durations_s[step])))
+        xi = capture_point_after(self.ends[step], cop, self.omega,
+                                 t - float(self.durations_s[step]))
         return xi, cop
 
