@@ -22,12 +22,10 @@ from tutorial_atlas_control.balance import (
 )
 from tutorial_atlas_control.walking.footsteps import Footstep
 from tutorial_atlas_control.walking.leg_tasks import LegGains, LegTasks, foot_pose
+from tutorial_atlas_control.walking.status_flags import STEPPING, SWAYING
 from tutorial_atlas_control.walking.swing import SwingPath
 
 __all__ = ['StaticStep', 'StepGains']
-
-#: step_feedback.status_flags (ASI.md: the library's values, not the message's constants).
-SWAYING, STEPPING = 1, 2
 
 
 @dataclass(frozen=True)

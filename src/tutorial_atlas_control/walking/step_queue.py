@@ -23,11 +23,10 @@ from tutorial_atlas_control.walking.footsteps import (
     side_sign,
     wrap_angle,
 )
-
-#: walk_feedback.status_flags (ASI.md): one of the first three, plus the warnings.
-OKAY, SWAYING, STEPPING, CATCHING = 0, 1, 2, 4
-WARNING_INSUFFICIENT_STEP_DATA = 8
-ERROR_INCONSISTENT_STEPS = 16
+from tutorial_atlas_control.walking.status_flags import (
+    ERROR_INCONSISTENT_STEPS,
+    WARNING_INSUFFICIENT_STEP_DATA,
+)
 
 
 @dataclass(frozen=True)

@@ -33,14 +33,9 @@ from tutorial_atlas_control.balance import (
 from tutorial_atlas_control.walking.dcm_plan import DcmPlan
 from tutorial_atlas_control.walking.footsteps import Footstep
 from tutorial_atlas_control.walking.leg_tasks import LegGains, LegTasks, foot_pose
+from tutorial_atlas_control.walking.status_flags import CATCHING, STEPPING, SWAYING
 from tutorial_atlas_control.walking.step_adjustment import foothold_shift
-from tutorial_atlas_control.walking.step_queue import (
-    CATCHING,
-    STEPPING,
-    SWAYING,
-    StepQueue,
-    clamp_pose,
-)
+from tutorial_atlas_control.walking.step_queue import StepQueue, clamp_pose
 from tutorial_atlas_control.walking.swing import SwingPath
 
 

@@ -20,12 +20,8 @@ import numpy as np
 from tutorial_atlas_control.balance import StandBehaviour
 from tutorial_atlas_control.walking.footsteps import DRCSIM_WALK_QUEUE, Footstep
 from tutorial_atlas_control.walking.leg_tasks import foot_pose
-from tutorial_atlas_control.walking.step_queue import (
-    DEFAULT_LIMITS,
-    STEPPING,
-    StepLimits,
-    StepQueue,
-)
+from tutorial_atlas_control.walking.status_flags import STEPPING
+from tutorial_atlas_control.walking.step_queue import DEFAULT_LIMITS, StepLimits, StepQueue
 from tutorial_atlas_control.walking.walk import WalkController, WalkGains
 
 __all__ = ['WalkBehaviour', 'WalkStatus']
