@@ -30,6 +30,7 @@ import numpy as np
 from tutorial_atlas_control.balance import (
     BalanceState,
     StandController,
+    box_corners,
     clamp_into,
     convex_hull,
     orientation_error,
@@ -225,8 +226,11 @@ class LegTasks:
             cop = _clamp_to_sole(state, 1 - swing_foot, self.sole_reach_m, cop)
         else:  # swaying or catching: the feet that are down (both, unless a landing is late)
             contact = state.in_contact if any(state.in_contact) else (True, True)
-            corners = np.concatenate([_sole_corners(state, foot, stand.sole_half_size_m)
-                                      for foot in (0, 1) if contact[foot]])
+            half_length, half_width = stand.sole_half_size_m
+            corners = np.concatenate([
+                box_corners(state.sole_centres[foot], state.sole_rotations[foot],
+                            (half_length, half_width, 0.0))[:, 0:2]
+                for foot in (0, 1) if contact[foot]])
             cop = clamp_into(convex_hull(corners), cop, stand.gains.cop_margin_m)
         torsion = self.gains.torsion_m if swing_foot is not None else None
         torque = stand.whole_body(state, cop, contact, joint_positions, joint_velocities,
@@ -265,12 +269,3 @@ def _clamp_to_sole(state: BalanceState, foot: int, reach_m: tuple[float, float],
     local[1] = min(max(local[1], -reach_y), reach_y)
     return centre + rotation @ local
 
-
-def _sole_corners(state: BalanceState, foot: int,
-                  half_size_m: tuple[float, float]) -> np.ndarray:
-    """The four corners (4, 2) of a sole's bottom face, world x, y."""
-    half_length, half_width = half_size_m
-    offsets = np.array([[half_length, half_width], [half_length, -half_width],
-                        [-half_length, -half_width], [-half_length, half_width]])
-    rotation = state.sole_rotations[foot][0:2, 0:2]
-    return state.sole_centres[foot][0:2] + offsets @ rotation.T
