@@ -1,15 +1,16 @@
 """Whole-body balance without ROS, the ground the AtlasSimInterface behaviours stand on.
 
-blend: the smoothstep timed moves follow, and its rate; lipm: the linear inverted pendulum
-and its capture point; support: the support polygon and keeping a pressure centre in it;
-contact_wrench: a wrench shared between the feet; sole: the model's sole boxes and their
-corners; stand_pose: DRCSim's Stand pose placed on the ground; stance_posture: that pose's
-legs solved for the stance the feet are in; manipulate: Manipulate's pelvis servo (targets
-clamped, the posture that reaches them); estimator: the balance state from the model;
-stand: the Stand controller (capture-point feedback, inverse statics, joint PD);
-stand_behaviour: that controller as the simulator's Stand behaviour, with the servo;
-stand_prep: StandPrep, the harnessed robot brought to the Stand pose; push_trial: offline
-trials of it on the simulator, standing and pushed.
+errors: BalanceError, what the balance refuses; blend: the smoothstep timed moves follow,
+and its rate; lipm: the linear inverted pendulum and its capture point; support: the
+support polygon and keeping a pressure centre in it; contact_wrench: a wrench shared
+between the feet; sole: the model's sole boxes and their corners; stand_pose: DRCSim's
+Stand pose placed on the ground; stance_posture: that pose's legs solved for the stance
+the feet are in; manipulate: Manipulate's pelvis servo (targets clamped, the posture that
+reaches them); estimator: the balance state from the model; stand: the Stand controller
+(capture-point feedback, inverse statics, joint PD); stand_behaviour: that controller as
+the simulator's Stand behaviour, with the servo; stand_prep: StandPrep, the harnessed
+robot brought to the Stand pose; push_trial: offline trials of it on the simulator,
+standing and pushed.
 """
 
 from tutorial_atlas_control.exports import lazy_exports
@@ -17,6 +18,7 @@ from tutorial_atlas_control.exports import lazy_exports
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'blend': ['smoothstep', 'smoothstep_rate'],
     'contact_wrench': ['make_feasible', 'split_wrench'],
+    'errors': ['BalanceError'],
     'estimator': ['CONTACT_HEIGHT_M', 'MIN_COM_HEIGHT_M', 'BalanceEstimator', 'BalanceState'],
     'manipulate': ['PelvisServo', 'SquatTable', 'bent_posture', 'clamp_servo'],
     'lipm': ['capture_point', 'capture_point_after', 'com_acceleration', 'cop_reaching',

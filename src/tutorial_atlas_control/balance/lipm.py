@@ -15,6 +15,8 @@ from typing import TypeVar
 
 import numpy as np
 
+from tutorial_atlas_control.balance.errors import BalanceError
+
 #: A point on one axis (float: step_adjustment's per-axis arithmetic) or in the plane (m).
 Point = TypeVar('Point', float, np.ndarray)
 
@@ -25,7 +27,7 @@ GRAVITY_M_S2 = 9.81
 def natural_frequency(com_height_m: float, gravity_m_s2: float = GRAVITY_M_S2) -> float:
     """omega = sqrt(g / z) (1/s) of a pendulum whose centre of mass is `com_height_m` up."""
     if not com_height_m > 0.0:
-        raise ValueError(f'centre-of-mass height {com_height_m} m must be above the ground')
+        raise BalanceError(f'centre-of-mass height {com_height_m} m must be above the ground')
     return math.sqrt(gravity_m_s2 / com_height_m)
 
 

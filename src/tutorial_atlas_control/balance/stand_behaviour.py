@@ -25,6 +25,7 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control.balance.blend import smoothstep, smoothstep_rate
+from tutorial_atlas_control.balance.errors import BalanceError
 from tutorial_atlas_control.balance.estimator import BalanceEstimator, BalanceState
 from tutorial_atlas_control.balance.manipulate import (
     PelvisServo,
@@ -182,7 +183,7 @@ class StandBehaviour:
             return target
         controller, state = self.controller, self.last_state
         if controller is None or state is None:
-            raise RuntimeError('StandBehaviour.servo before start()')
+            raise BalanceError('StandBehaviour.servo before start()')
         feet = state.sole_centres[:, :2]
         headings = state.sole_rotations[:, 0:2, 0].sum(axis=0)
         feet_yaw = float(np.arctan2(headings[1], headings[0]))
@@ -255,7 +256,7 @@ class StandBehaviour:
         """This step's f_out (N m, (28,)), within the effort limits."""
         controller = self.controller
         if controller is None:
-            raise RuntimeError('StandBehaviour.torque before start()')
+            raise BalanceError('StandBehaviour.torque before start()')
         if self._transition is not None:
             controller.reference = self._reference_at(float(data.time))
         atlas = self.atlas

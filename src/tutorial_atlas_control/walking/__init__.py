@@ -1,21 +1,23 @@
 """Walking without ROS: the footsteps Walk and Step take and the plan they follow.
 
-footsteps: a step as the AtlasSimInterface names it, DRCSim's fixed queue, straight and
-circular plans, a streaming client's window; status_flags: walk_feedback's and
-step_feedback's status values; step_queue: Walk's queue of steps merged by index, clamped
-to what the legs reach, and its feedback flags; dcm_plan: the capture point's plan over
-the steps; step_adjustment: where a pushed swing foot must land instead; swing: the swing
-foot's path; leg_tasks: what Walk and Step do alike each step (the whole-body law on the
-carrying soles, the swing foot, the pelvis's heading); walk: the walk's phases;
-walk_behaviour: Walk as the simulator's behaviour; start_noise: a trial's start perturbed
-by a seed; walk_trial: offline walking trials, landing by landing, pushed or not;
-static_step: one quasi-static step; step_behaviour: Step as the simulator's behaviour.
+errors: WalkingError, what the walk refuses; footsteps: a step as the AtlasSimInterface
+names it, DRCSim's fixed queue, straight and circular plans, a streaming client's window;
+status_flags: walk_feedback's and step_feedback's status values; step_queue: Walk's queue
+of steps merged by index, clamped to what the legs reach, and its feedback flags;
+dcm_plan: the capture point's plan over the steps; step_adjustment: where a pushed swing
+foot must land instead; swing: the swing foot's path; leg_tasks: what Walk and Step do
+alike each step (the whole-body law on the carrying soles, the swing foot, the pelvis's
+heading); walk: the walk's phases; walk_behaviour: Walk as the simulator's behaviour;
+start_noise: a trial's start perturbed by a seed; walk_trial: offline walking trials,
+landing by landing, pushed or not; static_step: one quasi-static step; step_behaviour:
+Step as the simulator's behaviour.
 """
 
 from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'dcm_plan': ['DcmPlan'],
+    'errors': ['WalkingError'],
     'footsteps': ['DRCSIM_WALK_QUEUE', 'LEFT', 'QUEUE_LENGTH', 'RIGHT', 'STANCE_WIDTH_M',
                   'STEP_DURATION_S', 'Footstep', 'circle_steps', 'placed', 'side_sign',
                   'straight_steps', 'window', 'wrap_angle'],

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tutorial_atlas_control.balance import capture_point_after
+from tutorial_atlas_control.walking.errors import WalkingError
 
 
 @dataclass(frozen=True)
@@ -35,9 +36,9 @@ class DcmPlan:
         cops = np.asarray(cops, dtype=float).reshape(-1, 2)
         durations = np.asarray(durations_s, dtype=float).reshape(-1)
         if len(cops) != len(durations) or len(cops) == 0:
-            raise ValueError('one duration per pressure centre, at least one step')
+            raise WalkingError('one duration per pressure centre, at least one step')
         if not np.all(durations > 0.0):
-            raise ValueError('every step duration must be positive')
+            raise WalkingError('every step duration must be positive')
         ends = np.empty_like(cops)
         after = np.asarray(final, dtype=float)
         for i in range(len(cops) - 1, -1, -1):

@@ -17,6 +17,7 @@ import math
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
 
+from tutorial_atlas_control.walking.errors import WalkingError
 from tutorial_atlas_control.walking.footsteps import (
     QUEUE_LENGTH,
     Footstep,
@@ -155,7 +156,7 @@ class StepQueue:
         """The step under way (`current_step_index + 1`) lands at `step` instead, already
         within the limits: the queue's preview says so until it is down."""
         if step.step_index != self.current_step_index + 1:
-            raise ValueError(f'step {step.step_index} is not the one under way '
+            raise WalkingError(f'step {step.step_index} is not the one under way '
                              f'({self.current_step_index + 1})')
         self._adjusted = step
         self._preview = None

@@ -18,6 +18,7 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control.balance import StandBehaviour
+from tutorial_atlas_control.walking.errors import WalkingError
 from tutorial_atlas_control.walking.footsteps import DRCSIM_WALK_QUEUE, Footstep
 from tutorial_atlas_control.walking.leg_tasks import foot_pose
 from tutorial_atlas_control.walking.status_flags import STEPPING
@@ -63,7 +64,7 @@ class WalkBehaviour:
     def offer(self, steps: Iterable[Footstep]) -> None:
         """A client's steps for the walk under way: into its queue by index."""
         if self.walk is None:
-            raise RuntimeError('WalkBehaviour.offer before start()')
+            raise WalkingError('WalkBehaviour.offer before start()')
         self.walk.queue.offer(steps)
 
     def finish(self) -> None:
@@ -71,7 +72,7 @@ class WalkBehaviour:
         itself and is done."""
         walk = self.walk
         if walk is None:
-            raise RuntimeError('WalkBehaviour.finish before start()')
+            raise WalkingError('WalkBehaviour.finish before start()')
         taking = walk.step.step_index if walk.phase == STEPPING and walk.step else None
         walk.queue.stop(taking)
 
@@ -91,7 +92,7 @@ class WalkBehaviour:
         """This step's f_out (N m, (28,)), within the effort limits."""
         walk = self.walk
         if walk is None:
-            raise RuntimeError('WalkBehaviour.torque before start()')
+            raise WalkingError('WalkBehaviour.torque before start()')
         stand, atlas = self.stand, self.stand.atlas
         state = stand.estimator.estimate(data.qpos, data.qvel)
         stand.last_state = state

@@ -8,7 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.balance import contact_wrench, lipm, support
+from tutorial_atlas_control.balance import BalanceError, contact_wrench, lipm, support
+from tutorial_atlas_control.errors import AtlasControlError
 
 OMEGA = lipm.natural_frequency(0.9)
 
@@ -17,6 +18,12 @@ def test_natural_frequency_is_sqrt_g_over_z() -> None:
     assert pytest.approx(math.sqrt(9.81 / 0.9)) == OMEGA
     with pytest.raises(ValueError, match='centre-of-mass height 0.0 m must be above'):
         lipm.natural_frequency(0.0)
+
+
+def test_a_pendulum_under_the_ground_raises_the_balances_error() -> None:
+    with pytest.raises(BalanceError, match='height -0.1 m must be above the ground') as raised:
+        lipm.natural_frequency(-0.1)
+    assert isinstance(raised.value, AtlasControlError)  # what the command lines catch
 
 
 def test_the_lipm_solution_obeys_its_equation() -> None:

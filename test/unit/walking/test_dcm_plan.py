@@ -8,6 +8,8 @@ import numpy as np
 import pytest
 
 from tutorial_atlas_control.balance.lipm import dcm_feedback_cop, natural_frequency
+from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.walking import WalkingError
 from tutorial_atlas_control.walking.dcm_plan import DcmPlan
 
 OMEGA = natural_frequency(0.85)
@@ -56,3 +58,9 @@ def test_the_law_with_the_plans_pressure_centre_makes_the_error_decay_at_omega_g
 def test_bad_plans_are_refused(durations: np.ndarray, message: str) -> None:
     with pytest.raises(ValueError, match=message):
         DcmPlan.plan(COPS, durations, FINAL, OMEGA)
+
+
+def test_a_bad_plan_raises_the_walks_error() -> None:
+    with pytest.raises(WalkingError, match='every step duration must be positive') as raised:
+        DcmPlan.plan(COPS, -DURATIONS, FINAL, OMEGA)
+    assert isinstance(raised.value, AtlasControlError)  # what the command lines catch
