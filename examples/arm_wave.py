@@ -25,7 +25,13 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control.asi import Behavior, BehaviourBase
-from tutorial_atlas_control.balance import STAND_POSE_RAD, StandBehaviour, StandGains
+from tutorial_atlas_control.balance import (
+    STAND_POSE_RAD,
+    StandBehaviour,
+    StandGains,
+    smoothstep,
+    smoothstep_rate,
+)
 from tutorial_atlas_control.control_modes import ControlMode
 from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.sim import AtlasModel
@@ -72,9 +78,7 @@ class ArmWave(BehaviourBase):
     def arm_targets(self, time_s: float) -> dict[int, tuple[float, float]]:
         """(angle rad, rate rad/s) of the shoulder and the elbow at `time_s`."""
         elapsed = time_s - self.started_s
-        fraction = min(max(elapsed / RAISE_S, 0.0), 1.0)
-        rise = fraction * fraction * (3.0 - 2.0 * fraction)
-        rise_rate = 6.0 * fraction * (1.0 - fraction) / RAISE_S if fraction < 1.0 else 0.0
+        rise, rise_rate = smoothstep(elapsed / RAISE_S), smoothstep_rate(elapsed / RAISE_S, RAISE_S)
         phase = 2.0 * math.pi * WAVE_HZ * elapsed
         targets = {}
         for joint, raised in RAISED_RAD.items():

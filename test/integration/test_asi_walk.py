@@ -51,7 +51,7 @@ from tutorial_atlas_control.walking import (
     straight_steps,
     window,
 )
-from tutorial_atlas_control.walking.step_queue import (
+from tutorial_atlas_control.walking.status_flags import (
     CATCHING,
     ERROR_INCONSISTENT_STEPS,
     STEPPING,
@@ -412,8 +412,6 @@ def command_of(behavior: Behavior) -> AsiCommand:
 
 # -- Step --------------------------------------------------------------------------------------
 
-#: step_feedback.status_flags (ASI.md: the library's values).
-STEP_SWAYING, STEP_STEPPING = 1, 2
 #: The issue's circle: radius (m), steps a turn.
 CIRCLE_RADIUS_M = 2.0
 CIRCLE_STEPS = 60
@@ -473,7 +471,7 @@ def step_through(interface: AtlasSimInterface, plan: list[Footstep], seconds: fl
         seen.behaviors.append(state.current_behavior)
         seen.status.append(state.behavior_feedback.status_flags)
         seen.lowest_pelvis_m = min(seen.lowest_pelvis_m, state.pelvis_position_m[2])
-        if previous == STEP_STEPPING and flags == STEP_SWAYING:
+        if previous == STEPPING and flags == SWAYING:
             target = plan[seen.taken]
             x, y, z, w = state.foot_poses[target.foot_index, 3:7]
             yaw = np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
@@ -483,7 +481,7 @@ def step_through(interface: AtlasSimInterface, plan: list[Footstep], seconds: fl
                 abs(float(np.angle(np.exp(1j * (yaw - target.yaw_rad)))))))
             seen.taken += 1
         previous = flags
-        if seen.taken == len(plan) and flags == STEP_SWAYING \
+        if seen.taken == len(plan) and flags == SWAYING \
                 and interface.stepping is not None and interface.stepping.stepping is None:
             break
     return seen
@@ -502,8 +500,8 @@ def test_static_steps_round_the_circle_eight_of_eight_seeds(
         landings.append(seen.errors)
         if not (seen.taken == STATIC_STEPS and seen.lowest_pelvis_m > PELVIS_ABOVE_M
                 and changes(seen.behaviors) == [Behavior.STEP]
-                and changes(seen.flags) == [STEP_SWAYING, STEP_STEPPING] * STATIC_STEPS
-                + [STEP_SWAYING]
+                and changes(seen.flags) == [SWAYING, STEPPING] * STATIC_STEPS
+                + [SWAYING]
                 and all(error_m < STATIC_LANDING_WITHIN_M and yaw_rad < 0.1
                         for error_m, yaw_rad in seen.errors)
                 and feedback.current_step_index == STATIC_STEPS
@@ -529,7 +527,7 @@ def test_a_target_already_reached_is_not_stepped_again(atlas: atlas_model.AtlasM
         interface.sim.step()
         state = interface.state()
         interface.end_step()
-        assert state.step_feedback.status_flags == STEP_SWAYING
+        assert state.step_feedback.status_flags == SWAYING
     assert state.step_feedback.current_step_index == 1
     assert state.current_behavior == Behavior.STEP
 
@@ -540,7 +538,7 @@ def test_stand_asked_for_during_a_step_waits_for_the_foot_to_be_down(
     plan = straight_steps(1, 0.1)
     seen = Stepped()
     sim = interface.sim
-    while not seen.flags or seen.flags[-1] != STEP_STEPPING:
+    while not seen.flags or seen.flags[-1] != STEPPING:
         step_through(interface, plan, sim.dt_s, seen)
     interface.apply(AsiCommand(0, Behavior.STAND, (StepData(),) * 4, False, StepData(), False,
                                ManipulateParams(), None, 0))

@@ -1,18 +1,19 @@
 """The open AtlasSimInterface, ROS-free: DRCSim 2.7's behaviour library contract (ASI.md)
-over the simulator and the balance. behaviors: its numbers and which control mode runs
-each behaviour; library: what the interface asks of a behaviour beyond Stand (Walk, Step,
-a user's own); user_behaviour: a user's class named by a launch argument, loaded; session:
-requests taken or refused and the feedback status; walk_params:
-a WALK's steps and walk_feedback; interface: one simulator's requests applied and its
-states built; walk_client: what a walking client does with each state; walk_demo: DRCSim's
-actionlib server's decisions; teleop: the keyboard teleop's keys and steps; mode_switching:
-DRCSim's mode-switching demo as cues of messages.
+over the simulator and the balance. errors: AsiInputError, an input its clients cannot
+take; behaviors: its numbers and which control mode runs each behaviour; library: what the
+interface asks of a behaviour beyond Stand (Walk, Step, a user's own); user_behaviour: a
+user's class named by a launch argument, loaded; session: requests taken or refused and the
+feedback status; walk_params: a WALK's steps and walk_feedback; interface: one simulator's
+requests applied and its states built; walk_client: what a walking client does with each
+state; walk_demo: DRCSim's actionlib server's decisions; teleop: the keyboard teleop's keys
+and steps; mode_switching: DRCSim's mode-switching demo as cues of messages.
 """
 
 from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'behaviors': ['BEHAVIOR_OF_MODE', 'MODE_OF_BEHAVIOR', 'AsiError', 'Behavior', 'Status'],
+    'errors': ['AsiInputError'],
     'interface': ['DOWN_PELVIS_M', 'FALLING_PELVIS_M', 'FALLING_TILT_RAD', 'AtlasSimInterface',
                   'fallen_robot', 'falling_robot'],
     'library': ['BehaviourBase', 'Handover', 'LibraryBehaviour', 'StepEntry', 'WalkEntry'],

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.asi.behaviors import Behavior
+from tutorial_atlas_control.asi.errors import AsiInputError
 from tutorial_atlas_control.joints import JOINT_INDEX, NUM_JOINTS
 from tutorial_atlas_control.msgs import (
     AsiCommand,
@@ -122,4 +123,4 @@ def cue_messages(cue: Cue, stamp_ns: int, kp_position: Sequence[float],
     if cue.name == 'USER, zeros':
         return [(topics.ASI_COMMAND, _asi_command(stamp_ns, Behavior.USER, every)),
                 (topics.ATLAS_COMMAND, _atlas_command(stamp_ns, zeros, kp_position, kp_velocity))]
-    raise ValueError(f'unknown cue {cue.name!r}')
+    raise AsiInputError(f'unknown cue {cue.name!r}')

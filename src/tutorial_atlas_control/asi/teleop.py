@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+from tutorial_atlas_control.asi.errors import AsiInputError
 from tutorial_atlas_control.walking import (
     LEFT,
     RIGHT,
@@ -80,7 +81,7 @@ def ego_steps(move: str, settings: Settings) -> list[Footstep]:
         return left if move == 'curve left' else [_mirrored(step) for step in left]
     if move in ('side left', 'side right'):
         return _side(count, 0.5 * stride, LEFT if move == 'side left' else RIGHT)
-    raise ValueError(f'no such move: {move!r}')
+    raise AsiInputError(f'no such move: {move!r}')
 
 
 def _turn(count: int, turn_rad: float) -> list[Footstep]:

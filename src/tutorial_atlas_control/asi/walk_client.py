@@ -13,6 +13,7 @@ from __future__ import annotations
 import enum
 
 from tutorial_atlas_control.asi.behaviors import Behavior, Status
+from tutorial_atlas_control.asi.errors import AsiInputError
 from tutorial_atlas_control.walking import QUEUE_LENGTH, Footstep, window
 
 __all__ = ['Outcome', 'WalkClient', 'refusal_hint']
@@ -35,7 +36,7 @@ class WalkClient:
 
     def __init__(self, plan: list[Footstep], streaming: bool = True) -> None:
         if not plan or [step.step_index for step in plan] != list(range(1, len(plan) + 1)):
-            raise ValueError('a plan is steps 1, 2, ... in order')
+            raise AsiInputError('a plan is steps 1, 2, ... in order')
         self.plan = plan
         self.streaming = streaming
         self.outcome: Outcome | None = None

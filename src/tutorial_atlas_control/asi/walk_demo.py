@@ -30,13 +30,10 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from tutorial_atlas_control.asi.behaviors import AsiError, Behavior, Status
+from tutorial_atlas_control.walking import QUEUE_LENGTH, STEPPING, SWAYING
 
 __all__ = ['Decision', 'WalkDemoServer']
 
-#: Steps in a WALK command's queue.
-QUEUE_LENGTH = 4
-#: Step feedback values (ASI.md: the library's, compared as literals by DRCSim's server).
-STEP_SWAYING, STEP_STEPPING = 1, 2
 _ABORTING_STATUS = frozenset({Status.FAILED_TRANS_UNKNOWN_BEHAVIOR,
                               Status.FAILED_TRANS_ILLEGAL_BEHAVIOR, Status.FAILED_TRANS_COM_POS,
                               Status.FAILED_TRANS_COM_VEL, Status.FAILED_TRANS_VEL,
@@ -185,10 +182,10 @@ class WalkDemoServer:
                 decision.commands.append(self._walk_command(start))
         elif goal.behavior == Behavior.STEP:
             flags = state.step_feedback.status_flags
-            if self.active and flags == STEP_SWAYING and self.stepping:
+            if self.active and flags == SWAYING and self.stepping:
                 self.stepping, self.active, self.executing = False, False, False
                 decision.succeeded = True
-            elif flags == STEP_STEPPING:
+            elif flags == STEPPING:
                 self.stepping = True
         elif goal.behavior in (Behavior.STAND, Behavior.STAND_PREP):
             if self.active and state.current_behavior == goal.behavior:

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -26,6 +26,9 @@ from tutorial_atlas_control.bags.reader import BagData
 from tutorial_atlas_control.bags.records import open_bag
 from tutorial_atlas_control.bags.typestore import load_typestore
 from tutorial_atlas_control.errors import BagAnalysisError
+
+if TYPE_CHECKING:
+    from tutorial_atlas_control.balance import SoleBox
 
 __all__ = ['FOOT_BODIES', 'Landing', 'StepTarget', 'WalkSummary', 'landings', 'match_landings',
            'plot_footprints', 'read_step_targets', 'summarise_walk', 'walk_lines']
@@ -86,6 +89,8 @@ class WalkSummary:
     #: How far the feet went, landing to landing, the two feet's mean (m): the path walked
     #: (a circle walked round is long; its distance from the start is short).
     path_m: float | None = None
+    #: The model's sole box, the footprint drawn (None: the plot reads it from the model).
+    sole: SoleBox | None = None
 
     @property
     def steps_taken(self) -> int:
@@ -223,14 +228,17 @@ def match_landings(targets: list[StepTarget],
 
 
 def _foot_poses(data: BagData, since_s: float, until_s: float = np.inf
-                ) -> tuple[np.ndarray, list[np.ndarray], list[np.ndarray], float]:
+                ) -> tuple[np.ndarray, list[np.ndarray], list[np.ndarray], float, SoleBox]:
     """Times (n,) at KINEMATICS_RATE_HZ from `since_s`, per foot its link's world positions
-    (n, 3) and yaws (n,) from the recorded pose, and the links' height (m) with the soles
-    flat on the ground (the Stand pose placed on it)."""
+    (n, 3) and yaws (n,) from the recorded pose, the links' height (m) with the soles
+    flat on the ground (the Stand pose placed on it), and the model's sole box."""
     pelvis, states = data.pelvis, data.joint_states
     assert pelvis is not None and states is not None
     kinematics = RecordedKinematics(data)
-    from tutorial_atlas_control.balance import place_in_stand_pose  # noqa: PLC0415 - mujoco
+    from tutorial_atlas_control.balance import (  # noqa: PLC0415 - they import mujoco
+        SoleBox,
+        place_in_stand_pose,
+    )
 
     bodies = [kinematics.body_id(name) for name in FOOT_BODIES]
     place_in_stand_pose(kinematics.atlas, kinematics.data)  # the soles flat on the ground
@@ -246,7 +254,7 @@ def _foot_poses(data: BagData, since_s: float, until_s: float = np.inf
             positions[foot][row] = placed.xpos[body]
             xmat = placed.xmat[body]
             yaws[foot][row] = np.arctan2(xmat[3], xmat[0])
-    return t_s, positions, yaws, standing_m
+    return t_s, positions, yaws, standing_m, SoleBox.of(kinematics.atlas.model)
 
 
 def summarise_walk(data: BagData, window_s: tuple[float, float] | None = None
@@ -259,7 +267,7 @@ def summarise_walk(data: BagData, window_s: tuple[float, float] | None = None
             or not len(pelvis.t_s) or not len(data.joint_states.t_s):
         return None
     until_s = np.inf if window_s is None else window_s[1]
-    t_s, positions, yaws, standing_m = _foot_poses(data, first_walk_s, until_s)
+    t_s, positions, yaws, standing_m, sole = _foot_poses(data, first_walk_s, until_s)
     by_foot = [landings(foot, t_s, positions[foot], yaws[foot], standing_m) for foot in (0, 1)]
     placements = match_landings(targets, by_foot)
     walking = (pelvis.t_s >= first_walk_s) & (pelvis.t_s <= until_s)
@@ -269,7 +277,7 @@ def summarise_walk(data: BagData, window_s: tuple[float, float] | None = None
     travel = [_travel(positions[foot][0, :2] if len(t_s) else None, by_foot[foot])
               for foot in (0, 1)]
     return WalkSummary(placements, distance, lowest is not None and lowest < FALL_HEIGHT_M,
-                       lowest, path[:, :2].copy(), path_m=float(np.mean(travel)))
+                       lowest, path[:, :2].copy(), path_m=float(np.mean(travel)), sole=sole)
 
 
 def _travel(start_xy: np.ndarray | None, landed: list[Landing]) -> float:
@@ -324,12 +332,13 @@ def plot_footprints(summary: WalkSummary, path: Path) -> Path:
                                                                  8.0)) + 1.4))
     ax.plot(summary.pelvis_xy[:, 0], summary.pelvis_xy[:, 1], color='0.6', lw=1,
             label='pelvis')
+    sole = summary.sole or _model_sole()
     for target, landing in summary.placements:
         colour = colours[target.foot_index % 2]
-        ax.add_patch(_sole(target.x_m, target.y_m, target.yaw_rad, Rectangle,
+        ax.add_patch(_sole(sole, target.x_m, target.y_m, target.yaw_rad, Rectangle,
                            fill=False, edgecolor=colour, lw=1))
         if landing is not None:
-            ax.add_patch(_sole(landing.x_m, landing.y_m, landing.yaw_rad, Rectangle,
+            ax.add_patch(_sole(sole, landing.x_m, landing.y_m, landing.yaw_rad, Rectangle,
                                facecolor=colour, alpha=0.35, edgecolor='none'))
     ax.plot([], [], color=colours[0], label='left foot: asked (outline), landed (filled)')
     ax.plot([], [], color=colours[1], label='right foot')
@@ -349,17 +358,20 @@ def plot_footprints(summary: WalkSummary, path: Path) -> Path:
     return path
 
 
-#: The sole drawn for a foot link's pose: (length, width) (m), and how far ahead of the
-#: link's origin its centre is (m), as the model's sole boxes.
-_SOLE_SIZE_M = (0.26, 0.125)
-_SOLE_AHEAD_M = 0.048
+def _model_sole() -> SoleBox:
+    """The sole box of the model, for a summary made without one."""
+    from tutorial_atlas_control.balance import SoleBox  # noqa: PLC0415 - imports mujoco
+    from tutorial_atlas_control.sim import load_model  # noqa: PLC0415 - imports mujoco
+
+    return SoleBox.of(load_model().model)
 
 
-def _sole(x_m: float, y_m: float, yaw_rad: float, rectangle: Any, **style: Any) -> Any:
+def _sole(sole: SoleBox, x_m: float, y_m: float, yaw_rad: float, rectangle: Any,
+          **style: Any) -> Any:
     """The sole's rectangle for a foot link at (x, y, yaw)."""
-    length, width = _SOLE_SIZE_M
+    length, width = 2.0 * sole.half_length_m, 2.0 * sole.half_width_m
     c, s = np.cos(yaw_rad), np.sin(yaw_rad)
-    centre = np.array([x_m + c * _SOLE_AHEAD_M, y_m + s * _SOLE_AHEAD_M])
+    centre = np.array([x_m + c * sole.ahead_m, y_m + s * sole.ahead_m])
     half_diagonal = np.array([c * length / 2 - s * width / 2, s * length / 2 + c * width / 2])
     corner = centre - half_diagonal  # matplotlib turns the rectangle about this corner
     return rectangle(tuple(corner), length, width, angle=float(np.degrees(yaw_rad)), **style)

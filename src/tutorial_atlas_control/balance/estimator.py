@@ -27,7 +27,7 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control.balance import lipm, support
-from tutorial_atlas_control.balance.stand_pose import SOLE_GEOMS
+from tutorial_atlas_control.balance.sole import BOTTOM_CORNER_SIGNS, SoleBox, sole_geom_ids
 from tutorial_atlas_control.sim import AtlasModel
 
 #: A sole within this of a surface (m) touches it and carries weight: the soles' collision
@@ -103,8 +103,8 @@ class BalanceEstimator:
         self.model = copy.deepcopy(atlas.model)
         self.scratch = mujoco.MjData(self.model)
         self.mass_kg = float(self.model.body_subtreemass[0])
-        self._soles = [mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_GEOM, name)
-                       for name in SOLE_GEOMS]
+        self._soles = sole_geom_ids(self.model)
+        self.sole = SoleBox.of(self.model)
         self.model.geom_margin[self._soles] = CONTACT_HEIGHT_M
         self._sole_bodies = [int(self.model.geom_bodyid[g]) for g in self._soles]
         self._pelvis = atlas.pelvis_body_id
@@ -112,8 +112,8 @@ class BalanceEstimator:
         self._dof_adr = atlas.dof_adr
         self._bias = np.zeros(self.model.nv)
         self._free_dof = int(self.model.jnt_dofadr[self.model.body_jntadr[self._pelvis]])
-        signs = np.array([[1, 1, -1], [1, -1, -1], [-1, -1, -1], [-1, 1, -1]], dtype=np.float64)
-        self._corner_offsets = np.array([signs * self.model.geom_size[g] for g in self._soles])
+        self._corner_offsets = np.array([BOTTOM_CORNER_SIGNS * self.model.geom_size[g]
+                                         for g in self._soles])
         self._half_thickness = self.model.geom_size[self._soles, 2][:, None]
         # The two soles are the same box.
         self._half_size = self.model.geom_size[self._soles[0]].copy()
@@ -131,12 +131,12 @@ class BalanceEstimator:
     def sole_ahead_m(self) -> float:
         """How far ahead of its foot link's origin (the ankle) a sole's centre lies (m),
         along the foot: the model's."""
-        return float(self.model.geom_pos[self._soles[0]][0])
+        return self.sole.ahead_m
 
     @property
     def sole_half_size_m(self) -> tuple[float, float]:
         """(half length, half width) of a sole box (m): the model's."""
-        return float(self._half_size[0]), float(self._half_size[1])
+        return self.sole.half_size_m
 
     def _support_polygon(self, positions: np.ndarray, rotations: np.ndarray,
                          contact: tuple[bool, bool]) -> np.ndarray:

@@ -11,8 +11,14 @@ inside the support polygon. These are the textbook formulas (Pratt 2006, Englsbe
 from __future__ import annotations
 
 import math
+from typing import TypeVar
 
 import numpy as np
+
+from tutorial_atlas_control.balance.errors import BalanceError
+
+#: A point on one axis (float: step_adjustment's per-axis arithmetic) or in the plane (m).
+Point = TypeVar('Point', float, np.ndarray)
 
 #: Standard gravity (m/s^2), the model's |gravity|.
 GRAVITY_M_S2 = 9.81
@@ -21,7 +27,7 @@ GRAVITY_M_S2 = 9.81
 def natural_frequency(com_height_m: float, gravity_m_s2: float = GRAVITY_M_S2) -> float:
     """omega = sqrt(g / z) (1/s) of a pendulum whose centre of mass is `com_height_m` up."""
     if not com_height_m > 0.0:
-        raise ValueError(f'centre-of-mass height {com_height_m} m must be above the ground')
+        raise BalanceError(f'centre-of-mass height {com_height_m} m must be above the ground')
     return math.sqrt(gravity_m_s2 / com_height_m)
 
 
@@ -43,14 +49,37 @@ def lipm_state(com0: np.ndarray, velocity0: np.ndarray, cop: np.ndarray, omega: 
     return com, velocity
 
 
-def dcm_feedback_cop(xi: np.ndarray, xi_ref: np.ndarray, gain: float) -> np.ndarray:
+def capture_point_after(xi0: Point, cop: Point, omega: float, t_s: float) -> Point:
+    """The capture point `t_s` after `xi0` with the pressure centre held at `cop` (m).
+
+    xi(t) = p + (xi0 - p) exp(omega t), xi' = omega (xi - p) solved; a negative `t_s` runs
+    it back: where the capture point must have been to reach `xi0` after -t_s.
+    """
+    return cop + (xi0 - cop) * math.exp(omega * t_s)
+
+
+def cop_reaching(xi0: np.ndarray, xi_target: np.ndarray, omega: float,
+                 t_s: float) -> np.ndarray:
+    """The pressure centre that, held, takes the capture point from `xi0` to `xi_target` in
+    `t_s` (m): capture_point_after solved for p, p = (xi_T - g xi0) / (1 - g),
+    g = exp(omega t_s)."""
+    growth = math.exp(omega * t_s)
+    return (np.asarray(xi_target) - growth * np.asarray(xi0)) / (1.0 - growth)
+
+
+def dcm_feedback_cop(xi: np.ndarray, xi_ref: np.ndarray, gain: float,
+                     cop_ref: np.ndarray | None = None) -> np.ndarray:
     """The centre of pressure that makes the capture point converge to `xi_ref`.
 
-    p = xi + gain (xi - xi_ref) gives xi' = -omega gain (xi - xi_ref): with gain > 0 the
-    error decays at rate omega * gain; with gain 0 the pressure centre sits on the
-    capture point and the capture point merely stops (no correction back).
+    p = p_ref + (1 + gain) (xi - xi_ref) gives (xi - xi_ref)' = -omega gain (xi - xi_ref)
+    for a reference moving as xi_ref' = omega (xi_ref - p_ref): with gain > 0 the error
+    decays at rate omega * gain; with gain 0 it merely stops growing. Stand's reference is
+    at rest (p_ref = xi_ref, the default: p = xi + gain (xi - xi_ref)); the walk's moves
+    with its plan's pressure centre `cop_ref`.
     """
-    return np.asarray(xi) + gain * (np.asarray(xi) - np.asarray(xi_ref))
+    xi_ref = np.asarray(xi_ref)
+    reference = xi_ref if cop_ref is None else np.asarray(cop_ref)
+    return reference + (1.0 + gain) * (np.asarray(xi) - xi_ref)
 
 
 def com_acceleration(com_xy: np.ndarray, cop_xy: np.ndarray, omega: float) -> np.ndarray:

@@ -26,12 +26,8 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from tutorial_atlas_control.balance.stand_pose import (
-    SOLE_GEOMS,
-    STAND_POSE_RAD,
-    place_in_stand_pose,
-    sole_corners,
-)
+from tutorial_atlas_control.balance.sole import lowest_sole_corner_m, sole_geom_ids
+from tutorial_atlas_control.balance.stand_pose import STAND_POSE_RAD, place_in_stand_pose
 from tutorial_atlas_control.joints import JOINT_INDEX
 from tutorial_atlas_control.sim import AtlasModel
 
@@ -104,22 +100,15 @@ def place_pitched(atlas: AtlasModel, data: mujoco.MjData,
     adr = atlas.free_qpos_adr
     data.qpos[adr + 3:adr + 7] = (np.cos(pitch / 2.0), 0.0, np.sin(pitch / 2.0), 0.0)
     mujoco.mj_kinematics(atlas.model, data)
-    lowest = min(float(np.min(sole_corners(atlas.model, data, name)[:, 2]))
-                 for name in SOLE_GEOMS)
-    data.qpos[adr + 2] -= lowest
+    data.qpos[adr + 2] -= lowest_sole_corner_m(atlas.model, data)
     mujoco.mj_kinematics(atlas.model, data)
     mujoco.mj_comPos(atlas.model, data)
     return float(data.qpos[adr + 2])
 
 
-def _sole_geoms(atlas: AtlasModel) -> list[int]:
-    return [mujoco.mj_name2id(atlas.model, mujoco.mjtObj.mjOBJ_GEOM, name)
-            for name in SOLE_GEOMS]
-
-
 def _com_ahead_m(atlas: AtlasModel, data: mujoco.MjData) -> float:
     """How far (m) the centre of mass is ahead of the soles' middle, after placing."""
-    soles = _sole_geoms(atlas)
+    soles = sole_geom_ids(atlas.model)
     return float(data.subtree_com[0][0] - np.mean([data.geom_xpos[g][0] for g in soles]))
 
 

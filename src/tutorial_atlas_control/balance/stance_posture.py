@@ -19,7 +19,8 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from tutorial_atlas_control.balance.stand_pose import SOLE_GEOMS, place_in_stand_pose
+from tutorial_atlas_control.balance.sole import SoleBox, sole_geom_ids
+from tutorial_atlas_control.balance.stand_pose import place_in_stand_pose
 from tutorial_atlas_control.sim import STAND_POSE_RAD, AtlasModel
 
 __all__ = ['Stance', 'StancePosture']
@@ -71,10 +72,9 @@ class StancePosture:
         self.atlas = atlas
         model = atlas.model
         self.data = mujoco.MjData(model)
-        self._soles = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
-                       for name in SOLE_GEOMS]
+        self._soles = sole_geom_ids(model)
         self._sole_bodies = [int(model.geom_bodyid[g]) for g in self._soles]
-        self._half_thickness = float(model.geom_size[self._soles[0]][2])
+        self._half_thickness = SoleBox.of(model).half_thickness_m
         self._lower = atlas.lower_rad + LIMIT_MARGIN_RAD
         self._upper = atlas.upper_rad - LIMIT_MARGIN_RAD
         self._damping = DAMPING_M ** 2 * np.eye(6)

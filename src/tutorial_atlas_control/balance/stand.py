@@ -1,16 +1,18 @@
 """The Stand controller: balance on both feet at DRCSim's Stand pose.
 
-Each 1 ms step it turns a BalanceState into the 28 joint torques, in three parts:
-1. a desired centroidal wrench: the horizontal force of the capture-point law (the centre
-   of pressure p = xi + k (xi - xi_ref), kept inside the support polygon, gives
-   F_xy = m omega^2 (c - p)), the weight plus a PD on the centre-of-mass height, and a PD
-   moment holding the pelvis upright at its reference yaw;
-2. that wrench shared between the feet (contact_wrench) and turned into joint torques by
-   inverse statics, tau = bias - J_c^T lambda (gravity and Coriolis of the whole body
-   included, so no joint has to sag to hold its weight);
-3. a joint PD to the Stand pose on top: stiff for the back, neck and arms (the balance
-   treats them as a rigid load), light damping only on the legs, whose angles follow from
-   where the pelvis is held.
+Each 1 ms step it builds the whole-body layer's tasks and constraints (whole_body.py) from
+its reference and solves them into the 28 joint torques:
+1. centroidal tasks: the horizontal force of the capture-point law (the centre of pressure
+   p = xi + k (xi - xi_ref), kept inside the support polygon, gives F_xy = m omega^2 (c - p)),
+   the weight plus a PD on the centre-of-mass height, and a PD moment holding the pelvis
+   upright at its reference yaw;
+2. a contact constraint per sole: that wrench shared between the feet in contact, each share
+   pressing down, its pressure centre on the sole and its force within friction, turned into
+   joint torques by inverse statics, tau = bias - J_c^T lambda (gravity and Coriolis of the
+   whole body included, so no joint has to sag to hold its weight);
+3. a posture task on top: a joint PD to the Stand pose, stiff for the back, neck and arms
+   (the balance treats them as a rigid load), light damping only on the legs, whose angles
+   follow from where the pelvis is held; and the joint torque limits.
 With the capture-point gain at 0 the pressure centre sits on the capture point, which then
 stops but never returns: that is the planted defect the tests show falling.
 """
@@ -22,9 +24,23 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tutorial_atlas_control.balance import contact_wrench, lipm, support
+from tutorial_atlas_control.balance import lipm, support
 from tutorial_atlas_control.balance.estimator import BalanceState
 from tutorial_atlas_control.balance.stand_pose import STAND_POSE_RAD
+from tutorial_atlas_control.balance.whole_body import (
+    CapturePointTask,
+    CentroidalTask,
+    ComHeightTask,
+    ContactConstraint,
+    PelvisOrientationTask,
+    PostureTask,
+    WholeBodyLayer,
+    orientation_error,
+)
+
+__all__ = ['STAND_JOINT_KD', 'STAND_JOINT_KP', 'StandController', 'StandGains', 'StandOutput',
+           'StandReference', 'orientation_error', 'pelvis_frame', 'pitch_of', 'yaw_of',
+           'yaw_rotation']
 
 #: Joint PD to the Stand pose (N m/rad, N m s/rad), tutorial order. Back, neck and arms:
 #: DRCSim's atlas_controller gains (config/atlas_controller.yaml), stable at 1 kHz on the
@@ -58,6 +74,9 @@ class StandGains:
     #: Pelvis orientation PD (N m/rad, N m s/rad).
     orientation_kp: float = 3000.0
     orientation_kd: float = 300.0
+    #: The soles' friction coefficient the contact wrenches are kept within (the model's
+    #: sole and floor friction, sim/atlas_v1.xml); None: not limited.
+    friction: float | None = 1.0
     #: Joint PD to the Stand pose (N m/rad, N m s/rad), tutorial order.
     joint_kp: np.ndarray = field(default_factory=STAND_JOINT_KP.copy)
     joint_kd: np.ndarray = field(default_factory=STAND_JOINT_KD.copy)
@@ -114,12 +133,6 @@ def pelvis_frame(yaw_rad: float, pitch_rad: float = 0.0) -> np.ndarray:
     return yaw_rotation(yaw_rad) @ np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
-def orientation_error(rotation: np.ndarray, reference: np.ndarray) -> np.ndarray:
-    """The small rotation (rad, world axis) that takes `rotation` to `reference`."""
-    (d00, d01, d02), (d10, d11, d12), (d20, d21, d22) = (reference @ rotation.T).tolist()
-    return np.array([0.5 * (d21 - d12), 0.5 * (d02 - d20), 0.5 * (d10 - d01)])
-
-
 @dataclass(frozen=True)
 class StandOutput:
     """One step's decision, kept for feedback and tests."""
@@ -144,6 +157,7 @@ class StandController:
         self.reference = reference
         self.sole_half_size_m = sole_half_size_m
         self.gains = gains or StandGains()
+        self.layer = WholeBodyLayer(mass_kg, self.effort_limit_nm)
         self._region: tuple[np.ndarray, support.Region] | None = None
 
     def desired_cop(self, state: BalanceState) -> np.ndarray:
@@ -158,54 +172,50 @@ class StandController:
             self._region = (polygon, support.Region(polygon, self.gains.cop_margin_m))
         return self._region[1].clamp(cop)
 
+    def tasks(self, state: BalanceState, cop: np.ndarray,
+              reference: StandReference) -> list[CentroidalTask]:
+        """The centroidal tasks that hold the robot at `reference` with the pressure centre
+        at `cop`: the capture point's force, the height's, the pelvis frame's moment."""
+        gains = self.gains
+        return [CapturePointTask(cop),
+                ComHeightTask(reference.com_height_m, reference.com_height_rate_m_s,
+                              gains.height_kp, gains.height_kd),
+                PelvisOrientationTask(reference.pelvis_rotation,
+                                      reference.pelvis_angular_velocity,
+                                      gains.orientation_kp, gains.orientation_kd)]
+
     def centroidal_wrench(self, state: BalanceState,
                           cop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(force (3,) N, moment about the CoM (3,) N m) the contacts should exert."""
-        gains, reference, mass = self.gains, self.reference, self.mass_kg
-        # In plain floats (every 1 ms step), in numpy's order of operations: the same bits.
-        com_x, com_y, com_z = state.com.tolist()
-        cop_x, cop_y = np.asarray(cop, dtype=np.float64).tolist()
-        stiffness = state.omega * state.omega  # lipm.com_acceleration's omega^2 (c - p)
-        vertical = (gains.height_kp * (reference.com_height_m - com_z)
-                    + gains.height_kd * (reference.com_height_rate_m_s
-                                         - float(state.com_velocity[2])))
-        force = np.array([mass * (stiffness * (com_x - cop_x) + 0.0),
-                          mass * (stiffness * (com_y - cop_y) + 0.0),
-                          mass * (vertical + lipm.GRAVITY_M_S2)])
-        error = orientation_error(state.pelvis_rotation, reference.pelvis_rotation).tolist()
-        kp, kd = gains.orientation_kp, gains.orientation_kd
-        moment = np.array([kp * e + kd * (w_ref - w) for e, w_ref, w in zip(
-            error, reference.pelvis_angular_velocity.tolist(),
-            state.pelvis_angular_velocity.tolist())])
-        return force, moment
+        return self.layer.centroidal_wrench(state, self.tasks(state, cop, self.reference))
 
     def step(self, state: BalanceState, joint_positions: np.ndarray,
              joint_velocities: np.ndarray) -> StandOutput:
         """The 28 joint torques (N m) for this step, clamped to the effort limits."""
         output = self.whole_body(state, self.desired_cop(state), state.in_contact,
                                  joint_positions, joint_velocities)
-        np.clip(output.torque_nm, -self.effort_limit_nm, self.effort_limit_nm,
-                out=output.torque_nm)
+        self.layer.limit(output.torque_nm)
         return output
 
     def whole_body(self, state: BalanceState, cop: np.ndarray, contact: tuple[bool, bool],
                    joint_positions: np.ndarray, joint_velocities: np.ndarray,
                    joint_gains: tuple[np.ndarray, np.ndarray] | None = None,
-                   torsion_m: float | None = None) -> StandOutput:
-        """The torques that make the soles in `contact` press the centroidal wrench for
-        `cop` (inverse statics, each sole's wrench made feasible: `torsion_m`, its yaw
-        moment too), plus the joint PD to the posture (`joint_gains` (kp, kd), else the
-        Stand's); not yet clamped to the effort limits (Walk adds its swing leg's first)."""
-        force, moment = self.centroidal_wrench(state, cop)
-        wrenches = contact_wrench.split_wrench(force, moment, state.sole_centres, state.com,
-                                               contact)
+                   torsion_m: float | None = None,
+                   reference: StandReference | None = None) -> StandOutput:
+        """The whole-body layer's torques for `reference` (else the Stand's own) with the
+        pressure centre at `cop`, pressed by the soles in `contact` (`torsion_m`: their yaw
+        moment limited too), plus the joint PD to the reference's posture (`joint_gains`
+        (kp, kd), else the Stand's); not yet clamped to the effort limits (Walk adds its
+        swing leg's first)."""
+        reference = reference or self.reference
         half_length, half_width = self.sole_half_size_m
-        for foot in (0, 1):
-            wrenches[foot] = contact_wrench.make_feasible(
-                wrenches[foot], state.sole_rotations[foot], half_length, half_width, torsion_m)
-        torque = state.bias_nm - state.sole_jacobians.reshape(12, -1).T @ wrenches.reshape(12)
+        friction = self.gains.friction
+        contacts = (ContactConstraint(contact[0], half_length, half_width, torsion_m, friction),
+                    ContactConstraint(contact[1], half_length, half_width, torsion_m, friction))
         joint_kp, joint_kd = joint_gains or (self.gains.joint_kp, self.gains.joint_kd)
-        reference = self.reference
-        torque += (joint_kp * (reference.posture_rad - joint_positions)
-                   + joint_kd * (reference.posture_rate_rad_s - joint_velocities))
-        return StandOutput(torque, cop, force, moment, wrenches)
+        posture = PostureTask(reference.posture_rad, reference.posture_rate_rad_s, joint_kp,
+                              joint_kd)
+        solved = self.layer.solve(state, self.tasks(state, cop, reference), contacts,
+                                  (posture,), joint_positions, joint_velocities)
+        return StandOutput(solved.torque_nm, cop, solved.force_n, solved.moment_nm,
+                           solved.contact_wrenches)

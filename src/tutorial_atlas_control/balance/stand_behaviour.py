@@ -24,6 +24,8 @@ import functools
 import mujoco
 import numpy as np
 
+from tutorial_atlas_control.balance.blend import smoothstep, smoothstep_rate
+from tutorial_atlas_control.balance.errors import BalanceError
 from tutorial_atlas_control.balance.estimator import BalanceEstimator, BalanceState
 from tutorial_atlas_control.balance.manipulate import (
     PelvisServo,
@@ -61,12 +63,6 @@ def stand_pose_com_height_m(atlas: AtlasModel) -> float:
     place_in_stand_pose(atlas, data)
     mujoco.mj_comPos(atlas.model, data)
     return float(data.subtree_com[0][2])
-
-
-def smoothstep(fraction: float) -> float:
-    """0 at 0, 1 at 1 and beyond, with zero slope at both ends."""
-    s = min(max(fraction, 0.0), 1.0)
-    return s * s * (3.0 - 2.0 * s)
 
 
 _UP = np.array([0.0, 0.0, 1.0])
@@ -187,7 +183,7 @@ class StandBehaviour:
             return target
         controller, state = self.controller, self.last_state
         if controller is None or state is None:
-            raise RuntimeError('StandBehaviour.servo before start()')
+            raise BalanceError('StandBehaviour.servo before start()')
         feet = state.sole_centres[:, :2]
         headings = state.sole_rotations[:, 0:2, 0].sum(axis=0)
         feet_yaw = float(np.arctan2(headings[1], headings[0]))
@@ -248,7 +244,7 @@ class StandBehaviour:
         if not transition.with_rates:
             return StandReference(capture_point, float(vector[29]), pelvis_frame(yaw, pitch),
                                   vector[:28])
-        s_rate = 6.0 * fraction * (1.0 - fraction) / duration  # ds/dt: smoothstep's
+        s_rate = smoothstep_rate(fraction, duration)  # ds/dt
         rate = per_s * s_rate
         return StandReference(
             capture_point, float(vector[29]), pelvis_frame(yaw, pitch), vector[:28],
@@ -260,7 +256,7 @@ class StandBehaviour:
         """This step's f_out (N m, (28,)), within the effort limits."""
         controller = self.controller
         if controller is None:
-            raise RuntimeError('StandBehaviour.torque before start()')
+            raise BalanceError('StandBehaviour.torque before start()')
         if self._transition is not None:
             controller.reference = self._reference_at(float(data.time))
         atlas = self.atlas

@@ -5,13 +5,10 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
+from tutorial_atlas_control.balance.sole import lowest_sole_corner_m
 from tutorial_atlas_control.sim import STAND_POSE_RAD, AtlasModel, reset_to_initial
 
-__all__ = ['STAND_POSE_RAD', 'place_in_stand_pose', 'sole_corners']
-
-
-#: The sole boxes of the model (sim/atlas_v1.xml), left then right.
-SOLE_GEOMS: tuple[str, str] = ('l_foot_sole', 'r_foot_sole')
+__all__ = ['STAND_POSE_RAD', 'place_in_stand_pose']
 
 
 def place_in_stand_pose(atlas: AtlasModel, data: mujoco.MjData,
@@ -25,19 +22,9 @@ def place_in_stand_pose(atlas: AtlasModel, data: mujoco.MjData,
     reset_to_initial(atlas, data)
     data.qpos[atlas.qpos_adr] = joint_angles_rad
     mujoco.mj_kinematics(atlas.model, data)
-    lowest = min(float(np.min(sole_corners(atlas.model, data, name)[:, 2]))
-                 for name in SOLE_GEOMS)
     adr = atlas.free_qpos_adr
-    data.qpos[adr + 2] -= lowest
+    data.qpos[adr + 2] -= lowest_sole_corner_m(atlas.model, data)
     data.qvel[:] = 0.0
     mujoco.mj_forward(atlas.model, data)
     return float(data.qpos[adr + 2])
 
-
-def sole_corners(model: mujoco.MjModel, data: mujoco.MjData, geom_name: str) -> np.ndarray:
-    """The four bottom corners (4, 3) (m, world) of a sole box, after kinematics."""
-    geom = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, geom_name)
-    half = model.geom_size[geom]
-    signs = np.array([[1, 1, -1], [1, -1, -1], [-1, -1, -1], [-1, 1, -1]], dtype=np.float64)
-    rotation = data.geom_xmat[geom].reshape(3, 3)
-    return data.geom_xpos[geom] + (signs * half) @ rotation.T

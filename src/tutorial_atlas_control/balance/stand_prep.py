@@ -12,7 +12,8 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from tutorial_atlas_control.balance.stand_behaviour import smoothstep
+from tutorial_atlas_control.balance.blend import smoothstep
+from tutorial_atlas_control.balance.errors import BalanceError
 from tutorial_atlas_control.balance.stand_pose import STAND_POSE_RAD
 from tutorial_atlas_control.sim import AtlasModel, Gains
 
@@ -38,7 +39,7 @@ class StandPrepBehaviour:
     def target_at(self, time_s: float) -> np.ndarray:
         """The pose (rad) followed at `time_s`: the Stand pose once PREP_S has passed."""
         if self._start is None:
-            raise RuntimeError('StandPrepBehaviour.target_at before start()')
+            raise BalanceError('StandPrepBehaviour.target_at before start()')
         started_s, initial = self._start
         s = smoothstep((time_s - started_s) / self.prep_s if self.prep_s > 0.0 else 1.0)
         return (1.0 - s) * initial + s * STAND_POSE_RAD

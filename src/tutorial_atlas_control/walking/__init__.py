@@ -1,31 +1,33 @@
 """Walking without ROS: the footsteps Walk and Step take and the plan they follow.
 
-footsteps: a step as the AtlasSimInterface names it, DRCSim's fixed queue, straight and
-circular plans, a streaming client's window; step_queue: Walk's queue of steps merged by
-index, clamped to what the legs reach, and its feedback flags; dcm_plan: the capture
-point's plan over the steps and the law that tracks it; step_adjustment: where a pushed
-swing foot must land instead; swing: the swing foot's path;
-leg_tasks: what Walk and Step do alike each step (the whole-body law on the carrying
-soles, the swing foot, the pelvis's heading); walk: the walk's phases; walk_behaviour: Walk as the
-simulator's behaviour; start_noise: a trial's start perturbed by a seed; walk_trial: offline
-walking trials, landing by landing, pushed or not; static_step:
-one quasi-static step; step_behaviour: Step as the simulator's behaviour.
+errors: WalkingError, what the walk refuses; footsteps: a step as the AtlasSimInterface
+names it, DRCSim's fixed queue, straight and circular plans, a streaming client's window;
+status_flags: walk_feedback's and step_feedback's status values; step_queue: Walk's queue
+of steps merged by index, clamped to what the legs reach, and its feedback flags;
+dcm_plan: the capture point's plan over the steps; step_adjustment: where a pushed swing
+foot must land instead; swing: the swing foot's path; leg_tasks: what Walk and Step do
+alike each step (the whole-body law on the carrying soles, the swing foot, the pelvis's
+heading); walk: the walk's phases; walk_behaviour: Walk as the simulator's behaviour;
+start_noise: a trial's start perturbed by a seed; walk_trial: offline walking trials,
+landing by landing, pushed or not; static_step: one quasi-static step; step_behaviour:
+Step as the simulator's behaviour.
 """
 
 from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
-    'dcm_plan': ['DcmPlan', 'tracking_cop'],
+    'dcm_plan': ['DcmPlan'],
+    'errors': ['WalkingError'],
     'footsteps': ['DRCSIM_WALK_QUEUE', 'LEFT', 'QUEUE_LENGTH', 'RIGHT', 'STANCE_WIDTH_M',
                   'STEP_DURATION_S', 'Footstep', 'circle_steps', 'placed', 'side_sign',
                   'straight_steps', 'window', 'wrap_angle'],
-    'step_queue': ['CATCHING', 'ERROR_INCONSISTENT_STEPS', 'OKAY', 'STEPPING', 'SWAYING',
-                   'WARNING_INSUFFICIENT_STEP_DATA', 'StepLimits', 'StepQueue', 'clamp_pose',
-                   'clamp_step'],
+    'status_flags': ['CATCHING', 'ERROR_INCONSISTENT_STEPS', 'OKAY', 'STEPPING', 'SWAYING',
+                     'WARNING_INSUFFICIENT_STEP_DATA'],
+    'step_queue': ['StepLimits', 'StepQueue', 'clamp_pose', 'clamp_step'],
     'step_adjustment': ['foothold_shift', 'predicted_error'],
     'swing': ['SWING_HEIGHT_M', 'SwingPath', 'bump', 'quintic'],
     'leg_tasks': ['LEG_JOINTS', 'LegGains', 'LegTasks', 'foot_pose'],
-    'walk': ['WalkController', 'WalkGains', 'WalkOutput', 'sway_cop'],
+    'walk': ['WalkController', 'WalkGains', 'WalkOutput'],
     'walk_behaviour': ['WalkBehaviour', 'WalkStatus'],
     'start_noise': ['DEFAULT_START_NOISE', 'StartNoise', 'perturb_start'],
     'walk_trial': ['Landing', 'WalkTrial', 'WalkingStand', 'pushed_walk_trial',

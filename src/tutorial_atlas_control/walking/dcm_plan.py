@@ -4,17 +4,19 @@ With the pressure centre held at the stance foot's centre p_i during step i (dur
 the capture point moves as xi(t) = p_i + (xi_i,end - p_i) exp(omega (t - T_i)). Ending the
 walk with the capture point between the last two feet fixes every step's end point by
 backward recursion, xi_i,end = p_(i+1) + (xi_(i+1),end - p_(i+1)) exp(-omega T_(i+1))
-(Englsberger, Ott and Albu-Schaeffer 2015, with constant pressure centres). Tracking it with
-p = p_ref + (1 + k) (xi - xi_ref) makes the error decay at omega k, the Stand's law with a
-moving reference.
+(Englsberger, Ott and Albu-Schaeffer 2015, with constant pressure centres). The walk tracks
+it with the Stand's law, lipm.dcm_feedback_cop with the plan's pressure centre as p_ref:
+p = p_ref + (1 + k) (xi - xi_ref), the error decaying at omega k.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
+
+from tutorial_atlas_control.balance import capture_point_after
+from tutorial_atlas_control.walking.errors import WalkingError
 
 
 @dataclass(frozen=True)
@@ -34,32 +36,27 @@ class DcmPlan:
         cops = np.asarray(cops, dtype=float).reshape(-1, 2)
         durations = np.asarray(durations_s, dtype=float).reshape(-1)
         if len(cops) != len(durations) or len(cops) == 0:
-            raise ValueError('one duration per pressure centre, at least one step')
+            raise WalkingError('one duration per pressure centre, at least one step')
         if not np.all(durations > 0.0):
-            raise ValueError('every step duration must be positive')
+            raise WalkingError('every step duration must be positive')
         ends = np.empty_like(cops)
         after = np.asarray(final, dtype=float)
         for i in range(len(cops) - 1, -1, -1):
             ends[i] = after
-            after = cops[i] + (after - cops[i]) * math.exp(-omega * durations[i])
+            after = capture_point_after(after, cops[i], omega, -float(durations[i]))
         return cls(cops, durations, ends, omega)
 
     @property
     def start(self) -> np.ndarray:
         """Where the capture point must be as step 0 begins."""
-        return self.cops[0] + (self.ends[0] - self.cops[0]) * math.exp(
-            -self.omega * self.durations_s[0])
+        return capture_point_after(self.ends[0], self.cops[0], self.omega,
+                                   -float(self.durations_s[0]))
 
     def reference(self, step: int, t_s: float) -> tuple[np.ndarray, np.ndarray]:
         """(xi_ref, p_ref) at `t_s` into step `step` (clamped to the step's duration)."""
         t = min(max(t_s, 0.0), float(self.durations_s[step]))
         cop = self.cops[step]
-        xi = cop + (self.ends[step] - cop) * math.exp(
-            self.omega * (t - float(self.durations_s[step])))
+        xi = capture_point_after(self.ends[step], cop, self.omega,
+                                 t - float(self.durations_s[step]))
         return xi, cop
 
-
-def tracking_cop(xi: np.ndarray, xi_ref: np.ndarray, cop_ref: np.ndarray,
-                 gain: float) -> np.ndarray:
-    """p = p_ref + (1 + gain) (xi - xi_ref): the error xi - xi_ref decays at omega * gain."""
-    return np.asarray(cop_ref) + (1.0 + gain) * (np.asarray(xi) - np.asarray(xi_ref))

@@ -1,7 +1,8 @@
-"""What Walk and Step do alike each 1 ms step: the Stand's whole-body law on the feet that
-carry the robot, a swing foot servoed along its path, a foot that should be down put back
-flat on its last pose, the pelvis turned towards the feet's heading and lowered to the
-walking height.
+"""What Walk and Step do alike each 1 ms step: the Stand's tasks on the whole-body layer
+(balance/whole_body.py) over the feet that carry the robot, with the legs' own reference
+(the pelvis turned towards the feet's heading, lowered to the walking height: the Stand's
+own reference is not touched), a swing foot servoed along its path, a foot that should be
+down put back flat on its last pose.
 
 The Stand's joint PD keeps the arms and the back; the legs' posture gains are off (leg_kd
 of damping instead): in single support the stance leg's joints follow from the pelvis and
@@ -30,10 +31,12 @@ import numpy as np
 from tutorial_atlas_control.balance import (
     BalanceState,
     StandController,
+    box_corners,
     clamp_into,
     convex_hull,
     orientation_error,
     smoothstep,
+    smoothstep_rate,
     yaw_of,
     yaw_rotation,
 )
@@ -93,11 +96,14 @@ def foot_pose(state: BalanceState, foot: int, step_index: int = 0) -> Footstep:
 
 
 class LegTasks:
-    """The shared torques over one StandController, whose reference's heading it turns."""
+    """The shared torques over one StandController's tasks, with a reference of their own."""
 
     def __init__(self, stand: StandController, gains: LegGains, time_s: float) -> None:
         self.stand = stand
         self.gains = gains
+        #: The legs' own reference for the whole-body layer: the Stand's as the walk or
+        #: step begins, its heading and height moved on (the Stand's is left as it is).
+        self.reference = stand.reference
         #: The Stand's joint PD with the legs' posture gains off (damping leg_kd instead).
         joint_kp, joint_kd = stand.gains.joint_kp.copy(), stand.gains.joint_kd.copy()
         joint_kp[LEG_JOINTS] = 0.0
@@ -124,9 +130,8 @@ class LegTasks:
         """The CoM height's reference and its rate at `time_s` (m, m/s)."""
         started_s, duration_s, start, change = self._height
         fraction = (time_s - started_s) / duration_s
-        rate = (6.0 * fraction * (1.0 - fraction) * change / duration_s
-                if 0.0 < fraction < 1.0 else 0.0)
-        return start + smoothstep(fraction) * change, rate
+        return (start + smoothstep(fraction) * change,
+                smoothstep_rate(fraction, duration_s) * change)
 
     def face(self, first_yaw_rad: float, second_yaw_rad: float, time_s: float,
              duration_s: float) -> None:
@@ -218,20 +223,22 @@ class LegTasks:
         is clipped yet."""
         stand = self.stand
         height, height_rate = self.height(time_s)
-        stand.reference = replace(stand.reference,
-                                  pelvis_rotation=yaw_rotation(self.heading(time_s)),
-                                  com_height_m=height, com_height_rate_m_s=height_rate)
+        reference = replace(self.reference, pelvis_rotation=yaw_rotation(self.heading(time_s)),
+                            com_height_m=height, com_height_rate_m_s=height_rate)
         if swing_foot is not None:
             contact = (swing_foot != 0, swing_foot != 1)
             cop = _clamp_to_sole(state, 1 - swing_foot, self.sole_reach_m, cop)
         else:  # swaying or catching: the feet that are down (both, unless a landing is late)
             contact = state.in_contact if any(state.in_contact) else (True, True)
-            corners = np.concatenate([_sole_corners(state, foot, stand.sole_half_size_m)
-                                      for foot in (0, 1) if contact[foot]])
+            half_length, half_width = stand.sole_half_size_m
+            corners = np.concatenate([
+                box_corners(state.sole_centres[foot], state.sole_rotations[foot],
+                            (half_length, half_width, 0.0))[:, 0:2]
+                for foot in (0, 1) if contact[foot]])
             cop = clamp_into(convex_hull(corners), cop, stand.gains.cop_margin_m)
         torsion = self.gains.torsion_m if swing_foot is not None else None
         torque = stand.whole_body(state, cop, contact, joint_positions, joint_velocities,
-                                  self._joint_gains, torsion).torque_nm
+                                  self._joint_gains, torsion, reference).torque_nm
         return torque, cop, contact
 
     def finish(self, state: BalanceState, joint_velocities: np.ndarray, torque: np.ndarray,
@@ -266,12 +273,3 @@ def _clamp_to_sole(state: BalanceState, foot: int, reach_m: tuple[float, float],
     local[1] = min(max(local[1], -reach_y), reach_y)
     return centre + rotation @ local
 
-
-def _sole_corners(state: BalanceState, foot: int,
-                  half_size_m: tuple[float, float]) -> np.ndarray:
-    """The four corners (4, 2) of a sole's bottom face, world x, y."""
-    half_length, half_width = half_size_m
-    offsets = np.array([[half_length, half_width], [half_length, -half_width],
-                        [-half_length, -half_width], [-half_length, half_width]])
-    rotation = state.sole_rotations[foot][0:2, 0:2]
-    return state.sole_centres[foot][0:2] + offsets @ rotation.T

@@ -14,6 +14,7 @@ import numpy as np
 
 from tutorial_atlas_control.balance import place_in_stand_pose
 from tutorial_atlas_control.sim import AtlasModel
+from tutorial_atlas_control.walking.errors import WalkingError
 
 __all__ = ['DEFAULT_START_NOISE', 'StartNoise', 'perturb_start']
 
@@ -27,7 +28,7 @@ class StartNoise:
 
     def __post_init__(self) -> None:
         if not (self.angle_rad >= 0.0 and self.rate_rad_s >= 0.0):
-            raise ValueError(f'start noise must be >= 0, got {self}')
+            raise WalkingError(f'start noise must be >= 0, got {self}')
 
 
 #: The trials' noise: 5 mrad and 5 mrad/s on every joint (at least the 1 mrad, 1 mrad/s

@@ -14,16 +14,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tutorial_atlas_control.balance import BalanceState, StandController, smoothstep
-from tutorial_atlas_control.walking.dcm_plan import tracking_cop
+from tutorial_atlas_control.balance import (
+    BalanceState,
+    StandController,
+    dcm_feedback_cop,
+    smoothstep,
+)
 from tutorial_atlas_control.walking.footsteps import Footstep
 from tutorial_atlas_control.walking.leg_tasks import LegGains, LegTasks, foot_pose
+from tutorial_atlas_control.walking.status_flags import STEPPING, SWAYING
 from tutorial_atlas_control.walking.swing import SwingPath
 
 __all__ = ['StaticStep', 'StepGains']
-
-#: step_feedback.status_flags (ASI.md: the library's values, not the message's constants).
-SWAYING, STEPPING = 1, 2
 
 
 @dataclass(frozen=True)
@@ -122,7 +124,7 @@ class StaticStep:
         """The 28 joint torques (N m) for this 1 ms step, within the effort limits."""
         self._advance(state, time_s)
         xi_ref = self._capture_reference(time_s)
-        cop = tracking_cop(state.capture_point, xi_ref, xi_ref, self.gains.dcm_gain)
+        cop = dcm_feedback_cop(state.capture_point, xi_ref, self.gains.dcm_gain)
         swinging = self.status == STEPPING
         unloading = self.landed is None and not swinging and float(
             np.linalg.norm(state.capture_point - self._shift[2])) < self.gains.unload_m

@@ -22,6 +22,8 @@ from __future__ import annotations
 
 import math
 
+from tutorial_atlas_control.balance import capture_point_after
+
 
 def predicted_error(error_m: float, reach_m: float, gain: float, omega: float,
                     remaining_s: float) -> float:
@@ -38,7 +40,7 @@ def predicted_error(error_m: float, reach_m: float, gain: float, omega: float,
         back_s = math.log((reach - linear) / (reach - magnitude)) / omega
         if back_s < remaining_s:
             return sign * linear * math.exp(-gain * omega * (remaining_s - back_s))
-    return sign * (reach + (magnitude - reach) * math.exp(omega * remaining_s))
+    return sign * capture_point_after(magnitude, reach, omega, remaining_s)  # p at the edge
 
 
 def foothold_shift(error_xy: tuple[float, float], sole_heading: tuple[float, float],

@@ -21,7 +21,8 @@ import numpy as np
 from tutorial_atlas_control.balance import StandBehaviour
 from tutorial_atlas_control.walking.footsteps import Footstep
 from tutorial_atlas_control.walking.leg_tasks import foot_pose
-from tutorial_atlas_control.walking.static_step import SWAYING, StaticStep, StepGains
+from tutorial_atlas_control.walking.static_step import StaticStep, StepGains
+from tutorial_atlas_control.walking.status_flags import SWAYING
 from tutorial_atlas_control.walking.step_queue import DEFAULT_LIMITS, StepLimits, clamp_step
 
 __all__ = ['StepBehaviour', 'StepStatus']
@@ -83,7 +84,6 @@ class StepBehaviour:
             return stand.torque(data)
         atlas = stand.atlas
         state = stand.estimator.estimate(data.qpos, data.qvel)
-        stand.last_state = state
         was_down = stepping.landed is not None
         torque = stepping.step_torque(state, data.qpos[atlas.qpos_adr],
                                       data.qvel[atlas.dof_adr], float(data.time))

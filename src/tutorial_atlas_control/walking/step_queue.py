@@ -17,17 +17,17 @@ import math
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
 
+from tutorial_atlas_control.walking.errors import WalkingError
 from tutorial_atlas_control.walking.footsteps import (
     QUEUE_LENGTH,
     Footstep,
     side_sign,
     wrap_angle,
 )
-
-#: walk_feedback.status_flags (ASI.md): one of the first three, plus the warnings.
-OKAY, SWAYING, STEPPING, CATCHING = 0, 1, 2, 4
-WARNING_INSUFFICIENT_STEP_DATA = 8
-ERROR_INCONSISTENT_STEPS = 16
+from tutorial_atlas_control.walking.status_flags import (
+    ERROR_INCONSISTENT_STEPS,
+    WARNING_INSUFFICIENT_STEP_DATA,
+)
 
 
 @dataclass(frozen=True)
@@ -156,7 +156,7 @@ class StepQueue:
         """The step under way (`current_step_index + 1`) lands at `step` instead, already
         within the limits: the queue's preview says so until it is down."""
         if step.step_index != self.current_step_index + 1:
-            raise ValueError(f'step {step.step_index} is not the one under way '
+            raise WalkingError(f'step {step.step_index} is not the one under way '
                              f'({self.current_step_index + 1})')
         self._adjusted = step
         self._preview = None

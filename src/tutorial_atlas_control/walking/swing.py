@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tutorial_atlas_control.walking.errors import WalkingError
 from tutorial_atlas_control.walking.footsteps import wrap_angle
 
 #: How high the swing foot's sole is lifted over the line between its ends (m).
@@ -47,7 +48,7 @@ class SwingPath:
 
     def __post_init__(self) -> None:
         if not self.duration_s > 0.0:
-            raise ValueError(f'swing duration {self.duration_s} s is not positive')
+            raise WalkingError(f'swing duration {self.duration_s} s is not positive')
 
     def at(self, t_s: float) -> tuple[np.ndarray, np.ndarray, float, float]:
         """(position (3,), velocity (3,), yaw, yaw rate) of the sole at `t_s` after lift-off;

@@ -23,18 +23,19 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from tutorial_atlas_control.balance import BalanceState, StandController
-from tutorial_atlas_control.walking.dcm_plan import DcmPlan, tracking_cop
+from tutorial_atlas_control.balance import (
+    BalanceState,
+    StandController,
+    capture_point_after,
+    cop_reaching,
+    dcm_feedback_cop,
+)
+from tutorial_atlas_control.walking.dcm_plan import DcmPlan
 from tutorial_atlas_control.walking.footsteps import Footstep
 from tutorial_atlas_control.walking.leg_tasks import LegGains, LegTasks, foot_pose
+from tutorial_atlas_control.walking.status_flags import CATCHING, STEPPING, SWAYING
 from tutorial_atlas_control.walking.step_adjustment import foothold_shift
-from tutorial_atlas_control.walking.step_queue import (
-    CATCHING,
-    STEPPING,
-    SWAYING,
-    StepQueue,
-    clamp_pose,
-)
+from tutorial_atlas_control.walking.step_queue import StepQueue, clamp_pose
 from tutorial_atlas_control.walking.swing import SwingPath
 
 
@@ -72,14 +73,6 @@ class WalkOutput:
     capture_point_ref: np.ndarray  # (2,)
     phase: int                    # SWAYING, STEPPING or CATCHING
     swing_foot: int | None
-
-
-def sway_cop(xi_now: np.ndarray, xi_target: np.ndarray, omega: float,
-             duration_s: float) -> np.ndarray:
-    """The constant pressure centre that takes the capture point from `xi_now` to
-    `xi_target` in `duration_s` (xi(T) = p + (xi0 - p) exp(omega T), solved for p)."""
-    growth = math.exp(omega * duration_s)
-    return (np.asarray(xi_target) - growth * np.asarray(xi_now)) / (1.0 - growth)
 
 
 class WalkController:
@@ -128,7 +121,8 @@ class WalkController:
         self._plan = self._plan_steps(self.queue.preview(), state.omega)
         target = (self._plan.start if self._plan is not None
                   else state.sole_centres[:, :2].mean(axis=0))
-        self._sway_cop = sway_cop(state.capture_point, target, state.omega, self.gains.sway_s)
+        self._sway_cop = cop_reaching(state.capture_point, target, state.omega,
+                                     self.gains.sway_s)
         self._sway_from = state.capture_point.copy()
 
     def _begin_step(self, state: BalanceState, time_s: float) -> None:
@@ -177,8 +171,8 @@ class WalkController:
         """(xi_ref, p_ref) now."""
         elapsed = time_s - self.phase_start_s
         if self.phase == SWAYING:
-            growth = math.exp(state.omega * min(elapsed, self.gains.sway_s))
-            xi = self._sway_cop + (self._sway_from - self._sway_cop) * growth
+            xi = capture_point_after(self._sway_from, self._sway_cop, state.omega,
+                                     min(elapsed, self.gains.sway_s))
             return xi, self._sway_cop
         if self.phase == STEPPING and self._plan is not None:
             return self._plan.reference(0, elapsed)
@@ -218,7 +212,7 @@ class WalkController:
         xi_ref, cop_ref = self._capture_reference(state, time_s)
         if self.phase == STEPPING and self.gains.adjust_steps:
             self._adjust(state, xi_ref, cop_ref, time_s)
-        cop = tracking_cop(state.capture_point, xi_ref, cop_ref, self.gains.dcm_gain)
+        cop = dcm_feedback_cop(state.capture_point, xi_ref, self.gains.dcm_gain, cop_ref)
         step = self.step if self.phase == STEPPING else None
         swing_foot = None if step is None else step.foot_index
         legs = self.legs

@@ -17,15 +17,12 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from tutorial_atlas_control.balance import StandBehaviour
+from tutorial_atlas_control.balance import BalanceState, StandBehaviour
+from tutorial_atlas_control.walking.errors import WalkingError
 from tutorial_atlas_control.walking.footsteps import DRCSIM_WALK_QUEUE, Footstep
 from tutorial_atlas_control.walking.leg_tasks import foot_pose
-from tutorial_atlas_control.walking.step_queue import (
-    DEFAULT_LIMITS,
-    STEPPING,
-    StepLimits,
-    StepQueue,
-)
+from tutorial_atlas_control.walking.status_flags import STEPPING
+from tutorial_atlas_control.walking.step_queue import DEFAULT_LIMITS, StepLimits, StepQueue
 from tutorial_atlas_control.walking.walk import WalkController, WalkGains
 
 __all__ = ['WalkBehaviour', 'WalkStatus']
@@ -58,6 +55,8 @@ class WalkBehaviour:
         self.walk: WalkController | None = None
         #: The steps the next start walks (None: default_steps).
         self.next_steps: list[Footstep] | None = None
+        #: The state the last tick estimated (None before the first).
+        self.last_state: BalanceState | None = None
 
     @property
     def done(self) -> bool:
@@ -67,7 +66,7 @@ class WalkBehaviour:
     def offer(self, steps: Iterable[Footstep]) -> None:
         """A client's steps for the walk under way: into its queue by index."""
         if self.walk is None:
-            raise RuntimeError('WalkBehaviour.offer before start()')
+            raise WalkingError('WalkBehaviour.offer before start()')
         self.walk.queue.offer(steps)
 
     def finish(self) -> None:
@@ -75,7 +74,7 @@ class WalkBehaviour:
         itself and is done."""
         walk = self.walk
         if walk is None:
-            raise RuntimeError('WalkBehaviour.finish before start()')
+            raise WalkingError('WalkBehaviour.finish before start()')
         taking = walk.step.step_index if walk.phase == STEPPING and walk.step else None
         walk.queue.stop(taking)
 
@@ -95,10 +94,10 @@ class WalkBehaviour:
         """This step's f_out (N m, (28,)), within the effort limits."""
         walk = self.walk
         if walk is None:
-            raise RuntimeError('WalkBehaviour.torque before start()')
+            raise WalkingError('WalkBehaviour.torque before start()')
         stand, atlas = self.stand, self.stand.atlas
         state = stand.estimator.estimate(data.qpos, data.qvel)
-        stand.last_state = state
+        self.last_state = state
         return walk.step_torque(state, data.qpos[atlas.qpos_adr], data.qvel[atlas.dof_adr],
                                 float(data.time)).torque_nm
 

@@ -164,7 +164,7 @@ class WalkingStand:
         taken, taking = walk.queue.current_step_index, walk.step
         torque = walking.torque(data)
         if walk.queue.current_step_index > taken:
-            state = self.stand.last_state
+            state = walking.last_state
             assert state is not None and taking is not None  # set by the torque call
             self._landed(walk, state, taking)
         return torque

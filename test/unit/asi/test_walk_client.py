@@ -5,8 +5,10 @@ from __future__ import annotations
 
 import pytest
 
+from tutorial_atlas_control.asi import AsiInputError
 from tutorial_atlas_control.asi.behaviors import Behavior, Status
 from tutorial_atlas_control.asi.walk_client import Outcome, WalkClient, refusal_hint
+from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.walking import Footstep, straight_steps
 
 PLAN = straight_steps(6, 0.25)
@@ -69,3 +71,9 @@ def test_a_refusal_is_said_with_what_to_do(status: int, behavior: Behavior, hint
 def test_a_plan_must_number_its_steps_from_one() -> None:
     with pytest.raises(ValueError, match='steps 1, 2'):
         WalkClient(PLAN[1:])
+
+
+def test_a_plan_out_of_order_raises_the_asis_input_error() -> None:
+    with pytest.raises(AsiInputError, match='a plan is steps 1, 2, ... in order') as raised:
+        WalkClient(PLAN[::-1])
+    assert isinstance(raised.value, AtlasControlError)  # what the command lines catch

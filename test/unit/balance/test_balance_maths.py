@@ -8,7 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.balance import contact_wrench, lipm, support
+from tutorial_atlas_control.balance import BalanceError, contact_wrench, lipm, support
+from tutorial_atlas_control.errors import AtlasControlError
 
 OMEGA = lipm.natural_frequency(0.9)
 
@@ -17,6 +18,12 @@ def test_natural_frequency_is_sqrt_g_over_z() -> None:
     assert pytest.approx(math.sqrt(9.81 / 0.9)) == OMEGA
     with pytest.raises(ValueError, match='centre-of-mass height 0.0 m must be above'):
         lipm.natural_frequency(0.0)
+
+
+def test_a_pendulum_under_the_ground_raises_the_balances_error() -> None:
+    with pytest.raises(BalanceError, match='height -0.1 m must be above the ground') as raised:
+        lipm.natural_frequency(-0.1)
+    assert isinstance(raised.value, AtlasControlError)  # what the command lines catch
 
 
 def test_the_lipm_solution_obeys_its_equation() -> None:
@@ -41,6 +48,32 @@ def test_a_pressure_centre_on_the_capture_point_brings_the_pendulum_to_rest() ->
     # Anywhere else, the pendulum runs away from the pressure centre.
     com, _ = lipm.lipm_state(c0, v0, xi - [0.01, 0.0], OMEGA, 3.0)
     assert com[0] > xi[0] + 1.0
+
+
+@pytest.mark.parametrize('t_s', [0.0, 0.3, 0.9])
+def test_the_capture_points_motion_is_the_pendulums(t_s: float) -> None:
+    """capture_point_after is xi = c + c'/omega of the exact LIPM state (cosh, sinh)."""
+    c0, v0, cop = np.array([0.03, -0.02]), np.array([0.15, 0.05]), np.array([0.01, 0.02])
+    com, velocity = lipm.lipm_state(c0, v0, cop, OMEGA, t_s)
+    xi0 = lipm.capture_point(c0, v0, OMEGA)
+    np.testing.assert_allclose(lipm.capture_point_after(xi0, cop, OMEGA, t_s),
+                               lipm.capture_point(com, velocity, OMEGA), atol=1e-12)
+    # Run back by as long, it returns where it started; one axis as plain floats.
+    ahead = lipm.capture_point_after(xi0, cop, OMEGA, t_s)
+    np.testing.assert_allclose(lipm.capture_point_after(ahead, cop, OMEGA, -t_s), xi0,
+                               atol=1e-12)
+    assert lipm.capture_point_after(0.04, 0.01, OMEGA, t_s) == pytest.approx(
+        0.01 + 0.03 * math.exp(OMEGA * t_s))
+
+
+def test_the_pressure_centre_reaching_a_target_takes_the_capture_point_there() -> None:
+    duration = 0.6
+    start, target = np.array([0.02, 0.0]), np.array([0.05, -0.08])
+    cop = lipm.cop_reaching(start, target, OMEGA, duration)
+    end = cop + (start - cop) * math.exp(OMEGA * duration)  # the closed form
+    np.testing.assert_allclose(end, target, atol=1e-12)
+    # It lies behind the start, away from the target: it pushes the capture point there.
+    assert np.dot(cop - start, target - start) < 0.0
 
 
 @pytest.mark.parametrize('gain', [0.0, 0.5, 2.0])

@@ -19,7 +19,7 @@ from tutorial_atlas_control.balance.manipulate import (
     pelvis_pitch_rad,
     place_pitched,
 )
-from tutorial_atlas_control.balance.stand_pose import SOLE_GEOMS, sole_corners
+from tutorial_atlas_control.balance.sole import SOLE_GEOMS, sole_corners
 from tutorial_atlas_control.joints import JOINT_INDEX
 from tutorial_atlas_control.sim import AtlasModel, load_model
 

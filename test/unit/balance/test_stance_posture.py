@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from tutorial_atlas_control.balance import STAND_POSE_RAD, place_in_stand_pose
+from tutorial_atlas_control.balance.sole import SOLE_GEOMS, sole_corners
 from tutorial_atlas_control.balance.stance_posture import Stance, StancePosture
-from tutorial_atlas_control.balance.stand_pose import SOLE_GEOMS, sole_corners
 from tutorial_atlas_control.joints import JOINT_INDEX
 from tutorial_atlas_control.sim import AtlasModel, load_model
 

@@ -9,7 +9,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.balance import lipm, support
+from tutorial_atlas_control.balance import BalanceError, lipm, support
 from tutorial_atlas_control.balance.estimator import BalanceEstimator
 from tutorial_atlas_control.balance.manipulate import PelvisServo
 from tutorial_atlas_control.balance.stand import StandController, StandReference, pitch_of
@@ -149,7 +149,7 @@ def test_stand_behaviour_is_the_controller_held_where_it_started(
     """The simulator's Stand behaviour: the controller's torque for the state in the
     MjData, with the reference taken at start(); asked before start(), an error."""
     behaviour = StandBehaviour(atlas)
-    with pytest.raises(RuntimeError, match='before start'):
+    with pytest.raises(BalanceError, match='before start'):
         behaviour.torque(placed)
     behaviour.start(placed)
     estimator = BalanceEstimator(atlas)

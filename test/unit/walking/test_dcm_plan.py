@@ -7,8 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.balance.lipm import natural_frequency
-from tutorial_atlas_control.walking.dcm_plan import DcmPlan, tracking_cop
+from tutorial_atlas_control.balance.lipm import dcm_feedback_cop, natural_frequency
+from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.walking import WalkingError
+from tutorial_atlas_control.walking.dcm_plan import DcmPlan
 
 OMEGA = natural_frequency(0.85)
 COPS = np.array([[0.0, -0.12], [0.2, 0.12], [0.4, -0.12], [0.6, 0.12]])
@@ -35,7 +37,7 @@ def test_the_reference_obeys_the_capture_points_dynamics() -> None:
         assert rate == pytest.approx(OMEGA * (xi - cop), rel=1e-6)
 
 
-def test_tracking_law_makes_the_error_decay_at_omega_times_gain() -> None:
+def test_the_law_with_the_plans_pressure_centre_makes_the_error_decay_at_omega_gain() -> None:
     plan = DcmPlan.plan(COPS, DURATIONS, FINAL, OMEGA)
     gain, dt = 2.0, 1e-4
     xi = plan.start + np.array([0.02, -0.01])
@@ -43,7 +45,7 @@ def test_tracking_law_makes_the_error_decay_at_omega_times_gain() -> None:
     t = 0.0
     while t < 0.5:
         xi_ref, cop_ref = plan.reference(0, t)
-        xi = xi + dt * OMEGA * (xi - tracking_cop(xi, xi_ref, cop_ref, gain))
+        xi = xi + dt * OMEGA * (xi - dcm_feedback_cop(xi, xi_ref, gain, cop_ref))
         t += dt
     error = np.linalg.norm(xi - plan.reference(0, t)[0])
     assert error == pytest.approx(error0 * math.exp(-OMEGA * gain * t), rel=1e-2)
@@ -56,3 +58,9 @@ def test_tracking_law_makes_the_error_decay_at_omega_times_gain() -> None:
 def test_bad_plans_are_refused(durations: np.ndarray, message: str) -> None:
     with pytest.raises(ValueError, match=message):
         DcmPlan.plan(COPS, durations, FINAL, OMEGA)
+
+
+def test_a_bad_plan_raises_the_walks_error() -> None:
+    with pytest.raises(WalkingError, match='every step duration must be positive') as raised:
+        DcmPlan.plan(COPS, -DURATIONS, FINAL, OMEGA)
+    assert isinstance(raised.value, AtlasControlError)  # what the command lines catch

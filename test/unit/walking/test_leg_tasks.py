@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from tutorial_atlas_control.balance.estimator import BalanceState
+from tutorial_atlas_control.balance.sole import box_corners
 from tutorial_atlas_control.balance.stand import orientation_error
 from tutorial_atlas_control.balance.stand_behaviour import StandBehaviour
 from tutorial_atlas_control.balance.stand_pose import place_in_stand_pose
@@ -22,7 +23,6 @@ from tutorial_atlas_control.walking.leg_tasks import (
     LegGains,
     LegTasks,
     _clamp_to_sole,
-    _sole_corners,
     foot_pose,
 )
 
@@ -162,15 +162,16 @@ def test_a_stance_soles_clamp_is_the_polygon_clamp_of_its_rectangle(
         standing: tuple[StandBehaviour, mujoco.MjData], foot: int) -> None:
     behaviour, data = standing
     state = behaviour.estimator.estimate(data.qpos, data.qvel)
-    half_size = behaviour.estimator.sole_half_size_m
-    polygon = convex_hull(_sole_corners(state, foot, half_size))
+    half_length, half_width = behaviour.estimator.sole_half_size_m
+    polygon = convex_hull(box_corners(state.sole_centres[foot], state.sole_rotations[foot],
+                                      (half_length, half_width, 0.0))[:, 0:2])
     centre = state.sole_centres[foot][0:2]
     rng = np.random.default_rng(7)
     for offset in rng.uniform(-0.3, 0.3, size=(200, 2)):
         point = centre + offset
         # The placed sole tilts a little: its corners' projection is a rectangle only to
         # some microns.
-        reach = (half_size[0] - 0.015, half_size[1] - 0.015)
+        reach = (half_length - 0.015, half_width - 0.015)
         np.testing.assert_allclose(_clamp_to_sole(state, foot, reach, point),
                                    clamp_into(polygon, point, 0.015), atol=2e-5)
 

@@ -15,11 +15,13 @@ from tutorial_atlas_control.walking.footsteps import (
     straight_steps,
     window,
 )
-from tutorial_atlas_control.walking.step_queue import (
+from tutorial_atlas_control.walking.status_flags import (
     ERROR_INCONSISTENT_STEPS,
     STEPPING,
     SWAYING,
     WARNING_INSUFFICIENT_STEP_DATA,
+)
+from tutorial_atlas_control.walking.step_queue import (
     StepLimits,
     StepQueue,
     clamp_step,

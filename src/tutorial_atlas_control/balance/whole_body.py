@@ -1,0 +1,200 @@
+"""The whole-body layer: tasks and constraints over one robot state, turned into joint torques.
+
+Tasks say what the robot should do. A centroidal task asks the contacts for a part of the
+wrench about the centre of mass: CapturePointTask the horizontal force that puts the pressure
+centre where asked (m omega^2 (c - p)), ComHeightTask the weight and a PD on the centre of
+mass's height, PelvisOrientationTask a PD moment holding the pelvis's frame. A joint task adds
+torques of its own: PostureTask a joint PD to a posture (the user's joints under k_effort are
+the simulator's blend, outside); a behaviour's own (Walk's swing-foot servo) is any callable
+giving (28,) torques. Constraints say what cannot be: a ContactConstraint per sole (no pull,
+the pressure centre inside the sole, the yaw moment and the tangential force within what
+friction holds) and the joint torque limits.
+
+The solver is inverse statics: the tasks' wrench, shared between the soles in contact
+(contact_wrench.split_wrench), each share made feasible, becomes tau = bias - J_c^T lambda
+(gravity and Coriolis of the whole body included), plus the joint tasks, within the limits.
+It holds a flat stance exactly and costs a few microseconds; a QP over the same tasks and
+constraints would trade the tasks off where they conflict (a slope's friction, a foot at its
+edge), at the price of a solve each tick. Every task and constraint computes in plain floats
+in numpy's order of operations: Stand's torques are the same bits as before the layer.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+from tutorial_atlas_control.balance import contact_wrench, lipm
+from tutorial_atlas_control.balance.estimator import BalanceState
+
+__all__ = ['CapturePointTask', 'CentroidalTask', 'ComHeightTask', 'ContactConstraint',
+           'JointTask', 'PelvisOrientationTask', 'PostureTask', 'WholeBodyLayer',
+           'WholeBodyOutput', 'orientation_error']
+
+#: A joint task: the robot's state, the joints' positions and velocities -> (28,) torques.
+JointTask = Callable[[BalanceState, np.ndarray, np.ndarray], np.ndarray]
+
+
+class CentroidalTask(Protocol):
+    """A part of the wrench about the centre of mass the contacts are asked for."""
+
+    def wrench(self, state: BalanceState, mass_kg: float) -> tuple[Sequence[float],
+                                                                    Sequence[float]]:
+        """(force (3,) N, moment (3,) N m) in the world frame."""
+
+
+def orientation_error(rotation: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """The small rotation (rad, world axis) that takes `rotation` to `reference`."""
+    (d00, d01, d02), (d10, d11, d12), (d20, d21, d22) = (reference @ rotation.T).tolist()
+    return np.array([0.5 * (d21 - d12), 0.5 * (d02 - d20), 0.5 * (d10 - d01)])
+
+
+@dataclass(frozen=True)
+class CapturePointTask:
+    """The horizontal force that makes the pressure centre `cop` ((2,) m, world): the
+    linear inverted pendulum's m omega^2 (c - p) (lipm.com_acceleration)."""
+
+    cop: np.ndarray
+
+    def wrench(self, state: BalanceState, mass_kg: float) -> tuple[Sequence[float],
+                                                                    Sequence[float]]:
+        com_x, com_y, _ = state.com.tolist()
+        cop_x, cop_y = np.asarray(self.cop, dtype=np.float64).tolist()
+        stiffness = state.omega * state.omega
+        return ((mass_kg * (stiffness * (com_x - cop_x) + 0.0),
+                 mass_kg * (stiffness * (com_y - cop_y) + 0.0), 0.0), (0.0, 0.0, 0.0))
+
+
+@dataclass(frozen=True)
+class ComHeightTask:
+    """The weight, and a PD (1/s^2, 1/s) on the centre of mass's height towards `height_m`
+    moving at `rate_m_s` (m, m/s): the vertical force."""
+
+    height_m: float
+    rate_m_s: float
+    kp: float
+    kd: float
+
+    def wrench(self, state: BalanceState, mass_kg: float) -> tuple[Sequence[float],
+                                                                    Sequence[float]]:
+        vertical = (self.kp * (self.height_m - float(state.com[2]))
+                    + self.kd * (self.rate_m_s - float(state.com_velocity[2])))
+        return (0.0, 0.0, mass_kg * (vertical + lipm.GRAVITY_M_S2)), (0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class PelvisOrientationTask:
+    """A PD moment (N m/rad, N m s/rad) holding the pelvis's frame at `rotation` ((3, 3))
+    turning at `angular_velocity` ((3,) rad/s, world)."""
+
+    rotation: np.ndarray
+    angular_velocity: np.ndarray
+    kp: float
+    kd: float
+
+    def wrench(self, state: BalanceState, mass_kg: float) -> tuple[Sequence[float],
+                                                                    Sequence[float]]:
+        error = orientation_error(state.pelvis_rotation, self.rotation).tolist()
+        kp, kd = self.kp, self.kd
+        return (0.0, 0.0, 0.0), tuple(kp * e + kd * (w_ref - w) for e, w_ref, w in zip(
+            error, self.angular_velocity.tolist(), state.pelvis_angular_velocity.tolist()))
+
+
+@dataclass(frozen=True)
+class PostureTask:
+    """A joint PD (N m/rad, N m s/rad, (28,) each) to `posture_rad` moving at `rate_rad_s`."""
+
+    posture_rad: np.ndarray
+    rate_rad_s: np.ndarray
+    kp: np.ndarray
+    kd: np.ndarray
+
+    def __call__(self, state: BalanceState, joint_positions: np.ndarray,
+                 joint_velocities: np.ndarray) -> np.ndarray:
+        return (self.kp * (self.posture_rad - joint_positions)
+                + self.kd * (self.rate_rad_s - joint_velocities))
+
+
+@dataclass(frozen=True)
+class ContactConstraint:
+    """What one sole's contact wrench may be: none if it does not carry (`carries` False);
+    else no pull, the pressure centre inside the sole's half sizes (m), with `torsion_m` the
+    yaw moment within torsion_m f_n, and with `friction` the tangential force within
+    friction f_n (a cone about the sole's normal)."""
+
+    carries: bool
+    half_length_m: float
+    half_width_m: float
+    torsion_m: float | None = None
+    friction: float | None = None
+
+    def feasible(self, wrench: np.ndarray, sole_rotation: np.ndarray) -> np.ndarray:
+        """`wrench` [f, m] (world, at the sole's centre) made feasible."""
+        made = contact_wrench.make_feasible(wrench, sole_rotation, self.half_length_m,
+                                            self.half_width_m, self.torsion_m)
+        if self.friction is None:
+            return made
+        normal = sole_rotation[:, 2]
+        force = made[0:3]
+        pressing = float(force @ normal)
+        tangential = force - pressing * normal
+        size = math.sqrt(float(tangential @ tangential))
+        limit = self.friction * max(pressing, 0.0)
+        if size > limit:
+            made[0:3] = force - (1.0 - limit / size) * tangential
+        return made
+
+
+@dataclass(frozen=True)
+class WholeBodyOutput:
+    """One tick's decision, kept for feedback and tests."""
+
+    torque_nm: np.ndarray          # (28,)
+    force_n: np.ndarray            # (3,) the centroidal tasks' force
+    moment_nm: np.ndarray          # (3,) their moment about the centre of mass
+    contact_wrenches: np.ndarray   # (2, 6) per sole, feasible
+
+
+class WholeBodyLayer:
+    """Tasks and constraints over one BalanceState, turned into the 28 joint torques."""
+
+    def __init__(self, mass_kg: float, effort_limit_nm: np.ndarray) -> None:
+        self.mass_kg = mass_kg
+        self.effort_limit_nm = np.asarray(effort_limit_nm, dtype=float)
+
+    def centroidal_wrench(self, state: BalanceState,
+                          tasks: Sequence[CentroidalTask]) -> tuple[np.ndarray, np.ndarray]:
+        """The tasks' (force (3,), moment (3,)) summed."""
+        force, moment = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
+        for task in tasks:
+            task_force, task_moment = task.wrench(state, self.mass_kg)
+            force = [a + b for a, b in zip(force, task_force)]
+            moment = [a + b for a, b in zip(moment, task_moment)]
+        return np.array(force), np.array(moment)
+
+    def solve(self, state: BalanceState, tasks: Sequence[CentroidalTask],
+              contacts: tuple[ContactConstraint, ContactConstraint],
+              joint_tasks: Sequence[JointTask], joint_positions: np.ndarray,
+              joint_velocities: np.ndarray) -> WholeBodyOutput:
+        """The torques that make the carrying soles press the tasks' wrench (shared between
+        them, each share made feasible), plus the joint tasks; not yet within the effort
+        limits (`limit` does that: a behaviour may add a swing leg's torque first)."""
+        force, moment = self.centroidal_wrench(state, tasks)
+        carrying = (contacts[0].carries, contacts[1].carries)
+        wrenches = contact_wrench.split_wrench(force, moment, state.sole_centres, state.com,
+                                               carrying)
+        for foot in (0, 1):
+            wrenches[foot] = contacts[foot].feasible(wrenches[foot], state.sole_rotations[foot])
+        torque = state.bias_nm - state.sole_jacobians.reshape(12, -1).T @ wrenches.reshape(12)
+        for joint_task in joint_tasks:
+            torque += joint_task(state, joint_positions, joint_velocities)
+        return WholeBodyOutput(torque, force, moment, wrenches)
+
+    def limit(self, torque: np.ndarray) -> np.ndarray:
+        """`torque` within the joints' effort limits, in place."""
+        np.clip(torque, -self.effort_limit_nm, self.effort_limit_nm, out=torque)
+        return torque
