@@ -15,6 +15,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                               'WINDOW_PARAM'],
     'copy_plan': ['CopyPlan'],
     'divergence': ['DivergenceCheck', 'PhysicsDivergenceError'],
+    'ground': ['Ground', 'GroundError', 'GroundHit', 'ROBOT_ROOT_BODY'],
     'joint_law': ['JointLaw'],
     'joint_trajectory': ['TrajectoryMessage', 'trajectory_input'],
     'law_kernel': ['CompiledLaw', 'LawJoints'],
