@@ -115,6 +115,12 @@ class _Cast(NamedTuple):
     mat: np.ndarray
     size: np.ndarray
     rbound: float
+    aabb: np.ndarray  # its bounding box in its own frame: centre (3,), half sizes (3,)
+
+    def top_m(self) -> float:
+        """The highest point (m) of its bounding box, as placed now."""
+        up = self.mat[6:9]  # the world z row of its rotation
+        return float(self.pos.item(2) + up @ self.aabb[:3] + np.abs(up) @ self.aabb[3:])
 
 
 def _inside_border(cast: _Cast, x: float, y: float) -> tuple[float, float]:
@@ -161,6 +167,23 @@ class Ground:
                              for i in range(len(self._static))]
         self._pnt = np.zeros(3)
         self._normal = np.zeros(3)
+        level = [c.pos.item(2) for c in self._planes if c.mat.item(8) == 1.0]
+        tilted = len(level) < len(self._planes)
+        #: The ground's height (m) everywhere when it is level planes only (today's world),
+        #: else None: callers skip the rays.
+        flat = level and not tilted and not self._static and not self._loose
+        self.level_m: float | None = max(level) if flat else None
+        self._static_top_m = max([-math.inf] + level + [c.top_m() for c in self._static])
+        if tilted:
+            self._static_top_m = math.inf
+
+    def top_m(self) -> float:
+        """No ground is higher than this (m), anywhere (inf under a tilted plane): a point
+        higher above it than a threshold is that high above the ground, without rays."""
+        top = self._static_top_m
+        for cast in self._loose:
+            top = max(top, cast.top_m())
+        return top
 
     def _prepare(self, geom: int, data: mujoco.MjData) -> _Cast:
         model = self.model
@@ -174,7 +197,7 @@ class Ground:
         if kind == _HFIELD:
             size = model.hfield_size[model.geom_dataid[geom]][:3].copy()
         return _Cast(geom, kind, data, data.geom_xpos[geom], data.geom_xmat[geom], size,
-                     float(model.geom_rbound[geom]) + 1e-9)
+                     float(model.geom_rbound[geom]) + 1e-9, model.geom_aabb[geom].copy())
 
     def _candidates(self, x: float, y: float) -> list[_Cast]:
         """Planes, and the bounded geoms whose bounding sphere is above (x, y)."""
