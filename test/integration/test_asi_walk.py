@@ -23,7 +23,6 @@ import pytest
 
 from support.arm_swing import ARMS, arm_command, swung
 from tutorial_atlas_control.asi import (
-    DOWN_PELVIS_M,
     AsiError,
     AtlasSimInterface,
     Behavior,
@@ -34,6 +33,7 @@ from tutorial_atlas_control.control_modes import ControlMode
 from tutorial_atlas_control.joints import JOINT_INDEX, NUM_JOINTS
 from tutorial_atlas_control.msgs.atlas_sim_interface import AsiCommand, ManipulateParams, StepData
 from tutorial_atlas_control.sim import (
+    FALL_HEIGHT_M,
     AtlasSimulator,
     ModeInput,
     VrcMode,
@@ -354,7 +354,7 @@ KNOCK_S = 0.2
 def test_knocked_down_while_walking_it_freezes_instead_of_crawling(
         atlas: atlas_model.AtlasModel) -> None:
     """Pushed over mid-walk, the state says ERROR_FALLING while it falls; once the pelvis is
-    below DOWN_PELVIS_M the library gives up: Freeze (WARNING_AUTO_TRANS once, from Walk),
+    below FALL_HEIGHT_M the library gives up: Freeze (WARNING_AUTO_TRANS once, from Walk),
     and the robot lies still (without it, the walk stepped on and dragged the fallen robot
     1.4 m in 2 s)."""
     interface = standing(atlas)
@@ -380,7 +380,7 @@ def test_knocked_down_while_walking_it_freezes_instead_of_crawling(
     state = interface.state()
     assert state.behavior_feedback.trans_from_behavior_index == Behavior.WALK
     assert state.behavior_feedback.trans_to_behavior_index == Behavior.FREEZE
-    assert pelvis[frozen][2] < DOWN_PELVIS_M
+    assert pelvis[frozen][2] < FALL_HEIGHT_M
     last = np.array(pelvis[-2000:])
     assert np.linalg.norm(last[-1, 0:2] - last[0, 0:2]) < 0.01  # lying still
 

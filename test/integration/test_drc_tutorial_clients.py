@@ -28,7 +28,8 @@ if shutil.which('roslaunch') is None:
 
 from support.launch import EXIT_TIMEOUT_S, TestLaunch
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.asi import FALLING_PELVIS_M, Behavior, Status
+from tutorial_atlas_control.asi import Behavior, Status
+from tutorial_atlas_control.sim import FALLING_PELVIS_M
 
 pytestmark = pytest.mark.filterwarnings('ignore::DeprecationWarning')
 

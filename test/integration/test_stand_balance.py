@@ -19,7 +19,6 @@ from tutorial_atlas_control.asi import AtlasSimInterface, Behavior
 from tutorial_atlas_control.balance import TRANSITION_S, StandBehaviour
 from tutorial_atlas_control.balance.push_trial import (
     FOOT_TRAVEL_LIMIT_M,
-    STANDING_PELVIS_M,
     push_survived,
     stand_trial,
 )
@@ -29,6 +28,7 @@ from tutorial_atlas_control.msgs.atlas_sim_interface import AsiCommand, Manipula
 from tutorial_atlas_control.sim import (
     DEFAULT_GAINS_FILE,
     STAND_POSE_RAD,
+    STANDING_PELVIS_M,
     AtlasSimulator,
     ControlMode,
     ModeInput,

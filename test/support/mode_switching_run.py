@@ -16,6 +16,7 @@ from tutorial_atlas_control.asi.mode_switching import (
     KP_VELOCITY,
     cue_messages,
 )
+from tutorial_atlas_control.sim import fallen
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
@@ -24,8 +25,6 @@ from tutorial_atlas_control.walking.start_noise import perturb_start
 CONFIG = Path(__file__).resolve().parents[2] / 'config' / 'atlas_controller.yaml'
 #: When the demo begins (s of sim time): the hold has settled after its 1 s pin.
 START_S = 3.0
-#: Below this the pelvis has fallen (m).
-FALLEN_M = 0.5
 
 
 @dataclass
@@ -71,7 +70,7 @@ def run_mode_switching(seed: int | None = None, kp_velocity: float = KP_VELOCITY
                 run.at_walk = position.copy()
             for topic, raw in cue_messages(cue, sim.sim_time_ns, gains.p, pose, kp_velocity):
                 loop.receive_command(raw, topic)
-        if position[2] < FALLEN_M:
+        if fallen(float(position[2])):  # sim/fall.py's criterion on the flat ground
             run.fell_at_s = t_s
         return t_s >= end_s or run.fell_at_s is not None
 

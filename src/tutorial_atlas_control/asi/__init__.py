@@ -14,8 +14,7 @@ from tutorial_atlas_control.exports import lazy_exports
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'behaviors': ['BEHAVIOR_OF_MODE', 'MODE_OF_BEHAVIOR', 'AsiError', 'Behavior', 'Status'],
     'errors': ['AsiInputError'],
-    'interface': ['DOWN_PELVIS_M', 'FALLING_PELVIS_M', 'FALLING_TILT_RAD', 'AtlasSimInterface',
-                  'fallen_robot', 'falling_robot'],
+    'interface': ['AtlasSimInterface'],
     'library': ['BehaviourBase', 'Handover', 'LibraryBehaviour', 'StepEntry', 'WalkEntry'],
     'mode_switching': ['AFTER_LAST_S', 'CUES', 'KP_VELOCITY', 'Cue', 'cue_messages'],
     'session': ['REFUSAL_REPORTED_STEPS', 'STANDING_BEHAVIORS', 'AsiSession', 'Refusal'],

@@ -29,8 +29,6 @@ TRANSITION_IN_PROGRESS meanwhile: a walk does not start from the hold's straight
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from tutorial_atlas_control.asi.behaviors import BEHAVIOR_OF_MODE, MODE_OF_BEHAVIOR, Behavior
@@ -55,21 +53,11 @@ from tutorial_atlas_control.msgs import (
     StepFeedback,
     WalkFeedback,
 )
-from tutorial_atlas_control.sim import AtlasSimulator, pelvis_height_m
+from tutorial_atlas_control.sim import AtlasSimulator, GroundUnderFeet
 from tutorial_atlas_control.walking import DRCSIM_WALK_QUEUE, StepBehaviour, WalkBehaviour
 
-__all__ = ['DOWN_PELVIS_M', 'FALLING_PELVIS_M', 'FALLING_TILT_RAD', 'AtlasSimInterface',
-           'fallen_robot', 'falling_robot']
+__all__ = ['AtlasSimInterface']
 
-#: A standing behaviour is falling once the pelvis is below this (m; Stand holds it at
-#: about 0.91 m) ...
-FALLING_PELVIS_M = 0.7
-#: ... or tilted more than this from upright (rad).
-FALLING_TILT_RAD = 0.5
-#: Walk or Step with the pelvis below this (m) has fallen for good: the library gives up
-#: and Freezes the joints where they are (else the walk goes on stepping on the ground and
-#: drags the fallen robot across the floor). A stumble that the walk catches stays above.
-DOWN_PELVIS_M = 0.5
 #: Stand is refused while the centre of mass is further than this outside the feet (m).
 COM_OUTSIDE_TOLERANCE_M = 0.0
 _K_EFFORT_ROW = (LAW_FIELDS.index('k_effort'),)
@@ -81,20 +69,6 @@ def servo_of(params: ManipulateParams) -> PelvisServo | None:
     if not params.use_desired:
         return None
     return PelvisServo(params.pelvis_height_m, params.pelvis_yaw_rad, params.pelvis_lat_m)
-
-
-def falling_robot(sim: AtlasSimulator) -> bool:
-    """The pelvis low or tilted (FALLING_PELVIS_M, FALLING_TILT_RAD)."""
-    data, pelvis = sim.data, sim.atlas.pelvis_body_id
-    upright = float(data.xmat[pelvis][8])  # the pelvis z axis's world z component
-    tilt = math.acos(max(-1.0, min(1.0, upright)))
-    return float(data.xpos[pelvis][2]) < FALLING_PELVIS_M or tilt > FALLING_TILT_RAD
-
-
-def fallen_robot(sim: AtlasSimulator) -> bool:
-    """The pelvis below DOWN_PELVIS_M (as the state's pelvis_position reports it): fallen
-    for good."""
-    return pelvis_height_m(sim.atlas, sim.data) < DOWN_PELVIS_M
 
 
 class AtlasSimInterface:
@@ -110,6 +84,7 @@ class AtlasSimInterface:
                  user_behaviour: LibraryBehaviour | None = None) -> None:
         self.sim = sim
         self.user_behaviour = user_behaviour
+        self._ground = GroundUnderFeet(sim.atlas, sim.data)  # falling and fallen: fall.py
         if balance and hold_at_start:
             sim.behaviours.hold_stand_at_start = True
             if sim.mode is ControlMode.STAND:
@@ -298,7 +273,7 @@ class AtlasSimInterface:
         what a recorded state's change is judged by."""
         self._observe()
         current = self.current_behavior
-        falling = current in STANDING_BEHAVIORS and falling_robot(self.sim)
+        falling = current in STANDING_BEHAVIORS and self._ground.falling()
         return int(current), self.session.status_flags(current, falling)
 
     def state(self) -> AsiState:
@@ -306,7 +281,7 @@ class AtlasSimInterface:
         self._observe()
         sim, session = self.sim, self.session
         current = self.current_behavior
-        falling = current in STANDING_BEHAVIORS and falling_robot(sim)
+        falling = current in STANDING_BEHAVIORS and self._ground.falling()
         acting = self.library.get(current)
         feedback = ({} if acting is None else
                     acting.feedback(float(sim.data.time), self._estimator.sole_ahead_m))
@@ -327,7 +302,7 @@ class AtlasSimInterface:
                 self._request(deferred, current)
             self._deferred = None
         acting = self.library.get(BEHAVIOR_OF_MODE.get(self.sim.mode, Behavior.USER))
-        handover = None if acting is None else acting.handover(fallen_robot(self.sim))
+        handover = None if acting is None else acting.handover(self._ground.fallen())
         if handover is not None:
             assert acting is not None
             self._switch(MODE_OF_BEHAVIOR[handover.behavior])

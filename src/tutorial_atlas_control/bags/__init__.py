@@ -7,7 +7,7 @@ test/support/synthetic_bags.py.
 from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
-    'analysis': ['Analysis', 'COMMAND_CHANGE_RAD', 'EFFORT_LIMIT_TOLERANCE_NM', 'FALL_HEIGHT_M',
+    'analysis': ['Analysis', 'COMMAND_CHANGE_RAD', 'EFFORT_LIMIT_TOLERANCE_NM',
                  'MOVED_RANGE_RAD', 'analyze', 'analyze_bag', 'analyze_try'],
     'capture_point': ['CaptureTrace', 'capture_trace', 'plot_capture'],
     'bag_dir': ['default_bag_dir', 'latest_bag', 'newest_bag', 'unwritable_reason'],

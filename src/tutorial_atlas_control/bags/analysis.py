@@ -28,12 +28,12 @@ from tutorial_atlas_control.bags.tries import Try, find_tries, pick_try, window
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.fall_report import LoggedFall
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES
+from tutorial_atlas_control.sim import FALL_HEIGHT_M, fallen_samples
 
 __all__ = [
     'COMMAND_CHANGE_RAD',
     'EFFORT_LIMITS_NM',
     'EFFORT_LIMIT_TOLERANCE_NM',
-    'FALL_HEIGHT_M',
     'MOVED_RANGE_RAD',
     'USER_MODE',
     'Analysis',
@@ -49,9 +49,6 @@ __all__ = [
 
 #: The control mode in which the simulator obeys /atlas/joint_commands.
 USER_MODE = 'User'
-
-#: Pelvis height (m) below which the robot counts as fallen (standing is ~0.93 m).
-FALL_HEIGHT_M = 0.5
 
 #: A joint "moved" if its measured position spans more than this (rad) over the run...
 MOVED_RANGE_RAD = 0.02
@@ -325,9 +322,10 @@ def _nan_range(values: np.ndarray) -> float | None:
 
 
 def _fall(pelvis: PelvisSeries) -> tuple[bool, float | None, float]:
-    """(fell, first time below FALL_HEIGHT_M or None, lowest pelvis height (m))."""
+    """(fell, first time fallen or None, lowest pelvis height (m)): sim/fall.py's
+    criterion in its flat-ground form, a bag holding no world."""
     height_m = pelvis.position_m[:, 2]
-    below = height_m < FALL_HEIGHT_M
+    below = fallen_samples(height_m)
     fell = bool(below.any())
     return fell, float(pelvis.t_s[np.argmax(below)]) if fell else None, float(height_m.min())
 

@@ -22,7 +22,6 @@ import numpy as np
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags.analysis import (
-    FALL_HEIGHT_M,
     Analysis,
     analyze_try,
 )
@@ -32,6 +31,7 @@ from tutorial_atlas_control.bags.report import json_safe, save_figure
 from tutorial_atlas_control.bags.run_log import PlayedTrajectory
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.joints import JOINT_INDEX
+from tutorial_atlas_control.sim import FALL_HEIGHT_M
 
 __all__ = ['ALIGNED_ON', 'Comparison', 'JointDifference', 'compare_analyses', 'compare_bags',
            'format_comparison', 'plot_comparison', 'comparison_to_json']

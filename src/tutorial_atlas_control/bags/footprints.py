@@ -26,6 +26,7 @@ from tutorial_atlas_control.bags.reader import BagData
 from tutorial_atlas_control.bags.records import open_bag
 from tutorial_atlas_control.bags.typestore import load_typestore
 from tutorial_atlas_control.errors import BagAnalysisError
+from tutorial_atlas_control.sim import fallen
 
 if TYPE_CHECKING:
     from tutorial_atlas_control.balance import SoleBox
@@ -48,8 +49,6 @@ MIN_PLANTED_S = 0.2
 MATCH_WINDOW = 5
 #: The rate (Hz) at which the recorded pose is turned into foot poses.
 KINEMATICS_RATE_HZ = 200.0
-#: The pelvis below this (m) is a fall (as the bag analysis says).
-FALL_HEIGHT_M = 0.5
 _COMMAND_TYPE = 'atlas_msgs/msg/AtlasSimInterfaceCommand'
 
 
@@ -276,7 +275,7 @@ def summarise_walk(data: BagData, window_s: tuple[float, float] | None = None
     lowest = float(path[:, 2].min()) if len(path) else None
     travel = [_travel(positions[foot][0, :2] if len(t_s) else None, by_foot[foot])
               for foot in (0, 1)]
-    return WalkSummary(placements, distance, lowest is not None and lowest < FALL_HEIGHT_M,
+    return WalkSummary(placements, distance, lowest is not None and fallen(lowest),
                        lowest, path[:, :2].copy(), path_m=float(np.mean(travel)), sole=sole)
 
 

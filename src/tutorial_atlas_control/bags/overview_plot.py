@@ -13,12 +13,13 @@ from typing import Any
 
 import numpy as np
 
-from tutorial_atlas_control.bags.analysis import FALL_HEIGHT_M, Analysis, TryAnalysis
+from tutorial_atlas_control.bags.analysis import Analysis, TryAnalysis
 from tutorial_atlas_control.bags.reader import BagData
 from tutorial_atlas_control.bags.tries import window
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.fall_report import fall_when
 from tutorial_atlas_control.joints import JOINT_NAMES
+from tutorial_atlas_control.sim import FALL_HEIGHT_M
 from tutorial_atlas_control.trajectories import load_trajectory
 
 __all__ = ['WORST_JOINTS', 'axis_shift_s', 'draw_overview', 'tracking_errors', 'waypoint_times']

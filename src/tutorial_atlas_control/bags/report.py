@@ -12,7 +12,6 @@ import numpy as np
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags.analysis import (
     EFFORT_LIMIT_TOLERANCE_NM,
-    FALL_HEIGHT_M,
     MOVED_RANGE_RAD,
     Analysis,
     TryAnalysis,
@@ -25,6 +24,7 @@ from tutorial_atlas_control.control_modes import is_refused_mode
 from tutorial_atlas_control.errors import BagAnalysisError
 from tutorial_atlas_control.fall_report import fall_line, fall_when
 from tutorial_atlas_control.joints import JOINT_NAMES
+from tutorial_atlas_control.sim import FALL_HEIGHT_M
 
 __all__ = ['analysis_to_json', 'format_summary', 'plot_joints', 'plot_run', 'write_csv']
 

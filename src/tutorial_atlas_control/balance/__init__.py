@@ -25,7 +25,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'manipulate': ['PelvisServo', 'SquatTable', 'bent_posture', 'clamp_servo'],
     'lipm': ['capture_point', 'capture_point_after', 'com_acceleration', 'cop_reaching',
              'dcm_feedback_cop', 'lipm_state', 'natural_frequency'],
-    'push_trial': ['STANDING_PELVIS_M', 'Push', 'TimedStand', 'TrialResult', 'apply_pushes',
+    'push_trial': ['Push', 'TimedStand', 'TrialResult', 'apply_pushes',
                    'push_events', 'push_survived', 'stand_trial', 'standing_simulator'],
     'stance_posture': ['Stance', 'StancePosture'],
     'stand': ['StandController', 'StandGains', 'StandOutput', 'StandReference',

@@ -23,9 +23,10 @@ from tutorial_atlas_control.sim import (
     DEFAULT_GAINS_FILE,
     AtlasModel,
     AtlasSimulator,
+    GroundUnderFeet,
     load_gains_yaml,
     load_model,
-    pelvis_height_m,
+    standing,
     wrench_input,
 )
 
@@ -33,8 +34,6 @@ Vector = tuple[float, float, float]
 
 #: The pushes of the robustness figures last this long (s), as the issue's bench does.
 PUSH_DURATION_S = 0.2
-#: Standing means the pelvis above this (m); Stand holds it at about 0.91 m.
-STANDING_PELVIS_M = 0.8
 #: A sole that moved more than this (m) in the horizontal plane has stepped or slid.
 FOOT_TRAVEL_LIMIT_M = 0.02
 
@@ -54,8 +53,9 @@ class Push:
 
 @dataclass(frozen=True)
 class TrialResult:
-    """What became of the robot: `stood` = the pelvis stayed above STANDING_PELVIS_M and
-    neither sole moved more than FOOT_TRAVEL_LIMIT_M."""
+    """What became of the robot: `stood` = sim/fall.py's `standing` throughout (the pelvis
+    at least STANDING_PELVIS_M above the ground under the feet) and neither sole moved more
+    than FOOT_TRAVEL_LIMIT_M; `lowest_pelvis_m` is the pelvis's lowest above that ground."""
 
     stood: bool
     lowest_pelvis_m: float
@@ -102,14 +102,15 @@ def stand_trial(duration_s: float, pushes: Sequence[Push] = (),
     feet_start = stand.last_state.sole_centres[:, :2].copy()
     events = push_events(pushes, sim.dt_s)
     lowest, travel = np.inf, 0.0
+    ground = GroundUnderFeet(sim.atlas, sim.data)
     steps = round(duration_s / sim.dt_s)
     for step in range(steps):
         apply_pushes(sim, events, step)
         sim.step()
-        lowest = min(lowest, pelvis_height_m(sim.atlas, sim.data))
+        lowest = min(lowest, ground.clearance_m())
         travel = max(travel, float(np.max(np.linalg.norm(
             stand.last_state.sole_centres[:, :2] - feet_start, axis=1))))
-        if lowest < STANDING_PELVIS_M:
+        if not standing(lowest):
             return TrialResult(False, lowest, travel, step + 1, stand.spent_s)
     return TrialResult(travel <= FOOT_TRAVEL_LIMIT_M, lowest, travel, steps, stand.spent_s)
 

@@ -12,7 +12,6 @@ from tutorial_atlas_control.bags import (
     DEFAULT_FPS,
     DEFAULT_SIZE,
     EFFORT_LIMIT_TOLERANCE_NM,
-    FALL_HEIGHT_M,
     MOVED_RANGE_RAD,
     WORST_JOINTS,
     Analysis,
@@ -55,6 +54,7 @@ from tutorial_atlas_control.cli.convention import (
     print_error,
 )
 from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.sim import FALL_HEIGHT_M
 
 PROG = 'analyze_bag.py'
 

@@ -34,7 +34,7 @@ from tutorial_atlas_control.cli.convention import (
     non_negative_number,
     print_error,
 )
-from tutorial_atlas_control.sim import GainsError, gains_from_params
+from tutorial_atlas_control.sim import GainsError, fallen, gains_from_params
 
 PROG = 'mode_switching_demo.py'
 #: How long (s, wall time) to wait for the first state and for the simulator to subscribe.
@@ -43,8 +43,6 @@ CONNECT_TIMEOUT_S = 30.0
 STATE_SILENCE_S = 5.0
 #: The first command goes this long (s of sim time) after the first state.
 LEAD_S = 0.5
-#: Below this the pelvis has fallen (m).
-FALLEN_M = 0.5
 
 
 class _Refused(Exception):
@@ -106,7 +104,7 @@ def _run(kp_velocity: float) -> int:
         due_s = start_s + (CUES[-1].at_s + AFTER_LAST_S if cue is None else cue.at_s)
         while (state := latest[0]) is not None and _sim_s(state) < due_s:
             lowest = min(lowest, state.pos_est.position.z)
-            if state.pos_est.position.z < FALLEN_M:
+            if fallen(state.pos_est.position.z):  # a state holds no world: flat ground
                 raise _Refused(f'the robot fell at sim time {_sim_s(state):.2f} s, '
                                + (f'before {cue.name} was sent' if cue else
                                   'after the last command'))

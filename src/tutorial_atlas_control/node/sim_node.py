@@ -16,8 +16,9 @@ reset and pause services (and DRCSim's /gazebo/reset_models). VRCPlugin's
 gazebo_ros_joint_trajectory's /joint_trajectory are checked here and applied by the loop
 (sim/vrc.py), each applied one echoed on /atlas/sim_inputs; /atlas/configuration is
 logged as not implemented, as in DRCSim. Publishes a latched /atlas/current_control_mode (the
-mode now). Logs one line per fall (pelvis below 0.5 m, once until a reset) and per reset,
-and warns when joint commands arrive in a mode that does not apply them.
+mode now). Logs one line per fall (sim/fall.py's: the pelvis less than 0.5 m above the
+ground under the feet, once until a reset) and per reset, and warns when joint commands
+arrive in a mode that does not apply them.
 
 Parameters (private unless noted):
     ~real_time_factor (float, 1.0): sim time per wall time; 0 runs as fast as possible.

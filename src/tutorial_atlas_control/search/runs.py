@@ -24,14 +24,12 @@ from tutorial_atlas_control.offline import (
     OfflineRunError,
     write_offline_bag,
 )
-from tutorial_atlas_control.sim import AtlasSimulator, Gains, wrench_input
+from tutorial_atlas_control.sim import AtlasSimulator, Gains, GroundUnderFeet, wrench_input
 from tutorial_atlas_control.trajectories import Waypoint
 from tutorial_atlas_control.units import NS_PER_S
 
-__all__ = ['FALL_HEIGHT_M', 'Push', 'RunSpec', 'SweepError', 'TABLE_COLUMNS', 'run_one']
+__all__ = ['Push', 'RunSpec', 'SweepError', 'TABLE_COLUMNS', 'run_one']
 
-#: Pelvis height (m) below which the robot counts as fallen: analysis.FALL_HEIGHT_M's line.
-FALL_HEIGHT_M = 0.5
 #: The probe samples tracking and feet every this many 1 ms steps (falls: every step).
 SAMPLE_EVERY_STEPS = 10
 #: Sim time (s) from spawn to User mode and the first command, as `make demo`.
@@ -129,6 +127,7 @@ class RunProbe:
         self.error_count = 0
         self.last: dict[str, np.ndarray] = {}
         self._feet: tuple[int, int] | None = None
+        self._ground: GroundUnderFeet | None = None  # the fall criterion's, once sim is known
 
     def _poses(self, sim: AtlasSimulator) -> dict[str, np.ndarray]:
         if self._feet is None:
@@ -152,7 +151,9 @@ class RunProbe:
                 self.pushing = False
         z_m = float(sim.data.qpos[sim.atlas.free_qpos_adr + 2])
         self.z_min_m = min(self.z_min_m, z_m)
-        if self.fall_ns is None and z_m < FALL_HEIGHT_M:
+        if self._ground is None:
+            self._ground = GroundUnderFeet(sim.atlas, sim.data)
+        if self.fall_ns is None and self._ground.fallen(z_m):
             self.fall_ns = now_ns
         if self.start is None:
             self.start = self._poses(sim)

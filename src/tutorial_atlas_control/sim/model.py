@@ -25,10 +25,6 @@ MODEL_PATH: Path = package_path('sim', 'atlas_v1.xml')
 #: dropped the robot 2.9 mm onto the ground; we start in contact instead.
 SPAWN_HEIGHT_M: float = 0.05 + 0.374 + 0.422 + 0.076119 + 0.005
 
-#: The robot has fallen once its pelvis is below this height (m): the simulator's log line
-#: and the bag analysis use the same criterion (standing, the pelvis is at about 0.92 m).
-FALL_HEIGHT_M: float = 0.5
-
 PELVIS_BODY = 'pelvis'
 PIN_EQUALITY = 'pelvis_pin'
 

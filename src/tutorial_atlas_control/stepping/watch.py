@@ -1,6 +1,7 @@
 """The run's headless log lines: what a user without a window sees of a run.
 
-One line per fall (pelvis below FALL_HEIGHT_M, once until a reset), one for the first
+One line per fall (sim/fall.py's: the pelvis less than FALL_HEIGHT_M above the ground under
+the feet, once until a reset), one for the first
 command since the start or a reset, a warning when joint commands arrive in a mode that
 does not apply them, and one line per applied cheat (throttled per kind).
 """
@@ -9,7 +10,13 @@ from __future__ import annotations
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.fall_report import fall_line
-from tutorial_atlas_control.sim import FALL_HEIGHT_M, AtlasSimulator, SimInput, describe_input
+from tutorial_atlas_control.sim import (
+    FALL_HEIGHT_M,
+    AtlasSimulator,
+    GroundUnderFeet,
+    SimInput,
+    describe_input,
+)
 from tutorial_atlas_control.stepping.outputs import LoopLog
 from tutorial_atlas_control.units import NS_PER_S
 
@@ -30,6 +37,7 @@ class RunWatch:
         self.sim = sim
         self.log = log
         self.pelvis_z_index = sim.atlas.free_qpos_adr + 2  # the pelvis height in qpos
+        self.ground = GroundUnderFeet(sim.atlas, sim.data)
         self.fall_armed = True  # one line per fall: disarmed by it, re-armed by a reset
         self.first_command_ns: int | None = None  # since the start or last reset
         self.not_user_warned_ns: int | None = None
@@ -42,9 +50,10 @@ class RunWatch:
         self.not_user_warned_ns = None
 
     def watch_fall(self) -> None:
-        """After a step: one line when the pelvis drops below FALL_HEIGHT_M (headless, the
-        only sign of a fall), then nothing until a reset."""
-        if self.fall_armed and self.sim.data.qpos[self.pelvis_z_index] < FALL_HEIGHT_M:
+        """After a step: one line when the robot falls (headless, the only sign of a
+        fall), then nothing until a reset."""
+        pelvis_z_m = float(self.sim.data.qpos[self.pelvis_z_index])
+        if self.fall_armed and self.ground.fallen(pelvis_z_m):
             self.fall_armed = False
             sim = self.sim
             after_s = (None if self.first_command_ns is None else

@@ -23,7 +23,6 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control.balance import (
-    STANDING_PELVIS_M,
     BalanceState,
     Push,
     StandBehaviour,
@@ -31,7 +30,7 @@ from tutorial_atlas_control.balance import (
     push_events,
     standing_simulator,
 )
-from tutorial_atlas_control.sim import AtlasModel, pelvis_height_m
+from tutorial_atlas_control.sim import STANDING_PELVIS_M, AtlasModel, pelvis_height_m
 from tutorial_atlas_control.walking.footsteps import (
     STEP_DURATION_S,
     Footstep,

@@ -15,7 +15,6 @@ from tutorial_atlas_control.asi import (
     AtlasSimInterface,
     Behavior,
     Status,
-    falling_robot,
 )
 from tutorial_atlas_control.balance import place_in_stand_pose
 from tutorial_atlas_control.control_modes import ControlMode
@@ -26,7 +25,7 @@ from tutorial_atlas_control.msgs.atlas_sim_interface import (
     StepData,
 )
 from tutorial_atlas_control.msgs.atlas_sim_interface_state import encode_asi_state
-from tutorial_atlas_control.sim import AtlasSimulator, load_gains_yaml, load_model
+from tutorial_atlas_control.sim import AtlasSimulator, GroundUnderFeet, load_gains_yaml, load_model
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.vrc import ModeInput, VrcMode, WrenchInput
 
@@ -134,7 +133,7 @@ def test_stand_is_refused_for_a_fallen_robot_which_reports_falling_in_stand(
     assert state.behavior_feedback.status_flags == Status.FAILED_TRANS_COM_POS
     assert state.error_code == AsiError.FAILED_TO_START_BEHAVIOR
     sim.set_mode(ControlMode.STAND)  # /atlas/control_mode Stand is not refused
-    assert falling_robot(sim)
+    assert GroundUnderFeet(sim.atlas, sim.data).falling()
     assert interface.state().behavior_feedback.status_flags == Status.ERROR_FALLING
 
 
@@ -142,7 +141,7 @@ def test_a_push_beyond_what_stand_survives_is_reported_falling(
         interface: AtlasSimInterface) -> None:
     sim = interface.sim
     run(interface, 500)
-    assert not falling_robot(sim)
+    assert not GroundUnderFeet(sim.atlas, sim.data).falling()
     sim.apply_input(WrenchInput((1000.0, 0.0, 0.0), (0.0, 0.0, 0.0)))  # 200 N s
     run(interface, 200)
     sim.apply_input(WrenchInput((0.0, 0.0, 0.0), (0.0, 0.0, 0.0)))

@@ -26,7 +26,8 @@ from tutorial_atlas_control.joints import JOINT_INDEX, NUM_JOINTS
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistics
-from tutorial_atlas_control.sim.model import FALL_HEIGHT_M, pelvis_height_m
+from tutorial_atlas_control.sim.fall import FALL_HEIGHT_M
+from tutorial_atlas_control.sim.model import pelvis_height_m
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode, PhysicsDivergenceError
 from tutorial_atlas_control.stepping import pacing
 from tutorial_atlas_control.stepping.divergence import (

@@ -1,0 +1,145 @@
+"""sim/ground.py on small worlds built here, and on the Atlas model: heights and normals."""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+import pytest
+
+from tutorial_atlas_control.sim import Ground, load_model
+
+
+def world(body: str, assets: str = '') -> mujoco.MjModel:
+    return mujoco.MjModel.from_xml_string(
+        f'<mujoco><asset>{assets}</asset><worldbody>{body}</worldbody></mujoco>')
+
+
+@pytest.mark.parametrize('z', [0.0, 0.3])
+def test_level_plane(z: float) -> None:
+    ground = Ground(world(f'<geom type="plane" size="1 1 0.1" pos="0 0 {z}"/>'))
+    for x, y in [(0.0, 0.0), (0.4, -0.7), (25.0, 40.0)]:  # beyond the rendered size too
+        hit = ground.hit(x, y)
+        assert hit.height_m == pytest.approx(z, abs=1e-9)
+        np.testing.assert_allclose(hit.normal, [0.0, 0.0, 1.0], atol=1e-9)
+        assert hit.geom_id == 0
+
+
+def test_tilted_plane() -> None:
+    ground = Ground(world('<geom type="plane" size="0 0 1" pos="0.2 -0.1 0.3" '
+                          'euler="10 -5 30"/>'))
+    rot = np.zeros(9)
+    quat = np.zeros(4)
+    mujoco.mju_euler2Quat(quat, np.radians([10.0, -5.0, 30.0]), 'xyz')
+    mujoco.mju_quat2Mat(rot, quat)
+    normal = rot.reshape(3, 3)[:, 2]
+    for x, y in [(0.0, 0.0), (3.0, -2.0), (-10.0, 7.0)]:
+        # on the plane: normal . (p - origin) = 0
+        z = 0.3 - (normal[0] * (x - 0.2) + normal[1] * (y + 0.1)) / normal[2]
+        hit = ground.hit(x, y)
+        assert hit.height_m == pytest.approx(z, abs=1e-9)
+        np.testing.assert_allclose(hit.normal, normal, atol=1e-9)
+
+
+def test_box_on_plane() -> None:
+    ground = Ground(world('<geom type="plane" size="0 0 1"/>'
+                          '<geom type="box" size="0.2 0.3 0.15" pos="1 0 0.15"/>'))
+    top = ground.hit(1.1, 0.2)
+    assert top.height_m == pytest.approx(0.3, abs=1e-9)
+    np.testing.assert_allclose(top.normal, [0.0, 0.0, 1.0], atol=1e-9)
+    assert top.geom_id == 1
+    beside = ground.hit(1.3, 0.0)
+    assert beside.height_m == pytest.approx(0.0, abs=1e-9)
+    assert beside.geom_id == 0
+
+
+def test_turned_box_answers_the_face_hit() -> None:
+    ground = Ground(world('<geom type="box" size="0.5 0.5 0.5" pos="0 0 0" euler="0 30 0"/>'))
+    hit = ground.hit(0.1, 0.0)
+    np.testing.assert_allclose(hit.normal, [math.sin(math.radians(30)), 0.0,
+                                            math.cos(math.radians(30))], atol=1e-9)
+
+
+def test_heightfield_heights_at_grid_points() -> None:
+    elevation = np.array([[0.0, 1.0, 2.0, 3.0], [4.0, 6.0, 5.0, 7.0], [8.0, 9.0, 11.0, 10.0]])
+    size = (1.0, 2.0, 0.5, 0.1)  # radius x, radius y, elevation z, base z
+    text = ' '.join(str(v) for v in elevation.ravel())
+    model = world('<geom type="hfield" hfield="h" pos="3 1 0.2"/>',
+                  f'<hfield name="h" nrow="3" ncol="4" size="{" ".join(map(str, size))}" '
+                  f'elevation="{text}"/>')
+    ground = Ground(model)
+    # MuJoCo scales the elevations to [0, 1], then by size z; the attribute's first row is
+    # the +y edge (an image's top row), so row r of the array sits at y from +y down.
+    scaled = (elevation - elevation.min()) / np.ptp(elevation) * size[2]
+    nrow, ncol = elevation.shape
+    for row in range(nrow):
+        for col in range(ncol):
+            x = 3.0 + (2.0 * col / (ncol - 1) - 1.0) * size[0]
+            y = 1.0 + (1.0 - 2.0 * row / (nrow - 1)) * size[1]
+            assert ground.height_m(x, y) == pytest.approx(0.2 + scaled[row, col], abs=1e-6)
+
+
+def test_heightfield_normal_on_a_slope() -> None:
+    # rising 1 m per 2 m along x everywhere: the normal is (-0.5, 0, 1), normalised
+    model = world('<geom type="hfield" hfield="h"/>',
+                  '<hfield name="h" nrow="2" ncol="3" size="2 1 2 0.1" '
+                  'elevation="0 1 2 0 1 2"/>')
+    hit = Ground(model).hit(0.3, 0.2)
+    np.testing.assert_allclose(hit.normal, np.array([-0.5, 0.0, 1.0]) / math.sqrt(1.25),
+                               atol=1e-6)
+    assert hit.height_m == pytest.approx(1.0 + 0.3 / 2.0, abs=1e-6)
+
+
+def test_what_cannot_collide_is_not_ground() -> None:
+    ground = Ground(world('<geom type="plane" size="0 0 1"/>'
+                          '<geom type="box" size="0.2 0.2 0.5" pos="0 0 0.5" contype="0" '
+                          'conaffinity="0"/>'
+                          '<geom type="box" size="0.2 0.2 0.2" pos="2 0 0.2" rgba="0 0 0 0"/>'))
+    assert ground.height_m(0.0, 0.0) == pytest.approx(0.0, abs=1e-9)
+    assert ground.height_m(2.0, 0.0) == pytest.approx(0.4, abs=1e-9)  # invisible, solid
+
+
+def test_loose_block_follows_the_data() -> None:
+    model = world('<geom type="plane" size="0 0 1"/>'
+                  '<body name="block" pos="0 0 0.1"><freejoint/>'
+                  '<geom type="box" size="0.2 0.1 0.1" mass="5"/></body>')
+    data = mujoco.MjData(model)
+    data.qpos[:3] = (1.0, 0.0, 0.1)
+    mujoco.mj_forward(model, data)
+    ground = Ground(model, data)
+    assert ground.height_m(1.0, 0.0) == pytest.approx(0.2, abs=1e-9)
+    assert ground.height_m(0.0, 0.0) == pytest.approx(0.0, abs=1e-9)
+    data.qpos[:3] = (0.0, 0.0, 0.1)
+    mujoco.mj_forward(model, data)
+    assert ground.height_m(0.0, 0.0) == pytest.approx(0.2, abs=1e-9)
+
+
+def test_nothing_below() -> None:
+    hit = Ground(world('<geom type="box" size="0.2 0.2 0.2"/>')).hit(5.0, 5.0)
+    assert hit.height_m == -math.inf and hit.geom_id == -1 and np.isnan(hit.normal).all()
+
+
+def test_batched_matches_single() -> None:
+    ground = Ground(world('<geom type="plane" size="0 0 1"/>'
+                          '<geom type="box" size="0.2 0.3 0.15" pos="1 0 0.15"/>'))
+    xy = np.array([[1.1, 0.2], [1.3, 0.0], [-4.0, 2.0]])
+    heights, normals = ground.hits(xy)
+    for (x, y), height, normal in zip(xy, heights, normals):
+        hit = ground.hit(float(x), float(y))
+        assert height == hit.height_m
+        np.testing.assert_array_equal(normal, hit.normal)
+
+
+def test_atlas_world_is_the_floor() -> None:
+    atlas = load_model()
+    data = mujoco.MjData(atlas.model)
+    mujoco.mj_forward(atlas.model, data)
+    ground = Ground(atlas.model, data)
+    floor = mujoco.mj_name2id(atlas.model, mujoco.mjtObj.mjOBJ_GEOM, 'floor')
+    assert ground.geom_ids == (floor,)
+    for body in ('l_foot', 'r_foot', 'pelvis'):
+        x, y, _ = data.xpos[atlas.model.body(body).id]
+        hit = ground.hit(float(x), float(y))
+        assert hit.height_m == 0.0 and hit.geom_id == floor
+        np.testing.assert_array_equal(hit.normal, [0.0, 0.0, 1.0])
