@@ -32,7 +32,12 @@ from __future__ import annotations
 import numpy as np
 
 from tutorial_atlas_control.asi.behaviors import BEHAVIOR_OF_MODE, MODE_OF_BEHAVIOR, Behavior
-from tutorial_atlas_control.asi.library import LibraryBehaviour, StepEntry, WalkEntry
+from tutorial_atlas_control.asi.library import (
+    LibraryBehaviour,
+    StepEntry,
+    WalkEntry,
+    on_ground,
+)
 from tutorial_atlas_control.asi.session import STANDING_BEHAVIORS, AsiSession, behavior_name
 from tutorial_atlas_control.asi.state_report import StateReport, manipulate_feedback
 from tutorial_atlas_control.asi.walk_params import sole_step
@@ -120,9 +125,10 @@ class AtlasSimInterface:
         sim.install_stand(StandPrepBehaviour(sim.atlas, sim.gains), ControlMode.STAND_PREP)
         self.session.served[Behavior.MANIPULATE] = ControlMode.STAND
         ahead = self.stand.estimator.sole_ahead_m
-        self.register(WalkEntry(WalkBehaviour(self.stand, default_steps=[
-            sole_step(step, ahead) for step in DRCSIM_WALK_QUEUE]), ahead))
-        self.register(StepEntry(StepBehaviour(self.stand), ahead))
+        ground = self._ground.ground
+        self.register(WalkEntry(WalkBehaviour(self.stand, default_steps=on_ground(
+            [sole_step(step, ahead) for step in DRCSIM_WALK_QUEUE], ground)), ahead, ground))
+        self.register(StepEntry(StepBehaviour(self.stand), ahead, ground))
         self._estimator = self.stand.estimator
         if self.user_behaviour is not None:
             self.register(self.user_behaviour)

@@ -20,6 +20,7 @@ from tutorial_atlas_control.asi.behaviors import Behavior
 from tutorial_atlas_control.asi.walk_params import footsteps_of, step_feedback, walk_feedback
 from tutorial_atlas_control.control_modes import ControlMode
 from tutorial_atlas_control.msgs import AsiCommand
+from tutorial_atlas_control.sim import Ground
 from tutorial_atlas_control.walking import (
     STEP_DURATION_S,
     Footstep,
@@ -27,7 +28,7 @@ from tutorial_atlas_control.walking import (
     WalkBehaviour,
 )
 
-__all__ = ['BehaviourBase', 'Handover', 'LibraryBehaviour', 'StepEntry', 'WalkEntry']
+__all__ = ['BehaviourBase', 'Handover', 'LibraryBehaviour', 'StepEntry', 'WalkEntry', 'on_ground']
 
 
 @dataclasses.dataclass(frozen=True)
@@ -113,6 +114,23 @@ class BehaviourBase:
         return {}
 
 
+def on_ground(steps: list[Footstep], ground: Ground | None) -> list[Footstep]:
+    """`steps` placed on the world's surface under each sole's centre (its height and
+    normal): a DRC-era client's z is the foot link's, or none (ASI.md: it may be ignored),
+    so the world says where a sole lands. Nothing below (off the world): as asked."""
+    if ground is None or ground.level_m == 0.0:
+        return steps  # the ground the robot starts on: every step's default
+    placed = []
+    for step in steps:
+        hit = ground.hit(step.x_m, step.y_m)
+        if hit.geom_id < 0:
+            placed.append(step)
+            continue
+        normal = (float(hit.normal[0]), float(hit.normal[1]), float(hit.normal[2]))
+        placed.append(dataclasses.replace(step, z_m=hit.height_m, normal=normal))
+    return placed
+
+
 class WalkEntry:
     """Walk in the library: a WALK's step queue, Stand deferred to the end of the step under
     way, Stand again once the walk has caught itself, Freeze once fallen."""
@@ -121,9 +139,12 @@ class WalkEntry:
     mode = ControlMode.WALK
     waits_for_stand = True
 
-    def __init__(self, walking: WalkBehaviour, sole_ahead_m: float) -> None:
+    def __init__(self, walking: WalkBehaviour, sole_ahead_m: float,
+                 ground: Ground | None = None) -> None:
+        """`ground`: the world's, where the steps land (None: the plane z = 0)."""
         self.walking = walking
         self.sole_ahead_m = sole_ahead_m
+        self.ground = ground
         self._stand_asked = False
         self._decoded: tuple[AsiCommand, list[Footstep]] | None = None
 
@@ -138,7 +159,8 @@ class WalkEntry:
         """The command's step queue as the soles' steps (kept for the same command: the
         refusal and the take read it once)."""
         if self._decoded is None or self._decoded[0] is not command:
-            self._decoded = (command, footsteps_of(command.step_queue, self.sole_ahead_m))
+            self._decoded = (command, on_ground(
+                footsteps_of(command.step_queue, self.sole_ahead_m), self.ground))
         return self._decoded[1]
 
     def refusal(self, command: AsiCommand, running: bool) -> str | None:
@@ -189,9 +211,12 @@ class StepEntry:
     mode = ControlMode.STEP
     waits_for_stand = True
 
-    def __init__(self, stepping: StepBehaviour, sole_ahead_m: float) -> None:
+    def __init__(self, stepping: StepBehaviour, sole_ahead_m: float,
+                 ground: Ground | None = None) -> None:
+        """`ground`: the world's, where the steps land (None: the plane z = 0)."""
         self.stepping = stepping
         self.sole_ahead_m = sole_ahead_m
+        self.ground = ground
         self._stand_asked = False
 
     def start(self, data: mujoco.MjData) -> None:
@@ -211,7 +236,7 @@ class StepEntry:
         desired = command.desired_step
         if desired.duration_s <= 0.0:
             desired = dataclasses.replace(desired, duration_s=STEP_DURATION_S)
-        steps = footsteps_of([desired], self.sole_ahead_m)
+        steps = on_ground(footsteps_of([desired], self.sole_ahead_m), self.ground)
         self.stepping.desire(steps[0] if steps else None)
 
     def take(self, command: AsiCommand, running: bool) -> None:

@@ -13,11 +13,12 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from tutorial_atlas_control.sim import SOLE_GEOMS
+
 __all__ = ['BOTTOM_CORNER_SIGNS', 'SOLE_GEOMS', 'SoleBox', 'box_corners',
            'lowest_sole_corner_m', 'sole_corners', 'sole_geom_ids']
 
 #: The sole boxes of the model, left then right.
-SOLE_GEOMS: tuple[str, str] = ('l_foot_sole', 'r_foot_sole')
 #: A box's bottom-face corners as signs on its half sizes (x ahead, y left, z up): front
 #: left, front right, back right, back left (counter-clockwise seen from below).
 BOTTOM_CORNER_SIGNS = np.array([[1, 1, -1], [1, -1, -1], [-1, -1, -1], [-1, 1, -1]],

@@ -44,8 +44,6 @@ FALLING_TILT_RAD = 0.5
 #: A trial's robot is still standing while its pelvis stays at least this (m) above the
 #: ground (Stand holds it 0.91 m up).
 STANDING_PELVIS_M = 0.8
-#: The soles' geoms, whose centres say where the feet are.
-_SOLE_GEOMS = ('l_foot_sole', 'r_foot_sole')
 
 
 def fallen(pelvis_z_m: float, ground_z_m: float = 0.0) -> bool:
@@ -84,9 +82,10 @@ class GroundUnderFeet:
     def __init__(self, atlas: AtlasModel, data: mujoco.MjData,
                  ground: Ground | None = None) -> None:
         from tutorial_atlas_control.sim.ground import Ground  # noqa: PLC0415 - bags: no MuJoCo
+        from tutorial_atlas_control.sim.model import SOLE_GEOMS  # noqa: PLC0415 - the same
         self.data = data
         self.ground = ground if ground is not None else Ground(atlas.model, data)
-        self._soles = [atlas.model.geom(name).id for name in _SOLE_GEOMS]
+        self._soles = [atlas.model.geom(name).id for name in SOLE_GEOMS]
         self._pelvis = atlas.pelvis_body_id
         self._pelvis_z = atlas.free_qpos_adr + 2
 

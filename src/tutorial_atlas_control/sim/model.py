@@ -26,6 +26,8 @@ MODEL_PATH: Path = package_path('sim', 'atlas_v1.xml')
 SPAWN_HEIGHT_M: float = 0.05 + 0.374 + 0.422 + 0.076119 + 0.005
 
 PELVIS_BODY = 'pelvis'
+#: The feet's sole boxes, left then right: what stands on the ground.
+SOLE_GEOMS: tuple[str, str] = ('l_foot_sole', 'r_foot_sole')
 PIN_EQUALITY = 'pelvis_pin'
 
 #: Sensors the model defines, by name (see sim/atlas_v1.xml).

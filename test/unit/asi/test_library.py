@@ -141,3 +141,34 @@ def test_walk_and_step_are_served_through_the_library(mode: ControlMode) -> None
     assert interface.serves(mode)
     assert sim.behaviours.installed[mode] is interface.library[Behavior[mode.name]]
     assert not AtlasSimInterface(sim, balance=False).serves(mode)
+
+
+def test_the_steps_a_client_sends_land_on_the_worlds_surface() -> None:
+    """A step's height and surface come from the world under the sole: on a 0.2 m block its
+    top, on a 10 degree ramp its height and tilt, on the ground the robot starts on as sent."""
+    import mujoco
+
+    from tutorial_atlas_control.asi import on_ground
+    from tutorial_atlas_control.sim import Ground
+    from tutorial_atlas_control.walking import Footstep
+
+    tilt = np.radians(10.0)
+    xml = f'''<mujoco><worldbody>
+      <geom name="floor" type="plane" size="0 0 1"/>
+      <geom name="block" type="box" size="0.2 0.2 0.1" pos="1 0 0.1"/>
+      <geom name="ramp" type="box" size="0.5 0.5 0.01" pos="-2 0 0.3"
+            euler="0 {-np.degrees(tilt)} 0"/>
+    </worldbody></mujoco>'''
+    model = mujoco.MjModel.from_xml_string(xml)
+    ground = Ground(model)
+    steps = [Footstep(1, 0, 1.0, 0.05, 0.0), Footstep(2, 1, 3.0, 0.0, 0.0),
+             Footstep(3, 0, -2.0, 0.0, 0.0)]
+    block, floor, ramp = on_ground(steps, ground)
+    assert block.z_m == pytest.approx(0.2, abs=1e-9)
+    assert block.normal == pytest.approx((0.0, 0.0, 1.0))
+    assert floor.z_m == pytest.approx(0.0, abs=1e-9)
+    assert ramp.z_m == pytest.approx(0.3 + 0.01 / np.cos(tilt), abs=1e-9)  # its top face
+    assert ramp.normal == pytest.approx((-np.sin(tilt), 0.0, np.cos(tilt)), abs=1e-9)
+    flat = Ground(mujoco.MjModel.from_xml_string(
+        '<mujoco><worldbody><geom type="plane" size="0 0 1"/></worldbody></mujoco>'))
+    assert on_ground(steps, flat) is steps
