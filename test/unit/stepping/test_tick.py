@@ -1,14 +1,27 @@
 """One tick in its order: inputs, the step (behaviour and physics), the state, the
 interface's end of step; a diverged physics recovered (state published), given up (nothing
-after) or, without recovery, raised."""
+after) or, without recovery, raised. The node's loop wires its parts in that order: the
+AtlasSimInterface's state is built before its end_step, never after."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
-from tutorial_atlas_control.sim.simulator import PhysicsDivergenceError
+from support.stepping_fakes import ALL_TOPICS, LAUNCH_RATES_HZ, FakeLog, FakeOutbox, stops_after
+from tutorial_atlas_control import topics
+from tutorial_atlas_control.asi import AtlasSimInterface
+from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.sim.controller import load_gains_yaml
+from tutorial_atlas_control.sim.controller_statistics import CommandAgeStatistics
+from tutorial_atlas_control.sim.simulator import AtlasSimulator, PhysicsDivergenceError
+from tutorial_atlas_control.stepping.inbox import CommandInbox
+from tutorial_atlas_control.stepping.loop import LoopSettings, SteppingLoop
+from tutorial_atlas_control.stepping.outputs import LoopOutputs
 from tutorial_atlas_control.stepping.tick import Tick
 
+CONFIG = Path(__file__).resolve().parents[3] / 'config' / 'atlas_controller.yaml'
 ONE_TICK = ['inputs', 'step', 'state', 'end_step']
 
 
@@ -78,3 +91,34 @@ def test_without_recovery_a_divergence_propagates() -> None:
     with pytest.raises(PhysicsDivergenceError):
         tick()
     assert calls == ['inputs', 'step']
+
+
+def test_the_loop_builds_the_interface_state_before_its_end_of_step(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """The node's loop: the controller, the step, the state (the AtlasSimInterface's among
+    it), then the interface's end_step, once per step."""
+    calls: list[str] = []
+    state, end_step = AtlasSimInterface.state, AtlasSimInterface.end_step
+    monkeypatch.setattr(AtlasSimInterface, 'state',
+                        lambda self: (calls.append('state'), state(self))[1])
+    monkeypatch.setattr(AtlasSimInterface, 'end_step',
+                        lambda self: (calls.append('end_step'), end_step(self))[1])
+
+    class Controller:
+        def __init__(self, inbox: CommandInbox) -> None:
+            self.inbox = inbox
+
+        def before_step(self) -> None:
+            calls.append('inputs')
+            self.inbox.apply_pending()
+
+    sim = AtlasSimulator(atlas_model.load_model(), load_gains_yaml(CONFIG))
+    step = sim.step
+    monkeypatch.setattr(sim, 'step', lambda: (calls.append('step'), step())[1])
+    outlets = {topic: topic for topic in (*ALL_TOPICS, topics.ASI_STATE)}
+    loop = SteppingLoop(sim, LoopOutputs(FakeOutbox({topics.ASI_STATE}), outlets, FakeLog(),
+                                         lambda _text: None),
+                        LoopSettings(LAUNCH_RATES_HZ), CommandAgeStatistics(sim.dt_s),
+                        controller=Controller)
+    loop.run(stops_after(3))
+    assert calls == ['state'] + ONE_TICK * 3  # the state before the first step, then ticks
