@@ -22,7 +22,7 @@ from pathlib import Path
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.asi import AtlasSimInterface, load_user_behaviour
-from tutorial_atlas_control.bags import open_bag, read_bag
+from tutorial_atlas_control.bags import BlockBagWriter, open_bag, read_bag
 from tutorial_atlas_control.command import CommandError
 from tutorial_atlas_control.msgs import decode_asi_command
 from tutorial_atlas_control.offline.player import (
@@ -95,21 +95,22 @@ def read_asi_stream(path: Path | str) -> AsiStream:
 
 
 class _AsiFeed:
-    """Before each step, the newest recorded command due, decoded and applied (and written
-    to the offline bag at its recorded time); after it, the interface's end of step."""
+    """The tick's inputs (a StepController): before each step, the newest recorded command
+    due, decoded and applied (and written to the offline bag at its recorded time)."""
 
-    def __init__(self, stream: AsiStream, interface: AtlasSimInterface,
-                 player: OfflinePlayer) -> None:
+    def __init__(self, stream: AsiStream, interface: AtlasSimInterface, sim: AtlasSimulator,
+                 sink: BlockBagWriter) -> None:
         self.commands = stream.commands
         self.next = 0
         self.interface = interface
-        self.player = player
+        self.sim = sim
+        self.sink = sink
         self.applied = 0
 
-    def before_step(self, sim: AtlasSimulator) -> None:
-        commands, due = self.commands, self.next
-        while due < len(commands) and commands[due][0] <= sim.sim_time_ns:
-            self.player.sink.write(topics.ASI_COMMAND, commands[due][0], commands[due][1])
+    def before_step(self) -> None:
+        commands, due, now_ns = self.commands, self.next, self.sim.sim_time_ns
+        while due < len(commands) and commands[due][0] <= now_ns:
+            self.sink.write(topics.ASI_COMMAND, commands[due][0], commands[due][1])
             due += 1
         if due == self.next:
             return
@@ -121,10 +122,6 @@ class _AsiFeed:
             return
         self.interface.apply(command)
         self.applied += 1
-
-    def after_step(self, sim: AtlasSimulator) -> None:
-        self.interface.end_step()
-        self.before_step(sim)
 
 
 def write_asi_bag(stream: AsiStream, bag: Path, settle_s: float,
@@ -139,13 +136,14 @@ def write_asi_bag(stream: AsiStream, bag: Path, settle_s: float,
     sink = open_offline_bag(bag)
     started_s = time.perf_counter()
     try:
-        player = OfflinePlayer(sim, sink)
-        feed = _AsiFeed(stream, interface, player)
-        player.on_step = feed.after_step
+        feed = _AsiFeed(stream, interface, sim, sink)
+        player = OfflinePlayer(sim, sink, controller=feed, interface=interface)
         player.write_config()
         player.publish()
-        feed.before_step(sim)
         player.advance(stream.end_ns / NS_PER_S + settle_s)
+        # The commands recorded up to the last step's end are in the bag too, as in the
+        # recording (applied to no step).
+        feed.before_step()
         player.write_steps()
     finally:
         sink.close()

@@ -29,6 +29,7 @@ import numpy as np
 from numpy.random import default_rng
 
 from tutorial_atlas_control import topics
+from tutorial_atlas_control.asi import AtlasSimInterface
 from tutorial_atlas_control.bags import (
     JOINT_COMMANDS_TYPE,
     BlockBagWriter,
@@ -54,7 +55,7 @@ from tutorial_atlas_control.sim import (
     load_gains_yaml,
     load_model,
 )
-from tutorial_atlas_control.stepping import step_stamp, steps_between
+from tutorial_atlas_control.stepping import StepController, Tick, step_stamp, steps_between
 from tutorial_atlas_control.trajectories import (
     Waypoint,
     done_line,
@@ -243,10 +244,22 @@ class _StepRows:
 
 
 class OfflinePlayer:
-    """The simulator, traj_yaml's commands and the recorder, on one sim clock."""
+    """The simulator, traj_yaml's commands and the recorder, on one sim clock; each step is
+    the node's tick (stepping.Tick), in its order.
+
+    Args:
+        on_step: called with the simulator at the end of every step (after its messages).
+        latency: each command delayed as a live run's delivery does.
+        controller: gives the simulator each step's command, after the delayed commands
+            due (an AtlasSimInterface session's recorded commands).
+        interface: the AtlasSimInterface played with the run: its end_step ends each step,
+            before on_step.
+    """
 
     def __init__(self, sim: AtlasSimulator, sink: BlockBagWriter,
-                 on_step: StepHook | None = None, latency: CommandLatency | None = None) -> None:
+                 on_step: StepHook | None = None, latency: CommandLatency | None = None,
+                 controller: StepController | None = None,
+                 interface: AtlasSimInterface | None = None) -> None:
         self.sim = sim
         self.latency = latency
         self.latency_rng = default_rng(latency.seed if latency else 0)
@@ -266,6 +279,9 @@ class OfflinePlayer:
         self._log = types['rosgraph_msgs/msg/Log']
         self._header = types['std_msgs/msg/Header']
         self._time = types['builtin_interfaces/msg/Time']
+        self.controller = controller
+        self.interface = interface
+        self.tick = Tick(sim, self, self._publish_step, self._end_step)
 
     def publish(self) -> None:
         """Keep what the simulator node sends after a step (or before the first)."""
@@ -275,19 +291,32 @@ class OfflinePlayer:
         """Step and publish for `duration_s` of sim time (whole steps, rounded up)."""
         sim = self.sim
         until_ns = sim.sim_time_ns + int(round(duration_s * NS_PER_S))
-        step, publish, on_step = sim.step, self.rows.publish, self.on_step
+        tick = self.tick
         try:
             while sim.sim_time_ns < until_ns:
-                if self.pending:
-                    self._deliver()
-                step()
-                self.steps += 1
-                publish(self.steps)
-                if on_step is not None:
-                    on_step(sim)
+                tick()
         except PhysicsDivergenceError as err:
             raise OfflineRunError(f'{err}; the live simulator would reset the robot here, '
                                   'an offline run stops') from None
+
+    def before_step(self) -> None:
+        """The tick's inputs: the delayed commands due, then the controller's."""
+        if self.pending:
+            self._deliver()
+        if self.controller is not None:
+            self.controller.before_step()
+
+    def _publish_step(self) -> None:
+        """The tick's state: what the node sends after the step, kept."""
+        self.steps += 1
+        self.rows.publish(self.steps)
+
+    def _end_step(self) -> None:
+        """The tick's end of step: the interface's handover, then the run's hook."""
+        if self.interface is not None:
+            self.interface.end_step()
+        if self.on_step is not None:
+            self.on_step(self.sim)
 
     def _deliver(self) -> None:
         """Apply the delayed commands due before this step, in order."""

@@ -1,8 +1,9 @@
 """The simulator node's stepping loop, without ROS.
 
-Each turn: let the controller give the simulator its command (by default, the commands
-that arrived since the last step), step, serialize what is due into the outbox, decide
-whether to send it, and wait for wall time. Each concern is a collaborator of its own:
+Each turn: one tick (tick.py: the controller gives the simulator its command, by default
+the commands that arrived since the last step; the step; what is due serialized into the
+outbox; the AtlasSimInterface's end of step), then decide whether to send it, and wait for
+wall time. Each concern is a collaborator of its own:
 the command inbox (inbox.py), what is published (publication.py), the synchronization
 window (sync_gate.py), resets and services (controls.py), the headless log lines
 (watch.py) and divergence recovery (divergence.py); a controller plugs in as a
@@ -19,12 +20,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
 from tutorial_atlas_control.asi import AtlasSimInterface, LibraryBehaviour
-from tutorial_atlas_control.sim import (
-    AtlasSimulator,
-    CommandAgeStatistics,
-    LinkTransforms,
-    PhysicsDivergenceError,
-)
+from tutorial_atlas_control.sim import AtlasSimulator, CommandAgeStatistics, LinkTransforms
 from tutorial_atlas_control.stepping.controller import StepController
 from tutorial_atlas_control.stepping.controls import SimControls
 from tutorial_atlas_control.stepping.divergence import DivergenceRecovery
@@ -34,6 +30,7 @@ from tutorial_atlas_control.stepping.pacing import Pacer
 from tutorial_atlas_control.stepping.publication import StepPublisher
 from tutorial_atlas_control.stepping.sync_gate import SyncGate
 from tutorial_atlas_control.stepping.synchronization import DelayBudgets, SynchronizationWindow
+from tutorial_atlas_control.stepping.tick import Tick
 from tutorial_atlas_control.stepping.watch import RunWatch
 
 __all__ = ['PAUSED_POLL_S', 'LoopSettings', 'SteppingLoop']
@@ -112,6 +109,9 @@ class SteppingLoop:
                                     settings.paused)
         self.divergence = DivergenceRecovery(sim, outputs.log,
                                              self.controls.reset_after_divergence)
+        #: One step with its inputs before and its state and the interface's handover after.
+        self.tick = Tick(sim, self.controller, self._publish_step, self.asi.end_step,
+                         self.divergence.recover)
         # The node's and tests' entry points, the collaborators' own methods.
         self.receive_command = self.inbox.receive
         self.apply_pending_commands = self.inbox.apply_pending
@@ -131,16 +131,23 @@ class SteppingLoop:
     def paused(self) -> bool:
         return self.controls.paused
 
+    def _publish_step(self) -> None:
+        """After a step (or a recovered divergence): count it, watch for a fall, publish."""
+        self.step_count += 1
+        watch = self.watch
+        if watch.fall_armed:
+            watch.watch_fall()
+        self.publisher.publish_step(self.step_count)
+
     def run(self, is_shutdown: Callable[[], bool]) -> int:
         """Step, publish and pace against wall time until `is_shutdown()`; the exit status
         (1: stopped because the physics kept diverging)."""
         sim, lock, outbox, pacer = self.sim, self.lock, self.outbox, self.pacer
-        controls, inbox, gate, watch = self.controls, self.inbox, self.gate, self.watch
-        publisher = self.publisher
+        controls, inbox, gate, tick = self.controls, self.inbox, self.gate, self.tick
         paced = pacer.real_time_factor > 0.0  # else there is nothing to wait for
         pacer.restart(sim.sim_time_ns)
         with lock:
-            publisher.publish(self.step_count)  # /clock and the state before the first step
+            self.publisher.publish(self.step_count)  # /clock and the state before the first step
         outbox.flush()
         pacer.flushed()
         while not is_shutdown():
@@ -154,17 +161,9 @@ class SteppingLoop:
             if inbox.period_ms:
                 gate.before_step()
             with lock:
-                self.controller.before_step()
-                try:
-                    sim.step()
-                except PhysicsDivergenceError as err:
-                    if not self.divergence.recover(err):
-                        self.exit_status = 1
-                        break
-                self.step_count += 1
-                if watch.fall_armed:
-                    watch.watch_fall()
-                publisher.publish_step(self.step_count)
+                if not tick():  # the physics kept diverging
+                    self.exit_status = 1
+                    break
                 sim_ns = sim.sim_time_ns
             # Send outside the lock, in batches when allowed (pacing.py): TCPROS is a byte
             # stream, one sendall carries many messages.

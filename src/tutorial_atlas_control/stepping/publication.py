@@ -58,7 +58,7 @@ class StepPublisher:
         links: with a /tf outlet, the links' transforms published in robot_state_publisher's
             stead (link_transforms.py), at rates_hz['links_tf']; None: not.
         asi: the AtlasSimInterface whose state goes out every step while someone listens
-            (its end_step is called after every step); None: no such state.
+            (its end_step is the tick's, after this); None: no such state.
     """
 
     def __init__(self, sim: AtlasSimulator, outputs: LoopOutputs, rates_hz: Mapping[str, float],
@@ -168,8 +168,6 @@ class StepPublisher:
         """After step `count`: its messages, and the command age into the statistics'
         window and, when due, out."""
         self.publish(count)
-        if self.asi is not None:
-            self.asi.end_step()
         if not self.outbox.wanted(self.statistics_outlet):
             return
         now_ns = self.sim.sim_time_ns
