@@ -6,8 +6,8 @@ about the axis between the feet is made by shifting vertical load from one foot 
 other, as far as MIN_LOAD_SHARE left on the lighter foot (an unloaded foot would slide or
 lift and land elsewhere): each foot takes the same share of F as of the vertical load.
 What moment remains goes to the ankles in the same shares. Then each foot's share is made
-feasible: no pull (f_z >= 0) and the pressure centre inside the sole (|m_x| <= f_z w/2,
-|m_y| <= f_z l/2 in the sole's frame); friction is not modelled.
+feasible: no pull (f_z >= 0), the pressure centre inside the sole (|m_x| <= f_z w/2,
+|m_y| <= f_z l/2 in the sole's frame) and, when asked, the force within friction.
 In plain floats: this runs every 1 ms step.
 """
 
@@ -79,16 +79,34 @@ def split_wrench(force_n: np.ndarray, moment_nm: np.ndarray, sole_centres: np.nd
     return wrenches
 
 
+def _within_friction(force: Vector, normal: Vector, friction: float) -> Vector:
+    """`force` with its part along the surface (normal `normal`) scaled down to friction
+    times its part pressing on it (none if it pulls)."""
+    pressing = force[0] * normal[0] + force[1] * normal[1] + force[2] * normal[2]
+    tangential = tuple(f - pressing * n for f, n in zip(force, normal))
+    size = math.sqrt(tangential[0] ** 2 + tangential[1] ** 2 + tangential[2] ** 2)
+    limit = friction * max(pressing, 0.0)
+    if size <= limit:
+        return force
+    scale = 1.0 - limit / size
+    return (force[0] - scale * tangential[0], force[1] - scale * tangential[1],
+            force[2] - scale * tangential[2])
+
+
 def make_feasible(wrench: np.ndarray, sole_rotation: np.ndarray,
                   half_length_m: float, half_width_m: float,
-                  torsion_m: float | None = None) -> np.ndarray:
+                  torsion_m: float | None = None, friction: float | None = None) -> np.ndarray:
     """`wrench` [f, m] (world) with f_z >= 0 and its pressure centre kept inside a sole of
     half sizes (half_length_m, half_width_m) (along the sole's x and y); with `torsion_m`,
     its moment about the sole's normal within torsion_m * f_z too (MuJoCo's torsional
-    friction: more turns the foot on the ground)."""
+    friction: more turns the foot on the ground); with `friction`, its force's part along
+    the sole within friction times the part pressing on it (a cone about the sole's
+    normal; without, friction is not modelled)."""
     fx, fy, fz, mx, my, mz = wrench.tolist()
     fz = max(fz, 0.0)
     (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = sole_rotation.tolist()
+    if friction is not None:
+        fx, fy, fz = _within_friction((fx, fy, fz), (r02, r12, r22), friction)
     # The moment in the sole's frame (R^T m), clamped, and back (R m).
     lx = r00 * mx + r10 * my + r20 * mz
     ly = r01 * mx + r11 * my + r21 * mz

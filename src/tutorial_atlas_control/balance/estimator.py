@@ -61,6 +61,19 @@ def _no_contacts() -> SoleContacts:
     return SoleContacts(empty, empty, np.zeros(0), np.zeros(0, dtype=np.int64))
 
 
+def _sole_contacts_of(sole: int, pairs: list[list[int]], distances: np.ndarray,
+                      points: np.ndarray, normals: np.ndarray) -> SoleContacts:
+    """One sole's rows of a copied contact list. MuJoCo's normal points from geom1 to geom2:
+    into the sole when the sole is geom2."""
+    rows = [row for row, pair in enumerate(pairs) if sole in pair]
+    if not rows:
+        return _no_contacts()
+    signs = np.array([[1.0] if pairs[row][1] == sole else [-1.0] for row in rows])
+    surfaces = np.array([pairs[row][0] if pairs[row][1] == sole else pairs[row][1]
+                         for row in rows])
+    return SoleContacts(points[rows], signs * normals[rows], distances[rows], surfaces)
+
+
 @dataclass(frozen=True)
 class BalanceState:
     """The robot's balance-relevant state, world frame (m, m/s, rad/s)."""
@@ -85,8 +98,14 @@ class BalanceState:
     joint_inertia: Callable[[slice], np.ndarray]
     #: Makes support_polygon, on first use (Walk's single support never asks).
     polygon_of: Callable[[], np.ndarray]
-    #: Each sole's contacts (left, right), from MuJoCo's contact list.
-    sole_contacts: tuple[SoleContacts, SoleContacts] = (_no_contacts(), _no_contacts())
+    #: Makes sole_contacts, on first use (from this estimate's copy of the contact list).
+    contacts_of: Callable[[], tuple[SoleContacts, SoleContacts]] = \
+        lambda: (_no_contacts(), _no_contacts())
+
+    @functools.cached_property
+    def sole_contacts(self) -> tuple[SoleContacts, SoleContacts]:
+        """Each sole's contacts (left, right), from MuJoCo's contact list."""
+        return self.contacts_of()
 
     @functools.cached_property
     def support_polygon(self) -> np.ndarray:
@@ -106,6 +125,13 @@ class BalanceEstimator:
         self._soles = sole_geom_ids(self.model)
         self.sole = SoleBox.of(self.model)
         self.model.geom_margin[self._soles] = CONTACT_HEIGHT_M
+        # Only the soles' contacts are asked for: the robot's other geoms collide with
+        # nothing in the copy (mj_collision 11 us a call with them, about 4 without).
+        robot = self.model.body_rootid[self.model.geom_bodyid] == atlas.pelvis_body_id
+        others = np.flatnonzero(robot)
+        others = others[~np.isin(others, self._soles)]
+        self.model.geom_contype[others] = 0
+        self.model.geom_conaffinity[others] = 0
         self._sole_bodies = [int(self.model.geom_bodyid[g]) for g in self._soles]
         self._pelvis = atlas.pelvis_body_id
         self._jac = np.zeros((2, 6, self.model.nv))  # [linear; angular] per sole
@@ -175,27 +201,24 @@ class BalanceEstimator:
             self._inertia_index[key] = index
         return self._inertia[index]
 
-    def _sole_contacts(self) -> tuple[SoleContacts, SoleContacts]:
-        """Each sole's contacts in the scratch data's contact list (after mj_collision)."""
+    def _touching(self) -> tuple[tuple[bool, bool], Callable[[], tuple[SoleContacts,
+                                                                        SoleContacts]]]:
+        """Which soles touch (after mj_collision: every contact of a sole's pair is within
+        its margin), and what makes their contacts from a copy of the list (in plain
+        Python: numpy's calls on eight rows cost more than MuJoCo's collision)."""
         count = self.scratch.ncon
         if count == 0:
-            return _no_contacts(), _no_contacts()
+            return (False, False), lambda: (_no_contacts(), _no_contacts())
         contact = self.scratch.contact
-        geoms = contact.geom[:count]
-        distances = contact.dist[:count]
-        found = []
-        for sole in self._soles:
-            rows = np.flatnonzero((geoms[:, 0] == sole) | (geoms[:, 1] == sole))
-            rows = rows[distances[rows] < CONTACT_HEIGHT_M]
-            if len(rows) == 0:
-                found.append(_no_contacts())
-                continue
-            # MuJoCo's normal points from geom1 to geom2: into the sole when the sole is geom2.
-            sign = np.where(geoms[rows, 1] == sole, 1.0, -1.0)[:, None]
-            surfaces = np.where(geoms[rows, 0] == sole, geoms[rows, 1], geoms[rows, 0])
-            found.append(SoleContacts(contact.pos[rows], sign * contact.frame[rows, 0:3],
-                                      distances[rows].copy(), surfaces))
-        return found[0], found[1]
+        pairs = contact.geom[:count].tolist()
+        left, right = self._soles
+        touching = (any(left in pair for pair in pairs), any(right in pair for pair in pairs))
+        if not (touching[0] or touching[1]):
+            return touching, lambda: (_no_contacts(), _no_contacts())
+        rows = (contact.dist[:count].copy(), contact.pos[:count].copy(),
+                contact.frame[:count, 0:3].copy())
+        return touching, lambda: (_sole_contacts_of(left, pairs, *rows),
+                                  _sole_contacts_of(right, pairs, *rows))
 
     def estimate(self, qpos: np.ndarray, qvel: np.ndarray) -> BalanceState:
         """The state at (qpos, qvel) (the full MuJoCo vectors)."""
@@ -218,8 +241,7 @@ class BalanceEstimator:
             mujoco.mj_jac(m, d, jac[foot, 0:3], jac[foot, 3:6], centres[foot],
                           self._sole_bodies[foot])
         sole_velocities = jac @ d.qvel
-        sole_contacts = self._sole_contacts()
-        contact = (sole_contacts[0].touching, sole_contacts[1].touching)
+        contact, contacts_of = self._touching()
         com = d.subtree_com[0].copy()
         com_velocity = d.subtree_linvel[0].copy()
         omega = lipm.natural_frequency(max(float(com[2]), MIN_COM_HEIGHT_M))
@@ -235,4 +257,4 @@ class BalanceEstimator:
             sole_velocities=sole_velocities,
             joint_inertia=self._joint_inertia,
             polygon_of=lambda: self._support_polygon(positions, rotations, contact),
-            sole_contacts=sole_contacts)
+            contacts_of=contacts_of)

@@ -158,6 +158,7 @@ class StandController:
         self.sole_half_size_m = sole_half_size_m
         self.gains = gains or StandGains()
         self.layer = WholeBodyLayer(mass_kg, self.effort_limit_nm)
+        self._contacts: dict[tuple[bool, float | None], ContactConstraint] = {}
         self._region: tuple[np.ndarray, support.Region] | None = None
 
     def desired_cop(self, state: BalanceState) -> np.ndarray:
@@ -197,6 +198,17 @@ class StandController:
         self.layer.limit(output.torque_nm)
         return output
 
+    def _contact(self, carries: bool, torsion_m: float | None) -> ContactConstraint:
+        """A sole's contact constraint (made once for each kind: it is the same each tick)."""
+        key = (carries, torsion_m)
+        made = self._contacts.get(key)
+        if made is None:
+            half_length, half_width = self.sole_half_size_m
+            made = ContactConstraint(carries, half_length, half_width, torsion_m,
+                                     self.gains.friction)
+            self._contacts[key] = made
+        return made
+
     def whole_body(self, state: BalanceState, cop: np.ndarray, contact: tuple[bool, bool],
                    joint_positions: np.ndarray, joint_velocities: np.ndarray,
                    joint_gains: tuple[np.ndarray, np.ndarray] | None = None,
@@ -208,10 +220,7 @@ class StandController:
         (kp, kd), else the Stand's); not yet clamped to the effort limits (Walk adds its
         swing leg's first)."""
         reference = reference or self.reference
-        half_length, half_width = self.sole_half_size_m
-        friction = self.gains.friction
-        contacts = (ContactConstraint(contact[0], half_length, half_width, torsion_m, friction),
-                    ContactConstraint(contact[1], half_length, half_width, torsion_m, friction))
+        contacts = (self._contact(contact[0], torsion_m), self._contact(contact[1], torsion_m))
         joint_kp, joint_kd = joint_gains or (self.gains.joint_kp, self.gains.joint_kd)
         posture = PostureTask(reference.posture_rad, reference.posture_rate_rad_s, joint_kp,
                               joint_kd)

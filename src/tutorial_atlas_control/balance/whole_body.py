@@ -16,12 +16,12 @@ The solver is inverse statics: the tasks' wrench, shared between the soles in co
 It holds a flat stance exactly and costs a few microseconds; a QP over the same tasks and
 constraints would trade the tasks off where they conflict (a slope's friction, a foot at its
 edge), at the price of a solve each tick. Every task and constraint computes in plain floats
-in numpy's order of operations: Stand's torques are the same bits as before the layer.
+in numpy's order of operations: Stand's torques are the same bits as before the layer. The
+tasks are made anew each tick: plain slotted classes, cheap to make.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
@@ -53,7 +53,7 @@ def orientation_error(rotation: np.ndarray, reference: np.ndarray) -> np.ndarray
     return np.array([0.5 * (d21 - d12), 0.5 * (d02 - d20), 0.5 * (d10 - d01)])
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)
 class CapturePointTask:
     """The horizontal force that makes the pressure centre `cop` ((2,) m, world): the
     linear inverted pendulum's m omega^2 (c - p) (lipm.com_acceleration)."""
@@ -69,7 +69,7 @@ class CapturePointTask:
                  mass_kg * (stiffness * (com_y - cop_y) + 0.0), 0.0), (0.0, 0.0, 0.0))
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)
 class ComHeightTask:
     """The weight, and a PD (1/s^2, 1/s) on the centre of mass's height towards `height_m`
     moving at `rate_m_s` (m, m/s): the vertical force."""
@@ -86,7 +86,7 @@ class ComHeightTask:
         return (0.0, 0.0, mass_kg * (vertical + lipm.GRAVITY_M_S2)), (0.0, 0.0, 0.0)
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)
 class PelvisOrientationTask:
     """A PD moment (N m/rad, N m s/rad) holding the pelvis's frame at `rotation` ((3, 3))
     turning at `angular_velocity` ((3,) rad/s, world)."""
@@ -104,7 +104,7 @@ class PelvisOrientationTask:
             error, self.angular_velocity.tolist(), state.pelvis_angular_velocity.tolist()))
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)
 class PostureTask:
     """A joint PD (N m/rad, N m s/rad, (28,) each) to `posture_rad` moving at `rate_rad_s`."""
 
@@ -134,22 +134,11 @@ class ContactConstraint:
 
     def feasible(self, wrench: np.ndarray, sole_rotation: np.ndarray) -> np.ndarray:
         """`wrench` [f, m] (world, at the sole's centre) made feasible."""
-        made = contact_wrench.make_feasible(wrench, sole_rotation, self.half_length_m,
-                                            self.half_width_m, self.torsion_m)
-        if self.friction is None:
-            return made
-        normal = sole_rotation[:, 2]
-        force = made[0:3]
-        pressing = float(force @ normal)
-        tangential = force - pressing * normal
-        size = math.sqrt(float(tangential @ tangential))
-        limit = self.friction * max(pressing, 0.0)
-        if size > limit:
-            made[0:3] = force - (1.0 - limit / size) * tangential
-        return made
+        return contact_wrench.make_feasible(wrench, sole_rotation, self.half_length_m,
+                                            self.half_width_m, self.torsion_m, self.friction)
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)
 class WholeBodyOutput:
     """One tick's decision, kept for feedback and tests."""
 
@@ -169,12 +158,11 @@ class WholeBodyLayer:
     def centroidal_wrench(self, state: BalanceState,
                           tasks: Sequence[CentroidalTask]) -> tuple[np.ndarray, np.ndarray]:
         """The tasks' (force (3,), moment (3,)) summed."""
-        force, moment = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
+        fx = fy = fz = mx = my = mz = 0.0
         for task in tasks:
-            task_force, task_moment = task.wrench(state, self.mass_kg)
-            force = [a + b for a, b in zip(force, task_force)]
-            moment = [a + b for a, b in zip(moment, task_moment)]
-        return np.array(force), np.array(moment)
+            (tfx, tfy, tfz), (tmx, tmy, tmz) = task.wrench(state, self.mass_kg)
+            fx, fy, fz, mx, my, mz = fx + tfx, fy + tfy, fz + tfz, mx + tmx, my + tmy, mz + tmz
+        return np.array([fx, fy, fz]), np.array([mx, my, mz])
 
     def solve(self, state: BalanceState, tasks: Sequence[CentroidalTask],
               contacts: tuple[ContactConstraint, ContactConstraint],
