@@ -5,9 +5,11 @@ names it, DRCSim's fixed queue, straight and circular plans, a streaming client'
 status_flags: walk_feedback's and step_feedback's status values; step_queue: Walk's queue
 of steps merged by index, clamped to what the legs reach, and its feedback flags;
 dcm_plan: the capture point's plan over the steps; step_adjustment: where a pushed swing
-foot must land instead; swing: the swing foot's path; leg_tasks: what Walk and Step do
-alike each step (the whole-body law on the carrying soles, the swing foot, the pelvis's
-heading); walk: the walk's phases; walk_behaviour: Walk as the simulator's behaviour;
+foot must land instead; swing: the swing foot's path; phases: the phase clock and the
+rules that end Walk's and Step's phases (settled, touched down, the swing begun);
+leg_tasks: what Walk and Step do alike each step (the whole-body law on the carrying soles,
+the swing foot, the pelvis's heading); walk: the walk's phases; walk_behaviour: Walk as the
+simulator's behaviour;
 start_noise: a trial's start perturbed by a seed; walk_trial: offline walking trials,
 landing by landing, pushed or not; static_step: one quasi-static step; step_behaviour:
 Step as the simulator's behaviour.
@@ -27,6 +29,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'step_adjustment': ['foothold_shift', 'predicted_error'],
     'swing': ['SWING_HEIGHT_M', 'SwingPath', 'bump', 'quintic'],
     'leg_tasks': ['LEG_JOINTS', 'LegGains', 'LegTasks', 'foot_pose'],
+    'phases': ['PhaseClock', 'settled', 'swing_to', 'touched_down'],
     'walk': ['WalkController', 'WalkGains', 'WalkOutput'],
     'walk_behaviour': ['WalkBehaviour', 'WalkStatus'],
     'start_noise': ['DEFAULT_START_NOISE', 'StartNoise', 'perturb_start'],

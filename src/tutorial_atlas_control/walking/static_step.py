@@ -22,6 +22,7 @@ from tutorial_atlas_control.balance import (
 )
 from tutorial_atlas_control.walking.footsteps import Footstep
 from tutorial_atlas_control.walking.leg_tasks import LegGains, LegTasks, foot_pose
+from tutorial_atlas_control.walking.phases import PhaseClock, settled, swing_to, touched_down
 from tutorial_atlas_control.walking.status_flags import STEPPING, SWAYING
 from tutorial_atlas_control.walking.swing import SwingPath
 
@@ -69,20 +70,25 @@ class StaticStep:
         self.legs = LegTasks(stand, self.gains.legs, time_s)
         self.legs.move_height(stand_com_height_m - self.gains.lowering_m, time_s,
                               self.gains.shift_s)
-        self.status = SWAYING
+        #: The phase (SWAYING or STEPPING: step_feedback's status) and when it began.
+        self.clock = PhaseClock(SWAYING, time_s)
         self.done = False
         self.landed: Footstep | None = None
         self.swing_s = max(step.duration_s, self.gains.shortest_swing_s)
         stance = self.feet[1 - step.foot_index]
         self._shift = (time_s, state.capture_point.copy(), np.array([stance.x_m, stance.y_m]))
         self._swing: SwingPath | None = None
-        self._swing_start_s = 0.0
+
+    @property
+    def status(self) -> int:
+        """SWAYING or STEPPING, as step_feedback reports it."""
+        return self.clock.phase
 
     def remaining_s(self, time_s: float) -> float:
         """The time left in the swing (s; 0 outside it)."""
         if self.status != STEPPING:
             return 0.0
-        return max(0.0, self.swing_s - (time_s - self._swing_start_s))
+        return max(0.0, self.swing_s - self.clock.elapsed_s(time_s))
 
     def _capture_reference(self, time_s: float) -> np.ndarray:
         started_s, start, goal = self._shift
@@ -91,33 +97,30 @@ class StaticStep:
 
     def _advance(self, state: BalanceState, time_s: float) -> None:
         gains, step = self.gains, self.step
-        started_s, _, goal = self._shift
-        elapsed = time_s - started_s
-        if self.landed is None and self.status == SWAYING and elapsed >= gains.shift_s and (
-                np.linalg.norm(state.capture_point - goal) < gains.over_stance_m
-                or elapsed >= gains.longest_shift_s):
-            lift = state.sole_centres[step.foot_index].copy()
-            self._swing = SwingPath(lift, np.array([step.x_m, step.y_m, step.z_m]),
-                                    foot_pose(state, step.foot_index).yaw_rad, step.yaw_rad,
-                                    self.swing_s)
-            stance = self.feet[1 - step.foot_index]
-            self.legs.face(stance.yaw_rad, step.yaw_rad, time_s, self.swing_s)
-            self.status, self._swing_start_s = STEPPING, time_s
-        elif self.status == STEPPING:
-            swung = time_s - self._swing_start_s
-            if swung >= self.swing_s and (state.in_contact[step.foot_index] or
-                                          swung >= self.swing_s + gains.legs.late_touchdown_s):
-                self.landed = foot_pose(state, step.foot_index, step.step_index)
-                self.feet[step.foot_index] = self.landed
-                left, right = self.feet
-                middle = np.array([0.5 * (left.x_m + right.x_m), 0.5 * (left.y_m + right.y_m)])
-                self._shift = (time_s, state.capture_point.copy(), middle)
-                self.legs.face(left.yaw_rad, right.yaw_rad, time_s, gains.shift_s)
-                self.status = SWAYING
-        elif self.landed is not None and elapsed >= gains.shift_s and (
-                np.linalg.norm(state.capture_point - goal) < gains.at_rest_m
-                or elapsed >= gains.longest_settle_s):
-            self.done = True
+        goal = self._shift[2]
+        elapsed = self.clock.elapsed_s(time_s)
+        if self.status == SWAYING and elapsed >= gains.shift_s:
+            off = float(np.linalg.norm(state.capture_point - goal))
+            if self.landed is None and settled(elapsed, gains.shift_s, gains.longest_shift_s,
+                                               off < gains.over_stance_m):
+                self._swing = swing_to(state, step, self.swing_s)
+                stance = self.feet[1 - step.foot_index]
+                self.legs.face(stance.yaw_rad, step.yaw_rad, time_s, self.swing_s)
+                self.clock.enter(STEPPING, time_s)
+            elif self.landed is not None and settled(elapsed, gains.shift_s,
+                                                     gains.longest_settle_s,
+                                                     off < gains.at_rest_m):
+                self.done = True
+        elif self.status == STEPPING and touched_down(
+                state.in_contact[step.foot_index], elapsed, self.swing_s,
+                gains.legs.late_touchdown_s):
+            self.landed = foot_pose(state, step.foot_index, step.step_index)
+            self.feet[step.foot_index] = self.landed
+            left, right = self.feet
+            middle = np.array([0.5 * (left.x_m + right.x_m), 0.5 * (left.y_m + right.y_m)])
+            self._shift = (time_s, state.capture_point.copy(), middle)
+            self.legs.face(left.yaw_rad, right.yaw_rad, time_s, gains.shift_s)
+            self.clock.enter(SWAYING, time_s)
 
     def step_torque(self, state: BalanceState, joint_positions: np.ndarray,
                     joint_velocities: np.ndarray, time_s: float) -> np.ndarray:
@@ -135,5 +138,5 @@ class StaticStep:
         swing = None
         if swinging:
             assert self._swing is not None  # set with STEPPING
-            swing = (self.step.foot_index, self._swing, time_s - self._swing_start_s)
+            swing = (self.step.foot_index, self._swing, self.clock.elapsed_s(time_s))
         return legs.finish(state, joint_velocities, torque, contact, swing, self.feet)

@@ -33,6 +33,7 @@ from tutorial_atlas_control.balance import (
 from tutorial_atlas_control.walking.dcm_plan import DcmPlan
 from tutorial_atlas_control.walking.footsteps import Footstep
 from tutorial_atlas_control.walking.leg_tasks import LegGains, LegTasks, foot_pose
+from tutorial_atlas_control.walking.phases import PhaseClock, settled, swing_to, touched_down
 from tutorial_atlas_control.walking.status_flags import CATCHING, STEPPING, SWAYING
 from tutorial_atlas_control.walking.step_adjustment import foothold_shift
 from tutorial_atlas_control.walking.step_queue import StepQueue, clamp_pose
@@ -84,9 +85,9 @@ class WalkController:
         self.queue = queue
         self.gains = gains or WalkGains()
         self.legs = LegTasks(stand, self.gains.legs, time_s)
-        self.phase = SWAYING
+        #: The phase (SWAYING, STEPPING or CATCHING) and when it began.
+        self.clock = PhaseClock(SWAYING, time_s)
         self.done = False
-        self.phase_start_s = time_s
         #: The step being taken (None while swaying or catching) and its swing path.
         self.step: Footstep | None = None
         self.swing: SwingPath | None = None
@@ -97,6 +98,16 @@ class WalkController:
         #: The CoM height the walk starts from and returns to (m).
         self.stand_height_m = stand.reference.com_height_m
         self._begin_sway(state, time_s)
+
+    @property
+    def phase(self) -> int:
+        """SWAYING, STEPPING or CATCHING."""
+        return self.clock.phase
+
+    @property
+    def phase_start_s(self) -> float:
+        """When the phase began (s)."""
+        return self.clock.started_s
 
     # -- the phases ---------------------------------------------------------------------------
 
@@ -115,7 +126,7 @@ class WalkController:
         return DcmPlan.plan(np.array(cops), np.array(durations), final, omega)
 
     def _begin_sway(self, state: BalanceState, time_s: float) -> None:
-        self.phase, self.phase_start_s = SWAYING, time_s
+        self.clock.enter(SWAYING, time_s)
         self.legs.move_height(self.stand_height_m - self.gains.walk_lowering_m, time_s,
                               self.gains.sway_s)
         self._plan = self._plan_steps(self.queue.preview(), state.omega)
@@ -132,36 +143,34 @@ class WalkController:
             self._begin_catch(state, time_s)
             return
         step = preview[0]
-        lift = state.sole_centres[step.foot_index]
         self.step = self._planned_step = step
         stance = self.queue.feet[1 - step.foot_index]
         self.legs.face(stance.yaw_rad, step.yaw_rad, time_s, step.duration_s)
-        self.swing = SwingPath(lift.copy(), np.array([step.x_m, step.y_m, step.z_m]),
-                               foot_pose(state, step.foot_index).yaw_rad, step.yaw_rad,
-                               step.duration_s)
-        self.phase, self.phase_start_s = STEPPING, time_s
+        self.swing = swing_to(state, step, step.duration_s)
+        self.clock.enter(STEPPING, time_s)
 
     def _begin_catch(self, state: BalanceState, time_s: float) -> None:
         self.legs.face(self.queue.feet[0].yaw_rad, self.queue.feet[1].yaw_rad, time_s,
                        self.gains.catch_s)
         self.legs.move_height(self.stand_height_m, time_s, self.gains.catch_s)
         self.step, self.swing, self._plan = None, None, None
-        self.phase, self.phase_start_s = CATCHING, time_s
+        self.clock.enter(CATCHING, time_s)
 
     def _advance(self, state: BalanceState, time_s: float) -> None:
         """Move on to the next phase when this one's time is up."""
-        elapsed = time_s - self.phase_start_s
-        if self.phase == SWAYING and elapsed >= self.gains.sway_s:
+        elapsed, gains, step = self.clock.elapsed_s(time_s), self.gains, self.step
+        if self.phase == SWAYING and settled(elapsed, gains.sway_s, gains.sway_s, True):
             self._begin_step(state, time_s)
-        elif self.phase == STEPPING and self.step is not None \
-                and elapsed >= self.step.duration_s \
-                and (state.in_contact[self.step.foot_index]
-                     or elapsed >= self.step.duration_s + self.gains.legs.late_touchdown_s):
-            self.queue.touchdown(foot_pose(state, self.step.foot_index, self.step.step_index))
+        elif self.phase == STEPPING and step is not None and touched_down(
+                state.in_contact[step.foot_index], elapsed, step.duration_s,
+                gains.legs.late_touchdown_s):
+            self.queue.touchdown(foot_pose(state, step.foot_index, step.step_index))
             self._begin_step(state, time_s)
-        elif self.phase == CATCHING and elapsed >= self.gains.catch_s and (
-                np.linalg.norm(state.capture_point - state.sole_centres[:, :2].mean(axis=0))
-                < self.gains.at_rest_m or elapsed >= self.gains.longest_catch_s):
+        elif self.phase == CATCHING and elapsed >= gains.catch_s and settled(
+                elapsed, gains.catch_s, gains.longest_catch_s,
+                float(np.linalg.norm(state.capture_point
+                                     - state.sole_centres[:, :2].mean(axis=0)))
+                < gains.at_rest_m):
             self.done = True
 
     # -- the references -----------------------------------------------------------------------
@@ -169,7 +178,7 @@ class WalkController:
     def _capture_reference(self, state: BalanceState,
                            time_s: float) -> tuple[np.ndarray, np.ndarray]:
         """(xi_ref, p_ref) now."""
-        elapsed = time_s - self.phase_start_s
+        elapsed = self.clock.elapsed_s(time_s)
         if self.phase == SWAYING:
             xi = capture_point_after(self._sway_from, self._sway_cop, state.omega,
                                      min(elapsed, self.gains.sway_s))
@@ -193,7 +202,7 @@ class WalkController:
         shift_x, shift_y = foothold_shift(
             (error_x, error_y), (float(sole[0, 0]), float(sole[1, 0])), (offset_x, offset_y),
             self.legs.sole_reach_m, self.gains.dcm_gain, state.omega,
-            step.duration_s - (time_s - self.phase_start_s),
+            step.duration_s - (self.clock.elapsed_s(time_s)),
             float(plan.durations_s[1]) if len(plan.durations_s) > 1 else None)
         x, y, _ = clamp_pose(step.foot_index, planned.x_m + shift_x, planned.y_m + shift_y,
                              planned.yaw_rad, self.queue.feet[stance], self.queue.limits)
@@ -221,6 +230,6 @@ class WalkController:
         swing = None
         if step is not None:
             assert self.swing is not None  # set with the step
-            swing = (step.foot_index, self.swing, time_s - self.phase_start_s)
+            swing = (step.foot_index, self.swing, self.clock.elapsed_s(time_s))
         legs.finish(state, joint_velocities, torque, contact, swing, self.queue.feet)
         return WalkOutput(torque, cop, xi_ref, self.phase, swing_foot)
