@@ -14,9 +14,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+from tutorial_atlas_control.msgs import STEP_QUEUE_LENGTH
+from tutorial_atlas_control.walking.errors import WalkingError
+
 LEFT, RIGHT = 0, 1
 #: How many steps a WALK command carries (`walk_params.step_queue`).
-QUEUE_LENGTH = 4
+QUEUE_LENGTH = STEP_QUEUE_LENGTH
 #: DRCSim's step duration (s) and distance between the feet's centres (m).
 STEP_DURATION_S = 0.63
 STANCE_WIDTH_M = 0.24
@@ -39,17 +42,17 @@ class Footstep:
 
     def __post_init__(self) -> None:
         if self.foot_index not in (LEFT, RIGHT):
-            raise ValueError(f'step {self.step_index}: foot_index {self.foot_index} is not '
+            raise WalkingError(f'step {self.step_index}: foot_index {self.foot_index} is not '
                              '0 (left) or 1 (right)')
         values = (self.x_m, self.y_m, self.z_m, self.yaw_rad, self.duration_s, *self.normal)
         if not all(math.isfinite(value) for value in values):
-            raise ValueError(f'step {self.step_index}: a pose or duration is not finite')
+            raise WalkingError(f'step {self.step_index}: a pose or duration is not finite')
         if len(self.normal) != 3 or abs(math.hypot(*self.normal) - 1.0) > 1e-6 \
                 or self.normal[2] <= 0.0:
-            raise ValueError(f'step {self.step_index}: surface normal {self.normal} is not '
+            raise WalkingError(f'step {self.step_index}: surface normal {self.normal} is not '
                              'a unit vector pointing up')
         if self.duration_s <= 0.0:
-            raise ValueError(f'step {self.step_index}: duration {self.duration_s} s is not '
+            raise WalkingError(f'step {self.step_index}: duration {self.duration_s} s is not '
                              'positive')
 
 
@@ -72,7 +75,7 @@ def straight_steps(count: int, stride_m: float, width_m: float = STANCE_WIDTH_M,
     """`count` steps along +x from feet side by side at the origin, each foot `stride_m`
     ahead of the other one's last step; the last step brings the feet side by side."""
     if count < 1:
-        raise ValueError(f'a walk needs at least one step, not {count}')
+        raise WalkingError(f'a walk needs at least one step, not {count}')
     steps = []
     for k in range(1, count + 1):
         foot = first_foot if k % 2 == 1 else 1 - first_foot
@@ -88,9 +91,9 @@ def circle_steps(radius_m: float, steps_per_circle: int, circles: int = 1,
     left, starting at the origin facing +x: each step turns the heading by a
     1/`steps_per_circle` turn, the feet `width_m` apart across the path."""
     if radius_m <= width_m / 2:
-        raise ValueError(f'radius {radius_m} m: the inner foot would cross the centre')
+        raise WalkingError(f'radius {radius_m} m: the inner foot would cross the centre')
     if steps_per_circle < 4 or circles < 1:
-        raise ValueError('a circle needs 4 or more steps, and one circle or more')
+        raise WalkingError('a circle needs 4 or more steps, and one circle or more')
     steps = []
     for k in range(1, steps_per_circle * circles + 1):
         foot = first_foot if k % 2 == 1 else 1 - first_foot

@@ -1,11 +1,12 @@
 """Offline walking trials: the robot placed standing, Stand for a moment, then a plan of
 footsteps walked, then Stand again; what happened, step by step.
 
-The figures the tests and the bench judge: whether it fell (pelvis below
-balance's STANDING_PELVIS_M), how many steps it took, where each foot came down against its
-target and where the pelvis was then, the lowest pelvis, where the pelvis ended, how much
-the legs' torques jump from one 1 ms step to the next while walking (a controller unstable
-at 1 kHz chatters between the effort limits), and the controller's CPU per step.
+The figures the tests and the bench judge: whether it fell (the pelvis less than
+sim.fall's STANDING_PELVIS_M above the ground under the feet), how many steps it took, where
+each foot came down against its target and where the pelvis was then, the lowest pelvis,
+where the pelvis ended, how much the legs' torques jump from one 1 ms step to the next while
+walking (a controller unstable at 1 kHz chatters between the effort limits), and the
+controller's CPU per step.
 
 A trial's `seed` perturbs its start (start_noise: the joints' angles and rates) and, for
 pushed walks, draws the pushes' phases and sides: a figure is then a fraction of seeds.
@@ -30,7 +31,7 @@ from tutorial_atlas_control.balance import (
     push_events,
     standing_simulator,
 )
-from tutorial_atlas_control.sim import STANDING_PELVIS_M, AtlasModel, pelvis_height_m
+from tutorial_atlas_control.sim import AtlasModel, GroundUnderFeet, pelvis_height_m
 from tutorial_atlas_control.walking.footsteps import (
     STEP_DURATION_S,
     Footstep,
@@ -207,12 +208,13 @@ def walk_trial(plan: Sequence[Footstep], duration_s: float, gains: WalkGains | N
     sim.install_stand(behaviour)
     trial = behaviour.trial
     events = push_events(pushes, sim.dt_s)
+    ground = GroundUnderFeet(sim.atlas, sim.data)
     for step in range(round(duration_s / sim.dt_s)):
         apply_pushes(sim, events, step)
         sim.step()
         height = pelvis_height_m(sim.atlas, sim.data)
         trial.lowest_pelvis_m = min(trial.lowest_pelvis_m, height)
-        if height < STANDING_PELVIS_M:
+        if not ground.standing(height):
             trial.fell = True
             break
     trial.pelvis_end = sim.data.xpos[sim.atlas.pelvis_body_id].copy()
