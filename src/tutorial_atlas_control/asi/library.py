@@ -5,7 +5,8 @@ A library behaviour is a simulator Behaviour (sim/behaviour.py: `start`, `torque
 says which ASI behaviour it answers to and which control mode runs it, takes its command's
 parameters, answers Stand asked for while it runs, reports its feedback, and says after each
 tick what it hands the robot over to (a walk done: Stand; fallen: Freeze). Adding one is a
-class with these members and an entry in `library_of` (or the interface's `register`).
+class with these members (BehaviourBase has their quiet defaults) and the interface's
+`register`.
 """
 
 from __future__ import annotations
@@ -131,29 +132,47 @@ def on_ground(steps: list[Footstep], ground: Ground | None) -> list[Footstep]:
     return placed
 
 
-class WalkEntry:
-    """Walk in the library: a WALK's step queue, Stand deferred to the end of the step under
-    way, Stand again once the walk has caught itself, Freeze once fallen."""
+class _SteppingEntry(BehaviourBase):
+    """What Walk's and Step's entries share: the behaviour they serve, where the soles'
+    steps are (`sole_ahead_m` of the foot link, on `ground`: None, the plane z = 0), and
+    whether a Stand was asked for while it ran (reset at each start)."""
 
-    behavior = Behavior.WALK
-    mode = ControlMode.WALK
     waits_for_stand = True
 
-    def __init__(self, walking: WalkBehaviour, sole_ahead_m: float,
+    def __init__(self, behaviour: WalkBehaviour | StepBehaviour, sole_ahead_m: float,
                  ground: Ground | None = None) -> None:
-        """`ground`: the world's, where the steps land (None: the plane z = 0)."""
-        self.walking = walking
+        self.behaviour = behaviour
         self.sole_ahead_m = sole_ahead_m
         self.ground = ground
         self._stand_asked = False
-        self._decoded: tuple[AsiCommand, list[Footstep]] | None = None
 
     def start(self, data: mujoco.MjData) -> None:
         self._stand_asked = False
-        self.walking.start(data)
+        self.behaviour.start(data)
 
     def torque(self, data: mujoco.MjData) -> np.ndarray:
-        return self.walking.torque(data)
+        return self.behaviour.torque(data)
+
+
+class WalkEntry(_SteppingEntry):
+    """Walk in the library: a WALK's step queue (for the next start once granted, or to the
+    walk under way; nothing before the request, so a refused WALK leaves the next start's
+    steps alone), Stand deferred to the end of the step under way, Stand again once the walk
+    has caught itself, Freeze once fallen."""
+
+    behavior = Behavior.WALK
+    mode = ControlMode.WALK
+
+    def __init__(self, walking: WalkBehaviour, sole_ahead_m: float,
+                 ground: Ground | None = None) -> None:
+        super().__init__(walking, sole_ahead_m, ground)
+        self._decoded: tuple[AsiCommand, list[Footstep]] | None = None
+
+    @property
+    def walking(self) -> WalkBehaviour:
+        """The Walk behaviour served."""
+        assert isinstance(self.behaviour, WalkBehaviour)
+        return self.behaviour
 
     def _steps(self, command: AsiCommand) -> list[Footstep]:
         """The command's step queue as the soles' steps (kept for the same command: the
@@ -174,9 +193,6 @@ class WalkEntry:
             return None
         return (f'its step_queue has step_index {indices or "none"}, and a new walk starts '
                 'with step_index 1')
-
-    def prepare(self, command: AsiCommand) -> None:
-        """Nothing before the request: a refused WALK leaves the next start's steps alone."""
 
     def take(self, command: AsiCommand, running: bool) -> None:
         if running:
@@ -203,31 +219,23 @@ class WalkEntry:
         return {'walk_feedback': walk_feedback(self.walking.status(time_s), sole_ahead_m)}
 
 
-class StepEntry:
-    """Step in the library: each STEP's desired step (kept even before the switch: Step's
-    start keeps it), Stand deferred until the step under way is down, Freeze once fallen."""
+class StepEntry(_SteppingEntry):
+    """Step in the library: each STEP's desired step (taken before the request, granted or
+    not: Step's start keeps it), Stand deferred until the step under way is down, Freeze
+    once fallen."""
 
     behavior = Behavior.STEP
     mode = ControlMode.STEP
-    waits_for_stand = True
 
     def __init__(self, stepping: StepBehaviour, sole_ahead_m: float,
                  ground: Ground | None = None) -> None:
-        """`ground`: the world's, where the steps land (None: the plane z = 0)."""
-        self.stepping = stepping
-        self.sole_ahead_m = sole_ahead_m
-        self.ground = ground
-        self._stand_asked = False
+        super().__init__(stepping, sole_ahead_m, ground)
 
-    def start(self, data: mujoco.MjData) -> None:
-        self._stand_asked = False
-        self.stepping.start(data)
-
-    def torque(self, data: mujoco.MjData) -> np.ndarray:
-        return self.stepping.torque(data)
-
-    def refusal(self, command: AsiCommand, running: bool) -> str | None:
-        return None
+    @property
+    def stepping(self) -> StepBehaviour:
+        """The Step behaviour served."""
+        assert isinstance(self.behaviour, StepBehaviour)
+        return self.behaviour
 
     def prepare(self, command: AsiCommand) -> None:
         """step_params.desired_step as a sole's step (None: an empty one, no step wanted);
@@ -238,9 +246,6 @@ class StepEntry:
             desired = dataclasses.replace(desired, duration_s=STEP_DURATION_S)
         steps = on_ground(footsteps_of([desired], self.sole_ahead_m), self.ground)
         self.stepping.desire(steps[0] if steps else None)
-
-    def take(self, command: AsiCommand, running: bool) -> None:
-        """The desired step was taken by `prepare`."""
 
     def stop(self) -> bool:
         if self.stepping.stepping is None:

@@ -12,8 +12,9 @@ model in which the soles' collision margin is CONTACT_HEIGHT_M, so a sole within
 surface (the plane today, a heightfield or a block tomorrow) is reported as touching, as the
 balance has always counted it, while the simulation's own model, whose contacts push, is
 left as it is (MuJoCo 4's `gap` no longer makes such contacts inactive: its contacts within
-margin + gap all push). Measured: mj_collision 11.5 us a call on the flat world, the
-contact list read back about as much again.
+margin + gap all push). In that copy only the soles collide. Measured on the flat world:
+mj_collision 8 us a call, which soles touch about 5 us more; their points and normals are
+read only when asked for.
 """
 
 from __future__ import annotations
@@ -141,10 +142,10 @@ class BalanceEstimator:
         self._corner_offsets = np.array([BOTTOM_CORNER_SIGNS * self.model.geom_size[g]
                                          for g in self._soles])
         self._half_thickness = self.model.geom_size[self._soles, 2][:, None]
-        # The two soles are the same box.
-        self._half_size = self.model.geom_size[self._soles[0]].copy()
         # A sole turned this much (rotation matrix entries) moves a corner the tolerance.
-        self._rotation_tolerance = POLYGON_TOLERANCE_M / float(np.linalg.norm(self._half_size))
+        sole = self.sole
+        self._rotation_tolerance = POLYGON_TOLERANCE_M / float(np.linalg.norm(
+            [sole.half_length_m, sole.half_width_m, sole.half_thickness_m]))
         self._last_polygon: (tuple[tuple[bool, bool], np.ndarray, np.ndarray, np.ndarray]
                              | None) = None
         self._inertia = np.zeros((self.model.nv, self.model.nv))

@@ -153,11 +153,10 @@ class StandController:
                  gains: StandGains | None = None) -> None:
         """`sole_half_size_m`: (half length, half width) of a sole box (m)."""
         self.mass_kg = mass_kg
-        self.effort_limit_nm = np.asarray(effort_limit_nm, dtype=float)
         self.reference = reference
         self.sole_half_size_m = sole_half_size_m
         self.gains = gains or StandGains()
-        self.layer = WholeBodyLayer(mass_kg, self.effort_limit_nm)
+        self.layer = WholeBodyLayer(mass_kg, effort_limit_nm)
         self._contacts: dict[tuple[bool, float | None], ContactConstraint] = {}
         self._region: tuple[np.ndarray, support.Region] | None = None
 

@@ -254,9 +254,7 @@ class LegTasks:
             for foot in (0, 1):
                 if not contact[foot] or not self.flat_down(state, foot, feet[foot]):
                     torque += self.put_down_torque(state, joint_velocities, foot, feet[foot])
-        limit = self.stand.effort_limit_nm
-        np.clip(torque, -limit, limit, out=torque)
-        return torque
+        return self.stand.layer.limit(torque)
 
 
 def _clamp_to_sole(state: BalanceState, foot: int, reach_m: tuple[float, float],
