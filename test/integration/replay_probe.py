@@ -8,8 +8,11 @@ lowest pelvis height, and rosbag play's outcome (or `error`).
 simulator could be connected and this probe not yet, which would miss the first commands.
 So the player starts paused, and is resumed (its `pause_playback` service) once its
 getBusInfo lists a connection to every subscriber the master knows for each played topic.
-When the player has ended, the probe waits for every command in the bag (`--commands`) to
-have been read before it reports.
+The player is kept alive past the bag's end (`--keep-alive`) until every command in the bag
+(`--commands`) has been read here, then stopped with SIGINT: rosbag play calls ros::shutdown
+right after its last publish, which would drop whatever its outgoing queue still held for a
+slow reader, and the wait runs from the resume with the whole `--timeout`, not from the
+player's exit.
 
 Its own process so that the test's pytest process never holds a rospy node (init_node is
 once per process) nor a ROS_MASTER_URI of its own: later tests do not depend on it.
@@ -20,10 +23,12 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import signal
 import subprocess
 import sys
 import threading
 import time
+from collections.abc import Callable
 
 import rospy
 from nav_msgs.msg import Odometry
@@ -38,8 +43,8 @@ PLAYED_TOPICS = ('/atlas/control_mode', '/atlas/joint_commands')
 PLAYER_PREFIX = '/play_'
 #: rosbag play's outgoing queue per topic (messages): more than a tutorial bag holds.
 PLAYER_QUEUE = 10000
-#: Wall s to wait, once rosbag play has ended, for its last commands to be read here.
-ARRIVAL_TIMEOUT_S = 30.0
+#: Wall s rosbag play gets to stop (SIGINT) once every command has arrived.
+STOP_TIMEOUT_S = 30.0
 
 
 class Probe:
@@ -71,9 +76,12 @@ class Probe:
         with self.lock:
             self.command_arrivals_s.append(self.clock_s)
 
-    def wait_for(self, condition, timeout_s: float, what: str) -> None:
+    def wait_for(self, condition, timeout_s: float, what: str,
+                 check: Callable[[], None] | None = None) -> None:
         deadline = time.monotonic() + timeout_s
         while True:
+            if check is not None:
+                check()
             with self.lock:
                 if condition(self):
                     return
@@ -105,22 +113,24 @@ def connected_player(master_uri: str, caller: str) -> str | None:
     return player
 
 
-def play(bag: str, timeout_s: float) -> subprocess.CompletedProcess:
-    """`rosbag play --pause` of the played topics, resumed once every subscriber is connected.
+def play(bag: str, probe: Probe, commands: int,
+         timeout_s: float) -> subprocess.CompletedProcess:
+    """`rosbag play --pause --keep-alive` of the played topics, resumed once every subscriber
+    is connected, stopped once `commands` joint commands have arrived at `probe`.
 
-    Raises TimeoutError if the player is not connected, or has not ended, within `timeout_s`.
+    Raises TimeoutError if the player is not connected, or the commands have not all
+    arrived, within `timeout_s` each.
     """
     player = subprocess.Popen(
         # --queue beyond the bag's commands: a slow reader backs the player up, never
         # makes it drop (its default queue is 100).
-        ['rosbag', 'play', '--quiet', '--pause', f'--queue={PLAYER_QUEUE}', bag,
-         '--topics', *PLAYED_TOPICS],
+        ['rosbag', 'play', '--quiet', '--pause', '--keep-alive', f'--queue={PLAYER_QUEUE}',
+         bag, '--topics', *PLAYED_TOPICS],
         stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
         def player_ended() -> None:
             if player.poll() is not None:
-                raise TimeoutError(f'rosbag play ended before it was connected, '
-                                   f'exit status {player.returncode}')
+                raise TimeoutError(f'rosbag play ended early, exit status {player.returncode}')
 
         found: list[str] = []
 
@@ -137,9 +147,12 @@ def play(bag: str, timeout_s: float) -> subprocess.CompletedProcess:
         resumed = rospy.ServiceProxy(f'{name}/pause_playback', SetBool)(False)
         if not resumed.success:
             raise TimeoutError(f'rosbag play did not resume: {resumed.message}')
-        output, _ = player.communicate(timeout=timeout_s)
+        probe.wait_for(lambda p: len(p.command_arrivals_s) >= commands, timeout_s,
+                       f'all {commands} played commands to arrive', check=player_ended)
+        player.send_signal(signal.SIGINT)
+        output, _ = player.communicate(timeout=STOP_TIMEOUT_S)
     except subprocess.TimeoutExpired as err:
-        raise TimeoutError(f'rosbag play did not end within {timeout_s:g} s') from err
+        raise TimeoutError(f'rosbag play did not stop within {STOP_TIMEOUT_S:g} s') from err
     except (rospy.ROSException, processes.ProcessError) as err:
         raise TimeoutError(str(err)) from err
     finally:
@@ -167,13 +180,9 @@ def main() -> int:
         probe.wait_for(lambda p: p.clock_s >= args.play_at and p.z_m is not None,
                        args.timeout, 'simulator start')
         result['z_before_m'] = probe.z_m
-        played = play(args.bag, args.timeout)
+        played = play(args.bag, probe, args.commands, args.timeout)
         result['play_returncode'] = played.returncode
         result['play_output'] = played.stdout
-        # rosbag play has sent everything when it ends, but this node's receive thread may
-        # not have read the last commands yet (the robot has usually fallen by then).
-        probe.wait_for(lambda p: len(p.command_arrivals_s) >= args.commands,
-                       ARRIVAL_TIMEOUT_S, f'all {args.commands} played commands to arrive')
         with probe.lock:
             played_until_s = probe.clock_s
         probe.wait_for(lambda p: p.min_z_m < args.fallen_below

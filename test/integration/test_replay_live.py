@@ -90,7 +90,10 @@ def test_played_commands_make_the_robot_fall(
         timeout=STARTUP_TIMEOUT_S + 2 * PLAY_TIMEOUT_S, check=False)
     assert probe.returncode == 0 and probe.stdout.strip(), probe
     outcome = json.loads(probe.stdout.strip().splitlines()[-1])
-    assert 'error' not in outcome, f'{outcome["error"]}:\n{fresh_simulator.output()}'
+    assert 'error' not in outcome, (
+        f'{outcome["error"]} ({len(outcome["arrivals_s"])} of {len(recorded.data.commands.t_s)} '
+        f'commands arrived; rosbag play: {outcome.get("play_output")!r}):\n'
+        f'{fresh_simulator.output()}')
     assert outcome['z_before_m'] > STANDING_ABOVE_M, \
         'the fresh robot is not standing before the replay'
     assert outcome['play_returncode'] == 0, f'rosbag play failed:\n{outcome["play_output"]}'
