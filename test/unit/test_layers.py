@@ -181,7 +181,9 @@ def test_the_import_check_catches_a_module_that_needs_rospy(tmp_path: Path) -> N
 #: it does: the facts (names, units, errors, paths) need nothing; the command model is what
 #: msgs' decoders produce and sim's law reads, so it sits below both; native (the compiled
 #: library's binding) mirrors the command's fields for the compiled law; msgs are the wire
-#: formats, plotting reads messages; sim fills messages from the simulator; balance (the
+#: formats, plotting reads messages; course describes the VRC course (its figures, world,
+#: mud and scoring: pure, below the simulator that loads and steps it); sim fills messages
+#: from the simulator; balance (the
 #: behaviours' controllers) computes torques over the model sim loads; walking plans steps
 #: on the balance's pendulum; stepping (the live loop) and trajectories run the simulation;
 #: bags read recorded runs, of trajectories; offline runs write and replay bags, demo runs
@@ -193,6 +195,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ('command',),
     ('native',),
     ('msgs', 'plotting'),
+    ('course',),
     ('sim',),
     ('balance',),
     ('walking',),
@@ -306,8 +309,8 @@ def test_the_layer_check_catches_upward_imports() -> None:
     ''')
     found = layer_order_violations(source, f'{PACKAGE}.msgs.example')
     assert found == [
-        f'{PACKAGE}.msgs.example:7: imports {PACKAGE}.sim.simulator (layer 4 above layer 3)',
-        f'{PACKAGE}.msgs.example:9: imports {PACKAGE}.offline (layer 10 above layer 3)',
+        f'{PACKAGE}.msgs.example:7: imports {PACKAGE}.sim.simulator (layer 5 above layer 3)',
+        f'{PACKAGE}.msgs.example:9: imports {PACKAGE}.offline (layer 11 above layer 3)',
         f'{PACKAGE}.msgs.example:10: imports {PACKAGE}.bags (layer 9 above layer 3)',
         f'{PACKAGE}.msgs.example:11: imports {PACKAGE}.stepping (layer 8 above layer 3)',
         f'{PACKAGE}.msgs.example:12: imports {PACKAGE}.nowhere (in no layer)',
