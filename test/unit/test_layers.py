@@ -311,8 +311,8 @@ def test_the_layer_check_catches_upward_imports() -> None:
     assert found == [
         f'{PACKAGE}.msgs.example:7: imports {PACKAGE}.sim.simulator (layer 5 above layer 3)',
         f'{PACKAGE}.msgs.example:9: imports {PACKAGE}.offline (layer 11 above layer 3)',
-        f'{PACKAGE}.msgs.example:10: imports {PACKAGE}.bags (layer 9 above layer 3)',
-        f'{PACKAGE}.msgs.example:11: imports {PACKAGE}.stepping (layer 8 above layer 3)',
+        f'{PACKAGE}.msgs.example:10: imports {PACKAGE}.bags (layer 10 above layer 3)',
+        f'{PACKAGE}.msgs.example:11: imports {PACKAGE}.stepping (layer 9 above layer 3)',
         f'{PACKAGE}.msgs.example:12: imports {PACKAGE}.nowhere (in no layer)',
     ]
 
