@@ -34,16 +34,18 @@ import numpy as np
 from tutorial_atlas_control.asi.behaviors import BEHAVIOR_OF_MODE, MODE_OF_BEHAVIOR, Behavior
 from tutorial_atlas_control.asi.library import (
     LibraryBehaviour,
+    ManipulateEntry,
+    NestedBehaviour,
     StepEntry,
     WalkEntry,
+    nested,
     on_ground,
 )
 from tutorial_atlas_control.asi.session import STANDING_BEHAVIORS, AsiSession, behavior_name
-from tutorial_atlas_control.asi.state_report import StateReport, manipulate_feedback
+from tutorial_atlas_control.asi.state_report import StateReport
 from tutorial_atlas_control.asi.walk_params import sole_step
 from tutorial_atlas_control.balance import (
     BalanceEstimator,
-    PelvisServo,
     StandBehaviour,
     StandPrepBehaviour,
     signed_distance,
@@ -54,7 +56,7 @@ from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.msgs import (
     AsiCommand,
     AsiState,
-    ManipulateParams,
+    ManipulateFeedback,
     StepFeedback,
     WalkFeedback,
 )
@@ -67,13 +69,6 @@ __all__ = ['AtlasSimInterface']
 COM_OUTSIDE_TOLERANCE_M = 0.0
 _K_EFFORT_ROW = (LAW_FIELDS.index('k_effort'),)
 _ALL_JOINTS = np.arange(NUM_JOINTS)
-
-
-def servo_of(params: ManipulateParams) -> PelvisServo | None:
-    """Manipulate's pelvis target: `desired` when use_desired, else None (the Stand pose)."""
-    if not params.use_desired:
-        return None
-    return PelvisServo(params.pelvis_height_m, params.pelvis_yaw_rad, params.pelvis_lat_m)
 
 
 class AtlasSimInterface:
@@ -105,46 +100,50 @@ class AtlasSimInterface:
         #: the one that deferred a Stand asked for while it runs.
         self.library: dict[Behavior, LibraryBehaviour] = {}
         self._stand_deferred_by: Behavior | None = None
+        #: The library behaviour running inside its mode's behaviour now (Manipulate in Stand).
+        self._nested: NestedBehaviour | None = None
         self.session = AsiSession(MODE_OF_BEHAVIOR)
         if balance:
             self._load_balance()
         else:
             self._estimator = BalanceEstimator(sim.atlas)
-        #: Manipulate runs: Stand, started `_stand_starts`-th, with its pelvis servoed.
-        self.manipulating = False
-        self._stand_starts = 0
-        #: The behaviour the mode was last seen running (Manipulate apart).
+        #: The behaviour the mode was last seen running (a nested one apart).
         self._seen = self._mode_behavior()
         self._report = StateReport(sim)
 
     def _load_balance(self) -> None:
-        """Stand and StandPrep become the balancing behaviours; Manipulate is served."""
+        """Stand and StandPrep become the balancing behaviours; Walk, Step and Manipulate
+        are served (the user's behaviour over them)."""
         sim = self.sim
         self.stand = StandBehaviour(sim.atlas)
         sim.install_stand(self.stand)
         sim.install_stand(StandPrepBehaviour(sim.atlas, sim.gains), ControlMode.STAND_PREP)
-        self.session.served[Behavior.MANIPULATE] = ControlMode.STAND
         ahead = self.stand.estimator.sole_ahead_m
         ground = self._ground.ground
         self.register(WalkEntry(WalkBehaviour(self.stand, default_steps=on_ground(
             [sole_step(step, ahead) for step in DRCSIM_WALK_QUEUE], ground)), ahead, ground))
         self.register(StepEntry(StepBehaviour(self.stand), ahead, ground))
+        self.register(ManipulateEntry(self.stand))
         self._estimator = self.stand.estimator
         if self.user_behaviour is not None:
             self.register(self.user_behaviour)
-            if self.user_behaviour.behavior == Behavior.STAND:
-                del self.session.served[Behavior.MANIPULATE]  # the library's Stand, servoed
 
     def register(self, behaviour: LibraryBehaviour) -> None:
-        """Serve `behaviour`: installed in the simulator for its control mode, requested by
-        its ASI behaviour number."""
-        self.sim.install_stand(behaviour, behaviour.mode)
+        """Serve `behaviour`, requested by its ASI behaviour number: installed in the
+        simulator for its control mode (the behaviours nested in what the mode ran before
+        are no longer served), or nested in the mode's behaviour."""
+        if nested(behaviour) is None:
+            self.sim.install_stand(behaviour, behaviour.mode)
+            for other in [entry for entry in self.library.values()
+                          if entry.mode is behaviour.mode and nested(entry) is not None]:
+                del self.library[other.behavior], self.session.served[other.behavior]
         self.session.served[behaviour.behavior] = behaviour.mode
         self.library[behaviour.behavior] = behaviour
 
     def serves(self, mode: ControlMode) -> bool:
-        """Whether a library behaviour runs control mode `mode`."""
-        return any(entry.mode is mode for entry in self.library.values())
+        """Whether a library behaviour is installed for control mode `mode`."""
+        return any(entry.mode is mode and nested(entry) is None
+                   for entry in self.library.values())
 
     @property
     def walking(self) -> WalkBehaviour | None:
@@ -160,7 +159,14 @@ class AtlasSimInterface:
 
     @property
     def current_behavior(self) -> Behavior:
-        return Behavior.MANIPULATE if self.manipulating else self._mode_behavior()
+        nested_now = self._nested
+        return self._mode_behavior() if nested_now is None else nested_now.behavior
+
+    @property
+    def manipulating(self) -> bool:
+        """Whether Manipulate runs (for tests and tools: the interface itself asks
+        current_behavior)."""
+        return self.current_behavior is Behavior.MANIPULATE
 
     def _mode_behavior(self) -> Behavior:
         """The behaviour the control mode runs: User during the start's hold (the PID with
@@ -181,9 +187,8 @@ class AtlasSimInterface:
         sim = self.sim
         current = self.current_behavior
         self._request(command, current)
-        if self.manipulating:
-            assert self.stand is not None  # served only with it
-            self.stand.servo(servo_of(command.manipulate), float(sim.data.time))
+        if self._nested is not None:
+            self._nested.follow(command, float(sim.data.time))
         if command.k_effort is not None:
             self._set_k_effort(command.k_effort)
 
@@ -222,7 +227,7 @@ class AtlasSimInterface:
             if target is not None:
                 target.take(command, running=False)
             self._switch(mode)
-            self._set_manipulating(command.behavior == Behavior.MANIPULATE)
+            self._nest(None if target is None else nested(target))
         elif running and target is not None:
             target.take(command, running=True)
 
@@ -236,27 +241,27 @@ class AtlasSimInterface:
             if kept is not None:
                 self._set_k_effort(kept)
 
-    def _set_manipulating(self, manipulating: bool) -> None:
-        """Enter Manipulate (in a started Stand), or leave it for Stand's own pose."""
-        stand = self.stand
-        if stand is not None and self.manipulating and not manipulating \
-                and self.sim.mode is ControlMode.STAND:
-            stand.servo(None, float(self.sim.data.time))
-        self.manipulating = manipulating
-        if stand is not None:
-            self._stand_starts = stand.starts
+    def _nest(self, entry: NestedBehaviour | None) -> None:
+        """After a granted request: `entry` runs inside its mode's behaviour (None: no
+        nested behaviour runs), the one that ran there left."""
+        running = self._nested
+        if running is not None and running is not entry:
+            running.leave(self.sim.mode, float(self.sim.data.time))
+        self._nested = entry
+        if entry is not None:
+            entry.enter()
 
     def _observe(self) -> None:
         """A control mode switched outside the interface is the library's transition; so is
-        Stand restarted under Manipulate (/atlas/control_mode Stand)."""
+        the behaviour a nested one runs in restarted (/atlas/control_mode Stand under
+        Manipulate)."""
         if self.stand is None and self.sim.startup_pin.bdi_stand:
             self._load_balance()  # BDI's Stand asked for: the library is there
-        mode, stand = self.sim.mode, self.stand
-        if self.manipulating and stand is not None and (
-                mode is not ControlMode.STAND or stand.starts != self._stand_starts):
-            self.manipulating = False
-            if mode is ControlMode.STAND:
-                self.session.switched(Behavior.STAND, Behavior.MANIPULATE)
+        mode, running = self.sim.mode, self._nested
+        if running is not None and not running.runs(mode):
+            self._nested = None
+            if mode is running.mode:
+                self.session.switched(BEHAVIOR_OF_MODE[mode], running.behavior)
         current = self._mode_behavior()
         if current is not self._seen:
             previous, self._seen = self._seen, current
@@ -293,7 +298,7 @@ class AtlasSimInterface:
                     acting.feedback(float(sim.data.time), self._estimator.sole_ahead_m))
         return self._report.state(
             current, session, falling,
-            manipulate_feedback(self.stand if self.manipulating else None),
+            feedback.get('manipulate_feedback', ManipulateFeedback()),
             feedback.get('walk_feedback', WalkFeedback()),
             feedback.get('step_feedback', StepFeedback()))
 

@@ -8,7 +8,6 @@ import numpy as np
 
 from tutorial_atlas_control.asi.behaviors import Behavior
 from tutorial_atlas_control.asi.session import AsiSession
-from tutorial_atlas_control.balance import PelvisServo, StandBehaviour
 from tutorial_atlas_control.control_modes import ControlMode
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.msgs import (
@@ -20,7 +19,7 @@ from tutorial_atlas_control.msgs import (
 )
 from tutorial_atlas_control.sim import AtlasSimulator
 
-__all__ = ['FOOT_BODIES', 'StateReport', 'manipulate_feedback']
+__all__ = ['FOOT_BODIES', 'StateReport']
 
 FOOT_BODIES = ('l_foot', 'r_foot')
 _NO_TORQUE = np.zeros(NUM_JOINTS)
@@ -86,11 +85,3 @@ class StateReport:
             manipulate_feedback=manipulate, walk_feedback=walk, step_feedback=step,
             k_effort=self.k_effort())
 
-
-def manipulate_feedback(manipulating: StandBehaviour | None) -> ManipulateFeedback:
-    """The pelvis target in use, as clamped, while Manipulate runs on `manipulating`'s Stand
-    (the Stand pose's without use_desired); zeros otherwise (None)."""
-    if manipulating is None:
-        return ManipulateFeedback()
-    target = manipulating.servo_target or PelvisServo(manipulating.squats.stand_height_m)
-    return ManipulateFeedback(0, target.height_m, target.yaw_rad, target.lateral_m)
