@@ -129,9 +129,8 @@ class AtlasSimInterface:
             self.register(self.user_behaviour)
 
     def register(self, behaviour: LibraryBehaviour) -> None:
-        """Serve `behaviour`, requested by its ASI behaviour number: installed in the
-        simulator for its control mode (the behaviours nested in what the mode ran before
-        are no longer served), or nested in the mode's behaviour."""
+        """Serve `behaviour` for its ASI number: installed for its control mode (those nested
+        in what the mode ran before unserved), or nested in the mode's behaviour."""
         if nested(behaviour) is None:
             self.sim.install_stand(behaviour, behaviour.mode)
             for other in [entry for entry in self.library.values()
@@ -159,13 +158,11 @@ class AtlasSimInterface:
 
     @property
     def current_behavior(self) -> Behavior:
-        nested_now = self._nested
-        return self._mode_behavior() if nested_now is None else nested_now.behavior
+        return self._mode_behavior() if self._nested is None else self._nested.behavior
 
     @property
     def manipulating(self) -> bool:
-        """Whether Manipulate runs (for tests and tools: the interface itself asks
-        current_behavior)."""
+        """Whether Manipulate runs (for tests and tools; the interface asks no such thing)."""
         return self.current_behavior is Behavior.MANIPULATE
 
     def _mode_behavior(self) -> Behavior:
@@ -242,8 +239,7 @@ class AtlasSimInterface:
                 self._set_k_effort(kept)
 
     def _nest(self, entry: NestedBehaviour | None) -> None:
-        """After a granted request: `entry` runs inside its mode's behaviour (None: no
-        nested behaviour runs), the one that ran there left."""
+        """After a granted request: `entry` nested in its mode's (None: none), the last left."""
         running = self._nested
         if running is not None and running is not entry:
             running.leave(self.sim.mode, float(self.sim.data.time))
