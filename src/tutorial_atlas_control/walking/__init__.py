@@ -5,8 +5,8 @@ names it, DRCSim's fixed queue, straight and circular plans, a streaming client'
 status_flags: walk_feedback's and step_feedback's status values; step_queue: Walk's queue
 of steps merged by index, clamped to what the legs reach, and its feedback flags;
 dcm_plan: the capture point's plan over the steps; step_adjustment: where a pushed swing
-foot must land instead; swing: the swing foot's path; phases: the phase clock and the
-rules that end Walk's and Step's phases (settled, touched down, the swing begun);
+foot must land instead; swing: the swing foot's path; phases: the one phase machine
+Walk and Step run (their phases in order, each one's end rule, the transition);
 leg_tasks: what Walk and Step do alike each step (the whole-body law on the carrying soles,
 the swing foot, the pelvis's heading); walk: the walk's phases; walk_behaviour: Walk as the
 simulator's behaviour;
@@ -29,7 +29,8 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'step_adjustment': ['foothold_shift', 'predicted_error'],
     'swing': ['SWING_HEIGHT_M', 'SwingPath', 'bump', 'quintic'],
     'leg_tasks': ['LEG_JOINTS', 'LegGains', 'LegTasks', 'foot_pose'],
-    'phases': ['PhaseClock', 'settled', 'swing_to', 'touched_down'],
+    'phases': ['STATIC_STEP_PHASES', 'WALK_PHASES', 'Phase', 'PhaseEnd', 'PhaseSequence',
+               'settled', 'swing_to'],
     'walk': ['WalkController', 'WalkGains', 'WalkOutput'],
     'walk_behaviour': ['WalkBehaviour', 'WalkStatus'],
     'start_noise': ['DEFAULT_START_NOISE', 'StartNoise', 'perturb_start'],
