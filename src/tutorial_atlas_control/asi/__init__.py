@@ -18,7 +18,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'library': ['BehaviourBase', 'Handover', 'LibraryBehaviour', 'StepEntry', 'WalkEntry',
                 'on_ground'],
     'mode_switching': ['AFTER_LAST_S', 'CUES', 'KP_VELOCITY', 'Cue', 'cue_messages'],
-    'session': ['REFUSAL_REPORTED_STEPS', 'STANDING_BEHAVIORS', 'AsiSession', 'Refusal'],
+    'session': ['REFUSAL_REPORTED_TICKS', 'STANDING_BEHAVIORS', 'AsiSession', 'Refusal'],
     'teleop': ['MOVES', 'Settings', 'ego_steps', 'key_action'],
     'user_behaviour': ['USER_BEHAVIORS', 'UserBehaviourError', 'load_user_behaviour'],
     'walk_client': ['Outcome', 'WalkClient', 'refusal_hint'],

@@ -1,5 +1,5 @@
-"""The open AtlasSimInterface over one simulator: requests applied between steps, the state
-reported after each step. ROS-free: the node hands it decoded commands and publishes the
+"""The open AtlasSimInterface over one simulator: requests applied between ticks, the state
+reported after each tick. ROS-free: the node hands it decoded commands and publishes the
 bytes of its states.
 
 What it does with a command (DRCSim 2.7's AtlasPlugin::SetASICommand): the behaviour is
@@ -179,7 +179,7 @@ class AtlasSimInterface:
         return refusal.line() if refusal is not None else line
 
     def apply(self, command: AsiCommand) -> None:
-        """One checked AtlasSimInterfaceCommand, between two steps."""
+        """One checked AtlasSimInterfaceCommand, between two ticks."""
         self._observe()
         sim = self.sim
         current = self.current_behavior
@@ -284,7 +284,7 @@ class AtlasSimInterface:
         return int(current), self.session.status_flags(current, falling)
 
     def state(self) -> AsiState:
-        """The AtlasSimInterfaceState of the step just taken."""
+        """The AtlasSimInterfaceState of the tick just run."""
         self._observe()
         sim, session = self.sim, self.session
         current = self.current_behavior
@@ -299,7 +299,7 @@ class AtlasSimInterface:
             feedback.get('step_feedback', StepFeedback()))
 
     def end_step(self) -> None:
-        """After each step, whether or not a state was built."""
+        """After each tick, whether or not a state was built."""
         self._observe()
         self.session.end_step()
         deferred, stand = self._deferred, self.stand

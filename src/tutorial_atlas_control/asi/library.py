@@ -280,7 +280,7 @@ class StepEntry(_SteppingEntry):
         self.stepping.desire(steps[0] if steps else None)
 
     def stop(self) -> bool:
-        if self.stepping.stepping is None:
+        if self.stepping.static_step is None:
             return False
         self._stand_asked = True
         return True
@@ -288,7 +288,7 @@ class StepEntry(_SteppingEntry):
     def handover(self, fallen: bool) -> Handover | None:
         if fallen:
             return Handover(Behavior.FREEZE, True)
-        if self._stand_asked and self.stepping.stepping is None:
+        if self._stand_asked and self.stepping.static_step is None:
             return Handover(Behavior.STAND, False)
         return None
 

@@ -40,7 +40,7 @@ class StateReport:
         self._free_dof = int(model.jnt_dofadr[free_joint])
 
     def f_out(self) -> np.ndarray:
-        """The behaviour's joint torques this step (N m): the Stand behaviour's or a hold's;
+        """The behaviour's joint torques this tick (N m): the Stand behaviour's or a hold's;
         none in User, ragdoll and the start's hold (the PID alone holds the robot)."""
         sim = self.sim
         if sim.mode in (ControlMode.USER, ControlMode.RAGDOLL) or sim.behaviours.holding_start:
@@ -70,7 +70,7 @@ class StateReport:
     def state(self, current: Behavior, session: AsiSession, falling: bool,
               manipulate: ManipulateFeedback, walk: WalkFeedback,
               step: StepFeedback) -> AsiState:
-        """The AtlasSimInterfaceState of the step just taken, with the library's values."""
+        """The AtlasSimInterfaceState of the tick just run, with the library's values."""
         sim, data = self.sim, self.sim.data
         adr, dof = sim.atlas.free_qpos_adr, self._free_dof
         return AsiState(

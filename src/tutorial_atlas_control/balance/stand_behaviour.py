@@ -11,7 +11,7 @@ reference, none in the torque). A robot taken over standing straight under the h
 bends its knees instead of fighting it.
 `servo` moves the reference the same way to a pelvis height, yaw and lateral offset
 (Manipulate, balance/manipulate.py), or back to the Stand pose (carried to the stance).
-Each step it estimates the
+Each tick it estimates the
 state from the simulator's MjData and returns the controller's torque, which the simulator
 blends with the user's PID by k_effort as f_out.
 """
@@ -114,7 +114,7 @@ class StandBehaviour:
         self.estimator = BalanceEstimator(atlas)
         self.com_height_m = stand_pose_com_height_m(atlas)
         self.controller: StandController | None = None
-        #: The last step's state and decision (None before the first), for feedback.
+        #: The last tick's state and decision (None before the first), for feedback.
         self.last_state: BalanceState | None = None
         self.last_output: StandOutput | None = None
         #: Manipulate's pelvis target as clamped (None: the Stand pose).
@@ -253,7 +253,7 @@ class StandBehaviour:
             posture_rate_rad_s=rate[:28])
 
     def torque(self, data: mujoco.MjData) -> np.ndarray:
-        """This step's f_out (N m, (28,)), within the effort limits."""
+        """This tick's f_out (N m, (28,)), within the effort limits."""
         controller = self.controller
         if controller is None:
             raise BalanceError('StandBehaviour.torque before start()')
@@ -261,6 +261,6 @@ class StandBehaviour:
             controller.reference = self._reference_at(float(data.time))
         atlas = self.atlas
         state = self.estimator.estimate(data.qpos, data.qvel)
-        output = controller.step(state, data.qpos[atlas.qpos_adr], data.qvel[atlas.dof_adr])
+        output = controller.tick(state, data.qpos[atlas.qpos_adr], data.qvel[atlas.dof_adr])
         self.last_state, self.last_output = state, output
         return output.torque_nm

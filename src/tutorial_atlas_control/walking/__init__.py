@@ -7,7 +7,7 @@ of steps merged by index, clamped to what the legs reach, and its feedback flags
 dcm_plan: the capture point's plan over the steps; step_adjustment: where a pushed swing
 foot must land instead; swing: the swing foot's path; phases: the one phase machine
 Walk and Step run (their phases in order, each one's end rule, the transition);
-leg_tasks: what Walk and Step do alike each step (the whole-body law on the carrying soles,
+leg_tasks: what Walk and Step do alike each tick (the whole-body law on the carrying soles,
 the swing foot, the pelvis's heading); walk: the walk's phases; walk_behaviour: Walk as the
 simulator's behaviour;
 start_noise: a trial's start perturbed by a seed; walk_trial: offline walking trials,

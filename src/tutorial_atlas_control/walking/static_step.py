@@ -141,9 +141,9 @@ class StaticStep:
         else:
             phases.finish()
 
-    def step_torque(self, state: BalanceState, joint_positions: np.ndarray,
+    def tick_torque(self, state: BalanceState, joint_positions: np.ndarray,
                     joint_velocities: np.ndarray, time_s: float) -> np.ndarray:
-        """The 28 joint torques (N m) for this 1 ms step, within the effort limits."""
+        """The 28 joint torques (N m) for this 1 ms tick, within the effort limits."""
         self._advance(state, time_s)
         xi_ref = self._capture_reference(time_s)
         cop = dcm_feedback_cop(state.capture_point, xi_ref, self.gains.dcm_gain)

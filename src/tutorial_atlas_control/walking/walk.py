@@ -8,7 +8,7 @@ Stand takes over. At each touchdown the capture point's plan (dcm_plan) is made 
 over the steps the queue then holds, so a streaming client's new steps enter it as
 they come.
 
-Each 1 ms step: the pressure centre p = p_ref + (1 + k)(xi - xi_ref), and leg_tasks
+Each 1 ms tick: the pressure centre p = p_ref + (1 + k)(xi - xi_ref), and leg_tasks
 turns it into torques (the Stand's whole-body law on the carrying soles, the swing foot's
 joint-space servo, feet put back down). The CoM walks 5 cm lower than it stands. While a
 foot swings, its landing moves with the capture point's error predicted at touchdown
@@ -75,7 +75,7 @@ class WalkGains:
 
 @dataclass(frozen=True)
 class WalkOutput:
-    """One step's decision, for feedback and tests."""
+    """One tick's decision, for feedback and tests."""
 
     torque_nm: np.ndarray         # (28,)
     desired_cop: np.ndarray       # (2,)
@@ -233,11 +233,11 @@ class WalkController:
         self.swing = replace(swing, end=np.array([x, y, planned.z_m]))
         self.queue.adjust(self.step)
 
-    # -- one step -----------------------------------------------------------------------------
+    # -- one tick -----------------------------------------------------------------------------
 
-    def step_torque(self, state: BalanceState, joint_positions: np.ndarray,
+    def tick_torque(self, state: BalanceState, joint_positions: np.ndarray,
                     joint_velocities: np.ndarray, time_s: float) -> WalkOutput:
-        """The 28 joint torques (N m) for this 1 ms step, within the effort limits."""
+        """The 28 joint torques (N m) for this 1 ms tick, within the effort limits."""
         self._advance(state, time_s)
         xi_ref, cop_ref = self._capture_reference(state, time_s)
         if self.phase == STEPPING and self.gains.adjust_steps:
