@@ -148,7 +148,7 @@ def test_the_steps_a_client_sends_land_on_the_worlds_surface() -> None:
     top, on a 10 degree ramp its height and tilt, on the ground the robot starts on as sent."""
     import mujoco
 
-    from tutorial_atlas_control.asi import on_ground
+    from tutorial_atlas_control.asi.library import on_ground
     from tutorial_atlas_control.sim import Ground
     from tutorial_atlas_control.walking import Footstep
 

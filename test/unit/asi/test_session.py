@@ -5,14 +5,9 @@ from __future__ import annotations
 
 import pytest
 
-from tutorial_atlas_control.asi import (
-    MODE_OF_BEHAVIOR,
-    REFUSAL_REPORTED_TICKS,
-    AsiError,
-    AsiSession,
-    Behavior,
-    Status,
-)
+from tutorial_atlas_control.asi import AsiError, Behavior, Status
+from tutorial_atlas_control.asi.behaviors import MODE_OF_BEHAVIOR
+from tutorial_atlas_control.asi.session import REFUSAL_REPORTED_TICKS, AsiSession
 from tutorial_atlas_control.control_modes import ControlMode
 
 STAND, USER = Behavior.STAND, Behavior.USER
