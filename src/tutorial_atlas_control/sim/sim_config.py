@@ -42,6 +42,9 @@ class SimConfig:
     last_reset_time_s: float
     recorded: bool = True
     startup_mode: str = DEFAULT_STARTUP_MODE
+    #: Where the robot starts (course.parse_start's text; '': the model's spawn pose at
+    #: the origin), written only when given.
+    start: str = ''
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON object, keys in the order the simulator has always published them."""
@@ -54,6 +57,8 @@ class SimConfig:
         }
         if self.startup_mode != DEFAULT_STARTUP_MODE:
             config['startup_mode'] = self.startup_mode
+        if self.start:
+            config['start'] = self.start
         return config
 
     def to_json(self) -> str:
@@ -74,7 +79,8 @@ class SimConfig:
                 timestep_s=float(config['timestep']),
                 time_to_unpin_s=float(config['time_to_unpin']),
                 last_reset_time_s=float(config['last_reset_time']),
-                startup_mode=str(config.get('startup_mode', DEFAULT_STARTUP_MODE)))
+                startup_mode=str(config.get('startup_mode', DEFAULT_STARTUP_MODE)),
+                start=str(config.get('start', '')))
         except (KeyError, TypeError, ValueError) as err:
             raise SimConfigError(f'lacks a valid {err} (expected JSON with '
                                  f'{", ".join(REQUIRED_KEYS)}).') from None
