@@ -52,6 +52,7 @@ from tutorial_atlas_control.balance import (
 )
 from tutorial_atlas_control.command import LAW_FIELDS, CommandUpdate
 from tutorial_atlas_control.control_modes import ControlMode
+from tutorial_atlas_control.course import Start
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.msgs import (
     AsiCommand,
@@ -61,7 +62,13 @@ from tutorial_atlas_control.msgs import (
     WalkFeedback,
 )
 from tutorial_atlas_control.sim import AtlasSimulator, GroundUnderFeet
-from tutorial_atlas_control.walking import DRCSIM_WALK_QUEUE, StepBehaviour, WalkBehaviour
+from tutorial_atlas_control.walking import (
+    DRCSIM_WALK_QUEUE,
+    Footstep,
+    StepBehaviour,
+    WalkBehaviour,
+    placed,
+)
 
 __all__ = ['AtlasSimInterface']
 
@@ -69,6 +76,14 @@ __all__ = ['AtlasSimInterface']
 COM_OUTSIDE_TOLERANCE_M = 0.0
 _K_EFFORT_ROW = (LAW_FIELDS.index('k_effort'),)
 _ALL_JOINTS = np.arange(NUM_JOINTS)
+
+
+def _from_start(steps: list[Footstep], start: Start | None) -> list[Footstep]:
+    """DRCSim's fixed Walk queue, made for a robot at the origin facing +x, carried to the
+    start the simulator resets the robot to (None: the origin)."""
+    if start is None:
+        return steps
+    return placed(steps, (start.x_m, start.y_m), start.yaw_rad)
 
 
 class AtlasSimInterface:
@@ -121,7 +136,8 @@ class AtlasSimInterface:
         ahead = self.stand.estimator.sole_ahead_m
         ground = self._ground.ground
         self.register(WalkEntry(WalkBehaviour(self.stand, default_steps=on_ground(
-            [sole_step(step, ahead) for step in DRCSIM_WALK_QUEUE], ground)), ahead, ground))
+            _from_start([sole_step(step, ahead) for step in DRCSIM_WALK_QUEUE], sim.start),
+            ground)), ahead, ground))
         self.register(StepEntry(StepBehaviour(self.stand), ahead, ground))
         self.register(ManipulateEntry(self.stand))
         self._estimator = self.stand.estimator

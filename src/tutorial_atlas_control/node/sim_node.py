@@ -53,6 +53,10 @@ Parameters (private unless noted):
         ~stand balance.
     ~model_file (str, the package's sim/atlas_v1.xml): the MJCF to simulate; it must have
         Atlas v1's joints, actuators and sensors (a variant of the package's model).
+    ~start (str, ''): where the robot starts and every reset puts it: a VRC Task 2 world's
+        start by name (vrc_task_2, vrc_task_2_mud_start, ...) or 'x y z yaw' (m, rad); the
+        pelvis at (x, y) turned by yaw, its z putting the soles on the model's ground (z is
+        a hint only). '': the model's spawn pose at the origin.
     /atlas/time_to_unpin (float, 1.0): seconds the torso stays pinned after start/reset.
     /atlas/startup_mode (str, pinned_with_gravity): VRCPlugin's start (sim/vrc.py STARTUP_MODES).
     atlas_controller/gains/<joint>/{p,i,d,i_clamp}: the gains Stand/Freeze/User-hold use.
@@ -100,6 +104,7 @@ from tutorial_atlas_control import topics
 from tutorial_atlas_control.asi import load_user_behaviour
 from tutorial_atlas_control.bags import unwritable_reason
 from tutorial_atlas_control.control_modes import ControlMode
+from tutorial_atlas_control.course import CourseError, Start, parse_start
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.node.cheats import WARN_THROTTLE_S, subscribe_cheats
@@ -500,7 +505,7 @@ def build_node() -> SimNode:
         raise AtlasControlError(f'parameter {rospy.resolve_name("~stand")} must be one of '
                                 f'{", ".join(STAND_CHOICES)}, got {stand!r}')
     sim = AtlasSimulator(load_model(Path(model_file)), gains, time_to_unpin_s,
-                         startup_mode=VrcMode(startup_mode))
+                         startup_mode=VrcMode(startup_mode), start=_start_param())
     behaviour_spec = rospy.get_param('~behaviour', '')
     if not isinstance(behaviour_spec, str):
         raise AtlasControlError(f'parameter {rospy.resolve_name("~behaviour")} must be '
@@ -519,6 +524,15 @@ def build_node() -> SimNode:
                             user_behaviour=user_behaviour)
     return SimNode(sim, settings, bool(rospy.get_param('~gui', False)),
                    description is not None, DelayBudgets.from_params(rospy.get_param))
+
+
+def _start_param() -> Start | None:
+    """~start as a start (None: unset or ''); its error names the parameter."""
+    text = rospy.get_param('~start', '')
+    try:
+        return parse_start(text if isinstance(text, str) else repr(text))
+    except CourseError as err:
+        raise AtlasControlError(f'parameter {rospy.resolve_name("~start")}: {err}') from None
 
 
 def _check_bag_dir() -> None:

@@ -42,9 +42,9 @@ from tutorial_atlas_control.command import CommandError, CommandUpdate
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES
 from tutorial_atlas_control.msgs import CommandDecoder, JointCommandsWire, StampedWire, clock_bytes
+from tutorial_atlas_control.offline.world import OfflineWorld
 from tutorial_atlas_control.sim import (
     DEFAULT_GAINS_FILE,
-    MODEL_PATH,
     TCPROS_PREFIX_BYTES,
     AtlasSimulator,
     ControlMode,
@@ -399,7 +399,7 @@ def _command_wire(gains: Gains) -> JointCommandsWire:
 
 def write_offline_bag(bag: Path, trajectory_file: str, name: str, waypoints: Sequence[Waypoint],
                       gains: Gains, settle_s: float, start_after_s: float,
-                      model_path: Path = MODEL_PATH,
+                      world: OfflineWorld | None = None,
                       play_after_s: float = 0.0,
                       on_step: StepHook | None = None,
                       latency: CommandLatency | None = None) -> OfflineRun:
@@ -408,8 +408,10 @@ def write_offline_bag(bag: Path, trajectory_file: str, name: str, waypoints: Seq
     `on_step`, if given, is called with the simulator after every step (and its messages):
     the sweep measures a run there, and applies its pushes, without reading the bag back.
     `latency`, if given, delays each command as a live run's delivery does (CommandLatency).
+    `world`: the model and start (None: the flat world's, at the origin).
     """
-    sim = AtlasSimulator(load_model(model_path), gains)
+    world = world or OfflineWorld()
+    sim = AtlasSimulator(load_model(world.model_path), gains, start=world.start)
     sink = open_offline_bag(bag)
     # The run's time, without loading the model and the message types (fixed costs).
     started_s = time.perf_counter()
@@ -437,13 +439,13 @@ def run_offline(trajectory_file: str, name: str, bag: Path | str,
                 settle_s: float = DEFAULT_SETTLE_S,
                 start_after_s: float = DEFAULT_START_AFTER_S,
                 gains_file: Path = DEFAULT_GAINS_FILE,
-                model_path: Path = MODEL_PATH,
+                world: OfflineWorld | None = None,
                 play_after_s: float = 0.0) -> OfflineRun:
     """Run trajectory `name` of `trajectory_file` offline into the bag `bag`.
 
     User mode starts `start_after_s` after spawn and the trajectory `play_after_s` later (a
     live traj_yaml.py starts a few seconds after the switch: to re-create a live run, give
-    both from its bag).
+    both from its bag). `world`: the model and start (None: the flat world at the origin).
 
     The bag is written under a temporary name beside `bag` and renamed when complete
     (replacing an existing file): a failed run leaves nothing.
@@ -457,7 +459,7 @@ def run_offline(trajectory_file: str, name: str, bag: Path | str,
     gains = load_gains_yaml(gains_file)
     return write_whole(Path(bag), lambda partial: write_offline_bag(
         partial, os.path.abspath(path), name, waypoints, gains, settle_s, start_after_s,
-        model_path, play_after_s))
+        world, play_after_s))
 
 
 def write_whole(target: Path, write: Callable[[Path], OfflineRun]) -> OfflineRun:

@@ -38,8 +38,10 @@ import numpy as np
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags import BagData, Try, find_tries, pick_try, read_bag, window
+from tutorial_atlas_control.course import CourseError
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.offline.world import recorded_world
 from tutorial_atlas_control.sim import (
     DEFAULT_GAINS_FILE,
     DEFAULT_TIME_TO_UNPIN_S,
@@ -553,8 +555,13 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
     if config.startup_mode not in STARTUP_MODES:
         raise ReplayError(f'{SIM_CONFIG_TOPIC} startup_mode {config.startup_mode!r} is not '
                           f'one of {", ".join(STARTUP_MODES)}.')
-    sim = AtlasSimulator(load_model(), load_gains_yaml(gains_file),
-                         config.time_to_unpin_s, startup_mode=VrcMode(config.startup_mode))
+    try:
+        world = recorded_world(config)
+    except CourseError as err:
+        raise ReplayError(f'{err}.') from None
+    sim = AtlasSimulator(load_model(world.model_path), load_gains_yaml(gains_file),
+                         config.time_to_unpin_s, startup_mode=VrcMode(config.startup_mode),
+                         start=world.start)
     sha1_matches = _check_model(config, sim, warnings)
     step_ns = sim.step_ns
     reset_step = _reset_step(config, step_ns)
