@@ -70,15 +70,22 @@ def run(sim: AtlasSimulator, interface: AtlasSimInterface, seconds: float) -> fl
 @pytest.mark.parametrize('ground_m', [0.0, RAISED_M])
 def test_the_vrc_start_stands_where_it_started(ground_m: float, tmp_path: Path) -> None:
     sim, interface = vrc_start(raised_model(tmp_path) if ground_m else MODEL_PATH)
-    run(sim, interface, 0.9)
-    assert sim.pinned and sim.mode is ControlMode.USER  # pinned in the Stand pose
+    # DRCSim's times: pinned in the Stand pose under the user's PID, released at 1 s, the
+    # Stand (BDI's, here the balancing one) at 2 s.
+    run(sim, interface, 0.999)
+    assert sim.pinned and sim.mode is ControlMode.USER
     np.testing.assert_allclose(sim.data.qpos[:2], (3.0, -2.0), atol=1e-3)
-    run(sim, interface, 1.6)  # released at 1 s, Stand from 2 s
-    assert sim.mode is ControlMode.STAND and not sim.pinned
+    run(sim, interface, 0.002)
+    assert not sim.pinned and sim.mode is ControlMode.USER
+    run(sim, interface, 0.998)
+    assert sim.mode is ControlMode.USER
+    run(sim, interface, 0.002)
+    assert sim.mode is ControlMode.STAND
+    run(sim, interface, 0.5)
     stand = interface.stand
     assert stand.last_state is not None
     feet = stand.last_state.sole_centres.copy()
-    lowest = run(sim, interface, 5.0)  # to 7.5 s: 6.5 s after the release
+    lowest = run(sim, interface, 5.0)  # from 2.5 s to 7.5 s: 6.5 s after the release
     pelvis = sim.data.qpos[:3]
     travel = float(np.max(np.linalg.norm(stand.last_state.sole_centres - feet, axis=1)))
     heading = yaw_of(sim.data.xmat[sim.atlas.pelvis_body_id].reshape(3, 3))

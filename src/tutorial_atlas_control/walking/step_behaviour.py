@@ -109,7 +109,8 @@ class StepBehaviour:
         feet = (foot_pose(state, 0), foot_pose(state, 1))
         step = clamp_step(wanted, feet[1 - wanted.foot_index], self.limits)
         self.static_step = StaticStep(stand.controller, feet, step, state, float(data.time),
-                                   stand.com_height_m, self.gains)
+                                      stand.ground_under_m(state) + stand.com_height_m,
+                                      self.gains)
         self._taken, self._saturated = wanted, step
 
     def status(self, time_s: float) -> StepStatus:
