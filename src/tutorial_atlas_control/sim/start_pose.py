@@ -24,7 +24,8 @@ from tutorial_atlas_control.sim.model import (
     reset_to_initial,
 )
 
-__all__ = ['StartPose', 'home_qpos', 'sole_bottom_corners', 'start_pose', 'yaw_quaternion']
+__all__ = ['StartPose', 'home_qpos', 'sole_bottom_corners', 'start_line', 'start_pose',
+           'yaw_quaternion']
 
 #: A pelvis pose as the free joint's qpos: x y z, then the quaternion w x y z.
 StartPose = np.ndarray
@@ -77,3 +78,11 @@ def home_qpos(atlas: AtlasModel, start: Start | None, ground: Ground | None = No
     if start is None:
         return np.array(ORIGIN_PELVIS_QPOS)
     return start_pose(atlas, start, ground)
+
+
+def start_line(start: Start, qpos: StartPose) -> str:
+    """The simulator's line saying where `start` put the pelvis (`qpos`: start_pose's)."""
+    name = f'{start.name} ' if start.name else ''
+    x, y, z = (float(value) for value in qpos[:3])
+    return (f'start {name}at x {x:.3f} m, y {y:.3f} m, yaw {math.degrees(start.yaw_rad):.1f} '
+            f'deg: the pelvis at z {z:.3f} m puts the soles on the ground')

@@ -18,7 +18,7 @@ from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.sim.ground import Ground
 from tutorial_atlas_control.sim.sim_config import SimConfig
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
-from tutorial_atlas_control.sim.start_pose import sole_bottom_corners, start_pose
+from tutorial_atlas_control.sim.start_pose import sole_bottom_corners, start_line, start_pose
 from tutorial_atlas_control.sim.vrc import CmdVelInput, ModeInput, PoseInput, VrcMode
 
 CONFIG = Path(__file__).resolve().parents[3] / 'config' / 'atlas_controller.yaml'
@@ -124,3 +124,10 @@ def test_without_a_start_the_robot_spawns_as_the_model_says(flat: atlas_model.At
     np.testing.assert_array_equal(sim.data.qpos[:7], atlas_model.ORIGIN_PELVIS_QPOS)
     assert 'start' not in sim.config().to_dict()  # the default run's config text unchanged
     assert Ground(flat.model).level_m == 0.0
+
+
+def test_the_start_line_says_where_the_pelvis_went(flat: atlas_model.AtlasModel) -> None:
+    mud = parse_start('vrc_task_2_mud_start')
+    assert start_line(mud, start_pose(flat, mud)) == (
+        'start vrc_task_2_mud_start at x -0.290 m, y -23.020 m, yaw 90.0 deg: the pelvis at '
+        'z 0.927 m puts the soles on the ground')
