@@ -1,14 +1,14 @@
 """DRCSim's VRC Task 2 course without ROS: its description, its world, its mud, its scoring.
 
 errors: CourseError, what the course refuses; vrc_task_2: the course's figures (the
-heightmap's scaling, the gates, the pen, the mud, the starts), the one description the
-world, the mud and the scoring read.
+heightmap's scaling, the gates, the pen, the mud, the blocks, the starts), the one
+description the world, the mud and the scoring read.
 """
 
 from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'errors': ['CourseError'],
-    'vrc_task_2': ['GATES', 'HEIGHTMAP', 'MUD_BOX', 'STARTS', 'WORLD_NAME', 'Box', 'Gate',
-                   'Heightmap', 'Start'],
+    'vrc_task_2': ['BLOCKS', 'GATES', 'HEIGHTMAP', 'MUD_BOX', 'PEN_WALLS', 'STARTS',
+                   'WORLD_NAME', 'Block', 'Box', 'Gate', 'Heightmap', 'Start'],
 })
