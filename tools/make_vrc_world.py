@@ -240,13 +240,47 @@ def block_pose(block: course.Block, grey: np.ndarray) -> tuple[np.ndarray, str]:
     return position, fmt(np.round(quat, 9))
 
 
+def terrain_height_m(grey: np.ndarray, x: float, y: float) -> float:
+    """The heightfield's surface (m) at world (x, y) as MuJoCo triangulates it: each cell
+    split along its diagonal from (-x, -y) to (+x, +y)."""
+    hm = course.HEIGHTMAP
+    u, v = (x + hm.size_m / 2) / hm.cell_m, (y + hm.size_m / 2) / hm.cell_m
+    col, row = min(int(u), hm.pixels - 2), min(int(v), hm.pixels - 2)
+    fu, fv = u - col, v - row
+    up = hm.pixels - 1 - row  # the image's row of the vertex at `row` from -y
+
+    def z(d_col: int, d_row: int) -> float:
+        return hm.height_m(float(grey[up - d_row, col + d_col]))
+
+    if fu >= fv:
+        return z(0, 0) + fu * (z(1, 0) - z(0, 0)) + fv * (z(1, 1) - z(1, 0))
+    return z(0, 0) + fv * (z(0, 1) - z(0, 0)) + fu * (z(1, 1) - z(0, 1))
+
+
+def sole_corners_m() -> np.ndarray:
+    """The soles' eight bottom corners (8, 3) in the pelvis frame, every joint at 0."""
+    corners = []
+    for side in 'lr':
+        chain = [ATLAS.JOINTS[f'{side}_leg_{j}'].origin_m
+                 for j in ('uhz', 'mhx', 'lhy', 'kny', 'uay', 'lax')]
+        foot = np.sum(chain, axis=0)
+        half = np.array(ATLAS.SOLE_SIZE_M) / 2
+        for sx in (-1, 1):
+            for sy in (-1, 1):
+                corners.append(foot + ATLAS.SOLE_POS_M + (sx * half[0], sy * half[1], -half[2]))
+    return np.array(corners)
+
+
 def spawn_pose(start: course.Start, grey: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The pelvis's pose for `start` with every joint at 0: at its (x, y) and yaw, the flat
-    soles on the highest ground within 0.35 m (DRCSim's z was its own model's origin)."""
-    reach = 0.35
-    ground = highest_ground_m(grey, start.x_m - reach, start.x_m + reach,
-                              start.y_m - reach, start.y_m + reach)
-    position = np.round((start.x_m, start.y_m, ground + ATLAS.SPAWN_HEIGHT_M), 9)
+    soles' lowest corner on the terrain and none in it (DRCSim's z was its own model's)."""
+    c, s = math.cos(start.yaw_rad), math.sin(start.yaw_rad)
+    corners = sole_corners_m()
+    above = []
+    for x, y, z in corners:
+        ground = terrain_height_m(grey, start.x_m + c * x - s * y, start.y_m + s * x + c * y)
+        above.append(ground - z)
+    position = np.round((start.x_m, start.y_m, max(above)), 9)
     return position, np.round(ATLAS.rpy_to_quat((0.0, 0.0, start.yaw_rad)), 9)
 
 
