@@ -45,7 +45,7 @@ from tutorial_atlas_control.balance.stand import (
 )
 from tutorial_atlas_control.balance.stand_pose import place_in_stand_pose
 from tutorial_atlas_control.joints import JOINT_NAMES
-from tutorial_atlas_control.sim import AtlasModel
+from tutorial_atlas_control.sim import AtlasModel, GroundUnderFeet
 
 __all__ = ['TRANSITION_S', 'StandBehaviour', 'stand_pose_com_height_m']
 
@@ -58,11 +58,12 @@ _LEGS = np.array([index for index, name in enumerate(JOINT_NAMES) if '_leg_' in 
 
 
 def stand_pose_com_height_m(atlas: AtlasModel) -> float:
-    """The centre of mass's height (m) of the robot in the Stand pose, feet on the ground."""
+    """The centre of mass's height (m) of the robot in the Stand pose above the ground its
+    flat feet stand on (the robot's own: a world's loose bodies are not the robot)."""
     data = mujoco.MjData(atlas.model)
     place_in_stand_pose(atlas, data)
     mujoco.mj_comPos(atlas.model, data)
-    return float(data.subtree_com[0][2])
+    return float(data.subtree_com[atlas.pelvis_body_id][2])
 
 
 _UP = np.array([0.0, 0.0, 1.0])
@@ -129,6 +130,9 @@ class StandBehaviour:
         #: The pelvis height (m) of the squat table's posture the reference is at or passing
         #: through (None: off the table, as after start()).
         self._table_height_m: float | None = None
+        #: The ground under the feet where Stand last started (m): the CoM height's zero.
+        self.ground_m = 0.0
+        self._ground: GroundUnderFeet | None = None
 
     @functools.cached_property
     def stand_height_m(self) -> float:
@@ -148,7 +152,13 @@ class StandBehaviour:
         puts them; staggered or turned, legs that reach the soles (the Stand pose's would
         push them against each other, and turn one on the ground)."""
         stance = self.stance.stance(state.sole_centres, state.sole_rotations, pelvis_yaw_rad)
-        return stance.posture_rad, self.com_height_m - stance.com_lowered_m
+        return stance.posture_rad, self.ground_m + self.com_height_m - stance.com_lowered_m
+
+    def _ground_under_feet_m(self, data: mujoco.MjData) -> float:
+        """The ground's height (m) under the lower sole (0.0 exactly on today's plane)."""
+        if self._ground is None or self._ground.data is not data:
+            self._ground = GroundUnderFeet(self.atlas, data)
+        return self._ground.height_m()
 
     @functools.cached_property
     def squats(self) -> SquatTable:
@@ -158,6 +168,7 @@ class StandBehaviour:
     def start(self, data: mujoco.MjData) -> None:
         """Stand where the robot stands now, going to the Stand pose over transition_s."""
         state = self.estimator.estimate(data.qpos, data.qvel)
+        self.ground_m = self._ground_under_feet_m(data)
         held = StandReference.from_state(state, posture_rad=data.qpos[self.atlas.qpos_adr])
         self.controller = StandController(
             self.estimator.mass_kg, self.atlas.effort_limit_nm, held,
