@@ -131,11 +131,13 @@ def load_model(path: Path = MODEL_PATH) -> AtlasModel:
 
 
 def reset_to_initial(atlas: AtlasModel, data: mujoco.MjData) -> None:
-    """Every joint at 0, pelvis upright at SPAWN_HEIGHT_M, at rest, unpinned."""
+    """Every joint at 0, the pelvis at the model file's spawn (its free joint's qpos0: on
+    atlas_v1.xml upright at SPAWN_HEIGHT_M over the origin, in a course world its start),
+    at rest, unpinned."""
     mujoco.mj_resetData(atlas.model, data)
     adr = atlas.free_qpos_adr
     data.qpos[atlas.qpos_adr] = 0.0
-    data.qpos[adr:adr + 7] = (0.0, 0.0, SPAWN_HEIGHT_M, 1.0, 0.0, 0.0, 0.0)
+    data.qpos[adr:adr + 7] = atlas.model.qpos0[adr:adr + 7]
     data.eq_active[atlas.pin_eq_id] = 0
     mujoco.mj_forward(atlas.model, data)
 
