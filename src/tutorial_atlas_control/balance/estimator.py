@@ -122,7 +122,7 @@ class BalanceEstimator:
         # A copy, so that the soles' wider margin finds near contacts without pushing.
         self.model = copy.deepcopy(atlas.model)
         self.scratch = mujoco.MjData(self.model)
-        self.mass_kg = float(self.model.body_subtreemass[0])
+        self.mass_kg = float(self.model.body_subtreemass[atlas.pelvis_body_id])  # the robot's
         self._soles = sole_geom_ids(self.model)
         self.sole = SoleBox.of(self.model)
         self.model.geom_margin[self._soles] = CONTACT_HEIGHT_M
@@ -133,6 +133,10 @@ class BalanceEstimator:
         others = others[~np.isin(others, self._soles)]
         self.model.geom_contype[others] = 0
         self.model.geom_conaffinity[others] = 0
+        # Nor does the world collide with itself there (a course's loose blocks on its
+        # heightfield: hundreds of contacts a call); the soles still meet all of it.
+        world = ~robot
+        self.model.geom_contype[world] = 0
         self._sole_bodies = [int(self.model.geom_bodyid[g]) for g in self._soles]
         self._pelvis = atlas.pelvis_body_id
         self._jac = np.zeros((2, 6, self.model.nv))  # [linear; angular] per sole
@@ -243,8 +247,8 @@ class BalanceEstimator:
                           self._sole_bodies[foot])
         sole_velocities = jac @ d.qvel
         contact, contacts_of = self._touching()
-        com = d.subtree_com[0].copy()
-        com_velocity = d.subtree_linvel[0].copy()
+        com = d.subtree_com[self._pelvis].copy()  # the robot's, not a world's loose bodies'
+        com_velocity = d.subtree_linvel[self._pelvis].copy()
         omega = lipm.natural_frequency(max(float(com[2]), MIN_COM_HEIGHT_M))
         free = self._free_dof
         pelvis_rotation = d.xmat[self._pelvis].reshape(3, 3).copy()

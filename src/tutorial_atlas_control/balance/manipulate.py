@@ -109,7 +109,8 @@ def place_pitched(atlas: AtlasModel, data: mujoco.MjData,
 def _com_ahead_m(atlas: AtlasModel, data: mujoco.MjData) -> float:
     """How far (m) the centre of mass is ahead of the soles' middle, after placing."""
     soles = sole_geom_ids(atlas.model)
-    return float(data.subtree_com[0][0] - np.mean([data.geom_xpos[g][0] for g in soles]))
+    return float(data.subtree_com[atlas.pelvis_body_id][0]
+                 - np.mean([data.geom_xpos[g][0] for g in soles]))
 
 
 class SquatTable:
@@ -143,7 +144,7 @@ class SquatTable:
         pelvis, com = [], []
         for posture in postures:
             pelvis.append(place_pitched(atlas, data, posture))
-            com.append(float(data.subtree_com[0][2]))
+            com.append(float(data.subtree_com[atlas.pelvis_body_id][2]))
         # Nearly straight knees stand a little lower than slightly bent ones: the table
         # starts at the highest bend, so that height and posture change together.
         highest = int(np.argmax(pelvis))

@@ -86,7 +86,8 @@ class StancePosture:
         centres, _ = self._soles_now()
         adr = atlas.free_qpos_adr
         self.pelvis_offset_m = self.data.qpos[adr:adr + 3] - centres.mean(axis=0)
-        self.com_height_m = float(self.data.subtree_com[0][2] - centres[:, 2].mean())
+        self.com_height_m = float(self.data.subtree_com[atlas.pelvis_body_id][2]
+                                  - centres[:, 2].mean())
 
     def _soles_now(self) -> tuple[np.ndarray, np.ndarray]:
         """(centres of the soles' bottom faces (2, 3), their rotations (2, 3, 3)), world,
@@ -127,7 +128,7 @@ class StancePosture:
         data.qpos[atlas.qpos_adr] = solved
         mujoco.mj_kinematics(atlas.model, data)
         mujoco.mj_comPos(atlas.model, data)
-        com_height = float(data.subtree_com[0][2] - middle[2])
+        com_height = float(data.subtree_com[atlas.pelvis_body_id][2] - middle[2])
         return Stance(solved, lowered, self.com_height_m - com_height, reached)
 
     def _solve(self, posture: np.ndarray, centres: np.ndarray,

@@ -59,11 +59,12 @@ _LEGS = np.array([index for index, name in enumerate(JOINT_NAMES) if '_leg_' in 
 
 
 def stand_pose_com_height_m(atlas: AtlasModel) -> float:
-    """The centre of mass's height (m) of the robot in the Stand pose, feet on the ground."""
+    """The centre of mass's height (m) of the robot in the Stand pose above the ground its
+    flat feet stand on (the robot's own: a world's loose bodies are not the robot)."""
     data = mujoco.MjData(atlas.model)
     place_in_stand_pose(atlas, data)
     mujoco.mj_comPos(atlas.model, data)
-    return float(data.subtree_com[0][2])
+    return float(data.subtree_com[atlas.pelvis_body_id][2])
 
 
 _UP = np.array([0.0, 0.0, 1.0])

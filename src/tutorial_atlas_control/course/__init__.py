@@ -1,9 +1,10 @@
 """DRCSim's VRC Task 2 course without ROS: its description, its world, its mud, its scoring.
 
 errors: CourseError, what the course refuses; vrc_task_2: the course's figures (the
-heightmap's scaling, the gates, the pen, the mud, the starts), the one description the
-world, the mud and the scoring read; starts: where a run starts Atlas (a world's start by
-name, or 'x y z yaw'), checked once for the node, the launches and offline runs.
+heightmap's scaling, the gates, the pen, the mud, the blocks, the starts), the one
+description the world, the mud and the scoring read; starts: where a run starts Atlas (a
+world's start by name, or 'x y z yaw'), checked once for the node, the launches and offline
+runs.
 """
 
 from tutorial_atlas_control.exports import lazy_exports
@@ -11,6 +12,6 @@ from tutorial_atlas_control.exports import lazy_exports
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'errors': ['CourseError'],
     'starts': ['WORLD_MODEL_FILE', 'parse_start', 'start_text', 'world_start'],
-    'vrc_task_2': ['GATES', 'HEIGHTMAP', 'MUD_BOX', 'STARTS', 'WORLD_NAME', 'Box', 'Gate',
-                   'Heightmap', 'Start'],
+    'vrc_task_2': ['BLOCKS', 'GATES', 'HEIGHTMAP', 'MUD_BOX', 'PEN_WALLS', 'STARTS',
+                   'WORLD_NAME', 'Block', 'Box', 'Gate', 'Heightmap', 'Start'],
 })

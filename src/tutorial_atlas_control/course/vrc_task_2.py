@@ -13,10 +13,12 @@ import math
 from dataclasses import dataclass
 
 __all__ = [
-    'BLOCK_MASS_KG', 'FOOT_FRICTION', 'GATES', 'GATE_POST_M', 'GATE_WIDTH_M', 'HEIGHTMAP',
-    'MUD_BOX', 'MUD_DAMPING', 'MUD_DAMPING_FINALS', 'MUD_FLOOR_FRICTION',
-    'MUD_FLOOR_FRICTION_FINALS', 'MUD_FLOOR_Z_M', 'MUD_LINKS', 'PEN', 'STARTS',
-    'TERRAIN_FRICTION', 'WORLD_NAME', 'Box', 'Gate', 'Heightmap', 'Start',
+    'BLOCKS', 'BLOCK_ENVELOPE_M', 'BLOCK_INERTIA', 'BLOCK_MASS_KG', 'BLOCK_WALLS',
+    'FOOT_FRICTION', 'GATES', 'GATE_POST_M', 'GATE_WIDTH_M', 'HEIGHTMAP', 'MUD_BOX',
+    'MUD_DAMPING', 'MUD_DAMPING_FINALS', 'MUD_FLOOR_FRICTION', 'MUD_FLOOR_FRICTION_FINALS',
+    'MUD_FLOOR_Z_M', 'MUD_LINKS', 'PEN', 'PEN_FLOOR', 'PEN_FLOOR_FRICTION', 'PEN_POSE',
+    'PEN_WALLS', 'STARTS', 'TERRAIN_FRICTION', 'WORLD_NAME', 'Block', 'Box', 'Gate',
+    'Heightmap', 'Start',
 ]
 
 #: The world's name: DRCSim's scoring is active in a world of this name only.
@@ -107,8 +109,90 @@ TERRAIN_FRICTION = 1.0
 #: 4.28 m walls, spanning x -8.3…2, y -43.9…-32.1, open east towards gate_0.
 PEN = Box((-3.15, -38.0, 0.02), (10.3, 11.8, 0.01))
 
-#: One 5 kg cinder block: five boxes inside a 0.435 × 0.203 × 0.203 m envelope.
+#: The pen model's frame in the world: (x, y, z) and yaw (rad), DRCSim's -1.5707.
+PEN_POSE = ((-8.27, -38.0, 0.02), -1.5707)
+#: Its collision boxes in its own frame (centre, full size; m), model.sdf's figures: seven
+#: 4.28 m walls, the arrow sign on the outer wall, and the 20 × 16 × 0.01 m floor, last.
+PEN_WALLS: tuple[Box, ...] = (
+    Box((0.0, 0.0, 2.14), (12.15, 0.31, 4.28)),
+    Box((-5.28, 14.3205, 2.14), (14.8, 0.46, 4.28)),
+    Box((-5.91, 5.0, 2.14), (0.385, 10.3, 4.28)),
+    Box((5.91, 5.161, 2.14), (0.385, 10.66, 4.28)),
+    Box((3.9, 10.285, 2.14), (4.38, 0.45, 4.28)),
+    Box((-4.0, 9.95, 2.14), (4.25, 0.45, 4.28)),
+    Box((1.94, 12.3, 2.14), (0.45, 4.5, 4.28)),
+    Box((-0.232, 14.03, 2.46), (3.33, 0.12, 1.16)),
+)
+PEN_FLOOR = Box((-3.21, 7.355, 0.0), (20.0, 16.0, 0.01))
+#: The pen floor's mu (mu2 50): ODE took the smaller of it and the feet's 1.5.
+PEN_FLOOR_FRICTION = 100.0
+
+#: One 5 kg cinder block: five boxes inside a 0.435 × 0.203 × 0.203 m envelope, its frame
+#: at the envelope's bottom centre (model.sdf of cinder_block).
 BLOCK_MASS_KG = 5.0
+BLOCK_ENVELOPE_M = (0.435, 0.203, 0.203)
+#: The five walls (centre, full size; m) in the block's frame: two long sides, the two
+#: ends and the middle web; hollow between them.
+BLOCK_WALLS: tuple[Box, ...] = (
+    Box((0.0, -0.08465, 0.1016), (0.43495, 0.0339, 0.2032)),
+    Box((0.0, 0.08465, 0.1016), (0.43495, 0.0339, 0.2032)),
+    Box((0.18625, 0.0, 0.1016), (0.0339, 0.1354, 0.203)),
+    Box((0.0, 0.0, 0.1016), (0.0339, 0.1354, 0.203)),
+    Box((-0.18625, 0.0, 0.1016), (0.0339, 0.1354, 0.203)),
+)
+#: Its inertia about its centre of mass (0, 0, 0.1016): model.sdf's diagonal (kg m²).
+BLOCK_INERTIA = (0.028705, 0.073708, 0.06908)
+
+
+@dataclass(frozen=True)
+class Block:
+    """A loose cinder block where the world file puts it: its frame's (x, y, z) and
+    Gazebo's roll, pitch, yaw (fixed axes x, y, z; rad). Gazebo let it settle on the ground
+    from there; z is above z 0, not above the heightmap."""
+
+    name: str
+    x_m: float
+    y_m: float
+    z_m: float
+    roll_rad: float
+    pitch_rad: float
+    yaw_rad: float
+
+
+#: The 30 blocks of the rubble (`vrc_task_2.world`), lying flat (roll and pitch 0), on a
+#: side (roll 1.57) or on end (pitch 1.57).
+BLOCKS: tuple[Block, ...] = (
+    Block('cinder_block', 5.0, 12.5548, 0.118705, 1.57, 0.0, 1.0),
+    Block('cinder_block_0', 8.0, 13.5719, 0.0, 0.0, 0.0, 0.2),
+    Block('cinder_block_1', 8.0, 11.0, 0.217475, 0.0, 1.57, -1.3),
+    Block('cinder_block_2', 6.0, 11.0, 0.217475, 0.0, 1.57, 0.2),
+    Block('cinder_block_3', 5.41703, 14.5289, 0.118279, 1.57, 0.0, 0.05),
+    Block('cinder_block_4', 7.44313, 15.0, 0.217475, 0.0, 1.57, 0.8),
+    Block('cinder_block_5', 7.0, 12.4875, 0.0, 0.0, 0.0, 2.0),
+    Block('cinder_block_6', 8.0, 8.0, 0.0, 0.0, 0.0, 3.0),
+    Block('cinder_block_7', 5.0, 8.0, 0.217475, 0.0, 1.57, -2.0),
+    Block('cinder_block_8', 5.0, 14.5, 0.11853, 1.57, 0.0, -0.5),
+    Block('cinder_block_9', 6.7, 9.0, 0.0, 0.0, 0.0, 2.6),
+    Block('cinder_block_10', 4.0, 16.4525, 0.0, 0.0, 0.0, 1.2),
+    Block('cinder_block_11', 4.44348, 9.51062, 0.11853, 1.57, 0.0, 0.0),
+    Block('cinder_block_12', 9.0, 16.0, 0.0, 0.0, 0.0, 0.3),
+    Block('cinder_block_13', 4.52065, 16.0, 0.0, 0.0, 0.0, 0.1),
+    Block('cinder_block_14', 9.0, 11.5289, 0.118707, 1.57, 0.0, 1.0),
+    Block('cinder_block_15', 8.0, 9.57994, 0.0, 0.0, 0.0, 0.0),
+    Block('cinder_block_16', 5.0, 16.0, 0.0, 0.0, 0.0, 0.8),
+    Block('cinder_block_17', 5.7, 16.5948, 0.217475, 0.0, 1.57, -0.8),
+    Block('cinder_block_18', 5.0, 11.0, 0.0, 0.0, 0.0, -0.005),
+    Block('cinder_block_19', 8.0, 7.58666, 0.217475, 0.0, 1.57, 0.5),
+    Block('cinder_block_20', 3.53091, 8.50047, 0.0, 0.0, 0.0, -0.1),
+    Block('cinder_block_21', 9.0, 8.59824, 0.217475, 0.0, 1.57, 2.3),
+    Block('cinder_block_22', 9.0, 15.4024, 0.0, 0.0, 0.0, 2.8),
+    Block('cinder_block_23', 5.0, 14.0, 0.217475, 0.0, 1.57, -1.9),
+    Block('cinder_block_24', 8.0, 12.0, 0.0, 0.0, 0.0, 1.9),
+    Block('cinder_block_25', 8.0, 13.0, 0.0, 0.0, 0.0, 0.3),
+    Block('cinder_block_26', 6.0, 7.5, 0.0, 0.0, 0.0, 0.1),
+    Block('cinder_block_27', 7.42157, 9.0, 0.0, 0.0, 0.0, 0.0),
+    Block('cinder_block_28', 4.0, 10.0, 0.0, 0.0, 0.0, 1.2),
+)
 
 
 @dataclass(frozen=True)

@@ -136,13 +136,15 @@ ORIGIN_PELVIS_QPOS = (0.0, 0.0, SPAWN_HEIGHT_M, 1.0, 0.0, 0.0, 0.0)
 
 
 def reset_to_initial(atlas: AtlasModel, data: mujoco.MjData,
-                     pelvis_qpos: Sequence[float] | np.ndarray = ORIGIN_PELVIS_QPOS) -> None:
+                     pelvis_qpos: Sequence[float] | np.ndarray | None = None) -> None:
     """Every joint at 0, the pelvis at `pelvis_qpos` (x y z, quaternion w x y z; default:
-    upright at the origin at SPAWN_HEIGHT_M), at rest, unpinned."""
+    the model file's spawn, its free joint's qpos0: on atlas_v1.xml upright at SPAWN_HEIGHT_M
+    over the origin, in a course world its start), at rest, unpinned."""
     mujoco.mj_resetData(atlas.model, data)
     adr = atlas.free_qpos_adr
     data.qpos[atlas.qpos_adr] = 0.0
-    data.qpos[adr:adr + 7] = pelvis_qpos
+    data.qpos[adr:adr + 7] = (atlas.model.qpos0[adr:adr + 7] if pelvis_qpos is None
+                              else pelvis_qpos)
     data.eq_active[atlas.pin_eq_id] = 0
     mujoco.mj_forward(atlas.model, data)
 

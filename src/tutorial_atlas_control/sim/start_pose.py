@@ -17,7 +17,6 @@ import numpy as np
 from tutorial_atlas_control.course import Start
 from tutorial_atlas_control.sim.ground import Ground
 from tutorial_atlas_control.sim.model import (
-    ORIGIN_PELVIS_QPOS,
     SOLE_GEOMS,
     AtlasModel,
     ModelError,
@@ -70,13 +69,15 @@ def start_pose(atlas: AtlasModel, start: Start, ground: Ground | None = None) ->
 def home_qpos(atlas: AtlasModel, start: Start | None, ground: Ground | None = None
               ) -> StartPose:
     """The pelvis's qpos (7,) a reset puts the robot at: start_pose's, or for None the
-    model's spawn pose (upright at the origin, the soles on z = 0).
+    model file's spawn (its free joint's qpos0: atlas_v1.xml's upright at the origin, the
+    soles on z = 0; a course world's at its start).
 
     Raises:
         ModelError: no ground under a sole corner at the start.
     """
     if start is None:
-        return np.array(ORIGIN_PELVIS_QPOS)
+        adr = atlas.free_qpos_adr
+        return np.array(atlas.model.qpos0[adr:adr + 7])
     return start_pose(atlas, start, ground)
 
 

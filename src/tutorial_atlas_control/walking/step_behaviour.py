@@ -108,6 +108,7 @@ class StepBehaviour:
         assert state is not None and stand.controller is not None  # set by start
         feet = (foot_pose(state, 0), foot_pose(state, 1))
         step = clamp_step(wanted, feet[1 - wanted.foot_index], self.limits)
+        # The Stand pose's CoM height above the ground it stands on (0 on the plane).
         self.static_step = StaticStep(stand.controller, feet, step, state, float(data.time),
                                       stand.ground_under_m(state) + stand.com_height_m,
                                       self.gains)
