@@ -45,7 +45,7 @@ class FakeNode:
     def __init__(self, hooks: list, reason: str) -> None:
         self.hooks = hooks
         self.reason = reason
-        self.sim = type('Sim', (), {'dt_s': 0.001, 'time_to_unpin_s': 1.0})()
+        self.sim = type('Sim', (), {'dt_s': 0.001, 'time_to_unpin_s': 1.0, 'start': None})()
         self.loop = type('Loop', (), {'real_time_factor': 1.0, 'paused': False,
                                       'outbox': WireBatch()})()
         self.publishers = {topics.CLOCK: 'clock'}
