@@ -70,6 +70,6 @@ def score_lines(entries: list[ScoreEntry]) -> list[str]:
     if entries[-1] not in events:
         events.append(entries[-1])
     last = entries[-1]
-    return ([f'VRC score ({topics.VRC_SCORE}; sim time): {last.completion} gates, '
-             f'{last.falls} falls, {last.sim_elapsed_s:.3f} s since gate 1']
+    return ([f'VRC score ({topics.VRC_SCORE}; sim time): completion {last.completion}, '
+             f'falls {last.falls}, {last.sim_elapsed_s:.3f} s since gate 1']
             + [entry.line() for entry in events])

@@ -3,6 +3,7 @@ the bag as the node publishes it, and analyze_bag.py prints its timeline."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -56,9 +57,14 @@ def test_analyze_bag_prints_the_score_timeline(scored_bag: Path,
                                                capsys: pytest.CaptureFixture[str]) -> None:
     assert main([str(scored_bag)]) == 0
     out = capsys.readouterr().out
-    assert 'VRC score (/vrc_score; sim time): 1 gates, 0 falls, 1.300 s since gate 1' in out
+    assert ('VRC score (/vrc_score; sim time): completion 1, falls 0, 1.300 s since gate 1'
+            in out)
     assert ('      0.901 s  score 1  falls 0     0.300 s since gate 1' in out
             and 'Successfully passed through gate 2.' in out)
+    assert main([str(scored_bag), '--json']) == 0
+    scores = json.loads(capsys.readouterr().out)['vrc_score']
+    assert [(s['completion'], round(s['sim_time_s'], 3)) for s in scores] == [
+        (0, 0.601), (1, 0.901), (1, 1.901)]
 
 
 def test_an_unscored_bag_prints_no_score(tmp_path: Path,
