@@ -47,6 +47,9 @@ class ScoreLog:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             self._fd = os.open(self.path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_APPEND,
                                0o644)
+        except FileExistsError:
+            raise CourseError(f'score log {self.path} cannot be written: {self.path.parent} '
+                              'is not a directory') from None
         except OSError as err:
             raise CourseError(f'score log {self.path} cannot be written: '
                               f'{err.strerror or err}') from None
