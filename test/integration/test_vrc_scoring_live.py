@@ -1,6 +1,7 @@
 """DRCSim's VRC scoring live: the node with ~vrc_scoring true on the default world, Atlas
 teleported through gate_0 and gate_1 with DRCSim's checks' Pose() (an all-zero quaternion);
-/vrc_score says completion 1, score.log has the plugin's rows, and the bag recorded them.
+/vrc_score says completion 1, score.log has the plugin's rows, the bag recorded them, and
+the bag's replay scores the same.
 
 Run with `python3 -m pytest test/integration/test_vrc_scoring_live.py -q -s` after
 `source env.sh` (needs roslaunch and the workspace's messages; skipped otherwise).
@@ -22,6 +23,7 @@ if shutil.which('roslaunch') is None:
 from support.launch import SIM, TestLaunch
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags import read_bag, read_scores
+from tutorial_atlas_control.offline.replay import format_report, replay_bag
 from tutorial_atlas_control.processes import RosMaster
 
 pytestmark = pytest.mark.filterwarnings('ignore::DeprecationWarning')
@@ -83,3 +85,9 @@ def test_teleports_through_gate_0_and_gate_1_score_1_live(tmp_path: Path,
     assert entries is not None
     assert [entry.message for entry in entries if entry.message] == list(PASSED)
     assert entries[-1].completion == 1
+    # Replayed offline, the run scores the same, row for row.
+    result = replay_bag(bag)
+    print(f'figures: replay: {result.recorded_steps} steps, score rows '
+          f'{result.score and result.score.line().strip()}')
+    assert result.score is not None and result.score.same, result.score
+    assert result.reproduced, format_report(result)

@@ -41,7 +41,9 @@ class ScoreEntry:
 
 def read_scores(data: BagData) -> list[ScoreEntry] | None:
     """Every /vrc_score message in `data`'s bag, in order; None when the bag has none
-    (an unscored run)."""
+    (an unscored run: then the bag is not opened again)."""
+    if not getattr(data.topics.get(topics.VRC_SCORE), 'count', 0):
+        return None
     records = open_bag(data.path)
     try:
         connections = [c for c in records.connections if c.topic == topics.VRC_SCORE]

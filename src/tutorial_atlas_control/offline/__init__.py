@@ -1,5 +1,6 @@
 """Runs without ROS: the offline trajectory player, an AtlasSimInterface session played again,
-and the replay of a recorded run."""
+and the replay of a recorded run (replay_score: a scored run's /vrc_score computed again on
+the replayed steps)."""
 
 from tutorial_atlas_control.exports import lazy_exports
 
@@ -8,4 +9,5 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'player': ['CommandLatency', 'DEFAULT_SETTLE_S', 'DEFAULT_START_AFTER_S', 'OfflineRunError',
                'run_offline', 'write_offline_bag'],
     'replay': ['DEFAULT_TOLERANCE', 'ReplayError', 'format_report', 'replay_bag'],
+    'replay_score': ['ScoreComparison', 'ScoreReplay'],
 })

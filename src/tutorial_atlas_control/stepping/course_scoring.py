@@ -31,7 +31,8 @@ class CourseScoring:
     """One Scorer and its score.log for a simulator; call it after each step.
 
     Args:
-        score_dir: where score.log goes (created if missing).
+        score_dir: where score.log goes (created if missing); None: no log (a replay's
+            re-scoring).
         emit: each row, after it is in score.log (None: the log only).
         wall_clock: wall time (ns); the run's start is its first reading.
 
@@ -39,7 +40,7 @@ class CourseScoring:
         CourseError: the model has no head link, or score.log cannot be written.
     """
 
-    def __init__(self, sim: AtlasSimulator, score_dir: Path,
+    def __init__(self, sim: AtlasSimulator, score_dir: Path | None,
                  emit: Callable[[ScoreRow], None] | None = None,
                  wall_clock: Callable[[], int] = time.time_ns) -> None:
         self.sim = sim
@@ -51,7 +52,7 @@ class CourseScoring:
         self.wall_clock = wall_clock
         start_ns = wall_clock()
         self.scorer = Scorer(start_ns)
-        self.log = ScoreLog(score_dir, start_ns)
+        self.log = ScoreLog(score_dir, start_ns) if score_dir is not None else None
         self.rows = 0
         self._velocity = np.zeros(6)
 
@@ -67,9 +68,11 @@ class CourseScoring:
         if row is None:
             return
         self.rows += 1
-        self.log.write(row)
+        if self.log is not None:
+            self.log.write(row)
         if self.emit is not None:
             self.emit(row)
 
     def close(self) -> None:
-        self.log.close()
+        if self.log is not None:
+            self.log.close()
