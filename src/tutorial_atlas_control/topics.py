@@ -68,6 +68,9 @@ RESET_CONTROLS_SERVICE = '/atlas/reset_controls'
 ROBOT_DESCRIPTION_PARAM = '/robot_description'
 #: robot_state_publisher's latched topic of the fixed joints' transforms.
 TF_STATIC = '/tf_static'
+#: atlas_msgs/VRCScore, latched: DRCSim's VRCScoringPlugin's score of the VRC course (with
+#: ~vrc_scoring), every 1 s of sim time and at each gate passed or fall.
+VRC_SCORE = '/vrc_score'
 
 class Direction(enum.Enum):
     """Who writes a topic: the simulator node, its users (commands, cheats), or every node."""
@@ -183,6 +186,9 @@ INTERFACE: tuple[Topic, ...] = (
     Topic(SIM_CONFIG, 'std_msgs/String', _OUT, Rate(when='at start and after each reset'),
           recorded=True, delivery=Delivery(latched=True, offline=True)),
     Topic(SIM_INPUTS, 'std_msgs/String', _OUT, Rate(when='each applied cheat'), recorded=True),
+    Topic(VRC_SCORE, 'atlas_msgs/VRCScore', _OUT,
+          Rate(when='with `~vrc_scoring`: every 1 s of sim time and at each gate or fall'),
+          recorded=True, delivery=Delivery(latched=True, offline=True)),
     Topic(CURRENT_CONTROL_MODE, 'std_msgs/String', _OUT, Rate(when='each mode switch'),
           delivery=Delivery(latched=True)),
     Topic(TF_STATIC, 'tf2_msgs/TFMessage', _OUT, Rate(when='once (`~tf_publisher` sim)'),

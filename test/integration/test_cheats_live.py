@@ -37,7 +37,8 @@ BAD_INPUTS = (
     (topics.MODE, 'std_msgs/String', "{data: flying}",
      "refused /atlas/mode: unknown mode 'flying'; valid modes: harnessed, pinned, "
      'pinned_with_gravity, nominal, feet, no_gravity, bdi_stand; nothing applied'),
-    (topics.SET_POSE, 'geometry_msgs/Pose', '{position: {z: 1.0}}',
+    # An all-zero quaternion is upright (Gazebo's reading); a near-zero one is refused.
+    (topics.SET_POSE, 'geometry_msgs/Pose', '{position: {z: 1.0}, orientation: {w: 1.0e-12}}',
      'refused /atlas/set_pose: orientation is a zero quaternion (set w = 1 for upright); '
      'nothing applied'),
     (topics.CMD_VEL, 'geometry_msgs/Twist', '{linear: {x: .nan}}',

@@ -14,6 +14,7 @@ import socket
 import subprocess
 import sys
 from collections.abc import Iterator, Mapping
+from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
 from unittest import mock
@@ -122,8 +123,10 @@ class FakePublisher:
 @contextlib.contextmanager
 def fake_ros_node(sim: AtlasSimulator, steps: int, tcp: bool = False,
                   rates_hz: Mapping[str, float] = LAUNCH_RATES_HZ,
-                  params: Mapping[str, object] | None = None) -> Iterator[Any]:
-    """A real SimNode (real_time_factor 0) around `sim`, on fake rospy.
+                  params: Mapping[str, object] | None = None,
+                  score_dir: Path | None = None) -> Iterator[Any]:
+    """A real SimNode (real_time_factor 0) around `sim`, on fake rospy (with `score_dir`,
+    scoring the VRC course into it).
 
     Each publisher has one subscriber (see Sinks); rospy.is_shutdown() ends spin() after
     `steps` steps. The node's `fake_publishers` maps each topic to its FakePublisher.
@@ -155,7 +158,8 @@ def fake_ros_node(sim: AtlasSimulator, steps: int, tcp: bool = False,
                                  logerr=mock.DEFAULT, logerr_throttle=mock.DEFAULT,
                                  logfatal=mock.DEFAULT), \
                 mock.patch.object(sim_node, 'serve_udpros'):  # no rospy node to register with
-            node = sim_node.SimNode(sim, LoopSettings(dict(rates_hz)), gui=False)
+            node = sim_node.SimNode(sim, LoopSettings(dict(rates_hz), score_dir=score_dir),
+                                    gui=False)
             node.fake_publishers = publishers
             yield node
     finally:

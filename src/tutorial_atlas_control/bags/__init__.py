@@ -1,4 +1,5 @@
-"""Recorded runs: bag records and reading, analysis, comparison, reports, videos, run logs.
+"""Recorded runs: bag records and reading, analysis, comparison, reports, videos, run logs,
+and the VRC course's score (vrc_score: /vrc_score as a timeline of events, the final score).
 
 No ROS: bags are read and written with rosbags. Synthetic bags for the tests are
 test/support/synthetic_bags.py.
@@ -32,4 +33,5 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'tries': ['RESET_SIMULATION', 'RESET_WORLD', 'RUN_START', 'Try', 'find_tries', 'pick_try',
               'window'],
     'typestore': ['JOINT_COMMANDS_TYPE', 'load_typestore', 'rosbags_msgtype'],
+    'vrc_score': ['ScoreEntry', 'read_scores', 'score_lines'],
 })

@@ -38,7 +38,7 @@ TF_MSG_DEFINITION = 'geometry_msgs/TransformStamped[] transforms'
 
 #: The vendored atlas_msgs messages (msg/atlas_msgs), registered from their .msg files.
 ATLAS_MSGS = ('AtlasCommand', 'AtlasState', 'ControllerStatistics', 'ForceTorqueSensors',
-              'SynchronizationStatistics', 'Test',
+              'SynchronizationStatistics', 'Test', 'VRCScore',
               # the AtlasSimInterface's, each after the ones it holds
               'AtlasBehaviorStepData', 'AtlasBehaviorStepParams', 'AtlasBehaviorStandParams',
               'AtlasBehaviorPelvisServoParams', 'AtlasBehaviorManipulateParams',

@@ -38,7 +38,9 @@ from tutorial_atlas_control.bags import (
     plot_run,
     read_bag,
     read_behaviours,
+    read_scores,
     render_bag_video,
+    score_lines,
     summarise_walk,
     walk_lines,
     walk_windows,
@@ -213,12 +215,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         walk = summarise_walk(analysis.data)
         changes = read_behaviours(analysis.data)
         walks = _walks(analysis, changes)
+        scores = read_scores(analysis.data)
         extra = (behaviour_lines(changes) if changes is not None else []) + [
-            line for title, each in walks for line in [title, *walk_lines(each)]]
+            line for title, each in walks for line in [title, *walk_lines(each)]] + (
+            score_lines(scores) if scores is not None else [])
         print(analysis_to_json(analysis, {
             'trajectory': _played_dict(played), 'walk': _walk_dict(walk),
             'walks': [_walk_dict(each) for _, each in walks],
-            'behaviours': None if changes is None else [vars(c) for c in changes]})
+            'behaviours': None if changes is None else [vars(c) for c in changes],
+            'vrc_score': None if scores is None else [vars(s) for s in scores]})
               if args.json else format_summary(analysis, trajectory=_played_text(played))
               + ''.join(f'\n{line}' for line in extra))
         if args.csv:

@@ -41,7 +41,7 @@ MuJoCo's mj_step, and compares the joint positions and velocities with every rec
 joint state and the pelvis pose with /ground_truth_odom. Steps before the recorder
 started are re-created with the simulator's own Stand-mode controller (the gains of
 config/atlas_controller.yaml). With the same model and MuJoCo build the replay is exact
-(all deviations 0).
+(all deviations 0). A scored run's /vrc_score is scored again and compared row for row.
 """
 
 EPILOG = """\
@@ -51,7 +51,9 @@ tries (how many the bag holds), model_sha1_matches (bool or null),
 start_time, end_time (s of sim time), reconstructed_steps, recorded_steps,
 joint_position and joint_velocity {max (rad, rad/s), time (s), joint, samples},
 pelvis_position {max (m), time, samples}, pelvis_orientation {max (rad), time, samples}
-(null without /ground_truth_odom), tolerance, reproduced (bool), warnings [text].
+(null without /ground_truth_odom), tolerance, reproduced (bool), vrc_score
+{recorded_rows, replayed_rows, completion, falls, first_difference (text or null)} (null
+for an unscored run or a replay from a reset), warnings [text].
 
 Exit status: 0 when every deviation is within --tolerance, 3 when the replay deviates,
 1 when the bag cannot be read or replayed (missing topics, no /atlas/sim_config without

@@ -4,13 +4,16 @@ errors: CourseError, what the course refuses; vrc_task_2: the course's figures (
 heightmap's scaling, the gates, the pen, the mud, the blocks, the starts), the one
 description the world, the mud and the scoring read; starts: where a run starts Atlas (a
 world's start by name, or 'x y z yaw'), checked once for the node, the launches and offline
-runs.
+runs; scoring: VRCScoringPlugin's rules, a Scorer fed once per physics step (gates in order,
+the clock, falls, the rows due); score_log: DRCSim's score.log (its header, whole rows).
 """
 
 from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'errors': ['CourseError'],
+    'score_log': ['DEFAULT_SCORE_DIR', 'SCORE_FILE_NAME', 'ScoreLog'],
+    'scoring': ['FALL_ACCEL_THRESHOLD', 'TASK_WALKING', 'ScoreRow', 'Scorer', 'seconds'],
     'starts': ['WORLD_MODEL_FILE', 'parse_start', 'start_text', 'world_start'],
     'vrc_task_2': ['BLOCKS', 'GATES', 'HEIGHTMAP', 'MUD_BOX', 'PEN_WALLS', 'STARTS',
                    'WORLD_NAME', 'Block', 'Box', 'Gate', 'Heightmap', 'Start'],

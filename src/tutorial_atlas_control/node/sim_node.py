@@ -56,7 +56,12 @@ Parameters (private unless noted):
     ~start (str, ''): where the robot starts and every reset puts it: a VRC Task 2 world's
         start by name (vrc_task_2, vrc_task_2_mud_start, ...) or 'x y z yaw' (m, rad); the
         pelvis at (x, y) turned by yaw, its z putting the soles on the model's ground (z is
-        a hint only). '': the model's spawn pose at the origin.
+        a hint only). '': the model file's spawn (atlas_v1.xml's at the origin).
+    ~vrc_scoring (bool, false): score the run as DRCSim's VRCScoringPlugin scored VRC Task 2
+        (the VRC launches set it): /vrc_score (latched, atlas_msgs/VRCScore) and score.log
+        in ~score_dir, every 1 s of sim time and at each gate or fall (stepping/course_scoring.py).
+    ~score_dir (str, /tmp/vrc_task_2): where score.log goes (created if missing; refused in
+        one line if it cannot be written).
     /atlas/time_to_unpin (float, 1.0): seconds the torso stays pinned after start/reset.
     /atlas/startup_mode (str, pinned_with_gravity): VRCPlugin's start (sim/vrc.py STARTUP_MODES).
     atlas_controller/gains/<joint>/{p,i,d,i_clamp}: the gains Stand/Freeze/User-hold use.
@@ -89,6 +94,7 @@ from atlas_msgs.msg import (
     ForceTorqueSensors,
     SynchronizationStatistics,
     Test,
+    VRCScore,
 )
 from atlas_msgs.srv import ResetControls, ResetControlsResponse
 from geometry_msgs.msg import TransformStamped, WrenchStamped
@@ -104,7 +110,13 @@ from tutorial_atlas_control import topics
 from tutorial_atlas_control.asi import load_user_behaviour
 from tutorial_atlas_control.bags import unwritable_reason
 from tutorial_atlas_control.control_modes import ControlMode
-from tutorial_atlas_control.course import CourseError, Start, parse_start
+from tutorial_atlas_control.course import (
+    DEFAULT_SCORE_DIR,
+    CourseError,
+    ScoreRow,
+    Start,
+    parse_start,
+)
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.node.cheats import WARN_THROTTLE_S, subscribe_cheats
@@ -152,7 +164,8 @@ TF_PUBLISHERS = ('sim', 'robot_state_publisher')
 #: The classes of the messages the node publishes, by ROS type (topics.INTERFACE's).
 MESSAGE_CLASSES: dict[str, type[genpy.Message]] = {cls._type: cls for cls in (
     Clock, JointState, Odometry, Imu, WrenchStamped, ControllerStatistics, AtlasState,
-    ForceTorqueSensors, SynchronizationStatistics, TFMessage, String, AtlasSimInterfaceState)}
+    ForceTorqueSensors, SynchronizationStatistics, TFMessage, String, AtlasSimInterfaceState,
+    VRCScore)}
 #: What ~stand chooses Stand to be (the first is the default).
 STAND_CHOICES = ('balance', 'hold')
 #: Queue size of the publishers the node itself calls publish() on (1 when not named).
@@ -286,14 +299,15 @@ class SimNode:
         # UDPROS for roscpp's unreliable() subscribers, before the master announces a topic.
         self.udpros = serve_udpros()
         widen_accept_queue()  # a dozen subscribers connect at once when it advertises
-        self._advertise(tf)
+        self._advertise(tf, settings.score_dir is not None)
         outbox = WireBatch()
         # Before rospy closes the connections: what a stalled-then-live subscriber (the
         # recorder) has not taken yet (transport.ConnectionWriter.drain).
         rospy.on_shutdown(outbox.drain)
         links = settings.links if tf else None
         outputs = LoopOutputs(outbox, self.publishers, RosLog(), self._publish_config,
-                              self._publish_input, self._latch_synchronization)
+                              self._publish_input, self._latch_synchronization,
+                              self._publish_score)
         self.loop = SteppingLoop(sim, outputs, replace(settings, links=links),
                                  self._controller_statistics(),
                                  synchronization=SynchronizationWindow(
@@ -304,7 +318,7 @@ class SimNode:
         self.node_publishers[topics.CURRENT_CONTROL_MODE].publish(String(data=sim.mode.value))
         self._subscribe()
 
-    def _advertise(self, tf: bool) -> None:
+    def _advertise(self, tf: bool, scored: bool) -> None:
         """The publishers of topics.INTERFACE: the loop's (`publishers`), whose messages it
         serializes itself (msgs/wire.py), and the node's own (`node_publishers`).
 
@@ -312,7 +326,7 @@ class SimNode:
         per-message writer-thread handoff. A subscriber that cannot keep up slows the loop
         (TCP back-pressure) instead of losing messages; one that stops reading is not
         waited for, and is dropped once it has accepted nothing for
-        transport.SEND_TIMEOUT_S (node/transport.py).
+        transport.SEND_TIMEOUT_S (node/transport.py). /vrc_score only in a scored run.
         """
         self.publishers: dict[str, rospy.Publisher] = {}
         self.node_publishers: dict[str, rospy.Publisher] = {}
@@ -320,7 +334,8 @@ class SimNode:
             warnings.simplefilter('ignore', SyntaxWarning)  # rospy: "explicit queue_size"
             for topic in topics.INTERFACE:
                 if topic.direction is not topics.Direction.PUBLISHED or (
-                        topic.name == topics.TF and not tf):
+                        topic.name == topics.TF and not tf) or (
+                        topic.name == topics.VRC_SCORE and not scored):
                     continue
                 name, latch = topic.name, topic.delivery.latched
                 if topic.delivery.loop:
@@ -390,6 +405,15 @@ class SimNode:
     def _publish_input(self, text: str) -> None:
         """/atlas/sim_inputs (recorded): one applied cheat."""
         self.node_publishers[topics.SIM_INPUTS].publish(String(data=text))
+
+    def _publish_score(self, row: ScoreRow) -> None:
+        """/vrc_score (latched, recorded): a row of the course's scoring."""
+        self.node_publishers[topics.VRC_SCORE].publish(VRCScore(
+            wall_time=_ros_time(row.wall_elapsed_ns), sim_time=_ros_time(row.sim_time_ns),
+            wall_time_elapsed=_ros_time(row.wall_since_gate0_ns),
+            sim_time_elapsed=_ros_time(row.sim_since_gate0_ns),
+            completion_score=row.completion, falls=row.falls, message=row.message,
+            task_type=row.task_type))
 
     def _publish_config(self, text: str) -> None:
         """/atlas/sim_config (latched, recorded in every bag): what replay needs."""
@@ -470,6 +494,23 @@ class SimNode:
         return status
 
 
+def _ros_time(ns: int) -> genpy.Time:
+    return genpy.Time(*divmod(ns, 1_000_000_000))
+
+
+def _score_dir() -> Path | None:
+    """~vrc_scoring and ~score_dir: where score.log goes, or None for an unscored run."""
+    scoring = rospy.get_param('~vrc_scoring', False)
+    if not isinstance(scoring, bool):
+        raise AtlasControlError(f'parameter {rospy.resolve_name("~vrc_scoring")} must be true '
+                                f'or false, got {scoring!r}')
+    score_dir = rospy.get_param('~score_dir', str(DEFAULT_SCORE_DIR))
+    if not isinstance(score_dir, str) or not score_dir:
+        raise AtlasControlError(f'parameter {rospy.resolve_name("~score_dir")} must be a '
+                                f'directory, got {score_dir!r}')
+    return Path(score_dir).expanduser() if scoring else None
+
+
 def _float_param(name: str, default: float, minimum: float = 0.0) -> float:
     value = rospy.get_param(name, default)
     number = finite_number(value)
@@ -521,7 +562,7 @@ def build_node() -> SimNode:
                             _links_publisher(description) if tf_publisher == 'sim' else None,
                             balance_stand=stand == 'balance',
                             hold_at_start=stand == 'balance',
-                            user_behaviour=user_behaviour)
+                            user_behaviour=user_behaviour, score_dir=_score_dir())
     return SimNode(sim, settings, bool(rospy.get_param('~gui', False)),
                    description is not None, DelayBudgets.from_params(rospy.get_param))
 

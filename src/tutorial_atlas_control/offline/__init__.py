@@ -1,6 +1,7 @@
 """Runs without ROS: the offline trajectory player, an AtlasSimInterface session played again,
-and the replay of a recorded run; world: the model and start they simulate (a VRC world by
-name, or the recorded run's)."""
+and the replay of a recorded run (replay_score: a scored run's /vrc_score computed again on
+the replayed steps); world: the model and start they simulate (a VRC world by name, or the
+recorded run's)."""
 
 from tutorial_atlas_control.exports import lazy_exports
 
@@ -10,4 +11,5 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                'run_offline', 'write_offline_bag'],
     'replay': ['DEFAULT_TOLERANCE', 'ReplayError', 'format_report', 'replay_bag'],
     'world': ['OfflineWorld', 'named_world', 'recorded_world'],
+    'replay_score': ['ScoreComparison', 'ScoreReplay'],
 })

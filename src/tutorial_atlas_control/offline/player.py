@@ -39,6 +39,7 @@ from tutorial_atlas_control.bags import (
     rosbags_msgtype,
 )
 from tutorial_atlas_control.command import CommandError, CommandUpdate
+from tutorial_atlas_control.course import ScoreRow
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES
 from tutorial_atlas_control.msgs import CommandDecoder, JointCommandsWire, StampedWire, clock_bytes
@@ -55,7 +56,13 @@ from tutorial_atlas_control.sim import (
     load_gains_yaml,
     load_model,
 )
-from tutorial_atlas_control.stepping import StepController, Tick, step_stamp, steps_between
+from tutorial_atlas_control.stepping import (
+    CourseScoring,
+    StepController,
+    Tick,
+    step_stamp,
+    steps_between,
+)
 from tutorial_atlas_control.trajectories import (
     Waypoint,
     done_line,
@@ -254,12 +261,15 @@ class OfflinePlayer:
             due (an AtlasSimInterface session's recorded commands).
         interface: the AtlasSimInterface played with the run: its end_step ends each step,
             before on_step.
+        score_dir: score the VRC course in the tick (stepping.CourseScoring): score.log
+            there and /vrc_score in the bag; None: not scored.
     """
 
     def __init__(self, sim: AtlasSimulator, sink: BlockBagWriter,
                  on_step: StepHook | None = None, latency: CommandLatency | None = None,
                  controller: StepController | None = None,
-                 interface: AtlasSimInterface | None = None) -> None:
+                 interface: AtlasSimInterface | None = None,
+                 score_dir: Path | None = None) -> None:
         self.sim = sim
         self.latency = latency
         self.latency_rng = default_rng(latency.seed if latency else 0)
@@ -281,7 +291,10 @@ class OfflinePlayer:
         self._time = types['builtin_interfaces/msg/Time']
         self.controller = controller
         self.interface = interface
-        self.tick = Tick(sim, self, self._publish_step, self._end_step)
+        self._score = types['atlas_msgs/msg/VRCScore']
+        self.scoring = (CourseScoring(sim, score_dir, self._write_score)
+                        if score_dir is not None else None)
+        self.tick = Tick(sim, self, self._publish_step, self._end_step, score=self.scoring)
 
     def publish(self) -> None:
         """Keep what the simulator node sends after a step (or before the first)."""
@@ -317,6 +330,18 @@ class OfflinePlayer:
             self.interface.end_step()
         if self.on_step is not None:
             self.on_step(self.sim)
+
+    def _write_score(self, row: ScoreRow) -> None:
+        """A row of the course's scoring into the bag's /vrc_score, as the node publishes it."""
+        def stamp(ns: int) -> object:
+            secs, nsecs = divmod(ns, NS_PER_S)
+            return self._time(sec=secs, nanosec=nsecs)
+
+        self.sink.write_message(topics.VRC_SCORE, self.sim.sim_time_ns, self._score(
+            wall_time=stamp(row.wall_elapsed_ns), sim_time=stamp(row.sim_time_ns),
+            wall_time_elapsed=stamp(row.wall_since_gate0_ns),
+            sim_time_elapsed=stamp(row.sim_since_gate0_ns), completion_score=row.completion,
+            falls=row.falls, message=row.message, task_type=row.task_type))
 
     def _deliver(self) -> None:
         """Apply the delayed commands due before this step, in order."""

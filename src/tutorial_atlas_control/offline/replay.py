@@ -37,10 +37,20 @@ from typing import Any
 import numpy as np
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.bags import BagData, Try, find_tries, pick_try, read_bag, window
+from tutorial_atlas_control.bags import (
+    BagData,
+    ScoreEntry,
+    Try,
+    find_tries,
+    pick_try,
+    read_bag,
+    read_scores,
+    window,
+)
 from tutorial_atlas_control.course import CourseError
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.offline.replay_score import ScoreComparison, ScoreReplay
 from tutorial_atlas_control.offline.world import recorded_world
 from tutorial_atlas_control.sim import (
     DEFAULT_GAINS_FILE,
@@ -113,6 +123,7 @@ class Recording:
     try_number: int = 1
     tries: int = 1
     try_asked: bool = False  # --try given: the report's 'try N of M' says it, no warning
+    scores: list[ScoreEntry] | None = None  # /vrc_score of a scored run (the whole bag's)
 
 
 def _read_sim_configs(data: BagData) -> list[dict[str, Any]]:
@@ -257,7 +268,8 @@ def load_recording(path: Path | str, data: BagData | None = None,
     inputs = _input_events(path, data, config, warnings)
     return Recording(path, config, resets, state_stamp_ns, position, velocity, effort,
                      odom_stamp_ns, odom_position, odom_quat, len(odom_stamp_ns) > 0, warnings,
-                     inputs, chosen.number, tries, try_asked=try_number is not None)
+                     inputs, chosen.number, tries, try_asked=try_number is not None,
+                     scores=read_scores(data))
 
 
 def _joint_columns(path: Path, names: Sequence[str]) -> list[int]:
@@ -318,13 +330,16 @@ class ReplayResult:
     warnings: list[str]
     try_number: int = 1          # the try replayed (bags.tries), of
     tries: int = 1               # the tries the bag holds
+    score: ScoreComparison | None = None  # a scored run's /vrc_score against the replay's
+
 
     @property
     def reproduced(self) -> bool:
         """Every compared deviation is within the tolerance."""
         compared = [self.joint_position, self.joint_velocity, self.pelvis_position,
                     self.pelvis_orientation]
-        return all(d.max_abs <= self.tolerance for d in compared if d is not None)
+        return (all(d.max_abs <= self.tolerance for d in compared if d is not None)
+                and (self.score is None or self.score.same))
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready dict (keys documented in replay_bag.py --help)."""
@@ -352,6 +367,7 @@ class ReplayResult:
             'pelvis_orientation': deviation(self.pelvis_orientation),
             'tolerance': self.tolerance,
             'reproduced': self.reproduced,
+            'vrc_score': None if self.score is None else self.score.to_dict(),
             'warnings': list(self.warnings),
         }
 
@@ -416,9 +432,13 @@ class _OdomProbe:
         self.rows: list[int] = []
         self.xpos: list[np.ndarray] = []
         self.xquat: list[np.ndarray] = []
+        #: The course's scoring of each replayed step (a scored run's), or None.
+        self.score: ScoreReplay | None = None
 
     def after_step(self, sim: AtlasSimulator, step: int) -> None:
         """Called after replaying step `step` (the state at sim time step * dt)."""
+        if self.score is not None:
+            self.score()
         # After mj_step, xpos/xquat describe the step's start; the simulator stamps its
         # odometry with that time, so the pose belongs to the previous step's number.
         row = self.row_at.get(step - 1)
@@ -576,6 +596,7 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
     rows = _segment(recording, all_steps, reset_step, sim.dt_s, warnings)
     steps, effort = all_steps[rows], recording.effort_nm[rows]
     probe = _OdomProbe(odom_steps, reset_step, int(steps[-1]))
+    probe.score = _score_replay(recording, sim, reset_step, warnings)
     inputs = _InputQueue(recording.inputs)
     prefix = _recreate_prefix(sim, config, reset_step, int(steps[0]), effort[0], probe, warnings,
                               inputs)
@@ -593,7 +614,20 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
                                   JOINT_NAMES),
         pelvis_position=pelvis_position, pelvis_orientation=pelvis_orientation,
         tolerance=tolerance, warnings=warnings, try_number=recording.try_number,
-        tries=recording.tries)
+        tries=recording.tries,
+        score=probe.score.compare(int(steps[-1]) * step_ns) if probe.score else None)
+
+
+def _score_replay(recording: Recording, sim: AtlasSimulator, reset_step: int,
+                  warnings: list[str]) -> ScoreReplay | None:
+    """The replay's scorer, for a scored run replayed from its start (else None)."""
+    if recording.scores is None:
+        return None
+    if reset_step != 0 or recording.tries != 1:
+        warnings.append(f'{topics.VRC_SCORE} is not compared: the score runs over the whole '
+                        'run and a replay from a reset cannot score it again.')
+        return None
+    return ScoreReplay(sim, recording.scores)
 
 
 def replay_bag(path: Path | str, tolerance: float = DEFAULT_TOLERANCE,
@@ -635,6 +669,8 @@ def format_report(result: ReplayResult) -> str:
         _describe('pelvis position', result.pelvis_position, 'm'),
         _describe('pelvis orientation', result.pelvis_orientation, 'rad'),
     ]
+    if result.score is not None:
+        lines.append(result.score.line())
     lines += [f'  warning: {text}' for text in result.warnings]
     verdict = 'REPRODUCED' if result.reproduced else 'DEVIATES'
     lines.append(f'{verdict} (tolerance {result.tolerance:g})')

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import enum
 import json
+import logging
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -94,6 +95,9 @@ MAX_SPEED_M_S = 1e2
 MAX_TURN_RAD_S = 1e2
 #: A quaternion shorter than this cannot be normalized into an orientation.
 MIN_QUATERNION_NORM = 1e-9
+#: The line logged when /atlas/set_pose's quaternion is all zeros (taken as upright).
+ZERO_QUATERNION_NOTE = ('orientation (0, 0, 0, 0), geometry_msgs/Pose()\'s default, '
+                        'taken as upright (identity), as Gazebo did')
 
 
 class InputError(AtlasControlError):
@@ -141,10 +145,12 @@ class ModeInput:
 
 @dataclass(frozen=True)
 class PoseInput:
-    """/atlas/set_pose: the pelvis pose (m; unit quaternion w x y z)."""
+    """/atlas/set_pose: the pelvis pose (m; unit quaternion w x y z). `notes` say what the
+    check took the message as (an all-zero quaternion as upright); not logged in the input."""
 
     position_m: tuple[float, float, float]
     quat_wxyz: tuple[float, float, float, float]
+    notes: tuple[InputNote, ...] = field(default=(), compare=False, repr=False)
     kind = 'set_pose'
 
     def to_dict(self) -> dict[str, Any]:
@@ -220,11 +226,18 @@ SimInput = Union[ModeInput, PoseInput, CmdVelInput, WrenchInput, TrajectoryInput
 def pose_input(position: Sequence[float], orientation_xyzw: Sequence[float]) -> PoseInput:
     """Check a geometry_msgs/Pose's numbers; the quaternion is normalized as VRCPlugin did.
 
+    A quaternion of exactly four zeros, geometry_msgs/Pose()'s default, is upright (the
+    identity), as Gazebo read it: DRCSim's own scoring checks teleport with Pose().
+
     Raises:
-        InputError: non-finite or absurd numbers, or a quaternion of (near) zero length.
+        InputError: non-finite or absurd numbers, or another quaternion of (near) zero
+            length.
     """
     pos = finite_values(position, 'position', MAX_POSITION_M)
     x, y, z, w = finite_values(orientation_xyzw, 'orientation', 1e6)
+    if (x, y, z, w) == (0.0, 0.0, 0.0, 0.0):
+        return PoseInput((pos[0], pos[1], pos[2]), (1.0, 0.0, 0.0, 0.0),
+                         (InputNote(logging.INFO, ZERO_QUATERNION_NOTE),))
     norm = math.sqrt(w * w + x * x + y * y + z * z)
     if norm < MIN_QUATERNION_NORM:
         raise InputError('orientation is a zero quaternion (set w = 1 for upright)')
@@ -253,7 +266,7 @@ INPUT_TOPICS = {'mode': '/atlas/mode', 'set_pose': '/atlas/set_pose', 'cmd_vel':
 
 def input_notes(item: SimInput) -> tuple[InputNote, ...]:
     """The lines to log about an accepted input (only a trajectory's check has any)."""
-    return item.notes if isinstance(item, TrajectoryInput) else ()
+    return item.notes if isinstance(item, (TrajectoryInput, PoseInput)) else ()
 
 
 def describe_input(item: SimInput) -> str:

@@ -18,11 +18,13 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from tutorial_atlas_control.asi import AtlasSimInterface, LibraryBehaviour
 from tutorial_atlas_control.sim import AtlasSimulator, CommandAgeStatistics, LinkTransforms
 from tutorial_atlas_control.stepping.controller import StepController
 from tutorial_atlas_control.stepping.controls import SimControls
+from tutorial_atlas_control.stepping.course_scoring import CourseScoring
 from tutorial_atlas_control.stepping.divergence import DivergenceRecovery
 from tutorial_atlas_control.stepping.inbox import CommandInbox
 from tutorial_atlas_control.stepping.outputs import LoopOutputs
@@ -57,6 +59,8 @@ class LoopSettings:
             for; False: the balancing Stand acts from the start.
         user_behaviour: a behaviour of the user's own for the AtlasSimInterface (with
             balance_stand), registered over the library's; None: the library's own.
+        score_dir: score the VRC course (DRCSim's VRCScoringPlugin) into score.log there,
+            and /vrc_score; None: not scored.
     """
 
     rates_hz: Mapping[str, float] = field(default_factory=dict)
@@ -66,6 +70,7 @@ class LoopSettings:
     balance_stand: bool = False
     hold_at_start: bool = False
     user_behaviour: LibraryBehaviour | None = None
+    score_dir: Path | None = None
 
 
 class SteppingLoop:
@@ -109,9 +114,12 @@ class SteppingLoop:
                                     settings.paused)
         self.divergence = DivergenceRecovery(sim, outputs.log,
                                              self.controls.reset_after_divergence)
+        #: The VRC course's scoring, in lockstep with the physics (None: not scored).
+        self.scoring = (CourseScoring(sim, settings.score_dir, outputs.publish_score)
+                        if settings.score_dir is not None else None)
         #: One step with its inputs before and its state and the interface's handover after.
         self.tick = Tick(sim, self.controller, self._publish_step, self.asi.end_step,
-                         self.divergence.recover)
+                         self.divergence.recover, self.scoring)
         # The node's and tests' entry points, the collaborators' own methods.
         self.receive_command = self.inbox.receive
         self.apply_pending_commands = self.inbox.apply_pending

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from typing import Protocol
 
 from tutorial_atlas_control import topics
+from tutorial_atlas_control.course import ScoreRow
 
 __all__ = ['LoopLog', 'LoopOutputs', 'Outbox']
 
@@ -60,6 +61,8 @@ class LoopOutputs:
         publish_input: sends /atlas/sim_inputs' JSON of each applied cheat (None: nowhere).
         latch_synchronization: keeps the latest /atlas/synchronization_statistics
             (serialized, without its length prefix) for later subscribers (None: not kept).
+        publish_score: sends a row of the course's scoring on the latched /vrc_score (None:
+            score.log only).
     """
 
     outbox: Outbox
@@ -68,3 +71,4 @@ class LoopOutputs:
     publish_config: Callable[[str], None]
     publish_input: Callable[[str], None] | None = None
     latch_synchronization: Callable[[bytes], None] | None = None
+    publish_score: Callable[[ScoreRow], None] | None = None

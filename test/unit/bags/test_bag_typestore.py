@@ -36,6 +36,7 @@ GENMSG_MD5 = {
     'ForceTorqueSensors': '608f43cae98f77f5fb6cfbbbfa4c9253',
     'SynchronizationStatistics': '27bc1701ef8ff889822573f985ebb2b6',
     'Test': '62f63cd4b6db15007d8d3d4a23411c4c',
+    'VRCScore': '15d1f218676ad0e9382ec3bd7afd4995',
 }
 #: What rosbags alone computes for AtlasState (its constants taken for fields).
 ROSBAGS_ATLAS_STATE_MD5 = 'f532b7233898211d080f25d52556e05d'

@@ -75,6 +75,8 @@ ATLAS_MSGS_MD5 = {
     'AtlasBehaviorManipulateParams': 'c4e967ec87266f9e108243e7ac4b9614',
     'AtlasBehaviorPelvisServoParams': '82f59d8aa26e61afaf2c8dbb7b4e7856',
     'AtlasPositionData': '589dbd8c358d253de2ab5441acd36a2b',
+    # VRCScoringPlugin's /vrc_score (../shared/reference/drcsim_2.x/vrc/VRC.md).
+    'VRCScore': '15d1f218676ad0e9382ec3bd7afd4995',
     # DRCSim's actionlib server's action, through actionlib_msgs' genaction (ASI.md gives
     # the first 8 digits of all but the first; the rest are genmsg's of the same text).
     'WalkDemoAction': 'abe30eb264997de30b2841a700221184',

@@ -18,6 +18,7 @@ from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.sim.sim_config import SimConfig
 from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode, PhysicsDivergenceError
 from tutorial_atlas_control.sim.vrc import ModeInput, VrcMode
+from tutorial_atlas_control.stepping.course_scoring import CourseScoring
 
 sim_node = pytest.importorskip('tutorial_atlas_control.node.sim_node',
                                reason='needs the catkin workspace: source ./env.sh')
@@ -317,3 +318,37 @@ def test_tf_publisher_parameter_chooses_who_publishes_the_links(
                        match="^parameter /atlas_sim/tf_publisher must be one of sim, "
                              "robot_state_publisher, got 'rsp'$"):
         sim_node.build_node()
+
+
+def test_vrc_scoring_parameters_choose_the_score_dir(monkeypatch: pytest.MonkeyPatch,
+                                                     tmp_path: Path) -> None:
+    """~vrc_scoring (false by default) scores into ~score_dir (DRCSim's /tmp/vrc_task_2 by
+    default); a non-bool ~vrc_scoring and a score_dir that cannot be made are one line."""
+    params: dict[str, Any] = {
+        'atlas_controller/gains': yaml.safe_load(CONFIG.read_text())['atlas_controller']['gains'],
+        '~tf': False}
+    monkeypatch.setattr(sim_node.rospy, 'get_param',
+                        lambda name, default=None: params.get(name, default))
+    monkeypatch.setattr(sim_node.rospy, 'resolve_name', lambda name: '/atlas_sim/' + name[1:])
+    built: list[tuple[Any, ...]] = []
+    monkeypatch.setattr(sim_node, 'SimNode', lambda *args: built.append(args))
+    sim_node.build_node()
+    assert built[-1][1].score_dir is None
+    params['~vrc_scoring'] = True
+    sim_node.build_node()
+    assert built[-1][1].score_dir == Path('/tmp/vrc_task_2')
+    params['~score_dir'] = str(tmp_path / 'scores')
+    sim_node.build_node()
+    assert built[-1][1].score_dir == tmp_path / 'scores'
+    params['~vrc_scoring'] = 'yes'
+    with pytest.raises(sim_node.AtlasControlError,
+                       match="^parameter /atlas_sim/vrc_scoring must be true or false, "
+                             "got 'yes'$"):
+        sim_node.build_node()
+    blocker = tmp_path / 'file'
+    blocker.write_text('')
+    sim = AtlasSimulator(atlas_model.load_model(), load_gains_yaml(CONFIG))
+    with pytest.raises(sim_node.AtlasControlError, match=r'^score log .*/file/score.log cannot '
+                                                          r'be written: .*/file is not a '
+                                                          r'directory$'):
+        CourseScoring(sim, blocker)  # the loop's, from LoopSettings.score_dir

@@ -554,3 +554,60 @@ def test_startup_mode_comes_from_sim_config(tmp_path: Path) -> None:
     result = replay_bag(run.write(tmp_path / 'pinned_start.bag'))
     assert result.config.startup_mode == 'pinned'
     assert result.joint_position.max_abs == 0.0 and result.pelvis_position.max_abs == 0.0
+
+
+# -- a scored run: the VRC course's score computed again on the replayed steps --------------
+
+#: Before which step the pelvis is put where (x, y; 1 m up): through gate_0, then gate_1.
+GATE_TELEPORTS = {100: (0.7, -38.0), 200: (1.3, -38.0), 300: (0.0, -22.3), 400: (0.0, -21.7)}
+
+
+def _scored_run() -> Run:
+    """A run whose scoring publishes /vrc_score as the node's does (after each step)."""
+    from tutorial_atlas_control.stepping.course_scoring import CourseScoring
+
+    run = Run()
+    stamp = _t('builtin_interfaces/msg/Time')
+
+    def emit(row: Any) -> None:
+        times = [stamp(sec=ns // 10**9, nanosec=ns % 10**9) for ns in (
+            row.wall_elapsed_ns, row.sim_time_ns, row.wall_since_gate0_ns,
+            row.sim_since_gate0_ns)]
+        message = _t('atlas_msgs/msg/VRCScore')(*times, completion_score=row.completion,
+                                                 falls=row.falls, message=row.message,
+                                                 task_type=row.task_type)
+        run.records.append(Record('/vrc_score', 'atlas_msgs/VRCScore', row.sim_time_ns / 1e9,
+                                  message))
+
+    scoring = CourseScoring(run.sim, None, emit, wall_clock=lambda: run.sim.sim_time_ns)
+
+    def before(sim: AtlasSimulator, step: int) -> None:
+        if step:
+            scoring()  # after the step before (nothing happened since)
+        if step in GATE_TELEPORTS:
+            _apply(run, vrc.pose_input((*GATE_TELEPORTS[step], 1.0), (0.0, 0.0, 0.0, 0.0)))
+    run.step(1200, before)
+    return run
+
+
+def test_a_scored_run_scores_the_same_in_replay(tmp_path: Path,
+                                                capsys: pytest.CaptureFixture[str]) -> None:
+    bag = _scored_run().write(tmp_path / 'scored.bag')
+    result = replay(load_recording(bag))
+    assert result.score is not None and result.score.same, result.score
+    assert (result.score.recorded_rows, result.score.completion) == (2, 1)
+    assert result.reproduced
+    assert main([str(bag)]) == 0
+    assert ('  VRC score            2 rows recorded, 2 replayed (completion 1, falls 0): the same'
+            in capsys.readouterr().out)
+
+
+def test_a_score_the_replay_does_not_give_deviates(tmp_path: Path) -> None:
+    run = _scored_run()
+    rows = [record for record in run.records if record.topic == '/vrc_score']
+    rows[1].message.completion_score = 2
+    result = replay(load_recording(run.write(tmp_path / 'changed.bag')))
+    assert result.score is not None and not result.reproduced
+    assert result.score.first_difference == (
+        "row 2: recorded 0.401 s completion 2 falls 0 'Successfully passed through gate 2. ', "
+        "replayed 0.401 s completion 1 falls 0 'Successfully passed through gate 2. '")

@@ -3,6 +3,7 @@ pelvis push, set_pose, cmd_vel, kinematic playback, and refused inputs."""
 
 from __future__ import annotations
 
+import logging
 import math
 from pathlib import Path
 
@@ -267,9 +268,24 @@ def test_a_trajectory_in_a_link_frame_keeps_that_link_in_place(atlas) -> None:
     assert pelvis(sim)[0][2] < pelvis_before[2] - 0.05  # the pelvis crouched over the foot
 
 
+def test_an_all_zero_quaternion_is_upright_with_one_note() -> None:
+    """geometry_msgs/Pose()'s quaternion, as DRCSim's scoring checks sent it: Gazebo took
+    it as the identity; the node logs the note once (INFO)."""
+    item = vrc.pose_input((1.5, -38.0, 1.0), (0.0, 0.0, 0.0, 0.0))
+    assert item.quat_wxyz == (1.0, 0.0, 0.0, 0.0)
+    assert item.position_m == (1.5, -38.0, 1.0)
+    notes = vrc.input_notes(item)
+    assert [note.level for note in notes] == [logging.INFO]
+    assert 'taken as upright' in notes[0].text
+    assert vrc.input_notes(vrc.pose_input((0, 0, 1), (0, 0, 0, 1))) == ()
+    assert item.to_dict()['quat_wxyz'] == [1.0, 0.0, 0.0, 0.0]  # replayed as applied
+
+
 def test_bad_poses_twists_and_wrenches_are_refused() -> None:
     with pytest.raises(InputError, match='zero quaternion'):
-        vrc.pose_input((0, 0, 1), (0, 0, 0, 0))
+        vrc.pose_input((0, 0, 1), (0, 0, 1e-12, 0))
+    with pytest.raises(InputError, match=r'orientation is not finite \(nan\)'):
+        vrc.pose_input((0, 0, 1), (0, 0, 0, math.nan))
     with pytest.raises(InputError, match=r'position is not finite \(nan\)'):
         vrc.pose_input((math.nan, 0, 1), (0, 0, 0, 1))
     with pytest.raises(InputError, match=r'angular velocity is not finite \(inf\)'):
