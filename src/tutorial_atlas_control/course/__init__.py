@@ -1,14 +1,18 @@
 """DRCSim's VRC Task 2 course without ROS: its description, its world, its mud, its scoring.
 
-errors: CourseError, what the course refuses; vrc_task_2: the course's figures (the
-heightmap's scaling, the gates, the pen, the mud, the starts), the one description the
-world, the mud and the scoring read.
+errors: CourseError, what the course refuses; mud: DRCSim's MudPlugin as a law (the drag a
+touching link feels, explicit and as ODE solved it, moved to the centre of mass);
+vrc_task_2: the course's figures (the heightmap's scaling, the gates, the pen, the mud, the
+starts), the one description the world, the mud and the scoring read.
 """
 
 from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'errors': ['CourseError'],
-    'vrc_task_2': ['GATES', 'HEIGHTMAP', 'MUD_BOX', 'STARTS', 'WORLD_NAME', 'Box', 'Gate',
+    'mud': ['MAX_MUD_DAMPING', 'check_mud_damping', 'drag_at_point', 'drag_wrench',
+            'implicit_drag', 'wrench_at_com'],
+    'vrc_task_2': ['GATES', 'HEIGHTMAP', 'MUD_BOX', 'MUD_DAMPING', 'MUD_DAMPING_FINALS',
+                   'MUD_LINKS', 'STARTS', 'WORLD_NAME', 'Box', 'Gate',
                    'Heightmap', 'Start'],
 })

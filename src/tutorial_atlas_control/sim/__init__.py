@@ -23,6 +23,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'law_kernel': ['CompiledLaw', 'LawJoints'],
     'link_transforms': ['LinkTransforms', 'RspSchedule'],
     'mode_commands': ['ControlMode', 'ModeCommands', 'ModeError', 'VALID_MODES', 'parse_mode'],
+    'mud': ['MUD_GEOM', 'MudDrag'],
     'model': ['AtlasModel', 'MODEL_PATH', 'SOLE_GEOMS', 'SPAWN_HEIGHT_M',
               'body_position_in_pose', 'load_model', 'pelvis_height_m', 'reset_to_initial'],
     'sim_config': ['SimConfig', 'SimConfigError', 'parse_sim_config'],

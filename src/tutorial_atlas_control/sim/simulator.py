@@ -5,7 +5,7 @@ everything that decides what torque a joint gets lives in this subpackage, so it
 unit-tested without a master and shared with offline replay. AtlasSimulator puts together
 its collaborators, each a concern of its own: the mode and its commands (mode_commands),
 the law applied to the joints (joint_law), the start-up pin (startup_pin), VRCPlugin's
-cheats (vrc) and the divergence check (divergence).
+cheats (vrc), the mud's drag in a world with mud (mud) and the divergence check (divergence).
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control.command import CommandUpdate, JointCommandArrays
+from tutorial_atlas_control.course import MUD_DAMPING
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.behaviour import Behaviour, ModeBehaviours
@@ -38,6 +39,7 @@ from tutorial_atlas_control.sim.mode_commands import (
     ModeError,
     parse_mode,
 )
+from tutorial_atlas_control.sim.mud import MudDrag
 from tutorial_atlas_control.sim.sim_config import SimConfig
 from tutorial_atlas_control.sim.startup_pin import StartupEvent, StartupPin
 from tutorial_atlas_control.sim.vrc import (
@@ -75,10 +77,17 @@ class AtlasSimulator:
     def __init__(self, atlas: atlas_model.AtlasModel, gains: Gains,
                  time_to_unpin_s: float = DEFAULT_TIME_TO_UNPIN_S,
                  compiled_law: bool = True,
-                 startup_mode: VrcMode = DEFAULT_STARTUP_MODE) -> None:
+                 startup_mode: VrcMode = DEFAULT_STARTUP_MODE,
+                 mud_damping: float = MUD_DAMPING) -> None:
         """`compiled_law`: run the law through law_kernel's C kernel when it is built
         (the same torques bit for bit, faster); False: always controller.compute_torque.
-        `startup_mode`: one of vrc.STARTUP_MODES, what reset_world starts the robot in."""
+        `startup_mode`: one of vrc.STARTUP_MODES, what reset_world starts the robot in.
+        `mud_damping`: the MudPlugin's damping (N s/m, N m s/rad) in a model with a
+        `mud_atlas` box (sim.mud); unused without one.
+
+        Raises:
+            CourseError: `mud_damping` is not a finite number >= 0.
+        """
         # A model of its own: the cheats move the pin weld's target (model.eq_data), which
         # must not move the pin of another simulator sharing the compiled model.
         atlas = dataclasses.replace(atlas, model=copy.deepcopy(atlas.model))
@@ -99,6 +108,8 @@ class AtlasSimulator:
         self.sim_time_ns = 0
         # VRCPlugin's cheats (modes, teleport, cmd_vel, pelvis wrench, kinematic playback).
         self.vrc = VrcState(atlas, self.data)
+        #: The mud's drag, None in a world without mud (nothing runs then).
+        self.mud = MudDrag.for_model(self.model, mud_damping)
         self.startup_pin = StartupPin(atlas, self.data, self.vrc, time_to_unpin_s, startup_mode)
         #: How many inputs were applied since the last reset, and the last one (sim time (ns)
         #: before the step it first acted in, input): /atlas/sim_inputs publishes each for
@@ -151,7 +162,8 @@ class AtlasSimulator:
         return SimConfig(model_file=self.atlas_path.name, model_sha1=self.atlas_sha1,
                          timestep_s=self.dt_s, time_to_unpin_s=self.time_to_unpin_s,
                          last_reset_time_s=self.last_reset_ns / NS_PER_S,
-                         startup_mode=self.startup_mode.value)
+                         startup_mode=self.startup_mode.value,
+                         mud_damping=None if self.mud is None else self.mud.damping)
 
     def reset_simulation(self, sim_time_ns: int = 0) -> None:
         """reset_world, and sim time back to `sim_time_ns`.
@@ -292,7 +304,10 @@ class AtlasSimulator:
                 self.law.apply_behaviour(behaviour.torque(self.data), commands.blend_command)
         else:
             self.law.set_torque(torque_nm)
-        mujoco.mj_step(self.model, self.data)
+        if self.mud is None:
+            mujoco.mj_step(self.model, self.data)
+        else:
+            viewer_xfrc = self._mud_step(viewer_xfrc)
         # mj_step integrates last: joint positions/velocities are at the new time, while body
         # poses and sensor readings were computed before integrating, at the step's start.
         if viewer_xfrc is not None:
@@ -300,6 +315,20 @@ class AtlasSimulator:
         self.state_time_ns = self.sim_time_ns
         self.sim_time_ns += self.step_ns
         self._check_divergence(self.sim_time_ns)
+
+    def _mud_step(self, saved_xfrc: np.ndarray | None) -> np.ndarray | None:
+        """mj_step in its two halves, the mud's drag added to xfrc_applied between them
+        (after the viewer's and the cheats' forces, in that order every step); the
+        xfrc_applied to restore after the step, as `step`'s `viewer_xfrc`."""
+        mud = self.mud
+        assert mud is not None
+        mujoco.mj_step1(self.model, self.data)
+        if mud.update(self.data, self.dt_s):
+            if saved_xfrc is None:
+                saved_xfrc = self.data.xfrc_applied.copy()
+            self.data.xfrc_applied += mud.xfrc
+        mujoco.mj_step2(self.model, self.data)
+        return saved_xfrc
 
     def _playback_step(self) -> None:
         """step() during kinematic playback: physics off, no torque, time advances."""
