@@ -100,6 +100,7 @@ from tutorial_atlas_control import topics
 from tutorial_atlas_control.asi import load_user_behaviour
 from tutorial_atlas_control.bags import unwritable_reason
 from tutorial_atlas_control.control_modes import ControlMode
+from tutorial_atlas_control.course import MUD_DAMPING, check_mud_damping
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.node.cheats import WARN_THROTTLE_S, subscribe_cheats
@@ -499,8 +500,11 @@ def build_node() -> SimNode:
     if stand not in STAND_CHOICES:
         raise AtlasControlError(f'parameter {rospy.resolve_name("~stand")} must be one of '
                                 f'{", ".join(STAND_CHOICES)}, got {stand!r}')
+    # The MudPlugin's damping (N s/m), used in a world with a `mud_atlas` box (sim.mud).
+    mud_damping = check_mud_damping(rospy.get_param('~mud_damping', MUD_DAMPING),
+                                    f'parameter {rospy.resolve_name("~mud_damping")}')
     sim = AtlasSimulator(load_model(Path(model_file)), gains, time_to_unpin_s,
-                         startup_mode=VrcMode(startup_mode))
+                         startup_mode=VrcMode(startup_mode), mud_damping=mud_damping)
     behaviour_spec = rospy.get_param('~behaviour', '')
     if not isinstance(behaviour_spec, str):
         raise AtlasControlError(f'parameter {rospy.resolve_name("~behaviour")} must be '

@@ -8,6 +8,7 @@ robot description, state_publisher_node.py, is imported by its module.
 from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    'body_forces': ['step_with_body_forces'],
     'camera': ['CAMERA', 'configure_viewer_camera', 'configure_viewer_scene'],
     'controller': ['DEFAULT_GAINS_FILE', 'Gains', 'GainsError', 'LOAD_HINT', 'gains_from_params',
                    'load_gains_yaml'],

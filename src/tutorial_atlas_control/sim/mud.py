@@ -7,7 +7,7 @@ which of course.MUD_LINKS touch the box (a collision geom of the link penetratin
 mj_geomDistance; a cheap test of each geom's bounding sphere against the box first), the
 mean of their contact points (each the middle of the penetration segment MuJoCo reports),
 and the drag of course.mud.implicit_drag for all touching links together, as one ODE step
-solved the plugin's joints, moved to each link's centre of mass. The simulator adds `xfrc`
+solved the plugin's joints, moved to each link's centre of mass. sim.body_forces adds `xfrc`
 to xfrc_applied for that step only; a link that stops touching feels nothing the next step.
 
 Measured (Atlas, one process, see docs/vrc.md#mud): mj_geomDistance on the six geoms costs
@@ -131,3 +131,4 @@ class MudDrag:
         self.xfrc[:] = 0.0
         self.xfrc[bodies] = wrench_at_com(at_points, self.points_m, data.xipos[bodies])
         return True
+

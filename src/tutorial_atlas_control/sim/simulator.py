@@ -23,6 +23,7 @@ from tutorial_atlas_control.course import MUD_DAMPING
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.behaviour import Behaviour, ModeBehaviours
+from tutorial_atlas_control.sim.body_forces import step_with_body_forces
 from tutorial_atlas_control.sim.controller import Gains, hold_command
 from tutorial_atlas_control.sim.divergence import (
     DIVERGENCE_WARNINGS,
@@ -82,12 +83,7 @@ class AtlasSimulator:
         """`compiled_law`: run the law through law_kernel's C kernel when it is built
         (the same torques bit for bit, faster); False: always controller.compute_torque.
         `startup_mode`: one of vrc.STARTUP_MODES, what reset_world starts the robot in.
-        `mud_damping`: the MudPlugin's damping (N s/m, N m s/rad) in a model with a
-        `mud_atlas` box (sim.mud); unused without one.
-
-        Raises:
-            CourseError: `mud_damping` is not a finite number >= 0.
-        """
+        `mud_damping`: the MudPlugin's damping (N s/m) in a world with mud (sim.mud)."""
         # A model of its own: the cheats move the pin weld's target (model.eq_data), which
         # must not move the pin of another simulator sharing the compiled model.
         atlas = dataclasses.replace(atlas, model=copy.deepcopy(atlas.model))
@@ -108,8 +104,7 @@ class AtlasSimulator:
         self.sim_time_ns = 0
         # VRCPlugin's cheats (modes, teleport, cmd_vel, pelvis wrench, kinematic playback).
         self.vrc = VrcState(atlas, self.data)
-        #: The mud's drag, None in a world without mud (nothing runs then).
-        self.mud = MudDrag.for_model(self.model, mud_damping)
+        self.mud = MudDrag.for_model(self.model, mud_damping)  # None: no mud in the world
         self.startup_pin = StartupPin(atlas, self.data, self.vrc, time_to_unpin_s, startup_mode)
         #: How many inputs were applied since the last reset, and the last one (sim time (ns)
         #: before the step it first acted in, input): /atlas/sim_inputs publishes each for
@@ -287,14 +282,11 @@ class AtlasSimulator:
                 and pin.release() is StartupEvent.STAND:
             self.set_mode(ControlMode.STAND)  # bdi_stand's end: every k_effort 0
         vrc = self.vrc
-        viewer_xfrc = None
         if vrc.active:
             if vrc.playback is not None:
                 self._playback_step()
                 return
             vrc.warp_step(self.dt_s)
-            viewer_xfrc = self.data.xfrc_applied.copy()  # the viewer's mouse forces, if any
-            self.data.xfrc_applied += vrc.xfrc
         if torque_nm is None:
             commands = self.commands
             behaviour = self.behaviours.acting
@@ -304,31 +296,13 @@ class AtlasSimulator:
                 self.law.apply_behaviour(behaviour.torque(self.data), commands.blend_command)
         else:
             self.law.set_torque(torque_nm)
-        if self.mud is None:
-            mujoco.mj_step(self.model, self.data)
-        else:
-            viewer_xfrc = self._mud_step(viewer_xfrc)
+        step_with_body_forces(self.model, self.data, vrc.xfrc if vrc.active else None,
+                              self.mud)
         # mj_step integrates last: joint positions/velocities are at the new time, while body
         # poses and sensor readings were computed before integrating, at the step's start.
-        if viewer_xfrc is not None:
-            self.data.xfrc_applied[:] = viewer_xfrc
         self.state_time_ns = self.sim_time_ns
         self.sim_time_ns += self.step_ns
         self._check_divergence(self.sim_time_ns)
-
-    def _mud_step(self, saved_xfrc: np.ndarray | None) -> np.ndarray | None:
-        """mj_step in its two halves, the mud's drag added to xfrc_applied between them
-        (after the viewer's and the cheats' forces, in that order every step); the
-        xfrc_applied to restore after the step, as `step`'s `viewer_xfrc`."""
-        mud = self.mud
-        assert mud is not None
-        mujoco.mj_step1(self.model, self.data)
-        if mud.update(self.data, self.dt_s):
-            if saved_xfrc is None:
-                saved_xfrc = self.data.xfrc_applied.copy()
-            self.data.xfrc_applied += mud.xfrc
-        mujoco.mj_step2(self.model, self.data)
-        return saved_xfrc
 
     def _playback_step(self) -> None:
         """step() during kinematic playback: physics off, no torque, time advances."""
