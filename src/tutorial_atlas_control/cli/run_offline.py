@@ -12,6 +12,7 @@ import numpy as np
 
 from tutorial_atlas_control.bags import analyze_bag, short_summary, summarise_walk, walk_lines
 from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED, EXIT_REFUSED, print_error
+from tutorial_atlas_control.course import MUD_DAMPING, CourseError, check_mud_damping
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.offline import (
     DEFAULT_SETTLE_S,
@@ -33,6 +34,14 @@ def _seconds(text: str) -> float:
     if not (np.isfinite(value) and value >= 0.0):
         raise argparse.ArgumentTypeError(f'{text!r} must be a finite number of seconds >= 0')
     return value
+
+
+def _mud_damping(text: str) -> float:
+    try:
+        return check_mud_damping(float(text), '--mud-damping')
+    except (ValueError, CourseError) as err:  # CourseError is a ValueError: one line
+        raise argparse.ArgumentTypeError(str(err) if isinstance(err, CourseError) else
+                                         f'{text!r} is not a number (N s/m)') from None
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -72,6 +81,9 @@ def build_parser() -> argparse.ArgumentParser:
                         'command (default: %(default)g; the torso is pinned for 1 s)')
     parser.add_argument('--gains', type=Path, default=DEFAULT_GAINS_FILE, metavar='FILE',
                         help='controller gains YAML (default: config/atlas_controller.yaml)')
+    parser.add_argument('--mud-damping', type=_mud_damping, default=MUD_DAMPING, metavar='C',
+                        help="the mud's damping, N s/m, in a world with mud, as the node's "
+                             '~mud_damping (default: %(default)g; the VRC finals: 70)')
     return parser
 
 
@@ -96,7 +108,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             else:
                 trajectory_file = locate_trajectory_file(args.trajectory_file, announce=print)
                 run = run_offline(trajectory_file, args.name, bag, args.settle,
-                                  args.start_after, args.gains, play_after_s=args.play_after)
+                                  args.start_after, args.gains, play_after_s=args.play_after,
+                                  mud_damping=args.mud_damping)
                 what = f'{args.name}: {run.commands} commands'
             analysis = analyze_bag(run.bag)
             walk = summarise_walk(analysis.data) if args.asi_from is not None else None

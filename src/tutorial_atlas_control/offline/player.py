@@ -39,6 +39,7 @@ from tutorial_atlas_control.bags import (
     rosbags_msgtype,
 )
 from tutorial_atlas_control.command import CommandError, CommandUpdate
+from tutorial_atlas_control.course import MUD_DAMPING, check_mud_damping
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES
 from tutorial_atlas_control.msgs import CommandDecoder, JointCommandsWire, StampedWire, clock_bytes
@@ -402,14 +403,16 @@ def write_offline_bag(bag: Path, trajectory_file: str, name: str, waypoints: Seq
                       model_path: Path = MODEL_PATH,
                       play_after_s: float = 0.0,
                       on_step: StepHook | None = None,
-                      latency: CommandLatency | None = None) -> OfflineRun:
+                      latency: CommandLatency | None = None,
+                      mud_damping: float = MUD_DAMPING) -> OfflineRun:
     """Simulate the run and write it to `bag` (a new file; see run_offline for the checks).
 
     `on_step`, if given, is called with the simulator after every step (and its messages):
     the sweep measures a run there, and applies its pushes, without reading the bag back.
     `latency`, if given, delays each command as a live run's delivery does (CommandLatency).
+    `mud_damping` (N s/m): the MudPlugin's in a world with mud (sim.mud), as ~mud_damping.
     """
-    sim = AtlasSimulator(load_model(model_path), gains)
+    sim = AtlasSimulator(load_model(model_path), gains, mud_damping=mud_damping)
     sink = open_offline_bag(bag)
     # The run's time, without loading the model and the message types (fixed costs).
     started_s = time.perf_counter()
@@ -438,7 +441,8 @@ def run_offline(trajectory_file: str, name: str, bag: Path | str,
                 start_after_s: float = DEFAULT_START_AFTER_S,
                 gains_file: Path = DEFAULT_GAINS_FILE,
                 model_path: Path = MODEL_PATH,
-                play_after_s: float = 0.0) -> OfflineRun:
+                play_after_s: float = 0.0,
+                mud_damping: float = MUD_DAMPING) -> OfflineRun:
     """Run trajectory `name` of `trajectory_file` offline into the bag `bag`.
 
     User mode starts `start_after_s` after spawn and the trajectory `play_after_s` later (a
@@ -449,15 +453,17 @@ def run_offline(trajectory_file: str, name: str, bag: Path | str,
     (replacing an existing file): a failed run leaves nothing.
 
     Raises:
-        TrajectoryError, GainsError, ModelError: bad inputs (checked before simulating).
+        TrajectoryError, GainsError, ModelError, CourseError: bad inputs (checked before
+            simulating).
         OfflineRunError: `bag`'s directory does not exist, or the physics diverged.
     """
+    check_mud_damping(mud_damping)
     path = locate_trajectory_file(trajectory_file)
     waypoints = load_trajectory(path, name)
     gains = load_gains_yaml(gains_file)
     return write_whole(Path(bag), lambda partial: write_offline_bag(
         partial, os.path.abspath(path), name, waypoints, gains, settle_s, start_after_s,
-        model_path, play_after_s))
+        model_path, play_after_s, mud_damping=mud_damping))
 
 
 def write_whole(target: Path, write: Callable[[Path], OfflineRun]) -> OfflineRun:
