@@ -59,7 +59,11 @@ class MudDrag:
         #: points (world, m), for tests and tools.
         self.touching = np.zeros(0, dtype=int)
         self.points_m = np.zeros((0, 3))
-        self._fromto = np.zeros(6)
+        self._fromtos = np.zeros((len(self.geoms), 6))
+        self._hits = np.zeros(len(self.geoms), dtype=bool)
+        #: (links, geoms): 1 where the geom is the link's.
+        self._membership = (self.geom_link[None, :]
+                            == np.arange(len(self.bodies))[:, None]).astype(float)
         self._dragging = False
         self._jac = np.zeros((6 * len(self.bodies), model.nv))
         self._mobility = np.zeros_like(self._jac)
@@ -87,22 +91,20 @@ class MudDrag:
         rotation = data.geom_xmat[self.mud_geom].reshape(3, 3)
         local = (data.geom_xpos[self.geoms] - centre) @ rotation
         near = np.flatnonzero((np.abs(local) <= self.geom_reach_m).all(axis=1))
-        if not len(near):
+        hits = self._hits
+        hits[:] = False
+        fromtos, model, mud = self._fromtos, self.model, self.mud_geom
+        for index in near.tolist():
+            hits[index] = mujoco.mj_geomDistance(model, data, int(self.geoms[index]), mud,
+                                                 0.0, fromtos[index]) < 0.0
+        if not hits.any():
             self.touching = self.touching[:0]
             return
-        sums: dict[int, list[float]] = {}
-        fromto = self._fromto
-        model, mud = self.model, self.mud_geom
-        for index in near.tolist():
-            if mujoco.mj_geomDistance(model, data, int(self.geoms[index]), mud, 0.0,
-                                      fromto) < 0.0:
-                entry = sums.setdefault(int(self.geom_link[index]), [0.0, 0.0, 0.0, 0.0])
-                for axis in range(3):
-                    entry[axis] += 0.5 * (fromto[axis] + fromto[axis + 3])
-                entry[3] += 1.0
-        self.touching = np.array(sorted(sums), dtype=int)
-        self.points_m = np.array([[s / sums[link][3] for s in sums[link][0:3]]
-                                  for link in self.touching]).reshape(-1, 3)
+        # Each link's mean of its penetrating geoms' points (the middles of their segments).
+        counts = self._membership @ hits
+        sums = self._membership @ (0.5 * (fromtos[:, 0:3] + fromtos[:, 3:6]) * hits[:, None])
+        self.touching = np.flatnonzero(counts)
+        self.points_m = sums[self.touching] / counts[self.touching, None]
 
     def update(self, data: mujoco.MjData, dt_s: float) -> bool:
         """Compute `xfrc` (N, N·m at each body's centre of mass, world frame) for the step
