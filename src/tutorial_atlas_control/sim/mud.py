@@ -3,20 +3,25 @@
 The world's mud is a box geom named `mud_atlas` that collides with nothing (contype and
 conaffinity 0): it detects, it never pushes. Each step, between mj_step1 (the new positions'
 kinematics and mass matrix) and mj_step2 (forces and integration), `MudDrag.update` finds
-which of course.MUD_LINKS touch the box (a collision geom of the link penetrating it, by
-mj_geomDistance; a cheap test of each geom's bounding sphere against the box first), the
-mean of their contact points (each the middle of the penetration segment MuJoCo reports),
-and the drag of course.mud.implicit_drag for all touching links together, as one ODE step
-solved the plugin's joints, moved to each link's centre of mass. sim.body_forces adds `xfrc`
-to xfrc_applied for that step only; a link that stops touching feels nothing the next step.
+which of course.MUD_LINKS touch the box and where, and the drag of course.mud.implicit_drag
+for all touching links together (as one ODE step solved the plugin's joints), moved to each
+link's centre of mass. sim.body_forces adds `xfrc` to xfrc_applied for that step only; a
+link that stops touching feels nothing the next step.
 
-Measured (Atlas, one process, see docs/vrc.md#mud): mj_geomDistance on the six geoms costs
-about 3 us each, a private model's kinematics and mj_collision for the same question about
-2 times as much, so the geoms are asked directly, and only those whose bounding sphere
-reaches the box.
+Where a link touches is MuJoCo's own contact list, as Gazebo's plugin read its contact
+sensor's: mj_collision on a private copy of the world compiled from the same file, in which
+only the mud links' collision geoms and the box collide (a runtime change of contype would
+not do: a geom that collides with nothing is left out of its body's collision tree at
+compile time), fed the step's poses copied from the simulation's data. The mean of a
+link's contact points is its joint's anchor. A test of each geom's bounding sphere against
+the box skips it all while no link is near the mud. Measured beside a bare mj_step (docs/
+vrc.md#mud): the private kinematics and mj_collision cost 0.16-0.25 of it, asking
+mj_geomDistance geom by geom 0.46-0.60 (its Python loop), so the contact list it is.
 """
 
 from __future__ import annotations
+
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -39,42 +44,38 @@ MUD_GEOM = 'mud_atlas'
 class MudDrag:
     """The mud of one model, and the drag it puts on one MjData each step."""
 
-    def __init__(self, model: mujoco.MjModel, mud_geom: int, damping: float) -> None:
+    def __init__(self, model: mujoco.MjModel, mud_geom: int, damping: float,
+                 contact_model: mujoco.MjModel) -> None:
         self.model = model
         self.mud_geom = mud_geom
         self.damping = check_mud_damping(damping)
         self.half_size_m = model.geom_size[mud_geom].copy()
-        bodies = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name)
-                  for name in MUD_LINKS]
-        #: The links the mud drags, and each one's collision geoms (what can touch the mud).
-        self.bodies = np.array([body for body in bodies if body >= 0], dtype=int)
-        geoms = [(link, geom) for link, body in enumerate(self.bodies)
-                 for geom in range(model.ngeom) if model.geom_bodyid[geom] == body
-                 and (model.geom_contype[geom] or model.geom_conaffinity[geom])]
-        self.geom_link = np.array([link for link, _ in geoms], dtype=int)
-        self.geoms = np.array([geom for _, geom in geoms], dtype=int)
+        self.bodies, self.geoms, self.geom_link = _mud_link_geoms(model)
         self.geom_reach_m = model.geom_rbound[self.geoms][:, None] + self.half_size_m[None, :]
+        self.contact_model = contact_model
+        self.contact_data = mujoco.MjData(contact_model)
+        #: A geom's link (index into `bodies`), -1 for the others (the box).
+        self._link_of_geom = np.full(model.ngeom, -1, dtype=int)
+        self._link_of_geom[self.geoms] = self.geom_link
         self.xfrc = np.zeros((model.nbody, 6))
         #: The last update's touching links (indices into `bodies`) and their mean contact
         #: points (world, m), for tests and tools.
         self.touching = np.zeros(0, dtype=int)
         self.points_m = np.zeros((0, 3))
-        self._fromtos = np.zeros((len(self.geoms), 6))
-        self._hits = np.zeros(len(self.geoms), dtype=bool)
-        #: (links, geoms): 1 where the geom is the link's.
-        self._membership = (self.geom_link[None, :]
-                            == np.arange(len(self.bodies))[:, None]).astype(float)
         self._dragging = False
         self._jac = np.zeros((6 * len(self.bodies), model.nv))
         self._mobility = np.zeros_like(self._jac)
 
     @classmethod
-    def for_model(cls, model: mujoco.MjModel, damping: float = MUD_DAMPING) -> MudDrag | None:
-        """The mud of `model`, or None when it has no `mud_atlas` box (nothing runs then).
+    def for_model(cls, model: mujoco.MjModel, path: Path,
+                  damping: float = MUD_DAMPING) -> MudDrag | None:
+        """The mud of `model`, compiled from the MJCF at `path`, or None when it has no
+        `mud_atlas` box (nothing runs then).
 
         Raises:
             CourseError: `damping` is not a finite number >= 0.
-            ModelError: the model's `mud_atlas` geom is not a box.
+            ModelError: the model's `mud_atlas` geom is not a box, or `path` does not
+                compile to the same geoms.
         """
         geom = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, MUD_GEOM)
         if geom < 0:
@@ -83,26 +84,33 @@ class MudDrag:
         if model.geom_type[geom] != mujoco.mjtGeom.mjGEOM_BOX:
             raise ModelError(f'geom {MUD_GEOM!r} must be a box (the mud volume), it is a '
                              f'{mujoco.mjtGeom(model.geom_type[geom]).name}')
-        return cls(model, geom, damping)
+        return cls(model, geom, damping, _contact_model(model, path, geom))
 
-    def _contact_points(self, data: mujoco.MjData) -> None:
-        """`touching` and `points_m` for the current kinematics."""
+    def _near(self, data: mujoco.MjData) -> bool:
+        """Whether a mud link's geom's bounding sphere reaches into the box."""
         centre = data.geom_xpos[self.mud_geom]
         rotation = data.geom_xmat[self.mud_geom].reshape(3, 3)
         local = (data.geom_xpos[self.geoms] - centre) @ rotation
-        near = np.flatnonzero((np.abs(local) <= self.geom_reach_m).all(axis=1))
-        hits = self._hits
-        hits[:] = False
-        fromtos, model, mud = self._fromtos, self.model, self.mud_geom
-        for index in near.tolist():
-            hits[index] = mujoco.mj_geomDistance(model, data, int(self.geoms[index]), mud,
-                                                 0.0, fromtos[index]) < 0.0
-        if not hits.any():
+        return bool((np.abs(local) <= self.geom_reach_m).all(axis=1).any())
+
+    def _contact_points(self, data: mujoco.MjData) -> None:
+        """`touching` and `points_m` for the current kinematics."""
+        if not self._near(data):
             self.touching = self.touching[:0]
             return
-        # Each link's mean of its penetrating geoms' points (the middles of their segments).
-        counts = self._membership @ hits
-        sums = self._membership @ (0.5 * (fromtos[:, 0:3] + fromtos[:, 3:6]) * hits[:, None])
+        contact_model, contact_data = self.contact_model, self.contact_data
+        for name in _POSE_FIELDS:
+            np.copyto(getattr(contact_data, name), getattr(data, name))
+        mujoco.mj_collision(contact_model, contact_data)
+        count = contact_data.ncon
+        if not count:
+            self.touching = self.touching[:0]
+            return
+        pairs = contact_data.contact.geom[:count]
+        links = np.maximum(self._link_of_geom[pairs[:, 0]], self._link_of_geom[pairs[:, 1]])
+        counts = np.bincount(links, minlength=len(self.bodies)).astype(float)
+        sums = np.stack([np.bincount(links, contact_data.contact.pos[:count, axis],
+                                     minlength=len(self.bodies)) for axis in range(3)], 1)
         self.touching = np.flatnonzero(counts)
         self.points_m = sums[self.touching] / counts[self.touching, None]
 
@@ -134,3 +142,41 @@ class MudDrag:
         self.xfrc[bodies] = wrench_at_com(at_points, self.points_m, data.xipos[bodies])
         return True
 
+
+
+#: What mj_collision reads of a step's poses (from mj_kinematics), copied to the private data.
+_POSE_FIELDS = ('xpos', 'xmat', 'xipos', 'ximat', 'geom_xpos', 'geom_xmat')
+
+
+def _mud_link_geoms(model: mujoco.MjModel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The mud links present (body ids), their collision geoms, and each geom's link (an
+    index into the first)."""
+    found = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name) for name in MUD_LINKS]
+    bodies = np.array([body for body in found if body >= 0], dtype=int)
+    pairs = [(link, geom) for link, body in enumerate(bodies.tolist())
+             for geom in range(model.ngeom) if model.geom_bodyid[geom] == body
+             and (model.geom_contype[geom] or model.geom_conaffinity[geom])]
+    return (bodies, np.array([geom for _, geom in pairs], dtype=int),
+            np.array([link for link, _ in pairs], dtype=int))
+
+
+def _contact_model(model: mujoco.MjModel, path: Path, mud_geom: int) -> mujoco.MjModel:
+    """The world of `path` again, in which only the mud links' collision geoms (contype 1)
+    and the mud box (conaffinity 1) collide.
+
+    Raises:
+        ModelError: `path` does not compile to `model`'s geoms.
+    """
+    spec = mujoco.MjSpec.from_file(str(path))
+    spec.compile()  # the ids of the spec's geoms
+    _, link_geoms, _ = _mud_link_geoms(model)
+    wanted = set(link_geoms.tolist())
+    for geom in spec.geoms:
+        geom.contype = 1 if geom.id in wanted else 0
+        geom.conaffinity = 1 if geom.id == mud_geom else 0
+    private = spec.compile()
+    if private.ngeom != model.ngeom or private.nbody != model.nbody \
+            or not np.array_equal(private.geom_bodyid, model.geom_bodyid):
+        raise ModelError(f'{path} does not compile to the simulated model\'s geoms; load the '
+                         'model from that file')
+    return private

@@ -104,7 +104,7 @@ class AtlasSimulator:
         self.sim_time_ns = 0
         # VRCPlugin's cheats (modes, teleport, cmd_vel, pelvis wrench, kinematic playback).
         self.vrc = VrcState(atlas, self.data)
-        self.mud = MudDrag.for_model(self.model, mud_damping)  # None: no mud in the world
+        self.mud = MudDrag.for_model(self.model, atlas.path, mud_damping)  # None: no mud
         self.startup_pin = StartupPin(atlas, self.data, self.vrc, time_to_unpin_s, startup_mode)
         #: How many inputs were applied since the last reset, and the last one (sim time (ns)
         #: before the step it first acted in, input): /atlas/sim_inputs publishes each for

@@ -40,15 +40,20 @@ FOOT_IN_MUD_XML = """
 """
 
 
-def _foot_run(steps: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
-                                        np.ndarray]]:
+#: One step of the foot's run: touched, the drag at the point, the point, two twists.
+FootStep = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+def _foot_run(tmp_path: Path, steps: int) -> list[FootStep]:
     """Drop the foot, spinning, into the mud; per step: whether it touched, the drag at
     the point (6,), the point, the link's twist at the point at the step's start and the
     twist the drag alone left at the step's end (both (6,), v then w)."""
-    model = mujoco.MjModel.from_xml_string(FOOT_IN_MUD_XML)
+    path = tmp_path / 'foot_in_mud.xml'
+    path.write_text(FOOT_IN_MUD_XML)
+    model = mujoco.MjModel.from_xml_path(str(path))
     data = mujoco.MjData(model)
     data.qvel[:] = [0.3, -0.2, -2.0, 4.0, -3.0, 5.0]
-    mud = MudDrag.for_model(model)
+    mud = MudDrag.for_model(model, path)
     assert mud is not None
     jac = np.zeros((6, model.nv))
     out = []
@@ -75,8 +80,9 @@ def _foot_run(steps: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, np.n
     return out
 
 
-def test_a_foot_in_the_mud_feels_minus_c_times_its_twist_at_the_contact_point() -> None:
-    run = _foot_run(1500)
+def test_a_foot_in_the_mud_feels_minus_c_times_its_twist_at_the_contact_point(
+        tmp_path: Path) -> None:
+    run = _foot_run(tmp_path, 1500)
     touching = [row for row in run if row[0]]
     assert len(touching) > 100
     for step, (_, wrench, point, start, end) in enumerate(touching):
@@ -92,8 +98,9 @@ def test_a_foot_in_the_mud_feels_minus_c_times_its_twist_at_the_contact_point() 
         assert -0.25 - 0.5 <= point[2] <= 0.0 + 1e-9  # within the mud's depth
 
 
-def test_the_drag_starts_with_contact_and_is_gone_when_the_foot_leaves_the_mud() -> None:
-    run = _foot_run(4000)
+def test_the_drag_starts_with_contact_and_is_gone_when_the_foot_leaves_the_mud(
+        tmp_path: Path) -> None:
+    run = _foot_run(tmp_path, 4000)
     touched = np.array([bool(row[0]) for row in run])
     first, last = int(np.argmax(touched)), len(touched) - 1 - int(np.argmax(touched[::-1]))
     assert 0 < first < last < len(run) - 100, 'the foot enters and leaves the mud'
@@ -167,3 +174,35 @@ def test_bad_damping_and_a_mud_that_is_not_a_box_are_refused(tmp_path: Path) -> 
         'name="mud_atlas" type="box"', 'name="mud_atlas" type="sphere"'))
     with pytest.raises(ModelError, match="'mud_atlas' must be a box"):
         _sim(sphere)
+
+
+def test_the_contact_points_are_mujocos_own_for_a_box_that_collides(tmp_path: Path) -> None:
+    path = _mud_model(tmp_path, '0 0 0.15')
+    model = mujoco.MjModel.from_xml_path(str(path))
+    colliding = mujoco.MjModel.from_xml_string(
+        path.read_text().replace('contype="0" conaffinity="0" group="1"', 'conaffinity="1"'))
+    data, reference = mujoco.MjData(model), mujoco.MjData(colliding)
+    mud = MudDrag.for_model(model, path)
+    assert mud is not None
+    link_of = {int(geom): link for geom, link in zip(mud.geoms, mud.geom_link)}
+    rng = np.random.default_rng(1)
+    links_seen = 0
+    for _ in range(20):  # the legs bent at random, the pelvis at 0.8-1.0 m
+        data.qpos[:] = model.qpos0
+        data.qpos[2] = 0.9 + rng.uniform(-0.1, 0.1)
+        data.qpos[7:] += rng.normal(0.0, 0.2, model.nq - 7)
+        mujoco.mj_forward(model, data)
+        mud.update(data, 1e-3)
+        reference.qpos[:] = data.qpos
+        mujoco.mj_forward(colliding, reference)
+        points: dict[int, list[np.ndarray]] = {}
+        for contact in reference.contact[:reference.ncon]:
+            other = [int(geom) for geom in contact.geom if geom != mud.mud_geom]
+            if len(other) == 1 and other[0] in link_of:
+                points.setdefault(link_of[other[0]], []).append(contact.pos.copy())
+        assert sorted(points) == mud.touching.tolist()
+        for row, link in enumerate(sorted(points)):
+            np.testing.assert_allclose(mud.points_m[row], np.mean(points[link], axis=0),
+                                       atol=1e-12)
+        links_seen += len(points)
+    assert links_seen > 40
