@@ -39,6 +39,9 @@ __all__ = ['MUD_GEOM', 'MudDrag']
 
 #: The world's mud volume: a box geom of this name (course.MUD_BOX in the VRC worlds).
 MUD_GEOM = 'mud_atlas'
+#: Every mud link's geoms lie within this of the first mud link's origin (m): Atlas's feet
+#: and lower legs span about 1.2 m. Farther from the box, nothing else is asked.
+MUD_LINKS_SPAN_M = 2.0
 
 
 class MudDrag:
@@ -50,13 +53,17 @@ class MudDrag:
         self.mud_geom = mud_geom
         self.damping = check_mud_damping(damping)
         self.half_size_m = model.geom_size[mud_geom].copy()
+        # The box is a static world geom: its centre, and the squared distance from it
+        # beyond which the first mud link cannot have a geom in the box.
+        self._centre_m = tuple(model.geom_pos[mud_geom].tolist())
+        self._far_m2 = (float(np.linalg.norm(self.half_size_m)) + MUD_LINKS_SPAN_M) ** 2
         self.bodies, self.geoms, self.geom_link = _mud_link_geoms(model)
-        self.geom_reach_m = model.geom_rbound[self.geoms][:, None] + self.half_size_m[None, :]
         self.contact_model = contact_model
         self.contact_data = mujoco.MjData(contact_model)
         #: A geom's link (index into `bodies`), -1 for the others (the box).
         self._link_of_geom = np.full(model.ngeom, -1, dtype=int)
         self._link_of_geom[self.geoms] = self.geom_link
+        self._one_hot = np.eye(len(self.bodies))
         self.xfrc = np.zeros((model.nbody, 6))
         #: The last update's touching links (indices into `bodies`) and their mean contact
         #: points (world, m), for tests and tools.
@@ -70,12 +77,12 @@ class MudDrag:
     def for_model(cls, model: mujoco.MjModel, path: Path,
                   damping: float = MUD_DAMPING) -> MudDrag | None:
         """The mud of `model`, compiled from the MJCF at `path`, or None when it has no
-        `mud_atlas` box (nothing runs then).
+        `mud_atlas` box or no mud link with a collision geom (nothing runs then).
 
         Raises:
             CourseError: `damping` is not a finite number >= 0.
-            ModelError: the model's `mud_atlas` geom is not a box, or `path` does not
-                compile to the same geoms.
+            ModelError: the model's `mud_atlas` geom is not a box of the worldbody, or
+                `path` does not compile to the same geoms.
         """
         geom = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, MUD_GEOM)
         if geom < 0:
@@ -84,14 +91,19 @@ class MudDrag:
         if model.geom_type[geom] != mujoco.mjtGeom.mjGEOM_BOX:
             raise ModelError(f'geom {MUD_GEOM!r} must be a box (the mud volume), it is a '
                              f'{mujoco.mjtGeom(model.geom_type[geom]).name}')
+        if model.geom_bodyid[geom] != 0:
+            raise ModelError(f'geom {MUD_GEOM!r} must be in the worldbody (the mud is static)')
+        if not len(_mud_link_geoms(model)[1]):  # no mud link that can touch: nothing to drag
+            check_mud_damping(damping)
+            return None
         return cls(model, geom, damping, _contact_model(model, path, geom))
 
     def _near(self, data: mujoco.MjData) -> bool:
-        """Whether a mud link's geom's bounding sphere reaches into the box."""
-        centre = data.geom_xpos[self.mud_geom]
-        rotation = data.geom_xmat[self.mud_geom].reshape(3, 3)
-        local = (data.geom_xpos[self.geoms] - centre) @ rotation
-        return bool((np.abs(local) <= self.geom_reach_m).all(axis=1).any())
+        """Whether the first mud link is within MUD_LINKS_SPAN_M of the box's bounding
+        sphere (in plain floats: the test of every step away from the mud)."""
+        x, y, z = data.xpos[self.bodies[0]].tolist()
+        cx, cy, cz = self._centre_m
+        return (x - cx) ** 2 + (y - cy) ** 2 + (z - cz) ** 2 <= self._far_m2
 
     def _contact_points(self, data: mujoco.MjData) -> None:
         """`touching` and `points_m` for the current kinematics."""
@@ -107,12 +119,13 @@ class MudDrag:
             self.touching = self.touching[:0]
             return
         pairs = contact_data.contact.geom[:count]
-        links = np.maximum(self._link_of_geom[pairs[:, 0]], self._link_of_geom[pairs[:, 1]])
-        counts = np.bincount(links, minlength=len(self.bodies)).astype(float)
-        sums = np.stack([np.bincount(links, contact_data.contact.pos[:count, axis],
-                                     minlength=len(self.bodies)) for axis in range(3)], 1)
+        # (contacts, links): 1 where the contact is the link's; then each link's mean point.
+        links = self._link_of_geom[pairs].max(axis=1)
+        one_hot = self._one_hot[links]
+        counts = one_hot.sum(axis=0)
         self.touching = np.flatnonzero(counts)
-        self.points_m = sums[self.touching] / counts[self.touching, None]
+        self.points_m = (one_hot.T @ contact_data.contact.pos[:count])[self.touching] \
+            / counts[self.touching, None]
 
     def update(self, data: mujoco.MjData, dt_s: float) -> bool:
         """Compute `xfrc` (N, N·m at each body's centre of mass, world frame) for the step
@@ -144,8 +157,9 @@ class MudDrag:
 
 
 
-#: What mj_collision reads of a step's poses (from mj_kinematics), copied to the private data.
-_POSE_FIELDS = ('xpos', 'xmat', 'xipos', 'ximat', 'geom_xpos', 'geom_xmat')
+#: What mj_collision reads of a step's poses (from mj_kinematics), copied to the private data:
+#: the geoms' (its broad phase bounds geoms; the test against MuJoCo's own contacts checks it).
+_POSE_FIELDS = ('geom_xpos', 'geom_xmat')
 
 
 def _mud_link_geoms(model: mujoco.MjModel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
