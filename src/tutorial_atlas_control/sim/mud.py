@@ -158,8 +158,8 @@ class MudDrag:
 
 
 #: What mj_collision reads of a step's poses (from mj_kinematics), copied to the private data:
-#: the geoms' (its broad phase bounds geoms; the test against MuJoCo's own contacts checks it).
-_POSE_FIELDS = ('geom_xpos', 'geom_xmat')
+#: the geoms' and the bodies' (a body of several geoms is bounded in its inertial frame).
+_POSE_FIELDS = ('xpos', 'xmat', 'xipos', 'ximat', 'geom_xpos', 'geom_xmat')
 
 
 def _mud_link_geoms(model: mujoco.MjModel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -111,12 +111,18 @@ def test_the_drag_starts_with_contact_and_is_gone_when_the_foot_leaves_the_mud(
     assert abs(run[last][3][2]) < 0.6
 
 
-def _mud_model(tmp_path: Path, centre: str, half_size: str = '1 1 0.2') -> Path:
-    """Atlas with a mud box (contype and conaffinity 0) in its world."""
+def _mud_model(tmp_path: Path, centre: str, half_size: str = '1 1 0.2',
+               sleep: bool = False) -> Path:
+    """Atlas with a mud box (contype and conaffinity 0) in its world; with `sleep`, MuJoCo's
+    sleeping bodies enabled, as in the VRC world (its collision then reads body poses)."""
     box = (f'<geom name="mud_atlas" type="box" size="{half_size}" pos="{centre}" '
            'contype="0" conaffinity="0" group="1"/>\n    <body name="pelvis"')
+    text = MODEL_PATH.read_text().replace('<body name="pelvis"', box, 1)
+    if sleep:
+        text = text.replace('cone="elliptic"/>', 'cone="elliptic"><flag sleep="enable"/></option>',
+                            1)
     path = tmp_path / 'atlas_mud.xml'
-    path.write_text(MODEL_PATH.read_text().replace('<body name="pelvis"', box, 1))
+    path.write_text(text)
     return path
 
 
@@ -177,7 +183,8 @@ def test_bad_damping_and_a_mud_that_is_not_a_box_are_refused(tmp_path: Path) -> 
 
 
 def test_the_contact_points_are_mujocos_own_for_a_box_that_collides(tmp_path: Path) -> None:
-    path = _mud_model(tmp_path, '0 0 0.15')
+    # Away from the origin, where the bodies' poses matter to MuJoCo's broad phase too.
+    path = _mud_model(tmp_path, '20 -15 0.15', sleep=True)
     model = mujoco.MjModel.from_xml_path(str(path))
     colliding = mujoco.MjModel.from_xml_string(
         path.read_text().replace('contype="0" conaffinity="0" group="1"', 'conaffinity="1"'))
@@ -187,9 +194,10 @@ def test_the_contact_points_are_mujocos_own_for_a_box_that_collides(tmp_path: Pa
     link_of = {int(geom): link for geom, link in zip(mud.geoms, mud.geom_link)}
     rng = np.random.default_rng(1)
     links_seen = 0
-    for _ in range(20):  # the legs bent at random, the pelvis at 0.8-1.0 m
+    for _ in range(20):  # the legs bent at random, the pelvis at 0.8-1.0 m, turned
         data.qpos[:] = model.qpos0
-        data.qpos[2] = 0.9 + rng.uniform(-0.1, 0.1)
+        data.qpos[0:3] = [20.0, -15.0, 0.9 + rng.uniform(-0.1, 0.1)]
+        data.qpos[3:7] = [np.cos(0.7), 0.0, 0.0, np.sin(0.7)]  # turned 80 degrees
         data.qpos[7:] += rng.normal(0.0, 0.2, model.nq - 7)
         mujoco.mj_forward(model, data)
         mud.update(data, 1e-3)
