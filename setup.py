@@ -11,6 +11,7 @@ setup(**generate_distutils_setup(
         'tutorial_atlas_control.bags',
         'tutorial_atlas_control.cli',
         'tutorial_atlas_control.command',
+        'tutorial_atlas_control.course',
         'tutorial_atlas_control.demo',
         'tutorial_atlas_control.msgs',
         'tutorial_atlas_control.node',

@@ -2,18 +2,21 @@
 
 roslaunch refuses an argument a launch file needs and lacks, but not one it was given and
 does not declare. The simulator, started by roslaunch, reads its parent's command line and
-compares the `name:=value` arguments with the `<arg>`s the launch files on it declare; each
-unknown one gets one warning line naming the closest declared argument.
+compares the `name:=value` arguments with the `<arg>`s the launch files on it declare (and
+the files they include with pass_all_args, which hands them every argument: the VRC
+launches pass atlas.launch's through); each unknown one gets one warning line naming the
+closest declared argument.
 """
 
 from __future__ import annotations
 
 import difflib
+import re
 import xml.etree.ElementTree as ElementTree
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-__all__ = ['declared_args', 'given_args', 'launch_files', 'unknown_arg_lines']
+__all__ = ['declared_args', 'given_args', 'included_file', 'launch_files', 'unknown_arg_lines']
 
 #: How alike a declared name must be to be offered as the one meant (difflib's ratio).
 SUGGESTION_CUTOFF = 0.6
@@ -52,13 +55,40 @@ def launch_files(argv: Sequence[str], find: LaunchFinder) -> list[Path] | None:
     return files or None
 
 
-def declared_args(path: Path) -> set[str] | None:
-    """The `<arg name=...>` of a launch file's top level; None if it cannot be read."""
+def included_file(path: Path, spec: str, find: LaunchFinder) -> Path | None:
+    """The file an `<include file=...>` of `path` names, when it is `$(dirname)/X.launch`
+    or `$(find PACKAGE)/launch/X.launch`; None for any other form or a file not found."""
+    match = re.fullmatch(r'\$\(dirname\)/([\w.-]+\.launch)', spec)
+    if match:
+        found = path.parent / match.group(1)
+        return found if found.is_file() else None
+    match = re.fullmatch(r'\$\(find ([\w-]+)\)/launch/([\w.-]+\.launch)', spec)
+    return find(match.group(1), match.group(2)) if match else None
+
+
+def declared_args(path: Path, find: LaunchFinder | None = None,
+                  _seen: frozenset[Path] = frozenset()) -> set[str] | None:
+    """The `<arg name=...>` of a launch file's top level, and with `find`, those of the files
+    it includes with pass_all_args="true"; None if one cannot be read or found."""
     try:
         root = ElementTree.parse(path).getroot()
     except (OSError, ElementTree.ParseError):
         return None
-    return {element.get('name', '') for element in root.findall('arg')}
+    names = {element.get('name', '') for element in root.findall('arg')}
+    if find is None:
+        return names
+    seen = _seen | {path.resolve()}
+    for include in root.findall('include'):
+        if include.get('pass_all_args', 'false').lower() != 'true':
+            continue
+        child = included_file(path, include.get('file', ''), find)
+        if child is None:
+            return None
+        inner = names if child.resolve() in seen else declared_args(child, find, seen)
+        if inner is None:
+            return None
+        names |= inner
+    return names
 
 
 def unknown_arg_lines(argv: Sequence[str], find: LaunchFinder) -> list[str]:
@@ -68,7 +98,7 @@ def unknown_arg_lines(argv: Sequence[str], find: LaunchFinder) -> list[str]:
         return []
     declared: set[str] = set()
     for path in files:
-        names = declared_args(path)
+        names = declared_args(path, find)
         if names is None:
             return []
         declared |= names

@@ -482,7 +482,7 @@ def step_through(interface: AtlasSimInterface, plan: list[Footstep], seconds: fl
             seen.taken += 1
         previous = flags
         if seen.taken == len(plan) and flags == SWAYING \
-                and interface.stepping is not None and interface.stepping.stepping is None:
+                and interface.stepping is not None and interface.stepping.static_step is None:
             break
     return seen
 

@@ -16,13 +16,14 @@ import pytest
 
 from support.arm_swing import ARMS, arm_command, swung
 from tutorial_atlas_control.asi import AtlasSimInterface, Behavior
-from tutorial_atlas_control.balance import TRANSITION_S, StandBehaviour
+from tutorial_atlas_control.balance import StandBehaviour
 from tutorial_atlas_control.balance.push_trial import (
     FOOT_TRAVEL_LIMIT_M,
     push_survived,
     stand_trial,
 )
 from tutorial_atlas_control.balance.stand import StandGains, pitch_of, yaw_of
+from tutorial_atlas_control.balance.stand_behaviour import TRANSITION_S
 from tutorial_atlas_control.joints import JOINT_INDEX
 from tutorial_atlas_control.msgs.atlas_sim_interface import AsiCommand, ManipulateParams, StepData
 from tutorial_atlas_control.sim import (

@@ -100,7 +100,7 @@ def _turned_by_a_step(interface: AtlasSimInterface) -> None:
     stepping = interface.stepping
     assert stepping is not None
     turn = Footstep(1, 0, 0.0, 0.14, 0.3)
-    _until(interface, lambda: stepping.steps_taken == 1 and stepping.stepping is None,
+    _until(interface, lambda: stepping.steps_taken == 1 and stepping.static_step is None,
            lambda: interface.apply(_command(Behavior.STEP, desired=turn)))
     interface.apply(_command(Behavior.STAND))
     _until(interface, _in_stand(interface))

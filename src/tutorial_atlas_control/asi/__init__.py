@@ -12,16 +12,13 @@ and steps; mode_switching: DRCSim's mode-switching demo as cues of messages.
 from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
-    'behaviors': ['BEHAVIOR_OF_MODE', 'MODE_OF_BEHAVIOR', 'AsiError', 'Behavior', 'Status'],
+    'behaviors': ['AsiError', 'Behavior', 'Status'],
     'errors': ['AsiInputError'],
     'interface': ['AtlasSimInterface'],
-    'library': ['BehaviourBase', 'Handover', 'LibraryBehaviour', 'StepEntry', 'WalkEntry',
-                'on_ground'],
-    'mode_switching': ['AFTER_LAST_S', 'CUES', 'KP_VELOCITY', 'Cue', 'cue_messages'],
-    'session': ['REFUSAL_REPORTED_STEPS', 'STANDING_BEHAVIORS', 'AsiSession', 'Refusal'],
-    'teleop': ['MOVES', 'Settings', 'ego_steps', 'key_action'],
-    'user_behaviour': ['USER_BEHAVIORS', 'UserBehaviourError', 'load_user_behaviour'],
+    'library': ['BehaviourBase', 'Handover', 'LibraryBehaviour'],
+    'mode_switching': ['AFTER_LAST_S', 'CUES', 'KP_VELOCITY', 'cue_messages'],
+    'teleop': ['Settings', 'ego_steps', 'key_action'],
+    'user_behaviour': ['UserBehaviourError', 'load_user_behaviour'],
     'walk_client': ['Outcome', 'WalkClient', 'refusal_hint'],
     'walk_demo': ['Decision', 'WalkDemoServer', 'yaw_of_quaternion'],
-    'walk_params': ['footsteps_of', 'sole_step', 'step_data_of', 'walk_feedback'],
 })

@@ -1,5 +1,5 @@
-"""The open AtlasSimInterface over one simulator: requests applied between steps, the state
-reported after each step. ROS-free: the node hands it decoded commands and publishes the
+"""The open AtlasSimInterface over one simulator: requests applied between ticks, the state
+reported after each tick. ROS-free: the node hands it decoded commands and publishes the
 bytes of its states.
 
 What it does with a command (DRCSim 2.7's AtlasPlugin::SetASICommand): the behaviour is
@@ -34,32 +34,41 @@ import numpy as np
 from tutorial_atlas_control.asi.behaviors import BEHAVIOR_OF_MODE, MODE_OF_BEHAVIOR, Behavior
 from tutorial_atlas_control.asi.library import (
     LibraryBehaviour,
+    ManipulateEntry,
+    NestedBehaviour,
     StepEntry,
     WalkEntry,
+    nested,
     on_ground,
 )
 from tutorial_atlas_control.asi.session import STANDING_BEHAVIORS, AsiSession, behavior_name
-from tutorial_atlas_control.asi.state_report import StateReport, manipulate_feedback
+from tutorial_atlas_control.asi.state_report import StateReport
 from tutorial_atlas_control.asi.walk_params import sole_step
 from tutorial_atlas_control.balance import (
     BalanceEstimator,
-    PelvisServo,
     StandBehaviour,
     StandPrepBehaviour,
     signed_distance,
 )
 from tutorial_atlas_control.command import LAW_FIELDS, CommandUpdate
 from tutorial_atlas_control.control_modes import ControlMode
+from tutorial_atlas_control.course import Start
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.msgs import (
     AsiCommand,
     AsiState,
-    ManipulateParams,
+    ManipulateFeedback,
     StepFeedback,
     WalkFeedback,
 )
 from tutorial_atlas_control.sim import AtlasSimulator, GroundUnderFeet
-from tutorial_atlas_control.walking import DRCSIM_WALK_QUEUE, StepBehaviour, WalkBehaviour
+from tutorial_atlas_control.walking import (
+    DRCSIM_WALK_QUEUE,
+    Footstep,
+    StepBehaviour,
+    WalkBehaviour,
+    placed,
+)
 
 __all__ = ['AtlasSimInterface']
 
@@ -69,11 +78,12 @@ _K_EFFORT_ROW = (LAW_FIELDS.index('k_effort'),)
 _ALL_JOINTS = np.arange(NUM_JOINTS)
 
 
-def servo_of(params: ManipulateParams) -> PelvisServo | None:
-    """Manipulate's pelvis target: `desired` when use_desired, else None (the Stand pose)."""
-    if not params.use_desired:
-        return None
-    return PelvisServo(params.pelvis_height_m, params.pelvis_yaw_rad, params.pelvis_lat_m)
+def _from_start(steps: list[Footstep], start: Start | None) -> list[Footstep]:
+    """DRCSim's fixed Walk queue, made for a robot at the origin facing +x, carried to the
+    start the simulator resets the robot to (None: the origin)."""
+    if start is None:
+        return steps
+    return placed(steps, (start.x_m, start.y_m), start.yaw_rad)
 
 
 class AtlasSimInterface:
@@ -105,46 +115,50 @@ class AtlasSimInterface:
         #: the one that deferred a Stand asked for while it runs.
         self.library: dict[Behavior, LibraryBehaviour] = {}
         self._stand_deferred_by: Behavior | None = None
+        #: The library behaviour running inside its mode's behaviour now (Manipulate in Stand).
+        self._nested: NestedBehaviour | None = None
         self.session = AsiSession(MODE_OF_BEHAVIOR)
         if balance:
             self._load_balance()
         else:
             self._estimator = BalanceEstimator(sim.atlas)
-        #: Manipulate runs: Stand, started `_stand_starts`-th, with its pelvis servoed.
-        self.manipulating = False
-        self._stand_starts = 0
-        #: The behaviour the mode was last seen running (Manipulate apart).
+        #: The behaviour the mode was last seen running (a nested one apart).
         self._seen = self._mode_behavior()
         self._report = StateReport(sim)
 
     def _load_balance(self) -> None:
-        """Stand and StandPrep become the balancing behaviours; Manipulate is served."""
+        """Stand and StandPrep become the balancing behaviours; Walk, Step and Manipulate
+        are served (the user's behaviour over them)."""
         sim = self.sim
         self.stand = StandBehaviour(sim.atlas)
         sim.install_stand(self.stand)
         sim.install_stand(StandPrepBehaviour(sim.atlas, sim.gains), ControlMode.STAND_PREP)
-        self.session.served[Behavior.MANIPULATE] = ControlMode.STAND
         ahead = self.stand.estimator.sole_ahead_m
         ground = self._ground.ground
         self.register(WalkEntry(WalkBehaviour(self.stand, default_steps=on_ground(
-            [sole_step(step, ahead) for step in DRCSIM_WALK_QUEUE], ground)), ahead, ground))
+            _from_start([sole_step(step, ahead) for step in DRCSIM_WALK_QUEUE], sim.start),
+            ground)), ahead, ground))
         self.register(StepEntry(StepBehaviour(self.stand), ahead, ground))
+        self.register(ManipulateEntry(self.stand))
         self._estimator = self.stand.estimator
         if self.user_behaviour is not None:
             self.register(self.user_behaviour)
-            if self.user_behaviour.behavior == Behavior.STAND:
-                del self.session.served[Behavior.MANIPULATE]  # the library's Stand, servoed
 
     def register(self, behaviour: LibraryBehaviour) -> None:
-        """Serve `behaviour`: installed in the simulator for its control mode, requested by
-        its ASI behaviour number."""
-        self.sim.install_stand(behaviour, behaviour.mode)
+        """Serve `behaviour` for its ASI number: installed for its control mode (those nested
+        in what the mode ran before unserved), or nested in the mode's behaviour."""
+        if nested(behaviour) is None:
+            self.sim.install_stand(behaviour, behaviour.mode)
+            for other in [entry for entry in self.library.values()
+                          if entry.mode is behaviour.mode and nested(entry) is not None]:
+                del self.library[other.behavior], self.session.served[other.behavior]
         self.session.served[behaviour.behavior] = behaviour.mode
         self.library[behaviour.behavior] = behaviour
 
     def serves(self, mode: ControlMode) -> bool:
-        """Whether a library behaviour runs control mode `mode`."""
-        return any(entry.mode is mode for entry in self.library.values())
+        """Whether a library behaviour is installed for control mode `mode`."""
+        return any(entry.mode is mode and nested(entry) is None
+                   for entry in self.library.values())
 
     @property
     def walking(self) -> WalkBehaviour | None:
@@ -160,7 +174,12 @@ class AtlasSimInterface:
 
     @property
     def current_behavior(self) -> Behavior:
-        return Behavior.MANIPULATE if self.manipulating else self._mode_behavior()
+        return self._mode_behavior() if self._nested is None else self._nested.behavior
+
+    @property
+    def manipulating(self) -> bool:
+        """Whether Manipulate runs (for tests and tools; the interface asks no such thing)."""
+        return self.current_behavior is Behavior.MANIPULATE
 
     def _mode_behavior(self) -> Behavior:
         """The behaviour the control mode runs: User during the start's hold (the PID with
@@ -176,14 +195,13 @@ class AtlasSimInterface:
         return refusal.line() if refusal is not None else line
 
     def apply(self, command: AsiCommand) -> None:
-        """One checked AtlasSimInterfaceCommand, between two steps."""
+        """One checked AtlasSimInterfaceCommand, between two ticks."""
         self._observe()
         sim = self.sim
         current = self.current_behavior
         self._request(command, current)
-        if self.manipulating:
-            assert self.stand is not None  # served only with it
-            self.stand.servo(servo_of(command.manipulate), float(sim.data.time))
+        if self._nested is not None:
+            self._nested.follow(command, float(sim.data.time))
         if command.k_effort is not None:
             self._set_k_effort(command.k_effort)
 
@@ -222,7 +240,7 @@ class AtlasSimInterface:
             if target is not None:
                 target.take(command, running=False)
             self._switch(mode)
-            self._set_manipulating(command.behavior == Behavior.MANIPULATE)
+            self._nest(None if target is None else nested(target))
         elif running and target is not None:
             target.take(command, running=True)
 
@@ -236,27 +254,26 @@ class AtlasSimInterface:
             if kept is not None:
                 self._set_k_effort(kept)
 
-    def _set_manipulating(self, manipulating: bool) -> None:
-        """Enter Manipulate (in a started Stand), or leave it for Stand's own pose."""
-        stand = self.stand
-        if stand is not None and self.manipulating and not manipulating \
-                and self.sim.mode is ControlMode.STAND:
-            stand.servo(None, float(self.sim.data.time))
-        self.manipulating = manipulating
-        if stand is not None:
-            self._stand_starts = stand.starts
+    def _nest(self, entry: NestedBehaviour | None) -> None:
+        """After a granted request: `entry` nested in its mode's (None: none), the last left."""
+        running = self._nested
+        if running is not None and running is not entry:
+            running.leave(self.sim.mode, float(self.sim.data.time))
+        self._nested = entry
+        if entry is not None:
+            entry.enter()
 
     def _observe(self) -> None:
         """A control mode switched outside the interface is the library's transition; so is
-        Stand restarted under Manipulate (/atlas/control_mode Stand)."""
+        the behaviour a nested one runs in restarted (/atlas/control_mode Stand under
+        Manipulate)."""
         if self.stand is None and self.sim.startup_pin.bdi_stand:
             self._load_balance()  # BDI's Stand asked for: the library is there
-        mode, stand = self.sim.mode, self.stand
-        if self.manipulating and stand is not None and (
-                mode is not ControlMode.STAND or stand.starts != self._stand_starts):
-            self.manipulating = False
-            if mode is ControlMode.STAND:
-                self.session.switched(Behavior.STAND, Behavior.MANIPULATE)
+        mode, running = self.sim.mode, self._nested
+        if running is not None and not running.runs(mode):
+            self._nested = None
+            if mode is running.mode:
+                self.session.switched(BEHAVIOR_OF_MODE[mode], running.behavior)
         current = self._mode_behavior()
         if current is not self._seen:
             previous, self._seen = self._seen, current
@@ -283,7 +300,7 @@ class AtlasSimInterface:
         return int(current), self.session.status_flags(current, falling)
 
     def state(self) -> AsiState:
-        """The AtlasSimInterfaceState of the step just taken."""
+        """The AtlasSimInterfaceState of the tick just run."""
         self._observe()
         sim, session = self.sim, self.session
         current = self.current_behavior
@@ -293,12 +310,12 @@ class AtlasSimInterface:
                     acting.feedback(float(sim.data.time), self._estimator.sole_ahead_m))
         return self._report.state(
             current, session, falling,
-            manipulate_feedback(self.stand if self.manipulating else None),
+            feedback.get('manipulate_feedback', ManipulateFeedback()),
             feedback.get('walk_feedback', WalkFeedback()),
             feedback.get('step_feedback', StepFeedback()))
 
     def end_step(self) -> None:
-        """After each step, whether or not a state was built."""
+        """After each tick, whether or not a state was built."""
         self._observe()
         self.session.end_step()
         deferred, stand = self._deferred, self.stand

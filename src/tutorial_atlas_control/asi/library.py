@@ -6,21 +6,25 @@ says which ASI behaviour it answers to and which control mode runs it, takes its
 parameters, answers Stand asked for while it runs, reports its feedback, and says after each
 tick what it hands the robot over to (a walk done: Stand; fallen: Freeze). Adding one is a
 class with these members (BehaviourBase has their quiet defaults) and the interface's
-`register`.
+`register`. A behaviour whose control mode reports another behaviour (Manipulate, in Stand's
+mode) is not installed for that mode but runs inside the behaviour there (NestedBehaviour):
+the interface enters and leaves it, asks whether the mode still runs it, and hands it every
+command while it runs.
 """
 
 from __future__ import annotations
 
 import dataclasses
-from typing import Protocol
+from typing import Protocol, cast
 
 import mujoco
 import numpy as np
 
-from tutorial_atlas_control.asi.behaviors import Behavior
+from tutorial_atlas_control.asi.behaviors import BEHAVIOR_OF_MODE, Behavior
 from tutorial_atlas_control.asi.walk_params import footsteps_of, step_feedback, walk_feedback
+from tutorial_atlas_control.balance import PelvisServo, StandBehaviour
 from tutorial_atlas_control.control_modes import ControlMode
-from tutorial_atlas_control.msgs import AsiCommand
+from tutorial_atlas_control.msgs import AsiCommand, ManipulateFeedback, ManipulateParams
 from tutorial_atlas_control.sim import Ground
 from tutorial_atlas_control.walking import (
     STEP_DURATION_S,
@@ -29,7 +33,8 @@ from tutorial_atlas_control.walking import (
     WalkBehaviour,
 )
 
-__all__ = ['BehaviourBase', 'Handover', 'LibraryBehaviour', 'StepEntry', 'WalkEntry', 'on_ground']
+__all__ = ['BehaviourBase', 'Handover', 'LibraryBehaviour', 'ManipulateEntry', 'NestedBehaviour',
+           'StepEntry', 'WalkEntry', 'nested', 'on_ground', 'servo_of']
 
 
 @dataclasses.dataclass(frozen=True)
@@ -78,6 +83,33 @@ class LibraryBehaviour(Protocol):
 
     def feedback(self, time_s: float, sole_ahead_m: float) -> dict[str, object]:
         """Its fields of AtlasSimInterfaceState (e.g. walk_feedback), now."""
+
+
+class NestedBehaviour(LibraryBehaviour, Protocol):
+    """A library behaviour that runs inside the behaviour of its control mode (Manipulate: the
+    balancing Stand with its pelvis servoed) instead of being installed for the mode."""
+
+    def enter(self) -> None:
+        """It becomes the current behaviour, inside its mode's behaviour as that runs now."""
+
+    def leave(self, mode: ControlMode, time_s: float) -> None:
+        """Another behaviour was granted; the simulator is now in `mode`."""
+
+    def runs(self, mode: ControlMode) -> bool:
+        """Whether it still runs with the simulator in `mode` (a switch or a restart made
+        elsewhere ends it)."""
+
+    def follow(self, command: AsiCommand, time_s: float) -> None:
+        """Every command while it runs, whatever behaviour the command asks for: BDI's
+        library read the running behaviour's parameters from each one."""
+
+
+def nested(behaviour: LibraryBehaviour) -> NestedBehaviour | None:
+    """`behaviour` if it runs inside its control mode's behaviour (the mode reports
+    another behaviour), None if it is installed for its mode."""
+    if BEHAVIOR_OF_MODE.get(behaviour.mode) is behaviour.behavior:
+        return None
+    return cast(NestedBehaviour, behaviour)
 
 
 class BehaviourBase:
@@ -248,7 +280,7 @@ class StepEntry(_SteppingEntry):
         self.stepping.desire(steps[0] if steps else None)
 
     def stop(self) -> bool:
-        if self.stepping.stepping is None:
+        if self.stepping.static_step is None:
             return False
         self._stand_asked = True
         return True
@@ -256,9 +288,56 @@ class StepEntry(_SteppingEntry):
     def handover(self, fallen: bool) -> Handover | None:
         if fallen:
             return Handover(Behavior.FREEZE, True)
-        if self._stand_asked and self.stepping.stepping is None:
+        if self._stand_asked and self.stepping.static_step is None:
             return Handover(Behavior.STAND, False)
         return None
 
     def feedback(self, time_s: float, sole_ahead_m: float) -> dict[str, object]:
         return {'step_feedback': step_feedback(self.stepping.status(time_s), sole_ahead_m)}
+
+
+def servo_of(params: ManipulateParams) -> PelvisServo | None:
+    """Manipulate's pelvis target: `desired` when use_desired, else None (the Stand pose)."""
+    if not params.use_desired:
+        return None
+    return PelvisServo(params.pelvis_height_m, params.pelvis_yaw_rad, params.pelvis_lat_m)
+
+
+class ManipulateEntry(BehaviourBase):
+    """Manipulate in the library: the balancing Stand, already running, with its pelvis
+    servoed to each command's `manipulate_params.desired` (the Stand pose without
+    use_desired), back to the Stand pose when another behaviour is granted in Stand; it ends
+    when Stand restarts or the mode changes elsewhere (/atlas/control_mode)."""
+
+    behavior = Behavior.MANIPULATE
+    mode = ControlMode.STAND
+
+    def __init__(self, stand: StandBehaviour) -> None:
+        self.stand = stand
+        #: The Stand's start it runs in (StandBehaviour.starts when entered).
+        self._stand_start = 0
+
+    def start(self, data: mujoco.MjData) -> None:
+        self.stand.start(data)
+
+    def torque(self, data: mujoco.MjData) -> np.ndarray:
+        return self.stand.torque(data)
+
+    def enter(self) -> None:
+        self._stand_start = self.stand.starts
+
+    def leave(self, mode: ControlMode, time_s: float) -> None:
+        if mode is self.mode:
+            self.stand.servo(None, time_s)
+
+    def runs(self, mode: ControlMode) -> bool:
+        return mode is self.mode and self.stand.starts == self._stand_start
+
+    def follow(self, command: AsiCommand, time_s: float) -> None:
+        self.stand.servo(servo_of(command.manipulate), time_s)
+
+    def feedback(self, time_s: float, sole_ahead_m: float) -> dict[str, object]:
+        """The pelvis target in use, as clamped (the Stand pose's without use_desired)."""
+        target = self.stand.servo_target or PelvisServo(self.stand.squats.stand_height_m)
+        return {'manipulate_feedback': ManipulateFeedback(
+            0, target.height_m, target.yaw_rad, target.lateral_m)}

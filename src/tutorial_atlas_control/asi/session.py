@@ -6,7 +6,7 @@ running behaviour changes nothing, so a client may stream it at 1 kHz; an accept
 reports TRANSITION_SUCCESS in the state of that step, then OK; a refusal (unknown or not
 served behaviour, Walk, Step or Manipulate asked for outside a standing behaviour, a standing
 behaviour with the centre of mass outside the feet) keeps the running behaviour, reports its
-FAILED_TRANS_* and error code until the next request or for REFUSAL_REPORTED_STEPS steps,
+FAILED_TRANS_* and error code until the next request or for REFUSAL_REPORTED_TICKS ticks,
 whichever comes first (never latched: a later client's first state is not an old refusal),
 and says in `refusal` why and what to send instead; Stand requested during Walk is
 taken once the step under way is down and the robot caught (TRANSITION_IN_PROGRESS until
@@ -30,7 +30,7 @@ from tutorial_atlas_control.asi.behaviors import (
 )
 from tutorial_atlas_control.control_modes import ControlMode
 
-__all__ = ['REFUSAL_REPORTED_STEPS', 'STANDING_BEHAVIORS', 'AsiSession', 'Refusal']
+__all__ = ['REFUSAL_REPORTED_TICKS', 'STANDING_BEHAVIORS', 'AsiSession', 'Refusal']
 
 #: Behaviours that keep the robot on its feet: only they can be falling, and entering one
 #: needs the centre of mass over the feet.
@@ -38,11 +38,11 @@ STANDING_BEHAVIORS = frozenset({Behavior.STAND, Behavior.MANIPULATE, Behavior.WA
                                 Behavior.STEP})
 #: Behaviours entered only from a standing one (BDI's library: Stand first).
 NEEDS_STANDING = frozenset({Behavior.MANIPULATE, Behavior.WALK, Behavior.STEP})
-#: How many steps (1 ms each) a refusal stays reported without a new request: long enough
+#: How many ticks (1 ms each) a refusal stays reported without a new request: long enough
 #: for a client reading every tenth state to see it, short enough that the next goal's first
 #: state is not about somebody else's request (DRCSim's actionlib server aborts a new goal
 #: on the error code of the first state it reads, before it sends anything).
-REFUSAL_REPORTED_STEPS = 50
+REFUSAL_REPORTED_TICKS = 50
 _KNOWN = frozenset(int(b) for b in Behavior)
 _REFUSALS = frozenset({Status.FAILED_TRANS_UNKNOWN_BEHAVIOR, Status.FAILED_TRANS_ILLEGAL_BEHAVIOR,
                        Status.FAILED_TRANS_COM_POS, Status.FAILED_TRANS_COM_VEL,
@@ -84,7 +84,7 @@ class AsiSession:
         self._status = Status.OK
         #: The newest refusal, for the log (the caller takes it: take_refusal).
         self.refusal: Refusal | None = None
-        self._refusal_steps_left = 0
+        self._refusal_ticks_left = 0
 
     def status_flags(self, current: Behavior, falling: bool) -> int:
         """behavior_feedback.status_flags: ERROR_FALLING while a standing behaviour is
@@ -153,14 +153,14 @@ class AsiSession:
         self._status = Status.WARNING_AUTO_TRANS
 
     def end_step(self) -> None:
-        """A step has passed: a success has been reported (or was not listened to); a
-        refusal is reported for REFUSAL_REPORTED_STEPS steps at most."""
+        """A tick has passed: a success has been reported (or was not listened to); a
+        refusal is reported for REFUSAL_REPORTED_TICKS ticks at most."""
         status = self._status
         if status in (Status.TRANSITION_SUCCESS, Status.WARNING_AUTO_TRANS):
             self._status = Status.OK
         elif status in _REFUSALS:
-            self._refusal_steps_left -= 1
-            if self._refusal_steps_left <= 0:
+            self._refusal_ticks_left -= 1
+            if self._refusal_ticks_left <= 0:
                 self._status, self.error_code = Status.OK, AsiError.NO_ERRORS
 
     def take_refusal(self) -> Refusal | None:
@@ -171,6 +171,6 @@ class AsiSession:
     def _refuse(self, behavior: int, current: Behavior, status: Status,
                 error: AsiError, reason: str) -> None:
         self._status, self.error_code = status, error
-        self._refusal_steps_left = REFUSAL_REPORTED_STEPS
+        self._refusal_ticks_left = REFUSAL_REPORTED_TICKS
         self.trans_from_behavior, self.trans_to_behavior = int(current), behavior
         self.refusal = Refusal(behavior, current, status, reason)

@@ -8,7 +8,6 @@ import numpy as np
 
 from tutorial_atlas_control.asi.behaviors import Behavior
 from tutorial_atlas_control.asi.session import AsiSession
-from tutorial_atlas_control.balance import PelvisServo, StandBehaviour
 from tutorial_atlas_control.control_modes import ControlMode
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.msgs import (
@@ -20,7 +19,7 @@ from tutorial_atlas_control.msgs import (
 )
 from tutorial_atlas_control.sim import AtlasSimulator
 
-__all__ = ['FOOT_BODIES', 'StateReport', 'manipulate_feedback']
+__all__ = ['FOOT_BODIES', 'StateReport']
 
 FOOT_BODIES = ('l_foot', 'r_foot')
 _NO_TORQUE = np.zeros(NUM_JOINTS)
@@ -41,7 +40,7 @@ class StateReport:
         self._free_dof = int(model.jnt_dofadr[free_joint])
 
     def f_out(self) -> np.ndarray:
-        """The behaviour's joint torques this step (N m): the Stand behaviour's or a hold's;
+        """The behaviour's joint torques this tick (N m): the Stand behaviour's or a hold's;
         none in User, ragdoll and the start's hold (the PID alone holds the robot)."""
         sim = self.sim
         if sim.mode in (ControlMode.USER, ControlMode.RAGDOLL) or sim.behaviours.holding_start:
@@ -71,7 +70,7 @@ class StateReport:
     def state(self, current: Behavior, session: AsiSession, falling: bool,
               manipulate: ManipulateFeedback, walk: WalkFeedback,
               step: StepFeedback) -> AsiState:
-        """The AtlasSimInterfaceState of the step just taken, with the library's values."""
+        """The AtlasSimInterfaceState of the tick just run, with the library's values."""
         sim, data = self.sim, self.sim.data
         adr, dof = sim.atlas.free_qpos_adr, self._free_dof
         return AsiState(
@@ -86,11 +85,3 @@ class StateReport:
             manipulate_feedback=manipulate, walk_feedback=walk, step_feedback=step,
             k_effort=self.k_effort())
 
-
-def manipulate_feedback(manipulating: StandBehaviour | None) -> ManipulateFeedback:
-    """The pelvis target in use, as clamped, while Manipulate runs on `manipulating`'s Stand
-    (the Stand pose's without use_desired); zeros otherwise (None)."""
-    if manipulating is None:
-        return ManipulateFeedback()
-    target = manipulating.servo_target or PelvisServo(manipulating.squats.stand_height_m)
-    return ManipulateFeedback(0, target.height_m, target.yaw_rad, target.lateral_m)

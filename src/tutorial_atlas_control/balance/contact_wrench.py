@@ -8,7 +8,7 @@ lift and land elsewhere): each foot takes the same share of F as of the vertical
 What moment remains goes to the ankles in the same shares. Then each foot's share is made
 feasible: no pull (f_z >= 0), the pressure centre inside the sole (|m_x| <= f_z w/2,
 |m_y| <= f_z l/2 in the sole's frame) and, when asked, the force within friction.
-In plain floats: this runs every 1 ms step.
+In plain floats: this runs every 1 ms tick.
 """
 
 from __future__ import annotations

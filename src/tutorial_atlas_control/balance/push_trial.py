@@ -77,17 +77,17 @@ def standing_simulator() -> AtlasSimulator:
 
 
 def push_events(pushes: Sequence[Push], dt_s: float) -> list[tuple[int, Vector]]:
-    """The pelvis force to set at each step where it changes, (step, force (N)) in order:
+    """The pelvis force to set at each tick where it changes, (tick, force (N)) in order:
     each push's force at its start, none at its end."""
     return sorted([(round(p.start_s / dt_s), p.force_n) for p in pushes]
                   + [(round((p.start_s + p.duration_s) / dt_s), (0.0, 0.0, 0.0))
                      for p in pushes], key=lambda event: event[0])
 
 
-def apply_pushes(sim: AtlasSimulator, events: list[tuple[int, Vector]], step: int) -> None:
-    """Set the pelvis force of the `events` (push_events) due at `step`, taking them off the
+def apply_pushes(sim: AtlasSimulator, events: list[tuple[int, Vector]], tick: int) -> None:
+    """Set the pelvis force of the `events` (push_events) due at `tick`, taking them off the
     list: the simulator's /atlas/apply_pelvis_force input, as a live push."""
-    while events and events[0][0] == step:
+    while events and events[0][0] == tick:
         sim.apply_input(wrench_input(events.pop(0)[1], (0.0, 0.0, 0.0)))
 
 

@@ -1,6 +1,6 @@
 """The Stand controller: balance on both feet at DRCSim's Stand pose.
 
-Each 1 ms step it builds the whole-body layer's tasks and constraints (whole_body.py) from
+Each 1 ms tick it builds the whole-body layer's tasks and constraints (whole_body.py) from
 its reference and solves them into the 28 joint torques:
 1. centroidal tasks: the horizontal force of the capture-point law (the centre of pressure
    p = xi + k (xi - xi_ref), kept inside the support polygon, gives F_xy = m omega^2 (c - p)),
@@ -135,7 +135,7 @@ def pelvis_frame(yaw_rad: float, pitch_rad: float = 0.0) -> np.ndarray:
 
 @dataclass(frozen=True)
 class StandOutput:
-    """One step's decision, kept for feedback and tests."""
+    """One tick's decision, kept for feedback and tests."""
 
     torque_nm: np.ndarray          # (28,)
     desired_cop: np.ndarray        # (2,) m, after clamping into the support polygon
@@ -145,7 +145,7 @@ class StandOutput:
 
 
 class StandController:
-    """Capture-point balance on both feet. Each step's torque depends on that step's state
+    """Capture-point balance on both feet. Each tick's torque depends on that tick's state
     alone; the only thing kept is the support region prepared for the estimator's polygon."""
 
     def __init__(self, mass_kg: float, effort_limit_nm: np.ndarray, reference: StandReference,
@@ -189,9 +189,9 @@ class StandController:
         """(force (3,) N, moment about the CoM (3,) N m) the contacts should exert."""
         return self.layer.centroidal_wrench(state, self.tasks(state, cop, self.reference))
 
-    def step(self, state: BalanceState, joint_positions: np.ndarray,
+    def tick(self, state: BalanceState, joint_positions: np.ndarray,
              joint_velocities: np.ndarray) -> StandOutput:
-        """The 28 joint torques (N m) for this step, clamped to the effort limits."""
+        """The 28 joint torques (N m) for this tick, clamped to the effort limits."""
         output = self.whole_body(state, self.desired_cop(state), state.in_contact,
                                  joint_positions, joint_velocities)
         self.layer.limit(output.torque_nm)

@@ -11,7 +11,7 @@ reference, none in the torque). A robot taken over standing straight under the h
 bends its knees instead of fighting it.
 `servo` moves the reference the same way to a pelvis height, yaw and lateral offset
 (Manipulate, balance/manipulate.py), or back to the Stand pose (carried to the stance).
-Each step it estimates the
+Each tick it estimates the
 state from the simulator's MjData and returns the controller's torque, which the simulator
 blends with the user's PID by k_effort as f_out.
 """
@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import math
 
 import mujoco
 import numpy as np
@@ -45,7 +46,7 @@ from tutorial_atlas_control.balance.stand import (
 )
 from tutorial_atlas_control.balance.stand_pose import place_in_stand_pose
 from tutorial_atlas_control.joints import JOINT_NAMES
-from tutorial_atlas_control.sim import AtlasModel
+from tutorial_atlas_control.sim import AtlasModel, Ground
 
 __all__ = ['TRANSITION_S', 'StandBehaviour', 'stand_pose_com_height_m']
 
@@ -114,7 +115,7 @@ class StandBehaviour:
         self.estimator = BalanceEstimator(atlas)
         self.com_height_m = stand_pose_com_height_m(atlas)
         self.controller: StandController | None = None
-        #: The last step's state and decision (None before the first), for feedback.
+        #: The last tick's state and decision (None before the first), for feedback.
         self.last_state: BalanceState | None = None
         self.last_output: StandOutput | None = None
         #: Manipulate's pelvis target as clamped (None: the Stand pose).
@@ -129,6 +130,7 @@ class StandBehaviour:
         #: The pelvis height (m) of the squat table's posture the reference is at or passing
         #: through (None: off the table, as after start()).
         self._table_height_m: float | None = None
+        self._ground: Ground | None = None
 
     @functools.cached_property
     def stand_height_m(self) -> float:
@@ -148,7 +150,17 @@ class StandBehaviour:
         puts them; staggered or turned, legs that reach the soles (the Stand pose's would
         push them against each other, and turn one on the ground)."""
         stance = self.stance.stance(state.sole_centres, state.sole_rotations, pelvis_yaw_rad)
-        return stance.posture_rad, self.com_height_m - stance.com_lowered_m
+        return (stance.posture_rad,
+                self.ground_under_m(state) + self.com_height_m - stance.com_lowered_m)
+
+    def ground_under_m(self, state: BalanceState) -> float:
+        """The ground's height (m) under the soles' centres, their mean: the Stand's heights
+        are over the world's ground, which is not z = 0 everywhere (0 off any ground)."""
+        if self._ground is None:
+            raise BalanceError('StandBehaviour.ground_under_m before start()')
+        heights = [self._ground.height_m(x, y) for x, y in state.sole_centres[:, :2].tolist()]
+        found = [height for height in heights if math.isfinite(height)]
+        return sum(found) / len(found) if found else 0.0
 
     @functools.cached_property
     def squats(self) -> SquatTable:
@@ -157,6 +169,8 @@ class StandBehaviour:
 
     def start(self, data: mujoco.MjData) -> None:
         """Stand where the robot stands now, going to the Stand pose over transition_s."""
+        if self._ground is None:  # the world's, its loose bodies where `data` has them
+            self._ground = Ground(self.atlas.model, data)
         state = self.estimator.estimate(data.qpos, data.qvel)
         held = StandReference.from_state(state, posture_rad=data.qpos[self.atlas.qpos_adr])
         self.controller = StandController(
@@ -198,7 +212,7 @@ class StandBehaviour:
         else:
             goal = StandReference(
                 feet.mean(axis=0) + target.lateral_m * left,
-                self.squats.com_for(target.height_m),
+                self.ground_under_m(state) + self.squats.com_for(target.height_m),
                 pelvis_frame(feet_yaw + target.yaw_rad, self.squats.pitch_for(target.height_m)),
                 self.squats.posture_for(target.height_m, target.yaw_rad))
         table_path = None
@@ -253,7 +267,7 @@ class StandBehaviour:
             posture_rate_rad_s=rate[:28])
 
     def torque(self, data: mujoco.MjData) -> np.ndarray:
-        """This step's f_out (N m, (28,)), within the effort limits."""
+        """This tick's f_out (N m, (28,)), within the effort limits."""
         controller = self.controller
         if controller is None:
             raise BalanceError('StandBehaviour.torque before start()')
@@ -261,6 +275,6 @@ class StandBehaviour:
             controller.reference = self._reference_at(float(data.time))
         atlas = self.atlas
         state = self.estimator.estimate(data.qpos, data.qvel)
-        output = controller.step(state, data.qpos[atlas.qpos_adr], data.qvel[atlas.dof_adr])
+        output = controller.tick(state, data.qpos[atlas.qpos_adr], data.qvel[atlas.dof_adr])
         self.last_state, self.last_output = state, output
         return output.torque_nm

@@ -45,7 +45,7 @@ class StandPrepBehaviour:
         return (1.0 - s) * initial + s * STAND_POSE_RAD
 
     def torque(self, data: mujoco.MjData) -> np.ndarray:
-        """This step's f_out (N m, (28,)); the simulator clamps it to the effort limits."""
+        """This tick's f_out (N m, (28,)); the simulator clamps it to the effort limits."""
         atlas = self.atlas
         return (self.kp * (self.target_at(float(data.time)) - data.qpos[atlas.qpos_adr])
                 - self.kd * data.qvel[atlas.dof_adr])

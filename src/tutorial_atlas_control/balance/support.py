@@ -1,7 +1,7 @@
 """The support polygon: the convex hull of the sole corners in contact, and keeping a
 desired centre of pressure inside it (a pressure centre cannot leave the feet).
 
-In plain floats: polygons of a few vertices, every 1 ms step, where numpy's per-call cost
+In plain floats: polygons of a few vertices, every 1 ms tick, where numpy's per-call cost
 would dominate.
 """
 

@@ -25,6 +25,7 @@ from tutorial_atlas_control.node import follow_own_clock, refuse_if_running, sim
 from tutorial_atlas_control.node.sim_node import NODE_NAME, build_node
 from tutorial_atlas_control.processes import PACKAGE
 from tutorial_atlas_control.resources import package_path
+from tutorial_atlas_control.sim import start_line
 
 HELP_OPTIONS = ('-h', '--help')
 #: What the master gives as the reason when another node registers under our name.
@@ -91,6 +92,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     rospy.loginfo(f'Atlas v1 simulator ready: dt={node.sim.dt_s * 1000:.1f} ms, '
                   f'real_time_factor={node.loop.real_time_factor}, paused={node.loop.paused}, '
                   f'torso pinned for {node.sim.time_to_unpin_s} s')
+    if node.sim.start is not None:
+        rospy.loginfo(start_line(node.sim.start, node.sim.start_qpos))
     for line in unknown_launch_arg_lines(os.getppid()):
         rospy.logwarn(line)
     status = node.spin()

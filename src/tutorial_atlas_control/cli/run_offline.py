@@ -6,17 +6,28 @@ from __future__ import annotations
 import argparse
 import tempfile
 from collections.abc import Sequence
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from tutorial_atlas_control.bags import analyze_bag, short_summary, summarise_walk, walk_lines
 from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED, EXIT_REFUSED, print_error
-from tutorial_atlas_control.course import MUD_DAMPING, CourseError, check_mud_damping
+from tutorial_atlas_control.course import (
+    MUD_DAMPING,
+    STARTS,
+    CourseError,
+    Start,
+    check_mud_damping,
+    parse_start,
+    world_start,
+)
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.offline import (
     DEFAULT_SETTLE_S,
     DEFAULT_START_AFTER_S,
+    OfflineWorld,
+    named_world,
     run_asi_offline,
     run_offline,
 )
@@ -81,10 +92,43 @@ def build_parser() -> argparse.ArgumentParser:
                         'command (default: %(default)g; the torso is pinned for 1 s)')
     parser.add_argument('--gains', type=Path, default=DEFAULT_GAINS_FILE, metavar='FILE',
                         help='controller gains YAML (default: config/atlas_controller.yaml)')
+    parser.add_argument('--world', type=_world, metavar='NAME',
+                        help='simulate DRCSim\'s VRC Task 2 world NAME (' + ', '.join(STARTS)
+                        + '): the course\'s model, the robot at that world\'s start (default: '
+                        'the flat world at the origin; with --asi-from: the recorded run\'s)')
+    parser.add_argument('--start', type=_start, metavar='START',
+                        help="start the robot at START: a world's start by name or 'x y z "
+                             "yaw' (m, rad; the soles put on the ground, z a hint only), in "
+                             'the flat world or --world\'s')
     parser.add_argument('--mud-damping', type=_mud_damping, default=MUD_DAMPING, metavar='C',
                         help="the mud's damping, N s/m, in a world with mud, as the node's "
                              '~mud_damping (default: %(default)g; the VRC finals: 70)')
     return parser
+
+
+def _world(text: str) -> str:
+    try:
+        return world_start(text).name
+    except CourseError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+
+
+def _start(text: str) -> Start | None:
+    try:
+        return parse_start(text)
+    except CourseError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+
+
+def _offline_world(world: str | None, start: Start | None,
+                   mud_damping: float = MUD_DAMPING) -> OfflineWorld | None:
+    """The model, start and mud --world, --start and --mud-damping ask for (None: none)."""
+    chosen = named_world(world) if world is not None else None
+    if start is not None:
+        chosen = OfflineWorld(start=start) if chosen is None else replace(chosen, start=start)
+    if mud_damping != MUD_DAMPING:
+        chosen = replace(chosen or OfflineWorld(), mud_damping=mud_damping)
+    return chosen
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -101,15 +145,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         with tempfile.TemporaryDirectory(prefix='tac_offline_') as scratch:
             # Without --bag the summary is read from a bag that is deleted afterwards.
             bag = args.bag if args.bag is not None else Path(scratch) / 'offline.bag'
+            world = _offline_world(args.world, args.start, args.mud_damping)
             if args.asi_from is not None:
                 run = run_asi_offline(args.asi_from, bag, args.settle, args.gains,
-                                      args.behaviour)
+                                      args.behaviour, world)
                 what = f'{args.asi_from}: {run.commands} AtlasSimInterface commands applied'
             else:
                 trajectory_file = locate_trajectory_file(args.trajectory_file, announce=print)
                 run = run_offline(trajectory_file, args.name, bag, args.settle,
-                                  args.start_after, args.gains, play_after_s=args.play_after,
-                                  mud_damping=args.mud_damping)
+                                  args.start_after, args.gains, world, args.play_after)
                 what = f'{args.name}: {run.commands} commands'
             analysis = analyze_bag(run.bag)
             walk = summarise_walk(analysis.data) if args.asi_from is not None else None

@@ -3,7 +3,9 @@
 errors: CourseError, what the course refuses; mud: DRCSim's MudPlugin as a law (the drag a
 touching link feels, explicit and as ODE solved it, moved to the centre of mass);
 vrc_task_2: the course's figures (the heightmap's scaling, the gates, the pen, the mud, the
-starts), the one description the world, the mud and the scoring read.
+starts), the one description the world, the mud and the scoring read; starts: where a run
+starts Atlas (a world's start by name, or 'x y z yaw'), checked once for the node, the
+launches and offline runs.
 """
 
 from tutorial_atlas_control.exports import lazy_exports
@@ -12,6 +14,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'errors': ['CourseError'],
     'mud': ['MAX_MUD_DAMPING', 'check_mud_damping', 'drag_at_point', 'drag_wrench',
             'implicit_drag', 'wrench_at_com'],
+    'starts': ['WORLD_MODEL_FILE', 'parse_start', 'start_text', 'world_start'],
     'vrc_task_2': ['GATES', 'HEIGHTMAP', 'MUD_BOX', 'MUD_DAMPING', 'MUD_DAMPING_FINALS',
                    'MUD_LINKS', 'STARTS', 'WORLD_NAME', 'Box', 'Gate',
                    'Heightmap', 'Start'],

@@ -53,6 +53,10 @@ Parameters (private unless noted):
         ~stand balance.
     ~model_file (str, the package's sim/atlas_v1.xml): the MJCF to simulate; it must have
         Atlas v1's joints, actuators and sensors (a variant of the package's model).
+    ~start (str, ''): where the robot starts and every reset puts it: a VRC Task 2 world's
+        start by name (vrc_task_2, vrc_task_2_mud_start, ...) or 'x y z yaw' (m, rad); the
+        pelvis at (x, y) turned by yaw, its z putting the soles on the model's ground (z is
+        a hint only). '': the model's spawn pose at the origin.
     /atlas/time_to_unpin (float, 1.0): seconds the torso stays pinned after start/reset.
     /atlas/startup_mode (str, pinned_with_gravity): VRCPlugin's start (sim/vrc.py STARTUP_MODES).
     atlas_controller/gains/<joint>/{p,i,d,i_clamp}: the gains Stand/Freeze/User-hold use.
@@ -100,7 +104,13 @@ from tutorial_atlas_control import topics
 from tutorial_atlas_control.asi import load_user_behaviour
 from tutorial_atlas_control.bags import unwritable_reason
 from tutorial_atlas_control.control_modes import ControlMode
-from tutorial_atlas_control.course import MUD_DAMPING, check_mud_damping
+from tutorial_atlas_control.course import (
+    MUD_DAMPING,
+    CourseError,
+    Start,
+    check_mud_damping,
+    parse_start,
+)
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.node.cheats import WARN_THROTTLE_S, subscribe_cheats
@@ -500,11 +510,9 @@ def build_node() -> SimNode:
     if stand not in STAND_CHOICES:
         raise AtlasControlError(f'parameter {rospy.resolve_name("~stand")} must be one of '
                                 f'{", ".join(STAND_CHOICES)}, got {stand!r}')
-    # The MudPlugin's damping (N s/m), used in a world with a `mud_atlas` box (sim.mud).
-    mud_damping = check_mud_damping(rospy.get_param('~mud_damping', MUD_DAMPING),
-                                    f'parameter {rospy.resolve_name("~mud_damping")}')
     sim = AtlasSimulator(load_model(Path(model_file)), gains, time_to_unpin_s,
-                         startup_mode=VrcMode(startup_mode), mud_damping=mud_damping)
+                         startup_mode=VrcMode(startup_mode), start=_start_param(),
+                         mud_damping=_mud_damping_param())
     behaviour_spec = rospy.get_param('~behaviour', '')
     if not isinstance(behaviour_spec, str):
         raise AtlasControlError(f'parameter {rospy.resolve_name("~behaviour")} must be '
@@ -523,6 +531,22 @@ def build_node() -> SimNode:
                             user_behaviour=user_behaviour)
     return SimNode(sim, settings, bool(rospy.get_param('~gui', False)),
                    description is not None, DelayBudgets.from_params(rospy.get_param))
+
+
+def _mud_damping_param() -> float:
+    """~mud_damping: the MudPlugin's damping (N s/m) in a world with a `mud_atlas` box
+    (sim.mud); its error names the parameter."""
+    return check_mud_damping(rospy.get_param('~mud_damping', MUD_DAMPING),
+                             f'parameter {rospy.resolve_name("~mud_damping")}')
+
+
+def _start_param() -> Start | None:
+    """~start as a start (None: unset or ''); its error names the parameter."""
+    text = rospy.get_param('~start', '')
+    try:
+        return parse_start(text if isinstance(text, str) else repr(text))
+    except CourseError as err:
+        raise AtlasControlError(f'parameter {rospy.resolve_name("~start")}: {err}') from None
 
 
 def _check_bag_dir() -> None:

@@ -1,5 +1,6 @@
 """Runs without ROS: the offline trajectory player, an AtlasSimInterface session played again,
-and the replay of a recorded run."""
+and the replay of a recorded run; world: the model and start they simulate (a VRC world by
+name, or the recorded run's)."""
 
 from tutorial_atlas_control.exports import lazy_exports
 
@@ -8,4 +9,5 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'player': ['CommandLatency', 'DEFAULT_SETTLE_S', 'DEFAULT_START_AFTER_S', 'OfflineRunError',
                'run_offline', 'write_offline_bag'],
     'replay': ['DEFAULT_TOLERANCE', 'ReplayError', 'format_report', 'replay_bag'],
+    'world': ['OfflineWorld', 'named_world', 'recorded_world'],
 })

@@ -16,6 +16,7 @@ its torques).
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -33,6 +34,7 @@ from tutorial_atlas_control.offline.player import (
     open_offline_bag,
     write_whole,
 )
+from tutorial_atlas_control.offline.world import OfflineWorld, recorded_world
 from tutorial_atlas_control.sim import (
     DEFAULT_GAINS_FILE,
     AtlasSimulator,
@@ -58,6 +60,8 @@ class AsiStream:
     commands: list[tuple[int, bytes]]
     #: The sim time (ns) of the bag's last record: the offline run goes on that long.
     end_ns: int
+    #: The recorded run's model and start (its /atlas/sim_config's).
+    world: OfflineWorld = OfflineWorld()
 
 
 def read_asi_stream(path: Path | str) -> AsiStream:
@@ -79,6 +83,7 @@ def read_asi_stream(path: Path | str) -> AsiStream:
     try:
         config = SimConfig.from_dict(parse_sim_config(data.sim_configs[0][1]))
         startup_mode = VrcMode(config.startup_mode)
+        world = recorded_world(config)
     except (SimConfigError, ValueError) as err:
         raise OfflineRunError(f'{source}: {topics.SIM_CONFIG}: {err}') from None
     records = open_bag(source)
@@ -91,7 +96,7 @@ def read_asi_stream(path: Path | str) -> AsiStream:
         raise OfflineRunError(f'{source}: holds no {topics.ASI_COMMAND} message to play')
     end_ns = int(round((data.start_time_s + data.duration_s) * NS_PER_S))
     return AsiStream(source, startup_mode, [(int(t), bytes(raw)) for t, raw in
-                                            zip(list(bag_ns), raws)], end_ns)
+                                            zip(list(bag_ns), raws)], end_ns, world)
 
 
 class _AsiFeed:
@@ -128,8 +133,9 @@ def write_asi_bag(stream: AsiStream, bag: Path, settle_s: float,
                   gains_file: Path = DEFAULT_GAINS_FILE, behaviour: str = '') -> OfflineRun:
     """Play `stream` offline and write the run to `bag` (a new file); `behaviour`: a user's
     own (`module:Class` or `file.py:Class`), as atlas.launch's argument."""
-    sim = AtlasSimulator(load_model(), load_gains_yaml(gains_file),
-                         startup_mode=stream.startup_mode)
+    sim = AtlasSimulator(load_model(stream.world.model_path), load_gains_yaml(gains_file),
+                         startup_mode=stream.startup_mode, start=stream.world.start,
+                         mud_damping=stream.world.mud_damping)
     user = load_user_behaviour(behaviour, sim.atlas) if behaviour else None
     # atlas.launch's default start
     interface = AtlasSimInterface(sim, hold_at_start=True, user_behaviour=user)
@@ -152,11 +158,13 @@ def write_asi_bag(stream: AsiStream, bag: Path, settle_s: float,
 
 
 def run_asi_offline(source: Path | str, bag: Path | str, settle_s: float = DEFAULT_SETTLE_S,
-                    gains_file: Path = DEFAULT_GAINS_FILE, behaviour: str = '') -> OfflineRun:
+                    gains_file: Path = DEFAULT_GAINS_FILE, behaviour: str = '',
+                    world: OfflineWorld | None = None) -> OfflineRun:
     """Play the AtlasSimInterface session recorded in `source` offline into the bag `bag`
     (written under a temporary name beside it and renamed when complete: a failed run
     leaves nothing); `settle_s` of sim time after the recording's end; `behaviour`: a
-    user's own, as the live run had it (atlas.launch's `behaviour`).
+    user's own, as the live run had it (atlas.launch's `behaviour`); `world`: another model
+    and start than the recorded run's.
 
     Raises:
         BagAnalysisError, OfflineRunError, GainsError, UserBehaviourError: bad inputs
@@ -164,6 +172,8 @@ def run_asi_offline(source: Path | str, bag: Path | str, settle_s: float = DEFAU
             diverged.
     """
     stream = read_asi_stream(source)
+    if world is not None:
+        stream = dataclasses.replace(stream, world=world)
     load_gains_yaml(gains_file)
     if behaviour:
         load_user_behaviour(behaviour, load_model())

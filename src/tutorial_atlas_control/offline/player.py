@@ -39,13 +39,13 @@ from tutorial_atlas_control.bags import (
     rosbags_msgtype,
 )
 from tutorial_atlas_control.command import CommandError, CommandUpdate
-from tutorial_atlas_control.course import MUD_DAMPING, check_mud_damping
+from tutorial_atlas_control.course import check_mud_damping
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES
 from tutorial_atlas_control.msgs import CommandDecoder, JointCommandsWire, StampedWire, clock_bytes
+from tutorial_atlas_control.offline.world import OfflineWorld
 from tutorial_atlas_control.sim import (
     DEFAULT_GAINS_FILE,
-    MODEL_PATH,
     TCPROS_PREFIX_BYTES,
     AtlasSimulator,
     ControlMode,
@@ -400,19 +400,21 @@ def _command_wire(gains: Gains) -> JointCommandsWire:
 
 def write_offline_bag(bag: Path, trajectory_file: str, name: str, waypoints: Sequence[Waypoint],
                       gains: Gains, settle_s: float, start_after_s: float,
-                      model_path: Path = MODEL_PATH,
+                      world: OfflineWorld | None = None,
                       play_after_s: float = 0.0,
                       on_step: StepHook | None = None,
-                      latency: CommandLatency | None = None,
-                      mud_damping: float = MUD_DAMPING) -> OfflineRun:
+                      latency: CommandLatency | None = None) -> OfflineRun:
     """Simulate the run and write it to `bag` (a new file; see run_offline for the checks).
 
     `on_step`, if given, is called with the simulator after every step (and its messages):
     the sweep measures a run there, and applies its pushes, without reading the bag back.
     `latency`, if given, delays each command as a live run's delivery does (CommandLatency).
-    `mud_damping` (N s/m): the MudPlugin's in a world with mud (sim.mud), as ~mud_damping.
+    `world`: the model, the start and the mud's damping (None: the flat world's, at the
+    origin).
     """
-    sim = AtlasSimulator(load_model(model_path), gains, mud_damping=mud_damping)
+    world = world or OfflineWorld()
+    sim = AtlasSimulator(load_model(world.model_path), gains, start=world.start,
+                         mud_damping=world.mud_damping)
     sink = open_offline_bag(bag)
     # The run's time, without loading the model and the message types (fixed costs).
     started_s = time.perf_counter()
@@ -440,14 +442,13 @@ def run_offline(trajectory_file: str, name: str, bag: Path | str,
                 settle_s: float = DEFAULT_SETTLE_S,
                 start_after_s: float = DEFAULT_START_AFTER_S,
                 gains_file: Path = DEFAULT_GAINS_FILE,
-                model_path: Path = MODEL_PATH,
-                play_after_s: float = 0.0,
-                mud_damping: float = MUD_DAMPING) -> OfflineRun:
+                world: OfflineWorld | None = None,
+                play_after_s: float = 0.0) -> OfflineRun:
     """Run trajectory `name` of `trajectory_file` offline into the bag `bag`.
 
     User mode starts `start_after_s` after spawn and the trajectory `play_after_s` later (a
     live traj_yaml.py starts a few seconds after the switch: to re-create a live run, give
-    both from its bag).
+    both from its bag). `world`: the model and start (None: the flat world at the origin).
 
     The bag is written under a temporary name beside `bag` and renamed when complete
     (replacing an existing file): a failed run leaves nothing.
@@ -457,13 +458,14 @@ def run_offline(trajectory_file: str, name: str, bag: Path | str,
             simulating).
         OfflineRunError: `bag`'s directory does not exist, or the physics diverged.
     """
-    check_mud_damping(mud_damping)
+    if world is not None:
+        check_mud_damping(world.mud_damping)
     path = locate_trajectory_file(trajectory_file)
     waypoints = load_trajectory(path, name)
     gains = load_gains_yaml(gains_file)
     return write_whole(Path(bag), lambda partial: write_offline_bag(
         partial, os.path.abspath(path), name, waypoints, gains, settle_s, start_after_s,
-        model_path, play_after_s, mud_damping=mud_damping))
+        world, play_after_s))
 
 
 def write_whole(target: Path, write: Callable[[Path], OfflineRun]) -> OfflineRun:

@@ -38,13 +38,13 @@ import numpy as np
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags import BagData, Try, find_tries, pick_try, read_bag, window
-from tutorial_atlas_control.course import MUD_DAMPING
+from tutorial_atlas_control.course import CourseError
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.offline.world import recorded_world
 from tutorial_atlas_control.sim import (
     DEFAULT_GAINS_FILE,
     DEFAULT_TIME_TO_UNPIN_S,
-    MODEL_PATH,
     STARTUP_MODES,
     AtlasSimulator,
     InputError,
@@ -544,9 +544,10 @@ def _replay_recorded(sim: AtlasSimulator, steps: np.ndarray, effort_nm: np.ndarr
 
 def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
            gains_file: Path = DEFAULT_GAINS_FILE,
-           model_path: Path = MODEL_PATH) -> ReplayResult:
-    """Re-simulate `recording` with the model at `model_path` (the run's own for an exact
-    replay; its mud with the config's mud_damping) and measure how far it strays.
+           model_path: Path | None = None) -> ReplayResult:
+    """Re-simulate `recording` and measure how far it strays from the recorded run: in the
+    world its config names (offline.world), or the model at `model_path`; in a world with
+    mud, with the config's mud_damping.
 
     Raises:
         ReplayError: unsupported recording (timestep differs from the model's; steps before
@@ -557,10 +558,14 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
     if config.startup_mode not in STARTUP_MODES:
         raise ReplayError(f'{SIM_CONFIG_TOPIC} startup_mode {config.startup_mode!r} is not '
                           f'one of {", ".join(STARTUP_MODES)}.')
-    sim = AtlasSimulator(load_model(model_path), load_gains_yaml(gains_file),
-                         config.time_to_unpin_s, startup_mode=VrcMode(config.startup_mode),
-                         mud_damping=(MUD_DAMPING if config.mud_damping is None
-                                      else config.mud_damping))
+    try:
+        world = recorded_world(config)
+    except CourseError as err:
+        raise ReplayError(f'{err}.') from None
+    sim = AtlasSimulator(load_model(model_path or world.model_path),
+                         load_gains_yaml(gains_file), config.time_to_unpin_s,
+                         startup_mode=VrcMode(config.startup_mode), start=world.start,
+                         mud_damping=world.mud_damping)
     sha1_matches = _check_model(config, sim, warnings)
     step_ns = sim.step_ns
     reset_step = _reset_step(config, step_ns)
@@ -597,7 +602,7 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
 
 def replay_bag(path: Path | str, tolerance: float = DEFAULT_TOLERANCE,
                try_number: int | None = None, assume_defaults: bool = False,
-               model_path: Path = MODEL_PATH) -> ReplayResult:
+               model_path: Path | None = None) -> ReplayResult:
     """:func:`load_recording` (of try `try_number`, None: the last) then :func:`replay`."""
     return replay(load_recording(path, try_number=try_number,
                                  assume_defaults=assume_defaults), tolerance,

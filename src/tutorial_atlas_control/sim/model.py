@@ -7,6 +7,7 @@ over joints in Python.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -130,21 +131,28 @@ def load_model(path: Path = MODEL_PATH) -> AtlasModel:
     )
 
 
-def reset_to_initial(atlas: AtlasModel, data: mujoco.MjData) -> None:
-    """Every joint at 0, pelvis upright at SPAWN_HEIGHT_M, at rest, unpinned."""
+#: The pelvis's free-joint qpos at the flat world's start: the origin, upright, facing +x.
+ORIGIN_PELVIS_QPOS = (0.0, 0.0, SPAWN_HEIGHT_M, 1.0, 0.0, 0.0, 0.0)
+
+
+def reset_to_initial(atlas: AtlasModel, data: mujoco.MjData,
+                     pelvis_qpos: Sequence[float] | np.ndarray = ORIGIN_PELVIS_QPOS) -> None:
+    """Every joint at 0, the pelvis at `pelvis_qpos` (x y z, quaternion w x y z; default:
+    upright at the origin at SPAWN_HEIGHT_M), at rest, unpinned."""
     mujoco.mj_resetData(atlas.model, data)
     adr = atlas.free_qpos_adr
     data.qpos[atlas.qpos_adr] = 0.0
-    data.qpos[adr:adr + 7] = (0.0, 0.0, SPAWN_HEIGHT_M, 1.0, 0.0, 0.0, 0.0)
+    data.qpos[adr:adr + 7] = pelvis_qpos
     data.eq_active[atlas.pin_eq_id] = 0
     mujoco.mj_forward(atlas.model, data)
 
 
 def set_pelvis_pinned(atlas: AtlasModel, data: mujoco.MjData, pinned: bool) -> None:
-    """Weld the pelvis to its spawn pose (DRCSim's start-up pin) or release it.
+    """Weld the pelvis to its start pose (DRCSim's start-up pin) or release it.
 
-    The weld holds the pose the model file spawns the pelvis at, so pin only
-    while the pelvis is there (e.g. right after reset_to_initial).
+    The weld holds the pose its data was last set to (the model file's spawn pose, or the
+    start's: vrc.VrcState.reset), so pin only while the pelvis is there (e.g. right after
+    reset_world).
     """
     data.eq_active[atlas.pin_eq_id] = 1 if pinned else 0
 

@@ -43,6 +43,9 @@ class SimConfig:
     last_reset_time_s: float
     recorded: bool = True
     startup_mode: str = DEFAULT_STARTUP_MODE
+    #: Where the robot starts (course.parse_start's text; '': the model's spawn pose at
+    #: the origin), written only when given.
+    start: str = ''
     mud_damping: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
@@ -56,6 +59,8 @@ class SimConfig:
         }
         if self.startup_mode != DEFAULT_STARTUP_MODE:
             config['startup_mode'] = self.startup_mode
+        if self.start:
+            config['start'] = self.start
         if self.mud_damping is not None:
             config['mud_damping'] = self.mud_damping
         return config
@@ -79,6 +84,7 @@ class SimConfig:
                 time_to_unpin_s=float(config['time_to_unpin']),
                 last_reset_time_s=float(config['last_reset_time']),
                 startup_mode=str(config.get('startup_mode', DEFAULT_STARTUP_MODE)),
+                start=str(config.get('start', '')),
                 mud_damping=(None if config.get('mud_damping') is None
                              else float(config['mud_damping'])))
         except (KeyError, TypeError, ValueError) as err:

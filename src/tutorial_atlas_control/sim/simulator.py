@@ -19,7 +19,7 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control.command import CommandUpdate, JointCommandArrays
-from tutorial_atlas_control.course import MUD_DAMPING
+from tutorial_atlas_control.course import MUD_DAMPING, Start, start_text
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.behaviour import Behaviour, ModeBehaviours
@@ -30,6 +30,7 @@ from tutorial_atlas_control.sim.divergence import (
     DivergenceCheck,
     PhysicsDivergenceError,
 )
+from tutorial_atlas_control.sim.ground import Ground
 from tutorial_atlas_control.sim.joint_law import JointLaw
 from tutorial_atlas_control.sim.mode_commands import (
     GAIN_FIELDS,
@@ -42,6 +43,7 @@ from tutorial_atlas_control.sim.mode_commands import (
 )
 from tutorial_atlas_control.sim.mud import MudDrag
 from tutorial_atlas_control.sim.sim_config import SimConfig
+from tutorial_atlas_control.sim.start_pose import home_qpos
 from tutorial_atlas_control.sim.startup_pin import StartupEvent, StartupPin
 from tutorial_atlas_control.sim.vrc import (
     DEFAULT_STARTUP_MODE,
@@ -69,20 +71,30 @@ _NO_PID.setflags(write=False)
 DEFAULT_TIME_TO_UNPIN_S = 1.0
 
 
-class AtlasSimulator:
-    """One Atlas in MuJoCo, driven by DRCSim's per-joint controller law.
+def _placed_cheats(atlas: atlas_model.AtlasModel, data: mujoco.MjData, start: Start | None
+                   ) -> tuple[Ground, np.ndarray, VrcState]:
+    """The world's ground, the pelvis's qpos (7,) at `start` (soles on that ground; None:
+    the origin) and VRCPlugin's cheats (modes, teleport, cmd_vel, pelvis wrench, kinematic
+    playback) pinning there."""
+    ground = Ground(atlas.model, data)
+    qpos = home_qpos(atlas, start, ground)
+    return ground, qpos, VrcState(atlas, data, ground, None if start is None else qpos)
 
-    Not thread-safe: the ROS node calls every method under its own lock.
-    """
+
+class AtlasSimulator:
+    """One Atlas in MuJoCo, driven by DRCSim's per-joint controller law. Not thread-safe:
+    the ROS node calls every method under its own lock."""
 
     def __init__(self, atlas: atlas_model.AtlasModel, gains: Gains,
                  time_to_unpin_s: float = DEFAULT_TIME_TO_UNPIN_S,
                  compiled_law: bool = True,
                  startup_mode: VrcMode = DEFAULT_STARTUP_MODE,
+                 start: Start | None = None,
                  mud_damping: float = MUD_DAMPING) -> None:
         """`compiled_law`: run the law through law_kernel's C kernel when it is built
         (the same torques bit for bit, faster); False: always controller.compute_torque.
-        `startup_mode`: one of vrc.STARTUP_MODES, what reset_world starts the robot in.
+        `startup_mode`: one of vrc.STARTUP_MODES, what reset_world starts the robot in;
+        `start`: where, soles on the ground (None: the origin; ModelError: no ground);
         `mud_damping`: the MudPlugin's damping (N s/m) in a world with mud (sim.mud)."""
         # A model of its own: the cheats move the pin weld's target (model.eq_data), which
         # must not move the pin of another simulator sharing the compiled model.
@@ -102,8 +114,9 @@ class AtlasSimulator:
         self.behaviours = ModeBehaviours()  # install_stand
         self._check_divergence = DivergenceCheck(self.data, self.law.state_is_finite).check
         self.sim_time_ns = 0
-        # VRCPlugin's cheats (modes, teleport, cmd_vel, pelvis wrench, kinematic playback).
-        self.vrc = VrcState(atlas, self.data)
+        self.start = start
+        # VRCPlugin's cheats, pinning at reset_world's pelvis qpos; the world's ground.
+        self.ground, self.start_qpos, self.vrc = _placed_cheats(atlas, self.data, start)
         self.mud = MudDrag.for_model(self.model, atlas.path, mud_damping)  # None: no mud
         self.startup_pin = StartupPin(atlas, self.data, self.vrc, time_to_unpin_s, startup_mode)
         #: How many inputs were applied since the last reset, and the last one (sim time (ns)
@@ -128,7 +141,7 @@ class AtlasSimulator:
     # -- state -------------------------------------------------------------------------
     def reset_world(self) -> None:
         """Robot back to its initial state (pinned again), sim time kept, as Gazebo did."""
-        atlas_model.reset_to_initial(self.atlas, self.data)
+        atlas_model.reset_to_initial(self.atlas, self.data, self.start_qpos)
         self.data.time = self.sim_time_ns / NS_PER_S
         self.last_reset_ns = self.sim_time_ns
         self.state_time_ns = self.sim_time_ns
@@ -153,18 +166,17 @@ class AtlasSimulator:
         self.commands.user_command = hold_command(self.gains, STAND_POSE_RAD)  # k_effort 1
 
     def config(self) -> SimConfig:
-        """What re-creates this run offline: the model, its step, pinning and last reset."""
+        """What re-creates this run offline: the model, its step, start, pin, last reset."""
         return SimConfig(model_file=self.atlas_path.name, model_sha1=self.atlas_sha1,
                          timestep_s=self.dt_s, time_to_unpin_s=self.time_to_unpin_s,
                          last_reset_time_s=self.last_reset_ns / NS_PER_S,
                          startup_mode=self.startup_mode.value,
+                         start=start_text(self.start) if self.start else '',
                          mud_damping=None if self.mud is None else self.mud.damping)
 
     def reset_simulation(self, sim_time_ns: int = 0) -> None:
-        """reset_world, and sim time back to `sim_time_ns`.
-
-        Gazebo's reset_simulation restarts at 0; replay restarts at a recorded reset.
-        """
+        """reset_world, and sim time back to `sim_time_ns` (Gazebo's reset_simulation
+        restarts at 0; replay restarts at a recorded reset)."""
         self.sim_time_ns = sim_time_ns
         self.reset_world()
 

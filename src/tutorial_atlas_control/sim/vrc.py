@@ -33,6 +33,7 @@ import numpy as np
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.sim import model as atlas_model
+from tutorial_atlas_control.sim.ground import Ground
 
 __all__ = [
     'DEFAULT_STARTUP_MODE', 'STARTUP_MODES', 'VALID_VRC_MODES', 'CmdVelInput', 'InputError',
@@ -81,7 +82,7 @@ STAND_POSE_RAD: np.ndarray = np.array([
 STAND_POSE_RAD.setflags(write=False)
 
 #: `harnessed` lifts the robot upright with DRCSim's pin link (utorso) this high (m) above
-#: the ground (the port's ground is the plane z = 0): the pelvis ends 4.3 cm above standing.
+#: the ground under it: the pelvis ends 4.3 cm above standing.
 HARNESS_UTORSO_HEIGHT_M = 1.11
 #: The links `feet` leaves under gravity (VRCPlugin's names).
 FEET_BODIES = ('l_foot', 'r_foot')
@@ -355,11 +356,16 @@ class VrcState:
     simulator's step then runs exactly as without this class.
     """
 
-    def __init__(self, atlas: atlas_model.AtlasModel, data: mujoco.MjData) -> None:
+    def __init__(self, atlas: atlas_model.AtlasModel, data: mujoco.MjData,
+                 ground: Ground | None = None, home_qpos: np.ndarray | None = None) -> None:
+        """`ground`: the world's ground, which `harnessed` lifts the robot above (None: the
+        plane z = 0); `home_qpos`: the pelvis's start pose (set_home; None: the model's)."""
         self.atlas = atlas
         self.model = model = atlas.model
         self.data = data
+        self.ground = ground
         self._pin_eq_data = model.eq_data[atlas.pin_eq_id].copy()
+        self._home_z_m = atlas_model.SPAWN_HEIGHT_M
         # The force that cancels each body's weight, at its centre of mass (N, world frame).
         self._weight_counter = -model.body_mass[:, None] * model.opt.gravity[None, :]
         self._feet = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name)
@@ -372,6 +378,8 @@ class VrcState:
             float(probe.xpos[utorso, 2] - probe.xpos[atlas.pelvis_body_id, 2]) if utorso >= 0
             else 0.0)
         self.xfrc = np.zeros((model.nbody, 6))
+        if home_qpos is not None:
+            self.set_home(home_qpos)
         self.reset()
 
     def reset(self) -> None:
@@ -380,14 +388,27 @@ class VrcState:
         self.gravity_off = np.zeros(self.model.nbody, dtype=bool)
         self.wrench = np.zeros(6)
         self.warp: CmdVelInput | None = None
-        self.warp_z_m = atlas_model.SPAWN_HEIGHT_M
+        self.warp_z_m = self._home_z_m
         self.playback: _Playback | None = None
         self.active = False
 
+    def set_home(self, pelvis_qpos: np.ndarray) -> None:
+        """The start the robot is reset to (the pelvis's qpos (7,)): the start-up pin's weld
+        holds it from the next reset on, and cmd_vel's warp starts at its height."""
+        relpos, relquat = np.zeros(3), np.zeros(4)
+        mujoco.mju_negPose(relpos, relquat, pelvis_qpos[:3], pelvis_qpos[3:7])
+        self._pin_eq_data[0:3] = 0.0
+        self._pin_eq_data[3:6] = relpos
+        self._pin_eq_data[6:10] = relquat
+        self._home_z_m = float(pelvis_qpos[2])
+
     # -- state ---------------------------------------------------------------------------
-    @property
-    def harness_pelvis_z_m(self) -> float:
-        return HARNESS_UTORSO_HEIGHT_M - self._utorso_above_pelvis_m
+    def harness_pelvis_z_m(self, x_m: float, y_m: float) -> float:
+        """The pelvis height (m) `harnessed` lifts the robot to over world (x, y)."""
+        ground_m = self.ground.height_m(x_m, y_m) if self.ground is not None else 0.0
+        if not math.isfinite(ground_m):  # off the world's ground: as over the plane
+            ground_m = 0.0
+        return ground_m + HARNESS_UTORSO_HEIGHT_M - self._utorso_above_pelvis_m
 
     def pelvis_pose(self) -> tuple[np.ndarray, np.ndarray]:
         adr = self.atlas.free_qpos_adr
@@ -448,7 +469,7 @@ class VrcState:
             return
         if mode is VrcMode.HARNESSED:
             pos, _ = self.pelvis_pose()
-            pos[2] = self.harness_pelvis_z_m
+            pos[2] = self.harness_pelvis_z_m(float(pos[0]), float(pos[1]))
             quat = np.array([1.0, 0.0, 0.0, 0.0])
             self._set_pelvis_pose(pos, quat)
             self._still_pelvis()

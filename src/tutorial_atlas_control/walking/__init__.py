@@ -5,9 +5,9 @@ names it, DRCSim's fixed queue, straight and circular plans, a streaming client'
 status_flags: walk_feedback's and step_feedback's status values; step_queue: Walk's queue
 of steps merged by index, clamped to what the legs reach, and its feedback flags;
 dcm_plan: the capture point's plan over the steps; step_adjustment: where a pushed swing
-foot must land instead; swing: the swing foot's path; phases: the phase clock and the
-rules that end Walk's and Step's phases (settled, touched down, the swing begun);
-leg_tasks: what Walk and Step do alike each step (the whole-body law on the carrying soles,
+foot must land instead; swing: the swing foot's path; phases: the one phase machine
+Walk and Step run (their phases in order, each one's end rule, the transition);
+leg_tasks: what Walk and Step do alike each tick (the whole-body law on the carrying soles,
 the swing foot, the pelvis's heading); walk: the walk's phases; walk_behaviour: Walk as the
 simulator's behaviour;
 start_noise: a trial's start perturbed by a seed; walk_trial: offline walking trials,
@@ -18,23 +18,16 @@ Step as the simulator's behaviour.
 from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
-    'dcm_plan': ['DcmPlan'],
     'errors': ['WalkingError'],
-    'footsteps': ['DRCSIM_WALK_QUEUE', 'LEFT', 'QUEUE_LENGTH', 'RIGHT', 'STANCE_WIDTH_M',
-                  'STEP_DURATION_S', 'Footstep', 'circle_steps', 'placed', 'side_sign',
-                  'straight_steps', 'window', 'wrap_angle'],
+    'footsteps': ['DRCSIM_WALK_QUEUE', 'LEFT', 'QUEUE_LENGTH', 'RIGHT', 'STEP_DURATION_S',
+                  'Footstep', 'circle_steps', 'placed', 'straight_steps', 'window', 'wrap_angle'],
     'status_flags': ['CATCHING', 'ERROR_INCONSISTENT_STEPS', 'OKAY', 'STEPPING', 'SWAYING',
                      'WARNING_INSUFFICIENT_STEP_DATA'],
-    'step_queue': ['StepLimits', 'StepQueue', 'clamp_pose', 'clamp_step'],
-    'step_adjustment': ['foothold_shift', 'predicted_error'],
-    'swing': ['SWING_HEIGHT_M', 'SwingPath', 'bump', 'quintic'],
-    'leg_tasks': ['LEG_JOINTS', 'LegGains', 'LegTasks', 'foot_pose'],
-    'phases': ['PhaseClock', 'settled', 'swing_to', 'touched_down'],
-    'walk': ['WalkController', 'WalkGains', 'WalkOutput'],
+    'swing': ['SWING_HEIGHT_M'],
+    'walk': ['WalkGains'],
     'walk_behaviour': ['WalkBehaviour', 'WalkStatus'],
-    'start_noise': ['DEFAULT_START_NOISE', 'StartNoise', 'perturb_start'],
-    'walk_trial': ['Landing', 'WalkTrial', 'WalkingStand', 'pushed_walk_trial',
-                   'random_pushes', 'straight_walk_trial', 'walk_started_s', 'walk_trial'],
-    'static_step': ['StaticStep', 'StepGains'],
+    'start_noise': ['perturb_start'],
+    'walk_trial': ['WalkTrial', 'pushed_walk_trial', 'random_pushes', 'straight_walk_trial',
+                   'walk_trial'],
     'step_behaviour': ['StepBehaviour', 'StepStatus'],
 })

@@ -1,4 +1,4 @@
-"""What Walk and Step do alike each 1 ms step: the Stand's tasks on the whole-body layer
+"""What Walk and Step do alike each 1 ms tick: the Stand's tasks on the whole-body layer
 (balance/whole_body.py) over the feet that carry the robot, with the legs' own reference
 (the pelvis turned towards the feet's heading, lowered to the walking height: the Stand's
 own reference is not touched), a swing foot servoed along its path, a foot that should be
@@ -137,7 +137,7 @@ class LegTasks:
              duration_s: float) -> None:
         """Turn the pelvis, upright, to face halfway between two feet's headings over
         `duration_s` (a smoothstep from where its heading is now: a jump in the heading's
-        reference at each step kicked the pelvis, which the stance sole's little yaw
+        reference at each tick kicked the pelvis, which the stance sole's little yaw
         moment could not stop)."""
         now = self.heading(time_s)
         goal = first_yaw_rad + 0.5 * wrap_angle(second_yaw_rad - first_yaw_rad)
@@ -261,7 +261,7 @@ def _clamp_to_sole(state: BalanceState, foot: int, reach_m: tuple[float, float],
                    point_xy: np.ndarray) -> np.ndarray:
     """`point_xy` moved to the nearest point of one sole's rectangle reaching `reach_m`
     from its centre along and across it (in the sole's frame a clamp of each coordinate:
-    the rectangle's hull and a general polygon's clamp, every step of single support, cost
+    the rectangle's hull and a general polygon's clamp, every tick of single support, cost
     more than the rest of the step's pressure-centre work)."""
     rotation = state.sole_rotations[foot][0:2, 0:2]
     centre = state.sole_centres[foot][0:2]

@@ -1,52 +1,123 @@
-"""The phases Walk and Step share, and the rules that end them.
+"""The one phase machine Walk and Step run: their phases in order, each with its end rule,
+and the transition from one to the next.
 
-Walk (walk.py) sways, steps and catches; Step (static_step.py) shifts its weight over the
-stance foot, swings and shifts back. Both are a phase clock moved on by the same rules:
-- a timed phase (a sway, a shift, a catch, a settle) ends at its shortest time once the
-  robot has settled (its capture point where the phase takes it), or at its longest;
-- a swing ends at its duration once the foot touches, or duration + late_touchdown_s
-  later whether or not it does (the foot is then put down where it is);
+Walk (walk.py) sways, swings once a step and catches; Step (static_step.py) shifts its
+weight over the stance foot, swings and settles back. Both are a PhaseSequence:
+- every phase ends by one rule (PhaseEnd): past its shortest time once its condition holds,
+  or at its longest whether or not. A timed phase (sway, shift, catch, settle) waits for the
+  robot at rest (its capture point where the phase takes it); a swing for its foot touching,
+  from its duration on, and is over late_touchdown_s later whether or not the foot is down
+  (it is then put down where it is);
+- the transition: a repeating phase (Walk's swing) is entered again while there are steps
+  to take, else the next phase in order (a repeating one skipped when there is nothing for
+  it), and none after the last: the sequence is done;
 - a swing begins along a SwingPath from where the foot lifts to the step's pose.
-Each rule is a pure function of the clock and a few figures, tested without MuJoCo.
+Each rule is a pure function of the time and what the behaviour observes, tested without
+MuJoCo.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from tutorial_atlas_control.balance import BalanceState, yaw_of
 from tutorial_atlas_control.walking.footsteps import Footstep
+from tutorial_atlas_control.walking.status_flags import CATCHING, STEPPING, SWAYING
 from tutorial_atlas_control.walking.swing import SwingPath
 
-__all__ = ['PhaseClock', 'settled', 'swing_to', 'touched_down']
+__all__ = ['STATIC_STEP_PHASES', 'WALK_PHASES', 'Phase', 'PhaseEnd', 'PhaseSequence', 'settled',
+           'swing_to']
 
 
-@dataclass
-class PhaseClock:
-    """The phase under way (a status value, status_flags.py) and when it began (s)."""
+def settled(elapsed_s: float, shortest_s: float, longest_s: float, at_rest: bool) -> bool:
+    """Whether a phase ends: past its shortest time and its condition holding (at rest, the
+    foot touching), or past its longest."""
+    return elapsed_s >= shortest_s and (at_rest or elapsed_s >= longest_s)
 
-    phase: int
-    started_s: float
 
-    def enter(self, phase: int, time_s: float) -> None:
-        """Begin `phase` at `time_s`."""
-        self.phase, self.started_s = phase, time_s
+@dataclass(frozen=True)
+class Phase:
+    """A phase: its name, the status value it reports (status_flags.py), and whether it is
+    entered again while there are steps to take (Walk's swing, once a step)."""
+
+    name: str
+    status: int
+    repeats: bool = False
+
+
+@dataclass(frozen=True)
+class PhaseEnd:
+    """When a phase ends (settled): past `shortest_s` once its condition holds, or at
+    `longest_s` whether or not."""
+
+    shortest_s: float
+    longest_s: float
+
+    @classmethod
+    def swing(cls, duration_s: float, late_s: float) -> PhaseEnd:
+        """A swing's: at its duration once the foot touches, `late_s` past it anyway."""
+        return cls(duration_s, duration_s + late_s)
+
+    def ends(self, elapsed_s: float, condition: bool) -> bool:
+        return settled(elapsed_s, self.shortest_s, self.longest_s, condition)
+
+
+#: Walk's phases: the sway over to the first stance foot, a swing per step, the catch.
+WALK_PHASES = (Phase('sway', SWAYING), Phase('swing', STEPPING, repeats=True),
+               Phase('catch', CATCHING))
+#: Step's: the weight shifted over the stance foot, the swing, the weight shifted back.
+STATIC_STEP_PHASES = (Phase('shift', SWAYING), Phase('swing', STEPPING),
+                      Phase('settle', SWAYING))
+
+
+class PhaseSequence:
+    """`phases` in order, the first entered at `time_s` with its end rule `end`. Each tick
+    the behaviour asks `ended` (given what it observes) and, when the phase has, enters
+    `following()`'s phase with that phase's rule, or finishes."""
+
+    def __init__(self, phases: Sequence[Phase], time_s: float, end: PhaseEnd) -> None:
+        self.phases = tuple(phases)
+        self.phase = self.phases[0]
+        self.started_s = time_s
+        self.end = end
+        #: The last phase has ended.
+        self.done = False
+
+    @property
+    def status(self) -> int:
+        """The phase's status value, as feedback reports it."""
+        return self.phase.status
+
+    def enter(self, phase: Phase, time_s: float, end: PhaseEnd) -> None:
+        """Begin `phase` at `time_s`, ending by `end`."""
+        self.phase, self.started_s, self.end = phase, time_s, end
 
     def elapsed_s(self, time_s: float) -> float:
         """How long the phase has run at `time_s` (s)."""
         return time_s - self.started_s
 
+    def ended(self, time_s: float, condition: bool) -> bool:
+        """Whether the phase under way ends at `time_s` with its condition as observed
+        (never once done)."""
+        return not self.done and self.end.ends(self.elapsed_s(time_s), condition)
 
-def settled(elapsed_s: float, shortest_s: float, longest_s: float, at_rest: bool) -> bool:
-    """Whether a timed phase ends: past its shortest time and at rest, or past its longest."""
-    return elapsed_s >= shortest_s and (at_rest or elapsed_s >= longest_s)
+    def following(self, more_steps: bool) -> Phase | None:
+        """The phase after the one under way: a repeating one again while there are
+        `more_steps`, else the next in order (a repeating one only with steps to take);
+        None after the last."""
+        if self.phase.repeats and more_steps:
+            return self.phase
+        for phase in self.phases[self.phases.index(self.phase) + 1:]:
+            if more_steps or not phase.repeats:
+                return phase
+        return None
 
-
-def touched_down(touching: bool, swung_s: float, duration_s: float, late_s: float) -> bool:
-    """Whether a swing ends: its duration up and the foot touching, or `late_s` past it."""
-    return swung_s >= duration_s and (touching or swung_s >= duration_s + late_s)
+    def finish(self) -> None:
+        """The last phase has ended: `ended` is never true again."""
+        self.done = True
 
 
 def swing_to(state: BalanceState, step: Footstep, duration_s: float) -> SwingPath:

@@ -22,11 +22,18 @@ from tutorial_atlas_control.balance import (
 )
 from tutorial_atlas_control.walking.footsteps import Footstep
 from tutorial_atlas_control.walking.leg_tasks import LegGains, LegTasks, foot_pose
-from tutorial_atlas_control.walking.phases import PhaseClock, settled, swing_to, touched_down
-from tutorial_atlas_control.walking.status_flags import STEPPING, SWAYING
+from tutorial_atlas_control.walking.phases import (
+    STATIC_STEP_PHASES,
+    PhaseEnd,
+    PhaseSequence,
+    swing_to,
+)
+from tutorial_atlas_control.walking.status_flags import STEPPING
 from tutorial_atlas_control.walking.swing import SwingPath
 
 __all__ = ['StaticStep', 'StepGains']
+
+_SHIFT, _SWING, _SETTLE = STATIC_STEP_PHASES
 
 
 @dataclass(frozen=True)
@@ -70,9 +77,10 @@ class StaticStep:
         self.legs = LegTasks(stand, self.gains.legs, time_s)
         self.legs.move_height(stand_com_height_m - self.gains.lowering_m, time_s,
                               self.gains.shift_s)
-        #: The phase (SWAYING or STEPPING: step_feedback's status) and when it began.
-        self.clock = PhaseClock(SWAYING, time_s)
-        self.done = False
+        #: The phase (shift, swing, settle; SWAYING or STEPPING, step_feedback's status) and
+        #: when it began.
+        self.phases = PhaseSequence(STATIC_STEP_PHASES, time_s,
+                                    PhaseEnd(self.gains.shift_s, self.gains.longest_shift_s))
         self.landed: Footstep | None = None
         self.swing_s = max(step.duration_s, self.gains.shortest_swing_s)
         stance = self.feet[1 - step.foot_index]
@@ -82,49 +90,60 @@ class StaticStep:
     @property
     def status(self) -> int:
         """SWAYING or STEPPING, as step_feedback reports it."""
-        return self.clock.phase
+        return self.phases.status
+
+    @property
+    def done(self) -> bool:
+        """The weight is back between the feet, at rest."""
+        return self.phases.done
 
     def remaining_s(self, time_s: float) -> float:
         """The time left in the swing (s; 0 outside it)."""
         if self.status != STEPPING:
             return 0.0
-        return max(0.0, self.swing_s - self.clock.elapsed_s(time_s))
+        return max(0.0, self.swing_s - self.phases.elapsed_s(time_s))
 
     def _capture_reference(self, time_s: float) -> np.ndarray:
         started_s, start, goal = self._shift
         s = smoothstep((time_s - started_s) / self.gains.shift_s)
         return (1.0 - s) * start + s * goal
 
+    def _condition(self, state: BalanceState) -> bool:
+        """What ends the phase under way once its time allows: the capture point over the
+        stance sole (shift) or at rest between the feet (settle), the swing foot touching."""
+        phase = self.phases.phase
+        if phase is _SWING:
+            return bool(state.in_contact[self.step.foot_index])
+        near_m = self.gains.over_stance_m if phase is _SHIFT else self.gains.at_rest_m
+        return float(np.linalg.norm(state.capture_point - self._shift[2])) < near_m
+
     def _advance(self, state: BalanceState, time_s: float) -> None:
-        gains, step = self.gains, self.step
-        goal = self._shift[2]
-        elapsed = self.clock.elapsed_s(time_s)
-        if self.status == SWAYING and elapsed >= gains.shift_s:
-            off = float(np.linalg.norm(state.capture_point - goal))
-            if self.landed is None and settled(elapsed, gains.shift_s, gains.longest_shift_s,
-                                               off < gains.over_stance_m):
-                self._swing = swing_to(state, step, self.swing_s)
-                stance = self.feet[1 - step.foot_index]
-                self.legs.face(stance.yaw_rad, step.yaw_rad, time_s, self.swing_s)
-                self.clock.enter(STEPPING, time_s)
-            elif self.landed is not None and settled(elapsed, gains.shift_s,
-                                                     gains.longest_settle_s,
-                                                     off < gains.at_rest_m):
-                self.done = True
-        elif self.status == STEPPING and touched_down(
-                state.in_contact[step.foot_index], elapsed, self.swing_s,
-                gains.legs.late_touchdown_s):
+        """Move on to the next phase when this one ends: the swing, then the landing taken
+        and the weight shifted back, then done."""
+        phases, gains, step = self.phases, self.gains, self.step
+        if not phases.ended(time_s, self._condition(state)):
+            return
+        following = phases.following(more_steps=False)
+        if following is _SWING:
+            self._swing = swing_to(state, step, self.swing_s)
+            stance = self.feet[1 - step.foot_index]
+            self.legs.face(stance.yaw_rad, step.yaw_rad, time_s, self.swing_s)
+            phases.enter(following, time_s, PhaseEnd.swing(self.swing_s,
+                                                           gains.legs.late_touchdown_s))
+        elif following is _SETTLE:
             self.landed = foot_pose(state, step.foot_index, step.step_index)
             self.feet[step.foot_index] = self.landed
             left, right = self.feet
             middle = np.array([0.5 * (left.x_m + right.x_m), 0.5 * (left.y_m + right.y_m)])
             self._shift = (time_s, state.capture_point.copy(), middle)
             self.legs.face(left.yaw_rad, right.yaw_rad, time_s, gains.shift_s)
-            self.clock.enter(SWAYING, time_s)
+            phases.enter(following, time_s, PhaseEnd(gains.shift_s, gains.longest_settle_s))
+        else:
+            phases.finish()
 
-    def step_torque(self, state: BalanceState, joint_positions: np.ndarray,
+    def tick_torque(self, state: BalanceState, joint_positions: np.ndarray,
                     joint_velocities: np.ndarray, time_s: float) -> np.ndarray:
-        """The 28 joint torques (N m) for this 1 ms step, within the effort limits."""
+        """The 28 joint torques (N m) for this 1 ms tick, within the effort limits."""
         self._advance(state, time_s)
         xi_ref = self._capture_reference(time_s)
         cop = dcm_feedback_cop(state.capture_point, xi_ref, self.gains.dcm_gain)
@@ -138,5 +157,5 @@ class StaticStep:
         swing = None
         if swinging:
             assert self._swing is not None  # set with STEPPING
-            swing = (self.step.foot_index, self._swing, self.clock.elapsed_s(time_s))
+            swing = (self.step.foot_index, self._swing, self.phases.elapsed_s(time_s))
         return legs.finish(state, joint_velocities, torque, contact, swing, self.feet)

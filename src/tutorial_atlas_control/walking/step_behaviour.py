@@ -51,7 +51,7 @@ class StepBehaviour:
         #: The latest target a client sent (a sole's step), None before any.
         self.desired: Footstep | None = None
         #: The step under way (None while standing).
-        self.stepping: StaticStep | None = None
+        self.static_step: StaticStep | None = None
         self.steps_taken = 0
         self._taken: Footstep | None = None
         self._saturated: Footstep | None = None
@@ -65,29 +65,29 @@ class StepBehaviour:
     def start(self, data: mujoco.MjData) -> None:
         """Stand where the robot stands; the count of steps starts again."""
         self.stand.start(data)
-        self.stepping, self.steps_taken = None, 0
+        self.static_step, self.steps_taken = None, 0
         self._taken = self._saturated = self._desired_at_touchdown = None
 
     def torque(self, data: mujoco.MjData) -> np.ndarray:
-        """This step's f_out (N m, (28,)), within the effort limits."""
+        """This tick's f_out (N m, (28,)), within the effort limits."""
         stand = self.stand
-        if self.stepping is not None and self.stepping.done:
-            self.stepping = None
+        if self.static_step is not None and self.static_step.done:
+            self.static_step = None
             self.steps_taken += 1
             stand.start(data)  # stand where it landed
-        if self.stepping is None:
+        if self.static_step is None:
             wanted = self._next_target()
             if wanted is not None:
                 self._begin(data, wanted)
-        stepping = self.stepping
-        if stepping is None:
+        static_step = self.static_step
+        if static_step is None:
             return stand.torque(data)
         atlas = stand.atlas
         state = stand.estimator.estimate(data.qpos, data.qvel)
-        was_down = stepping.landed is not None
-        torque = stepping.step_torque(state, data.qpos[atlas.qpos_adr],
+        was_down = static_step.landed is not None
+        torque = static_step.tick_torque(state, data.qpos[atlas.qpos_adr],
                                       data.qvel[atlas.dof_adr], float(data.time))
-        if not was_down and stepping.landed is not None:
+        if not was_down and static_step.landed is not None:
             self._desired_at_touchdown = self.desired
         return torque
 
@@ -108,14 +108,15 @@ class StepBehaviour:
         assert state is not None and stand.controller is not None  # set by start
         feet = (foot_pose(state, 0), foot_pose(state, 1))
         step = clamp_step(wanted, feet[1 - wanted.foot_index], self.limits)
-        self.stepping = StaticStep(stand.controller, feet, step, state, float(data.time),
-                                   stand.com_height_m, self.gains)
+        self.static_step = StaticStep(stand.controller, feet, step, state, float(data.time),
+                                      stand.ground_under_m(state) + stand.com_height_m,
+                                      self.gains)
         self._taken, self._saturated = wanted, step
 
     def status(self, time_s: float) -> StepStatus:
         """step_feedback's values now."""
-        stepping = self.stepping
-        flags = SWAYING if stepping is None else stepping.status
-        remaining = 0.0 if stepping is None else stepping.remaining_s(time_s)
+        static_step = self.static_step
+        flags = SWAYING if static_step is None else static_step.status
+        remaining = 0.0 if static_step is None else static_step.remaining_s(time_s)
         return StepStatus(flags, remaining, self.steps_taken, self.steps_taken + 1,
                           self._saturated)

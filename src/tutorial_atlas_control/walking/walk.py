@@ -8,7 +8,7 @@ Stand takes over. At each touchdown the capture point's plan (dcm_plan) is made 
 over the steps the queue then holds, so a streaming client's new steps enter it as
 they come.
 
-Each 1 ms step: the pressure centre p = p_ref + (1 + k)(xi - xi_ref), and leg_tasks
+Each 1 ms tick: the pressure centre p = p_ref + (1 + k)(xi - xi_ref), and leg_tasks
 turns it into torques (the Stand's whole-body law on the carrying soles, the swing foot's
 joint-space servo, feet put back down). The CoM walks 5 cm lower than it stands. While a
 foot swings, its landing moves with the capture point's error predicted at touchdown
@@ -33,11 +33,19 @@ from tutorial_atlas_control.balance import (
 from tutorial_atlas_control.walking.dcm_plan import DcmPlan
 from tutorial_atlas_control.walking.footsteps import Footstep
 from tutorial_atlas_control.walking.leg_tasks import LegGains, LegTasks, foot_pose
-from tutorial_atlas_control.walking.phases import PhaseClock, settled, swing_to, touched_down
-from tutorial_atlas_control.walking.status_flags import CATCHING, STEPPING, SWAYING
+from tutorial_atlas_control.walking.phases import (
+    WALK_PHASES,
+    Phase,
+    PhaseEnd,
+    PhaseSequence,
+    swing_to,
+)
+from tutorial_atlas_control.walking.status_flags import STEPPING
 from tutorial_atlas_control.walking.step_adjustment import foothold_shift
 from tutorial_atlas_control.walking.step_queue import StepQueue, clamp_pose
 from tutorial_atlas_control.walking.swing import SwingPath
+
+_SWAY, _SWING, _CATCH = WALK_PHASES
 
 
 @dataclass(frozen=True)
@@ -67,7 +75,7 @@ class WalkGains:
 
 @dataclass(frozen=True)
 class WalkOutput:
-    """One step's decision, for feedback and tests."""
+    """One tick's decision, for feedback and tests."""
 
     torque_nm: np.ndarray         # (28,)
     desired_cop: np.ndarray       # (2,)
@@ -85,9 +93,9 @@ class WalkController:
         self.queue = queue
         self.gains = gains or WalkGains()
         self.legs = LegTasks(stand, self.gains.legs, time_s)
-        #: The phase (SWAYING, STEPPING or CATCHING) and when it began.
-        self.clock = PhaseClock(SWAYING, time_s)
-        self.done = False
+        #: The phase (sway, swing or catch) and when it began.
+        self.phases = PhaseSequence(WALK_PHASES, time_s,
+                                    PhaseEnd(self.gains.sway_s, self.gains.sway_s))
         #: The step being taken (None while swaying or catching) and its swing path.
         self.step: Footstep | None = None
         self.swing: SwingPath | None = None
@@ -102,12 +110,17 @@ class WalkController:
     @property
     def phase(self) -> int:
         """SWAYING, STEPPING or CATCHING."""
-        return self.clock.phase
+        return self.phases.status
 
     @property
     def phase_start_s(self) -> float:
         """When the phase began (s)."""
-        return self.clock.started_s
+        return self.phases.started_s
+
+    @property
+    def done(self) -> bool:
+        """The walk has caught itself after its last step."""
+        return self.phases.done
 
     # -- the phases ---------------------------------------------------------------------------
 
@@ -126,7 +139,6 @@ class WalkController:
         return DcmPlan.plan(np.array(cops), np.array(durations), final, omega)
 
     def _begin_sway(self, state: BalanceState, time_s: float) -> None:
-        self.clock.enter(SWAYING, time_s)
         self.legs.move_height(self.stand_height_m - self.gains.walk_lowering_m, time_s,
                               self.gains.sway_s)
         self._plan = self._plan_steps(self.queue.preview(), state.omega)
@@ -136,50 +148,59 @@ class WalkController:
                                      self.gains.sway_s)
         self._sway_from = state.capture_point.copy()
 
-    def _begin_step(self, state: BalanceState, time_s: float) -> None:
+    def _begin_step(self, phase: Phase, state: BalanceState, time_s: float) -> None:
         preview = self.queue.preview()
         self._plan = self._plan_steps(preview, state.omega)
-        if self._plan is None:
-            self._begin_catch(state, time_s)
-            return
+        assert self._plan is not None  # entered with steps to take only
         step = preview[0]
         self.step = self._planned_step = step
         stance = self.queue.feet[1 - step.foot_index]
         self.legs.face(stance.yaw_rad, step.yaw_rad, time_s, step.duration_s)
         self.swing = swing_to(state, step, step.duration_s)
-        self.clock.enter(STEPPING, time_s)
+        self.phases.enter(phase, time_s,
+                          PhaseEnd.swing(step.duration_s, self.gains.legs.late_touchdown_s))
 
-    def _begin_catch(self, state: BalanceState, time_s: float) -> None:
+    def _begin_catch(self, phase: Phase, time_s: float) -> None:
         self.legs.face(self.queue.feet[0].yaw_rad, self.queue.feet[1].yaw_rad, time_s,
                        self.gains.catch_s)
         self.legs.move_height(self.stand_height_m, time_s, self.gains.catch_s)
         self.step, self.swing, self._plan = None, None, None
-        self.clock.enter(CATCHING, time_s)
+        self.phases.enter(phase, time_s, PhaseEnd(self.gains.catch_s, self.gains.longest_catch_s))
+
+    def _condition(self, state: BalanceState) -> bool:
+        """What ends the phase under way once its time allows: nothing for the sway, the
+        swing foot touching, the capture point at rest between the feet for the catch."""
+        phase, step = self.phases.phase, self.step
+        if phase is _SWING and step is not None:
+            return bool(state.in_contact[step.foot_index])
+        if phase is _CATCH:
+            middle = state.sole_centres[:, :2].mean(axis=0)
+            return float(np.linalg.norm(state.capture_point - middle)) < self.gains.at_rest_m
+        return True
 
     def _advance(self, state: BalanceState, time_s: float) -> None:
-        """Move on to the next phase when this one's time is up."""
-        elapsed, gains, step = self.clock.elapsed_s(time_s), self.gains, self.step
-        if self.phase == SWAYING and settled(elapsed, gains.sway_s, gains.sway_s, True):
-            self._begin_step(state, time_s)
-        elif self.phase == STEPPING and step is not None and touched_down(
-                state.in_contact[step.foot_index], elapsed, step.duration_s,
-                gains.legs.late_touchdown_s):
+        """Move on to the next phase when this one ends: a swing's touchdown taken into the
+        queue, then another swing while the queue has steps, else the catch."""
+        phases, step = self.phases, self.step
+        if not phases.ended(time_s, self._condition(state)):
+            return
+        if phases.phase is _SWING and step is not None:
             self.queue.touchdown(foot_pose(state, step.foot_index, step.step_index))
-            self._begin_step(state, time_s)
-        elif self.phase == CATCHING and elapsed >= gains.catch_s and settled(
-                elapsed, gains.catch_s, gains.longest_catch_s,
-                float(np.linalg.norm(state.capture_point
-                                     - state.sole_centres[:, :2].mean(axis=0)))
-                < gains.at_rest_m):
-            self.done = True
+        following = phases.following(more_steps=bool(self.queue.preview()))
+        if following is None:
+            phases.finish()
+        elif following is _SWING:
+            self._begin_step(following, state, time_s)
+        else:
+            self._begin_catch(following, time_s)
 
     # -- the references -----------------------------------------------------------------------
 
     def _capture_reference(self, state: BalanceState,
                            time_s: float) -> tuple[np.ndarray, np.ndarray]:
         """(xi_ref, p_ref) now."""
-        elapsed = self.clock.elapsed_s(time_s)
-        if self.phase == SWAYING:
+        elapsed = self.phases.elapsed_s(time_s)
+        if self.phases.phase is _SWAY:
             xi = capture_point_after(self._sway_from, self._sway_cop, state.omega,
                                      min(elapsed, self.gains.sway_s))
             return xi, self._sway_cop
@@ -202,7 +223,7 @@ class WalkController:
         shift_x, shift_y = foothold_shift(
             (error_x, error_y), (float(sole[0, 0]), float(sole[1, 0])), (offset_x, offset_y),
             self.legs.sole_reach_m, self.gains.dcm_gain, state.omega,
-            step.duration_s - (self.clock.elapsed_s(time_s)),
+            step.duration_s - (self.phases.elapsed_s(time_s)),
             float(plan.durations_s[1]) if len(plan.durations_s) > 1 else None)
         x, y, _ = clamp_pose(step.foot_index, planned.x_m + shift_x, planned.y_m + shift_y,
                              planned.yaw_rad, self.queue.feet[stance], self.queue.limits)
@@ -212,11 +233,11 @@ class WalkController:
         self.swing = replace(swing, end=np.array([x, y, planned.z_m]))
         self.queue.adjust(self.step)
 
-    # -- one step -----------------------------------------------------------------------------
+    # -- one tick -----------------------------------------------------------------------------
 
-    def step_torque(self, state: BalanceState, joint_positions: np.ndarray,
+    def tick_torque(self, state: BalanceState, joint_positions: np.ndarray,
                     joint_velocities: np.ndarray, time_s: float) -> WalkOutput:
-        """The 28 joint torques (N m) for this 1 ms step, within the effort limits."""
+        """The 28 joint torques (N m) for this 1 ms tick, within the effort limits."""
         self._advance(state, time_s)
         xi_ref, cop_ref = self._capture_reference(state, time_s)
         if self.phase == STEPPING and self.gains.adjust_steps:
@@ -230,6 +251,6 @@ class WalkController:
         swing = None
         if step is not None:
             assert self.swing is not None  # set with the step
-            swing = (step.foot_index, self.swing, self.clock.elapsed_s(time_s))
+            swing = (step.foot_index, self.swing, self.phases.elapsed_s(time_s))
         legs.finish(state, joint_velocities, torque, contact, swing, self.queue.feet)
         return WalkOutput(torque, cop, xi_ref, self.phase, swing_foot)

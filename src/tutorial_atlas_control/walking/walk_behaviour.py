@@ -91,14 +91,14 @@ class WalkBehaviour:
         self.walk = WalkController(controller, queue, state, float(data.time), self.gains)
 
     def torque(self, data: mujoco.MjData) -> np.ndarray:
-        """This step's f_out (N m, (28,)), within the effort limits."""
+        """This tick's f_out (N m, (28,)), within the effort limits."""
         walk = self.walk
         if walk is None:
             raise WalkingError('WalkBehaviour.torque before start()')
         stand, atlas = self.stand, self.stand.atlas
         state = stand.estimator.estimate(data.qpos, data.qvel)
         self.last_state = state
-        return walk.step_torque(state, data.qpos[atlas.qpos_adr], data.qvel[atlas.dof_adr],
+        return walk.tick_torque(state, data.qpos[atlas.qpos_adr], data.qvel[atlas.dof_adr],
                                 float(data.time)).torque_nm
 
     def status(self, time_s: float) -> WalkStatus:

@@ -4,9 +4,9 @@ footsteps walked, then Stand again; what happened, step by step.
 The figures the tests and the bench judge: whether it fell (the pelvis less than
 sim.fall's STANDING_PELVIS_M above the ground under the feet), how many steps it took, where
 each foot came down against its target and where the pelvis was then, the lowest pelvis,
-where the pelvis ended, how much the legs' torques jump from one 1 ms step to the next while
+where the pelvis ended, how much the legs' torques jump from one 1 ms tick to the next while
 walking (a controller unstable at 1 kHz chatters between the effort limits), and the
-controller's CPU per step.
+controller's CPU per tick.
 
 A trial's `seed` perturbs its start (start_noise: the joints' angles and rates) and, for
 pushed walks, draws the pushes' phases and sides: a figure is then a fraction of seeds.
@@ -82,11 +82,11 @@ class WalkTrial:
     walk_ended_s: float | None = None
     #: Where the pelvis was when the walk began (world x, y, m).
     pelvis_start_xy: tuple[float, float] = (0.0, 0.0)
-    #: The largest, over the leg joints, of a joint's mean |torque change| per 1 ms step
+    #: The largest, over the leg joints, of a joint's mean |torque change| per 1 ms tick
     #: while walking (N m).
     leg_torque_jump_nm: float = 0.0
     controller_cpu_s: float = 0.0
-    control_steps: int = 0
+    control_ticks: int = 0
 
     @property
     def worst_landing_m(self) -> float:
@@ -94,7 +94,7 @@ class WalkTrial:
 
     @property
     def cost_per_step_us(self) -> float:
-        return self.controller_cpu_s / max(self.control_steps, 1) * 1e6
+        return self.controller_cpu_s / max(self.control_ticks, 1) * 1e6
 
     @property
     def mean_ahead_m(self) -> float:
@@ -136,7 +136,7 @@ class WalkingStand:
             torque = self._torque(data)
         finally:
             self.trial.controller_cpu_s += time.process_time() - started
-            self.trial.control_steps += 1
+            self.trial.control_ticks += 1
         if self._phase == 'walk':
             self._note_jump(torque)  # the trial's own figure: not the controller's cost
         return torque
@@ -199,7 +199,7 @@ def walk_trial(plan: Sequence[Footstep], duration_s: float, gains: WalkGains | N
                streaming: bool = False, pushes: Sequence[Push] = (), seed: int | None = None,
                noise: StartNoise = DEFAULT_START_NOISE) -> WalkTrial:
     """Place the robot in the Stand pose (perturbed by `noise` drawn from `seed`; None:
-    not), stand SETTLE_S, walk `plan` (sent once, or `streaming` its window every step),
+    not), stand SETTLE_S, walk `plan` (sent once, or `streaming` its window every tick),
     stand; with `pushes` on the pelvis (their times in sim time from the start); run for
     `duration_s` (s) of sim time or until it falls."""
     sim = standing_simulator()

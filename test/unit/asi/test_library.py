@@ -148,7 +148,7 @@ def test_the_steps_a_client_sends_land_on_the_worlds_surface() -> None:
     top, on a 10 degree ramp its height and tilt, on the ground the robot starts on as sent."""
     import mujoco
 
-    from tutorial_atlas_control.asi import on_ground
+    from tutorial_atlas_control.asi.library import on_ground
     from tutorial_atlas_control.sim import Ground
     from tutorial_atlas_control.walking import Footstep
 
@@ -172,3 +172,24 @@ def test_the_steps_a_client_sends_land_on_the_worlds_surface() -> None:
     flat = Ground(mujoco.MjModel.from_xml_string(
         '<mujoco><worldbody><geom type="plane" size="0 0 1"/></worldbody></mujoco>'))
     assert on_ground(steps, flat) is steps
+
+
+def test_manipulate_is_a_library_entry_nested_in_the_running_stand() -> None:
+    """Manipulate is registered like Walk and Step but not installed: Stand keeps running,
+    servoed by each command while Manipulate is current, and leaves it when Stand restarts."""
+    sim = AtlasSimulator(load_model(), load_gains_yaml(CONFIG), time_to_unpin_s=0.0)
+    place_in_stand_pose(sim.atlas, sim.data)
+    interface = AtlasSimInterface(sim)
+    assert interface.library[Behavior.MANIPULATE].mode is ControlMode.STAND
+    assert sim.behaviours.installed[ControlMode.STAND] is interface.stand
+    assert not interface.serves(ControlMode.STAND)
+    _tick(interface, 10)
+    interface.apply(AsiCommand(0, Behavior.MANIPULATE, (StepData(),) * 4, False, StepData(),
+                               False, ManipulateParams(True, 0.85, 0.0, 0.0), None, 0))
+    assert sim.behaviours.acting is interface.stand
+    assert interface.state().current_behavior == Behavior.MANIPULATE
+    assert interface.stand.servo_target is not None
+    assert interface.stand.servo_target.height_m == 0.85
+    sim.set_mode(ControlMode.STAND)  # a restart made elsewhere ends it
+    _tick(interface)
+    assert interface.state().current_behavior == Behavior.STAND

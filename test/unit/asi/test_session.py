@@ -5,14 +5,9 @@ from __future__ import annotations
 
 import pytest
 
-from tutorial_atlas_control.asi import (
-    MODE_OF_BEHAVIOR,
-    REFUSAL_REPORTED_STEPS,
-    AsiError,
-    AsiSession,
-    Behavior,
-    Status,
-)
+from tutorial_atlas_control.asi import AsiError, Behavior, Status
+from tutorial_atlas_control.asi.behaviors import MODE_OF_BEHAVIOR
+from tutorial_atlas_control.asi.session import REFUSAL_REPORTED_TICKS, AsiSession
 from tutorial_atlas_control.control_modes import ControlMode
 
 STAND, USER = Behavior.STAND, Behavior.USER
@@ -134,9 +129,9 @@ def test_a_refusal_is_answered_by_the_next_request_and_never_latched() -> None:
     assert session.request(Behavior.STAND, STAND, True) is None  # the running one: fine
     assert session.status_flags(STAND, False) == Status.OK
     assert session.error_code == AsiError.NO_ERRORS
-    # Unanswered, it is reported for REFUSAL_REPORTED_STEPS steps, then no more.
+    # Unanswered, it is reported for REFUSAL_REPORTED_TICKS ticks, then no more.
     session.request(Behavior.WALK, STAND, True)
-    for _ in range(REFUSAL_REPORTED_STEPS - 1):
+    for _ in range(REFUSAL_REPORTED_TICKS - 1):
         session.end_step()
     assert session.status_flags(STAND, False) == Status.FAILED_TRANS_ILLEGAL_BEHAVIOR
     session.end_step()

@@ -10,11 +10,10 @@ from tutorial_atlas_control.balance import (
     SOLE_GEOMS,
     SoleBox,
     box_corners,
-    lowest_sole_corner_m,
     place_in_stand_pose,
     sole_corners,
-    sole_geom_ids,
 )
+from tutorial_atlas_control.balance.sole import lowest_sole_corner_m, sole_geom_ids
 from tutorial_atlas_control.sim import AtlasModel, load_model
 
 

@@ -94,7 +94,7 @@ def test_at_rest_the_controller_holds_the_weight_by_statics(atlas: atlas_model.A
                                capture_point=state.capture_point)
     controller = StandController(estimator.mass_kg, atlas.effort_limit_nm, here,
                                  SOLE_HALF_SIZE_M)
-    out = controller.step(state, placed.qpos[atlas.qpos_adr], placed.qvel[atlas.dof_adr])
+    out = controller.tick(state, placed.qpos[atlas.qpos_adr], placed.qvel[atlas.dof_adr])
     weight_n = estimator.mass_kg * lipm.GRAVITY_M_S2
     np.testing.assert_allclose(out.contact_wrenches[:, 0:3].sum(axis=0), [0, 0, weight_n],
                                atol=1e-6 * weight_n)
@@ -160,7 +160,7 @@ def test_stand_behaviour_is_the_controller_held_where_it_started(
     pushed = mujoco.MjData(atlas.model)
     pushed.qpos[:], pushed.qvel[:] = placed.qpos, placed.qvel
     pushed.qvel[0] = 0.2  # moving forward: the capture point ahead of where it started
-    expected = controller.step(estimator.estimate(pushed.qpos, pushed.qvel),
+    expected = controller.tick(estimator.estimate(pushed.qpos, pushed.qvel),
                                pushed.qpos[atlas.qpos_adr], pushed.qvel[atlas.dof_adr])
     np.testing.assert_array_equal(behaviour.torque(pushed), expected.torque_nm)
     assert behaviour.last_output is not None

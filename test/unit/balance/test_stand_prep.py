@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from tutorial_atlas_control.asi import AtlasSimInterface
-from tutorial_atlas_control.balance import PREP_S, STAND_POSE_RAD, StandPrepBehaviour
+from tutorial_atlas_control.balance import STAND_POSE_RAD, StandPrepBehaviour
+from tutorial_atlas_control.balance.stand_prep import PREP_S
 from tutorial_atlas_control.control_modes import ControlMode
 from tutorial_atlas_control.sim import (
     DEFAULT_GAINS_FILE,

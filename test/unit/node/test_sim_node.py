@@ -8,6 +8,7 @@ from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
 
+import numpy as np
 import pytest
 import yaml
 
@@ -263,6 +264,30 @@ def test_startup_mode_parameter_is_checked(monkeypatch: pytest.MonkeyPatch) -> N
     params[topics.STARTUP_MODE_PARAM] = 'bdi_stand'
     monkeypatch.setattr(sim_node, 'SimNode', lambda sim, *args: sim)
     assert sim_node.build_node().startup_mode is VrcMode.BDI_STAND
+
+
+def test_start_parameter_places_the_robot_and_a_bad_one_is_one_line(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """~start: the pelvis at the start's (x, y) and yaw on the model's ground, named in
+    /atlas/sim_config; a bad start stops the node with one line naming the parameter."""
+    params: dict[str, Any] = {
+        'atlas_controller/gains': yaml.safe_load(CONFIG.read_text())['atlas_controller']['gains'],
+        '~start': '2 -1.5 0.9 nope'}
+    monkeypatch.setattr(sim_node.rospy, 'get_param',
+                        lambda name, default=None: params.get(name, default))
+    monkeypatch.setattr(sim_node.rospy, 'set_param', params.__setitem__)
+    monkeypatch.setattr(sim_node.rospy, 'resolve_name', lambda name: '/atlas_sim/start')
+    with pytest.raises(sim_node.AtlasControlError,
+                       match="^parameter /atlas_sim/start: start '2 -1.5 0.9 nope': yaw 'nope' "
+                             'is not a finite number'):
+        sim_node.build_node()
+    params['~start'] = '2 -1.5 0.9 1.5707963267948966'
+    monkeypatch.setattr(sim_node, 'SimNode', lambda sim, *args: sim)
+    sim = sim_node.build_node()
+    position, quat = atlas_model.pelvis_pose(sim.atlas, sim.data)
+    np.testing.assert_allclose(position, (2.0, -1.5, atlas_model.SPAWN_HEIGHT_M), atol=1e-9)
+    np.testing.assert_allclose(quat, (0.5 ** 0.5, 0.0, 0.0, 0.5 ** 0.5), atol=1e-9)
+    assert sim.config().to_dict()['start'] == '2.0 -1.5 0.9 1.5707963267948966'
 
 
 def test_tf_publisher_parameter_chooses_who_publishes_the_links(

@@ -7,6 +7,7 @@ from pathlib import Path
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.offline.player import run_offline
 from tutorial_atlas_control.offline.replay import replay_bag
+from tutorial_atlas_control.offline.world import OfflineWorld
 from tutorial_atlas_control.sim import MODEL_PATH
 
 
@@ -27,7 +28,7 @@ def test_a_run_in_mud_replays_exactly_and_strays_without_the_mud(tmp_path: Path)
     trajectory.write_text('knee:\n  - [0.3, "' + ' '.join(bent) + '"]\n')
     bag = tmp_path / 'mud.bag'
     run_offline(str(trajectory), 'knee', bag, settle_s=0.3, start_after_s=1.1,
-                model_path=world, mud_damping=70.0)
+                world=OfflineWorld(world, mud_damping=70.0))
     result = replay_bag(bag, model_path=world)
     assert result.config.mud_damping == 70.0
     assert result.reproduced

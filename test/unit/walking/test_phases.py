@@ -1,6 +1,8 @@
-"""The rules that end Walk's and Step's phases, without MuJoCo: a timed phase ends once at
-rest after its shortest time or at its longest, a swing at touchdown after its duration or
-late_touchdown_s past it, and a swing runs from the sole where it lifts to the step's pose."""
+"""The one phase machine Walk and Step run, without MuJoCo: a phase ends past its shortest time
+once its condition holds or at its longest, a swing at touchdown after its duration or
+late_touchdown_s past it; Walk swings again while it has steps and catches when it has none
+(a stop), Step shifts, swings and settles once; a swing runs from the sole where it lifts to
+the step's pose."""
 
 from __future__ import annotations
 
@@ -10,15 +12,20 @@ import numpy as np
 import pytest
 
 from tutorial_atlas_control.walking.footsteps import Footstep
-from tutorial_atlas_control.walking.phases import PhaseClock, settled, swing_to, touched_down
-from tutorial_atlas_control.walking.status_flags import STEPPING, SWAYING
+from tutorial_atlas_control.walking.phases import (
+    STATIC_STEP_PHASES,
+    WALK_PHASES,
+    PhaseEnd,
+    PhaseSequence,
+    settled,
+    swing_to,
+)
+from tutorial_atlas_control.walking.status_flags import CATCHING, STEPPING, SWAYING
 
-
-def test_the_clock_counts_from_the_phase_entered() -> None:
-    clock = PhaseClock(SWAYING, 1.0)
-    assert clock.elapsed_s(1.25) == pytest.approx(0.25)
-    clock.enter(STEPPING, 2.0)
-    assert (clock.phase, clock.elapsed_s(2.5)) == (STEPPING, 0.5)
+SWAY, WALK_SWING, CATCH = WALK_PHASES
+SHIFT, STEP_SWING, SETTLE = STATIC_STEP_PHASES
+#: A swing's duration and how late it may touch down (s), as the walk's defaults.
+SWING_S, LATE_S = 0.63, 0.4
 
 
 @pytest.mark.parametrize(('elapsed_s', 'at_rest', 'ends'), [
@@ -39,7 +46,82 @@ def test_a_timed_phase_ends_at_rest_after_its_shortest_time_or_at_its_longest(
     (False, 1.03, True),   # late_touchdown_s past its duration: put down where it is
 ])
 def test_a_swing_ends_at_touchdown_or_late(touching: bool, swung_s: float, ends: bool) -> None:
-    assert touched_down(touching, swung_s, 0.63, 0.4) is ends
+    assert PhaseEnd.swing(SWING_S, LATE_S).ends(swung_s, touching) is ends
+
+
+def first_ending(sequence: PhaseSequence, start_s: float, condition_from_s: float) -> float:
+    """When the phase under way ends, ticking each 1 ms from `start_s`, its condition holding
+    from `condition_from_s` on."""
+    for tick in range(10_000):
+        time_s = start_s + tick * 0.001
+        if sequence.ended(time_s, time_s >= condition_from_s):
+            return time_s
+    raise AssertionError('the phase never ended')
+
+
+def walk(time_s: float = 0.0) -> PhaseSequence:
+    return PhaseSequence(WALK_PHASES, time_s, PhaseEnd(0.6, 0.6))
+
+
+def test_a_walk_sways_then_swings_to_each_touchdown_while_it_has_steps() -> None:
+    phases = walk()
+    assert (phases.phase, phases.status) == (SWAY, SWAYING)
+    ended_s = first_ending(phases, 0.0, 0.0)
+    assert ended_s == pytest.approx(0.6)
+    assert phases.following(more_steps=True) is WALK_SWING
+    phases.enter(WALK_SWING, ended_s, PhaseEnd.swing(SWING_S, LATE_S))
+    assert phases.status == STEPPING
+    touchdown_s = first_ending(phases, ended_s, ended_s + 0.3)  # down early: waits
+    assert touchdown_s - ended_s == pytest.approx(SWING_S)
+    assert phases.following(more_steps=True) is WALK_SWING  # the next step
+    phases.enter(WALK_SWING, touchdown_s, PhaseEnd.swing(SWING_S, LATE_S))
+    assert phases.elapsed_s(touchdown_s + 0.1) == pytest.approx(0.1)
+
+
+def test_a_late_touchdown_ends_the_swing_when_the_foot_comes_down() -> None:
+    phases = walk()
+    phases.enter(WALK_SWING, 1.0, PhaseEnd.swing(SWING_S, LATE_S))
+    assert first_ending(phases, 1.0, 1.0 + SWING_S + 0.15) == pytest.approx(
+        1.0 + SWING_S + 0.15)
+
+
+def test_a_swing_that_never_touches_ends_late_touchdown_s_past_its_duration() -> None:
+    phases = walk()
+    phases.enter(WALK_SWING, 1.0, PhaseEnd.swing(SWING_S, LATE_S))
+    assert first_ending(phases, 1.0, 99.0) == pytest.approx(1.0 + SWING_S + LATE_S)
+
+
+def test_a_walk_stopped_catches_after_its_swing_and_is_done_at_rest() -> None:
+    phases = walk()
+    phases.enter(WALK_SWING, 1.0, PhaseEnd.swing(SWING_S, LATE_S))
+    assert phases.following(more_steps=False) is CATCH  # stopped: no step after this one
+    phases.enter(CATCH, 2.0, PhaseEnd(0.6, 3.0))
+    assert phases.status == CATCHING
+    assert first_ending(phases, 2.0, 3.0) == pytest.approx(3.0)  # at rest after 1 s
+    assert phases.following(more_steps=True) is None
+    phases.finish()
+    assert phases.done and not phases.ended(9.0, True)
+
+
+def test_a_walk_without_steps_catches_after_its_sway() -> None:
+    assert walk().following(more_steps=False) is CATCH
+
+
+def test_a_catch_never_at_rest_ends_at_its_longest() -> None:
+    phases = walk()
+    phases.enter(CATCH, 2.0, PhaseEnd(0.6, 3.0))
+    assert first_ending(phases, 2.0, 99.0) == pytest.approx(5.0)
+
+
+def test_a_static_step_shifts_swings_and_settles_once() -> None:
+    phases = PhaseSequence(STATIC_STEP_PHASES, 0.0, PhaseEnd(1.0, 2.0))
+    assert [(phase.name, phase.status) for phase in STATIC_STEP_PHASES] == [
+        ('shift', SWAYING), ('swing', STEPPING), ('settle', SWAYING)]
+    assert phases.following(more_steps=True) is STEP_SWING
+    phases.enter(STEP_SWING, 1.0, PhaseEnd.swing(SWING_S, LATE_S))
+    assert phases.following(more_steps=True) is SETTLE  # Step's swing does not repeat
+    phases.enter(SETTLE, 2.0, PhaseEnd(1.0, 2.0))
+    assert phases.following(more_steps=True) is None
 
 
 def test_a_swing_runs_from_the_lifted_sole_to_the_steps_whole_pose() -> None:
