@@ -13,7 +13,15 @@ import numpy as np
 
 from tutorial_atlas_control.bags import analyze_bag, short_summary, summarise_walk, walk_lines
 from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED, EXIT_REFUSED, print_error
-from tutorial_atlas_control.course import STARTS, CourseError, Start, parse_start, world_start
+from tutorial_atlas_control.course import (
+    MUD_DAMPING,
+    STARTS,
+    CourseError,
+    Start,
+    check_mud_damping,
+    parse_start,
+    world_start,
+)
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.offline import (
     DEFAULT_SETTLE_S,
@@ -37,6 +45,14 @@ def _seconds(text: str) -> float:
     if not (np.isfinite(value) and value >= 0.0):
         raise argparse.ArgumentTypeError(f'{text!r} must be a finite number of seconds >= 0')
     return value
+
+
+def _mud_damping(text: str) -> float:
+    try:
+        return check_mud_damping(float(text), '--mud-damping')
+    except (ValueError, CourseError) as err:  # CourseError is a ValueError: one line
+        raise argparse.ArgumentTypeError(str(err) if isinstance(err, CourseError) else
+                                         f'{text!r} is not a number (N s/m)') from None
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -84,6 +100,9 @@ def build_parser() -> argparse.ArgumentParser:
                         help="start the robot at START: a world's start by name or 'x y z "
                              "yaw' (m, rad; the soles put on the ground, z a hint only), in "
                              'the flat world or --world\'s')
+    parser.add_argument('--mud-damping', type=_mud_damping, default=MUD_DAMPING, metavar='C',
+                        help="the mud's damping, N s/m, in a world with mud, as the node's "
+                             '~mud_damping (default: %(default)g; the VRC finals: 70)')
     return parser
 
 
@@ -101,12 +120,15 @@ def _start(text: str) -> Start | None:
         raise argparse.ArgumentTypeError(str(err)) from None
 
 
-def _offline_world(world: str | None, start: Start | None) -> OfflineWorld | None:
-    """The model and start --world and --start ask for (None: neither given)."""
+def _offline_world(world: str | None, start: Start | None,
+                   mud_damping: float = MUD_DAMPING) -> OfflineWorld | None:
+    """The model, start and mud --world, --start and --mud-damping ask for (None: none)."""
     chosen = named_world(world) if world is not None else None
-    if start is None:
-        return chosen
-    return OfflineWorld(start=start) if chosen is None else replace(chosen, start=start)
+    if start is not None:
+        chosen = OfflineWorld(start=start) if chosen is None else replace(chosen, start=start)
+    if mud_damping != MUD_DAMPING:
+        chosen = replace(chosen or OfflineWorld(), mud_damping=mud_damping)
+    return chosen
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -123,7 +145,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         with tempfile.TemporaryDirectory(prefix='tac_offline_') as scratch:
             # Without --bag the summary is read from a bag that is deleted afterwards.
             bag = args.bag if args.bag is not None else Path(scratch) / 'offline.bag'
-            world = _offline_world(args.world, args.start)
+            world = _offline_world(args.world, args.start, args.mud_damping)
             if args.asi_from is not None:
                 run = run_asi_offline(args.asi_from, bag, args.settle, args.gains,
                                       args.behaviour, world)

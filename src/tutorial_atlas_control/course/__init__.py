@@ -1,20 +1,25 @@
 """DRCSim's VRC Task 2 course without ROS: its description, its world, its mud, its scoring.
 
-errors: CourseError, what the course refuses; vrc_task_2: the course's figures (the
-heightmap's scaling, the gates, the pen, the mud, the blocks, the starts), the one
-description the world, the mud and the scoring read; starts: where a run starts Atlas (a
-world's start by name, or 'x y z yaw'), checked once for the node, the launches and offline
-runs; scoring: VRCScoringPlugin's rules, a Scorer fed once per physics step (gates in order,
-the clock, falls, the rows due); score_log: DRCSim's score.log (its header, whole rows).
+errors: CourseError, what the course refuses; mud: DRCSim's MudPlugin as a law (the drag a
+touching link feels, explicit and as ODE solved it, moved to the centre of mass);
+vrc_task_2: the course's figures (the heightmap's scaling, the gates, the pen, the mud, the
+blocks, the starts), the one description the world, the mud and the scoring read; starts:
+where a run starts Atlas (a world's start by name, or 'x y z yaw'), checked once for the
+node, the launches and offline runs; scoring: VRCScoringPlugin's rules, a Scorer fed once per
+physics step (gates in order, the clock, falls, the rows due); score_log: DRCSim's score.log
+(its header, whole rows).
 """
 
 from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'errors': ['CourseError'],
+    'mud': ['MAX_MUD_DAMPING', 'check_mud_damping', 'drag_at_point', 'drag_wrench',
+            'implicit_drag', 'wrench_at_com'],
     'score_log': ['DEFAULT_SCORE_DIR', 'SCORE_FILE_NAME', 'ScoreLog'],
     'scoring': ['FALL_ACCEL_THRESHOLD', 'TASK_WALKING', 'ScoreRow', 'Scorer', 'seconds'],
     'starts': ['WORLD_MODEL_FILE', 'parse_start', 'start_text', 'world_start'],
-    'vrc_task_2': ['BLOCKS', 'GATES', 'HEIGHTMAP', 'MUD_BOX', 'PEN_WALLS', 'STARTS',
-                   'WORLD_NAME', 'Block', 'Box', 'Gate', 'Heightmap', 'Start'],
+    'vrc_task_2': ['BLOCKS', 'GATES', 'HEIGHTMAP', 'MUD_BOX', 'MUD_DAMPING', 'MUD_DAMPING_FINALS',
+                   'MUD_LINKS', 'PEN_WALLS', 'STARTS', 'WORLD_NAME', 'Block', 'Box', 'Gate',
+                   'Heightmap', 'Start'],
 })

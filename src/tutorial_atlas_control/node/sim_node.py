@@ -112,9 +112,11 @@ from tutorial_atlas_control.bags import unwritable_reason
 from tutorial_atlas_control.control_modes import ControlMode
 from tutorial_atlas_control.course import (
     DEFAULT_SCORE_DIR,
+    MUD_DAMPING,
     CourseError,
     ScoreRow,
     Start,
+    check_mud_damping,
     parse_start,
 )
 from tutorial_atlas_control.errors import AtlasControlError
@@ -546,7 +548,8 @@ def build_node() -> SimNode:
         raise AtlasControlError(f'parameter {rospy.resolve_name("~stand")} must be one of '
                                 f'{", ".join(STAND_CHOICES)}, got {stand!r}')
     sim = AtlasSimulator(load_model(Path(model_file)), gains, time_to_unpin_s,
-                         startup_mode=VrcMode(startup_mode), start=_start_param())
+                         startup_mode=VrcMode(startup_mode), start=_start_param(),
+                         mud_damping=_mud_damping_param())
     behaviour_spec = rospy.get_param('~behaviour', '')
     if not isinstance(behaviour_spec, str):
         raise AtlasControlError(f'parameter {rospy.resolve_name("~behaviour")} must be '
@@ -565,6 +568,13 @@ def build_node() -> SimNode:
                             user_behaviour=user_behaviour, score_dir=_score_dir())
     return SimNode(sim, settings, bool(rospy.get_param('~gui', False)),
                    description is not None, DelayBudgets.from_params(rospy.get_param))
+
+
+def _mud_damping_param() -> float:
+    """~mud_damping: the MudPlugin's damping (N s/m) in a world with a `mud_atlas` box
+    (sim.mud); its error names the parameter."""
+    return check_mud_damping(rospy.get_param('~mud_damping', MUD_DAMPING),
+                             f'parameter {rospy.resolve_name("~mud_damping")}')
 
 
 def _start_param() -> Start | None:

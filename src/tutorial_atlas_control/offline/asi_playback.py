@@ -134,7 +134,8 @@ def write_asi_bag(stream: AsiStream, bag: Path, settle_s: float,
     """Play `stream` offline and write the run to `bag` (a new file); `behaviour`: a user's
     own (`module:Class` or `file.py:Class`), as atlas.launch's argument."""
     sim = AtlasSimulator(load_model(stream.world.model_path), load_gains_yaml(gains_file),
-                         startup_mode=stream.startup_mode, start=stream.world.start)
+                         startup_mode=stream.startup_mode, start=stream.world.start,
+                         mud_damping=stream.world.mud_damping)
     user = load_user_behaviour(behaviour, sim.atlas) if behaviour else None
     # atlas.launch's default start
     interface = AtlasSimInterface(sim, hold_at_start=True, user_behaviour=user)

@@ -39,7 +39,7 @@ from tutorial_atlas_control.bags import (
     rosbags_msgtype,
 )
 from tutorial_atlas_control.command import CommandError, CommandUpdate
-from tutorial_atlas_control.course import ScoreRow
+from tutorial_atlas_control.course import ScoreRow, check_mud_damping
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES
 from tutorial_atlas_control.msgs import CommandDecoder, JointCommandsWire, StampedWire, clock_bytes
@@ -433,10 +433,12 @@ def write_offline_bag(bag: Path, trajectory_file: str, name: str, waypoints: Seq
     `on_step`, if given, is called with the simulator after every step (and its messages):
     the sweep measures a run there, and applies its pushes, without reading the bag back.
     `latency`, if given, delays each command as a live run's delivery does (CommandLatency).
-    `world`: the model and start (None: the flat world's, at the origin).
+    `world`: the model, the start and the mud's damping (None: the flat world's, at the
+    origin).
     """
     world = world or OfflineWorld()
-    sim = AtlasSimulator(load_model(world.model_path), gains, start=world.start)
+    sim = AtlasSimulator(load_model(world.model_path), gains, start=world.start,
+                         mud_damping=world.mud_damping)
     sink = open_offline_bag(bag)
     # The run's time, without loading the model and the message types (fixed costs).
     started_s = time.perf_counter()
@@ -476,9 +478,12 @@ def run_offline(trajectory_file: str, name: str, bag: Path | str,
     (replacing an existing file): a failed run leaves nothing.
 
     Raises:
-        TrajectoryError, GainsError, ModelError: bad inputs (checked before simulating).
+        TrajectoryError, GainsError, ModelError, CourseError: bad inputs (checked before
+            simulating).
         OfflineRunError: `bag`'s directory does not exist, or the physics diverged.
     """
+    if world is not None:
+        check_mud_damping(world.mud_damping)
     path = locate_trajectory_file(trajectory_file)
     waypoints = load_trajectory(path, name)
     gains = load_gains_yaml(gains_file)

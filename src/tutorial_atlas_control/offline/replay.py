@@ -563,8 +563,11 @@ def _replay_recorded(sim: AtlasSimulator, steps: np.ndarray, effort_nm: np.ndarr
 
 
 def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
-           gains_file: Path = DEFAULT_GAINS_FILE) -> ReplayResult:
-    """Re-simulate `recording` and measure how far it strays from the recorded run.
+           gains_file: Path = DEFAULT_GAINS_FILE,
+           model_path: Path | None = None) -> ReplayResult:
+    """Re-simulate `recording` and measure how far it strays from the recorded run: in the
+    world its config names (offline.world), or the model at `model_path`; in a world with
+    mud, with the config's mud_damping.
 
     Raises:
         ReplayError: unsupported recording (timestep differs from the model's; steps before
@@ -579,9 +582,10 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
         world = recorded_world(config)
     except CourseError as err:
         raise ReplayError(f'{err}.') from None
-    sim = AtlasSimulator(load_model(world.model_path), load_gains_yaml(gains_file),
-                         config.time_to_unpin_s, startup_mode=VrcMode(config.startup_mode),
-                         start=world.start)
+    sim = AtlasSimulator(load_model(model_path or world.model_path),
+                         load_gains_yaml(gains_file), config.time_to_unpin_s,
+                         startup_mode=VrcMode(config.startup_mode), start=world.start,
+                         mud_damping=world.mud_damping)
     sha1_matches = _check_model(config, sim, warnings)
     step_ns = sim.step_ns
     reset_step = _reset_step(config, step_ns)
@@ -631,10 +635,12 @@ def _score_replay(recording: Recording, sim: AtlasSimulator, reset_step: int,
 
 
 def replay_bag(path: Path | str, tolerance: float = DEFAULT_TOLERANCE,
-               try_number: int | None = None, assume_defaults: bool = False) -> ReplayResult:
+               try_number: int | None = None, assume_defaults: bool = False,
+               model_path: Path | None = None) -> ReplayResult:
     """:func:`load_recording` (of try `try_number`, None: the last) then :func:`replay`."""
     return replay(load_recording(path, try_number=try_number,
-                                 assume_defaults=assume_defaults), tolerance)
+                                 assume_defaults=assume_defaults), tolerance,
+                  model_path=model_path)
 
 
 # ---------------------------------------------------------------------------- report

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from tutorial_atlas_control.course import (
+    MUD_DAMPING,
     WORLD_MODEL_FILE,
     CourseError,
     Start,
@@ -26,10 +27,12 @@ __all__ = ['OfflineWorld', 'named_world', 'recorded_world']
 
 @dataclass(frozen=True)
 class OfflineWorld:
-    """A model file and the start the simulator resets to (None: the model's spawn pose)."""
+    """A model file, the start the simulator resets to (None: the model's spawn pose), and
+    the mud's damping (N s/m) if the model has mud (sim.mud)."""
 
     model_path: Path = MODEL_PATH
     start: Start | None = None
+    mud_damping: float = MUD_DAMPING
 
 
 def named_world(name: str) -> OfflineWorld:
@@ -49,7 +52,7 @@ def named_world(name: str) -> OfflineWorld:
 def recorded_world(config: SimConfig) -> OfflineWorld:
     """The world a recorded run's config names: its model file when the package's sim/
     holds one of that name (else the default model: replay's checksum check then says
-    so), and its start.
+    so), its start and its mud's damping.
 
     Raises:
         CourseError: the config's start is not a start.
@@ -63,4 +66,5 @@ def recorded_world(config: SimConfig) -> OfflineWorld:
         start = parse_start(config.start)
     except CourseError as err:
         raise CourseError(f'the recorded /atlas/sim_config: {err}') from None
-    return OfflineWorld(model_path, start)
+    return OfflineWorld(model_path, start, MUD_DAMPING if config.mud_damping is None
+                        else config.mud_damping)

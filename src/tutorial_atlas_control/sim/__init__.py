@@ -8,6 +8,7 @@ robot description, state_publisher_node.py, is imported by its module.
 from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
+    'body_forces': ['step_with_body_forces'],
     'camera': ['CAMERA', 'configure_viewer_camera', 'configure_viewer_scene'],
     'controller': ['DEFAULT_GAINS_FILE', 'Gains', 'GainsError', 'LOAD_HINT', 'gains_from_params',
                    'load_gains_yaml'],
@@ -23,6 +24,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'law_kernel': ['CompiledLaw', 'LawJoints'],
     'link_transforms': ['LinkTransforms', 'RspSchedule'],
     'mode_commands': ['ControlMode', 'ModeCommands', 'ModeError', 'VALID_MODES', 'parse_mode'],
+    'mud': ['MUD_GEOM', 'MudDrag'],
     'model': ['AtlasModel', 'MODEL_PATH', 'ORIGIN_PELVIS_QPOS', 'SOLE_GEOMS', 'SPAWN_HEIGHT_M',
               'body_position_in_pose', 'load_model', 'pelvis_height_m', 'reset_to_initial'],
     'sim_config': ['SimConfig', 'SimConfigError', 'parse_sim_config'],

@@ -32,7 +32,8 @@ class SimConfig:
     """The simulator's config (times in s).
 
     `recorded` is not on the wire: False marks defaults assumed for a bag that has no
-    config (recorded before the simulator published one).
+    config (recorded before the simulator published one). `mud_damping` (N s/m) is written
+    only by a simulator whose world has mud (None: none), so other runs' text is unchanged.
     """
 
     model_file: str | None
@@ -45,6 +46,7 @@ class SimConfig:
     #: Where the robot starts (course.parse_start's text; '': the model's spawn pose at
     #: the origin), written only when given.
     start: str = ''
+    mud_damping: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON object, keys in the order the simulator has always published them."""
@@ -59,6 +61,8 @@ class SimConfig:
             config['startup_mode'] = self.startup_mode
         if self.start:
             config['start'] = self.start
+        if self.mud_damping is not None:
+            config['mud_damping'] = self.mud_damping
         return config
 
     def to_json(self) -> str:
@@ -80,7 +84,9 @@ class SimConfig:
                 time_to_unpin_s=float(config['time_to_unpin']),
                 last_reset_time_s=float(config['last_reset_time']),
                 startup_mode=str(config.get('startup_mode', DEFAULT_STARTUP_MODE)),
-                start=str(config.get('start', '')))
+                start=str(config.get('start', '')),
+                mud_damping=(None if config.get('mud_damping') is None
+                             else float(config['mud_damping'])))
         except (KeyError, TypeError, ValueError) as err:
             raise SimConfigError(f'lacks a valid {err} (expected JSON with '
                                  f'{", ".join(REQUIRED_KEYS)}).') from None

@@ -5,7 +5,7 @@ everything that decides what torque a joint gets lives in this subpackage, so it
 unit-tested without a master and shared with offline replay. AtlasSimulator puts together
 its collaborators, each a concern of its own: the mode and its commands (mode_commands),
 the law applied to the joints (joint_law), the start-up pin (startup_pin), VRCPlugin's
-cheats (vrc) and the divergence check (divergence).
+cheats (vrc), the mud's drag in a world with mud (mud) and the divergence check (divergence).
 """
 
 from __future__ import annotations
@@ -19,10 +19,11 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control.command import CommandUpdate, JointCommandArrays
-from tutorial_atlas_control.course import Start, start_text
+from tutorial_atlas_control.course import MUD_DAMPING, Start, start_text
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.behaviour import Behaviour, ModeBehaviours
+from tutorial_atlas_control.sim.body_forces import step_with_body_forces
 from tutorial_atlas_control.sim.controller import Gains, hold_command
 from tutorial_atlas_control.sim.divergence import (
     DIVERGENCE_WARNINGS,
@@ -40,6 +41,7 @@ from tutorial_atlas_control.sim.mode_commands import (
     ModeError,
     parse_mode,
 )
+from tutorial_atlas_control.sim.mud import MudDrag
 from tutorial_atlas_control.sim.sim_config import SimConfig
 from tutorial_atlas_control.sim.start_pose import home_qpos
 from tutorial_atlas_control.sim.startup_pin import StartupEvent, StartupPin
@@ -87,11 +89,13 @@ class AtlasSimulator:
                  time_to_unpin_s: float = DEFAULT_TIME_TO_UNPIN_S,
                  compiled_law: bool = True,
                  startup_mode: VrcMode = DEFAULT_STARTUP_MODE,
-                 start: Start | None = None) -> None:
+                 start: Start | None = None,
+                 mud_damping: float = MUD_DAMPING) -> None:
         """`compiled_law`: run the law through law_kernel's C kernel when it is built
         (the same torques bit for bit, faster); False: always controller.compute_torque.
         `startup_mode`: one of vrc.STARTUP_MODES, what reset_world starts the robot in;
-        `start`: where, soles on the ground (None: the origin; ModelError: no ground)."""
+        `start`: where, soles on the ground (None: the origin; ModelError: no ground);
+        `mud_damping`: the MudPlugin's damping (N s/m) in a world with mud (sim.mud)."""
         # A model of its own: the cheats move the pin weld's target (model.eq_data), which
         # must not move the pin of another simulator sharing the compiled model.
         atlas = dataclasses.replace(atlas, model=copy.deepcopy(atlas.model))
@@ -113,6 +117,7 @@ class AtlasSimulator:
         self.start = start
         # VRCPlugin's cheats, pinning at reset_world's pelvis qpos; the world's ground.
         self.ground, self.start_qpos, self.vrc = _placed_cheats(atlas, self.data, start)
+        self.mud = MudDrag.for_model(self.model, atlas.path, mud_damping)  # None: no mud
         self.startup_pin = StartupPin(atlas, self.data, self.vrc, time_to_unpin_s, startup_mode)
         #: How many inputs were applied since the last reset, and the last one (sim time (ns)
         #: before the step it first acted in, input): /atlas/sim_inputs publishes each for
@@ -166,7 +171,8 @@ class AtlasSimulator:
                          timestep_s=self.dt_s, time_to_unpin_s=self.time_to_unpin_s,
                          last_reset_time_s=self.last_reset_ns / NS_PER_S,
                          startup_mode=self.startup_mode.value,
-                         start=start_text(self.start) if self.start else '')
+                         start=start_text(self.start) if self.start else '',
+                         mud_damping=None if self.mud is None else self.mud.damping)
 
     def reset_simulation(self, sim_time_ns: int = 0) -> None:
         """reset_world, and sim time back to `sim_time_ns` (Gazebo's reset_simulation
@@ -288,14 +294,11 @@ class AtlasSimulator:
                 and pin.release() is StartupEvent.STAND:
             self.set_mode(ControlMode.STAND)  # bdi_stand's end: every k_effort 0
         vrc = self.vrc
-        viewer_xfrc = None
         if vrc.active:
             if vrc.playback is not None:
                 self._playback_step()
                 return
             vrc.warp_step(self.dt_s)
-            viewer_xfrc = self.data.xfrc_applied.copy()  # the viewer's mouse forces, if any
-            self.data.xfrc_applied += vrc.xfrc
         if torque_nm is None:
             commands = self.commands
             behaviour = self.behaviours.acting
@@ -305,11 +308,10 @@ class AtlasSimulator:
                 self.law.apply_behaviour(behaviour.torque(self.data), commands.blend_command)
         else:
             self.law.set_torque(torque_nm)
-        mujoco.mj_step(self.model, self.data)
+        step_with_body_forces(self.model, self.data, vrc.xfrc if vrc.active else None,
+                              self.mud)
         # mj_step integrates last: joint positions/velocities are at the new time, while body
         # poses and sensor readings were computed before integrating, at the step's start.
-        if viewer_xfrc is not None:
-            self.data.xfrc_applied[:] = viewer_xfrc
         self.state_time_ns = self.sim_time_ns
         self.sim_time_ns += self.step_ns
         self._check_divergence(self.sim_time_ns)
