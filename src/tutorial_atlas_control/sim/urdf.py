@@ -86,8 +86,8 @@ def matching_urdf(model_path: Path | str, model: mujoco.MjModel) -> tuple[Path, 
     """The URDF beside `model_path` and its text, if it describes `model`'s kinematics.
 
     Every hinge joint of the model must be a URDF revolute joint of the same name between
-    the same two links, with the same origin and axis; the URDF's links are the model's
-    bodies.
+    the same two links, with the same origin and axis; the URDF's links are the robot's
+    bodies (the pelvis's tree: a world's loose bodies are not in the URDF).
 
     Raises:
         UrdfError: no such file, or it describes a different robot (the message says what).
@@ -98,7 +98,10 @@ def matching_urdf(model_path: Path | str, model: mujoco.MjModel) -> tuple[Path, 
     text = path.read_text()
     links, joints = read_joints(text, str(path))
     by_name = {joint.name: joint for joint in joints}
-    bodies = {mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) for b in range(1, model.nbody)}
+    # The robot's bodies: the pelvis's tree (a course's loose blocks are not the robot).
+    robot_root = model.body_rootid[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, 'pelvis')]
+    bodies = {mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) for b in range(1, model.nbody)
+              if model.body_rootid[b] == robot_root}
     if set(links) != bodies:
         differ = sorted(set(links) ^ bodies)
         raise UrdfError(f'{path} does not match the model {model_path}: links and bodies differ '

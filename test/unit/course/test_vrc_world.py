@@ -15,6 +15,7 @@ from tutorial_atlas_control.course import vrc_task_2 as course
 from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.sim import model
 from tutorial_atlas_control.sim.ground import Ground
+from tutorial_atlas_control.sim.urdf import matching_urdf, read_joints
 
 WORLD = load_generator()
 TABLE = load_table()
@@ -60,6 +61,18 @@ def test_world_file_is_what_the_generator_writes() -> None:
     terrain = WORLD.load_terrain(WORLD_PATH.parent / WORLD.TERRAIN_FILE)
     assert WORLD_PATH.read_text() == WORLD.build(terrain), \
         'sim/vrc_task_2.xml is stale: run `python3 tools/make_vrc_world.py`'
+    assert WORLD_PATH.with_suffix('.urdf').read_text() == WORLD.build_urdf(), \
+        'sim/vrc_task_2.urdf is stale: run `python3 tools/make_vrc_world.py`'
+
+
+def test_urdf_matches_the_robot_not_the_blocks(atlas: model.AtlasModel) -> None:
+    """/tf and rviz get the VRC robot: its hands' and Hokuyo's links on fixed joints, the
+    course's loose blocks (bodies of the world, not of the robot) left out."""
+    path, text = matching_urdf(WORLD_PATH, atlas.model)
+    links, joints = read_joints(text, str(path))
+    assert {'l_palm', 'r_f3', 'hokuyo_link'} <= set(links)
+    assert not any(link.startswith('cinder_block') for link in links)
+    assert {joint.name: joint.kind for joint in joints}['hokuyo_joint'] == 'fixed'
 
 
 def test_terrain_heights_are_the_heightmap_scaled_as_gazebo_did(
