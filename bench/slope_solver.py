@@ -27,10 +27,11 @@ import statistics
 import sys
 import time
 import timeit
+from typing import Any
 
 import mujoco
 
-from tutorial_atlas_control.balance import INVERSE_STATICS, QP, Push, StandGains
+from tutorial_atlas_control.balance import INVERSE_STATICS, QP, Push, StandGains, contact_qp
 from tutorial_atlas_control.balance.push_trial import apply_pushes, push_events
 from tutorial_atlas_control.balance.slope_trial import (
     place_on_slope,
@@ -118,6 +119,20 @@ def print_costs(slope_deg: float, rounds: int = 5, calls: int = 1000) -> None:
               f'{os.getloadavg()[0]:.2f}', flush=True)
 
 
+def box_about_vertical() -> None:
+    """The QP's sole box scaled by 1/n_z (the ground normal's vertical part): the pressure
+    centre held about the vertical force, as inverse statics does; an experiment."""
+    solve = contact_qp.solve_contact_qp
+
+    def scaled(*args: Any) -> Any:
+        frames, (half_length, half_width, torsion, friction) = args[4], args[5]
+        up = min(frame[2][2] for frame in frames if frame is not None)
+        return solve(*args[:5], (half_length / up, half_width / up, torsion, friction),
+                     *args[6:])
+
+    contact_qp.solve_contact_qp = scaled
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--seeds', type=int, default=8)
@@ -127,7 +142,12 @@ def main() -> int:
     parser.add_argument('--solvers', nargs='+', default=[INVERSE_STATICS, QP])
     parser.add_argument('--json')
     parser.add_argument('--cost', action='store_true')
+    parser.add_argument('--qp-box-vertical', action='store_true',
+                        help="the QP's pressure-centre box about the vertical force, as inverse "
+                             'statics holds it (1/cos(slope) larger), not the normal one')
     args = parser.parse_args()
+    if args.qp_box_vertical:
+        box_about_vertical()
     if args.cost:
         for slope in args.slopes:
             print_costs(slope)
