@@ -7,11 +7,12 @@ between the feet; sole: the model's sole boxes and their corners; stand_pose: DR
 Stand pose placed on the ground; stance_posture: that pose's legs solved for the stance
 the feet are in; manipulate: Manipulate's pelvis servo (targets clamped, the posture that
 reaches them); estimator: the balance state from the model; whole_body: tasks and
-constraints over one state, solved into torques (inverse statics); stand: the Stand
-controller (its tasks: capture-point feedback, height, pelvis frame, posture);
-stand_behaviour: that controller as the simulator's Stand behaviour, with the servo;
-stand_prep: StandPrep, the harnessed robot brought to the Stand pose; push_trial: offline
-trials of it on the simulator, standing and pushed.
+constraints over one state, solved into torques (inverse statics, or contact_qp: the
+contact wrenches by a QP); stand: the Stand controller (its tasks: capture-point feedback,
+height, pelvis frame, posture); stand_behaviour: that controller as the simulator's Stand
+behaviour, with the servo; stand_prep: StandPrep, the harnessed robot brought to the
+Stand pose; push_trial: offline trials of it on the simulator, standing and pushed;
+slope_trial: Stand trials on a slope.
 """
 
 from tutorial_atlas_control.exports import lazy_exports
@@ -28,9 +29,10 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'stand_behaviour': ['StandBehaviour'],
     'sole': ['SOLE_GEOMS', 'SoleBox', 'box_corners', 'sole_corners'],
     'stand_pose': ['STAND_POSE_RAD', 'place_in_stand_pose'],
-    'whole_body': ['CapturePointTask', 'CentroidalTask', 'ComHeightTask', 'ContactConstraint',
-                   'JointTask', 'PelvisOrientationTask', 'PostureTask', 'WholeBodyLayer',
-                   'WholeBodyOutput'],
+    'whole_body': ['INVERSE_STATICS', 'QP', 'SOLVERS', 'CapturePointTask', 'CentroidalTask',
+                   'ComHeightTask', 'ContactConstraint', 'JointTask', 'PelvisOrientationTask',
+                   'PostureTask', 'WholeBodyLayer', 'WholeBodyOutput'],
+    'slope_trial': ['place_on_slope', 'slope_model', 'slope_stand_trial'],
     'stand_prep': ['StandPrepBehaviour'],
     'support': ['clamp_into', 'convex_hull', 'signed_distance'],
 })

@@ -28,6 +28,7 @@ from tutorial_atlas_control.balance import lipm, support
 from tutorial_atlas_control.balance.estimator import BalanceState
 from tutorial_atlas_control.balance.stand_pose import STAND_POSE_RAD
 from tutorial_atlas_control.balance.whole_body import (
+    INVERSE_STATICS,
     CapturePointTask,
     CentroidalTask,
     ComHeightTask,
@@ -77,6 +78,9 @@ class StandGains:
     #: The soles' friction coefficient the contact wrenches are kept within (the model's
     #: sole and floor friction, sim/atlas_v1.xml); None: not limited.
     friction: float | None = 1.0
+    #: The whole-body layer's solver (whole_body.SOLVERS): inverse statics, or the contact
+    #: QP (docs/controllers.md, "Solver": what each costs and buys on a slope).
+    solver: str = INVERSE_STATICS
     #: Joint PD to the Stand pose (N m/rad, N m s/rad), tutorial order.
     joint_kp: np.ndarray = field(default_factory=STAND_JOINT_KP.copy)
     joint_kd: np.ndarray = field(default_factory=STAND_JOINT_KD.copy)
@@ -156,7 +160,7 @@ class StandController:
         self.reference = reference
         self.sole_half_size_m = sole_half_size_m
         self.gains = gains or StandGains()
-        self.layer = WholeBodyLayer(mass_kg, effort_limit_nm)
+        self.layer = WholeBodyLayer(mass_kg, effort_limit_nm, self.gains.solver)
         self._contacts: dict[tuple[bool, float | None], ContactConstraint] = {}
         self._region: tuple[np.ndarray, support.Region] | None = None
 

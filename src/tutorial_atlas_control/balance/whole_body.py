@@ -10,14 +10,18 @@ giving (28,) torques. Constraints say what cannot be: a ContactConstraint per so
 the pressure centre inside the sole, the yaw moment and the tangential force within what
 friction holds) and the joint torque limits.
 
-The solver is inverse statics: the tasks' wrench, shared between the soles in contact
-(contact_wrench.split_wrench), each share made feasible, becomes tau = bias - J_c^T lambda
-(gravity and Coriolis of the whole body included), plus the joint tasks, within the limits.
-It holds a flat stance exactly and costs a few microseconds; a QP over the same tasks and
-constraints would trade the tasks off where they conflict (a slope's friction, a foot at its
-edge), at the price of a solve each tick. Every task and constraint computes in plain floats
-in numpy's order of operations: Stand's torques are the same bits as before the layer. The
-tasks are made anew each tick: plain slotted classes, cheap to make.
+Two solvers, chosen by name (SOLVERS). INVERSE_STATICS, the default: the tasks' wrench,
+shared between the soles in contact (contact_wrench.split_wrench), each share made
+feasible, becomes tau = bias - J_c^T lambda (gravity and Coriolis of the whole body
+included), plus the joint tasks, within the limits. It holds a flat stance exactly and
+costs a few microseconds. QP (contact_qp): the soles' wrenches that make the tasks' wrench
+as nearly as each sole's friction pyramid and pressure centre about the ground's normal
+(MuJoCo's contacts) and the joints' torque limits allow, near the same split: where the
+split is feasible, the same wrenches; where not, the other sole carries what one cannot,
+for a solve each tick (the figures on a slope: docs/controllers.md, "Solver"). Inverse
+statics computes in plain floats in numpy's order of operations: Stand's torques are the
+same bits as before the layer. The tasks are made anew each tick: plain slotted classes,
+cheap to make.
 """
 
 from __future__ import annotations
@@ -29,11 +33,19 @@ from typing import Protocol
 import numpy as np
 
 from tutorial_atlas_control.balance import contact_wrench, lipm
+from tutorial_atlas_control.balance.errors import BalanceError
 from tutorial_atlas_control.balance.estimator import BalanceState
 
-__all__ = ['CapturePointTask', 'CentroidalTask', 'ComHeightTask', 'ContactConstraint',
-           'JointTask', 'PelvisOrientationTask', 'PostureTask', 'WholeBodyLayer',
-           'WholeBodyOutput', 'orientation_error']
+__all__ = ['INVERSE_STATICS', 'QP', 'SOLVERS', 'CapturePointTask', 'CentroidalTask',
+           'ComHeightTask', 'ContactConstraint', 'JointTask', 'PelvisOrientationTask',
+           'PostureTask', 'WholeBodyLayer', 'WholeBodyOutput', 'ground_normal',
+           'orientation_error']
+
+#: The whole-body layer's solvers: the contact wrenches shared by a rule and clamped, or
+#: found by a QP (contact_qp).
+INVERSE_STATICS = 'inverse_statics'
+QP = 'qp'
+SOLVERS = (INVERSE_STATICS, QP)
 
 #: A joint task: the robot's state, the joints' positions and velocities -> (28,) torques.
 JointTask = Callable[[BalanceState, np.ndarray, np.ndarray], np.ndarray]
@@ -148,12 +160,29 @@ class WholeBodyOutput:
     contact_wrenches: np.ndarray   # (2, 6) per sole, feasible
 
 
-class WholeBodyLayer:
-    """Tasks and constraints over one BalanceState, turned into the 28 joint torques."""
+def ground_normal(state: BalanceState, foot: int) -> np.ndarray:
+    """The unit normal of the ground under a sole: the mean of its contacts' normals
+    (MuJoCo's), else the sole's own z axis."""
+    contacts = state.sole_contacts[foot]
+    if not contacts.touching:
+        return state.sole_rotations[foot][:, 2].copy()
+    normal = contacts.normals.mean(axis=0)
+    return normal / np.linalg.norm(normal)
 
-    def __init__(self, mass_kg: float, effort_limit_nm: np.ndarray) -> None:
+
+class WholeBodyLayer:
+    """Tasks and constraints over one BalanceState, turned into the 28 joint torques by
+    `solver` (one of SOLVERS)."""
+
+    def __init__(self, mass_kg: float, effort_limit_nm: np.ndarray,
+                 solver: str = INVERSE_STATICS) -> None:
+        if solver not in SOLVERS:
+            raise BalanceError(f'whole-body solver {solver!r} is not one of {SOLVERS}')
         self.mass_kg = mass_kg
         self.effort_limit_nm = np.asarray(effort_limit_nm, dtype=float)
+        self.solver = solver
+        #: How many ticks the QP found no feasible wrench (inverse statics' was used).
+        self.qp_fallbacks = 0
 
     def centroidal_wrench(self, state: BalanceState,
                           tasks: Sequence[CentroidalTask]) -> tuple[np.ndarray, np.ndarray]:
@@ -175,12 +204,36 @@ class WholeBodyLayer:
         carrying = (contacts[0].carries, contacts[1].carries)
         wrenches = contact_wrench.split_wrench(force, moment, state.sole_centres, state.com,
                                                carrying)
+        if self.solver == QP and (carrying[0] or carrying[1]):
+            base = state.bias_nm.copy()
+            for joint_task in joint_tasks:
+                base += joint_task(state, joint_positions, joint_velocities)
+            solved = self._solve_qp(state, force, moment, wrenches, contacts, base)
+            if solved is not None:
+                torque = base - state.sole_jacobians.reshape(12, -1).T @ solved.reshape(12)
+                return WholeBodyOutput(torque, force, moment, solved)
+            self.qp_fallbacks += 1
         for foot in (0, 1):
             wrenches[foot] = contacts[foot].feasible(wrenches[foot], state.sole_rotations[foot])
         torque = state.bias_nm - state.sole_jacobians.reshape(12, -1).T @ wrenches.reshape(12)
         for joint_task in joint_tasks:
             torque += joint_task(state, joint_positions, joint_velocities)
         return WholeBodyOutput(torque, force, moment, wrenches)
+
+    def _solve_qp(self, state: BalanceState, force: np.ndarray, moment: np.ndarray,
+                  split: np.ndarray, contacts: tuple[ContactConstraint, ContactConstraint],
+                  base_torque_nm: np.ndarray) -> np.ndarray | None:
+        """The contact QP's wrenches (contact_qp), each carrying sole's constraint about
+        the ground's normal; None when it has none."""
+        from tutorial_atlas_control.balance import contact_qp  # noqa: PLC0415 - scipy, on use
+        frames = [contact_qp.contact_frame(ground_normal(state, foot),
+                                           state.sole_rotations[foot])
+                  if contacts[foot].carries else None for foot in (0, 1)]
+        sole = contacts[0] if contacts[0].carries else contacts[1]
+        return contact_qp.solve_contact_qp(
+            np.concatenate([force, moment]), split, state.com, state.sole_centres, frames,
+            (sole.half_length_m, sole.half_width_m, sole.torsion_m, sole.friction),
+            state.sole_jacobians, base_torque_nm, self.effort_limit_nm)
 
     def limit(self, torque: np.ndarray) -> np.ndarray:
         """`torque` within the joints' effort limits, in place."""

@@ -88,7 +88,17 @@ def load_model(path: Path = MODEL_PATH) -> AtlasModel:
         model = mujoco.MjModel.from_xml_path(str(path))
     except ValueError as err:
         raise ModelError(f'Could not compile MuJoCo model {path}: {err}') from err
+    return index_model(model, path)
 
+
+def index_model(model: mujoco.MjModel, path: Path = MODEL_PATH) -> AtlasModel:
+    """Index a compiled Atlas model (`path`: where it came from, for messages) by the
+    tutorial's joint names: a world built in memory (a tilted floor) as load_model's.
+
+    Raises:
+        ModelError: it lacks a joint, actuator, body, equality or sensor this package
+            relies on.
+    """
     joint_ids = np.array([_require_id(model, mujoco.mjtObj.mjOBJ_JOINT, name, path)
                           for name in JOINT_NAMES])
     for index, name in enumerate(JOINT_NAMES):
