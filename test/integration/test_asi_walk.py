@@ -1,7 +1,7 @@
 """Walk through the open AtlasSimInterface, offline and deterministic: a WALK command's queue
 walked with walk_feedback as ASI.md says, then Stand by itself (WARNING_AUTO_TRANS); a
 client streaming its window at 1 kHz walks the same walk; /atlas/control_mode Walk walks
-DRCSim's fixed queue and stands 10 s after (with this run's exact figures); two steps with
+DRCSim's fixed queue and stands after it (with this run's exact figures); two steps with
 one foot end the walk (ERROR_INCONSISTENT_STEPS); without the balancing Stand, Walk is not
 served. DRCSim's scripts' sequence from the harness (harnessed, StandPrep, 5 s, nominal, 0.3
 s, Stand, 1 s, Walk) lands, stands, walks and stands; eight steps walked with the arms swung
@@ -70,9 +70,13 @@ RUN_S = 7.0
 #: A standing or walking pelvis stays above this (m; the walk lowers it 5 cm; falling is
 #: below 0.7).
 PELVIS_ABOVE_M = 0.80
-#: Stand after DRCSim's queue (s), the issue's; how long that walk took (s) and the lowest
-#: the pelvis went (m): this run's figures.
-STAND_AFTER_S = 10.0
+#: Stand after DRCSim's queue (s): long enough for a Stand that cannot hold the queue's
+#: stance to fall (planted once: the Stand's torques at 30 % after the walk, down within it).
+#: The issue's 10 s are held live (sim_interface's test_09: each foot under 1 cm and 0.02 rad)
+#: and, stricter, offline over 5 s of every stance a walk leaves (test_stance_hold.py, the
+#: queue's 0.2 m stagger among them); here they cost 7 CPU s more. How long that walk took (s)
+#: and the lowest the pelvis went (m): this run's figures.
+STAND_AFTER_S = 3.0
 WALKED_S = 3.726
 LOWEST_PELVIS_M = 0.840
 LANDING_WITHIN_M = 0.05
@@ -152,12 +156,20 @@ def changes(values: list[int]) -> list[int]:
     return [v for i, v in enumerate(values) if i == 0 or v != values[i - 1]]
 
 
-def test_a_walk_command_walks_its_queue_and_returns_to_stand_by_itself(
-        atlas: atlas_model.AtlasModel) -> None:
+@pytest.fixture(scope='module')
+def queue_walked_once(atlas: atlas_model.AtlasModel) -> tuple[AtlasSimInterface, Run]:
+    """DRCSim's queue sent once in a WALK command, run for RUN_S: the run the first test
+    judges and the streaming client's must equal (run once for both; read, never stepped
+    on)."""
     interface = standing(atlas)
     interface.apply(walk_command(list(DRCSIM_WALK_QUEUE)))
     assert interface.sim.mode is ControlMode.WALK
-    seen = run(interface, RUN_S)
+    return interface, run(interface, RUN_S)
+
+
+def test_a_walk_command_walks_its_queue_and_returns_to_stand_by_itself(
+        queue_walked_once: tuple[AtlasSimInterface, Run]) -> None:
+    interface, seen = queue_walked_once
     assert seen.lowest_pelvis_m > PELVIS_ABOVE_M
     # Walk, then Stand by itself, warning so once it is there.
     assert changes(seen.behaviors) == [Behavior.WALK, Behavior.STAND]
@@ -180,17 +192,16 @@ def test_a_walk_command_walks_its_queue_and_returns_to_stand_by_itself(
 
 
 def test_a_client_streaming_its_window_at_1khz_walks_the_same_walk(
-        atlas: atlas_model.AtlasModel) -> None:
+        atlas: atlas_model.AtlasModel,
+        queue_walked_once: tuple[AtlasSimInterface, Run]) -> None:
     plan = list(DRCSIM_WALK_QUEUE)
-    once, streamed = standing(atlas), standing(atlas)
-    once.apply(walk_command(plan))
-    run(once, RUN_S)
+    once, streamed = queue_walked_once[0], standing(atlas)
     seen = run(streamed, RUN_S, plan)
     assert changes(seen.behaviors) == [Behavior.WALK, Behavior.STAND]
     assert streamed.sim.data.qpos.tobytes() == once.sim.data.qpos.tobytes()
 
 
-def test_control_mode_walk_walks_drcsims_queue_then_stands_ten_seconds(
+def test_control_mode_walk_walks_drcsims_queue_then_stands(
         atlas: atlas_model.AtlasModel) -> None:
     interface = standing(atlas)
     interface.sim.set_mode(ControlMode.WALK)  # what /atlas/control_mode Walk does

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
 
@@ -46,26 +47,50 @@ def _records(log: Path) -> list[dict]:
     return [json.loads(line) for line in log.read_text().splitlines()]
 
 
-def test_toy_search_improves_deterministically_and_resumes(tmp_path: Path, tiny: Path) -> None:
+@dataclass(frozen=True)
+class Ran:
+    """A search's outcome, as subprocess.CompletedProcess gives the script's."""
+
+    returncode: int
+    stdout: str
+    stderr: str
+
+
+def _search_here(capsys: pytest.CaptureFixture[str], *args: str) -> Ran:
+    """search.py's main in this process, its output captured: each search without a new
+    interpreter's imports (cma, scipy, dask: about 4 CPU s a start). The script itself, its
+    start-up, exit status and one-line errors, is test_ctrl_c_keeps_the_finished_generations'
+    and test_missing_file_and_unknown_name's."""
+    capsys.readouterr()
+    status = search_cli.main(list(args))
+    captured = capsys.readouterr()
+    return Ran(status, captured.out, captured.err)
+
+
+def test_toy_search_improves_deterministically_and_resumes(
+        tmp_path: Path, tiny: Path, capsys: pytest.CaptureFixture[str]) -> None:
     whole = tmp_path / 'whole'
     whole.mkdir()
-    result = _search(str(tiny), *TOY, '--generations', '3',
-                     '--log', str(whole / 'log.jsonl'), '--yaml', str(whole / 'found.yaml'))
+    result = _search_here(capsys, str(tiny), *TOY, '--generations', '3',
+                          '--log', str(whole / 'log.jsonl'), '--yaml', str(whole / 'found.yaml'))
     assert result.returncode == 0, result.stderr
     log = _records(whole / 'log.jsonl')
     start = log[1]['cost']
     best = min(min(r['cost']) for r in log if r['kind'] == 'generation')
     assert start > 0.05  # the squat starts ~0.1 m too high
     assert best < start / 2
-    # Two generations in another process, then resumed to three: the same candidates, costs
+    # Two generations in another search, then resumed to three: the same candidates, costs
     # and file as three in one go (same seed, same inputs: deterministic, and resumed exactly).
+    # These two on one worker, in this process, against the whole run's Dask cluster of two:
+    # the search does not depend on its workers either (and no cluster starts twice more).
     out = tmp_path / 'resumed'
     out.mkdir()
-    first = _search(str(tiny), *TOY, '--generations', '2', '--log', str(out / 'log.jsonl'),
-                    '--yaml', str(out / 'found.yaml'))
+    first = _search_here(capsys, str(tiny), *TOY, '--generations', '2', '--workers', '1',
+                         '--log', str(out / 'log.jsonl'), '--yaml', str(out / 'found.yaml'))
     assert first.returncode == 0, first.stderr
-    resumed = _search(str(tiny), *TOY, '--generations', '3', '--resume',
-                      '--log', str(out / 'log.jsonl'), '--yaml', str(out / 'found.yaml'))
+    resumed = _search_here(capsys, str(tiny), *TOY, '--generations', '3', '--resume',
+                           '--workers', '1', '--log', str(out / 'log.jsonl'),
+                           '--yaml', str(out / 'found.yaml'))
     assert resumed.returncode == 0, resumed.stderr
     assert 'resumed after generation 2' in resumed.stdout
     assert (out / 'log.jsonl').read_text() == (whole / 'log.jsonl').read_text()
@@ -82,11 +107,13 @@ def test_toy_search_improves_deterministically_and_resumes(tmp_path: Path, tiny:
     assert abs(rows[0]['pelvis_z_end_m'] - 0.8) == pytest.approx(best, abs=1e-12)
 
 
-def test_gain_search_writes_a_gains_file(tmp_path: Path, tiny: Path) -> None:
-    result = _search(str(tiny), 'bend', '--objective', 'pelvis_height:z=0.8,settle=0.3',
-                     '--vary-gain', 'l_leg_kny+r_leg_kny', '--popsize', '3', '--generations',
-                     '1', '--workers', '1', '--log', str(tmp_path / 'log.jsonl'),
-                     '--yaml', str(tmp_path / 'found.yaml'))
+def test_gain_search_writes_a_gains_file(tmp_path: Path, tiny: Path,
+                                        capsys: pytest.CaptureFixture[str]) -> None:
+    result = _search_here(capsys, str(tiny), 'bend', '--objective',
+                          'pelvis_height:z=0.8,settle=0.3', '--vary-gain', 'l_leg_kny+r_leg_kny',
+                          '--popsize', '3', '--generations', '1', '--workers', '1',
+                          '--log', str(tmp_path / 'log.jsonl'),
+                          '--yaml', str(tmp_path / 'found.yaml'))
     assert result.returncode == 0, result.stderr
     gains = load_gains_yaml(tmp_path / 'found_gains.yaml')
     base = load_gains_yaml(REPO / 'config' / 'atlas_controller.yaml')
@@ -122,7 +149,9 @@ def test_ctrl_c_keeps_the_finished_generations(tmp_path: Path, tiny: Path) -> No
         f'best so far in {found}',
         f'search.py: interrupted; the log {log} keeps the finished generations'), lines
     assert load_trajectory(found, 'bend_found')
-    resumed = _search(*args, '--generations', str(len(generations) + 1), '--resume')
+    # Resumed on one worker: the Ctrl-C above is the cluster's test.
+    resumed = _search(*args, '--generations', str(len(generations) + 1), '--resume',
+                      '--workers', '1')
     assert resumed.returncode == 0, resumed.stderr
     assert f'resumed after generation {len(generations)}' in resumed.stdout
 
@@ -157,23 +186,29 @@ def test_bad_input_one_line_exit_1_nothing_written(tmp_path: Path, tiny: Path,
     assert list(out.iterdir()) == []
 
 
-def test_missing_file_and_unknown_name(tmp_path: Path, tiny: Path) -> None:
-    for trajectory, name, message in ((tmp_path / 'none.yaml', 'bend', 'none.yaml'),
-                                      (tiny, 'walk', 'walk')):
-        result = _search(str(trajectory), name, '--objective', 'stay_up', '--vary',
-                         '0:l_leg_kny', '--log', str(tmp_path / 'log.jsonl'),
-                         '--yaml', str(tmp_path / 'found.yaml'))
+def test_missing_file_and_unknown_name(tmp_path: Path, tiny: Path,
+                                      capsys: pytest.CaptureFixture[str]) -> None:
+    """The script (its wrapper's exit status) for the missing file, main in this process for
+    the unknown name."""
+    for search, trajectory, name, message in (
+            (_search, tmp_path / 'none.yaml', 'bend', 'none.yaml'),
+            (partial(_search_here, capsys), tiny, 'walk', 'walk')):
+        result = search(str(trajectory), name, '--objective', 'stay_up', '--vary',
+                        '0:l_leg_kny', '--log', str(tmp_path / 'log.jsonl'),
+                        '--yaml', str(tmp_path / 'found.yaml'))
         assert result.returncode == 1 and len(result.stderr.splitlines()) == 1
         assert message in result.stderr
         assert not (tmp_path / 'log.jsonl').exists() and not (tmp_path / 'found.yaml').exists()
 
 
-def test_robust_cost_is_the_mean_over_variants(tmp_path: Path, tiny: Path) -> None:
+def test_robust_cost_is_the_mean_over_variants(tmp_path: Path, tiny: Path,
+                                               capsys: pytest.CaptureFixture[str]) -> None:
     """--robust GAIN:TIME plays each candidate again with those scales; its cost is the mean."""
-    result = _search(str(tiny), 'bend', '--objective', 'pelvis_height:z=0.8,settle=0.3',
-                     '--vary', SQUAT, '--robust', '0.5:1.5', '--popsize', '2',
-                     '--generations', '1', '--workers', '1', '--log', str(tmp_path / 'log.jsonl'),
-                     '--yaml', str(tmp_path / 'found.yaml'))
+    result = _search_here(capsys, str(tiny), 'bend', '--objective',
+                          'pelvis_height:z=0.8,settle=0.3', '--vary', SQUAT,
+                          '--robust', '0.5:1.5', '--popsize', '2', '--generations', '1',
+                          '--workers', '1', '--log', str(tmp_path / 'log.jsonl'),
+                          '--yaml', str(tmp_path / 'found.yaml'))
     assert result.returncode == 0, result.stderr
     header, start, generation = _records(tmp_path / 'log.jsonl')
     assert header['config']['variants'] == [[0.5, 1.5]]
@@ -189,13 +224,16 @@ def test_robust_cost_is_the_mean_over_variants(tmp_path: Path, tiny: Path) -> No
     assert start['cost'] == pytest.approx(sum(costs) / 2, abs=1e-12)
 
 
-def test_latency_draws_are_the_same_for_every_candidate(tmp_path: Path, tiny: Path) -> None:
+def test_latency_draws_are_the_same_for_every_candidate(
+        tmp_path: Path, tiny: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """--latency-ms/--latency-draws: each candidate is played again N times with its commands
     delayed, the same N draws for all (seeds fixed), and its cost is the mean."""
-    result = _search(str(tiny), 'bend', '--objective', 'pelvis_height:z=0.8,settle=0.3',
-                     '--vary', SQUAT, '--latency-ms', '0:20', '--latency-draws', '2',
-                     '--popsize', '2', '--generations', '1', '--workers', '1',
-                     '--log', str(tmp_path / 'log.jsonl'), '--yaml', str(tmp_path / 'found.yaml'))
+    result = _search_here(capsys, str(tiny), 'bend', '--objective',
+                          'pelvis_height:z=0.8,settle=0.3', '--vary', SQUAT,
+                          '--latency-ms', '0:20', '--latency-draws', '2', '--popsize', '2',
+                          '--generations', '1', '--workers', '1',
+                          '--log', str(tmp_path / 'log.jsonl'),
+                          '--yaml', str(tmp_path / 'found.yaml'))
     assert result.returncode == 0, result.stderr
     header, start, generation = _records(tmp_path / 'log.jsonl')
     assert header['config']['latency'] == [0, 20, 2]

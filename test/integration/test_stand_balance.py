@@ -11,6 +11,8 @@ while Stand balances the rest.
 
 from __future__ import annotations
 
+from functools import cache
+
 import numpy as np
 import pytest
 
@@ -19,6 +21,7 @@ from tutorial_atlas_control.asi import AtlasSimInterface, Behavior
 from tutorial_atlas_control.balance import StandBehaviour
 from tutorial_atlas_control.balance.push_trial import (
     FOOT_TRAVEL_LIMIT_M,
+    TrialResult,
     push_survived,
     stand_trial,
 )
@@ -53,6 +56,14 @@ SURVIVED = {'forward': ((1.0, 0.0), 45.0), 'backward': ((-1.0, 0.0), 45.0),
 GOALS = {'forward': 40.0, 'backward': 25.0, 'left': 40.0, 'right': 40.0}
 
 
+@cache
+def largest_push_survived(direction: str) -> TrialResult:
+    """The push of SURVIVED[direction], run once in the module: the largest-push test judges
+    it and the determinism test runs it again."""
+    unit, impulse = SURVIVED[direction]
+    return push_survived(unit, impulse)
+
+
 def test_stand_holds_ten_seconds_in_place() -> None:
     result = stand_trial(10.0)
     assert result.stood
@@ -62,9 +73,8 @@ def test_stand_holds_ten_seconds_in_place() -> None:
 
 @pytest.mark.parametrize('direction', sorted(SURVIVED))
 def test_the_largest_push_found_is_survived_without_a_step(direction: str) -> None:
-    unit, impulse = SURVIVED[direction]
-    assert impulse >= GOALS[direction]
-    result = push_survived(unit, impulse)
+    assert SURVIVED[direction][1] >= GOALS[direction]
+    result = largest_push_survived(direction)
     assert result.stood, result
     assert result.lowest_pelvis_m > STANDING_PELVIS_M
     assert result.foot_travel_m <= FOOT_TRAVEL_LIMIT_M
@@ -87,8 +97,10 @@ def test_without_capture_point_correction_the_same_push_is_not_survived(
 
 
 def test_a_trial_is_deterministic() -> None:
-    """Offline runs replay: the same push gives the same motion, to the bit."""
-    first, second = (push_survived((0.0, 1.0), 30.0) for _ in range(2))
+    """Offline runs replay: the same push gives the same motion, to the bit (the largest
+    left push, at the edge of what is survived, run again)."""
+    unit, impulse = SURVIVED['left']
+    first, second = largest_push_survived('left'), push_survived(unit, impulse)
     assert (first.lowest_pelvis_m, first.foot_travel_m, first.steps) == (
         second.lowest_pelvis_m, second.foot_travel_m, second.steps)
 

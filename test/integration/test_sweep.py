@@ -4,12 +4,14 @@ and the refusals (one line, exit 1, nothing written)."""
 from __future__ import annotations
 
 import json
+from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
 
 import pytest
 
 from support.scripts import interrupt_script, run_script
+from tutorial_atlas_control.cli import sweep as sweep_cli
 from tutorial_atlas_control.search.sweep import (
     SweepEngine,
     SweepInputs,
@@ -37,6 +39,26 @@ bend:
 arms:
   - [0.2, "0 0 0 0  0 0 0 0 0 0  0 0 0 0 0 0  0 -0.5 0 1 0 0  0 0.5 0 -1 0 0"]
 """
+
+
+@dataclass(frozen=True)
+class Ran:
+    """A sweep's outcome, as subprocess.CompletedProcess gives the script's."""
+
+    returncode: int
+    stdout: str
+    stderr: str
+
+
+def _sweep_here(capsys: pytest.CaptureFixture[str], *args: str) -> Ran:
+    """sweep.py's main in this process, its output captured: no new interpreter's imports
+    (1.5-2 CPU s a start) for what is the sweep's, not the script's. The script itself, its
+    start-up, exit status and one-line errors, is test_ctrl_c_keeps_the_finished_rows' and
+    the missing file's case of test_bad_input_one_line_exit_1_nothing_written."""
+    capsys.readouterr()
+    status = sweep_cli.main(list(args))
+    captured = capsys.readouterr()
+    return Ran(status, captured.out, captured.err)
 
 
 @pytest.fixture(scope='module')
@@ -67,10 +89,14 @@ def test_same_table_on_one_and_two_workers(tiny_file: Path) -> None:
     assert rows[0]['tracking_rms_rad'] != rows[1]['tracking_rms_rad']
 
 
-def test_tutorial_trajectories_classified(tmp_path: Path) -> None:
+def test_tutorial_trajectories_classified(tmp_path: Path,
+                                          capsys: pytest.CaptureFixture[str]) -> None:
+    """In this process, on one worker (the cluster of two: test_same_table_on_one_and_two_
+    workers, test_ctrl_c_keeps_the_finished_rows)."""
     out = tmp_path / 'tutorial'
-    result = _sweep(str(TRAJ_DATA2), 'step_and_fall', 'touchdown', 'touchdown_exhausted',
-                    '--workers', '2', '--out', str(out), '--no-progress')
+    result = _sweep_here(capsys, str(TRAJ_DATA2), 'step_and_fall', 'touchdown',
+                         'touchdown_exhausted', '--workers', '1', '--out', str(out),
+                         '--no-progress')
     assert result.returncode == 0, result.stderr
     assert result.stdout.splitlines()[-1].startswith('sweep: 3 runs, 1 stayed up; table: ')
     rows = {row['name']: row for row in json.loads((tmp_path / 'tutorial.json').read_text())}
@@ -90,11 +116,13 @@ def test_tutorial_trajectories_classified(tmp_path: Path) -> None:
                              'latency_ms,seed,played_s,fell,fall_time_s,')
 
 
-def test_push_topples_touchdown(tmp_path: Path, tiny_file: Path) -> None:
+def test_push_topples_touchdown(tmp_path: Path, tiny_file: Path,
+                                capsys: pytest.CaptureFixture[str]) -> None:
     """A 0.2 s, 300 N forward shove 1 s into touchdown fells it; the same run unpushed stands."""
     out = tmp_path / 'push'
-    result = _sweep(str(TRAJ_DATA2), 'touchdown', '--push', 'none', '--push', '1:300,0,0:0.2',
-                    '--workers', '1', '--out', str(out), '--no-progress', '--settle', '1')
+    result = _sweep_here(capsys, str(TRAJ_DATA2), 'touchdown', '--push', 'none',
+                         '--push', '1:300,0,0:0.2', '--workers', '1', '--out', str(out),
+                         '--no-progress', '--settle', '1')
     assert result.returncode == 0, result.stderr
     rows = json.loads((tmp_path / 'push.json').read_text())
     assert [row['push'] for row in rows] == ['', '1:300,0,0:0.2']
@@ -128,9 +156,13 @@ def test_ctrl_c_keeps_the_finished_rows(tmp_path: Path, tiny_file: Path) -> None
      'cannot reach the Dask scheduler at tcp://127.0.0.1:9'),
 ])
 def test_bad_input_one_line_exit_1_nothing_written(tmp_path: Path, tiny_file: Path,
-                                                    args: list[str], message: str) -> None:
+                                                    args: list[str], message: str,
+                                                    capsys: pytest.CaptureFixture[str]) -> None:
+    """The missing file through the script (its wrapper's exit status), the rest through
+    main in this process."""
     args = [arg.replace('{tiny}', str(tiny_file)) for arg in args]
-    result = _sweep(*args, '--out', str(tmp_path / 'table'), '--no-progress')
+    sweep = _sweep if args[0] == 'missing.yaml' else partial(_sweep_here, capsys)
+    result = sweep(*args, '--out', str(tmp_path / 'table'), '--no-progress')
     assert result.returncode == 1
     lines = result.stderr.splitlines()
     assert len(lines) == 1, result.stderr

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from support.xdist_scheduling import SHARED_FIXTURE_GROUPS, scope_of
+from support.xdist_scheduling import SHARED_FIXTURE_GROUPS, scope_of, work_order
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -23,3 +23,15 @@ def test_every_grouped_module_exists_and_uses_its_fixture() -> None:
     """A renamed module would silently leave its group (and run the demo once more)."""
     for module, fixture in SHARED_FIXTURE_GROUPS.items():
         assert fixture in (REPO / module).read_text(), module
+
+
+def test_the_offline_runs_modules_go_out_before_the_unit_tests() -> None:
+    """Few tests but long ones first; xdist's order (most tests first) within each part. By
+    test count alone test_walk_circle_seeds (1 test, about 30 CPU s) went out last."""
+    scopes = {'test/unit/sim/test_model.py': 300, 'test/integration/test_walk_seeds.py': 5,
+              'test/unit/test_docs.py': 40, 'test/integration/test_search.py': 15,
+              'test/integration/test_walk_circle_seeds.py': 1}
+    assert work_order(scopes) == [
+        'test/integration/test_search.py', 'test/integration/test_walk_seeds.py',
+        'test/integration/test_walk_circle_seeds.py', 'test/unit/sim/test_model.py',
+        'test/unit/test_docs.py']
