@@ -31,8 +31,9 @@ from tutorial_atlas_control.sim import fallen
 if TYPE_CHECKING:
     from tutorial_atlas_control.balance import SoleBox
 
-__all__ = ['FOOT_BODIES', 'Landing', 'StepTarget', 'WalkSummary', 'landings', 'match_landings',
-           'plot_footprints', 'read_step_targets', 'summarise_walk', 'walk_lines']
+__all__ = ['FOOT_BODIES', 'Landing', 'StepTarget', 'WalkSummary', 'foot_poses', 'landings',
+           'match_landings', 'plot_footprints', 'read_step_targets', 'sole_patch',
+           'summarise_walk', 'walk_lines']
 
 #: The AtlasSimInterface's WALK behaviour number.
 WALK_BEHAVIOR = 4
@@ -226,7 +227,7 @@ def match_landings(targets: list[StepTarget],
     return placements
 
 
-def _foot_poses(data: BagData, since_s: float, until_s: float = np.inf
+def foot_poses(data: BagData, since_s: float, until_s: float = np.inf
                 ) -> tuple[np.ndarray, list[np.ndarray], list[np.ndarray], float, SoleBox]:
     """Times (n,) at KINEMATICS_RATE_HZ from `since_s`, per foot its link's world positions
     (n, 3) and yaws (n,) from the recorded pose, the links' height (m) with the soles
@@ -266,7 +267,7 @@ def summarise_walk(data: BagData, window_s: tuple[float, float] | None = None
             or not len(pelvis.t_s) or not len(data.joint_states.t_s):
         return None
     until_s = np.inf if window_s is None else window_s[1]
-    t_s, positions, yaws, standing_m, sole = _foot_poses(data, first_walk_s, until_s)
+    t_s, positions, yaws, standing_m, sole = foot_poses(data, first_walk_s, until_s)
     by_foot = [landings(foot, t_s, positions[foot], yaws[foot], standing_m) for foot in (0, 1)]
     placements = match_landings(targets, by_foot)
     walking = (pelvis.t_s >= first_walk_s) & (pelvis.t_s <= until_s)
@@ -334,10 +335,10 @@ def plot_footprints(summary: WalkSummary, path: Path) -> Path:
     sole = summary.sole or _model_sole()
     for target, landing in summary.placements:
         colour = colours[target.foot_index % 2]
-        ax.add_patch(_sole(sole, target.x_m, target.y_m, target.yaw_rad, Rectangle,
+        ax.add_patch(sole_patch(sole, target.x_m, target.y_m, target.yaw_rad, Rectangle,
                            fill=False, edgecolor=colour, lw=1))
         if landing is not None:
-            ax.add_patch(_sole(sole, landing.x_m, landing.y_m, landing.yaw_rad, Rectangle,
+            ax.add_patch(sole_patch(sole, landing.x_m, landing.y_m, landing.yaw_rad, Rectangle,
                                facecolor=colour, alpha=0.35, edgecolor='none'))
     ax.plot([], [], color=colours[0], label='left foot: asked (outline), landed (filled)')
     ax.plot([], [], color=colours[1], label='right foot')
@@ -365,7 +366,7 @@ def _model_sole() -> SoleBox:
     return SoleBox.of(load_model().model)
 
 
-def _sole(sole: SoleBox, x_m: float, y_m: float, yaw_rad: float, rectangle: Any,
+def sole_patch(sole: SoleBox, x_m: float, y_m: float, yaw_rad: float, rectangle: Any,
           **style: Any) -> Any:
     """The sole's rectangle for a foot link at (x, y, yaw)."""
     length, width = 2.0 * sole.half_length_m, 2.0 * sole.half_width_m
