@@ -16,7 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from tutorial_atlas_control.bags.course_run import CourseRun, terrain_heights
+from tutorial_atlas_control.bags.course_run import CourseRun
+from tutorial_atlas_control.bags.course_terrain import terrain_heights
 from tutorial_atlas_control.bags.footprints import sole_patch
 from tutorial_atlas_control.course import (
     BLOCK_ENVELOPE_M,
@@ -167,7 +168,7 @@ def _draw_run(ax: Any, run: CourseRun) -> None:
 
     path = run.pelvis_xy
     ax.plot(path[:, 0], path[:, 1], color=PATH_COLOUR, lw=1.5, zorder=6, label='pelvis')
-    ax.plot(path[:1, 0], path[:1, 1], 'o', color=PATH_COLOUR, mec='white', zorder=7,
+    ax.plot(path[:1, 0], path[:1, 1], 'o', color=PATH_COLOUR, mec='white', ms=4, zorder=7,
             label='start')
     if run.sole is not None:
         for landing in run.landings:

@@ -1,11 +1,9 @@
-"""A recorded run on DRCSim's VRC Task 2 course, as the map draws it: whether the bag is one,
-the pelvis's path, where the feet landed on the terrain, the falls and the score's events,
-each placed where the pelvis was.
+"""A recorded run on DRCSim's VRC Task 2 course, as the map draws it: the pelvis's path,
+where the feet landed on the terrain, the falls and the score's events, each placed where the
+pelvis was.
 
-A bag is a course run when the simulator's /atlas/sim_config names the course's model file
-(as offline.world.recorded_world reads it back) or when the bag has /vrc_score. The feet's
-landings are bags/footprints.py's, found on the height above the terrain under the foot (the
-heightmap, course.HEIGHTMAP's scaling) instead of above z 0: a foot standing on the course's
+The feet's landings are bags/footprints.py's, found on the height above the terrain under
+the foot (bags/course_terrain.py) instead of above z 0: a foot standing on the course's
 ground (z 0.03, the pit at -0.6, the hills) is down; on a cinder block it is not.
 """
 
@@ -16,22 +14,17 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from tutorial_atlas_control import topics
+from tutorial_atlas_control.bags.course_terrain import above_ground, ground_under, terrain_heights
 from tutorial_atlas_control.bags.footprints import Landing, foot_poses, landings
 from tutorial_atlas_control.bags.reader import BagData
 from tutorial_atlas_control.bags.vrc_score import ScoreEntry
-from tutorial_atlas_control.course import HEIGHTMAP, WORLD_MODEL_FILE
-from tutorial_atlas_control.resources import package_path
-from tutorial_atlas_control.sim import FALL_HEIGHT_M, SimConfig, SimConfigError
+from tutorial_atlas_control.sim import FALL_HEIGHT_M
 
 if TYPE_CHECKING:
     from tutorial_atlas_control.balance import SoleBox
 
-__all__ = ['TERRAIN_FILE', 'CourseRun', 'MapMark', 'ground_under', 'is_course_run',
-           'read_course_run', 'terrain_heights', 'terrain_landings']
+__all__ = ['CourseRun', 'MapMark', 'read_course_run', 'terrain_landings']
 
-#: The course's terrain image in the package's sim/ (8-bit grey, course.HEIGHTMAP's levels).
-TERRAIN_FILE = 'vrc_task_2_terrain.png'
 #: Most pelvis points kept for the path drawn.
 PATH_MAX_POINTS = 5000
 
@@ -57,46 +50,6 @@ class CourseRun:
     events: list[MapMark] = field(default_factory=list)
     last_score: ScoreEntry | None = None
     sole: SoleBox | None = None
-
-
-def is_course_run(data: BagData) -> bool:
-    """Whether `data`'s bag is a run on the VRC Task 2 course: a /atlas/sim_config naming the
-    course's model file, or /vrc_score messages."""
-    if getattr(data.topics.get(topics.VRC_SCORE), 'count', 0):
-        return True
-    for _t_s, text in data.sim_configs:
-        try:
-            config = SimConfig.from_json(text)
-        except SimConfigError:
-            continue
-        if config.model_file == WORLD_MODEL_FILE:
-            return True
-    return False
-
-
-def terrain_heights() -> np.ndarray:
-    """The course's terrain heights (m), rows from +y down, columns from -x (the image's
-    layout), from the package's terrain image and course.HEIGHTMAP's scaling."""
-    import matplotlib.image  # noqa: PLC0415 - only the map needs it
-
-    grey = np.asarray(matplotlib.image.imread(package_path('sim', TERRAIN_FILE)))
-    if grey.dtype.kind == 'f':  # matplotlib reads an 8-bit PNG as levels / 255
-        grey = np.rint(grey * 255.0)
-    return HEIGHTMAP.z0_m + HEIGHTMAP.relief_m * grey.astype(float) / HEIGHTMAP.brightest
-
-
-def ground_under(heights: np.ndarray, x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
-    """The terrain's height (m) under world points, bilinear between the heightmap's
-    vertices (MuJoCo's triangles differ by millimetres on the hills, not on ramps)."""
-    half, cell = HEIGHTMAP.size_m / 2.0, HEIGHTMAP.cell_m
-    last = heights.shape[0] - 1
-    col = np.clip((np.asarray(x_m) + half) / cell, 0.0, last)
-    row = np.clip((half - np.asarray(y_m)) / cell, 0.0, last)
-    c0, r0 = np.minimum(col.astype(int), last - 1), np.minimum(row.astype(int), last - 1)
-    fc, fr = col - c0, row - r0
-    top = heights[r0, c0] * (1 - fc) + heights[r0, c0 + 1] * fc
-    bottom = heights[r0 + 1, c0] * (1 - fc) + heights[r0 + 1, c0 + 1] * fc
-    return top * (1 - fr) + bottom * fr
 
 
 def _run_time_of(data: BagData, sim_times_s: list[float]) -> list[float]:
@@ -146,9 +99,7 @@ def terrain_landings(foot_index: int, t_s: np.ndarray, position_m: np.ndarray,
     """footprints.landings on the foot link's height above the terrain under it: `heights`
     the course's (terrain_heights), `standing_m` the link's height with the sole flat on
     flat ground."""
-    above = np.array(position_m, dtype=float)
-    above[:, 2] -= ground_under(heights, above[:, 0], above[:, 1])
-    return landings(foot_index, t_s, above, yaw_rad, standing_m)
+    return landings(foot_index, t_s, above_ground(position_m, heights), yaw_rad, standing_m)
 
 
 def _landings_on_terrain(data: BagData, heights: np.ndarray

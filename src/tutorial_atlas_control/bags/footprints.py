@@ -6,7 +6,8 @@ The steps asked for are the WALK commands' `walk_params.step_queue` on
 last pose sent for a step index is its target). Where the feet landed comes from the
 recorded pose (/ground_truth_odom and /atlas/joint_states) by the model's forward
 kinematics, as bags/feet.py does: a foot is down while its link is within PLANTED_HEIGHT_M
-of the lowest it went; each time it comes down again after the first is a step, and its
+of its height standing flat (on the VRC course, above the terrain under it:
+bags/course_terrain.py); each time it comes down again after the first is a step, and its
 landing pose is taken LANDING_SETTLE_S later. The n-th landing of a foot is matched with
 the n-th step asked of that foot, by step index. Step targets and landings are foot link
 poses in the world frame (the AtlasSimInterface's pos_est frame here).
@@ -21,6 +22,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from tutorial_atlas_control import topics
+from tutorial_atlas_control.bags.course_terrain import (
+    above_ground,
+    is_course_run,
+    terrain_heights,
+)
 from tutorial_atlas_control.bags.feet import RecordedKinematics
 from tutorial_atlas_control.bags.reader import BagData
 from tutorial_atlas_control.bags.records import open_bag
@@ -268,7 +274,9 @@ def summarise_walk(data: BagData, window_s: tuple[float, float] | None = None
         return None
     until_s = np.inf if window_s is None else window_s[1]
     t_s, positions, yaws, standing_m, sole = foot_poses(data, first_walk_s, until_s)
-    by_foot = [landings(foot, t_s, positions[foot], yaws[foot], standing_m) for foot in (0, 1)]
+    heights = terrain_heights() if is_course_run(data) else None  # the course's ground
+    by_foot = [landings(foot, t_s, above_ground(positions[foot], heights), yaws[foot],
+                        standing_m) for foot in (0, 1)]
     placements = match_landings(targets, by_foot)
     walking = (pelvis.t_s >= first_walk_s) & (pelvis.t_s <= until_s)
     path = pelvis.position_m[walking]

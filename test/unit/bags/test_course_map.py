@@ -20,12 +20,11 @@ from tutorial_atlas_control.bags.course_map import (
     map_pixel,
     plot_course_map,
 )
-from tutorial_atlas_control.bags.course_run import (
+from tutorial_atlas_control.bags.course_run import read_course_run, terrain_landings
+from tutorial_atlas_control.bags.course_terrain import (
     ground_under,
     is_course_run,
-    read_course_run,
     terrain_heights,
-    terrain_landings,
 )
 from tutorial_atlas_control.cli.analyze_bag import main
 from tutorial_atlas_control.course import GATES
