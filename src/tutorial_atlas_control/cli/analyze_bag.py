@@ -220,6 +220,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.video:  # fail on a bad output before reading and analyzing the bag
             check_output_path(args.video, *args.size, args.fps)
         analysis = _chosen(args.bag, args)
+        _check_course_map(analysis, args)  # before any output: a refusal is one line
         played = [p for _, p in analysis.data.played]
         walk = summarise_walk(analysis.data)
         changes = read_behaviours(analysis.data)
@@ -268,23 +269,32 @@ def main(argv: Sequence[str] | None = None) -> int:
     return 0
 
 
+def _check_course_map(analysis: Analysis, args: argparse.Namespace) -> None:
+    """--course-map needs a course run.
+
+    Raises:
+        BagAnalysisError: the bag is not one.
+    """
+    if args.course_map and not is_course_run(analysis.data):
+        raise BagAnalysisError(f'{analysis.data.path} is not a VRC Task 2 run (its '
+                               '/atlas/sim_config names no vrc_task_2.xml and it has no '
+                               '/vrc_score): --course-map draws course runs only')
+
+
 def _course_maps(analysis: Analysis, args: argparse.Namespace) -> list[Path]:
     """The course maps asked for: --course-map's, and --plot's beside it for a course run.
 
     Raises:
-        BagAnalysisError: --course-map for a bag that is not a course run, or no pelvis.
+        BagAnalysisError: --course-map for a run without a pelvis pose.
     """
     data = analysis.data
-    course = is_course_run(data)
-    if args.course_map and not course:
-        raise BagAnalysisError(f'{data.path} is not a VRC Task 2 run (its /atlas/sim_config '
-                               'names no vrc_task_2.xml and it has no /vrc_score): '
-                               '--course-map draws course runs only')
     paths = ([Path(args.course_map)] if args.course_map else []) + (
-        [Path(args.plot).with_suffix('.course.png')] if args.plot and course else [])
+        [Path(args.plot).with_suffix('.course.png')] if args.plot and is_course_run(data)
+        else [])
     if not paths:
         return []
-    run = read_course_run(data, read_scores(data), [t_s for t_s, _ in data.logged_falls] or None)
+    run = read_course_run(data, read_scores(data),
+                          [t_s for t_s, _ in data.logged_falls] or None)
     if run is None and args.course_map:
         raise BagAnalysisError(f'{data.path} has no pelvis pose (/ground_truth_odom): '
                                'no path to draw on the course map')

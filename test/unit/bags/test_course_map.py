@@ -165,6 +165,7 @@ def test_plot_writes_the_course_map_beside_and_refuses_it_off_the_course(
     flat = write_run_bag(tmp_path / 'flat.bag', duration_s=0.5)
     capsys.readouterr()
     assert main([str(flat), '--course-map', str(tmp_path / 'flat.png')]) == 1
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and 'is not a VRC Task 2 run' in err[0], err
+    out, err = capsys.readouterr()
+    assert out == '' and len(err.strip().splitlines()) == 1, (out, err)  # before the summary
+    assert 'is not a VRC Task 2 run' in err
     assert not (tmp_path / 'flat.png').exists()
