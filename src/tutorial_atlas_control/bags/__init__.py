@@ -1,5 +1,8 @@
 """Recorded runs: bag records and reading, analysis, comparison, reports, videos, run logs,
-and the VRC course's score (vrc_score: /vrc_score as a timeline of events, the final score).
+and the VRC course's score (vrc_score: /vrc_score as a timeline of events, the final score)
+and map (course_terrain: whether a bag is a course run, the terrain under a point; course_run:
+its path, landings on the terrain, falls and events; course_map: the course from above with
+the run on it, a PNG).
 
 No ROS: bags are read and written with rosbags. Synthetic bags for the tests are
 test/support/synthetic_bags.py.
@@ -11,6 +14,9 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'analysis': ['Analysis', 'COMMAND_CHANGE_RAD', 'EFFORT_LIMIT_TOLERANCE_NM',
                  'MOVED_RANGE_RAD', 'analyze', 'analyze_bag', 'analyze_try'],
     'capture_point': ['CaptureTrace', 'capture_trace', 'plot_capture'],
+    'course_map': ['COURSE_EXTENT_M', 'MAP_SIZE_PX', 'map_pixel', 'plot_course_map'],
+    'course_run': ['CourseRun', 'MapMark', 'read_course_run', 'terrain_landings'],
+    'course_terrain': ['above_ground', 'ground_under', 'is_course_run', 'terrain_heights'],
     'bag_dir': ['default_bag_dir', 'latest_bag', 'newest_bag', 'unwritable_reason'],
     'compare': ['compare_analyses', 'compare_bags', 'comparison_to_json',
                 'first_applied_command_s', 'format_comparison', 'plot_comparison'],

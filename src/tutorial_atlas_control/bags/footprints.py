@@ -6,7 +6,8 @@ The steps asked for are the WALK commands' `walk_params.step_queue` on
 last pose sent for a step index is its target). Where the feet landed comes from the
 recorded pose (/ground_truth_odom and /atlas/joint_states) by the model's forward
 kinematics, as bags/feet.py does: a foot is down while its link is within PLANTED_HEIGHT_M
-of the lowest it went; each time it comes down again after the first is a step, and its
+of its height standing flat (on the VRC course, above the terrain under it:
+bags/course_terrain.py); each time it comes down again after the first is a step, and its
 landing pose is taken LANDING_SETTLE_S later. The n-th landing of a foot is matched with
 the n-th step asked of that foot, by step index. Step targets and landings are foot link
 poses in the world frame (the AtlasSimInterface's pos_est frame here).
@@ -21,6 +22,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from tutorial_atlas_control import topics
+from tutorial_atlas_control.bags.course_terrain import (
+    above_ground,
+    is_course_run,
+    terrain_heights,
+)
 from tutorial_atlas_control.bags.feet import RecordedKinematics
 from tutorial_atlas_control.bags.reader import BagData
 from tutorial_atlas_control.bags.records import open_bag
@@ -31,8 +37,9 @@ from tutorial_atlas_control.sim import fallen
 if TYPE_CHECKING:
     from tutorial_atlas_control.balance import SoleBox
 
-__all__ = ['FOOT_BODIES', 'Landing', 'StepTarget', 'WalkSummary', 'landings', 'match_landings',
-           'plot_footprints', 'read_step_targets', 'summarise_walk', 'walk_lines']
+__all__ = ['FOOT_BODIES', 'Landing', 'StepTarget', 'WalkSummary', 'foot_poses', 'landings',
+           'match_landings', 'plot_footprints', 'read_step_targets', 'sole_patch',
+           'summarise_walk', 'walk_lines']
 
 #: The AtlasSimInterface's WALK behaviour number.
 WALK_BEHAVIOR = 4
@@ -226,7 +233,7 @@ def match_landings(targets: list[StepTarget],
     return placements
 
 
-def _foot_poses(data: BagData, since_s: float, until_s: float = np.inf
+def foot_poses(data: BagData, since_s: float, until_s: float = np.inf
                 ) -> tuple[np.ndarray, list[np.ndarray], list[np.ndarray], float, SoleBox]:
     """Times (n,) at KINEMATICS_RATE_HZ from `since_s`, per foot its link's world positions
     (n, 3) and yaws (n,) from the recorded pose, the links' height (m) with the soles
@@ -266,8 +273,10 @@ def summarise_walk(data: BagData, window_s: tuple[float, float] | None = None
             or not len(pelvis.t_s) or not len(data.joint_states.t_s):
         return None
     until_s = np.inf if window_s is None else window_s[1]
-    t_s, positions, yaws, standing_m, sole = _foot_poses(data, first_walk_s, until_s)
-    by_foot = [landings(foot, t_s, positions[foot], yaws[foot], standing_m) for foot in (0, 1)]
+    t_s, positions, yaws, standing_m, sole = foot_poses(data, first_walk_s, until_s)
+    heights = terrain_heights() if is_course_run(data) else None  # the course's ground
+    by_foot = [landings(foot, t_s, above_ground(positions[foot], heights), yaws[foot],
+                        standing_m) for foot in (0, 1)]
     placements = match_landings(targets, by_foot)
     walking = (pelvis.t_s >= first_walk_s) & (pelvis.t_s <= until_s)
     path = pelvis.position_m[walking]
@@ -334,10 +343,10 @@ def plot_footprints(summary: WalkSummary, path: Path) -> Path:
     sole = summary.sole or _model_sole()
     for target, landing in summary.placements:
         colour = colours[target.foot_index % 2]
-        ax.add_patch(_sole(sole, target.x_m, target.y_m, target.yaw_rad, Rectangle,
+        ax.add_patch(sole_patch(sole, target.x_m, target.y_m, target.yaw_rad, Rectangle,
                            fill=False, edgecolor=colour, lw=1))
         if landing is not None:
-            ax.add_patch(_sole(sole, landing.x_m, landing.y_m, landing.yaw_rad, Rectangle,
+            ax.add_patch(sole_patch(sole, landing.x_m, landing.y_m, landing.yaw_rad, Rectangle,
                                facecolor=colour, alpha=0.35, edgecolor='none'))
     ax.plot([], [], color=colours[0], label='left foot: asked (outline), landed (filled)')
     ax.plot([], [], color=colours[1], label='right foot')
@@ -365,7 +374,7 @@ def _model_sole() -> SoleBox:
     return SoleBox.of(load_model().model)
 
 
-def _sole(sole: SoleBox, x_m: float, y_m: float, yaw_rad: float, rectangle: Any,
+def sole_patch(sole: SoleBox, x_m: float, y_m: float, yaw_rad: float, rectangle: Any,
           **style: Any) -> Any:
     """The sole's rectangle for a foot link at (x, y, yaw)."""
     length, width = 2.0 * sole.half_length_m, 2.0 * sole.half_width_m

@@ -28,16 +28,19 @@ from tutorial_atlas_control.bags import (
     comparison_to_json,
     format_comparison,
     format_summary,
+    is_course_run,
     parse_fps,
     parse_size,
     plot_behaviours,
     plot_capture,
     plot_comparison,
+    plot_course_map,
     plot_footprints,
     plot_joints,
     plot_run,
     read_bag,
     read_behaviours,
+    read_course_run,
     read_scores,
     render_bag_video,
     score_lines,
@@ -55,7 +58,7 @@ from tutorial_atlas_control.cli.convention import (
     chosen_bag,
     print_error,
 )
-from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.errors import AtlasControlError, BagAnalysisError
 from tutorial_atlas_control.sim import FALL_HEIGHT_M
 
 PROG = 'analyze_bag.py'
@@ -160,6 +163,11 @@ def build_parser() -> argparse.ArgumentParser:
                              'fall (sim time, s after the try\'s first command), the tries with '
                              'their trajectories and waypoints, control modes, and the '
                              f'{WORST_JOINTS} worst-tracked joints\' error')
+    parser.add_argument('--course-map', metavar='FILE.png',
+                        help='write the VRC Task 2 course from above with the run on it: the '
+                             'terrain shaded, the pen, the gates, the mud box, the blocks, the '
+                             'pelvis\'s path, the feet\'s landings, falls and the score\'s events '
+                             '(a course run only; --plot run.png writes it as run.course.png)')
     parser.add_argument('--plot-joints', metavar='FILE.png',
                         help='write commanded vs measured positions of every joint that moved '
                              '(one panel each) and the pelvis height to this image')
@@ -187,8 +195,9 @@ def _check_arguments(parser: argparse.ArgumentParser, args: argparse.Namespace) 
         parser.error(f'--end {args.end:g} must be after --start {args.start:g}')
     if args.try_b is not None and not args.compare:
         parser.error('--try-b chooses the try of the --compare bag; give --compare B.bag')
-    if args.compare and (args.csv or args.video):
-        parser.error('--csv and --video describe one run; leave them out with --compare')
+    if args.compare and (args.csv or args.video or args.course_map):
+        parser.error('--csv, --video and --course-map describe one run; leave them out with '
+                     '--compare')
 
 
 def _chosen(path: str, args: argparse.Namespace) -> Analysis:
@@ -211,6 +220,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.video:  # fail on a bad output before reading and analyzing the bag
             check_output_path(args.video, *args.size, args.fps)
         analysis = _chosen(args.bag, args)
+        _check_course_map(analysis, args)  # before any output: a refusal is one line
         played = [p for _, p in analysis.data.played]
         walk = summarise_walk(analysis.data)
         changes = read_behaviours(analysis.data)
@@ -243,6 +253,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             if trace is not None:  # and the capture point against the support polygon
                 capture = plot_capture(trace, Path(args.plot).with_suffix('.capture.png'))
                 print(f'wrote {capture}', file=sys.stderr)
+        for course_map in _course_maps(analysis, args):
+            print(f'wrote {course_map}', file=sys.stderr)
         if args.plot_joints:
             print(f'wrote {plot_joints(analysis, args.plot_joints)}', file=sys.stderr)
         if args.video:
@@ -255,6 +267,38 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         return EXIT_INTERRUPTED
     return 0
+
+
+def _check_course_map(analysis: Analysis, args: argparse.Namespace) -> None:
+    """--course-map needs a course run.
+
+    Raises:
+        BagAnalysisError: the bag is not one.
+    """
+    if args.course_map and not is_course_run(analysis.data):
+        raise BagAnalysisError(f'{analysis.data.path} is not a VRC Task 2 run (its '
+                               '/atlas/sim_config names no vrc_task_2.xml and it has no '
+                               '/vrc_score): --course-map draws course runs only')
+
+
+def _course_maps(analysis: Analysis, args: argparse.Namespace) -> list[Path]:
+    """The course maps asked for: --course-map's, and --plot's beside it for a course run.
+
+    Raises:
+        BagAnalysisError: --course-map for a run without a pelvis pose.
+    """
+    data = analysis.data
+    paths = ([Path(args.course_map)] if args.course_map else []) + (
+        [Path(args.plot).with_suffix('.course.png')] if args.plot and is_course_run(data)
+        else [])
+    if not paths:
+        return []
+    run = read_course_run(data, read_scores(data),
+                          [t_s for t_s, _ in data.logged_falls] or None)
+    if run is None and args.course_map:
+        raise BagAnalysisError(f'{data.path} has no pelvis pose (/ground_truth_odom): '
+                               'no path to draw on the course map')
+    return [plot_course_map(run, path) for path in paths] if run is not None else []
 
 
 def _walks(analysis: Analysis, changes: list[BehaviourChange] | None
