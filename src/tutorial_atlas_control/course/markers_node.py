@@ -22,9 +22,9 @@ from visualization_msgs.msg import Marker, MarkerArray
 from tutorial_atlas_control.course.markers import BoxShape, CourseShapes, TerrainMesh
 from tutorial_atlas_control.topics import COURSE_MARKERS_TOPIC, WORLD_FRAME
 
-#: The markers' namespaces in rviz's display: the terrains' meshes and the boxes.
+#: The terrains' namespace in rviz's display; a box's is its name's first word (`gate`,
+#: `pen`, `mud`), so that the display's Namespaces turn each kind on and off.
 TERRAIN_NAMESPACE = 'terrain'
-BOX_NAMESPACE = 'course'
 
 
 def _point(xyz: np.ndarray) -> Point:
@@ -55,14 +55,14 @@ def terrain_marker(mesh: TerrainMesh, marker_id: int) -> Marker:
 
 
 def box_marker(box: BoxShape, marker_id: int) -> Marker:
-    """A CUBE marker of the box: its pose, full size and colour."""
-    marker = _marker(BOX_NAMESPACE, marker_id, Marker.CUBE)
+    """A CUBE marker of the box: its pose, full size and colour (no text: rviz warns of
+    text on a marker that does not show it)."""
+    marker = _marker(box.name.split('_')[0], marker_id, Marker.CUBE)
     position, orientation = marker.pose.position, marker.pose.orientation
     position.x, position.y, position.z = (float(v) for v in box.centre)
     orientation.w, orientation.x, orientation.y, orientation.z = (float(v) for v in box.quat)
     marker.scale.x, marker.scale.y, marker.scale.z = (float(v) for v in box.size)
     marker.color = _colour(box.rgba)
-    marker.text = box.name
     return marker
 
 
