@@ -1,5 +1,5 @@
 """course_markers.py on a private master: a client that starts after it gets the VRC course's
-markers, latched, once (the terrain's mesh and the 25 static boxes, in `world`)."""
+markers, latched, once (the terrain's mesh and the 24 static boxes, in `world`)."""
 
 from __future__ import annotations
 
@@ -19,8 +19,8 @@ from tutorial_atlas_control.topics import COURSE_MARKERS_TOPIC
 SCRIPT = Path(__file__).resolve().parents[2] / 'scripts' / 'course_markers.py'
 #: Wall seconds for the node to load the course and advertise (a loaded 2-core machine).
 ADVERTISE_TIMEOUT_S = 60.0
-#: The terrain's one mesh, then 5 gates of 3 boxes, the pen's 8 walls and floor, the mud.
-EXPECTED_MARKERS = 1 + 5 * 3 + 9 + 1
+#: The terrain's one mesh, then 5 gates of 3 boxes, the pen's 8 walls, the mud.
+EXPECTED_MARKERS = 1 + 5 * 3 + 8 + 1
 
 #: A late subscriber: the latched array, summarized on one line.
 CLIENT = textwrap.dedent(f'''

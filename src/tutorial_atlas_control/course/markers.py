@@ -6,7 +6,8 @@ walked, every `stride`-th vertex, so that the mesh stays within a triangle budge
 draws at once), coloured by height, and each box welded to the world (gates, the pen's
 walls and floor, the mud volume) with its pose, full size and material colour. Loose bodies
 (the cinder blocks) move and are left out; so are planes (the pit's floor plane lies under
-the terrain everywhere but in the pit).
+the terrain everywhere but in the pit) and boxes whose top lies under the terrain at their
+centre (the pen's floor, 5 mm under the flat ground: drawn, it flickers through the mesh).
 """
 
 from __future__ import annotations
@@ -87,11 +88,25 @@ def course_shapes(model: mujoco.MjModel, area: Area = COURSE_AREA,
     mujoco.mj_kinematics(model, data)
     static = [g for g in range(model.ngeom)
               if model.body_weldid[model.geom_bodyid[g]] == 0]
-    terrains = tuple(terrain_mesh(model, data, g, area, max_triangles) for g in static
-                     if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_HFIELD)
-    boxes = tuple(_box(model, data, g) for g in static
-                  if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX)
+    fields = [g for g in static if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_HFIELD]
+    terrains = tuple(terrain_mesh(model, data, g, area, max_triangles) for g in fields)
+    grids = [_hfield_vertices(model, data, g).reshape(-1, 3) for g in fields]
+    boxes = tuple(box for box in (_box(model, data, g) for g in static
+                                  if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX)
+                  if not _under_terrain(box, grids))
     return CourseShapes(terrains, boxes)
+
+
+def _under_terrain(box: BoxShape, grids: list[np.ndarray]) -> bool:
+    """Whether the box's highest corner lies under a terrain's vertex nearest its centre."""
+    rotation = np.zeros(9)
+    mujoco.mju_quat2Mat(rotation, box.quat)
+    top = box.centre[2] + np.abs(rotation.reshape(3, 3)[2]) @ box.size / 2
+    for grid in grids:
+        nearest = np.argmin(np.sum((grid[:, :2] - box.centre[:2]) ** 2, axis=1))
+        if top < grid[nearest, 2]:
+            return True
+    return False
 
 
 def _geom_name(model: mujoco.MjModel, geom: int) -> str:

@@ -128,6 +128,8 @@ def test_the_mud_is_its_own_translucent_box(shapes: CourseShapes) -> None:
     # Static shapes only: the loose cinder blocks and the robot are not among them.
     assert not any(name.startswith(('cinder_block', 'pelvis')) for name in boxes)
     assert {name.split('_')[0] for name in boxes} == {'mud', 'pen', 'gate'}
+    # The pen's floor, 5 mm under the terrain, would only flicker through it.
+    assert 'pen_floor' not in boxes and 'pen_wall_0' in boxes
 
 
 def test_an_area_off_the_terrain_is_refused_with_its_reason(world: mujoco.MjModel) -> None:
