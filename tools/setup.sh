@@ -24,7 +24,7 @@ APT_PACKAGES=(
   librostest-dev librosbag-storage-dev libtopic-tools-dev python3-venv python3-yaml python3-numpy
   libosmesa6 libegl1 libopengl0 libgl1-mesa-dri
   ros-robot-state-publisher ros-tf2-msgs python3-tf2-msgs python3-tf2-ros rviz
-  ros-trajectory-msgs python3-trajectory-msgs
+  ros-trajectory-msgs python3-trajectory-msgs ros-visualization-msgs python3-visualization-msgs
   # What DRC-era Python clients import: tf.transformations, tf_conversions.posemath with
   # PyKDL, actionlib, roslib.load_manifest, tf2_geometry_msgs, tf2_kdl, angles; and the
   # package.xml files that let rospack, rosmsg and a client's manifest find tf,

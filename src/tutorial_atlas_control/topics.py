@@ -248,3 +248,6 @@ STARTUP_MODE_PARAM = '/atlas/startup_mode'
 
 WORLD_FRAME = 'world'
 PELVIS_FRAME = 'pelvis'
+
+#: The VRC course's static shapes for rviz (course_markers.py; latched, published once).
+COURSE_MARKERS_TOPIC = '/vrc_course/markers'

@@ -1,5 +1,6 @@
 """The VRC Task 2 launches as roslaunch reads them (no master): each includes atlas.launch
-with the course's model, its world's start, DRCSim's bdi_stand start and the scorer on;
+with the course's model, its world's start, DRCSim's bdi_stand start and the scorer on,
+and starts course_markers.py on the same model (rviz's course; course_markers:=false not);
 DRCSim's gzname chooses the viewer, a bad one stops the launch with its reason; every
 argument of atlas.launch reaches through; roslaunch's own check (roslaunch-check) passes."""
 
@@ -44,7 +45,7 @@ def test_each_launch_starts_its_world_as_drcsim_did(
     assert found['/atlas_sim/vrc_scoring'] is True
     assert found['/atlas_sim/score_dir'] == '/tmp/vrc_task_2'
     assert found['/atlas_sim/gui'] is False  # no display
-    assert sorted(nodes) == ['atlas_sim_node.py', 'record_run.sh']
+    assert sorted(nodes) == ['atlas_sim_node.py', 'course_markers.py', 'record_run.sh']
     assert rlutil.check_roslaunch(str(LAUNCH_DIR / launch)) is None  # roslaunch-check
 
 
@@ -78,7 +79,8 @@ def test_atlas_launch_arguments_reach_through_and_a_variant_keeps_its_start(
                           'real_time_factor:=0.5', 'score_dir:=/tmp/scores', 'stand:=hold',
                           'start:=vrc_task_2', 'model:=/tmp/course.xml',
                           monkeypatch=monkeypatch)
-    assert nodes == ['atlas_sim_node.py'] and '/atlas_sim/bag_dir' not in found
+    assert nodes == ['atlas_sim_node.py', 'course_markers.py']
+    assert '/atlas_sim/bag_dir' not in found
     assert found['/atlas_sim/real_time_factor'] == 0.5
     assert found['/atlas_sim/score_dir'] == '/tmp/scores'
     assert found['/atlas_sim/stand'] == 'hold'
@@ -96,3 +98,13 @@ def test_atlas_launch_passes_its_start(monkeypatch: pytest.MonkeyPatch) -> None:
     assert '/atlas_sim/vrc_scoring' not in found
     found, _nodes = params('atlas.launch', 'start:=vrc_task_2_mud_start', monkeypatch=monkeypatch)
     assert found['/atlas_sim/start'] == 'vrc_task_2_mud_start'
+
+
+def test_the_course_markers_follow_the_model_and_can_be_left_out(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    loaded = config.load_config_default(
+        [(str(LAUNCH_DIR / 'vrc_task_2_mud_start.launch'), ['model:=/tmp/course.xml'])], None)
+    (markers,) = [node for node in loaded.nodes if node.type == 'course_markers.py']
+    assert markers.args == '/tmp/course.xml' and markers.name == 'course_markers'
+    _found, nodes = params('vrc_task_2.launch', 'course_markers:=false', monkeypatch=monkeypatch)
+    assert 'course_markers.py' not in nodes

@@ -7,13 +7,17 @@ blocks, the starts), the one description the world, the mud and the scoring read
 where a run starts Atlas (a world's start by name, or 'x y z yaw'), checked once for the
 node, the launches and offline runs; scoring: VRCScoringPlugin's rules, a Scorer fed once per
 physics step (gates in order, the clock, falls, the rows due); score_log: DRCSim's score.log
-(its header, whole rows).
+(its header, whole rows); markers: the course's static shapes for a viewer (the terrain as a
+height-coloured triangle mesh over the walked area, the boxes welded to the world), plain
+arrays; its rospy side, markers_node.py (rviz's MarkerArray), is imported by its module.
 """
 
 from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'errors': ['CourseError'],
+    'markers': ['COURSE_AREA', 'MAX_TRIANGLES', 'Area', 'BoxShape', 'CourseShapes',
+                'TerrainMesh', 'course_shapes', 'height_colours', 'terrain_mesh'],
     'mud': ['MAX_MUD_DAMPING', 'check_mud_damping', 'drag_at_point', 'drag_wrench',
             'implicit_drag', 'wrench_at_com'],
     'score_log': ['DEFAULT_SCORE_DIR', 'SCORE_FILE_NAME', 'ScoreLog'],
