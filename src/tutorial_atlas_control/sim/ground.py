@@ -10,9 +10,12 @@ collision box is.
 The answer is a vertical ray cast down on each such geom with MuJoCo's own per-geom ray
 functions (`mju_rayGeom` for planes and primitives, `mj_rayHfield`, `mj_rayMesh`), from
 above the geom's highest point, the highest hit winning: the first surface a ray from
-above the whole world meets. Per geom, not `mj_ray`, because `mj_ray` skips by
-visibility (transparent geoms) and group, not by collision, and excludes one body, not
-the robot's subtree. Geoms whose bounding sphere is not above (x, y) are culled first.
+above the whole world meets, unless it is overhead: a surface whose geom's underside has
+more than OVERHEAD_CLEARANCE_M of free space below it, down to the next surface (a VRC
+gate's bar, 4 m over the course), is not the ground under it: the surface below is.
+Per geom, not `mj_ray`, because `mj_ray` skips by visibility (transparent geoms) and
+group, not by collision, and excludes one body, not the robot's subtree. Geoms whose
+bounding sphere is not above (x, y) are culled first.
 Planes are cast as unbounded (size 0), as MuJoCo collides them, not as rendered.
 
 The normal is MuJoCo's: the installed MuJoCo (4.0.0) returns the hit surface's unit
@@ -41,6 +44,12 @@ __all__ = ['Ground', 'GroundError', 'GroundHit', 'ROBOT_ROOT_BODY']
 
 #: The robot's floating base: it and every body under it are the robot, never ground.
 ROBOT_ROOT_BODY = 'pelvis'
+#: A surface is overhead, not ground, when its geom's underside is more than this (m) above
+#: the next ground surface below it: a robot under it stands on that one (walking under a
+#: VRC gate's bar, the fall criterion, the Stand's height and Walk's steps took the bar
+#: 4 m up for the ground). Cinder blocks and the pen's floor rest on what is below them.
+OVERHEAD_CLEARANCE_M = 1.0
+_OVERHEAD_TOLERANCE_M = 1e-6  # a surface touching an underside is under it
 #: The rays start this far (m) above a geom's highest point.
 _RAY_MARGIN_M = 1.0
 _DOWN = np.array([0.0, 0.0, -1.0])
@@ -121,6 +130,13 @@ class _Cast(NamedTuple):
         """The highest point (m) of its bounding box, as placed now."""
         up = self.mat[6:9]  # the world z row of its rotation
         return float(self.pos.item(2) + up @ self.aabb[:3] + np.abs(up) @ self.aabb[3:])
+
+    def bottom_m(self) -> float:
+        """The lowest point (m) of its bounding box, as placed now (-inf for a plane)."""
+        if self.kind == _PLANE:
+            return -math.inf
+        up = self.mat[6:9]
+        return float(self.pos.item(2) + up @ self.aabb[:3] - np.abs(up) @ self.aabb[3:])
 
 
 def _inside_border(cast: _Cast, x: float, y: float) -> tuple[float, float]:
@@ -250,12 +266,29 @@ class Ground:
         return -math.inf if distance < 0 else (top + _RAY_MARGIN_M) - distance
 
     def _highest(self, x: float, y: float) -> tuple[float, int, np.ndarray | None]:
-        best, best_geom, normal = -math.inf, -1, None
-        for cast in self._candidates(x, y):
+        """The highest surface under (x, y) that is not overhead (OVERHEAD_CLEARANCE_M)."""
+        candidates = self._candidates(x, y)
+        found = self._highest_below(candidates, x, y, math.inf)
+        while found[2] is not None:
+            cast = found[3]
+            if cast is None or cast.kind in (_PLANE, _HFIELD):
+                break  # nothing lies under a plane or a heightfield's surface
+            underside = cast.bottom_m()
+            below = self._highest_below(candidates, x, y, underside)
+            if below[2] is None or underside - below[0] <= OVERHEAD_CLEARANCE_M:
+                break
+            found = below
+        return found[0], found[1], found[2]
+
+    def _highest_below(self, candidates: list[_Cast], x: float, y: float, below_m: float
+                       ) -> tuple[float, int, np.ndarray | None, _Cast | None]:
+        """The highest hit under (x, y) at or below `below_m`: height, geom, normal, cast."""
+        best, best_geom, normal, best_cast = -math.inf, -1, None, None
+        for cast in candidates:
             height = self._cast(cast, x, y)
-            if height > best:
-                best, best_geom, normal = height, cast.geom, self._normal.copy()
-        return best, best_geom, normal
+            if best < height <= below_m + _OVERHEAD_TOLERANCE_M:
+                best, best_geom, normal, best_cast = height, cast.geom, self._normal.copy(), cast
+        return best, best_geom, normal, best_cast
 
     def hit(self, x: float, y: float) -> GroundHit:
         """The highest ground surface under world (x, y): height, normal, geom."""

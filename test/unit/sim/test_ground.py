@@ -54,6 +54,23 @@ def test_box_on_plane() -> None:
     assert beside.geom_id == 0
 
 
+def test_a_bar_overhead_is_not_the_ground_under_it() -> None:
+    """A VRC gate: two posts and a bar 4 m up over ground 3 cm up. Under the bar the ground
+    is the ground (a walk through the gate took the bar for it: its steps aimed 4 m up and
+    the robot fell); on a post's top and a block resting on the ground, what is on top."""
+    ground = Ground(world('<geom type="plane" size="0 0 1" pos="0 0 0.03"/>'
+                          '<geom type="box" size="0.1 0.1 2" pos="1 -2.5 2"/>'
+                          '<geom type="box" size="0.1 2.6 0.1" pos="1 0 4.1"/>'
+                          '<geom type="box" size="0.2 0.1 0.1" pos="3 0 0.13"/>'
+                          '<geom type="box" size="0.1 0.1 0.1" pos="3 0 1.2"/>'))
+    under = ground.hit(1.05, 0.3)
+    assert under.height_m == pytest.approx(0.03, abs=1e-9) and under.geom_id == 0
+    assert ground.height_m(1.0, -2.5) == pytest.approx(4.2, abs=1e-9)  # the bar on a post
+    assert ground.height_m(3.15, 0.0) == pytest.approx(0.23, abs=1e-9)  # the block's top
+    # 0.87 m of free space under a box: within OVERHEAD_CLEARANCE_M, it is ground.
+    assert ground.height_m(3.0, 0.0) == pytest.approx(1.3, abs=1e-9)
+
+
 def test_turned_box_answers_the_face_hit() -> None:
     ground = Ground(world('<geom type="box" size="0.5 0.5 0.5" pos="0 0 0" euler="0 30 0"/>'))
     hit = ground.hit(0.1, 0.0)
