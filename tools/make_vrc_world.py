@@ -33,6 +33,7 @@ from PIL import Image
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO_ROOT / 'src'))
+from tutorial_atlas_control.course import starts as course_starts  # noqa: E402
 from tutorial_atlas_control.course import vrc_task_2 as course  # noqa: E402
 
 
@@ -53,7 +54,7 @@ ATLAS = _atlas_table()
 fmt = ATLAS.fmt
 
 DEFAULT_OUTPUT = REPO_ROOT / 'sim' / 'vrc_task_2.xml'
-TERRAIN_FILE = 'vrc_task_2_terrain.png'
+TERRAIN_FILE = course_starts.TERRAIN_FILE
 #: The heightfield's solid base below its lowest point (m): deeper than a foot can press.
 TERRAIN_BASE_M = 0.2
 #: The course's contact priority: above the soles' 1, so that the course's geoms' friction,

@@ -13,14 +13,11 @@ import numpy as np
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags.reader import BagData
-from tutorial_atlas_control.course import HEIGHTMAP, WORLD_MODEL_FILE
+from tutorial_atlas_control.course import HEIGHTMAP, TERRAIN_FILE, WORLD_MODEL_FILE
 from tutorial_atlas_control.resources import package_path
 from tutorial_atlas_control.sim import SimConfig, SimConfigError
 
-__all__ = ['TERRAIN_FILE', 'above_ground', 'ground_under', 'is_course_run', 'terrain_heights']
-
-#: The course's terrain image in the package's sim/ (8-bit grey, course.HEIGHTMAP's levels).
-TERRAIN_FILE = 'vrc_task_2_terrain.png'
+__all__ = ['above_ground', 'ground_under', 'is_course_run', 'terrain_heights']
 
 
 def is_course_run(data: BagData) -> bool:

@@ -13,11 +13,14 @@ import math
 from tutorial_atlas_control.course.errors import CourseError
 from tutorial_atlas_control.course.vrc_task_2 import STARTS, WORLD_NAME, Start
 
-__all__ = ['MAX_START_M', 'WORLD_MODEL_FILE', 'parse_start', 'start_text', 'world_start']
+__all__ = ['MAX_START_M', 'TERRAIN_FILE', 'WORLD_MODEL_FILE', 'parse_start', 'start_text',
+           'world_start']
 
 #: The model file (in the package's sim/) of every VRC Task 2 world: they differ only in
 #: their start.
 WORLD_MODEL_FILE = f'{WORLD_NAME}.xml'
+#: Its terrain's elevation image, beside it (8-bit grey, vrc_task_2.HEIGHTMAP's levels).
+TERRAIN_FILE = f'{WORLD_NAME}_terrain.png'
 #: A start further than this (m) from the origin on x or y is refused as a typo.
 MAX_START_M = 1e4
 _FORM = "a start name or 'x y z yaw' (m, m, m, rad; z is only a hint)"

@@ -16,6 +16,7 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.sim.model import PELVIS_BODY
 
 __all__ = ['UrdfError', 'UrdfJoint', 'matching_urdf', 'read_joints', 'urdf_path_for']
 
@@ -99,7 +100,7 @@ def matching_urdf(model_path: Path | str, model: mujoco.MjModel) -> tuple[Path, 
     links, joints = read_joints(text, str(path))
     by_name = {joint.name: joint for joint in joints}
     # The robot's bodies: the pelvis's tree (a course's loose blocks are not the robot).
-    robot_root = model.body_rootid[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, 'pelvis')]
+    robot_root = model.body_rootid[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, PELVIS_BODY)]
     bodies = {mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) for b in range(1, model.nbody)
               if model.body_rootid[b] == robot_root}
     if set(links) != bodies:
