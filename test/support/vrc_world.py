@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-import importlib.util
-import sys
 from pathlib import Path
 from types import ModuleType
 
-from support.model_table import load_table
+from support.model_table import load_script, load_table
 
 GENERATOR = Path(__file__).resolve().parents[2] / 'tools' / 'make_vrc_world.py'
 WORLD_PATH = GENERATOR.parents[1] / 'sim' / 'vrc_task_2.xml'
@@ -17,10 +15,4 @@ def load_generator() -> ModuleType:
     """Import the generator once (a script, not a package module), on the tests' copy of
     tools/make_atlas_mjcf.py."""
     load_table()
-    name = 'make_vrc_world'
-    if name not in sys.modules:
-        spec = importlib.util.spec_from_file_location(name, GENERATOR)
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[name] = module
-        spec.loader.exec_module(module)
-    return sys.modules[name]
+    return load_script(GENERATOR)

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from support.scored_runs import GATE_TELEPORTS, record_teleported_run
 from support.synthetic_bags import Record, sim_config, write_bag, write_run_bag
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags import course_map, read_bag
@@ -28,16 +29,14 @@ from tutorial_atlas_control.bags.course_terrain import (
 )
 from tutorial_atlas_control.cli.analyze_bag import main
 from tutorial_atlas_control.course import GATES
-from tutorial_atlas_control.offline.player import OfflinePlayer, open_offline_bag
 from tutorial_atlas_control.offline.world import named_world
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
-from tutorial_atlas_control.sim.vrc import pose_input
 
 CONFIG = Path(__file__).resolve().parents[3] / 'config' / 'atlas_controller.yaml'
 #: (sim time s, pelvis x, y): from the pen through gate_0, then through gate_1.
-TELEPORTS = ((0.5, 0.7, -38.0), (0.6, 1.3, -38.0), (0.8, 0.0, -22.3), (0.9, 0.0, -21.7))
+TELEPORTS = GATE_TELEPORTS
 #: A point on each gate's line, away from the posts, the labels and the path (m).
 GATE_POINTS = ((1.0, -39.5), (1.6, -22.0), (-1.4, -10.5), (5.0, 6.5), (7.0, 18.0))
 #: A colour channel may differ this much (0-255) from the colour drawn (antialiasing,
@@ -53,20 +52,7 @@ def course_bag(tmp_path_factory: pytest.TempPathFactory) -> Path:
     world = named_world('vrc_task_2')
     sim = AtlasSimulator(atlas_model.load_model(world.model_path), load_gains_yaml(CONFIG),
                          start=world.start)
-    bag = directory / 'course.bag'
-    sink = open_offline_bag(bag)
-    try:
-        player = OfflinePlayer(sim, sink, score_dir=directory / 'vrc_task_2')
-        player.write_config()
-        player.publish()
-        for t_s, x_m, y_m in TELEPORTS:
-            player.advance(t_s - player.now_s())
-            sim.apply_input(pose_input((x_m, y_m, 1.0), (0.0, 0.0, 0.0, 0.0)))
-        player.advance(3.0 - player.now_s())
-        player.write_steps()
-    finally:
-        sink.close()
-    return bag
+    return record_teleported_run(sim, directory / 'course.bag', directory / 'vrc_task_2', 3.0)
 
 
 def _pixels(path: Path) -> np.ndarray:

@@ -8,37 +8,24 @@ from pathlib import Path
 
 import pytest
 
+from support.scored_runs import GATE_TELEPORTS, record_teleported_run
 from tutorial_atlas_control.bags import read_bag, read_scores
 from tutorial_atlas_control.cli.analyze_bag import main
 from tutorial_atlas_control.offline.player import OfflinePlayer, open_offline_bag
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.sim.controller import load_gains_yaml
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
-from tutorial_atlas_control.sim.vrc import pose_input
 
 CONFIG = Path(__file__).resolve().parents[3] / 'config' / 'atlas_controller.yaml'
 #: (sim time s, pelvis x, y): through gate_0 (x 1, y -38, yaw 0), then gate_1 (0, -22, 90°).
-TELEPORTS = ((0.5, 0.7, -38.0), (0.6, 1.3, -38.0), (0.8, 0.0, -22.3), (0.9, 0.0, -21.7))
+TELEPORTS = GATE_TELEPORTS
 
 
 @pytest.fixture(scope='module')
 def scored_bag(tmp_path_factory: pytest.TempPathFactory) -> Path:
     directory = tmp_path_factory.mktemp('scored')
     sim = AtlasSimulator(atlas_model.load_model(), load_gains_yaml(CONFIG))
-    bag = directory / 'scored.bag'
-    sink = open_offline_bag(bag)
-    try:
-        player = OfflinePlayer(sim, sink, score_dir=directory / 'vrc_task_2')
-        player.write_config()
-        player.publish()
-        for t_s, x_m, y_m in TELEPORTS:
-            player.advance(t_s - player.now_s())
-            sim.apply_input(pose_input((x_m, y_m, 1.0), (0.0, 0.0, 0.0, 0.0)))
-        player.advance(2.5 - player.now_s())
-        player.write_steps()
-    finally:
-        sink.close()
-    return bag
+    return record_teleported_run(sim, directory / 'scored.bag', directory / 'vrc_task_2', 2.5)
 
 
 def test_the_bag_has_the_scores_rows(scored_bag: Path) -> None:
