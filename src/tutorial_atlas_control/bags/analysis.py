@@ -16,6 +16,11 @@ from typing import Any
 import numpy as np
 
 from tutorial_atlas_control import topics
+from tutorial_atlas_control.bags.course_terrain import (
+    above_ground,
+    is_course_run,
+    terrain_heights,
+)
 from tutorial_atlas_control.bags.reader import (
     BagData,
     JointCommandSeries,
@@ -138,6 +143,9 @@ class Analysis:
     effort_saturation: dict[str, EffortSaturation] | None
     unavailable: dict[str, str]
     tries: list[TryAnalysis] = field(default_factory=list)
+    #: The pelvis's heights (the fall, the lowest) are over the VRC course's terrain under
+    #: it, not over z 0 (a course run: bags/course_terrain.is_course_run).
+    over_terrain: bool = False
 
     @property
     def mode_timeline(self) -> list[tuple[float, str]]:
@@ -202,7 +210,9 @@ class Analysis:
                 name: {'limit': sat.limit_nm, 'duration': sat.duration_s,
                        'first_time': sat.first_time_s, 'samples': sat.samples}
                 for name, sat in self.effort_saturation.items()}),
-            'thresholds': {'fall_height': FALL_HEIGHT_M, 'moved_range': MOVED_RANGE_RAD,
+            'thresholds': {'fall_height': FALL_HEIGHT_M,
+                           'fall_height_over': 'terrain' if self.over_terrain else 'z 0',
+                           'moved_range': MOVED_RANGE_RAD,
                            'command_change': COMMAND_CHANGE_RAD,
                            'effort_tolerance': EFFORT_LIMIT_TOLERANCE_NM},
             'unavailable': dict(self.unavailable),
@@ -321,10 +331,14 @@ def _nan_range(values: np.ndarray) -> float | None:
     return float(finite.max() - finite.min()) if len(finite) else None
 
 
-def _fall(pelvis: PelvisSeries) -> tuple[bool, float | None, float]:
+def _fall(pelvis: PelvisSeries, over_terrain: bool) -> tuple[bool, float | None, float]:
     """(fell, first time fallen or None, lowest pelvis height (m)): sim/fall.py's
-    criterion in its flat-ground form, a bag holding no world."""
-    height_m = pelvis.position_m[:, 2]
+    criterion, over the course's terrain under the pelvis on a course run (standing in the
+    mud pit, 0.6 m down, is not a fall), else over z 0 (the empty world's plane)."""
+    position_m = pelvis.position_m
+    if over_terrain:
+        position_m = above_ground(position_m, terrain_heights())
+    height_m = position_m[:, 2]
     below = fallen_samples(height_m)
     fell = bool(below.any())
     return fell, float(pelvis.t_s[np.argmax(below)]) if fell else None, float(height_m.min())
@@ -405,10 +419,11 @@ def _analyze(data: BagData, starts_s: list[float]) -> Analysis:
     """The metrics of `data`, whose tries begin at `starts_s` (s, after the first)."""
     unavailable: dict[str, str] = {}
     fell = fall_time_s = min_height_m = None
+    over_terrain = is_course_run(data)
     if data.pelvis is None or not len(data.pelvis.t_s):
         unavailable['fall'] = f'no {topics.GROUND_TRUTH_ODOM} in the bag'
     else:
-        fell, fall_time_s, min_height_m = _fall(data.pelvis)
+        fell, fall_time_s, min_height_m = _fall(data.pelvis, over_terrain)
 
     commands = data.commands
     command_rate_hz = None
@@ -430,7 +445,7 @@ def _analyze(data: BagData, starts_s: list[float]) -> Analysis:
         if commands is None:
             unavailable['command_age'] = f'no {topics.JOINT_COMMANDS} in the bag'
     return Analysis(data, fell, fall_time_s, min_height_m, joints, command_rate_hz,
-                    age_mean_s, age_max_s, saturation, unavailable)
+                    age_mean_s, age_max_s, saturation, unavailable, over_terrain=over_terrain)
 
 
 def _analyze_try(data: BagData, each: Try) -> TryAnalysis:

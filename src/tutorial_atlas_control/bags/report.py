@@ -75,13 +75,14 @@ def _fall_line(analysis: Analysis) -> str:
     if analysis.fell is None:
         return f'Fall:     unknown ({analysis.unavailable.get("fall", "no pelvis data")})'
     first = analysis.first_fall()
+    over = ' over the terrain' if analysis.over_terrain else ''
     if analysis.fell and first is not None:
         number, fall = first
         where = '' if number is None else f'try {number}, '
         return (f'Fall:     FELL {fall_when(fall.sim_time_s, fall.after_command_s)} ({where}'
-                f'{analysis.fall_time_s:.3f} s from bag start; pelvis below {FALL_HEIGHT_M} m; '
-                f'lowest {analysis.min_pelvis_height_m:.3f} m)')
-    return (f'Fall:     no (pelvis stayed above {FALL_HEIGHT_M} m; lowest '
+                f'{analysis.fall_time_s:.3f} s from bag start; pelvis below {FALL_HEIGHT_M} m'
+                f'{over}; lowest {analysis.min_pelvis_height_m:.3f} m)')
+    return (f'Fall:     no (pelvis stayed above {FALL_HEIGHT_M} m{over}; lowest '
             f'{analysis.min_pelvis_height_m:.3f} m)')
 
 

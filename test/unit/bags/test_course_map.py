@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from support.scored_runs import GATE_TELEPORTS, record_teleported_run
-from support.synthetic_bags import Record, sim_config, write_bag, write_run_bag
+from support.synthetic_bags import Record, odometry, sim_config, write_bag, write_run_bag
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.bags import course_map, read_bag
+from tutorial_atlas_control.bags import analyze_bag, course_map, format_summary, read_bag
 from tutorial_atlas_control.bags.course_map import (
     GATE_COLOUR,
     MAP_SIZE_PX,
@@ -155,3 +155,28 @@ def test_plot_writes_the_course_map_beside_and_refuses_it_off_the_course(
     assert out == '' and len(err.strip().splitlines()) == 1, (out, err)  # before the summary
     assert 'is not a VRC Task 2 run' in err
     assert not (tmp_path / 'flat.png').exists()
+
+
+def _course_config(t_s: float) -> Record:
+    config = sim_config(t_s, 0.0)
+    text = json.loads(config.message.data)
+    text['model_file'] = 'vrc_task_2.xml'
+    return Record(topics.SIM_CONFIG, 'std_msgs/String', t_s,
+                  type(config.message)(data=json.dumps(text)))
+
+
+def test_standing_in_the_pit_is_no_fall_on_the_course_and_one_on_the_plane(
+        tmp_path: Path) -> None:
+    """The pelvis 0.85 m over the pit's floor (z 0.25) for 2 s, then 0.3 m over it: on the
+    course the fall is found at the drop, its lowest over the terrain; the same path in a
+    bag naming no course is fallen from the first sample (over z 0)."""
+    path = [odometry(t_s, (0.85 if t_s < 2.0 else 0.3) - 0.6, x_m=0.5, y_m=-16.6)
+            for t_s in np.arange(0.0, 3.0, 0.01)]
+    course = analyze_bag(write_bag(tmp_path / 'pit.bag', [_course_config(0.0), *path]))
+    assert course.over_terrain
+    assert course.fell and course.fall_time_s == pytest.approx(2.0, abs=0.011)
+    assert course.min_pelvis_height_m == pytest.approx(0.3, abs=0.005)
+    assert 'pelvis below 0.5 m over the terrain' in format_summary(course)
+    plane = analyze_bag(write_bag(tmp_path / 'plane.bag', [sim_config(0.0, 0.0), *path]))
+    assert not plane.over_terrain
+    assert plane.fell and plane.fall_time_s == pytest.approx(0.0, abs=0.011)
