@@ -1,7 +1,8 @@
 """The analysis plot's first page: what a person looks for first in a run, on one picture.
 
-The pelvis height with the fall threshold and each fall (in fall_report's words: sim time,
-seconds after the try's first command), the tries as bands labelled with what was played,
+The pelvis height (over the terrain under it on a VRC course run) with the fall threshold
+and each fall (in fall_report's words: sim time, seconds after the try's first command), the
+tries as bands labelled with what was played,
 the played trajectories' waypoint boundaries, the control modes (a refused one marked),
 and the tracking error of the few joints that tracked worst. The per-joint pages are
 report.plot_joints, behind analyze_bag.py's --plot-joints.
@@ -14,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from tutorial_atlas_control.bags.analysis import Analysis, TryAnalysis
+from tutorial_atlas_control.bags.course_terrain import above_ground, terrain_heights
 from tutorial_atlas_control.bags.reader import BagData
 from tutorial_atlas_control.bags.tries import window
 from tutorial_atlas_control.errors import AtlasControlError
@@ -99,8 +101,11 @@ def _draw_pelvis(ax: Any, analysis: Analysis, shift_s: float) -> None:
         ax.text(0.5, 0.5, 'no pelvis data (/ground_truth_odom)', ha='center', va='center',
                 transform=ax.transAxes)
         return
-    ax.plot(pelvis.t_s + shift_s, pelvis.position_m[:, 2], color='tab:green',
-            label='pelvis height')
+    # On a course run the height the fall is judged by: over the terrain under the pelvis.
+    height_m = (above_ground(pelvis.position_m, terrain_heights())[:, 2]
+                if analysis.over_terrain else pelvis.position_m[:, 2])
+    ax.plot(pelvis.t_s + shift_s, height_m, color='tab:green',
+            label='pelvis over the terrain' if analysis.over_terrain else 'pelvis height')
     ax.axhline(FALL_HEIGHT_M, color='tab:red', linestyle=':', label='fall threshold')
     # On a sim-time axis a fall sits at the sim time its label (the live log's) gives.
     falls = [(each.fall.sim_time_s if shift_s else each.analysis.fall_time_s,
@@ -111,7 +116,8 @@ def _draw_pelvis(ax: Any, analysis: Analysis, shift_s: float) -> None:
                 label='fall' if number == 0 else None)
         ax.annotate(label, (t_s, FALL_HEIGHT_M), xytext=(6, -14 - 11 * (number % 2)),
                     textcoords='offset points', fontsize=8, color='tab:red')
-    ax.set_ylabel('pelvis height (m)')
+    ax.set_ylabel('pelvis over the terrain (m)' if analysis.over_terrain
+                  else 'pelvis height (m)')
 
 
 def _draw_tries(axes: list[Any], analysis: Analysis, shift_s: float) -> None:

@@ -27,6 +27,7 @@ from tutorial_atlas_control.bags.course_terrain import (
     is_course_run,
     terrain_heights,
 )
+from tutorial_atlas_control.bags.overview_plot import draw_overview
 from tutorial_atlas_control.cli.analyze_bag import main
 from tutorial_atlas_control.course import GATES
 from tutorial_atlas_control.offline.world import named_world
@@ -177,6 +178,10 @@ def test_standing_in_the_pit_is_no_fall_on_the_course_and_one_on_the_plane(
     assert course.fell and course.fall_time_s == pytest.approx(2.0, abs=0.011)
     assert course.min_pelvis_height_m == pytest.approx(0.3, abs=0.005)
     assert 'pelvis below 0.5 m over the terrain' in format_summary(course)
+    page = draw_overview(course, set())
+    line = next(each for each in page.axes[0].lines
+                if each.get_label() == 'pelvis over the terrain')
+    assert line.get_ydata().min() == pytest.approx(0.3, abs=0.005)
     plane = analyze_bag(write_bag(tmp_path / 'plane.bag', [sim_config(0.0, 0.0), *path]))
     assert not plane.over_terrain
     assert plane.fell and plane.fall_time_s == pytest.approx(0.0, abs=0.011)
