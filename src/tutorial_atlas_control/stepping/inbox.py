@@ -22,11 +22,11 @@ from tutorial_atlas_control.command import (
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.msgs import (
     AsiCommand,
+    AtlasCommandDecoder,
     AtlasUpdate,
     CommandDecoder,
     FieldCursor,
     decode_asi_command,
-    decode_atlas_command,
     decode_test,
 )
 from tutorial_atlas_control.sim import AtlasSimulator, CommandAgeStatistics, ControlMode
@@ -73,6 +73,7 @@ class CommandInbox:
         self.watch = watch
         self.budgets = budgets
         self.decoder = CommandDecoder()
+        self.atlas_decoder = AtlasCommandDecoder()
         # Bounded, so that a stalled loop cannot make it grow without limit.
         self.pending: collections.deque[tuple[str, bytes]] = collections.deque(
             maxlen=MAX_PENDING_COMMANDS)
@@ -98,7 +99,7 @@ class CommandInbox:
         if topic == topics.JOINT_COMMANDS:
             return self.decoder.decode(raw)
         if topic == topics.ATLAS_COMMAND:
-            return decode_atlas_command(raw)
+            return self.atlas_decoder.decode(raw)
         if topic == ASI_TOPIC:
             return decode_asi_command(raw)
         return decode_test(raw)
