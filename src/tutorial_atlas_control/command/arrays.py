@@ -96,10 +96,14 @@ class JointCommandArrays:
         block = self.__dict__.get('_block')
         if block is None:
             return None
-        for name in LAW_FIELDS:
-            if getattr(self, name).base is not block:
-                return None
-        return block
+        # Spelled out, not a loop over LAW_FIELDS: the node asks several times a step.
+        if (self.position.base is block and self.velocity.base is block
+                and self.effort.base is block and self.kp_position.base is block
+                and self.ki_position.base is block and self.kd_position.base is block
+                and self.kp_velocity.base is block and self.i_effort_min.base is block
+                and self.i_effort_max.base is block and self.k_effort.base is block):
+            return block
+        return None
 
 
 assert tuple(f.name for f in fields(JointCommandArrays)) == LAW_FIELDS
