@@ -146,6 +146,8 @@ _FULL_BODY = np.dtype([item for name, dtype in ATLAS_COMMAND_FIELDS
                       + [('desired_controller_period_ms', 'u1')])
 _FULL_COUNTS = struct.Struct('<' + ''.join(f'I{dtype.itemsize * NUM_JOINTS}x'
                                            for _, dtype in ATLAS_COMMAND_FIELDS))
+#: Those counts when every array has 28 entries.
+_ALL_FULL = (NUM_JOINTS,) * len(ATLAS_COMMAND_FIELDS)
 _FULL_ROWS = tuple(LAW_FIELDS.index(name) for name, _ in ATLAS_COMMAND_FIELDS)
 _K_EFFORT_INDEX = _FULL_ROWS.index(K_EFFORT_ROW)
 
@@ -191,7 +193,7 @@ def _decode_full(raw: bytes, memo: GainMemo | None = None) -> AtlasUpdate | None
     start = cursor.pos
     if len(raw) - start != _FULL_BODY.itemsize:
         return None
-    if any(count != NUM_JOINTS for count in _FULL_COUNTS.unpack_from(raw, start)):
+    if _FULL_COUNTS.unpack_from(raw, start) != _ALL_FULL:
         return None
     block = np.empty((len(_FULL_ROWS), NUM_JOINTS))
     gains_from = start + _GAINS_FROM

@@ -132,8 +132,9 @@ class CommandInbox:
             except CommandError as err:
                 self.log.refused_command(f'refused {topic}: {err}; previous command kept', topic)
                 continue
-            if not stamped and topic in STAMPED_COMMANDS:
-                self._note_command_stamp(raw)  # the newest applied command
+            if not stamped and topic in STAMPED_COMMANDS:  # the newest applied command
+                self._note_command_stamp(result.stamp_ns if isinstance(result, AtlasUpdate)
+                                         else FieldCursor(raw).header_stamp_ns())
                 stamped = True
             decoded.append((topic, result))
             if isinstance(result, AsiCommand):
@@ -189,9 +190,8 @@ class CommandInbox:
         if refusal is not None:
             self.log.refused_command(refusal, ASI_TOPIC)
 
-    def _note_command_stamp(self, raw: bytes) -> None:
-        """The command in `raw` is applied from the coming step on: remember its stamp."""
-        stamp_ns = FieldCursor(raw).header_stamp_ns()
+    def _note_command_stamp(self, stamp_ns: int) -> None:
+        """The command stamped `stamp_ns` is applied from the coming step on: remember it."""
         self.command_stamp_ns = stamp_ns
         self.statistics.command_applied(stamp_ns, self.sim.sim_time_ns + self.sim.step_ns)
 
