@@ -233,7 +233,8 @@ class AtlasCommandDecoder:
 
     A controller sends the same gains in every message and changes only its targets: the
     decoder remembers the last gains' bytes and values (GainMemo), so such a message costs
-    the conversion and checks of its three target arrays, not of all ten. One thread only.
+    the conversion and checks of its three target arrays, not of all ten. Not for
+    concurrent calls (the loop's lock serializes the inbox's).
     """
 
     def __init__(self) -> None:
