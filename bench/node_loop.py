@@ -3,7 +3,8 @@
 On a shared 2-core machine a node-level figure moves with everyone else's load; these
 loops run in one process, so an A/B of two variants (compiled vs numpy law, one node
 loop vs another) compares like with like. `python3 bench/node_loop.py` prints µs per
-step of each (interleaved rounds, best of them).
+step of each (interleaved rounds, best of them); `--phases` splits the tick of a node
+serving a 1 kHz controller into its phases (controller_phases_run).
 """
 
 from __future__ import annotations
@@ -93,6 +94,70 @@ def node_spin_run(steps: int = 5000, warmup_steps: int = 1500, compiled_law: boo
         return (time.process_time() - start) / steps * 1e6
 
 
+#: Where the tick of a node serving a 1 kHz controller goes (controller_phases_run).
+PHASES = ('command in', 'inbox', 'sim.step', 'publish', 'end_step', 'flush')
+#: The topics heard in the controller section's runs (bench/controller.py): the bench's
+#: /clock and statistics probes, and the controller's /atlas/atlas_state.
+CONTROLLER_RUN_TOPICS = ('/clock', '/atlas/controller_statistics', '/atlas/atlas_state')
+
+
+def controller_command(sim: Any) -> bytes:
+    """An AtlasCommand as echo_controller sends it: every array of 28, the target the
+    joints' positions now, the same gains in every message."""
+    from tutorial_atlas_control.joints import NUM_JOINTS
+    from tutorial_atlas_control.msgs import encode_atlas_command
+
+    def full(value: float) -> list[float]:
+        return [value] * NUM_JOINTS
+
+    return encode_atlas_command(sim.sim_time_ns, {
+        'position': sim.joint_positions().tolist(), 'velocity': full(0.0), 'effort': full(0.0),
+        'kp_position': full(100.0), 'ki_position': full(0.0), 'kd_position': full(1.0),
+        'kp_velocity': full(0.0), 'k_effort': [255] * NUM_JOINTS, 'i_effort_min': full(-1.0),
+        'i_effort_max': full(1.0)})
+
+
+def controller_phases_run(steps: int = 3000, answered: bool = True) -> dict[str, float]:
+    """CPU µs per step of each of PHASES (this thread's: a loaded host's waits are not
+    counted; six clock reads of about 1 µs each are), and 'cpu' (this process), of the
+    loop's turn (loop.py, tick.py) on fake rospy serving a 1 kHz controller: an AtlasCommand
+    received before every step (`answered` False: none), the CONTROLLER_RUN_TOPICS heard
+    over loopback TCP, sent after every step as at real time, no pacing, no rospy threads.
+    """
+    sim = make_simulator()
+    for _ in range(1500):
+        sim.step()
+    raw = controller_command(sim)
+    with fake_rospy.fake_ros_node(sim, 0, tcp=True, heard=CONTROLLER_RUN_TOPICS) as node:
+        loop = node.loop
+        tick, outbox, lock, clock = loop.tick, loop.outbox, loop.lock, time.thread_time
+        receive = loop.receive_command if answered else (lambda *_args: None)
+        before, step, publish, end = (tick.controller.before_step, sim.step,
+                                      loop._publish_step, tick.end_step)
+        spent = [0.0] * len(PHASES)
+        cpu_start = time.process_time()
+        for _ in range(steps):
+            t0 = clock()
+            receive(raw, '/atlas/atlas_command')
+            with lock:
+                t1 = clock()
+                before()
+                t2 = clock()
+                step()
+                t3 = clock()
+                publish()
+                t4 = clock()
+                end()
+                t5 = clock()
+            outbox.flush()
+            for index, elapsed in enumerate((t1 - t0, t2 - t1, t3 - t2, t4 - t3, t5 - t4,
+                                             clock() - t5)):
+                spent[index] += elapsed
+        figures = {'cpu': (time.process_time() - cpu_start) / steps * 1e6}
+    figures.update({name: value / steps * 1e6 for name, value in zip(PHASES, spent)})
+    return figures
+
+
 def unheard_topic_run(calls: int = 20000, rounds: int = 5) -> float:
     """µs per step that one published topic nobody subscribes to costs the node's loop.
 
@@ -129,7 +194,32 @@ def unheard_topic_run(calls: int = 20000, rounds: int = 5) -> float:
         return (min(with_s) - min(without_s)) / calls / len(repeated) * 1e6
 
 
+def phases_main(rounds: int) -> int:
+    """`node_loop.py --phases [ROUNDS]`: controller_phases_run with and without the
+    controller's commands, and bare mj_step, interleaved; each figure's best round."""
+    best: dict[str, dict[str, float]] = {}
+    for _ in range(rounds):
+        runs = {'bare mj_step': {'cpu': 1e6 / bare_physics_run(3000)},
+                'with a controller': controller_phases_run(),
+                'no controller': controller_phases_run(answered=False)}
+        for name, figures in runs.items():
+            kept = best.setdefault(name, figures)
+            for key, value in figures.items():
+                kept[key] = min(kept[key], value)
+    bare_us = best['bare mj_step']['cpu']
+    print(f'best of {rounds} (µs per step, x bare mj_step {bare_us:.1f} µs; '
+          f'load {os.getloadavg()[0]:.1f}):')
+    for name in ('with a controller', 'no controller'):
+        figures = best[name]
+        print(f'  {name}: cpu {figures["cpu"]:.1f} ({figures["cpu"] / bare_us:.2f}x); '
+              + ', '.join(f'{phase} {figures[phase]:.1f} ({figures[phase] / bare_us:.2f}x)'
+                          for phase in PHASES))
+    return 0
+
+
 def main() -> int:
+    if sys.argv[1:2] == ['--phases']:
+        return phases_main(int(sys.argv[2]) if len(sys.argv) > 2 else 3)
     rounds = int(sys.argv[1]) if len(sys.argv) > 1 else 3
     best: dict[str, float] = {}
     for _ in range(rounds):

@@ -13,7 +13,7 @@ import os
 import socket
 import subprocess
 import sys
-from collections.abc import Iterator, Mapping
+from collections.abc import Collection, Iterator, Mapping
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
@@ -124,12 +124,15 @@ class FakePublisher:
 def fake_ros_node(sim: AtlasSimulator, steps: int, tcp: bool = False,
                   rates_hz: Mapping[str, float] = LAUNCH_RATES_HZ,
                   params: Mapping[str, object] | None = None,
-                  score_dir: Path | None = None) -> Iterator[Any]:
+                  score_dir: Path | None = None,
+                  heard: Collection[str] | None = None) -> Iterator[Any]:
     """A real SimNode (real_time_factor 0) around `sim`, on fake rospy (with `score_dir`,
     scoring the VRC course into it).
 
-    Each publisher has one subscriber (see Sinks); rospy.is_shutdown() ends spin() after
-    `steps` steps. The node's `fake_publishers` maps each topic to its FakePublisher.
+    Each publisher has one subscriber (see Sinks), but those of UNHEARD_TOPICS, or, given
+    `heard`, each publisher of a topic in `heard` and no other; rospy.is_shutdown() ends
+    spin() after `steps` steps. The node's `fake_publishers` maps each topic to its
+    FakePublisher.
     """
     from tutorial_atlas_control.node import sim_node
 
@@ -143,7 +146,8 @@ def fake_ros_node(sim: AtlasSimulator, steps: int, tcp: bool = False,
         return calls['left'] < 0
 
     def publisher(topic: str, msg_class: type, *_args: object, **kwargs: object) -> FakePublisher:
-        publishers[topic] = FakePublisher(sinks, topic)
+        publishers[topic] = FakePublisher(sinks, topic,
+                                          None if heard is None else topic in heard)
         publishers[topic].advertised = (msg_class._type, bool(kwargs.get('latch', False)))
         return publishers[topic]
 

@@ -74,12 +74,21 @@ class JointCommandArrays:
         The copy's arrays are the rows of one (fields, joints) block, in LAW_FIELDS order:
         the compiled law binds a new command by one address instead of ten (rows_block).
         """
+        source = self.rows_block()
+        if source is not None:
+            return JointCommandArrays.from_block(source.copy())  # one copy, not ten
         block = np.empty((len(LAW_FIELDS), NUM_JOINTS))
         for row, name in enumerate(LAW_FIELDS):
             block[row] = getattr(self, name)
-        copied = JointCommandArrays(*block)
-        copied._block = block
-        return copied
+        return JointCommandArrays.from_block(block)
+
+    @classmethod
+    def from_block(cls, block: np.ndarray) -> JointCommandArrays:
+        """The command whose arrays are the rows of `block` ((fields, joints) float64, in
+        LAW_FIELDS order; not copied): what rows_block() then returns."""
+        command = cls(*block)
+        command._block = block
+        return command
 
     def rows_block(self) -> np.ndarray | None:
         """The float64 block whose rows, in LAW_FIELDS order, are this command's arrays (a
@@ -87,10 +96,14 @@ class JointCommandArrays:
         block = self.__dict__.get('_block')
         if block is None:
             return None
-        for name in LAW_FIELDS:
-            if getattr(self, name).base is not block:
-                return None
-        return block
+        # Spelled out, not a loop over LAW_FIELDS: the node asks several times a step.
+        if (self.position.base is block and self.velocity.base is block
+                and self.effort.base is block and self.kp_position.base is block
+                and self.ki_position.base is block and self.kd_position.base is block
+                and self.kp_velocity.base is block and self.i_effort_min.base is block
+                and self.i_effort_max.base is block and self.k_effort.base is block):
+            return block
+        return None
 
 
 assert tuple(f.name for f in fields(JointCommandArrays)) == LAW_FIELDS
@@ -138,6 +151,15 @@ def joint_indices(names: Sequence[str]) -> np.ndarray:
 
 
 @functools.lru_cache(maxsize=64)
+def _distinct_rows(rows: tuple[int, ...]) -> np.ndarray | None:
+    """`rows` as an index array when no row repeats (one assignment writes them all, as
+    one per row would), else None: a repeated row's last values win row by row."""
+    if len(set(rows)) != len(rows):
+        return None
+    return np.array(rows, dtype=np.intp)
+
+
+@functools.lru_cache(maxsize=64)
 def _indices_of(names: tuple[str, ...]) -> np.ndarray:
     indices = np.empty(len(names), dtype=np.intp)
     seen: set[int] = set()
@@ -149,6 +171,8 @@ def _indices_of(names: tuple[str, ...]) -> np.ndarray:
             raise CommandError(f'joint {name!r} is named twice')
         seen.add(index)
         indices[slot] = index
+    if np.array_equal(indices, ALL_JOINTS):
+        return ALL_JOINTS  # the tutorial's order: CommandUpdate.apply_to's whole rows
     indices.setflags(write=False)  # shared by every message with these names
     return indices
 
@@ -177,7 +201,16 @@ class CommandUpdate:
         return len(set(self.rows)) == len(LAW_FIELDS) and self.all_joints
 
     def apply_to(self, command: JointCommandArrays) -> None:
-        """Write this update into `command` (in place)."""
+        """Write this update into `command` (in place).
+
+        A controller's update sets whole rows of every joint in order: written into the
+        command's block by one assignment instead of one per field (the same values).
+        """
+        block = command.rows_block() if self.indices is ALL_JOINTS else None
+        rows = _distinct_rows(self.rows) if block is not None else None
+        if rows is not None:
+            block[rows] = self.values
+            return
         for row, values in zip(self.rows, self.values):
             getattr(command, LAW_FIELDS[row])[self.indices] = values
 

@@ -6,7 +6,7 @@ What fills the messages from the simulator each step is sim/sim_messages.py.
 from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
-    'atlas_command': ['AtlasUpdate', 'decode_atlas_command', 'decode_test',
+    'atlas_command': ['AtlasCommandDecoder', 'AtlasUpdate', 'decode_atlas_command', 'decode_test',
                       'encode_atlas_command'],
     'atlas_sim_interface': ['STEP_QUEUE_LENGTH', 'AsiCommand', 'ManipulateParams', 'StepData',
                             'decode_asi_command', 'encode_asi_command'],

@@ -31,8 +31,9 @@ from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.msgs.ros1_fields import FieldCursor
 from tutorial_atlas_control.units import NS_PER_S
 
-__all__ = ['ATLAS_COMMAND_FIELDS', 'MAX_DAMPING', 'TEST_FIELDS', 'AtlasUpdate',
-           'decode_atlas_command', 'decode_test', 'encode_atlas_command', 'encode_test']
+__all__ = ['ATLAS_COMMAND_FIELDS', 'MAX_DAMPING', 'TEST_FIELDS', 'AtlasCommandDecoder',
+           'AtlasUpdate', 'GainMemo', 'decode_atlas_command', 'decode_test', 'encode_atlas_command',
+           'encode_test']
 
 _F8, _F4, _U1 = np.dtype('<f8'), np.dtype('<f4'), np.dtype('u1')
 #: AtlasCommand's arrays in message order (2.7.0), with their wire types.
@@ -145,6 +146,8 @@ _FULL_BODY = np.dtype([item for name, dtype in ATLAS_COMMAND_FIELDS
                       + [('desired_controller_period_ms', 'u1')])
 _FULL_COUNTS = struct.Struct('<' + ''.join(f'I{dtype.itemsize * NUM_JOINTS}x'
                                            for _, dtype in ATLAS_COMMAND_FIELDS))
+#: Those counts when every array has 28 entries.
+_ALL_FULL = (NUM_JOINTS,) * len(ATLAS_COMMAND_FIELDS)
 _FULL_ROWS = tuple(LAW_FIELDS.index(name) for name, _ in ATLAS_COMMAND_FIELDS)
 _K_EFFORT_INDEX = _FULL_ROWS.index(K_EFFORT_ROW)
 
@@ -168,8 +171,20 @@ def _full_groups() -> tuple[tuple[int, int, np.dtype, int], ...]:
 _FULL_GROUPS = _full_groups()
 
 
-def _decode_full(raw: bytes) -> AtlasUpdate | None:
-    """The fast path for an AtlasCommand whose arrays all have 28 entries; None otherwise."""
+#: The full body's rows past its float64 group (the gains and k_effort, in message order),
+#: the offset of their bytes after the header (from kp_position's count, to before the
+#: period's byte), and the float64 group's rows (position, velocity, effort).
+_GAIN_ROWS = _FULL_GROUPS[1][0]
+_GAINS_FROM = _FULL_GROUPS[1][3] - 4
+_TARGET_ROWS = _FULL_ROWS[:_GAIN_ROWS]
+
+
+def _decode_full(raw: bytes, memo: GainMemo | None = None) -> AtlasUpdate | None:
+    """The fast path for an AtlasCommand whose arrays all have 28 entries; None otherwise.
+
+    With `memo`: gains whose bytes equal the last checked ones are taken from it, already
+    converted and checked (the same values); only the targets are read and checked.
+    """
     try:
         cursor = FieldCursor(raw)
         stamp_ns = cursor.header_stamp_ns()
@@ -178,17 +193,59 @@ def _decode_full(raw: bytes) -> AtlasUpdate | None:
     start = cursor.pos
     if len(raw) - start != _FULL_BODY.itemsize:
         return None
-    if any(count != NUM_JOINTS for count in _FULL_COUNTS.unpack_from(raw, start)):
+    if _FULL_COUNTS.unpack_from(raw, start) != _ALL_FULL:
         return None
     block = np.empty((len(_FULL_ROWS), NUM_JOINTS))
-    for first, count, dtype, offset in _FULL_GROUPS:
+    gains_from = start + _GAINS_FROM
+    known = (memo is not None and bool(memo.gain_bytes)
+             and raw.startswith(memo.gain_bytes, gains_from))
+    for first, count, dtype, offset in (_FULL_GROUPS[:1] if known else _FULL_GROUPS):
         row_bytes = 4 + dtype.itemsize * NUM_JOINTS
         block[first:first + count] = np.ndarray((count, NUM_JOINTS), dtype, raw, start + offset,
                                                 (row_bytes, dtype.itemsize))
-    check_values(_FULL_ROWS, block)
-    block[_K_EFFORT_INDEX] /= K_EFFORT_FULL_SCALE
+    if known:
+        assert memo is not None
+        check_values(_TARGET_ROWS, block[:_GAIN_ROWS])
+        block[_GAIN_ROWS:] = memo.gains
+    else:
+        check_values(_FULL_ROWS, block)
+        block[_K_EFFORT_INDEX] /= K_EFFORT_FULL_SCALE
+        if memo is not None:
+            memo.gains = block[_GAIN_ROWS:].copy()
+            memo.gain_bytes = raw[gains_from:-1]
     # The body's last byte: desired_controller_period_ms (uint8).
     return AtlasUpdate(CommandUpdate(ALL_JOINTS, _FULL_ROWS, block), (), stamp_ns, raw[-1])
+
+
+class GainMemo:
+    """The gains (and k_effort) of the last full AtlasCommand decoded: its bytes, and its
+    rows past the targets as checked float64 (k_effort already / 255)."""
+
+    __slots__ = ('gain_bytes', 'gains')
+
+    def __init__(self) -> None:
+        self.gain_bytes = b''
+        self.gains = np.zeros((len(_FULL_ROWS) - _GAIN_ROWS, NUM_JOINTS))
+
+
+class AtlasCommandDecoder:
+    """decode_atlas_command for one stream of messages.
+
+    A controller sends the same gains in every message and changes only its targets: the
+    decoder remembers the last gains' bytes and values (GainMemo), so such a message costs
+    the conversion and checks of its three target arrays, not of all ten. Not for
+    concurrent calls (the loop's lock serializes the inbox's).
+    """
+
+    def __init__(self) -> None:
+        self.memo = GainMemo()
+
+    def decode(self, raw: bytes) -> AtlasUpdate:
+        """Raises CommandError as decode_atlas_command does."""
+        full = _decode_full(raw, self.memo)
+        if full is not None:
+            return full
+        return _decode(raw, ATLAS_COMMAND_FIELDS, with_period=True)
 
 
 def decode_atlas_command(raw: bytes) -> AtlasUpdate:

@@ -107,16 +107,18 @@ class CompiledLaw:
 
     def _bind(self, command: JointCommandArrays) -> None:
         """Point the kernel at another command's arrays (a new command arrived)."""
-        arrays = tuple(getattr(command, name) for name in LAW_FIELDS)
         count = self._step.n
         block = command.rows_block()
         if block is not None and block.shape == (len(LAW_FIELDS), count):
-            # One address for the ten rows (JointCommandArrays.copy: a new command's).
+            # One address for the ten rows (JointCommandArrays.copy: a new command's); the
+            # block is kept, and with it every row the kernel points at.
             base, row_bytes = address(block, np.float64), block.strides[0]
+            pointers = self._step.command
             for index in range(len(LAW_FIELDS)):
-                self._step.command[index] = base + index * row_bytes
-            self._command, self._command_arrays = command, arrays
+                pointers[index] = base + index * row_bytes
+            self._command, self._command_arrays = command, (block,)
             return
+        arrays = tuple(getattr(command, name) for name in LAW_FIELDS)
         for index, (name, array) in enumerate(zip(LAW_FIELDS, arrays)):
             if array.shape != (count,):
                 raise ValueError(f'command.{name} has shape {array.shape}, expected ({count},)')

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from tutorial_atlas_control.command import LAW_FIELDS
 from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.msgs import (
     WRENCH_FLOATS,
@@ -54,6 +55,11 @@ DRCSIM_FOOT_COMPONENTS = (2, 3, 4)
 HAND_BODIES = {'l_hand': 'l_hand', 'r_hand': 'r_hand'}
 #: The feet, whose contact wrench /atlas/debug/{l,r}_foot_contact carry.
 FOOT_BODIES = {'l': 'l_foot', 'r': 'r_foot'}
+
+
+#: AtlasState's gain rows (its joint arrays 3..8), which are LAW_FIELDS' rows 3..8 too.
+_GAIN_ROWS = slice(3, 9)
+assert AtlasStateWire.FIELDS[_GAIN_ROWS] == LAW_FIELDS[_GAIN_ROWS]
 
 
 def _float_offset(message: StampedWire) -> int:
@@ -143,6 +149,13 @@ class SimMessages:
         self._body = {name: int(model.body(name).id)
                       for name in (*HAND_BODIES.values(), *FOOT_BODIES.values())}
         self._root = {name: int(model.body_rootid[body]) for name, body in self._body.items()}
+        # Each body's frame in MjData (position, its subtree's com, rotation): views made
+        # once (MjData's arrays are never reallocated), not three attribute reads a wrench.
+        self._frames = {name: (data.xpos[body], data.subtree_com[self._root[name]],
+                               data.xmat[body]) for name, body in self._body.items()}
+        #: (wrench name, what the last wrist joint transmits to the hand, its body's name).
+        self._hands = tuple((field, data.cfrc_int[self._body[body]], body)
+                            for field, body in HAND_BODIES.items())
         self._spatial = np.zeros(6)  # MuJoCo's (torque, force) at a new point
         self._wrench = np.zeros(WRENCH_FLOATS)  # (force, torque) in a body frame
         # AtlasState's float32 joint rows in float64 first: position, velocity, effort
@@ -178,32 +191,39 @@ class SimMessages:
         The force sensors' own transformation (a site at the body origin reads the same).
         The result is a scratch array, valid until the next call.
         """
-        data, body = self.sim.data, self._body[body_name]
-        # Moved to the body origin and rotated into the body frame (xmat: body to world).
-        mujoco.mju_transformSpatial(self._spatial, spatial, 1, data.xpos[body],
-                                    data.subtree_com[self._root[body_name]], data.xmat[body])
         wrench = self._wrench
-        wrench[:3] = self._spatial[3:]
-        wrench[3:] = self._spatial[:3]
+        self._body_wrench_into(wrench, spatial, body_name)
         return wrench
+
+    def _body_wrench_into(self, wrench: np.ndarray, spatial: np.ndarray, body_name: str) -> None:
+        """body_wrench written into `wrench` (6 floats, of any float type)."""
+        position, com, rotation = self._frames[body_name]
+        # Moved to the body origin and rotated into the body frame (xmat: body to world).
+        mujoco.mju_transformSpatial(self._spatial, spatial, 1, position, com, rotation)
+        moved = self._spatial
+        wrench[:3] = moved[3:]
+        wrench[3:] = moved[:3]
 
     def _fill_hands(self, wrenches: dict[str, np.ndarray]) -> None:
         """What each last wrist joint transmits to the hand link (parent on child)."""
-        interaction = self.sim.data.cfrc_int
-        for field, body in HAND_BODIES.items():
-            wrenches[field][:] = self.body_wrench(interaction[self._body[body]], body)
+        for field, interaction, body in self._hands:
+            self._body_wrench_into(wrenches[field], interaction, body)
 
     def fill_atlas_state(self) -> bool:
         """AtlasState: joints after the step (as joint_state), the active gains and
         k_effort, IMU and wrenches from the step's start. Always sent."""
         self._atlas_state_plan()
         rows, command = self._joint_rows, self.sim.commands.pid_command()
-        rows[3] = command.kp_position
-        rows[4] = command.ki_position
-        rows[5] = command.kd_position
-        rows[6] = command.kp_velocity
-        rows[7] = command.i_effort_min
-        rows[8] = command.i_effort_max
+        block = command.rows_block()
+        if block is not None:  # the gains are rows 3..8 of both, in the same order
+            rows[_GAIN_ROWS] = block[_GAIN_ROWS]
+        else:
+            rows[3] = command.kp_position
+            rows[4] = command.ki_position
+            rows[5] = command.kd_position
+            rows[6] = command.kp_velocity
+            rows[7] = command.i_effort_min
+            rows[8] = command.i_effort_max
         state = self.atlas_state_wire
         state.joints[:] = rows
         state.k_effort[:] = self.sim.active_k_effort()

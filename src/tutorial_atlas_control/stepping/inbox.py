@@ -22,11 +22,11 @@ from tutorial_atlas_control.command import (
 from tutorial_atlas_control.joints import NUM_JOINTS
 from tutorial_atlas_control.msgs import (
     AsiCommand,
+    AtlasCommandDecoder,
     AtlasUpdate,
     CommandDecoder,
     FieldCursor,
     decode_asi_command,
-    decode_atlas_command,
     decode_test,
 )
 from tutorial_atlas_control.sim import AtlasSimulator, CommandAgeStatistics, ControlMode
@@ -73,6 +73,7 @@ class CommandInbox:
         self.watch = watch
         self.budgets = budgets
         self.decoder = CommandDecoder()
+        self.atlas_decoder = AtlasCommandDecoder()
         # Bounded, so that a stalled loop cannot make it grow without limit.
         self.pending: collections.deque[tuple[str, bytes]] = collections.deque(
             maxlen=MAX_PENDING_COMMANDS)
@@ -98,7 +99,7 @@ class CommandInbox:
         if topic == topics.JOINT_COMMANDS:
             return self.decoder.decode(raw)
         if topic == topics.ATLAS_COMMAND:
-            return decode_atlas_command(raw)
+            return self.atlas_decoder.decode(raw)
         if topic == ASI_TOPIC:
             return decode_asi_command(raw)
         return decode_test(raw)
@@ -131,8 +132,9 @@ class CommandInbox:
             except CommandError as err:
                 self.log.refused_command(f'refused {topic}: {err}; previous command kept', topic)
                 continue
-            if not stamped and topic in STAMPED_COMMANDS:
-                self._note_command_stamp(raw)  # the newest applied command
+            if not stamped and topic in STAMPED_COMMANDS:  # the newest applied command
+                self._note_command_stamp(result.stamp_ns if isinstance(result, AtlasUpdate)
+                                         else FieldCursor(raw).header_stamp_ns())
                 stamped = True
             decoded.append((topic, result))
             if isinstance(result, AsiCommand):
@@ -188,9 +190,8 @@ class CommandInbox:
         if refusal is not None:
             self.log.refused_command(refusal, ASI_TOPIC)
 
-    def _note_command_stamp(self, raw: bytes) -> None:
-        """The command in `raw` is applied from the coming step on: remember its stamp."""
-        stamp_ns = FieldCursor(raw).header_stamp_ns()
+    def _note_command_stamp(self, stamp_ns: int) -> None:
+        """The command stamped `stamp_ns` is applied from the coming step on: remember it."""
         self.command_stamp_ns = stamp_ns
         self.statistics.command_applied(stamp_ns, self.sim.sim_time_ns + self.sim.step_ns)
 

@@ -9,9 +9,12 @@ import numpy as np
 import pytest
 
 from tutorial_atlas_control.command.arrays import (
+    ALL_JOINTS,
     FIELD_NAMES,
+    LAW_FIELDS,
     MAX_MAGNITUDE,
     CommandError,
+    CommandUpdate,
     JointCommandArrays,
     joint_indices,
     merge_command,
@@ -173,3 +176,37 @@ def test_decoder_refuses_what_merge_command_refuses() -> None:
         CommandDecoder().decode(serialized(['neck_ay'], kd_position=[1e12]))
     with pytest.raises(CommandError, match='unknown joint name'):
         CommandDecoder().decode(serialized(['nose'], position=[0.0]))
+
+
+def _field_by_field(command: JointCommandArrays, update: CommandUpdate) -> JointCommandArrays:
+    """update.apply_to as one indexed write per field, on a command without a block."""
+    plain = JointCommandArrays(*(getattr(command, name).copy() for name in LAW_FIELDS))
+    for row, values in zip(update.rows, update.values):
+        getattr(plain, LAW_FIELDS[row])[update.indices] = values
+    return plain
+
+
+def test_whole_row_updates_write_the_block_as_field_by_field_writes_do() -> None:
+    """A controller's updates (every joint in order, fields in any order, k_effort among
+    them or not), a named subset, a repeated row: each leaves the same numbers as one
+    write per field, and a copied command keeps its fields the rows of one block."""
+    rng = np.random.default_rng(4)
+    ordered = joint_indices(list(JOINT_NAMES))
+    assert ordered is ALL_JOINTS  # the tutorial's order: whole rows
+    subset = joint_indices(['r_arm_elx', 'back_lbz'])
+    updates = [CommandUpdate(ALL_JOINTS, (0, 1, 2, 3, 4, 5, 6, 9, 7, 8),
+                             rng.uniform(-1, 1, (10, NUM_JOINTS))),
+               CommandUpdate(ordered, (0, 2, 5), rng.uniform(-1, 1, (3, NUM_JOINTS))),
+               CommandUpdate(subset, (1, 9), rng.uniform(-1, 1, (2, 2))),
+               CommandUpdate(ALL_JOINTS, (4, 4), rng.uniform(-1, 1, (2, NUM_JOINTS)))]
+    command = previous_command().copy()
+    for update in updates:
+        expected = _field_by_field(command, update)
+        merged = command.copy()
+        block = merged.rows_block()
+        assert block is not None
+        update.apply_to(merged)
+        assert merged.rows_block() is block
+        for name in LAW_FIELDS:
+            assert getattr(merged, name).tobytes() == getattr(expected, name).tobytes(), name
+        command = merged

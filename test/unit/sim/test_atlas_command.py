@@ -4,6 +4,7 @@ simulator, merging with JointCommands in the loop, and /atlas/reset_controls."""
 from __future__ import annotations
 
 import io
+import re
 from pathlib import Path
 
 import numpy as np
@@ -456,3 +457,42 @@ def test_the_fast_path_for_full_commands_agrees_with_the_general_one() -> None:
     arrays['kd_position'][5] = float('nan')
     with pytest.raises(CommandError, match=r'^kd_position\[5\] is nan \(NaN/Inf are refused\)$'):
         decode_atlas_command(encode_atlas_command(0, arrays))
+
+
+def test_the_gain_memo_decodes_a_stream_as_each_message_alone() -> None:
+    """A controller's stream through one AtlasCommandDecoder: new targets on remembered
+    gains, new gains, the old ones again, a refused target or gain (same text as alone, and
+    the memo still right after it), a short array: every result is decode_atlas_command's."""
+    from tutorial_atlas_control.msgs.atlas_command import ATLAS_COMMAND_FIELDS, AtlasCommandDecoder
+
+    rng = np.random.default_rng(8)
+
+    def message(gains_seed: int, **changes: float) -> bytes:
+        gains = np.random.default_rng(gains_seed)
+        arrays = {name: gains.uniform(0.0, 9.0, N) for name, _ in ATLAS_COMMAND_FIELDS}
+        arrays['k_effort'] = gains.integers(0, 256, N)
+        for name in ('position', 'velocity', 'effort'):
+            arrays[name] = rng.uniform(-2.0, 2.0, N)
+        for name, value in changes.items():
+            arrays[name][4] = value
+        return encode_atlas_command(int(rng.integers(0, 10**12)), arrays, int(rng.integers(256)))
+
+    decoder = AtlasCommandDecoder()
+    stream = [message(1), message(1), message(2), message(1), message(1, velocity=np.inf),
+              message(1), message(1, kp_velocity=np.nan), message(1, kp_velocity=np.nan),
+              message(1), message(3),
+              encode_atlas_command(0, {'position': full(0.5), 'kp_position': [1.0] * 3}),
+              message(3)]
+    for index, raw in enumerate(stream):
+        try:
+            alone = decode_atlas_command(raw)
+        except CommandError as err:
+            with pytest.raises(CommandError, match=f'^{re.escape(str(err))}$'):
+                decoder.decode(raw)
+            continue
+        streamed = decoder.decode(raw)
+        assert streamed.update.rows == alone.update.rows, index
+        assert streamed.update.values.tobytes() == alone.update.values.tobytes(), index
+        assert streamed.update.indices.tobytes() == alone.update.indices.tobytes(), index
+        assert (streamed.stamp_ns, streamed.desired_controller_period_ms, streamed.ignored) == (
+            alone.stamp_ns, alone.desired_controller_period_ms, alone.ignored), index

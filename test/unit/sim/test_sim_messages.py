@@ -12,7 +12,7 @@ import pytest
 from tutorial_atlas_control.msgs.atlas_command import decode_atlas_command, encode_atlas_command
 from tutorial_atlas_control.sim import controller, model
 from tutorial_atlas_control.sim.sim_messages import SimMessages
-from tutorial_atlas_control.sim.simulator import AtlasSimulator
+from tutorial_atlas_control.sim.simulator import AtlasSimulator, ControlMode
 from tutorial_atlas_control.trajectories.schedule import (
     parse_trajectory_log_line,
     trajectory_log_line,
@@ -229,3 +229,55 @@ def test_the_ports_imu_and_ankle_topics_mean_gravity_and_the_weight(
         foot = standing.model.body(f'{side}_foot').id
         pushes_world += standing.data.xmat[foot].reshape(3, 3) @ contact.force
     assert pushes_world == pytest.approx([0.0, 0.0, -above_ankles_n], abs=0.02 * above_ankles_n)
+
+
+def _atlas_state_as_before(messages: SimMessages) -> bytes:
+    """AtlasState filled as the node did before its fill was trimmed: gains row by row from
+    the PID command, each hand's wrench through MjData's attributes read afresh."""
+    sim, data = messages.sim, messages.sim.data
+    messages._atlas_state_plan()
+    rows, command = messages._joint_rows, sim.commands.pid_command()
+    for row, name in enumerate(('kp_position', 'ki_position', 'kd_position', 'kp_velocity',
+                                'i_effort_min', 'i_effort_max'), start=3):
+        rows[row] = getattr(command, name)
+    state = messages.atlas_state_wire
+    state.joints[:] = rows
+    state.k_effort[:] = sim.active_k_effort()
+    spatial = np.zeros(6)
+    for field, body_name in (('l_hand', 'l_hand'), ('r_hand', 'r_hand')):
+        body = sim.model.body(body_name).id
+        mujoco.mju_transformSpatial(spatial, data.cfrc_int[body], 1, data.xpos[body],
+                                    data.subtree_com[sim.model.body_rootid[body]],
+                                    data.xmat[body])
+        wrench = np.r_[spatial[3:], spatial[:3]]
+        state.wrenches[field][:] = wrench
+    return bytes(state.stamped(0))[16:]  # after the length prefix and the header's seq
+
+
+def test_atlas_state_bytes_equal_the_untrimmed_fill_step_by_step() -> None:
+    """A controller's full AtlasCommands at every step (the gains one block), then Stand
+    (the hold's command, no block): the wire's bytes equal the field-by-field fill's."""
+    sim = AtlasSimulator(model.load_model(), controller.load_gains_yaml(GAINS))
+    for _ in range(1100):
+        sim.step()
+    messages = SimMessages(sim)
+    rng = np.random.default_rng(5)
+    n = len(sim.torque_nm)
+    gains = {'kp_position': rng.uniform(50, 200, n), 'ki_position': rng.uniform(0, 1, n),
+             'kd_position': rng.uniform(1, 5, n), 'kp_velocity': rng.uniform(0, 2, n),
+             'i_effort_min': -rng.uniform(0, 5, n), 'i_effort_max': rng.uniform(0, 5, n),
+             'k_effort': rng.integers(0, 256, n)}
+    for step in range(60):
+        if step == 30:
+            sim.set_mode(ControlMode.STAND)
+        elif step < 30:
+            targets = sim.joint_positions() + rng.normal(0.0, 0.01, n)
+            update = decode_atlas_command(encode_atlas_command(
+                sim.sim_time_ns, {'position': targets, **gains})).update
+            sim.receive_updates([update])
+        sim.step()
+        blocked = sim.commands.pid_command().rows_block() is not None
+        assert blocked == (step < 30)  # both ways of filling the gains are taken
+        messages.fill_atlas_state()
+        trimmed = bytes(messages.atlas_state_wire.stamped(0))[16:]
+        assert trimmed == _atlas_state_as_before(messages), f'step {step}'
