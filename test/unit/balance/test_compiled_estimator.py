@@ -113,3 +113,12 @@ def test_python_estimator_chosen_by_the_environment(
     assert not BalanceEstimator(atlas).compiled
     monkeypatch.delenv('TAC_ESTIMATOR')
     assert BalanceEstimator(atlas).compiled
+
+
+def test_one_mujoco_in_the_process(library, atlas: atlas_model.AtlasModel) -> None:
+    """The library's MuJoCo is the bindings' (a second copy would own other globals: its
+    own plugin table, warning counters and allocator)."""
+    BalanceEstimator(atlas, compiled=True)
+    with open('/proc/self/maps', encoding='utf-8') as maps:
+        loaded = {line.split()[-1] for line in maps if 'libmujoco.so' in line}
+    assert len(loaded) == 1, loaded
