@@ -23,6 +23,9 @@
 typedef struct {
   const mjModel *model;       /* the estimator's copy of the model (wide sole margins) */
   mjData *data;               /* its scratch MjData */
+  const double *qpos;         /* (nq,) the state to estimate, copied in by Python */
+  const double *qvel;         /* (nv,) */
+  double *out;                /* this tick's output (the layout below), set each tick */
   const ptrdiff_t *dof_adr;   /* (n,) qvel index of each joint, tutorial order */
   double *jac;                /* (2, 6, nv) scratch: [linear; angular] per sole */
   double *bias;               /* (nv,) scratch: qfrc_bias */
@@ -105,13 +108,13 @@ static void soles(const AtlasEstimator *e, double *out) {
 
 /* The estimate at (qpos, qvel) (full MuJoCo vectors) into out; returns the sole contacts'
  * row count (rows beyond contact_capacity are not written: atlas_estimator_contacts then). */
-long atlas_estimate(const AtlasEstimator *e, const double *qpos, const double *qvel,
-                    double *out) {
+long atlas_estimate(const AtlasEstimator *e) {
   const mjModel *m = e->model;
   mjData *d = e->data;
+  double *out = e->out;
   long n = e->n;
-  memcpy(d->qpos, qpos, m->nq * sizeof(double));
-  memcpy(d->qvel, qvel, m->nv * sizeof(double));
+  memcpy(d->qpos, e->qpos, m->nq * sizeof(double));
+  memcpy(d->qvel, e->qvel, m->nv * sizeof(double));
   mj_kinematics(m, d);
   mj_collision(m, d);
   mj_comPos(m, d);

@@ -68,6 +68,7 @@ class AtlasEstimator(ctypes.Structure):
     """AtlasEstimator in src/atlas_estimator.c (same fields, same order)."""
 
     _fields_ = [('model', ctypes.c_void_p), ('data', ctypes.c_void_p),
+                ('qpos', ctypes.c_void_p), ('qvel', ctypes.c_void_p), ('out', ctypes.c_void_p),
                 ('dof_adr', ctypes.c_void_p), ('jac', ctypes.c_void_p),
                 ('bias', ctypes.c_void_p), ('half_thickness', ctypes.c_double * 2),
                 ('gravity_m_s2', ctypes.c_double), ('min_com_height_m', ctypes.c_double),
@@ -143,8 +144,7 @@ def _declare(library: ctypes.CDLL) -> None:
     library.atlas_copy_all.argtypes = [ctypes.POINTER(AtlasCopy), ctypes.c_long]
     library.atlas_copy_all.restype = None
     estimator = ctypes.POINTER(AtlasEstimator)
-    library.atlas_estimate.argtypes = [estimator, ctypes.c_void_p, ctypes.c_void_p,
-                                       ctypes.c_void_p]
+    library.atlas_estimate.argtypes = [estimator]
     library.atlas_estimate.restype = ctypes.c_long
     library.atlas_estimator_contacts.argtypes = [estimator, ctypes.c_void_p, ctypes.c_void_p,
                                                  ctypes.c_long]

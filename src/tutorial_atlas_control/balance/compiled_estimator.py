@@ -3,8 +3,8 @@
 estimator.BalanceEstimator.estimate in Python calls six MuJoCo passes and two jacobians, then
 spends as long again in numpy's indexing and copies; the C twin runs the same passes on the
 estimator's own model and scratch MjData (their C pointers) and writes every number of the
-estimate into one new flat array per tick, whose slices become the BalanceState's fields (a
-state never shares memory with the next). The library is found and checked by
+estimate into a flat row of its own per tick, whose slices become the BalanceState's fields
+(a state never shares memory with the next). The library is found and checked by
 tutorial_atlas_control.native; the estimator falls back to Python after one warning without
 it. Both agree to rounding (test/unit/balance/test_compiled_estimator.py: 1e-9).
 """
@@ -12,6 +12,7 @@ it. Both agree to rounding (test/unit/balance/test_compiled_estimator.py: 1e-9).
 from __future__ import annotations
 
 import ctypes
+import math
 from dataclasses import dataclass
 
 import mujoco
@@ -33,6 +34,8 @@ FIXED_FIELDS: tuple[tuple[str, int, tuple[int, ...]], ...] = (
     ('sole_rotations', 33, (2, 3, 3)), ('in_contact', 51, (2,)), ('omega', 53, ()),
     ('capture_point', 54, (2,)), ('sole_velocities', 56, (2, 6)))
 FIXED_SIZE = 68
+#: Ticks' outputs allocated at once.
+BLOCK_TICKS = 64
 
 
 @dataclass(frozen=True)
@@ -51,8 +54,9 @@ class EstimatorGeometry:
 
 @dataclass(frozen=True)
 class RawEstimate:
-    """One tick's numbers, views of one new array: the FIXED_FIELDS by name, the joints'
-    bias (n,) and sole jacobians (2, 6, n), and each sole's contact rows (k, ROW)."""
+    """One tick's numbers, views of its own row of an output block: the FIXED_FIELDS by
+    name, the joints' bias (n,) and sole jacobians (2, 6, n), each sole's contact rows
+    (k, ROW)."""
 
     fields: dict[str, np.ndarray]
     bias_nm: np.ndarray
@@ -60,24 +64,46 @@ class RawEstimate:
     contact_rows: tuple[np.ndarray, np.ndarray]
 
 
+class OutputBlock:
+    """BLOCK_TICKS ticks' outputs in one array, with each field's view across the ticks made
+    once: a tick's fields are then one index each, and no tick shares memory with another
+    (a state kept for later is never overwritten)."""
+
+    def __init__(self, size: int, joints: int) -> None:
+        self.array = np.empty((BLOCK_TICKS, size))
+        self.base = self.array.ctypes.data
+        self.next = 0
+        array = self.array
+        self.fields = [(name, array[:, at:at + math.prod(shape)].reshape((BLOCK_TICKS, *shape)))
+                       for name, at, shape in FIXED_FIELDS]
+        jac_at, counts_at = FIXED_SIZE + joints, FIXED_SIZE + 13 * joints
+        self.bias = array[:, FIXED_SIZE:jac_at]
+        self.jacobians = array[:, jac_at:counts_at].reshape(BLOCK_TICKS, 2, 6, joints)
+        self.counts = array[:, counts_at:counts_at + 2]
+        self.rows = array[:, counts_at + 2:].reshape(BLOCK_TICKS, CONTACT_CAPACITY, ROW)
+
+
 class CompiledEstimate:
     """atlas_estimate for one model, scratch MjData and geometry, as a single C call.
 
     Holds the model, data and scratch arrays so that the pointers given to C outlive it;
-    MjData's arrays never move.
+    MjData's arrays never move. The state is copied into arrays of its own, whose addresses
+    C keeps; each tick writes the next row of an OutputBlock.
     """
 
     def __init__(self, library: ctypes.CDLL, model: mujoco.MjModel, data: mujoco.MjData,
                  geometry: EstimatorGeometry) -> None:
         self._library = library
-        self._nq, self._nv = model.nq, model.nv
         count = len(geometry.dof_adr)
         self._dof_adr = np.ascontiguousarray(geometry.dof_adr, dtype=np.intp)
         self._jac = np.zeros((2, 6, model.nv))
         self._bias = np.zeros(model.nv)
+        self._qpos, self._qvel = np.zeros(model.nq), np.zeros(model.nv)
         self._keep = (model, data)
         kernel = self._kernel = AtlasEstimator()
         kernel.model, kernel.data = model._address, data._address
+        kernel.qpos = address(self._qpos, np.float64)
+        kernel.qvel = address(self._qvel, np.float64)
         kernel.dof_adr = address(self._dof_adr, np.intp)
         kernel.jac = address(self._jac, np.float64)
         kernel.bias = address(self._bias, np.float64)
@@ -92,32 +118,30 @@ class CompiledEstimate:
         kernel.contact_capacity = CONTACT_CAPACITY
         self._pointer = ctypes.byref(kernel)
         self._count = count
-        self._bias_at = FIXED_SIZE
-        self._jac_at = FIXED_SIZE + count
-        self._counts_at = FIXED_SIZE + 13 * count
-        self._size = self._counts_at + 2 + ROW * CONTACT_CAPACITY
-        self._fields = [(name, slice(at, at + int(np.prod(shape, dtype=int))), shape)
-                        for name, at, shape in FIXED_FIELDS]
+        self._size = FIXED_SIZE + 13 * count + 2 + ROW * CONTACT_CAPACITY
+        self._block = OutputBlock(self._size, count)
 
     def run(self, qpos: np.ndarray, qvel: np.ndarray) -> RawEstimate:
         """The estimate at (qpos, qvel), the full MuJoCo vectors."""
-        qpos = np.ascontiguousarray(qpos, dtype=np.float64)
-        qvel = np.ascontiguousarray(qvel, dtype=np.float64)
-        if qpos.shape != (self._nq,) or qvel.shape != (self._nv,):
-            raise BalanceError(f'qpos, qvel have shapes {qpos.shape}, {qvel.shape}; expected '
-                             f'({self._nq},), ({self._nv},)')
-        out = np.empty(self._size)
-        total = self._library.atlas_estimate(self._pointer, qpos.ctypes.data,
-                                             qvel.ctypes.data, out.ctypes.data)
-        counts_at, count = self._counts_at, self._count
+        if np.shape(qpos) != self._qpos.shape or np.shape(qvel) != self._qvel.shape:
+            raise BalanceError(f'qpos, qvel have shapes {np.shape(qpos)}, {np.shape(qvel)}; '
+                               f'expected {self._qpos.shape}, {self._qvel.shape}')
+        self._qpos[:] = qpos
+        self._qvel[:] = qvel
+        block = self._block
+        if block.next == BLOCK_TICKS:
+            block = self._block = OutputBlock(self._size, self._count)
+        tick = block.next
+        block.next = tick + 1
+        self._kernel.out = block.base + 8 * self._size * tick
+        total = self._library.atlas_estimate(self._pointer)
+        counts = block.counts[tick]
         if total > CONTACT_CAPACITY:
             rows = np.empty((total, ROW))
-            self._library.atlas_estimator_contacts(self._pointer, out[counts_at:].ctypes.data,
+            self._library.atlas_estimator_contacts(self._pointer, counts.ctypes.data,
                                                    rows.ctypes.data, total)
         else:
-            rows = out[counts_at + 2:counts_at + 2 + ROW * total].reshape(total, ROW)
-        left = int(out[counts_at])
-        fields = {name: out[where].reshape(shape) for name, where, shape in self._fields}
-        return RawEstimate(fields, out[self._bias_at:self._jac_at],
-                           out[self._jac_at:counts_at].reshape(2, 6, count),
-                           (rows[:left], rows[left:]))
+            rows = block.rows[tick, :total]
+        left = int(counts[0])
+        return RawEstimate({name: views[tick] for name, views in block.fields},
+                           block.bias[tick], block.jacobians[tick], (rows[:left], rows[left:]))
