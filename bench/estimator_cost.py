@@ -20,7 +20,8 @@ import time
 
 import mujoco
 import numpy as np
-from offline import stand_run, walk_run
+from node_loop import RESTORE_EVERY_STEPS, STANDING_AFTER_S
+from offline import make_simulator, stand_run, walk_run
 
 from tutorial_atlas_control.balance import BalanceEstimator, place_in_stand_pose
 from tutorial_atlas_control.sim import model as atlas_model
@@ -28,19 +29,30 @@ from tutorial_atlas_control.sim import model as atlas_model
 KINDS = ('python', 'compiled')
 
 
-def bare_step_us(atlas: atlas_model.AtlasModel, batches: int = 20, steps: int = 50) -> float:
-    """Process µs of one mj_step of the robot placed standing (unactuated: each batch of
-    `steps` starts again from the placed pose, before it sags)."""
-    placed, data = mujoco.MjData(atlas.model), mujoco.MjData(atlas.model)
-    place_in_stand_pose(atlas, placed)
-    spent = 0.0
-    for _ in range(batches):
-        mujoco.mj_copyData(data, atlas.model, placed)
-        start = time.process_time()
-        for _ in range(steps):
-            mujoco.mj_step(atlas.model, data)
-        spent += time.process_time() - start
-    return spent / (batches * steps) * 1e6
+class BareStep:
+    """A bare mj_step as bench/node_loop.py's bare_physics_run times it: from the state
+    standing at STANDING_AFTER_S under the law, the last torques held, that snapshot
+    restored every RESTORE_EVERY_STEPS steps (process time here)."""
+
+    def __init__(self) -> None:
+        sim = make_simulator()
+        while sim.sim_time_ns < STANDING_AFTER_S * 1e9:
+            sim.step()
+        self.model, self.data = sim.model, sim.data
+        self.spec = mujoco.mjtState.mjSTATE_INTEGRATION
+        self.snapshot = np.empty(mujoco.mj_stateSize(self.model, self.spec))
+        mujoco.mj_getState(self.model, self.data, self.snapshot, self.spec)
+
+    def us(self, blocks: int = 5) -> float:
+        """Process µs of one mj_step, over `blocks` restored blocks."""
+        spent = 0.0
+        for _ in range(blocks):
+            mujoco.mj_setState(self.model, self.data, self.snapshot, self.spec)
+            start = time.process_time()
+            for _ in range(RESTORE_EVERY_STEPS):
+                mujoco.mj_step(self.model, self.data)
+            spent += time.process_time() - start
+        return spent / (blocks * RESTORE_EVERY_STEPS) * 1e6
 
 
 def estimate_us(estimator: BalanceEstimator, states: list[tuple[np.ndarray, np.ndarray]],
@@ -88,17 +100,17 @@ def compare_estimates(rounds: int) -> None:
                   'compiled': BalanceEstimator(atlas, compiled=True)}
     assert estimators['compiled'].compiled, 'the compiled library is not built'
     figures: dict[str, list[float]] = {kind: [] for kind in KINDS}
-    steps = []
+    steps, bare = [], BareStep()
     for round_index in range(rounds):
         order = KINDS if round_index % 2 == 0 else KINDS[::-1]
-        steps.append(bare_step_us(atlas))
+        steps.append(bare.us())
         for kind in order:
             figures[kind].append(estimate_us(estimators[kind], states))
     _summary('estimate', figures, steps)
 
 
 def compare_runs(pairs: int) -> None:
-    atlas = atlas_model.load_model()
+    bare = BareStep()
     stand: dict[str, list[float]] = {kind: [] for kind in KINDS}
     walk: dict[str, list[float]] = {kind: [] for kind in KINDS}
     steps = []
@@ -106,7 +118,7 @@ def compare_runs(pairs: int) -> None:
         order = KINDS if pair % 2 == 0 else KINDS[::-1]
         for kind in order:
             os.environ['TAC_ESTIMATOR'] = kind
-            steps.append(bare_step_us(atlas))
+            steps.append(bare.us())
             stand[kind].append(stand_run(steps=3000))
             walk[kind].append(walk_run()[0])
     os.environ.pop('TAC_ESTIMATOR')

@@ -5,10 +5,12 @@ touchdowns, a swing foot in the air, and the robot lifted clear of the ground.""
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+from tutorial_atlas_control import native
 from tutorial_atlas_control.balance import compiled_estimator
 from tutorial_atlas_control.balance.estimator import BalanceEstimator, BalanceState
 from tutorial_atlas_control.sim import model as atlas_model
@@ -122,3 +124,14 @@ def test_one_mujoco_in_the_process(library, atlas: atlas_model.AtlasModel) -> No
     with open('/proc/self/maps', encoding='utf-8') as maps:
         loaded = {line.split()[-1] for line in maps if 'libmujoco.so' in line}
     assert len(loaded) == 1, loaded
+
+
+def test_without_the_library_the_python_estimate_runs_after_one_warning(
+        atlas: atlas_model.AtlasModel, monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    monkeypatch.setattr(native, '_library', None)
+    monkeypatch.setattr(native, '_warned', False)
+    monkeypatch.setenv(native.LIBRARY_ENV, str(tmp_path / 'missing.so'))
+    with pytest.warns(RuntimeWarning, match='and the Python balance estimator$') as caught:
+        estimators = [BalanceEstimator(atlas) for _ in range(2)]
+    assert len(caught) == 1
+    assert not any(estimator.compiled for estimator in estimators)
