@@ -5,9 +5,11 @@ in one process, each figure (process time) beside a bare mj_step timed in the sa
 
     python3 bench/estimator_cost.py [--rounds 9] [--pairs 3] [--skip-runs]
 
-The estimator is chosen at its construction by TAC_ESTIMATOR (`python`, else compiled);
-each round alternates which goes first. Prints the medians, their ratios to mj_step, and
-the load (`uptime`) before and after.
+The estimator is chosen at its construction by TAC_ESTIMATOR, inverse statics by
+TAC_STATICS (`python`, else compiled); the runs compare both in Python, the estimator
+compiled, and both compiled; each round alternates which goes first. Prints the medians,
+their ratios to mj_step and to Python's in each pair, and the load (`uptime`) before and
+after.
 """
 
 from __future__ import annotations
@@ -27,6 +29,10 @@ from tutorial_atlas_control.balance import BalanceEstimator, place_in_stand_pose
 from tutorial_atlas_control.sim import model as atlas_model
 
 KINDS = ('python', 'compiled')
+#: The runs' kinds: the environment each sets (the estimator and inverse statics in Python,
+#: the estimator compiled, both compiled).
+RUN_KINDS = {'python': {'TAC_ESTIMATOR': 'python', 'TAC_STATICS': 'python'},
+             'estimator': {'TAC_STATICS': 'python'}, 'compiled': {}}
 
 
 class BareStep:
@@ -83,13 +89,16 @@ def placed_states(atlas: atlas_model.AtlasModel) -> list[tuple[np.ndarray, np.nd
 def _summary(name: str, figures: dict[str, list[float]], steps: list[float]) -> None:
     step = statistics.median(steps)
     parts = []
-    for kind in KINDS:
-        median = statistics.median(figures[kind])
+    for kind, values in figures.items():
+        median = statistics.median(values)
         parts.append(f'{kind} {median:.1f} µs = {median / step:.2f} mj_step '
-                     f'({min(figures[kind]):.1f}–{max(figures[kind]):.1f})')
-    ratios = [c / p for p, c in zip(figures['python'], figures['compiled'], strict=True)]
-    print(f'{name}: {"; ".join(parts)}; compiled/python per pair median '
-          f'{statistics.median(ratios):.3f} ({min(ratios):.3f}–{max(ratios):.3f}); '
+                     f'({min(values):.1f}–{max(values):.1f})')
+    ratios = []
+    for kind in list(figures)[1:]:
+        pairs = [c / p for p, c in zip(figures['python'], figures[kind], strict=True)]
+        ratios.append(f'{kind}/python per pair median {statistics.median(pairs):.3f} '
+                      f'({min(pairs):.3f}–{max(pairs):.3f})')
+    print(f'{name}: {"; ".join(parts)}; {"; ".join(ratios)}; '
           f'bare mj_step {step:.1f} µs ({min(steps):.1f}–{max(steps):.1f})', flush=True)
 
 
@@ -111,17 +120,18 @@ def compare_estimates(rounds: int) -> None:
 
 def compare_runs(pairs: int) -> None:
     bare = BareStep()
-    stand: dict[str, list[float]] = {kind: [] for kind in KINDS}
-    walk: dict[str, list[float]] = {kind: [] for kind in KINDS}
+    stand: dict[str, list[float]] = {kind: [] for kind in RUN_KINDS}
+    walk: dict[str, list[float]] = {kind: [] for kind in RUN_KINDS}
     steps = []
+    kinds = list(RUN_KINDS)
     for pair in range(pairs):
-        order = KINDS if pair % 2 == 0 else KINDS[::-1]
-        for kind in order:
-            os.environ['TAC_ESTIMATOR'] = kind
+        for kind in kinds if pair % 2 == 0 else kinds[::-1]:
+            for name in ('TAC_ESTIMATOR', 'TAC_STATICS'):
+                os.environ.pop(name, None)
+            os.environ.update(RUN_KINDS[kind])
             steps.append(bare.us())
             stand[kind].append(stand_run(steps=3000))
             walk[kind].append(walk_run()[0])
-    os.environ.pop('TAC_ESTIMATOR')
     _summary('Stand µs/tick (stand_run)', stand, steps)
     _summary('Walk µs/tick (walk_run, 6 steps, CPU)', walk, steps)
 

@@ -1,11 +1,12 @@
 """The package's compiled library (src/atlas_law.c, src/atlas_gather.c,
-src/atlas_estimator.c): found, loaded, checked.
+src/atlas_estimator.c, src/atlas_statics.c): found, loaded, checked.
 
 One place knows the library's binary interface: the ctypes mirrors of its structs, the
 signatures of its functions, and where catkin puts it (a devel space's lib/ and an
 install space's lib/ are both on CMAKE_PREFIX_PATH once their setup.bash is sourced).
 Its users, the compiled law (sim/law_kernel.py), the messages' copies
-(sim/copy_plan.py) and the balance estimator (balance/compiled_estimator.py), ask here.
+(sim/copy_plan.py), the balance estimator (balance/compiled_estimator.py) and the
+whole-body layer's inverse statics (balance/compiled_statics.py), ask here.
 The estimator's part calls MuJoCo: the library is linked against the Python wheel's
 libmujoco, the one `import mujoco` loads, so that one MuJoCo runs in the process.
 
@@ -28,7 +29,8 @@ import numpy as np
 from tutorial_atlas_control.command import LAW_FIELDS
 
 __all__ = ['LIBRARY_ENV', 'LIBRARY_NAME', 'MIRRORED_STRUCTS', 'AtlasCopy', 'AtlasEstimator',
-           'AtlasLawStep', 'address', 'find_library', 'load_library', 'size_mismatches']
+           'AtlasLawStep', 'AtlasStatics', 'address', 'find_library', 'load_library',
+           'size_mismatches']
 
 #: The shared library CMakeLists.txt builds (devel/lib, installed to the prefix's lib/).
 LIBRARY_NAME = 'libtutorial_atlas_control_law.so'
@@ -36,7 +38,7 @@ LIBRARY_NAME = 'libtutorial_atlas_control_law.so'
 LIBRARY_ENV = 'TAC_LAW_LIBRARY'
 #: What the callers do without the library (the end of the one warning).
 FALLBACK = ('using the numpy controller law (same torques, slower) and the Python balance '
-            'estimator')
+            'estimator and statics')
 #: How the library names the function that returns sizeof(Struct).
 SIZEOF_PREFIX = 'tac_sizeof_'
 
@@ -77,12 +79,21 @@ class AtlasEstimator(ctypes.Structure):
                 ('free_dof', ctypes.c_long), ('contact_capacity', ctypes.c_long)]
 
 
+class AtlasStatics(ctypes.Structure):
+    """AtlasStatics in src/atlas_statics.c (same fields, same order)."""
+
+    _fields_ = [('in_', ctypes.c_void_p), ('feet', ctypes.c_void_p),
+                ('wrenches', ctypes.c_void_p), ('torque', ctypes.c_void_p),
+                ('min_load_share', ctypes.c_double), ('n', ctypes.c_long)]
+
+
 #: Every struct Python lays out for the library, by its C name: the library must export
 #: SIZEOF_PREFIX + name, returning the same size as the mirror's.
 MIRRORED_STRUCTS: dict[str, type[ctypes.Structure]] = {
     'AtlasLawStep': AtlasLawStep,
     'AtlasCopy': AtlasCopy,
     'AtlasEstimator': AtlasEstimator,
+    'AtlasStatics': AtlasStatics,
 }
 
 
@@ -149,6 +160,8 @@ def _declare(library: ctypes.CDLL) -> None:
     library.atlas_estimator_contacts.argtypes = [estimator, ctypes.c_void_p, ctypes.c_void_p,
                                                  ctypes.c_long]
     library.atlas_estimator_contacts.restype = ctypes.c_long
+    library.atlas_inverse_statics.argtypes = [ctypes.POINTER(AtlasStatics)]
+    library.atlas_inverse_statics.restype = None
 
 
 _library: ctypes.CDLL | None = None

@@ -8,7 +8,8 @@ Stand pose placed on the ground; stance_posture: that pose's legs solved for the
 the feet are in; manipulate: Manipulate's pelvis servo (targets clamped, the posture that
 reaches them); estimator: the balance state from the model; compiled_estimator: its
 per-tick work as one C call; whole_body: tasks and constraints over one state, solved into
-torques (inverse statics, or contact_qp: the contact wrenches by a QP); stand: the Stand
+torques (inverse statics, compiled_statics its C call, or contact_qp: the contact wrenches
+by a QP); stand: the Stand
 controller (its tasks: capture-point feedback, height, pelvis frame, posture);
 stand_behaviour: that controller as the simulator's Stand behaviour, with the servo;
 stand_prep: StandPrep, the harnessed robot brought to the Stand pose; push_trial: offline
@@ -21,6 +22,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'blend': ['smoothstep', 'smoothstep_rate'],
     'errors': ['BalanceError'],
     'compiled_estimator': ['CompiledEstimate', 'EstimatorGeometry', 'RawEstimate'],
+    'compiled_statics': ['CompiledStatics'],
     'estimator': ['CONTACT_HEIGHT_M', 'ESTIMATOR_ENV', 'MIN_COM_HEIGHT_M', 'BalanceEstimator',
                   'BalanceState'],
     'manipulate': ['PelvisServo'],
@@ -31,9 +33,9 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'stand_behaviour': ['StandBehaviour'],
     'sole': ['SOLE_GEOMS', 'SoleBox', 'box_corners', 'sole_corners'],
     'stand_pose': ['STAND_POSE_RAD', 'place_in_stand_pose'],
-    'whole_body': ['INVERSE_STATICS', 'QP', 'SOLVERS', 'CapturePointTask', 'CentroidalTask',
-                   'ComHeightTask', 'ContactConstraint', 'JointTask', 'PelvisOrientationTask',
-                   'PostureTask', 'WholeBodyLayer', 'WholeBodyOutput'],
+    'whole_body': ['INVERSE_STATICS', 'QP', 'SOLVERS', 'STATICS_ENV', 'CapturePointTask',
+                   'CentroidalTask', 'ComHeightTask', 'ContactConstraint', 'JointTask',
+                   'PelvisOrientationTask', 'PostureTask', 'WholeBodyLayer', 'WholeBodyOutput'],
     'slope_trial': ['place_on_slope', 'slope_model', 'slope_stand_trial'],
     'stand_prep': ['StandPrepBehaviour'],
     'support': ['clamp_into', 'convex_hull', 'signed_distance'],
