@@ -13,6 +13,8 @@ if [ "$#" -ne 2 ]; then
 fi
 repo_dir=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd -P)
 workspace=$1 prefix=$2
+# shellcheck source=tools/paths.sh
+source "$repo_dir/tools/paths.sh"
 mkdir -p "$workspace/src"
 ln -sfn "$repo_dir" "$workspace/src/tutorial_atlas_control"
 ln -sfn "$repo_dir/msg/osrf_msgs" "$workspace/src/osrf_msgs"
@@ -24,7 +26,8 @@ log="$workspace/catkin_make.log"
 if ! (cd "$workspace" && env -i HOME="${HOME:-/tmp}" PATH=/usr/local/bin:/usr/bin:/bin \
         LANG="${LANG:-C.UTF-8}" \
         catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 \
-        -DCATKIN_ENABLE_TESTING=OFF "-DCMAKE_INSTALL_PREFIX=$prefix" install) > "$log" 2>&1; then
+        "-DTAC_MUJOCO_PYTHON=$TAC_VENV/bin/python" -DCATKIN_ENABLE_TESTING=OFF \
+        "-DCMAKE_INSTALL_PREFIX=$prefix" install) > "$log" 2>&1; then
   tail -40 "$log" >&2
   echo "build_install_space.sh: catkin_make install failed; full log: $log" >&2
   exit 1

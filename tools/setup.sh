@@ -81,7 +81,7 @@ build_workspace() {
   ln -sfn "$repo_dir/msg/osrf_msgs" "$TAC_WS/src/osrf_msgs"
   ln -sfn "$repo_dir/msg/atlas_msgs" "$TAC_WS/src/atlas_msgs"
   local stamp="$TAC_WS/.build-inputs.sha1" want
-  want=$( (cd "$repo_dir" && cat CMakeLists.txt package.xml setup.py msg/*/CMakeLists.txt \
+  want=$( (cd "$repo_dir" && cat CMakeLists.txt package.xml setup.py requirements.txt msg/*/CMakeLists.txt \
             msg/*/package.xml msg/*/msg/*.msg src/*.c src/*.cpp test/rostest/*.cpp; ls scripts sim rviz test/rostest 2>/dev/null) | sha1sum | cut -d' ' -f1)
   if [ -f "$TAC_WS/devel/setup.bash" ] && [ "$(cat "$stamp" 2>/dev/null)" = "$want" ]; then
     log "catkin workspace up to date ($TAC_WS)"; return
@@ -91,7 +91,9 @@ build_workspace() {
     # catkin must use Debian's Python (where ROS lives), not whatever python3 is first on PATH.
     unset PYTHONPATH CMAKE_PREFIX_PATH ROS_PACKAGE_PATH
     cd "$TAC_WS"
-    catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 -DCATKIN_ENABLE_TESTING=ON > "$TAC_WS/build.log" 2>&1 \
+    # The compiled library links the virtualenv's mujoco wheel (CMakeLists.txt).
+    catkin_make -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 \
+      "-DTAC_MUJOCO_PYTHON=$TAC_VENV/bin/python" -DCATKIN_ENABLE_TESTING=ON > "$TAC_WS/build.log" 2>&1 \
       || { tail -40 "$TAC_WS/build.log" >&2; echo "setup: catkin_make failed; full log: $TAC_WS/build.log" >&2; exit 1; }
   )
   echo "$want" > "$stamp"

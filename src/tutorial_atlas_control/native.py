@@ -1,10 +1,14 @@
-"""The package's compiled library (src/atlas_law.c, src/atlas_gather.c): found, loaded, checked.
+"""The package's compiled library (src/atlas_law.c, src/atlas_gather.c,
+src/atlas_estimator.c, src/atlas_statics.c): found, loaded, checked.
 
 One place knows the library's binary interface: the ctypes mirrors of its structs, the
 signatures of its functions, and where catkin puts it (a devel space's lib/ and an
 install space's lib/ are both on CMAKE_PREFIX_PATH once their setup.bash is sourced).
-Its users, the compiled law (sim/law_kernel.py) and the messages' copies
-(sim/copy_plan.py), ask here.
+Its users, the compiled law (sim/law_kernel.py), the messages' copies
+(sim/copy_plan.py), the balance estimator (balance/compiled_estimator.py) and the
+whole-body layer's inverse statics (balance/compiled_statics.py), ask here.
+The estimator's part calls MuJoCo: the library is linked against the Python wheel's
+libmujoco, the one `import mujoco` loads, so that one MuJoCo runs in the process.
 
 A mirror that disagrees with the C struct would let C read or write past the fields
 Python laid out, so the library exports `size_t tac_sizeof_<Struct>(void)` for each
@@ -24,15 +28,17 @@ import numpy as np
 
 from tutorial_atlas_control.command import LAW_FIELDS
 
-__all__ = ['LIBRARY_ENV', 'LIBRARY_NAME', 'MIRRORED_STRUCTS', 'AtlasCopy', 'AtlasLawStep',
-           'address', 'find_library', 'load_library', 'size_mismatches']
+__all__ = ['LIBRARY_ENV', 'LIBRARY_NAME', 'MIRRORED_STRUCTS', 'AtlasCopy', 'AtlasEstimator',
+           'AtlasLawStep', 'AtlasStatics', 'address', 'find_library', 'load_library',
+           'size_mismatches']
 
 #: The shared library CMakeLists.txt builds (devel/lib, installed to the prefix's lib/).
 LIBRARY_NAME = 'libtutorial_atlas_control_law.so'
 #: Set to a library path to use that one (or to a missing path to force numpy).
 LIBRARY_ENV = 'TAC_LAW_LIBRARY'
 #: What the callers do without the library (the end of the one warning).
-FALLBACK = 'using the numpy controller law (same torques, slower)'
+FALLBACK = ('using the numpy controller law (same torques, slower) and the Python balance '
+            'estimator and statics')
 #: How the library names the function that returns sizeof(Struct).
 SIZEOF_PREFIX = 'tac_sizeof_'
 
@@ -60,11 +66,34 @@ class AtlasCopy(ctypes.Structure):
                 ('count', ctypes.c_long)]
 
 
+class AtlasEstimator(ctypes.Structure):
+    """AtlasEstimator in src/atlas_estimator.c (same fields, same order)."""
+
+    _fields_ = [('model', ctypes.c_void_p), ('data', ctypes.c_void_p),
+                ('qpos', ctypes.c_void_p), ('qvel', ctypes.c_void_p), ('out', ctypes.c_void_p),
+                ('dof_adr', ctypes.c_void_p), ('jac', ctypes.c_void_p),
+                ('bias', ctypes.c_void_p), ('half_thickness', ctypes.c_double * 2),
+                ('gravity_m_s2', ctypes.c_double), ('min_com_height_m', ctypes.c_double),
+                ('n', ctypes.c_long), ('soles', ctypes.c_long * 2),
+                ('sole_bodies', ctypes.c_long * 2), ('pelvis', ctypes.c_long),
+                ('free_dof', ctypes.c_long), ('contact_capacity', ctypes.c_long)]
+
+
+class AtlasStatics(ctypes.Structure):
+    """AtlasStatics in src/atlas_statics.c (same fields, same order)."""
+
+    _fields_ = [('in_', ctypes.c_void_p), ('feet', ctypes.c_void_p),
+                ('wrenches', ctypes.c_void_p), ('torque', ctypes.c_void_p),
+                ('min_load_share', ctypes.c_double), ('n', ctypes.c_long)]
+
+
 #: Every struct Python lays out for the library, by its C name: the library must export
 #: SIZEOF_PREFIX + name, returning the same size as the mirror's.
 MIRRORED_STRUCTS: dict[str, type[ctypes.Structure]] = {
     'AtlasLawStep': AtlasLawStep,
     'AtlasCopy': AtlasCopy,
+    'AtlasEstimator': AtlasEstimator,
+    'AtlasStatics': AtlasStatics,
 }
 
 
@@ -125,6 +154,14 @@ def _declare(library: ctypes.CDLL) -> None:
     library.atlas_state_is_finite.restype = ctypes.c_int
     library.atlas_copy_all.argtypes = [ctypes.POINTER(AtlasCopy), ctypes.c_long]
     library.atlas_copy_all.restype = None
+    estimator = ctypes.POINTER(AtlasEstimator)
+    library.atlas_estimate.argtypes = [estimator]
+    library.atlas_estimate.restype = ctypes.c_long
+    library.atlas_estimator_contacts.argtypes = [estimator, ctypes.c_void_p, ctypes.c_void_p,
+                                                 ctypes.c_long]
+    library.atlas_estimator_contacts.restype = ctypes.c_long
+    library.atlas_inverse_statics.argtypes = [ctypes.POINTER(AtlasStatics)]
+    library.atlas_inverse_statics.restype = None
 
 
 _library: ctypes.CDLL | None = None

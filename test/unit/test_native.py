@@ -18,7 +18,8 @@ from tutorial_atlas_control.sim.copy_plan import CopyPlan
 from tutorial_atlas_control.sim.simulator import AtlasSimulator
 
 REPO = Path(__file__).resolve().parents[2]
-C_SOURCES = (REPO / 'src' / 'atlas_law.c', REPO / 'src' / 'atlas_gather.c')
+C_SOURCES = (REPO / 'src' / 'atlas_law.c', REPO / 'src' / 'atlas_gather.c',
+             REPO / 'src' / 'atlas_estimator.c', REPO / 'src' / 'atlas_statics.c')
 CONFIG = REPO / 'config' / 'atlas_controller.yaml'
 #: A C struct Python may lay out: `typedef struct { ... } Name;`.
 C_TYPEDEF_STRUCT = re.compile(r'typedef struct \{.*?\} (\w+);', re.S)
@@ -34,7 +35,8 @@ def fresh_loader(monkeypatch: pytest.MonkeyPatch) -> None:
 def test_every_struct_of_the_c_sources_is_mirrored() -> None:
     c_structs = {name for source in C_SOURCES
                  for name in C_TYPEDEF_STRUCT.findall(source.read_text())}
-    assert c_structs == set(native.MIRRORED_STRUCTS) == {'AtlasLawStep', 'AtlasCopy'}
+    assert c_structs == set(native.MIRRORED_STRUCTS) == {'AtlasLawStep', 'AtlasCopy',
+                                                         'AtlasEstimator', 'AtlasStatics'}
     for name, mirror in native.MIRRORED_STRUCTS.items():
         assert mirror.__name__ == name
 
@@ -63,7 +65,8 @@ def test_a_library_whose_sizes_differ_is_refused_with_one_warning(
     expected = (rf'^{re.escape(str(path))} does not match this code \(sizeof\(AtlasCopy\) is '
                 rf'{ctypes.sizeof(native.AtlasCopy)} bytes there, {ctypes.sizeof(_LongerCopy)}'
                 r' in tutorial_atlas_control.native\); rebuild it \(`make setup`\); '
-                r'using the numpy controller law \(same torques, slower\)$')
+                r'using the numpy controller law \(same torques, slower\) and the Python '
+                r'balance estimator and statics$')
     with pytest.warns(RuntimeWarning, match=expected) as caught:
         assert native.load_library() is None
         sim = AtlasSimulator(atlas_model.load_model(), load_gains_yaml(CONFIG))
@@ -83,7 +86,9 @@ def test_a_library_without_size_functions_is_refused(
                    check=True)
     monkeypatch.setenv(native.LIBRARY_ENV, str(old))
     with pytest.warns(RuntimeWarning, match=rf'^{re.escape(str(old))} does not match this '
-                                            r'code \(no tac_sizeof_AtlasCopy\(\)\); rebuild'):
+                                            r'code \(no tac_sizeof_AtlasCopy\(\); no '
+                                            r'tac_sizeof_AtlasEstimator\(\); no '
+                                            r'tac_sizeof_AtlasStatics\(\)\); rebuild'):
         assert native.load_library() is None
 
 

@@ -15,19 +15,26 @@ left as it is (MuJoCo 4's `gap` no longer makes such contacts inactive: its cont
 margin + gap all push). In that copy only the soles collide. Measured on the flat world:
 mj_collision 8 us a call, which soles touch about 5 us more; their points and normals are
 read only when asked for.
+
+The per-tick work runs as one C call (compiled_estimator, src/atlas_estimator.c) when the
+package's library is built, the Python below otherwise (after one warning) or when
+ESTIMATOR_ENV says `python`: the reference the compiled one is tested against.
 """
 
 from __future__ import annotations
 
 import copy
 import functools
+import os
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import mujoco
 import numpy as np
 
+from tutorial_atlas_control import native
 from tutorial_atlas_control.balance import lipm, support
+from tutorial_atlas_control.balance.compiled_estimator import CompiledEstimate, EstimatorGeometry
 from tutorial_atlas_control.balance.sole import BOTTOM_CORNER_SIGNS, SoleBox, sole_geom_ids
 from tutorial_atlas_control.sim import AtlasModel
 
@@ -38,6 +45,8 @@ CONTACT_HEIGHT_M = 0.01
 POLYGON_TOLERANCE_M = 5e-4
 #: The pendulum's height is taken as at least this (m), so omega stays finite in a fall.
 MIN_COM_HEIGHT_M = 0.05
+#: Set to `python` to estimate in Python even where the compiled library is built.
+ESTIMATOR_ENV = 'TAC_ESTIMATOR'
 
 
 @dataclass(frozen=True)
@@ -73,6 +82,14 @@ def _sole_contacts_of(sole: int, pairs: list[list[int]], distances: np.ndarray,
     surfaces = np.array([pairs[row][0] if pairs[row][1] == sole else pairs[row][1]
                          for row in rows])
     return SoleContacts(points[rows], signs * normals[rows], distances[rows], surfaces)
+
+
+def _contacts_of_rows(rows: np.ndarray) -> SoleContacts:
+    """One sole's contacts from the compiled estimate's rows (point, normal into the sole,
+    distance, surface geom)."""
+    if len(rows) == 0:
+        return _no_contacts()
+    return SoleContacts(rows[:, 0:3], rows[:, 3:6], rows[:, 6], rows[:, 7].astype(np.int64))
 
 
 @dataclass(frozen=True)
@@ -115,9 +132,13 @@ class BalanceState:
 
 
 class BalanceEstimator:
-    """Turns (qpos, qvel) into a BalanceState with a scratch MjData of its own."""
+    """Turns (qpos, qvel) into a BalanceState with a scratch MjData of its own.
 
-    def __init__(self, atlas: AtlasModel) -> None:
+    `compiled`: one C call a tick when the library is built (None: unless ESTIMATOR_ENV
+    says `python`); False: the Python reference.
+    """
+
+    def __init__(self, atlas: AtlasModel, compiled: bool | None = None) -> None:
         self.atlas = atlas
         # A copy, so that the soles' wider margin finds near contacts without pushing.
         self.model = copy.deepcopy(atlas.model)
@@ -157,6 +178,20 @@ class BalanceEstimator:
         #: Each joint slice's dof indices: a slice where they run on (a leg's do), else
         #: an index array.
         self._inertia_index: dict[tuple[int, int], tuple[slice, slice] | tuple] = {}
+        if compiled is None:
+            compiled = os.environ.get(ESTIMATOR_ENV, '').strip().lower() != 'python'
+        library = native.load_library() if compiled else None
+        self._kernel = None if library is None else CompiledEstimate(
+            library, self.model, self.scratch, EstimatorGeometry(
+                (self._soles[0], self._soles[1]), (self._sole_bodies[0], self._sole_bodies[1]),
+                (float(self._half_thickness[0, 0]), float(self._half_thickness[1, 0])),
+                self._pelvis, self._free_dof, np.asarray(self._dof_adr, dtype=np.intp),
+                lipm.GRAVITY_M_S2, MIN_COM_HEIGHT_M))
+
+    @property
+    def compiled(self) -> bool:
+        """Whether estimate runs the C call."""
+        return self._kernel is not None
 
     @property
     def sole_ahead_m(self) -> float:
@@ -227,6 +262,27 @@ class BalanceEstimator:
 
     def estimate(self, qpos: np.ndarray, qvel: np.ndarray) -> BalanceState:
         """The state at (qpos, qvel) (the full MuJoCo vectors)."""
+        if self._kernel is None:
+            return self._estimate_in_python(qpos, qvel)
+        raw = self._kernel.run(qpos, qvel)
+        self._inertia_current = False
+        f = raw.fields
+        contact = (bool(f['in_contact'][0]), bool(f['in_contact'][1]))
+        positions, rotations = f['sole_positions'], f['sole_rotations']
+        left, right = raw.contact_rows
+        return BalanceState(
+            com=f['com'], com_velocity=f['com_velocity'],
+            pelvis_position=f['pelvis_position'], pelvis_rotation=f['pelvis_rotation'],
+            pelvis_angular_velocity=f['pelvis_angular_velocity'],
+            sole_centres=f['sole_centres'], sole_rotations=rotations, in_contact=contact,
+            omega=float(f['omega']), capture_point=f['capture_point'], bias_nm=raw.bias_nm,
+            sole_jacobians=raw.sole_jacobians, sole_velocities=f['sole_velocities'],
+            joint_inertia=self._joint_inertia,
+            polygon_of=lambda: self._support_polygon(positions, rotations, contact),
+            contacts_of=lambda: (_contacts_of_rows(left), _contacts_of_rows(right)))
+
+    def _estimate_in_python(self, qpos: np.ndarray, qvel: np.ndarray) -> BalanceState:
+        """estimate's reference: the same passes and arithmetic through the bindings."""
         m, d = self.model, self.scratch
         d.qpos[:] = qpos
         d.qvel[:] = qvel

@@ -19,20 +19,25 @@ as nearly as each sole's friction pyramid and pressure centre about the ground's
 (MuJoCo's contacts) and the joints' torque limits allow, near the same split: where the
 split is feasible, the same wrenches; where not, the other sole carries what one cannot,
 for a solve each tick (the figures on a slope: docs/controllers.md, "Solver"). Inverse
-statics computes in plain floats in numpy's order of operations: Stand's torques are the
-same bits as before the layer. The tasks are made anew each tick: plain slotted classes,
+statics runs as one C call (compiled_statics) where the package's library is built, equal to
+the Python here to rounding; in Python (STATICS_ENV=python, or no library) it computes in
+plain floats in numpy's order of operations, Stand's torques the same bits as before the
+layer. The tasks are made anew each tick: plain slotted classes,
 cheap to make.
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
 
+from tutorial_atlas_control import native
 from tutorial_atlas_control.balance import contact_wrench, lipm
+from tutorial_atlas_control.balance.compiled_statics import CompiledStatics
 from tutorial_atlas_control.balance.errors import BalanceError
 from tutorial_atlas_control.balance.estimator import BalanceState
 
@@ -46,6 +51,8 @@ __all__ = ['INVERSE_STATICS', 'QP', 'SOLVERS', 'CapturePointTask', 'CentroidalTa
 INVERSE_STATICS = 'inverse_statics'
 QP = 'qp'
 SOLVERS = (INVERSE_STATICS, QP)
+#: Set to `python` for inverse statics in Python even where the compiled library is built.
+STATICS_ENV = 'TAC_STATICS'
 
 #: A joint task: the robot's state, the joints' positions and velocities -> (28,) torques.
 JointTask = Callable[[BalanceState, np.ndarray, np.ndarray], np.ndarray]
@@ -175,7 +182,9 @@ class WholeBodyLayer:
     `solver` (one of SOLVERS)."""
 
     def __init__(self, mass_kg: float, effort_limit_nm: np.ndarray,
-                 solver: str = INVERSE_STATICS) -> None:
+                 solver: str = INVERSE_STATICS, compiled: bool | None = None) -> None:
+        """`compiled`: inverse statics by one C call when the library is built (None: unless
+        STATICS_ENV says `python`); False: in Python."""
         if solver not in SOLVERS:
             raise BalanceError(f'whole-body solver {solver!r} is not one of {SOLVERS}')
         self.mass_kg = mass_kg
@@ -183,6 +192,16 @@ class WholeBodyLayer:
         self.solver = solver
         #: How many ticks the QP found no feasible wrench (inverse statics' was used).
         self.qp_fallbacks = 0
+        if compiled is None:
+            compiled = os.environ.get(STATICS_ENV, '').strip().lower() != 'python'
+        library = native.load_library() if compiled and solver == INVERSE_STATICS else None
+        self._statics = (None if library is None
+                         else CompiledStatics(library, len(self.effort_limit_nm)))
+
+    @property
+    def compiled(self) -> bool:
+        """Whether inverse statics runs the C call."""
+        return self._statics is not None
 
     def centroidal_wrench(self, state: BalanceState,
                           tasks: Sequence[CentroidalTask]) -> tuple[np.ndarray, np.ndarray]:
@@ -201,6 +220,11 @@ class WholeBodyLayer:
         them, each share made feasible), plus the joint tasks; not yet within the effort
         limits (`limit` does that: a behaviour may add a swing leg's torque first)."""
         force, moment = self.centroidal_wrench(state, tasks)
+        if self._statics is not None:
+            wrenches, torque = self._statics.solve(force, moment, state, contacts)
+            for joint_task in joint_tasks:
+                torque += joint_task(state, joint_positions, joint_velocities)
+            return WholeBodyOutput(torque, force, moment, wrenches)
         carrying = (contacts[0].carries, contacts[1].carries)
         wrenches = contact_wrench.split_wrench(force, moment, state.sole_centres, state.com,
                                                carrying)

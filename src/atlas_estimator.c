@@ -1,0 +1,147 @@
+/*
+ * The balance estimator's per-tick work in one call: the compiled twin of
+ * BalanceEstimator.estimate in src/tutorial_atlas_control/balance/estimator.py (whose
+ * docstring says what it computes and why). Python's estimate spends more time in numpy's
+ * indexing and copies than MuJoCo spends in its passes; here the passes and the arithmetic
+ * run in one ctypes call (balance/compiled_estimator.py) that writes one flat array.
+ *
+ * MuJoCo is the one the Python bindings loaded: this library is linked against the wheel's
+ * libmujoco.so.4.0.0 (CMakeLists.txt), whose soname the dynamic linker finds already loaded,
+ * and the model and data are the bindings' own (MjModel._address, MjData._address).
+ * The results agree with Python's to rounding (sums in another order), not bit for bit:
+ * test/unit/balance/test_compiled_estimator.py holds them to 1e-9.
+ */
+#include <math.h>
+#include <stddef.h>
+#include <string.h>
+
+#include <mujoco/mujoco.h>
+
+/* What the estimator keeps between calls; laid out once by balance/compiled_estimator.py,
+ * mirrored in native.py (same fields, same order; tac_sizeof_AtlasEstimator lets the
+ * loader check). */
+typedef struct {
+  const mjModel *model;       /* the estimator's copy of the model (wide sole margins) */
+  mjData *data;               /* its scratch MjData */
+  const double *qpos;         /* (nq,) the state to estimate, copied in by Python */
+  const double *qvel;         /* (nv,) */
+  double *out;                /* this tick's output (the layout below), set each tick */
+  const ptrdiff_t *dof_adr;   /* (n,) qvel index of each joint, tutorial order */
+  double *jac;                /* (2, 6, nv) scratch: [linear; angular] per sole */
+  double *bias;               /* (nv,) scratch: qfrc_bias */
+  double half_thickness[2];   /* the sole boxes' half thickness (m), left, right */
+  double gravity_m_s2;        /* lipm.GRAVITY_M_S2 */
+  double min_com_height_m;    /* estimator.MIN_COM_HEIGHT_M */
+  long n;                     /* joints */
+  long soles[2];              /* the sole geoms, left, right */
+  long sole_bodies[2];        /* their bodies */
+  long pelvis;                /* the pelvis body: the robot's subtree */
+  long free_dof;              /* the floating base's first dof */
+  long contact_capacity;      /* contact rows the output holds */
+} AtlasEstimator;
+
+/* The output, flat doubles (compiled_estimator.py's EstimateLayout says the same). */
+enum {
+  OUT_COM = 0, OUT_COM_VELOCITY = 3, OUT_PELVIS_POSITION = 6, OUT_PELVIS_ROTATION = 9,
+  OUT_PELVIS_ANGULAR_VELOCITY = 18, OUT_SOLE_POSITIONS = 21, OUT_SOLE_CENTRES = 27,
+  OUT_SOLE_ROTATIONS = 33, OUT_IN_CONTACT = 51, OUT_OMEGA = 53, OUT_CAPTURE_POINT = 54,
+  OUT_SOLE_VELOCITIES = 56, OUT_FIXED = 68
+  /* then bias (n), sole jacobians (2, 6, n), contact counts (2), contact rows
+   * (capacity, ROW): point (3), normal into the sole (3), distance, surface geom */
+};
+#define ROW 8
+
+size_t tac_sizeof_AtlasEstimator(void) { return sizeof(AtlasEstimator); }
+
+/* Each sole's rows of the contact list (left's, then right's) into rows[capacity][ROW];
+ * counts[foot] = that sole's rows. Returns the total, written only while within capacity.
+ * MuJoCo's normal points from geom[0] to geom[1]: into the sole when the sole is geom[1]. */
+long atlas_estimator_contacts(const AtlasEstimator *e, double *counts, double *rows,
+                              long capacity) {
+  const mjData *d = e->data;
+  long total = 0;
+  for (int foot = 0; foot < 2; ++foot) {
+    long sole = e->soles[foot], count = 0;
+    for (int c = 0; c < d->ncon; ++c) {
+      const mjContact *con = &d->contact[c];
+      if (con->geom[0] != sole && con->geom[1] != sole) continue;
+      if (total < capacity) {
+        double *row = rows + ROW * total;
+        double sign = con->geom[1] == sole ? 1.0 : -1.0;
+        memcpy(row, con->pos, 3 * sizeof(double));
+        for (int i = 0; i < 3; ++i) row[3 + i] = sign * con->frame[i];
+        row[6] = con->dist;
+        row[7] = (double)(con->geom[1] == sole ? con->geom[0] : con->geom[1]);
+      }
+      ++count;
+      ++total;
+    }
+    counts[foot] = (double)count;
+  }
+  return total;
+}
+
+/* The sole boxes' poses, their bottom-face centres, jacobians and velocities. */
+static void soles(const AtlasEstimator *e, double *out) {
+  const mjModel *m = e->model;
+  mjData *d = e->data;
+  long nv = m->nv, n = e->n;
+  double *jac_out = out + OUT_FIXED + n;
+  for (int foot = 0; foot < 2; ++foot) {
+    const double *pos = d->geom_xpos + 3 * e->soles[foot];
+    const double *mat = d->geom_xmat + 9 * e->soles[foot];
+    double *centre = out + OUT_SOLE_CENTRES + 3 * foot;
+    memcpy(out + OUT_SOLE_POSITIONS + 3 * foot, pos, 3 * sizeof(double));
+    memcpy(out + OUT_SOLE_ROTATIONS + 9 * foot, mat, 9 * sizeof(double));
+    for (int i = 0; i < 3; ++i) centre[i] = pos[i] - mat[3 * i + 2] * e->half_thickness[foot];
+    double *jac = e->jac + 6 * nv * foot;
+    mj_jac(m, d, jac, jac + 3 * nv, centre, (int)e->sole_bodies[foot]);
+    for (int r = 0; r < 6; ++r) {
+      double sum = 0.0;
+      for (long k = 0; k < nv; ++k) sum += jac[r * nv + k] * d->qvel[k];
+      out[OUT_SOLE_VELOCITIES + 6 * foot + r] = sum;
+      for (long j = 0; j < n; ++j)
+        jac_out[(6 * foot + r) * n + j] = jac[r * nv + e->dof_adr[j]];
+    }
+  }
+}
+
+/* The estimate at (qpos, qvel) (full MuJoCo vectors) into out; returns the sole contacts'
+ * row count (rows beyond contact_capacity are not written: atlas_estimator_contacts then). */
+long atlas_estimate(const AtlasEstimator *e) {
+  const mjModel *m = e->model;
+  mjData *d = e->data;
+  double *out = e->out;
+  long n = e->n;
+  memcpy(d->qpos, e->qpos, m->nq * sizeof(double));
+  memcpy(d->qvel, e->qvel, m->nv * sizeof(double));
+  mj_kinematics(m, d);
+  mj_collision(m, d);
+  mj_comPos(m, d);
+  mj_comVel(m, d);
+  mj_subtreeVel(m, d);
+  mj_rne(m, d, 0, e->bias);
+  soles(e, out);
+  const double *com = d->subtree_com + 3 * e->pelvis;
+  const double *com_velocity = d->subtree_linvel + 3 * e->pelvis;
+  const double *rotation = d->xmat + 9 * e->pelvis;
+  const double *rates = d->qvel + e->free_dof + 3;
+  memcpy(out + OUT_COM, com, 3 * sizeof(double));
+  memcpy(out + OUT_COM_VELOCITY, com_velocity, 3 * sizeof(double));
+  memcpy(out + OUT_PELVIS_POSITION, d->xpos + 3 * e->pelvis, 3 * sizeof(double));
+  memcpy(out + OUT_PELVIS_ROTATION, rotation, 9 * sizeof(double));
+  for (int i = 0; i < 3; ++i)
+    out[OUT_PELVIS_ANGULAR_VELOCITY + i] =
+        rotation[3 * i] * rates[0] + rotation[3 * i + 1] * rates[1] +
+        rotation[3 * i + 2] * rates[2];
+  double height = com[2] > e->min_com_height_m ? com[2] : e->min_com_height_m;
+  double omega = sqrt(e->gravity_m_s2 / height);
+  out[OUT_OMEGA] = omega;
+  for (int i = 0; i < 2; ++i) out[OUT_CAPTURE_POINT + i] = com[i] + com_velocity[i] / omega;
+  for (long j = 0; j < n; ++j) out[OUT_FIXED + j] = e->bias[e->dof_adr[j]];
+  double *counts = out + OUT_FIXED + 13 * n;
+  long total = atlas_estimator_contacts(e, counts, counts + 2, e->contact_capacity);
+  out[OUT_IN_CONTACT] = counts[0] > 0 ? 1.0 : 0.0;
+  out[OUT_IN_CONTACT + 1] = counts[1] > 0 ? 1.0 : 0.0;
+  return total;
+}

@@ -1,0 +1,147 @@
+"""The balance estimator's per-tick work as one C call (src/atlas_estimator.c through ctypes).
+
+estimator.BalanceEstimator.estimate in Python calls six MuJoCo passes and two jacobians, then
+spends as long again in numpy's indexing and copies; the C twin runs the same passes on the
+estimator's own model and scratch MjData (their C pointers) and writes every number of the
+estimate into a flat row of its own per tick, whose slices become the BalanceState's fields
+(a state never shares memory with the next). The library is found and checked by
+tutorial_atlas_control.native; the estimator falls back to Python after one warning without
+it. Both agree to rounding (test/unit/balance/test_compiled_estimator.py: 1e-9).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import math
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from tutorial_atlas_control.balance.errors import BalanceError
+from tutorial_atlas_control.native import AtlasEstimator, address
+
+#: Sole contact rows the flat output holds (a box on a plane makes four a sole); more are
+#: fetched by a second call.
+CONTACT_CAPACITY = 32
+#: A contact row: point (3), normal into the sole (3), signed distance, surface geom.
+ROW = 8
+#: The fixed part of the output (src/atlas_estimator.c's enum): name, offset, shape.
+FIXED_FIELDS: tuple[tuple[str, int, tuple[int, ...]], ...] = (
+    ('com', 0, (3,)), ('com_velocity', 3, (3,)), ('pelvis_position', 6, (3,)),
+    ('pelvis_rotation', 9, (3, 3)), ('pelvis_angular_velocity', 18, (3,)),
+    ('sole_positions', 21, (2, 3)), ('sole_centres', 27, (2, 3)),
+    ('sole_rotations', 33, (2, 3, 3)), ('in_contact', 51, (2,)), ('omega', 53, ()),
+    ('capture_point', 54, (2,)), ('sole_velocities', 56, (2, 6)))
+FIXED_SIZE = 68
+#: Ticks' outputs allocated at once.
+BLOCK_TICKS = 64
+
+
+@dataclass(frozen=True)
+class EstimatorGeometry:
+    """What the C estimate needs to know of the model besides the model itself."""
+
+    soles: tuple[int, int]          # sole geoms, left, right
+    sole_bodies: tuple[int, int]
+    half_thickness_m: tuple[float, float]
+    pelvis: int
+    free_dof: int
+    dof_adr: np.ndarray             # (n,) intp
+    gravity_m_s2: float
+    min_com_height_m: float
+
+
+@dataclass(frozen=True)
+class RawEstimate:
+    """One tick's numbers, views of its own row of an output block: the FIXED_FIELDS by
+    name, the joints' bias (n,) and sole jacobians (2, 6, n), each sole's contact rows
+    (k, ROW)."""
+
+    fields: dict[str, np.ndarray]
+    bias_nm: np.ndarray
+    sole_jacobians: np.ndarray
+    contact_rows: tuple[np.ndarray, np.ndarray]
+
+
+class OutputBlock:
+    """BLOCK_TICKS ticks' outputs in one array, with each field's view across the ticks made
+    once: a tick's fields are then one index each, and no tick shares memory with another
+    (a state kept for later is never overwritten)."""
+
+    def __init__(self, size: int, joints: int) -> None:
+        self.array = np.empty((BLOCK_TICKS, size))
+        self.base = self.array.ctypes.data
+        self.next = 0
+        array = self.array
+        self.fields = [(name, array[:, at:at + math.prod(shape)].reshape((BLOCK_TICKS, *shape)))
+                       for name, at, shape in FIXED_FIELDS]
+        jac_at, counts_at = FIXED_SIZE + joints, FIXED_SIZE + 13 * joints
+        self.bias = array[:, FIXED_SIZE:jac_at]
+        self.jacobians = array[:, jac_at:counts_at].reshape(BLOCK_TICKS, 2, 6, joints)
+        self.counts = array[:, counts_at:counts_at + 2]
+        self.rows = array[:, counts_at + 2:].reshape(BLOCK_TICKS, CONTACT_CAPACITY, ROW)
+
+
+class CompiledEstimate:
+    """atlas_estimate for one model, scratch MjData and geometry, as a single C call.
+
+    Holds the model, data and scratch arrays so that the pointers given to C outlive it;
+    MjData's arrays never move. The state is copied into arrays of its own, whose addresses
+    C keeps; each tick writes the next row of an OutputBlock.
+    """
+
+    def __init__(self, library: ctypes.CDLL, model: mujoco.MjModel, data: mujoco.MjData,
+                 geometry: EstimatorGeometry) -> None:
+        self._library = library
+        count = len(geometry.dof_adr)
+        self._dof_adr = np.ascontiguousarray(geometry.dof_adr, dtype=np.intp)
+        self._jac = np.zeros((2, 6, model.nv))
+        self._bias = np.zeros(model.nv)
+        self._qpos, self._qvel = np.zeros(model.nq), np.zeros(model.nv)
+        self._keep = (model, data)
+        kernel = self._kernel = AtlasEstimator()
+        kernel.model, kernel.data = model._address, data._address
+        kernel.qpos = address(self._qpos, np.float64)
+        kernel.qvel = address(self._qvel, np.float64)
+        kernel.dof_adr = address(self._dof_adr, np.intp)
+        kernel.jac = address(self._jac, np.float64)
+        kernel.bias = address(self._bias, np.float64)
+        kernel.half_thickness[:] = geometry.half_thickness_m
+        kernel.gravity_m_s2 = geometry.gravity_m_s2
+        kernel.min_com_height_m = geometry.min_com_height_m
+        kernel.n = count
+        kernel.soles[:] = geometry.soles
+        kernel.sole_bodies[:] = geometry.sole_bodies
+        kernel.pelvis = geometry.pelvis
+        kernel.free_dof = geometry.free_dof
+        kernel.contact_capacity = CONTACT_CAPACITY
+        self._pointer = ctypes.byref(kernel)
+        self._count = count
+        self._size = FIXED_SIZE + 13 * count + 2 + ROW * CONTACT_CAPACITY
+        self._block = OutputBlock(self._size, count)
+
+    def run(self, qpos: np.ndarray, qvel: np.ndarray) -> RawEstimate:
+        """The estimate at (qpos, qvel), the full MuJoCo vectors."""
+        if np.shape(qpos) != self._qpos.shape or np.shape(qvel) != self._qvel.shape:
+            raise BalanceError(f'qpos, qvel have shapes {np.shape(qpos)}, {np.shape(qvel)}; '
+                               f'expected {self._qpos.shape}, {self._qvel.shape}')
+        self._qpos[:] = qpos
+        self._qvel[:] = qvel
+        block = self._block
+        if block.next == BLOCK_TICKS:
+            block = self._block = OutputBlock(self._size, self._count)
+        tick = block.next
+        block.next = tick + 1
+        self._kernel.out = block.base + 8 * self._size * tick
+        total = self._library.atlas_estimate(self._pointer)
+        counts = block.counts[tick]
+        if total > CONTACT_CAPACITY:
+            rows = np.empty((total, ROW))
+            self._library.atlas_estimator_contacts(self._pointer, counts.ctypes.data,
+                                                   rows.ctypes.data, total)
+        else:
+            rows = block.rows[tick, :total]
+        left = int(counts[0])
+        return RawEstimate({name: views[tick] for name, views in block.fields},
+                           block.bias[tick], block.jacobians[tick], (rows[:left], rows[left:]))
