@@ -71,7 +71,7 @@ def test_a_turn_of_a_two_metre_circle_streamed() -> None:
         assert np.linalg.norm(np.array(after.pelvis_xy) - start) < BACK_WITHIN_M
     assert trial.leg_torque_jump_nm < TORQUE_JUMP_BELOW_NM
     # This run's figures (deterministic).
-    assert round(trial.worst_landing_m, 3) == 0.006
+    assert round(trial.worst_landing_m, 3) == 0.007
 
 
 def _pushed_walk(adjust_steps: bool) -> WalkTrial:
@@ -92,7 +92,7 @@ def _pushed_walk(adjust_steps: bool) -> WalkTrial:
 def test_pushed_while_walking_without_step_adjustment_it_falls() -> None:
     trial = _pushed_walk(adjust_steps=False)
     assert trial.fell
-    assert trial.steps == 7
+    assert trial.steps == 6
 
 
 def test_at_the_stands_height_the_trailing_leg_cannot_lift_and_it_falls() -> None:

@@ -41,7 +41,7 @@ from tutorial_atlas_control.balance import (
     yaw_rotation,
 )
 from tutorial_atlas_control.walking.footsteps import Footstep, wrap_angle
-from tutorial_atlas_control.walking.swing import SwingPath
+from tutorial_atlas_control.walking.swing import SwingPath, quintic
 
 __all__ = ['LEG_JOINTS', 'LegGains', 'LegTasks', 'foot_pose']
 
@@ -82,6 +82,11 @@ class LegGains:
     torsion_m: float | None = 0.015
     #: A foot put back down aims this far below the ground (m), so that it lands.
     press_m: float = 0.005
+    #: A swing foot's path ends this far below its step's surface (m): the servo lags its
+    #: path, and a path ending on the surface left the sole 1.5 cm up, heel first, when the
+    #: next step put the whole weight on it (on the course a landing slammed down and the
+    #: stance foot rolled over).
+    swing_press_m: float = 0.005
     #: A sole is flat on the ground with its centre below flat_height_m (m) and its normal
     #: within acos(flat_cos) of vertical (0.05 rad).
     flat_height_m: float = 0.005
@@ -157,6 +162,7 @@ class LegTasks:
         position, velocity, yaw, yaw_rate = swing.at(elapsed_s)
         acceleration, yaw_acceleration = (swing.acceleration(elapsed_s)
                                           if gains.swing_feedforward else (None, 0.0))
+        position[2] -= gains.swing_press_m * quintic(elapsed_s / swing.duration_s)[0]
         late = elapsed_s - swing.duration_s
         if late > 0.0:  # not down yet: on down
             position[2] -= gains.touchdown_speed_m_s * late

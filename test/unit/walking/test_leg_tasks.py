@@ -25,6 +25,7 @@ from tutorial_atlas_control.walking.leg_tasks import (
     _clamp_to_sole,
     foot_pose,
 )
+from tutorial_atlas_control.walking.swing import SwingPath
 
 LEFT, RIGHT = 0, 1
 
@@ -210,3 +211,29 @@ def test_a_foot_put_down_aims_just_below_its_poses_surface(
         torque = legs.put_down_torque(state, np.zeros(28), RIGHT, target)
         acceleration = np.linalg.solve(state.joint_inertia(leg), torque[leg])
         assert sign * float((jacobian @ acceleration)[2]) > 0.0
+
+
+def test_a_swing_foot_is_asked_just_below_its_steps_surface_by_its_paths_end(
+        standing: tuple[StandBehaviour, mujoco.MjData]) -> None:
+    """At its path's end a swing sole still at rest on its step is asked swing_press_m
+    down (the servo lags; a path ending on the surface left the sole 1.5 cm up when the
+    next step loaded it); without the press, nothing."""
+    behaviour, data = standing
+    gains = LegGains(ik_damping_m=0.0, swing_feedforward=False)
+    assert gains.swing_press_m > 0.0
+    legs = _legs(standing, gains)
+    state = behaviour.estimator.estimate(data.qpos, np.zeros_like(data.qvel))
+    pose = foot_pose(state, RIGHT)
+    sole = state.sole_centres[RIGHT].copy()
+    path = SwingPath(sole, sole.copy(), pose.yaw_rad, pose.yaw_rad, 0.63)
+    leg = LEG_OF_FOOT[RIGHT]
+    jacobian = state.sole_jacobians[RIGHT][:, leg]
+    torque = legs.swing_torque(state, np.zeros(28), RIGHT, path, path.duration_s)
+    acceleration = jacobian @ np.linalg.solve(state.joint_inertia(leg), torque[leg])
+    assert float(acceleration[2]) == pytest.approx(-gains.swing_kp * gains.swing_press_m,
+                                                   rel=1e-6)
+    unpressed = LegGains(ik_damping_m=0.0, swing_feedforward=False, swing_press_m=0.0)
+    torque = _legs(standing, unpressed).swing_torque(state, np.zeros(28), RIGHT, path,
+                                                      path.duration_s)
+    acceleration = jacobian @ np.linalg.solve(state.joint_inertia(leg), torque[leg])
+    assert abs(float(acceleration[2])) < 1e-6
