@@ -29,8 +29,8 @@ import numpy as np
 from tutorial_atlas_control.command import LAW_FIELDS
 
 __all__ = ['LIBRARY_ENV', 'LIBRARY_NAME', 'MIRRORED_STRUCTS', 'AtlasCopy', 'AtlasEstimator',
-           'AtlasLawStep', 'AtlasStatics', 'address', 'find_library', 'load_library',
-           'size_mismatches']
+           'AtlasLawStep', 'AtlasStatics', 'address', 'chosen_library', 'find_library',
+           'load_library', 'size_mismatches']
 
 #: The shared library CMakeLists.txt builds (devel/lib, installed to the prefix's lib/).
 LIBRARY_NAME = 'libtutorial_atlas_control_law.so'
@@ -196,3 +196,12 @@ def load_library() -> ctypes.CDLL | None:
         warnings.warn(f'{problem}; {FALLBACK}', RuntimeWarning, stacklevel=2)
         _warned = True
     return None
+
+
+def chosen_library(switch_env: str, compiled: bool | None) -> ctypes.CDLL | None:
+    """The library for a part with a compiled and a Python path: None when `compiled` is
+    False, or (`compiled` None) when the environment variable `switch_env` says `python`;
+    else load_library()'s answer."""
+    if compiled is None:
+        compiled = os.environ.get(switch_env, '').strip().lower() != 'python'
+    return load_library() if compiled else None

@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import copy
 import functools
-import os
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -178,9 +177,7 @@ class BalanceEstimator:
         #: Each joint slice's dof indices: a slice where they run on (a leg's do), else
         #: an index array.
         self._inertia_index: dict[tuple[int, int], tuple[slice, slice] | tuple] = {}
-        if compiled is None:
-            compiled = os.environ.get(ESTIMATOR_ENV, '').strip().lower() != 'python'
-        library = native.load_library() if compiled else None
+        library = native.chosen_library(ESTIMATOR_ENV, compiled)
         self._kernel = None if library is None else CompiledEstimate(
             library, self.model, self.scratch, EstimatorGeometry(
                 (self._soles[0], self._soles[1]), (self._sole_bodies[0], self._sole_bodies[1]),

@@ -28,7 +28,6 @@ cheap to make.
 
 from __future__ import annotations
 
-import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
@@ -192,9 +191,8 @@ class WholeBodyLayer:
         self.solver = solver
         #: How many ticks the QP found no feasible wrench (inverse statics' was used).
         self.qp_fallbacks = 0
-        if compiled is None:
-            compiled = os.environ.get(STATICS_ENV, '').strip().lower() != 'python'
-        library = native.load_library() if compiled and solver == INVERSE_STATICS else None
+        library = (native.chosen_library(STATICS_ENV, compiled) if solver == INVERSE_STATICS
+                   else None)
         self._statics = (None if library is None
                          else CompiledStatics(library, len(self.effort_limit_nm)))
 
