@@ -9,6 +9,8 @@ world's heightfield is made of.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from tutorial_atlas_control import topics
@@ -35,15 +37,19 @@ def is_course_run(data: BagData) -> bool:
     return False
 
 
+@functools.cache
 def terrain_heights() -> np.ndarray:
     """The course's terrain heights (m), rows from +y down, columns from -x (the image's
-    layout), from the package's terrain image and course.HEIGHTMAP's scaling."""
-    import matplotlib.image  # noqa: PLC0415 - only the map needs it
+    layout), from the package's terrain image and course.HEIGHTMAP's scaling: read once a
+    process (each try's fall, the plot, the landings and the map ask for it), read-only."""
+    import matplotlib.image  # noqa: PLC0415 - only course runs need it
 
     grey = np.asarray(matplotlib.image.imread(package_path('sim', TERRAIN_FILE)))
     if grey.dtype.kind == 'f':  # matplotlib reads an 8-bit PNG as levels / 255
         grey = np.rint(grey * 255.0)
-    return HEIGHTMAP.z0_m + HEIGHTMAP.relief_m * grey.astype(float) / HEIGHTMAP.brightest
+    heights = HEIGHTMAP.z0_m + HEIGHTMAP.relief_m * grey.astype(float) / HEIGHTMAP.brightest
+    heights.setflags(write=False)
+    return heights
 
 
 def ground_under(heights: np.ndarray, x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
