@@ -1,7 +1,7 @@
 # The project's commands. Each one sets the project up first when needed.
 #   make setup   Debian packages, virtualenv, catkin workspace (idempotent)
 #   make test    unit, integration and reliability tests (pytest), ruff and catkin_lint, the
-#                rostests, then a one-run --quick bench of the sections that start no launch
+#                rostests, then a one-run --quick bench of physics, offline, analysis and walking
 #                (its arithmetic, not its speed)
 #   make demo    the tutorial end to end, headless (TRAJ=step_and_fall|touchdown|touchdown_exhausted)
 #                or a step that stands: make demo TRAJ=step_and_stand (Stepping.yaml, its gains)
