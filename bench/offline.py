@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import sys
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -50,6 +52,31 @@ def physics_run(warmup_steps: int = 1500, steps: int = 5000, compiled_law: bool 
     for _ in range(steps):
         step()
     return steps / (time.perf_counter() - start)
+
+
+def python_reference_switches() -> tuple[str, ...]:
+    """The environment variables that switch each compiled part of the controller to its
+    pure Python reference: the bench's "before" of the compiled core."""
+    from tutorial_atlas_control.balance import ESTIMATOR_ENV, STATICS_ENV
+
+    return ESTIMATOR_ENV, STATICS_ENV
+
+
+@contextlib.contextmanager
+def python_reference() -> Iterator[None]:
+    """Controllers built inside run their pure Python reference: every compiled part
+    switched off (each part reads its variable when it is built), restored after."""
+    switches = python_reference_switches()
+    saved = {name: os.environ.get(name) for name in switches}
+    os.environ.update({name: 'python' for name in switches})
+    try:
+        yield
+    finally:
+        for name, value in saved.items():
+            if value is None:
+                os.environ.pop(name, None)
+            else:
+                os.environ[name] = value
 
 
 def stand_run(warmup_steps: int = 2500, steps: int = 5000) -> float:

@@ -45,6 +45,7 @@ import sys
 import tempfile
 import time
 import traceback
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -101,6 +102,13 @@ ROWS = (
     ('stand_us_per_step', 'balancing Stand: estimate + control', 'us/step', '<= 100', 1),
     ('walk_us_per_step', 'Walk, 6 steps: estimate + control (CPU)', 'us/step', '<= 150', 1),
     ('walk_offline_rtf', 'the same walk offline (no bag)', 'x real time', '>= 10', 2),
+    ('stand_bare_ratio', 'Stand per step / bare mj_step', '', '<= 0.7', 2),
+    ('stand_python_us_per_step', 'Stand, the Python reference (before)', 'us/step', '', 1),
+    ('stand_python_bare_ratio', 'the same / bare mj_step', '', '', 2),
+    ('walk_bare_ratio', 'Walk per step / bare mj_step', '', '<= 1.0', 2),
+    ('walk_python_us_per_step', 'Walk, the Python reference (before)', 'us/step', '', 1),
+    ('walk_python_bare_ratio', 'the same / bare mj_step', '', '', 2),
+    ('walk_offline_bare_ratio', 'bare physics rtf / walk offline rtf', '', '<= 2.2', 2),
     ('offline_rtf', 'run_offline.py to a bag', 'x real time', '', 2),
     ('offline_ratio', 'offline_rtf*1000 / physics limit', '', '>= 0.8', 3),
     ('fast_rtf', 'node rtf:=0 + recorder', 'x real time', '>= 0.6 x bare/1000', 2),
@@ -296,6 +304,10 @@ TARGETS = {
     # Walking: the controller in the 1 ms loop, and offline runs of it (issue's goals).
     'walk_us_per_step': Target(high=150.0),
     'walk_offline_rtf': Target(low=10.0),
+    # The compiled core's targets, as multiples of the same run's bare mj_step.
+    'stand_bare_ratio': Target(high=0.7),
+    'walk_bare_ratio': Target(high=1.0),
+    'walk_offline_bare_ratio': Target(high=2.2),
     'offline_ratio': Target(low=0.8),
     'fast_rtf': Target(low=0.6, per_bare='rtf'),
     'fast_bare_ratio': Target(low=0.6),
@@ -352,7 +364,10 @@ TARGETS = {
 EXPECTED = {
     'physics': ('bare_physics_steps_per_s', 'physics_limit_steps_per_s',
                 'physics_numpy_law_steps_per_s', 'unheard_topic_us_per_step',
-                'stand_us_per_step', 'walk_us_per_step', 'walk_offline_rtf'),
+                'stand_us_per_step', 'walk_us_per_step', 'walk_offline_rtf',
+                'stand_python_us_per_step', 'walk_python_us_per_step',
+                *(f'{name}_bare_ratio' for name in ('stand', 'stand_python', 'walk',
+                                                    'walk_python', 'walk_offline'))),
     'offline': ('offline_rtf', 'offline_ratio'),
     'analysis': ('analysis_s', 'rosbag_s', 'analysis_msgs_per_s', 'rosbag_msgs_per_s',
                  'analysis_speedup'),
@@ -484,14 +499,24 @@ def run_offline(args: argparse.Namespace, samples: dict[str, list[float]],
                 unheard_us = node_loop.unheard_topic_run(args.budget.unheard_calls)
                 log(f'physics run {run + 1}: an unheard topic costs {unheard_us:.3f} us/step')
                 add(samples, {'unheard_topic_us_per_step': unheard_us})
+                # Compiled (as shipped) and the pure Python reference, interleaved: the
+                # compiled core's before/after, paired on the same load.
                 stand_us = offline.stand_run(steps=steps)
-                log(f'physics run {run + 1}: the balancing Stand costs {stand_us:.1f} us/step')
-                add(samples, {'stand_us_per_step': stand_us})
+                with offline.python_reference():
+                    stand_python_us = offline.stand_run(steps=steps)
+                log(f'physics run {run + 1}: the balancing Stand costs {stand_us:.1f} us/step '
+                    f'({stand_python_us:.1f} in Python)')
+                add(samples, {'stand_us_per_step': stand_us,
+                              'stand_python_us_per_step': stand_python_us})
                 if run < args.runs:  # a walk is 7 s of sim time: --quick walks once
                     walk_us, walk_rtf = offline.walk_run()
-                    log(f'physics run {run + 1}: Walk costs {walk_us:.1f} us/step, walks '
-                        f'offline at {walk_rtf:.2f}x real time')
-                    add(samples, {'walk_us_per_step': walk_us, 'walk_offline_rtf': walk_rtf})
+                    with offline.python_reference():
+                        walk_python_us, _ = offline.walk_run()
+                    log(f'physics run {run + 1}: Walk costs {walk_us:.1f} us/step '
+                        f'({walk_python_us:.1f} in Python), walks offline at {walk_rtf:.2f}x '
+                        'real time')
+                    add(samples, {'walk_us_per_step': walk_us, 'walk_offline_rtf': walk_rtf,
+                                  'walk_python_us_per_step': walk_python_us})
     if 'offline' in args.sections:
         steps_per_s = offline.steps_per_sim_second()
         with Section('offline', loads), tempfile.TemporaryDirectory(prefix='tac_bench_') as tmp:
@@ -781,19 +806,40 @@ def summarize(samples: dict[str, list[float]],
             sum(cpus) * 1e6 / (rtf * per_sim_s)
             for rtf, *cpus in zip(samples['fast_rtf'], *(samples[key] for key in cpu_keys))]
         medians['fast_cpu_us_per_step'] = statistics.median(samples['fast_cpu_us_per_step'])
-    if 'bare_physics_steps_per_s' in medians:  # targets as ratios to bare mj_step
-        bare = medians['bare_physics_steps_per_s']
-        for key, ratio in (('fast_rtf', lambda rtf: rtf * per_sim_s / bare),
-                           ('node_us_per_step', lambda us: us * bare / 1e6)):
-            if key in samples:
-                name = 'fast_bare_ratio' if key == 'fast_rtf' else 'node_bare_ratio'
-                samples[name] = [ratio(value) for value in samples[key]]
-                medians[name] = ratio(medians[key])
+    if 'bare_physics_steps_per_s' in medians:
+        add_bare_ratios(samples, medians, per_sim_s)
     for pct in (50, 99):  # the headline: the worse of the two command rates
         rates = [medians.get(f'cmd_latency_p{pct}_ms_{label}') for label in ('50hz', '1khz')]
         if all(value is not None for value in rates):
             medians[f'cmd_latency_p{pct}_ms'] = max(rates)
     return medians
+
+
+def bare_ratios(keys: list[str], bare_steps_per_s: float,
+                per_sim_s: float) -> dict[str, tuple[str, Callable[[float], float]]]:
+    """Each figure's ratio to the same run's bare mj_step, by the figure's key: `X_us_per_step`
+    (a cost) as X_bare_ratio = µs / bare µs; `fast_rtf` as fast_rtf × steps per sim second /
+    bare steps/s; `walk_offline_rtf` as bare physics's real-time factor / the walk's."""
+    bare_us = 1e6 / bare_steps_per_s
+    ratios: dict[str, tuple[str, Callable[[float], float]]] = {
+        key: (key.removesuffix('_us_per_step') + '_bare_ratio', lambda us: us / bare_us)
+        for key in keys if key.endswith('_us_per_step') and key != 'unheard_topic_us_per_step'}
+    if 'fast_rtf' in keys:
+        ratios['fast_rtf'] = ('fast_bare_ratio', lambda rtf: rtf * per_sim_s / bare_steps_per_s)
+    if 'walk_offline_rtf' in keys:
+        ratios['walk_offline_rtf'] = ('walk_offline_bare_ratio',
+                                      lambda rtf: bare_steps_per_s / per_sim_s / rtf)
+    return ratios
+
+
+def add_bare_ratios(samples: dict[str, list[float]], medians: dict[str, float],
+                    per_sim_s: float) -> None:
+    """bare_ratios' figures, per run and as the ratio of the medians (the issue's targets are
+    ratios: a host 40 % slower moves both sides)."""
+    bare = medians['bare_physics_steps_per_s']
+    for key, (name, ratio) in bare_ratios(list(medians), bare, per_sim_s).items():
+        samples[name] = [ratio(value) for value in samples[key]]
+        medians[name] = ratio(medians[key])
 
 
 def table(samples: dict[str, list[float]], loads: dict[str, str], runs: int,

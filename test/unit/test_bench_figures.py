@@ -48,6 +48,32 @@ def test_per_step_figures_are_cpu_over_simulated_steps() -> None:
     assert medians['node_bare_ratio'] == pytest.approx(95.0 / (1e6 / 22000))
 
 
+def test_controller_costs_as_ratios_to_bare_physics() -> None:
+    """The compiled core's figures (compiled and its Python reference, paired) as multiples
+    of the same run's bare mj_step, and the offline walk against bare physics's speed."""
+    samples = {'bare_physics_steps_per_s': [10000.0, 12500.0, 8000.0],  # median 100 µs
+               'stand_us_per_step': [60.0, 50.0, 70.0],
+               'stand_python_us_per_step': [300.0, 250.0, 350.0],
+               'walk_us_per_step': [150.0], 'walk_python_us_per_step': [400.0],
+               'walk_offline_rtf': [4.0],
+               'controller_tcp_node_us_per_step': [120.0, 130.0]}
+    medians = run_bench.summarize(samples, per_sim_s=PER_SIM_S)
+    assert medians['stand_bare_ratio'] == pytest.approx(0.6)
+    assert samples['stand_bare_ratio'] == pytest.approx([0.6, 0.5, 0.7])
+    assert medians['stand_python_bare_ratio'] == pytest.approx(3.0)
+    assert medians['walk_bare_ratio'] == pytest.approx(1.5)
+    assert medians['walk_python_bare_ratio'] == pytest.approx(4.0)
+    # bare physics runs at 10x real time, the walk at 4x: 2.5 times slower.
+    assert medians['walk_offline_bare_ratio'] == pytest.approx(2.5)
+    assert medians['controller_tcp_node_bare_ratio'] == pytest.approx(1.25)
+    assert 'unheard_topic_bare_ratio' not in medians
+    judged = run_bench.verdicts(medians, run_bench.DEFAULT_COMPRESSION)
+    assert {key: judged[key] for key in ('stand_bare_ratio', 'walk_bare_ratio',
+                                         'walk_offline_bare_ratio')} == {
+        'stand_bare_ratio': 'met', 'walk_bare_ratio': 'MISSED',
+        'walk_offline_bare_ratio': 'MISSED'}
+
+
 def test_per_step_cpu_sum_skips_a_process_missing_from_some_runs() -> None:
     samples = fast_samples()
     samples['fast_state_publisher_cpu'] = [0.1]  # one run without robot_state_publisher
