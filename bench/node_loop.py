@@ -9,6 +9,7 @@ serving a 1 kHz controller into its phases (controller_phases_run).
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import os
 import sys
@@ -217,10 +218,24 @@ def phases_main(rounds: int) -> int:
     return 0
 
 
-def main() -> int:
-    if sys.argv[1:2] == ['--phases']:
-        return phases_main(int(sys.argv[2]) if len(sys.argv) > 2 else 3)
-    rounds = int(sys.argv[1]) if len(sys.argv) > 1 else 3
+def parse_args(argv: list[str]) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument('rounds', nargs='?', type=int, default=3,
+                        help='interleaved rounds; each figure is its best round (default 3)')
+    parser.add_argument('--phases', action='store_true',
+                        help="split the tick of a node serving a 1 kHz controller into phases")
+    args = parser.parse_args(argv)
+    if args.rounds < 1:
+        parser.error('rounds must be >= 1')
+    return args
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parse_args(sys.argv[1:] if argv is None else argv)
+    if args.phases:
+        return phases_main(args.rounds)
+    rounds = args.rounds
     best: dict[str, float] = {}
     for _ in range(rounds):
         figures = {
