@@ -1,8 +1,8 @@
 # The project's commands. Each one sets the project up first when needed.
 #   make setup   Debian packages, virtualenv, catkin workspace (idempotent)
 #   make test    unit, integration and reliability tests (pytest), ruff and catkin_lint, the
-#                rostests, then a one-run --quick bench of physics, offline, analysis and walking
-#                (its arithmetic, not its speed)
+#                rostests, and a one-run --quick bench of physics, offline, analysis and walking
+#                (its code, not its speed: test_bench_quick.py)
 #   make demo    the tutorial end to end, headless (TRAJ=step_and_fall|touchdown|touchdown_exhausted)
 #                or a step that stands: make demo TRAJ=step_and_stand (Stepping.yaml, its gains)
 #                or Atlas walking: make demo TRAJ=walk_straight (or walk_circle; run_demo.py --help)
@@ -32,8 +32,8 @@ lint: setup
 rostest: setup
 	@$(IN_ENV) bash tools/run_rostests.sh
 
-# Lint, the rostests beside pytest on two workers, the serial tests, the quick bench's
-# offline sections
+# Lint, the live tests on two workers beside the rostests, the serial tests, and the offline
+# tests (the quick bench's offline sections among them) at the lowest priority throughout
 # (tools/run_tests.sh; docs/TESTING.md).
 test: setup
 	@$(IN_ENV) bash tools/run_tests.sh
