@@ -1,12 +1,13 @@
 """The package's compiled library (src/atlas_law.c, src/atlas_gather.c,
-src/atlas_estimator.c, src/atlas_statics.c): found, loaded, checked.
+src/atlas_estimator.c, src/atlas_statics.c, src/atlas_swing.c): found, loaded, checked.
 
 One place knows the library's binary interface: the ctypes mirrors of its structs, the
 signatures of its functions, and where catkin puts it (a devel space's lib/ and an
 install space's lib/ are both on CMAKE_PREFIX_PATH once their setup.bash is sourced).
 Its users, the compiled law (sim/law_kernel.py), the messages' copies
-(sim/copy_plan.py), the balance estimator (balance/compiled_estimator.py) and the
-whole-body layer's inverse statics (balance/compiled_statics.py), ask here.
+(sim/copy_plan.py), the balance estimator (balance/compiled_estimator.py), the
+whole-body layer's inverse statics (balance/compiled_statics.py) and the swing foot's
+servo (walking/compiled_swing.py), ask here.
 The estimator's part calls MuJoCo: the library is linked against the Python wheel's
 libmujoco, the one `import mujoco` loads, so that one MuJoCo runs in the process.
 
@@ -29,16 +30,16 @@ import numpy as np
 from tutorial_atlas_control.command import LAW_FIELDS
 
 __all__ = ['LIBRARY_ENV', 'LIBRARY_NAME', 'MIRRORED_STRUCTS', 'AtlasCopy', 'AtlasEstimator',
-           'AtlasLawStep', 'AtlasStatics', 'address', 'chosen_library', 'find_library',
-           'load_library', 'size_mismatches']
+           'AtlasLawStep', 'AtlasStatics', 'AtlasSwing', 'address', 'chosen_library',
+           'find_library', 'load_library', 'size_mismatches']
 
 #: The shared library CMakeLists.txt builds (devel/lib, installed to the prefix's lib/).
 LIBRARY_NAME = 'libtutorial_atlas_control_law.so'
 #: Set to a library path to use that one (or to a missing path to force numpy).
 LIBRARY_ENV = 'TAC_LAW_LIBRARY'
 #: What the callers do without the library (the end of the one warning).
-FALLBACK = ('using the numpy controller law (same torques, slower) and the Python balance '
-            'estimator and statics')
+FALLBACK = ('using the numpy controller law (same torques, slower), the Python swing-foot '
+            'servo and the Python balance estimator and statics')
 #: How the library names the function that returns sizeof(Struct).
 SIZEOF_PREFIX = 'tac_sizeof_'
 
@@ -87,6 +88,16 @@ class AtlasStatics(ctypes.Structure):
                 ('min_load_share', ctypes.c_double), ('n', ctypes.c_long)]
 
 
+class AtlasSwing(ctypes.Structure):
+    """AtlasSwing in src/atlas_swing.c (same fields, same order)."""
+
+    _fields_ = [('in_', ctypes.c_void_p), ('torque', ctypes.c_void_p),
+                ('swing_kp', ctypes.c_double), ('swing_kd', ctypes.c_double),
+                ('damping', ctypes.c_double), ('press_m', ctypes.c_double),
+                ('touchdown_speed_m_s', ctypes.c_double), ('world', ctypes.c_long),
+                ('feedforward', ctypes.c_long)]
+
+
 #: Every struct Python lays out for the library, by its C name: the library must export
 #: SIZEOF_PREFIX + name, returning the same size as the mirror's.
 MIRRORED_STRUCTS: dict[str, type[ctypes.Structure]] = {
@@ -94,6 +105,7 @@ MIRRORED_STRUCTS: dict[str, type[ctypes.Structure]] = {
     'AtlasCopy': AtlasCopy,
     'AtlasEstimator': AtlasEstimator,
     'AtlasStatics': AtlasStatics,
+    'AtlasSwing': AtlasSwing,
 }
 
 
@@ -162,6 +174,10 @@ def _declare(library: ctypes.CDLL) -> None:
     library.atlas_estimator_contacts.restype = ctypes.c_long
     library.atlas_inverse_statics.argtypes = [ctypes.POINTER(AtlasStatics)]
     library.atlas_inverse_statics.restype = None
+    for name in ('atlas_foot_servo', 'atlas_swing_torque'):
+        function = getattr(library, name)
+        function.argtypes = [ctypes.POINTER(AtlasSwing)]
+        function.restype = None
 
 
 _library: ctypes.CDLL | None = None

@@ -8,7 +8,8 @@ dcm_plan: the capture point's plan over the steps; step_adjustment: where a push
 foot must land instead; swing: the swing foot's path; phases: the one phase machine
 Walk and Step run (their phases in order, each one's end rule, the transition);
 leg_tasks: what Walk and Step do alike each tick (the whole-body law on the carrying soles,
-the swing foot, the pelvis's heading); walk: the walk's phases; walk_behaviour: Walk as the
+the swing foot, the pelvis's heading); compiled_swing: the swing foot's path and servo as
+one C call (src/atlas_swing.c); walk: the walk's phases; walk_behaviour: Walk as the
 simulator's behaviour;
 start_noise: a trial's start perturbed by a seed; walk_trial: offline walking trials,
 landing by landing, pushed or not; static_step: one quasi-static step; step_behaviour:
@@ -24,6 +25,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'status_flags': ['CATCHING', 'ERROR_INCONSISTENT_STEPS', 'OKAY', 'STEPPING', 'SWAYING',
                      'WARNING_INSUFFICIENT_STEP_DATA'],
     'swing': ['SWING_HEIGHT_M'],
+    'compiled_swing': ['CompiledSwing'],
     'walk': ['WalkGains'],
     'walk_behaviour': ['WalkBehaviour', 'WalkStatus'],
     'start_noise': ['perturb_start'],

@@ -19,6 +19,10 @@ ahead of its path as it slowed down and with the pelvis's speed, and every landi
 sole, 600 N m/rad and 30 N m s/rad on its turn) was unstable at 1 kHz on the light foot:
 the legs' torques flipped between their effort limits every millisecond (280 N m per
 step on the hip pitch), and that shaking decided, chaotically, which walks stood.
+
+The swing torque and the servo run as one C call a tick (compiled_swing) where the
+package's library is built, equal to the Python here to rounding; in Python (SWING_ENV=python,
+or no library) they compute here.
 """
 
 from __future__ import annotations
@@ -28,6 +32,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from tutorial_atlas_control import native
 from tutorial_atlas_control.balance import (
     BalanceState,
     StandController,
@@ -40,10 +45,14 @@ from tutorial_atlas_control.balance import (
     yaw_of,
     yaw_rotation,
 )
+from tutorial_atlas_control.walking.compiled_swing import CompiledSwing
 from tutorial_atlas_control.walking.footsteps import Footstep, wrap_angle
 from tutorial_atlas_control.walking.swing import SwingPath, quintic
 
-__all__ = ['LEG_JOINTS', 'LegGains', 'LegTasks', 'foot_pose']
+__all__ = ['LEG_JOINTS', 'SWING_ENV', 'LegGains', 'LegTasks', 'foot_pose']
+
+#: Set to `python` for the swing servo in Python even where the compiled library is built.
+SWING_ENV = 'TAC_SWING'
 
 #: The leg joints (tutorial order): their Stand posture PD is off while stepping.
 LEG_JOINTS = slice(4, 16)
@@ -103,7 +112,10 @@ def foot_pose(state: BalanceState, foot: int, step_index: int = 0) -> Footstep:
 class LegTasks:
     """The shared torques over one StandController's tasks, with a reference of their own."""
 
-    def __init__(self, stand: StandController, gains: LegGains, time_s: float) -> None:
+    def __init__(self, stand: StandController, gains: LegGains, time_s: float,
+                 compiled: bool | None = None) -> None:
+        """`compiled`: the swing servo by one C call when the library is built (None:
+        unless SWING_ENV says `python`); False: in Python."""
         self.stand = stand
         self.gains = gains
         #: The legs' own reference for the whole-body layer: the Stand's as the walk or
@@ -124,6 +136,14 @@ class LegTasks:
         self._facing = (time_s, 1.0, yaw_of(stand.reference.pelvis_rotation), 0.0)
         #: The CoM height moving on: (start time, duration, from, change) (s, m).
         self._height = (time_s, 1.0, stand.reference.com_height_m, 0.0)
+        library = native.chosen_library(SWING_ENV, compiled)
+        self._kernel = None if library is None else CompiledSwing(
+            library, gains, len(stand.gains.joint_kp))
+
+    @property
+    def compiled(self) -> bool:
+        """Whether the swing servo runs the C call."""
+        return self._kernel is not None
 
     def move_height(self, height_m: float, time_s: float, duration_s: float) -> None:
         """Take the CoM's reference height from where it is now to `height_m` over
@@ -158,6 +178,9 @@ class LegTasks:
         """The swing leg's torques (28,) along `swing`, `elapsed_s` into it, the path's
         acceleration fed forward; past its end the foot goes on down at
         touchdown_speed_m_s."""
+        if self._kernel is not None:
+            return self._kernel.swing_torque(state, joint_velocities, LEG_OF_FOOT[foot], foot,
+                                             swing, elapsed_s)
         gains = self.gains
         position, velocity, yaw, yaw_rate = swing.at(elapsed_s)
         acceleration, yaw_acceleration = (swing.acceleration(elapsed_s)
@@ -180,8 +203,12 @@ class LegTasks:
         through the same inverse; `world`: damping the sole's velocity in the world (a
         swing foot's path is in the world, the pelvis's motion adds to it) rather than the
         leg's joint velocities (a foot put back down: its pelvis moves over it)."""
-        gains = self.gains
         leg = LEG_OF_FOOT[foot]
+        if self._kernel is not None:
+            return self._kernel.foot_servo(
+                state, joint_velocities, leg, foot,
+                (position, velocity, yaw, yaw_rate, acceleration, yaw_acceleration), world)
+        gains = self.gains
         jacobian = state.sole_jacobians[foot][:, leg]
         columns = 2 if acceleration is None else 3
         targets = np.zeros((6, columns))  # the pose's error, the velocity asked for, ...
