@@ -188,6 +188,7 @@ class WholeBodyLayer:
             raise BalanceError(f'whole-body solver {solver!r} is not one of {SOLVERS}')
         self.mass_kg = mass_kg
         self.effort_limit_nm = np.asarray(effort_limit_nm, dtype=float)
+        self._lowest_nm = -self.effort_limit_nm
         self.solver = solver
         #: How many ticks the QP found no feasible wrench (inverse statics' was used).
         self.qp_fallbacks = 0
@@ -258,6 +259,7 @@ class WholeBodyLayer:
             state.sole_jacobians, base_torque_nm, self.effort_limit_nm)
 
     def limit(self, torque: np.ndarray) -> np.ndarray:
-        """`torque` within the joints' effort limits, in place."""
-        np.clip(torque, -self.effort_limit_nm, self.effort_limit_nm, out=torque)
-        return torque
+        """`torque` within the joints' effort limits, in place (np.clip's own arithmetic,
+        max then min, without its three Python wrappers: twice a walking tick)."""
+        np.maximum(torque, self._lowest_nm, out=torque)
+        return np.minimum(torque, self.effort_limit_nm, out=torque)

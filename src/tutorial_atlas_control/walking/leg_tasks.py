@@ -36,6 +36,7 @@ from tutorial_atlas_control import native
 from tutorial_atlas_control.balance import (
     BalanceState,
     StandController,
+    StandReference,
     box_corners,
     clamp_into,
     convex_hull,
@@ -136,6 +137,8 @@ class LegTasks:
         self._facing = (time_s, 1.0, yaw_of(stand.reference.pelvis_rotation), 0.0)
         #: The CoM height moving on: (start time, duration, from, change) (s, m).
         self._height = (time_s, 1.0, stand.reference.com_height_m, 0.0)
+        self._last_reference: tuple[tuple[float, float, float], StandReference,
+                                    StandReference] | None = None
         library = native.chosen_library(SWING_ENV, compiled)
         self._kernel = None if library is None else CompiledSwing(
             library, gains, len(stand.gains.joint_kp))
@@ -172,6 +175,20 @@ class LegTasks:
         """The pelvis heading's reference at `time_s` (rad)."""
         started_s, duration_s, start, turn = self._facing
         return start + smoothstep((time_s - started_s) / duration_s) * turn
+
+    def _moved_reference(self, time_s: float) -> StandReference:
+        """The legs' reference at `time_s`: its heading and height moved on (the same object
+        as last tick's while they stand still, as they do between a step's turn and the
+        next: a dataclass replace and a rotation a tick saved)."""
+        height, height_rate = self.height(time_s)
+        key = (self.heading(time_s), height, height_rate)
+        last = self._last_reference
+        if last is not None and last[0] == key and last[1] is self.reference:
+            return last[2]
+        moved = replace(self.reference, pelvis_rotation=yaw_rotation(key[0]),
+                        com_height_m=height, com_height_rate_m_s=height_rate)
+        self._last_reference = (key, self.reference, moved)
+        return moved
 
     def swing_torque(self, state: BalanceState, joint_velocities: np.ndarray, foot: int,
                      swing: SwingPath, elapsed_s: float) -> np.ndarray:
@@ -255,9 +272,7 @@ class LegTasks:
         kept, and which soles carry. `finish` adds the swing or put-down torques; nothing
         is clipped yet."""
         stand = self.stand
-        height, height_rate = self.height(time_s)
-        reference = replace(self.reference, pelvis_rotation=yaw_rotation(self.heading(time_s)),
-                            com_height_m=height, com_height_rate_m_s=height_rate)
+        reference = self._moved_reference(time_s)
         if swing_foot is not None:
             contact = (swing_foot != 0, swing_foot != 1)
             cop = _clamp_to_sole(state, 1 - swing_foot, self.sole_reach_m, cop)
