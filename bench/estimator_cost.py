@@ -6,10 +6,10 @@ in one process, each figure (process time) beside a bare mj_step timed in the sa
     python3 bench/estimator_cost.py [--rounds 9] [--pairs 3] [--skip-runs]
 
 The estimator is chosen at its construction by TAC_ESTIMATOR, inverse statics by
-TAC_STATICS (`python`, else compiled); the runs compare both in Python, the estimator
-compiled, and both compiled; each round alternates which goes first. Prints the medians,
-their ratios to mj_step and to Python's in each pair, and the load (`uptime`) before and
-after.
+TAC_STATICS, Walk's swing servo by TAC_SWING (`python`, else compiled); the runs compare all
+in Python, the estimator compiled, the estimator and statics compiled, and all three
+compiled; each round alternates which goes first. Prints the medians, their ratios to
+mj_step and to Python's in each pair, and the load (`uptime`) before and after.
 """
 
 from __future__ import annotations
@@ -29,10 +29,14 @@ from tutorial_atlas_control.balance import BalanceEstimator, place_in_stand_pose
 from tutorial_atlas_control.sim import model as atlas_model
 
 KINDS = ('python', 'compiled')
-#: The runs' kinds: the environment each sets (the estimator and inverse statics in Python,
-#: the estimator compiled, both compiled).
-RUN_KINDS = {'python': {'TAC_ESTIMATOR': 'python', 'TAC_STATICS': 'python'},
-             'estimator': {'TAC_STATICS': 'python'}, 'compiled': {}}
+#: The runs' kinds: the environment each sets (the estimator, inverse statics and the swing
+#: servo in Python; the estimator compiled; it and the statics; all three compiled).
+RUN_KINDS = {'python': {'TAC_ESTIMATOR': 'python', 'TAC_STATICS': 'python',
+                        'TAC_SWING': 'python'},
+             'estimator': {'TAC_STATICS': 'python', 'TAC_SWING': 'python'},
+             'statics': {'TAC_SWING': 'python'}, 'compiled': {}}
+#: The variables the kinds set.
+SWITCHES = ('TAC_ESTIMATOR', 'TAC_STATICS', 'TAC_SWING')
 
 
 class BareStep:
@@ -94,9 +98,13 @@ def _summary(name: str, figures: dict[str, list[float]], steps: list[float]) -> 
         parts.append(f'{kind} {median:.1f} µs = {median / step:.2f} mj_step '
                      f'({min(values):.1f}–{max(values):.1f})')
     ratios = []
-    for kind in list(figures)[1:]:
-        pairs = [c / p for p, c in zip(figures['python'], figures[kind], strict=True)]
-        ratios.append(f'{kind}/python per pair median {statistics.median(pairs):.3f} '
+    kinds = list(figures)
+    compared = [(kind, 'python') for kind in kinds[1:]]
+    if 'statics' in figures and 'compiled' in figures:  # what the swing servo's C adds
+        compared.append(('compiled', 'statics'))
+    for kind, base in compared:
+        pairs = [c / p for p, c in zip(figures[base], figures[kind], strict=True)]
+        ratios.append(f'{kind}/{base} per pair median {statistics.median(pairs):.3f} '
                       f'({min(pairs):.3f}–{max(pairs):.3f})')
     print(f'{name}: {"; ".join(parts)}; {"; ".join(ratios)}; '
           f'bare mj_step {step:.1f} µs ({min(steps):.1f}–{max(steps):.1f})', flush=True)
@@ -126,7 +134,7 @@ def compare_runs(pairs: int) -> None:
     kinds = list(RUN_KINDS)
     for pair in range(pairs):
         for kind in kinds if pair % 2 == 0 else kinds[::-1]:
-            for name in ('TAC_ESTIMATOR', 'TAC_STATICS'):
+            for name in SWITCHES:
                 os.environ.pop(name, None)
             os.environ.update(RUN_KINDS[kind])
             steps.append(bare.us())
