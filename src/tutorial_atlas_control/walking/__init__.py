@@ -26,6 +26,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                      'WARNING_INSUFFICIENT_STEP_DATA'],
     'swing': ['SWING_HEIGHT_M'],
     'compiled_swing': ['CompiledSwing'],
+    'leg_tasks': ['SWING_ENV'],
     'walk': ['WalkGains'],
     'walk_behaviour': ['WalkBehaviour', 'WalkStatus'],
     'start_noise': ['perturb_start'],
