@@ -23,20 +23,19 @@ import time
 import mujoco
 import numpy as np
 from node_loop import RESTORE_EVERY_STEPS, STANDING_AFTER_S
-from offline import make_simulator, stand_run, walk_run
+from offline import make_simulator, python_reference_switches, stand_run, walk_run
 
 from tutorial_atlas_control.balance import BalanceEstimator, place_in_stand_pose
 from tutorial_atlas_control.sim import model as atlas_model
 
 KINDS = ('python', 'compiled')
-#: The runs' kinds: the environment each sets (the estimator, inverse statics and the swing
-#: servo in Python; the estimator compiled; it and the statics; all three compiled).
-RUN_KINDS = {'python': {'TAC_ESTIMATOR': 'python', 'TAC_STATICS': 'python',
-                        'TAC_SWING': 'python'},
-             'estimator': {'TAC_STATICS': 'python', 'TAC_SWING': 'python'},
-             'statics': {'TAC_SWING': 'python'}, 'compiled': {}}
-#: The variables the kinds set.
-SWITCHES = ('TAC_ESTIMATOR', 'TAC_STATICS', 'TAC_SWING')
+#: The variables that switch the estimator, inverse statics and the swing servo to Python.
+SWITCHES = ESTIMATOR, STATICS, SWING = python_reference_switches()
+#: The runs' kinds: the parts each runs in Python (all; the statics and the swing servo; the
+#: swing servo; none).
+RUN_KINDS = {'python': dict.fromkeys(SWITCHES, 'python'),
+             'estimator': dict.fromkeys((STATICS, SWING), 'python'),
+             'statics': {SWING: 'python'}, 'compiled': {}}
 
 
 class BareStep:
