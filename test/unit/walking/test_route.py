@@ -1,0 +1,105 @@
+"""A route's footsteps: strides, turns, the first foot, the feet side by side at the end, and
+every step within what the legs reach from the one before."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from tutorial_atlas_control.walking import WalkingError
+from tutorial_atlas_control.walking.footsteps import LEFT, RIGHT, Footstep, wrap_angle
+from tutorial_atlas_control.walking.route import RouteGait, route_steps
+from tutorial_atlas_control.walking.step_queue import clamp_step
+
+
+def centre_after(steps: list[Footstep]) -> tuple[float, float]:
+    """The midpoint of the last two soles."""
+    a, b = steps[-2], steps[-1]
+    return (a.x_m + b.x_m) / 2, (a.y_m + b.y_m) / 2
+
+
+def test_a_straight_route_strides_equally_and_ends_with_the_feet_side_by_side() -> None:
+    steps = route_steps((1.0, 2.0), 0.0, [(1.6, 2.0)])
+    assert [s.step_index for s in steps] == [1, 2, 3, 4, 5]
+    assert [s.foot_index for s in steps] == [LEFT, RIGHT, LEFT, RIGHT, LEFT]
+    assert [round(s.x_m, 9) for s in steps] == [1.15, 1.3, 1.45, 1.6, 1.6]
+    assert [round(s.y_m, 9) for s in steps] == [2.12, 1.88, 2.12, 1.88, 2.12]
+    assert all(s.yaw_rad == 0.0 and s.duration_s == 0.63 for s in steps)
+
+
+def test_a_stride_is_never_longer_than_the_gaits() -> None:
+    steps = route_steps((0.0, 0.0), 0.0, [(1.0, 0.0)], RouteGait(stride_m=0.3))
+    strides = [b.x_m - a.x_m for a, b in zip(steps, steps[1:-1])]
+    assert len(steps) == 5  # four strides of 0.25 m, then the feet together
+    assert strides == pytest.approx([0.25] * 3)
+
+
+@pytest.mark.parametrize('goal, first_foot, turn', [
+    ((0.0, 3.0), LEFT, math.pi / 2), ((0.0, -3.0), RIGHT, -math.pi / 2)])
+def test_a_turn_starts_with_the_foot_on_its_side_and_turns_at_most_a_step_each(
+        goal: tuple[float, float], first_foot: int, turn: float) -> None:
+    steps = route_steps((0.0, 0.0), 0.0, [goal])
+    assert steps[0].foot_index == first_foot
+    headings = [0.0] + [s.yaw_rad for s in steps]
+    assert max(abs(wrap_angle(b - a)) for a, b in zip(headings, headings[1:])) <= 0.2 + 1e-12
+    assert abs(wrap_angle(steps[-1].yaw_rad - turn)) < 0.2  # the turn moved the centre on
+    assert centre_after(steps) == pytest.approx(goal, abs=1e-9)
+
+
+def test_turning_in_place_faces_the_waypoint_exactly() -> None:
+    steps = route_steps((0.0, 0.0), 0.0, [(0.0, 1.0)], RouteGait(turn_stride_m=0.0))
+    assert [round(s.yaw_rad, 9) for s in steps[:8]] == [
+        round(min(0.2 * k, math.pi / 2), 9) for k in range(1, 9)]
+    assert centre_after(steps) == pytest.approx((0.0, 1.0), abs=1e-9)
+    assert steps[-1].yaw_rad == pytest.approx(math.pi / 2)
+
+
+def test_a_waypoint_inside_the_turning_circle_is_refused() -> None:
+    with pytest.raises(WalkingError, match=r'waypoint \(0.0, 0.3\) lies inside the turning '):
+        route_steps((0.0, 0.0), 0.0, [(0.0, 0.3)])
+
+
+def test_waypoints_in_turn_and_a_final_heading() -> None:
+    steps = route_steps((-3.0, -38.0), 0.0, [(2.5, -38.0), (0.5, -24.5)],
+                        final_heading_rad=math.pi / 2)
+    # The final turn (1.72 rad to pi/2: one turning step) carries the centre 0.08 m on.
+    assert centre_after(steps) == pytest.approx((0.5, -24.42), abs=1e-9)
+    assert steps[-1].yaw_rad == pytest.approx(math.pi / 2)
+    assert steps[-2].yaw_rad == pytest.approx(math.pi / 2)
+    passed = [s for s in steps if abs(s.x_m - 2.5) < 0.13 and abs(s.y_m + 38.0) < 0.13]
+    assert passed, 'the route goes through its first waypoint'
+
+
+@pytest.mark.parametrize('start_yaw, waypoints', [
+    (0.0, [(5.0, 0.0)]), (0.0, [(0.0, 2.0), (2.0, 2.0)]), (1.0, [(-1.0, -1.0)]),
+    (math.pi / 2, [(0.3, 4.0), (3.0, 4.5), (3.0, 0.0)])])
+def test_every_step_is_within_the_legs_reach_of_the_one_before(
+        start_yaw: float, waypoints: list[tuple[float, float]]) -> None:
+    steps = route_steps((0.0, 0.0), start_yaw, waypoints)
+    half = RouteGait().width_m / 2
+    feet = {foot: Footstep(0, foot, -side * half * math.sin(start_yaw),
+                           side * half * math.cos(start_yaw), start_yaw)
+            for foot, side in ((LEFT, 1.0), (RIGHT, -1.0))}
+    for step in steps:
+        stance = feet[1 - step.foot_index]
+        clamped = clamp_step(step, stance)
+        assert (clamped.x_m, clamped.y_m, clamped.yaw_rad) == pytest.approx(
+            (step.x_m, step.y_m, step.yaw_rad), abs=1e-9), step
+        feet[step.foot_index] = step
+
+
+@pytest.mark.parametrize('waypoints, message', [
+    ([], 'a route needs at least one waypoint'),
+    ([(math.nan, 1.0)], 'waypoint (nan, 1.0) is not finite'),
+    ([(0.0, 0.0)], 'the route from (0.0, 0.0) goes nowhere: every waypoint is there')])
+def test_bad_routes_are_refused_with_a_reason(waypoints: list[tuple[float, float]],
+                                              message: str) -> None:
+    with pytest.raises(WalkingError) as raised:
+        route_steps((0.0, 0.0), 0.0, waypoints)
+    assert str(raised.value) == message
+
+
+def test_a_gait_of_zero_stride_is_refused() -> None:
+    with pytest.raises(WalkingError, match='a route gait needs positive finite numbers'):
+        RouteGait(stride_m=0.0)
