@@ -1,0 +1,175 @@
+"""A streamed walk along a route on a VRC world, offline and scored: how far the walk gets.
+
+The run is the course's as the node runs it (DRCSim's `bdi_stand` start: pinned, released at
+1 s, the balancing Stand at 2 s; the AtlasSimInterface; the course's scorer in lockstep),
+its start perturbed by a seed (walking/start_noise.py: the joints' angles and rates, the pin
+holding the pelvis). Once Stand has held until `walk_at_s`, a streaming client
+(asi/walk_client.py) walks the route's steps (walking/route.py), planned from where the
+feet are then, as a DRC-era client plans from `foot_pos_est`: every state is answered with
+the window of steps from `next_step_index_needed`. The run ends when the walk has ended (back
+in Stand, or ERROR_FALLING, or refused), the robot has fallen (sim/fall.py, asked every
+10 ms), or the route's time has run out; then it stands `stand_after_s` more. What it
+returns: the walk's outcome and steps, the scorer's gate messages with their sim times,
+completion and falls, the fall if any, and the CPU the run took.
+"""
+
+from __future__ import annotations
+
+import math
+import tempfile
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from tutorial_atlas_control.asi import (
+    AtlasSimInterface,
+    Behavior,
+    WalkClient,
+    step_data_of,
+    yaw_of_quaternion,
+)
+from tutorial_atlas_control.course import ScoreRow
+from tutorial_atlas_control.msgs import AsiCommand, ManipulateParams, StepData
+from tutorial_atlas_control.offline.world import named_world
+from tutorial_atlas_control.sim import (
+    DEFAULT_GAINS_FILE,
+    AtlasSimulator,
+    GroundUnderFeet,
+    VrcMode,
+    load_gains_yaml,
+    load_model,
+)
+from tutorial_atlas_control.stepping import CourseScoring, Tick
+from tutorial_atlas_control.units import NS_PER_S
+from tutorial_atlas_control.walking import (
+    QUEUE_LENGTH,
+    Footstep,
+    RouteGait,
+    perturb_start,
+    route_steps,
+    wrap_angle,
+)
+
+__all__ = ['CourseWalk', 'GATE_1_ROUTE', 'course_walk']
+
+#: From the pen's start through gate_0 (x 1) and north through gate_1 (y -22), the feet
+#: stopping at y -21.95, short of the pit's ramp (the streamed walk of docs/vrc.md).
+GATE_1_ROUTE: tuple[tuple[float, float], ...] = ((2.5, -38.0), (0.5, -24.5), (0.5, -21.95))
+#: The fall criterion is asked this often (ticks).
+FALL_CHECK_TICKS = 10
+#: A route's steps may take this long each, on average, before the run gives up (s).
+SECONDS_PER_STEP = 0.9
+
+
+@dataclass(frozen=True)
+class CourseWalk:
+    """How one walk went. `gates`: the scorer's event messages with their sim times (s);
+    `fell_at_s`: when sim/fall.py's criterion first held (None: it never did)."""
+
+    seed: int | None
+    outcome: str | None         # WalkClient's Outcome value; None: the time ran out
+    steps_planned: int
+    steps_taken: int
+    gates: tuple[tuple[float, str], ...]
+    completion: int
+    scorer_falls: int
+    fell_at_s: float | None
+    pelvis_xy: tuple[float, float]
+    sim_s: float
+    cpu_s: float
+
+
+class _Streamer:
+    """The client's side of each tick: the newest WALK before the step, the state after."""
+
+    def __init__(self, sim: AtlasSimulator, interface: AtlasSimInterface) -> None:
+        self.sim, self.interface = sim, interface
+        self.client: WalkClient | None = None
+        self.pending: list[Footstep] | None = None
+        self.ground = GroundUnderFeet(sim.atlas, sim.data)
+        self.fell_at_s: float | None = None
+        self.ticks = 0
+
+    def before_step(self) -> None:
+        if self.pending is not None:
+            queue = [step_data_of(step, 0.0) for step in self.pending]  # the links' poses
+            queue += [StepData()] * (QUEUE_LENGTH - len(queue))
+            self.interface.apply(AsiCommand(0, Behavior.WALK, tuple(queue), False, StepData(),
+                                            False, ManipulateParams(), None, 0))
+            self.pending = None
+
+    def after_step(self) -> None:
+        self.ticks += 1
+        if self.client is not None:
+            state = self.interface.state()
+            steps = self.client.on_state(state.current_behavior,
+                                         state.behavior_feedback.status_flags,
+                                         state.walk_feedback.current_step_index,
+                                         state.walk_feedback.next_step_index_needed)
+            if steps:
+                self.pending = steps
+        if self.ticks % FALL_CHECK_TICKS == 0 and self.fell_at_s is None \
+                and self.ground.fallen():
+            self.fell_at_s = self.sim.sim_time_ns / NS_PER_S
+
+
+def feet_origin(interface: AtlasSimInterface) -> tuple[tuple[float, float], float]:
+    """The foot links' midpoint (x, y) and mean heading, from foot_pos_est."""
+    feet = interface.state().foot_poses
+    left, right = (yaw_of_quaternion(*foot[3:7]) for foot in feet)
+    heading = left + 0.5 * wrap_angle(right - left)
+    return (float(feet[:, 0].mean()), float(feet[:, 1].mean())), heading
+
+
+def course_walk(seed: int | None, waypoints: Sequence[tuple[float, float]] = GATE_1_ROUTE,
+                world_name: str = 'vrc_task_2', gait: RouteGait | None = None,
+                walk_at_s: float = 3.0, stand_after_s: float = 3.0,
+                score_dir: Path | None = None) -> CourseWalk:
+    """Walk `waypoints` on the world `world_name` from its start perturbed by `seed`
+    (None: unperturbed); score.log goes to `score_dir` (None: a temporary directory)."""
+    world = named_world(world_name)
+    sim = AtlasSimulator(load_model(world.model_path), load_gains_yaml(DEFAULT_GAINS_FILE),
+                         startup_mode=VrcMode.BDI_STAND, start=world.start,
+                         mud_damping=world.mud_damping)
+    perturb_start(sim.atlas, sim.data, seed, on_ground=False)
+    interface = AtlasSimInterface(sim, hold_at_start=True)
+    streamer = _Streamer(sim, interface)
+    rows: list[ScoreRow] = []
+    started = time.process_time()
+    with tempfile.TemporaryDirectory(prefix='course_walk_') as scratch:
+        scoring = CourseScoring(sim, score_dir or Path(scratch), rows.append)
+        tick = Tick(sim, streamer, streamer.after_step, interface.end_step, score=scoring)
+        _run_until(tick, sim, walk_at_s, streamer)
+        plan: list[Footstep] = []
+        if streamer.fell_at_s is None:
+            origin, heading = feet_origin(interface)
+            plan = route_steps(origin, heading, waypoints, gait)
+            streamer.client = WalkClient(plan, streaming=True)
+            limit_s = sim.sim_time_ns / NS_PER_S + len(plan) * SECONDS_PER_STEP
+            client = streamer.client
+            while client.outcome is None and streamer.fell_at_s is None \
+                    and sim.sim_time_ns < limit_s * NS_PER_S:
+                tick()
+            _run_until(tick, sim, sim.sim_time_ns / NS_PER_S + stand_after_s, streamer)
+        scoring.close()
+    client = streamer.client
+    pelvis = sim.data.xpos[sim.atlas.pelvis_body_id]
+    last = rows[-1] if rows else None
+    return CourseWalk(
+        seed=seed, outcome=None if client is None or client.outcome is None
+        else client.outcome.value, steps_planned=len(plan),
+        steps_taken=0 if client is None else client.steps_taken,
+        gates=tuple((row.sim_time_ns / NS_PER_S, row.message.strip()) for row in rows
+                    if row.message),
+        completion=0 if last is None else last.completion,
+        scorer_falls=0 if last is None else last.falls, fell_at_s=streamer.fell_at_s,
+        pelvis_xy=(float(pelvis[0]), float(pelvis[1])), sim_s=sim.sim_time_ns / NS_PER_S,
+        cpu_s=time.process_time() - started)
+
+
+def _run_until(tick: Tick, sim: AtlasSimulator, until_s: float, streamer: _Streamer) -> None:
+    """Tick until sim time `until_s` or a fall."""
+    until_ns = math.floor(until_s * NS_PER_S)
+    while sim.sim_time_ns < until_ns and streamer.fell_at_s is None:
+        tick()

@@ -1,0 +1,31 @@
+"""offline/course_route.py: a streamed walk along a route on the VRC course, scored, as
+tools/course_walk.py measures the walk to gate_1 (docs/vrc.md). Here a short route from the
+pen's start (DRCSim's bdi_stand start, Stand from 2 s, the walk planned at 3 s from
+foot_pos_est): four 0.1 m strides east on the pen's floor (from the foot links' midpoint,
+a few centimetres behind the pelvis), which the robot must walk to the end without a fall,
+its pelvis brought to the route's end (within 5 cm), no gate passed. About 20 s of CPU at a
+load of 4 (the course's physics)."""
+
+from __future__ import annotations
+
+import pytest
+
+from tutorial_atlas_control.offline import course_walk
+from tutorial_atlas_control.walking import RouteGait
+
+pytestmark = pytest.mark.offline
+
+#: The pen's start is at (-3.0, -38.0), facing east.
+ROUTE = ((-2.65, -38.0),)
+
+
+def test_a_short_route_in_the_pen_is_walked_to_its_end() -> None:
+    walk = course_walk(None, ROUTE, gait=RouteGait(stride_m=0.1), stand_after_s=1.0)
+    assert walk.outcome == 'walked', walk
+    assert walk.steps_taken == walk.steps_planned
+    assert walk.steps_planned in (5, 6)  # four or five strides, then the feet together
+    assert walk.fell_at_s is None and walk.scorer_falls == 0, walk
+    assert walk.gates == () and walk.completion == 0
+    x, y = walk.pelvis_xy
+    assert x == pytest.approx(-2.65, abs=0.05)
+    assert y == pytest.approx(-38.0, abs=0.05)

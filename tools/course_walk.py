@@ -1,0 +1,75 @@
+#!/usr/bin/env python3
+"""Streamed walks on the VRC Task 2 course, offline and scored, one seed after another: the
+measurement behind docs/vrc.md's figures for the walk to gate_1.
+
+    python3 tools/course_walk.py [--waypoints 'X,Y X,Y ...'] [--stride M] SEED [SEED ...]
+
+SEED is an integer (walking/start_noise.py's perturbed start) or `none` (the start as the
+world gives it). Each walk prints one JSON line (offline/course_route.py's CourseWalk) as it
+ends; a run costs about 300-500 s of CPU on this host (the course's physics). Run it under
+tools/lowest_priority.py beside other work. Needs `source ./env.sh`. Exits 0 when every walk
+reached the end of its route without a fall, 1 otherwise, 2 for bad arguments.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import sys
+
+from tutorial_atlas_control.errors import AtlasControlError
+from tutorial_atlas_control.offline import GATE_1_ROUTE, course_walk
+from tutorial_atlas_control.walking import RouteGait
+
+PROG = 'course_walk.py'
+
+
+def _seed(text: str) -> int | None:
+    if text == 'none':
+        return None
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'seed {text!r} is not an integer or none') from None
+
+
+def _waypoints(text: str) -> tuple[tuple[float, float], ...]:
+    points = []
+    for pair in text.split():
+        try:
+            x, y = (float(value) for value in pair.split(','))
+        except ValueError:
+            raise argparse.ArgumentTypeError(f'waypoint {pair!r} is not X,Y') from None
+        points.append((x, y))
+    if not points:
+        raise argparse.ArgumentTypeError('no waypoint given')
+    return tuple(points)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog=PROG, description=__doc__.split('\n\n')[0])
+    parser.add_argument('seeds', type=_seed, nargs='+', metavar='SEED')
+    parser.add_argument('--waypoints', type=_waypoints, default=None,
+                        help="the route, world x,y pairs (default: the pen to gate_1)")
+    parser.add_argument('--stride', type=float, default=0.15, help='longest stride (m)')
+    parser.add_argument('--world', default='vrc_task_2', help='a VRC Task 2 world name')
+    args = parser.parse_args(argv)
+    try:
+        gait = RouteGait(stride_m=args.stride)
+    except AtlasControlError as err:
+        parser.error(str(err))
+    all_walked = True
+    for seed in args.seeds:
+        try:
+            walk = course_walk(seed, args.waypoints or GATE_1_ROUTE, args.world, gait)
+        except AtlasControlError as err:
+            print(f'{PROG}: {err}', file=sys.stderr)
+            return 2
+        print(json.dumps(dataclasses.asdict(walk)), flush=True)
+        all_walked &= walk.outcome == 'walked' and walk.fell_at_s is None
+    return 0 if all_walked else 1
+
+
+if __name__ == '__main__':
+    sys.exit(main())
