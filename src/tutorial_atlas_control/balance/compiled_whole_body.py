@@ -127,8 +127,8 @@ class CompiledWholeBody:
 
     def _results(self) -> Tick:
         wrenches, torque = self._statics.outputs
-        out = self._out
-        return torque.copy(), out[0:2].copy(), out[2:5].copy(), out[5:8].copy(), wrenches.copy()
+        out = self._out.copy()
+        return torque.copy(), out[0:2], out[2:5], out[5:8], wrenches.copy()
 
     def tick(self, state: BalanceState, region: Region | None,
              contacts: tuple[ContactConstraint, ContactConstraint],
