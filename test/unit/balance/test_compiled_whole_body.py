@@ -31,6 +31,7 @@ from tutorial_atlas_control.balance.stand import (
 )
 from tutorial_atlas_control.balance.stand_behaviour import StandBehaviour
 from tutorial_atlas_control.balance.stand_pose import place_in_stand_pose
+from tutorial_atlas_control.balance.whole_body import QP, STATICS_ENV
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.walking import straight_steps
 from tutorial_atlas_control.walking.walk_trial import SETTLE_S, walk_trial
@@ -190,3 +191,21 @@ def test_compiled_stand_runs_are_deterministic(library,
     monkeypatch.delenv(WHOLE_BODY_ENV, raising=False)
     first, second = _pushed_stand_qpos(0.6), _pushed_stand_qpos(0.6)
     assert first.tobytes() == second.tobytes()
+
+
+@pytest.mark.parametrize(('variable', 'gains', 'compiled'), [
+    (None, StandGains(), True), (WHOLE_BODY_ENV, StandGains(), False),
+    (STATICS_ENV, StandGains(), False), (None, StandGains(solver=QP), False)])
+def test_the_python_tick_is_chosen_by_its_switches_and_the_qp(
+        library, monkeypatch: pytest.MonkeyPatch, variable: str | None, gains: StandGains,
+        compiled: bool) -> None:
+    """TAC_WHOLE_BODY=python, TAC_STATICS=python (the C tick calls the C statics) and the
+    QP solver (Python only) each choose the Python tick."""
+    for name in (WHOLE_BODY_ENV, STATICS_ENV):
+        monkeypatch.delenv(name, raising=False)
+    if variable is not None:
+        monkeypatch.setenv(variable, 'python')
+    reference = StandReference(np.zeros(2), 0.85, np.eye(3))
+    controller = StandController(90.0, np.full(JOINTS, 100.0), reference, SOLE_HALF_SIZE_M,
+                                 gains)
+    assert controller.compiled is compiled
