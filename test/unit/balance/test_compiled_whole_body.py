@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from tutorial_atlas_control.balance import support
-from tutorial_atlas_control.balance.estimator import BalanceEstimator, BalanceState
+from tutorial_atlas_control.balance.estimator import BalanceEstimator, BalanceState, _within
 from tutorial_atlas_control.balance.push_trial import (
     Push,
     apply_pushes,
@@ -209,3 +209,19 @@ def test_the_python_tick_is_chosen_by_its_switches_and_the_qp(
     controller = StandController(90.0, np.full(JOINTS, 100.0), reference, SOLE_HALF_SIZE_M,
                                  gains)
     assert controller.compiled is compiled
+
+
+def test_the_polygon_cache_s_moved_test_answers_as_numpy_s() -> None:
+    """The estimator keeps its support polygon while the soles moved less than a tolerance:
+    its plain-float test answers as float(np.max(np.abs(d))) < tolerance, NaN and inf too."""
+    rng = np.random.default_rng(61)
+    answers = set()
+    for case in range(4000):
+        difference = rng.normal(0.0, 5e-4, (2, 3) if case % 2 else (2, 3, 3))
+        if case % 5 == 0:
+            difference.flat[rng.integers(difference.size)] = (np.nan, np.inf, -np.inf,
+                                                              5e-4, -5e-4)[case % 25 // 5]
+        expected = float(np.max(np.abs(difference))) < 5e-4
+        assert _within(difference, 5e-4) is expected
+        answers.add(expected)
+    assert answers == {True, False}
