@@ -185,12 +185,19 @@ def _pushed_stand_qpos(seconds: float) -> np.ndarray:
     return sim.data.qpos.copy()
 
 
-def test_compiled_stand_runs_are_deterministic(library,
-                                               monkeypatch: pytest.MonkeyPatch) -> None:
-    """Two offline runs of the compiled Stand end in the same state, bit for bit."""
+def test_compiled_stand_and_walk_runs_are_deterministic(
+        library, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Two offline runs of the compiled Stand end in the same state, bit for bit; two
+    walks end with the pelvis at the same bits, their landings and torque jumps the same."""
     monkeypatch.delenv(WHOLE_BODY_ENV, raising=False)
     first, second = _pushed_stand_qpos(0.6), _pushed_stand_qpos(0.6)
     assert first.tobytes() == second.tobytes()
+    walks = [walk_trial(straight_steps(2, 0.25), SETTLE_S + 0.6 + 2 * 0.63 + 0.2)
+             for _ in range(2)]
+    assert walks[0].steps == 2
+    assert walks[0].pelvis_end.tobytes() == walks[1].pelvis_end.tobytes()
+    assert walks[0].landings == walks[1].landings
+    assert walks[0].leg_torque_jump_nm == walks[1].leg_torque_jump_nm
 
 
 @pytest.mark.parametrize(('variable', 'gains', 'compiled'), [
