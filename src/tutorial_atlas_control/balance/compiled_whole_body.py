@@ -8,7 +8,8 @@ StandController.whole_body does the same at a given pressure centre without the 
 a tick, here one call around the inverse statics' own C (compiled_statics, whose input
 buffer this fills). Per tick the state's numbers are copied into the buffers whose
 addresses C keeps; the reference, the joint gains and the support region are copied only
-when they are other objects than last tick's. Both agree to rounding
+when they are other objects than last tick's (the package makes a new reference to change
+one, never writing into its arrays). Both agree to rounding
 (test/unit/balance/test_compiled_whole_body.py: 1e-9).
 """
 
