@@ -7,11 +7,13 @@ far outside the polygon, a region shrunk to a point, user joint gains, moving re
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 import mujoco
 import numpy as np
 import pytest
 
+from tutorial_atlas_control import native
 from tutorial_atlas_control.balance import support
 from tutorial_atlas_control.balance.estimator import BalanceEstimator, BalanceState, _within
 from tutorial_atlas_control.balance.push_trial import (
@@ -232,3 +234,16 @@ def test_the_polygon_cache_s_moved_test_answers_as_numpy_s() -> None:
         assert _within(difference, 5e-4) is expected
         answers.add(expected)
     assert answers == {True, False}
+
+
+def test_without_the_library_the_python_tick_runs_after_one_warning(
+        monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    monkeypatch.setattr(native, '_library', None)
+    monkeypatch.setattr(native, '_warned', False)
+    monkeypatch.setenv(native.LIBRARY_ENV, str(tmp_path / 'missing.so'))
+    reference = StandReference(np.zeros(2), 0.85, np.eye(3))
+    with pytest.warns(RuntimeWarning, match='statics and whole-body tick$') as caught:
+        controllers = [StandController(90.0, np.full(JOINTS, 100.0), reference,
+                                       SOLE_HALF_SIZE_M) for _ in range(2)]
+    assert len(caught) == 1
+    assert not any(controller.compiled for controller in controllers)
