@@ -3,13 +3,17 @@ tick of the bench's Stand and Walk (bench/offline.py's stand_run and walk_run), 
 in one process, each figure (process time) beside a bare mj_step timed in the same round
 (not a `make bench` section: a decision's figures, run by hand).
 
-    python3 bench/estimator_cost.py [--rounds 9] [--pairs 3] [--skip-runs]
+    python3 bench/estimator_cost.py [--rounds 9] [--pairs 3] [--skip-runs] [--skip-estimates]
+        [--ticks] [--kinds python swing compiled]
 
 The estimator is chosen at its construction by TAC_ESTIMATOR, inverse statics by
-TAC_STATICS, Walk's swing servo by TAC_SWING (`python`, else compiled); the runs compare all
-in Python, the estimator compiled, the estimator and statics compiled, and all three
-compiled; each round alternates which goes first. Prints the medians, their ratios to
-mj_step and to Python's in each pair, and the load (`uptime`) before and after.
+TAC_STATICS, Walk's swing servo by TAC_SWING, the whole-body tick around the statics by
+TAC_WHOLE_BODY (`python`, else compiled); the runs compare all in Python, the estimator
+compiled, the estimator and statics compiled, all but the whole-body tick compiled, and all
+four compiled (--kinds picks some); with --ticks, StandController.tick alone on a Stand
+run's recorded inputs too. Each round alternates which goes first. Prints the
+medians, their ratios to mj_step and to Python's in each pair, and the load (`uptime`)
+before and after.
 """
 
 from __future__ import annotations
@@ -25,17 +29,24 @@ import numpy as np
 from node_loop import RESTORE_EVERY_STEPS, STANDING_AFTER_S
 from offline import make_simulator, python_reference_switches, stand_run, walk_run
 
-from tutorial_atlas_control.balance import BalanceEstimator, place_in_stand_pose
+from tutorial_atlas_control.balance import (
+    BalanceEstimator,
+    StandController,
+    TimedStand,
+    place_in_stand_pose,
+)
 from tutorial_atlas_control.sim import model as atlas_model
 
 KINDS = ('python', 'compiled')
-#: The variables that switch the estimator, inverse statics and the swing servo to Python.
-SWITCHES = ESTIMATOR, STATICS, SWING = python_reference_switches()
-#: The runs' kinds: the parts each runs in Python (all; the statics and the swing servo; the
-#: swing servo; none).
+#: The variables that switch the estimator, inverse statics, the swing servo and the
+#: whole-body tick to Python.
+SWITCHES = ESTIMATOR, STATICS, SWING, WHOLE_BODY = python_reference_switches()
+#: The runs' kinds: the parts each runs in Python (all; all but the estimator; the swing
+#: servo and the whole-body tick; the whole-body tick; none).
 RUN_KINDS = {'python': dict.fromkeys(SWITCHES, 'python'),
-             'estimator': dict.fromkeys((STATICS, SWING), 'python'),
-             'statics': {SWING: 'python'}, 'compiled': {}}
+             'estimator': dict.fromkeys((STATICS, SWING, WHOLE_BODY), 'python'),
+             'statics': dict.fromkeys((SWING, WHOLE_BODY), 'python'),
+             'swing': {WHOLE_BODY: 'python'}, 'compiled': {}}
 
 
 class BareStep:
@@ -98,9 +109,11 @@ def _summary(name: str, figures: dict[str, list[float]], steps: list[float]) -> 
                      f'({min(values):.1f}–{max(values):.1f})')
     ratios = []
     kinds = list(figures)
-    compared = [(kind, 'python') for kind in kinds[1:]]
-    if 'statics' in figures and 'compiled' in figures:  # what the swing servo's C adds
-        compared.append(('compiled', 'statics'))
+    compared = [(kind, 'python') for kind in kinds if kind != 'python' and 'python' in figures]
+    if 'statics' in figures and 'swing' in figures:  # what the swing servo's C adds
+        compared.append(('swing', 'statics'))
+    if 'swing' in figures and 'compiled' in figures:  # what the whole-body tick's C adds
+        compared.append(('compiled', 'swing'))
     for kind, base in compared:
         pairs = [c / p for p, c in zip(figures[base], figures[kind], strict=True)]
         ratios.append(f'{kind}/{base} per pair median {statistics.median(pairs):.3f} '
@@ -125,12 +138,49 @@ def compare_estimates(rounds: int) -> None:
     _summary('estimate', figures, steps)
 
 
-def compare_runs(pairs: int) -> None:
+def recorded_stand_ticks(ticks: int = 500) -> tuple[StandController, list[tuple]]:
+    """A Stand run's controller and its last `ticks` inputs (state, joint positions and
+    velocities), standing after the take-over; each state's polygon asked for once."""
+    sim = make_simulator()
+    stand = TimedStand(sim.atlas)
+    sim.install_stand(stand)
+    recorded = []
+    for step in range(2500 + ticks):
+        sim.step()
+        if step >= 2500:
+            state = stand.last_state
+            state.support_polygon  # noqa: B018 - the controller's first ask, done here
+            recorded.append((state, sim.data.qpos[sim.atlas.qpos_adr].copy(),
+                             sim.data.qvel[sim.atlas.dof_adr].copy()))
+    return stand.controller, recorded
+
+
+def compare_ticks(rounds: int) -> None:
+    """StandController.tick alone, Python against compiled, on a run's recorded inputs."""
+    base, recorded = recorded_stand_ticks()
+    controllers = {kind: StandController(base.mass_kg, base.layer.effort_limit_nm,
+                                         base.reference, base.sole_half_size_m, base.gains,
+                                         compiled=kind == 'compiled') for kind in KINDS}
+    assert controllers['compiled'].compiled, 'the compiled library is not built'
+    figures: dict[str, list[float]] = {kind: [] for kind in KINDS}
+    steps, bare = [], BareStep()
+    for round_index in range(rounds):
+        steps.append(bare.us())
+        for kind in KINDS if round_index % 2 == 0 else KINDS[::-1]:
+            tick = controllers[kind].tick
+            start = time.process_time()
+            for _ in range(10):
+                for state, positions, velocities in recorded:
+                    tick(state, positions, velocities)
+            figures[kind].append((time.process_time() - start) / (10 * len(recorded)) * 1e6)
+    _summary('StandController.tick', figures, steps)
+
+
+def compare_runs(pairs: int, kinds: list[str]) -> None:
     bare = BareStep()
-    stand: dict[str, list[float]] = {kind: [] for kind in RUN_KINDS}
-    walk: dict[str, list[float]] = {kind: [] for kind in RUN_KINDS}
+    stand: dict[str, list[float]] = {kind: [] for kind in kinds}
+    walk: dict[str, list[float]] = {kind: [] for kind in kinds}
     steps = []
-    kinds = list(RUN_KINDS)
     for pair in range(pairs):
         for kind in kinds if pair % 2 == 0 else kinds[::-1]:
             for name in SWITCHES:
@@ -148,11 +198,19 @@ def main() -> None:
     parser.add_argument('--rounds', type=int, default=9)
     parser.add_argument('--pairs', type=int, default=3)
     parser.add_argument('--skip-runs', action='store_true', help='only the estimates')
+    parser.add_argument('--skip-estimates', action='store_true', help='only the runs')
+    parser.add_argument('--ticks', action='store_true',
+                        help='also StandController.tick alone, Python against compiled')
+    parser.add_argument('--kinds', nargs='+', choices=list(RUN_KINDS), default=list(RUN_KINDS),
+                        help='the runs\' kinds (each paired with python\'s, if run)')
     args = parser.parse_args()
     print('load before:', subprocess.run(['uptime'], capture_output=True, text=True).stdout.strip())
-    compare_estimates(args.rounds)
+    if not args.skip_estimates:
+        compare_estimates(args.rounds)
+    if args.ticks:
+        compare_ticks(args.rounds)
     if not args.skip_runs:
-        compare_runs(args.pairs)
+        compare_runs(args.pairs, [kind for kind in RUN_KINDS if kind in args.kinds])
     print('load after:', subprocess.run(['uptime'], capture_output=True, text=True).stdout.strip())
 
 

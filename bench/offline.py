@@ -57,10 +57,10 @@ def physics_run(warmup_steps: int = 1500, steps: int = 5000, compiled_law: bool 
 def python_reference_switches() -> tuple[str, ...]:
     """The environment variables that switch each compiled part of the controller to its
     pure Python reference: the bench's "before" of the compiled core."""
-    from tutorial_atlas_control.balance import ESTIMATOR_ENV, STATICS_ENV
+    from tutorial_atlas_control.balance import ESTIMATOR_ENV, STATICS_ENV, WHOLE_BODY_ENV
     from tutorial_atlas_control.walking import SWING_ENV
 
-    return ESTIMATOR_ENV, STATICS_ENV, SWING_ENV
+    return ESTIMATOR_ENV, STATICS_ENV, SWING_ENV, WHOLE_BODY_ENV
 
 
 @contextlib.contextmanager

@@ -1,12 +1,14 @@
 """The package's compiled library (src/atlas_law.c, src/atlas_gather.c,
-src/atlas_estimator.c, src/atlas_statics.c, src/atlas_swing.c): found, loaded, checked.
+src/atlas_estimator.c, src/atlas_statics.c, src/atlas_whole_body.c, src/atlas_swing.c):
+found, loaded, checked.
 
 One place knows the library's binary interface: the ctypes mirrors of its structs, the
 signatures of its functions, and where catkin puts it (a devel space's lib/ and an
 install space's lib/ are both on CMAKE_PREFIX_PATH once their setup.bash is sourced).
 Its users, the compiled law (sim/law_kernel.py), the messages' copies
 (sim/copy_plan.py), the balance estimator (balance/compiled_estimator.py), the
-whole-body layer's inverse statics (balance/compiled_statics.py) and the swing foot's
+whole-body layer's inverse statics (balance/compiled_statics.py), Stand's whole-body tick
+around them (balance/compiled_whole_body.py) and the swing foot's
 servo (walking/compiled_swing.py), ask here.
 The estimator's part calls MuJoCo: the library is linked against the Python wheel's
 libmujoco, the one `import mujoco` loads, so that one MuJoCo runs in the process.
@@ -30,8 +32,8 @@ import numpy as np
 from tutorial_atlas_control.command import LAW_FIELDS
 
 __all__ = ['LIBRARY_ENV', 'LIBRARY_NAME', 'MIRRORED_STRUCTS', 'AtlasCopy', 'AtlasEstimator',
-           'AtlasLawStep', 'AtlasStatics', 'AtlasSwing', 'address', 'chosen_library',
-           'find_library', 'load_library', 'size_mismatches']
+           'AtlasLawStep', 'AtlasStatics', 'AtlasSwing', 'AtlasWholeBody', 'address',
+           'chosen_library', 'find_library', 'load_library', 'size_mismatches']
 
 #: The shared library CMakeLists.txt builds (devel/lib, installed to the prefix's lib/).
 LIBRARY_NAME = 'libtutorial_atlas_control_law.so'
@@ -39,7 +41,7 @@ LIBRARY_NAME = 'libtutorial_atlas_control_law.so'
 LIBRARY_ENV = 'TAC_LAW_LIBRARY'
 #: What the callers do without the library (the end of the one warning).
 FALLBACK = ('using the numpy controller law (same torques, slower), the Python swing-foot '
-            'servo and the Python balance estimator and statics')
+            'servo and the Python balance estimator, statics and whole-body tick')
 #: How the library names the function that returns sizeof(Struct).
 SIZEOF_PREFIX = 'tac_sizeof_'
 
@@ -88,6 +90,16 @@ class AtlasStatics(ctypes.Structure):
                 ('min_load_share', ctypes.c_double), ('n', ctypes.c_long)]
 
 
+class AtlasWholeBody(ctypes.Structure):
+    """AtlasWholeBody in src/atlas_whole_body.c (same fields, same order)."""
+
+    _fields_ = [('statics', ctypes.c_void_p), ('in_', ctypes.c_void_p),
+                ('reference', ctypes.c_void_p), ('gains', ctypes.c_void_p),
+                ('joint_gains', ctypes.c_void_p), ('effort_limit', ctypes.c_void_p),
+                ('region', ctypes.c_void_p), ('out', ctypes.c_void_p),
+                ('region_count', ctypes.c_long)]
+
+
 class AtlasSwing(ctypes.Structure):
     """AtlasSwing in src/atlas_swing.c (same fields, same order)."""
 
@@ -106,6 +118,7 @@ MIRRORED_STRUCTS: dict[str, type[ctypes.Structure]] = {
     'AtlasEstimator': AtlasEstimator,
     'AtlasStatics': AtlasStatics,
     'AtlasSwing': AtlasSwing,
+    'AtlasWholeBody': AtlasWholeBody,
 }
 
 
@@ -174,6 +187,10 @@ def _declare(library: ctypes.CDLL) -> None:
     library.atlas_estimator_contacts.restype = ctypes.c_long
     library.atlas_inverse_statics.argtypes = [ctypes.POINTER(AtlasStatics)]
     library.atlas_inverse_statics.restype = None
+    for name in ('atlas_whole_body', 'atlas_stand_tick'):
+        function = getattr(library, name)
+        function.argtypes = [ctypes.POINTER(AtlasWholeBody)]
+        function.restype = None
     for name in ('atlas_foot_servo', 'atlas_swing_torque'):
         function = getattr(library, name)
         function.argtypes = [ctypes.POINTER(AtlasSwing)]

@@ -19,8 +19,9 @@ from tutorial_atlas_control.sim.simulator import AtlasSimulator
 
 REPO = Path(__file__).resolve().parents[2]
 C_SOURCES = (REPO / 'src' / 'atlas_law.c', REPO / 'src' / 'atlas_gather.c',
-             REPO / 'src' / 'atlas_estimator.c', REPO / 'src' / 'atlas_statics.c',
-             REPO / 'src' / 'atlas_swing.c')
+             REPO / 'src' / 'atlas_estimator.c', REPO / 'src' / 'atlas_statics.h',
+             REPO / 'src' / 'atlas_statics.c', REPO / 'src' / 'atlas_swing.c',
+             REPO / 'src' / 'atlas_whole_body.c')
 CONFIG = REPO / 'config' / 'atlas_controller.yaml'
 #: A C struct Python may lay out: `typedef struct { ... } Name;`.
 C_TYPEDEF_STRUCT = re.compile(r'typedef struct \{.*?\} (\w+);', re.S)
@@ -38,7 +39,7 @@ def test_every_struct_of_the_c_sources_is_mirrored() -> None:
                  for name in C_TYPEDEF_STRUCT.findall(source.read_text())}
     assert c_structs == set(native.MIRRORED_STRUCTS) == {'AtlasLawStep', 'AtlasCopy',
                                                          'AtlasEstimator', 'AtlasStatics',
-                                                         'AtlasSwing'}
+                                                         'AtlasSwing', 'AtlasWholeBody'}
     for name, mirror in native.MIRRORED_STRUCTS.items():
         assert mirror.__name__ == name
 
@@ -68,7 +69,8 @@ def test_a_library_whose_sizes_differ_is_refused_with_one_warning(
                 rf'{ctypes.sizeof(native.AtlasCopy)} bytes there, {ctypes.sizeof(_LongerCopy)}'
                 r' in tutorial_atlas_control.native\); rebuild it \(`make setup`\); '
                 r'using the numpy controller law \(same torques, slower\), the Python '
-                r'swing-foot servo and the Python balance estimator and statics$')
+                r'swing-foot servo and the Python balance estimator, statics and '
+                r'whole-body tick$')
     with pytest.warns(RuntimeWarning, match=expected) as caught:
         assert native.load_library() is None
         sim = AtlasSimulator(atlas_model.load_model(), load_gains_yaml(CONFIG))
@@ -91,7 +93,8 @@ def test_a_library_without_size_functions_is_refused(
                                             r'code \(no tac_sizeof_AtlasCopy\(\); no '
                                             r'tac_sizeof_AtlasEstimator\(\); no '
                                             r'tac_sizeof_AtlasStatics\(\); no '
-                                            r'tac_sizeof_AtlasSwing\(\)\); rebuild'):
+                                            r'tac_sizeof_AtlasSwing\(\); no '
+                                            r'tac_sizeof_AtlasWholeBody\(\)\); rebuild'):
         assert native.load_library() is None
 
 

@@ -11,6 +11,7 @@ per-tick work as one C call; whole_body: tasks and constraints over one state, s
 torques (inverse statics, compiled_statics its C call, or contact_qp: the contact wrenches
 by a QP); stand: the Stand
 controller (its tasks: capture-point feedback, height, pelvis frame, posture);
+compiled_whole_body: its tick (pressure centre, tasks, statics, posture, limits) as one C call;
 stand_behaviour: that controller as the simulator's Stand behaviour, with the servo;
 stand_prep: StandPrep, the harnessed robot brought to the Stand pose; push_trial: offline
 trials of it on the simulator, standing and pushed; slope_trial: Stand trials on a slope.
@@ -23,14 +24,15 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'errors': ['BalanceError'],
     'compiled_estimator': ['CompiledEstimate', 'EstimatorGeometry', 'RawEstimate'],
     'compiled_statics': ['CompiledStatics'],
+    'compiled_whole_body': ['CompiledWholeBody'],
     'estimator': ['CONTACT_HEIGHT_M', 'ESTIMATOR_ENV', 'MIN_COM_HEIGHT_M', 'BalanceEstimator',
                   'BalanceState'],
     'manipulate': ['PelvisServo'],
     'lipm': ['capture_point', 'capture_point_after', 'cop_reaching', 'dcm_feedback_cop',
              'natural_frequency'],
     'push_trial': ['Push', 'TimedStand', 'apply_pushes', 'push_events', 'standing_simulator'],
-    'stand': ['StandController', 'StandGains', 'StandReference', 'orientation_error', 'yaw_of',
-              'yaw_rotation'],
+    'stand': ['WHOLE_BODY_ENV', 'StandController', 'StandGains', 'StandReference',
+              'orientation_error', 'yaw_of', 'yaw_rotation'],
     'stand_behaviour': ['StandBehaviour'],
     'sole': ['SOLE_GEOMS', 'SoleBox', 'box_corners', 'sole_corners'],
     'stand_pose': ['STAND_POSE_RAD', 'place_in_stand_pose'],

@@ -64,21 +64,37 @@ class CompiledStatics:
                 math.nan if contact.friction is None else contact.friction)
         self._contacts = contacts
 
+    @property
+    def address(self) -> int:
+        """The address of its AtlasStatics, for a call that fills the force and moment and
+        calls atlas_inverse_statics itself (compiled_whole_body)."""
+        return ctypes.addressof(self._call)
+
+    @property
+    def outputs(self) -> tuple[np.ndarray, np.ndarray]:
+        """Its output buffers (wrenches (2, 6), torque (n,)), rewritten by each call."""
+        return self._wrenches, self._torque
+
+    def load(self, state: BalanceState,
+             contacts: tuple[ContactConstraint, ContactConstraint]) -> None:
+        """Copy the numbers of `state` the statics reads, and `contacts` when they changed."""
+        last = self._contacts
+        if last is None or last[0] is not contacts[0] or last[1] is not contacts[1]:
+            self._set_contacts(contacts)
+        self._com[:] = state.com
+        self._centres[:] = state.sole_centres
+        self._rotations[:] = state.sole_rotations
+        self._bias[:] = state.bias_nm
+        self._jacobians[:] = state.sole_jacobians
+
     def solve(self, force: np.ndarray, moment: np.ndarray, state: BalanceState,
               contacts: tuple[ContactConstraint, ContactConstraint],
               ) -> tuple[np.ndarray, np.ndarray]:
         """(wrenches (2, 6), torque (n,)), new arrays: `force`, `moment` about the centre of
         mass shared between the carrying soles of `contacts`, each share feasible, and
         bias - J^T w at `state`."""
-        last = self._contacts
-        if last is None or last[0] is not contacts[0] or last[1] is not contacts[1]:
-            self._set_contacts(contacts)
+        self.load(state, contacts)
         self._force[:] = force
         self._moment[:] = moment
-        self._com[:] = state.com
-        self._centres[:] = state.sole_centres
-        self._rotations[:] = state.sole_rotations
-        self._bias[:] = state.bias_nm
-        self._jacobians[:] = state.sole_jacobians
         self._library.atlas_inverse_statics(self._pointer)
         return self._wrenches.copy(), self._torque.copy()

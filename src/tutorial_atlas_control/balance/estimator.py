@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import copy
 import functools
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -130,6 +131,14 @@ class BalanceState:
         return self.polygon_of()
 
 
+def _within(difference: np.ndarray, tolerance: float) -> bool:
+    """Whether every element of `difference` is within +-`tolerance` (NaN: not): the
+    test of float(np.max(np.abs(difference))) < tolerance, in plain floats (a third of its
+    time for a few elements, each tick). min and max skip a NaN their sum keeps."""
+    values = difference.ravel().tolist()
+    return -tolerance < min(values) and max(values) < tolerance and not math.isnan(sum(values))
+
+
 class BalanceEstimator:
     """Turns (qpos, qvel) into a BalanceState with a scratch MjData of its own.
 
@@ -209,8 +218,8 @@ class BalanceEstimator:
         controller can cache on it). `positions`, `rotations`: the sole boxes' poses."""
         last = self._last_polygon
         if (last is not None and last[0] == contact
-                and float(np.max(np.abs(positions - last[1]))) < POLYGON_TOLERANCE_M
-                and float(np.max(np.abs(rotations - last[2]))) < self._rotation_tolerance):
+                and _within(positions - last[1], POLYGON_TOLERANCE_M)
+                and _within(rotations - last[2], self._rotation_tolerance)):
             return last[3]
         corners = positions[:, None, 0:2] + np.einsum(
             'fcj,fij->fci', self._corner_offsets, rotations)[:, :, 0:2]

@@ -15,6 +15,11 @@ its reference and solves them into the 28 joint torques:
    follow from where the pelvis is held; and the joint torque limits.
 With the capture-point gain at 0 the pressure centre sits on the capture point, which then
 stops but never returns: that is the planted defect the tests show falling.
+
+Where the package's library is built, a tick (and whole_body) is one C call
+(compiled_whole_body, around the inverse statics' C) equal to the Python here to rounding;
+the Python is the reference (WHOLE_BODY_ENV=python, STATICS_ENV=python, the QP solver, or
+no library).
 """
 
 from __future__ import annotations
@@ -24,7 +29,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from tutorial_atlas_control import native
 from tutorial_atlas_control.balance import lipm, support
+from tutorial_atlas_control.balance.compiled_whole_body import CompiledWholeBody
 from tutorial_atlas_control.balance.estimator import BalanceState
 from tutorial_atlas_control.balance.stand_pose import STAND_POSE_RAD
 from tutorial_atlas_control.balance.whole_body import (
@@ -39,9 +46,12 @@ from tutorial_atlas_control.balance.whole_body import (
     orientation_error,
 )
 
-__all__ = ['STAND_JOINT_KD', 'STAND_JOINT_KP', 'StandController', 'StandGains', 'StandOutput',
-           'StandReference', 'orientation_error', 'pelvis_frame', 'pitch_of', 'yaw_of',
-           'yaw_rotation']
+__all__ = ['STAND_JOINT_KD', 'STAND_JOINT_KP', 'WHOLE_BODY_ENV', 'StandController', 'StandGains',
+           'StandOutput', 'StandReference', 'orientation_error', 'pelvis_frame', 'pitch_of',
+           'yaw_of', 'yaw_rotation']
+
+#: Set to `python` for the whole-body tick in Python even where the compiled library is built.
+WHOLE_BODY_ENV = 'TAC_WHOLE_BODY'
 
 #: Joint PD to the Stand pose (N m/rad, N m s/rad), tutorial order. Back, neck and arms:
 #: DRCSim's atlas_controller gains (config/atlas_controller.yaml), stable at 1 kHz on the
@@ -153,28 +163,45 @@ class StandController:
     alone; the only thing kept is the support region prepared for the estimator's polygon."""
 
     def __init__(self, mass_kg: float, effort_limit_nm: np.ndarray, reference: StandReference,
-                 sole_half_size_m: tuple[float, float],
-                 gains: StandGains | None = None) -> None:
-        """`sole_half_size_m`: (half length, half width) of a sole box (m)."""
+                 sole_half_size_m: tuple[float, float], gains: StandGains | None = None,
+                 compiled: bool | None = None) -> None:
+        """`sole_half_size_m`: (half length, half width) of a sole box (m). `compiled`: the
+        tick by one C call when the library is built and inverse statics compiled (None:
+        unless WHOLE_BODY_ENV says `python`); False: in Python."""
         self.mass_kg = mass_kg
         self.reference = reference
         self.sole_half_size_m = sole_half_size_m
         self.gains = gains or StandGains()
-        self.layer = WholeBodyLayer(mass_kg, effort_limit_nm, self.gains.solver)
+        self.layer = WholeBodyLayer(mass_kg, effort_limit_nm, self.gains.solver, compiled)
         self._contacts: dict[tuple[bool, float | None], ContactConstraint] = {}
         self._region: tuple[np.ndarray, support.Region] | None = None
+        self._joint_gains = (self.gains.joint_kp, self.gains.joint_kd)
+        statics = self.layer.statics
+        library = None if statics is None else native.chosen_library(WHOLE_BODY_ENV, compiled)
+        self._kernel = None if library is None else CompiledWholeBody(
+            library, statics, mass_kg, self.gains, self.layer.effort_limit_nm)
+
+    @property
+    def compiled(self) -> bool:
+        """Whether the tick runs the C call."""
+        return self._kernel is not None
+
+    def support_region(self, state: BalanceState) -> support.Region | None:
+        """The support polygon shrunk by the margin (None: no polygon to keep to)."""
+        polygon = state.support_polygon
+        if len(polygon) < 3:
+            return None
+        if self._region is None or self._region[0] is not polygon:
+            # The estimator hands over the same polygon while the feet stay put.
+            self._region = (polygon, support.Region(polygon, self.gains.cop_margin_m))
+        return self._region[1]
 
     def desired_cop(self, state: BalanceState) -> np.ndarray:
         """The capture-point law's pressure centre, inside the support polygon."""
         cop = lipm.dcm_feedback_cop(state.capture_point, self.reference.capture_point,
                                     self.gains.capture_gain)
-        polygon = state.support_polygon
-        if len(polygon) < 3:
-            return cop
-        if self._region is None or self._region[0] is not polygon:
-            # The estimator hands over the same polygon while the feet stay put.
-            self._region = (polygon, support.Region(polygon, self.gains.cop_margin_m))
-        return self._region[1].clamp(cop)
+        region = self.support_region(state)
+        return cop if region is None else region.clamp(cop)
 
     def tasks(self, state: BalanceState, cop: np.ndarray,
               reference: StandReference) -> list[CentroidalTask]:
@@ -196,6 +223,10 @@ class StandController:
     def tick(self, state: BalanceState, joint_positions: np.ndarray,
              joint_velocities: np.ndarray) -> StandOutput:
         """The 28 joint torques (N m) for this tick, clamped to the effort limits."""
+        if self._kernel is not None:
+            return StandOutput(*self._kernel.tick(
+                state, self.support_region(state), self._contacts_for(state.in_contact, None),
+                joint_positions, joint_velocities, self._joint_gains, self.reference))
         output = self.whole_body(state, self.desired_cop(state), state.in_contact,
                                  joint_positions, joint_velocities)
         self.layer.limit(output.torque_nm)
@@ -212,6 +243,10 @@ class StandController:
             self._contacts[key] = made
         return made
 
+    def _contacts_for(self, contact: tuple[bool, bool],
+                      torsion_m: float | None) -> tuple[ContactConstraint, ContactConstraint]:
+        return self._contact(contact[0], torsion_m), self._contact(contact[1], torsion_m)
+
     def whole_body(self, state: BalanceState, cop: np.ndarray, contact: tuple[bool, bool],
                    joint_positions: np.ndarray, joint_velocities: np.ndarray,
                    joint_gains: tuple[np.ndarray, np.ndarray] | None = None,
@@ -223,8 +258,12 @@ class StandController:
         (kp, kd), else the Stand's); not yet clamped to the effort limits (Walk adds its
         swing leg's first)."""
         reference = reference or self.reference
-        contacts = (self._contact(contact[0], torsion_m), self._contact(contact[1], torsion_m))
-        joint_kp, joint_kd = joint_gains or (self.gains.joint_kp, self.gains.joint_kd)
+        contacts = self._contacts_for(contact, torsion_m)
+        if self._kernel is not None:
+            return StandOutput(*self._kernel.whole_body(
+                state, cop, contacts, joint_positions, joint_velocities,
+                joint_gains or self._joint_gains, reference))
+        joint_kp, joint_kd = joint_gains or self._joint_gains
         posture = PostureTask(reference.posture_rad, reference.posture_rate_rad_s, joint_kp,
                               joint_kd)
         solved = self.layer.solve(state, self.tasks(state, cop, reference), contacts,

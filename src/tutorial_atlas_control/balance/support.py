@@ -95,7 +95,9 @@ class Region:
 
     def __init__(self, polygon: np.ndarray, margin_m: float = 0.0) -> None:
         self.vertices = _shrunk(np.asarray(polygon).tolist(), margin_m)
-        self._lines = _inward_lines(self.vertices) if len(self.vertices) >= 3 else []
+        #: Each edge's (inward normal x, y, offset), edge i from vertex i to i + 1 (none for
+        #: a region shrunk to a point).
+        self.lines = _inward_lines(self.vertices) if len(self.vertices) >= 3 else []
 
     def clamp(self, point_xy: np.ndarray) -> np.ndarray:
         """`point_xy` if it is inside, else the region's nearest point."""
@@ -103,7 +105,7 @@ class Region:
         vertices = self.vertices
         if len(vertices) < 3:
             return np.array(vertices[0])
-        if _distance(self._lines, x, y) >= 0.0:
+        if _distance(self.lines, x, y) >= 0.0:
             return np.array([x, y])
         best, best_d2 = (x, y), math.inf
         for (ax, ay), (bx, by) in zip(vertices, vertices[1:] + vertices[:1]):

@@ -202,6 +202,11 @@ class WholeBodyLayer:
         """Whether inverse statics runs the C call."""
         return self._statics is not None
 
+    @property
+    def statics(self) -> CompiledStatics | None:
+        """The compiled inverse statics (None: in Python), for a tick around it in C."""
+        return self._statics
+
     def centroidal_wrench(self, state: BalanceState,
                           tasks: Sequence[CentroidalTask]) -> tuple[np.ndarray, np.ndarray]:
         """The tasks' (force (3,), moment (3,)) summed."""

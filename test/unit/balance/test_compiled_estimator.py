@@ -131,7 +131,7 @@ def test_without_the_library_the_python_estimate_runs_after_one_warning(
     monkeypatch.setattr(native, '_library', None)
     monkeypatch.setattr(native, '_warned', False)
     monkeypatch.setenv(native.LIBRARY_ENV, str(tmp_path / 'missing.so'))
-    with pytest.warns(RuntimeWarning, match='the Python balance estimator and statics$') as caught:
+    with pytest.warns(RuntimeWarning, match='statics and whole-body tick$') as caught:
         estimators = [BalanceEstimator(atlas) for _ in range(2)]
     assert len(caught) == 1
     assert not any(estimator.compiled for estimator in estimators)

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from tutorial_atlas_control.balance.estimator import BalanceEstimator, BalanceState
+from tutorial_atlas_control.balance.stand import WHOLE_BODY_ENV
 from tutorial_atlas_control.balance.stand_pose import place_in_stand_pose
 from tutorial_atlas_control.balance.whole_body import (
     ContactConstraint,
@@ -84,7 +85,10 @@ def test_compiled_statics_agrees_with_python_on_random_cases(library) -> None:
 
 def test_compiled_statics_agrees_with_python_through_a_walk(
         library, monkeypatch: pytest.MonkeyPatch) -> None:
-    """Each tick's solve (its joint tasks left out: a swing servo keeps state) by both."""
+    """Each tick's solve (its joint tasks left out: a swing servo keeps state) by both; the
+    whole-body tick in Python, which calls the layer's solve (the compiled tick calls the C
+    statics itself: test_compiled_whole_body.py)."""
+    monkeypatch.setenv(WHOLE_BODY_ENV, 'python')
     solve = WholeBodyLayer.solve
     differences: list[float] = []
     carrying: set[tuple[bool, bool]] = set()

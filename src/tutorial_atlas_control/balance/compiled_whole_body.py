@@ -1,0 +1,156 @@
+"""Stand's whole-body tick as one C call (src/atlas_whole_body.c through ctypes).
+
+StandController.tick picks the pressure centre (the capture-point law, clamped into the
+support polygon shrunk by the margin), builds the centroidal tasks and the posture task,
+solves them by inverse statics and clamps the torques to the effort limits;
+StandController.whole_body does the same at a given pressure centre without the clamp
+(Walk's legs call it). In Python that is some two hundred small float and numpy operations
+a tick, here one call around the inverse statics' own C (compiled_statics, whose input
+buffer this fills). Per tick the state's numbers are copied into the buffers whose
+addresses C keeps; the reference, the joint gains and the support region are copied only
+when they are other objects than last tick's (the package makes a new reference to change
+one, never writing into its arrays). Both agree to rounding
+(test/unit/balance/test_compiled_whole_body.py: 1e-9).
+"""
+
+from __future__ import annotations
+
+import ctypes
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from tutorial_atlas_control.balance.lipm import GRAVITY_M_S2
+from tutorial_atlas_control.native import AtlasWholeBody, address
+
+if TYPE_CHECKING:
+    from tutorial_atlas_control.balance.compiled_statics import CompiledStatics
+    from tutorial_atlas_control.balance.estimator import BalanceState
+    from tutorial_atlas_control.balance.stand import StandGains, StandReference
+    from tutorial_atlas_control.balance.support import Region
+    from tutorial_atlas_control.balance.whole_body import ContactConstraint
+
+#: The per-tick input's fixed part (src/atlas_whole_body.c's WB_IN_*): the pressure centre,
+#: the capture point, omega, the CoM's velocity, the pelvis's rotation and angular velocity.
+IN_FIXED = 20
+#: The reference's fixed part (WB_REF_*): capture point, height, its rate, pelvis rotation,
+#: pelvis angular velocity.
+REFERENCE_FIXED = 16
+#: Where a region row's fields sit: vertex x, y, then its edge's inward normal and offset.
+REGION_ROW = 5
+
+#: One tick's results: torque (n,), pressure centre (2,), force (3,), moment (3,) and the
+#: soles' wrenches (2, 6), new arrays.
+Tick = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+class CompiledWholeBody:
+    """atlas_stand_tick and atlas_whole_body over `statics`, with Stand's `gains` for a robot
+    of `mass_kg` and its `effort_limit_nm`; its buffers its own."""
+
+    def __init__(self, library: ctypes.CDLL, statics: CompiledStatics, mass_kg: float,
+                 gains: StandGains, effort_limit_nm: np.ndarray) -> None:
+        joints = len(effort_limit_nm)
+        self._library = library
+        self._statics = statics
+        self._in = np.zeros(IN_FIXED + 2 * joints)
+        self._reference = np.zeros(REFERENCE_FIXED + 2 * joints)
+        self._gains = np.array([mass_kg, gains.capture_gain, gains.height_kp, gains.height_kd,
+                                gains.orientation_kp, gains.orientation_kd, GRAVITY_M_S2])
+        self._joint_gains = np.zeros(2 * joints)
+        self._effort_limit = np.array(effort_limit_nm, dtype=np.float64)
+        self._out = np.zeros(8)
+        self._region = np.zeros((1, REGION_ROW))
+        buffer = self._in
+        self._cop, self._capture = buffer[0:2], buffer[2:4]
+        self._com_velocity = buffer[5:8]
+        self._pelvis_rotation = buffer[8:17].reshape(3, 3)
+        self._pelvis_angular = buffer[17:20]
+        self._joints = buffer[IN_FIXED:].reshape(2, joints)
+        self._last_reference: StandReference | None = None
+        self._last_gains: tuple[np.ndarray, np.ndarray] | None = None
+        self._last_region: Region | None | bool = False
+        call = self._call = AtlasWholeBody()
+        call.statics = statics.address
+        call.in_ = address(self._in, np.float64)
+        call.reference = address(self._reference, np.float64)
+        call.gains = address(self._gains, np.float64)
+        call.joint_gains = address(self._joint_gains, np.float64)
+        call.effort_limit = address(self._effort_limit, np.float64)
+        call.region = address(self._region, np.float64)
+        call.out = address(self._out, np.float64)
+        self._pointer = ctypes.byref(call)
+
+    def _set_reference(self, reference: StandReference) -> None:
+        joints = len(self._effort_limit)
+        buffer = self._reference
+        buffer[0:2] = reference.capture_point
+        buffer[2:4] = (reference.com_height_m, reference.com_height_rate_m_s)
+        buffer[4:13] = reference.pelvis_rotation.reshape(9)
+        buffer[13:16] = reference.pelvis_angular_velocity
+        buffer[REFERENCE_FIXED:REFERENCE_FIXED + joints] = reference.posture_rad
+        buffer[REFERENCE_FIXED + joints:] = reference.posture_rate_rad_s
+        self._last_reference = reference
+
+    def _set_region(self, region: Region | None) -> None:
+        """The region's vertices and edge lines (none: the pressure centre is not clamped)."""
+        if region is None:
+            self._call.region_count = 0
+        else:
+            count = len(region.vertices)
+            rows = np.zeros((count, REGION_ROW))
+            rows[:, 0:2] = region.vertices
+            if count >= 3:
+                rows[:, 2:5] = region.lines
+            self._region = rows
+            self._call.region = address(rows, np.float64)
+            self._call.region_count = count
+        self._last_region = region
+
+    def _load(self, state: BalanceState, contacts: tuple[ContactConstraint, ContactConstraint],
+              joint_positions: np.ndarray, joint_velocities: np.ndarray,
+              joint_gains: tuple[np.ndarray, np.ndarray], reference: StandReference) -> None:
+        self._statics.load(state, contacts)
+        if reference is not self._last_reference:
+            self._set_reference(reference)
+        if joint_gains is not self._last_gains:
+            joints = len(self._effort_limit)
+            self._joint_gains[:joints] = joint_gains[0]
+            self._joint_gains[joints:] = joint_gains[1]
+            self._last_gains = joint_gains
+        self._capture[:] = state.capture_point
+        self._in[4] = state.omega
+        self._com_velocity[:] = state.com_velocity
+        self._pelvis_rotation[:] = state.pelvis_rotation
+        self._pelvis_angular[:] = state.pelvis_angular_velocity
+        self._joints[0] = joint_positions
+        self._joints[1] = joint_velocities
+
+    def _results(self) -> Tick:
+        wrenches, torque = self._statics.outputs
+        out = self._out.copy()
+        return torque.copy(), out[0:2], out[2:5], out[5:8], wrenches.copy()
+
+    def tick(self, state: BalanceState, region: Region | None,
+             contacts: tuple[ContactConstraint, ContactConstraint],
+             joint_positions: np.ndarray, joint_velocities: np.ndarray,
+             joint_gains: tuple[np.ndarray, np.ndarray], reference: StandReference) -> Tick:
+        """StandController.tick's numbers: the pressure centre by the capture-point law
+        clamped into `region` (None: not clamped), the torques within the effort limits."""
+        self._load(state, contacts, joint_positions, joint_velocities, joint_gains, reference)
+        if region is not self._last_region:
+            self._set_region(region)
+        self._library.atlas_stand_tick(self._pointer)
+        return self._results()
+
+    def whole_body(self, state: BalanceState, cop: np.ndarray,
+                   contacts: tuple[ContactConstraint, ContactConstraint],
+                   joint_positions: np.ndarray, joint_velocities: np.ndarray,
+                   joint_gains: tuple[np.ndarray, np.ndarray],
+                   reference: StandReference) -> Tick:
+        """StandController.whole_body's numbers at the pressure centre `cop`, not clamped
+        to the effort limits."""
+        self._load(state, contacts, joint_positions, joint_velocities, joint_gains, reference)
+        self._cop[:] = cop
+        self._library.atlas_whole_body(self._pointer)
+        return self._results()
