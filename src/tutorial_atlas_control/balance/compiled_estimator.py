@@ -43,6 +43,11 @@ POLYGON_KEPT, POLYGON_COUNT, POLYGON_AT = 68, 69, 70
 #: Two soles' four corners.
 POLYGON_CAPACITY = 8
 FIXED_SIZE = POLYGON_AT + 2 * POLYGON_CAPACITY
+#: The FIXED_FIELDS a BalanceState holds as arrays, in the order of OutputBlock.fields (the
+#: sole boxes' positions are read only for a new polygon; the scalars as one list).
+STATE_ARRAYS = ('com', 'com_velocity', 'pelvis_position', 'pelvis_rotation',
+                'pelvis_angular_velocity', 'sole_centres', 'sole_rotations', 'capture_point',
+                'sole_velocities')
 #: Ticks' outputs allocated at once.
 BLOCK_TICKS = 64
 
@@ -96,9 +101,11 @@ class OutputBlock:
         self.base = self.array.ctypes.data
         self.next = 0
         array = self.array
-        #: FIXED_FIELDS' views, in their order.
-        self.fields = tuple(array[:, at:at + math.prod(shape)].reshape((BLOCK_TICKS, *shape))
-                            for _, at, shape in FIXED_FIELDS)
+        views = {name: array[:, at:at + math.prod(shape)].reshape((BLOCK_TICKS, *shape))
+                 for name, at, shape in FIXED_FIELDS}
+        #: STATE_ARRAYS' views, in their order.
+        self.fields = tuple(views[name] for name in STATE_ARRAYS)
+        self.sole_positions = views['sole_positions']
         self.polygons = array[:, POLYGON_AT:FIXED_SIZE].reshape(BLOCK_TICKS, POLYGON_CAPACITY, 2)
         jac_at, counts_at = FIXED_SIZE + joints, FIXED_SIZE + 13 * joints
         self.bias = array[:, FIXED_SIZE:jac_at]
@@ -145,6 +152,7 @@ class CompiledEstimate:
         kernel.rotation_tolerance = geometry.rotation_tolerance
         self._polygon_reference: tuple[np.ndarray, np.ndarray] | None = None
         self._pointer = ctypes.byref(kernel)
+        self._estimate = library.atlas_estimate
         self._count = count
         self._size = FIXED_SIZE + 13 * count + 2 + ROW * CONTACT_CAPACITY
         self._block = OutputBlock(self._size, count)
@@ -172,7 +180,7 @@ class CompiledEstimate:
         tick = block.next
         block.next = tick + 1
         self._kernel.out = block.base + 8 * self._size * tick
-        total = self._library.atlas_estimate(self._pointer)
+        total = self._estimate(self._pointer)
         overflow = None
         if total > CONTACT_CAPACITY:
             overflow = np.empty((total, ROW))

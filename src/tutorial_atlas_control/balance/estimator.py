@@ -282,10 +282,11 @@ class BalanceEstimator:
             self._kernel.hold_polygon(contact, positions, rotations)
 
     def _compiled_polygon(self, raw: RawEstimate, contact: tuple[bool, bool],
-                          positions: np.ndarray, rotations: np.ndarray, held: int) -> np.ndarray:
+                          rotations: np.ndarray, held: int) -> np.ndarray:
         """A compiled estimate's new polygon, handed over on first use: the C call's hull
         while no other polygon was handed over since that estimate, else _support_polygon's
         test against the one that was (a state asked for after a later one)."""
+        positions = raw.block.sole_positions[raw.tick]
         if held != self._polygons_held:
             return self._support_polygon(positions, rotations, contact)
         polygon = raw.polygon().copy()
@@ -337,8 +338,8 @@ class BalanceEstimator:
         self._inertia_current = False
         block, tick = raw.block, raw.tick
         (com, com_velocity, pelvis_position, pelvis_rotation, pelvis_angular_velocity,
-         positions, centres, rotations, _, _, capture_point, sole_velocities) = [
-            view[tick] for view in block.fields]
+         centres, rotations, capture_point, sole_velocities) = [
+            view[tick] for view in block.fields]  # compiled_estimator.STATE_ARRAYS
         scalars = block.array[tick, SCALARS_AT:POLYGON_KEPT + 1].tolist()
         contact = (scalars[0] != 0.0, scalars[1] != 0.0)
         state = _new_object(BalanceState)
@@ -350,7 +351,7 @@ class BalanceEstimator:
             held = self._polygons_held
 
             def polygon_of() -> np.ndarray:
-                return self._compiled_polygon(raw, contact, positions, rotations, held)
+                return self._compiled_polygon(raw, contact, rotations, held)
         # The dataclass's fields without its frozen __init__ (an object.__setattr__ a field).
         values.update(
             com=com, com_velocity=com_velocity, pelvis_position=pelvis_position,
