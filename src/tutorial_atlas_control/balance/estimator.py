@@ -18,7 +18,12 @@ read only when asked for.
 
 The per-tick work runs as one C call (compiled_estimator, src/atlas_estimator.c) when the
 package's library is built, the Python below otherwise (after one warning) or when
-ESTIMATOR_ENV says `python`: the reference the compiled one is tested against.
+ESTIMATOR_ENV says `python`: the reference the compiled one is tested against. The C call
+also tests whether the support polygon last handed over still holds and makes the new hull
+where it does not (bit for bit the Python's); which polygon was handed over, and so the
+poses the next ticks are tested against, stays Python's to say, as the polygon is made only
+when asked for. A compiled state's polygon, when kept, is in it from the start: the one
+current at its estimate.
 """
 
 from __future__ import annotations
