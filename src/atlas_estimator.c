@@ -144,17 +144,17 @@ static int before(const double *a, const double *b) {
 
 /* One chain of Andrew's monotone chain over points[0..count) taken in `step` order
  * (support.convex_hull's chain, the same arithmetic); returns its length in chain. */
-static int chain(const double (*points)[2], int count, int step, double (*chain)[2]) {
+static int chain(const double (*points)[2], int count, int step, double (*hull)[2]) {
   int length = 0;
   for (int k = 0; k < count; ++k) {
     const double *p = points[step > 0 ? k : count - 1 - k];
     while (length >= 2) {
-      const double *o = chain[length - 2], *a = chain[length - 1];
+      const double *o = hull[length - 2], *a = hull[length - 1];
       if ((a[0] - o[0]) * (p[1] - o[1]) - (a[1] - o[1]) * (p[0] - o[0]) > 0.0) break;
       --length;
     }
-    chain[length][0] = p[0];
-    chain[length][1] = p[1];
+    hull[length][0] = p[0];
+    hull[length][1] = p[1];
     ++length;
   }
   return length;
@@ -200,8 +200,8 @@ static int support_polygon(const AtlasEstimator *e, double *out) {
   int lows = chain((const double (*)[2])points, count, 1, lower);
   int ups = chain((const double (*)[2])points, count, -1, upper);
   int vertices = 0;
-  for (int k = 0; k + 1 < lows; ++k, ++vertices) memcpy(polygon + 2 * vertices, lower[k], 16);
-  for (int k = 0; k + 1 < ups; ++k, ++vertices) memcpy(polygon + 2 * vertices, upper[k], 16);
+  for (int k = 0; k + 1 < lows; ++k, ++vertices) memcpy(polygon + 2 * vertices, lower[k], 2 * sizeof(double));
+  for (int k = 0; k + 1 < ups; ++k, ++vertices) memcpy(polygon + 2 * vertices, upper[k], 2 * sizeof(double));
   return vertices;
 }
 
