@@ -200,8 +200,10 @@ static int support_polygon(const AtlasEstimator *e, double *out) {
   int lows = chain((const double (*)[2])points, count, 1, lower);
   int ups = chain((const double (*)[2])points, count, -1, upper);
   int vertices = 0;
-  for (int k = 0; k + 1 < lows; ++k, ++vertices) memcpy(polygon + 2 * vertices, lower[k], 2 * sizeof(double));
-  for (int k = 0; k + 1 < ups; ++k, ++vertices) memcpy(polygon + 2 * vertices, upper[k], 2 * sizeof(double));
+  for (int k = 0; k + 1 < lows; ++k, ++vertices)
+    memcpy(polygon + 2 * vertices, lower[k], 2 * sizeof(double));
+  for (int k = 0; k + 1 < ups; ++k, ++vertices)
+    memcpy(polygon + 2 * vertices, upper[k], 2 * sizeof(double));
   return vertices;
 }
 
