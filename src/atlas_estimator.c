@@ -58,8 +58,9 @@ enum {
   OUT_SOLE_VELOCITIES = 56, OUT_POLYGON_KEPT = 68, OUT_POLYGON_COUNT = 69, OUT_POLYGON = 70,
   OUT_FIXED = 86
   /* OUT_POLYGON_KEPT: 1 when the cached polygon still holds, else the hull of the touching
-   * soles' corners is at OUT_POLYGON (OUT_POLYGON_COUNT vertices, x y each); then bias (n), sole jacobians (2, 6, n), contact counts (2), contact rows
-   * (capacity, ROW): point (3), normal into the sole (3), distance, surface geom */
+   * soles' corners is at OUT_POLYGON (OUT_POLYGON_COUNT vertices, x y each); then bias (n),
+   * sole jacobians (2, 6, n), contact counts (2), contact rows (capacity, ROW): point (3),
+   * normal into the sole (3), distance, surface geom */
 };
 #define ROW 8
 
