@@ -50,7 +50,7 @@ typedef struct {
   double corner_offsets[2][4][3];    /* each sole's bottom corners in its own frame */
 } AtlasEstimator;
 
-/* The output, flat doubles (compiled_estimator.py's EstimateLayout says the same). */
+/* The output, flat doubles (compiled_estimator.py's FIXED_FIELDS and POLYGON_* say the same). */
 enum {
   OUT_COM = 0, OUT_COM_VELOCITY = 3, OUT_PELVIS_POSITION = 6, OUT_PELVIS_ROTATION = 9,
   OUT_PELVIS_ANGULAR_VELOCITY = 18, OUT_SOLE_POSITIONS = 21, OUT_SOLE_CENTRES = 27,
