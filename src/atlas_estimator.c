@@ -38,16 +38,29 @@ typedef struct {
   long pelvis;                /* the pelvis body: the robot's subtree */
   long free_dof;              /* the floating base's first dof */
   long contact_capacity;      /* contact rows the output holds */
+  /* The support polygon's cache (estimator._support_polygon's): the sole poses and contact
+   * flags the last handed-over polygon was made from, set by Python when it hands one over
+   * (NULL: none yet). Python keeps them because it alone knows which estimate's polygon was
+   * asked for (Walk's single support never asks): the reference moves only then. */
+  const double *polygon_positions;   /* (2, 3) sole box centres */
+  const double *polygon_rotations;   /* (2, 3, 3) */
+  long polygon_contact[2];
+  double polygon_tolerance_m;        /* estimator.POLYGON_TOLERANCE_M */
+  double rotation_tolerance;         /* the rotation entries' change that moves a corner so */
+  double corner_offsets[2][4][3];    /* each sole's bottom corners in its own frame */
 } AtlasEstimator;
 
-/* The output, flat doubles (compiled_estimator.py's EstimateLayout says the same). */
+/* The output, flat doubles (compiled_estimator.py's FIXED_FIELDS and POLYGON_* say the same). */
 enum {
   OUT_COM = 0, OUT_COM_VELOCITY = 3, OUT_PELVIS_POSITION = 6, OUT_PELVIS_ROTATION = 9,
   OUT_PELVIS_ANGULAR_VELOCITY = 18, OUT_SOLE_POSITIONS = 21, OUT_SOLE_CENTRES = 27,
   OUT_SOLE_ROTATIONS = 33, OUT_IN_CONTACT = 51, OUT_OMEGA = 53, OUT_CAPTURE_POINT = 54,
-  OUT_SOLE_VELOCITIES = 56, OUT_FIXED = 68
-  /* then bias (n), sole jacobians (2, 6, n), contact counts (2), contact rows
-   * (capacity, ROW): point (3), normal into the sole (3), distance, surface geom */
+  OUT_SOLE_VELOCITIES = 56, OUT_POLYGON_KEPT = 68, OUT_POLYGON_COUNT = 69, OUT_POLYGON = 70,
+  OUT_FIXED = 86
+  /* OUT_POLYGON_KEPT: 1 when the cached polygon still holds, else the hull of the touching
+   * soles' corners is at OUT_POLYGON (OUT_POLYGON_COUNT vertices, x y each); then bias (n),
+   * sole jacobians (2, 6, n), contact counts (2), contact rows (capacity, ROW): point (3),
+   * normal into the sole (3), distance, surface geom */
 };
 #define ROW 8
 
@@ -106,6 +119,95 @@ static void soles(const AtlasEstimator *e, double *out) {
   }
 }
 
+/* Whether every a[i] - b[i] is within +-tolerance (NaN: not): estimator._within. */
+static int within(const double *a, const double *b, int count, double tolerance) {
+  for (int i = 0; i < count; ++i) {
+    double difference = a[i] - b[i];
+    if (!(-tolerance < difference && difference < tolerance)) return 0;
+  }
+  return 1;
+}
+
+/* Whether the polygon last handed over still holds: the same contacts, and neither sole box
+ * moved its tolerance (estimator.BalanceEstimator._support_polygon's test). */
+static int polygon_kept(const AtlasEstimator *e, const double *out) {
+  if (e->polygon_positions == NULL) return 0;
+  for (int foot = 0; foot < 2; ++foot)
+    if ((out[OUT_IN_CONTACT + foot] != 0.0) != (e->polygon_contact[foot] != 0)) return 0;
+  return within(out + OUT_SOLE_POSITIONS, e->polygon_positions, 6, e->polygon_tolerance_m) &&
+         within(out + OUT_SOLE_ROTATIONS, e->polygon_rotations, 18, e->rotation_tolerance);
+}
+
+/* Lexicographic order of (x, y) points, as Python orders tuples. */
+static int before(const double *a, const double *b) {
+  return a[0] < b[0] || (a[0] == b[0] && a[1] < b[1]);
+}
+
+/* One chain of Andrew's monotone chain over points[0..count) taken in `step` order
+ * (support.convex_hull's chain, the same arithmetic); returns its length in chain. */
+static int chain(const double (*points)[2], int count, int step, double (*hull)[2]) {
+  int length = 0;
+  for (int k = 0; k < count; ++k) {
+    const double *p = points[step > 0 ? k : count - 1 - k];
+    while (length >= 2) {
+      const double *o = hull[length - 2], *a = hull[length - 1];
+      if ((a[0] - o[0]) * (p[1] - o[1]) - (a[1] - o[1]) * (p[0] - o[0]) > 0.0) break;
+      --length;
+    }
+    hull[length][0] = p[0];
+    hull[length][1] = p[1];
+    ++length;
+  }
+  return length;
+}
+
+/* support.convex_hull of the touching soles' bottom corners (estimator's _support_polygon:
+ * each corner the box centre plus its rotated offset, summed in the order numpy 2.4's einsum
+ * sums three products, (0 + 2) + 1: the test holds the two bit for bit), into
+ * out[OUT_POLYGON]; returns the vertex count. */
+static int support_polygon(const AtlasEstimator *e, double *out) {
+  double points[8][2], lower[9][2], upper[9][2];
+  int count = 0;
+  for (int foot = 0; foot < 2; ++foot) {
+    if (out[OUT_IN_CONTACT + foot] == 0.0) continue;
+    const double *pos = out + OUT_SOLE_POSITIONS + 3 * foot;
+    const double *mat = out + OUT_SOLE_ROTATIONS + 9 * foot;
+    for (int c = 0; c < 4; ++c) {
+      const double *offset = e->corner_offsets[foot][c];
+      double point[2];
+      for (int i = 0; i < 2; ++i)
+        point[i] = pos[i] + ((offset[0] * mat[3 * i] + offset[2] * mat[3 * i + 2]) +
+                             offset[1] * mat[3 * i + 1]);
+      int at = count;  /* insertion sort; an equal point is dropped (Python's set) */
+      int equal = 0;
+      for (int k = 0; k < count; ++k)
+        if (points[k][0] == point[0] && points[k][1] == point[1]) equal = 1;
+      if (equal) continue;
+      while (at > 0 && before(point, points[at - 1])) {
+        points[at][0] = points[at - 1][0];
+        points[at][1] = points[at - 1][1];
+        --at;
+      }
+      points[at][0] = point[0];
+      points[at][1] = point[1];
+      ++count;
+    }
+  }
+  double *polygon = out + OUT_POLYGON;
+  if (count < 3) {
+    memcpy(polygon, points, 2 * count * sizeof(double));
+    return count;
+  }
+  int lows = chain((const double (*)[2])points, count, 1, lower);
+  int ups = chain((const double (*)[2])points, count, -1, upper);
+  int vertices = 0;
+  for (int k = 0; k + 1 < lows; ++k, ++vertices)
+    memcpy(polygon + 2 * vertices, lower[k], 2 * sizeof(double));
+  for (int k = 0; k + 1 < ups; ++k, ++vertices)
+    memcpy(polygon + 2 * vertices, upper[k], 2 * sizeof(double));
+  return vertices;
+}
+
 /* The estimate at (qpos, qvel) (full MuJoCo vectors) into out; returns the sole contacts'
  * row count (rows beyond contact_capacity are not written: atlas_estimator_contacts then). */
 long atlas_estimate(const AtlasEstimator *e) {
@@ -143,5 +245,8 @@ long atlas_estimate(const AtlasEstimator *e) {
   long total = atlas_estimator_contacts(e, counts, counts + 2, e->contact_capacity);
   out[OUT_IN_CONTACT] = counts[0] > 0 ? 1.0 : 0.0;
   out[OUT_IN_CONTACT + 1] = counts[1] > 0 ? 1.0 : 0.0;
+  int kept = polygon_kept(e, out);
+  out[OUT_POLYGON_KEPT] = kept ? 1.0 : 0.0;
+  out[OUT_POLYGON_COUNT] = kept ? 0.0 : (double)support_polygon(e, out);
   return total;
 }

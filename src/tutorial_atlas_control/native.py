@@ -79,7 +79,11 @@ class AtlasEstimator(ctypes.Structure):
                 ('gravity_m_s2', ctypes.c_double), ('min_com_height_m', ctypes.c_double),
                 ('n', ctypes.c_long), ('soles', ctypes.c_long * 2),
                 ('sole_bodies', ctypes.c_long * 2), ('pelvis', ctypes.c_long),
-                ('free_dof', ctypes.c_long), ('contact_capacity', ctypes.c_long)]
+                ('free_dof', ctypes.c_long), ('contact_capacity', ctypes.c_long),
+                ('polygon_positions', ctypes.c_void_p), ('polygon_rotations', ctypes.c_void_p),
+                ('polygon_contact', ctypes.c_long * 2), ('polygon_tolerance_m', ctypes.c_double),
+                ('rotation_tolerance', ctypes.c_double),
+                ('corner_offsets', ctypes.c_double * 24)]
 
 
 class AtlasStatics(ctypes.Structure):

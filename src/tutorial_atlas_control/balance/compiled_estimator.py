@@ -4,9 +4,11 @@ estimator.BalanceEstimator.estimate in Python calls six MuJoCo passes and two ja
 spends as long again in numpy's indexing and copies; the C twin runs the same passes on the
 estimator's own model and scratch MjData (their C pointers) and writes every number of the
 estimate into a flat row of its own per tick, whose slices become the BalanceState's fields
-(a state never shares memory with the next). The library is found and checked by
-tutorial_atlas_control.native; the estimator falls back to Python after one warning without
-it. Both agree to rounding (test/unit/balance/test_compiled_estimator.py: 1e-9).
+(a state never shares memory with the next). The same call tests whether the support polygon
+last handed over still holds and, where it does not, makes the new one (its cache's reference
+poses are set from Python, which alone knows which polygon was asked for). The library is
+found and checked by tutorial_atlas_control.native; the estimator falls back to Python after
+one warning without it. Both agree to rounding (test/unit/balance/test_compiled_estimator.py: 1e-9).
 """
 
 from __future__ import annotations
@@ -33,7 +35,19 @@ FIXED_FIELDS: tuple[tuple[str, int, tuple[int, ...]], ...] = (
     ('sole_positions', 21, (2, 3)), ('sole_centres', 27, (2, 3)),
     ('sole_rotations', 33, (2, 3, 3)), ('in_contact', 51, (2,)), ('omega', 53, ()),
     ('capture_point', 54, (2,)), ('sole_velocities', 56, (2, 6)))
-FIXED_SIZE = 68
+#: Where the row's scalars read at once start: in_contact (2), omega, ... POLYGON_KEPT.
+SCALARS_AT = 51
+#: The support polygon's part of the output: 1.0 when the polygon last handed over holds,
+#: else the vertex count and up to POLYGON_CAPACITY vertices (x, y).
+POLYGON_KEPT, POLYGON_COUNT, POLYGON_AT = 68, 69, 70
+#: Two soles' four corners.
+POLYGON_CAPACITY = 8
+FIXED_SIZE = POLYGON_AT + 2 * POLYGON_CAPACITY
+#: The FIXED_FIELDS a BalanceState holds as arrays, in the order of OutputBlock.fields (the
+#: sole boxes' positions are read only for a new polygon; the scalars as one list).
+STATE_ARRAYS = ('com', 'com_velocity', 'pelvis_position', 'pelvis_rotation',
+                'pelvis_angular_velocity', 'sole_centres', 'sole_rotations', 'capture_point',
+                'sole_velocities')
 #: Ticks' outputs allocated at once.
 BLOCK_TICKS = 64
 
@@ -50,18 +64,31 @@ class EstimatorGeometry:
     dof_adr: np.ndarray             # (n,) intp
     gravity_m_s2: float
     min_com_height_m: float
+    corner_offsets: np.ndarray      # (2, 4, 3) each sole's bottom corners in its frame
+    polygon_tolerance_m: float      # a sole box's move that makes a new polygon
+    rotation_tolerance: float       # its rotation entries' change that does
 
 
-@dataclass(frozen=True)
 class RawEstimate:
-    """One tick's numbers, views of its own row of an output block: the FIXED_FIELDS by
-    name, the joints' bias (n,) and sole jacobians (2, 6, n), each sole's contact rows
-    (k, ROW)."""
+    """One tick's numbers: row `tick` of `block` (its views across the ticks index it),
+    the sole contacts' count, and their rows when more than the row holds."""
 
-    fields: dict[str, np.ndarray]
-    bias_nm: np.ndarray
-    sole_jacobians: np.ndarray
-    contact_rows: tuple[np.ndarray, np.ndarray]
+    __slots__ = ('block', 'tick', 'total', 'overflow')
+
+    def __init__(self, block: OutputBlock, tick: int, total: int,
+                 overflow: np.ndarray | None) -> None:
+        self.block, self.tick, self.total, self.overflow = block, tick, total, overflow
+
+    def contact_rows(self) -> tuple[np.ndarray, np.ndarray]:
+        """Each sole's contact rows (k, ROW): left, right."""
+        block, tick = self.block, self.tick
+        rows = block.rows[tick, :self.total] if self.overflow is None else self.overflow
+        left = int(block.counts[tick, 0])
+        return rows[:left], rows[left:]
+
+    def polygon(self) -> np.ndarray:
+        """The new support polygon's vertices (a view: valid when not kept)."""
+        return self.block.polygons[self.tick, :int(self.block.array[self.tick, POLYGON_COUNT])]
 
 
 class OutputBlock:
@@ -74,8 +101,12 @@ class OutputBlock:
         self.base = self.array.ctypes.data
         self.next = 0
         array = self.array
-        self.fields = [(name, array[:, at:at + math.prod(shape)].reshape((BLOCK_TICKS, *shape)))
-                       for name, at, shape in FIXED_FIELDS]
+        views = {name: array[:, at:at + math.prod(shape)].reshape((BLOCK_TICKS, *shape))
+                 for name, at, shape in FIXED_FIELDS}
+        #: STATE_ARRAYS' views, in their order.
+        self.fields = tuple(views[name] for name in STATE_ARRAYS)
+        self.sole_positions = views['sole_positions']
+        self.polygons = array[:, POLYGON_AT:FIXED_SIZE].reshape(BLOCK_TICKS, POLYGON_CAPACITY, 2)
         jac_at, counts_at = FIXED_SIZE + joints, FIXED_SIZE + 13 * joints
         self.bias = array[:, FIXED_SIZE:jac_at]
         self.jacobians = array[:, jac_at:counts_at].reshape(BLOCK_TICKS, 2, 6, joints)
@@ -116,10 +147,25 @@ class CompiledEstimate:
         kernel.pelvis = geometry.pelvis
         kernel.free_dof = geometry.free_dof
         kernel.contact_capacity = CONTACT_CAPACITY
+        kernel.corner_offsets[:] = np.asarray(geometry.corner_offsets, dtype=np.float64).ravel()
+        kernel.polygon_tolerance_m = geometry.polygon_tolerance_m
+        kernel.rotation_tolerance = geometry.rotation_tolerance
+        self._polygon_reference: tuple[np.ndarray, np.ndarray] | None = None
         self._pointer = ctypes.byref(kernel)
+        self._estimate = library.atlas_estimate
         self._count = count
         self._size = FIXED_SIZE + 13 * count + 2 + ROW * CONTACT_CAPACITY
         self._block = OutputBlock(self._size, count)
+
+    def hold_polygon(self, contact: tuple[bool, bool], positions: np.ndarray,
+                     rotations: np.ndarray) -> None:
+        """The poses and contacts the polygon just handed over was made from: the next
+        calls test against them (kept here too, so that C's pointers stay valid)."""
+        kernel = self._kernel
+        kernel.polygon_positions = address(positions, np.float64)
+        kernel.polygon_rotations = address(rotations, np.float64)
+        kernel.polygon_contact[:] = contact
+        self._polygon_reference = (positions, rotations)
 
     def run(self, qpos: np.ndarray, qvel: np.ndarray) -> RawEstimate:
         """The estimate at (qpos, qvel), the full MuJoCo vectors."""
@@ -134,14 +180,10 @@ class CompiledEstimate:
         tick = block.next
         block.next = tick + 1
         self._kernel.out = block.base + 8 * self._size * tick
-        total = self._library.atlas_estimate(self._pointer)
-        counts = block.counts[tick]
+        total = self._estimate(self._pointer)
+        overflow = None
         if total > CONTACT_CAPACITY:
-            rows = np.empty((total, ROW))
-            self._library.atlas_estimator_contacts(self._pointer, counts.ctypes.data,
-                                                   rows.ctypes.data, total)
-        else:
-            rows = block.rows[tick, :total]
-        left = int(counts[0])
-        return RawEstimate({name: views[tick] for name, views in block.fields},
-                           block.bias[tick], block.jacobians[tick], (rows[:left], rows[left:]))
+            overflow = np.empty((total, ROW))
+            self._library.atlas_estimator_contacts(self._pointer, block.counts[tick].ctypes.data,
+                                                   overflow.ctypes.data, total)
+        return RawEstimate(block, tick, total, overflow)

@@ -18,23 +18,34 @@ read only when asked for.
 
 The per-tick work runs as one C call (compiled_estimator, src/atlas_estimator.c) when the
 package's library is built, the Python below otherwise (after one warning) or when
-ESTIMATOR_ENV says `python`: the reference the compiled one is tested against.
+ESTIMATOR_ENV says `python`: the reference the compiled one is tested against. The C call
+also tests whether the support polygon last handed over still holds and makes the new hull
+where it does not (bit for bit the Python's); which polygon was handed over, and so the
+poses the next ticks are tested against, stays Python's to say, as the polygon is made only
+when asked for. A compiled state's polygon, when kept, is in it from the start: the one
+current at its estimate.
 """
 
 from __future__ import annotations
 
 import copy
-import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import mujoco
 import numpy as np
 
 from tutorial_atlas_control import native
 from tutorial_atlas_control.balance import lipm, support
-from tutorial_atlas_control.balance.compiled_estimator import CompiledEstimate, EstimatorGeometry
+from tutorial_atlas_control.balance.compiled_estimator import (
+    POLYGON_KEPT,
+    SCALARS_AT,
+    CompiledEstimate,
+    EstimatorGeometry,
+    RawEstimate,
+)
 from tutorial_atlas_control.balance.sole import BOTTOM_CORNER_SIGNS, SoleBox, sole_geom_ids
 from tutorial_atlas_control.sim import AtlasModel
 
@@ -84,6 +95,32 @@ def _sole_contacts_of(sole: int, pairs: list[list[int]], distances: np.ndarray,
     return SoleContacts(points[rows], signs * normals[rows], distances[rows], surfaces)
 
 
+def _contacts_of_raw(raw: RawEstimate) -> tuple[SoleContacts, SoleContacts]:
+    """Both soles' contacts from the compiled estimate's rows."""
+    left, right = raw.contact_rows()
+    return _contacts_of_rows(left), _contacts_of_rows(right)
+
+
+class _Cached:
+    """A property made on first use and kept in the instance's __dict__: cached_property
+    without the lock Python 3.11's takes at each first use (a few us a tick; making one
+    twice from two threads gives equal values)."""
+
+    def __init__(self, make: Callable[[Any], Any]) -> None:
+        self._make = make
+        self._name = make.__name__
+        self.__doc__ = make.__doc__
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self._name = name
+
+    def __get__(self, instance: Any, owner: type | None = None) -> Any:
+        if instance is None:
+            return self
+        value = instance.__dict__[self._name] = self._make(instance)
+        return value
+
+
 def _contacts_of_rows(rows: np.ndarray) -> SoleContacts:
     """One sole's contacts from the compiled estimate's rows (point, normal into the sole,
     distance, surface geom)."""
@@ -120,15 +157,18 @@ class BalanceState:
     contacts_of: Callable[[], tuple[SoleContacts, SoleContacts]] = \
         lambda: (_no_contacts(), _no_contacts())
 
-    @functools.cached_property
+    @_Cached
     def sole_contacts(self) -> tuple[SoleContacts, SoleContacts]:
         """Each sole's contacts (left, right), from MuJoCo's contact list."""
         return self.contacts_of()
 
-    @functools.cached_property
+    @_Cached
     def support_polygon(self) -> np.ndarray:
         """(k, 2) the convex hull of the soles in contact, counter-clockwise."""
         return self.polygon_of()
+
+
+_new_object = object.__new__
 
 
 def _within(difference: np.ndarray, tolerance: float) -> bool:
@@ -181,6 +221,11 @@ class BalanceEstimator:
             [sole.half_length_m, sole.half_width_m, sole.half_thickness_m]))
         self._last_polygon: (tuple[tuple[bool, bool], np.ndarray, np.ndarray, np.ndarray]
                              | None) = None
+        #: How many polygons were handed over: a compiled estimate's new polygon is valid
+        #: while none was handed over since.
+        self._polygons_held = 0
+        self._held_polygon_of: Callable[[], np.ndarray] = lambda: np.zeros((0, 2))
+        self._inertia_of = self._joint_inertia
         self._inertia = np.zeros((self.model.nv, self.model.nv))
         self._inertia_current = False
         #: Each joint slice's dof indices: a slice where they run on (a leg's do), else
@@ -192,7 +237,8 @@ class BalanceEstimator:
                 (self._soles[0], self._soles[1]), (self._sole_bodies[0], self._sole_bodies[1]),
                 (float(self._half_thickness[0, 0]), float(self._half_thickness[1, 0])),
                 self._pelvis, self._free_dof, np.asarray(self._dof_adr, dtype=np.intp),
-                lipm.GRAVITY_M_S2, MIN_COM_HEIGHT_M))
+                lipm.GRAVITY_M_S2, MIN_COM_HEIGHT_M, self._corner_offsets,
+                POLYGON_TOLERANCE_M, self._rotation_tolerance))
 
     @property
     def compiled(self) -> bool:
@@ -227,7 +273,30 @@ class BalanceEstimator:
         polygon = (support.convex_hull(corners[touching].reshape(-1, 2)) if touching
                    else np.zeros((0, 2)))
         polygon.setflags(write=False)
+        self._hold_polygon(contact, positions, rotations, polygon)
+        return polygon
+
+    def _hold_polygon(self, contact: tuple[bool, bool], positions: np.ndarray,
+                      rotations: np.ndarray, polygon: np.ndarray) -> None:
+        """Hand `polygon` over: the next estimates keep it while the soles stay within the
+        tolerance of these poses (the compiled call tests that itself)."""
         self._last_polygon = (contact, positions, rotations, polygon)
+        self._polygons_held += 1
+        self._held_polygon_of = lambda: polygon
+        if self._kernel is not None:
+            self._kernel.hold_polygon(contact, positions, rotations)
+
+    def _compiled_polygon(self, raw: RawEstimate, contact: tuple[bool, bool],
+                          rotations: np.ndarray, held: int) -> np.ndarray:
+        """A compiled estimate's new polygon, handed over on first use: the C call's hull
+        while no other polygon was handed over since that estimate, else _support_polygon's
+        test against the one that was (a state asked for after a later one)."""
+        positions = raw.block.sole_positions[raw.tick]
+        if held != self._polygons_held:
+            return self._support_polygon(positions, rotations, contact)
+        polygon = raw.polygon().copy()
+        polygon.setflags(write=False)
+        self._hold_polygon(contact, positions, rotations, polygon)
         return polygon
 
     def _joint_inertia(self, joints: slice) -> np.ndarray:
@@ -272,20 +341,32 @@ class BalanceEstimator:
             return self._estimate_in_python(qpos, qvel)
         raw = self._kernel.run(qpos, qvel)
         self._inertia_current = False
-        f = raw.fields
-        contact = (bool(f['in_contact'][0]), bool(f['in_contact'][1]))
-        positions, rotations = f['sole_positions'], f['sole_rotations']
-        left, right = raw.contact_rows
-        return BalanceState(
-            com=f['com'], com_velocity=f['com_velocity'],
-            pelvis_position=f['pelvis_position'], pelvis_rotation=f['pelvis_rotation'],
-            pelvis_angular_velocity=f['pelvis_angular_velocity'],
-            sole_centres=f['sole_centres'], sole_rotations=rotations, in_contact=contact,
-            omega=float(f['omega']), capture_point=f['capture_point'], bias_nm=raw.bias_nm,
-            sole_jacobians=raw.sole_jacobians, sole_velocities=f['sole_velocities'],
-            joint_inertia=self._joint_inertia,
-            polygon_of=lambda: self._support_polygon(positions, rotations, contact),
-            contacts_of=lambda: (_contacts_of_rows(left), _contacts_of_rows(right)))
+        block, tick = raw.block, raw.tick
+        (com, com_velocity, pelvis_position, pelvis_rotation, pelvis_angular_velocity,
+         centres, rotations, capture_point, sole_velocities) = [
+            view[tick] for view in block.fields]  # compiled_estimator.STATE_ARRAYS
+        scalars = block.array[tick, SCALARS_AT:POLYGON_KEPT + 1].tolist()
+        contact = (scalars[0] != 0.0, scalars[1] != 0.0)
+        state = _new_object(BalanceState)
+        values = state.__dict__
+        if scalars[-1] != 0.0:  # the polygon last handed over holds: this state's too
+            values['support_polygon'] = self._last_polygon[3]
+            polygon_of = self._held_polygon_of
+        else:
+            held = self._polygons_held
+
+            def polygon_of() -> np.ndarray:
+                return self._compiled_polygon(raw, contact, rotations, held)
+        # The dataclass's fields without its frozen __init__ (an object.__setattr__ a field).
+        values.update(
+            com=com, com_velocity=com_velocity, pelvis_position=pelvis_position,
+            pelvis_rotation=pelvis_rotation, pelvis_angular_velocity=pelvis_angular_velocity,
+            sole_centres=centres, sole_rotations=rotations, in_contact=contact,
+            omega=scalars[2], capture_point=capture_point, bias_nm=block.bias[tick],
+            sole_jacobians=block.jacobians[tick], sole_velocities=sole_velocities,
+            joint_inertia=self._inertia_of, polygon_of=polygon_of,
+            contacts_of=lambda: _contacts_of_raw(raw))
+        return state
 
     def _estimate_in_python(self, qpos: np.ndarray, qvel: np.ndarray) -> BalanceState:
         """estimate's reference: the same passes and arithmetic through the bindings."""

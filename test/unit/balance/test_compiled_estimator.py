@@ -31,9 +31,8 @@ def atlas() -> atlas_model.AtlasModel:
 
 
 @pytest.fixture(scope='module')
-def walking_ticks(atlas: atlas_model.AtlasModel) -> list[tuple[np.ndarray, np.ndarray]]:
-    """(qpos, qvel) of every estimate of a two-step walk (Python estimator), and that walk's
-    last tick lifted 0.1 m: no sole touches."""
+def every_walking_tick() -> list[tuple[np.ndarray, np.ndarray]]:
+    """(qpos, qvel) of every estimate of a two-step walk (Python estimator)."""
     recorded: list[tuple[np.ndarray, np.ndarray]] = []
     estimate = BalanceEstimator.estimate
 
@@ -46,6 +45,15 @@ def walking_ticks(atlas: atlas_model.AtlasModel) -> list[tuple[np.ndarray, np.nd
         patch.setattr(BalanceEstimator, 'estimate', recording)
         trial = walk_trial(straight_steps(2, 0.25), SETTLE_S + 0.6 + 2 * 0.63 + 0.2)
     assert not trial.fell and trial.steps == 2
+    return recorded
+
+
+@pytest.fixture(scope='module')
+def walking_ticks(atlas: atlas_model.AtlasModel,
+                  every_walking_tick: list[tuple[np.ndarray, np.ndarray]]
+                  ) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Every third estimate of the walk, and its last tick lifted 0.1 m: no sole touches."""
+    recorded = every_walking_tick
     lifted = recorded[-1][0].copy()
     lifted[atlas.free_qpos_adr + 2] += 0.1
     return [*recorded[::3], (lifted, recorded[-1][1])]
@@ -135,3 +143,52 @@ def test_without_the_library_the_python_estimate_runs_after_one_warning(
         estimators = [BalanceEstimator(atlas) for _ in range(2)]
     assert len(caught) == 1
     assert not any(estimator.compiled for estimator in estimators)
+
+
+def _polygons(estimator: BalanceEstimator, ticks: list[tuple[np.ndarray, np.ndarray]],
+              asked: list[int]) -> list[tuple[bytes, tuple[int, ...], bool]]:
+    """Each asked tick's support polygon (its bytes and shape) and whether it is the very
+    array handed over before it; every tick is estimated, only `asked` ones asked."""
+    found, last = [], None
+    asked_ticks = set(asked)
+    for index, (qpos, qvel) in enumerate(ticks):
+        state = estimator.estimate(qpos, qvel)
+        if index in asked_ticks:
+            polygon = state.support_polygon
+            found.append((polygon.tobytes(), polygon.shape, polygon is last))
+            last = polygon
+    return found
+
+
+@pytest.mark.parametrize('stride', [1, 7])
+def test_compiled_support_polygon_is_python_s_bit_for_bit(
+        library, atlas: atlas_model.AtlasModel,
+        every_walking_tick: list[tuple[np.ndarray, np.ndarray]], stride: int) -> None:
+    """The same vertices in the same order, kept and remade at the same ticks, through a
+    walk whose feet move past the tolerance: asked every tick, and every seventh only
+    (the cache's reference then moves only at asked ticks, in both)."""
+    asked = list(range(0, len(every_walking_tick), stride))
+    compiled = _polygons(BalanceEstimator(atlas, compiled=True), every_walking_tick, asked)
+    python = _polygons(BalanceEstimator(atlas, compiled=False), every_walking_tick, asked)
+    assert compiled == python
+    remade = sum(not kept for _, _, kept in python)
+    assert 10 < remade < len(asked) - 10
+    assert {shape for _, shape, _ in python} >= {(4, 2), (6, 2)}
+
+
+@pytest.mark.parametrize('later', [1, 700])
+def test_a_state_asked_after_a_later_one_gets_python_s_polygon(
+        library, atlas: atlas_model.AtlasModel,
+        every_walking_tick: list[tuple[np.ndarray, np.ndarray]], later: int) -> None:
+    """Two estimates (a tick apart: the feet still; a step apart: moved), the later's
+    polygon asked first: the earlier one's is then tested against the later's, as in
+    Python (the same array while the feet stayed)."""
+    early, late = every_walking_tick[0], every_walking_tick[later]
+    found = []
+    for compiled in (True, False):
+        estimator = BalanceEstimator(atlas, compiled=compiled)
+        first, second = estimator.estimate(*early), estimator.estimate(*late)
+        polygons = second.support_polygon, first.support_polygon
+        found.append([p.tobytes() for p in polygons] + [polygons[1] is polygons[0]])
+    assert found[0] == found[1]
+    assert found[0][2] == (later == 1)
