@@ -24,7 +24,7 @@ import numpy as np
 
 from tutorial_atlas_control.balance.compiled_estimator import row_offsets
 from tutorial_atlas_control.balance.lipm import GRAVITY_M_S2
-from tutorial_atlas_control.native import WHOLE_BODY_ROW_FIELDS, AtlasWholeBody, address
+from tutorial_atlas_control.native import AtlasWholeBody, address
 
 if TYPE_CHECKING:
     from tutorial_atlas_control.balance.compiled_statics import CompiledStatics
@@ -42,7 +42,7 @@ REFERENCE_FIXED = 16
 #: Where a region row's fields sit: vertex x, y, then its edge's inward normal and offset.
 REGION_ROW = 5
 #: The state's fields C reads from the estimate's row, in the order of atlas_whole_body.c's
-#: WB_ROW_* offsets.
+#: WB_ROW_* offsets (as many as native.WHOLE_BODY_ROW_FIELDS: ctypes refuses another count).
 ROW_FIELDS = ('com', 'com_velocity', 'pelvis_rotation', 'pelvis_angular_velocity',
               'sole_centres', 'sole_rotations', 'omega', 'capture_point', 'bias_nm',
               'sole_jacobians')
@@ -87,7 +87,6 @@ class CompiledWholeBody:
         call.effort_limit = address(self._effort_limit, np.float64)
         call.region = address(self._region, np.float64)
         call.out = address(self._out, np.float64)
-        assert len(ROW_FIELDS) == WHOLE_BODY_ROW_FIELDS
         offsets = row_offsets(joints)
         call.row_at[:] = [offsets[name] for name in ROW_FIELDS]
         self._pointer = ctypes.byref(call)
