@@ -12,8 +12,15 @@
  */
 #include <math.h>
 #include <stddef.h>
+#include <string.h>
 
 #include "atlas_statics.h"
+
+/* Where the compiled estimate's row holds the state's fields the tick reads (the row's layout
+ * is balance/compiled_estimator.py's, whose offsets compiled_whole_body.py writes here). */
+enum { WB_ROW_COM = 0, WB_ROW_COM_VELOCITY, WB_ROW_PELVIS_ROTATION, WB_ROW_PELVIS_ANGULAR,
+       WB_ROW_SOLE_CENTRES, WB_ROW_SOLE_ROTATIONS, WB_ROW_OMEGA, WB_ROW_CAPTURE, WB_ROW_BIAS,
+       WB_ROW_JACOBIANS, WB_ROW_FIELDS };
 
 /* Laid out once by balance/compiled_whole_body.py, mirrored in native.py (same fields, same
  * order; tac_sizeof_AtlasWholeBody lets the loader check). */
@@ -29,6 +36,9 @@ typedef struct {
                                * offset of its edge to the next vertex */
   double *out;                /* WB_OUT_*: the pressure centre, the tasks' force and moment */
   long region_count;          /* 0: no region (the law's pressure centre kept); 1: a point */
+  const double *row;          /* NULL: the state's fields were copied into `in` and the
+                               * statics' input; else the estimate's row, read at row_at */
+  long row_at[WB_ROW_FIELDS]; /* each field's offset in the row (doubles) */
 } AtlasWholeBody;
 
 enum { WB_IN_COP = 0, WB_IN_CAPTURE = 2, WB_IN_OMEGA = 4, WB_IN_COM_VELOCITY = 5,
@@ -40,6 +50,26 @@ enum { WB_GAIN_MASS = 0, WB_GAIN_CAPTURE, WB_GAIN_HEIGHT_KP, WB_GAIN_HEIGHT_KD,
 enum { WB_OUT_COP = 0, WB_OUT_FORCE = 2, WB_OUT_MOMENT = 5 };
 
 size_t tac_sizeof_AtlasWholeBody(void) { return sizeof(AtlasWholeBody); }
+
+/* The state's fields from the estimate's row into the inputs (the same numbers the Python
+ * copies would put there). */
+static void load_row(const AtlasWholeBody *w) {
+  const double *row = w->row;
+  const long *at = w->row_at;
+  if (row == NULL) return;
+  long n = w->statics->n;
+  double *in = (double *)w->in, *in_statics = (double *)w->statics->in;
+  memcpy(in_statics + IN_COM, row + at[WB_ROW_COM], 3 * sizeof(double));
+  memcpy(in_statics + IN_CENTRES, row + at[WB_ROW_SOLE_CENTRES], 6 * sizeof(double));
+  memcpy(in_statics + IN_ROTATIONS, row + at[WB_ROW_SOLE_ROTATIONS], 18 * sizeof(double));
+  memcpy(in_statics + IN_BIAS, row + at[WB_ROW_BIAS], (size_t)n * sizeof(double));
+  memcpy(in_statics + IN_BIAS + n, row + at[WB_ROW_JACOBIANS], (size_t)(12 * n) * sizeof(double));
+  memcpy(in + WB_IN_CAPTURE, row + at[WB_ROW_CAPTURE], 2 * sizeof(double));
+  in[WB_IN_OMEGA] = row[at[WB_ROW_OMEGA]];
+  memcpy(in + WB_IN_COM_VELOCITY, row + at[WB_ROW_COM_VELOCITY], 3 * sizeof(double));
+  memcpy(in + WB_IN_PELVIS_ROTATION, row + at[WB_ROW_PELVIS_ROTATION], 9 * sizeof(double));
+  memcpy(in + WB_IN_PELVIS_ANGULAR, row + at[WB_ROW_PELVIS_ANGULAR], 3 * sizeof(double));
+}
 
 /* support.Region.clamp: `p` if inside the region, else the region's nearest point. */
 static void clamp_into_region(const AtlasWholeBody *w, double p[2]) {
@@ -130,11 +160,15 @@ static void whole_body(const AtlasWholeBody *w, const double cop[2]) {
 }
 
 /* StandController.whole_body with the pressure centre given in the input. */
-void atlas_whole_body(const AtlasWholeBody *w) { whole_body(w, w->in + WB_IN_COP); }
+void atlas_whole_body(const AtlasWholeBody *w) {
+  load_row(w);
+  whole_body(w, w->in + WB_IN_COP);
+}
 
 /* StandController.tick: the capture-point law's pressure centre kept in the region, the
  * whole body's torques, within the effort limits (np.maximum then np.minimum). */
 void atlas_stand_tick(const AtlasWholeBody *w) {
+  load_row(w);
   const double *xi = w->in + WB_IN_CAPTURE, *xi_ref = w->reference + WB_REF_CAPTURE;
   double gain = 1.0 + w->gains[WB_GAIN_CAPTURE], cop[2];
   for (int i = 0; i < 2; ++i) cop[i] = xi_ref[i] + gain * (xi[i] - xi_ref[i]);

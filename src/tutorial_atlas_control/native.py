@@ -94,6 +94,10 @@ class AtlasStatics(ctypes.Structure):
                 ('min_load_share', ctypes.c_double), ('n', ctypes.c_long)]
 
 
+#: The estimate's fields atlas_whole_body.c reads from its row (WB_ROW_FIELDS).
+WHOLE_BODY_ROW_FIELDS = 10
+
+
 class AtlasWholeBody(ctypes.Structure):
     """AtlasWholeBody in src/atlas_whole_body.c (same fields, same order)."""
 
@@ -101,7 +105,8 @@ class AtlasWholeBody(ctypes.Structure):
                 ('reference', ctypes.c_void_p), ('gains', ctypes.c_void_p),
                 ('joint_gains', ctypes.c_void_p), ('effort_limit', ctypes.c_void_p),
                 ('region', ctypes.c_void_p), ('out', ctypes.c_void_p),
-                ('region_count', ctypes.c_long)]
+                ('region_count', ctypes.c_long), ('row', ctypes.c_void_p),
+                ('row_at', ctypes.c_long * WHOLE_BODY_ROW_FIELDS)]
 
 
 class AtlasSwing(ctypes.Structure):

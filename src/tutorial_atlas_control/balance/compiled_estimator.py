@@ -52,6 +52,15 @@ STATE_ARRAYS = ('com', 'com_velocity', 'pelvis_position', 'pelvis_rotation',
 BLOCK_TICKS = 64
 
 
+def row_offsets(joints: int) -> dict[str, int]:
+    """Where each of a BalanceState's arrays and omega start in a tick's row (doubles), for a
+    call that reads the row in place (compiled_whole_body)."""
+    offsets = {name: at for name, at, _ in FIXED_FIELDS}
+    offsets['bias_nm'] = FIXED_SIZE
+    offsets['sole_jacobians'] = FIXED_SIZE + joints
+    return offsets
+
+
 @dataclass(frozen=True)
 class EstimatorGeometry:
     """What the C estimate needs to know of the model besides the model itself."""
@@ -70,14 +79,15 @@ class EstimatorGeometry:
 
 
 class RawEstimate:
-    """One tick's numbers: row `tick` of `block` (its views across the ticks index it),
-    the sole contacts' count, and their rows when more than the row holds."""
+    """One tick's numbers: row `tick` of `block` (its views across the ticks index it) at
+    `address`, the sole contacts' count, and their rows when more than the row holds."""
 
-    __slots__ = ('block', 'tick', 'total', 'overflow')
+    __slots__ = ('block', 'tick', 'address', 'total', 'overflow')
 
-    def __init__(self, block: OutputBlock, tick: int, total: int,
+    def __init__(self, block: OutputBlock, tick: int, address: int, total: int,
                  overflow: np.ndarray | None) -> None:
-        self.block, self.tick, self.total, self.overflow = block, tick, total, overflow
+        self.block, self.tick, self.address = block, tick, address
+        self.total, self.overflow = total, overflow
 
     def contact_rows(self) -> tuple[np.ndarray, np.ndarray]:
         """Each sole's contact rows (k, ROW): left, right."""
@@ -179,11 +189,11 @@ class CompiledEstimate:
             block = self._block = OutputBlock(self._size, self._count)
         tick = block.next
         block.next = tick + 1
-        self._kernel.out = block.base + 8 * self._size * tick
+        row = self._kernel.out = block.base + 8 * self._size * tick
         total = self._estimate(self._pointer)
         overflow = None
         if total > CONTACT_CAPACITY:
             overflow = np.empty((total, ROW))
             self._library.atlas_estimator_contacts(self._pointer, block.counts[tick].ctypes.data,
                                                    overflow.ctypes.data, total)
-        return RawEstimate(block, tick, total, overflow)
+        return RawEstimate(block, tick, row, total, overflow)

@@ -75,12 +75,16 @@ class CompiledStatics:
         """Its output buffers (wrenches (2, 6), torque (n,)), rewritten by each call."""
         return self._wrenches, self._torque
 
-    def load(self, state: BalanceState,
-             contacts: tuple[ContactConstraint, ContactConstraint]) -> None:
-        """Copy the numbers of `state` the statics reads, and `contacts` when they changed."""
+    def load_contacts(self, contacts: tuple[ContactConstraint, ContactConstraint]) -> None:
+        """Write `contacts` when they are other objects than last call's."""
         last = self._contacts
         if last is None or last[0] is not contacts[0] or last[1] is not contacts[1]:
             self._set_contacts(contacts)
+
+    def load(self, state: BalanceState,
+             contacts: tuple[ContactConstraint, ContactConstraint]) -> None:
+        """Copy the numbers of `state` the statics reads, and `contacts` when they changed."""
+        self.load_contacts(contacts)
         self._com[:] = state.com
         self._centres[:] = state.sole_centres
         self._rotations[:] = state.sole_rotations

@@ -6,10 +6,12 @@ solves them by inverse statics and clamps the torques to the effort limits;
 StandController.whole_body does the same at a given pressure centre without the clamp
 (Walk's legs call it). In Python that is some two hundred small float and numpy operations
 a tick, here one call around the inverse statics' own C (compiled_statics, whose input
-buffer this fills). Per tick the state's numbers are copied into the buffers whose
-addresses C keeps; the reference, the joint gains and the support region are copied only
-when they are other objects than last tick's (the package makes a new reference to change
-one, never writing into its arrays). Both agree to rounding
+buffer this fills). A state from the compiled estimator is read by C in place, from the
+estimate's row (its address and the row's offsets: no copy in Python); any other state's
+numbers are copied into the buffers whose addresses C keeps. The reference, the joint
+gains and the support region are copied only when they are other objects than last tick's
+(the package makes a new reference to change one, never writing into its arrays). Both
+agree to rounding
 (test/unit/balance/test_compiled_whole_body.py: 1e-9).
 """
 
@@ -20,6 +22,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from tutorial_atlas_control.balance.compiled_estimator import row_offsets
 from tutorial_atlas_control.balance.lipm import GRAVITY_M_S2
 from tutorial_atlas_control.native import AtlasWholeBody, address
 
@@ -38,6 +41,11 @@ IN_FIXED = 20
 REFERENCE_FIXED = 16
 #: Where a region row's fields sit: vertex x, y, then its edge's inward normal and offset.
 REGION_ROW = 5
+#: The state's fields C reads from the estimate's row, in the order of atlas_whole_body.c's
+#: WB_ROW_* offsets (as many as native.WHOLE_BODY_ROW_FIELDS: ctypes refuses another count).
+ROW_FIELDS = ('com', 'com_velocity', 'pelvis_rotation', 'pelvis_angular_velocity',
+              'sole_centres', 'sole_rotations', 'omega', 'capture_point', 'bias_nm',
+              'sole_jacobians')
 
 #: One tick's results: torque (n,), pressure centre (2,), force (3,), moment (3,) and the
 #: soles' wrenches (2, 6), new arrays.
@@ -79,6 +87,8 @@ class CompiledWholeBody:
         call.effort_limit = address(self._effort_limit, np.float64)
         call.region = address(self._region, np.float64)
         call.out = address(self._out, np.float64)
+        offsets = row_offsets(joints)
+        call.row_at[:] = [offsets[name] for name in ROW_FIELDS]
         self._pointer = ctypes.byref(call)
 
     def _set_reference(self, reference: StandReference) -> None:
@@ -107,10 +117,25 @@ class CompiledWholeBody:
             self._call.region_count = count
         self._last_region = region
 
+    def _load_state(self, state: BalanceState,
+                    contacts: tuple[ContactConstraint, ContactConstraint]) -> None:
+        """Copy the numbers of a state not read in place (not the compiled estimator's)."""
+        self._statics.load(state, contacts)
+        self._capture[:] = state.capture_point
+        self._in[4] = state.omega
+        self._com_velocity[:] = state.com_velocity
+        self._pelvis_rotation[:] = state.pelvis_rotation
+        self._pelvis_angular[:] = state.pelvis_angular_velocity
+
     def _load(self, state: BalanceState, contacts: tuple[ContactConstraint, ContactConstraint],
               joint_positions: np.ndarray, joint_velocities: np.ndarray,
               joint_gains: tuple[np.ndarray, np.ndarray], reference: StandReference) -> None:
-        self._statics.load(state, contacts)
+        row = state.row_address
+        self._call.row = row
+        if row is None:
+            self._load_state(state, contacts)
+        else:
+            self._statics.load_contacts(contacts)
         if reference is not self._last_reference:
             self._set_reference(reference)
         if joint_gains is not self._last_gains:
@@ -118,11 +143,6 @@ class CompiledWholeBody:
             self._joint_gains[:joints] = joint_gains[0]
             self._joint_gains[joints:] = joint_gains[1]
             self._last_gains = joint_gains
-        self._capture[:] = state.capture_point
-        self._in[4] = state.omega
-        self._com_velocity[:] = state.com_velocity
-        self._pelvis_rotation[:] = state.pelvis_rotation
-        self._pelvis_angular[:] = state.pelvis_angular_velocity
         self._joints[0] = joint_positions
         self._joints[1] = joint_velocities
 

@@ -32,7 +32,7 @@ import copy
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import mujoco
 import numpy as np
@@ -156,6 +156,10 @@ class BalanceState:
     #: Makes sole_contacts, on first use (from this estimate's copy of the contact list).
     contacts_of: Callable[[], tuple[SoleContacts, SoleContacts]] = \
         lambda: (_no_contacts(), _no_contacts())
+    #: The address of the compiled estimate's row holding these numbers, which the compiled
+    #: whole-body tick reads in place: set in the instance by the compiled estimate only, not
+    #: a field (so a state from __init__ or dataclasses.replace has None: its fields copied).
+    row_address: ClassVar[int | None] = None
 
     @_Cached
     def sole_contacts(self) -> tuple[SoleContacts, SoleContacts]:
@@ -365,7 +369,7 @@ class BalanceEstimator:
             omega=scalars[2], capture_point=capture_point, bias_nm=block.bias[tick],
             sole_jacobians=block.jacobians[tick], sole_velocities=sole_velocities,
             joint_inertia=self._inertia_of, polygon_of=polygon_of,
-            contacts_of=lambda: _contacts_of_raw(raw))
+            contacts_of=lambda: _contacts_of_raw(raw), row_address=raw.address)
         return state
 
     def _estimate_in_python(self, qpos: np.ndarray, qvel: np.ndarray) -> BalanceState:

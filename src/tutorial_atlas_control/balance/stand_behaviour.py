@@ -132,6 +132,9 @@ class StandBehaviour:
         #: through (None: off the table, as after start()).
         self._table_height_m: float | None = None
         self._ground: Ground | None = None
+        #: The MjData torque() was last given and its qpos, qvel views (the binding makes a
+        #: new view at each attribute read; MjData's arrays never move).
+        self._vectors: tuple[mujoco.MjData, np.ndarray, np.ndarray] | None = None
 
     @functools.cached_property
     def stand_height_m(self) -> float:
@@ -274,8 +277,11 @@ class StandBehaviour:
             raise BalanceError('StandBehaviour.torque before start()')
         if self._transition is not None:
             controller.reference = self._reference_at(float(data.time))
-        atlas = self.atlas
-        state = self.estimator.estimate(data.qpos, data.qvel)
-        output = controller.tick(state, data.qpos[atlas.qpos_adr], data.qvel[atlas.dof_adr])
+        atlas, vectors = self.atlas, self._vectors
+        if vectors is None or vectors[0] is not data:
+            vectors = self._vectors = (data, data.qpos, data.qvel)
+        qpos, qvel = vectors[1], vectors[2]
+        state = self.estimator.estimate(qpos, qvel)
+        output = controller.tick(state, qpos[atlas.qpos_adr], qvel[atlas.dof_adr])
         self.last_state, self.last_output = state, output
         return output.torque_nm
