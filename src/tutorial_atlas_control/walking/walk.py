@@ -10,7 +10,9 @@ they come.
 
 Each 1 ms tick: the pressure centre p = p_ref + (1 + k)(xi - xi_ref), and leg_tasks
 turns it into torques (the Stand's whole-body law on the carrying soles, the swing foot's
-joint-space servo, feet put back down). The CoM walks 5 cm lower than it stands. While a
+joint-space servo, feet put back down). The CoM walks 5 cm lower than it stands, but not
+below the Stand pose's height over the ground less that and LOWEST_WALK_MARGIN_M: a Stand
+already lowered (its legs not reaching a foot that landed turned) walks at its height. While a
 foot swings, its landing moves with the capture point's error predicted at touchdown
 (step_adjustment): a push that the stance sole cannot take back is caught by where the foot
 comes down, within the step limits, and the queue reports the step so moved.
@@ -46,6 +48,11 @@ from tutorial_atlas_control.walking.step_queue import StepQueue, clamp_pose
 from tutorial_atlas_control.walking.swing import SwingPath
 
 _SWAY, _SWING, _CATCH = WALK_PHASES
+#: How far (m) below the Stand pose's height less walk_lowering_m a walk may still go: one
+#: starting from a Stand lowered more than that walks at the height it starts from. (A Stand
+#: 13 cm low over a foot that landed 17 degrees turned, lowered 5 cm more, had its pelvis
+#: 0.70 m over the ground at the first swing, and the stance leg gave way.)
+LOWEST_WALK_MARGIN_M = 0.02
 
 
 @dataclass(frozen=True)
@@ -88,7 +95,10 @@ class WalkController:
     """Walks the queue's steps from a standing start; `done` once it stands again."""
 
     def __init__(self, stand: StandController, queue: StepQueue, state: BalanceState,
-                 time_s: float, gains: WalkGains | None = None) -> None:
+                 time_s: float, gains: WalkGains | None = None,
+                 standing_height_m: float | None = None) -> None:
+        """`standing_height_m`: the Stand pose's CoM height (m, world z) over the ground
+        here; None: the walk lowers the CoM walk_lowering_m from where it starts."""
         self.stand = stand
         self.queue = queue
         self.gains = gains or WalkGains()
@@ -105,6 +115,11 @@ class WalkController:
         self._sway_cop = np.zeros(2)
         #: The CoM height the walk starts from and returns to (m).
         self.stand_height_m = stand.reference.com_height_m
+        #: The CoM height the walk walks at (m).
+        self.walk_height_m = self.stand_height_m - self.gains.walk_lowering_m
+        if standing_height_m is not None:
+            lowest = standing_height_m - self.gains.walk_lowering_m - LOWEST_WALK_MARGIN_M
+            self.walk_height_m = max(self.walk_height_m, min(self.stand_height_m, lowest))
         self._begin_sway(state, time_s)
 
     @property
@@ -139,8 +154,7 @@ class WalkController:
         return DcmPlan.plan(np.array(cops), np.array(durations), final, omega)
 
     def _begin_sway(self, state: BalanceState, time_s: float) -> None:
-        self.legs.move_height(self.stand_height_m - self.gains.walk_lowering_m, time_s,
-                              self.gains.sway_s)
+        self.legs.move_height(self.walk_height_m, time_s, self.gains.sway_s)
         self._plan = self._plan_steps(self.queue.preview(), state.omega)
         target = (self._plan.start if self._plan is not None
                   else state.sole_centres[:, :2].mean(axis=0))
