@@ -5,14 +5,14 @@ the first stance foot), then one single-support phase per step (the stance foot 
 the whole wrench, the other foot swings to its target along swing.SwingPath), then a
 catch (both feet down, the capture point brought to rest between them), after which
 Stand takes over. Each step begins with a weight transfer (phases.WeightTransfer): both
-feet carry, the pressure centre moves over to the sole that has just landed (which a foot
-servo presses flat on its step's surface), and the other foot lifts once that sole is flat
-and carries half the weight, or after at most 0.1 s; the swing then takes the rest of the
-step's duration, so the step ends when planned and the capture point's plan, made at the
-step's start over the step's whole duration, stays the reference throughout (the transfer's
-slower pressure centre is an error its feedback takes back). At each touchdown the capture
-point's plan (dcm_plan) is made again over the steps the queue then holds, so a streaming
-client's new steps enter it as they come.
+feet carry, the pressure centre moves over to the sole that has just landed in 0.03 s (a
+foot servo pressing that sole flat on its step's surface), and the other foot lifts once
+that sole is flat and carries half the weight, or after at most 0.1 s; the swing then
+takes the rest of the step's duration, so the step ends when planned and the capture
+point's plan, made at the step's start over the step's whole duration, stays the reference
+throughout (the blend's slower pressure centre is an error its feedback takes back). At
+each touchdown the capture point's plan (dcm_plan) is made again over the steps the queue
+then holds, so a streaming client's new steps enter it as they come.
 
 Each 1 ms tick: the pressure centre p = p_ref + (1 + k)(xi - xi_ref), and leg_tasks
 turns it into torques (the Stand's whole-body law on the carrying soles, the swing foot's
@@ -84,9 +84,11 @@ class WalkGains:
     #: the least change (m) that moves its path.
     adjust_steps: bool = True
     adjust_tolerance_m: float = 0.001
-    #: The weight transfer at each step's start: at most 0.1 s (and a quarter of the
-    #: step), over once the landed sole is flat and carries half the weight.
-    transfer: WeightTransfer = field(default_factory=lambda: WeightTransfer(0.1, 0.5))
+    #: The weight transfer at each step's start: the pressure centre over in 0.03 s, the
+    #: other foot down at most 0.1 s (and a quarter of the step), until the landed sole is
+    #: flat and carries half the weight.
+    transfer: WeightTransfer = field(
+        default_factory=lambda: WeightTransfer(0.1, 0.5, blend_s=0.03))
     #: The legs' gains and limits (leg_tasks).
     legs: LegGains = field(default_factory=LegGains)
 
