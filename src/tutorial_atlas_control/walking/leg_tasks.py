@@ -276,7 +276,7 @@ class LegTasks:
         if swing_foot is not None:
             contact = (swing_foot != 0, swing_foot != 1)
             cop = _clamp_to_sole(state, 1 - swing_foot, self.sole_reach_m, cop)
-        else:  # swaying or catching: the feet that are down (both, unless a landing is late)
+        else:  # swaying, moving the weight, catching: the feet that are down (both, unless late)
             contact = state.in_contact if any(state.in_contact) else (True, True)
             half_length, half_width = stand.sole_half_size_m
             corners = np.concatenate([

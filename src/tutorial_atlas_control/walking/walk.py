@@ -4,13 +4,21 @@ A walk is a row of phases: a sway (both feet down, the capture point moved over 
 the first stance foot), then one single-support phase per step (the stance foot carries
 the whole wrench, the other foot swings to its target along swing.SwingPath), then a
 catch (both feet down, the capture point brought to rest between them), after which
-Stand takes over. At each touchdown the capture point's plan (dcm_plan) is made again
-over the steps the queue then holds, so a streaming client's new steps enter it as
-they come.
+Stand takes over. Each step begins with a weight transfer (phases.WeightTransfer): both
+feet carry, the pressure centre moves over to the sole that has just landed in 0.03 s (a
+foot servo pressing that sole flat on its step's surface), and the other foot lifts once
+that sole is flat and carries half the weight, or after at most 0.1 s; the swing then
+takes the rest of the step's duration, so the step ends when planned and the capture
+point's plan, made at the step's start over the step's whole duration, stays the reference
+throughout (the blend's slower pressure centre is an error its feedback takes back). At
+each touchdown the capture point's plan (dcm_plan) is made again over the steps the queue
+then holds, so a streaming client's new steps enter it as they come.
 
 Each 1 ms tick: the pressure centre p = p_ref + (1 + k)(xi - xi_ref), and leg_tasks
 turns it into torques (the Stand's whole-body law on the carrying soles, the swing foot's
-joint-space servo, feet put back down). The CoM walks 5 cm lower than it stands. While a
+joint-space servo, feet put back down). The CoM walks 5 cm lower than it stands, but not
+below the Stand pose's height over the ground less that and LOWEST_WALK_MARGIN_M: a Stand
+already lowered (its legs not reaching a foot that landed turned) walks at its height. While a
 foot swings, its landing moves with the capture point's error predicted at touchdown
 (step_adjustment): a push that the stance sole cannot take back is caught by where the foot
 comes down, within the step limits, and the queue reports the step so moved.
@@ -38,6 +46,8 @@ from tutorial_atlas_control.walking.phases import (
     Phase,
     PhaseEnd,
     PhaseSequence,
+    WeightTransfer,
+    carried_share,
     swing_to,
 )
 from tutorial_atlas_control.walking.status_flags import STEPPING
@@ -46,6 +56,11 @@ from tutorial_atlas_control.walking.step_queue import StepQueue, clamp_pose
 from tutorial_atlas_control.walking.swing import SwingPath
 
 _SWAY, _SWING, _CATCH = WALK_PHASES
+#: How far (m) below the Stand pose's height less walk_lowering_m a walk may still go: one
+#: starting from a Stand lowered more than that walks at the height it starts from. (A Stand
+#: 13 cm low over a foot that landed 17 degrees turned, lowered 5 cm more, had its pelvis
+#: 0.70 m over the ground at the first swing, and the stance leg gave way.)
+LOWEST_WALK_MARGIN_M = 0.02
 
 
 @dataclass(frozen=True)
@@ -69,6 +84,11 @@ class WalkGains:
     #: the least change (m) that moves its path.
     adjust_steps: bool = True
     adjust_tolerance_m: float = 0.001
+    #: The weight transfer at each step's start: the pressure centre over in 0.03 s, the
+    #: other foot down at most 0.1 s (and a quarter of the step), until the landed sole is
+    #: flat and carries half the weight.
+    transfer: WeightTransfer = field(
+        default_factory=lambda: WeightTransfer(0.1, 0.5, blend_s=0.03))
     #: The legs' gains and limits (leg_tasks).
     legs: LegGains = field(default_factory=LegGains)
 
@@ -88,7 +108,10 @@ class WalkController:
     """Walks the queue's steps from a standing start; `done` once it stands again."""
 
     def __init__(self, stand: StandController, queue: StepQueue, state: BalanceState,
-                 time_s: float, gains: WalkGains | None = None) -> None:
+                 time_s: float, gains: WalkGains | None = None,
+                 standing_height_m: float | None = None) -> None:
+        """`standing_height_m`: the Stand pose's CoM height (m, world z) over the ground
+        here; None: the walk lowers the CoM walk_lowering_m from where it starts."""
         self.stand = stand
         self.queue = queue
         self.gains = gains or WalkGains()
@@ -103,8 +126,20 @@ class WalkController:
         self._planned_step: Footstep | None = None
         self._plan: DcmPlan | None = None
         self._sway_cop = np.zeros(2)
+        #: When the step's other foot lifted, in the step (s); None while the weight moves.
+        self._lift_off_s: float | None = None
+        #: The pressure centre kept last tick, and where the step's transfer moves it from.
+        self._last_cop = state.sole_centres[:, :2].mean(axis=0)
+        self._transfer_from = self._last_cop
+        #: The sole that landed last, on its step's surface (None before the first step).
+        self._landed: Footstep | None = None
         #: The CoM height the walk starts from and returns to (m).
         self.stand_height_m = stand.reference.com_height_m
+        #: The CoM height the walk walks at (m).
+        self.walk_height_m = self.stand_height_m - self.gains.walk_lowering_m
+        if standing_height_m is not None:
+            lowest = standing_height_m - self.gains.walk_lowering_m - LOWEST_WALK_MARGIN_M
+            self.walk_height_m = max(self.walk_height_m, min(self.stand_height_m, lowest))
         self._begin_sway(state, time_s)
 
     @property
@@ -139,8 +174,7 @@ class WalkController:
         return DcmPlan.plan(np.array(cops), np.array(durations), final, omega)
 
     def _begin_sway(self, state: BalanceState, time_s: float) -> None:
-        self.legs.move_height(self.stand_height_m - self.gains.walk_lowering_m, time_s,
-                              self.gains.sway_s)
+        self.legs.move_height(self.walk_height_m, time_s, self.gains.sway_s)
         self._plan = self._plan_steps(self.queue.preview(), state.omega)
         target = (self._plan.start if self._plan is not None
                   else state.sole_centres[:, :2].mean(axis=0))
@@ -156,7 +190,8 @@ class WalkController:
         self.step = self._planned_step = step
         stance = self.queue.feet[1 - step.foot_index]
         self.legs.face(stance.yaw_rad, step.yaw_rad, time_s, step.duration_s)
-        self.swing = swing_to(state, step, step.duration_s)
+        self.swing, self._lift_off_s = None, None  # the swing begins once the weight moved
+        self._transfer_from = self._last_cop
         self.phases.enter(phase, time_s,
                           PhaseEnd.swing(step.duration_s, self.gains.legs.late_touchdown_s))
 
@@ -185,7 +220,9 @@ class WalkController:
         if not phases.ended(time_s, self._condition(state)):
             return
         if phases.phase is _SWING and step is not None:
-            self.queue.touchdown(foot_pose(state, step.foot_index, step.step_index))
+            landed = foot_pose(state, step.foot_index, step.step_index)
+            self.queue.touchdown(landed)
+            self._landed = replace(landed, z_m=step.z_m)
         following = phases.following(more_steps=bool(self.queue.preview()))
         if following is None:
             phases.finish()
@@ -193,6 +230,42 @@ class WalkController:
             self._begin_step(following, state, time_s)
         else:
             self._begin_catch(following, time_s)
+
+    @property
+    def transferring(self) -> bool:
+        """Whether the step under way is still moving its weight, both feet down."""
+        return self.phases.phase is _SWING and self._lift_off_s is None
+
+    def _stance_pose(self) -> Footstep:
+        """The step's stance sole as the transfer presses it: on the surface it landed on."""
+        assert self.step is not None  # while stepping
+        stance = 1 - self.step.foot_index
+        landed = self._landed
+        if landed is not None and landed.foot_index == stance:
+            return landed
+        return self.queue.feet[stance]
+
+    def _lift_off(self, state: BalanceState, time_s: float) -> None:
+        """Lift the step's foot once the transfer's rule says so: its swing begins from where
+        the sole is, for the rest of the step's duration."""
+        step = self.step
+        if not self.transferring or step is None:
+            return
+        elapsed = self.phases.elapsed_s(time_s)
+        stance = 1 - step.foot_index
+        flat = self.legs.flat_down(state, stance, self._stance_pose())
+        share = carried_share(self._last_cop, state.sole_centres[step.foot_index][0:2],
+                              state.sole_centres[stance][0:2])
+        if self.gains.transfer.lifts(elapsed, step.duration_s, flat, share):
+            self._lift_off_s = elapsed
+            self.swing = swing_to(state, step, step.duration_s - elapsed)
+
+    def _transfer_cop(self, cop: np.ndarray, time_s: float) -> np.ndarray:
+        """The pressure centre while the weight moves: from where it was as the step began
+        towards the law's `cop`, along the transfer's blend."""
+        assert self.step is not None  # while stepping
+        blend = self.gains.transfer.blend(self.phases.elapsed_s(time_s), self.step.duration_s)
+        return self._transfer_from + blend * (cop - self._transfer_from)
 
     # -- the references -----------------------------------------------------------------------
 
@@ -214,8 +287,7 @@ class WalkController:
         """Move the swing foot's landing by where the capture point will be at touchdown
         (step_adjustment), within the step limits from the stance foot."""
         step, planned, plan, swing = self.step, self._planned_step, self._plan, self.swing
-        assert step is not None and planned is not None and plan is not None \
-            and swing is not None  # set with the step
+        assert step is not None and planned is not None and plan is not None  # with the step
         stance = 1 - step.foot_index
         sole = state.sole_rotations[stance]
         error_x, error_y = (state.capture_point - xi_ref).tolist()
@@ -230,7 +302,8 @@ class WalkController:
         if math.hypot(x - step.x_m, y - step.y_m) < self.gains.adjust_tolerance_m:
             return
         self.step = replace(planned, x_m=x, y_m=y)
-        self.swing = replace(swing, end=np.array([x, y, planned.z_m]))
+        if swing is not None:  # else it begins at lift-off, to the step as adjusted
+            self.swing = replace(swing, end=np.array([x, y, planned.z_m]))
         self.queue.adjust(self.step)
 
     # -- one tick -----------------------------------------------------------------------------
@@ -239,18 +312,28 @@ class WalkController:
                     joint_velocities: np.ndarray, time_s: float) -> WalkOutput:
         """The 28 joint torques (N m) for this 1 ms tick, within the effort limits."""
         self._advance(state, time_s)
+        self._lift_off(state, time_s)
         xi_ref, cop_ref = self._capture_reference(state, time_s)
         if self.phase == STEPPING and self.gains.adjust_steps:
             self._adjust(state, xi_ref, cop_ref, time_s)
         cop = dcm_feedback_cop(state.capture_point, xi_ref, self.gains.dcm_gain, cop_ref)
-        step = self.step if self.phase == STEPPING else None
+        transferring = self.transferring
+        feet = self.queue.feet
+        if transferring:  # both feet carry, the landed one pressed onto its surface
+            cop = self._transfer_cop(cop, time_s)
+            feet = list(feet)
+            stance = self._stance_pose()
+            feet[stance.foot_index] = stance
+        step = self.step if self.phase == STEPPING and not transferring else None
         swing_foot = None if step is None else step.foot_index
         legs = self.legs
         torque, cop, contact = legs.torque(state, joint_positions, joint_velocities, time_s,
                                            cop, swing_foot)
         swing = None
         if step is not None:
-            assert self.swing is not None  # set with the step
-            swing = (step.foot_index, self.swing, self.phases.elapsed_s(time_s))
-        legs.finish(state, joint_velocities, torque, contact, swing, self.queue.feet)
+            assert self.swing is not None and self._lift_off_s is not None  # at lift-off
+            swing = (step.foot_index, self.swing,
+                     self.phases.elapsed_s(time_s) - self._lift_off_s)
+        legs.finish(state, joint_velocities, torque, contact, swing, feet)
+        self._last_cop = cop
         return WalkOutput(torque, cop, xi_ref, self.phase, swing_foot)

@@ -88,7 +88,8 @@ class WalkBehaviour:
         queue = StepQueue(foot_pose(state, 0), foot_pose(state, 1), self.limits)
         queue.offer(self.default_steps if self.next_steps is None else self.next_steps)
         self.next_steps = None
-        self.walk = WalkController(controller, queue, state, float(data.time), self.gains)
+        self.walk = WalkController(controller, queue, state, float(data.time), self.gains,
+                                   stand.ground_under_m(state) + stand.com_height_m)
 
     def torque(self, data: mujoco.MjData) -> np.ndarray:
         """This tick's f_out (N m, (28,)), within the effort limits."""

@@ -2,7 +2,8 @@
 once its condition holds or at its longest, a swing at touchdown after its duration or
 late_touchdown_s past it; Walk swings again while it has steps and catches when it has none
 (a stop), Step shifts, swings and settles once; a swing runs from the sole where it lifts to
-the step's pose."""
+the step's pose; a walking step's weight transfer lifts the other foot once the landed sole
+is flat and carries its share, or at its longest, and the share is the whole-body layer's."""
 
 from __future__ import annotations
 
@@ -11,12 +12,15 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from tutorial_atlas_control.balance.contact_wrench import left_share
 from tutorial_atlas_control.walking.footsteps import Footstep
 from tutorial_atlas_control.walking.phases import (
     STATIC_STEP_PHASES,
     WALK_PHASES,
     PhaseEnd,
     PhaseSequence,
+    WeightTransfer,
+    carried_share,
     settled,
     swing_to,
 )
@@ -138,3 +142,65 @@ def test_a_swing_runs_from_the_lifted_sole_to_the_steps_whole_pose() -> None:
         pytest.approx(yaw), 0.5, 0.7)
     state.sole_centres[1, 0] = 9.0
     assert path.start[0] == 0.1  # a copy: the estimate's arrays are not kept
+
+
+#: The walk's weight transfer: at most 0.1 s, over once the landed sole carries half; the
+#: pressure centre over in 0.03 s.
+TRANSFER = WeightTransfer(0.1, 0.5, blend_s=0.03)
+
+
+@pytest.mark.parametrize(('elapsed_s', 'flat', 'share', 'lifts'), [
+    (0.02, True, 0.6, True),     # flat and carrying its share: the other foot lifts
+    (0.02, False, 0.9, False),   # carrying, but on its heel's edge: both feet stay down
+    (0.02, True, 0.3, False),    # flat, but the weight not yet over it
+    (0.099, False, 0.0, False),  # neither, not yet the longest
+    (0.1, False, 0.0, True),     # the longest: it lifts anyway
+])
+def test_a_transfer_lifts_the_other_foot_once_the_landed_sole_is_flat_and_carries_its_share(
+        elapsed_s: float, flat: bool, share: float, lifts: bool) -> None:
+    assert TRANSFER.lifts(elapsed_s, SWING_S, flat, share) is lifts
+
+
+def test_a_transfer_takes_at_most_a_quarter_of_a_short_step() -> None:
+    """The swing keeps the rest: the step still ends on time."""
+    assert TRANSFER.longest_for(SWING_S) == pytest.approx(0.1)
+    assert TRANSFER.longest_for(0.2) == pytest.approx(0.05)
+    assert TRANSFER.lifts(0.05, 0.2, False, 0.0)
+
+
+def test_a_transfer_moves_the_pressure_centre_smoothly_to_the_laws_in_its_blend() -> None:
+    blends = [TRANSFER.blend(tick * 0.001, SWING_S) for tick in range(0, 121)]
+    assert blends[0] == 0.0 and blends[15] == pytest.approx(0.5) and blends[30] == 1.0
+    assert all(later >= earlier for earlier, later in zip(blends, blends[1:]))
+    assert blends[1] < 0.01 and 1.0 - blends[29] < 0.01  # no jump at either end
+    assert blends[120] == 1.0
+    # Within a short step's longest transfer too.
+    assert WeightTransfer(0.1, 0.5, blend_s=0.2).blend(0.05, 0.2) == 1.0
+
+
+@pytest.mark.parametrize(('cop', 'share'), [
+    ((0.0, -0.12), 0.0),    # on the lifting sole's centre
+    ((0.3, 0.12), 1.0),     # on the landed one's
+    ((0.15, 0.0), 0.5),     # halfway
+    ((0.2, 0.08), 0.7317),  # nearly three quarters of the way, a little off the line
+    ((0.4, 0.3), 1.0),      # beyond the landed sole: all of it
+    ((-0.1, -0.2), 0.0),    # behind the lifting one: none
+])
+def test_the_landed_soles_share_is_the_pressure_centres_place_between_the_soles(
+        cop: tuple[float, float], share: float) -> None:
+    lifting, landed = np.array([0.0, -0.12]), np.array([0.3, 0.12])
+    assert carried_share(np.array(cop), lifting, landed) == pytest.approx(share, abs=1e-4)
+
+
+@pytest.mark.parametrize('along', [0.1, 0.3, 0.5, 0.8])
+def test_the_landed_soles_share_is_the_whole_body_layers_split_of_the_weight(
+        along: float) -> None:
+    """balance/contact_wrench.left_share (how the layer shares the weight between two soles)
+    gives the landed (left) sole the same share for the weight over the pressure centre."""
+    landed, lifting = np.array([0.3, 0.12, 0.0]), np.array([0.0, -0.12, 0.0])
+    cop = lifting + along * (landed - lifting)
+    middle = 0.5 * (landed + lifting)
+    weight = 900.0
+    moment_mid = np.cross(cop - middle, [0.0, 0.0, weight])
+    share = left_share((0.0, 0.0, weight), tuple(moment_mid), tuple(landed), tuple(lifting))
+    assert carried_share(cop[0:2], lifting[0:2], landed[0:2]) == pytest.approx(share)
