@@ -11,10 +11,11 @@ SWAYING, already sends the step after it). Each target is clamped from the stanc
 (step_queue's limits) and reported as `desired_step_saturated`.
 
 The step is taken over the world's ground (sim/ground.py's rays, loose bodies where the
-simulator has them): the step's CoM height is the Stand's over the lowest of the soles'
-surfaces and the target's (a foot stepping down off a block must reach the floor, the
-stance leg bends for it; one stepping up keeps the lower stance until both feet are up), and
-the swing steps over the highest ground under its sweep (static_step, step_over).
+simulator has them): its target on the highest ground under the sole's footprint there (a
+hollow block's rims, where the ray at its centre falls through a hole), its CoM height the
+Stand's over the stance sole's surface less STANCE_DROP_SHARE of that surface's height over
+the lowest in play, and its swing over the highest ground under the sole's sweep
+(static_step, step_over). On level ground all three are as they were.
 """
 
 from __future__ import annotations
@@ -37,9 +38,12 @@ from tutorial_atlas_control.walking.step_queue import DEFAULT_LIMITS, StepLimits
 __all__ = ['StepBehaviour', 'StepStatus']
 
 #: A step's CoM height is the Stand's over the stance sole's surface lowered by this share of
-#: that surface's height over the lowest surface in play (the other sole's, the target's):
-#: a foot stepping down off a block must reach the floor; a stance leg crouched by the whole
-#: block (0.2 m, and Step's 0.05 m) has its ankle on its limit and its heel lifts.
+#: that surface's height over the lowest surface in play (the other sole's, the target's): a
+#: foot stepping down off a block must reach the floor, a trailing foot on the floor must
+#: reach it until it lifts. Neither this share nor 0.6-1 took the second foot from the floor
+#: onto a 0.2 m block (docs/vrc.md): from the floor's height the stance knee on the block
+#: is on its effort limit, from half-way the trailing leg is straight before the weight is
+#: over the block.
 STANCE_DROP_SHARE = 0.5
 _UP = (0.0, 0.0, 1.0)
 
