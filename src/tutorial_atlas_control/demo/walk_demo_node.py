@@ -59,7 +59,11 @@ def run_walk_demo(walk: str, bag_dir: Path, real_time_factor: float, log_dir: Pa
     is a result, not an error: walk_client.py's exit status is reported through `warn`."""
     return run_launched('atlas.launch startup_mode:=bdi_stand', {'startup_mode': 'bdi_stand'},
                         bag_dir, real_time_factor, log_dir,
-                        lambda launch: _drive(launch, walk, progress, warn), progress, warn)
+                        lambda launch: _drive(launch, 'walk_client.py', WALKS[walk][1],
+                                              WALK_TIMEOUT_S,
+                                              'a fall, or a walk that did not end in Stand',
+                                              progress, warn),
+                        progress, warn)
 
 
 def run_course_demo(walk: str, bag_dir: Path, real_time_factor: float, log_dir: Path,
@@ -70,36 +74,24 @@ def run_course_demo(walk: str, bag_dir: Path, real_time_factor: float, log_dir: 
     args = {'gzname': 'gzserver', 'course_markers': 'false',
             'score_dir': bag_dir / 'vrc_task_2'}
     return run_launched('vrc_task_2.launch', args, bag_dir, real_time_factor, log_dir,
-                        lambda launch: _drive_course(launch, walk, progress, warn), progress,
-                        warn, launch_file='vrc_task_2.launch')
+                        lambda launch: _drive(launch, 'vrc_walker.py', COURSE_WALKS[walk][1],
+                                              COURSE_TIMEOUT_S, 'a fall, or a gate not reached',
+                                              progress, warn),
+                        progress, warn, launch_file='vrc_task_2.launch')
 
 
-def _drive_course(launch: AtlasLaunch, walk: str, progress: Report, warn: Report) -> None:
-    from rosgraph_msgs.msg import Clock  # noqa: PLC0415 - rospy loads only once a launch runs
-
-    join(launch, 'tutorial_course_demo')
-    wait_sim_time(Clock, WALK_START_S)
-    command = ['rosrun', 'tutorial_atlas_control', 'vrc_walker.py', *COURSE_WALKS[walk][1],
-               '--timeout', f'{COURSE_TIMEOUT_S:.0f}']
-    progress('demo: ' + ' '.join(command))
-    status = run_to_end(command, launch.env, COURSE_TIMEOUT_S + 30.0,
-                        TRAJECTORY_STOP_TIMEOUT_S)
-    if status != 0:
-        warn(f'demo: vrc_walker.py exited with status {status} (a fall, or a gate not '
-             'reached)')
-    wait_sim_time(Clock, END_SETTLE_S)
-
-
-def _drive(launch: AtlasLaunch, walk: str, progress: Report, warn: Report) -> None:
+def _drive(launch: AtlasLaunch, client: str, args: tuple[str, ...], timeout_s: float,
+           failure: str, progress: Report, warn: Report) -> None:
+    """From WALK_START_S of sim time, `rosrun tutorial_atlas_control client args` until it
+    ends; a non-zero exit (`failure` says what it means) is reported through `warn`."""
     from rosgraph_msgs.msg import Clock  # noqa: PLC0415 - rospy loads only once a launch runs
 
     join(launch, 'tutorial_walk_demo')
     wait_sim_time(Clock, WALK_START_S)
-    command = ['rosrun', 'tutorial_atlas_control', 'walk_client.py', *WALKS[walk][1],
-               '--timeout', f'{WALK_TIMEOUT_S:.0f}']
+    command = ['rosrun', 'tutorial_atlas_control', client, *args, '--timeout',
+               f'{timeout_s:.0f}']
     progress('demo: ' + ' '.join(command))
-    status = run_to_end(command, launch.env, WALK_TIMEOUT_S + 30.0, TRAJECTORY_STOP_TIMEOUT_S)
+    status = run_to_end(command, launch.env, timeout_s + 30.0, TRAJECTORY_STOP_TIMEOUT_S)
     if status != 0:
-        warn(f'demo: walk_client.py exited with status {status} (a fall, or a walk that did '
-             'not end in Stand)')
+        warn(f'demo: {client} exited with status {status} ({failure})')
     wait_sim_time(Clock, END_SETTLE_S)
