@@ -2,7 +2,8 @@
 and the replay of a recorded run (replay_score: a scored run's /vrc_score computed again on
 the replayed steps); world: the model and start they simulate (a VRC world by name, or the
 recorded run's); course_route: a course walker's streamed walk, leg by leg, on a VRC world,
-scored."""
+scored; terrain_trial: straight walks on the course's kinds of ground one at a time (mud,
+slopes), over seeds."""
 
 from tutorial_atlas_control.exports import lazy_exports
 
@@ -12,6 +13,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'player': ['CommandLatency', 'DEFAULT_SETTLE_S', 'DEFAULT_START_AFTER_S', 'OfflineRunError',
                'run_offline', 'write_offline_bag'],
     'replay': ['DEFAULT_TOLERANCE', 'ReplayError', 'format_report', 'replay_bag'],
+    'terrain_trial': ['MUD_DEPTH_M', 'TERRAINS', 'Terrain', 'mud_model', 'terrain_walk'],
     'world': ['OfflineWorld', 'named_world', 'recorded_world'],
     'replay_score': ['ScoreComparison', 'ScoreReplay'],
 })

@@ -33,7 +33,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'walk_behaviour': ['WalkBehaviour', 'WalkStatus'],
     'route': ['RouteGait', 'feet_origin', 'route_steps'],
     'start_noise': ['perturb_start'],
-    'walk_trial': ['WalkTrial', 'pushed_walk_trial', 'random_pushes', 'straight_walk_trial',
-                   'walk_trial'],
+    'walk_trial': ['SETTLE_S', 'WalkTrial', 'WalkingStand', 'pushed_walk_trial',
+                   'random_pushes', 'straight_walk_trial', 'walk_trial'],
     'step_behaviour': ['StepBehaviour', 'StepStatus'],
 })
