@@ -105,6 +105,17 @@ class AsiLink:
                 raise Refused(f'no {topics.ASI_STATE} after STAND: is the simulator running?')
             time.sleep(0.01)
 
+    def hold(self, sim_s: float) -> None:
+        """Until the states' stamps are `sim_s` (s of sim time) past the last one's;
+        Refused when they stop for STATE_SILENCE_S."""
+        assert self.last is not None  # connected
+        until = self.last.header.stamp.to_sec() + sim_s
+        while self.last.header.stamp.to_sec() < until:
+            if time.monotonic() - self._heard > STATE_SILENCE_S:
+                raise Refused(f'no {topics.ASI_STATE} for {STATE_SILENCE_S:g} s: the '
+                              'simulator stopped or is paused')
+            time.sleep(0.01)
+
     def walk(self, client: WalkClient, timeout_s: float) -> None:
         """Stream `client`'s walk until it ends; Refused when the states stop for
         STATE_SILENCE_S or at `timeout_s` (wall time)."""

@@ -2,7 +2,8 @@
 
 It walks the course gate to gate through the AtlasSimInterface, as a VRC team's client did:
 the legs from the nearest gate still ahead of the robot to --to (course/legs.py), each
-planned from where the feet are (foot_pos_est) when the last one ended and streamed as WALK
+planned from where the feet are (foot_pos_est) once Stand has held a second after the last
+one, and streamed as WALK
 commands (the window from next_step_index_needed on every state). Steps land where the
 course's ground is (the simulator puts each on the surface under it). It prints each gate
 passed and every other event of /vrc_score, then the score. It ends with exit 0 once
@@ -30,7 +31,7 @@ from tutorial_atlas_control.cli.convention import (
     positive_number,
     print_error,
 )
-from tutorial_atlas_control.course import GATES, Leg, legs_ahead
+from tutorial_atlas_control.course import GATES, LEG_PAUSE_S, Leg, legs_ahead
 from tutorial_atlas_control.walking import RouteGait, WalkingError, route_steps
 
 PROG = 'vrc_walker.py'
@@ -114,7 +115,9 @@ def _walk_course(link: AsiLink, to_gate: str, gait: RouteGait, timeout_s: float)
     if first.current_behavior == Behavior.USER:
         link.stand_first(0)
     deadline = time.monotonic() + timeout_s
-    for leg in legs:
+    for number, leg in enumerate(legs):
+        if number > 0:
+            link.hold(LEG_PAUSE_S)
         _walk_leg(link, leg, gait, deadline - time.monotonic())
     passed = score.wait_for(to_gate, SCORE_WAIT_S)
     last = score.last

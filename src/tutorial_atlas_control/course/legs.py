@@ -1,14 +1,14 @@
 """The course as a walker's legs: the waypoints from each gate to the next.
 
 A course walker (cli/vrc_walker.py, offline/course_route.py) walks one leg at a time, each
-planned again from where the feet are when the last one ended. The legs keep clear of what
-is not ground to walk on: from the pen east through gate_0 to x 3.2, 1.3 m clear of the pen's
-east wall (on a route turning north at x 2.5 the pelvis came within 0.5-0.6 m of it and two
-landings fell 17 cm east of their steps: docs/vrc.md), north past the wall's end, then to
-gate_1 (its feet stopping 5 cm past the gate's line, short of the mud pit's ramp), through
-the pit to gate_2, over the hills to gate_3, and across the rubble to gate_4. A walker that
-starts elsewhere (one of the later starts) begins with the nearest gate still ahead of it,
-walking that leg from its waypoint nearest the walker.
+planned again from where the feet are once Stand has held LEG_PAUSE_S after the last one.
+The legs keep clear of what is not ground to walk on: from the pen east through gate_0 to
+x 3.2, 1.3 m clear of the pen's east wall (on a route turning north at x 2.5 the pelvis came
+within 0.5-0.6 m of it and two landings fell 17 cm east of their steps: docs/vrc.md), north
+past the wall's end, then to gate_1 (its feet stopping 5 cm past the gate's line, short of
+the mud pit's ramp), through the pit to gate_2, over the hills to gate_3, and across the
+rubble to gate_4. A walker that starts elsewhere (one of the later starts) begins with the
+nearest gate still ahead of it, walking that leg from its waypoint nearest the walker.
 """
 
 from __future__ import annotations
@@ -19,7 +19,13 @@ from dataclasses import dataclass
 from tutorial_atlas_control.course.errors import CourseError
 from tutorial_atlas_control.course.vrc_task_2 import GATES, Gate
 
-__all__ = ['COURSE_LEGS', 'Leg', 'legs_ahead']
+__all__ = ['COURSE_LEGS', 'LEG_PAUSE_S', 'Leg', 'legs_ahead']
+
+#: Stand holds this long (s of sim time) between one leg's end and the next one's first
+#: WALK: the catch after a walk settles, and a bag's walks stay apart (its analysis tells
+#: one walk's steps from the next by the behaviour's changes; a next WALK within the same
+#: millisecond fell into the last walk's window).
+LEG_PAUSE_S = 1.0
 
 
 @dataclass(frozen=True)

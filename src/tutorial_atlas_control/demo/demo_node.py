@@ -22,11 +22,12 @@ from tutorial_atlas_control.bags import (
     plot_course_map,
     plot_footprints,
     plot_run,
+    read_behaviours,
     read_course_run,
     read_scores,
     render_bag_video,
     short_summary,
-    summarise_walk,
+    titled_walks,
     walk_lines,
 )
 from tutorial_atlas_control.errors import AtlasControlError
@@ -186,24 +187,26 @@ def _course_lines(data: BagData, bag: Path, report: Report) -> Path | None:
 def summarise(bag: Path, video_fps: float, video_size: tuple[int, int],
               report: Report = silent, table: bool = False, walk: bool = False) -> None:
     """Report the short summary; write the plot and (unless video_fps is 0) the video.
-    `walk`: a walk's bag: the walk's figures and its footprints (<bag>.footprints.png)
-    instead of the right foot's displacement; on the VRC course also the score and the
-    course map (<bag>.course.png).
+    `walk`: a walk's bag: each walk's figures and, for one walk, its footprints
+    (<bag>.footprints.png) instead of the right foot's displacement; on the VRC course also
+    the score and the course map (<bag>.course.png, every leg's landings).
 
     The summary is reported before the (slower) plot and video are made.
     """
     analysis = analyze_bag(bag)
     footprints = None
     if walk:
-        summary = summarise_walk(analysis.data)
-        if summary is None:
+        walks = titled_walks(analysis.data, read_behaviours(analysis.data))
+        if not walks:
             report('\n' + short_summary(analysis, table, tracking=False))
             report('walk: the bag holds no WALK command')
         else:  # the walk's lines say whether it fell: one line, not two
             report('\n=== summary ===')
-            for line in walk_lines(summary):
-                report(line)
-            footprints = plot_footprints(summary, bag.with_suffix('.footprints.png'))
+            for title, summary in walks:
+                for line in ([] if len(walks) == 1 else [title]) + walk_lines(summary):
+                    report(line)
+            if len(walks) == 1:  # several walks (a course's legs) go on the course map
+                footprints = plot_footprints(walks[0][1], bag.with_suffix('.footprints.png'))
     else:
         report('\n' + short_summary(analysis, table))
         foot = foot_line(analysis.data)

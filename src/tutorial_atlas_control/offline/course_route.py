@@ -33,7 +33,7 @@ from tutorial_atlas_control.asi import (
     step_data_of,
     yaw_of_quaternion,
 )
-from tutorial_atlas_control.course import Leg, ScoreRow, legs_ahead
+from tutorial_atlas_control.course import LEG_PAUSE_S, Leg, ScoreRow, legs_ahead
 from tutorial_atlas_control.msgs import AsiCommand, ManipulateParams, StepData
 from tutorial_atlas_control.offline.world import named_world
 from tutorial_atlas_control.sim import (
@@ -148,7 +148,9 @@ def course_walk(seed: int | None, legs: Sequence[Leg] | None = None, to_gate: st
         scoring = CourseScoring(sim, score_dir or Path(scratch), rows.append)
         tick = Tick(sim, streamer, streamer.after_step, interface.end_step, score=scoring)
         _run_until(tick, sim, walk_at_s, streamer)
-        for leg in legs:
+        for number, leg in enumerate(legs):
+            if number > 0:
+                _run_until(tick, sim, sim.sim_time_ns / NS_PER_S + LEG_PAUSE_S, streamer)
             if streamer.fell_at_s is not None:
                 break
             client = _walk_leg(tick, sim, interface, streamer, leg, gait)
