@@ -2,10 +2,12 @@
 """Straight walks on the course's kinds of ground, one case at a time, offline, over seeds:
 the measurement behind docs/vrc.md's table of Walk on mud and slopes.
 
-    python3 tools/terrain_walk.py CASE SEED [SEED ...]
+    python3 tools/terrain_walk.py [--push N] CASE SEED [SEED ...]
 
 CASE is one of offline/terrain_trial.py's TERRAINS (mud_40, mud_70, up_8deg, down_8deg,
-up_16deg, down_16deg); SEED an integer (walking/start_noise.py's perturbed start) or `none`.
+up_16deg, down_16deg); SEED an integer (walking/start_noise.py's perturbed start, and the
+pushes' draw) or `none`; --push N pushes the pelvis sideways by N newtons for 0.1 s once
+every 5 s of the walk.
 Each walk prints one JSON line as it ends: whether it fell, the steps landed of those
 planned, the worst landing (m), the lowest pelvis over the ground (m), where the pelvis
 ended, the CPU it took. Needs `source ./env.sh`. Exits 0 when no walk fell, 1 otherwise, 2
@@ -16,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 import time
 
@@ -33,20 +36,33 @@ def _seed(text: str) -> int | None:
         raise argparse.ArgumentTypeError(f'seed {text!r} is not an integer or none') from None
 
 
+def _force(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not 0.0 <= value < math.inf:
+        raise argparse.ArgumentTypeError(f'push {text!r} is not a finite force >= 0 N')
+    return value
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog=PROG, description=__doc__.split('\n\n')[0])
     parser.add_argument('case', choices=sorted(TERRAINS), metavar='CASE',
                         help=f'one of {", ".join(TERRAINS)}')
     parser.add_argument('seeds', type=_seed, nargs='+', metavar='SEED')
+    parser.add_argument('--push', type=_force, default=0.0, metavar='N',
+                        help='pelvis pushes of N newtons (default 0: none)')
     args = parser.parse_args(argv)
     terrain = TERRAINS[args.case]
     none_fell = True
     for seed in args.seeds:
         started = time.process_time()
-        trial = terrain_walk(terrain, seed)
+        trial = terrain_walk(terrain, seed, args.push)
         print(json.dumps({
-            'case': terrain.name, 'seed': seed, 'fell': trial.fell, 'steps': trial.steps,
-            'planned': terrain.steps, 'worst_landing_m': round(trial.worst_landing_m, 4),
+            'case': terrain.name, 'seed': seed, 'push_n': args.push, 'fell': trial.fell,
+            'steps': trial.steps, 'planned': terrain.steps,
+            'worst_landing_m': round(trial.worst_landing_m, 4),
             'lowest_pelvis_m': round(trial.lowest_pelvis_m, 3),
             'pelvis_end': [round(float(value), 3) for value in trial.pelvis_end],
             'cpu_s': round(time.process_time() - started, 1)}), flush=True)
