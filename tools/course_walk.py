@@ -22,21 +22,13 @@ import dataclasses
 import json
 import sys
 
+from tutorial_atlas_control.cli.convention import seed_or_none
 from tutorial_atlas_control.course import GATES, Leg
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.offline import course_walk
 from tutorial_atlas_control.walking import RouteGait
 
 PROG = 'course_walk.py'
-
-
-def _seed(text: str) -> int | None:
-    if text == 'none':
-        return None
-    try:
-        return int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'seed {text!r} is not an integer or none') from None
 
 
 def _waypoints(text: str) -> tuple[tuple[float, float], ...]:
@@ -54,7 +46,7 @@ def _waypoints(text: str) -> tuple[tuple[float, float], ...]:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog=PROG, description=__doc__.split('\n\n')[0])
-    parser.add_argument('seeds', type=_seed, nargs='+', metavar='SEED')
+    parser.add_argument('seeds', type=seed_or_none, nargs='+', metavar='SEED')
     parser.add_argument('--to', choices=[gate.name for gate in GATES], default='gate_1',
                         metavar='GATE', help='the last gate (default: %(default)s)')
     parser.add_argument('--waypoints', type=_waypoints, default=None,

@@ -18,40 +18,21 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 import time
 
+from tutorial_atlas_control.cli.convention import non_negative_number, seed_or_none
 from tutorial_atlas_control.offline import TERRAINS, terrain_walk
 
 PROG = 'terrain_walk.py'
-
-
-def _seed(text: str) -> int | None:
-    if text == 'none':
-        return None
-    try:
-        return int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'seed {text!r} is not an integer or none') from None
-
-
-def _force(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not 0.0 <= value < math.inf:
-        raise argparse.ArgumentTypeError(f'push {text!r} is not a finite force >= 0 N')
-    return value
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog=PROG, description=__doc__.split('\n\n')[0])
     parser.add_argument('case', choices=sorted(TERRAINS), metavar='CASE',
                         help=f'one of {", ".join(TERRAINS)}')
-    parser.add_argument('seeds', type=_seed, nargs='+', metavar='SEED')
-    parser.add_argument('--push', type=_force, default=0.0, metavar='N',
+    parser.add_argument('seeds', type=seed_or_none, nargs='+', metavar='SEED')
+    parser.add_argument('--push', type=non_negative_number, default=0.0, metavar='N',
                         help='pelvis pushes of N newtons (default 0: none)')
     args = parser.parse_args(argv)
     terrain = TERRAINS[args.case]
