@@ -2,8 +2,12 @@
 """Streamed walks on the VRC Task 2 course, offline and scored, one seed after another: the
 measurement behind docs/vrc.md's figures for the walk to gate_1.
 
-    python3 tools/course_walk.py [--waypoints 'X,Y X,Y ...'] [--stride M] SEED [SEED ...]
+    python3 tools/course_walk.py [--to GATE | --waypoints 'X,Y X,Y ...'] [--stride M]
+                                 [--world NAME] SEED [SEED ...]
 
+The walk is vrc_walker.py's, offline: the course's legs (course/legs.py) from the world's
+start to --to (default gate_1), each planned from where the feet are as it begins; or one
+leg through --waypoints.
 SEED is an integer (walking/start_noise.py's perturbed start) or `none` (the start as the
 world gives it). Each walk prints one JSON line (offline/course_route.py's CourseWalk) as it
 ends; a run costs about 300-500 s of CPU on this host (the course's physics). Run it under
@@ -18,20 +22,13 @@ import dataclasses
 import json
 import sys
 
+from tutorial_atlas_control.cli.convention import seed_or_none
+from tutorial_atlas_control.course import GATES, Leg
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.offline import GATE_1_ROUTE, course_walk
+from tutorial_atlas_control.offline import course_walk
 from tutorial_atlas_control.walking import RouteGait
 
 PROG = 'course_walk.py'
-
-
-def _seed(text: str) -> int | None:
-    if text == 'none':
-        return None
-    try:
-        return int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'seed {text!r} is not an integer or none') from None
 
 
 def _waypoints(text: str) -> tuple[tuple[float, float], ...]:
@@ -49,9 +46,11 @@ def _waypoints(text: str) -> tuple[tuple[float, float], ...]:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog=PROG, description=__doc__.split('\n\n')[0])
-    parser.add_argument('seeds', type=_seed, nargs='+', metavar='SEED')
+    parser.add_argument('seeds', type=seed_or_none, nargs='+', metavar='SEED')
+    parser.add_argument('--to', choices=[gate.name for gate in GATES], default='gate_1',
+                        metavar='GATE', help='the last gate (default: %(default)s)')
     parser.add_argument('--waypoints', type=_waypoints, default=None,
-                        help="the route, world x,y pairs (default: the pen to gate_1)")
+                        help='one leg through these world x,y pairs instead of the course\'s')
     parser.add_argument('--stride', type=float, default=0.15, help='longest stride (m)')
     parser.add_argument('--world', default='vrc_task_2', help='a VRC Task 2 world name')
     args = parser.parse_args(argv)
@@ -62,7 +61,8 @@ def main(argv: list[str] | None = None) -> int:
     all_walked = True
     for seed in args.seeds:
         try:
-            walk = course_walk(seed, args.waypoints or GATE_1_ROUTE, args.world, gait)
+            legs = None if args.waypoints is None else [Leg('route', args.waypoints)]
+            walk = course_walk(seed, legs, args.to, args.world, gait)
         except AtlasControlError as err:
             print(f'{PROG}: {err}', file=sys.stderr)
             return 2

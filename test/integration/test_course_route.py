@@ -10,18 +10,19 @@ from __future__ import annotations
 
 import pytest
 
+from tutorial_atlas_control.course import Leg
 from tutorial_atlas_control.offline import course_walk
 from tutorial_atlas_control.walking import RouteGait
 
 pytestmark = pytest.mark.offline
 
 #: The pen's start is at (-3.0, -38.0), facing east.
-ROUTE = ((-2.65, -38.0),)
+ROUTE = (Leg('gate_0', ((-2.65, -38.0),)),)
 
 
 def test_a_short_route_in_the_pen_is_walked_to_its_end() -> None:
     walk = course_walk(None, ROUTE, gait=RouteGait(stride_m=0.1), stand_after_s=1.0)
-    assert walk.outcome == 'walked', walk
+    assert walk.outcome == 'walked' and walk.legs_walked == 1, walk
     assert walk.steps_taken == walk.steps_planned
     assert walk.steps_planned in (5, 6)  # four or five strides, then the feet together
     assert walk.fell_at_s is None and walk.scorer_falls == 0, walk

@@ -1,5 +1,5 @@
-"""tools/course_walk.py's arguments: a bad seed, waypoint, stride or world is one line and exit
-status 2, before any physics runs."""
+"""tools/course_walk.py's arguments: a bad seed, waypoint, gate, stride or world is one line
+and exit status 2, before any physics runs."""
 
 from __future__ import annotations
 
@@ -16,6 +16,8 @@ TOOL = Path(__file__).resolve().parents[2] / 'tools' / 'course_walk.py'
     (['x'], "course_walk.py: error: argument SEED: seed 'x' is not an integer or none"),
     (['--waypoints', '1;2', '1'],
      "course_walk.py: error: argument --waypoints: waypoint '1;2' is not X,Y"),
+    (['--to', 'gate_5', '1'], "course_walk.py: error: argument --to: invalid choice: "
+     "'gate_5' (choose from 'gate_0', 'gate_1', 'gate_2', 'gate_3', 'gate_4')"),
     (['--world', 'nowhere', 'none'],
      "course_walk.py: unknown world 'nowhere'; the VRC Task 2 worlds are vrc_task_2, "
      'vrc_task_2_mud_start, vrc_task_2_uneven_start, vrc_task_2_rubble_start'),

@@ -15,7 +15,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'behaviors': ['AsiError', 'Behavior', 'Status'],
     'errors': ['AsiInputError'],
     'interface': ['AtlasSimInterface'],
-    'library': ['BehaviourBase', 'Handover', 'LibraryBehaviour'],
+    'library': ['BehaviourBase', 'Handover', 'LibraryBehaviour', 'on_ground'],
     'mode_switching': ['AFTER_LAST_S', 'CUES', 'KP_VELOCITY', 'cue_messages'],
     'teleop': ['Settings', 'ego_steps', 'key_action'],
     'user_behaviour': ['UserBehaviourError', 'load_user_behaviour'],

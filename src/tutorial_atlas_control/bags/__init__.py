@@ -24,7 +24,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'behaviours': ['BehaviourChange', 'behaviour_lines', 'plot_behaviours', 'read_behaviours',
                    'walk_windows'],
     'footprints': ['Landing', 'StepTarget', 'WalkSummary', 'plot_footprints',
-                   'read_step_targets', 'summarise_walk', 'walk_lines'],
+                   'read_step_targets', 'summarise_walk', 'titled_walks', 'walk_lines'],
     'overview_plot': ['WORST_JOINTS'],
     'reader': ['BagData', 'JointStateSeries', 'read_bag'],
     'records': ['open_bag'],

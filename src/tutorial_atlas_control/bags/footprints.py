@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from tutorial_atlas_control import topics
+from tutorial_atlas_control.bags.behaviours import BehaviourChange, walk_windows
 from tutorial_atlas_control.bags.course_terrain import (
     above_ground,
     is_course_run,
@@ -39,7 +40,7 @@ if TYPE_CHECKING:
 
 __all__ = ['FOOT_BODIES', 'Landing', 'StepTarget', 'WalkSummary', 'foot_poses', 'landings',
            'match_landings', 'plot_footprints', 'read_step_targets', 'sole_patch',
-           'summarise_walk', 'walk_lines']
+           'summarise_walk', 'titled_walks', 'walk_lines']
 
 #: The AtlasSimInterface's WALK behaviour number.
 WALK_BEHAVIOR = 4
@@ -293,6 +294,23 @@ def _travel(start_xy: np.ndarray | None, landed: list[Landing]) -> float:
     points = ([start_xy] if start_xy is not None else []) + [
         np.array([landing.x_m, landing.y_m]) for landing in landed]
     return float(sum(np.hypot(*(b - a)) for a, b in zip(points, points[1:])))
+
+
+def titled_walks(data: BagData, changes: list[BehaviourChange] | None
+                 ) -> list[tuple[str, WalkSummary]]:
+    """Each walk of `data`'s run, titled: by the recorded behaviours' walk windows
+    (`changes`, read_behaviours's; a client's step indices start at 1 again each walk), else
+    the bag's WALK commands as one."""
+    if changes is not None:
+        found = []
+        for number, window in enumerate(walk_windows(changes), 1):
+            each = summarise_walk(data, window)
+            if each is not None:
+                end = 'the end' if window[1] == float('inf') else f'{window[1]:.1f} s'
+                found.append((f'Walk {number} (from {window[0]:.1f} s to {end}):', each))
+        return found
+    walk = summarise_walk(data)
+    return [] if walk is None else [('Walk (the bag\'s WALK commands):', walk)]
 
 
 def walk_lines(summary: WalkSummary) -> list[str]:

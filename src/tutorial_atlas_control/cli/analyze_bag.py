@@ -15,7 +15,6 @@ from tutorial_atlas_control.bags import (
     MOVED_RANGE_RAD,
     WORST_JOINTS,
     Analysis,
-    BehaviourChange,
     PlayedTrajectory,
     WalkSummary,
     analysis_to_json,
@@ -45,8 +44,8 @@ from tutorial_atlas_control.bags import (
     render_bag_video,
     score_lines,
     summarise_walk,
+    titled_walks,
     walk_lines,
-    walk_windows,
     write_csv,
 )
 from tutorial_atlas_control.cli.convention import (
@@ -224,7 +223,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         played = [p for _, p in analysis.data.played]
         walk = summarise_walk(analysis.data)
         changes = read_behaviours(analysis.data)
-        walks = _walks(analysis, changes)
+        walks = titled_walks(analysis.data, changes)
         scores = read_scores(analysis.data)
         extra = (behaviour_lines(changes) if changes is not None else []) + [
             line for title, each in walks for line in [title, *walk_lines(each)]] + (
@@ -299,22 +298,6 @@ def _course_maps(analysis: Analysis, args: argparse.Namespace) -> list[Path]:
         raise BagAnalysisError(f'{data.path} has no pelvis pose (/ground_truth_odom): '
                                'no path to draw on the course map')
     return [plot_course_map(run, path) for path in paths] if run is not None else []
-
-
-def _walks(analysis: Analysis, changes: list[BehaviourChange] | None
-           ) -> list[tuple[str, WalkSummary]]:
-    """Each walk of the run, titled: by the recorded behaviours' walk windows (a client's
-    step indices start at 1 again each walk), else the bag's WALK commands as one."""
-    if changes is not None:
-        found = []
-        for number, window in enumerate(walk_windows(changes), 1):
-            each = summarise_walk(analysis.data, window)
-            if each is not None:
-                end = 'the end' if window[1] == float('inf') else f'{window[1]:.1f} s'
-                found.append((f'Walk {number} (from {window[0]:.1f} s to {end}):', each))
-        return found
-    walk = summarise_walk(analysis.data)
-    return [] if walk is None else [('Walk (the bag\'s WALK commands):', walk)]
 
 
 def _walk_dict(walk: WalkSummary | None) -> dict[str, Any] | None:

@@ -77,6 +77,16 @@ def non_negative_number(text: str) -> float:
     return value
 
 
+def seed_or_none(text: str) -> int | None:
+    """An argparse `type=` for a run's seed: an integer, or `none` (the unperturbed run)."""
+    if text == 'none':
+        return None
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'seed {text!r} is not an integer or none') from None
+
+
 #: A wrong command line (argparse's status).
 EXIT_USAGE = 2
 HELP_OPTIONS = ('-h', '--help')

@@ -32,13 +32,13 @@ from std_msgs.msg import String
 
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.asi import Behavior, Settings, ego_steps, key_action
+from tutorial_atlas_control.cli.asi_link import step_message
 from tutorial_atlas_control.cli.convention import (
     EXIT_INTERRUPTED,
     EXIT_REFUSED,
     node_arguments,
     print_error,
 )
-from tutorial_atlas_control.cli.walk_client import step_message
 
 PROG = 'keyboard_teleop.py'
 ACTION = 'atlas/bdi_control'

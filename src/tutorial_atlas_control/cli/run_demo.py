@@ -30,7 +30,8 @@ PROG = 'run_demo.py'
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser (its --help is the documentation)."""
     parser = argparse.ArgumentParser(prog=PROG, description=demo.__doc__.split('\n\n')[0])
-    walks = '; '.join(f'{name}: {what}' for name, (what, _) in walk_demo.WALKS.items())
+    walks = '; '.join(f'{name}: {what}' for name, (what, _) in
+                      {**walk_demo.WALKS, **walk_demo.COURSE_WALKS}.items())
     parser.add_argument('trajectory', nargs='?', default='step_and_fall',
                         help='trajectory name (default: step_and_fall); without --file it '
                              "must be in exactly one of the package's trajectories/*.yaml, "
@@ -82,7 +83,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the exit status."""
     args = build_parser().parse_args(argv)
     started_s = time.time()
-    walk = args.trajectory in walk_demo.WALKS and args.file is None
+    walk = args.file is None and (args.trajectory in walk_demo.WALKS
+                                  or args.trajectory in walk_demo.COURSE_WALKS)
     if walk and (args.gains_file is not None or args.table):
         print_error(PROG, f'{args.trajectory} is a walk: --gains-file and --table apply to '
                           'trajectories only')
@@ -107,8 +109,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _play(args: argparse.Namespace) -> None:
     """run_demo.py TRAJECTORY: the tutorial's way, User mode and traj_yaml.py."""
     # Everything is checked before anything starts.
-    trajectory_file = args.file or find_trajectory(args.trajectory,
-                                                   walks=tuple(walk_demo.WALKS))
+    walks = (*walk_demo.WALKS, *walk_demo.COURSE_WALKS)
+    trajectory_file = args.file or find_trajectory(args.trajectory, walks=walks)
     load_trajectory(trajectory_file, args.trajectory)
     gains = gains_for(trajectory_file, args.gains_file)
     load_gains_yaml(gains.path)
@@ -120,10 +122,11 @@ def _play(args: argparse.Namespace) -> None:
 
 def _walk(args: argparse.Namespace) -> None:
     """run_demo.py WALK: a walk through the AtlasSimInterface (the balancing Stand walks;
-    the tutorial's gains are the user's PID's)."""
-    bag = walk_demo.run_walk_demo(args.trajectory, args.bag_dir.expanduser().resolve(),
-                                  args.real_time_factor, args.bag_dir.expanduser() / 'logs',
-                                  progress=print, warn=_warn)
+    the tutorial's gains are the user's PID's), on the VRC course for a COURSE_WALKS name."""
+    run = walk_demo.run_course_demo if args.trajectory in walk_demo.COURSE_WALKS \
+        else walk_demo.run_walk_demo
+    bag = run(args.trajectory, args.bag_dir.expanduser().resolve(), args.real_time_factor,
+              args.bag_dir.expanduser() / 'logs', progress=print, warn=_warn)
     demo.summarise(bag, args.video_fps, args.video_size, report=print, walk=True)
 
 

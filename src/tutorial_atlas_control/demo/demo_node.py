@@ -15,13 +15,19 @@ from collections.abc import Callable
 from pathlib import Path
 
 from tutorial_atlas_control.bags import (
+    BagData,
     analyze_bag,
     foot_line,
+    is_course_run,
+    plot_course_map,
     plot_footprints,
     plot_run,
+    read_behaviours,
+    read_course_run,
+    read_scores,
     render_bag_video,
     short_summary,
-    summarise_walk,
+    titled_walks,
     walk_lines,
 )
 from tutorial_atlas_control.errors import AtlasControlError
@@ -91,15 +97,16 @@ def run_demo(trajectory: str, trajectory_file: Path, bag_dir: Path, real_time_fa
 
 def run_launched(label: str, args: dict[str, object], bag_dir: Path, real_time_factor: float,
                  log_dir: Path, drive: Callable[[AtlasLaunch], None],
-                 progress: Report = silent, warn: Report = silent) -> Path:
-    """atlas.launch with `args` (headless unless there is a display, recording to `bag_dir`)
+                 progress: Report = silent, warn: Report = silent,
+                 launch_file: str = 'atlas.launch') -> Path:
+    """`launch_file` with `args` (headless unless there is a display, recording to `bag_dir`)
     on a private master, `drive` with it, then stopped; the closed bag's path. `label` names
     the launch in the progress line; `warn` gets a line if roslaunch had to be killed."""
     started_s = time.time()
     gui = 'true' if os.environ.get('DISPLAY') else 'false'
     launch = AtlasLaunch(log_dir / 'atlas_launch.log',
                          {'gui': gui, 'bag_dir': bag_dir, 'real_time_factor': real_time_factor,
-                          **args})
+                          **args}, launch_file=launch_file)
     try:
         progress(f'demo: {label} started (master on port {launch.port}, log {launch.log_path})')
         drive(launch)
@@ -163,31 +170,49 @@ def wait_sim_time(clock_type: type, seconds: float) -> None:
         time.sleep(0.05)
 
 
+def _course_lines(data: BagData, bag: Path, report: Report) -> Path | None:
+    """A course run's score line (gates, falls, the course clock) and its map; None (and
+    nothing reported) for a run elsewhere."""
+    if not is_course_run(data):
+        return None
+    scores = read_scores(data) or []
+    if scores:
+        last = scores[-1]
+        report(f'score: {last.completion} of 4 gates, falls {last.falls}, course clock '
+               f'{last.sim_elapsed_s:.1f} s')
+    run = read_course_run(data, scores or None, [t_s for t_s, _ in data.logged_falls] or None)
+    return None if run is None else plot_course_map(run, bag.with_suffix('.course.png'))
+
+
 def summarise(bag: Path, video_fps: float, video_size: tuple[int, int],
               report: Report = silent, table: bool = False, walk: bool = False) -> None:
     """Report the short summary; write the plot and (unless video_fps is 0) the video.
-    `walk`: a walk's bag: the walk's figures and its footprints (<bag>.footprints.png)
-    instead of the right foot's displacement.
+    `walk`: a walk's bag: each walk's figures and, for one walk, its footprints
+    (<bag>.footprints.png) instead of the right foot's displacement; on the VRC course also
+    the score and the course map (<bag>.course.png, every leg's landings).
 
     The summary is reported before the (slower) plot and video are made.
     """
     analysis = analyze_bag(bag)
     footprints = None
     if walk:
-        summary = summarise_walk(analysis.data)
-        if summary is None:
+        walks = titled_walks(analysis.data, read_behaviours(analysis.data))
+        if not walks:
             report('\n' + short_summary(analysis, table, tracking=False))
             report('walk: the bag holds no WALK command')
         else:  # the walk's lines say whether it fell: one line, not two
             report('\n=== summary ===')
-            for line in walk_lines(summary):
-                report(line)
-            footprints = plot_footprints(summary, bag.with_suffix('.footprints.png'))
+            for title, summary in walks:
+                for line in ([] if len(walks) == 1 else [title]) + walk_lines(summary):
+                    report(line)
+            if len(walks) == 1:  # several walks (a course's legs) go on the course map
+                footprints = plot_footprints(walks[0][1], bag.with_suffix('.footprints.png'))
     else:
         report('\n' + short_summary(analysis, table))
         foot = foot_line(analysis.data)
         if foot is not None:
             report(foot)
+    course_map = _course_lines(analysis.data, bag, report) if walk else None
     plot = plot_run(analysis, bag.with_suffix('.png'))
     video = None
     if video_fps > 0:
@@ -197,5 +222,7 @@ def summarise(bag: Path, video_fps: float, video_size: tuple[int, int],
     report(f'plot:  {plot}')
     if footprints is not None:
         report(f'footprints: {footprints}')
+    if course_map is not None:
+        report(f'course map: {course_map}')
     if video is not None:
         report(f'video: {video}')

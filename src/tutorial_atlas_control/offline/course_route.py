@@ -1,16 +1,19 @@
-"""A streamed walk along a route on a VRC world, offline and scored: how far the walk gets.
+"""A course walker's streamed walk on a VRC world, offline and scored: how far the walk gets.
 
 The run is the course's as the node runs it (DRCSim's `bdi_stand` start: pinned, released at
 1 s, the balancing Stand at 2 s; the AtlasSimInterface; the course's scorer in lockstep),
 its start perturbed by a seed (walking/start_noise.py: the joints' angles and rates, the pin
 holding the pelvis). Once Stand has held until `walk_at_s`, a streaming client
-(asi/walk_client.py) walks the route's steps (walking/route.py), planned from where the
-feet are then, as a DRC-era client plans from `foot_pos_est`: every state is answered with
-the window of steps from `next_step_index_needed`. The run ends when the walk has ended (back
-in Stand, or ERROR_FALLING, or refused), the robot has fallen (sim/fall.py, asked every
-10 ms), or the route's time has run out; then it stands `stand_after_s` more. What it
-returns: the walk's outcome and steps, the scorer's gate messages with their sim times,
-completion and falls, the fall if any, and the CPU the run took.
+(asi/walk_client.py) walks the legs (course/legs.py: by default those from the start to
+`to_gate`, as vrc_walker.py walks them live) one after another, each leg's steps
+(walking/route.py) planned from where the feet are as it begins, as a DRC-era client plans
+from `foot_pos_est`: every state is answered with the window of steps from
+`next_step_index_needed`. A leg ends when its walk has ended (back in Stand, or
+ERROR_FALLING, or refused), the robot has fallen (sim/fall.py, asked every 10 ms), or the
+leg's time has run out; the run ends after the last leg or the first that did not end back
+in Stand, then it stands `stand_after_s` more. What it returns: the walk's outcome and
+steps, the scorer's gate messages with their sim times, completion and falls, the fall if
+any, and the CPU the run took.
 """
 
 from __future__ import annotations
@@ -25,11 +28,12 @@ from pathlib import Path
 from tutorial_atlas_control.asi import (
     AtlasSimInterface,
     Behavior,
+    Outcome,
     WalkClient,
     step_data_of,
     yaw_of_quaternion,
 )
-from tutorial_atlas_control.course import ScoreRow
+from tutorial_atlas_control.course import LEG_PAUSE_S, Leg, ScoreRow, legs_ahead
 from tutorial_atlas_control.msgs import AsiCommand, ManipulateParams, StepData
 from tutorial_atlas_control.offline.world import named_world
 from tutorial_atlas_control.sim import (
@@ -46,20 +50,13 @@ from tutorial_atlas_control.walking import (
     QUEUE_LENGTH,
     Footstep,
     RouteGait,
+    feet_origin,
     perturb_start,
     route_steps,
-    wrap_angle,
 )
 
-__all__ = ['CourseWalk', 'GATE_1_ROUTE', 'course_walk']
+__all__ = ['CourseWalk', 'course_walk']
 
-#: From the pen's start east through gate_0 (x 1) to x 3.2, 1.3 m clear of the pen's east
-#: wall (x 1.46-1.91 from y -36.1 to -31.9: on a route turning north at x 2.5 the pelvis
-#: walked 0.5-0.6 m from it, two landings came down 17 cm east of their steps and the robot
-#: fell there), north past the wall's end, then to gate_1 (y -22), the feet
-#: stopping at y -21.95, short of the pit's ramp (docs/vrc.md).
-GATE_1_ROUTE: tuple[tuple[float, float], ...] = (
-    (3.2, -38.0), (3.2, -31.0), (0.5, -24.5), (0.5, -21.95))
 #: The fall criterion is asked this often (ticks).
 FALL_CHECK_TICKS = 10
 #: A route's steps may take this long each, on average, before the run gives up (s).
@@ -68,11 +65,13 @@ SECONDS_PER_STEP = 0.9
 
 @dataclass(frozen=True)
 class CourseWalk:
-    """How one walk went. `gates`: the scorer's event messages with their sim times (s);
-    `fell_at_s`: when sim/fall.py's criterion first held (None: it never did)."""
+    """How one walk went. `outcome`: the last leg's; `steps_*`: over the legs begun; `gates`:
+    the scorer's event messages with their sim times (s); `fell_at_s`: when sim/fall.py's
+    criterion first held (None: it never did)."""
 
     seed: int | None
     outcome: str | None         # WalkClient's Outcome value; None: the time ran out
+    legs_walked: int
     steps_planned: int
     steps_taken: int
     gates: tuple[tuple[float, str], ...]
@@ -118,58 +117,76 @@ class _Streamer:
             self.fell_at_s = self.sim.sim_time_ns / NS_PER_S
 
 
-def feet_origin(interface: AtlasSimInterface) -> tuple[tuple[float, float], float]:
+def _feet(interface: AtlasSimInterface) -> tuple[tuple[float, float], float]:
     """The foot links' midpoint (x, y) and mean heading, from foot_pos_est."""
-    feet = interface.state().foot_poses
-    left, right = (yaw_of_quaternion(*foot[3:7]) for foot in feet)
-    heading = left + 0.5 * wrap_angle(right - left)
-    return (float(feet[:, 0].mean()), float(feet[:, 1].mean())), heading
+    left, right = ((float(foot[0]), float(foot[1]), yaw_of_quaternion(*foot[3:7]))
+                   for foot in interface.state().foot_poses)
+    return feet_origin(left, right)
 
 
-def course_walk(seed: int | None, waypoints: Sequence[tuple[float, float]] = GATE_1_ROUTE,
+def course_walk(seed: int | None, legs: Sequence[Leg] | None = None, to_gate: str = 'gate_1',
                 world_name: str = 'vrc_task_2', gait: RouteGait | None = None,
                 walk_at_s: float = 3.0, stand_after_s: float = 3.0,
                 score_dir: Path | None = None) -> CourseWalk:
-    """Walk `waypoints` on the world `world_name` from its start perturbed by `seed`
-    (None: unperturbed); score.log goes to `score_dir` (None: a temporary directory)."""
+    """Walk `legs` (None: the course's legs from the start to `to_gate`) on the world
+    `world_name` from its start perturbed by `seed` (None: unperturbed); score.log goes to
+    `score_dir` (None: a temporary directory)."""
     world = named_world(world_name)
     sim = AtlasSimulator(load_model(world.model_path), load_gains_yaml(DEFAULT_GAINS_FILE),
                          startup_mode=VrcMode.BDI_STAND, start=world.start,
                          mud_damping=world.mud_damping)
+    if legs is None:
+        pelvis = sim.data.xpos[sim.atlas.pelvis_body_id]
+        legs = legs_ahead(float(pelvis[0]), float(pelvis[1]), to_gate)
     perturb_start(sim.atlas, sim.data, seed, on_ground=False)
     interface = AtlasSimInterface(sim, hold_at_start=True)
     streamer = _Streamer(sim, interface)
     rows: list[ScoreRow] = []
     started = time.process_time()
+    planned = taken = walked = 0
     with tempfile.TemporaryDirectory(prefix='course_walk_') as scratch:
         scoring = CourseScoring(sim, score_dir or Path(scratch), rows.append)
         tick = Tick(sim, streamer, streamer.after_step, interface.end_step, score=scoring)
         _run_until(tick, sim, walk_at_s, streamer)
-        plan: list[Footstep] = []
-        if streamer.fell_at_s is None:
-            origin, heading = feet_origin(interface)
-            plan = route_steps(origin, heading, waypoints, gait)
-            streamer.client = WalkClient(plan, streaming=True)
-            limit_s = sim.sim_time_ns / NS_PER_S + len(plan) * SECONDS_PER_STEP
-            client = streamer.client
-            while client.outcome is None and streamer.fell_at_s is None \
-                    and sim.sim_time_ns < limit_s * NS_PER_S:
-                tick()
-            _run_until(tick, sim, sim.sim_time_ns / NS_PER_S + stand_after_s, streamer)
+        for number, leg in enumerate(legs):
+            if number > 0:
+                _run_until(tick, sim, sim.sim_time_ns / NS_PER_S + LEG_PAUSE_S, streamer)
+            if streamer.fell_at_s is not None:
+                break
+            client = _walk_leg(tick, sim, interface, streamer, leg, gait)
+            planned, taken = planned + len(client.plan), taken + client.steps_taken
+            if client.outcome is not Outcome.WALKED:
+                break
+            walked += 1
+        _run_until(tick, sim, sim.sim_time_ns / NS_PER_S + stand_after_s, streamer)
         scoring.close()
     client = streamer.client
     pelvis = sim.data.xpos[sim.atlas.pelvis_body_id]
     last = rows[-1] if rows else None
     return CourseWalk(
         seed=seed, outcome=None if client is None or client.outcome is None
-        else client.outcome.value, steps_planned=len(plan),
-        steps_taken=0 if client is None else client.steps_taken,
+        else client.outcome.value, legs_walked=walked, steps_planned=planned,
+        steps_taken=taken,
         gates=tuple((row.sim_time_ns / NS_PER_S, row.message.strip()) for row in rows
                     if row.message),
         completion=0 if last is None else last.completion,
         scorer_falls=0 if last is None else last.falls, fell_at_s=streamer.fell_at_s,
         pelvis_xy=(float(pelvis[0]), float(pelvis[1])), sim_s=sim.sim_time_ns / NS_PER_S,
         cpu_s=time.process_time() - started)
+
+
+def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,
+              streamer: _Streamer, leg: Leg, gait: RouteGait | None) -> WalkClient:
+    """One leg planned from where the feet are now, streamed until it ends, the robot
+    falls or the leg's time (SECONDS_PER_STEP a step) runs out."""
+    origin, heading = _feet(interface)
+    plan = route_steps(origin, heading, leg.waypoints, gait)
+    client = streamer.client = WalkClient(plan, streaming=True)
+    limit_ns = sim.sim_time_ns + math.floor(len(plan) * SECONDS_PER_STEP * NS_PER_S)
+    while client.outcome is None and streamer.fell_at_s is None \
+            and sim.sim_time_ns < limit_ns:
+        tick()
+    return client
 
 
 def _run_until(tick: Tick, sim: AtlasSimulator, until_s: float, streamer: _Streamer) -> None:

@@ -11,7 +11,8 @@ leg_tasks: what Walk and Step do alike each tick (the whole-body law on the carr
 the swing foot, the pelvis's heading); compiled_swing: the swing foot's path and servo as
 one C call (src/atlas_swing.c); walk: the walk's phases; walk_behaviour: Walk as the
 simulator's behaviour;
-route: footsteps through a route of waypoints (a course walker's plan);
+route: footsteps through a route of waypoints (a course walker's plan) from where the
+feet are;
 start_noise: a trial's start perturbed by a seed; walk_trial: offline walking trials,
 landing by landing, pushed or not; static_step: one quasi-static step; step_over: its swing
 over terrain higher than its line (up, across, down) and the apex that clears it;
@@ -31,10 +32,10 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'leg_tasks': ['SWING_ENV'],
     'walk': ['WalkGains'],
     'walk_behaviour': ['WalkBehaviour', 'WalkStatus'],
-    'route': ['RouteGait', 'route_steps'],
+    'route': ['RouteGait', 'feet_origin', 'route_steps'],
     'start_noise': ['perturb_start'],
-    'walk_trial': ['WalkTrial', 'pushed_walk_trial', 'random_pushes', 'straight_walk_trial',
-                   'walk_trial'],
+    'walk_trial': ['SETTLE_S', 'WalkTrial', 'WalkingStand', 'pushed_walk_trial',
+                   'random_pushes', 'straight_walk_trial', 'walk_trial'],
     'step_over': ['STEP_OVER_CLEARANCE_M', 'StepOverPath', 'clear_apex_m', 'needs_step_over',
                   'sweep_points', 'terrain_top_m'],
     'step_behaviour': ['StepBehaviour', 'StepStatus'],

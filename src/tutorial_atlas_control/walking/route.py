@@ -29,7 +29,7 @@ from tutorial_atlas_control.walking.footsteps import (
     wrap_angle,
 )
 
-__all__ = ['RouteGait', 'route_steps']
+__all__ = ['RouteGait', 'feet_origin', 'route_steps']
 
 #: A waypoint this near the centre line's point (m) is reached: no move towards it.
 REACHED_M = 1e-6
@@ -142,3 +142,11 @@ def _foot_at(index: int, foot: int, x_m: float, y_m: float, heading_rad: float,
     return Footstep(index, foot, x_m - half * math.sin(heading_rad),
                     y_m + half * math.cos(heading_rad), wrap_angle(heading_rad),
                     gait.duration_s)
+
+
+def feet_origin(left: tuple[float, float, float],
+                right: tuple[float, float, float]) -> tuple[tuple[float, float], float]:
+    """Where a route starts from feet at `left` and `right` ((x, y, yaw), world): their
+    midpoint and mean heading (the mean taken across the short way between the two yaws)."""
+    heading = wrap_angle(left[2] + 0.5 * wrap_angle(right[2] - left[2]))
+    return (0.5 * (left[0] + right[0]), 0.5 * (left[1] + right[1])), heading

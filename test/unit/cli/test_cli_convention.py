@@ -11,7 +11,7 @@ import pytest
 
 SCRIPTS = Path(__file__).resolve().parents[3] / 'scripts'
 PYTHON_SCRIPTS = ('analyze_bag.py', 'replay_bag.py', 'run_demo.py', 'run_offline.py',
-                  'traj_yaml.py', 'plot_topics.py', 'sweep.py', 'search.py')
+                  'traj_yaml.py', 'plot_topics.py', 'sweep.py', 'search.py', 'vrc_walker.py')
 
 
 def run(script: str, *args: str) -> subprocess.CompletedProcess[str]:
@@ -46,6 +46,8 @@ def test_help_works_from_anywhere(script: str) -> None:
                    '--latency-draws', '-1'], "argument --latency-draws: '-1' must be at least 0"),
     ('search.py', ['Traj.yaml', 'bend', '--objective', 'stay_up', '--log', 'l', '--yaml', 'y',
                    '--popsize', '0'], "argument --popsize: '0' must be at least 1"),
+    ('vrc_walker.py', ['--to', 'gate_5'], "argument --to: invalid choice: 'gate_5'"),
+    ('vrc_walker.py', ['--stride', '0'], "argument --stride: '0' must be a finite number > 0"),
     ('record_run.sh', [], 'expected BAG_DIR [atlas_recorder|rosbag [lz4|bz2|none]], got 0 '
      'argument(s)'),
     ('record_run.sh', ['/tmp', 'rosbag2'], "unknown recorder 'rosbag2'"),

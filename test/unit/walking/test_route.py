@@ -9,7 +9,7 @@ import pytest
 
 from tutorial_atlas_control.walking import WalkingError
 from tutorial_atlas_control.walking.footsteps import LEFT, RIGHT, Footstep, wrap_angle
-from tutorial_atlas_control.walking.route import RouteGait, route_steps
+from tutorial_atlas_control.walking.route import RouteGait, feet_origin, route_steps
 from tutorial_atlas_control.walking.step_queue import clamp_step
 
 
@@ -103,3 +103,14 @@ def test_bad_routes_are_refused_with_a_reason(waypoints: list[tuple[float, float
 def test_a_gait_of_zero_stride_is_refused() -> None:
     with pytest.raises(WalkingError, match='a route gait needs positive finite numbers'):
         RouteGait(stride_m=0.0)
+
+
+@pytest.mark.parametrize(('left_yaw', 'right_yaw', 'heading'), [
+    (0.1, -0.1, 0.0), (math.pi - 0.1, -math.pi + 0.1, math.pi),
+    (-math.pi + 0.05, math.pi - 0.15, -math.pi + 0.05 - 0.1)])
+def test_a_route_starts_between_the_feet_facing_their_mean_heading_the_short_way(
+        left_yaw: float, right_yaw: float, heading: float) -> None:
+    (x, y), yaw = feet_origin((1.0, 2.12, left_yaw), (1.2, 1.88, right_yaw))
+    assert (x, y) == pytest.approx((1.1, 2.0))
+    assert abs(wrap_angle(yaw - heading)) < 1e-12
+    assert -math.pi <= yaw <= math.pi

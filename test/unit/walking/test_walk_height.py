@@ -7,13 +7,10 @@ from __future__ import annotations
 
 import dataclasses
 
-import mujoco
 import pytest
 
-from tutorial_atlas_control.balance import StandBehaviour
+from support.standing import started_stand
 from tutorial_atlas_control.balance.stand import StandController
-from tutorial_atlas_control.balance.stand_pose import place_in_stand_pose
-from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.walking import straight_steps
 from tutorial_atlas_control.walking.leg_tasks import foot_pose
 from tutorial_atlas_control.walking.step_queue import StepQueue
@@ -28,11 +25,7 @@ LOWERING_M = WalkGains().walk_lowering_m
 
 def _walk_from(lowered_m: float, standing: bool = True) -> WalkController:
     """A walk of two steps from a Stand `lowered_m` below the Stand pose's CoM height."""
-    atlas = atlas_model.load_model()
-    data = mujoco.MjData(atlas.model)
-    place_in_stand_pose(atlas, data)
-    stand = StandBehaviour(atlas)
-    stand.start(data)
+    atlas, _, stand = started_stand()
     state, held = stand.last_state, stand.controller
     assert state is not None and held is not None
     standing_m = stand.ground_under_m(state) + stand.com_height_m

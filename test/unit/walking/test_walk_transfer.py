@@ -8,13 +8,11 @@ from __future__ import annotations
 import dataclasses
 import math
 
-import mujoco
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.balance import BalanceState, StandBehaviour
-from tutorial_atlas_control.balance.stand_pose import place_in_stand_pose
-from tutorial_atlas_control.sim import model as atlas_model
+from support.standing import started_stand
+from tutorial_atlas_control.balance import BalanceState
 from tutorial_atlas_control.walking import straight_steps
 from tutorial_atlas_control.walking.leg_tasks import foot_pose
 from tutorial_atlas_control.walking.status_flags import STEPPING
@@ -38,11 +36,7 @@ def _first_step(tilt_deg: float) -> tuple[WalkController, BalanceState, np.ndarr
     """A walk of two steps ticked on one estimate of the Stand pose (its first step's stance
     sole pitched `tilt_deg` heel first) until its first step's foot lifts; the outputs of the
     step's ticks."""
-    atlas = atlas_model.load_model()
-    data = mujoco.MjData(atlas.model)
-    place_in_stand_pose(atlas, data)
-    stand = StandBehaviour(atlas)
-    stand.start(data)
+    atlas, data, stand = started_stand()
     state, controller = stand.last_state, stand.controller
     assert state is not None and controller is not None
     queue = StepQueue(foot_pose(state, 0), foot_pose(state, 1))

@@ -1,0 +1,154 @@
+"""Command line of vrc_walker.py: a DRC-era course walker for the VRC's Task 2.
+
+It walks the course gate to gate through the AtlasSimInterface, as a VRC team's client did:
+the legs from the nearest gate still ahead of the robot to --to (course/legs.py), each
+planned from where the feet are (foot_pos_est) once Stand has held a second after the last
+one, and streamed as WALK
+commands (the window from next_step_index_needed on every state). Steps land where the
+course's ground is (the simulator puts each on the surface under it). It prints each gate
+passed and every other event of /vrc_score, then the score. It ends with exit 0 once
+--to is passed with no fall, 1 on a fall, a refused walk, a walk that did not end or a gate
+not passed, 130 on Ctrl-C.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import threading
+import time
+from collections.abc import Sequence
+
+import rospy
+from atlas_msgs.msg import VRCScore
+
+from tutorial_atlas_control import topics
+from tutorial_atlas_control.asi import Behavior, Outcome, WalkClient, refusal_hint
+from tutorial_atlas_control.cli.asi_link import AsiLink, Refused
+from tutorial_atlas_control.cli.convention import (
+    EXIT_INTERRUPTED,
+    EXIT_REFUSED,
+    positive_number,
+    print_error,
+)
+from tutorial_atlas_control.course import GATES, LEG_PAUSE_S, Leg, legs_ahead
+from tutorial_atlas_control.walking import RouteGait, WalkingError, route_steps
+
+PROG = 'vrc_walker.py'
+#: How long (s, wall time) /vrc_score may take to report a gate the walk has passed.
+SCORE_WAIT_S = 5.0
+
+
+def _parser() -> argparse.ArgumentParser:
+    gates = [gate.name for gate in GATES]
+    parser = argparse.ArgumentParser(
+        prog=PROG, description=__doc__.split('\n\n')[1].replace('\n', ' '),
+        epilog='Start the course first: roslaunch tutorial_atlas_control vrc_task_2.launch '
+               '(or one of its start variants, vrc_task_2_mud_start.launch, ...)')
+    parser.add_argument('--to', choices=gates, default=gates[-1], metavar='GATE',
+                        help=f'the last gate to pass ({", ".join(gates)}; default '
+                             '%(default)s: the whole course)')
+    parser.add_argument('--stride', type=positive_number, default=RouteGait.stride_m,
+                        metavar='M', help='longest stride (m, default %(default)g)')
+    parser.add_argument('--timeout', type=positive_number, default=900.0, metavar='S',
+                        help='give up after this long (s, wall time; default %(default)g)')
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of scripts/vrc_walker.py (`argv` without the program name)."""
+    parser = _parser()
+    args = parser.parse_args(sys.argv[1:] if argv is None else argv)
+    try:
+        gait = RouteGait(stride_m=args.stride)
+    except WalkingError as err:
+        parser.error(str(err))
+    link = AsiLink(PROG)
+    try:
+        return _walk_course(link, args.to, gait, args.timeout)
+    except KeyboardInterrupt:
+        print(f'{PROG}: interrupted', file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except Refused as err:
+        print_error(PROG, err)
+        return EXIT_REFUSED
+
+
+class _ScoreWatch:
+    """/vrc_score's messages as they come: each event printed, the last kept."""
+
+    def __init__(self) -> None:
+        self.last: VRCScore | None = None
+        self.events: list[str] = []
+        self._changed = threading.Condition()
+
+    def on_score(self, score: VRCScore) -> None:
+        with self._changed:
+            self.last = score
+            if score.message.strip():
+                elapsed = score.sim_time_elapsed.to_sec()
+                print(f'{PROG}: /vrc_score at {score.sim_time.to_sec():.2f} s (course clock '
+                      f'{elapsed:.2f} s): {score.message.strip()}', flush=True)
+                self.events.append(score.message)
+            self._changed.notify_all()
+
+    def passed(self, gate: str) -> bool:
+        number = [known.name for known in GATES].index(gate) + 1
+        return any(f'passed through gate {number}.' in event for event in self.events)
+
+    def wait_for(self, gate: str, timeout_s: float) -> bool:
+        """Whether `gate` was reported passed within `timeout_s` (wall time)."""
+        with self._changed:
+            return self._changed.wait_for(lambda: self.passed(gate), timeout_s)
+
+
+def _walk_course(link: AsiLink, to_gate: str, gait: RouteGait, timeout_s: float) -> int:
+    score = _ScoreWatch()
+    first = link.connect('vrc_walker')
+    rospy.Subscriber(topics.VRC_SCORE, VRCScore, score.on_score, queue_size=100)
+    pelvis = first.pos_est.position
+    legs = legs_ahead(pelvis.x, pelvis.y, to_gate)
+    if not legs:
+        raise Refused(f'{to_gate} is behind the robot at ({pelvis.x:.2f}, {pelvis.y:.2f})')
+    print(f'{PROG}: from ({pelvis.x:.2f}, {pelvis.y:.2f}): '
+          f'{", ".join(leg.gate for leg in legs)}', flush=True)
+    if first.current_behavior == Behavior.USER:
+        link.stand_first(0)
+    deadline = time.monotonic() + timeout_s
+    for number, leg in enumerate(legs):
+        if number > 0:
+            link.hold(LEG_PAUSE_S)
+        _walk_leg(link, leg, gait, deadline - time.monotonic())
+    passed = score.wait_for(to_gate, SCORE_WAIT_S)
+    last = score.last
+    if last is not None:
+        print(f'{PROG}: score: completion {last.completion_score} of 4, falls {last.falls}, '
+              f'course clock {last.sim_time_elapsed.to_sec():.2f} s', flush=True)
+    link.close('walked')
+    if last is not None and last.falls > 0:
+        raise Refused(f'/vrc_score counts {last.falls} fall(s)')
+    if not passed:
+        raise Refused(f'the walk ended but /vrc_score did not report {to_gate} passed')
+    return 0
+
+
+def _walk_leg(link: AsiLink, leg: Leg, gait: RouteGait, timeout_s: float) -> None:
+    """One leg, planned from where the feet are now, streamed to its end."""
+    if timeout_s <= 0.0:
+        raise Refused(f'no time left for the leg to {leg.gate}')
+    origin, heading = link.feet()
+    try:
+        plan = route_steps(origin, heading, leg.waypoints, gait)
+    except WalkingError as err:
+        raise Refused(f'no route to {leg.gate} from ({origin[0]:.2f}, {origin[1]:.2f}): '
+                      f'{err}') from None
+    print(f'{PROG}: to {leg.gate} from ({origin[0]:.2f}, {origin[1]:.2f}): {len(plan)} steps',
+          flush=True)
+    client = WalkClient(plan, streaming=True)
+    link.walk(client, timeout_s)
+    if client.outcome is not Outcome.WALKED:
+        state = link.last
+        assert state is not None  # connected
+        hint = refusal_hint(state.behavior_feedback.status_flags, state.current_behavior)
+        raise Refused(f'the walk to {leg.gate} {client.outcome.value} after '
+                      f'{client.steps_taken} of {len(plan)} steps ({hint})')

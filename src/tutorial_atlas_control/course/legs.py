@@ -1,0 +1,79 @@
+"""The course as a walker's legs: the waypoints from each gate to the next.
+
+A course walker (cli/vrc_walker.py, offline/course_route.py) walks one leg at a time, each
+planned again from where the feet are once Stand has held LEG_PAUSE_S after the last one.
+The legs keep clear of what is not ground to walk on: from the pen east through gate_0 to
+x 3.2, 1.3 m clear of the pen's east wall (on a route turning north at x 2.5 the pelvis came
+within 0.5-0.6 m of it and two landings fell 17 cm east of their steps: docs/vrc.md), north
+past the wall's end, then to gate_1 (its feet stopping 5 cm past the gate's line, short of
+the mud pit's ramp), through the pit to gate_2, over the hills to gate_3, and across the
+rubble to gate_4. A walker that starts elsewhere (one of the later starts) begins with the
+nearest gate still ahead of it, walking that leg from its waypoint nearest the walker.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from tutorial_atlas_control.course.errors import CourseError
+from tutorial_atlas_control.course.vrc_task_2 import GATES, Gate
+
+__all__ = ['COURSE_LEGS', 'LEG_PAUSE_S', 'Leg', 'legs_ahead']
+
+#: Stand holds this long (s of sim time) between one leg's end and the next one's first
+#: WALK: the catch after a walk settles, and a bag's walks stay apart (its analysis tells
+#: one walk's steps from the next by the behaviour's changes; a next WALK within the same
+#: millisecond fell into the last walk's window).
+LEG_PAUSE_S = 1.0
+
+
+@dataclass(frozen=True)
+class Leg:
+    """The waypoints (world x, y) to walk through to pass `gate`, the last one past it."""
+
+    gate: str
+    waypoints: tuple[tuple[float, float], ...]
+
+
+#: The course from the pen's start, gate by gate, in scoring order.
+COURSE_LEGS: tuple[Leg, ...] = (
+    Leg('gate_0', ((1.6, -38.0),)),
+    Leg('gate_1', ((3.2, -38.0), (3.2, -31.0), (0.5, -24.5), (0.5, -21.95))),
+    Leg('gate_2', ((0.5, -10.0),)),
+    Leg('gate_3', ((3.0, -2.0), (6.0, 7.0))),
+    Leg('gate_4', ((6.0, 18.5),)),
+)
+
+
+def _ahead(gate: Gate, x_m: float, y_m: float) -> bool:
+    """Whether (x, y) is still on the near side of `gate` (its line crossed along its yaw)."""
+    along = (x_m - gate.x_m) * math.cos(gate.yaw_rad) + (y_m - gate.y_m) * math.sin(gate.yaw_rad)
+    return along < 0.0
+
+
+def legs_ahead(x_m: float, y_m: float, to_gate: str = GATES[-1].name) -> tuple[Leg, ...]:
+    """The legs a walker at (x, y) walks to pass `to_gate`: from the nearest gate still ahead
+    of it, its leg from the waypoint nearest the walker; none when `to_gate` is behind it.
+
+    Raises:
+        CourseError: `to_gate` is not a gate, or (x, y) is not finite.
+    """
+    names = [gate.name for gate in GATES]
+    if to_gate not in names:
+        raise CourseError(f'{to_gate!r} is not a gate of the course ({", ".join(names)})')
+    if not (math.isfinite(x_m) and math.isfinite(y_m)):
+        raise CourseError(f'a walker at ({x_m}, {y_m}) is nowhere')
+    last = names.index(to_gate)
+    ahead = [index for index, gate in enumerate(GATES[:last + 1]) if _ahead(gate, x_m, y_m)]
+    if not ahead:
+        return ()
+    first = min(ahead, key=lambda index: math.hypot(GATES[index].x_m - x_m,
+                                                   GATES[index].y_m - y_m))
+    legs = list(COURSE_LEGS[first:last + 1])
+    waypoints = legs[0].waypoints
+    nearest = min(range(len(waypoints)),
+                  key=lambda index: math.hypot(waypoints[index][0] - x_m,
+                                               waypoints[index][1] - y_m))
+    legs[0] = Leg(legs[0].gate, waypoints[nearest:])
+    return tuple(legs)

@@ -1,0 +1,159 @@
+"""Offline walks on terrain other than the flat floor: the course's cases, one at a time.
+
+Each case is Atlas's own world changed in one way, the robot placed standing in it facing
++x, Stand for a moment, then a straight walk (walking/walk_trial.py's WalkingStand, the
+plan sent once) with every step placed on the ground under it as the AtlasSimInterface
+places a client's steps (asi/library.py's on_ground: the surface's height and normal):
+
+- mud (DRCSim's MudPlugin, sim/mud.py): the floor flat, a `mud_atlas` volume over the walk
+  whose top is MUD_DEPTH_M above the floor (the VRC pit's mud stood 0.46 m over its floor:
+  the feet and lower legs in it), its damping DRCSim's 40 N s/m or the finals' 70;
+- slopes (balance/slope_trial.py's world): the floor turned to rise (or fall) along +x by the
+  slope, the robot placed on it with its ankles pitched to lie on it.
+
+A case's seed perturbs the start (walking/start_noise.py) and, for a pushed walk, draws the
+pushes' phases and sides, so a figure is a fraction of seeds (the start's noise alone is
+forgotten in the second of Stand before the walk where the walk is stable: eight seeds of
+the 10 m through the mud ended within a millimetre of each other). What a walk returns is
+walk_trial's WalkTrial (fell, steps, landings; its lowest pelvis over the ground under the
+feet).
+"""
+
+from __future__ import annotations
+
+import math
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import mujoco
+
+from tutorial_atlas_control.asi import on_ground
+from tutorial_atlas_control.balance import (
+    apply_pushes,
+    place_in_stand_pose,
+    place_on_slope,
+    push_events,
+    slope_model,
+)
+from tutorial_atlas_control.course import MUD_DAMPING, MUD_DAMPING_FINALS
+from tutorial_atlas_control.sim import (
+    DEFAULT_GAINS_FILE,
+    MODEL_PATH,
+    AtlasModel,
+    AtlasSimulator,
+    GroundUnderFeet,
+    load_gains_yaml,
+    load_model,
+    pelvis_height_m,
+)
+from tutorial_atlas_control.walking import (
+    SETTLE_S,
+    WalkingError,
+    WalkingStand,
+    WalkTrial,
+    perturb_start,
+    random_pushes,
+    straight_steps,
+)
+
+__all__ = ['MUD_DEPTH_M', 'TERRAINS', 'Terrain', 'mud_model', 'terrain_walk']
+
+#: The mud's top over the floor (m): the VRC pit's 0.46 m.
+MUD_DEPTH_M = 0.46
+#: The mud volume's extent along the walk (m of x, from the start) and across it (m of y).
+MUD_LENGTH_M = 14.0
+MUD_WIDTH_M = 3.0
+#: After the walk has ended, the robot stands this long (s).
+STAND_AFTER_S = 1.5
+#: A push lasts PUSH_S (s), one in every PUSH_EVERY_S (s) of the walk.
+PUSH_S = 0.1
+PUSH_EVERY_S = 5.0
+#: A walk may take this many times its steps' durations (the mud slows the swings) before
+#: the trial ends without it.
+SLOWEST_WALK = 2.0
+
+
+@dataclass(frozen=True)
+class Terrain:
+    """One case: the floor's slope along +x (rad; negative falls), the mud's damping
+    (N s/m; None: no mud), and the walk: `steps` steps of `stride_m`."""
+
+    name: str
+    slope_rad: float = 0.0
+    mud_damping: float | None = None
+    steps: int = 16
+    stride_m: float = 0.25
+
+
+#: The cases by name: 10 m through the mud at DRCSim's and the finals' damping, in strides
+#: of 0.15 m (at 0.25 m 7 of 8 seeds fell at 40 N s/m: docs/vrc.md); 4 m up and down slopes
+#: of 8 and 16 degrees.
+TERRAINS: dict[str, Terrain] = {case.name: case for case in (
+    Terrain('mud_40', mud_damping=MUD_DAMPING, steps=67, stride_m=0.15),
+    Terrain('mud_70', mud_damping=MUD_DAMPING_FINALS, steps=67, stride_m=0.15),
+    Terrain('up_8deg', slope_rad=math.radians(8.0), steps=20, stride_m=0.2),
+    Terrain('down_8deg', slope_rad=-math.radians(8.0), steps=20, stride_m=0.2),
+    Terrain('up_16deg', slope_rad=math.radians(16.0), steps=20, stride_m=0.2),
+    Terrain('down_16deg', slope_rad=-math.radians(16.0), steps=20, stride_m=0.2),
+)}
+
+
+def mud_model(scratch: Path) -> AtlasModel:
+    """Atlas's world with a mud volume over the walk, written where sim/mud.py can compile
+    its private copy from the same file."""
+    spec = mujoco.MjSpec.from_file(str(MODEL_PATH))
+    half_height = (MUD_DEPTH_M + 0.05) / 2  # from 5 cm under the floor
+    spec.worldbody.add_geom(
+        name='mud_atlas', type=mujoco.mjtGeom.mjGEOM_BOX,
+        size=[MUD_LENGTH_M / 2, MUD_WIDTH_M / 2, half_height],
+        pos=[MUD_LENGTH_M / 2 - 1.0, 0.0, MUD_DEPTH_M - half_height], contype=0,
+        conaffinity=0, rgba=[0.4, 0.3, 0.2, 0.4])
+    path = scratch / 'atlas_v1_mud.xml'
+    path.write_text(spec.to_xml())
+    return load_model(path)
+
+
+def terrain_walk(terrain: Terrain, seed: int | None, push_n: float = 0.0) -> WalkTrial:
+    """Walk `terrain`'s case once from a start perturbed by `seed` (None: not), pushed on
+    the pelvis by `push_n` (N; 0: not) as pushed flat walks are (walk_trial.random_pushes:
+    0.1 s to a side drawn from the seed, once in every PUSH_EVERY_S of the walk)."""
+    if terrain.slope_rad != 0.0 and terrain.mud_damping is not None:
+        raise WalkingError(f'terrain {terrain.name}: mud on a slope is not a case')
+    gains = load_gains_yaml(DEFAULT_GAINS_FILE)
+    with tempfile.TemporaryDirectory(prefix='terrain_walk_') as scratch:
+        if terrain.mud_damping is None:
+            sim = AtlasSimulator(slope_model(terrain.slope_rad), gains, time_to_unpin_s=0.0)
+        else:
+            sim = AtlasSimulator(mud_model(Path(scratch)), gains, time_to_unpin_s=0.0,
+                                 mud_damping=terrain.mud_damping)
+        ground = GroundUnderFeet(sim.atlas, sim.data)
+        if terrain.slope_rad == 0.0:
+            place_in_stand_pose(sim.atlas, sim.data)
+            perturb_start(sim.atlas, sim.data, seed)
+        else:
+            place_on_slope(sim.atlas, sim.data, terrain.slope_rad, ground.ground,
+                           lambda atlas, data: perturb_start(atlas, data, seed,
+                                                             on_ground=False))
+        plan = on_ground(straight_steps(terrain.steps, terrain.stride_m), ground.ground)
+        behaviour = WalkingStand(sim.atlas, plan, SETTLE_S)
+        sim.install_stand(behaviour)
+        trial = behaviour.trial
+        walk_s = terrain.steps * plan[0].duration_s
+        events = push_events(random_pushes(0 if seed is None else seed, SETTLE_S,
+                                           SETTLE_S + walk_s, push_n, PUSH_S, PUSH_EVERY_S)
+                             if push_n > 0.0 else [], sim.dt_s)
+        longest_s = SETTLE_S + SLOWEST_WALK * walk_s + STAND_AFTER_S
+        for tick in range(round(longest_s / sim.dt_s)):
+            if trial.walk_ended_s is not None \
+                    and sim.data.time >= trial.walk_ended_s + STAND_AFTER_S:
+                break
+            apply_pushes(sim, events, tick)
+            sim.step()
+            height = pelvis_height_m(sim.atlas, sim.data)
+            trial.lowest_pelvis_m = min(trial.lowest_pelvis_m, ground.clearance_m(height))
+            if not ground.standing(height):
+                trial.fell = True
+                break
+        trial.pelvis_end = sim.data.xpos[sim.atlas.pelvis_body_id].copy()
+    return trial
