@@ -18,23 +18,15 @@ from __future__ import annotations
 import argparse
 import sys
 
+from tutorial_atlas_control.cli.convention import seed_or_none
 from tutorial_atlas_control.offline import PLANS, CinderBlock, block_step_trial
 
 PROG = 'block_steps.py'
 
 
-def _seed(text: str) -> int | None:
-    if text == 'none':
-        return None
-    try:
-        return int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'seed {text!r} is not an integer or none') from None
-
-
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog=PROG, description=__doc__.split('\n\n')[0])
-    parser.add_argument('seeds', type=_seed, nargs='+', metavar='SEED')
+    parser.add_argument('seeds', type=seed_or_none, nargs='+', metavar='SEED')
     parser.add_argument('--on-side', action='store_true', help='the block on a long side')
     parser.add_argument('--plan', choices=PLANS, default='back',
                         help="'back': the left foot onto it and back; 'across': both feet "
