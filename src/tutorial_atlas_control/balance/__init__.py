@@ -34,7 +34,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'stand': ['WHOLE_BODY_ENV', 'StandController', 'StandGains', 'StandReference',
               'orientation_error', 'yaw_of', 'yaw_rotation'],
     'stand_behaviour': ['StandBehaviour'],
-    'sole': ['SOLE_GEOMS', 'SoleBox', 'box_corners', 'sole_corners'],
+    'sole': ['SOLE_GEOMS', 'SoleBox', 'box_corners', 'sole_corners', 'sole_geom_ids'],
     'stand_pose': ['STAND_POSE_RAD', 'place_in_stand_pose'],
     'whole_body': ['INVERSE_STATICS', 'QP', 'SOLVERS', 'STATICS_ENV', 'CapturePointTask',
                    'CentroidalTask', 'ComHeightTask', 'ContactConstraint', 'JointTask',

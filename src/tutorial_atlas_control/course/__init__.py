@@ -25,7 +25,8 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'score_log': ['DEFAULT_SCORE_DIR', 'SCORE_FILE_NAME', 'ScoreLog'],
     'scoring': ['FALL_ACCEL_THRESHOLD', 'TASK_WALKING', 'ScoreRow', 'Scorer', 'seconds'],
     'starts': ['TERRAIN_FILE', 'WORLD_MODEL_FILE', 'parse_start', 'start_text', 'world_start'],
-    'vrc_task_2': ['BLOCKS', 'BLOCK_ENVELOPE_M', 'GATES', 'HEIGHTMAP', 'MUD_BOX', 'MUD_DAMPING',
+    'vrc_task_2': ['BLOCKS', 'BLOCK_ENVELOPE_M', 'BLOCK_INERTIA', 'BLOCK_MASS_KG', 'BLOCK_WALLS',
+                   'GATES', 'HEIGHTMAP', 'MUD_BOX', 'MUD_DAMPING',
                    'MUD_DAMPING_FINALS', 'MUD_LINKS', 'PEN_POSE', 'PEN_WALLS', 'STARTS',
                    'WORLD_NAME', 'Block', 'Box', 'Gate', 'Heightmap', 'Start'],
 })

@@ -3,12 +3,15 @@ and the replay of a recorded run (replay_score: a scored run's /vrc_score comput
 the replayed steps); world: the model and start they simulate (a VRC world by name, or the
 recorded run's); course_route: a course walker's streamed walk, leg by leg, on a VRC world,
 scored; terrain_trial: straight walks on the course's kinds of ground one at a time (mud,
-slopes), over seeds."""
+slopes), over seeds; block_step: static steps onto a cinder block and off again, from a
+seeded start."""
 
 from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'asi_playback': ['AsiStream', 'read_asi_stream', 'run_asi_offline'],
+    'block_step': ['PLANS', 'BlockRun', 'BlockStep', 'CinderBlock', 'block_model', 'block_plan',
+                   'block_step_trial'],
     'course_route': ['CourseWalk', 'course_walk'],
     'player': ['CommandLatency', 'DEFAULT_SETTLE_S', 'DEFAULT_START_AFTER_S', 'OfflineRunError',
                'run_offline', 'write_offline_bag'],

@@ -14,8 +14,9 @@ simulator's behaviour;
 route: footsteps through a route of waypoints (a course walker's plan) from where the
 feet are;
 start_noise: a trial's start perturbed by a seed; walk_trial: offline walking trials,
-landing by landing, pushed or not; static_step: one quasi-static step; step_behaviour:
-Step as the simulator's behaviour.
+landing by landing, pushed or not; static_step: one quasi-static step; step_over: its swing
+over terrain higher than its line (up, across, down) and the apex that clears it;
+step_behaviour: Step as the simulator's behaviour.
 """
 
 from tutorial_atlas_control.exports import lazy_exports
@@ -35,5 +36,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'start_noise': ['perturb_start'],
     'walk_trial': ['SETTLE_S', 'WalkTrial', 'WalkingStand', 'pushed_walk_trial',
                    'random_pushes', 'straight_walk_trial', 'walk_trial'],
+    'step_over': ['STEP_OVER_CLEARANCE_M', 'StepOverPath', 'clear_apex_m', 'needs_step_over',
+                  'sweep_points', 'terrain_top_m'],
     'step_behaviour': ['StepBehaviour', 'StepStatus'],
 })

@@ -6,6 +6,11 @@ it the other foot, still down, carries nothing: SWAYING), the other foot lifted
 and placed along swing.SwingPath with the capture point held over the stance sole
 (STEPPING), then the weight brought back between the feet (SWAYING again); `done` once it
 is there and at rest. Nothing is dynamic: at any instant the robot could stop and stand.
+
+Where the terrain under the swing's sweep (clear_terrain: the caller's rays) or its end
+rises above the lower of its ends (a cinder block stepped onto, across or off), the swing
+steps over it instead (step_over.StepOverPath: up, across at the clearance, down; slower,
+step_over_swing_s), its servo fed the path's target through LegTasks.foot_servo.
 """
 
 from __future__ import annotations
@@ -29,7 +34,13 @@ from tutorial_atlas_control.walking.phases import (
     swing_to,
 )
 from tutorial_atlas_control.walking.status_flags import STEPPING
-from tutorial_atlas_control.walking.swing import SwingPath
+from tutorial_atlas_control.walking.step_over import (
+    STEP_OVER_CLEARANCE_M,
+    StepOverPath,
+    clear_apex_m,
+    needs_step_over,
+)
+from tutorial_atlas_control.walking.swing import SwingPath, quintic
 
 __all__ = ['StaticStep', 'StepGains']
 
@@ -61,6 +72,10 @@ class StepGains:
     #: Stand's height a trailing leg lifts off with its hip pitch, knee and ankle pitch on
     #: their limits and the servo cannot lift it.
     lowering_m: float = 0.05
+    #: A swing stepping over higher terrain: how high over it the sole crosses (m), and
+    #: the shortest such swing (s; a third up, a third across, a third down).
+    step_over_clearance_m: float = STEP_OVER_CLEARANCE_M
+    step_over_swing_s: float = 1.5
     legs: LegGains = field(default_factory=LegGains)
 
 
@@ -83,9 +98,20 @@ class StaticStep:
                                     PhaseEnd(self.gains.shift_s, self.gains.longest_shift_s))
         self.landed: Footstep | None = None
         self.swing_s = max(step.duration_s, self.gains.shortest_swing_s)
+        #: The height the swing crosses at when it steps over (None: SwingPath's swing).
+        self.apex_m: float | None = None
         stance = self.feet[1 - step.foot_index]
         self._shift = (time_s, state.capture_point.copy(), np.array([stance.x_m, stance.y_m]))
-        self._swing: SwingPath | None = None
+        self._swing: SwingPath | StepOverPath | None = None
+
+    def clear_terrain(self, terrain_top_m: float) -> None:
+        """Before the swing: the highest ground under its sweep is `terrain_top_m` (m); where
+        it or the step's end rises above the lower end, the swing steps over it."""
+        start_z, step = self.feet[self.step.foot_index].z_m, self.step
+        if needs_step_over(start_z, step.z_m, terrain_top_m):
+            self.apex_m = clear_apex_m(start_z, step.z_m, terrain_top_m,
+                                       self.gains.step_over_clearance_m)
+            self.swing_s = max(self.swing_s, self.gains.step_over_swing_s)
 
     @property
     def status(self) -> int:
@@ -126,10 +152,17 @@ class StaticStep:
         following = phases.following(more_steps=False)
         if following is _SWING:
             self._swing = swing_to(state, step, self.swing_s)
+            if self.apex_m is not None:
+                swing = self._swing
+                apex = max(self.apex_m, float(swing.start[2]), float(swing.end[2]))
+                self._swing = StepOverPath(swing.start, swing.end, swing.start_yaw_rad,
+                                           swing.end_yaw_rad, swing.duration_s, apex)
             stance = self.feet[1 - step.foot_index]
             self.legs.face(stance.yaw_rad, step.yaw_rad, time_s, self.swing_s)
-            phases.enter(following, time_s, PhaseEnd.swing(self.swing_s,
-                                                           gains.legs.late_touchdown_s))
+            end = PhaseEnd.swing(self.swing_s, gains.legs.late_touchdown_s)
+            if isinstance(self._swing, StepOverPath):  # landed once down on its surface
+                end = PhaseEnd(self._swing.descent_s, end.longest_s)
+            phases.enter(following, time_s, end)
         elif following is _SETTLE:
             self.landed = foot_pose(state, step.foot_index, step.step_index)
             self.feet[step.foot_index] = self.landed
@@ -154,8 +187,32 @@ class StaticStep:
         legs = self.legs
         torque, _, contact = legs.torque(state, joint_positions, joint_velocities, time_s, cop,
                                          unloaded)
-        swing = None
-        if swinging:
-            assert self._swing is not None  # set with STEPPING
-            swing = (self.step.foot_index, self._swing, self.phases.elapsed_s(time_s))
-        return legs.finish(state, joint_velocities, torque, contact, swing, self.feet)
+        path = self._swing
+        if not swinging:
+            return legs.finish(state, joint_velocities, torque, contact, None, self.feet)
+        assert path is not None  # set with STEPPING
+        elapsed_s = self.phases.elapsed_s(time_s)
+        if isinstance(path, SwingPath):
+            return legs.finish(state, joint_velocities, torque, contact,
+                               (self.step.foot_index, path, elapsed_s), self.feet)
+        torque += self._step_over_torque(state, joint_velocities, path, elapsed_s)
+        return legs.stand.layer.limit(torque)
+
+    def _step_over_torque(self, state: BalanceState, joint_velocities: np.ndarray,
+                          path: StepOverPath, elapsed_s: float) -> np.ndarray:
+        """The swing leg's torques along a step-over path, as LegTasks.swing_torque does
+        along a SwingPath: its acceleration fed forward, its end pressed into the surface,
+        past its end on down at touchdown_speed_m_s."""
+        gains = self.gains.legs
+        position, velocity, yaw, yaw_rate = path.at(elapsed_s)
+        acceleration, yaw_acceleration = path.acceleration(elapsed_s)
+        if not gains.swing_feedforward:
+            acceleration, yaw_acceleration = None, 0.0
+        position[2] -= gains.swing_press_m * quintic(elapsed_s / path.duration_s)[0]
+        late = elapsed_s - path.duration_s
+        if late > 0.0:  # not down yet: on down
+            position[2] -= gains.touchdown_speed_m_s * late
+            velocity[2] = -gains.touchdown_speed_m_s
+        return self.legs.foot_servo(state, joint_velocities, self.step.foot_index, position,
+                                    velocity, yaw, yaw_rate, acceleration, yaw_acceleration,
+                                    world=gains.world_velocity)
