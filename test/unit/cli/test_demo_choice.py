@@ -185,7 +185,7 @@ def test_main_runs_the_name_with_its_gains(launched: Launched, argv: list[str], 
     (['--gains-file', '{tmp}/bad.yaml'],
      "{tmp}/bad.yaml: atlas_controller/gains/back_lbz/p is 'x', not a finite number"),
     (['jump'], "no trajectory or walk named jump in the package's trajectory files: (walks: "
-               'walk_straight, walk_twenty, walk_circle; valid names: '
+               'walk_straight, walk_twenty, walk_circle, vrc_task_2; valid names: '
                'Traj_data2.yaml: step_and_fall, touchdown, touchdown_exhausted; '
                f'{QUICK_STEP.name}: {", ".join(load_trajectory_file(QUICK_STEP))}; Stepping.yaml: '
                f'{", ".join(load_trajectory_file(STEPPING))}); give its file with --file'),
