@@ -25,7 +25,7 @@ no library).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -46,9 +46,10 @@ from tutorial_atlas_control.balance.whole_body import (
     orientation_error,
 )
 
-__all__ = ['STAND_JOINT_KD', 'STAND_JOINT_KP', 'WHOLE_BODY_ENV', 'StandController', 'StandGains',
-           'StandOutput', 'StandReference', 'orientation_error', 'pelvis_frame', 'pitch_of',
-           'yaw_of', 'yaw_rotation']
+__all__ = ['STAND_JOINT_KD', 'STAND_JOINT_KP', 'WHOLE_BODY_ENV', 'MovedReference',
+           'StandController', 'StandGains', 'StandOutput', 'StandReference',
+           'moved_reference', 'orientation_error', 'pelvis_frame', 'pitch_of', 'yaw_of',
+           'yaw_rotation']
 
 #: Set to `python` for the whole-body tick in Python even where the compiled library is built.
 WHOLE_BODY_ENV = 'TAC_WHOLE_BODY'
@@ -134,6 +135,19 @@ def yaw_rotation(yaw_rad: float) -> np.ndarray:
     """An upright frame turned by `yaw_rad` about z."""
     c, s = math.cos(yaw_rad), math.sin(yaw_rad)
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+#: A reference's pelvis heading (rad), CoM height (m) and its rate (m/s) moved on: Walk's
+#: and Step's legs move these every tick, the rest of the Stand's reference stays.
+MovedReference = tuple[float, float, float]
+
+
+def moved_reference(reference: StandReference, moved: MovedReference) -> StandReference:
+    """`reference` with its pelvis frame turned upright to `moved`'s heading and its CoM
+    height and rate replaced (a new reference: the package never writes into one)."""
+    yaw_rad, height_m, rate_m_s = moved
+    return replace(reference, pelvis_rotation=yaw_rotation(yaw_rad), com_height_m=height_m,
+                   com_height_rate_m_s=rate_m_s)
 
 
 def pitch_of(rotation: np.ndarray) -> float:
@@ -251,8 +265,10 @@ class StandController:
                    joint_positions: np.ndarray, joint_velocities: np.ndarray,
                    joint_gains: tuple[np.ndarray, np.ndarray] | None = None,
                    torsion_m: float | None = None,
-                   reference: StandReference | None = None) -> StandOutput:
-        """The whole-body layer's torques for `reference` (else the Stand's own) with the
+                   reference: StandReference | None = None,
+                   moved: MovedReference | None = None) -> StandOutput:
+        """The whole-body layer's torques for `reference` (else the Stand's own; `moved`:
+        its pelvis heading, CoM height and rate replaced) with the
         pressure centre at `cop`, pressed by the soles in `contact` (`torsion_m`: their yaw
         moment limited too), plus the joint PD to the reference's posture (`joint_gains`
         (kp, kd), else the Stand's); not yet clamped to the effort limits (Walk adds its
@@ -262,7 +278,9 @@ class StandController:
         if self._kernel is not None:
             return StandOutput(*self._kernel.whole_body(
                 state, cop, contacts, joint_positions, joint_velocities,
-                joint_gains or self._joint_gains, reference))
+                joint_gains or self._joint_gains, reference, moved))
+        if moved is not None:
+            reference = moved_reference(reference, moved)
         joint_kp, joint_kd = joint_gains or self._joint_gains
         posture = PostureTask(reference.posture_rad, reference.posture_rate_rad_s, joint_kp,
                               joint_kd)

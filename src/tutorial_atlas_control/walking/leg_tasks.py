@@ -28,15 +28,15 @@ or no library) they compute here.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
 from tutorial_atlas_control import native
 from tutorial_atlas_control.balance import (
     BalanceState,
+    MovedReference,
     StandController,
-    StandReference,
     box_corners,
     clamp_into,
     convex_hull,
@@ -137,8 +137,6 @@ class LegTasks:
         self._facing = (time_s, 1.0, yaw_of(stand.reference.pelvis_rotation), 0.0)
         #: The CoM height moving on: (start time, duration, from, change) (s, m).
         self._height = (time_s, 1.0, stand.reference.com_height_m, 0.0)
-        self._last_reference: tuple[tuple[float, float, float], StandReference,
-                                    StandReference] | None = None
         library = native.chosen_library(SWING_ENV, compiled)
         self._kernel = None if library is None else CompiledSwing(
             library, gains, len(stand.gains.joint_kp))
@@ -176,19 +174,12 @@ class LegTasks:
         started_s, duration_s, start, turn = self._facing
         return start + smoothstep((time_s - started_s) / duration_s) * turn
 
-    def _moved_reference(self, time_s: float) -> StandReference:
-        """The legs' reference at `time_s`: its heading and height moved on (the same object
-        as last tick's while they stand still, as they do between a step's turn and the
-        next: a dataclass replace and a rotation a tick saved)."""
+    def _moved_reference(self, time_s: float) -> MovedReference:
+        """The legs' reference's heading, CoM height and rate at `time_s` (the rest is
+        self.reference's): the whole-body call writes them over its copy of the reference
+        (no new reference a tick, as the heading turns through every step)."""
         height, height_rate = self.height(time_s)
-        key = (self.heading(time_s), height, height_rate)
-        last = self._last_reference
-        if last is not None and last[0] == key and last[1] is self.reference:
-            return last[2]
-        moved = replace(self.reference, pelvis_rotation=yaw_rotation(key[0]),
-                        com_height_m=height, com_height_rate_m_s=height_rate)
-        self._last_reference = (key, self.reference, moved)
-        return moved
+        return self.heading(time_s), height, height_rate
 
     def swing_torque(self, state: BalanceState, joint_velocities: np.ndarray, foot: int,
                      swing: SwingPath, elapsed_s: float) -> np.ndarray:
@@ -272,7 +263,7 @@ class LegTasks:
         kept, and which soles carry. `finish` adds the swing or put-down torques; nothing
         is clipped yet."""
         stand = self.stand
-        reference = self._moved_reference(time_s)
+        moved = self._moved_reference(time_s)
         if swing_foot is not None:
             contact = (swing_foot != 0, swing_foot != 1)
             cop = _clamp_to_sole(state, 1 - swing_foot, self.sole_reach_m, cop)
@@ -286,7 +277,8 @@ class LegTasks:
             cop = clamp_into(convex_hull(corners), cop, stand.gains.cop_margin_m)
         torsion = self.gains.torsion_m if swing_foot is not None else None
         torque = stand.whole_body(state, cop, contact, joint_positions, joint_velocities,
-                                  self._joint_gains, torsion, reference).torque_nm
+                                  self._joint_gains, torsion, self.reference,
+                                  moved).torque_nm
         return torque, cop, contact
 
     def finish(self, state: BalanceState, joint_velocities: np.ndarray, torque: np.ndarray,
@@ -310,12 +302,14 @@ def _clamp_to_sole(state: BalanceState, foot: int, reach_m: tuple[float, float],
     """`point_xy` moved to the nearest point of one sole's rectangle reaching `reach_m`
     from its centre along and across it (in the sole's frame a clamp of each coordinate:
     the rectangle's hull and a general polygon's clamp, every tick of single support, cost
-    more than the rest of the step's pressure-centre work)."""
-    rotation = state.sole_rotations[foot][0:2, 0:2]
-    centre = state.sole_centres[foot][0:2]
-    local = rotation.T @ (np.asarray(point_xy, dtype=np.float64) - centre)
+    more than the rest of the step's pressure-centre work; plain floats, as numpy's calls
+    on two numbers cost more than the arithmetic)."""
+    (r00, r01, _), (r10, r11, _), _ = state.sole_rotations[foot].tolist()
+    centre_x, centre_y, _ = state.sole_centres[foot].tolist()
+    x, y = point_xy.tolist()
+    dx, dy = x - centre_x, y - centre_y
     reach_x, reach_y = reach_m
-    local[0] = min(max(local[0], -reach_x), reach_x)
-    local[1] = min(max(local[1], -reach_y), reach_y)
-    return centre + rotation @ local
-
+    along = min(max(r00 * dx + r10 * dy, -reach_x), reach_x)
+    across = min(max(r01 * dx + r11 * dy, -reach_y), reach_y)
+    return np.array([centre_x + (r00 * along + r01 * across),
+                     centre_y + (r10 * along + r11 * across)])
