@@ -140,10 +140,27 @@ class CompiledWholeBody:
         self._pelvis_rotation[:] = state.pelvis_rotation
         self._pelvis_angular[:] = state.pelvis_angular_velocity
 
-    def _load(self, state: BalanceState, contacts: tuple[ContactConstraint, ContactConstraint],
+    @property
+    def joints(self) -> int:
+        """How many joints the call's torques hold."""
+        return len(self._effort_limit)
+
+    @property
+    def address(self) -> int:
+        """The call's struct, for a call that runs the whole body itself (Walk's legs)."""
+        return ctypes.addressof(self._call)
+
+    def set_cop(self, cop: np.ndarray) -> None:
+        """The pressure centre atlas_whole_body solves at."""
+        self._cop[:] = cop
+
+    def load(self, state: BalanceState, contacts: tuple[ContactConstraint, ContactConstraint],
               joint_positions: np.ndarray, joint_velocities: np.ndarray,
               joint_gains: tuple[np.ndarray, np.ndarray], reference: StandReference,
               moved: MovedReference | None = None) -> None:
+        """This tick's input: the state (read in place from a compiled estimate's row, else
+        copied), the contacts, the reference (`moved`: its heading, height and rate
+        replaced) and joint gains when they changed, the joints."""
         row = state.row_address
         self._call.row = row
         if row is None:
@@ -174,7 +191,7 @@ class CompiledWholeBody:
              joint_gains: tuple[np.ndarray, np.ndarray], reference: StandReference) -> Tick:
         """StandController.tick's numbers: the pressure centre by the capture-point law
         clamped into `region` (None: not clamped), the torques within the effort limits."""
-        self._load(state, contacts, joint_positions, joint_velocities, joint_gains, reference)
+        self.load(state, contacts, joint_positions, joint_velocities, joint_gains, reference)
         if region is not self._last_region:
             self._set_region(region)
         self._library.atlas_stand_tick(self._pointer)
@@ -187,8 +204,8 @@ class CompiledWholeBody:
                    reference: StandReference, moved: MovedReference | None = None) -> Tick:
         """StandController.whole_body's numbers at the pressure centre `cop`, not clamped
         to the effort limits (`moved`: the reference's heading, height and rate replaced)."""
-        self._load(state, contacts, joint_positions, joint_velocities, joint_gains, reference,
+        self.load(state, contacts, joint_positions, joint_velocities, joint_gains, reference,
                    moved)
-        self._cop[:] = cop
+        self.set_cop(cop)
         self._library.atlas_whole_body(self._pointer)
         return self._results()

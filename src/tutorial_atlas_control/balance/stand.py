@@ -200,6 +200,11 @@ class StandController:
         """Whether the tick runs the C call."""
         return self._kernel is not None
 
+    @property
+    def compiled_whole_body(self) -> CompiledWholeBody | None:
+        """The C call (None: the Python tick), for Walk's legs' own call around it."""
+        return self._kernel
+
     def support_region(self, state: BalanceState) -> support.Region | None:
         """The support polygon shrunk by the margin (None: no polygon to keep to)."""
         polygon = state.support_polygon
@@ -239,7 +244,7 @@ class StandController:
         """The 28 joint torques (N m) for this tick, clamped to the effort limits."""
         if self._kernel is not None:
             return StandOutput(*self._kernel.tick(
-                state, self.support_region(state), self._contacts_for(state.in_contact, None),
+                state, self.support_region(state), self.contacts_for(state.in_contact, None),
                 joint_positions, joint_velocities, self._joint_gains, self.reference))
         output = self.whole_body(state, self.desired_cop(state), state.in_contact,
                                  joint_positions, joint_velocities)
@@ -257,8 +262,10 @@ class StandController:
             self._contacts[key] = made
         return made
 
-    def _contacts_for(self, contact: tuple[bool, bool],
-                      torsion_m: float | None) -> tuple[ContactConstraint, ContactConstraint]:
+    def contacts_for(self, contact: tuple[bool, bool],
+                     torsion_m: float | None) -> tuple[ContactConstraint, ContactConstraint]:
+        """Both soles' contact constraints: which carry, their yaw moment limited by
+        `torsion_m` (None: not)."""
         return self._contact(contact[0], torsion_m), self._contact(contact[1], torsion_m)
 
     def whole_body(self, state: BalanceState, cop: np.ndarray, contact: tuple[bool, bool],
@@ -274,7 +281,7 @@ class StandController:
         (kp, kd), else the Stand's); not yet clamped to the effort limits (Walk adds its
         swing leg's first)."""
         reference = reference or self.reference
-        contacts = self._contacts_for(contact, torsion_m)
+        contacts = self.contacts_for(contact, torsion_m)
         if self._kernel is not None:
             return StandOutput(*self._kernel.whole_body(
                 state, cop, contacts, joint_positions, joint_velocities,

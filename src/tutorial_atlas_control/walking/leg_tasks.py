@@ -22,7 +22,9 @@ step on the hip pitch), and that shaking decided, chaotically, which walks stood
 
 The swing torque and the servo run as one C call a tick (compiled_swing) where the
 package's library is built, equal to the Python here to rounding; in Python (SWING_ENV=python,
-or no library) they compute here.
+or no library) they compute here. With a foot swinging, torque and finish together (the
+sole clamp, the whole body, the swing servo, the effort limits) are one C call around both
+(compiled_legs: swing_tick) on a compiled estimate's state, unless LEGS_ENV says `python`.
 """
 
 from __future__ import annotations
@@ -46,14 +48,18 @@ from tutorial_atlas_control.balance import (
     yaw_of,
     yaw_rotation,
 )
+from tutorial_atlas_control.walking.compiled_legs import CompiledLegs
 from tutorial_atlas_control.walking.compiled_swing import CompiledSwing
 from tutorial_atlas_control.walking.footsteps import Footstep, wrap_angle
 from tutorial_atlas_control.walking.swing import SwingPath, quintic
 
-__all__ = ['LEG_JOINTS', 'SWING_ENV', 'LegGains', 'LegTasks', 'foot_pose']
+__all__ = ['LEGS_ENV', 'LEG_JOINTS', 'SWING_ENV', 'LegGains', 'LegTasks', 'foot_pose']
 
 #: Set to `python` for the swing servo in Python even where the compiled library is built.
 SWING_ENV = 'TAC_SWING'
+#: Set to `python` for a swinging tick's pieces called from Python (each compiled or not by
+#: its own switch) rather than the one call around them.
+LEGS_ENV = 'TAC_LEGS'
 
 #: The leg joints (tutorial order): their Stand posture PD is off while stepping.
 LEG_JOINTS = slice(4, 16)
@@ -140,11 +146,22 @@ class LegTasks:
         library = native.chosen_library(SWING_ENV, compiled)
         self._kernel = None if library is None else CompiledSwing(
             library, gains, len(stand.gains.joint_kp))
+        legs_library = native.chosen_library(LEGS_ENV, compiled)
+        whole_body = stand.compiled_whole_body
+        self._legs_kernel = (
+            None if legs_library is None or whole_body is None or self._kernel is None
+            else CompiledLegs(legs_library, whole_body, self._kernel, self.sole_reach_m,
+                              (LEG_OF_FOOT[0].start, LEG_OF_FOOT[1].start)))
 
     @property
     def compiled(self) -> bool:
         """Whether the swing servo runs the C call."""
         return self._kernel is not None
+
+    @property
+    def compiled_swing_tick(self) -> bool:
+        """Whether swing_tick runs the one C call (on a compiled estimate's state)."""
+        return self._legs_kernel is not None
 
     def move_height(self, height_m: float, time_s: float, duration_s: float) -> None:
         """Take the CoM's reference height from where it is now to `height_m` over
@@ -279,6 +296,26 @@ class LegTasks:
         torque = stand.whole_body(state, cop, contact, joint_positions, joint_velocities,
                                   self._joint_gains, torsion, self.reference,
                                   moved).torque_nm
+        return torque, cop, contact
+
+    def swing_tick(self, state: BalanceState, joint_positions: np.ndarray,
+                   joint_velocities: np.ndarray, time_s: float, cop: np.ndarray,
+                   swing: tuple[int, SwingPath, float]) -> tuple[np.ndarray, np.ndarray,
+                                                                 tuple[bool, bool]]:
+        """torque() then finish() with `swing` (the foot, its path and the time into it):
+        the torques within the effort limits, the pressure centre as kept, which soles
+        carry."""
+        legs = self._legs_kernel
+        if legs is None or state.row_address is None:
+            torque, cop, contact = self.torque(state, joint_positions, joint_velocities,
+                                               time_s, cop, swing[0])
+            return self.finish(state, joint_velocities, torque, contact, swing, ()), cop, contact
+        foot = swing[0]
+        contact = (foot != 0, foot != 1)
+        torque, cop = legs.swing_tick(
+            state, self.stand.contacts_for(contact, self.gains.torsion_m),
+            (joint_positions, joint_velocities), self._joint_gains, self.reference,
+            self._moved_reference(time_s), cop, swing)
         return torque, cop, contact
 
     def finish(self, state: BalanceState, joint_velocities: np.ndarray, torque: np.ndarray,

@@ -327,13 +327,15 @@ class WalkController:
         step = self.step if self.phase == STEPPING and not transferring else None
         swing_foot = None if step is None else step.foot_index
         legs = self.legs
-        torque, cop, contact = legs.torque(state, joint_positions, joint_velocities, time_s,
-                                           cop, swing_foot)
-        swing = None
         if step is not None:
             assert self.swing is not None and self._lift_off_s is not None  # at lift-off
             swing = (step.foot_index, self.swing,
                      self.phases.elapsed_s(time_s) - self._lift_off_s)
-        legs.finish(state, joint_velocities, torque, contact, swing, feet)
+            torque, cop, _ = legs.swing_tick(state, joint_positions, joint_velocities, time_s,
+                                             cop, swing)
+        else:
+            torque, cop, contact = legs.torque(state, joint_positions, joint_velocities,
+                                               time_s, cop, None)
+            legs.finish(state, joint_velocities, torque, contact, None, feet)
         self._last_cop = cop
         return WalkOutput(torque, cop, xi_ref, self.phase, swing_foot)
