@@ -40,8 +40,10 @@ static void load_row(const AtlasWholeBody *w) {
 
 /* support.Region.clamp: `p` if inside the region, else the region's nearest point. */
 static void clamp_into_region(const AtlasWholeBody *w, double p[2]) {
-  const double *region = w->region;
-  long count = w->region_count;
+  atlas_clamp_into_rows(w->region, w->region_count, p);
+}
+
+void atlas_clamp_into_rows(const double *region, long count, double p[2]) {
   if (count == 0) return;
   if (count < 3) {
     p[0] = region[0];

@@ -40,6 +40,10 @@ enum { WB_GAIN_MASS = 0, WB_GAIN_CAPTURE, WB_GAIN_HEIGHT_KP, WB_GAIN_HEIGHT_KD,
        WB_GAIN_ORIENTATION_KP, WB_GAIN_ORIENTATION_KD, WB_GAIN_GRAVITY };
 enum { WB_OUT_COP = 0, WB_OUT_FORCE = 2, WB_OUT_MOMENT = 5 };
 
+/* support.Region.clamp over `count` region rows (vertex x, y, then the inward normal x, y
+ * and offset of its edge to the next vertex; 0 rows: `p` kept, 1 or 2: the first vertex):
+ * `p` if inside, else the region's nearest point. */
+void atlas_clamp_into_rows(const double *region, long count, double p[2]);
 void atlas_whole_body(const AtlasWholeBody *w);
 void atlas_stand_tick(const AtlasWholeBody *w);
 

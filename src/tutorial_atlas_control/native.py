@@ -128,7 +128,9 @@ class AtlasLegs(ctypes.Structure):
                 ('mass_matrix', ctypes.c_void_p), ('out', ctypes.c_void_p),
                 ('reach', ctypes.c_double * 2), ('stance', ctypes.c_long),
                 ('leg_start', ctypes.c_long), ('leg_dofs', ctypes.c_long * 6),
-                ('sole_velocities_at', ctypes.c_long)]
+                ('sole_velocities_at', ctypes.c_long), ('row', ctypes.c_void_p),
+                ('half_size', ctypes.c_double * 2), ('margin_m', ctypes.c_double),
+                ('carrying', ctypes.c_long * 2)]
 
 
 #: Every struct Python lays out for the library, by its C name: the library must export
@@ -217,8 +219,10 @@ def _declare(library: ctypes.CDLL) -> None:
         function = getattr(library, name)
         function.argtypes = [ctypes.POINTER(AtlasSwing)]
         function.restype = None
-    library.atlas_legs_swing_tick.argtypes = [ctypes.POINTER(AtlasLegs)]
-    library.atlas_legs_swing_tick.restype = None
+    for name in ('atlas_legs_swing_tick', 'atlas_legs_support_clamp'):
+        function = getattr(library, name)
+        function.argtypes = [ctypes.POINTER(AtlasLegs)]
+        function.restype = None
 
 
 _library: ctypes.CDLL | None = None

@@ -38,11 +38,13 @@ LEG = 6
 
 class CompiledLegs:
     """atlas_legs_swing_tick over a whole-body call and a swing servo, with the stance sole's
-    `reach_m` (along, across) and the legs' first joints; its buffers its own."""
+    `reach_m` (along, across) and the legs' first joints; atlas_legs_support_clamp with the
+    soles' half size and the support region's margin (m); its buffers its own."""
 
     def __init__(self, library: ctypes.CDLL, whole_body: CompiledWholeBody,
                  swing: CompiledSwing, reach_m: tuple[float, float],
-                 leg_starts: tuple[int, int]) -> None:
+                 leg_starts: tuple[int, int], sole_half_size_m: tuple[float, float],
+                 margin_m: float) -> None:
         self._library = library
         self._whole_body = whole_body
         self._swing = swing
@@ -56,6 +58,8 @@ class CompiledLegs:
         call.out = address(self._out, np.float64)
         call.reach[:] = reach_m
         call.sole_velocities_at = row_offsets(joints)['sole_velocities']
+        call.half_size[:] = sole_half_size_m
+        call.margin_m = margin_m
         self._pointer = ctypes.byref(call)
         #: The scratch data whose mass matrix was last read (None: not yet), its dofs.
         self._scratch: tuple[int, int] | None = None
@@ -104,3 +108,16 @@ class CompiledLegs:
         self._library.atlas_legs_swing_tick(self._pointer)
         out = self._out
         return out[:self._joints].copy(), out[self._joints:].copy()
+
+    def support_clamp(self, state: BalanceState, carrying: tuple[bool, bool],
+                      cop: np.ndarray) -> np.ndarray:
+        """`cop` clamped into the hull of the `carrying` soles shrunk by the margin (the
+        Python: clamp_into(convex_hull(their box_corners)), a new array; a compiled
+        estimate's state only."""
+        call = self._call
+        call.row = state.row_address
+        call.carrying[:] = carrying
+        out = self._out
+        out[self._joints:] = cop
+        self._library.atlas_legs_support_clamp(self._pointer)
+        return out[self._joints:].copy()

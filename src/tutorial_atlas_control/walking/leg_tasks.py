@@ -151,7 +151,8 @@ class LegTasks:
         self._legs_kernel = (
             None if legs_library is None or whole_body is None or self._kernel is None
             else CompiledLegs(legs_library, whole_body, self._kernel, self.sole_reach_m,
-                              (LEG_OF_FOOT[0].start, LEG_OF_FOOT[1].start)))
+                              (LEG_OF_FOOT[0].start, LEG_OF_FOOT[1].start),
+                              stand.sole_half_size_m, stand.gains.cop_margin_m))
 
     @property
     def compiled(self) -> bool:
@@ -286,12 +287,7 @@ class LegTasks:
             cop = _clamp_to_sole(state, 1 - swing_foot, self.sole_reach_m, cop)
         else:  # swaying, moving the weight, catching: the feet that are down (both, unless late)
             contact = state.in_contact if any(state.in_contact) else (True, True)
-            half_length, half_width = stand.sole_half_size_m
-            corners = np.concatenate([
-                box_corners(state.sole_centres[foot], state.sole_rotations[foot],
-                            (half_length, half_width, 0.0))[:, 0:2]
-                for foot in (0, 1) if contact[foot]])
-            cop = clamp_into(convex_hull(corners), cop, stand.gains.cop_margin_m)
+            cop = self._support_clamp(state, contact, cop)
         torsion = self.gains.torsion_m if swing_foot is not None else None
         torque = stand.whole_body(state, cop, contact, joint_positions, joint_velocities,
                                   self._joint_gains, torsion, self.reference,
@@ -317,6 +313,21 @@ class LegTasks:
             (joint_positions, joint_velocities), self._joint_gains, self.reference,
             self._moved_reference(time_s), cop, swing)
         return torque, cop, contact
+
+    def _support_clamp(self, state: BalanceState, contact: tuple[bool, bool],
+                       cop: np.ndarray) -> np.ndarray:
+        """`cop` kept in the hull of the soles in `contact` shrunk by the margin (one C call
+        on a compiled estimate's state)."""
+        legs = self._legs_kernel
+        if legs is not None and state.row_address is not None:
+            return legs.support_clamp(state, contact, cop)
+        stand = self.stand
+        half_length, half_width = stand.sole_half_size_m
+        corners = np.concatenate([
+            box_corners(state.sole_centres[foot], state.sole_rotations[foot],
+                        (half_length, half_width, 0.0))[:, 0:2]
+            for foot in (0, 1) if contact[foot]])
+        return clamp_into(convex_hull(corners), cop, stand.gains.cop_margin_m)
 
     def finish(self, state: BalanceState, joint_velocities: np.ndarray, torque: np.ndarray,
                contact: tuple[bool, bool], swing: tuple[int, SwingPath, float] | None,

@@ -2,7 +2,9 @@
 with the same tick by LegTasks.torque and finish in Python (every part's Python: whole body,
 statics, swing servo) and by the compiled pieces called from Python: every swing tick of a
 two-step walk, and at states of that walk, random pressure centres, paths and times (before,
-inside and after a path, either foot swinging, far outside the stance sole)."""
+inside and after a path, either foot swinging, far outside the stance sole). So does the
+pressure centre kept in the carrying soles' hull with no foot swinging (one C call): every
+such tick of the walk, and random pressure centres on one sole or both."""
 
 from __future__ import annotations
 
@@ -26,6 +28,7 @@ TOLERANCE = 1e-9
 #: Random cases tried at every this many swing ticks.
 EVERY_TICKS = 40
 SWING_TICK = LegTasks.swing_tick
+TORQUE = LegTasks.torque
 Tick = tuple[np.ndarray, np.ndarray, tuple[bool, bool]]
 
 
@@ -103,10 +106,38 @@ def test_the_one_call_agrees_with_the_pieces_and_python_through_a_walk(
             tried.extend(_random_cases(self, state, positions, velocities, time_s, rng))
         return ours
 
+    def both_feet(self: LegTasks, state: BalanceState, positions: np.ndarray,
+                  velocities: np.ndarray, time_s: float, cop: np.ndarray,
+                  swing_foot: int | None) -> Tick:
+        ours = TORQUE(self, state, positions, velocities, time_s, cop, swing_foot)
+        if swing_foot is not None:  # the pieces of a swinging tick, compared above
+            return ours
+        for python in (False, True):
+            restore = _set_aside(self, python)
+            try:
+                theirs = TORQUE(self, state, positions, velocities, time_s, cop, None)
+            finally:
+                restore()
+            supported.append(_difference(ours, theirs))
+        for case in range(2 if len(supported) % 50 == 0 else 0):
+            carrying = ((True, True), (True, False), (False, True))[case + len(supported) % 2]
+            far = state.sole_centres[:, 0:2].mean(axis=0) + rng.normal(0.0, 0.2, 2)
+            ours_far = self._support_clamp(state, carrying, far)
+            restore = _set_aside(self, True)
+            try:
+                tried.append(float(np.max(np.abs(
+                    ours_far - self._support_clamp(state, carrying, far)))))
+            finally:
+                restore()
+        return ours
+
+    supported: list[float] = []
     monkeypatch.setattr(LegTasks, 'swing_tick', both)
+    monkeypatch.setattr(LegTasks, 'torque', both_feet)
     trial = walk_trial(straight_steps(2, 0.25), SETTLE_S + 0.6 + 2 * 0.63 + 0.2)
     assert not trial.fell and trial.steps == 2
-    assert len(walked) > 1500 and len(tried) > 200
+    assert len(walked) > 1500 and len(tried) > 200 and len(supported) > 1000
+    assert max(supported) < TOLERANCE
     assert max(largest) > 20.0  # the legs' torques, not zeros compared
     assert max(walked) < TOLERANCE
     assert max(tried) < TOLERANCE
