@@ -65,7 +65,17 @@ class CompiledLegs:
         self._scratch: tuple[int, int] | None = None
         self._mass_matrix = np.zeros(0)
         self._dof_adr: np.ndarray | None = None
-        self._path: SwingPath | None = None
+        #: The swinging foot the call's leg is set for (None: none yet).
+        self._foot: int | None = None
+
+    def _set_foot(self, foot: int) -> None:
+        """The swinging foot: its leg's joints and dofs, the other sole the stance."""
+        call = self._call
+        call.stance = 1 - foot
+        start = call.leg_start = self._leg_starts[foot]
+        assert self._dof_adr is not None  # bound first
+        call.leg_dofs[:] = self._dof_adr[start:start + LEG].tolist()
+        self._foot = foot
 
     def _bind(self, state: BalanceState) -> None:
         """The estimator's model and scratch data the state came from (its mass matrix)."""
@@ -79,6 +89,7 @@ class CompiledLegs:
         call.mass_matrix = address(self._mass_matrix, np.float64)
         self._dof_adr = dof_adr
         self._scratch = (model, data)
+        self._foot = None  # the leg's dofs set again, from these
 
     def swing_tick(self, state: BalanceState, contacts: tuple[ContactConstraint,
                                                               ContactConstraint],
@@ -93,17 +104,12 @@ class CompiledLegs:
         if source is None or self._scratch != source[0:2]:
             self._bind(state)
         foot, path, elapsed_s = swing
-        call = self._call
-        call.stance = 1 - foot
-        start = call.leg_start = self._leg_starts[foot]
-        assert self._dof_adr is not None  # bound above
-        call.leg_dofs[:] = self._dof_adr[start:start + LEG].tolist()
+        if foot != self._foot:
+            self._set_foot(foot)
         self._whole_body.load(state, contacts, joints[0], joints[1], joint_gains, reference,
                               moved)
         self._whole_body.set_cop(cop)
-        if path is not self._path:
-            self._swing.set_path(path)
-            self._path = path
+        self._swing.set_path(path)
         self._swing.prepare_swing(elapsed_s)
         self._library.atlas_legs_swing_tick(self._pointer)
         out = self._out
