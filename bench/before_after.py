@@ -3,13 +3,14 @@
 figure (process time) beside a bare mj_step timed in the same round (not a `make bench`
 section: a decision's figures, run by hand).
 
-    python3 bench/before_after.py --ref main --library OLD.so [--rounds 9] [--pairs 3]
+    python3 bench/before_after.py --ref main --library OLD.so [--rounds 9] [--pairs 3] [--loop]
 
 --library: the library built from that revision's sources (e.g. the main checkout's
 devel/lib/libtutorial_atlas_control_law.so, copied before it is rebuilt); this tree's comes
 from the environment as usual. Figures: one estimate (four states, as estimator_cost.py's;
 its sole contacts and support polygon asked for), the balancing Stand's tick (stand_run's,
-process time) and Walk's (walk_trial of 6 steps, CPU). Prints the medians, their ratios to
+process time) and Walk's (walk_trial of 6 steps, CPU); with --loop the whole offline walk's
+CPU per simulated step too. Prints the medians, their ratios to
 mj_step and after/before per pair, and the load (`uptime`) before and after.
 """
 
@@ -99,6 +100,20 @@ def walk_us(package: str, steps: int = 6) -> float:
     return trial.cost_per_step_us
 
 
+def walk_loop_us(package: str, steps: int = 6) -> float:
+    """The whole offline walk's CPU µs per simulated step (offline.walk_run's trial: set-up,
+    physics, controller and the trial's bookkeeping): over a bare mj_step, the
+    walk_offline_bare_ratio of the same trial."""
+    walking, trial_module = _module(package, 'walking'), _module(package, 'walking.walk_trial')
+    sim_s = trial_module.SETTLE_S + 0.6 + steps * 0.63 + 0.8
+    start = time.process_time()
+    trial = trial_module.walk_trial(walking.straight_steps(steps, 0.25), sim_s)
+    spent = time.process_time() - start
+    if trial.fell or trial.steps != steps:
+        raise SystemExit(f'{package}: the walk fell or took {trial.steps} of {steps} steps')
+    return spent / round(sim_s / 0.001) * 1e6
+
+
 def compare(name: str, measure: Callable[[str], float], rounds: int, bare: BareStep) -> None:
     """`rounds` interleaved pairs of `measure`, each round beside a bare mj_step."""
     figures: dict[str, list[float]] = {BEFORE: [], AFTER: []}
@@ -124,6 +139,8 @@ def main() -> None:
                         help="the library built from that revision's sources")
     parser.add_argument('--rounds', type=int, default=9, help='estimate rounds')
     parser.add_argument('--pairs', type=int, default=3, help='Stand and Walk rounds')
+    parser.add_argument('--loop', action='store_true',
+                        help="also the whole offline walk's CPU per simulated step")
     args = parser.parse_args()
     if not args.library.is_file():
         raise SystemExit(f'before_after.py: --library {args.library}: no such file')
@@ -137,6 +154,9 @@ def main() -> None:
         compare('estimate', estimate_us, args.rounds, bare)
         compare('Stand µs/tick (torque(), process time)', stand_us, args.pairs, bare)
         compare('Walk µs/tick (walk_trial, 6 steps, CPU)', walk_us, args.pairs, bare)
+        if args.loop:
+            compare('offline walk µs/step (walk_trial, 6 steps, whole CPU)', walk_loop_us,
+                    args.pairs, bare)
         print('load after:', subprocess.run(uptime, capture_output=True, text=True).stdout.strip())
 
 

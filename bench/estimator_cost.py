@@ -8,9 +8,10 @@ in one process, each figure (process time) beside a bare mj_step timed in the sa
 
 The estimator is chosen at its construction by TAC_ESTIMATOR, inverse statics by
 TAC_STATICS, Walk's swing servo by TAC_SWING, the whole-body tick around the statics by
-TAC_WHOLE_BODY (`python`, else compiled); the runs compare all in Python, the estimator
-compiled, the estimator and statics compiled, all but the whole-body tick compiled, and all
-four compiled (--kinds picks some); with --ticks, StandController.tick alone on a Stand
+TAC_WHOLE_BODY, Walk's one call around the last two by TAC_LEGS (`python`, else compiled);
+the runs compare all in Python, the estimator compiled, the estimator and statics compiled,
+all but the whole-body tick compiled, all but the one call, and all compiled (--kinds picks
+some); with --ticks, StandController.tick alone on a Stand
 run's recorded inputs too. Each round alternates which goes first. Prints the
 medians, their ratios to mj_step and to Python's in each pair, and the load (`uptime`)
 before and after.
@@ -38,15 +39,17 @@ from tutorial_atlas_control.balance import (
 from tutorial_atlas_control.sim import model as atlas_model
 
 KINDS = ('python', 'compiled')
-#: The variables that switch the estimator, inverse statics, the swing servo and the
-#: whole-body tick to Python.
-SWITCHES = ESTIMATOR, STATICS, SWING, WHOLE_BODY = python_reference_switches()
+#: The variables that switch the estimator, inverse statics, the swing servo, the
+#: whole-body tick and Walk's one call around the last two to Python.
+SWITCHES = ESTIMATOR, STATICS, SWING, WHOLE_BODY, LEGS = python_reference_switches()
 #: The runs' kinds: the parts each runs in Python (all; all but the estimator; the swing
-#: servo and the whole-body tick; the whole-body tick; none).
+#: servo and the whole-body tick; the whole-body tick; Walk's one call around the pieces;
+#: none).
 RUN_KINDS = {'python': dict.fromkeys(SWITCHES, 'python'),
-             'estimator': dict.fromkeys((STATICS, SWING, WHOLE_BODY), 'python'),
-             'statics': dict.fromkeys((SWING, WHOLE_BODY), 'python'),
-             'swing': {WHOLE_BODY: 'python'}, 'compiled': {}}
+             'estimator': dict.fromkeys((STATICS, SWING, WHOLE_BODY, LEGS), 'python'),
+             'statics': dict.fromkeys((SWING, WHOLE_BODY, LEGS), 'python'),
+             'swing': dict.fromkeys((WHOLE_BODY, LEGS), 'python'),
+             'legs': {LEGS: 'python'}, 'compiled': {}}
 
 
 class BareStep:

@@ -82,7 +82,7 @@ build_workspace() {
   ln -sfn "$repo_dir/msg/atlas_msgs" "$TAC_WS/src/atlas_msgs"
   local stamp="$TAC_WS/.build-inputs.sha1" want
   want=$( (cd "$repo_dir" && cat CMakeLists.txt package.xml setup.py requirements.txt msg/*/CMakeLists.txt \
-            msg/*/package.xml msg/*/msg/*.msg src/*.c src/*.cpp test/rostest/*.cpp; ls scripts sim rviz test/rostest 2>/dev/null) | sha1sum | cut -d' ' -f1)
+            msg/*/package.xml msg/*/msg/*.msg src/*.c src/*.h src/*.cpp test/rostest/*.cpp; ls scripts sim rviz test/rostest 2>/dev/null) | sha1sum | cut -d' ' -f1)
   if [ -f "$TAC_WS/devel/setup.bash" ] && [ "$(cat "$stamp" 2>/dev/null)" = "$want" ]; then
     log "catkin workspace up to date ($TAC_WS)"; return
   fi

@@ -1,6 +1,6 @@
 """The package's compiled library (src/atlas_law.c, src/atlas_gather.c,
-src/atlas_estimator.c, src/atlas_statics.c, src/atlas_whole_body.c, src/atlas_swing.c):
-found, loaded, checked.
+src/atlas_estimator.c, src/atlas_statics.c, src/atlas_whole_body.c, src/atlas_swing.c,
+src/atlas_legs.c): found, loaded, checked.
 
 One place knows the library's binary interface: the ctypes mirrors of its structs, the
 signatures of its functions, and where catkin puts it (a devel space's lib/ and an
@@ -8,8 +8,9 @@ install space's lib/ are both on CMAKE_PREFIX_PATH once their setup.bash is sour
 Its users, the compiled law (sim/law_kernel.py), the messages' copies
 (sim/copy_plan.py), the balance estimator (balance/compiled_estimator.py), the
 whole-body layer's inverse statics (balance/compiled_statics.py), Stand's whole-body tick
-around them (balance/compiled_whole_body.py) and the swing foot's
-servo (walking/compiled_swing.py), ask here.
+around them (balance/compiled_whole_body.py), the swing foot's
+servo (walking/compiled_swing.py) and Walk's single-support tick of the legs around both
+(walking/compiled_legs.py), ask here.
 The estimator's part calls MuJoCo: the library is linked against the Python wheel's
 libmujoco, the one `import mujoco` loads, so that one MuJoCo runs in the process.
 
@@ -32,7 +33,7 @@ import numpy as np
 from tutorial_atlas_control.command import LAW_FIELDS
 
 __all__ = ['LIBRARY_ENV', 'LIBRARY_NAME', 'MIRRORED_STRUCTS', 'AtlasCopy', 'AtlasEstimator',
-           'AtlasLawStep', 'AtlasStatics', 'AtlasSwing', 'AtlasWholeBody', 'address',
+           'AtlasLawStep', 'AtlasLegs', 'AtlasStatics', 'AtlasSwing', 'AtlasWholeBody', 'address',
            'chosen_library', 'find_library', 'load_library', 'size_mismatches']
 
 #: The shared library CMakeLists.txt builds (devel/lib, installed to the prefix's lib/).
@@ -119,6 +120,19 @@ class AtlasSwing(ctypes.Structure):
                 ('feedforward', ctypes.c_long)]
 
 
+class AtlasLegs(ctypes.Structure):
+    """AtlasLegs in src/atlas_legs.c (same fields, same order)."""
+
+    _fields_ = [('whole_body', ctypes.c_void_p), ('swing', ctypes.c_void_p),
+                ('model', ctypes.c_void_p), ('data', ctypes.c_void_p),
+                ('mass_matrix', ctypes.c_void_p), ('out', ctypes.c_void_p),
+                ('reach', ctypes.c_double * 2), ('stance', ctypes.c_long),
+                ('leg_start', ctypes.c_long), ('leg_dofs', ctypes.c_long * 6),
+                ('sole_velocities_at', ctypes.c_long), ('row', ctypes.c_void_p),
+                ('half_size', ctypes.c_double * 2), ('margin_m', ctypes.c_double),
+                ('carrying', ctypes.c_long * 2)]
+
+
 #: Every struct Python lays out for the library, by its C name: the library must export
 #: SIZEOF_PREFIX + name, returning the same size as the mirror's.
 MIRRORED_STRUCTS: dict[str, type[ctypes.Structure]] = {
@@ -128,6 +142,7 @@ MIRRORED_STRUCTS: dict[str, type[ctypes.Structure]] = {
     'AtlasStatics': AtlasStatics,
     'AtlasSwing': AtlasSwing,
     'AtlasWholeBody': AtlasWholeBody,
+    'AtlasLegs': AtlasLegs,
 }
 
 
@@ -203,6 +218,10 @@ def _declare(library: ctypes.CDLL) -> None:
     for name in ('atlas_foot_servo', 'atlas_swing_torque'):
         function = getattr(library, name)
         function.argtypes = [ctypes.POINTER(AtlasSwing)]
+        function.restype = None
+    for name in ('atlas_legs_swing_tick', 'atlas_legs_support_clamp'):
+        function = getattr(library, name)
+        function.argtypes = [ctypes.POINTER(AtlasLegs)]
         function.restype = None
 
 

@@ -20,8 +20,9 @@ from tutorial_atlas_control.sim.simulator import AtlasSimulator
 REPO = Path(__file__).resolve().parents[2]
 C_SOURCES = (REPO / 'src' / 'atlas_law.c', REPO / 'src' / 'atlas_gather.c',
              REPO / 'src' / 'atlas_estimator.c', REPO / 'src' / 'atlas_statics.h',
-             REPO / 'src' / 'atlas_statics.c', REPO / 'src' / 'atlas_swing.c',
-             REPO / 'src' / 'atlas_whole_body.c')
+             REPO / 'src' / 'atlas_statics.c', REPO / 'src' / 'atlas_swing.h',
+             REPO / 'src' / 'atlas_swing.c', REPO / 'src' / 'atlas_whole_body.h',
+             REPO / 'src' / 'atlas_whole_body.c', REPO / 'src' / 'atlas_legs.c')
 CONFIG = REPO / 'config' / 'atlas_controller.yaml'
 #: A C struct Python may lay out: `typedef struct { ... } Name;`.
 C_TYPEDEF_STRUCT = re.compile(r'typedef struct \{.*?\} (\w+);', re.S)
@@ -39,7 +40,8 @@ def test_every_struct_of_the_c_sources_is_mirrored() -> None:
                  for name in C_TYPEDEF_STRUCT.findall(source.read_text())}
     assert c_structs == set(native.MIRRORED_STRUCTS) == {'AtlasLawStep', 'AtlasCopy',
                                                          'AtlasEstimator', 'AtlasStatics',
-                                                         'AtlasSwing', 'AtlasWholeBody'}
+                                                         'AtlasSwing', 'AtlasWholeBody',
+                                                         'AtlasLegs'}
     for name, mirror in native.MIRRORED_STRUCTS.items():
         assert mirror.__name__ == name
 
@@ -94,7 +96,8 @@ def test_a_library_without_size_functions_is_refused(
                                             r'tac_sizeof_AtlasEstimator\(\); no '
                                             r'tac_sizeof_AtlasStatics\(\); no '
                                             r'tac_sizeof_AtlasSwing\(\); no '
-                                            r'tac_sizeof_AtlasWholeBody\(\)\); rebuild'):
+                                            r'tac_sizeof_AtlasWholeBody\(\); no '
+                                            r'tac_sizeof_AtlasLegs\(\)\); rebuild'):
         assert native.load_library() is None
 
 

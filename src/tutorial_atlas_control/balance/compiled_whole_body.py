@@ -18,6 +18,7 @@ agree to rounding
 from __future__ import annotations
 
 import ctypes
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -29,7 +30,7 @@ from tutorial_atlas_control.native import AtlasWholeBody, address
 if TYPE_CHECKING:
     from tutorial_atlas_control.balance.compiled_statics import CompiledStatics
     from tutorial_atlas_control.balance.estimator import BalanceState
-    from tutorial_atlas_control.balance.stand import StandGains, StandReference
+    from tutorial_atlas_control.balance.stand import MovedReference, StandGains, StandReference
     from tutorial_atlas_control.balance.support import Region
     from tutorial_atlas_control.balance.whole_body import ContactConstraint
 
@@ -76,6 +77,8 @@ class CompiledWholeBody:
         self._pelvis_angular = buffer[17:20]
         self._joints = buffer[IN_FIXED:].reshape(2, joints)
         self._last_reference: StandReference | None = None
+        #: The heading, height and rate written over the last reference's (None: its own).
+        self._last_moved: MovedReference | None = None
         self._last_gains: tuple[np.ndarray, np.ndarray] | None = None
         self._last_region: Region | None | bool = False
         call = self._call = AtlasWholeBody()
@@ -101,6 +104,16 @@ class CompiledWholeBody:
         buffer[REFERENCE_FIXED:REFERENCE_FIXED + joints] = reference.posture_rad
         buffer[REFERENCE_FIXED + joints:] = reference.posture_rate_rad_s
         self._last_reference = reference
+        self._last_moved = None
+
+    def _move_reference(self, moved: MovedReference) -> None:
+        """The reference's pelvis frame (upright, stand.yaw_rotation's numbers), CoM height
+        and rate replaced in the buffer: stand.moved_reference without a new reference."""
+        yaw_rad, height_m, rate_m_s = moved
+        c, s = math.cos(yaw_rad), math.sin(yaw_rad)
+        buffer = self._reference
+        buffer[2:13] = (height_m, rate_m_s, c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
+        self._last_moved = moved
 
     def _set_region(self, region: Region | None) -> None:
         """The region's vertices and edge lines (none: the pressure centre is not clamped)."""
@@ -127,17 +140,38 @@ class CompiledWholeBody:
         self._pelvis_rotation[:] = state.pelvis_rotation
         self._pelvis_angular[:] = state.pelvis_angular_velocity
 
-    def _load(self, state: BalanceState, contacts: tuple[ContactConstraint, ContactConstraint],
+    @property
+    def joints(self) -> int:
+        """How many joints the call's torques hold."""
+        return len(self._effort_limit)
+
+    @property
+    def address(self) -> int:
+        """The call's struct, for a call that runs the whole body itself (Walk's legs)."""
+        return ctypes.addressof(self._call)
+
+    def set_cop(self, cop: np.ndarray) -> None:
+        """The pressure centre atlas_whole_body solves at."""
+        self._cop[:] = cop
+
+    def load(self, state: BalanceState, contacts: tuple[ContactConstraint, ContactConstraint],
               joint_positions: np.ndarray, joint_velocities: np.ndarray,
-              joint_gains: tuple[np.ndarray, np.ndarray], reference: StandReference) -> None:
+              joint_gains: tuple[np.ndarray, np.ndarray], reference: StandReference,
+              moved: MovedReference | None = None) -> None:
+        """This tick's input: the state (read in place from a compiled estimate's row, else
+        copied), the contacts, the reference (`moved`: its heading, height and rate
+        replaced) and joint gains when they changed, the joints."""
         row = state.row_address
         self._call.row = row
         if row is None:
             self._load_state(state, contacts)
         else:
             self._statics.load_contacts(contacts)
-        if reference is not self._last_reference:
+        if reference is not self._last_reference or (moved is None
+                                                     and self._last_moved is not None):
             self._set_reference(reference)
+        if moved is not None and moved != self._last_moved:
+            self._move_reference(moved)
         if joint_gains is not self._last_gains:
             joints = len(self._effort_limit)
             self._joint_gains[:joints] = joint_gains[0]
@@ -157,7 +191,7 @@ class CompiledWholeBody:
              joint_gains: tuple[np.ndarray, np.ndarray], reference: StandReference) -> Tick:
         """StandController.tick's numbers: the pressure centre by the capture-point law
         clamped into `region` (None: not clamped), the torques within the effort limits."""
-        self._load(state, contacts, joint_positions, joint_velocities, joint_gains, reference)
+        self.load(state, contacts, joint_positions, joint_velocities, joint_gains, reference)
         if region is not self._last_region:
             self._set_region(region)
         self._library.atlas_stand_tick(self._pointer)
@@ -167,10 +201,11 @@ class CompiledWholeBody:
                    contacts: tuple[ContactConstraint, ContactConstraint],
                    joint_positions: np.ndarray, joint_velocities: np.ndarray,
                    joint_gains: tuple[np.ndarray, np.ndarray],
-                   reference: StandReference) -> Tick:
+                   reference: StandReference, moved: MovedReference | None = None) -> Tick:
         """StandController.whole_body's numbers at the pressure centre `cop`, not clamped
-        to the effort limits."""
-        self._load(state, contacts, joint_positions, joint_velocities, joint_gains, reference)
-        self._cop[:] = cop
+        to the effort limits (`moved`: the reference's heading, height and rate replaced)."""
+        self.load(state, contacts, joint_positions, joint_velocities, joint_gains, reference,
+                   moved)
+        self.set_cop(cop)
         self._library.atlas_whole_body(self._pointer)
         return self._results()

@@ -160,6 +160,10 @@ class BalanceState:
     #: whole-body tick reads in place: set in the instance by the compiled estimate only, not
     #: a field (so a state from __init__ or dataclasses.replace has None: its fields copied).
     row_address: ClassVar[int | None] = None
+    #: The compiled estimate's model and scratch data (their addresses), nv and each joint's
+    #: dof (tutorial order): the mass matrix of this state, which Walk's compiled legs read
+    #: (mj_crb) before the next estimate; set as row_address is (None: not compiled).
+    mass_matrix_source: ClassVar[tuple[int, int, int, np.ndarray] | None] = None
 
     @_Cached
     def sole_contacts(self) -> tuple[SoleContacts, SoleContacts]:
@@ -235,6 +239,8 @@ class BalanceEstimator:
         #: Each joint slice's dof indices: a slice where they run on (a leg's do), else
         #: an index array.
         self._inertia_index: dict[tuple[int, int], tuple[slice, slice] | tuple] = {}
+        self._mass_matrix_source = (self.model._address, self.scratch._address,
+                                    int(self.model.nv), np.asarray(self._dof_adr, dtype=np.intp))
         library = native.chosen_library(ESTIMATOR_ENV, compiled)
         self._kernel = None if library is None else CompiledEstimate(
             library, self.model, self.scratch, EstimatorGeometry(
@@ -369,7 +375,8 @@ class BalanceEstimator:
             omega=scalars[2], capture_point=capture_point, bias_nm=block.bias[tick],
             sole_jacobians=block.jacobians[tick], sole_velocities=sole_velocities,
             joint_inertia=self._inertia_of, polygon_of=polygon_of,
-            contacts_of=lambda: _contacts_of_raw(raw), row_address=raw.address)
+            contacts_of=lambda: _contacts_of_raw(raw), row_address=raw.address,
+            mass_matrix_source=self._mass_matrix_source)
         return state
 
     def _estimate_in_python(self, qpos: np.ndarray, qvel: np.ndarray) -> BalanceState:

@@ -77,9 +77,15 @@ def dcm_feedback_cop(xi: np.ndarray, xi_ref: np.ndarray, gain: float,
     at rest (p_ref = xi_ref, the default: p = xi + gain (xi - xi_ref)); the walk's moves
     with its plan's pressure centre `cop_ref`.
     """
-    xi_ref = np.asarray(xi_ref)
-    reference = xi_ref if cop_ref is None else np.asarray(cop_ref)
-    return reference + (1.0 + gain) * (np.asarray(xi) - xi_ref)
+    (x, y), (x_ref, y_ref) = _plane(xi), _plane(xi_ref)
+    p_x, p_y = (x_ref, y_ref) if cop_ref is None else _plane(cop_ref)
+    factor = 1.0 + gain  # numpy's elementwise arithmetic in plain floats: every 1 ms tick
+    return np.array([p_x + factor * (x - x_ref), p_y + factor * (y - y_ref)])
+
+
+def _plane(point: np.ndarray) -> list[float]:
+    """A point in the plane as two floats."""
+    return np.asarray(point, dtype=np.float64).tolist()
 
 
 def com_acceleration(com_xy: np.ndarray, cop_xy: np.ndarray, omega: float) -> np.ndarray:

@@ -25,7 +25,7 @@ no library).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -46,9 +46,10 @@ from tutorial_atlas_control.balance.whole_body import (
     orientation_error,
 )
 
-__all__ = ['STAND_JOINT_KD', 'STAND_JOINT_KP', 'WHOLE_BODY_ENV', 'StandController', 'StandGains',
-           'StandOutput', 'StandReference', 'orientation_error', 'pelvis_frame', 'pitch_of',
-           'yaw_of', 'yaw_rotation']
+__all__ = ['STAND_JOINT_KD', 'STAND_JOINT_KP', 'WHOLE_BODY_ENV', 'MovedReference',
+           'StandController', 'StandGains', 'StandOutput', 'StandReference',
+           'moved_reference', 'orientation_error', 'pelvis_frame', 'pitch_of', 'yaw_of',
+           'yaw_rotation']
 
 #: Set to `python` for the whole-body tick in Python even where the compiled library is built.
 WHOLE_BODY_ENV = 'TAC_WHOLE_BODY'
@@ -136,6 +137,19 @@ def yaw_rotation(yaw_rad: float) -> np.ndarray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
+#: A reference's pelvis heading (rad), CoM height (m) and its rate (m/s) moved on: Walk's
+#: and Step's legs move these every tick, the rest of the Stand's reference stays.
+MovedReference = tuple[float, float, float]
+
+
+def moved_reference(reference: StandReference, moved: MovedReference) -> StandReference:
+    """`reference` with its pelvis frame turned upright to `moved`'s heading and its CoM
+    height and rate replaced (a new reference: the package never writes into one)."""
+    yaw_rad, height_m, rate_m_s = moved
+    return replace(reference, pelvis_rotation=yaw_rotation(yaw_rad), com_height_m=height_m,
+                   com_height_rate_m_s=rate_m_s)
+
+
 def pitch_of(rotation: np.ndarray) -> float:
     """The pitch (rad, + leaning forward) of a frame's x axis below the horizontal."""
     return float(np.arctan2(-rotation[2, 0], np.hypot(rotation[0, 0], rotation[1, 0])))
@@ -186,6 +200,11 @@ class StandController:
         """Whether the tick runs the C call."""
         return self._kernel is not None
 
+    @property
+    def compiled_whole_body(self) -> CompiledWholeBody | None:
+        """The C call (None: the Python tick), for Walk's legs' own call around it."""
+        return self._kernel
+
     def support_region(self, state: BalanceState) -> support.Region | None:
         """The support polygon shrunk by the margin (None: no polygon to keep to)."""
         polygon = state.support_polygon
@@ -225,7 +244,7 @@ class StandController:
         """The 28 joint torques (N m) for this tick, clamped to the effort limits."""
         if self._kernel is not None:
             return StandOutput(*self._kernel.tick(
-                state, self.support_region(state), self._contacts_for(state.in_contact, None),
+                state, self.support_region(state), self.contacts_for(state.in_contact, None),
                 joint_positions, joint_velocities, self._joint_gains, self.reference))
         output = self.whole_body(state, self.desired_cop(state), state.in_contact,
                                  joint_positions, joint_velocities)
@@ -243,26 +262,32 @@ class StandController:
             self._contacts[key] = made
         return made
 
-    def _contacts_for(self, contact: tuple[bool, bool],
-                      torsion_m: float | None) -> tuple[ContactConstraint, ContactConstraint]:
+    def contacts_for(self, contact: tuple[bool, bool],
+                     torsion_m: float | None) -> tuple[ContactConstraint, ContactConstraint]:
+        """Both soles' contact constraints: which carry, their yaw moment limited by
+        `torsion_m` (None: not)."""
         return self._contact(contact[0], torsion_m), self._contact(contact[1], torsion_m)
 
     def whole_body(self, state: BalanceState, cop: np.ndarray, contact: tuple[bool, bool],
                    joint_positions: np.ndarray, joint_velocities: np.ndarray,
                    joint_gains: tuple[np.ndarray, np.ndarray] | None = None,
                    torsion_m: float | None = None,
-                   reference: StandReference | None = None) -> StandOutput:
-        """The whole-body layer's torques for `reference` (else the Stand's own) with the
+                   reference: StandReference | None = None,
+                   moved: MovedReference | None = None) -> StandOutput:
+        """The whole-body layer's torques for `reference` (else the Stand's own; `moved`:
+        its pelvis heading, CoM height and rate replaced) with the
         pressure centre at `cop`, pressed by the soles in `contact` (`torsion_m`: their yaw
         moment limited too), plus the joint PD to the reference's posture (`joint_gains`
         (kp, kd), else the Stand's); not yet clamped to the effort limits (Walk adds its
         swing leg's first)."""
         reference = reference or self.reference
-        contacts = self._contacts_for(contact, torsion_m)
+        contacts = self.contacts_for(contact, torsion_m)
         if self._kernel is not None:
             return StandOutput(*self._kernel.whole_body(
                 state, cop, contacts, joint_positions, joint_velocities,
-                joint_gains or self._joint_gains, reference))
+                joint_gains or self._joint_gains, reference, moved))
+        if moved is not None:
+            reference = moved_reference(reference, moved)
         joint_kp, joint_kd = joint_gains or self._joint_gains
         posture = PostureTask(reference.posture_rad, reference.posture_rate_rad_s, joint_kp,
                               joint_kd)

@@ -9,8 +9,9 @@ foot must land instead; swing: the swing foot's path; phases: the one phase mach
 Walk and Step run (their phases in order, each one's end rule, the transition);
 leg_tasks: what Walk and Step do alike each tick (the whole-body law on the carrying soles,
 the swing foot, the pelvis's heading); compiled_swing: the swing foot's path and servo as
-one C call (src/atlas_swing.c); walk: the walk's phases; walk_behaviour: Walk as the
-simulator's behaviour;
+one C call (src/atlas_swing.c); compiled_legs: a swinging tick of the legs (sole clamp,
+whole body, swing servo, effort limits) as one C call (src/atlas_legs.c); walk: the walk's
+phases; walk_behaviour: Walk as the simulator's behaviour;
 route: footsteps through a route of waypoints (a course walker's plan) from where the
 feet are;
 start_noise: a trial's start perturbed by a seed; walk_trial: offline walking trials,
@@ -29,7 +30,8 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                      'WARNING_INSUFFICIENT_STEP_DATA'],
     'swing': ['SWING_HEIGHT_M'],
     'compiled_swing': ['CompiledSwing'],
-    'leg_tasks': ['SWING_ENV'],
+    'compiled_legs': ['CompiledLegs'],
+    'leg_tasks': ['LEGS_ENV', 'SWING_ENV'],
     'walk': ['WalkGains'],
     'walk_behaviour': ['WalkBehaviour', 'WalkStatus'],
     'route': ['RouteGait', 'feet_origin', 'route_steps'],

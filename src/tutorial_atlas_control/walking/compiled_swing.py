@@ -53,6 +53,31 @@ class CompiledSwing:
         self._feedforward = int(gains.swing_feedforward)
         self._world = int(gains.world_velocity)
         self._pointer = ctypes.byref(call)
+        #: The path whose numbers the input holds (None: none yet).
+        self._last_path: SwingPath | None = None
+
+    @property
+    def address(self) -> int:
+        """The call's struct, for a call that runs the servo itself (compiled_legs)."""
+        return ctypes.addressof(self._call)
+
+    def set_path(self, swing: SwingPath) -> None:
+        """The swing path's numbers into the input (unless they are there already: the
+        package makes a new path to change one)."""
+        if swing is self._last_path:
+            return
+        path = self._path
+        path[0:3] = swing.start
+        path[3:6] = swing.end
+        path[6:10] = (swing.start_yaw_rad, swing.end_yaw_rad, swing.duration_s,
+                      swing.height_m)
+        self._last_path = swing
+
+    def prepare_swing(self, elapsed_s: float) -> None:
+        """The time into the path, and the swing's servo settings."""
+        self._path[10] = elapsed_s
+        call = self._call
+        call.world, call.feedforward = self._world, self._feedforward
 
     def _load(self, state: BalanceState, joint_velocities: np.ndarray, leg: slice,
               foot: int) -> None:
@@ -72,13 +97,8 @@ class CompiledSwing:
                      foot: int, swing: SwingPath, elapsed_s: float) -> np.ndarray:
         """LegTasks.swing_torque's torques (joints,), a new array."""
         self._load(state, joint_velocities, leg, foot)
-        path = self._path
-        path[0:3] = swing.start
-        path[3:6] = swing.end
-        path[6:] = (swing.start_yaw_rad, swing.end_yaw_rad, swing.duration_s, swing.height_m,
-                    elapsed_s)
-        call = self._call
-        call.world, call.feedforward = self._world, self._feedforward
+        self.set_path(swing)
+        self.prepare_swing(elapsed_s)
         self._library.atlas_swing_torque(self._pointer)
         return self._result(leg)
 

@@ -11,6 +11,7 @@ p = p_ref + (1 + k) (xi - xi_ref), the error decaying at omega k.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -54,9 +55,12 @@ class DcmPlan:
 
     def reference(self, step: int, t_s: float) -> tuple[np.ndarray, np.ndarray]:
         """(xi_ref, p_ref) at `t_s` into step `step` (clamped to the step's duration)."""
-        t = min(max(t_s, 0.0), float(self.durations_s[step]))
+        duration = float(self.durations_s[step])
+        t = min(max(t_s, 0.0), duration)
         cop = self.cops[step]
-        xi = capture_point_after(self.ends[step], cop, self.omega,
-                                 t - float(self.durations_s[step]))
-        return xi, cop
+        # capture_point_after's elementwise arithmetic in plain floats (every 1 ms tick)
+        growth = math.exp(self.omega * (t - duration))
+        (end_x, end_y), (cop_x, cop_y) = self.ends[step].tolist(), cop.tolist()
+        return np.array([cop_x + (end_x - cop_x) * growth,
+                         cop_y + (end_y - cop_y) * growth]), cop
 

@@ -22,21 +22,23 @@ step on the hip pitch), and that shaking decided, chaotically, which walks stood
 
 The swing torque and the servo run as one C call a tick (compiled_swing) where the
 package's library is built, equal to the Python here to rounding; in Python (SWING_ENV=python,
-or no library) they compute here.
+or no library) they compute here. With a foot swinging, torque and finish together (the
+sole clamp, the whole body, the swing servo, the effort limits) are one C call around both
+(compiled_legs: swing_tick) on a compiled estimate's state, unless LEGS_ENV says `python`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
 from tutorial_atlas_control import native
 from tutorial_atlas_control.balance import (
     BalanceState,
+    MovedReference,
     StandController,
-    StandReference,
     box_corners,
     clamp_into,
     convex_hull,
@@ -46,14 +48,18 @@ from tutorial_atlas_control.balance import (
     yaw_of,
     yaw_rotation,
 )
+from tutorial_atlas_control.walking.compiled_legs import CompiledLegs
 from tutorial_atlas_control.walking.compiled_swing import CompiledSwing
 from tutorial_atlas_control.walking.footsteps import Footstep, wrap_angle
 from tutorial_atlas_control.walking.swing import SwingPath, quintic
 
-__all__ = ['LEG_JOINTS', 'SWING_ENV', 'LegGains', 'LegTasks', 'foot_pose']
+__all__ = ['LEGS_ENV', 'LEG_JOINTS', 'SWING_ENV', 'LegGains', 'LegTasks', 'foot_pose']
 
 #: Set to `python` for the swing servo in Python even where the compiled library is built.
 SWING_ENV = 'TAC_SWING'
+#: Set to `python` for a swinging tick's pieces called from Python (each compiled or not by
+#: its own switch) rather than the one call around them.
+LEGS_ENV = 'TAC_LEGS'
 
 #: The leg joints (tutorial order): their Stand posture PD is off while stepping.
 LEG_JOINTS = slice(4, 16)
@@ -137,16 +143,26 @@ class LegTasks:
         self._facing = (time_s, 1.0, yaw_of(stand.reference.pelvis_rotation), 0.0)
         #: The CoM height moving on: (start time, duration, from, change) (s, m).
         self._height = (time_s, 1.0, stand.reference.com_height_m, 0.0)
-        self._last_reference: tuple[tuple[float, float, float], StandReference,
-                                    StandReference] | None = None
         library = native.chosen_library(SWING_ENV, compiled)
         self._kernel = None if library is None else CompiledSwing(
             library, gains, len(stand.gains.joint_kp))
+        legs_library = native.chosen_library(LEGS_ENV, compiled)
+        whole_body = stand.compiled_whole_body
+        self._legs_kernel = (
+            None if legs_library is None or whole_body is None or self._kernel is None
+            else CompiledLegs(legs_library, whole_body, self._kernel, self.sole_reach_m,
+                              (LEG_OF_FOOT[0].start, LEG_OF_FOOT[1].start),
+                              stand.sole_half_size_m, stand.gains.cop_margin_m))
 
     @property
     def compiled(self) -> bool:
         """Whether the swing servo runs the C call."""
         return self._kernel is not None
+
+    @property
+    def compiled_swing_tick(self) -> bool:
+        """Whether swing_tick runs the one C call (on a compiled estimate's state)."""
+        return self._legs_kernel is not None
 
     def move_height(self, height_m: float, time_s: float, duration_s: float) -> None:
         """Take the CoM's reference height from where it is now to `height_m` over
@@ -176,19 +192,12 @@ class LegTasks:
         started_s, duration_s, start, turn = self._facing
         return start + smoothstep((time_s - started_s) / duration_s) * turn
 
-    def _moved_reference(self, time_s: float) -> StandReference:
-        """The legs' reference at `time_s`: its heading and height moved on (the same object
-        as last tick's while they stand still, as they do between a step's turn and the
-        next: a dataclass replace and a rotation a tick saved)."""
+    def _moved_reference(self, time_s: float) -> MovedReference:
+        """The legs' reference's heading, CoM height and rate at `time_s` (the rest is
+        self.reference's): the whole-body call writes them over its copy of the reference
+        (no new reference a tick, as the heading turns through every step)."""
         height, height_rate = self.height(time_s)
-        key = (self.heading(time_s), height, height_rate)
-        last = self._last_reference
-        if last is not None and last[0] == key and last[1] is self.reference:
-            return last[2]
-        moved = replace(self.reference, pelvis_rotation=yaw_rotation(key[0]),
-                        com_height_m=height, com_height_rate_m_s=height_rate)
-        self._last_reference = (key, self.reference, moved)
-        return moved
+        return self.heading(time_s), height, height_rate
 
     def swing_torque(self, state: BalanceState, joint_velocities: np.ndarray, foot: int,
                      swing: SwingPath, elapsed_s: float) -> np.ndarray:
@@ -272,22 +281,53 @@ class LegTasks:
         kept, and which soles carry. `finish` adds the swing or put-down torques; nothing
         is clipped yet."""
         stand = self.stand
-        reference = self._moved_reference(time_s)
+        moved = self._moved_reference(time_s)
         if swing_foot is not None:
             contact = (swing_foot != 0, swing_foot != 1)
             cop = _clamp_to_sole(state, 1 - swing_foot, self.sole_reach_m, cop)
         else:  # swaying, moving the weight, catching: the feet that are down (both, unless late)
             contact = state.in_contact if any(state.in_contact) else (True, True)
-            half_length, half_width = stand.sole_half_size_m
-            corners = np.concatenate([
-                box_corners(state.sole_centres[foot], state.sole_rotations[foot],
-                            (half_length, half_width, 0.0))[:, 0:2]
-                for foot in (0, 1) if contact[foot]])
-            cop = clamp_into(convex_hull(corners), cop, stand.gains.cop_margin_m)
+            cop = self._support_clamp(state, contact, cop)
         torsion = self.gains.torsion_m if swing_foot is not None else None
         torque = stand.whole_body(state, cop, contact, joint_positions, joint_velocities,
-                                  self._joint_gains, torsion, reference).torque_nm
+                                  self._joint_gains, torsion, self.reference,
+                                  moved).torque_nm
         return torque, cop, contact
+
+    def swing_tick(self, state: BalanceState, joint_positions: np.ndarray,
+                   joint_velocities: np.ndarray, time_s: float, cop: np.ndarray,
+                   swing: tuple[int, SwingPath, float]) -> tuple[np.ndarray, np.ndarray,
+                                                                 tuple[bool, bool]]:
+        """torque() then finish() with `swing` (the foot, its path and the time into it):
+        the torques within the effort limits, the pressure centre as kept, which soles
+        carry."""
+        legs = self._legs_kernel
+        if legs is None or state.row_address is None:
+            torque, cop, contact = self.torque(state, joint_positions, joint_velocities,
+                                               time_s, cop, swing[0])
+            return self.finish(state, joint_velocities, torque, contact, swing, ()), cop, contact
+        foot = swing[0]
+        contact = (foot != 0, foot != 1)
+        torque, cop = legs.swing_tick(
+            state, self.stand.contacts_for(contact, self.gains.torsion_m),
+            (joint_positions, joint_velocities), self._joint_gains, self.reference,
+            self._moved_reference(time_s), cop, swing)
+        return torque, cop, contact
+
+    def _support_clamp(self, state: BalanceState, contact: tuple[bool, bool],
+                       cop: np.ndarray) -> np.ndarray:
+        """`cop` kept in the hull of the soles in `contact` shrunk by the margin (one C call
+        on a compiled estimate's state)."""
+        legs = self._legs_kernel
+        if legs is not None and state.row_address is not None:
+            return legs.support_clamp(state, contact, cop)
+        stand = self.stand
+        half_length, half_width = stand.sole_half_size_m
+        corners = np.concatenate([
+            box_corners(state.sole_centres[foot], state.sole_rotations[foot],
+                        (half_length, half_width, 0.0))[:, 0:2]
+            for foot in (0, 1) if contact[foot]])
+        return clamp_into(convex_hull(corners), cop, stand.gains.cop_margin_m)
 
     def finish(self, state: BalanceState, joint_velocities: np.ndarray, torque: np.ndarray,
                contact: tuple[bool, bool], swing: tuple[int, SwingPath, float] | None,
@@ -310,12 +350,14 @@ def _clamp_to_sole(state: BalanceState, foot: int, reach_m: tuple[float, float],
     """`point_xy` moved to the nearest point of one sole's rectangle reaching `reach_m`
     from its centre along and across it (in the sole's frame a clamp of each coordinate:
     the rectangle's hull and a general polygon's clamp, every tick of single support, cost
-    more than the rest of the step's pressure-centre work)."""
-    rotation = state.sole_rotations[foot][0:2, 0:2]
-    centre = state.sole_centres[foot][0:2]
-    local = rotation.T @ (np.asarray(point_xy, dtype=np.float64) - centre)
+    more than the rest of the step's pressure-centre work; plain floats, as numpy's calls
+    on two numbers cost more than the arithmetic)."""
+    (r00, r01, _), (r10, r11, _), _ = state.sole_rotations[foot].tolist()
+    centre_x, centre_y, _ = state.sole_centres[foot].tolist()
+    x, y = point_xy.tolist()
+    dx, dy = x - centre_x, y - centre_y
     reach_x, reach_y = reach_m
-    local[0] = min(max(local[0], -reach_x), reach_x)
-    local[1] = min(max(local[1], -reach_y), reach_y)
-    return centre + rotation @ local
-
+    along = min(max(r00 * dx + r10 * dy, -reach_x), reach_x)
+    across = min(max(r01 * dx + r11 * dy, -reach_y), reach_y)
+    return np.array([centre_x + (r00 * along + r01 * across),
+                     centre_y + (r10 * along + r11 * across)])

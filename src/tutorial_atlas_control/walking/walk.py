@@ -289,14 +289,17 @@ class WalkController:
         step, planned, plan, swing = self.step, self._planned_step, self._plan, self.swing
         assert step is not None and planned is not None and plan is not None  # with the step
         stance = 1 - step.foot_index
-        sole = state.sole_rotations[stance]
-        error_x, error_y = (state.capture_point - xi_ref).tolist()
-        offset_x, offset_y = (cop_ref - state.sole_centres[stance][0:2]).tolist()
+        # numpy's elementwise differences in plain floats (the same bits): every 1 ms tick
+        (capture_x, capture_y), (ref_x, ref_y) = state.capture_point.tolist(), xi_ref.tolist()
+        (cop_x, cop_y), (centre_x, centre_y, _) = (cop_ref.tolist(),
+                                                   state.sole_centres[stance].tolist())
+        (heading_x, _, _), (heading_y, _, _), _ = state.sole_rotations[stance].tolist()
+        durations = plan.durations_s
         shift_x, shift_y = foothold_shift(
-            (error_x, error_y), (float(sole[0, 0]), float(sole[1, 0])), (offset_x, offset_y),
-            self.legs.sole_reach_m, self.gains.dcm_gain, state.omega,
-            step.duration_s - (self.phases.elapsed_s(time_s)),
-            float(plan.durations_s[1]) if len(plan.durations_s) > 1 else None)
+            (capture_x - ref_x, capture_y - ref_y), (heading_x, heading_y),
+            (cop_x - centre_x, cop_y - centre_y), self.legs.sole_reach_m, self.gains.dcm_gain,
+            state.omega, step.duration_s - (self.phases.elapsed_s(time_s)),
+            float(durations[1]) if len(durations) > 1 else None)
         x, y, _ = clamp_pose(step.foot_index, planned.x_m + shift_x, planned.y_m + shift_y,
                              planned.yaw_rad, self.queue.feet[stance], self.queue.limits)
         if math.hypot(x - step.x_m, y - step.y_m) < self.gains.adjust_tolerance_m:
@@ -327,13 +330,15 @@ class WalkController:
         step = self.step if self.phase == STEPPING and not transferring else None
         swing_foot = None if step is None else step.foot_index
         legs = self.legs
-        torque, cop, contact = legs.torque(state, joint_positions, joint_velocities, time_s,
-                                           cop, swing_foot)
-        swing = None
         if step is not None:
             assert self.swing is not None and self._lift_off_s is not None  # at lift-off
             swing = (step.foot_index, self.swing,
                      self.phases.elapsed_s(time_s) - self._lift_off_s)
-        legs.finish(state, joint_velocities, torque, contact, swing, feet)
+            torque, cop, _ = legs.swing_tick(state, joint_positions, joint_velocities, time_s,
+                                             cop, swing)
+        else:
+            torque, cop, contact = legs.torque(state, joint_positions, joint_velocities,
+                                               time_s, cop, None)
+            legs.finish(state, joint_velocities, torque, contact, None, feet)
         self._last_cop = cop
         return WalkOutput(torque, cop, xi_ref, self.phase, swing_foot)

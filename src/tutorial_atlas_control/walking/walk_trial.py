@@ -118,9 +118,12 @@ class WalkingStand:
         self.walk_at_s = walk_at_s
         self.trial = WalkTrial()
         self._phase = 'stand'  # then 'walk', then 'stand again'
-        #: The last walking torque, and the legs' |torque changes| summed, with their count.
-        self._last_torque: np.ndarray | None = None
-        self._jumps = np.zeros(LEG_JOINTS.stop - LEG_JOINTS.start)
+        #: The legs' last walking torques (None before the first), their |changes| summed,
+        #: with their count, and this tick's change (arrays reused: a walk's every tick).
+        legs = LEG_JOINTS.stop - LEG_JOINTS.start
+        self._last_legs: np.ndarray | None = None
+        self._jumps = np.zeros(legs)
+        self._jump = np.zeros(legs)
         self._jump_count = 0
 
     @property
@@ -170,12 +173,24 @@ class WalkingStand:
         return torque
 
     def _note_jump(self, torque: np.ndarray) -> None:
-        """Add this walking step's leg torque changes to the trial's figure."""
-        if self._last_torque is not None:
-            self._jumps += np.abs(torque[LEG_JOINTS] - self._last_torque[LEG_JOINTS])
-            self._jump_count += 1
+        """Add this walking step's leg torque changes to the sums (in place: the offline
+        walk's every tick; note_jumps makes the trial's figure of them once)."""
+        legs = torque[LEG_JOINTS]
+        last = self._last_legs
+        if last is None:
+            self._last_legs = legs.copy()
+            return
+        jump = self._jump
+        np.subtract(legs, last, out=jump)
+        np.abs(jump, out=jump)
+        np.add(self._jumps, jump, out=self._jumps)
+        self._jump_count += 1
+        last[:] = legs
+
+    def note_jumps(self) -> None:
+        """The trial's leg_torque_jump_nm from the changes summed so far."""
+        if self._jump_count:
             self.trial.leg_torque_jump_nm = float(np.max(self._jumps)) / self._jump_count
-        self._last_torque = torque.copy()
 
     def _landed(self, walk: WalkController, state: BalanceState, taken: Footstep) -> None:
         """Note the step just down against its target and against `taken`, the step as
@@ -218,6 +233,7 @@ def walk_trial(plan: Sequence[Footstep], duration_s: float, gains: WalkGains | N
             trial.fell = True
             break
     trial.pelvis_end = sim.data.xpos[sim.atlas.pelvis_body_id].copy()
+    behaviour.note_jumps()
     return trial
 
 

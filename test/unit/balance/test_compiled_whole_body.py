@@ -36,6 +36,7 @@ from tutorial_atlas_control.balance.stand_pose import place_in_stand_pose
 from tutorial_atlas_control.balance.whole_body import QP, STATICS_ENV
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.walking import straight_steps
+from tutorial_atlas_control.walking.leg_tasks import LEGS_ENV
 from tutorial_atlas_control.walking.walk_trial import SETTLE_S, walk_trial
 
 TOLERANCE = 1e-9
@@ -113,6 +114,7 @@ def test_compiled_whole_body_agrees_with_python_through_a_walk(
         torsions.add(args[6] if len(args) > 6 else None)
         return ours
 
+    monkeypatch.setenv(LEGS_ENV, 'python')  # the pieces, not the one call around them
     monkeypatch.setattr(StandController, 'whole_body', both)
     trial = walk_trial(straight_steps(2, 0.25), SETTLE_S + 0.6 + 2 * 0.63 + 0.2)
     assert not trial.fell and trial.steps == 2
@@ -172,6 +174,47 @@ def test_compiled_stand_agrees_with_python_on_random_states(library) -> None:
         worst = max(worst, _difference(ours, theirs))
     assert worst < TOLERANCE
     assert outside > 20 and points > 5
+
+
+def test_a_moved_reference_is_written_over_the_compiled_copy_and_taken_back(library) -> None:
+    """Walk's legs move the reference's heading, height and rate every tick (`moved`), which
+    the C call writes over its copy of the reference; a call without `moved` (Stand's tick,
+    or whole_body after a walk) must see the reference's own values again, and a new
+    reference must replace the moved one. Each call of a mixed sequence against Python's
+    (stand.moved_reference)."""
+    atlas = atlas_model.load_model()
+    data = mujoco.MjData(atlas.model)
+    place_in_stand_pose(atlas, data)
+    estimator = BalanceEstimator(atlas)
+    base = estimator.estimate(data.qpos, data.qvel)
+    rng = np.random.default_rng(62)
+    references = [dataclasses.replace(StandReference.from_state(base),
+                                      com_height_m=float(base.com[2] + rng.normal(0.0, 0.03)))
+                  for _ in range(2)]
+    controllers = [StandController(estimator.mass_kg, atlas.effort_limit_nm, references[0],
+                                   SOLE_HALF_SIZE_M, compiled=compiled)
+                   for compiled in (True, False)]
+    worst, moved, kinds = 0.0, None, set()
+    for case in range(200):
+        state = _moved(base, rng, case)
+        positions = data.qpos[atlas.qpos_adr] + rng.normal(0.0, 0.05, JOINTS)
+        velocities = rng.normal(0.0, 0.5, JOINTS)
+        kind = int(rng.integers(4))  # tick; whole_body: new moved, the same moved, none
+        kinds.add(kind)
+        if kind == 0:
+            ours, theirs = (c.tick(state, positions, velocities) for c in controllers)
+        else:
+            if kind == 1 or moved is None:
+                moved = (float(rng.normal(0.0, 0.5)), float(base.com[2] + rng.normal(0.0, 0.05)),
+                         float(rng.normal(0.0, 0.1)))
+            reference, cop = references[case % 7 == 0], rng.normal(0.0, 0.1, 2)
+            ours, theirs = (c.whole_body(state, cop, state.in_contact,
+                                         positions, velocities, None, 0.015, reference,
+                                         None if kind == 3 else moved)
+                            for c in controllers)
+        worst = max(worst, _difference(ours, theirs))
+    assert kinds == {0, 1, 2, 3}
+    assert worst < TOLERANCE
 
 
 def _pushed_stand_qpos(seconds: float) -> np.ndarray:

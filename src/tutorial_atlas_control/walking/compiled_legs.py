@@ -1,0 +1,129 @@
+"""Walk's single-support tick of the legs as one C call (src/atlas_legs.c through ctypes).
+
+With a foot swinging, LegTasks.torque clamps the pressure centre to the stance sole and
+has the whole body solve there, and LegTasks.finish adds the swing leg's servo and clamps
+the sum to the effort limits. With the whole-body call and the swing servo compiled, the
+Python between them (the clamp, the servo's input copied from the state, the leg's inertia
+block, the results' arrays, the sum) cost more than the two calls; here the whole-body
+call's input is loaded as it loads it (compiled_whole_body), and one call does the rest,
+reading the swing sole's numbers from the compiled estimate's row in place. Used only for a
+compiled estimate's state (its row and scratch data); both agree with the pieces and the
+Python to rounding (test/unit/walking/test_compiled_legs.py: 1e-9).
+"""
+
+from __future__ import annotations
+
+import ctypes
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from tutorial_atlas_control.balance import row_offsets
+from tutorial_atlas_control.native import AtlasLegs, address
+
+if TYPE_CHECKING:
+    from tutorial_atlas_control.balance import (
+        BalanceState,
+        CompiledWholeBody,
+        ContactConstraint,
+        MovedReference,
+        StandReference,
+    )
+    from tutorial_atlas_control.walking.compiled_swing import CompiledSwing
+    from tutorial_atlas_control.walking.swing import SwingPath
+
+#: The swing leg's joints.
+LEG = 6
+
+
+class CompiledLegs:
+    """atlas_legs_swing_tick over a whole-body call and a swing servo, with the stance sole's
+    `reach_m` (along, across) and the legs' first joints; atlas_legs_support_clamp with the
+    soles' half size and the support region's margin (m); its buffers its own."""
+
+    def __init__(self, library: ctypes.CDLL, whole_body: CompiledWholeBody,
+                 swing: CompiledSwing, reach_m: tuple[float, float],
+                 leg_starts: tuple[int, int], sole_half_size_m: tuple[float, float],
+                 margin_m: float) -> None:
+        self._library = library
+        self._whole_body = whole_body
+        self._swing = swing
+        joints = whole_body.joints
+        self._joints = joints
+        self._out = np.zeros(joints + 2)
+        self._leg_starts = leg_starts
+        call = self._call = AtlasLegs()
+        call.whole_body = whole_body.address
+        call.swing = swing.address
+        call.out = address(self._out, np.float64)
+        call.reach[:] = reach_m
+        call.sole_velocities_at = row_offsets(joints)['sole_velocities']
+        call.half_size[:] = sole_half_size_m
+        call.margin_m = margin_m
+        self._pointer = ctypes.byref(call)
+        #: The scratch data whose mass matrix was last read (None: not yet), its dofs.
+        self._scratch: tuple[int, int] | None = None
+        self._mass_matrix = np.zeros(0)
+        self._dof_adr: np.ndarray | None = None
+        #: The swinging foot the call's leg is set for (None: none yet).
+        self._foot: int | None = None
+
+    def _set_foot(self, foot: int) -> None:
+        """The swinging foot: its leg's joints and dofs, the other sole the stance."""
+        call = self._call
+        call.stance = 1 - foot
+        start = call.leg_start = self._leg_starts[foot]
+        assert self._dof_adr is not None  # bound first
+        call.leg_dofs[:] = self._dof_adr[start:start + LEG].tolist()
+        self._foot = foot
+
+    def _bind(self, state: BalanceState) -> None:
+        """The estimator's model and scratch data the state came from (its mass matrix)."""
+        source = state.mass_matrix_source
+        assert source is not None  # a compiled estimate's state only
+        model, data, nv, dof_adr = source
+        if self._mass_matrix.size != nv * nv:
+            self._mass_matrix = np.zeros(nv * nv)
+        call = self._call
+        call.model, call.data = model, data
+        call.mass_matrix = address(self._mass_matrix, np.float64)
+        self._dof_adr = dof_adr
+        self._scratch = (model, data)
+        self._foot = None  # the leg's dofs set again, from these
+
+    def swing_tick(self, state: BalanceState, contacts: tuple[ContactConstraint,
+                                                              ContactConstraint],
+                   joints: tuple[np.ndarray, np.ndarray],
+                   joint_gains: tuple[np.ndarray, np.ndarray], reference: StandReference,
+                   moved: MovedReference, cop: np.ndarray,
+                   swing: tuple[int, SwingPath, float]) -> tuple[np.ndarray, np.ndarray]:
+        """LegTasks.torque then LegTasks.finish with `swing` (the foot, its path, the time
+        into it): the torques (joints,) within the effort limits and the pressure centre as
+        kept, new arrays. `joints`: their positions and velocities."""
+        source = state.mass_matrix_source
+        if source is None or self._scratch != source[0:2]:
+            self._bind(state)
+        foot, path, elapsed_s = swing
+        if foot != self._foot:
+            self._set_foot(foot)
+        self._whole_body.load(state, contacts, joints[0], joints[1], joint_gains, reference,
+                              moved)
+        self._whole_body.set_cop(cop)
+        self._swing.set_path(path)
+        self._swing.prepare_swing(elapsed_s)
+        self._library.atlas_legs_swing_tick(self._pointer)
+        out = self._out
+        return out[:self._joints].copy(), out[self._joints:].copy()
+
+    def support_clamp(self, state: BalanceState, carrying: tuple[bool, bool],
+                      cop: np.ndarray) -> np.ndarray:
+        """`cop` clamped into the hull of the `carrying` soles shrunk by the margin (the
+        Python: clamp_into(convex_hull(their box_corners)), a new array; a compiled
+        estimate's state only."""
+        call = self._call
+        call.row = state.row_address
+        call.carrying[:] = carrying
+        out = self._out
+        out[self._joints:] = cop
+        self._library.atlas_legs_support_clamp(self._pointer)
+        return out[self._joints:].copy()
