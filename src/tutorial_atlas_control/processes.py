@@ -98,12 +98,16 @@ def rss_kib(pid: int) -> int | None:
     return None
 
 
-def cpu_seconds(pid: int) -> float:
-    """CPU time `pid` has used (user + system, s), 0.0 if it is gone."""
+def cpu_seconds(pid: int, reaped_children: bool = False) -> float:
+    """CPU time `pid` has used (user + system, s), with that of the children it has waited for
+    if `reaped_children`; 0.0 if it is gone."""
     fields = _stat(pid)
     if fields is None:
         return 0.0
-    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+    ticks = int(fields[11]) + int(fields[12])
+    if reaped_children:
+        ticks += int(fields[13]) + int(fields[14])
+    return ticks / os.sysconf('SC_CLK_TCK')
 
 
 def kill_if_unchanged(pids: Mapping[int, str]) -> None:

@@ -21,9 +21,14 @@ def run_script(name: str, *args: str,
                           text=True, timeout=timeout_s, check=False)
 
 
-#: Wall-clock guard (s) for an interrupted script to get going (a Dask cluster starting, its
-#: first runs finishing) on a loaded machine.
-READY_TIMEOUT_S = 180.0
+#: Guard against a script that never gets ready to be interrupted (a Dask cluster starting,
+#: its first runs finishing), in CPU seconds of the script's process tree, not wall seconds:
+#: `make test` runs these tests at the lowest priority, where a script can wait minutes for a
+#: core (a search starved beside the live tests had not logged its two generations after 180
+#: wall seconds, 2026-11-29).
+READY_CPU_S = 180.0
+#: Wall-clock guard (s) against a hang that uses no CPU (a deadlock, a lost worker).
+READY_WALL_S = 1800.0
 
 
 def interrupt_script(name: str, *args: str, ready: Callable[[str], bool],
@@ -39,9 +44,9 @@ def interrupt_script(name: str, *args: str, ready: Callable[[str], bool],
                                    stdout=out, stderr=err, text=True, start_new_session=True,
                                    preexec_fn=processes.default_sigint)
         try:
-            processes.wait_until(lambda: ready(err_path.read_text()), READY_TIMEOUT_S,
+            processes.wait_until(lambda: ready(err_path.read_text()), READY_WALL_S,
                                  f'{name} did not get ready to be interrupted',
-                                 lambda: _still_running(process, err_path))
+                                 lambda: _still_working(process, err_path))
         finally:
             clean = processes.stop_tree(process)
     result = subprocess.CompletedProcess(process.args, process.returncode,
@@ -52,7 +57,19 @@ def interrupt_script(name: str, *args: str, ready: Callable[[str], bool],
     return result
 
 
-def _still_running(process: subprocess.Popen, err_path: Path) -> None:
+def _still_working(process: subprocess.Popen, err_path: Path) -> None:
+    """Raise if the script ended, or its process tree spent READY_CPU_S without getting
+    ready."""
     if process.poll() is not None:
         raise processes.ProcessError(f'it ended first ({process.returncode}): '
                                      f'{err_path.read_text()}')
+    spent = tree_cpu_seconds(process.pid)
+    if spent > READY_CPU_S:
+        raise processes.ProcessError(f'it spent {spent:.0f} CPU s without getting ready: '
+                                     f'{err_path.read_text()}')
+
+
+def tree_cpu_seconds(pid: int) -> float:
+    """CPU time (s) of `pid` and its live descendants, with the children each has reaped."""
+    return sum(processes.cpu_seconds(each, reaped_children=True)
+               for each in (pid, *processes.descendants(pid)))

@@ -21,6 +21,7 @@ from tutorial_atlas_control.processes import (
     _ephemeral_ports,
     alive,
     command_line,
+    cpu_seconds,
     default_sigint,
     descendants,
     free_local_port,
@@ -104,6 +105,21 @@ def test_command_line_and_memory_of_a_process() -> None:
         child.kill()
         child.wait()
     assert command_line(child.pid) == '' and rss_kib(child.pid) is None
+
+
+def test_cpu_seconds_counts_reaped_children_only_when_asked() -> None:
+    """A shell that has waited for a 0.3 CPU s child: its own time is ~0, with the reaped
+    child's the busy loop's (a guard on a starved script's work measures this)."""
+    busy = 'import time\nt = time.process_time()\nwhile time.process_time() - t < 0.3: pass'
+    shell = subprocess.Popen(['sh', '-c', f'python3 -c "{busy}"; exec sleep 300'])
+    try:
+        wait_until(lambda: command_line(shell.pid) == 'sleep 300', GUARD_S, 'no sleep')
+        assert cpu_seconds(shell.pid) < 0.1
+        assert cpu_seconds(shell.pid, reaped_children=True) >= 0.29
+    finally:
+        shell.kill()
+        shell.wait()
+    assert cpu_seconds(shell.pid, reaped_children=True) == 0.0
 
 
 def test_free_local_port_can_be_bound_and_is_below_the_kernel_s_own_picks() -> None:
