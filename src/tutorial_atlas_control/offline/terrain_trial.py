@@ -30,7 +30,6 @@ import mujoco
 
 from tutorial_atlas_control.asi import on_ground
 from tutorial_atlas_control.balance import (
-    apply_pushes,
     place_in_stand_pose,
     place_on_slope,
     push_events,
@@ -45,7 +44,6 @@ from tutorial_atlas_control.sim import (
     GroundUnderFeet,
     load_gains_yaml,
     load_model,
-    pelvis_height_m,
 )
 from tutorial_atlas_control.walking import (
     SETTLE_S,
@@ -54,6 +52,7 @@ from tutorial_atlas_control.walking import (
     WalkTrial,
     perturb_start,
     random_pushes,
+    run_walking_stand,
     straight_steps,
 )
 
@@ -138,22 +137,10 @@ def terrain_walk(terrain: Terrain, seed: int | None, push_n: float = 0.0) -> Wal
         plan = on_ground(straight_steps(terrain.steps, terrain.stride_m), ground.ground)
         behaviour = WalkingStand(sim.atlas, plan, SETTLE_S)
         sim.install_stand(behaviour)
-        trial = behaviour.trial
         walk_s = terrain.steps * plan[0].duration_s
         events = push_events(random_pushes(0 if seed is None else seed, SETTLE_S,
                                            SETTLE_S + walk_s, push_n, PUSH_S, PUSH_EVERY_S)
                              if push_n > 0.0 else [], sim.dt_s)
-        longest_s = SETTLE_S + SLOWEST_WALK * walk_s + STAND_AFTER_S
-        for tick in range(round(longest_s / sim.dt_s)):
-            if trial.walk_ended_s is not None \
-                    and sim.data.time >= trial.walk_ended_s + STAND_AFTER_S:
-                break
-            apply_pushes(sim, events, tick)
-            sim.step()
-            height = pelvis_height_m(sim.atlas, sim.data)
-            trial.lowest_pelvis_m = min(trial.lowest_pelvis_m, ground.clearance_m(height))
-            if not ground.standing(height):
-                trial.fell = True
-                break
-        trial.pelvis_end = sim.data.xpos[sim.atlas.pelvis_body_id].copy()
-    return trial
+        return run_walking_stand(sim, behaviour, ground,
+                                 SETTLE_S + SLOWEST_WALK * walk_s + STAND_AFTER_S, events,
+                                 stand_after_s=STAND_AFTER_S)

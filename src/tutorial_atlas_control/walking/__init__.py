@@ -37,7 +37,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'route': ['RouteGait', 'feet_origin', 'route_steps'],
     'start_noise': ['perturb_start'],
     'walk_trial': ['SETTLE_S', 'WalkTrial', 'WalkingStand', 'pushed_walk_trial',
-                   'random_pushes', 'straight_walk_trial', 'walk_trial'],
+                   'random_pushes', 'run_walking_stand', 'straight_walk_trial', 'walk_trial'],
     'step_over': ['STEP_OVER_CLEARANCE_M', 'StepOverPath', 'clear_apex_m', 'needs_step_over',
                   'sweep_points', 'terrain_top_m'],
     'step_behaviour': ['StepBehaviour', 'StepStatus'],

@@ -31,7 +31,12 @@ from tutorial_atlas_control.balance import (
     push_events,
     standing_simulator,
 )
-from tutorial_atlas_control.sim import AtlasModel, GroundUnderFeet, pelvis_height_m
+from tutorial_atlas_control.sim import (
+    AtlasModel,
+    AtlasSimulator,
+    GroundUnderFeet,
+    pelvis_height_m,
+)
 from tutorial_atlas_control.walking.footsteps import (
     STEP_DURATION_S,
     Footstep,
@@ -221,14 +226,26 @@ def walk_trial(plan: Sequence[Footstep], duration_s: float, gains: WalkGains | N
     perturb_start(sim.atlas, sim.data, seed, noise)
     behaviour = WalkingStand(sim.atlas, plan, SETTLE_S, gains, streaming)
     sim.install_stand(behaviour)
+    return run_walking_stand(sim, behaviour, GroundUnderFeet(sim.atlas, sim.data), duration_s,
+                             push_events(pushes, sim.dt_s))
+
+
+def run_walking_stand(sim: AtlasSimulator, behaviour: WalkingStand, ground: GroundUnderFeet,
+                      duration_s: float, events: Sequence[tuple[int, Sequence[float]]] = (),
+                      stand_after_s: float | None = None) -> WalkTrial:
+    """Step `sim` under its installed `behaviour` for `duration_s` (s) of sim time, pushed
+    by `events`, until the robot is no longer standing over `ground` or (`stand_after_s`
+    not None) that long after the walk ended; the behaviour's trial, its lowest pelvis
+    measured over the ground."""
     trial = behaviour.trial
-    events = push_events(pushes, sim.dt_s)
-    ground = GroundUnderFeet(sim.atlas, sim.data)
-    for step in range(round(duration_s / sim.dt_s)):
-        apply_pushes(sim, events, step)
+    for tick in range(round(duration_s / sim.dt_s)):
+        if stand_after_s is not None and trial.walk_ended_s is not None \
+                and sim.data.time >= trial.walk_ended_s + stand_after_s:
+            break
+        apply_pushes(sim, events, tick)
         sim.step()
         height = pelvis_height_m(sim.atlas, sim.data)
-        trial.lowest_pelvis_m = min(trial.lowest_pelvis_m, height)
+        trial.lowest_pelvis_m = min(trial.lowest_pelvis_m, ground.clearance_m(height))
         if not ground.standing(height):
             trial.fell = True
             break
