@@ -23,7 +23,8 @@ from tutorial_atlas_control.sim import FALL_HEIGHT_M
 if TYPE_CHECKING:
     from tutorial_atlas_control.balance import SoleBox
 
-__all__ = ['CourseRun', 'MapMark', 'read_course_run', 'terrain_landings']
+__all__ = ['CourseRun', 'MapMark', 'read_course_run', 'recorded_course_run',
+           'terrain_landings']
 
 #: Most pelvis points kept for the path drawn.
 PATH_MAX_POINTS = 5000
@@ -151,3 +152,9 @@ def read_course_run(data: BagData, scores: list[ScoreEntry] | None,
         falls.append(MapMark(x, y, data.sim_time_s(t_s), 'fell (pelvis low)'))
     found, sole = _landings_on_terrain(data, heights)
     return CourseRun(path, found, falls, events, scores[-1] if scores else None, sole)
+
+
+def recorded_course_run(data: BagData, scores: list[ScoreEntry] | None) -> CourseRun | None:
+    """read_course_run with the run's falls as the bag tells them: the simulator's fall
+    lines, or, when it logged none, the pelvis low over the terrain."""
+    return read_course_run(data, scores, [t_s for t_s, _ in data.logged_falls] or None)

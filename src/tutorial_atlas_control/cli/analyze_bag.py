@@ -39,8 +39,8 @@ from tutorial_atlas_control.bags import (
     plot_run,
     read_bag,
     read_behaviours,
-    read_course_run,
     read_scores,
+    recorded_course_run,
     render_bag_video,
     score_lines,
     summarise_walk,
@@ -292,8 +292,7 @@ def _course_maps(analysis: Analysis, args: argparse.Namespace) -> list[Path]:
         else [])
     if not paths:
         return []
-    run = read_course_run(data, read_scores(data),
-                          [t_s for t_s, _ in data.logged_falls] or None)
+    run = recorded_course_run(data, read_scores(data))
     if run is None and args.course_map:
         raise BagAnalysisError(f'{data.path} has no pelvis pose (/ground_truth_odom): '
                                'no path to draw on the course map')

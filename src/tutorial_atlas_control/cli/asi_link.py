@@ -84,8 +84,9 @@ class AsiLink:
                        for foot in self.last.foot_pos_est)
         return feet_origin(left, right)
 
-    def stand_first(self, planned: int) -> None:
-        """The start's hold (User): STAND, then wait until the state says Stand."""
+    def stand_first(self, planned: int | None = None) -> None:
+        """The start's hold (User): STAND, then wait until the state says Stand; a refusal
+        says that none of the `planned` steps (None: no plan yet) were taken."""
         assert self._publisher is not None  # connected
         print(f'{self.prog}: the robot is in User (the tutorial\'s hold): sending STAND first',
               flush=True)
@@ -99,8 +100,9 @@ class AsiLink:
                 state = self.last
                 hint = '' if state is None else refusal_hint(
                     state.behavior_feedback.status_flags, state.current_behavior)
-                raise Refused(f'STAND was not taken within {STAND_TIMEOUT_S:g} s ({hint}); '
-                              f'0 of {planned} steps taken')
+                taken = '' if planned is None else f'; 0 of {planned} steps taken'
+                raise Refused(f'STAND was not taken within {STAND_TIMEOUT_S:g} s '
+                              f'({hint}){taken}')
             if time.monotonic() - self._heard > STATE_SILENCE_S:
                 raise Refused(f'no {topics.ASI_STATE} after STAND: is the simulator running?')
             time.sleep(0.01)

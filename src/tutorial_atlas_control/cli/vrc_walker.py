@@ -113,7 +113,7 @@ def _walk_course(link: AsiLink, to_gate: str, gait: RouteGait, timeout_s: float)
     print(f'{PROG}: from ({pelvis.x:.2f}, {pelvis.y:.2f}): '
           f'{", ".join(leg.gate for leg in legs)}', flush=True)
     if first.current_behavior == Behavior.USER:
-        link.stand_first(0)
+        link.stand_first()
     deadline = time.monotonic() + timeout_s
     for number, leg in enumerate(legs):
         if number > 0:

@@ -23,8 +23,8 @@ from tutorial_atlas_control.bags import (
     plot_footprints,
     plot_run,
     read_behaviours,
-    read_course_run,
     read_scores,
+    recorded_course_run,
     render_bag_video,
     short_summary,
     titled_walks,
@@ -180,7 +180,7 @@ def _course_lines(data: BagData, bag: Path, report: Report) -> Path | None:
         last = scores[-1]
         report(f'score: {last.completion} of 4 gates, falls {last.falls}, course clock '
                f'{last.sim_elapsed_s:.1f} s')
-    run = read_course_run(data, scores or None, [t_s for t_s, _ in data.logged_falls] or None)
+    run = recorded_course_run(data, scores or None)
     return None if run is None else plot_course_map(run, bag.with_suffix('.course.png'))
 
 
