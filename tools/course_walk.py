@@ -3,11 +3,12 @@
 measurement behind docs/vrc.md's figures for the walk to gate_1.
 
     python3 tools/course_walk.py [--to GATE | --waypoints 'X,Y X,Y ...'] [--stride M]
-                                 [--world NAME] SEED [SEED ...]
+                                 [--world NAME] [--variant NAME] SEED [SEED ...]
 
 The walk is vrc_walker.py's, offline: the course's legs (course/legs.py) from the world's
 start to --to (default gate_1), each planned from where the feet are as it begins; or one
-leg through --waypoints.
+leg through --waypoints. --variant: one of the finals' changes to the course
+(course/variants.py; default the world as shipped).
 SEED is an integer (walking/start_noise.py's perturbed start) or `none` (the start as the
 world gives it). Each walk prints one JSON line (offline/course_route.py's CourseWalk) as it
 ends; a run costs about 300-500 s of CPU on this host (the course's physics). Run it under
@@ -23,7 +24,7 @@ import json
 import sys
 
 from tutorial_atlas_control.cli.convention import seed_or_none
-from tutorial_atlas_control.course import GATES, Leg
+from tutorial_atlas_control.course import COURSE_VARIANTS, GATES, Leg, course_variant
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.offline import course_walk
 from tutorial_atlas_control.walking import RouteGait
@@ -53,6 +54,8 @@ def main(argv: list[str] | None = None) -> int:
                         help='one leg through these world x,y pairs instead of the course\'s')
     parser.add_argument('--stride', type=float, default=0.15, help='longest stride (m)')
     parser.add_argument('--world', default='vrc_task_2', help='a VRC Task 2 world name')
+    parser.add_argument('--variant', choices=[v.name for v in COURSE_VARIANTS], default=None,
+                        help="one of the VRC finals' changes to the course")
     args = parser.parse_args(argv)
     try:
         gait = RouteGait(stride_m=args.stride)
@@ -62,7 +65,8 @@ def main(argv: list[str] | None = None) -> int:
     for seed in args.seeds:
         try:
             legs = None if args.waypoints is None else [Leg('route', args.waypoints)]
-            walk = course_walk(seed, legs, args.to, args.world, gait)
+            walk = course_walk(seed, legs, args.to, args.world, gait,
+                               variant=args.variant and course_variant(args.variant))
         except AtlasControlError as err:
             print(f'{PROG}: {err}', file=sys.stderr)
             return 2

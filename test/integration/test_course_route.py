@@ -3,7 +3,8 @@ tools/course_walk.py measures the walk to gate_1 (docs/vrc.md). Here a short rou
 pen's start (DRCSim's bdi_stand start, Stand from 2 s, the walk planned at 3 s from
 foot_pos_est): four 0.1 m strides east on the pen's floor (from the foot links' midpoint,
 a few centimetres behind the pelvis), which the robot must walk to the end without a fall,
-its pelvis brought to the route's end (within 5 cm), no gate passed. About 20 s of CPU at a
+its pelvis brought to the route's end (within 5 cm), no gate passed, its closest call far
+from a fall. About 20 s of CPU at a
 load of 4 (the course's physics)."""
 
 from __future__ import annotations
@@ -27,6 +28,12 @@ def test_a_short_route_in_the_pen_is_walked_to_its_end() -> None:
     assert walk.steps_planned in (5, 6)  # four or five strides, then the feet together
     assert walk.fell_at_s is None and walk.scorer_falls == 0, walk
     assert walk.gates == () and walk.completion == 0
+    # Its one leg's closest call: the pelvis near its standing height, the capture point
+    # no further from the soles than a calm walk's lead towards the next step (0.175 m).
+    (leg,) = walk.legs
+    assert leg.gate == 'gate_0' and walk.variant == 'qualification'
+    assert 0.75 < leg.lowest_pelvis_m < 0.95, leg
+    assert 0.05 < leg.widest_capture_m < 0.25, leg
     x, y = walk.pelvis_xy
     assert x == pytest.approx(-2.65, abs=0.05)
     assert y == pytest.approx(-38.0, abs=0.05)

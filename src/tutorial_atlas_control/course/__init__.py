@@ -8,9 +8,11 @@ the course as a walker's legs, gate to gate, and the ones ahead of a walker; sta
 where a run starts Atlas (a world's start by name, or 'x y z yaw'), checked once for the
 node, the launches and offline runs; scoring: VRCScoringPlugin's rules, a Scorer fed once per
 physics step (gates in order, the clock, falls, the rows due); score_log: DRCSim's score.log
-(its header, whole rows); markers: the course's static shapes for a viewer (the terrain as a
-height-coloured triangle mesh over the walked area, the boxes welded to the world), plain
-arrays; its rospy side, markers_node.py (rviz's MarkerArray), is imported by its module.
+(its header, whole rows); variants: the VRC finals' changes to the course (the mud floor's
+friction, the mud's damping, the rubble rearranged by a seed); markers: the course's static
+shapes for a viewer (the terrain as a height-coloured triangle mesh over the walked area, the
+boxes welded to the world), plain arrays; its rospy side, markers_node.py (rviz's
+MarkerArray), is imported by its module.
 """
 
 from tutorial_atlas_control.exports import lazy_exports
@@ -24,6 +26,8 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
             'implicit_drag', 'wrench_at_com'],
     'score_log': ['DEFAULT_SCORE_DIR', 'SCORE_FILE_NAME', 'ScoreLog'],
     'scoring': ['FALL_ACCEL_THRESHOLD', 'TASK_WALKING', 'ScoreRow', 'Scorer', 'seconds'],
+    'variants': ['COURSE_VARIANTS', 'RUBBLE_SEED', 'CourseVariant', 'course_variant',
+                 'rearranged_blocks'],
     'starts': ['TERRAIN_FILE', 'WORLD_MODEL_FILE', 'parse_start', 'start_text', 'world_start'],
     'vrc_task_2': ['BLOCKS', 'BLOCK_ENVELOPE_M', 'BLOCK_INERTIA', 'BLOCK_MASS_KG', 'BLOCK_WALLS',
                    'GATES', 'HEIGHTMAP', 'MUD_BOX', 'MUD_DAMPING',

@@ -2,7 +2,8 @@
 and the replay of a recorded run (replay_score: a scored run's /vrc_score computed again on
 the replayed steps); world: the model and start they simulate (a VRC world by name, or the
 recorded run's); course_route: a course walker's streamed walk, leg by leg, on a VRC world,
-scored; terrain_trial: straight walks on the course's kinds of ground one at a time (mud,
+scored; course_variant: a finals' variant of the course's world (course/variants.py) compiled
+in memory; terrain_trial: straight walks on the course's kinds of ground one at a time (mud,
 slopes), over seeds; block_step: static steps onto a cinder block and off again, from a
 seeded start."""
 
@@ -12,7 +13,9 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'asi_playback': ['AsiStream', 'read_asi_stream', 'run_asi_offline'],
     'block_step': ['PLANS', 'BlockRun', 'BlockStep', 'CinderBlock', 'block_model', 'block_plan',
                    'block_step_trial'],
-    'course_route': ['CourseWalk', 'course_walk'],
+    'course_route': ['CourseWalk', 'LegFigures', 'course_walk'],
+    'course_variant': ['BLOCK_CLEARANCE_M', 'MUD_FLOOR_GEOM', 'block_placement',
+                       'highest_ground_m', 'variant_model'],
     'player': ['CommandLatency', 'DEFAULT_SETTLE_S', 'DEFAULT_START_AFTER_S', 'OfflineRunError',
                'run_offline', 'write_offline_bag'],
     'replay': ['DEFAULT_TOLERANCE', 'ReplayError', 'format_report', 'replay_bag'],

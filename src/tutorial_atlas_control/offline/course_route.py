@@ -13,7 +13,9 @@ ERROR_FALLING, or refused), the robot has fallen (sim/fall.py, asked every 10 ms
 leg's time has run out; the run ends after the last leg or the first that did not end back
 in Stand, then it stands `stand_after_s` more. What it returns: the walk's outcome and
 steps, the scorer's gate messages with their sim times, completion and falls, the fall if
-any, and the CPU the run took.
+any, where each leg came closest to a fall (LegFigures), and the CPU the run took. The world
+is the qualification's, or one of the finals' variants (course/variants.py: the mud floor's
+friction, the mud's damping, the rubble rearranged).
 """
 
 from __future__ import annotations
@@ -25,6 +27,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from tutorial_atlas_control.asi import (
     AtlasSimInterface,
     Behavior,
@@ -33,11 +37,20 @@ from tutorial_atlas_control.asi import (
     step_data_of,
     yaw_of_quaternion,
 )
-from tutorial_atlas_control.course import LEG_PAUSE_S, Leg, ScoreRow, legs_ahead
+from tutorial_atlas_control.course import (
+    COURSE_VARIANTS,
+    LEG_PAUSE_S,
+    CourseVariant,
+    Leg,
+    ScoreRow,
+    legs_ahead,
+)
 from tutorial_atlas_control.msgs import AsiCommand, ManipulateParams, StepData
+from tutorial_atlas_control.offline.course_variant import variant_model
 from tutorial_atlas_control.offline.world import named_world
 from tutorial_atlas_control.sim import (
     DEFAULT_GAINS_FILE,
+    SOLE_GEOMS,
     AtlasSimulator,
     GroundUnderFeet,
     VrcMode,
@@ -55,12 +68,35 @@ from tutorial_atlas_control.walking import (
     route_steps,
 )
 
-__all__ = ['CourseWalk', 'course_walk']
+__all__ = ['CourseWalk', 'LegFigures', 'course_walk']
 
 #: The fall criterion is asked this often (ticks).
 FALL_CHECK_TICKS = 10
 #: A route's steps may take this long each, on average, before the run gives up (s).
 SECONDS_PER_STEP = 0.9
+#: The lowest CoM height (m over the ground) the capture point's LIPM frequency is taken at.
+LOWEST_LIPM_HEIGHT_M = 0.3
+GRAVITY_M_S2 = 9.81
+#: A sole whose centre is this close (m) to the ground under it carries the robot.
+SOLE_ON_GROUND_M = 0.03
+
+
+@dataclass(frozen=True)
+class LegFigures:
+    """Where a leg came closest to a fall, from the fall checks' samples (every
+    FALL_CHECK_TICKS): the pelvis's lowest height over the ground under the lower sole, and
+    the capture point's widest excursion, its horizontal distance (m) from the support's
+    spine (the segment between the centres of the soles on the ground, or the one sole's
+    centre; the capture point is CoM + velocity / omega of the linear inverted pendulum at
+    the CoM's height over the ground; while a foot swings it leads the stance foot towards
+    the next step: 0.175 m in the pen's calm 0.1 m strides), each with the pelvis's (x, y)
+    then."""
+
+    gate: str
+    lowest_pelvis_m: float
+    lowest_at: tuple[float, float]
+    widest_capture_m: float
+    widest_at: tuple[float, float]
 
 
 @dataclass(frozen=True)
@@ -81,6 +117,68 @@ class CourseWalk:
     pelvis_xy: tuple[float, float]
     sim_s: float
     cpu_s: float
+    variant: str = 'qualification'
+    legs: tuple[LegFigures, ...] = ()
+    #: The scorer's clock: sim time (s) from gate_0 to the last gate passed (0 before gate_0).
+    course_clock_s: float = 0.0
+
+
+class _Closest:
+    """The leg's LegFigures so far, from samples of the robot's state."""
+
+    def __init__(self, sim: AtlasSimulator, ground: GroundUnderFeet) -> None:
+        self.sim, self.ground = sim, ground
+        self._soles = [sim.model.geom(name).id for name in SOLE_GEOMS]
+        self._last: tuple[float, np.ndarray] | None = None  # (time, CoM) of the last sample
+        self.gate = ''
+        self.lowest: tuple[float, tuple[float, float]] = (math.inf, (0.0, 0.0))
+        self.widest: tuple[float, tuple[float, float]] = (0.0, (0.0, 0.0))
+
+    def start(self, gate: str) -> LegFigures | None:
+        """Begin the leg to `gate`; the last leg's figures (None before the first)."""
+        last = self.figures() if self.gate else None
+        self.gate = gate
+        self.lowest, self.widest = (math.inf, (0.0, 0.0)), (0.0, (0.0, 0.0))
+        return last
+
+    def figures(self) -> LegFigures:
+        return LegFigures(self.gate, round(self.lowest[0], 4), self.lowest[1],
+                          round(self.widest[0], 4), self.widest[1])
+
+    def sample(self) -> None:
+        data = self.sim.data
+        pelvis = data.xpos[self.sim.atlas.pelvis_body_id]
+        at = (round(float(pelvis[0]), 3), round(float(pelvis[1]), 3))
+        ground_m = self.ground.height_m()
+        clearance = self.ground.pelvis_z_m() - ground_m
+        if clearance < self.lowest[0]:
+            self.lowest = (clearance, at)
+        com = data.subtree_com[self.sim.atlas.pelvis_body_id].copy()
+        if self._last is not None and data.time > self._last[0]:
+            velocity = (com - self._last[1]) / (data.time - self._last[0])
+            omega = math.sqrt(GRAVITY_M_S2 / max(float(com[2]) - ground_m, LOWEST_LIPM_HEIGHT_M))
+            excursion = _distance_to_segment(com[:2] + velocity[:2] / omega,
+                                             *self._support(ground_m))
+            if excursion > self.widest[0]:
+                self.widest = (excursion, at)
+        self._last = (data.time, com)
+
+    def _support(self, ground_m: float) -> tuple[np.ndarray, np.ndarray]:
+        """The support's spine: the centres (x, y) of the soles on the ground (within
+        SOLE_ON_GROUND_M of the ground under them; both when neither is)."""
+        centres = [self.sim.data.geom_xpos[sole] for sole in self._soles]
+        down = [c for c in centres
+                if c[2] - self.ground.ground.height_m(float(c[0]), float(c[1]))
+                < SOLE_ON_GROUND_M] or centres
+        return down[0][:2], down[-1][:2]
+
+
+def _distance_to_segment(point: np.ndarray, start: np.ndarray, end: np.ndarray) -> float:
+    """The distance (m) from `point` to the segment start..end (a point when they meet)."""
+    along = end - start
+    length2 = float(along @ along)
+    t = 0.0 if length2 == 0.0 else min(1.0, max(0.0, float((point - start) @ along) / length2))
+    return float(np.hypot(*(point - (start + t * along))))
 
 
 class _Streamer:
@@ -91,6 +189,7 @@ class _Streamer:
         self.client: WalkClient | None = None
         self.pending: list[Footstep] | None = None
         self.ground = GroundUnderFeet(sim.atlas, sim.data)
+        self.closest = _Closest(sim, self.ground)
         self.fell_at_s: float | None = None
         self.ticks = 0
 
@@ -112,9 +211,10 @@ class _Streamer:
                                          state.walk_feedback.next_step_index_needed)
             if steps:
                 self.pending = steps
-        if self.ticks % FALL_CHECK_TICKS == 0 and self.fell_at_s is None \
-                and self.ground.fallen():
-            self.fell_at_s = self.sim.sim_time_ns / NS_PER_S
+        if self.ticks % FALL_CHECK_TICKS == 0 and self.fell_at_s is None:
+            self.closest.sample()
+            if self.ground.fallen():
+                self.fell_at_s = self.sim.sim_time_ns / NS_PER_S
 
 
 def _feet(interface: AtlasSimInterface) -> tuple[tuple[float, float], float]:
@@ -127,14 +227,13 @@ def _feet(interface: AtlasSimInterface) -> tuple[tuple[float, float], float]:
 def course_walk(seed: int | None, legs: Sequence[Leg] | None = None, to_gate: str = 'gate_1',
                 world_name: str = 'vrc_task_2', gait: RouteGait | None = None,
                 walk_at_s: float = 3.0, stand_after_s: float = 3.0,
-                score_dir: Path | None = None) -> CourseWalk:
+                score_dir: Path | None = None, variant: CourseVariant | None = None
+                ) -> CourseWalk:
     """Walk `legs` (None: the course's legs from the start to `to_gate`) on the world
-    `world_name` from its start perturbed by `seed` (None: unperturbed); score.log goes to
-    `score_dir` (None: a temporary directory)."""
-    world = named_world(world_name)
-    sim = AtlasSimulator(load_model(world.model_path), load_gains_yaml(DEFAULT_GAINS_FILE),
-                         startup_mode=VrcMode.BDI_STAND, start=world.start,
-                         mud_damping=world.mud_damping)
+    `world_name` (its start) changed as `variant` says (None: the world as shipped) from its
+    start perturbed by `seed` (None: unperturbed); score.log goes to `score_dir` (None: a
+    temporary directory)."""
+    sim = _course_simulator(world_name, variant)
     if legs is None:
         pelvis = sim.data.xpos[sim.atlas.pelvis_body_id]
         legs = legs_ahead(float(pelvis[0]), float(pelvis[1]), to_gate)
@@ -142,6 +241,7 @@ def course_walk(seed: int | None, legs: Sequence[Leg] | None = None, to_gate: st
     interface = AtlasSimInterface(sim, hold_at_start=True)
     streamer = _Streamer(sim, interface)
     rows: list[ScoreRow] = []
+    figures: list[LegFigures] = []
     started = time.process_time()
     planned = taken = walked = 0
     with tempfile.TemporaryDirectory(prefix='course_walk_') as scratch:
@@ -153,6 +253,7 @@ def course_walk(seed: int | None, legs: Sequence[Leg] | None = None, to_gate: st
                 _run_until(tick, sim, sim.sim_time_ns / NS_PER_S + LEG_PAUSE_S, streamer)
             if streamer.fell_at_s is not None:
                 break
+            figures += [done] if (done := streamer.closest.start(leg.gate)) else []
             client = _walk_leg(tick, sim, interface, streamer, leg, gait)
             planned, taken = planned + len(client.plan), taken + client.steps_taken
             if client.outcome is not Outcome.WALKED:
@@ -160,6 +261,7 @@ def course_walk(seed: int | None, legs: Sequence[Leg] | None = None, to_gate: st
             walked += 1
         _run_until(tick, sim, sim.sim_time_ns / NS_PER_S + stand_after_s, streamer)
         scoring.close()
+    figures += [streamer.closest.figures()] if streamer.closest.gate else []
     client = streamer.client
     pelvis = sim.data.xpos[sim.atlas.pelvis_body_id]
     last = rows[-1] if rows else None
@@ -172,7 +274,19 @@ def course_walk(seed: int | None, legs: Sequence[Leg] | None = None, to_gate: st
         completion=0 if last is None else last.completion,
         scorer_falls=0 if last is None else last.falls, fell_at_s=streamer.fell_at_s,
         pelvis_xy=(float(pelvis[0]), float(pelvis[1])), sim_s=sim.sim_time_ns / NS_PER_S,
-        cpu_s=time.process_time() - started)
+        cpu_s=time.process_time() - started,
+        variant=(variant or COURSE_VARIANTS[0]).name, legs=tuple(figures),
+        course_clock_s=0.0 if last is None else last.sim_since_gate0_ns / NS_PER_S)
+
+
+def _course_simulator(world_name: str, variant: CourseVariant | None) -> AtlasSimulator:
+    """The world's simulator, DRCSim's `bdi_stand` start, the variant's world and mud."""
+    world = named_world(world_name)
+    atlas = load_model(world.model_path) if variant is None else variant_model(variant)
+    return AtlasSimulator(atlas, load_gains_yaml(DEFAULT_GAINS_FILE),
+                          startup_mode=VrcMode.BDI_STAND, start=world.start,
+                          mud_damping=world.mud_damping if variant is None
+                          else variant.mud_damping)
 
 
 def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,

@@ -262,15 +262,16 @@ def _json_value(value: Any) -> Any:
     return value
 
 
-def table_texts(rows: Iterable[dict[str, Any]]) -> tuple[str, str]:
-    """The table as CSV and JSON text (columns TABLE_COLUMNS)."""
+def table_texts(rows: Iterable[dict[str, Any]], columns: Sequence[str] = TABLE_COLUMNS
+                ) -> tuple[str, str]:
+    """The table as CSV and JSON text (`columns`: the trajectory sweep's by default)."""
     rows = list(rows)
     out = io.StringIO()
     writer = csv.writer(out, lineterminator='\n')
-    writer.writerow(TABLE_COLUMNS)
+    writer.writerow(columns)
     for row in rows:
-        writer.writerow([_csv_value(row.get(column)) for column in TABLE_COLUMNS])
-    doc = [{column: _json_value(row.get(column)) for column in TABLE_COLUMNS} for row in rows]
+        writer.writerow([_csv_value(row.get(column)) for column in columns])
+    doc = [{column: _json_value(row.get(column)) for column in columns} for row in rows]
     return out.getvalue(), json.dumps(doc, indent=1) + '\n'
 
 
@@ -280,9 +281,11 @@ def check_output(prefix: Path) -> None:
         raise SweepError(f'{prefix}: directory {prefix.parent} does not exist')
 
 
-def write_table(rows: Iterable[dict[str, Any]], prefix: Path) -> tuple[Path, Path]:
-    """PREFIX.csv and PREFIX.json, each written to a temporary file and renamed."""
-    csv_text, json_text = table_texts(rows)
+def write_table(rows: Iterable[dict[str, Any]], prefix: Path,
+                columns: Sequence[str] = TABLE_COLUMNS) -> tuple[Path, Path]:
+    """PREFIX.csv and PREFIX.json (`columns`), each written to a temporary file and
+    renamed."""
+    csv_text, json_text = table_texts(rows, columns)
     paths = (prefix.with_name(prefix.name + '.csv'), prefix.with_name(prefix.name + '.json'))
     for path, text in zip(paths, (csv_text, json_text)):
         atomic_write(path, text)

@@ -11,7 +11,8 @@ import pytest
 
 SCRIPTS = Path(__file__).resolve().parents[3] / 'scripts'
 PYTHON_SCRIPTS = ('analyze_bag.py', 'replay_bag.py', 'run_demo.py', 'run_offline.py',
-                  'traj_yaml.py', 'plot_topics.py', 'sweep.py', 'search.py', 'vrc_walker.py')
+                  'traj_yaml.py', 'plot_topics.py', 'sweep.py', 'search.py', 'vrc_walker.py',
+                  'course_sweep.py')
 
 
 def run(script: str, *args: str) -> subprocess.CompletedProcess[str]:
@@ -48,6 +49,9 @@ def test_help_works_from_anywhere(script: str) -> None:
                    '--popsize', '0'], "argument --popsize: '0' must be at least 1"),
     ('vrc_walker.py', ['--to', 'gate_5'], "argument --to: invalid choice: 'gate_5'"),
     ('vrc_walker.py', ['--stride', '0'], "argument --stride: '0' must be a finite number > 0"),
+    ('course_sweep.py', ['--variants', 'finals'], "argument --variants: invalid choice: "
+     "'finals'"),
+    ('course_sweep.py', ['--seeds', 'x'], "argument --seeds: seed 'x' is not an integer"),
     ('record_run.sh', [], 'expected BAG_DIR [atlas_recorder|rosbag [lz4|bz2|none]], got 0 '
      'argument(s)'),
     ('record_run.sh', ['/tmp', 'rosbag2'], "unknown recorder 'rosbag2'"),
