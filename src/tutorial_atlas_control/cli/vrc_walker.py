@@ -31,7 +31,15 @@ from tutorial_atlas_control.cli.convention import (
     positive_number,
     print_error,
 )
-from tutorial_atlas_control.course import GATES, LEG_PAUSE_S, Leg, legs_ahead
+from tutorial_atlas_control.course import (
+    BLOCKS,
+    GATES,
+    LEG_PAUSE_S,
+    CourseError,
+    Leg,
+    leg_waypoints,
+    legs_ahead,
+)
 from tutorial_atlas_control.walking import RouteGait, WalkingError, route_steps
 
 PROG = 'vrc_walker.py'
@@ -138,8 +146,9 @@ def _walk_leg(link: AsiLink, leg: Leg, gait: RouteGait, timeout_s: float) -> Non
         raise Refused(f'no time left for the leg to {leg.gate}')
     origin, heading = link.feet()
     try:
-        plan = route_steps(origin, heading, leg.waypoints, gait)
-    except WalkingError as err:
+        plan = route_steps(origin, heading, leg_waypoints(leg, *origin, BLOCKS),
+                           gait.turning_in_place() if leg.clear_of_blocks else gait)
+    except (WalkingError, CourseError) as err:
         raise Refused(f'no route to {leg.gate} from ({origin[0]:.2f}, {origin[1]:.2f}): '
                       f'{err}') from None
     print(f'{PROG}: to {leg.gate} from ({origin[0]:.2f}, {origin[1]:.2f}): {len(plan)} steps',

@@ -4,7 +4,8 @@ errors: CourseError, what the course refuses; mud: DRCSim's MudPlugin as a law (
 touching link feels, explicit and as ODE solved it, moved to the centre of mass);
 vrc_task_2: the course's figures (the heightmap's scaling, the gates, the pen, the mud, the
 blocks, the starts), the one description the world, the mud and the scoring read; legs:
-the course as a walker's legs, gate to gate, and the ones ahead of a walker; starts:
+the course as a walker's legs, gate to gate, and the ones ahead of a walker; rubble_way: a
+way across the rubble that keeps the feet clear of every block; starts:
 where a run starts Atlas (a world's start by name, or 'x y z yaw'), checked once for the
 node, the launches and offline runs; scoring: VRCScoringPlugin's rules, a Scorer fed once per
 physics step (gates in order, the clock, falls, the rows due); score_log: DRCSim's score.log
@@ -19,7 +20,9 @@ from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'errors': ['CourseError'],
-    'legs': ['COURSE_LEGS', 'LEG_PAUSE_S', 'Leg', 'legs_ahead'],
+    'rubble_way': ['CLEARANCE_M', 'GRID_M', 'block_footprint', 'clear_path',
+                   'distance_to_polygon'],
+    'legs': ['COURSE_LEGS', 'LEG_PAUSE_S', 'Leg', 'leg_waypoints', 'legs_ahead'],
     'markers': ['COURSE_AREA', 'MAX_TRIANGLES', 'Area', 'BoxShape', 'CourseShapes',
                 'TerrainMesh', 'course_shapes', 'height_colours', 'terrain_mesh'],
     'mud': ['MAX_MUD_DAMPING', 'check_mud_damping', 'drag_at_point', 'drag_wrench',

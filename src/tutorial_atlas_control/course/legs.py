@@ -7,19 +7,22 @@ x 3.2, 1.3 m clear of the pen's east wall (on a route turning north at x 2.5 the
 within 0.5-0.6 m of it and two landings fell 17 cm east of their steps: docs/vrc.md), north
 past the wall's end, then to gate_1 (its feet stopping 5 cm past the gate's line, short of
 the mud pit's ramp), through the pit to gate_2, over the hills to gate_3, and across the
-rubble to gate_4. A walker that starts elsewhere (one of the later starts) begins with the
+rubble to gate_4 (a way around the blocks, planned when that leg begins: rubble_way.py). A
+walker that starts elsewhere (one of the later starts) begins with the
 nearest gate still ahead of it, walking that leg from its waypoint nearest the walker.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
 
 from tutorial_atlas_control.course.errors import CourseError
-from tutorial_atlas_control.course.vrc_task_2 import GATES, Gate
+from tutorial_atlas_control.course.rubble_way import clear_path
+from tutorial_atlas_control.course.vrc_task_2 import GATES, Block, Gate
 
-__all__ = ['COURSE_LEGS', 'LEG_PAUSE_S', 'Leg', 'legs_ahead']
+__all__ = ['COURSE_LEGS', 'LEG_PAUSE_S', 'Leg', 'leg_waypoints', 'legs_ahead']
 
 #: Stand holds this long (s of sim time) between one leg's end and the next one's first
 #: WALK: the catch after a walk settles, and a bag's walks stay apart (its analysis tells
@@ -30,10 +33,13 @@ LEG_PAUSE_S = 1.0
 
 @dataclass(frozen=True)
 class Leg:
-    """The waypoints (world x, y) to walk through to pass `gate`, the last one past it."""
+    """The waypoints (world x, y) to walk through to pass `gate`, the last one past it;
+    `clear_of_blocks`: a leg across the rubble, whose way to its last waypoint is planned
+    around the blocks when it begins (leg_waypoints)."""
 
     gate: str
     waypoints: tuple[tuple[float, float], ...]
+    clear_of_blocks: bool = False
 
 
 #: The course from the pen's start, gate by gate, in scoring order.
@@ -42,7 +48,7 @@ COURSE_LEGS: tuple[Leg, ...] = (
     Leg('gate_1', ((3.2, -38.0), (3.2, -31.0), (0.5, -24.5), (0.5, -21.95))),
     Leg('gate_2', ((0.5, -10.0),)),
     Leg('gate_3', ((3.0, -2.0), (6.0, 7.0))),
-    Leg('gate_4', ((6.0, 18.5),)),
+    Leg('gate_4', ((6.0, 18.5),), clear_of_blocks=True),
 )
 
 
@@ -75,5 +81,18 @@ def legs_ahead(x_m: float, y_m: float, to_gate: str = GATES[-1].name) -> tuple[L
     nearest = min(range(len(waypoints)),
                   key=lambda index: math.hypot(waypoints[index][0] - x_m,
                                                waypoints[index][1] - y_m))
-    legs[0] = Leg(legs[0].gate, waypoints[nearest:])
+    legs[0] = replace(legs[0], waypoints=waypoints[nearest:])
     return tuple(legs)
+
+
+def leg_waypoints(leg: Leg, x_m: float, y_m: float, blocks: Sequence[Block]
+                  ) -> tuple[tuple[float, float], ...]:
+    """The waypoints a walker at (x, y) walks for `leg`: its own, or across the rubble a way
+    around `blocks` to its last one (clear_path).
+
+    Raises:
+        CourseError: no way around the blocks.
+    """
+    if not leg.clear_of_blocks:
+        return leg.waypoints
+    return clear_path(blocks, (x_m, y_m), leg.waypoints[-1])

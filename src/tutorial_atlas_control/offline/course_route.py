@@ -40,9 +40,11 @@ from tutorial_atlas_control.asi import (
 from tutorial_atlas_control.course import (
     COURSE_VARIANTS,
     LEG_PAUSE_S,
+    Block,
     CourseVariant,
     Leg,
     ScoreRow,
+    leg_waypoints,
     legs_ahead,
 )
 from tutorial_atlas_control.msgs import AsiCommand, ManipulateParams, StepData
@@ -254,7 +256,8 @@ def course_walk(seed: int | None, legs: Sequence[Leg] | None = None, to_gate: st
             if streamer.fell_at_s is not None:
                 break
             figures += [done] if (done := streamer.closest.start(leg.gate)) else []
-            client = _walk_leg(tick, sim, interface, streamer, leg, gait)
+            client = _walk_leg(tick, sim, interface, streamer, leg, gait,
+                               (variant or COURSE_VARIANTS[0]).blocks)
             planned, taken = planned + len(client.plan), taken + client.steps_taken
             if client.outcome is not Outcome.WALKED:
                 break
@@ -290,11 +293,15 @@ def _course_simulator(world_name: str, variant: CourseVariant | None) -> AtlasSi
 
 
 def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,
-              streamer: _Streamer, leg: Leg, gait: RouteGait | None) -> WalkClient:
-    """One leg planned from where the feet are now, streamed until it ends, the robot
-    falls or the leg's time (SECONDS_PER_STEP a step) runs out."""
+              streamer: _Streamer, leg: Leg, gait: RouteGait | None,
+              blocks: Sequence[Block]) -> WalkClient:
+    """One leg planned from where the feet are now (around `blocks` across the rubble),
+    streamed until it ends, the robot falls or the leg's time (SECONDS_PER_STEP a step)
+    runs out."""
     origin, heading = _feet(interface)
-    plan = route_steps(origin, heading, leg.waypoints, gait)
+    if leg.clear_of_blocks:  # around blocks: the corners turned on the spot
+        gait = (gait or RouteGait()).turning_in_place()
+    plan = route_steps(origin, heading, leg_waypoints(leg, *origin, blocks), gait)
     client = streamer.client = WalkClient(plan, streaming=True)
     limit_ns = sim.sim_time_ns + math.floor(len(plan) * SECONDS_PER_STEP * NS_PER_S)
     while client.outcome is None and streamer.fell_at_s is None \

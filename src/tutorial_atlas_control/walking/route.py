@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from tutorial_atlas_control.walking.errors import WalkingError
 from tutorial_atlas_control.walking.footsteps import (
@@ -49,6 +49,11 @@ class RouteGait:
     turn_stride_m: float = 0.08
     width_m: float = STANCE_WIDTH_M
     duration_s: float = STEP_DURATION_S
+
+    def turning_in_place(self) -> RouteGait:
+        """This gait with its turns in place: among obstacles, where a corner must be
+        turned on the spot (a turning stride sweeps a circle)."""
+        return replace(self, turn_stride_m=0.0)
 
     def __post_init__(self) -> None:
         numbers = (self.stride_m, self.turn_step_rad, self.width_m, self.duration_s)

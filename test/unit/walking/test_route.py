@@ -58,6 +58,11 @@ def test_turning_in_place_faces_the_waypoint_exactly() -> None:
 def test_a_waypoint_inside_the_turning_circle_is_refused() -> None:
     with pytest.raises(WalkingError, match=r'waypoint \(0.0, 0.3\) lies inside the turning '):
         route_steps((0.0, 0.0), 0.0, [(0.0, 0.3)])
+    # The same gait turning in place (as among the rubble's blocks) reaches it.
+    gait = RouteGait().turning_in_place()
+    assert gait == RouteGait(turn_stride_m=0.0)
+    assert centre_after(route_steps((0.0, 0.0), 0.0, [(0.0, 0.3)], gait)) == \
+        pytest.approx((0.0, 0.3), abs=1e-9)
 
 
 def test_waypoints_in_turn_and_a_final_heading() -> None:

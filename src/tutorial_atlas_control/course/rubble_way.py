@@ -1,0 +1,208 @@
+"""A walker's way across the rubble: waypoints that keep its feet clear of every block.
+
+Walk steps on the ground, not onto blocks: a leg through the rubble (course/legs.py's
+`clear_of_blocks`) is planned when it begins, from where the walker is, around the blocks
+the world description puts there (course/vrc_task_2.py's BLOCKS, or a variant's) and the
+gates' posts. The ground is a grid of GRID_M cells over the leg's area; a cell is free when
+its centre is more than `clearance_m` from every block's footprint (its 0.435 x 0.203 x
+0.203 m envelope turned as it lies, seen from above) and every post. A* over the free cells
+(8-connected, the straight-line distance as its estimate) finds the shortest grid path;
+it is shortened to the few waypoints between which a straight line keeps the clearance less
+SHORTCUT_SLACK_M, the ones a route of straight strides (walking/route.py) walks.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from tutorial_atlas_control.course.errors import CourseError
+from tutorial_atlas_control.course.vrc_task_2 import (
+    BLOCK_ENVELOPE_M,
+    GATE_POST_M,
+    GATE_WIDTH_M,
+    GATES,
+    Block,
+)
+
+__all__ = ['CLEARANCE_M', 'GRID_M', 'block_footprint', 'clear_path', 'distance_to_polygon']
+
+#: Grid cell (m).
+GRID_M = 0.05
+#: A foot's centre line to a block's edge (m): half the feet's stance width (0.12) and half a
+#: sole's (0.07), a swing's sway and the route's tracking, with room to spare.
+CLEARANCE_M = 0.45
+#: A shortened path's straight lines may pass this much (m) nearer than the clearance: the
+#: grid path hugs the clearance's edge, and lines between its cells cut it by a cell or two.
+SHORTCUT_SLACK_M = 0.1
+#: The grid reaches this far (m) beyond the start, the goal and the blocks between them.
+MARGIN_M = 1.5
+
+Point = tuple[float, float]
+
+
+def _rotation(block: Block) -> np.ndarray:
+    """Gazebo's roll, pitch, yaw (fixed axes x, y, z) as a rotation matrix."""
+    cr, sr = math.cos(block.roll_rad), math.sin(block.roll_rad)
+    cp, sp = math.cos(block.pitch_rad), math.sin(block.pitch_rad)
+    cy, sy = math.cos(block.yaw_rad), math.sin(block.yaw_rad)
+    return (np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]])
+            @ np.array([[cp, 0.0, sp], [0.0, 1.0, 0.0], [-sp, 0.0, cp]])
+            @ np.array([[1.0, 0.0, 0.0], [0.0, cr, -sr], [0.0, sr, cr]]))
+
+
+def block_footprint(block: Block) -> np.ndarray:
+    """The block's envelope seen from above: its convex hull's corners (k, 2),
+    counter-clockwise."""
+    half = np.array(BLOCK_ENVELOPE_M) / 2
+    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+    corners = (signs * half + (0.0, 0.0, half[2])) @ _rotation(block).T
+    return _hull(corners[:, :2] + (block.x_m, block.y_m))
+
+
+def _hull(points: np.ndarray) -> np.ndarray:
+    """Andrew's monotone chain: the convex hull (counter-clockwise, no repeated point)."""
+    ordered = sorted({(round(float(x), 9), round(float(y), 9)) for x, y in points})
+    if len(ordered) < 3:
+        return np.array(ordered)
+
+    def chain(sequence: Sequence[Point]) -> list[Point]:
+        kept: list[Point] = []
+        for p in sequence:
+            while len(kept) >= 2 and ((kept[-1][0] - kept[-2][0]) * (p[1] - kept[-2][1])
+                                      - (kept[-1][1] - kept[-2][1]) * (p[0] - kept[-2][0])) <= 0:
+                kept.pop()
+            kept.append(p)
+        return kept
+
+    lower, upper = chain(ordered), chain(ordered[::-1])
+    return np.array(lower[:-1] + upper[:-1])
+
+
+def distance_to_polygon(polygon: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Distance (m) from points (x, y) to a convex counter-clockwise polygon (0 inside)."""
+    inside = np.ones(np.shape(x), dtype=bool)
+    distance = np.full(np.shape(x), np.inf)
+    for (ax, ay), (bx, by) in zip(polygon, np.roll(polygon, -1, axis=0)):
+        ex, ey = bx - ax, by - ay
+        inside &= ex * (y - ay) - ey * (x - ax) >= 0.0
+        t = np.clip(((x - ax) * ex + (y - ay) * ey) / (ex * ex + ey * ey), 0.0, 1.0)
+        distance = np.minimum(distance, np.hypot(x - (ax + t * ex), y - (ay + t * ey)))
+    return np.where(inside, 0.0, distance)
+
+
+def _posts() -> list[np.ndarray]:
+    """Every gate's two posts, seen from above."""
+    half = GATE_POST_M[0] / 2
+    square = np.array([[-half, -half], [half, -half], [half, half], [-half, half]])
+    posts = []
+    for gate in GATES:
+        c, s = math.cos(gate.yaw_rad), math.sin(gate.yaw_rad)
+        for side in (-1.0, 1.0):
+            offset = side * (GATE_WIDTH_M / 2 - half)
+            posts.append(square + (gate.x_m - s * offset, gate.y_m + c * offset))
+    return posts
+
+
+def clear_path(blocks: Sequence[Block], start: Point, goal: Point,
+               clearance_m: float = CLEARANCE_M) -> tuple[Point, ...]:
+    """Waypoints from `start` (excluded) to `goal` (the last one) whose straight lines keep
+    `clearance_m` from every block and gate post (from a start nearer one than that, the
+    first goes straight to the nearest place that is not).
+
+    Raises:
+        CourseError: the goal is not clear, or no way joins them.
+    """
+    x0 = min(start[0], goal[0]) - MARGIN_M
+    y0 = min(start[1], goal[1]) - MARGIN_M
+    xs = np.arange(x0, max(start[0], goal[0]) + MARGIN_M + GRID_M / 2, GRID_M)
+    ys = np.arange(y0, max(start[1], goal[1]) + MARGIN_M + GRID_M / 2, GRID_M)
+    grid_x, grid_y = np.meshgrid(xs, ys, indexing='ij')
+    nearest_m = np.full(grid_x.shape, np.inf)
+    for polygon in [block_footprint(block) for block in blocks] + _posts():
+        nearest_m = np.minimum(nearest_m, distance_to_polygon(polygon, grid_x, grid_y))
+    free = nearest_m > clearance_m
+
+    def cell(point: Point) -> tuple[int, int]:
+        return int(round((point[0] - x0) / GRID_M)), int(round((point[1] - y0) / GRID_M))
+
+    if not free[cell(goal)]:
+        raise CourseError(f'the goal ({goal[0]:.2f}, {goal[1]:.2f}) is within {clearance_m} m '
+                          'of a block or a gate post')
+    # A walker already nearer a block than the clearance first steps to the nearest free cell.
+    first = cell(start)
+    if not free[first]:
+        spaces = np.argwhere(free)
+        if not len(spaces):
+            raise CourseError(f'nothing around ({start[0]:.2f}, {start[1]:.2f}) keeps '
+                              f'{clearance_m} m from the blocks')
+        nearest = spaces[np.argmin(np.hypot(*(spaces - first).T))]
+        free[first] = True
+        free[_line(first, (int(nearest[0]), int(nearest[1])))] = True
+    cells = _a_star(free, first, cell(goal))
+    if cells is None:
+        raise CourseError(f'no way from ({start[0]:.2f}, {start[1]:.2f}) to '
+                          f'({goal[0]:.2f}, {goal[1]:.2f}) keeps {clearance_m} m from the blocks')
+    kept = _shortened(free | (nearest_m > clearance_m - SHORTCUT_SLACK_M), cells)
+    return tuple((round(float(xs[i]), 3), round(float(ys[j]), 3)) for i, j in kept[1:-1]) \
+        + (goal,)
+
+
+_MOVES = [(di, dj, math.hypot(di, dj)) for di in (-1, 0, 1) for dj in (-1, 0, 1)
+          if (di, dj) != (0, 0)]
+
+
+def _a_star(free: np.ndarray, start: tuple[int, int], goal: tuple[int, int]
+            ) -> list[tuple[int, int]] | None:
+    """The shortest 8-connected path over free cells, start and goal included."""
+    def estimate(c: tuple[int, int]) -> float:
+        return math.hypot(c[0] - goal[0], c[1] - goal[1])
+
+    cost = {start: 0.0}
+    came: dict[tuple[int, int], tuple[int, int]] = {}
+    todo = [(estimate(start), start)]
+    while todo:
+        _, here = heapq.heappop(todo)
+        if here == goal:
+            path = [here]
+            while path[-1] in came:
+                path.append(came[path[-1]])
+            return path[::-1]
+        for di, dj, step in _MOVES:
+            there = (here[0] + di, here[1] + dj)
+            if not (0 <= there[0] < free.shape[0] and 0 <= there[1] < free.shape[1]) \
+                    or not free[there]:
+                continue
+            new = cost[here] + step
+            if new < cost.get(there, math.inf):
+                cost[there], came[there] = new, here
+                heapq.heappush(todo, (new + estimate(there), there))
+    return None
+
+
+def _line(a: tuple[int, int], b: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """The cells on the straight line a..b (indices into the grid)."""
+    count = max(abs(b[0] - a[0]), abs(b[1] - a[1])) * 2 + 1
+    return (np.rint(np.linspace(a[0], b[0], count)).astype(int),
+            np.rint(np.linspace(a[1], b[1], count)).astype(int))
+
+
+def _visible(free: np.ndarray, a: tuple[int, int], b: tuple[int, int]) -> bool:
+    """Whether every cell on the straight line a..b is free."""
+    return bool(free[_line(a, b)].all())
+
+
+def _shortened(free: np.ndarray, cells: list[tuple[int, int]]) -> list[tuple[int, int]]:
+    """The path's corners: from each kept cell, the farthest cell still in straight sight."""
+    kept = [cells[0]]
+    here = 0
+    while here < len(cells) - 1:
+        far = len(cells) - 1
+        while far > here + 1 and not _visible(free, cells[here], cells[far]):
+            far -= 1
+        kept.append(cells[far])
+        here = far
+    return kept

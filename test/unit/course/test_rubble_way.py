@@ -1,0 +1,99 @@
+"""A way across the rubble (course/rubble_way.py): around every block and gate post with the
+clearance the feet need, on the shipped rubble and the finals' rearranged one, in few
+straight lines; the blocks' footprints as they lie; refusals in one line."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from tutorial_atlas_control.course import (
+    BLOCKS,
+    CLEARANCE_M,
+    COURSE_LEGS,
+    Block,
+    CourseError,
+    block_footprint,
+    clear_path,
+    distance_to_polygon,
+    leg_waypoints,
+    rearranged_blocks,
+)
+from tutorial_atlas_control.course.rubble_way import SHORTCUT_SLACK_M
+
+#: The gate_3 leg's end and the gate_4 leg's goal.
+FROM, TO = (6.0, 7.0), (6.0, 18.5)
+
+
+def nearest_block_m(blocks: tuple[Block, ...], start: tuple[float, float],
+                    waypoints: tuple[tuple[float, float], ...]) -> float:
+    """The closest any point of the straight lines start..waypoints comes to a block."""
+    points = np.array([start, *waypoints])
+    samples = np.concatenate([np.linspace(a, b, max(2, int(np.hypot(*(b - a)) / 0.01)))
+                              for a, b in zip(points[:-1], points[1:])])
+    return min(float(distance_to_polygon(block_footprint(b), samples[:, 0],
+                                         samples[:, 1]).min()) for b in blocks)
+
+
+@pytest.mark.parametrize('blocks', [BLOCKS, rearranged_blocks(BLOCKS, 2013)],
+                         ids=['shipped', 'finals'])
+def test_the_way_across_keeps_the_feet_clear_of_every_block(blocks: tuple[Block, ...]) -> None:
+    waypoints = clear_path(blocks, (6.0, 6.6), TO)
+    assert waypoints[-1] == TO
+    assert nearest_block_m(blocks, (6.0, 6.6), waypoints) >= CLEARANCE_M - SHORTCUT_SLACK_M
+    assert len(waypoints) <= 10
+    legs = np.diff(np.array([(6.0, 6.6), *waypoints]), axis=0)
+    assert np.hypot(*legs.T).min() > 0.2  # corners, not the grid's jitter
+    # The straight line would have run into blocks.
+    assert nearest_block_m(blocks, (6.0, 6.6), (TO,)) < CLEARANCE_M - SHORTCUT_SLACK_M
+
+
+def test_without_blocks_it_goes_straight_and_one_block_makes_a_detour() -> None:
+    assert clear_path((), (6.0, 8.0), (6.0, 12.0)) == ((6.0, 12.0),)
+    block = Block('b', 6.0, 10.0, 0.0, 0.0, 0.0, 0.0)  # lying flat across the line
+    waypoints = clear_path((block,), (6.0, 8.0), (6.0, 12.0))
+    assert len(waypoints) >= 2
+    assert nearest_block_m((block,), (6.0, 8.0), waypoints) >= CLEARANCE_M - SHORTCUT_SLACK_M
+
+
+def test_a_walker_nearer_a_block_than_the_clearance_first_steps_away() -> None:
+    block = Block('b', 6.0, 8.3, 0.0, 0.0, 0.0, 0.0)  # its edge 0.2 m ahead of the walker
+    first = clear_path((block,), (6.0, 8.0), (6.0, 12.0))[0]
+    start_m = distance_to_polygon(block_footprint(block), np.array(6.0), np.array(8.0))
+    first_m = distance_to_polygon(block_footprint(block), np.array(first[0]),
+                                  np.array(first[1]))
+    assert start_m < CLEARANCE_M < first_m + 0.05
+
+
+def test_no_way_or_a_goal_in_the_blocks_is_one_line() -> None:
+    wall = tuple(Block(f'b{k}', 2.0 + 0.4 * k, 10.0, 0.0, 0.0, 0.0, 0.0) for k in range(21))
+    with pytest.raises(CourseError, match=r'no way from \(6.00, 8.00\) to \(6.00, 12.00\) '
+                                          'keeps 0.45 m from the blocks'):
+        clear_path(wall, (6.0, 8.0), (6.0, 12.0))
+    with pytest.raises(CourseError, match=r'the goal \(6.00, 10.00\) is within 0.45 m'):
+        clear_path(wall, (6.0, 8.0), (6.0, 10.0))
+
+
+@pytest.mark.parametrize('roll, pitch, size', [(0.0, 0.0, (0.435, 0.203)),
+                                               (math.pi / 2, 0.0, (0.435, 0.203)),
+                                               (0.0, math.pi / 2, (0.203, 0.203))],
+                         ids=['flat', 'on its side', 'on end'])
+def test_a_block_s_footprint_is_its_envelope_seen_from_above(roll: float, pitch: float,
+                                                             size: tuple[float, float]) -> None:
+    corners = block_footprint(Block('b', 1.0, 2.0, 0.0, roll, pitch, 0.0))
+    extent = corners.max(axis=0) - corners.min(axis=0)
+    assert extent == pytest.approx(size, abs=1e-6)
+    # Turned about its frame (the envelope's bottom centre) it lies beside where it stood.
+    centre = (corners.max(axis=0) + corners.min(axis=0)) / 2
+    assert np.hypot(*(centre - (1.0, 2.0))) == pytest.approx(0.0 if roll == pitch == 0.0
+                                                             else 0.1015, abs=1e-3)
+
+
+def test_only_the_rubble_s_leg_is_planned_around_blocks() -> None:
+    assert [leg.gate for leg in COURSE_LEGS if leg.clear_of_blocks] == ['gate_4']
+    gate_2 = COURSE_LEGS[2]
+    assert leg_waypoints(gate_2, 0.5, -21.0, BLOCKS) == gate_2.waypoints
+    across = leg_waypoints(COURSE_LEGS[4], *FROM, BLOCKS)
+    assert across[-1] == TO and len(across) > 1
