@@ -3,6 +3,8 @@
 Horizontally and in yaw a quintic in the phase s = t / T (no speed and no acceleration at
 lift-off or touchdown, so the foot neither scuffs nor slaps); vertically up to
 `height_m` and down again along 64 s^3 (1 - s)^3, which also starts and ends at rest.
+Between ends at different heights (`swing_height_m`) the lift is raised so that the apex
+clears the higher end; on level ground it is SWING_HEIGHT_M.
 """
 
 from __future__ import annotations
@@ -16,6 +18,18 @@ from tutorial_atlas_control.walking.footsteps import wrap_angle
 
 #: How high the swing foot's sole is lifted over the line between its ends (m).
 SWING_HEIGHT_M = 0.08
+#: A swing between ends at different heights (a slope, a ramp) passes at least this high
+#: (m) over the higher end: where the ground bends between them (a ramp's top or foot) it
+#: rises above the line between the ends.
+END_CLEARANCE_M = 0.06
+
+
+def swing_height_m(start_z_m: float, end_z_m: float, lift_m: float = SWING_HEIGHT_M,
+                   clearance_m: float = END_CLEARANCE_M) -> float:
+    """How high (m) over the line between its ends a swing lifts the sole: `lift_m`, or more
+    so that its apex (the line's middle plus that) is `clearance_m` over the higher end. On
+    level ground (ends less than 2 (lift_m - clearance_m) apart in height) `lift_m` itself."""
+    return max(lift_m, 0.5 * abs(end_z_m - start_z_m) + clearance_m)
 
 
 def quintic(s: float) -> tuple[float, float, float]:

@@ -12,7 +12,7 @@ join the queue by index. Once the walk has caught itself after its last step it 
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import mujoco
 import numpy as np
@@ -85,11 +85,14 @@ class WalkBehaviour:
         stand.start(data)
         controller, state = stand.controller, stand.last_state
         assert controller is not None and state is not None  # set by start
-        queue = StepQueue(foot_pose(state, 0), foot_pose(state, 1), self.limits)
+        under = stand.ground_under_soles(state)  # each sole's surface: its height, normal
+        queue = StepQueue(*(replace(foot_pose(state, foot), normal=under[foot][1])
+                            for foot in (0, 1)), self.limits)
         queue.offer(self.default_steps if self.next_steps is None else self.next_steps)
         self.next_steps = None
         self.walk = WalkController(controller, queue, state, float(data.time), self.gains,
-                                   stand.ground_under_m(state) + stand.com_height_m)
+                                   stand.ground_under_m(state) + stand.com_height_m,
+                                   (under[0][0], under[1][0]))
 
     def torque(self, data: mujoco.MjData) -> np.ndarray:
         """This tick's f_out (N m, (28,)), within the effort limits."""
