@@ -197,7 +197,7 @@ class WalkController:
         self.step = self._planned_step = step
         stance = self.queue.feet[1 - step.foot_index]
         self.legs.face(stance.yaw_rad, step.yaw_rad, time_s, step.duration_s)
-        if self.surfaces.step(step.foot_index, step.z_m):  # up or down: the CoM follows
+        if self.surfaces.step(step.foot_index, step.z_m, time_s, step.duration_s):  # the CoM
             self.legs.move_height(self.surfaces.over_feet_m(self.walk_height_m), time_s,
                                   step.duration_s)
         self.swing, self._lift_off_s = None, None  # the swing begins once the weight moved
