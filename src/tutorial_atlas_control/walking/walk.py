@@ -270,7 +270,8 @@ class WalkController:
                               state.sole_centres[stance][0:2])
         if self.gains.transfer.lifts(elapsed, step.duration_s, flat, share):
             self._lift_off_s = elapsed
-            self.swing = swing_to(state, step, step.duration_s - elapsed)
+            self.swing = swing_to(state, step, step.duration_s - elapsed,
+                                  self.queue.feet[step.foot_index].normal)
 
     def _transfer_cop(self, cop: np.ndarray, time_s: float) -> np.ndarray:
         """The pressure centre while the weight moves: from where it was as the step began
