@@ -22,9 +22,10 @@ from tutorial_atlas_control.walking.footsteps import wrap_angle
 #: How high the swing foot's sole is lifted over the line between its ends (m).
 SWING_HEIGHT_M = 0.08
 #: A swing between ends at different heights (a slope, a ramp) passes at least this high
-#: (m) over the higher end: where the ground bends between them (a ramp's top or foot) it
-#: rises above the line between the ends.
-END_CLEARANCE_M = 0.06
+#: (m) over the higher end: where the ground bends between them (a ramp's top) it rises
+#: above the line between the ends. Not more: 6 cm (the apex 0.12 m over the line up 16
+#: degrees) and the swing leg, stretched up the slope, flailed at the fifth step and fell.
+END_CLEARANCE_M = 0.03
 
 
 def swing_height_m(start_z_m: float, end_z_m: float, lift_m: float = SWING_HEIGHT_M,
