@@ -7,10 +7,13 @@ from __future__ import annotations
 
 import math
 
+import mujoco
 import numpy as np
 import pytest
 
 from support.standing import started_stand
+from tutorial_atlas_control.balance import StandBehaviour, place_on_slope, slope_model
+from tutorial_atlas_control.sim import Ground
 from tutorial_atlas_control.walking import straight_steps
 from tutorial_atlas_control.walking.feet_surfaces import FeetSurfaces, support_height_m
 from tutorial_atlas_control.walking.footsteps import Footstep
@@ -99,3 +102,20 @@ def test_the_walk_s_com_height_follows_a_step_up() -> None:
     # Over the first step the reference rises by half the step's rise (one foot up, one not).
     assert walk.legs.height(sway_end + duration)[0] == pytest.approx(before + rise / 2)
     assert walk.surfaces.support_at(sway_end + duration) == pytest.approx(rise / 2)
+
+
+def test_a_walk_starts_on_the_ground_under_its_soles() -> None:
+    _, _, level = started_stand()
+    assert level.last_state is not None
+    assert level.ground_under_soles(level.last_state) == ((0.0, (0.0, 0.0, 1.0)),) * 2
+    slope = math.radians(8.0)
+    atlas = slope_model(slope)
+    data = mujoco.MjData(atlas.model)
+    place_on_slope(atlas, data, slope, Ground(atlas.model))
+    stand = StandBehaviour(atlas)
+    stand.start(data)
+    assert stand.last_state is not None
+    for (height, normal), centre in zip(stand.ground_under_soles(stand.last_state),
+                                        stand.last_state.sole_centres, strict=True):
+        assert height == pytest.approx(centre[0] * math.tan(slope), abs=1e-9)
+        assert normal == pytest.approx((-math.sin(slope), 0.0, math.cos(slope)), abs=1e-9)
