@@ -108,7 +108,9 @@ class WalkBehaviour:
         if walk is None:
             raise WalkingError('WalkBehaviour.torque before start()')
         stand, atlas = self.stand, self.stand.atlas
-        stand.estimator.ground_m = walk.surfaces.support_at(float(data.time))
+        ground = walk.surfaces.support_at(float(data.time))
+        if ground != stand.estimator.ground_m:  # on level ground never: no C field written
+            stand.estimator.ground_m = ground
         state = stand.estimator.estimate(data.qpos, data.qvel)
         self.last_state = state
         return walk.tick_torque(state, data.qpos[atlas.qpos_adr], data.qvel[atlas.dof_adr],
