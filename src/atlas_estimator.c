@@ -32,6 +32,7 @@ typedef struct {
   double half_thickness[2];   /* the sole boxes' half thickness (m), left, right */
   double gravity_m_s2;        /* lipm.GRAVITY_M_S2 */
   double min_com_height_m;    /* estimator.MIN_COM_HEIGHT_M */
+  double ground_m;            /* the pendulum's ground (m, world z): its height is over it */
   long n;                     /* joints */
   long soles[2];              /* the sole geoms, left, right */
   long sole_bodies[2];        /* their bodies */
@@ -236,7 +237,8 @@ long atlas_estimate(const AtlasEstimator *e) {
     out[OUT_PELVIS_ANGULAR_VELOCITY + i] =
         rotation[3 * i] * rates[0] + rotation[3 * i + 1] * rates[1] +
         rotation[3 * i + 2] * rates[2];
-  double height = com[2] > e->min_com_height_m ? com[2] : e->min_com_height_m;
+  double over = com[2] - e->ground_m;
+  double height = over > e->min_com_height_m ? over : e->min_com_height_m;
   double omega = sqrt(e->gravity_m_s2 / height);
   out[OUT_OMEGA] = omega;
   for (int i = 0; i < 2; ++i) out[OUT_CAPTURE_POINT + i] = com[i] + com_velocity[i] / omega;

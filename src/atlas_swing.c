@@ -71,6 +71,8 @@ static void swing_target(const AtlasSwing *c) {
   position[2] = position[2] + height * b[0];
   velocity[2] = velocity[2] + height * b[1] / duration;
   if (!inside) memset(velocity, 0, 3 * sizeof(double));
+  for (int i = 0; i < 2; ++i)  /* SwingPath.tilt */
+    in[IN_TILT + i] = in[IN_START_TILT + i] + q[0] * (in[IN_END_TILT + i] - in[IN_START_TILT + i]);
   double turn = wrap_angle(in[IN_END_YAW] - in[IN_START_YAW]);
   in[IN_YAW] = wrap_angle(in[IN_START_YAW] + q[0] * turn);
   in[IN_YAW_RATE] = inside ? q[1] * turn / duration : 0.0;
@@ -91,6 +93,27 @@ static void swing_target(const AtlasSwing *c) {
     position[2] = position[2] - c->touchdown_speed_m_s * late;
     velocity[2] = -c->touchdown_speed_m_s;
   }
+}
+
+/* swing.sole_frame: the upright frame turned by yaw, then tilted about the tilt's
+ * horizontal axis by its length (Rodrigues); the upright frame itself for no tilt. */
+static void sole_frame(double yaw, const double tilt[2], double out[3][3]) {
+  double cy = cos(yaw), sy = sin(yaw);
+  double upright[3][3] = {{cy, -sy, 0.0}, {sy, cy, 0.0}, {0.0, 0.0, 1.0}};
+  if (tilt[0] == 0.0 && tilt[1] == 0.0) {
+    memcpy(out, upright, sizeof(upright));
+    return;
+  }
+  double angle = hypot(tilt[0], tilt[1]);
+  double kx = tilt[0] / angle, ky = tilt[1] / angle;
+  double ca = cos(angle), sa = sin(angle), v = 1.0 - ca;
+  double tilted[3][3] = {{ca + kx * kx * v, kx * ky * v, ky * sa},
+                         {kx * ky * v, ca + ky * ky * v, -kx * sa},
+                         {-ky * sa, kx * sa, ca}};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      out[i][j] = tilted[i][0] * upright[0][j] + tilted[i][1] * upright[1][j]
+                  + tilted[i][2] * upright[2][j];
 }
 
 /* Solves a (LEG, LEG) system for `columns` right-hand sides (rhs: LEG rows of `columns`,
@@ -129,9 +152,9 @@ void atlas_foot_servo(const AtlasSwing *c) {
   int columns = c->feedforward ? 3 : 2;
   double targets[LEG][3] = {{0.0}};
   for (int i = 0; i < 3; ++i) targets[i][0] = in[IN_POSITION + i] - centre[i];
-  /* orientation_error(R, yaw_rotation(yaw)): d = reference R^T */
-  double cy = cos(in[IN_YAW]), sy = sin(in[IN_YAW]);
-  double ref[3][3] = {{cy, -sy, 0.0}, {sy, cy, 0.0}, {0.0, 0.0, 1.0}}, d[3][3];
+  /* orientation_error(R, sole_frame(yaw, tilt)): d = reference R^T */
+  double ref[3][3], d[3][3];
+  sole_frame(in[IN_YAW], in + IN_TILT, ref);
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
       d[i][j] = ref[i][0] * r[3 * j] + ref[i][1] * r[3 * j + 1] + ref[i][2] * r[3 * j + 2];

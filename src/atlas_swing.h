@@ -36,7 +36,10 @@ enum {
   IN_START = 108,           /* (3,) the swing path: start, end, their yaws, duration, */
   IN_END = 111,             /* height, and the time into it */
   IN_START_YAW = 114, IN_END_YAW = 115, IN_DURATION = 116, IN_HEIGHT = 117, IN_ELAPSED = 118,
-  IN_SIZE = 119
+  IN_TILT = 119,            /* (2,) the target's tilt (swing.surface_tilt: x, y) */
+  IN_START_TILT = 121,      /* (2,) the path's tilt at lift-off, */
+  IN_END_TILT = 123,        /* (2,) and at touchdown */
+  IN_SIZE = 125
 };
 
 void atlas_foot_servo(const AtlasSwing *c);

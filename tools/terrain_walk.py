@@ -5,9 +5,9 @@ the measurement behind docs/vrc.md's table of Walk on mud and slopes.
     python3 tools/terrain_walk.py [--push N] CASE SEED [SEED ...]
 
 CASE is one of offline/terrain_trial.py's TERRAINS (mud_40, mud_70, up_8deg, down_8deg,
-up_16deg, down_16deg); SEED an integer (walking/start_noise.py's perturbed start, and the
-pushes' draw) or `none`; --push N pushes the pelvis sideways by N newtons for 0.1 s once
-every 5 s of the walk.
+up_16deg, down_16deg, ramp_up_22deg, ramp_down_22deg); SEED an integer
+(walking/start_noise.py's perturbed start, and the pushes' draw) or `none`; --push N
+pushes the pelvis sideways by N newtons for 0.1 s once every 5 s of the walk.
 Each walk prints one JSON line as it ends: whether it fell, the steps landed of those
 planned, the worst landing (m), the lowest pelvis over the ground (m), where the pelvis
 ended, the CPU it took. Needs `source ./env.sh`. Exits 0 when no walk fell, 1 otherwise, 2

@@ -78,6 +78,7 @@ class AtlasEstimator(ctypes.Structure):
                 ('dof_adr', ctypes.c_void_p), ('jac', ctypes.c_void_p),
                 ('bias', ctypes.c_void_p), ('half_thickness', ctypes.c_double * 2),
                 ('gravity_m_s2', ctypes.c_double), ('min_com_height_m', ctypes.c_double),
+                ('ground_m', ctypes.c_double),
                 ('n', ctypes.c_long), ('soles', ctypes.c_long * 2),
                 ('sole_bodies', ctypes.c_long * 2), ('pelvis', ctypes.c_long),
                 ('free_dof', ctypes.c_long), ('contact_capacity', ctypes.c_long),

@@ -151,6 +151,7 @@ class CompiledEstimate:
         kernel.half_thickness[:] = geometry.half_thickness_m
         kernel.gravity_m_s2 = geometry.gravity_m_s2
         kernel.min_com_height_m = geometry.min_com_height_m
+        kernel.ground_m = 0.0
         kernel.n = count
         kernel.soles[:] = geometry.soles
         kernel.sole_bodies[:] = geometry.sole_bodies
@@ -176,6 +177,10 @@ class CompiledEstimate:
         kernel.polygon_rotations = address(rotations, np.float64)
         kernel.polygon_contact[:] = contact
         self._polygon_reference = (positions, rotations)
+
+    def set_ground(self, height_m: float) -> None:
+        """The pendulum's ground (m, world z): omega is the CoM's height over it."""
+        self._kernel.ground_m = height_m
 
     def run(self, qpos: np.ndarray, qvel: np.ndarray) -> RawEstimate:
         """The estimate at (qpos, qvel), the full MuJoCo vectors."""

@@ -241,6 +241,7 @@ class BalanceEstimator:
         self._inertia_index: dict[tuple[int, int], tuple[slice, slice] | tuple] = {}
         self._mass_matrix_source = (self.model._address, self.scratch._address,
                                     int(self.model.nv), np.asarray(self._dof_adr, dtype=np.intp))
+        self._ground_m = 0.0
         library = native.chosen_library(ESTIMATOR_ENV, compiled)
         self._kernel = None if library is None else CompiledEstimate(
             library, self.model, self.scratch, EstimatorGeometry(
@@ -254,6 +255,20 @@ class BalanceEstimator:
     def compiled(self) -> bool:
         """Whether estimate runs the C call."""
         return self._kernel is not None
+
+    @property
+    def ground_m(self) -> float:
+        """The ground the pendulum stands on (m, world z): omega is that of the CoM's height
+        over it. 0 unless a walk sets it: on a slope the feet's surface moves away from z 0
+        (20 steps down 8 degrees: 0.56 m), and the capture point with omega of the CoM's
+        world height ran ahead of the feet until the walk fell."""
+        return self._ground_m
+
+    @ground_m.setter
+    def ground_m(self, height_m: float) -> None:
+        self._ground_m = float(height_m)
+        if self._kernel is not None:
+            self._kernel.set_ground(self._ground_m)
 
     @property
     def sole_ahead_m(self) -> float:
@@ -403,7 +418,7 @@ class BalanceEstimator:
         contact, contacts_of = self._touching()
         com = d.subtree_com[self._pelvis].copy()  # the robot's, not a world's loose bodies'
         com_velocity = d.subtree_linvel[self._pelvis].copy()
-        omega = lipm.natural_frequency(max(float(com[2]), MIN_COM_HEIGHT_M))
+        omega = lipm.natural_frequency(max(float(com[2]) - self._ground_m, MIN_COM_HEIGHT_M))
         free = self._free_dof
         pelvis_rotation = d.xmat[self._pelvis].reshape(3, 3).copy()
         return BalanceState(

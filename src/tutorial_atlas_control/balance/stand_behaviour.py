@@ -157,6 +157,23 @@ class StandBehaviour:
         return (stance.posture_rad,
                 self.ground_under_m(state) + self.com_height_m - stance.com_lowered_m)
 
+    def ground_under_soles(self, state: BalanceState
+                           ) -> tuple[tuple[float, tuple[float, float, float]], ...]:
+        """The ground's height (m) and unit normal under each sole's centre (left, right):
+        the level ground's own where the world is level planes (no rays: z 0 and upright in
+        Atlas's world); 0 and upright off any ground. Walk's feet stand on these."""
+        if self._ground is None:
+            raise BalanceError('StandBehaviour.ground_under_soles before start()')
+        ground, upright = self._ground, (0.0, 0.0, 1.0)
+        if ground.level_m is not None:
+            return (ground.level_m, upright), (ground.level_m, upright)
+        under = []
+        for x, y in state.sole_centres[:, :2].tolist():
+            height, normal, geom = ground.hit(x, y)
+            under.append((height, tuple(normal.tolist())) if geom >= 0 and math.isfinite(height)
+                         else (0.0, upright))
+        return tuple(under)
+
     def ground_under_m(self, state: BalanceState) -> float:
         """The ground's height (m) under the soles' centres, their mean: the Stand's heights
         are over the world's ground, which is not z = 0 everywhere (0 off any ground)."""

@@ -9,7 +9,11 @@ places a client's steps (asi/library.py's on_ground: the surface's height and no
   whose top is MUD_DEPTH_M above the floor (the VRC pit's mud stood 0.46 m over its floor:
   the feet and lower legs in it), its damping DRCSim's 40 N s/m or the finals' 70;
 - slopes (balance/slope_trial.py's world): the floor turned to rise (or fall) along +x by the
-  slope, the robot placed on it with its ankles pitched to lie on it.
+  slope, the robot placed on it with its ankles pitched to lie on it;
+- ramps (the VRC mud pit's: about 0.6 m of height over 1.5 m, 22 degrees): the floor flat,
+  a ramp RAMP_START_M ahead rising RAMP_RUN_M later to a platform (up), or the robot on a
+  platform and the ramp falling from it to the floor (down): flat, a bend, the slope, a
+  bend, flat.
 
 A case's seed perturbs the start (walking/start_noise.py) and, for a pushed walk, draws the
 pushes' phases and sides, so a figure is a fraction of seeds (the start's noise alone is
@@ -42,6 +46,7 @@ from tutorial_atlas_control.sim import (
     AtlasModel,
     AtlasSimulator,
     GroundUnderFeet,
+    index_model,
     load_gains_yaml,
     load_model,
 )
@@ -56,13 +61,22 @@ from tutorial_atlas_control.walking import (
     straight_steps,
 )
 
-__all__ = ['MUD_DEPTH_M', 'TERRAINS', 'Terrain', 'mud_model', 'terrain_walk']
+__all__ = ['MUD_DEPTH_M', 'RAMP_RISE_M', 'TERRAINS', 'Terrain', 'mud_model', 'ramp_model',
+           'terrain_walk']
 
 #: The mud's top over the floor (m): the VRC pit's 0.46 m.
 MUD_DEPTH_M = 0.46
 #: The mud volume's extent along the walk (m of x, from the start) and across it (m of y).
 MUD_LENGTH_M = 14.0
 MUD_WIDTH_M = 3.0
+#: The pit's ramps: their height (m) over their horizontal run (m), beginning this far
+#: (m of x) ahead of the start; the ramps and platforms are this wide (m of y) and the
+#: platforms this long (m of x).
+RAMP_RISE_M = 0.6
+RAMP_RUN_M = 1.5
+RAMP_START_M = 0.6
+RAMP_WIDTH_M = 3.0
+PLATFORM_M = 4.0
 #: After the walk has ended, the robot stands this long (s).
 STAND_AFTER_S = 1.5
 #: A push lasts PUSH_S (s), one in every PUSH_EVERY_S (s) of the walk.
@@ -75,11 +89,13 @@ SLOWEST_WALK = 2.0
 
 @dataclass(frozen=True)
 class Terrain:
-    """One case: the floor's slope along +x (rad; negative falls), the mud's damping
-    (N s/m; None: no mud), and the walk: `steps` steps of `stride_m`."""
+    """One case: the floor's slope along +x (rad; negative falls), or a ramp's rise (m;
+    negative: down from a platform; ramp_model), the mud's damping (N s/m; None: no mud),
+    and the walk: `steps` steps of `stride_m`."""
 
     name: str
     slope_rad: float = 0.0
+    ramp_rise_m: float = 0.0
     mud_damping: float | None = None
     steps: int = 16
     stride_m: float = 0.25
@@ -95,6 +111,8 @@ TERRAINS: dict[str, Terrain] = {case.name: case for case in (
     Terrain('down_8deg', slope_rad=-math.radians(8.0), steps=20, stride_m=0.2),
     Terrain('up_16deg', slope_rad=math.radians(16.0), steps=20, stride_m=0.2),
     Terrain('down_16deg', slope_rad=-math.radians(16.0), steps=20, stride_m=0.2),
+    Terrain('ramp_up_22deg', ramp_rise_m=RAMP_RISE_M, steps=20, stride_m=0.2),
+    Terrain('ramp_down_22deg', ramp_rise_m=-RAMP_RISE_M, steps=20, stride_m=0.2),
 )}
 
 
@@ -113,21 +131,56 @@ def mud_model(scratch: Path) -> AtlasModel:
     return load_model(path)
 
 
+def _box(spec: mujoco.MjSpec, name: str, centre: tuple[float, float, float],
+         half_size: tuple[float, float, float], pitch_rad: float = 0.0) -> None:
+    """A box of the floor's material and contact, welded to the world, turned about y."""
+    floor = spec.geom('floor')
+    half = -0.5 * pitch_rad
+    spec.worldbody.add_geom(
+        name=name, type=mujoco.mjtGeom.mjGEOM_BOX, size=list(half_size), pos=list(centre),
+        quat=[math.cos(half), 0.0, math.sin(half), 0.0], material=floor.material,
+        condim=floor.condim, contype=floor.contype, conaffinity=floor.conaffinity,
+        friction=list(floor.friction), solref=list(floor.solref), solimp=list(floor.solimp))
+
+
+def ramp_model(rise_m: float) -> AtlasModel:
+    """Atlas's world with a ramp over RAMP_RUN_M from RAMP_START_M ahead: rising `rise_m`
+    (m) from the floor to a platform, or (negative) falling from a platform under the start
+    to the floor."""
+    spec = mujoco.MjSpec.from_file(str(MODEL_PATH))
+    height = abs(rise_m)
+    top_m = RAMP_START_M + RAMP_RUN_M if rise_m > 0.0 else -PLATFORM_M
+    end_m = top_m + PLATFORM_M if rise_m > 0.0 else RAMP_START_M
+    width = 0.5 * RAMP_WIDTH_M
+    _box(spec, 'platform', (0.5 * (top_m + end_m), 0.0, 0.5 * height),
+         (0.5 * (end_m - top_m), width, 0.5 * height))
+    slope = math.atan2(rise_m, RAMP_RUN_M)
+    thickness = 0.1  # its top face the ramp, its body in the floor and the platform
+    middle = (RAMP_START_M + 0.5 * RAMP_RUN_M, 0.5 * height)
+    _box(spec, 'ramp', (middle[0] + math.sin(slope) * thickness, 0.0,
+                        middle[1] - math.cos(slope) * thickness),
+         (0.5 * math.hypot(RAMP_RUN_M, rise_m), width, thickness), slope)
+    return index_model(spec.compile(), MODEL_PATH)
+
+
 def terrain_walk(terrain: Terrain, seed: int | None, push_n: float = 0.0) -> WalkTrial:
     """Walk `terrain`'s case once from a start perturbed by `seed` (None: not), pushed on
     the pelvis by `push_n` (N; 0: not) as pushed flat walks are (walk_trial.random_pushes:
     0.1 s to a side drawn from the seed, once in every PUSH_EVERY_S of the walk)."""
-    if terrain.slope_rad != 0.0 and terrain.mud_damping is not None:
+    if (terrain.slope_rad != 0.0 or terrain.ramp_rise_m != 0.0) \
+            and terrain.mud_damping is not None:
         raise WalkingError(f'terrain {terrain.name}: mud on a slope is not a case')
     gains = load_gains_yaml(DEFAULT_GAINS_FILE)
     with tempfile.TemporaryDirectory(prefix='terrain_walk_') as scratch:
-        if terrain.mud_damping is None:
+        if terrain.ramp_rise_m != 0.0:
+            sim = AtlasSimulator(ramp_model(terrain.ramp_rise_m), gains, time_to_unpin_s=0.0)
+        elif terrain.mud_damping is None:
             sim = AtlasSimulator(slope_model(terrain.slope_rad), gains, time_to_unpin_s=0.0)
         else:
             sim = AtlasSimulator(mud_model(Path(scratch)), gains, time_to_unpin_s=0.0,
                                  mud_damping=terrain.mud_damping)
         ground = GroundUnderFeet(sim.atlas, sim.data)
-        if terrain.slope_rad == 0.0:
+        if terrain.slope_rad == 0.0 and terrain.ramp_rise_m == 0.0:
             place_in_stand_pose(sim.atlas, sim.data)
             perturb_start(sim.atlas, sim.data, seed)
         else:

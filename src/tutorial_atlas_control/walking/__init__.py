@@ -5,7 +5,9 @@ names it, DRCSim's fixed queue, straight and circular plans, a streaming client'
 status_flags: walk_feedback's and step_feedback's status values; step_queue: Walk's queue
 of steps merged by index, clamped to what the legs reach, and its feedback flags;
 dcm_plan: the capture point's plan over the steps; step_adjustment: where a pushed swing
-foot must land instead; swing: the swing foot's path; phases: the one phase machine
+foot must land instead; swing: the swing foot's path (its apex over the higher end, the sole
+laid on its surfaces' tilts); feet_surfaces: the surfaces the walk's feet stand on and the
+CoM height over them (a slope's steps up or down); phases: the one phase machine
 Walk and Step run (their phases in order, each one's end rule, the transition);
 leg_tasks: what Walk and Step do alike each tick (the whole-body law on the carrying soles,
 the swing foot, the pelvis's heading); compiled_swing: the swing foot's path and servo as
@@ -28,7 +30,9 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                   'Footstep', 'circle_steps', 'placed', 'straight_steps', 'window', 'wrap_angle'],
     'status_flags': ['CATCHING', 'ERROR_INCONSISTENT_STEPS', 'OKAY', 'STEPPING', 'SWAYING',
                      'WARNING_INSUFFICIENT_STEP_DATA'],
-    'swing': ['SWING_HEIGHT_M'],
+    'swing': ['END_CLEARANCE_M', 'SWING_HEIGHT_M', 'sole_frame', 'surface_tilt',
+              'swing_height_m'],
+    'feet_surfaces': ['FeetSurfaces', 'support_height_m'],
     'compiled_swing': ['CompiledSwing'],
     'compiled_legs': ['CompiledLegs'],
     'leg_tasks': ['LEGS_ENV', 'SWING_ENV'],

@@ -25,7 +25,7 @@ if TYPE_CHECKING:
     from tutorial_atlas_control.walking.swing import SwingPath
 
 #: The input's size and layout (src/atlas_swing.c's enum).
-IN_SIZE = 119
+IN_SIZE = 125
 LEG = 6
 
 
@@ -43,6 +43,8 @@ class CompiledSwing:
         self._inertia = buffer[60:96].reshape(LEG, LEG)
         self._target = buffer[96:108]  # position, velocity, yaw, yaw rate, acceleration, ...
         self._path = buffer[108:119]   # start, end, their yaws, duration, height, time into it
+        self._tilt = buffer[119:121]   # the target's tilt
+        self._path_tilts = buffer[121:125]  # the path's tilts at lift-off and touchdown
         call = self._call = AtlasSwing()
         call.in_ = address(self._in, np.float64)
         call.torque = address(self._torque, np.float64)
@@ -71,6 +73,7 @@ class CompiledSwing:
         path[3:6] = swing.end
         path[6:10] = (swing.start_yaw_rad, swing.end_yaw_rad, swing.duration_s,
                       swing.height_m)
+        self._path_tilts[:] = (*swing.start_tilt, *swing.end_tilt)
         self._last_path = swing
 
     def prepare_swing(self, elapsed_s: float) -> None:
@@ -105,9 +108,10 @@ class CompiledSwing:
     def foot_servo(self, state: BalanceState, joint_velocities: np.ndarray, leg: slice,
                    foot: int, target: tuple[np.ndarray, np.ndarray, float, float,
                                             np.ndarray | None, float],
-                   world: bool) -> np.ndarray:
+                   world: bool, tilt: tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
         """LegTasks.foot_servo's torques (joints,), a new array; `target`: position,
-        velocity, yaw, yaw rate, acceleration (None: none fed forward), yaw acceleration."""
+        velocity, yaw, yaw rate, acceleration (None: none fed forward), yaw acceleration;
+        `tilt`: the sole's (swing.surface_tilt)."""
         self._load(state, joint_velocities, leg, foot)
         position, velocity, yaw, yaw_rate, acceleration, yaw_acceleration = target
         values = self._target
@@ -116,6 +120,7 @@ class CompiledSwing:
         values[6], values[7] = yaw, yaw_rate
         values[8:11] = 0.0 if acceleration is None else acceleration
         values[11] = yaw_acceleration
+        self._tilt[:] = tilt
         call = self._call
         call.world, call.feedforward = int(world), int(acceleration is not None)
         self._library.atlas_foot_servo(self._pointer)

@@ -46,12 +46,11 @@ from tutorial_atlas_control.balance import (
     smoothstep,
     smoothstep_rate,
     yaw_of,
-    yaw_rotation,
 )
 from tutorial_atlas_control.walking.compiled_legs import CompiledLegs
 from tutorial_atlas_control.walking.compiled_swing import CompiledSwing
 from tutorial_atlas_control.walking.footsteps import Footstep, wrap_angle
-from tutorial_atlas_control.walking.swing import SwingPath, quintic
+from tutorial_atlas_control.walking.swing import SwingPath, quintic, sole_frame, surface_tilt
 
 __all__ = ['LEGS_ENV', 'LEG_JOINTS', 'SWING_ENV', 'LegGains', 'LegTasks', 'foot_pose']
 
@@ -209,6 +208,7 @@ class LegTasks:
                                              swing, elapsed_s)
         gains = self.gains
         position, velocity, yaw, yaw_rate = swing.at(elapsed_s)
+        tilt = swing.tilt(elapsed_s)
         acceleration, yaw_acceleration = (swing.acceleration(elapsed_s)
                                           if gains.swing_feedforward else (None, 0.0))
         position[2] -= gains.swing_press_m * quintic(elapsed_s / swing.duration_s)[0]
@@ -218,28 +218,31 @@ class LegTasks:
             velocity[2] = -gains.touchdown_speed_m_s
         return self.foot_servo(state, joint_velocities, foot, position, velocity, yaw,
                                yaw_rate, acceleration, yaw_acceleration,
-                               world=gains.world_velocity)
+                               world=gains.world_velocity, tilt=tilt)
 
     def foot_servo(self, state: BalanceState, joint_velocities: np.ndarray, foot: int,
                    position: np.ndarray, velocity: np.ndarray, yaw: float,
                    yaw_rate: float, acceleration: np.ndarray | None = None,
-                   yaw_acceleration: float = 0.0, world: bool = False) -> np.ndarray:
+                   yaw_acceleration: float = 0.0, world: bool = False,
+                   tilt: tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
         """The leg's torques (28,) moving a sole towards a pose at a velocity (the module's
         joint-space servo), with `acceleration` (the sole's, and its yaw's) fed forward
         through the same inverse; `world`: damping the sole's velocity in the world (a
         swing foot's path is in the world, the pelvis's motion adds to it) rather than the
-        leg's joint velocities (a foot put back down: its pelvis moves over it)."""
+        leg's joint velocities (a foot put back down: its pelvis moves over it); `tilt`:
+        the sole laid on a sloping surface (swing.surface_tilt), not upright."""
         leg = LEG_OF_FOOT[foot]
         if self._kernel is not None:
             return self._kernel.foot_servo(
                 state, joint_velocities, leg, foot,
-                (position, velocity, yaw, yaw_rate, acceleration, yaw_acceleration), world)
+                (position, velocity, yaw, yaw_rate, acceleration, yaw_acceleration), world,
+                tilt)
         gains = self.gains
         jacobian = state.sole_jacobians[foot][:, leg]
         columns = 2 if acceleration is None else 3
         targets = np.zeros((6, columns))  # the pose's error, the velocity asked for, ...
         targets[0:3, 0] = position - state.sole_centres[foot]
-        targets[3:6, 0] = orientation_error(state.sole_rotations[foot], yaw_rotation(yaw))
+        targets[3:6, 0] = orientation_error(state.sole_rotations[foot], sole_frame(yaw, tilt))
         targets[0:3, 1] = velocity
         targets[5, 1] = yaw_rate
         if world:
@@ -270,7 +273,7 @@ class LegTasks:
         """A foot off the ground while both should be down: back onto `pose`."""
         target = np.array([pose.x_m, pose.y_m, pose.z_m - self.gains.press_m])
         return self.foot_servo(state, joint_velocities, foot, target, np.zeros(3),
-                               pose.yaw_rad, 0.0)
+                               pose.yaw_rad, 0.0, tilt=surface_tilt(pose.normal))
 
     def torque(self, state: BalanceState, joint_positions: np.ndarray,
                joint_velocities: np.ndarray, time_s: float, cop: np.ndarray,

@@ -29,7 +29,7 @@ import numpy as np
 from tutorial_atlas_control.balance import BalanceState, smoothstep, yaw_of
 from tutorial_atlas_control.walking.footsteps import Footstep
 from tutorial_atlas_control.walking.status_flags import CATCHING, STEPPING, SWAYING
-from tutorial_atlas_control.walking.swing import SwingPath
+from tutorial_atlas_control.walking.swing import SwingPath, surface_tilt, swing_height_m
 
 __all__ = ['STATIC_STEP_PHASES', 'WALK_PHASES', 'Phase', 'PhaseEnd', 'PhaseSequence',
            'WeightTransfer', 'carried_share', 'settled', 'swing_to']
@@ -168,9 +168,14 @@ class PhaseSequence:
         self.done = True
 
 
-def swing_to(state: BalanceState, step: Footstep, duration_s: float) -> SwingPath:
-    """The swing of `step`'s foot from where its sole is now to the step's pose (its height
-    too: the surface it lands on) in `duration_s`."""
+def swing_to(state: BalanceState, step: Footstep, duration_s: float,
+             start_normal: tuple[float, float, float] = (0.0, 0.0, 1.0)) -> SwingPath:
+    """The swing of `step`'s foot from where its sole is now (on a surface of
+    `start_normal`) to the step's pose (its height and normal too: the surface it lands
+    on) in `duration_s`, its apex clear of the higher end."""
     foot = step.foot_index
-    return SwingPath(state.sole_centres[foot].copy(), np.array([step.x_m, step.y_m, step.z_m]),
-                     yaw_of(state.sole_rotations[foot]), step.yaw_rad, duration_s)
+    start = state.sole_centres[foot].copy()
+    return SwingPath(start, np.array([step.x_m, step.y_m, step.z_m]),
+                     yaw_of(state.sole_rotations[foot]), step.yaw_rad, duration_s,
+                     swing_height_m(float(start[2]), step.z_m), surface_tilt(start_normal),
+                     surface_tilt(step.normal))

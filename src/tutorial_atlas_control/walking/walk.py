@@ -18,7 +18,9 @@ Each 1 ms tick: the pressure centre p = p_ref + (1 + k)(xi - xi_ref), and leg_ta
 turns it into torques (the Stand's whole-body law on the carrying soles, the swing foot's
 joint-space servo, feet put back down). The CoM walks 5 cm lower than it stands, but not
 below the Stand pose's height over the ground less that and LOWEST_WALK_MARGIN_M: a Stand
-already lowered (its legs not reaching a foot that landed turned) walks at its height. While a
+already lowered (its legs not reaching a foot that landed turned) walks at its height; that
+height is over the feet's surfaces (feet_surfaces), moving up or down with them step by step
+on a slope. While a
 foot swings, its landing moves with the capture point's error predicted at touchdown
 (step_adjustment): a push that the stance sole cannot take back is caught by where the foot
 comes down, within the step limits, and the queue reports the step so moved.
@@ -39,6 +41,7 @@ from tutorial_atlas_control.balance import (
     dcm_feedback_cop,
 )
 from tutorial_atlas_control.walking.dcm_plan import DcmPlan
+from tutorial_atlas_control.walking.feet_surfaces import FeetSurfaces
 from tutorial_atlas_control.walking.footsteps import Footstep
 from tutorial_atlas_control.walking.leg_tasks import LegGains, LegTasks, foot_pose
 from tutorial_atlas_control.walking.phases import (
@@ -109,9 +112,11 @@ class WalkController:
 
     def __init__(self, stand: StandController, queue: StepQueue, state: BalanceState,
                  time_s: float, gains: WalkGains | None = None,
-                 standing_height_m: float | None = None) -> None:
+                 standing_height_m: float | None = None,
+                 surfaces_m: tuple[float, float] = (0.0, 0.0)) -> None:
         """`standing_height_m`: the Stand pose's CoM height (m, world z) over the ground
-        here; None: the walk lowers the CoM walk_lowering_m from where it starts."""
+        here; None: the walk lowers the CoM walk_lowering_m from where it starts.
+        `surfaces_m`: the ground's height (m) under each sole here (left, right)."""
         self.stand = stand
         self.queue = queue
         self.gains = gains or WalkGains()
@@ -133,7 +138,9 @@ class WalkController:
         self._transfer_from = self._last_cop
         #: The sole that landed last, on its step's surface (None before the first step).
         self._landed: Footstep | None = None
-        #: The CoM height the walk starts from and returns to (m).
+        #: Each foot's surface: the walk's heights follow their mean from where it began.
+        self.surfaces = FeetSurfaces(surfaces_m)
+        #: The CoM height the walk starts from and returns to (m, where it began).
         self.stand_height_m = stand.reference.com_height_m
         #: The CoM height the walk walks at (m).
         self.walk_height_m = self.stand_height_m - self.gains.walk_lowering_m
@@ -190,6 +197,9 @@ class WalkController:
         self.step = self._planned_step = step
         stance = self.queue.feet[1 - step.foot_index]
         self.legs.face(stance.yaw_rad, step.yaw_rad, time_s, step.duration_s)
+        if self.surfaces.step(step.foot_index, step.z_m, time_s, step.duration_s):  # the CoM
+            self.legs.move_height(self.surfaces.over_feet_m(self.walk_height_m), time_s,
+                                  step.duration_s)
         self.swing, self._lift_off_s = None, None  # the swing begins once the weight moved
         self._transfer_from = self._last_cop
         self.phases.enter(phase, time_s,
@@ -198,7 +208,8 @@ class WalkController:
     def _begin_catch(self, phase: Phase, time_s: float) -> None:
         self.legs.face(self.queue.feet[0].yaw_rad, self.queue.feet[1].yaw_rad, time_s,
                        self.gains.catch_s)
-        self.legs.move_height(self.stand_height_m, time_s, self.gains.catch_s)
+        self.legs.move_height(self.surfaces.over_feet_m(self.stand_height_m), time_s,
+                              self.gains.catch_s)
         self.step, self.swing, self._plan = None, None, None
         self.phases.enter(phase, time_s, PhaseEnd(self.gains.catch_s, self.gains.longest_catch_s))
 
@@ -220,7 +231,8 @@ class WalkController:
         if not phases.ended(time_s, self._condition(state)):
             return
         if phases.phase is _SWING and step is not None:
-            landed = foot_pose(state, step.foot_index, step.step_index)
+            landed = replace(foot_pose(state, step.foot_index, step.step_index),
+                             normal=step.normal)  # on its step's surface
             self.queue.touchdown(landed)
             self._landed = replace(landed, z_m=step.z_m)
         following = phases.following(more_steps=bool(self.queue.preview()))
@@ -258,7 +270,8 @@ class WalkController:
                               state.sole_centres[stance][0:2])
         if self.gains.transfer.lifts(elapsed, step.duration_s, flat, share):
             self._lift_off_s = elapsed
-            self.swing = swing_to(state, step, step.duration_s - elapsed)
+            self.swing = swing_to(state, step, step.duration_s - elapsed,
+                                  self.queue.feet[step.foot_index].normal)
 
     def _transfer_cop(self, cop: np.ndarray, time_s: float) -> np.ndarray:
         """The pressure centre while the weight moves: from where it was as the step began

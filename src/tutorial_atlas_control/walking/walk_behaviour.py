@@ -6,19 +6,23 @@ itself does), builds a step queue from the feet as they are, and walks `next_ste
 before the start from an AtlasSimInterfaceCommand's queue) or, without them, its default
 steps (DRCSim's fixed queue: /atlas/control_mode Walk). Steps offered while it walks
 join the queue by index. Once the walk has caught itself after its last step it is
-`done`: the interface then hands the robot back to Stand.
+`done`: the interface then hands the robot back to Stand. The feet stand on the ground
+under their soles (its height and normal, from the Stand's ground), and each tick the
+estimator's pendulum ground is the walk's support height (feet_surfaces): on a slope omega
+is the CoM's height over the feet, not over z 0; it stays there for the Stand after.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import mujoco
 import numpy as np
 
 from tutorial_atlas_control.balance import BalanceState, StandBehaviour
 from tutorial_atlas_control.walking.errors import WalkingError
+from tutorial_atlas_control.walking.feet_surfaces import support_height_m
 from tutorial_atlas_control.walking.footsteps import DRCSIM_WALK_QUEUE, Footstep
 from tutorial_atlas_control.walking.leg_tasks import foot_pose
 from tutorial_atlas_control.walking.status_flags import STEPPING
@@ -85,11 +89,18 @@ class WalkBehaviour:
         stand.start(data)
         controller, state = stand.controller, stand.last_state
         assert controller is not None and state is not None  # set by start
-        queue = StepQueue(foot_pose(state, 0), foot_pose(state, 1), self.limits)
+        under = stand.ground_under_soles(state)  # each sole's surface: its height, normal
+        ground = support_height_m(under[0][0], under[1][0])
+        if stand.estimator.ground_m != ground:  # the pendulum over the feet from the start
+            stand.estimator.ground_m = ground
+            state = stand.estimator.estimate(data.qpos, data.qvel)
+        queue = StepQueue(*(replace(foot_pose(state, foot), normal=under[foot][1])
+                            for foot in (0, 1)), self.limits)
         queue.offer(self.default_steps if self.next_steps is None else self.next_steps)
         self.next_steps = None
         self.walk = WalkController(controller, queue, state, float(data.time), self.gains,
-                                   stand.ground_under_m(state) + stand.com_height_m)
+                                   stand.ground_under_m(state) + stand.com_height_m,
+                                   (under[0][0], under[1][0]))
 
     def torque(self, data: mujoco.MjData) -> np.ndarray:
         """This tick's f_out (N m, (28,)), within the effort limits."""
@@ -97,6 +108,9 @@ class WalkBehaviour:
         if walk is None:
             raise WalkingError('WalkBehaviour.torque before start()')
         stand, atlas = self.stand, self.stand.atlas
+        ground = walk.surfaces.support_at(float(data.time))
+        if ground != stand.estimator.ground_m:  # on level ground never: no C field written
+            stand.estimator.ground_m = ground
         state = stand.estimator.estimate(data.qpos, data.qvel)
         self.last_state = state
         return walk.tick_torque(state, data.qpos[atlas.qpos_adr], data.qvel[atlas.dof_adr],

@@ -1,6 +1,7 @@
 """The compiled estimate (src/atlas_estimator.c) agrees with the Python reference to 1e-9 on
 every field of BalanceState, tick by tick through a walking trial: standing, single support,
-touchdowns, a swing foot in the air, and the robot lifted clear of the ground."""
+touchdowns, a swing foot in the air, and the robot lifted clear of the ground; and with the
+pendulum's ground moved (a walk on a slope), omega that of the CoM's height over it."""
 
 from __future__ import annotations
 
@@ -81,11 +82,14 @@ def _worst(compiled: BalanceState, python: BalanceState) -> float:
 
 
 def _compare(atlas: atlas_model.AtlasModel,
-             ticks: list[tuple[np.ndarray, np.ndarray]]) -> tuple[float, set]:
-    """The worst difference over `ticks`, and the contact cases they covered."""
+             ticks: list[tuple[np.ndarray, np.ndarray]],
+             ground_m: float = 0.0) -> tuple[float, set]:
+    """The worst difference over `ticks` with the pendulum's ground at `ground_m`, and the
+    contact cases they covered."""
     compiled, python = BalanceEstimator(atlas, compiled=True), BalanceEstimator(atlas,
                                                                                 compiled=False)
     assert compiled.compiled and not python.compiled
+    compiled.ground_m = python.ground_m = ground_m
     worst, cases, previous = 0.0, set(), None
     for qpos, qvel in ticks:
         ours, theirs = compiled.estimate(qpos, qvel), python.estimate(qpos, qvel)
@@ -104,6 +108,22 @@ def test_compiled_estimate_agrees_with_python_through_a_walk(
     assert worst < TOLERANCE
     assert {(True, True), (False, False), 'touchdown'} <= cases
     assert (True, False) in cases or (False, True) in cases
+
+
+def test_the_pendulum_over_a_moved_ground_agrees_and_is_its_height_over_it(
+        library, atlas: atlas_model.AtlasModel,
+        walking_ticks: list[tuple[np.ndarray, np.ndarray]]) -> None:
+    worst, _ = _compare(atlas, walking_ticks[::10], ground_m=-0.4)
+    assert worst < TOLERANCE
+    for compiled in (True, False):
+        estimator = BalanceEstimator(atlas, compiled=compiled)
+        qpos, qvel = walking_ticks[0]
+        level = estimator.estimate(qpos, qvel)
+        estimator.ground_m = -0.4  # the feet 0.4 m down a slope: the CoM 0.4 m higher over them
+        lowered = estimator.estimate(qpos, qvel)
+        assert lowered.omega == pytest.approx(9.81 ** 0.5 / (level.com[2] + 0.4) ** 0.5,
+                                              rel=1e-3)
+        assert lowered.omega < 0.85 * level.omega
 
 
 def test_contact_rows_beyond_the_flat_output_are_fetched_whole(

@@ -1,7 +1,7 @@
 """The compiled swing servo (src/atlas_swing.c) agrees with LegTasks' Python to 1e-9: every
 swing tick of a two-step walk, and at states of that walk, random targets and paths (joint
 or world damping, with and without an acceleration fed forward, before, inside and after a
-path's time, turns across the heading's wrap)."""
+path's time, turns across the heading's wrap, soles upright and tilted onto slopes)."""
 
 from __future__ import annotations
 
@@ -55,13 +55,17 @@ def _random_cases(legs: LegTasks, state: BalanceState, velocities: np.ndarray,
         args = (state, velocities, foot, position, rng.normal(0.0, 0.5, 3), yaw,
                 float(rng.normal(0.0, 0.5)), acceleration, float(rng.normal(0.0, 2.0)))
         world = bool(case % 3)
-        ours = _compiled(legs, 'foot_servo', *args, world=world)
+        tilted = case % 2 == 1  # half the cases on a slope of up to about 20 degrees
+        tilt = tuple(rng.normal(0.0, 0.2, 2).tolist()) if tilted else (0.0, 0.0)
+        ours = _compiled(legs, 'foot_servo', *args, world=world, tilt=tilt)
         differences.append(float(np.max(np.abs(
-            ours - _in_python(legs, 'foot_servo', *args, world=world)))))
-        # A path ending across the heading's wrap, at a time before, in or after it.
+            ours - _in_python(legs, 'foot_servo', *args, world=world, tilt=tilt)))))
+        # A path ending across the heading's wrap, at a time before, in or after it, from
+        # one surface's tilt to another's.
+        end_tilt = tuple(rng.normal(0.0, 0.2, 2).tolist()) if tilted else (0.0, 0.0)
         path = SwingPath(centre.copy(), centre + rng.normal(0.0, 0.2, 3),
                          math.pi - 0.1, -math.pi + float(rng.uniform(0.0, 0.3)),
-                         float(rng.uniform(0.4, 0.8)))
+                         float(rng.uniform(0.4, 0.8)), start_tilt=tilt, end_tilt=end_tilt)
         elapsed = float(rng.uniform(-0.1, 1.3)) * path.duration_s
         ours = _compiled(legs, 'swing_torque', state, velocities, foot, path, elapsed)
         differences.append(float(np.max(np.abs(
