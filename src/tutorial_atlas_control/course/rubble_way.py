@@ -32,9 +32,10 @@ __all__ = ['CLEARANCE_M', 'GRID_M', 'block_footprint', 'clear_path', 'distance_t
 
 #: Grid cell (m).
 GRID_M = 0.05
-#: A foot's centre line to a block's edge (m): half the feet's stance width (0.12) and half a
-#: sole's (0.07), a swing's sway and the route's tracking, with room to spare.
-CLEARANCE_M = 0.45
+#: The walker's centre line to a block's edge (m): half the feet's stance width (0.12) and half a
+#: sole's (0.07), a swing's sway and the route's tracking, with room to spare (at 0.45 a walk
+#: fell beside a block, 0.18 m from its left sole's edge).
+CLEARANCE_M = 0.55
 #: A shortened path's straight lines may pass this much (m) nearer than the clearance: the
 #: grid path hugs the clearance's edge, and lines between its cells cut it by a cell or two.
 SHORTCUT_SLACK_M = 0.1

@@ -33,7 +33,8 @@ def test_the_mud_covers_the_walk_to_its_depth_and_pushes_nothing(tmp_path: Path)
 
 @pytest.mark.parametrize(('args', 'line'), [
     (['mud_9', '1'], "terrain_walk.py: error: argument CASE: invalid choice: 'mud_9' (choose "
-     "from 'down_16deg', 'down_8deg', 'mud_40', 'mud_70', 'up_16deg', 'up_8deg')"),
+     "from 'down_16deg', 'down_8deg', 'mud_40', 'mud_70', 'ramp_down_22deg', 'ramp_up_22deg', "
+     "'up_16deg', 'up_8deg')"),
     (['mud_40', 'x'], "terrain_walk.py: error: argument SEED: seed 'x' is not an integer or "
      'none'),
     (['--push', '-1', 'mud_40', '1'], "terrain_walk.py: error: argument --push: '-1' must be a "
