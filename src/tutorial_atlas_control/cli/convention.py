@@ -138,3 +138,15 @@ def chosen_bag(args: argparse.Namespace, doing: str) -> str:
     newest = newest_bag()
     print(f'{doing} {newest.path} (the newest bag{newest.skipped_note()})', file=sys.stderr)
     return str(newest.path)
+
+
+def add_dask_arguments(parser: argparse.ArgumentParser, progress: bool = True) -> None:
+    """--workers and --scheduler (and --no-progress) of the scripts whose runs are Dask
+    tasks (search/sweep.py's engine)."""
+    parser.add_argument('--workers', type=whole_number(1), default=None, metavar='N',
+                        help='local cluster size (default: one per core; 1: the runs in this '
+                             'process, no cluster)')
+    parser.add_argument('--scheduler', metavar='ADDRESS',
+                        help='use this Dask scheduler (e.g. tcp://host:8786), not a local cluster')
+    if progress:
+        parser.add_argument('--no-progress', action='store_true', help='no progress bar')

@@ -11,9 +11,9 @@ from pathlib import Path
 from tutorial_atlas_control.cli.convention import (
     EXIT_INTERRUPTED,
     EXIT_REFUSED,
+    add_dask_arguments,
     print_error,
     seed_or_none,
-    whole_number,
 )
 from tutorial_atlas_control.course import COURSE_VARIANTS, GATES, STARTS
 from tutorial_atlas_control.errors import AtlasControlError
@@ -52,14 +52,9 @@ def build_parser() -> argparse.ArgumentParser:
                                               '%(default)s, the pen)')
     parser.add_argument('--to', default=GATES[-1].name, choices=[g.name for g in GATES],
                         metavar='GATE', help='the last gate (default: %(default)s)')
-    parser.add_argument('--workers', type=whole_number(1), default=None, metavar='N',
-                        help='local cluster size (default: one per core; 1: the runs in this '
-                             'process, no cluster)')
-    parser.add_argument('--scheduler', metavar='ADDRESS',
-                        help='use this Dask scheduler (e.g. tcp://host:8786), not a local cluster')
     parser.add_argument('--out', type=Path, default=Path('course_sweep'), metavar='OUT',
                         help='prefix: OUT.csv, OUT.json, OUT.md (default: %(default)s)')
-    parser.add_argument('--no-progress', action='store_true', help='no progress bar')
+    add_dask_arguments(parser)
     return parser
 
 

@@ -10,6 +10,7 @@ from pathlib import Path
 from tutorial_atlas_control.cli.convention import (
     EXIT_INTERRUPTED,
     EXIT_REFUSED,
+    add_dask_arguments,
     print_error,
     whole_number,
 )
@@ -95,10 +96,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument('--gains-out', type=Path, metavar='FILE',
                         help='where the best gains are written (default: OUT_gains.yaml beside '
                              '--yaml, when gains are searched)')
-    parser.add_argument('--workers', type=whole_number(1), default=None, metavar='N',
-                        help='local cluster size (default: one per core; 1: the runs in this '
-                             'process, no cluster)')
-    parser.add_argument('--scheduler', metavar='ADDRESS', help='use this Dask scheduler')
+    add_dask_arguments(parser, progress=False)
     return parser
 
 

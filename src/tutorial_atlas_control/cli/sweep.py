@@ -10,6 +10,7 @@ from pathlib import Path
 from tutorial_atlas_control.cli.convention import (
     EXIT_INTERRUPTED,
     EXIT_REFUSED,
+    add_dask_arguments,
     positive_number,
     print_error,
     whole_number,
@@ -69,14 +70,9 @@ def build_parser() -> argparse.ArgumentParser:
                         help='sim time after the last waypoint (default: %(default)g)')
     parser.add_argument('--seed', type=int, default=0,
                         help='first row\'s seed; row k has SEED + k (default: 0)')
-    parser.add_argument('--workers', type=whole_number(1), default=None, metavar='N',
-                        help='local cluster size (default: one per core; 1: the runs in this '
-                             'process, no cluster)')
-    parser.add_argument('--scheduler', metavar='ADDRESS',
-                        help='use this Dask scheduler (e.g. tcp://host:8786), not a local cluster')
     parser.add_argument('--out', type=Path, default=Path('sweep'), metavar='OUT',
                         help='table prefix: OUT.csv and OUT.json (default: %(default)s)')
-    parser.add_argument('--no-progress', action='store_true', help='no progress bar')
+    add_dask_arguments(parser)
     return parser
 
 

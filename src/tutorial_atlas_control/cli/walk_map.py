@@ -11,6 +11,7 @@ from pathlib import Path
 from tutorial_atlas_control.cli.convention import (
     EXIT_INTERRUPTED,
     EXIT_REFUSED,
+    add_dask_arguments,
     positive_number,
     print_error,
     whole_number,
@@ -48,14 +49,9 @@ def build_parser() -> argparse.ArgumentParser:
                         help='the first seed; seeds K..K+N-1 (default: 0)')
     parser.add_argument('--steps', type=whole_number(1), default=20, metavar='N',
                         help='steps of each walk (default: 20)')
-    parser.add_argument('--workers', type=whole_number(1), default=None, metavar='N',
-                        help='local cluster size (default: one per core; 1: the runs in this '
-                             'process, no cluster)')
-    parser.add_argument('--scheduler', metavar='ADDRESS',
-                        help='use this Dask scheduler (e.g. tcp://host:8786), not a local cluster')
     parser.add_argument('--out', type=Path, default=Path('walk_map'), metavar='OUT',
                         help='prefix: OUT.csv, OUT_runs.csv, OUT.png (default: %(default)s)')
-    parser.add_argument('--no-progress', action='store_true', help='no progress bar')
+    add_dask_arguments(parser)
     return parser
 
 
