@@ -187,6 +187,19 @@ def _within(difference: np.ndarray, tolerance: float) -> bool:
     return -tolerance < min(values) and max(values) < tolerance and not math.isnan(sum(values))
 
 
+def _bodies_collide_as_their_geoms(model: mujoco.MjModel) -> None:
+    """Each body's contype and conaffinity set to its geoms' (their bitwise or), as the
+    compiler makes them: the broad phase skips a body by these, so a copy whose geoms were
+    switched off there still sorted every robot body (mj_collision 14.6 us a call on the
+    flat world, 5.5 us once they say none collides; the same contacts, bit for bit)."""
+    contype = np.zeros(model.nbody, dtype=model.body_contype.dtype)
+    conaffinity = np.zeros(model.nbody, dtype=model.body_conaffinity.dtype)
+    np.bitwise_or.at(contype, model.geom_bodyid, model.geom_contype)
+    np.bitwise_or.at(conaffinity, model.geom_bodyid, model.geom_conaffinity)
+    model.body_contype[:] = contype
+    model.body_conaffinity[:] = conaffinity
+
+
 class BalanceEstimator:
     """Turns (qpos, qvel) into a BalanceState with a scratch MjData of its own.
 
@@ -214,6 +227,7 @@ class BalanceEstimator:
         # heightfield: hundreds of contacts a call); the soles still meet all of it.
         world = ~robot
         self.model.geom_contype[world] = 0
+        _bodies_collide_as_their_geoms(self.model)
         self._sole_bodies = [int(self.model.geom_bodyid[g]) for g in self._soles]
         self._pelvis = atlas.pelvis_body_id
         self._jac = np.zeros((2, 6, self.model.nv))  # [linear; angular] per sole
