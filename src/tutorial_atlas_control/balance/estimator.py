@@ -47,7 +47,7 @@ from tutorial_atlas_control.balance.compiled_estimator import (
     RawEstimate,
 )
 from tutorial_atlas_control.balance.sole import BOTTOM_CORNER_SIGNS, SoleBox, sole_geom_ids
-from tutorial_atlas_control.sim import AtlasModel
+from tutorial_atlas_control.sim import AtlasModel, passes_current
 
 #: A sole within this of a surface (m) touches it and carries weight: the soles' collision
 #: margin in the estimator's copy of the model.
@@ -187,6 +187,14 @@ def _within(difference: np.ndarray, tolerance: float) -> bool:
     return -tolerance < min(values) and max(values) < tolerance and not math.isnan(sum(values))
 
 
+def _sized_as(model: mujoco.MjModel, data: mujoco.MjData) -> bool:
+    """Whether `data` is of a model sized as `model` in every array the compiled estimate
+    copies from a simulator's MjData (atlas_estimate_stepped)."""
+    sizes = (data.qpos.shape[0], data.qvel.shape[0], data.xpos.shape[0], data.xanchor.shape[0],
+             data.geom_xpos.shape[0], data.site_xpos.shape[0])
+    return sizes == (model.nq, model.nv, model.nbody, model.njnt, model.ngeom, model.nsite)
+
+
 def _bodies_collide_as_their_geoms(model: mujoco.MjModel) -> None:
     """Each body's contype and conaffinity set to its geoms' (their bitwise or), as the
     compiler makes them: the broad phase skips a body by these, so a copy whose geoms were
@@ -253,6 +261,7 @@ class BalanceEstimator:
         #: Each joint slice's dof indices: a slice where they run on (a leg's do), else
         #: an index array.
         self._inertia_index: dict[tuple[int, int], tuple[slice, slice] | tuple] = {}
+        self._sized_data: mujoco.MjData | None = None  # the last found _sized_as the copy
         self._mass_matrix_source = (self.model._address, self.scratch._address,
                                     int(self.model.nv), np.asarray(self._dof_adr, dtype=np.intp))
         library = native.chosen_library(ESTIMATOR_ENV, compiled)
@@ -363,7 +372,22 @@ class BalanceEstimator:
         """The state at (qpos, qvel) (the full MuJoCo vectors)."""
         if self._kernel is None:
             return self._estimate_in_python(qpos, qvel)
-        raw = self._kernel.run(qpos, qvel)
+        return self._state_of(self._kernel.run(qpos, qvel))
+
+    def estimate_stepped(self, data: mujoco.MjData) -> BalanceState:
+        """estimate(data.qpos, data.qvel), bit for bit, read from the simulator's own passes
+        while its step has them current (sim.shared_passes: within a behaviour's torque)."""
+        kernel = self._kernel
+        if kernel is None or not passes_current(data):
+            return self.estimate(data.qpos, data.qvel)
+        if data is not self._sized_data:
+            if not _sized_as(self.model, data):
+                return self.estimate(data.qpos, data.qvel)
+            self._sized_data = data
+        return self._state_of(kernel.run_stepped(data._address))
+
+    def _state_of(self, raw: RawEstimate) -> BalanceState:
+        """The BalanceState of a compiled estimate's row."""
         self._inertia_current = False
         block, tick = raw.block, raw.tick
         (com, com_velocity, pelvis_position, pelvis_rotation, pelvis_angular_velocity,

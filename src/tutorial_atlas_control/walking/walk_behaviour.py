@@ -97,7 +97,7 @@ class WalkBehaviour:
         if walk is None:
             raise WalkingError('WalkBehaviour.torque before start()')
         stand, atlas = self.stand, self.stand.atlas
-        state = stand.estimator.estimate(data.qpos, data.qvel)
+        state = stand.estimator.estimate_stepped(data)
         self.last_state = state
         return walk.tick_torque(state, data.qpos[atlas.qpos_adr], data.qvel[atlas.dof_adr],
                                 float(data.time)).torque_nm
