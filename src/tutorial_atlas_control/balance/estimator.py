@@ -16,6 +16,11 @@ margin + gap all push). In that copy only the soles collide. Measured on the fla
 mj_collision 8 us a call, which soles touch about 5 us more; their points and normals are
 read only when asked for.
 
+Within the simulator's step (estimate_stepped, sim.shared_passes) the compiled estimate
+copies the kinematics, centres of mass, their velocities and the bias forces that the
+step's mj_step1 has just computed at the same state from the simulator's MjData, and runs
+only the soles' collision and the subtree velocity in its scratch data: the same numbers.
+
 The per-tick work runs as one C call (compiled_estimator, src/atlas_estimator.c) when the
 package's library is built, the Python below otherwise (after one warning) or when
 ESTIMATOR_ENV says `python`: the reference the compiled one is tested against. The C call
