@@ -63,11 +63,21 @@ def python_reference_switches() -> tuple[str, ...]:
     return ESTIMATOR_ENV, STATICS_ENV, SWING_ENV, WHOLE_BODY_ENV, LEGS_ENV
 
 
+def own_passes_switches() -> tuple[str, ...]:
+    """The environment variables that make a simulator step a behaviour with mj_step whole,
+    its estimate computing MuJoCo's passes of its own (sim.shared_passes): the Python
+    reference's way, and the "before" of the shared passes (`python` or `own`)."""
+    from tutorial_atlas_control.sim import SHARED_PASSES_ENV
+
+    return (SHARED_PASSES_ENV,)
+
+
 @contextlib.contextmanager
 def python_reference() -> Iterator[None]:
     """Controllers built inside run their pure Python reference: every compiled part
-    switched off (each part reads its variable when it is built), restored after."""
-    switches = python_reference_switches()
+    switched off (each part reads its variable when it is built), the estimate's passes
+    its own, restored after."""
+    switches = python_reference_switches() + own_passes_switches()
     saved = {name: os.environ.get(name) for name in switches}
     os.environ.update({name: 'python' for name in switches})
     try:

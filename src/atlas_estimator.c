@@ -209,21 +209,13 @@ static int support_polygon(const AtlasEstimator *e, double *out) {
   return vertices;
 }
 
-/* The estimate at (qpos, qvel) (full MuJoCo vectors) into out; returns the sole contacts'
- * row count (rows beyond contact_capacity are not written: atlas_estimator_contacts then). */
-long atlas_estimate(const AtlasEstimator *e) {
-  const mjModel *m = e->model;
+/* The estimate from the scratch data's passes (the state's kinematics, collision, centre of
+ * mass and its velocity, subtree velocity) and the bias forces in e->bias, into out;
+ * returns the sole contacts' row count. */
+static long estimate_from_passes(const AtlasEstimator *e) {
   mjData *d = e->data;
   double *out = e->out;
   long n = e->n;
-  memcpy(d->qpos, e->qpos, m->nq * sizeof(double));
-  memcpy(d->qvel, e->qvel, m->nv * sizeof(double));
-  mj_kinematics(m, d);
-  mj_collision(m, d);
-  mj_comPos(m, d);
-  mj_comVel(m, d);
-  mj_subtreeVel(m, d);
-  mj_rne(m, d, 0, e->bias);
   soles(e, out);
   const double *com = d->subtree_com + 3 * e->pelvis;
   const double *com_velocity = d->subtree_linvel + 3 * e->pelvis;
@@ -251,4 +243,56 @@ long atlas_estimate(const AtlasEstimator *e) {
   out[OUT_POLYGON_KEPT] = kept ? 1.0 : 0.0;
   out[OUT_POLYGON_COUNT] = kept ? 0.0 : (double)support_polygon(e, out);
   return total;
+}
+
+/* The estimate at (qpos, qvel) (full MuJoCo vectors) into out; returns the sole contacts'
+ * row count (rows beyond contact_capacity are not written: atlas_estimator_contacts then). */
+long atlas_estimate(const AtlasEstimator *e) {
+  const mjModel *m = e->model;
+  mjData *d = e->data;
+  memcpy(d->qpos, e->qpos, m->nq * sizeof(double));
+  memcpy(d->qvel, e->qvel, m->nv * sizeof(double));
+  mj_kinematics(m, d);
+  mj_collision(m, d);
+  mj_comPos(m, d);
+  mj_comVel(m, d);
+  mj_subtreeVel(m, d);
+  mj_rne(m, d, 0, e->bias);
+  return estimate_from_passes(e);
+}
+
+#define COPY(field, count) memcpy(d->field, s->field, (size_t)(count) * sizeof(mjtNum))
+
+/* atlas_estimate at the state of `stepped`, the simulator's own MjData after mj_step1 (of a
+ * model the same but for margins and collision flags, sizes checked by the caller): its
+ * position and velocity stages (mj_kinematics, mj_comPos, mj_comVel, and mj_rne's bias
+ * forces: the same functions on the same numbers) copied into the scratch data instead of
+ * computed again; only the soles' collision within their wider margin and the subtree
+ * velocity, which mj_step1 does not compute, run here. `stepped` is read, never written. */
+long atlas_estimate_stepped(const AtlasEstimator *e, const mjData *s) {
+  const mjModel *m = e->model;
+  mjData *d = e->data;
+  long nbody = m->nbody, nv = m->nv;
+  COPY(qpos, m->nq);
+  COPY(qvel, nv);
+  COPY(xpos, 3 * nbody);
+  COPY(xquat, 4 * nbody);
+  COPY(xmat, 9 * nbody);
+  COPY(xipos, 3 * nbody);
+  COPY(ximat, 9 * nbody);
+  COPY(xanchor, 3 * m->njnt);
+  COPY(xaxis, 3 * m->njnt);
+  COPY(geom_xpos, 3 * m->ngeom);
+  COPY(geom_xmat, 9 * m->ngeom);
+  COPY(site_xpos, 3 * m->nsite);
+  COPY(site_xmat, 9 * m->nsite);
+  COPY(subtree_com, 3 * nbody);
+  COPY(cinert, 10 * nbody);
+  COPY(cdof, 6 * nv);
+  COPY(cvel, 6 * nbody);
+  COPY(cdof_dot, 6 * nv);
+  memcpy(e->bias, s->qfrc_bias, (size_t)nv * sizeof(mjtNum));
+  mj_collision(m, d);
+  mj_subtreeVel(m, d);
+  return estimate_from_passes(e);
 }

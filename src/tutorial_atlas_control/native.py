@@ -207,6 +207,8 @@ def _declare(library: ctypes.CDLL) -> None:
     estimator = ctypes.POINTER(AtlasEstimator)
     library.atlas_estimate.argtypes = [estimator]
     library.atlas_estimate.restype = ctypes.c_long
+    library.atlas_estimate_stepped.argtypes = [estimator, ctypes.c_void_p]
+    library.atlas_estimate_stepped.restype = ctypes.c_long
     library.atlas_estimator_contacts.argtypes = [estimator, ctypes.c_void_p, ctypes.c_void_p,
                                                  ctypes.c_long]
     library.atlas_estimator_contacts.restype = ctypes.c_long

@@ -164,6 +164,7 @@ class CompiledEstimate:
         self._polygon_reference: tuple[np.ndarray, np.ndarray] | None = None
         self._pointer = ctypes.byref(kernel)
         self._estimate = library.atlas_estimate
+        self._estimate_stepped = library.atlas_estimate_stepped
         self._count = count
         self._size = FIXED_SIZE + 13 * count + 2 + ROW * CONTACT_CAPACITY
         self._block = OutputBlock(self._size, count)
@@ -189,13 +190,29 @@ class CompiledEstimate:
                                f'expected {self._qpos.shape}, {self._qvel.shape}')
         self._qpos[:] = qpos
         self._qvel[:] = qvel
+        block, tick, row = self._next_row()
+        return self._raw(block, tick, row, self._estimate(self._pointer))
+
+    def run_stepped(self, stepped_address: int) -> RawEstimate:
+        """The estimate at the state of an MjData (its address) whose position and velocity
+        stages mj_step1 has just computed, for a model of the same sizes: those passes read,
+        not run again (atlas_estimate_stepped)."""
+        block, tick, row = self._next_row()
+        return self._raw(block, tick, row,
+                         self._estimate_stepped(self._pointer, stepped_address))
+
+    def _next_row(self) -> tuple[OutputBlock, int, int]:
+        """The next tick's block, row index and row address (set as the kernel's output)."""
         block = self._block
         if block.next == BLOCK_TICKS:
             block = self._block = OutputBlock(self._size, self._count)
         tick = block.next
         block.next = tick + 1
         row = self._kernel.out = block.base + 8 * self._size * tick
-        total = self._estimate(self._pointer)
+        return block, tick, row
+
+    def _raw(self, block: OutputBlock, tick: int, row: int, total: int) -> RawEstimate:
+        """A tick's RawEstimate, the contact rows beyond the row's capacity fetched."""
         overflow = None
         if total > CONTACT_CAPACITY:
             overflow = np.empty((total, ROW))

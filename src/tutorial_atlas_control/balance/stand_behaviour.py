@@ -298,7 +298,7 @@ class StandBehaviour:
         if vectors is None or vectors[0] is not data:
             vectors = self._vectors = (data, data.qpos, data.qvel)
         qpos, qvel = vectors[1], vectors[2]
-        state = self.estimator.estimate(qpos, qvel)
+        state = self.estimator.estimate_stepped(data)
         output = controller.tick(state, qpos[atlas.qpos_adr], qvel[atlas.dof_adr])
         self.last_state, self.last_output = state, output
         return output.torque_nm

@@ -27,7 +27,9 @@ class Behaviour(Protocol):
 
     def torque(self, data: mujoco.MjData) -> np.ndarray:
         """This step's f_out (N m, (28,), the tutorial's joint order) from `data`'s joint
-        positions and velocities; `data` is read, never written."""
+        positions and velocities; `data` is read, never written. Within the simulator's
+        step its body poses and centres of mass are at those positions (sim.shared_passes;
+        with TAC_SHARED_PASSES=own, at the previous step's start)."""
 
 
 class ModeBehaviours:

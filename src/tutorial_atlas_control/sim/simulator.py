@@ -13,7 +13,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import hashlib
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 import mujoco
 import numpy as np
@@ -42,6 +42,7 @@ from tutorial_atlas_control.sim.mode_commands import (
     parse_mode,
 )
 from tutorial_atlas_control.sim.mud import MudDrag
+from tutorial_atlas_control.sim.shared_passes import behaviour_between, shares_passes
 from tutorial_atlas_control.sim.sim_config import SimConfig
 from tutorial_atlas_control.sim.start_pose import home_qpos
 from tutorial_atlas_control.sim.startup_pin import StartupEvent, StartupPin
@@ -81,6 +82,27 @@ def _placed_cheats(atlas: atlas_model.AtlasModel, data: mujoco.MjData, start: St
     return ground, qpos, VrcState(atlas, data, ground, None if start is None else qpos)
 
 
+def _apply_torque(sim: AtlasSimulator, torque_nm: np.ndarray | None
+                  ) -> Callable[[], None] | None:
+    """A step's torque applied by the simulator's law before the step: the law on the mode's
+    command, the acting behaviour's f_out, or `torque_nm` (a recorded torque; None: the
+    law's); or, returned, what applies the behaviour's between mj_step1 and mj_step2 when it
+    steps on the step's own passes (sim.shared_passes)."""
+    law = sim.law
+    if torque_nm is not None:
+        law.set_torque(torque_nm)
+        return None
+    commands = sim.commands
+    behaviour = sim.behaviours.acting
+    if behaviour is None:
+        law.apply(commands.law_command, commands.blend_command)
+    elif sim.shares_passes:
+        return behaviour_between(law, behaviour, sim.data, commands.blend_command)
+    else:
+        law.apply_behaviour(behaviour.torque(sim.data), commands.blend_command)
+    return None
+
+
 class AtlasSimulator:
     """One Atlas in MuJoCo, driven by DRCSim's per-joint controller law. Not thread-safe:
     the ROS node calls every method under its own lock."""
@@ -118,6 +140,8 @@ class AtlasSimulator:
         # VRCPlugin's cheats, pinning at reset_world's pelvis qpos; the world's ground.
         self.ground, self.start_qpos, self.vrc = _placed_cheats(atlas, self.data, start)
         self.mud = MudDrag.for_model(self.model, atlas.path, mud_damping)  # None: no mud
+        #: A behaviour's step is mj_step1, its torque, mj_step2 (sim.shared_passes).
+        self.shares_passes = shares_passes()
         self.startup_pin = StartupPin(atlas, self.data, self.vrc, time_to_unpin_s, startup_mode)
         #: How many inputs were applied since the last reset, and the last one (sim time (ns)
         #: before the step it first acted in, input): /atlas/sim_inputs publishes each for
@@ -299,17 +323,8 @@ class AtlasSimulator:
                 self._playback_step()
                 return
             vrc.warp_step(self.dt_s)
-        if torque_nm is None:
-            commands = self.commands
-            behaviour = self.behaviours.acting
-            if behaviour is None:
-                self.law.apply(commands.law_command, commands.blend_command)
-            else:
-                self.law.apply_behaviour(behaviour.torque(self.data), commands.blend_command)
-        else:
-            self.law.set_torque(torque_nm)
         step_with_body_forces(self.model, self.data, vrc.xfrc if vrc.active else None,
-                              self.mud)
+                              self.mud, _apply_torque(self, torque_nm))
         # mj_step integrates last: joint positions/velocities are at the new time, while body
         # poses and sensor readings were computed before integrating, at the step's start.
         self.state_time_ns = self.sim_time_ns

@@ -107,7 +107,7 @@ class StepBehaviour:
         if static_step is None:
             return stand.torque(data)
         atlas = stand.atlas
-        state = stand.estimator.estimate(data.qpos, data.qvel)
+        state = stand.estimator.estimate_stepped(data)
         was_down = static_step.landed is not None
         torque = static_step.tick_torque(state, data.qpos[atlas.qpos_adr],
                                       data.qvel[atlas.dof_adr], float(data.time))

@@ -111,7 +111,7 @@ class WalkBehaviour:
         ground = walk.surfaces.support_at(float(data.time))
         if ground != stand.estimator.ground_m:  # on level ground never: no C field written
             stand.estimator.ground_m = ground
-        state = stand.estimator.estimate(data.qpos, data.qvel)
+        state = stand.estimator.estimate_stepped(data)
         self.last_state = state
         return walk.tick_torque(state, data.qpos[atlas.qpos_adr], data.qvel[atlas.dof_adr],
                                 float(data.time)).torque_nm
