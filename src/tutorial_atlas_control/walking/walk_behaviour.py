@@ -8,8 +8,11 @@ steps (DRCSim's fixed queue: /atlas/control_mode Walk). Steps offered while it w
 join the queue by index. Once the walk has caught itself after its last step it is
 `done`: the interface then hands the robot back to Stand. The feet stand on the ground
 under their soles (its height and normal, from the Stand's ground), and each tick the
-estimator's pendulum ground is the walk's support height (feet_surfaces): on a slope omega
-is the CoM's height over the feet, not over z 0; it stays there for the Stand after.
+estimator's pendulum ground moves with the walk's support height (feet_surfaces) from where
+it was as the walk began: on a slope omega follows the CoM's height over the feet as they
+rise or fall, not over z 0; it stays there for the Stand after. (Set to the support's own
+height instead, a walk begun on the course's level ground at z 0.03 landed its steps 13 cm
+ahead on average: the walk's gains were found with omega over z 0.)
 """
 
 from __future__ import annotations
@@ -57,6 +60,8 @@ class WalkBehaviour:
         self.limits = limits
         #: The walk under way (None before the first start).
         self.walk: WalkController | None = None
+        #: The estimator's pendulum ground less the feet's support height as the walk began.
+        self.pendulum_offset_m = 0.0
         #: The steps the next start walks (None: default_steps).
         self.next_steps: list[Footstep] | None = None
         #: The state the last tick estimated (None before the first).
@@ -90,10 +95,9 @@ class WalkBehaviour:
         controller, state = stand.controller, stand.last_state
         assert controller is not None and state is not None  # set by start
         under = stand.ground_under_soles(state)  # each sole's surface: its height, normal
-        ground = support_height_m(under[0][0], under[1][0])
-        if stand.estimator.ground_m != ground:  # the pendulum over the feet from the start
-            stand.estimator.ground_m = ground
-            state = stand.estimator.estimate(data.qpos, data.qvel)
+        # The pendulum's ground moves with the feet's support from where it is now.
+        self.pendulum_offset_m = (stand.estimator.ground_m
+                                  - support_height_m(under[0][0], under[1][0]))
         queue = StepQueue(*(replace(foot_pose(state, foot), normal=under[foot][1])
                             for foot in (0, 1)), self.limits)
         queue.offer(self.default_steps if self.next_steps is None else self.next_steps)
@@ -108,7 +112,7 @@ class WalkBehaviour:
         if walk is None:
             raise WalkingError('WalkBehaviour.torque before start()')
         stand, atlas = self.stand, self.stand.atlas
-        ground = walk.surfaces.support_at(float(data.time))
+        ground = walk.surfaces.support_at(float(data.time)) + self.pendulum_offset_m
         if ground != stand.estimator.ground_m:  # on level ground never: no C field written
             stand.estimator.ground_m = ground
         state = stand.estimator.estimate_stepped(data)
