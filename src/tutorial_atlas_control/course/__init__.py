@@ -20,7 +20,7 @@ from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'errors': ['CourseError'],
-    'rubble_way': ['CLEARANCE_M', 'GRID_M', 'block_footprint', 'clear_path',
+    'rubble_way': ['CLEARANCE_M', 'GRID_M', 'block_corners', 'block_footprint', 'clear_path',
                    'distance_to_polygon'],
     'legs': ['COURSE_LEGS', 'LEG_PAUSE_S', 'Leg', 'leg_waypoints', 'legs_ahead'],
     'markers': ['COURSE_AREA', 'MAX_TRIANGLES', 'Area', 'BoxShape', 'CourseShapes',

@@ -28,7 +28,8 @@ from tutorial_atlas_control.course.vrc_task_2 import (
     Block,
 )
 
-__all__ = ['CLEARANCE_M', 'GRID_M', 'block_footprint', 'clear_path', 'distance_to_polygon']
+__all__ = ['CLEARANCE_M', 'GRID_M', 'block_corners', 'block_footprint', 'clear_path',
+           'distance_to_polygon']
 
 #: Grid cell (m).
 GRID_M = 0.05
@@ -55,13 +56,19 @@ def _rotation(block: Block) -> np.ndarray:
             @ np.array([[1.0, 0.0, 0.0], [0.0, cr, -sr], [0.0, sr, cr]]))
 
 
+def block_corners(block: Block) -> np.ndarray:
+    """The world corners (8, 3) of the block's envelope as it lies (its frame at the
+    envelope's bottom centre, turned by Gazebo's roll, pitch, yaw)."""
+    half = np.array(BLOCK_ENVELOPE_M) / 2
+    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+    return ((signs * half + (0.0, 0.0, half[2])) @ _rotation(block).T
+            + (block.x_m, block.y_m, block.z_m))
+
+
 def block_footprint(block: Block) -> np.ndarray:
     """The block's envelope seen from above: its convex hull's corners (k, 2),
     counter-clockwise."""
-    half = np.array(BLOCK_ENVELOPE_M) / 2
-    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
-    corners = (signs * half + (0.0, 0.0, half[2])) @ _rotation(block).T
-    return _hull(corners[:, :2] + (block.x_m, block.y_m))
+    return _hull(block_corners(block)[:, :2])
 
 
 def _hull(points: np.ndarray) -> np.ndarray:

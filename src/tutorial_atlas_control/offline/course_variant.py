@@ -19,12 +19,12 @@ import numpy as np
 
 from tutorial_atlas_control.bags import terrain_heights
 from tutorial_atlas_control.course import (
-    BLOCK_ENVELOPE_M,
     HEIGHTMAP,
     WORLD_MODEL_FILE,
     Block,
     CourseError,
     CourseVariant,
+    block_corners,
 )
 from tutorial_atlas_control.resources import package_path
 from tutorial_atlas_control.sim import AtlasModel, index_model
@@ -66,17 +66,11 @@ def highest_ground_m(heights: np.ndarray, x0: float, x1: float, y0: float, y1: f
 def block_placement(block: Block, heights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The block's body position and quaternion: its pose, raised (never lowered) so that
     its envelope's lowest corner clears the highest ground under it by BLOCK_CLEARANCE_M."""
-    quat = _quaternion(block)
-    rotation = np.zeros(9)
-    mujoco.mju_quat2Mat(rotation, quat)
-    half = np.array(BLOCK_ENVELOPE_M) / 2
-    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
-    corners = ((signs * half + (0.0, 0.0, half[2])) @ rotation.reshape(3, 3).T
-               + (block.x_m, block.y_m, block.z_m))
+    corners = block_corners(block)
     ground = highest_ground_m(heights, corners[:, 0].min(), corners[:, 0].max(),
                               corners[:, 1].min(), corners[:, 1].max())
     lift = max(0.0, ground + BLOCK_CLEARANCE_M - float(corners[:, 2].min()))
-    return np.array([block.x_m, block.y_m, block.z_m + lift]), quat
+    return np.array([block.x_m, block.y_m, block.z_m + lift]), _quaternion(block)
 
 
 def variant_model(variant: CourseVariant) -> AtlasModel:
