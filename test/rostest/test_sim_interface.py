@@ -274,19 +274,22 @@ class SimInterfaceTest(unittest.TestCase):
         self.assertLess(probe.sim_time_s(), 0.5, 'reset_simulation rewinds sim time')
         self.assertAlmostEqual(probe.pelvis_z(), spawn_z, delta=0.002)
 
+        # pause_physics answers once the node has stopped and sent every /clock of the steps
+        # before it; those still on their way arrive, then none: wait until the clock stops,
+        # then watch it stand still. Unpaused whatever happens, for the tests after this one.
         probe.call('/gazebo/pause_physics')
-        # The /clock sent before the pause arrives, then none: wait until it stops, then
-        # watch it stand still.
-        def clock_stopped() -> bool:
-            before_ns = probe.clock_ns
-            time.sleep(CLOCK_QUIET_S)
-            return probe.clock_ns == before_ns
+        try:
+            def clock_stopped() -> bool:
+                before_ns = probe.clock_ns
+                time.sleep(CLOCK_QUIET_S)
+                return probe.clock_ns == before_ns
 
-        probe.wait_until(clock_stopped, 'the clock to stop after pause_physics')
-        paused_ns = probe.clock_ns
-        time.sleep(PAUSE_WATCH_S)  # the window it must stand still in, not a wait
-        self.assertEqual(probe.clock_ns, paused_ns, 'paused physics: clock stands still')
-        probe.call('/gazebo/unpause_physics')
+            probe.wait_until(clock_stopped, 'the clock to stop after pause_physics')
+            paused_ns = probe.clock_ns
+            time.sleep(PAUSE_WATCH_S)  # the window it must stand still in, not a wait
+            self.assertEqual(probe.clock_ns, paused_ns, 'paused physics: clock stands still')
+        finally:
+            probe.call('/gazebo/unpause_physics')
         probe.wait_sim(0.1)
         self.assertGreater(probe.clock_ns, paused_ns)
         probe.set_mode('Stand')

@@ -42,6 +42,9 @@ TIME_WENT_BACK = 'sim time went back'
 #: A reset_world try starts this long (s) after the reset's time, half a 1 ms step: the
 #: simulator's joint state stamped at that time was published before the reset.
 _AFTER_RESET_S = 0.0005
+#: How far (s) a recorder's clock may lag the simulator's: its record time of the config
+#: a reset re-publishes can be that much before the reset (0.44 s seen under load).
+RECORDER_LAG_S = 2.0
 #: A rewind of sim time this close (s, run time) to a config's reset is that reset.
 _SAME_RESET_S = 2.0 * EPOCH_GAP_NS / NS_PER_S
 
@@ -69,6 +72,18 @@ def _last_reset_s(text: str) -> float | None:
         return None
 
 
+def _reset_run_time_s(data: BagData, last_reset_s: float, t_s: float) -> float:
+    """Where on the run timeline the reset_world of a config recorded at `t_s` happened: at
+    its last_reset_time in the latest epoch holding that time, up to RECORDER_LAG_S after
+    `t_s` (a lagging recorder's clock records the config before the reset's time); `t_s`
+    when no epoch does (a config recorded after a rewind that followed its reset)."""
+    for epoch in range(data.epoch_at(t_s), -1, -1):
+        reset_s = data.run_time_s(last_reset_s, epoch)
+        if reset_s <= t_s + RECORDER_LAG_S and data.epoch_at(reset_s) == epoch:
+            return max(reset_s, 0.0)
+    return t_s
+
+
 def _config_resets(data: BagData) -> list[tuple[float, str, str]]:
     """(start, cause, config text) of each reset a re-published config marks."""
     resets = []
@@ -76,7 +91,6 @@ def _config_resets(data: BagData) -> list[tuple[float, str, str]]:
         last_reset_s = _last_reset_s(text)
         if last_reset_s is None:
             continue
-        epoch = data.epoch_at(t_s)
         later = [start for start in data.epoch_starts_s if start > t_s - _SAME_RESET_S]
         if last_reset_s == 0.0 and data.epoch_starts_s and later:
             # reset_simulation: the rewind nearest the config (it may arrive on either side).
@@ -85,7 +99,7 @@ def _config_resets(data: BagData) -> list[tuple[float, str, str]]:
             resets.append((start_s, RESET_SIMULATION, text))
         else:
             # The joint state stamped at the reset time is the last one before it.
-            start_s = min(max(data.run_time_s(last_reset_s, epoch), 0.0), t_s) + _AFTER_RESET_S
+            start_s = _reset_run_time_s(data, last_reset_s, t_s) + _AFTER_RESET_S
             resets.append((start_s, RESET_WORLD, text))
     return resets
 

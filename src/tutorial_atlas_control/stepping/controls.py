@@ -16,7 +16,10 @@ from tutorial_atlas_control.stepping.outputs import LoopOutputs
 from tutorial_atlas_control.stepping.watch import RunWatch
 from tutorial_atlas_control.units import NS_PER_S
 
-__all__ = ['ResetControlsRequest', 'SimControls']
+__all__ = ['PAUSE_WAIT_S', 'ResetControlsRequest', 'SimControls']
+
+#: Wall time (s) pause() waits for the loop to stop: a tick, a flush, a stalled host.
+PAUSE_WAIT_S = 5.0
 
 
 @dataclass(frozen=True)
@@ -49,6 +52,9 @@ class SimControls:
         self._send_config = outputs.publish_config
         self._send_input = outputs.publish_input
         self.paused = paused
+        #: Set by the loop while run() steps (pause() then waits for stopped_for_pause).
+        self.loop_running = False
+        self._stopped = threading.Event()
 
     def reset_controls(self, request: ResetControlsRequest) -> tuple[bool, str]:
         """atlas_msgs/ResetControls, as AtlasPlugin::ResetControls: (success, status).
@@ -135,8 +141,19 @@ class SimControls:
         self.publish_config()
 
     def pause(self) -> None:
-        self.paused = True
+        """Stop stepping. With the loop running, returns once it has stopped and sent what
+        it stepped before (/clock included): whoever paused sees no step after the reply
+        (waits at most PAUSE_WAIT_S for a loop that does not answer)."""
+        with self.lock:
+            self.paused = True
+            self._stopped.clear()
+        if self.loop_running:
+            self._stopped.wait(PAUSE_WAIT_S)
         self.log.info('physics paused')
+
+    def stopped_for_pause(self) -> None:
+        """The loop's word that, paused, it steps no more and has sent all it stepped."""
+        self._stopped.set()
 
     def unpause(self) -> None:
         self.paused = False

@@ -150,25 +150,40 @@ class SteppingLoop:
     def run(self, is_shutdown: Callable[[], bool]) -> int:
         """Step, publish and pace against wall time until `is_shutdown()`; the exit status
         (1: stopped because the physics kept diverging)."""
-        sim, lock, outbox, pacer = self.sim, self.lock, self.outbox, self.pacer
-        controls, inbox, gate, tick = self.controls, self.inbox, self.gate, self.tick
-        paced = pacer.real_time_factor > 0.0  # else there is nothing to wait for
+        sim, lock, outbox, pacer, controls = (self.sim, self.lock, self.outbox, self.pacer,
+                                              self.controls)
         pacer.restart(sim.sim_time_ns)
         with lock:
             self.publisher.publish(self.step_count)  # /clock and the state before the first step
         outbox.flush()
         pacer.flushed()
+        controls.loop_running = True
+        try:
+            self._step_until(is_shutdown)
+        finally:
+            controls.loop_running = False
+            controls.stopped_for_pause()  # nobody waits for a loop that has ended
+        return self.exit_status
+
+    def _step_until(self, is_shutdown: Callable[[], bool]) -> None:
+        """run()'s loop: a tick at a time, or, paused, the commands and a poll."""
+        sim, lock, outbox, pacer = self.sim, self.lock, self.outbox, self.pacer
+        controls, inbox, gate, tick = self.controls, self.inbox, self.gate, self.tick
+        paced = pacer.real_time_factor > 0.0  # else there is nothing to wait for
         while not is_shutdown():
             if controls.paused:
                 with lock:
                     inbox.apply_pending()
                 outbox.flush()
+                controls.stopped_for_pause()
                 pacer.sleep(PAUSED_POLL_S)
                 pacer.restart(sim.sim_time_ns)
                 continue
             if inbox.period_ms:
                 gate.before_step()
             with lock:
+                if controls.paused:  # pause() came after the check above: no more steps
+                    continue
                 if not tick():  # the physics kept diverging
                     self.exit_status = 1
                     break
@@ -179,4 +194,3 @@ class SteppingLoop:
                 outbox.flush()
             if paced:
                 pacer.wait(sim_ns)
-        return self.exit_status

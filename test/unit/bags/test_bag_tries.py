@@ -126,6 +126,26 @@ def test_a_lagging_recorder_keeps_each_message_in_the_try_it_was_stamped_in(
     assert len(states.t_s) == round(SESSION[2].duration_s / 0.01) - 1
 
 
+def test_a_reset_world_recorded_by_a_lagging_recorder_starts_its_try_at_the_reset(
+        tmp_path: Path) -> None:
+    """The config re-published at reset_world reaches a recorder whose clock lags: its record
+    time is before the reset. The try still begins at the reset (the config's
+    last_reset_time), so the robot lying after try 1's fall is no fall of try 2."""
+    records = tries_records(SESSION)
+    at = len(tries_records(SESSION[:1]))
+    config = records[at]
+    assert config.topic == '/atlas/sim_config'
+    late = dataclasses.replace(config, t_s=config.t_s - RECORDER_LAG_S)
+    arrival = next(i for i, record in enumerate(records) if record.t_s > late.t_s)
+    records = records[:arrival] + [late] + records[arrival:at] + records[at + 1:]
+    analysis = analyze_bag(write_bag(tmp_path / 'late_config.bag', records,
+                                     in_given_order=True))
+    assert [each.window.cause for each in analysis.tries] == [RUN_START, RESET_WORLD,
+                                                              RESET_SIMULATION]
+    assert analysis.tries[1].window.start_s == pytest.approx(SESSION[0].duration_s, abs=0.001)
+    assert [each.to_dict()['fell'] for each in analysis.tries] == [True, False, True]
+
+
 def test_messages_recorded_across_a_reset_from_their_stamps_keep_the_try_stamped_in(
         tmp_path: Path) -> None:
     """Around reset_simulation the recorder writes in arrival order: the last joint states

@@ -3,6 +3,8 @@ command merging, divergence retries. A fake outbox stands for the publishers."""
 
 from __future__ import annotations
 
+import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -273,6 +275,36 @@ def test_a_controller_plugs_in_and_is_called_once_before_each_step(sim: AtlasSim
     loop.run(stops_after(3))
     assert [controller.steps_ns for controller in made] == [[k * sim.step_ns for k in range(5)]]
     np.testing.assert_array_equal(sim.user_command.position, [0.1] * NUM_JOINTS)
+
+
+def wait_for(condition, what: str, timeout_s: float = 30.0) -> None:
+    """Poll `condition` (another thread makes it true) until it holds, or fail naming it."""
+    deadline = time.monotonic() + timeout_s
+    while not condition():
+        assert time.monotonic() < deadline, f'waited {timeout_s} s for {what}'
+        time.sleep(0.001)
+
+
+def test_pause_returns_once_the_loop_has_stopped_and_sent_what_it_stepped(
+        sim: AtlasSimulator) -> None:
+    """/gazebo/pause_physics from another thread: when it returns, the last /clock sent is
+    the paused time, and no step follows (the loop's batches are flushed first)."""
+    loop, outbox, _, _ = make_loop(sim)  # its wall clock stands still: nothing is flushed
+    stop = threading.Event()           # until the loop pauses
+    runner = threading.Thread(target=loop.run, args=(stop.is_set,))
+    runner.start()
+    try:
+        wait_for(lambda: sim.sim_time_ns >= 20 * sim.step_ns, '20 steps')
+        loop.pause()
+        paused_ns = sim.sim_time_ns
+        assert clock_ns(outbox.sent[topics.CLOCK][-1]) == paused_ns
+        flushes = outbox.flushes
+        wait_for(lambda: outbox.flushes >= flushes + 20, '20 polls while paused')
+        assert sim.sim_time_ns == paused_ns
+    finally:
+        stop.set()
+        runner.join()
+    assert not loop.controls.loop_running
 
 
 # -- services ------------------------------------------------------------------------------
