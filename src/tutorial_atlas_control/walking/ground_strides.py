@@ -6,17 +6,19 @@ Up and down the VRC mud pit's 22-degree ramps (0.6 m over 1.5 m) Walk fell in 0.
 of 0.63 s (docs/vrc.md). Two things felled it:
 
 - a sole across a bend (the ramp's foot, its top edge) is laid on the surface under its
-  centre and tips over the bend. A sole is 0.26 m long: at any stride under about 0.3 m one
-  foothold in every run of them lands across a bend. Here a foothold across one is pulled
-  back to the last place clear of it (the other foot is brought beside the leading one),
-  and the bend is crossed in one longer stride (at most `crossing_m`) to the first clear
-  place beyond it; the other foot then comes beside it before striding on.
-- on ground steeper than `steep_rad` (22 degrees) the steps are `steep_stride_m` long and
-  take `steep_duration_s`: up the slope in 0.2 m strides the rear ankle reached its
-  dorsiflexion limit (0.698 rad: 22 degrees of slope plus the shank's lean) and the pelvis
+  centre and tips over the bend. A sole is 0.26 m long: at any stride under about 0.3 m
+  some foothold lands across a bend. Here a foothold across one is pulled back to the last
+  place clear of it (where the other foot stands, at the least: beside it), and the bend is
+  crossed in one longer stride (at most `crossing_m`) to the first clear place beyond it;
+  the other foot then comes beside it (its swing is at most two steep strides) before
+  striding on. (The highest ground under the footprint, as Step takes it, fell at the top
+  edge: a sole flat on the platform, its heel over the ramp, rests on the edge.)
+- on ground steeper than `steep_rad` (20 degrees) the steps are `steep_stride_m` long and
+  take `steep_duration_s`: up 22 degrees in 0.2 m strides the ankles reached their
+  dorsiflexion stop (0.698 rad: 0.384 of slope plus the shank's lean) and the pelvis
   pitched back; in 0.1 m strides of 0.9 s a constant 22-degree slope walked up for every
-  seed tried, and down (where 0.2 m strides left the pelvis under the trial's 0.8 m over the
-  lower sole) too. Slopes of 16 degrees and less keep the gait's strides (they walked).
+  start tried, and down (where 0.2 m strides left the pelvis under the trial's 0.8 m over
+  the lower sole) too. Slopes of 16 degrees keep the gait's strides (they walked).
 
 A foothold is clear of bends when the ground under its sole and `margin_m` beyond its ends
 lies within `flat_m` of the plane through the ground under its centre (the slopes along and
