@@ -19,7 +19,8 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'player': ['CommandLatency', 'DEFAULT_SETTLE_S', 'DEFAULT_START_AFTER_S', 'OfflineRunError',
                'run_offline', 'write_offline_bag'],
     'replay': ['DEFAULT_TOLERANCE', 'ReplayError', 'format_report', 'replay_bag'],
-    'terrain_trial': ['MUD_DEPTH_M', 'TERRAINS', 'Terrain', 'mud_model', 'terrain_walk'],
+    'terrain_trial': ['MUD_DEPTH_M', 'TERRAINS', 'Terrain', 'mud_model', 'planned_steps',
+                      'terrain_plan', 'terrain_walk'],
     'world': ['OfflineWorld', 'named_world', 'recorded_world'],
     'replay_score': ['ScoreComparison', 'ScoreReplay'],
 })

@@ -54,6 +54,7 @@ from tutorial_atlas_control.sim import (
     DEFAULT_GAINS_FILE,
     SOLE_GEOMS,
     AtlasSimulator,
+    Ground,
     GroundUnderFeet,
     VrcMode,
     load_gains_yaml,
@@ -301,7 +302,9 @@ def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,
     origin, heading = _feet(interface)
     if leg.clear_of_blocks:  # around blocks: the corners turned on the spot
         gait = (gait or RouteGait()).turning_in_place()
-    plan = route_steps(origin, heading, leg_waypoints(leg, *origin, blocks), gait)
+    ground = Ground(sim.atlas.model, sim.data).height_m if gait and gait.fit_ground else None
+    plan = route_steps(origin, heading, leg_waypoints(leg, *origin, blocks), gait,
+                       ground=ground)
     client = streamer.client = WalkClient(plan, streaming=True)
     limit_ns = sim.sim_time_ns + math.floor(len(plan) * SECONDS_PER_STEP * NS_PER_S)
     while client.outcome is None and streamer.fell_at_s is None \

@@ -13,7 +13,10 @@ places a client's steps (asi/library.py's on_ground: the surface's height and no
 - ramps (the VRC mud pit's: about 0.6 m of height over 1.5 m, 22 degrees): the floor flat,
   a ramp RAMP_START_M ahead rising RAMP_RUN_M later to a platform (up), or the robot on a
   platform and the ramp falling from it to the floor (down): flat, a bend, the slope, a
-  bend, flat.
+  bend, flat. Their steps are planned on the ground as a footstep planner would
+  (walking/ground_strides.py: no sole across a bend, 0.1 m strides of 0.9 s on the ramp)
+  over the case's `run_m`; in the slopes' 0.2 m strides, each placed where it fell, every
+  ramp walk fell (docs/vrc.md).
 
 A case's seed perturbs the start (walking/start_noise.py) and, for a pushed walk, draws the
 pushes' phases and sides, so a figure is a fraction of seeds (the start's noise alone is
@@ -45,6 +48,7 @@ from tutorial_atlas_control.sim import (
     MODEL_PATH,
     AtlasModel,
     AtlasSimulator,
+    Ground,
     GroundUnderFeet,
     index_model,
     load_gains_yaml,
@@ -52,17 +56,20 @@ from tutorial_atlas_control.sim import (
 )
 from tutorial_atlas_control.walking import (
     SETTLE_S,
+    Footstep,
+    GroundGait,
     WalkingError,
     WalkingStand,
     WalkTrial,
+    ground_steps,
     perturb_start,
     random_pushes,
     run_walking_stand,
     straight_steps,
 )
 
-__all__ = ['MUD_DEPTH_M', 'RAMP_RISE_M', 'TERRAINS', 'Terrain', 'mud_model', 'ramp_model',
-           'terrain_walk']
+__all__ = ['MUD_DEPTH_M', 'RAMP_RISE_M', 'TERRAINS', 'Terrain', 'mud_model', 'planned_steps',
+           'ramp_model', 'terrain_plan', 'terrain_walk']
 
 #: The mud's top over the floor (m): the VRC pit's 0.46 m.
 MUD_DEPTH_M = 0.46
@@ -77,6 +84,8 @@ RAMP_RUN_M = 1.5
 RAMP_START_M = 0.6
 RAMP_WIDTH_M = 3.0
 PLATFORM_M = 4.0
+#: A ramp case's walk (m): over the ramp and 1.5 m on beyond it.
+RAMP_WALK_M = 3.6
 #: After the walk has ended, the robot stands this long (s).
 STAND_AFTER_S = 1.5
 #: A push lasts PUSH_S (s), one in every PUSH_EVERY_S (s) of the walk.
@@ -99,11 +108,14 @@ class Terrain:
     mud_damping: float | None = None
     steps: int = 16
     stride_m: float = 0.25
+    #: When positive: the walk is this long (m), its steps planned on the ground
+    #: (ground_steps, strides of at most `stride_m`), not `steps` of `stride_m`.
+    run_m: float = 0.0
 
 
 #: The cases by name: 10 m through the mud at DRCSim's and the finals' damping, in strides
 #: of 0.15 m (at 0.25 m 7 of 8 seeds fell at 40 N s/m: docs/vrc.md); 4 m up and down slopes
-#: of 8 and 16 degrees.
+#: of 8 and 16 degrees; 3.6 m up and down the pit's ramps.
 TERRAINS: dict[str, Terrain] = {case.name: case for case in (
     Terrain('mud_40', mud_damping=MUD_DAMPING, steps=67, stride_m=0.15),
     Terrain('mud_70', mud_damping=MUD_DAMPING_FINALS, steps=67, stride_m=0.15),
@@ -111,8 +123,8 @@ TERRAINS: dict[str, Terrain] = {case.name: case for case in (
     Terrain('down_8deg', slope_rad=-math.radians(8.0), steps=20, stride_m=0.2),
     Terrain('up_16deg', slope_rad=math.radians(16.0), steps=20, stride_m=0.2),
     Terrain('down_16deg', slope_rad=-math.radians(16.0), steps=20, stride_m=0.2),
-    Terrain('ramp_up_22deg', ramp_rise_m=RAMP_RISE_M, steps=20, stride_m=0.2),
-    Terrain('ramp_down_22deg', ramp_rise_m=-RAMP_RISE_M, steps=20, stride_m=0.2),
+    Terrain('ramp_up_22deg', ramp_rise_m=RAMP_RISE_M, stride_m=0.2, run_m=RAMP_WALK_M),
+    Terrain('ramp_down_22deg', ramp_rise_m=-RAMP_RISE_M, stride_m=0.2, run_m=RAMP_WALK_M),
 )}
 
 
@@ -187,13 +199,36 @@ def terrain_walk(terrain: Terrain, seed: int | None, push_n: float = 0.0) -> Wal
             place_on_slope(sim.atlas, sim.data, terrain.slope_rad, ground.ground,
                            lambda atlas, data: perturb_start(atlas, data, seed,
                                                              on_ground=False))
-        plan = on_ground(straight_steps(terrain.steps, terrain.stride_m), ground.ground)
+        plan = terrain_plan(terrain, ground.ground)
         behaviour = WalkingStand(sim.atlas, plan, SETTLE_S)
         sim.install_stand(behaviour)
-        walk_s = terrain.steps * plan[0].duration_s
+        walk_s = sum(step.duration_s for step in plan)
         events = push_events(random_pushes(0 if seed is None else seed, SETTLE_S,
                                            SETTLE_S + walk_s, push_n, PUSH_S, PUSH_EVERY_S)
                              if push_n > 0.0 else [], sim.dt_s)
         return run_walking_stand(sim, behaviour, ground,
                                  SETTLE_S + SLOWEST_WALK * walk_s + STAND_AFTER_S, events,
                                  stand_after_s=STAND_AFTER_S)
+
+
+def terrain_plan(terrain: Terrain, ground: Ground) -> list[Footstep]:
+    """The case's steps from feet side by side at the origin facing +x, put on `ground` as
+    the interface puts a client's (on_ground): `steps` straight strides, or (`run_m`) the
+    run planned on the ground's heights."""
+    if terrain.run_m > 0.0:
+        steps = ground_steps(terrain.run_m, ground.height_m,
+                             GroundGait(stride_m=terrain.stride_m))
+    else:
+        steps = straight_steps(terrain.steps, terrain.stride_m)
+    return on_ground(steps, ground)
+
+
+def planned_steps(terrain: Terrain) -> int:
+    """How many steps the case's walk has (a planned run's: on its world's ground)."""
+    if terrain.run_m <= 0.0:
+        return terrain.steps
+    atlas = ramp_model(terrain.ramp_rise_m) if terrain.ramp_rise_m != 0.0 \
+        else slope_model(terrain.slope_rad)
+    data = mujoco.MjData(atlas.model)
+    mujoco.mj_forward(atlas.model, data)
+    return len(terrain_plan(terrain, Ground(atlas.model, data)))

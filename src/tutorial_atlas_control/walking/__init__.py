@@ -15,7 +15,8 @@ one C call (src/atlas_swing.c); compiled_legs: a swinging tick of the legs (sole
 whole body, swing servo, effort limits) as one C call (src/atlas_legs.c); walk: the walk's
 phases; walk_behaviour: Walk as the simulator's behaviour;
 route: footsteps through a route of waypoints (a course walker's plan) from where the
-feet are;
+feet are; ground_strides: a straight run's strides fitted to the ground (no sole across a
+bend, short slow steps on steep ground);
 start_noise: a trial's start perturbed by a seed; walk_trial: offline walking trials,
 landing by landing, pushed or not; static_step: one quasi-static step; step_over: its swing
 over terrain higher than its line (up, across, down) and the apex that clears it;
@@ -39,6 +40,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'walk': ['WalkGains'],
     'walk_behaviour': ['WalkBehaviour', 'WalkStatus'],
     'route': ['RouteGait', 'feet_origin', 'route_steps'],
+    'ground_strides': ['GroundGait', 'SoleFit', 'ground_steps', 'sole_fit'],
     'start_noise': ['perturb_start'],
     'walk_trial': ['SETTLE_S', 'WalkTrial', 'WalkingStand', 'pushed_walk_trial',
                    'random_pushes', 'run_walking_stand', 'straight_walk_trial', 'walk_trial'],

@@ -9,7 +9,10 @@ heading, if one is given, and brings the trailing foot beside the leading one.
 Each foot lands across the centre line from the other, `width_m` apart, as straight_steps
 places them: step k's sole is the centre line's point after k moves, moved half the width
 to its own side. The heights are the world's: the AtlasSimInterface puts every step on the
-ground under it (asi/library.py's on_ground).
+ground under it (asi/library.py's on_ground). Given the ground's heights, a straight run
+whose equal strides would put a sole across a bend or on ground steeper than 20 degrees is
+planned on the ground instead (ground_strides.py: footholds clear of the bends, short slow
+strides on the steep part); every other run keeps its equal strides.
 """
 
 from __future__ import annotations
@@ -27,6 +30,12 @@ from tutorial_atlas_control.walking.footsteps import (
     Footstep,
     side_sign,
     wrap_angle,
+)
+from tutorial_atlas_control.walking.ground_strides import (
+    GroundGait,
+    HeightField,
+    ground_steps,
+    sole_fit,
 )
 
 __all__ = ['RouteGait', 'feet_origin', 'route_steps']
@@ -49,6 +58,9 @@ class RouteGait:
     turn_stride_m: float = 0.08
     width_m: float = STANCE_WIDTH_M
     duration_s: float = STEP_DURATION_S
+    #: Whether a walker that knows the world's ground plans its straight runs on it
+    #: (route_steps' `ground`: the pit's ramps). Off: the figures before it were walked so.
+    fit_ground: bool = False
 
     def turning_in_place(self) -> RouteGait:
         """This gait with its turns in place: among obstacles, where a corner must be
@@ -63,23 +75,60 @@ class RouteGait:
                                f'stride of 0 turns in place): {self}')
 
 
-def _turn(heading_rad: float, goal_rad: float, gait: RouteGait) -> list[tuple[float, float]]:
-    """The moves (heading, length) turning from `heading_rad` to face `goal_rad` in equal
-    parts of at most a step's turn."""
+#: A move of the centre line: its heading (rad), length (m) and the step's duration (s).
+Move = tuple[float, float, float]
+
+
+def _turn(heading_rad: float, goal_rad: float, gait: RouteGait) -> list[Move]:
+    """The moves turning from `heading_rad` to face `goal_rad` in equal parts of at most a
+    step's turn."""
     turn = wrap_angle(goal_rad - heading_rad)
     count = math.ceil(abs(turn) / gait.turn_step_rad - 1e-9)
-    return [(heading_rad + turn * (k + 1) / count, gait.turn_stride_m) for k in range(count)]
+    return [(heading_rad + turn * (k + 1) / count, gait.turn_stride_m, gait.duration_s)
+            for k in range(count)]
+
+
+def _straight(start_xy: tuple[float, float], heading_rad: float, distance_m: float,
+              gait: RouteGait, ground: HeightField | None, foot: int) -> list[Move]:
+    """The moves straight over `distance_m`, `foot` first: equal strides of at most the
+    gait's, or (`ground` given, and one of those footholds across a bend or steep) the
+    run's strides fitted to the ground, without its last step (the feet side by side)."""
+    count = math.ceil(distance_m / gait.stride_m - 1e-9)
+    equal = [(heading_rad, distance_m / count, gait.duration_s)] * count
+    if ground is None:
+        return equal
+    fitted = GroundGait(stride_m=gait.stride_m, duration_s=gait.duration_s,
+                        width_m=gait.width_m)
+    cos, sin = math.cos(heading_rad), math.sin(heading_rad)
+    for k in range(1, count + 1):
+        moving = foot if k % 2 == 1 else 1 - foot
+        half = side_sign(moving) * gait.width_m / 2
+        along = distance_m * k / count
+        fit = sole_fit(ground, start_xy[0] + along * cos - half * sin,
+                       start_xy[1] + along * sin + half * cos, heading_rad, fitted)
+        if not fit.flat or fit.slope_rad > fitted.steep_rad:
+            break
+    else:
+        return equal
+    steps = ground_steps(distance_m, ground, fitted, start_xy, heading_rad, foot)[:-1]
+    moves, last = [], 0.0
+    for step in steps:
+        along = (step.x_m - start_xy[0]) * cos + (step.y_m - start_xy[1]) * sin
+        moves.append((heading_rad, along - last, step.duration_s))
+        last = along
+    return moves
 
 
 def _moves(start_xy: tuple[float, float], start_yaw_rad: float,
            waypoints: Sequence[tuple[float, float]], final_heading_rad: float | None,
-           gait: RouteGait) -> list[tuple[float, float]]:
-    """The centre line's moves (heading, length) through every waypoint: turning steps
-    while the waypoint's bearing is more than a step's turn away (each moves the centre,
-    so the bearing is taken again), then equal strides straight to it."""
+           gait: RouteGait, ground: HeightField | None = None, first_foot: int = LEFT
+           ) -> list[Move]:
+    """The centre line's moves through every waypoint: turning steps while the waypoint's
+    bearing is more than a step's turn away (each moves the centre, so the bearing is taken
+    again), then strides straight to it (_straight; step k moves `first_foot` for odd k)."""
     x, y = start_xy
     heading = start_yaw_rad
-    moves: list[tuple[float, float]] = []
+    moves: list[Move] = []
     for goal_x, goal_y in waypoints:
         if not (math.isfinite(goal_x) and math.isfinite(goal_y)):
             raise WalkingError(f'waypoint ({goal_x}, {goal_y}) is not finite')
@@ -91,7 +140,7 @@ def _moves(start_xy: tuple[float, float], start_yaw_rad: float,
             heading += math.copysign(gait.turn_step_rad, turn)
             x += gait.turn_stride_m * math.cos(heading)
             y += gait.turn_stride_m * math.sin(heading)
-            moves.append((heading, gait.turn_stride_m))
+            moves.append((heading, gait.turn_stride_m, gait.duration_s))
         else:
             raise WalkingError(f'waypoint ({goal_x}, {goal_y}) lies inside the turning circle '
                                f'from ({x:.3f}, {y:.3f}): no step faces it')
@@ -99,8 +148,8 @@ def _moves(start_xy: tuple[float, float], start_yaw_rad: float,
         if distance < REACHED_M:
             continue
         heading = math.atan2(goal_y - y, goal_x - x)
-        count = math.ceil(distance / gait.stride_m - 1e-9)
-        moves += [(heading, distance / count)] * count
+        moves += _straight((x, y), heading, distance, gait, ground,
+                           first_foot if len(moves) % 2 == 0 else 1 - first_foot)
         x, y = goal_x, goal_y
     if final_heading_rad is not None:
         moves += _turn(heading, final_heading_rad, gait)
@@ -109,11 +158,13 @@ def _moves(start_xy: tuple[float, float], start_yaw_rad: float,
 
 def route_steps(start_xy: tuple[float, float], start_yaw_rad: float,
                 waypoints: Sequence[tuple[float, float]], gait: RouteGait | None = None,
-                final_heading_rad: float | None = None) -> list[Footstep]:
+                final_heading_rad: float | None = None, ground: HeightField | None = None
+                ) -> list[Footstep]:
     """The steps (indices from 1) walking from feet side by side at `start_xy` facing
     `start_yaw_rad` through `waypoints` (world x, y), the last step bringing the feet side
     by side. The first foot to move is the one on the side of the first turn (left when
-    the route starts straight).
+    the route starts straight). `ground`: the world's heights, for straight runs over a
+    bend or steep ground (None: equal strides everywhere).
 
     Raises:
         WalkingError: no waypoint, a waypoint not finite, or a route with no move.
@@ -126,27 +177,29 @@ def route_steps(start_xy: tuple[float, float], start_yaw_rad: float,
         raise WalkingError(f'the route from {start_xy} goes nowhere: every waypoint is there')
     first_turn = wrap_angle(moves[0][0] - start_yaw_rad)
     first_foot = RIGHT if first_turn < 0.0 else LEFT
+    if ground is not None:  # the same first move, its strides fitted to the ground
+        moves = _moves(start_xy, start_yaw_rad, waypoints, final_heading_rad, gait, ground,
+                       first_foot)
     steps = []
     x, y = start_xy
     heading = start_yaw_rad
-    for k, (heading, length) in enumerate(moves, start=1):
+    for k, (heading, length, duration) in enumerate(moves, start=1):
         x += length * math.cos(heading)
         y += length * math.sin(heading)
         steps.append(_foot_at(k, first_foot if k % 2 == 1 else 1 - first_foot, x, y, heading,
-                              gait))
+                              gait, duration))
     last = len(moves) + 1
     steps.append(_foot_at(last, first_foot if last % 2 == 1 else 1 - first_foot, x, y, heading,
-                          gait))
+                          gait, gait.duration_s))
     return steps
 
 
 def _foot_at(index: int, foot: int, x_m: float, y_m: float, heading_rad: float,
-             gait: RouteGait) -> Footstep:
+             gait: RouteGait, duration_s: float) -> Footstep:
     """Step `index` of `foot`: half the width to its side of the centre line's point."""
     half = side_sign(foot) * gait.width_m / 2
     return Footstep(index, foot, x_m - half * math.sin(heading_rad),
-                    y_m + half * math.cos(heading_rad), wrap_angle(heading_rad),
-                    gait.duration_s)
+                    y_m + half * math.cos(heading_rad), wrap_angle(heading_rad), duration_s)
 
 
 def feet_origin(left: tuple[float, float, float],

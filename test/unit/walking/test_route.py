@@ -9,6 +9,7 @@ import pytest
 
 from tutorial_atlas_control.walking import WalkingError
 from tutorial_atlas_control.walking.footsteps import LEFT, RIGHT, Footstep, wrap_angle
+from tutorial_atlas_control.walking.ground_strides import sole_fit
 from tutorial_atlas_control.walking.route import RouteGait, feet_origin, route_steps
 from tutorial_atlas_control.walking.step_queue import clamp_step
 
@@ -119,3 +120,25 @@ def test_a_route_starts_between_the_feet_facing_their_mean_heading_the_short_way
     assert (x, y) == pytest.approx((1.1, 2.0))
     assert abs(wrap_angle(yaw - heading)) < 1e-12
     assert -math.pi <= yaw <= math.pi
+
+
+def test_a_route_given_level_ground_strides_as_it_does_without() -> None:
+    waypoints = [(1.6, 2.0), (2.5, 3.0)]
+    assert route_steps((1.0, 2.0), 0.0, waypoints, ground=lambda x, y: 0.25) \
+        == route_steps((1.0, 2.0), 0.0, waypoints)
+
+
+def test_a_route_down_a_ramp_given_the_ground_puts_no_sole_across_its_bends() -> None:
+    grade = math.tan(math.radians(22.0))
+
+    def ramp_down(x_m: float, y_m: float) -> float:  # north: 1.5 m down from y 1 to 2.5
+        return -grade * min(max(y_m - 1.0, 0.0), 1.5)
+
+    steps = route_steps((0.0, 0.0), math.pi / 2, [(0.0, 3.5)], ground=ramp_down)
+    assert all(sole_fit(ramp_down, s.x_m, s.y_m, s.yaw_rad).flat for s in steps)
+    assert [s.foot_index for s in steps] == [LEFT, RIGHT] * (len(steps) // 2) \
+        + [LEFT] * (len(steps) % 2)
+    assert {s.duration_s for s in steps if 1.0 < s.y_m < 2.5} == {0.9}
+    assert centre_after(steps) == pytest.approx((0.0, 3.5))
+    plain = route_steps((0.0, 0.0), math.pi / 2, [(0.0, 3.5)])
+    assert not all(sole_fit(ramp_down, s.x_m, s.y_m, s.yaw_rad).flat for s in plain)
