@@ -69,7 +69,7 @@ from tutorial_atlas_control.walking import (
 )
 
 __all__ = ['MUD_DEPTH_M', 'RAMP_RISE_M', 'TERRAINS', 'Terrain', 'mud_model', 'planned_steps',
-           'ramp_model', 'terrain_plan', 'terrain_walk']
+           'ramp_model', 'stairs_model', 'terrain_plan', 'terrain_walk']
 
 #: The mud's top over the floor (m): the VRC pit's 0.46 m.
 MUD_DEPTH_M = 0.46
@@ -86,6 +86,13 @@ RAMP_WIDTH_M = 3.0
 PLATFORM_M = 4.0
 #: A ramp case's walk (m): over the ramp and 1.5 m on beyond it.
 RAMP_WALK_M = 3.6
+#: Stairs (the issue's 0.15 m risers): this many steps, each this deep (m): a tread holds a
+#: sole (0.26 m) and the planner's margins (4 cm each end) with 6 cm to spare.
+STAIR_RISE_M = 0.15
+STAIR_COUNT = 4
+STAIR_TREAD_M = 0.4
+#: A stairs case's walk (m): over the stairs and 0.6 m on beyond them.
+STAIRS_WALK_M = RAMP_START_M + STAIR_COUNT * STAIR_TREAD_M + 0.6
 #: After the walk has ended, the robot stands this long (s).
 STAND_AFTER_S = 1.5
 #: A push lasts PUSH_S (s), one in every PUSH_EVERY_S (s) of the walk.
@@ -111,6 +118,9 @@ class Terrain:
     #: When positive: the walk is this long (m), its steps planned on the ground
     #: (ground_steps, strides of at most `stride_m`), not `steps` of `stride_m`.
     run_m: float = 0.0
+    #: Stairs (m, each riser; negative: down from a landing; stairs_model): STAIR_COUNT
+    #: steps of STAIR_TREAD_M from RAMP_START_M ahead.
+    stair_rise_m: float = 0.0
 
 
 #: The cases by name: 10 m through the mud at DRCSim's and the finals' damping, in strides
@@ -125,6 +135,8 @@ TERRAINS: dict[str, Terrain] = {case.name: case for case in (
     Terrain('down_16deg', slope_rad=-math.radians(16.0), steps=20, stride_m=0.2),
     Terrain('ramp_up_22deg', ramp_rise_m=RAMP_RISE_M, stride_m=0.2, run_m=RAMP_WALK_M),
     Terrain('ramp_down_22deg', ramp_rise_m=-RAMP_RISE_M, stride_m=0.2, run_m=RAMP_WALK_M),
+    Terrain('stairs_up_15cm', stair_rise_m=STAIR_RISE_M, stride_m=0.2, run_m=STAIRS_WALK_M),
+    Terrain('stairs_down_15cm', stair_rise_m=-STAIR_RISE_M, stride_m=0.2, run_m=STAIRS_WALK_M),
 )}
 
 
@@ -175,24 +187,50 @@ def ramp_model(rise_m: float) -> AtlasModel:
     return index_model(spec.compile(), MODEL_PATH)
 
 
+def stairs_model(rise_m: float) -> AtlasModel:
+    """Atlas's world with STAIR_COUNT stairs from RAMP_START_M ahead, each riser `rise_m`
+    (m) up to a landing, or (negative) down from a landing under the start to the floor:
+    boxes stacked, each reaching from its riser to the far end of its side."""
+    spec = mujoco.MjSpec.from_file(str(MODEL_PATH))
+    width = 0.5 * RAMP_WIDTH_M
+    last_m = RAMP_START_M + STAIR_COUNT * STAIR_TREAD_M
+    for level in range(1, STAIR_COUNT + 1):
+        if rise_m > 0.0:
+            start_m, end_m = RAMP_START_M + (level - 1) * STAIR_TREAD_M, last_m + PLATFORM_M
+        else:
+            start_m, end_m = -PLATFORM_M, RAMP_START_M + (STAIR_COUNT - level) * STAIR_TREAD_M
+        top_m = level * abs(rise_m)
+        _box(spec, f'stair_{level}', (0.5 * (start_m + end_m), 0.0, 0.5 * top_m),
+             (0.5 * (end_m - start_m), width, 0.5 * top_m))
+    return index_model(spec.compile(), MODEL_PATH)
+
+
+def _terrain_model(terrain: Terrain) -> AtlasModel:
+    """The case's world without mud: a ramp, stairs, or the floor turned by the slope."""
+    if terrain.ramp_rise_m != 0.0:
+        return ramp_model(terrain.ramp_rise_m)
+    if terrain.stair_rise_m != 0.0:
+        return stairs_model(terrain.stair_rise_m)
+    return slope_model(terrain.slope_rad)
+
+
 def terrain_walk(terrain: Terrain, seed: int | None, push_n: float = 0.0) -> WalkTrial:
     """Walk `terrain`'s case once from a start perturbed by `seed` (None: not), pushed on
     the pelvis by `push_n` (N; 0: not) as pushed flat walks are (walk_trial.random_pushes:
     0.1 s to a side drawn from the seed, once in every PUSH_EVERY_S of the walk)."""
-    if (terrain.slope_rad != 0.0 or terrain.ramp_rise_m != 0.0) \
-            and terrain.mud_damping is not None:
+    shaped = terrain.slope_rad != 0.0 or terrain.ramp_rise_m != 0.0 \
+        or terrain.stair_rise_m != 0.0
+    if shaped and terrain.mud_damping is not None:
         raise WalkingError(f'terrain {terrain.name}: mud on a slope is not a case')
     gains = load_gains_yaml(DEFAULT_GAINS_FILE)
     with tempfile.TemporaryDirectory(prefix='terrain_walk_') as scratch:
-        if terrain.ramp_rise_m != 0.0:
-            sim = AtlasSimulator(ramp_model(terrain.ramp_rise_m), gains, time_to_unpin_s=0.0)
-        elif terrain.mud_damping is None:
-            sim = AtlasSimulator(slope_model(terrain.slope_rad), gains, time_to_unpin_s=0.0)
+        if terrain.mud_damping is None:
+            sim = AtlasSimulator(_terrain_model(terrain), gains, time_to_unpin_s=0.0)
         else:
             sim = AtlasSimulator(mud_model(Path(scratch)), gains, time_to_unpin_s=0.0,
                                  mud_damping=terrain.mud_damping)
         ground = GroundUnderFeet(sim.atlas, sim.data)
-        if terrain.slope_rad == 0.0 and terrain.ramp_rise_m == 0.0:
+        if not shaped:
             place_in_stand_pose(sim.atlas, sim.data)
             perturb_start(sim.atlas, sim.data, seed)
         else:
@@ -227,8 +265,7 @@ def planned_steps(terrain: Terrain) -> int:
     """How many steps the case's walk has (a planned run's: on its world's ground)."""
     if terrain.run_m <= 0.0:
         return terrain.steps
-    atlas = ramp_model(terrain.ramp_rise_m) if terrain.ramp_rise_m != 0.0 \
-        else slope_model(terrain.slope_rad)
+    atlas = _terrain_model(terrain)
     data = mujoco.MjData(atlas.model)
     mujoco.mj_forward(atlas.model, data)
     return len(terrain_plan(terrain, Ground(atlas.model, data)))
