@@ -59,8 +59,9 @@ class RouteGait:
     width_m: float = STANCE_WIDTH_M
     duration_s: float = STEP_DURATION_S
     #: Whether a walker that knows the world's ground plans its straight runs on it
-    #: (route_steps' `ground`: the pit's ramps). Off: the figures before it were walked so.
-    fit_ground: bool = False
+    #: (route_steps' `ground`: the pit's ramps). On: the pen-to-gate_1 legs plan the same
+    #: steps either way, and the pit walks only so (docs/vrc.md).
+    fit_ground: bool = True
     #: How far (m) the ground under a foothold (and its margins) may lie off one plane and
     #: still count as clear of a bend, on ground fitted so. The course's ground is a curved
     #: heightfield: up the pit's exit ramp, whose slope turns through about 25 degrees over
