@@ -64,10 +64,10 @@ class RouteGait:
     fit_ground: bool = True
     #: How far (m) the ground under a foothold (and its margins) may lie off one plane and
     #: still count as clear of a bend, on ground fitted so. The course's ground is a curved
-    #: heightfield: up the pit's exit ramp, whose slope turns through about 25 degrees over
-    #: 1 m, many footholds lay 5-10 mm off a plane, and at ground_strides' 5 mm (its box
-    #: ramps' sharp bends) the planner pulled them back and crossed 0.25-0.33 m at a time;
-    #: at 1 cm every foothold there was clear and the strides even (docs/vrc.md).
+    #: heightfield: over 3 m of the pit's exit ramp most places a sole could stand lie 5-14
+    #: mm off a plane, and at ground_strides' 5 mm (its box ramps' sharp bends) the planner
+    #: pulled footholds back and swung up to 0.33 m; at 1 cm the strides there are even
+    #: (docs/vrc.md).
     ground_flat_m: float = 0.01
 
     def turning_in_place(self) -> RouteGait:
