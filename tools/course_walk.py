@@ -3,13 +3,14 @@
 measurement behind docs/vrc.md's figures for the walk to gate_1.
 
     python3 tools/course_walk.py [--to GATE | --waypoints 'X,Y X,Y ...'] [--stride M]
-                                 [--fit-ground] [--world NAME] [--variant NAME] SEED ...
+                                 [--no-fit-ground] [--world NAME] [--variant NAME] SEED ...
 
 The walk is vrc_walker.py's, offline: the course's legs (course/legs.py) from the world's
 start to --to (default gate_1), each planned from where the feet are as it begins; or one
-leg through --waypoints. --fit-ground: a straight run over a bend or steep ground (the
-pit's ramps) planned on the world's ground (walking/ground_strides.py). --variant: one of
-the finals' changes to the course (course/variants.py; default the world as shipped).
+leg through --waypoints. A straight run over a bend or steep ground (the pit's ramps) is
+planned on the world's ground (walking/ground_strides.py); --no-fit-ground: equal strides.
+--variant: one of the finals' changes to the course (course/variants.py; default the world
+as shipped).
 SEED is an integer (walking/start_noise.py's perturbed start) or `none` (the start as the
 world gives it). Each walk prints one JSON line (offline/course_route.py's CourseWalk) as it
 ends; a run costs about 300-500 s of CPU on this host (the course's physics). Run it under
@@ -54,9 +55,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--waypoints', type=_waypoints, default=None,
                         help='one leg through these world x,y pairs instead of the course\'s')
     parser.add_argument('--stride', type=float, default=0.15, help='longest stride (m)')
-    parser.add_argument('--fit-ground', action='store_true',
+    parser.add_argument('--fit-ground', action=argparse.BooleanOptionalAction, default=True,
                         help='plan straight runs over a bend or steep ground on the world\'s '
-                        'ground (walking/ground_strides.py: the pit\'s ramps)')
+                        'ground (walking/ground_strides.py: the pit\'s ramps; default: on)')
     parser.add_argument('--world', default='vrc_task_2', help='a VRC Task 2 world name')
     parser.add_argument('--variant', choices=[v.name for v in COURSE_VARIANTS], default=None,
                         help="one of the VRC finals' changes to the course")

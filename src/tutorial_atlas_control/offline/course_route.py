@@ -300,9 +300,10 @@ def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,
     streamed until it ends, the robot falls or the leg's time (SECONDS_PER_STEP a step)
     runs out."""
     origin, heading = _feet(interface)
+    gait = gait or RouteGait()
     if leg.clear_of_blocks:  # around blocks: the corners turned on the spot
-        gait = (gait or RouteGait()).turning_in_place()
-    ground = Ground(sim.atlas.model, sim.data).height_m if gait and gait.fit_ground else None
+        gait = gait.turning_in_place()
+    ground = Ground(sim.atlas.model, sim.data).height_m if gait.fit_ground else None
     plan = route_steps(origin, heading, leg_waypoints(leg, *origin, blocks), gait,
                        ground=ground)
     client = streamer.client = WalkClient(plan, streaming=True)

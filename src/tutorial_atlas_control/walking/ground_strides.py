@@ -13,12 +13,13 @@ of 0.63 s (docs/vrc.md). Two things felled it:
   the other foot then comes beside it (its swing is at most two steep strides) before
   striding on. (The highest ground under the footprint, as Step takes it, fell at the top
   edge: a sole flat on the platform, its heel over the ramp, rests on the edge.)
-- on ground steeper than `steep_rad` (20 degrees) the steps are `steep_stride_m` long and
+- on ground steeper than `steep_rad` (12 degrees) the steps are `steep_stride_m` long and
   take `steep_duration_s`: up 22 degrees in 0.2 m strides the ankles reached their
   dorsiflexion stop (0.698 rad: 0.384 of slope plus the shank's lean) and the pelvis
   pitched back; in 0.1 m strides of 0.9 s a constant 22-degree slope walked up for every
   start tried, and down (where 0.2 m strides left the pelvis under the trial's 0.8 m over
-  the lower sole) too. Slopes of 16 degrees keep the gait's strides (they walked).
+  the lower sole) too. Up the course's pit exit ramp in mud (17-22 degrees under a sole)
+  0.15 m strides of 0.63 s fell where the threshold was 20 degrees; from 12 it walked.
 
 A foothold is clear of bends when the ground under its sole and `margin_m` beyond its ends
 lies within `flat_m` of the plane through the ground under its centre (the slopes along and
@@ -60,8 +61,10 @@ class GroundGait:
 
     stride_m: float = 0.2
     duration_s: float = STEP_DURATION_S
-    #: Ground steeper than this (rad) under a step's ends is walked in steep strides.
-    steep_rad: float = math.radians(20.0)
+    #: Ground steeper than this (rad) under a step's ends is walked in steep strides. At 20
+    #: degrees the course's pit exit ramp (in mud) fell: its steps there flipped between
+    #: normal strides on 17-20 degrees and steep ones.
+    steep_rad: float = math.radians(12.0)
     steep_stride_m: float = 0.1
     steep_duration_s: float = 0.9
     #: The longest stride (and swing) that crosses a bend (m).

@@ -59,8 +59,16 @@ class RouteGait:
     width_m: float = STANCE_WIDTH_M
     duration_s: float = STEP_DURATION_S
     #: Whether a walker that knows the world's ground plans its straight runs on it
-    #: (route_steps' `ground`: the pit's ramps). Off: the figures before it were walked so.
-    fit_ground: bool = False
+    #: (route_steps' `ground`: the pit's ramps). On: the pen-to-gate_1 legs plan the same
+    #: steps either way, and the pit walks only so (docs/vrc.md).
+    fit_ground: bool = True
+    #: How far (m) the ground under a foothold (and its margins) may lie off one plane and
+    #: still count as clear of a bend, on ground fitted so. The course's ground is a curved
+    #: heightfield: over 3 m of the pit's exit ramp most places a sole could stand lie 5-14
+    #: mm off a plane, and at ground_strides' 5 mm (its box ramps' sharp bends) the planner
+    #: pulled footholds back and swung up to 0.33 m; at 1 cm the strides there are even
+    #: (docs/vrc.md).
+    ground_flat_m: float = 0.01
 
     def turning_in_place(self) -> RouteGait:
         """This gait with its turns in place: among obstacles, where a corner must be
@@ -68,7 +76,8 @@ class RouteGait:
         return replace(self, turn_stride_m=0.0)
 
     def __post_init__(self) -> None:
-        numbers = (self.stride_m, self.turn_step_rad, self.width_m, self.duration_s)
+        numbers = (self.stride_m, self.turn_step_rad, self.width_m, self.duration_s,
+                   self.ground_flat_m)
         if not all(math.isfinite(value) and value > 0.0 for value in numbers) \
                 or not (math.isfinite(self.turn_stride_m) and self.turn_stride_m >= 0.0):
             raise WalkingError(f'a route gait needs positive finite numbers (a turning '
@@ -98,7 +107,7 @@ def _straight(start_xy: tuple[float, float], heading_rad: float, distance_m: flo
     if ground is None:
         return equal
     fitted = GroundGait(stride_m=gait.stride_m, duration_s=gait.duration_s,
-                        width_m=gait.width_m)
+                        width_m=gait.width_m, flat_m=gait.ground_flat_m)
     cos, sin = math.cos(heading_rad), math.sin(heading_rad)
     for k in range(1, count + 1):
         moving = foot if k % 2 == 1 else 1 - foot

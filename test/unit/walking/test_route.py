@@ -9,7 +9,7 @@ import pytest
 
 from tutorial_atlas_control.walking import WalkingError
 from tutorial_atlas_control.walking.footsteps import LEFT, RIGHT, Footstep, wrap_angle
-from tutorial_atlas_control.walking.ground_strides import sole_fit
+from tutorial_atlas_control.walking.ground_strides import GroundGait, sole_fit
 from tutorial_atlas_control.walking.route import RouteGait, feet_origin, route_steps
 from tutorial_atlas_control.walking.step_queue import clamp_step
 
@@ -135,10 +135,33 @@ def test_a_route_down_a_ramp_given_the_ground_puts_no_sole_across_its_bends() ->
         return -grade * min(max(y_m - 1.0, 0.0), 1.5)
 
     steps = route_steps((0.0, 0.0), math.pi / 2, [(0.0, 3.5)], ground=ramp_down)
-    assert all(sole_fit(ramp_down, s.x_m, s.y_m, s.yaw_rad).flat for s in steps)
+    tolerance = GroundGait(flat_m=RouteGait().ground_flat_m)  # the route's, for a heightfield
+    assert all(sole_fit(ramp_down, s.x_m, s.y_m, s.yaw_rad, tolerance).flat for s in steps)
     assert [s.foot_index for s in steps] == [LEFT, RIGHT] * (len(steps) // 2) \
         + [LEFT] * (len(steps) % 2)
     assert {s.duration_s for s in steps if 1.0 < s.y_m < 2.5} == {0.9}
     assert centre_after(steps) == pytest.approx((0.0, 3.5))
     plain = route_steps((0.0, 0.0), math.pi / 2, [(0.0, 3.5)])
     assert not all(sole_fit(ramp_down, s.x_m, s.y_m, s.yaw_rad).flat for s in plain)
+
+
+def test_a_route_up_a_curved_ramp_strides_evenly_and_slowly_where_it_is_steep() -> None:
+    """The course's pit ramps are a curved heightfield: its soles lie up to 14 mm off one
+    plane without any bend. Planned on such a ramp (0.6 m up over 2.3 m, 22 degrees at its
+    steepest), no foothold is pulled back or crossed to (each foot's swing at most two
+    strides) and every step where the ramp is steeper than 15 degrees is a steep one."""
+    gait = RouteGait()
+
+    def curved(x_m: float, y_m: float) -> float:  # north, from y 1 to 3.3
+        along = min(max((y_m - 1.0) / 2.3, 0.0), 1.0)
+        return 0.3 * (1.0 - math.cos(math.pi * along))
+
+    steps = route_steps((0.0, 0.0), math.pi / 2, [(0.0, 4.5)], gait, ground=curved)
+    feet = [0.0, 0.0]
+    for step in steps:
+        swing = step.y_m - feet[step.foot_index]
+        assert 0.0 <= swing <= 2 * gait.stride_m + 1e-9, step
+        feet[step.foot_index] = step.y_m
+        if 1.55 < step.y_m < 2.75:  # the ramp steeper than 15 degrees
+            assert step.duration_s == 0.9, step
+    assert centre_after(steps) == pytest.approx((0.0, 4.5))
