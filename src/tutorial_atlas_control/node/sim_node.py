@@ -124,7 +124,12 @@ from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.node.cheats import WARN_THROTTLE_S, subscribe_cheats
 from tutorial_atlas_control.node.master_watch import start_master_watch
 from tutorial_atlas_control.node.recorder_watch import start_recorder_watch
-from tutorial_atlas_control.node.transport import WireBatch, flush_rosout, widen_accept_queue
+from tutorial_atlas_control.node.transport import (
+    WireBatch,
+    flush_queued,
+    flush_rosout,
+    widen_accept_queue,
+)
 from tutorial_atlas_control.node.udpros import serve as serve_udpros
 from tutorial_atlas_control.node.viewer_window import open_viewer
 from tutorial_atlas_control.sim import (
@@ -171,7 +176,9 @@ MESSAGE_CLASSES: dict[str, type[genpy.Message]] = {cls._type: cls for cls in (
 #: What ~stand chooses Stand to be (the first is the default).
 STAND_CHOICES = ('balance', 'hold')
 #: Queue size of the publishers the node itself calls publish() on (1 when not named).
-QUEUE_SIZES = {topics.SIM_INPUTS: 100}
+#: A reset's /atlas/sim_config must reach the bag (replay reads it): resets one step apart
+#: (a diverging model's) published two before rospy's writer took the first.
+QUEUE_SIZES = {topics.SIM_INPUTS: 100, topics.SIM_CONFIG: 100}
 
 
 class RawMessage(genpy.Message):
@@ -488,8 +495,9 @@ class SimNode:
         start_master_watch(watch)
         status = self.loop.run(rospy.is_shutdown)
         watch.set()
-        if status:
-            flush_rosout()  # the line saying why reaches the recorder before the shutdown
+        if status:  # the last reset's config and the line saying why reach the recorder
+            flush_queued(self.node_publishers[topics.SIM_CONFIG])
+            flush_rosout()
             rospy.signal_shutdown('physics diverges after every reset')
         if viewer is not None:
             viewer.close()

@@ -27,7 +27,7 @@ from rospy.impl import rosout, tcpros_base
 from rospy.impl.tcpros_base import TransportTerminated
 
 __all__ = ['MAX_BACKLOG_BYTES', 'SEND_TIMEOUT_S', 'STALL_PROBE_S', 'ConnectionWriter',
-           'WireBatch', 'flush_rosout', 'subscriber_names', 'widen_accept_queue']
+           'WireBatch', 'flush_queued', 'flush_rosout', 'subscriber_names', 'widen_accept_queue']
 
 #: A subscriber that accepts nothing for this long (s) is dropped: slow subscribers lose
 #: nothing, stalled ones do not hold their bytes (and the node's memory) forever.
@@ -59,15 +59,20 @@ def flush_rosout(timeout_s: float = 2.0) -> None:
     """Return once rospy has written every /rosout message logged so far (or after
     `timeout_s`): its /rosout publisher hands each line to a writer thread per subscriber,
     and a shutdown right after a log call closed the connection before the simulator's last
-    line (why it stopped) reached the recorder (a forced-divergence run beside a busy core).
+    line (why it stopped) reached the recorder (a forced-divergence run beside a busy core)."""
+    publisher = rosout._rosout_pub
+    if publisher is not None:
+        flush_queued(publisher, timeout_s)
+
+
+def flush_queued(publisher: rospy.Publisher, timeout_s: float = 2.0) -> None:
+    """Return once `publisher`'s writer threads have written every message published so far
+    (or after `timeout_s`).
 
     Per connection, two empty barriers in turn: the writer takes its queue as one batch, so
-    once the second barrier is taken the batch holding the first, and every line before it,
-    has been written. rospy offers no flush; its QueuedConnection is used as it is.
+    once the second barrier is taken the batch holding the first, and every message before
+    it, has been written. rospy offers no flush; its QueuedConnection is used as it is.
     """
-    publisher = rosout._rosout_pub
-    if publisher is None:
-        return
     deadline = time.monotonic() + timeout_s
     for connection in list(publisher.impl.connections):
         lock = getattr(connection, '_lock', None)
@@ -76,8 +81,8 @@ def flush_rosout(timeout_s: float = 2.0) -> None:
         if lock is None or queue is None or wake is None:  # a synchronous connection
             continue
         for _barrier in range(2):
-            with lock:
-                queue.append(b'')
+            with lock:  # the writer swaps in a new list as it takes a batch: append to today's
+                connection._queue.append(b'')
                 wake.notify()
             while time.monotonic() < deadline and not connection.done:
                 with lock:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import socket
 import threading
+import time
 
 import pytest
 
@@ -454,3 +455,41 @@ def test_real_sockets_a_stalled_reader_is_left_then_drained_in_order(
     assert writer.backlogs == {} and bytes(received) == sent
     conn.close()
     conn.peer.close()
+
+
+class _SlowTransport:
+    """A connection rospy's writer thread relays to, 20 ms a message."""
+
+    def __init__(self) -> None:
+        self.done = False
+        self.written: list[bytes] = []
+
+    def set_cleanup_callback(self, _callback: object) -> None:
+        pass
+
+    def write_data(self, data: bytes) -> bool:
+        time.sleep(0.02)
+        if data:  # the flush's barriers are empty
+            self.written.append(data)
+        return True
+
+
+def test_flush_queued_returns_once_rospy_s_writer_has_written_everything() -> None:
+    """The node's last sim_config and log line before a divergence shutdown: published into
+    rospy's queued connection, written by its thread; the flush waits for them."""
+    from types import SimpleNamespace
+
+    from rospy.topics import QueuedConnection
+
+    slow = _SlowTransport()
+    queued = QueuedConnection(slow, 100)
+    try:
+        for k in range(3):
+            queued.write_data(b'config %d' % k)
+        transport.flush_queued(SimpleNamespace(impl=SimpleNamespace(connections=[queued])))
+        assert slow.written == [b'config 0', b'config 1', b'config 2']
+    finally:
+        slow.done = True
+        with queued._lock:
+            queued._cond_data_available.notify()
+        queued._thread.join(timeout=5.0)
