@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import contextlib
+import os
+import signal
 import subprocess
 import sys
 from collections.abc import Callable
@@ -29,6 +32,12 @@ def run_script(name: str, *args: str,
 READY_CPU_S = 180.0
 #: Wall-clock guard (s) against a hang that uses no CPU (a deadlock, a lost worker).
 READY_WALL_S = 1800.0
+#: After the Ctrl-C, the script's tree may spend this many CPU seconds ending (its Dask
+#: cluster's teardown), in at most STOP_WALL_S: at the lowest priority a search's cluster took
+#: over processes.STOP_TIMEOUT_S's 20 wall seconds to end, its "interrupted" line already
+#: written (fresh clone, 2026-11-29).
+STOP_CPU_S = 60.0
+STOP_WALL_S = 600.0
 
 
 def interrupt_script(name: str, *args: str, ready: Callable[[str], bool],
@@ -47,6 +56,12 @@ def interrupt_script(name: str, *args: str, ready: Callable[[str], bool],
             processes.wait_until(lambda: ready(err_path.read_text()), READY_WALL_S,
                                  f'{name} did not get ready to be interrupted',
                                  lambda: _still_working(process, err_path))
+            with contextlib.suppress(ProcessLookupError):  # Ctrl-C, to its workers too
+                os.killpg(process.pid, signal.SIGINT)
+            spent_s = tree_cpu_seconds(process.pid)
+            processes.wait_until(lambda: process.poll() is not None, STOP_WALL_S,
+                                 f'{name} did not end on SIGINT',
+                                 lambda: _still_stopping(process, spent_s, err_path))
         finally:
             clean = processes.stop_tree(process)
     result = subprocess.CompletedProcess(process.args, process.returncode,
@@ -67,6 +82,14 @@ def _still_working(process: subprocess.Popen, err_path: Path) -> None:
     if spent > READY_CPU_S:
         raise processes.ProcessError(f'it spent {spent:.0f} CPU s without getting ready: '
                                      f'{err_path.read_text()}')
+
+
+def _still_stopping(process: subprocess.Popen, spent_s: float, err_path: Path) -> None:
+    """Raise if the script's tree spent STOP_CPU_S since the Ctrl-C without ending."""
+    ending_s = tree_cpu_seconds(process.pid) - spent_s
+    if process.poll() is None and ending_s > STOP_CPU_S:
+        raise processes.ProcessError(f'it spent {ending_s:.0f} CPU s after SIGINT without '
+                                     f'ending: {err_path.read_text()}')
 
 
 def tree_cpu_seconds(pid: int) -> float:
