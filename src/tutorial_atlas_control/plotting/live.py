@@ -172,10 +172,12 @@ class LivePlot:
                 plot_field.samples += len(times)
         return lines
 
-    def advance(self, now_s: float) -> bool:
+    def advance(self, now_s: float, rewound: bool | None = None) -> bool:
         """ROS time is `now_s`: slide the window; True (and every series cleared) when time
-        moved back."""
-        if self.clock.moved_back(now_s):
+        moved back: as `rewound` says when given (a /clock watch that saw every message),
+        else when `now_s` is earlier than the time last given."""
+        moved_back = self.clock.moved_back(now_s)
+        if moved_back if rewound is None else rewound:
             for plot_field in self.fields:
                 plot_field.series.clear()
             self.resets += 1

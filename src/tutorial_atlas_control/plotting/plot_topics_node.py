@@ -24,10 +24,12 @@ from pathlib import Path
 import rosgraph
 import roslib.message
 import rospy
+from rosgraph_msgs.msg import Clock
 
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.plotting.figure import PlotFigure
 from tutorial_atlas_control.plotting.live import LivePlot
+from tutorial_atlas_control.plotting.series import BACKWARD_JUMP_S
 
 __all__ = ['PlotOptions', 'PlotRefused', 'TopicTap', 'require_master', 'run_plot']
 
@@ -167,6 +169,20 @@ class PlotSession:
         self._clock_wait_since = time.monotonic()
         self._clock_said = False
         self.interrupted = False
+        # Sim time: every /clock message, in order, for its rewinds. Polling ROS time missed
+        # a reset_simulation when the niced plotter was starved until sim time had passed
+        # the time it last saw (make test, 2026-11-29).
+        self._rewinds = self._rewinds_seen = 0
+        self._clock_s: float | None = None
+        self._clock_watch = (rospy.Subscriber('/clock', Clock, self._on_clock)
+                             if self.sim_time else None)
+
+    def _on_clock(self, message: Clock) -> None:
+        """rospy's thread: count /clock going back (reset_simulation)."""
+        now_s = message.clock.to_sec()
+        if self._clock_s is not None and now_s < self._clock_s - BACKWARD_JUMP_S:
+            self._rewinds += 1
+        self._clock_s = now_s
 
     def interrupt(self, _signum: int, _frame: object) -> None:
         """SIGINT: end the loops at their next turn."""
@@ -201,11 +217,16 @@ class PlotSession:
             self.say('ROS time is not moving: /use_sim_time is set and no /clock arrives '
                      '(is the simulator running and unpaused?)')
         self._last_s = now_s
-        if self.plot.advance(now_s):
+        rewinds = self._rewinds
+        rewound = rewinds != self._rewinds_seen if self._clock_watch is not None else None
+        self._rewinds_seen = rewinds
+        if self.plot.advance(now_s, rewound):
             self.say(f'ROS time moved back to {now_s:.3f} s (a reset): plot cleared')
 
     def close(self) -> None:
         self.tap.close()
+        if self._clock_watch is not None:
+            self._clock_watch.unregister()
 
 
 def _refused_count(plot: LivePlot) -> int:
