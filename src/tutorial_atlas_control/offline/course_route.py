@@ -54,7 +54,6 @@ from tutorial_atlas_control.sim import (
     DEFAULT_GAINS_FILE,
     SOLE_GEOMS,
     AtlasSimulator,
-    Ground,
     GroundUnderFeet,
     VrcMode,
     load_gains_yaml,
@@ -303,7 +302,7 @@ def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,
     gait = gait or RouteGait()
     if leg.clear_of_blocks:  # around blocks: the corners turned on the spot
         gait = gait.turning_in_place()
-    ground = Ground(sim.atlas.model, sim.data).height_m if gait.fit_ground else None
+    ground = streamer.ground.ground.height_m if gait.fit_ground else None
     plan = route_steps(origin, heading, leg_waypoints(leg, *origin, blocks), gait,
                        ground=ground)
     client = streamer.client = WalkClient(plan, streaming=True)

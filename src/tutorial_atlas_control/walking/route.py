@@ -10,9 +10,10 @@ Each foot lands across the centre line from the other, `width_m` apart, as strai
 places them: step k's sole is the centre line's point after k moves, moved half the width
 to its own side. The heights are the world's: the AtlasSimInterface puts every step on the
 ground under it (asi/library.py's on_ground). Given the ground's heights, a straight run
-whose equal strides would put a sole across a bend or on ground steeper than 20 degrees is
-planned on the ground instead (ground_strides.py: footholds clear of the bends, short slow
-strides on the steep part); every other run keeps its equal strides.
+whose equal strides would put a sole across a bend or on ground steeper than GroundGait's
+steep_rad (12 degrees) is planned on the ground instead (ground_strides.py: footholds clear
+of the bends, short slow strides on the steep part); every other run keeps its equal
+strides.
 """
 
 from __future__ import annotations
@@ -110,11 +111,10 @@ def _straight(start_xy: tuple[float, float], heading_rad: float, distance_m: flo
                         width_m=gait.width_m, flat_m=gait.ground_flat_m)
     cos, sin = math.cos(heading_rad), math.sin(heading_rad)
     for k in range(1, count + 1):
-        moving = foot if k % 2 == 1 else 1 - foot
-        half = side_sign(moving) * gait.width_m / 2
         along = distance_m * k / count
-        fit = sole_fit(ground, start_xy[0] + along * cos - half * sin,
-                       start_xy[1] + along * sin + half * cos, heading_rad, fitted)
+        sole = _foot_at(k, foot if k % 2 == 1 else 1 - foot, start_xy[0] + along * cos,
+                        start_xy[1] + along * sin, heading_rad, gait, gait.duration_s)
+        fit = sole_fit(ground, sole.x_m, sole.y_m, heading_rad, fitted)
         if not fit.flat or fit.slope_rad > fitted.steep_rad:
             break
     else:
