@@ -5,7 +5,9 @@ touching link feels, explicit and as ODE solved it, moved to the centre of mass)
 vrc_task_2: the course's figures (the heightmap's scaling, the gates, the pen, the mud, the
 blocks, the starts), the one description the world, the mud and the scoring read; legs:
 the course as a walker's legs, gate to gate, and the ones ahead of a walker; rubble_way: a
-way across the rubble that keeps the feet clear of every block; starts:
+way across the rubble that keeps the feet clear of every block; hill_way: a way over the
+hills on their gentle ground; grid_path: the shortest way over a grid's free cells, in few
+straight lines, for both; terrain: the course's heights from its terrain image; starts:
 where a run starts Atlas (a world's start by name, or 'x y z yaw'), checked once for the
 node, the launches and offline runs; scoring: VRCScoringPlugin's rules, a Scorer fed once per
 physics step (gates in order, the clock, falls, the rows due); score_log: DRCSim's score.log
@@ -21,7 +23,7 @@ from tutorial_atlas_control.exports import lazy_exports
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'errors': ['CourseError'],
     'rubble_way': ['CLEARANCE_M', 'GRID_M', 'block_corners', 'block_footprint', 'clear_path',
-                   'distance_to_polygon'],
+                   'distance_to_polygon', 'gate_posts'],
     'legs': ['COURSE_LEGS', 'LEG_PAUSE_S', 'Leg', 'leg_waypoints', 'legs_ahead'],
     'markers': ['COURSE_AREA', 'MAX_TRIANGLES', 'Area', 'BoxShape', 'CourseShapes',
                 'TerrainMesh', 'course_shapes', 'height_colours', 'terrain_mesh'],
@@ -31,6 +33,8 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'scoring': ['FALL_ACCEL_THRESHOLD', 'TASK_WALKING', 'ScoreRow', 'Scorer', 'seconds'],
     'variants': ['COURSE_VARIANTS', 'RUBBLE_SEED', 'CourseVariant', 'course_variant',
                  'rearranged_blocks'],
+    'terrain': ['ground_under', 'terrain_heights'],
+    'hill_way': ['STEEPEST_DEG', 'gentle_path', 'slope_deg'],
     'starts': ['TERRAIN_FILE', 'WORLD_MODEL_FILE', 'parse_start', 'start_text', 'world_start'],
     'vrc_task_2': ['BLOCKS', 'BLOCK_ENVELOPE_M', 'BLOCK_INERTIA', 'BLOCK_MASS_KG', 'BLOCK_WALLS',
                    'GATES', 'HEIGHTMAP', 'MUD_BOX', 'MUD_DAMPING',

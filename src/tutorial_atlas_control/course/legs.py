@@ -6,8 +6,9 @@ The legs keep clear of what is not ground to walk on: from the pen east through 
 x 3.2, 1.3 m clear of the pen's east wall (on a route turning north at x 2.5 the pelvis came
 within 0.5-0.6 m of it and two landings fell 17 cm east of their steps: docs/vrc.md), north
 past the wall's end, then to gate_1 (its feet stopping 5 cm past the gate's line, short of
-the mud pit's ramp), through the pit to gate_2, over the hills to gate_3, and across the
-rubble to gate_4 (a way around the blocks, planned when that leg begins: rubble_way.py). A
+the mud pit's ramp), through the pit to gate_2, over the hills to gate_3 (a way on the gentle
+ground between them, planned when that leg begins: hill_way.py), and across the rubble to
+gate_4 (a way around the blocks, planned so too: rubble_way.py). A
 walker that starts elsewhere (one of the later starts) begins with the
 nearest gate still ahead of it, walking that leg from its waypoint nearest the walker.
 """
@@ -19,6 +20,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 from tutorial_atlas_control.course.errors import CourseError
+from tutorial_atlas_control.course.hill_way import gentle_path
 from tutorial_atlas_control.course.rubble_way import clear_path
 from tutorial_atlas_control.course.vrc_task_2 import GATES, Block, Gate
 
@@ -35,11 +37,13 @@ LEG_PAUSE_S = 1.0
 class Leg:
     """The waypoints (world x, y) to walk through to pass `gate`, the last one past it;
     `clear_of_blocks`: a leg across the rubble, whose way to its last waypoint is planned
-    around the blocks when it begins (leg_waypoints)."""
+    around the blocks when it begins (leg_waypoints); `over_hills`: a leg whose way to its
+    last waypoint is planned on the gentle ground between the hills so."""
 
     gate: str
     waypoints: tuple[tuple[float, float], ...]
     clear_of_blocks: bool = False
+    over_hills: bool = False
 
 
 #: The course from the pen's start, gate by gate, in scoring order.
@@ -47,7 +51,7 @@ COURSE_LEGS: tuple[Leg, ...] = (
     Leg('gate_0', ((1.6, -38.0),)),
     Leg('gate_1', ((3.2, -38.0), (3.2, -31.0), (0.5, -24.5), (0.5, -21.95))),
     Leg('gate_2', ((0.5, -10.0),)),
-    Leg('gate_3', ((3.0, -2.0), (6.0, 7.0))),
+    Leg('gate_3', ((6.0, 7.0),), over_hills=True),
     Leg('gate_4', ((6.0, 18.5),), clear_of_blocks=True),
 )
 
@@ -87,12 +91,15 @@ def legs_ahead(x_m: float, y_m: float, to_gate: str = GATES[-1].name) -> tuple[L
 
 def leg_waypoints(leg: Leg, x_m: float, y_m: float, blocks: Sequence[Block]
                   ) -> tuple[tuple[float, float], ...]:
-    """The waypoints a walker at (x, y) walks for `leg`: its own, or across the rubble a way
-    around `blocks` to its last one (clear_path).
+    """The waypoints a walker at (x, y) walks for `leg`: its own, across the rubble a way
+    around `blocks` to its last one (clear_path), or over the hills a way on their gentle
+    ground (gentle_path).
 
     Raises:
-        CourseError: no way around the blocks.
+        CourseError: no way around the blocks, or none over gentle ground.
     """
-    if not leg.clear_of_blocks:
-        return leg.waypoints
-    return clear_path(blocks, (x_m, y_m), leg.waypoints[-1])
+    if leg.clear_of_blocks:
+        return clear_path(blocks, (x_m, y_m), leg.waypoints[-1])
+    if leg.over_hills:
+        return gentle_path((x_m, y_m), leg.waypoints[-1])
+    return leg.waypoints

@@ -13,13 +13,13 @@ SHORTCUT_SLACK_M, the ones a route of straight strides (walking/route.py) walks.
 
 from __future__ import annotations
 
-import heapq
 import math
 from collections.abc import Sequence
 
 import numpy as np
 
 from tutorial_atlas_control.course.errors import CourseError
+from tutorial_atlas_control.course.grid_path import a_star, cells_on_line, shortened
 from tutorial_atlas_control.course.vrc_task_2 import (
     BLOCK_ENVELOPE_M,
     GATE_POST_M,
@@ -29,7 +29,7 @@ from tutorial_atlas_control.course.vrc_task_2 import (
 )
 
 __all__ = ['CLEARANCE_M', 'GRID_M', 'block_corners', 'block_footprint', 'clear_path',
-           'distance_to_polygon']
+           'distance_to_polygon', 'gate_posts']
 
 #: Grid cell (m).
 GRID_M = 0.05
@@ -102,7 +102,7 @@ def distance_to_polygon(polygon: np.ndarray, x: np.ndarray, y: np.ndarray) -> np
     return np.where(inside, 0.0, distance)
 
 
-def _posts() -> list[np.ndarray]:
+def gate_posts() -> list[np.ndarray]:
     """Every gate's two posts, seen from above."""
     half = GATE_POST_M[0] / 2
     square = np.array([[-half, -half], [half, -half], [half, half], [-half, half]])
@@ -130,7 +130,7 @@ def clear_path(blocks: Sequence[Block], start: Point, goal: Point,
     ys = np.arange(y0, max(start[1], goal[1]) + MARGIN_M + GRID_M / 2, GRID_M)
     grid_x, grid_y = np.meshgrid(xs, ys, indexing='ij')
     nearest_m = np.full(grid_x.shape, np.inf)
-    for polygon in [block_footprint(block) for block in blocks] + _posts():
+    for polygon in [block_footprint(block) for block in blocks] + gate_posts():
         nearest_m = np.minimum(nearest_m, distance_to_polygon(polygon, grid_x, grid_y))
     free = nearest_m > clearance_m
 
@@ -149,68 +149,11 @@ def clear_path(blocks: Sequence[Block], start: Point, goal: Point,
                               f'{clearance_m} m from the blocks')
         nearest = spaces[np.argmin(np.hypot(*(spaces - first).T))]
         free[first] = True
-        free[_line(first, (int(nearest[0]), int(nearest[1])))] = True
-    cells = _a_star(free, first, cell(goal))
+        free[cells_on_line(first, (int(nearest[0]), int(nearest[1])))] = True
+    cells = a_star(free, first, cell(goal))
     if cells is None:
         raise CourseError(f'no way from ({start[0]:.2f}, {start[1]:.2f}) to '
                           f'({goal[0]:.2f}, {goal[1]:.2f}) keeps {clearance_m} m from the blocks')
-    kept = _shortened(free | (nearest_m > clearance_m - SHORTCUT_SLACK_M), cells)
+    kept = shortened(free | (nearest_m > clearance_m - SHORTCUT_SLACK_M), cells)
     return tuple((round(float(xs[i]), 3), round(float(ys[j]), 3)) for i, j in kept[1:-1]) \
         + (goal,)
-
-
-_MOVES = [(di, dj, math.hypot(di, dj)) for di in (-1, 0, 1) for dj in (-1, 0, 1)
-          if (di, dj) != (0, 0)]
-
-
-def _a_star(free: np.ndarray, start: tuple[int, int], goal: tuple[int, int]
-            ) -> list[tuple[int, int]] | None:
-    """The shortest 8-connected path over free cells, start and goal included."""
-    def estimate(c: tuple[int, int]) -> float:
-        return math.hypot(c[0] - goal[0], c[1] - goal[1])
-
-    cost = {start: 0.0}
-    came: dict[tuple[int, int], tuple[int, int]] = {}
-    todo = [(estimate(start), start)]
-    while todo:
-        _, here = heapq.heappop(todo)
-        if here == goal:
-            path = [here]
-            while path[-1] in came:
-                path.append(came[path[-1]])
-            return path[::-1]
-        for di, dj, step in _MOVES:
-            there = (here[0] + di, here[1] + dj)
-            if not (0 <= there[0] < free.shape[0] and 0 <= there[1] < free.shape[1]) \
-                    or not free[there]:
-                continue
-            new = cost[here] + step
-            if new < cost.get(there, math.inf):
-                cost[there], came[there] = new, here
-                heapq.heappush(todo, (new + estimate(there), there))
-    return None
-
-
-def _line(a: tuple[int, int], b: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
-    """The cells on the straight line a..b (indices into the grid)."""
-    count = max(abs(b[0] - a[0]), abs(b[1] - a[1])) * 2 + 1
-    return (np.rint(np.linspace(a[0], b[0], count)).astype(int),
-            np.rint(np.linspace(a[1], b[1], count)).astype(int))
-
-
-def _visible(free: np.ndarray, a: tuple[int, int], b: tuple[int, int]) -> bool:
-    """Whether every cell on the straight line a..b is free."""
-    return bool(free[_line(a, b)].all())
-
-
-def _shortened(free: np.ndarray, cells: list[tuple[int, int]]) -> list[tuple[int, int]]:
-    """The path's corners: from each kept cell, the farthest cell still in straight sight."""
-    kept = [cells[0]]
-    here = 0
-    while here < len(cells) - 1:
-        far = len(cells) - 1
-        while far > here + 1 and not _visible(free, cells[here], cells[far]):
-            far -= 1
-        kept.append(cells[far])
-        here = far
-    return kept

@@ -1,0 +1,73 @@
+"""Shortest ways over a grid of the ground, for a walker's waypoints: A* over the free cells,
+then shortened to the few straight lines a route of straight strides (walking/route.py)
+walks. rubble_way.py (around the blocks) and hill_way.py (over the gentle ground between the
+hills) mark the free cells; both grids are indexed [i, j] = (x, y) or (y, x) alike: a cell is
+a pair of indices.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+
+import numpy as np
+
+__all__ = ['Cell', 'a_star', 'cells_on_line', 'shortened', 'visible']
+
+Cell = tuple[int, int]
+
+_MOVES = [(di, dj, math.hypot(di, dj)) for di in (-1, 0, 1) for dj in (-1, 0, 1)
+          if (di, dj) != (0, 0)]
+
+
+def a_star(free: np.ndarray, start: Cell, goal: Cell) -> list[Cell] | None:
+    """The shortest 8-connected path over free cells, start and goal included (None: no
+    way joins them)."""
+    def estimate(c: Cell) -> float:
+        return math.hypot(c[0] - goal[0], c[1] - goal[1])
+
+    cost = {start: 0.0}
+    came: dict[Cell, Cell] = {}
+    todo = [(estimate(start), start)]
+    while todo:
+        _, here = heapq.heappop(todo)
+        if here == goal:
+            path = [here]
+            while path[-1] in came:
+                path.append(came[path[-1]])
+            return path[::-1]
+        for di, dj, step in _MOVES:
+            there = (here[0] + di, here[1] + dj)
+            if not (0 <= there[0] < free.shape[0] and 0 <= there[1] < free.shape[1]) \
+                    or not free[there]:
+                continue
+            new = cost[here] + step
+            if new < cost.get(there, math.inf):
+                cost[there], came[there] = new, here
+                heapq.heappush(todo, (new + estimate(there), there))
+    return None
+
+
+def cells_on_line(a: Cell, b: Cell) -> tuple[np.ndarray, np.ndarray]:
+    """The cells on the straight line a..b (indices into the grid)."""
+    count = max(abs(b[0] - a[0]), abs(b[1] - a[1])) * 2 + 1
+    return (np.rint(np.linspace(a[0], b[0], count)).astype(int),
+            np.rint(np.linspace(a[1], b[1], count)).astype(int))
+
+
+def visible(free: np.ndarray, a: Cell, b: Cell) -> bool:
+    """Whether every cell on the straight line a..b is free."""
+    return bool(free[cells_on_line(a, b)].all())
+
+
+def shortened(free: np.ndarray, cells: list[Cell]) -> list[Cell]:
+    """The path's corners: from each kept cell, the farthest cell still in straight sight."""
+    kept = [cells[0]]
+    here = 0
+    while here < len(cells) - 1:
+        far = len(cells) - 1
+        while far > here + 1 and not visible(free, cells[here], cells[far]):
+            far -= 1
+        kept.append(cells[far])
+        here = far
+    return kept

@@ -1,0 +1,157 @@
+"""A walker's way over the hills: waypoints on the gentle ground between them.
+
+Between gate_2 and gate_3 the course's hills rise 0.2-0.4 m over a metre or two; straight
+lines from gate to gate cross ground up to 21 degrees steep under a sole, and Walk fell there
+on every start tried (docs/vrc.md). Between the hills the ground is gentler: a way to gate_3
+exists whose ground stays within about 11 degrees under the feet. Such a leg (course/legs.py's
+`over_hills`) is planned when it begins, from where the walker is, on the course's heights
+(terrain.py: the image the world's heightfield is made of).
+
+The slope under a foot is the terrain's gradient over a sole's length (central differences
+SOLE_SPAN_M apart); a cell of the GRID_M grid is free when the steepest slope within `reach_m`
+of it (the feet's half stance and a sole's half width around the centre line) is at most
+`steepest_deg`, and it keeps POST_CLEARANCE_M from every gate post. A* over the free cells
+(grid_path.py) finds the shortest way; it is shortened to the corners between which straight
+lines stay within SLACK_DEG more, and a corner inside the turning circle at the one before
+it is dropped where a line past it stays within DROP_SLACK_DEG more: a walker turning in
+strides cannot face a waypoint that lies within its turning circle (where neither line does,
+the corner moves back along the way to it until the next one lies outside).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy import ndimage
+
+from tutorial_atlas_control.course.errors import CourseError
+from tutorial_atlas_control.course.grid_path import Cell, a_star, shortened, visible
+from tutorial_atlas_control.course.rubble_way import distance_to_polygon, gate_posts
+from tutorial_atlas_control.course.terrain import ground_under, terrain_heights
+
+__all__ = ['GRID_M', 'REACH_M', 'STEEPEST_DEG', 'gentle_path', 'slope_deg']
+
+#: Grid cell (m).
+GRID_M = 0.05
+#: Between the gradient's two samples (m): about a sole's length (0.26 m).
+SOLE_SPAN_M = 0.3
+#: The steepest ground (degrees) a way's cells may have within REACH_M of them. Walk went up
+#: and down 8 degrees on every start tried and fell on the hills' 15-21 (docs/vrc.md); at 10
+#: the way to gate_3 is 27.5 m long, at 11 22.4 m, at 9 there is none.
+STEEPEST_DEG = 11.0
+#: Around the centre line (m): half the feet's stance width and half a sole's width.
+REACH_M = 0.15
+#: The shortened way's straight lines may cross ground this much steeper (degrees).
+SLACK_DEG = 1.0
+#: A walker turning in strides turns on a circle of about this radius (m; route.py's turning
+#: steps: 0.08 m each turning 0.2 rad make 0.4): a corner inside the circle from the one
+#: before (as the walker arrives there) cannot be faced. Such a corner is dropped where the
+#: line past it (or, else, the line past the one before to it) crosses ground at most
+#: DROP_SLACK_DEG steeper than the way.
+TURN_RADIUS_M = 0.45
+DROP_SLACK_DEG = 3.0
+#: The centre line keeps this far (m) from a gate post's side.
+POST_CLEARANCE_M = 0.6
+#: The grid reaches this far (m) beyond the start and the goal.
+MARGIN_M = 3.0
+
+Point = tuple[float, float]
+
+
+def slope_deg(x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
+    """The course's slope (degrees) under a sole at each of the world points (any shape):
+    the gradient by central differences SOLE_SPAN_M apart."""
+    heights, half = terrain_heights(), SOLE_SPAN_M / 2.0
+    grade_x = (ground_under(heights, x_m + half, y_m)
+               - ground_under(heights, x_m - half, y_m)) / SOLE_SPAN_M
+    grade_y = (ground_under(heights, x_m, y_m + half)
+               - ground_under(heights, x_m, y_m - half)) / SOLE_SPAN_M
+    return np.degrees(np.arctan(np.hypot(grade_x, grade_y)))
+
+
+def gentle_path(start: Point, goal: Point, steepest_deg: float = STEEPEST_DEG,
+                reach_m: float = REACH_M) -> tuple[Point, ...]:
+    """Waypoints from `start` (excluded) to `goal` (the last one) over ground no steeper than
+    `steepest_deg` within `reach_m` of the way (its straight lines SLACK_DEG more), clear of
+    the gate posts. The start and the goal count as free.
+
+    Raises:
+        CourseError: no such way joins them.
+    """
+    if not (math.isfinite(steepest_deg) and 0.0 < steepest_deg < 90.0):
+        raise CourseError(f'steepest_deg must be within (0, 90): {steepest_deg}')
+    x0, y0 = min(start[0], goal[0]) - MARGIN_M, min(start[1], goal[1]) - MARGIN_M
+    xs = np.arange(x0, max(start[0], goal[0]) + MARGIN_M + GRID_M / 2, GRID_M)
+    ys = np.arange(y0, max(start[1], goal[1]) + MARGIN_M + GRID_M / 2, GRID_M)
+    grid_x, grid_y = np.meshgrid(xs, ys, indexing='ij')
+    radius = max(1, round(reach_m / GRID_M))
+    di, dj = np.mgrid[-radius:radius + 1, -radius:radius + 1]
+    steepest = ndimage.maximum_filter(slope_deg(grid_x, grid_y),
+                                      footprint=di ** 2 + dj ** 2 <= radius ** 2)
+    clear = np.ones(grid_x.shape, dtype=bool)
+    for post in gate_posts():
+        clear &= distance_to_polygon(post, grid_x, grid_y) > POST_CLEARANCE_M
+
+    def cell(point: Point) -> Cell:
+        return int(round((point[0] - x0) / GRID_M)), int(round((point[1] - y0) / GRID_M))
+
+    first, last = cell(start), cell(goal)
+    free = clear & (steepest <= steepest_deg)
+    free[first] = free[last] = True
+    cells = a_star(free, first, last)
+    if cells is None:
+        raise CourseError(f'no way from ({start[0]:.2f}, {start[1]:.2f}) to '
+                          f'({goal[0]:.2f}, {goal[1]:.2f}) keeps to ground within '
+                          f'{steepest_deg:g} degrees')
+    loose = clear & (steepest <= steepest_deg + SLACK_DEG)
+    looser = clear & (steepest <= steepest_deg + DROP_SLACK_DEG)
+    loose[first] = loose[last] = looser[first] = looser[last] = True
+    kept = _turnable(looser, shortened(loose, cells))
+    return tuple((round(float(xs[i]), 3), round(float(ys[j]), 3)) for i, j in kept[1:-1]) \
+        + (goal,)
+
+
+def _inside_turn(before: Cell, corner: Cell, after: Cell) -> bool:
+    """Whether `after` lies inside the turning circle at `corner` of a walker arriving there
+    from `before`, on the side it turns to."""
+    heading = math.atan2(corner[1] - before[1], corner[0] - before[0])
+    bearing = math.atan2(after[1] - corner[1], after[0] - corner[0])
+    side = math.copysign(1.0, math.remainder(bearing - heading, math.tau))
+    radius = TURN_RADIUS_M / GRID_M
+    centre = (corner[0] - side * radius * math.sin(heading),
+              corner[1] + side * radius * math.cos(heading))
+    return math.dist(after, centre) < radius
+
+
+def _turnable(looser: np.ndarray, corners: list[Cell]) -> list[Cell]:
+    """`corners` without those inside the turning circle at the one before: the corner
+    itself where the line from the one before to the one after stays on `looser` cells,
+    else the one before it where the line past that one does."""
+    kept = list(corners)
+    index = 2
+    while index < len(kept):
+        if not _inside_turn(kept[index - 2], kept[index - 1], kept[index]):
+            index += 1
+        elif index + 1 < len(kept) and visible(looser, kept[index - 1], kept[index + 1]):
+            del kept[index]
+        elif visible(looser, kept[index - 2], kept[index]):
+            del kept[index - 1]
+            index = max(2, index - 1)
+        else:
+            kept[index - 1] = _turned_earlier(looser, *kept[index - 2:index + 1])
+            index += 1
+    return kept
+
+
+def _turned_earlier(looser: np.ndarray, before: Cell, corner: Cell, after: Cell) -> Cell:
+    """`corner` moved back towards `before`, a cell at a time, to the first place from which
+    `after` lies outside the turning circle and the line to it stays on `looser` cells (the
+    corner itself when there is none)."""
+    count = max(abs(corner[0] - before[0]), abs(corner[1] - before[1]))
+    for k in range(1, count):
+        earlier = (round(corner[0] + (before[0] - corner[0]) * k / count),
+                   round(corner[1] + (before[1] - corner[1]) * k / count))
+        if not _inside_turn(before, earlier, after) and visible(looser, earlier, after):
+            return earlier
+    return corner

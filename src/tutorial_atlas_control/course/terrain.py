@@ -1,0 +1,46 @@
+"""The course's terrain as heights: the package's terrain image with course.HEIGHTMAP's
+scaling, the image the world's heightfield is made of (tools/make_vrc_world.py).
+
+Read once a process and shared: a recorded run's analysis (the ground under a fall, the
+landings, the map) and a walker's plan over the hills (hill_way.py) ask for it.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from tutorial_atlas_control.course.starts import TERRAIN_FILE
+from tutorial_atlas_control.course.vrc_task_2 import HEIGHTMAP
+from tutorial_atlas_control.resources import package_path
+
+__all__ = ['ground_under', 'terrain_heights']
+
+
+@functools.cache
+def terrain_heights() -> np.ndarray:
+    """The course's terrain heights (m), rows from +y down, columns from -x (the image's
+    layout), read-only."""
+    import matplotlib.image  # noqa: PLC0415 - only course runs need it
+
+    grey = np.asarray(matplotlib.image.imread(package_path('sim', TERRAIN_FILE)))
+    if grey.dtype.kind == 'f':  # matplotlib reads an 8-bit PNG as levels / 255
+        grey = np.rint(grey * 255.0)
+    heights = HEIGHTMAP.z0_m + HEIGHTMAP.relief_m * grey.astype(float) / HEIGHTMAP.brightest
+    heights.setflags(write=False)
+    return heights
+
+
+def ground_under(heights: np.ndarray, x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
+    """The terrain's height (m) under world points, bilinear between the heightmap's
+    vertices (MuJoCo's triangles differ by millimetres on the hills, not on ramps)."""
+    half, cell = HEIGHTMAP.size_m / 2.0, HEIGHTMAP.cell_m
+    last = heights.shape[0] - 1
+    col = np.clip((np.asarray(x_m) + half) / cell, 0.0, last)
+    row = np.clip((half - np.asarray(y_m)) / cell, 0.0, last)
+    c0, r0 = np.minimum(col.astype(int), last - 1), np.minimum(row.astype(int), last - 1)
+    fc, fr = col - c0, row - r0
+    top = heights[r0, c0] * (1 - fc) + heights[r0, c0 + 1] * fc
+    bottom = heights[r0 + 1, c0] * (1 - fc) + heights[r0 + 1, c0 + 1] * fc
+    return top * (1 - fr) + bottom * fr
