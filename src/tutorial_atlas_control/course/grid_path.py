@@ -1,9 +1,8 @@
 """Shortest ways over a grid of the ground, for a walker's waypoints: A* over the free cells,
 then shortened to the few straight lines a route of straight strides (walking/route.py)
-walks. rubble_way.py (around the blocks) and hill_way.py (over the gentle ground between the
-hills) mark the free cells; both grids are indexed [i, j] = (x, y) or (y, x) alike: a cell is
-a pair of indices.
-"""
+walks, and its corners made ones a walker turning in strides can face (turnable).
+rubble_way.py (around the blocks) and hill_way.py (over the gentle ground between the hills)
+mark the free cells; a cell is a pair of indices into the grid, x first."""
 
 from __future__ import annotations
 
@@ -12,7 +11,8 @@ import math
 
 import numpy as np
 
-__all__ = ['Cell', 'a_star', 'cells_on_line', 'shortened', 'visible']
+__all__ = ['Cell', 'a_star', 'cells_on_line', 'inside_turn', 'shortened', 'turnable',
+           'turned_earlier', 'visible']
 
 Cell = tuple[int, int]
 
@@ -71,3 +71,49 @@ def shortened(free: np.ndarray, cells: list[Cell]) -> list[Cell]:
         kept.append(cells[far])
         here = far
     return kept
+
+
+def inside_turn(before: Cell, corner: Cell, after: Cell, radius: float) -> bool:
+    """Whether `after` lies inside the turning circle at `corner` of a walker arriving there
+    from `before`, on the side it turns to (`radius` in cells)."""
+    heading = math.atan2(corner[1] - before[1], corner[0] - before[0])
+    bearing = math.atan2(after[1] - corner[1], after[0] - corner[0])
+    side = math.copysign(1.0, math.remainder(bearing - heading, math.tau))
+    centre = (corner[0] - side * radius * math.sin(heading),
+              corner[1] + side * radius * math.cos(heading))
+    return math.dist(after, centre) < radius
+
+
+def turnable(looser: np.ndarray, corners: list[Cell], radius: float) -> list[Cell]:
+    """`corners` fit for a walker turning in strides on a circle of `radius` (cells): a
+    corner inside the turning circle at the one before is dropped where the line from the
+    one before to the one after stays on `looser` cells, else the one before it where the
+    line past that one does, else that one is moved back along its run (turned_earlier)."""
+    kept = list(corners)
+    index = 2
+    while index < len(kept):
+        if not inside_turn(kept[index - 2], kept[index - 1], kept[index], radius):
+            index += 1
+        elif index + 1 < len(kept) and visible(looser, kept[index - 1], kept[index + 1]):
+            del kept[index]
+        elif visible(looser, kept[index - 2], kept[index]):
+            del kept[index - 1]
+            index = max(2, index - 1)
+        else:
+            kept[index - 1] = turned_earlier(looser, *kept[index - 2:index + 1], radius)
+            index += 1
+    return kept
+
+
+def turned_earlier(looser: np.ndarray, before: Cell, corner: Cell, after: Cell,
+                   radius: float) -> Cell:
+    """`corner` moved back towards `before`, a cell at a time, to the first place from which
+    `after` lies outside the turning circle and the line to it stays on `looser` cells (the
+    corner itself when there is none)."""
+    count = max(abs(corner[0] - before[0]), abs(corner[1] - before[1]))
+    for k in range(1, count):
+        earlier = (round(corner[0] + (before[0] - corner[0]) * k / count),
+                   round(corner[1] + (before[1] - corner[1]) * k / count))
+        if not inside_turn(before, earlier, after, radius) and visible(looser, earlier, after):
+            return earlier
+    return corner

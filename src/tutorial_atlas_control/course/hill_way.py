@@ -26,7 +26,7 @@ import numpy as np
 from scipy import ndimage
 
 from tutorial_atlas_control.course.errors import CourseError
-from tutorial_atlas_control.course.grid_path import Cell, a_star, shortened, visible
+from tutorial_atlas_control.course.grid_path import Cell, a_star, shortened, turnable
 from tutorial_atlas_control.course.rubble_way import distance_to_polygon, gate_posts
 from tutorial_atlas_control.course.terrain import ground_under, terrain_heights
 
@@ -107,51 +107,6 @@ def gentle_path(start: Point, goal: Point, steepest_deg: float = STEEPEST_DEG,
     loose = clear & (steepest <= steepest_deg + SLACK_DEG)
     looser = clear & (steepest <= steepest_deg + DROP_SLACK_DEG)
     loose[first] = loose[last] = looser[first] = looser[last] = True
-    kept = _turnable(looser, shortened(loose, cells))
+    kept = turnable(looser, shortened(loose, cells), TURN_RADIUS_M / GRID_M)
     return tuple((round(float(xs[i]), 3), round(float(ys[j]), 3)) for i, j in kept[1:-1]) \
         + (goal,)
-
-
-def _inside_turn(before: Cell, corner: Cell, after: Cell) -> bool:
-    """Whether `after` lies inside the turning circle at `corner` of a walker arriving there
-    from `before`, on the side it turns to."""
-    heading = math.atan2(corner[1] - before[1], corner[0] - before[0])
-    bearing = math.atan2(after[1] - corner[1], after[0] - corner[0])
-    side = math.copysign(1.0, math.remainder(bearing - heading, math.tau))
-    radius = TURN_RADIUS_M / GRID_M
-    centre = (corner[0] - side * radius * math.sin(heading),
-              corner[1] + side * radius * math.cos(heading))
-    return math.dist(after, centre) < radius
-
-
-def _turnable(looser: np.ndarray, corners: list[Cell]) -> list[Cell]:
-    """`corners` without those inside the turning circle at the one before: the corner
-    itself where the line from the one before to the one after stays on `looser` cells,
-    else the one before it where the line past that one does."""
-    kept = list(corners)
-    index = 2
-    while index < len(kept):
-        if not _inside_turn(kept[index - 2], kept[index - 1], kept[index]):
-            index += 1
-        elif index + 1 < len(kept) and visible(looser, kept[index - 1], kept[index + 1]):
-            del kept[index]
-        elif visible(looser, kept[index - 2], kept[index]):
-            del kept[index - 1]
-            index = max(2, index - 1)
-        else:
-            kept[index - 1] = _turned_earlier(looser, *kept[index - 2:index + 1])
-            index += 1
-    return kept
-
-
-def _turned_earlier(looser: np.ndarray, before: Cell, corner: Cell, after: Cell) -> Cell:
-    """`corner` moved back towards `before`, a cell at a time, to the first place from which
-    `after` lies outside the turning circle and the line to it stays on `looser` cells (the
-    corner itself when there is none)."""
-    count = max(abs(corner[0] - before[0]), abs(corner[1] - before[1]))
-    for k in range(1, count):
-        earlier = (round(corner[0] + (before[0] - corner[0]) * k / count),
-                   round(corner[1] + (before[1] - corner[1]) * k / count))
-        if not _inside_turn(before, earlier, after) and visible(looser, earlier, after):
-            return earlier
-    return corner
