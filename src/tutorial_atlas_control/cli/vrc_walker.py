@@ -37,10 +37,11 @@ from tutorial_atlas_control.course import (
     LEG_PAUSE_S,
     CourseError,
     Leg,
-    leg_waypoints,
+    course_height_m,
     legs_ahead,
 )
-from tutorial_atlas_control.walking import RouteGait, WalkingError, route_steps
+from tutorial_atlas_control.offline import leg_plan
+from tutorial_atlas_control.walking import RouteGait, WalkingError
 
 PROG = 'vrc_walker.py'
 #: How long (s, wall time) /vrc_score may take to report a gate the walk has passed.
@@ -146,8 +147,7 @@ def _walk_leg(link: AsiLink, leg: Leg, gait: RouteGait, timeout_s: float) -> Non
         raise Refused(f'no time left for the leg to {leg.gate}')
     origin, heading = link.feet()
     try:
-        plan = route_steps(origin, heading, leg_waypoints(leg, *origin, BLOCKS),
-                           gait.turning_in_place() if leg.clear_of_blocks else gait)
+        plan = leg_plan(leg, origin, heading, gait, BLOCKS, course_height_m)
     except (WalkingError, CourseError) as err:
         raise Refused(f'no route to {leg.gate} from ({origin[0]:.2f}, {origin[1]:.2f}): '
                       f'{err}') from None

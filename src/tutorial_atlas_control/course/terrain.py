@@ -2,7 +2,8 @@
 scaling, the image the world's heightfield is made of (tools/make_vrc_world.py).
 
 Read once a process and shared: a recorded run's analysis (the ground under a fall, the
-landings, the map) and a walker's plan over the hills (hill_way.py) ask for it.
+landings, the map), a walker's way over the hills (hill_way.py) and the live course walker's
+strides on the ground (cli/vrc_walker.py) ask for it.
 """
 
 from __future__ import annotations
@@ -12,10 +13,10 @@ import functools
 import numpy as np
 
 from tutorial_atlas_control.course.starts import TERRAIN_FILE
-from tutorial_atlas_control.course.vrc_task_2 import HEIGHTMAP
+from tutorial_atlas_control.course.vrc_task_2 import HEIGHTMAP, MUD_FLOOR_Z_M, PEN
 from tutorial_atlas_control.resources import package_path
 
-__all__ = ['ground_under', 'terrain_heights']
+__all__ = ['course_height_m', 'ground_under', 'terrain_heights']
 
 
 @functools.cache
@@ -44,3 +45,16 @@ def ground_under(heights: np.ndarray, x_m: np.ndarray, y_m: np.ndarray) -> np.nd
     top = heights[r0, c0] * (1 - fc) + heights[r0, c0 + 1] * fc
     bottom = heights[r0 + 1, c0] * (1 - fc) + heights[r0 + 1, c0 + 1] * fc
     return top * (1 - fr) + bottom * fr
+
+
+def course_height_m(x_m: float, y_m: float) -> float:
+    """The ground's height (m) under one world point: the terrain, the mud pit's floor plane
+    (MUD_FLOOR_Z_M, 1 cm over the terrain's deepest) and the pen's floor: the ground a walker
+    plans on when it knows the world only from its description (walking/route.py's
+    `ground`)."""
+    height = max(float(ground_under(terrain_heights(), np.asarray(x_m), np.asarray(y_m))),
+                 MUD_FLOOR_Z_M)
+    (cx, cy, cz), (sx, sy, sz) = PEN.centre_m, PEN.size_m
+    if abs(x_m - cx) <= sx / 2 and abs(y_m - cy) <= sy / 2:
+        height = max(height, cz + sz / 2)
+    return height

@@ -13,7 +13,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'asi_playback': ['AsiStream', 'read_asi_stream', 'run_asi_offline'],
     'block_step': ['PLANS', 'BlockRun', 'BlockStep', 'CinderBlock', 'block_model', 'block_plan',
                    'block_step_trial'],
-    'course_route': ['CourseWalk', 'LegFigures', 'course_walk'],
+    'course_route': ['CourseWalk', 'LegFigures', 'course_walk', 'leg_plan'],
     'course_variant': ['BLOCK_CLEARANCE_M', 'MUD_FLOOR_GEOM', 'block_placement',
                        'highest_ground_m', 'variant_model'],
     'player': ['CommandLatency', 'DEFAULT_SETTLE_S', 'DEFAULT_START_AFTER_S', 'OfflineRunError',

@@ -69,8 +69,9 @@ from tutorial_atlas_control.walking import (
     perturb_start,
     route_steps,
 )
+from tutorial_atlas_control.walking.ground_strides import HeightField
 
-__all__ = ['CourseWalk', 'LegFigures', 'course_walk']
+__all__ = ['CourseWalk', 'LegFigures', 'course_walk', 'leg_plan']
 
 #: The fall criterion is asked this often (ticks).
 FALL_CHECK_TICKS = 10
@@ -292,6 +293,23 @@ def _course_simulator(world_name: str, variant: CourseVariant | None) -> AtlasSi
                           else variant.mud_damping)
 
 
+def leg_plan(leg: Leg, origin: tuple[float, float], heading_rad: float, gait: RouteGait,
+             blocks: Sequence[Block], ground: HeightField) -> list[Footstep]:
+    """A leg's steps from feet side by side at `origin` facing `heading_rad`: its waypoints
+    (around `blocks` across the rubble, on gentle ground over the hills: leg_waypoints), the
+    corners among the blocks turned on the spot, the straight runs fitted to `ground` when
+    the gait says so (the offline walker's world, the live one's course description).
+
+    Raises:
+        CourseError: no way around the blocks or over the hills.
+        WalkingError: a waypoint the route cannot reach.
+    """
+    if leg.clear_of_blocks:  # around blocks: the corners turned on the spot
+        gait = gait.turning_in_place()
+    return route_steps(origin, heading_rad, leg_waypoints(leg, *origin, blocks), gait,
+                       ground=ground if gait.fit_ground else None)
+
+
 def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,
               streamer: _Streamer, leg: Leg, gait: RouteGait | None,
               blocks: Sequence[Block]) -> WalkClient:
@@ -299,12 +317,8 @@ def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,
     streamed until it ends, the robot falls or the leg's time (SECONDS_PER_STEP a step)
     runs out."""
     origin, heading = _feet(interface)
-    gait = gait or RouteGait()
-    if leg.clear_of_blocks:  # around blocks: the corners turned on the spot
-        gait = gait.turning_in_place()
-    ground = streamer.ground.ground.height_m if gait.fit_ground else None
-    plan = route_steps(origin, heading, leg_waypoints(leg, *origin, blocks), gait,
-                       ground=ground)
+    plan = leg_plan(leg, origin, heading, gait or RouteGait(), blocks,
+                    streamer.ground.ground.height_m)
     client = streamer.client = WalkClient(plan, streaming=True)
     limit_ns = sim.sim_time_ns + math.floor(len(plan) * SECONDS_PER_STEP * NS_PER_S)
     while client.outcome is None and streamer.fell_at_s is None \
