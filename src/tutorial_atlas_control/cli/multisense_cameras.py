@@ -26,7 +26,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     import rospy  # noqa: PLC0415 - after MUJOCO_GL, as every import below
 
     from tutorial_atlas_control.stereo import camera_node  # noqa: PLC0415
-    from tutorial_atlas_control.stereo.head_cameras import (  # noqa: PLC0415
+    from tutorial_atlas_control.stereo import (  # noqa: PLC0415
         ImageNoise,
         StereoRenderer,
         camera_model,
