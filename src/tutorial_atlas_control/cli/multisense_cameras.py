@@ -25,11 +25,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         os.environ['MUJOCO_GL'] = os.environ['PYOPENGL_PLATFORM'] = 'osmesa'
     import rospy  # noqa: PLC0415 - after MUJOCO_GL, as every import below
 
-    from tutorial_atlas_control.stereo import camera_node  # noqa: PLC0415
     from tutorial_atlas_control.stereo import (  # noqa: PLC0415
         ImageNoise,
         StereoRenderer,
         camera_model,
+        camera_node,
     )
     argv = list(sys.argv if argv is None else argv)
     plain = [arg for arg in argv[1:] if ':=' not in arg]
