@@ -25,6 +25,9 @@ Sections (see bench/README.md for what each figure means and how it is measured)
             2.6's synchronization window on (--period-ms 1) at real_time_factor:=0
   plot      realtime_rtf and node_us_per_step without and with plot_topics.py plotting
             three 1 kHz fields (bench/plot_cost.py)
+  cameras   the head's stereo cameras at real_time_factor:=1.0: achieved factor, images per
+            second of sim time and CPU per second of sim time, unwatched, the left image,
+            both, and in the VRC course (bench/camera_cost.py)
   walking   the fractions of seeds whose walks fall: pushed every 5 s (walk_pushes.py), one
             push at each phase of a step, test_asi_live's walks varied (walk_variations.py);
             once, whatever --runs says (bench/walking.py)
