@@ -11,6 +11,7 @@ import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 from tutorial_atlas_control.cli.convention import EXIT_INTERRUPTED, EXIT_REFUSED
 
@@ -38,6 +39,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print((camera_node.__doc__ or '').strip(), file=sys.stdout if asked else sys.stderr)
         return 0 if asked else EXIT_REFUSED
     rospy.init_node(NODE_NAME, argv=argv)
+    _drop_clock(rospy)
     noise = rospy.get_param('~noise', True)
     try:
         model = camera_model(str(Path(plain[0])))
@@ -55,3 +57,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(node.summary(), flush=True)
         renderer.close()
     return 0
+
+
+def _drop_clock(rospy: Any) -> None:
+    """Unsubscribes rospy's own /clock subscriber (made under /use_sim_time): the node's
+    stamps are the rendered states' sim times, and decoding 1000 clocks a second cost it
+    0.07 s of CPU per second of sim time while nobody looked (rospy offers no public way)."""
+    subscriber = getattr(rospy.impl.simtime, '_clock_sub', None)
+    if subscriber is not None:
+        subscriber.unregister()
