@@ -64,12 +64,12 @@ from tutorial_atlas_control.units import NS_PER_S
 from tutorial_atlas_control.walking import (
     QUEUE_LENGTH,
     Footstep,
+    HeightField,
     RouteGait,
     feet_origin,
     perturb_start,
     route_steps,
 )
-from tutorial_atlas_control.walking.ground_strides import HeightField
 
 __all__ = ['CourseWalk', 'LegFigures', 'course_walk', 'leg_plan']
 

@@ -40,7 +40,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'walk': ['WalkGains'],
     'walk_behaviour': ['WalkBehaviour', 'WalkStatus'],
     'route': ['RouteGait', 'feet_origin', 'route_steps'],
-    'ground_strides': ['GroundGait', 'SoleFit', 'ground_steps', 'sole_fit'],
+    'ground_strides': ['GroundGait', 'HeightField', 'SoleFit', 'ground_steps', 'sole_fit'],
     'start_noise': ['perturb_start'],
     'walk_trial': ['SETTLE_S', 'WalkTrial', 'WalkingStand', 'pushed_walk_trial',
                    'random_pushes', 'run_walking_stand', 'straight_walk_trial', 'walk_trial'],
