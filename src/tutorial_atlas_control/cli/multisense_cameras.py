@@ -43,19 +43,24 @@ def main(argv: Sequence[str] | None = None) -> int:
     noise = rospy.get_param('~noise', True)
     try:
         model = camera_model(str(Path(plain[0])))
-        renderer = StereoRenderer(model, ImageNoise() if noise else None)
-    except Exception as err:  # noqa: BLE001 - MuJoCo's and OpenGL's errors, said in one line
+    except Exception as err:  # noqa: BLE001 - MuJoCo's errors, said in one line
         print(f'{PROG}: error: cannot render {plain[0]}: {" ".join(str(err).split())}',
               file=sys.stderr)
         return EXIT_REFUSED
-    node = camera_node.CameraNode(renderer)
+    node = camera_node.CameraNode(
+        lambda: StereoRenderer(model, ImageNoise() if noise else None))
     try:
         node.spin()
     except KeyboardInterrupt:
         return EXIT_INTERRUPTED
+    except Exception as err:  # noqa: BLE001 - OpenGL's errors at the first image, one line
+        print(f'{PROG}: error: cannot render {plain[0]}: {" ".join(str(err).split())}',
+              file=sys.stderr)
+        return EXIT_REFUSED
     finally:
         print(node.summary(), flush=True)
-        renderer.close()
+        if node.renderer is not None:
+            node.renderer.close()
     return 0
 
 

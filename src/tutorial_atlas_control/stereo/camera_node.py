@@ -17,6 +17,7 @@ from __future__ import annotations
 import io
 import threading
 import time
+from collections.abc import Callable
 
 import numpy as np
 import rospy
@@ -87,8 +88,11 @@ class _DemandListener(rospy.SubscribeListener):
 class CameraNode:
     """Subscribes to the world state while heard, renders what is due, publishes it."""
 
-    def __init__(self, renderer: StereoRenderer) -> None:
-        self.renderer = renderer
+    def __init__(self, make_renderer: Callable[[], StereoRenderer]) -> None:
+        #: The renderer, made when the first image is asked for: its OpenGL context and the
+        #: noise's table cost half a second of CPU, and every launch starts this node.
+        self.make_renderer = make_renderer
+        self.renderer: StereoRenderer | None = None
         self.clock = FrameClock(DEFAULT_FPS)
         self.ready = threading.Condition()
         self.pending: tuple[rospy.Time, np.ndarray] | None = None
@@ -152,8 +156,10 @@ class CameraNode:
     def publish_frame(self, stamp: rospy.Time, qpos: np.ndarray) -> None:
         """The images and camera_infos of one state, for the sides someone listens to."""
         sides = [name for name, outlets in self.outlets.items() if outlets.wants_image()]
+        if sides and self.renderer is None:
+            self.renderer = self.make_renderer()
         start = time.perf_counter()
-        images = self.renderer.render_sides(qpos, sides) if sides else {}
+        images = self.renderer.render_sides(qpos, sides) if sides and self.renderer else {}
         self.render_s += time.perf_counter() - start
         self.frames += 1
         self.images += len(images)
