@@ -61,6 +61,7 @@ class LoopSettings:
             balance_stand), registered over the library's; None: the library's own.
         score_dir: score the VRC course (DRCSim's VRCScoringPlugin) into score.log there,
             and /vrc_score; None: not scored.
+        sensor_seed: the seed of the head's laser noise (offline runs and replays: the run's).
     """
 
     rates_hz: Mapping[str, float] = field(default_factory=dict)
@@ -71,6 +72,7 @@ class LoopSettings:
     hold_at_start: bool = False
     user_behaviour: LibraryBehaviour | None = None
     score_dir: Path | None = None
+    sensor_seed: int = 0
 
 
 class SteppingLoop:
@@ -108,7 +110,7 @@ class SteppingLoop:
         self.controller: StepController = (controller(self.inbox) if controller is not None
                                            else self.inbox)
         self.publisher = StepPublisher(sim, outputs, settings.rates_hz, statistics,
-                                       settings.links, self.asi)
+                                       settings.links, self.asi, settings.sensor_seed)
         self.gate = SyncGate(sim, self.lock, self.inbox, outputs, self.pacer, window)
         self.controls = SimControls(sim, self.lock, self.inbox, self.watch, outputs,
                                     settings.paused)
@@ -129,6 +131,11 @@ class SteppingLoop:
         self.apply_input, self.publish_config = controls.apply_input, controls.publish_config
         self.reset_world, self.reset_simulation = controls.reset_world, controls.reset_simulation
         self.pause, self.unpause = controls.pause, controls.unpause
+
+    def set_spindle_speed(self, speed: float) -> None:
+        """The laser spindle's speed from the next step on (rad/s, within its limits)."""
+        with self.lock:
+            self.publisher.head.spindle.command(speed)
 
     @property
     def real_time_factor(self) -> float:

@@ -18,6 +18,7 @@ from tutorial_atlas_control.msgs import (
     clock_bytes,
     encode_asi_state,
 )
+from tutorial_atlas_control.sensors import HeadSensors
 from tutorial_atlas_control.sim import (
     AtlasSimulator,
     CommandAgeStatistics,
@@ -59,12 +60,17 @@ class StepPublisher:
             stead (link_transforms.py), at rates_hz['links_tf']; None: not.
         asi: the AtlasSimInterface whose state goes out every step while someone listens
             (its end_step is the tick's, after this); None: no such state.
+        sensor_seed: the seed of the head's laser noise (~sensor_seed).
     """
 
     def __init__(self, sim: AtlasSimulator, outputs: LoopOutputs, rates_hz: Mapping[str, float],
                  statistics: CommandAgeStatistics, links: LinkTransforms | None,
-                 asi: AtlasSimInterface | None = None) -> None:
+                 asi: AtlasSimInterface | None = None, sensor_seed: int = 0) -> None:
         self.sim = sim
+        #: The MultiSense SL head: the spindle stepped each step, its messages on demand.
+        self.head = HeadSensors(sim.model, sim.data, sim.dt_s, sensor_seed)
+        self.scan_outlet = outputs.outlets.get(topics.LASER_SCAN)
+        self.head_joint_state_outlet = outputs.outlets.get(topics.HEAD_JOINT_STATES)
         self.asi = asi
         self.asi_outlet = outputs.outlets.get(topics.ASI_STATE) if asi is not None else None
         self.asi_seq = 0
@@ -140,6 +146,8 @@ class StepPublisher:
         if (links is not None and count % self.every['joint_states'] == 0
                 and links.due(now_ns) and wanted(tf_outlet)):
             outbox.add(tf_outlet, messages.links_tf(now_ns))
+            outbox.add(tf_outlet, self.head.hokuyo_tf(now_ns))
+        self._publish_head(count, sensed_ns, now_ns)
         asi_outlet = self.asi_outlet
         state = None
         if asi_outlet is not None and wanted(asi_outlet):
@@ -151,6 +159,16 @@ class StepPublisher:
         recorded = self.asi_recorded_outlet
         if recorded is not None and wanted(recorded):
             self._record_asi_state(count, recorded, state)
+
+    def _publish_head(self, count: int, sensed_ns: int, now_ns: int) -> None:
+        """The head's laser scan and spindle joint state, when due and heard."""
+        wanted, outbox, head = self.outbox.wanted, self.outbox, self.head
+        scan = self.scan_outlet
+        if scan is not None and count % self.every['laser'] == 0 and wanted(scan):
+            outbox.add(scan, head.scan(sensed_ns))
+        joints = self.head_joint_state_outlet
+        if joints is not None and count % self.every['head_joint_states'] == 0 and wanted(joints):
+            outbox.add(joints, head.joint_state(now_ns))
 
     def _record_asi_state(self, count: int, outlet: object, state: AsiState | None) -> None:
         """The bag's copy of the state, when due or changed (`state`: built already)."""
@@ -165,8 +183,9 @@ class StepPublisher:
         self.outbox.add(outlet, len(body).to_bytes(4, 'little') + body)
 
     def publish_step(self, count: int) -> None:
-        """After step `count`: its messages, and the command age into the statistics'
-        window and, when due, out."""
+        """After step `count`: the spindle's step, the step's messages, and the command age
+        into the statistics' window and, when due, out."""
+        self.head.step()
         self.publish(count)
         if not self.outbox.wanted(self.statistics_outlet):
             return

@@ -1,0 +1,80 @@
+"""The MultiSense SL head's messages from a simulator's state: the laser's scan, the
+spindle's joint state and hokuyo_link's transform, as wire bytes (msgs/wire.py).
+
+One writer for the node's stepping loop (stepping/publication.py) and offline runs: the
+spindle is stepped with each physics step whether or not anyone listens (its angle is the
+same either way); a scan is cast only when one is due and wanted. A scan describes the
+state at the start of the last step (the head's pose mj_step computed before integrating,
+the spindle's angle before its step: stamp with `sim.state_time_ns`); the joint state and
+the transform the spindle after it (stamp with `sim.sim_time_ns`, as /atlas/joint_states).
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from tutorial_atlas_control.msgs import JointStateWire, LaserScanWire, TransformWire
+from tutorial_atlas_control.sensors.frames import (
+    HEAD_HOKUYO_FRAME,
+    HEAD_LINK,
+    HOKUYO_JOINT,
+    HOKUYO_LINK,
+)
+from tutorial_atlas_control.sensors.laser import HOKUYO, HokuyoLaser, LaserSpec
+from tutorial_atlas_control.sensors.spindle import Spindle
+
+__all__ = ['HeadSensors']
+
+
+class HeadSensors:
+    """The head's laser and spindle on one model and its MjData.
+
+    Args:
+        dt_s: the physics step (s): the spindle's.
+        seed: the laser noise's seed (~sensor_seed).
+    """
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, dt_s: float,
+                 seed: int = 0, spec: LaserSpec = HOKUYO) -> None:
+        self.data = data
+        self.spindle = Spindle(dt_s)
+        self.laser = HokuyoLaser(model, spec, seed)
+        # gazebo_ros_laser: time_increment 0 (one instant), scan_time one period.
+        figures = (spec.min_angle, spec.max_angle, spec.angle_increment, 0.0,
+                   1.0 / spec.rate_hz, spec.range_min, spec.range_max)
+        self.scan_wire = LaserScanWire(HEAD_HOKUYO_FRAME, figures, spec.samples)
+        self.joint_state_wire = JointStateWire((HOKUYO_JOINT.joint,))
+        self.hokuyo_tf_wire = TransformWire(HEAD_LINK, HOKUYO_LINK)
+        self.hokuyo_tf_wire.translation[:] = HOKUYO_JOINT.xyz_m
+
+    def step(self) -> None:
+        """With each physics step (after it, before its messages): the spindle's step."""
+        self.spindle.step()
+
+    def reset(self) -> None:
+        """A reset of the world: the spindle at rest at 0, its command kept."""
+        self.spindle.reset()
+
+    def scan(self, stamp_ns: int) -> bytearray:
+        """/multisense_sl/laser/scan of the last step's start, stamped `stamp_ns`: the wire's
+        buffer, valid until the next call."""
+        wire = self.scan_wire
+        self.laser.scan(self.data, self.spindle.previous_angle, stamp_ns, wire.ranges)
+        return wire.stamped(stamp_ns)
+
+    def joint_state(self, stamp_ns: int) -> bytearray:
+        """/multisense_sl/joint_states: hokuyo_joint's angle (in [-pi, pi), as DRCSim's),
+        speed and the PID's torque."""
+        wire, spindle = self.joint_state_wire, self.spindle
+        wire.position[0] = spindle.normalized_angle
+        wire.velocity[0] = spindle.velocity
+        wire.effort[0] = spindle.effort
+        return wire.stamped(stamp_ns)
+
+    def hokuyo_tf(self, stamp_ns: int) -> bytes:
+        """head -> hokuyo_link on /tf (hokuyo_joint at its angle about x)."""
+        half = 0.5 * self.spindle.angle
+        rotation = self.hokuyo_tf_wire.rotation_xyzw
+        rotation[0], rotation[3] = np.sin(half), np.cos(half)
+        return self.hokuyo_tf_wire.to_bytes(stamp_ns)
