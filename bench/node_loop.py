@@ -258,3 +258,24 @@ def main(argv: list[str] | None = None) -> int:
 
 if __name__ == '__main__':
     sys.exit(main())
+
+
+def head_sensors_run(scans: int = 200, steps: int = 5000) -> dict[str, float]:
+    """The MultiSense SL head's cost on the standing robot (sensors/head.py, as the node's
+    loop calls it): `laser_ms_per_sim_s`, the wall ms a second of sim time of subscribed
+    scans costs (40 scans: 720 rays cast, noised, serialized); `spindle_step_us`, the
+    spinning spindle's step (µs; at rest and asked for 0 it is a test)."""
+    with fake_ros_node(0) as node:
+        head = node.loop.publisher.head
+        sim = node.loop.sim
+        rate_hz = head.laser.spec.rate_hz
+        start = time.perf_counter()
+        for k in range(scans):
+            head.scan(sim.state_time_ns + k)
+        scan_s = (time.perf_counter() - start) / scans
+        head.spindle.command(5.0)
+        start = time.perf_counter()
+        for _ in range(steps):
+            head.step()
+        step_s = (time.perf_counter() - start) / steps
+    return {'laser_ms_per_sim_s': scan_s * rate_hz * 1e3, 'spindle_step_us': step_s * 1e6}

@@ -80,7 +80,11 @@ class Spindle:
         self._integral = self._last_error = 0.0
 
     def step(self) -> None:
-        """One physics step: the plugin's PID update, then the joint integrated."""
+        """One physics step: the plugin's PID update, then the joint integrated (at rest and
+        asked for 0, as at start, nothing changes: a test, not the arithmetic)."""
+        if not (self.target or self.velocity or self._integral):
+            self.previous_angle = self.angle
+            return
         dt = self.dt_s
         p_gain, i_gain, d_gain = PID_GAINS
         error = self.velocity - self.target
