@@ -196,7 +196,7 @@ INTERFACE: tuple[Topic, ...] = (
           Rate(when='with `~vrc_scoring`: every 1 s of sim time and at each gate or fall'),
           recorded=True, delivery=Delivery(latched=True, offline=True)),
     Topic(LASER_SCAN, 'sensor_msgs/LaserScan', _OUT, Rate('~laser_rate', 40.0),
-          on_demand=True, recorded=True, delivery=Delivery(loop=True)),
+          on_demand=True, recorded=True, delivery=Delivery(offline=True, loop=True)),
     Topic(HEAD_JOINT_STATES, 'sensor_msgs/JointState', _OUT,
           Rate('~head_joint_states_rate', 1000.0), on_demand=True, delivery=Delivery(loop=True)),
     Topic(CURRENT_CONTROL_MODE, 'std_msgs/String', _OUT, Rate(when='each mode switch'),

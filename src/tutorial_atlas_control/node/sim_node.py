@@ -569,6 +569,7 @@ def build_node() -> SimNode:
     sim = AtlasSimulator(load_model(Path(model_file)), gains, time_to_unpin_s,
                          startup_mode=VrcMode(startup_mode), start=_start_param(),
                          mud_damping=_mud_damping_param())
+    sim.sensor_seed = _sensor_seed_param()
     behaviour_spec = rospy.get_param('~behaviour', '')
     if not isinstance(behaviour_spec, str):
         raise AtlasControlError(f'parameter {rospy.resolve_name("~behaviour")} must be '
@@ -584,8 +585,7 @@ def build_node() -> SimNode:
                             _links_publisher(description) if tf_publisher == 'sim' else None,
                             balance_stand=stand == 'balance',
                             hold_at_start=stand == 'balance',
-                            user_behaviour=user_behaviour, score_dir=_score_dir(),
-                            sensor_seed=_sensor_seed_param())
+                            user_behaviour=user_behaviour, score_dir=_score_dir())
     return SimNode(sim, settings, bool(rospy.get_param('~gui', False)),
                    description is not None, DelayBudgets.from_params(rospy.get_param))
 

@@ -44,6 +44,7 @@ from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import ATLAS_PREFIX, JOINT_NAMES
 from tutorial_atlas_control.msgs import CommandDecoder, JointCommandsWire, StampedWire, clock_bytes
 from tutorial_atlas_control.offline.world import OfflineWorld
+from tutorial_atlas_control.sensors import HeadSensors
 from tutorial_atlas_control.sim import (
     DEFAULT_GAINS_FILE,
     TCPROS_PREFIX_BYTES,
@@ -86,6 +87,8 @@ DEFAULT_SETTLE_S = 3.0
 CLOCK_PERIOD_NS = 10_000_000
 #: /ground_truth_odom's rate (Hz), the simulator's default (~odom_rate).
 ODOM_RATE_HZ = topics.BY_NAME[topics.GROUND_TRUTH_ODOM].rate.default_hz
+#: /multisense_sl/laser/scan's rate (Hz), the simulator's default (~laser_rate).
+LASER_RATE_HZ = topics.BY_NAME[topics.LASER_SCAN].rate.default_hz
 #: Who published what in a live run: the bag's connections name them as callers.
 SIMULATOR_NODE = '/atlas_sim'
 PLAYER_NODE = '/tutorial_atlas_control'
@@ -170,12 +173,15 @@ class _StepRows:
     """What the simulator node publishes after each step, kept as rows of numbers (qpos,
     qvel, torque, sensordata, stamps); every BLOCK_STEPS steps they become messages, all
     at once (write_steps): the joint states, and the table's sensor messages through
-    SimMessages.sensor_selection.
+    SimMessages.sensor_selection. The head's laser scans are written as they are cast.
     """
 
     def __init__(self, sim: AtlasSimulator, sink: BlockBagWriter) -> None:
         self.sim = sim
         self.sink = sink
+        #: The head's laser and spindle (stepped by the player with each step).
+        self.head = HeadSensors(sim.model, sim.data, sim.dt_s, sim.sensor_seed)
+        self.laser_every = steps_between(LASER_RATE_HZ, sim.dt_s)
         self.messages = messages = SimMessages(sim)
         self.joint_states = self._block(topics.JOINT_STATES, messages.joint_state_wire)
         self.odometry = self._block(topics.GROUND_TRUTH_ODOM, messages.odometry_wire)
@@ -223,6 +229,9 @@ class _StepRows:
             self.odometry.add(now_ns, sim.state_time_ns)
             self.sink.write(topics.TF, now_ns,
                             self.messages.pelvis_tf(sim.state_time_ns)[TCPROS_PREFIX_BYTES:])
+        if steps % self.laser_every == 0:
+            self.sink.write(topics.LASER_SCAN, now_ns,
+                            self.head.scan(sim.state_time_ns)[TCPROS_PREFIX_BYTES:])
         self.count = k + 1
         if self.count == BLOCK_STEPS:
             self.write_steps()
@@ -320,8 +329,10 @@ class OfflinePlayer:
             self.controller.before_step()
 
     def _publish_step(self) -> None:
-        """The tick's state: what the node sends after the step, kept."""
+        """The tick's state: the spindle's step, then what the node sends after the step,
+        kept."""
         self.steps += 1
+        self.rows.head.step()
         self.rows.publish(self.steps)
 
     def _end_step(self) -> None:

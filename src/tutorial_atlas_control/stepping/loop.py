@@ -61,7 +61,6 @@ class LoopSettings:
             balance_stand), registered over the library's; None: the library's own.
         score_dir: score the VRC course (DRCSim's VRCScoringPlugin) into score.log there,
             and /vrc_score; None: not scored.
-        sensor_seed: the seed of the head's laser noise (offline runs and replays: the run's).
     """
 
     rates_hz: Mapping[str, float] = field(default_factory=dict)
@@ -72,7 +71,6 @@ class LoopSettings:
     hold_at_start: bool = False
     user_behaviour: LibraryBehaviour | None = None
     score_dir: Path | None = None
-    sensor_seed: int = 0
 
 
 class SteppingLoop:
@@ -110,7 +108,7 @@ class SteppingLoop:
         self.controller: StepController = (controller(self.inbox) if controller is not None
                                            else self.inbox)
         self.publisher = StepPublisher(sim, outputs, settings.rates_hz, statistics,
-                                       settings.links, self.asi, settings.sensor_seed)
+                                       settings.links, self.asi)
         self.gate = SyncGate(sim, self.lock, self.inbox, outputs, self.pacer, window)
         self.controls = SimControls(sim, self.lock, self.inbox, self.watch, outputs,
                                     settings.paused)

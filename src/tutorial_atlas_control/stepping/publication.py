@@ -60,15 +60,14 @@ class StepPublisher:
             stead (link_transforms.py), at rates_hz['links_tf']; None: not.
         asi: the AtlasSimInterface whose state goes out every step while someone listens
             (its end_step is the tick's, after this); None: no such state.
-        sensor_seed: the seed of the head's laser noise (~sensor_seed).
     """
 
     def __init__(self, sim: AtlasSimulator, outputs: LoopOutputs, rates_hz: Mapping[str, float],
                  statistics: CommandAgeStatistics, links: LinkTransforms | None,
-                 asi: AtlasSimInterface | None = None, sensor_seed: int = 0) -> None:
+                 asi: AtlasSimInterface | None = None) -> None:
         self.sim = sim
         #: The MultiSense SL head: the spindle stepped each step, its messages on demand.
-        self.head = HeadSensors(sim.model, sim.data, sim.dt_s, sensor_seed)
+        self.head = HeadSensors(sim.model, sim.data, sim.dt_s, sim.sensor_seed)
         self.scan_outlet = outputs.outlets.get(topics.LASER_SCAN)
         self.head_joint_state_outlet = outputs.outlets.get(topics.HEAD_JOINT_STATES)
         self.asi = asi
