@@ -77,6 +77,8 @@ VRC_SCORE = '/vrc_score'
 LASER_SCAN = '/multisense_sl/laser/scan'
 SET_SPINDLE_SPEED = '/multisense_sl/set_spindle_speed'
 HEAD_JOINT_STATES = '/multisense_sl/joint_states'
+#: sensor_msgs/Imu of head_imu_link (DRCSim's MultiSenseSL plugin's, 1 kHz).
+HEAD_IMU = '/multisense_sl/imu'
 
 class Direction(enum.Enum):
     """Who writes a topic: the simulator node, its users (commands, cheats), or every node."""
@@ -199,6 +201,8 @@ INTERFACE: tuple[Topic, ...] = (
           on_demand=True, recorded=True, delivery=Delivery(offline=True, loop=True)),
     Topic(HEAD_JOINT_STATES, 'sensor_msgs/JointState', _OUT,
           Rate('~head_joint_states_rate', 1000.0), on_demand=True, delivery=Delivery(loop=True)),
+    Topic(HEAD_IMU, 'sensor_msgs/Imu', _OUT, Rate('~head_imu_rate', 1000.0), on_demand=True,
+          delivery=Delivery(loop=True)),
     Topic(CURRENT_CONTROL_MODE, 'std_msgs/String', _OUT, Rate(when='each mode switch'),
           delivery=Delivery(latched=True)),
     Topic(TF_STATIC, 'tf2_msgs/TFMessage', _OUT, Rate(when='once (`~tf_publisher` sim)'),

@@ -108,6 +108,7 @@ PORT_OWN_TOPICS = {
     # The MultiSense SL head's laser, by DRCSim 2.7's names (not in the 2.5.2 lists).
     '/multisense_sl/laser/scan': 'sensor_msgs/LaserScan',
     '/multisense_sl/joint_states': 'sensor_msgs/JointState',
+    '/multisense_sl/imu': 'sensor_msgs/Imu',
     '/multisense_sl/set_spindle_speed': 'std_msgs/Float64',
 }
 

@@ -1,5 +1,6 @@
 """The MultiSense SL head's messages from a simulator's state: the laser's scan, the
-spindle's joint state and hokuyo_link's transform, as wire bytes (msgs/wire.py).
+spindle's joint state, hokuyo_link's transform and the head's IMU, as wire bytes
+(msgs/wire.py).
 
 One writer for the node's stepping loop (stepping/publication.py) and offline runs: the
 spindle is stepped with each physics step whether or not anyone listens (its angle is the
@@ -14,9 +15,10 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from tutorial_atlas_control.msgs import JointStateWire, LaserScanWire, TransformWire
+from tutorial_atlas_control.msgs import ImuWire, JointStateWire, LaserScanWire, TransformWire
 from tutorial_atlas_control.sensors.frames import (
     HEAD_HOKUYO_FRAME,
+    HEAD_IMU,
     HEAD_LINK,
     HOKUYO_JOINT,
     HOKUYO_LINK,
@@ -47,6 +49,12 @@ class HeadSensors:
         self.joint_state_wire = JointStateWire((HOKUYO_JOINT.joint,))
         self.hokuyo_tf_wire = TransformWire(HEAD_LINK, HOKUYO_LINK)
         self.hokuyo_tf_wire.translation[:] = HOKUYO_JOINT.xyz_m
+        self.model = model
+        self.head_body = self.laser.head_body
+        self.imu_wire = ImuWire(HEAD_IMU.child)
+        self._imu_offset = np.array(HEAD_IMU.xyz_m)
+        self._velocity = np.zeros(6)
+        self._acceleration = np.zeros(6)
 
     def step(self) -> None:
         """With each physics step (after it, before its messages): the spindle's step."""
@@ -78,3 +86,24 @@ class HeadSensors:
         rotation = self.hokuyo_tf_wire.rotation_xyzw
         rotation[0], rotation[3] = np.sin(half), np.cos(half)
         return self.hokuyo_tf_wire.to_bytes(stamp_ns)
+
+    def imu(self, stamp_ns: int) -> bytearray:
+        """/multisense_sl/imu at head_imu_link, of the last step's start (stamp with
+        `sim.state_time_ns`, as /atlas/imu): the head's orientation in the world (x y z w),
+        its angular velocity and the proper acceleration at the IMU's point (gravity's
+        reaction included, 9.81 m/s2 up standing still), both in the IMU's frame (the
+        head's axes). MuJoCo's accelerations of that step (its accelerometer's, computed
+        by mj_step); no noise."""
+        data, body, wire = self.data, self.head_body, self.imu_wire
+        quat = data.xquat[body]
+        wire.orientation_xyzw[:3] = quat[1:]
+        wire.orientation_xyzw[3] = quat[0]
+        velocity, acceleration = self._velocity, self._acceleration
+        mujoco.mj_objectVelocity(self.model, data, mujoco.mjtObj.mjOBJ_BODY, body, velocity, 1)
+        mujoco.mj_objectAcceleration(self.model, data, mujoco.mjtObj.mjOBJ_BODY, body,
+                                     acceleration, 1)
+        omega, r = velocity[:3], self._imu_offset
+        wire.angular_velocity[:] = omega
+        wire.linear_acceleration[:] = (acceleration[3:] + np.cross(acceleration[:3], r)
+                                       + np.cross(omega, np.cross(omega, r)))
+        return wire.stamped(stamp_ns)

@@ -70,6 +70,7 @@ class StepPublisher:
         self.head = HeadSensors(sim.model, sim.data, sim.dt_s, sim.sensor_seed)
         self.scan_outlet = outputs.outlets.get(topics.LASER_SCAN)
         self.head_joint_state_outlet = outputs.outlets.get(topics.HEAD_JOINT_STATES)
+        self.head_imu_outlet = outputs.outlets.get(topics.HEAD_IMU)
         self.asi = asi
         self.asi_outlet = outputs.outlets.get(topics.ASI_STATE) if asi is not None else None
         self.asi_seq = 0
@@ -160,7 +161,7 @@ class StepPublisher:
             self._record_asi_state(count, recorded, state)
 
     def _publish_head(self, count: int, sensed_ns: int, now_ns: int) -> None:
-        """The head's laser scan and spindle joint state, when due and heard."""
+        """The head's laser scan, spindle joint state and IMU, when due and heard."""
         wanted, outbox, head = self.outbox.wanted, self.outbox, self.head
         scan = self.scan_outlet
         if scan is not None and count % self.every['laser'] == 0 and wanted(scan):
@@ -168,6 +169,9 @@ class StepPublisher:
         joints = self.head_joint_state_outlet
         if joints is not None and count % self.every['head_joint_states'] == 0 and wanted(joints):
             outbox.add(joints, head.joint_state(now_ns))
+        imu = self.head_imu_outlet
+        if imu is not None and count % self.every['head_imu'] == 0 and wanted(imu):
+            outbox.add(imu, head.imu(sensed_ns))
 
     def _record_asi_state(self, count: int, outlet: object, state: AsiState | None) -> None:
         """The bag's copy of the state, when due or changed (`state`: built already)."""

@@ -159,3 +159,22 @@ def test_the_head_sends_laserscan_and_joint_state_bytes(world) -> None:
     assert state.name == ['hokuyo_joint']
     assert state.position[0] == pytest.approx(head.spindle.angle)
     assert 0.5 < state.velocity[0] < 1.0
+
+
+def test_the_head_imu_reads_gravity_and_the_turn_at_its_point(world) -> None:
+    """The head turning at 2 rad/s about y through its origin: the IMU, 4.75 cm behind and
+    3.5 cm left of it, reads that rate, gravity's reaction up and the centripetal pull
+    towards the axis (0.0475 m x 4 rad2/s2 forward)."""
+    sensor_msgs = pytest.importorskip('sensor_msgs.msg', reason='needs ROS: source ./env.sh')
+    model, data = world
+    data.qvel[0] = 2.0
+    mujoco.mj_forward(model, data)
+    mujoco.mj_rnePostConstraint(model, data)  # Atlas's accelerometer has mj_step do it
+    imu = sensor_msgs.Imu().deserialize(bytes(HeadSensors(model, data, 0.001).imu(7))[4:])
+    assert imu.header.frame_id == 'head_imu_link'
+    assert (imu.orientation.x, imu.orientation.w) == (0.0, 1.0)
+    np.testing.assert_allclose([imu.angular_velocity.x, imu.angular_velocity.y,
+                                imu.angular_velocity.z], [0.0, 2.0, 0.0], atol=1e-12)
+    acceleration = imu.linear_acceleration
+    np.testing.assert_allclose([acceleration.x, acceleration.y, acceleration.z],
+                               [0.0475 * 4.0, 0.0, 9.81], atol=1e-9)
