@@ -273,12 +273,15 @@ def load_recording(path: Path | str, data: BagData | None = None,
     return Recording(path, config, resets, state_stamp_ns, position, velocity, effort,
                      odom_stamp_ns, odom_position, odom_quat, len(odom_stamp_ns) > 0, warnings,
                      inputs, chosen.number, tries, try_asked=try_number is not None,
-                     scores=read_scores(data), scans=_comparable_scans(path, warnings))
+                     scores=read_scores(data), scans=_comparable_scans(data, warnings))
 
 
-def _comparable_scans(path: Path, warnings: list[str]) -> LaserScans | None:
-    """The bag's laser scans, if it has any that replay can compare."""
-    scans = read_laser_scans(path)
+def _comparable_scans(data: BagData, warnings: list[str]) -> LaserScans | None:
+    """The bag's laser scans, if it has any that replay can compare (a bag without any is
+    not opened again)."""
+    if not getattr(data.topics.get(topics.LASER_SCAN), 'count', 0):
+        return None
+    scans = read_laser_scans(data.path)
     return scans if ScanReplay.comparable(scans, warnings) else None
 
 
@@ -618,8 +621,7 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
     steps, effort = all_steps[rows], recording.effort_nm[rows]
     probe = _OdomProbe(odom_steps, reset_step, int(steps[-1]))
     probe.score = _score_replay(recording, sim, reset_step, warnings)
-    if recording.scans is not None:
-        probe.scans = ScanReplay(sim, recording.scans, config.sensor_seed)
+    probe.scans = ScanReplay.of(sim, recording.scans, config.sensor_seed)
     inputs = _InputQueue(recording.inputs)
     prefix = _recreate_prefix(sim, config, reset_step, int(steps[0]), effort[0], probe, warnings,
                               inputs)

@@ -58,6 +58,11 @@ class ScanReplay:
         self.differing = 0
         self.first_difference_ns: int | None = None
 
+    @classmethod
+    def of(cls, sim: AtlasSimulator, scans: LaserScans | None, seed: int) -> ScanReplay | None:
+        """A replay of `scans` (None without any)."""
+        return None if scans is None else cls(sim, scans, seed)
+
     @staticmethod
     def comparable(scans: LaserScans | None, warnings: list[str]) -> bool:
         """Whether a recording's scans can be compared (else a warning says why not)."""
