@@ -278,7 +278,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _check_course_map(analysis: Analysis, args: argparse.Namespace) -> None:
-    """--course-map needs a course run.
+    """--course-map needs a course run, --scan-cloud a bag with scans.
 
     Raises:
         BagAnalysisError: the bag is not one.
@@ -287,6 +287,10 @@ def _check_course_map(analysis: Analysis, args: argparse.Namespace) -> None:
         raise BagAnalysisError(f'{analysis.data.path} is not a VRC Task 2 run (its '
                                '/atlas/sim_config names no vrc_task_2.xml and it has no '
                                '/vrc_score): --course-map draws course runs only')
+    scans = analysis.data.topics.get(topics.LASER_SCAN)
+    if args.scan_cloud and not getattr(scans, 'count', 0):
+        raise BagAnalysisError(f'{analysis.data.path} has no {topics.LASER_SCAN}: no scan to '
+                               'draw')
 
 
 def _course_maps(analysis: Analysis, args: argparse.Namespace) -> list[Path]:
@@ -308,9 +312,7 @@ def _course_maps(analysis: Analysis, args: argparse.Namespace) -> list[Path]:
     cloud = None
     if args.scan_cloud:
         scans = read_laser_scans(data.path)
-        if scans is None:
-            raise BagAnalysisError(f'{data.path} has no {topics.LASER_SCAN}: no scan to draw')
-        cloud = scan_cloud(data, scans)
+        cloud = None if scans is None else scan_cloud(data, scans)
     return [plot_course_map(run, path, cloud) for path in paths] if run is not None else []
 
 

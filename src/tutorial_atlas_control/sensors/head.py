@@ -60,10 +60,6 @@ class HeadSensors:
         """With each physics step (after it, before its messages): the spindle's step."""
         self.spindle.step()
 
-    def reset(self) -> None:
-        """A reset of the world: the spindle at rest at 0, its command kept."""
-        self.spindle.reset()
-
     def scan(self, stamp_ns: int) -> bytearray:
         """/multisense_sl/laser/scan of the last step's start, stamped `stamp_ns`: the wire's
         buffer, valid until the next call."""

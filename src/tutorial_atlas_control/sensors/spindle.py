@@ -74,11 +74,6 @@ class Spindle:
         """The speed to hold (rad/s; spindle_command's, within the limits)."""
         self.target = speed
 
-    def reset(self) -> None:
-        """The joint back to rest at angle 0 (the command is kept, as the plugin's)."""
-        self.angle = self.previous_angle = self.velocity = self.effort = 0.0
-        self._integral = self._last_error = 0.0
-
     def step(self) -> None:
         """One physics step: the plugin's PID update, then the joint integrated (at rest and
         asked for 0, as at start, nothing changes: a test, not the arithmetic)."""

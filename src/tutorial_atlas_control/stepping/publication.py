@@ -2,8 +2,9 @@
 
 The table's rows with a SimMessages wire are filled by plans and sent at their rate; the
 on-demand ones are filled only when due and someone listens (an unheard one costs a test
-per step). /clock, /ground_truth_odom, /tf, /atlas/controller_statistics and the AtlasSimInterface's
-state (and the bag's copy of it) have builders of their own.
+per step). /clock, /ground_truth_odom, /tf, /atlas/controller_statistics, the
+AtlasSimInterface's state (and the bag's copy of it) and the MultiSense SL head's topics
+(sensors/head.py) have builders of their own.
 """
 
 from __future__ import annotations
