@@ -95,8 +95,8 @@ class HeadSensors:
         wire.orientation_xyzw[:3] = quat[1:]
         wire.orientation_xyzw[3] = quat[0]
         velocity, acceleration = self._velocity, self._acceleration
-        mujoco.mj_objectVelocity(self.model, data, mujoco.mjtObj.mjOBJ_BODY, body, velocity, 1)
-        mujoco.mj_objectAcceleration(self.model, data, mujoco.mjtObj.mjOBJ_BODY, body,
+        mujoco.mj_objectVelocity(self.model, data, mujoco.mjtObj.mjOBJ_XBODY, body, velocity, 1)
+        mujoco.mj_objectAcceleration(self.model, data, mujoco.mjtObj.mjOBJ_XBODY, body,
                                      acceleration, 1)
         omega, r = velocity[:3], self._imu_offset
         wire.angular_velocity[:] = omega

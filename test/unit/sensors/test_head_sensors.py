@@ -22,7 +22,8 @@ from tutorial_atlas_control.sensors import (
 
 #: A head 1.5 m over a floor, a 0.2 m box 2 m in front of it (its near face at 1.9 m), the
 #: head's own box around the laser (which the rays must not see), a wall 40 m away (beyond
-#: range_max) and a visual-only geom (group 1) 1 m to the left.
+#: range_max) and a visual-only geom (group 1) 1 m to the left. The head's principal axes
+#: are not its frame's (as Atlas's links'): the IMU must read the frame's.
 WORLD = """
 <mujoco>
   <worldbody>
@@ -31,6 +32,7 @@ WORLD = """
     <geom name="far_wall" type="box" size="0.1 50 50" pos="-40 0 0"/>
     <geom name="ghost" type="box" size="0.1 0.1 3" pos="0 1 0" group="1"/>
     <body name="head" pos="0 0 1.5">
+      <inertial pos="0 0 0" mass="1" fullinertia="0.01 0.02 0.03 0.005 0 0"/>
       <joint name="pitch" type="hinge" axis="0 1 0"/>
       <geom name="shell" type="box" size="0.2 0.2 0.2"/>
     </body>
