@@ -197,8 +197,9 @@ INTERFACE: tuple[Topic, ...] = (
     Topic(VRC_SCORE, 'atlas_msgs/VRCScore', _OUT,
           Rate(when='with `~vrc_scoring`: every 1 s of sim time and at each gate or fall'),
           recorded=True, delivery=Delivery(latched=True, offline=True)),
+    # Offline runs write it when asked (run_offline.py --scans): it costs them a fifth.
     Topic(LASER_SCAN, 'sensor_msgs/LaserScan', _OUT, Rate('~laser_rate', 40.0),
-          on_demand=True, recorded=True, delivery=Delivery(offline=True, loop=True)),
+          on_demand=True, recorded=True, delivery=Delivery(loop=True)),
     Topic(HEAD_JOINT_STATES, 'sensor_msgs/JointState', _OUT,
           Rate('~head_joint_states_rate', 1000.0), on_demand=True, delivery=Delivery(loop=True)),
     Topic(HEAD_IMU, 'sensor_msgs/Imu', _OUT, Rate('~head_imu_rate', 1000.0), on_demand=True,

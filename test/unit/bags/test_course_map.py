@@ -48,12 +48,13 @@ TOLERANCE = 40
 @pytest.fixture(scope='module')
 def course_bag(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """3 s of sim time in the course (its model, the pen's start, scored), the robot
-    teleported through gate_0 and gate_1 (about 3 s of wall time)."""
+    teleported through gate_0 and gate_1 (about 3 s of wall time), with the laser's scans."""
     directory = tmp_path_factory.mktemp('course')
     world = named_world('vrc_task_2')
     sim = AtlasSimulator(atlas_model.load_model(world.model_path), load_gains_yaml(CONFIG),
                          start=world.start)
-    return record_teleported_run(sim, directory / 'course.bag', directory / 'vrc_task_2', 3.0)
+    return record_teleported_run(sim, directory / 'course.bag', directory / 'vrc_task_2', 3.0,
+                                 scans=True)
 
 
 def _pixels(path: Path) -> np.ndarray:

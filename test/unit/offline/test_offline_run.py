@@ -39,7 +39,6 @@ RECORDED = {
     '/atlas/sim_config': ('std_msgs/String', '992ce8a1687cec8c8bd883ec73ca41d1'),
     '/rosout': ('rosgraph_msgs/Log', 'acffd30cd6b6de30f120938c17c593fb'),
     '/tf': ('tf2_msgs/TFMessage', '94810edda583a504dfda3829e70d7eec'),
-    '/multisense_sl/laser/scan': ('sensor_msgs/LaserScan', '90c7ef2dc6895d81024acba2ac42f369'),
 }
 START_AFTER_S = 1.1
 SETTLE_S = 0.2

@@ -31,7 +31,7 @@ def still_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     trajectory.write_text('still:\n  - [0.1, "0 0 0 0.6 ' + ' '.join(['0'] * 24) + '"]\n')
     bag = tmp / 'run.bag'
     run_offline(str(trajectory), 'still', bag, settle_s=0.3, start_after_s=0.3,
-                gains_file=CONFIG)
+                gains_file=CONFIG, scans=True)
     return bag
 
 
