@@ -21,6 +21,7 @@ setup(**generate_distutils_setup(
         'tutorial_atlas_control.sensors',
         'tutorial_atlas_control.sim',
         'tutorial_atlas_control.stepping',
+        'tutorial_atlas_control.stereo',
         'tutorial_atlas_control.trajectories',
         'tutorial_atlas_control.walking',
     ],

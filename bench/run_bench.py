@@ -25,6 +25,9 @@ Sections (see bench/README.md for what each figure means and how it is measured)
             2.6's synchronization window on (--period-ms 1) at real_time_factor:=0
   plot      realtime_rtf and node_us_per_step without and with plot_topics.py plotting
             three 1 kHz fields (bench/plot_cost.py)
+  cameras   the head's stereo cameras at real_time_factor:=1.0: achieved factor, images per
+            second of sim time and CPU per second of sim time, unwatched, the left image,
+            both, and in the VRC course (bench/camera_cost.py)
   walking   the fractions of seeds whose walks fall: pushed every 5 s (walk_pushes.py), one
             push at each phase of a step, test_asi_live's walks varied (walk_variations.py);
             once, whatever --runs says (bench/walking.py)
@@ -89,7 +92,7 @@ COMPRESSIONS = ('lz4', 'bz2', 'none')
 #: What the table and the JSON call the launch's own compression (lz4, atlas.launch).
 DEFAULT_COMPRESSION = 'the launch\'s default'
 SECTIONS = ('physics', 'offline', 'analysis', 'fast', 'realtime', 'load', 'tutorial',
-            'controller', 'plot', 'sweep', 'search', 'walking')
+            'controller', 'plot', 'cameras', 'sweep', 'search', 'walking')
 #: What the table and the JSON say for the UDP figures while no UDP connection is made.
 NO_UDP = 'n/a (no UDP connection)'
 
@@ -186,6 +189,23 @@ ROWS = (
     ('plot_off_node_us_per_step', 'node CPU per step rtf:=0, no plotter', 'us', '', 1),
     ('plot_on_node_us_per_step', 'node CPU per step rtf:=0, plotted', 'us', '', 1),
     ('plot_on_plotter_cpu', 'plot_topics.py CPU at rtf:=1', 'cores', '', 2),
+    ('cameras_none_rtf', 'node rtf:=1, cameras unwatched', 'x real time', '', 4),
+    ('cameras_none_camera_cpu', 'camera node CPU then, per sim s', 's', '', 3),
+    ('cameras_left_rtf', 'node rtf:=1, left image watched', 'x real time', '>= 0.99', 4),
+    ('cameras_left_hz', 'left images per sim s', 'Hz', '', 1),
+    ('cameras_left_camera_cpu', 'camera node CPU per sim s', 's', '', 3),
+    ('cameras_left_node_cpu', 'simulator CPU per sim s', 's', '', 3),
+    ('cameras_pair_rtf', 'node rtf:=1, both images watched', 'x real time', '', 4),
+    ('cameras_pair_hz', 'pairs per sim s', 'Hz', '', 1),
+    ('cameras_pair_camera_cpu', 'camera node CPU per sim s', 's', '', 3),
+    ('cameras_course_none_rtf', 'VRC course rtf:=1, cameras unwatched', 'x real time', '',
+     4),
+    ('cameras_course_none_node_cpu', 'simulator CPU per sim s', 's', '', 3),
+    ('cameras_course_left_rtf', 'VRC course rtf:=1, left image watched', 'x real time', '',
+     4),
+    ('cameras_course_left_node_cpu', 'simulator CPU per sim s', 's', '', 3),
+    ('cameras_course_left_hz', 'left images per sim s', 'Hz', '', 1),
+    ('cameras_course_left_camera_cpu', 'camera node CPU per sim s', 's', '', 3),
     ('sweep_runs_per_s_1', 'sweep.py offline runs, 1 worker', 'runs/s', '', 3),
     ('sweep_runs_per_s_2', 'sweep.py offline runs, 2 workers', 'runs/s', '', 3),
     ('sweep_scaling', 'sweep runs/s, 2 workers / 1', 'x', '', 2),
@@ -313,6 +333,8 @@ TARGETS = {
     'walk_bare_ratio': Target(high=1.0),
     'walk_offline_bare_ratio': Target(high=2.2),
     'offline_ratio': Target(low=0.8),
+    # Standing with the left camera watched, real time holds (its node at niceness 10).
+    'cameras_left_rtf': Target(low=0.99),
     'fast_rtf': Target(low=0.6, per_bare='rtf'),
     'fast_bare_ratio': Target(low=0.6),
     'node_us_per_step': Target(high=1.5, per_bare='us'),
@@ -396,6 +418,9 @@ EXPECTED = {
                    'controller_tcp_age_p99_ms',
                    'controller_tcp_node_us_per_step', 'controller_window_steps_per_s',
                    'controller_window_age_p99_ms'),
+    'cameras': tuple(f'cameras_{case}_{key}'
+                     for case in ('none', 'left', 'pair', 'course_none', 'course_left')
+                     for key in ('rtf', 'hz', 'node_cpu', 'camera_cpu')),
     'plot': ('plot_off_realtime_rtf', 'plot_on_realtime_rtf', 'plot_off_node_us_per_step',
              'plot_on_node_us_per_step', 'plot_on_plotter_cpu'),
     'sweep': ('sweep_runs_per_s_1', 'sweep_runs_per_s_2', 'sweep_scaling'),
@@ -613,7 +638,7 @@ def run_walking(args: argparse.Namespace, samples: dict[str, list[float]],
 
 def run_online(args: argparse.Namespace, samples: dict[str, list[float]],
                loads: dict[str, str], work_dir: Path) -> None:
-    if not {'fast', 'realtime', 'load', 'controller', 'plot'} & set(args.sections):
+    if not {'fast', 'realtime', 'load', 'controller', 'plot', 'cameras'} & set(args.sections):
         return
     import online
 
@@ -643,6 +668,9 @@ def run_online(args: argparse.Namespace, samples: dict[str, list[float]],
         if 'plot' in args.sections:
             with Section('plot', loads):
                 run_plot(args, samples, master, probes, work_dir)
+        if 'cameras' in args.sections:
+            with Section('cameras', loads):
+                run_cameras(args, samples, master, probes, work_dir)
         rospy.signal_shutdown('bench done')
     finally:
         master.close()
@@ -715,6 +743,21 @@ def run_plot(args, samples, master, probes, work_dir) -> None:  # noqa: ANN001
             f'{values["plot_off_node_us_per_step"]:.1f} / '
             f'{values["plot_on_node_us_per_step"]:.1f} us per step; plotter '
             f'{values["plot_on_plotter_cpu"]:.2f} cores')
+        add(samples, values)
+
+
+def run_cameras(args, samples, master, probes, work_dir) -> None:  # noqa: ANN001
+    import camera_cost
+
+    for run in range(args.budget.side(args.runs)):
+        values = camera_cost.camera_run(master, args.launch_file, probes, work_dir,
+                                        f'cameras{run + 1}', warmup_s=3.0,
+                                        window_s=args.budget.plot_window_s)
+        log(f'cameras run {run + 1}: rtf {values["cameras_left_rtf"]:.4f} with the left image '
+            f'at {values["cameras_left_hz"]:.1f} Hz (camera node '
+            f'{values["cameras_left_camera_cpu"]:.2f} s per sim s), pair at '
+            f'{values["cameras_pair_hz"]:.1f} Hz, course left at '
+            f'{values["cameras_course_left_hz"]:.1f} Hz')
         add(samples, values)
 
 

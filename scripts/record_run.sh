@@ -36,7 +36,8 @@ case $compression in
 esac
 # The list has one home, tutorial_atlas_control.topics, shared with the analysis and replay
 # that read these bags; a copy here would drift from it.
-topics=$(python3 -c 'from tutorial_atlas_control.topics import RECORDED_TOPICS; print(*RECORDED_TOPICS)' 2>/dev/null) \
+# $TAC_RECORD_IMAGES=true (atlas.launch's record_images): the cameras' JPEG images too.
+topics=$(python3 -c 'import sys; from tutorial_atlas_control.topics import RECORDED_TOPICS as R, IMAGE_RECORDED_TOPICS as I; print(*R, *(I if sys.argv[1] == "true" else ()))' "${TAC_RECORD_IMAGES:-false}" 2>/dev/null) \
   || fail "cannot import tutorial_atlas_control.topics for the topic list; source ./env.sh (or the workspace's setup.bash) first"
 read -r -a TOPICS <<< "$topics"
 # Another launch's recorder on this master: refuse before registering (the master would

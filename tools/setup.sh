@@ -34,6 +34,9 @@ APT_PACKAGES=(
   libtf-dev libtf-conversions-dev libtrajectory-msgs-dev
   xvfb xdotool x11-apps imagemagick iproute2 tmux
   python3-tk
+  # The cameras: stereo_image_proc turns the pair into disparity and points2 (docs/cameras.md);
+  # pluginlib finds its nodelets through the package.xml files the -dev and -tools packages hold.
+  ros-stereo-image-proc libstereo-image-proc-dev libnodeletlib-tools python3-stereo-msgs
 )
 
 log() { printf 'setup: %s\n' "$*"; }

@@ -68,6 +68,10 @@ RESET_CONTROLS_SERVICE = '/atlas/reset_controls'
 ROBOT_DESCRIPTION_PARAM = '/robot_description'
 #: robot_state_publisher's latched topic of the fixed joints' transforms.
 TF_STATIC = '/tf_static'
+#: sensor_msgs/JointState whose position is the world's whole MuJoCo qpos (the robot and
+#: anything loose), stamped with its sim time: what the camera node renders, sent while it
+#: listens (while someone looks at an image).
+RENDER_STATE = '/atlas/render_state'
 #: atlas_msgs/VRCScore, latched: DRCSim's VRCScoringPlugin's score of the VRC course (with
 #: ~vrc_scoring), every 1 s of sim time and at each gate passed or fall.
 VRC_SCORE = '/vrc_score'
@@ -188,6 +192,9 @@ INTERFACE: tuple[Topic, ...] = (
     Topic(ASI_STATE_RECORDED, 'atlas_msgs/AtlasSimInterfaceState', _OUT,
           Rate('~asi_state_recorded_rate', 50.0, 'and at each change of behaviour or status'),
           on_demand=True, recorded=True, delivery=Delivery(loop=True)),
+    Topic(RENDER_STATE, 'sensor_msgs/JointState', _OUT,
+          Rate('~render_state_rate', 30.0, "the world's qpos, for the cameras"), on_demand=True,
+          delivery=Delivery('render_state', loop=True)),
     Topic(SYNCHRONIZATION_STATISTICS, 'atlas_msgs/SynchronizationStatistics', _OUT,
           Rate(when='every step while the synchronization window is on'),
           delivery=Delivery(latched=True, loop=True)),
@@ -264,6 +271,15 @@ STARTUP_MODE_PARAM = '/atlas/startup_mode'
 
 WORLD_FRAME = 'world'
 PELVIS_FRAME = 'pelvis'
+
+#: The multisense_sl head's stereo cameras (stereo/; rendered by multisense_cameras.py).
+CAMERA_NAMESPACE = '/multisense_sl/camera'
+SET_FPS = '/multisense_sl/set_fps'
+#: What record_run.sh adds with atlas.launch's record_images:=true: the images as JPEG
+#: (image_transport's compressed topic names) and their camera_info; never the raw images.
+IMAGE_RECORDED_TOPICS: tuple[str, ...] = tuple(
+    f'{CAMERA_NAMESPACE}/{side}/{name}' for side in ('left', 'right')
+    for name in ('image_raw/compressed', 'camera_info'))
 
 #: The VRC course's static shapes for rviz (course_markers.py; latched, published once).
 COURSE_MARKERS_TOPIC = '/vrc_course/markers'

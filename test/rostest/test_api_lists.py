@@ -8,7 +8,7 @@ atlas_cheats_rosapi.yaml (ANY: the lists' -1, any count). Out of scope: /drc_wor
 /tf2_buffer_server/* and the multisense entries. Entries that other branches are adding
 are in NOT_YET_SERVED: missing is fine, but once served they are checked like the rest
 (and the test prints which could leave the set). As in DRCSim's strict check, a topic in the
-graph that is in neither list nor PORT_OWN_TOPICS fails the test.
+graph that is in neither list nor PORT_OWN_TOPICS (nor the head's cameras') fails the test.
 
 The test is a bare observer: it asks the master (rosgraph), and is no node of the graph.
 """
@@ -110,6 +110,16 @@ PORT_OWN_TOPICS = {
     '/multisense_sl/joint_states': 'sensor_msgs/JointState',
     '/multisense_sl/imu': 'sensor_msgs/Imu',
     '/multisense_sl/set_spindle_speed': 'std_msgs/Float64',
+    '/atlas/render_state': 'sensor_msgs/JointState',
+}
+#: The multisense_sl head's stereo pair (docs/cameras.md), named as DRCSim's plugin named it
+#: (its lists left the head out); image_raw/compressed is the port's JPEG beside each image.
+MULTISENSE_CAMERA_TOPICS = {
+    **{f'/multisense_sl/camera/{side}/{name}': msgtype for side in ('left', 'right')
+       for name, msgtype in (('image_raw', 'sensor_msgs/Image'),
+                             ('image_raw/compressed', 'sensor_msgs/CompressedImage'),
+                             ('camera_info', 'sensor_msgs/CameraInfo'))},
+    '/multisense_sl/set_fps': 'std_msgs/Float64',
 }
 
 EXPECTED = DRCSIM_2_5_2 + DRCSIM_2_7_0
@@ -149,10 +159,11 @@ def problems(graph: Graph) -> list[str]:
             if expected != ANY and len(nodes) != expected:
                 found.append(f'{topic}: {len(nodes)} {what} ({", ".join(nodes) or "none"}), '
                              f'expected {expected}')
-    for topic, msgtype in PORT_OWN_TOPICS.items():
+    own = {**PORT_OWN_TOPICS, **MULTISENSE_CAMERA_TOPICS}
+    for topic, msgtype in own.items():
         if graph.types.get(topic) != msgtype:
             found.append(f'{topic}: type {graph.types.get(topic)}, expected {msgtype}')
-    known = {entry.topic for entry in EXPECTED} | set(PORT_OWN_TOPICS)
+    known = {entry.topic for entry in EXPECTED} | set(own)
     found += [f'{topic}: not in the API lists (type {graph.types[topic]})'
               for topic in sorted(set(graph.types) - known)]
     for name, srv_type in SERVICES.items():

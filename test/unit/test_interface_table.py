@@ -65,7 +65,8 @@ def test_each_row_is_well_formed() -> None:
     names = [topic.name for topic in topics.INTERFACE]
     assert len(names) == len(set(names)), 'a topic declared twice'
     filled = set(SimMessages.SENSOR_MESSAGES) | {'joint_state', 'atlas_state',
-                                                  'force_torque_sensors', 'debug_l', 'debug_r'}
+                                                  'force_torque_sensors', 'debug_l', 'debug_r',
+                                                  'render_state'}
     for topic in topics.INTERFACE:
         assert topic.delivery.message in filled | {''}, topic.name
         assert not topic.delivery.loop or topic.direction is PUBLISHED, topic.name

@@ -184,7 +184,8 @@ def test_the_import_check_catches_a_module_that_needs_rospy(tmp_path: Path) -> N
 #: formats, plotting reads messages; course describes the VRC course (its figures, world,
 #: mud and scoring: pure, below the simulator that loads and steps it); sim fills messages
 #: from the simulator; balance (the
-#: behaviours' controllers) computes torques over the model sim loads; walking plans steps
+#: behaviours' controllers) computes torques over the model sim loads, and stereo renders the
+#: head's cameras in a copy of it; walking plans steps
 #: on the balance's pendulum; stepping (the live loop) and trajectories run the simulation;
 #: bags read recorded runs, of trajectories; offline runs write and replay bags, demo runs
 #: the tutorial and reads its bag; search sweeps offline runs; node is the simulator node
@@ -198,7 +199,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ('course',),
     ('sim',),
     ('sensors',),
-    ('balance',),
+    ('balance', 'stereo'),
     ('walking',),
     ('asi',),
     ('stepping', 'trajectories'),

@@ -45,7 +45,8 @@ def test_each_launch_starts_its_world_as_drcsim_did(
     assert found['/atlas_sim/vrc_scoring'] is True
     assert found['/atlas_sim/score_dir'] == '/tmp/vrc_task_2'
     assert found['/atlas_sim/gui'] is False  # no display
-    assert sorted(nodes) == ['atlas_sim_node.py', 'course_markers.py', 'record_run.sh']
+    assert sorted(nodes) == ['atlas_sim_node.py', 'course_markers.py', 'multisense_cameras.py',
+                             'record_run.sh']
     assert rlutil.check_roslaunch(str(LAUNCH_DIR / launch)) is None  # roslaunch-check
 
 
@@ -77,7 +78,7 @@ def test_atlas_launch_arguments_reach_through_and_a_variant_keeps_its_start(
         monkeypatch: pytest.MonkeyPatch) -> None:
     found, nodes = params('vrc_task_2_rubble_start.launch', 'record:=false',
                           'real_time_factor:=0.5', 'score_dir:=/tmp/scores', 'stand:=hold',
-                          'start:=vrc_task_2', 'model:=/tmp/course.xml',
+                          'start:=vrc_task_2', 'model:=/tmp/course.xml', 'cameras:=false',
                           monkeypatch=monkeypatch)
     assert nodes == ['atlas_sim_node.py', 'course_markers.py']
     assert '/atlas_sim/bag_dir' not in found

@@ -81,7 +81,10 @@ def gentle_path(start: Point, goal: Point, steepest_deg: float = STEEPEST_DEG,
     """
     if not (math.isfinite(steepest_deg) and 0.0 < steepest_deg < 90.0):
         raise CourseError(f'steepest_deg must be within (0, 90): {steepest_deg}')
-    x0, y0 = min(start[0], goal[0]) - MARGIN_M, min(start[1], goal[1]) - MARGIN_M
+    # The grid is the world's (cells on multiples of GRID_M), not the start's: a way from
+    # places a few centimetres apart crosses the same cells.
+    x0 = math.floor((min(start[0], goal[0]) - MARGIN_M) / GRID_M) * GRID_M
+    y0 = math.floor((min(start[1], goal[1]) - MARGIN_M) / GRID_M) * GRID_M
     xs = np.arange(x0, max(start[0], goal[0]) + MARGIN_M + GRID_M / 2, GRID_M)
     ys = np.arange(y0, max(start[1], goal[1]) + MARGIN_M + GRID_M / 2, GRID_M)
     grid_x, grid_y = np.meshgrid(xs, ys, indexing='ij')

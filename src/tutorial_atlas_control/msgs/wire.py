@@ -69,6 +69,16 @@ class JointStateWire(StampedWire):
             for k in range(3))
 
 
+class PositionsWire(StampedWire):
+    """sensor_msgs/JointState without names, velocities or efforts: `positions` (a view)
+    carries `count` numbers. The trailing float's eight zero bytes are the empty velocity
+    and effort arrays' lengths."""
+
+    def __init__(self, count: int) -> None:
+        super().__init__('', count + 1, struct.pack('<II', 0, count))
+        self.positions = self.floats[:count]
+
+
 class ImuWire(StampedWire):
     """sensor_msgs/Imu, covariances 0: orientation (x y z w), angular_velocity,
     linear_acceleration are views."""

@@ -25,6 +25,7 @@ from tutorial_atlas_control.msgs import (
     ImuWire,
     JointStateWire,
     OdometryWire,
+    PositionsWire,
     StampedWire,
     TransformsWire,
     TransformWire,
@@ -146,6 +147,7 @@ class SimMessages:
         self.atlas_state_wire = AtlasStateWire(len(JOINT_NAMES))
         self.force_torque_wire = ForceTorqueSensorsWire()
         self.debug_contact_wires = {side: WrenchStampedWire(f'{side}_foot') for side in 'lr'}
+        self.render_state_wire = PositionsWire(model.nq)
         self._body = {name: int(model.body(name).id)
                       for name in (*HAND_BODIES.values(), *FOOT_BODIES.values())}
         self._root = {name: int(model.body_rootid[body]) for name, body in self._body.items()}
@@ -182,6 +184,7 @@ class SimMessages:
             'force_torque_sensors': (torque, self.fill_force_torque_sensors),
             'debug_l': (self.debug_contact_wires['l'], lambda: self.fill_debug_contact('l')),
             'debug_r': (self.debug_contact_wires['r'], lambda: self.fill_debug_contact('r')),
+            'render_state': (self.render_state_wire, self.fill_render_state),
         }
 
     def body_wrench(self, spatial: np.ndarray, body_name: str) -> np.ndarray:
@@ -234,6 +237,11 @@ class SimMessages:
         """ForceTorqueSensors: ankles (Fz, Mx, My) and wrists. Always sent."""
         self._force_torque_plan()
         self._fill_hands(self.force_torque_wire.wrenches)
+        return True
+
+    def fill_render_state(self) -> bool:
+        """The world's whole qpos after the step, for the camera node. Always sent."""
+        self.render_state_wire.positions[:] = self.sim.data.qpos
         return True
 
     def fill_debug_contact(self, side: str) -> bool:

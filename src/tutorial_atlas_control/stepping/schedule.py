@@ -15,10 +15,10 @@ __all__ = ['STAMPED_AT_STEP_END', 'step_stamp', 'steps_between']
 
 #: The per-step messages stamped at the end of the step that made them: the joint states
 #: (positions, velocities, and the torque applied during the step), and AtlasState, which
-#: repeats them (its IMU and wrenches, as /atlas/imu's, are from the step's start). The
-#: others, poses and sensors, describe the state at the step's start (MuJoCo computes them
-#: before it integrates), and carry that time.
-STAMPED_AT_STEP_END = frozenset({topics.JOINT_STATES, topics.ATLAS_STATE})
+#: repeats them (its IMU and wrenches, as /atlas/imu's, are from the step's start), and the
+#: world's positions the cameras render. The others, poses and sensors, describe the state at
+#: the step's start (MuJoCo computes them before it integrates), and carry that time.
+STAMPED_AT_STEP_END = frozenset({topics.JOINT_STATES, topics.ATLAS_STATE, topics.RENDER_STATE})
 
 Stamp = TypeVar('Stamp')
 

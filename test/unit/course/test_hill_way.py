@@ -96,3 +96,12 @@ def test_no_gentle_way_is_one_error(steepest: float, message: str) -> None:
     with pytest.raises(CourseError) as caught:
         gentle_path(GATE_2_END, GATE_3_GOAL, steepest)
     assert str(caught.value) == message
+
+
+def test_starts_a_few_centimetres_apart_share_the_way_beyond_its_first_corners() -> None:
+    rng = np.random.default_rng(3)
+    ways = [gentle_path((GATE_2_END[0] + dx, GATE_2_END[1] + dy), GATE_3_GOAL)
+            for dx, dy in rng.uniform(-0.03, 0.03, (6, 2))]
+    assert all(len(way) >= 5 for way in ways)
+    spread = max(math.dist(a, b) for way in ways for a, b in zip(way[-5:], ways[0][-5:]))
+    assert spread <= 0.1  # a grid cell or two of the shortening's choice

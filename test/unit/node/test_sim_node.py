@@ -71,8 +71,8 @@ def test_the_node_advertises_the_topics_and_steps_until_shutdown(sim: AtlasSimul
             topics.SIM_CONFIG, topics.ATLAS_STATE, topics.FORCE_TORQUE_SENSORS,
             topics.DEBUG_L_FOOT_CONTACT, topics.DEBUG_R_FOOT_CONTACT, topics.SIM_INPUTS,
             topics.CURRENT_CONTROL_MODE, topics.SYNCHRONIZATION_STATISTICS, topics.ASI_STATE,
-            topics.ASI_STATE_RECORDED, topics.LASER_SCAN, topics.HEAD_JOINT_STATES,
-            topics.HEAD_IMU}
+            topics.ASI_STATE_RECORDED, topics.RENDER_STATE, topics.LASER_SCAN,
+            topics.HEAD_JOINT_STATES, topics.HEAD_IMU}
         config, = node.fake_publishers[topics.SIM_CONFIG].published
         mode, = node.fake_publishers[topics.CURRENT_CONTROL_MODE].published
         assert mode.data == 'Stand'

@@ -281,3 +281,28 @@ def test_atlas_state_bytes_equal_the_untrimmed_fill_step_by_step() -> None:
         messages.fill_atlas_state()
         trimmed = bytes(messages.atlas_state_wire.stamped(0))[16:]
         assert trimmed == _atlas_state_as_before(messages), f'step {step}'
+
+
+def test_render_state_is_the_whole_qpos_a_renderer_places_the_head_with(
+        standing: AtlasSimulator) -> None:
+    """/atlas/render_state, decoded as sensor_msgs/JointState, puts the cameras' copy of the
+    model in the simulated pose: its head where the simulator's head is."""
+    from sensor_msgs.msg import JointState
+
+    from tutorial_atlas_control.stereo import StereoRenderer, camera_model
+
+    messages = SimMessages(standing)
+    wire, fill = messages.on_demand['render_state']
+    assert fill()
+    msg = JointState()
+    msg.deserialize(bytes(wire.stamped(standing.sim_time_ns))[4:])
+    assert msg.header.stamp.to_nsec() == standing.sim_time_ns
+    assert len(msg.name) == len(msg.velocity) == len(msg.effort) == 0
+    posed = mujoco.MjData(standing.model)  # the simulated model at the state sent
+    posed.qpos[:] = standing.data.qpos
+    mujoco.mj_kinematics(standing.model, posed)
+    with StereoRenderer(camera_model(str(model.MODEL_PATH))) as renderer:
+        renderer.set_state(np.asarray(msg.position))
+        head = renderer.data.xpos[renderer.model.body('head').id]
+        assert np.allclose(head, posed.xpos[standing.model.body('head').id], atol=1e-12)
+        assert head[2] > 1.5  # standing
