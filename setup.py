@@ -18,6 +18,7 @@ setup(**generate_distutils_setup(
         'tutorial_atlas_control.offline',
         'tutorial_atlas_control.plotting',
         'tutorial_atlas_control.search',
+        'tutorial_atlas_control.sensors',
         'tutorial_atlas_control.sim',
         'tutorial_atlas_control.stepping',
         'tutorial_atlas_control.stereo',

@@ -258,3 +258,34 @@ def main(argv: list[str] | None = None) -> int:
 
 if __name__ == '__main__':
     sys.exit(main())
+
+
+def head_sensors_run(scans: int = 200, steps: int = 5000) -> dict[str, float]:
+    """The MultiSense SL head's cost on the standing robot (sensors/head.py, as the node's
+    loop calls it), each subscribed topic in wall ms per second of sim time at its default
+    rate: `laser_ms_per_sim_s` (40 scans: 720 rays cast, noised, serialized),
+    `head_imu_ms_per_sim_s` and `head_joint_states_ms_per_sim_s` (1000 messages each);
+    `spindle_step_us`, the spinning spindle's step (µs; at rest and asked for 0, a test)."""
+    with fake_ros_node(0) as node:
+        head = node.loop.publisher.head
+        sim = node.loop.sim
+        rate_hz = head.laser.spec.rate_hz
+        start = time.perf_counter()
+        for k in range(scans):
+            head.scan(sim.state_time_ns + k)
+        scan_s = (time.perf_counter() - start) / scans
+        head.spindle.command(5.0)
+        start = time.perf_counter()
+        for _ in range(steps):
+            head.step()
+        step_s = (time.perf_counter() - start) / steps
+        start = time.perf_counter()
+        for k in range(steps):
+            head.imu(k)
+        imu_s = (time.perf_counter() - start) / steps
+        start = time.perf_counter()
+        for k in range(steps):
+            head.joint_state(k)
+        joints_s = (time.perf_counter() - start) / steps
+    return {'laser_ms_per_sim_s': scan_s * rate_hz * 1e3, 'spindle_step_us': step_s * 1e6,
+            'head_imu_ms_per_sim_s': imu_s * 1e6, 'head_joint_states_ms_per_sim_s': joints_s * 1e6}

@@ -103,6 +103,10 @@ ROWS = (
     ('physics_numpy_law_steps_per_s', 'physics + numpy law, plain loop', 'steps/s', '', 0),
     ('unheard_topic_us_per_step', 'a topic nobody subscribes to', 'us/step', '< 1', 3),
     ('stand_us_per_step', 'balancing Stand: estimate + control', 'us/step', '<= 100', 1),
+    ('laser_ms_per_sim_s', 'the head laser subscribed (40 scans)', 'ms/sim s', '', 2),
+    ('spindle_step_us', 'the laser spindle spinning', 'us/step', '', 2),
+    ('head_imu_ms_per_sim_s', 'the head IMU subscribed (1 kHz)', 'ms/sim s', '', 2),
+    ('head_joint_states_ms_per_sim_s', 'the spindle joint state subscribed', 'ms/sim s', '', 2),
     ('walk_us_per_step', 'Walk, 6 steps: estimate + control (CPU)', 'us/step', '<= 150', 1),
     ('walk_offline_rtf', 'the same walk offline (no bag)', 'x real time', '>= 10', 2),
     ('stand_bare_ratio', 'Stand per step / bare mj_step', '', '<= 0.7', 2),
@@ -387,7 +391,9 @@ EXPECTED = {
     'physics': ('bare_physics_steps_per_s', 'physics_limit_steps_per_s',
                 'physics_numpy_law_steps_per_s', 'unheard_topic_us_per_step',
                 'stand_us_per_step', 'walk_us_per_step', 'walk_offline_rtf',
-                'stand_python_us_per_step', 'walk_python_us_per_step',
+                'laser_ms_per_sim_s', 'spindle_step_us', 'head_imu_ms_per_sim_s',
+                'head_joint_states_ms_per_sim_s', 'stand_python_us_per_step',
+                'walk_python_us_per_step',
                 *(f'{name}_bare_ratio' for name in ('stand', 'stand_python', 'walk',
                                                     'walk_python', 'walk_offline'))),
     'offline': ('offline_rtf', 'offline_ratio'),
@@ -524,6 +530,13 @@ def run_offline(args: argparse.Namespace, samples: dict[str, list[float]],
                 unheard_us = node_loop.unheard_topic_run(args.budget.unheard_calls)
                 log(f'physics run {run + 1}: an unheard topic costs {unheard_us:.3f} us/step')
                 add(samples, {'unheard_topic_us_per_step': unheard_us})
+                head = node_loop.head_sensors_run()
+                log(f'physics run {run + 1}: the head laser costs '
+                    f'{head["laser_ms_per_sim_s"]:.2f} ms per sim s, its IMU '
+                    f'{head["head_imu_ms_per_sim_s"]:.2f}, the spindle\'s joint state '
+                    f'{head["head_joint_states_ms_per_sim_s"]:.2f}; the spinning spindle '
+                    f'{head["spindle_step_us"]:.2f} us/step')
+                add(samples, head)
                 # Compiled (as shipped) and the pure Python reference, interleaved: the
                 # compiled core's before/after, paired on the same load.
                 stand_us = offline.stand_run(steps=steps)

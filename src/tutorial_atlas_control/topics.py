@@ -75,6 +75,14 @@ RENDER_STATE = '/atlas/render_state'
 #: atlas_msgs/VRCScore, latched: DRCSim's VRCScoringPlugin's score of the VRC course (with
 #: ~vrc_scoring), every 1 s of sim time and at each gate passed or fall.
 VRC_SCORE = '/vrc_score'
+#: The MultiSense SL head's laser (sensor_msgs/LaserScan in head_hokuyo_frame), its spindle's
+#: speed command (std_msgs/Float64, rad/s) and the spindle's sensor_msgs/JointState
+#: (hokuyo_joint), as DRCSim 2.7 named them.
+LASER_SCAN = '/multisense_sl/laser/scan'
+SET_SPINDLE_SPEED = '/multisense_sl/set_spindle_speed'
+HEAD_JOINT_STATES = '/multisense_sl/joint_states'
+#: sensor_msgs/Imu of head_imu_link (DRCSim's MultiSenseSL plugin's, 1 kHz).
+HEAD_IMU = '/multisense_sl/imu'
 
 class Direction(enum.Enum):
     """Who writes a topic: the simulator node, its users (commands, cheats), or every node."""
@@ -196,6 +204,13 @@ INTERFACE: tuple[Topic, ...] = (
     Topic(VRC_SCORE, 'atlas_msgs/VRCScore', _OUT,
           Rate(when='with `~vrc_scoring`: every 1 s of sim time and at each gate or fall'),
           recorded=True, delivery=Delivery(latched=True, offline=True)),
+    # Offline runs write it when asked (run_offline.py --scans): it costs them a fifth.
+    Topic(LASER_SCAN, 'sensor_msgs/LaserScan', _OUT, Rate('~laser_rate', 40.0),
+          on_demand=True, recorded=True, delivery=Delivery(loop=True)),
+    Topic(HEAD_JOINT_STATES, 'sensor_msgs/JointState', _OUT,
+          Rate('~head_joint_states_rate', 1000.0), on_demand=True, delivery=Delivery(loop=True)),
+    Topic(HEAD_IMU, 'sensor_msgs/Imu', _OUT, Rate('~head_imu_rate', 1000.0), on_demand=True,
+          delivery=Delivery(loop=True)),
     Topic(CURRENT_CONTROL_MODE, 'std_msgs/String', _OUT, Rate(when='each mode switch'),
           delivery=Delivery(latched=True)),
     Topic(TF_STATIC, 'tf2_msgs/TFMessage', _OUT, Rate(when='once (`~tf_publisher` sim)'),
@@ -214,6 +229,7 @@ INTERFACE: tuple[Topic, ...] = (
     Topic(APPLY_PELVIS_FORCE, 'geometry_msgs/Wrench', _IN, AS_SENT, recorded=True),
     Topic(JOINT_TRAJECTORY, 'trajectory_msgs/JointTrajectory', _IN, AS_SENT, recorded=True),
     Topic(CONFIGURATION, 'sensor_msgs/JointState', _IN, AS_SENT),
+    Topic(SET_SPINDLE_SPEED, 'std_msgs/Float64', _IN, AS_SENT, recorded=True),
     Topic(SYNC_DELAY, 'std_msgs/String', _IN, AS_SENT),
     Topic(ROSOUT, 'rosgraph_msgs/Log', Direction.LOG, Rate(when='each log line'), recorded=True,
           delivery=Delivery(offline=True)),

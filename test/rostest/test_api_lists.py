@@ -105,6 +105,11 @@ PORT_OWN_TOPICS = {
     '/atlas/sim_inputs': 'std_msgs/String',
     '/atlas/current_control_mode': 'std_msgs/String',
     '/atlas/asi_state_recorded': 'atlas_msgs/AtlasSimInterfaceState',
+    # The MultiSense SL head's laser, by DRCSim 2.7's names (not in the 2.5.2 lists).
+    '/multisense_sl/laser/scan': 'sensor_msgs/LaserScan',
+    '/multisense_sl/joint_states': 'sensor_msgs/JointState',
+    '/multisense_sl/imu': 'sensor_msgs/Imu',
+    '/multisense_sl/set_spindle_speed': 'std_msgs/Float64',
     '/atlas/render_state': 'sensor_msgs/JointState',
 }
 #: The multisense_sl head's stereo pair (docs/cameras.md), named as DRCSim's plugin named it

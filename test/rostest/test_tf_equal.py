@@ -66,8 +66,9 @@ def _rsp_hears_the_simulator() -> bool:
 
 def _by_stamp(store: ByStamp, msg: TFMessage) -> None:
     for transform in msg.transforms:
-        if (transform.header.frame_id, transform.child_frame_id) == ('world', 'pelvis'):
-            continue  # the simulator's ground truth, not a link
+        if (transform.header.frame_id, transform.child_frame_id) in (
+                ('world', 'pelvis'), ('head', 'hokuyo_link')):
+            continue  # the simulator's ground truth, the laser's spindle: not URDF joints
         t, r = transform.transform.translation, transform.transform.rotation
         quaternion = np.array([r.x, r.y, r.z, r.w])
         if quaternion[3] < 0:  # q and -q are one rotation

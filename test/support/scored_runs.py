@@ -16,11 +16,12 @@ GATE_TELEPORTS = ((0.5, 0.7, -38.0), (0.6, 1.3, -38.0), (0.8, 0.0, -22.3), (0.9,
 
 
 def record_teleported_run(sim: AtlasSimulator, bag: Path, score_dir: Path, until_s: float,
-                          teleports: Sequence[tuple[float, float, float]] = GATE_TELEPORTS
-                          ) -> Path:
+                          teleports: Sequence[tuple[float, float, float]] = GATE_TELEPORTS,
+                          scans: bool = False) -> Path:
     """Run `sim` offline to `until_s`, scored into `score_dir`, teleporting the pelvis to
-    (x, y, 1 m) at each teleport's sim time; the bag at `bag`."""
-    sink = open_offline_bag(bag)
+    (x, y, 1 m) at each teleport's sim time; the bag at `bag` (with the laser's scans if
+    `scans`)."""
+    sink = open_offline_bag(bag, scans)
     try:
         player = OfflinePlayer(sim, sink, score_dir=score_dir)
         player.write_config()

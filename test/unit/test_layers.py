@@ -198,6 +198,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ('msgs', 'plotting'),
     ('course',),
     ('sim',),
+    ('sensors',),
     ('balance', 'stereo'),
     ('walking',),
     ('asi',),
@@ -311,9 +312,9 @@ def test_the_layer_check_catches_upward_imports() -> None:
     found = layer_order_violations(source, f'{PACKAGE}.msgs.example')
     assert found == [
         f'{PACKAGE}.msgs.example:7: imports {PACKAGE}.sim.simulator (layer 5 above layer 3)',
-        f'{PACKAGE}.msgs.example:9: imports {PACKAGE}.offline (layer 11 above layer 3)',
-        f'{PACKAGE}.msgs.example:10: imports {PACKAGE}.bags (layer 10 above layer 3)',
-        f'{PACKAGE}.msgs.example:11: imports {PACKAGE}.stepping (layer 9 above layer 3)',
+        f'{PACKAGE}.msgs.example:9: imports {PACKAGE}.offline (layer 12 above layer 3)',
+        f'{PACKAGE}.msgs.example:10: imports {PACKAGE}.bags (layer 11 above layer 3)',
+        f'{PACKAGE}.msgs.example:11: imports {PACKAGE}.stepping (layer 10 above layer 3)',
         f'{PACKAGE}.msgs.example:12: imports {PACKAGE}.nowhere (in no layer)',
     ]
 

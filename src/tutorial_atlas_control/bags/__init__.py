@@ -2,7 +2,8 @@
 and the VRC course's score (vrc_score: /vrc_score as a timeline of events, the final score)
 and map (course_terrain: whether a bag is a course run, the terrain under a point; course_run:
 its path, landings on the terrain, falls and events; course_map: the course from above with
-the run on it, a PNG).
+the run on it, a PNG); laser_scans: the head laser's recorded scans and their points in the
+world.
 
 No ROS: bags are read and written with rosbags. Synthetic bags for the tests are
 test/support/synthetic_bags.py.
@@ -15,6 +16,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                  'MOVED_RANGE_RAD', 'analyze', 'analyze_bag', 'analyze_try'],
     'capture_point': ['CaptureTrace', 'capture_trace', 'plot_capture'],
     'course_map': ['COURSE_EXTENT_M', 'MAP_SIZE_PX', 'map_pixel', 'plot_course_map'],
+    'laser_scans': ['LaserScans', 'read_laser_scans', 'scan_cloud', 'spindle_angles'],
     'course_run': ['CourseRun', 'MapMark', 'read_course_run', 'recorded_course_run',
                    'terrain_landings'],
     'course_terrain': ['above_ground', 'ground_under', 'is_course_run', 'terrain_heights'],

@@ -199,8 +199,10 @@ def _title(run: CourseRun | None) -> str:
             f'{last.sim_elapsed_s:.1f} s since gate 1 (sim time {last.sim_time_s:.1f} s)')
 
 
-def plot_course_map(run: CourseRun | None, path: Path | str) -> Path:
-    """The map of `run` (None: the course alone), written to `path` (PNG, MAP_SIZE_PX).
+def plot_course_map(run: CourseRun | None, path: Path | str,
+                    cloud: np.ndarray | None = None) -> Path:
+    """The map of `run` (None: the course alone), written to `path` (PNG, MAP_SIZE_PX);
+    with `cloud`, the laser's points (x, y, z in the world, m) over it, coloured by height.
 
     Raises:
         BagAnalysisError: The image cannot be written.
@@ -219,6 +221,9 @@ def plot_course_map(run: CourseRun | None, path: Path | str) -> Path:
     draw_course(ax)
     if run is not None:
         _draw_run(ax, run)
+    if cloud is not None and len(cloud):
+        ax.scatter(cloud[:, 0], cloud[:, 1], c=cloud[:, 2], s=0.3, cmap='viridis', zorder=5,
+                   linewidths=0, label=f'laser points ({len(cloud)})')
     x0, x1, y0, y1 = COURSE_EXTENT_M
     ax.set_xlim(x0, x1)
     ax.set_ylim(y0, y1)

@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 from typing import Any, Sequence
 
+from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags import (
     COMMAND_CHANGE_RAD,
     DEFAULT_FPS,
@@ -39,9 +40,11 @@ from tutorial_atlas_control.bags import (
     plot_run,
     read_bag,
     read_behaviours,
+    read_laser_scans,
     read_scores,
     recorded_course_run,
     render_bag_video,
+    scan_cloud,
     score_lines,
     summarise_walk,
     titled_walks,
@@ -167,6 +170,10 @@ def build_parser() -> argparse.ArgumentParser:
                              'terrain shaded, the pen, the gates, the mud box, the blocks, the '
                              'pelvis\'s path, the feet\'s landings, falls and the score\'s events '
                              '(a course run only; --plot run.png writes it as run.course.png)')
+    parser.add_argument('--scan-cloud', action='store_true',
+                        help='with --course-map: the head laser\'s recorded scans over it, each '
+                             'range a point in the world (the head\'s recorded pose, the spindle '
+                             'simulated from set_spindle_speed), coloured by height')
     parser.add_argument('--plot-joints', metavar='FILE.png',
                         help='write commanded vs measured positions of every joint that moved '
                              '(one panel each) and the pelvis height to this image')
@@ -194,6 +201,8 @@ def _check_arguments(parser: argparse.ArgumentParser, args: argparse.Namespace) 
         parser.error(f'--end {args.end:g} must be after --start {args.start:g}')
     if args.try_b is not None and not args.compare:
         parser.error('--try-b chooses the try of the --compare bag; give --compare B.bag')
+    if args.scan_cloud and not args.course_map:
+        parser.error('--scan-cloud draws on the course map: give --course-map FILE.png')
     if args.compare and (args.csv or args.video or args.course_map):
         parser.error('--csv, --video and --course-map describe one run; leave them out with '
                      '--compare')
@@ -269,7 +278,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _check_course_map(analysis: Analysis, args: argparse.Namespace) -> None:
-    """--course-map needs a course run.
+    """--course-map needs a course run, --scan-cloud a bag with scans.
 
     Raises:
         BagAnalysisError: the bag is not one.
@@ -278,6 +287,10 @@ def _check_course_map(analysis: Analysis, args: argparse.Namespace) -> None:
         raise BagAnalysisError(f'{analysis.data.path} is not a VRC Task 2 run (its '
                                '/atlas/sim_config names no vrc_task_2.xml and it has no '
                                '/vrc_score): --course-map draws course runs only')
+    scans = analysis.data.topics.get(topics.LASER_SCAN)
+    if args.scan_cloud and not getattr(scans, 'count', 0):
+        raise BagAnalysisError(f'{analysis.data.path} has no {topics.LASER_SCAN}: no scan to '
+                               'draw')
 
 
 def _course_maps(analysis: Analysis, args: argparse.Namespace) -> list[Path]:
@@ -296,7 +309,11 @@ def _course_maps(analysis: Analysis, args: argparse.Namespace) -> list[Path]:
     if run is None and args.course_map:
         raise BagAnalysisError(f'{data.path} has no pelvis pose (/ground_truth_odom): '
                                'no path to draw on the course map')
-    return [plot_course_map(run, path) for path in paths] if run is not None else []
+    cloud = None
+    if args.scan_cloud:
+        scans = read_laser_scans(data.path)
+        cloud = None if scans is None else scan_cloud(data, scans)
+    return [plot_course_map(run, path, cloud) for path in paths] if run is not None else []
 
 
 def _walk_dict(walk: WalkSummary | None) -> dict[str, Any] | None:

@@ -87,6 +87,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument('--play-after', type=_seconds, default=0.0, metavar='S',
                         help='sim time between the switch to User and the first command '
                              '(default: 0; a live traj_yaml.py starts a few seconds after)')
+    parser.add_argument('--scans', action='store_true',
+                        help='write the head laser\'s scans too, as a live run\'s bag has them '
+                             '(about a fifth more time; a trajectory run only)')
     parser.add_argument('--start-after', type=_seconds, default=DEFAULT_START_AFTER_S,
                         metavar='S', help='sim time from spawn to User mode and the first '
                         'command (default: %(default)g; the torso is pinned for 1 s)')
@@ -153,7 +156,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             else:
                 trajectory_file = locate_trajectory_file(args.trajectory_file, announce=print)
                 run = run_offline(trajectory_file, args.name, bag, args.settle,
-                                  args.start_after, args.gains, world, args.play_after)
+                                  args.start_after, args.gains, world, args.play_after,
+                                  scans=args.scans)
                 what = f'{args.name}: {run.commands} commands'
             analysis = analyze_bag(run.bag)
             walk = summarise_walk(analysis.data) if args.asi_from is not None else None

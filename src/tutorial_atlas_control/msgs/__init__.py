@@ -17,7 +17,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'udpros': ['HEADER', 'HEADER_SIZE', 'OP_DATA0', 'OP_DATAN', 'PROTOCOL', 'UdprosError',
                'framed_messages', 'message_blocks', 'next_message_id', 'parse_request', 'reply'],
     'wire': ['AtlasStateWire', 'ControllerStatisticsWire', 'ForceTorqueSensorsWire', 'ImuWire',
-             'JointCommandsWire', 'JointStateWire', 'OdometryWire', 'PositionsWire',
-             'StampedWire', 'TransformWire', 'TransformsWire', 'WRENCH_FLOATS',
+             'JointCommandsWire', 'JointStateWire', 'LaserScanWire', 'OdometryWire',
+             'PositionsWire', 'StampedWire', 'TransformWire', 'TransformsWire', 'WRENCH_FLOATS',
              'WrenchStampedWire', 'clock_bytes'],
 })

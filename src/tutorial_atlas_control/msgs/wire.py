@@ -147,6 +147,18 @@ class ForceTorqueSensorsWire(StampedWire):
                          for k, name in enumerate(FORCE_TORQUE_SENSORS)}
 
 
+class LaserScanWire(StampedWire):
+    """sensor_msgs/LaserScan with a fixed number of rays: its seven float32 figures
+    (angle_min, angle_max, angle_increment, time_increment, scan_time, range_min,
+    range_max) set once, `ranges` a float32 view; `intensities` empty."""
+
+    def __init__(self, frame_id: str, figures: Sequence[float], samples: int) -> None:
+        middle = struct.pack('<7f', *figures) + struct.pack('<I', samples) + bytes(4 * samples)
+        super().__init__(frame_id, 0, middle + struct.pack('<I', 0))
+        self.ranges = np.frombuffer(self.buf, dtype='<f4', offset=len(self.buf) - 4 - 4 * samples,
+                                    count=samples)
+
+
 class OdometryWire(StampedWire):
     """nav_msgs/Odometry, covariances 0: position, orientation (x y z w), linear, angular."""
 

@@ -101,8 +101,8 @@ from geometry_msgs.msg import TransformStamped, WrenchStamped
 from nav_msgs.msg import Odometry
 from osrf_msgs.msg import JointCommands
 from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import Imu, JointState
-from std_msgs.msg import String
+from sensor_msgs.msg import Imu, JointState, LaserScan
+from std_msgs.msg import Float64, String
 from std_srvs.srv import Empty, EmptyResponse
 from tf2_msgs.msg import TFMessage
 
@@ -132,6 +132,7 @@ from tutorial_atlas_control.node.transport import (
 )
 from tutorial_atlas_control.node.udpros import serve as serve_udpros
 from tutorial_atlas_control.node.viewer_window import open_viewer
+from tutorial_atlas_control.sensors import spindle_command
 from tutorial_atlas_control.sim import (
     DEFAULT_STARTUP_MODE,
     DEFAULT_TIME_TO_UNPIN_S,
@@ -172,7 +173,7 @@ TF_PUBLISHERS = ('sim', 'robot_state_publisher')
 MESSAGE_CLASSES: dict[str, type[genpy.Message]] = {cls._type: cls for cls in (
     Clock, JointState, Odometry, Imu, WrenchStamped, ControllerStatistics, AtlasState,
     ForceTorqueSensors, SynchronizationStatistics, TFMessage, String, AtlasSimInterfaceState,
-    VRCScore)}
+    VRCScore, LaserScan)}
 #: What ~stand chooses Stand to be (the first is the default).
 STAND_CHOICES = ('balance', 'hold')
 #: Queue size of the publishers the node itself calls publish() on (1 when not named).
@@ -390,6 +391,7 @@ class SimNode:
         rospy.Subscriber(topics.ASI_COMMAND, RawAsiCommand, self.on_asi_command, queue_size=1,
                          tcp_nodelay=True)
         rospy.Subscriber(topics.CONTROL_MODE, String, self.on_control_mode, queue_size=10)
+        rospy.Subscriber(topics.SET_SPINDLE_SPEED, Float64, self.on_spindle_speed, queue_size=10)
         # DRCSim 2.6's cheat: any message ends the synchronization window's wait early.
         rospy.Subscriber(topics.SYNC_DELAY, String, lambda _msg: self.loop.wake(), queue_size=1,
                          tcp_nodelay=True)
@@ -477,6 +479,15 @@ class SimNode:
         self.node_publishers[topics.CURRENT_CONTROL_MODE].publish(String(data=mode.value))
         rospy.loginfo(f'control mode: {previous.value} -> {mode.value}')
 
+    def on_spindle_speed(self, msg: Float64) -> None:
+        """The laser spindle's speed, taken as DRCSim took it (sensors/spindle.py): one
+        warning line when it is clamped or, NaN, ignored."""
+        command = spindle_command(float(msg.data))
+        if command.warning:
+            rospy.logwarn_throttle(WARN_THROTTLE_S, command.warning)
+        if command.speed is not None:
+            self.loop.set_spindle_speed(command.speed)
+
     def _service(self, action: Callable[[], None]) -> Callable[[object], EmptyResponse]:
         def handle(_request: object) -> EmptyResponse:
             action()
@@ -558,6 +569,7 @@ def build_node() -> SimNode:
     sim = AtlasSimulator(load_model(Path(model_file)), gains, time_to_unpin_s,
                          startup_mode=VrcMode(startup_mode), start=_start_param(),
                          mud_damping=_mud_damping_param())
+    sim.sensor_seed = _sensor_seed_param()
     behaviour_spec = rospy.get_param('~behaviour', '')
     if not isinstance(behaviour_spec, str):
         raise AtlasControlError(f'parameter {rospy.resolve_name("~behaviour")} must be '
@@ -576,6 +588,15 @@ def build_node() -> SimNode:
                             user_behaviour=user_behaviour, score_dir=_score_dir())
     return SimNode(sim, settings, bool(rospy.get_param('~gui', False)),
                    description is not None, DelayBudgets.from_params(rospy.get_param))
+
+
+def _sensor_seed_param() -> int:
+    """~sensor_seed: the seed of the head's laser noise (a non-negative integer, default 0)."""
+    seed = rospy.get_param('~sensor_seed', 0)
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise AtlasControlError(f'parameter {rospy.resolve_name("~sensor_seed")} must be a '
+                                f'non-negative integer, got {seed!r}')
+    return seed
 
 
 def _mud_damping_param() -> float:

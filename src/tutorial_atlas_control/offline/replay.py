@@ -39,17 +39,20 @@ import numpy as np
 from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags import (
     BagData,
+    LaserScans,
     ScoreEntry,
     Try,
     find_tries,
     pick_try,
     read_bag,
+    read_laser_scans,
     read_scores,
     window,
 )
 from tutorial_atlas_control.course import CourseError
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
+from tutorial_atlas_control.offline.replay_scan import ScanComparison, ScanReplay
 from tutorial_atlas_control.offline.replay_score import ScoreComparison, ScoreReplay
 from tutorial_atlas_control.offline.world import recorded_world
 from tutorial_atlas_control.sim import (
@@ -124,6 +127,7 @@ class Recording:
     tries: int = 1
     try_asked: bool = False  # --try given: the report's 'try N of M' says it, no warning
     scores: list[ScoreEntry] | None = None  # /vrc_score of a scored run (the whole bag's)
+    scans: LaserScans | None = None  # the head laser's scans, when comparable
 
 
 def _read_sim_configs(data: BagData) -> list[dict[str, Any]]:
@@ -269,7 +273,16 @@ def load_recording(path: Path | str, data: BagData | None = None,
     return Recording(path, config, resets, state_stamp_ns, position, velocity, effort,
                      odom_stamp_ns, odom_position, odom_quat, len(odom_stamp_ns) > 0, warnings,
                      inputs, chosen.number, tries, try_asked=try_number is not None,
-                     scores=read_scores(data))
+                     scores=read_scores(data), scans=_comparable_scans(data, warnings))
+
+
+def _comparable_scans(data: BagData, warnings: list[str]) -> LaserScans | None:
+    """The bag's laser scans, if it has any that replay can compare (a bag without any is
+    not opened again)."""
+    if not getattr(data.topics.get(topics.LASER_SCAN), 'count', 0):
+        return None
+    scans = read_laser_scans(data.path)
+    return scans if ScanReplay.comparable(scans, warnings) else None
 
 
 def _joint_columns(path: Path, names: Sequence[str]) -> list[int]:
@@ -331,6 +344,7 @@ class ReplayResult:
     try_number: int = 1          # the try replayed (bags.tries), of
     tries: int = 1               # the tries the bag holds
     score: ScoreComparison | None = None  # a scored run's /vrc_score against the replay's
+    scans: ScanComparison | None = None  # the laser's scans cast again against the recorded
 
 
     @property
@@ -339,7 +353,8 @@ class ReplayResult:
         compared = [self.joint_position, self.joint_velocity, self.pelvis_position,
                     self.pelvis_orientation]
         return (all(d.max_abs <= self.tolerance for d in compared if d is not None)
-                and (self.score is None or self.score.same))
+                and (self.score is None or self.score.same)
+                and (self.scans is None or self.scans.same))
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready dict (keys documented in replay_bag.py --help)."""
@@ -368,6 +383,7 @@ class ReplayResult:
             'tolerance': self.tolerance,
             'reproduced': self.reproduced,
             'vrc_score': None if self.score is None else self.score.to_dict(),
+            'laser_scans': None if self.scans is None else self.scans.to_dict(),
             'warnings': list(self.warnings),
         }
 
@@ -434,11 +450,15 @@ class _OdomProbe:
         self.xquat: list[np.ndarray] = []
         #: The course's scoring of each replayed step (a scored run's), or None.
         self.score: ScoreReplay | None = None
+        #: The laser's scans cast again after each replayed step, or None.
+        self.scans: ScanReplay | None = None
 
     def after_step(self, sim: AtlasSimulator, step: int) -> None:
         """Called after replaying step `step` (the state at sim time step * dt)."""
         if self.score is not None:
             self.score()
+        if self.scans is not None:
+            self.scans()
         # After mj_step, xpos/xquat describe the step's start; the simulator stamps its
         # odometry with that time, so the pose belongs to the previous step's number.
         row = self.row_at.get(step - 1)
@@ -601,6 +621,7 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
     steps, effort = all_steps[rows], recording.effort_nm[rows]
     probe = _OdomProbe(odom_steps, reset_step, int(steps[-1]))
     probe.score = _score_replay(recording, sim, reset_step, warnings)
+    probe.scans = ScanReplay.of(sim, recording.scans, config.sensor_seed)
     inputs = _InputQueue(recording.inputs)
     prefix = _recreate_prefix(sim, config, reset_step, int(steps[0]), effort[0], probe, warnings,
                               inputs)
@@ -619,7 +640,8 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
         pelvis_position=pelvis_position, pelvis_orientation=pelvis_orientation,
         tolerance=tolerance, warnings=warnings, try_number=recording.try_number,
         tries=recording.tries,
-        score=probe.score.compare(int(steps[-1]) * step_ns) if probe.score else None)
+        score=probe.score.compare(int(steps[-1]) * step_ns) if probe.score else None,
+        scans=probe.scans.compare() if probe.scans else None)
 
 
 def _score_replay(recording: Recording, sim: AtlasSimulator, reset_step: int,
@@ -677,6 +699,8 @@ def format_report(result: ReplayResult) -> str:
     ]
     if result.score is not None:
         lines.append(result.score.line())
+    if result.scans is not None:
+        lines.append(result.scans.line())
     lines += [f'  warning: {text}' for text in result.warnings]
     verdict = 'REPRODUCED' if result.reproduced else 'DEVIATES'
     lines.append(f'{verdict} (tolerance {result.tolerance:g})')

@@ -47,6 +47,8 @@ class SimConfig:
     #: the origin), written only when given.
     start: str = ''
     mud_damping: float | None = None
+    #: The seed of the head laser's noise (~sensor_seed), written only when not 0.
+    sensor_seed: int = 0
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON object, keys in the order the simulator has always published them."""
@@ -63,6 +65,8 @@ class SimConfig:
             config['start'] = self.start
         if self.mud_damping is not None:
             config['mud_damping'] = self.mud_damping
+        if self.sensor_seed:
+            config['sensor_seed'] = self.sensor_seed
         return config
 
     def to_json(self) -> str:
@@ -86,7 +90,8 @@ class SimConfig:
                 startup_mode=str(config.get('startup_mode', DEFAULT_STARTUP_MODE)),
                 start=str(config.get('start', '')),
                 mud_damping=(None if config.get('mud_damping') is None
-                             else float(config['mud_damping'])))
+                             else float(config['mud_damping'])),
+                sensor_seed=int(config.get('sensor_seed', 0)))
         except (KeyError, TypeError, ValueError) as err:
             raise SimConfigError(f'lacks a valid {err} (expected JSON with '
                                  f'{", ".join(REQUIRED_KEYS)}).') from None

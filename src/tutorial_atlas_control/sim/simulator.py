@@ -148,6 +148,7 @@ class AtlasSimulator:
         #: replay. Only a count is kept: a 1 kHz wrench stream must not grow a list.
         self.inputs_since_reset = 0
         self._last_input: tuple[int, SimInput] | None = None
+        self.sensor_seed = 0  #: the head laser's noise seed (sensors/), for the config
         self.reset_world()
 
     @property
@@ -196,7 +197,8 @@ class AtlasSimulator:
                          last_reset_time_s=self.last_reset_ns / NS_PER_S,
                          startup_mode=self.startup_mode.value,
                          start=start_text(self.start) if self.start else '',
-                         mud_damping=None if self.mud is None else self.mud.damping)
+                         mud_damping=None if self.mud is None else self.mud.damping,
+                         sensor_seed=self.sensor_seed)
 
     def reset_simulation(self, sim_time_ns: int = 0) -> None:
         """reset_world, and sim time back to `sim_time_ns` (Gazebo's reset_simulation

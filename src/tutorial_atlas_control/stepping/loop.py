@@ -130,6 +130,11 @@ class SteppingLoop:
         self.reset_world, self.reset_simulation = controls.reset_world, controls.reset_simulation
         self.pause, self.unpause = controls.pause, controls.unpause
 
+    def set_spindle_speed(self, speed: float) -> None:
+        """The laser spindle's speed from the next step on (rad/s, within its limits)."""
+        with self.lock:
+            self.publisher.head.spindle.command(speed)
+
     @property
     def real_time_factor(self) -> float:
         """Sim time per wall time (the pacer's); 0 = as fast as possible."""

@@ -2,8 +2,9 @@
 
 The table's rows with a SimMessages wire are filled by plans and sent at their rate; the
 on-demand ones are filled only when due and someone listens (an unheard one costs a test
-per step). /clock, /ground_truth_odom, /tf, /atlas/controller_statistics and the AtlasSimInterface's
-state (and the bag's copy of it) have builders of their own.
+per step). /clock, /ground_truth_odom, /tf, /atlas/controller_statistics, the
+AtlasSimInterface's state (and the bag's copy of it) and the MultiSense SL head's topics
+(sensors/head.py) have builders of their own.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from tutorial_atlas_control.msgs import (
     clock_bytes,
     encode_asi_state,
 )
+from tutorial_atlas_control.sensors import HeadSensors
 from tutorial_atlas_control.sim import (
     AtlasSimulator,
     CommandAgeStatistics,
@@ -65,6 +67,11 @@ class StepPublisher:
                  statistics: CommandAgeStatistics, links: LinkTransforms | None,
                  asi: AtlasSimInterface | None = None) -> None:
         self.sim = sim
+        #: The MultiSense SL head: the spindle stepped each step, its messages on demand.
+        self.head = HeadSensors(sim.model, sim.data, sim.dt_s, sim.sensor_seed)
+        self.scan_outlet = outputs.outlets.get(topics.LASER_SCAN)
+        self.head_joint_state_outlet = outputs.outlets.get(topics.HEAD_JOINT_STATES)
+        self.head_imu_outlet = outputs.outlets.get(topics.HEAD_IMU)
         self.asi = asi
         self.asi_outlet = outputs.outlets.get(topics.ASI_STATE) if asi is not None else None
         self.asi_seq = 0
@@ -140,6 +147,8 @@ class StepPublisher:
         if (links is not None and count % self.every['joint_states'] == 0
                 and links.due(now_ns) and wanted(tf_outlet)):
             outbox.add(tf_outlet, messages.links_tf(now_ns))
+            outbox.add(tf_outlet, self.head.hokuyo_tf(now_ns))
+        self._publish_head(count, sensed_ns, now_ns)
         asi_outlet = self.asi_outlet
         state = None
         if asi_outlet is not None and wanted(asi_outlet):
@@ -151,6 +160,19 @@ class StepPublisher:
         recorded = self.asi_recorded_outlet
         if recorded is not None and wanted(recorded):
             self._record_asi_state(count, recorded, state)
+
+    def _publish_head(self, count: int, sensed_ns: int, now_ns: int) -> None:
+        """The head's laser scan, spindle joint state and IMU, when due and heard."""
+        wanted, outbox, head = self.outbox.wanted, self.outbox, self.head
+        scan = self.scan_outlet
+        if scan is not None and count % self.every['laser'] == 0 and wanted(scan):
+            outbox.add(scan, head.scan(sensed_ns))
+        joints = self.head_joint_state_outlet
+        if joints is not None and count % self.every['head_joint_states'] == 0 and wanted(joints):
+            outbox.add(joints, head.joint_state(now_ns))
+        imu = self.head_imu_outlet
+        if imu is not None and count % self.every['head_imu'] == 0 and wanted(imu):
+            outbox.add(imu, head.imu(sensed_ns))
 
     def _record_asi_state(self, count: int, outlet: object, state: AsiState | None) -> None:
         """The bag's copy of the state, when due or changed (`state`: built already)."""
@@ -165,8 +187,9 @@ class StepPublisher:
         self.outbox.add(outlet, len(body).to_bytes(4, 'little') + body)
 
     def publish_step(self, count: int) -> None:
-        """After step `count`: its messages, and the command age into the statistics'
-        window and, when due, out."""
+        """After step `count`: the spindle's step, the step's messages, and the command age
+        into the statistics' window and, when due, out."""
+        self.head.step()
         self.publish(count)
         if not self.outbox.wanted(self.statistics_outlet):
             return

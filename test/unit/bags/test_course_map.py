@@ -48,12 +48,13 @@ TOLERANCE = 40
 @pytest.fixture(scope='module')
 def course_bag(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """3 s of sim time in the course (its model, the pen's start, scored), the robot
-    teleported through gate_0 and gate_1 (about 3 s of wall time)."""
+    teleported through gate_0 and gate_1 (about 3 s of wall time), with the laser's scans."""
     directory = tmp_path_factory.mktemp('course')
     world = named_world('vrc_task_2')
     sim = AtlasSimulator(atlas_model.load_model(world.model_path), load_gains_yaml(CONFIG),
                          start=world.start)
-    return record_teleported_run(sim, directory / 'course.bag', directory / 'vrc_task_2', 3.0)
+    return record_teleported_run(sim, directory / 'course.bag', directory / 'vrc_task_2', 3.0,
+                                 scans=True)
 
 
 def _pixels(path: Path) -> np.ndarray:
@@ -185,3 +186,22 @@ def test_standing_in_the_pit_is_no_fall_on_the_course_and_one_on_the_plane(
     plane = analyze_bag(write_bag(tmp_path / 'plane.bag', [sim_config(0.0, 0.0), *path]))
     assert not plane.over_terrain
     assert plane.fell and plane.fall_time_s == pytest.approx(0.0, abs=0.011)
+
+
+def test_scan_cloud_needs_the_course_map_and_scans(course_bag: Path, tmp_path: Path,
+                                                   capsys: pytest.CaptureFixture[str]) -> None:
+    """--scan-cloud draws on --course-map's map (the course run's scans, as recorded); a
+    course bag without scans is one line before the summary, and no map."""
+    with pytest.raises(SystemExit) as exit_info:
+        main([str(course_bag), '--scan-cloud'])
+    assert exit_info.value.code == 2
+    png = tmp_path / 'cloud.png'
+    assert main([str(course_bag), '--course-map', str(png), '--scan-cloud']) == 0
+    assert png.is_file()
+    bare = write_bag(tmp_path / 'no_scans.bag', [_course_config(0.0)] + [
+        odometry(t_s, 0.3, x_m=-3.0, y_m=-38.0) for t_s in np.arange(0.0, 1.0, 0.01)])
+    capsys.readouterr()
+    assert main([str(bare), '--course-map', str(tmp_path / 'none.png'), '--scan-cloud']) == 1
+    out, err = capsys.readouterr()
+    assert out == '' and f'has no {topics.LASER_SCAN}' in err
+    assert not (tmp_path / 'none.png').exists()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import math
 import shutil
 from pathlib import Path
 from types import SimpleNamespace
@@ -70,7 +71,8 @@ def test_the_node_advertises_the_topics_and_steps_until_shutdown(sim: AtlasSimul
             topics.SIM_CONFIG, topics.ATLAS_STATE, topics.FORCE_TORQUE_SENSORS,
             topics.DEBUG_L_FOOT_CONTACT, topics.DEBUG_R_FOOT_CONTACT, topics.SIM_INPUTS,
             topics.CURRENT_CONTROL_MODE, topics.SYNCHRONIZATION_STATISTICS, topics.ASI_STATE,
-            topics.ASI_STATE_RECORDED, topics.RENDER_STATE}
+            topics.ASI_STATE_RECORDED, topics.RENDER_STATE, topics.LASER_SCAN,
+            topics.HEAD_JOINT_STATES, topics.HEAD_IMU}
         config, = node.fake_publishers[topics.SIM_CONFIG].published
         mode, = node.fake_publishers[topics.CURRENT_CONTROL_MODE].published
         assert mode.data == 'Stand'
@@ -78,6 +80,20 @@ def test_the_node_advertises_the_topics_and_steps_until_shutdown(sim: AtlasSimul
         assert node.fake_publishers[topics.CURRENT_CONTROL_MODE].published[-1].data == 'User'
         assert SimConfig.from_json(config.data) == sim.config()
     assert sim.sim_time_ns == 50 * sim.step_ns
+
+
+@pytest.mark.parametrize(('sent', 'taken', 'warnings'), [
+    (2.0, 2.0, 0), (9.0, 50 * 2 * math.pi / 60, 1), (-1.0, 0.0, 1), (math.nan, 0.0, 1)])
+def test_set_spindle_speed_is_clamped_or_ignored_with_one_warning(
+        sim: AtlasSimulator, sent: float, taken: float, warnings: int) -> None:
+    """DRCSim's limits (0..50 RPM), NaN ignored (the spindle keeps its speed, here 0)."""
+    from support.fake_rospy import fake_ros_node
+
+    with fake_ros_node(sim, steps=1) as node:
+        sim_node.rospy.logwarn_throttle.reset_mock()
+        node.on_spindle_speed(SimpleNamespace(data=sent))
+        assert node.loop.publisher.head.spindle.target == pytest.approx(taken)
+        assert sim_node.rospy.logwarn_throttle.call_count == warnings
 
 
 def test_a_diverging_model_shuts_the_node_down_with_status_1(

@@ -223,8 +223,12 @@ def test_loop_publishes_links_at_robot_state_publishers_stamps(
     steps = [0]
     loop.run(lambda: (steps.__setitem__(0, steps[0] + 1) or steps[0] > 100))
     links_messages = [m for m in outbox.tf if len(m) > 200]
-    pelvis = [m for m in outbox.tf if len(m) <= 200]
+    # The laser's spindle (head -> hokuyo_link) goes out with the links, stamped alike.
+    spindle = [m for m in outbox.tf if len(m) <= 200 and b'hokuyo_link' in m]
+    pelvis = [m for m in outbox.tf if len(m) <= 200 and b'hokuyo_link' not in m]
     assert len(pelvis) == 11  # steps 0, 10, ..., 100
+    assert [TFMessage().deserialize(m[4:]).transforms[0].header.stamp for m in spindle] == [
+        TFMessage().deserialize(m[4:]).transforms[0].header.stamp for m in links_messages]
     stamps = [TFMessage().deserialize(m[4:]).transforms[0].header.stamp.to_nsec()
               for m in links_messages]
     js_every_ms = 1 if joint_states_rate_hz == 1000.0 else 3

@@ -1,0 +1,141 @@
+"""A recorded run's laser: its /multisense_sl/laser/scan stream, its spindle's commands, and
+the scans' points placed in the world (`analyze_bag.py --scan-cloud`).
+
+The scans are parsed straight from their ROS 1 bytes (a header, seven float32 figures, the
+ranges, the intensities): a minute of scans is 2 400 messages of 720 ranges. A point's place
+is the scan's stamp's pose of the `head` body (the model placed as the bag recorded it:
+bags/feet.RecordedKinematics), multisense_sl.urdf's frames (sensors/frames.py) and the
+spindle's angle then, which the bag does not hold: it is simulated again from the recorded
+set_spindle_speed commands (sensors/spindle.py) from 0 at sim time 0, each taken at its
+record time (the live simulator takes it at the next step after it arrives: the angle can
+lag by a few steps' turn, a few mrad at 50 RPM).
+"""
+
+from __future__ import annotations
+
+import struct
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from tutorial_atlas_control import topics
+from tutorial_atlas_control.bags.feet import RecordedKinematics
+from tutorial_atlas_control.bags.reader import BagData
+from tutorial_atlas_control.bags.records import open_bag
+from tutorial_atlas_control.sensors import (
+    HEAD_HOKUYO_FRAME,
+    HEAD_LINK,
+    Spindle,
+    frame_in_head,
+    spindle_command,
+)
+from tutorial_atlas_control.units import NS_PER_S
+
+__all__ = ['LaserScans', 'read_laser_scans', 'scan_cloud', 'spindle_angles']
+
+_HEADER = struct.Struct('<III')
+_U32 = struct.Struct('<I')
+_FIGURES = struct.Struct('<7f')
+#: The physics step the spindle is simulated at (s): the simulator's.
+SPINDLE_STEP_S = 0.001
+
+
+@dataclass(frozen=True)
+class LaserScans:
+    """The scans of a bag: stamps (sim time, ns), ranges (scans, rays; float32, as sent),
+    the first scan's frame and angles, and set_spindle_speed as recorded: (record time in
+    sim ns, value)."""
+
+    stamp_ns: np.ndarray
+    ranges: np.ndarray
+    frame_id: str
+    angle_min: float
+    angle_increment: float
+    spindle_commands: list[tuple[int, float]]
+
+    def angles(self) -> np.ndarray:
+        return self.angle_min + self.angle_increment * np.arange(self.ranges.shape[1])
+
+
+def _parse_scan(raw: bytes) -> tuple[int, str, tuple[float, ...], np.ndarray]:
+    """(stamp ns, frame_id, the seven figures, ranges) of one serialized LaserScan."""
+    _seq, secs, nsecs = _HEADER.unpack_from(raw, 0)
+    (length,) = _U32.unpack_from(raw, 12)
+    frame = raw[16:16 + length].decode()
+    at = 16 + length
+    figures = _FIGURES.unpack_from(raw, at)
+    (count,) = _U32.unpack_from(raw, at + _FIGURES.size)
+    ranges = np.frombuffer(raw, dtype='<f4', count=count, offset=at + _FIGURES.size + 4)
+    return secs * NS_PER_S + nsecs, frame, figures, ranges
+
+
+def read_laser_scans(path: Path | str) -> LaserScans | None:
+    """The bag's scans and spindle commands; None when it has no scan."""
+    records = open_bag(Path(path))
+    try:
+        scan_connections = [c for c in records.connections if c.topic == topics.LASER_SCAN]
+        if not scan_connections:
+            return None
+        _times, raws = records.raw_messages(scan_connections)
+        speed_connections = [c for c in records.connections
+                             if c.topic == topics.SET_SPINDLE_SPEED]
+        speed_times, speed_raws = records.raw_messages(speed_connections)
+    finally:
+        records.close()
+    if not raws:
+        return None
+    parsed = [_parse_scan(raw) for raw in raws]
+    _stamp, frame, figures, _ranges = parsed[0]
+    commands = [(int(t), struct.unpack_from('<d', raw, 0)[0])
+                for t, raw in zip(speed_times.tolist(), speed_raws)]
+    return LaserScans(np.array([p[0] for p in parsed], dtype=np.int64),
+                      np.stack([p[3] for p in parsed]), frame, figures[0], figures[2], commands)
+
+
+def spindle_angles(scans: LaserScans) -> np.ndarray:
+    """The spindle's angle (rad) at each scan's stamp, simulated again from the commands."""
+    angles = np.zeros(len(scans.stamp_ns))
+    if not scans.spindle_commands:
+        return angles
+    spindle = Spindle(SPINDLE_STEP_S)
+    step_ns = round(SPINDLE_STEP_S * NS_PER_S)
+    commands = sorted(scans.spindle_commands)
+    now_ns, next_command = 0, 0
+    for row, stamp in enumerate(scans.stamp_ns.tolist()):
+        while now_ns < stamp:
+            while next_command < len(commands) and commands[next_command][0] <= now_ns:
+                speed = spindle_command(commands[next_command][1]).speed
+                if speed is not None:
+                    spindle.command(speed)
+                next_command += 1
+            spindle.step()
+            now_ns += step_ns
+        angles[row] = spindle.angle
+    return angles
+
+
+def scan_cloud(data: BagData, scans: LaserScans, every: int = 1) -> np.ndarray:
+    """The points (x, y, z in the world, m) of every `every`-th scan's finite ranges."""
+    if scans.frame_id != HEAD_HOKUYO_FRAME:
+        return np.empty((0, 3))
+    kinematics = RecordedKinematics(data)
+    head = kinematics.body_id(HEAD_LINK)
+    spindle = spindle_angles(scans)
+    angles = scans.angles()
+    rays = np.stack((np.cos(angles), np.sin(angles), np.zeros_like(angles)), 1)
+    points = []
+    for row in range(0, len(scans.stamp_ns), max(1, every)):
+        ranges = scans.ranges[row].astype(float)
+        hit = np.isfinite(ranges)
+        if not hit.any():
+            continue
+        # Sim time on the run's timeline; a run whose sim time went back (a
+        # reset_simulation) is placed in its first epoch's.
+        placed = kinematics.place(data.run_time_s(scans.stamp_ns[row] / NS_PER_S, 0))
+        offset, rotation = frame_in_head(HEAD_HOKUYO_FRAME, float(spindle[row]))
+        head_rotation = placed.xmat[head].reshape(3, 3)
+        origin = placed.xpos[head] + head_rotation @ offset
+        world = rays[hit] @ (head_rotation @ rotation).T
+        points.append(origin + world * ranges[hit, None])
+    return np.concatenate(points) if points else np.empty((0, 3))
