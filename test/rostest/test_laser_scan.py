@@ -11,7 +11,6 @@ simulator's) and the URDF's laser frame, lie on the floor (z = 0) within 3 cm.
 from __future__ import annotations
 
 import threading
-import time
 import unittest
 
 import numpy as np
@@ -23,6 +22,7 @@ from sensor_msgs.msg import JointState, LaserScan
 from std_msgs.msg import Float64
 
 from tutorial_atlas_control import topics
+from tutorial_atlas_control.processes import wait_until
 from tutorial_atlas_control.sensors import HOKUYO, HOKUYO_FRAME, MAX_SPINDLE_SPEED
 
 PKG = 'tutorial_atlas_control'
@@ -33,6 +33,11 @@ SPIN_FOR_S = 1.5
 FLOOR_TOLERANCE_M = 0.03
 WALL_TIMEOUT_S = 60.0
 
+
+
+def _not_shut_down() -> None:
+    if rospy.is_shutdown():
+        raise AssertionError('rospy shut down while waiting')
 
 class LaserScanTest(unittest.TestCase):
     """The scan stream of a standing robot, still then spinning."""
@@ -61,11 +66,7 @@ class LaserScanTest(unittest.TestCase):
 
     @classmethod
     def _wait(cls, predicate, what: str) -> None:
-        deadline = time.monotonic() + WALL_TIMEOUT_S
-        while not predicate():
-            if time.monotonic() > deadline or rospy.is_shutdown():
-                raise AssertionError(f'timed out after {WALL_TIMEOUT_S} s waiting for {what}')
-            time.sleep(0.01)
+        wait_until(predicate, WALL_TIMEOUT_S, f'no {what}', check=_not_shut_down)
 
     @classmethod
     def _on_clock(cls, msg: Clock) -> None:
