@@ -2,13 +2,16 @@
 
 One place for the pair's numbers (multisense_sl.urdf's multicamera block and its camera
 frames on `head`) and for the pinhole model they imply, so that the renderer, the node and
-stereo_image_proc's inputs agree. Pure numbers, no MuJoCo, no ROS.
+stereo_image_proc's inputs agree (the frames' origins are sensors/frames.py's). Pure
+numbers, no MuJoCo, no ROS.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+
+from tutorial_atlas_control.sensors import CAMERA_FRAMES, HEAD_LINK
 
 __all__ = ['BASELINE_M', 'DEFAULT_FPS', 'FAR_M', 'HEAD_BODY', 'HFOV_RAD', 'HEIGHT_PX',
            'NEAR_M', 'NOISE_STDDEV', 'OPTICAL_FRAME', 'SIDES', 'WIDTH_PX', 'CameraSide',
@@ -27,7 +30,7 @@ NOISE_STDDEV = 0.007
 #: The sensor's update_rate, and set_fps's upper limit at 800 x 800 (imager mode 1).
 DEFAULT_FPS = 30.0
 #: The body the cameras ride on (the MuJoCo model's and the URDF's `head`).
-HEAD_BODY = 'head'
+HEAD_BODY = HEAD_LINK
 #: Both images' header.frame_id: the plugin's frameName, the right one's too (DRCSim left
 #: rightFrameName out; the baseline is in the right camera_info's P instead).
 OPTICAL_FRAME = 'left_camera_optical_frame'
@@ -51,7 +54,9 @@ class CameraSide:
         return f'{self.name}_camera_frame'
 
 
-SIDES = (CameraSide('left', (0.0, 0.035, -0.002)), CameraSide('right', (0.0, -0.035, -0.002)))
+#: The camera frames' origins on `head`: sensors/frames.py's, the URDF's numbers.
+_ON_HEAD = {frame.child: frame.xyz_m for frame in CAMERA_FRAMES if frame.parent == HEAD_LINK}
+SIDES = tuple(CameraSide(name, _ON_HEAD[f'{name}_camera_frame']) for name in ('left', 'right'))
 
 
 @dataclass(frozen=True)
