@@ -31,6 +31,10 @@ STILL_UNTIL_S = 2.0
 SPIN_FOR_S = 1.5
 #: A floor point's height tolerance (m): 3 sigma of noise, the pose's interpolation in /tf.
 FLOOR_TOLERANCE_M = 0.03
+#: No point lies below the floor by more than the noise can put it: six standard deviations
+#: (over the ~10^4 floor points of a run, 3 sigma is passed about once: a run's lowest point
+#: at -3.07 cm failed a 3 cm bound; a ray through the floor would read far below it).
+BELOW_FLOOR_M = 6.0 * HOKUYO.noise_m
 WALL_TIMEOUT_S = 60.0
 
 
@@ -118,7 +122,8 @@ class LaserScanTest(unittest.TestCase):
         self.assertAlmostEqual(angles[-1] - angles[0], MAX_SPINDLE_SPEED * span_s, delta=0.05)
 
     def test_spinning_the_scans_meet_the_floor(self) -> None:
-        """The lowest points of each sweep's scans are the floor's: z = 0 within 3 cm."""
+        """The spinning scans' points meet the floor (z = 0 within 3 cm), and none lies
+        below it by more than the noise can put it."""
         with self.lock:
             spinning = [s for s in self.scans
                         if s.header.stamp.to_sec() > self.spin_from_s + 0.5]
@@ -138,7 +143,7 @@ class LaserScanTest(unittest.TestCase):
             floor_points += int(np.sum(np.abs(z) < FLOOR_TOLERANCE_M))
             lowest.append(float(z.min()))
         self.assertGreater(floor_points, 500)
-        self.assertGreater(min(lowest), -FLOOR_TOLERANCE_M)
+        self.assertGreater(min(lowest), -BELOW_FLOOR_M)
 
 
 def _matrix(x: float, y: float, z: float, w: float) -> np.ndarray:
