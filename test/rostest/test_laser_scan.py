@@ -38,10 +38,10 @@ BELOW_FLOOR_M = 6.0 * HOKUYO.noise_m
 WALL_TIMEOUT_S = 60.0
 
 
-
 def _not_shut_down() -> None:
     if rospy.is_shutdown():
         raise AssertionError('rospy shut down while waiting')
+
 
 class LaserScanTest(unittest.TestCase):
     """The scan stream of a standing robot, still then spinning."""
@@ -67,6 +67,13 @@ class LaserScanTest(unittest.TestCase):
         speed.publish(Float64(MAX_SPINDLE_SPEED))
         cls._wait(lambda: cls.clock_s > cls.spin_from_s + SPIN_FOR_S + 0.2,
                   'the spindle spinning')
+        # The spinning scans as of now, and /tf caught up with the last of them (a scan can
+        # come before the transform of its step).
+        with cls.lock:
+            cls.spun = [s for s in cls.scans if s.header.stamp.to_sec() > cls.spin_from_s + 0.5]
+        last = cls.spun[-1].header.stamp if cls.spun else rospy.Time(0)
+        cls._wait(lambda: cls.buffer.can_transform('world', 'hokuyo_link', last),
+                  f'/tf of hokuyo_link at {last.to_sec():.3f} s')
 
     @classmethod
     def _wait(cls, predicate, what: str) -> None:
@@ -124,9 +131,7 @@ class LaserScanTest(unittest.TestCase):
     def test_spinning_the_scans_meet_the_floor(self) -> None:
         """The spinning scans' points meet the floor (z = 0 within 3 cm), and none lies
         below it by more than the noise can put it."""
-        with self.lock:
-            spinning = [s for s in self.scans
-                        if s.header.stamp.to_sec() > self.spin_from_s + 0.5]
+        spinning = self.spun
         floor_points, lowest = 0, []
         angles = HOKUYO.angles()
         for scan in spinning:
