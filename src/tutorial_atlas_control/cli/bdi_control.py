@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import sys
 import threading
+import time
 from collections.abc import Sequence
 
 import actionlib
@@ -38,6 +39,10 @@ from tutorial_atlas_control.cli.convention import (
 PROG = 'bdi_control.py'
 NODE_NAME = 'atlas_bdi_control'
 ACTION = 'atlas/bdi_control'
+#: How long (s, wall) the server waits for the simulator to connect to its commands before it
+#: takes goals: a goal's first command published before that connection is lost, and the goal
+#: then waits for ever for a state that says what came of it.
+SIMULATOR_WAIT_S = 60.0
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -102,6 +107,13 @@ def _serve(argv: list[str]) -> int:
     action.register_preempt_callback(on_preempt)
     rospy.Subscriber(topics.ATLAS_STATE, AtlasState, on_atlas_state, queue_size=1)
     rospy.Subscriber(topics.ASI_STATE, AtlasSimInterfaceState, on_state, queue_size=1)
+    deadline = time.monotonic() + SIMULATOR_WAIT_S
+    while commands.get_num_connections() == 0 and not rospy.is_shutdown():
+        if time.monotonic() > deadline:
+            rospy.logwarn(f'{ACTION}: nothing subscribes to {topics.ASI_COMMAND} after '
+                          f'{SIMULATOR_WAIT_S:.0f} s; taking goals all the same')
+            break
+        time.sleep(0.01)
     action.start()
     rospy.loginfo(f'{ACTION}: ready (DRCSim\'s actionlib server, in Python)')
     rospy.spin()
