@@ -107,14 +107,20 @@ def _serve(argv: list[str]) -> int:
     action.register_preempt_callback(on_preempt)
     rospy.Subscriber(topics.ATLAS_STATE, AtlasState, on_atlas_state, queue_size=1)
     rospy.Subscriber(topics.ASI_STATE, AtlasSimInterfaceState, on_state, queue_size=1)
+    _wait_for_simulator(commands)
+    action.start()
+    rospy.loginfo(f'{ACTION}: ready (DRCSim\'s actionlib server, in Python)')
+    rospy.spin()
+    return 0
+
+
+def _wait_for_simulator(commands: rospy.Publisher) -> None:
+    """Until the simulator subscribes to `commands` (at most SIMULATOR_WAIT_S of wall time):
+    a goal's first command published before that is lost."""
     deadline = time.monotonic() + SIMULATOR_WAIT_S
     while commands.get_num_connections() == 0 and not rospy.is_shutdown():
         if time.monotonic() > deadline:
             rospy.logwarn(f'{ACTION}: nothing subscribes to {topics.ASI_COMMAND} after '
                           f'{SIMULATOR_WAIT_S:.0f} s; taking goals all the same')
-            break
+            return
         time.sleep(0.01)
-    action.start()
-    rospy.loginfo(f'{ACTION}: ready (DRCSim\'s actionlib server, in Python)')
-    rospy.spin()
-    return 0
