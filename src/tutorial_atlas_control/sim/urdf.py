@@ -125,6 +125,9 @@ def matching_urdf(model_path: Path | str, model: mujoco.MjModel) -> tuple[Path, 
         raise UrdfError(f'the model {model_path} has no URDF beside it ({path} does not exist)')
     text = path.read_text()
     links, joints = read_joints(text, str(path))
+    twice = sorted({link for link in links if links.count(link) > 1})
+    if twice:  # rviz's RobotModel refuses such a robot ("link ... is not unique")
+        raise UrdfError(f'{path}: link {twice[0]!r} is described twice')
     by_name = {joint.name: joint for joint in joints}
     # The robot's bodies: the pelvis's tree (a course's loose blocks are not the robot).
     robot_root = model.body_rootid[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, PELVIS_BODY)]

@@ -229,3 +229,14 @@ def test_a_link_the_model_lacks_is_no_frame(tmp_path: Path, mjcf: mujoco.MjModel
         URDF_PATH.read_text().replace('<link name="head">', '<link name="skull">'))
     with pytest.raises(urdf.UrdfError, match=r'links and bodies differ \(head\)'):
         urdf.matching_urdf(variant, mjcf)
+
+
+def test_a_link_described_twice_is_refused(tmp_path: Path, mjcf: mujoco.MjModel) -> None:
+    """rviz's RobotModel draws nothing of a URDF with a link twice: refused, named."""
+    variant = tmp_path / 'variant.xml'
+    shutil.copy(model.MODEL_PATH, variant)
+    (tmp_path / 'variant.urdf').write_text(URDF_PATH.read_text().replace(
+        '</robot>', '<joint name="again" type="fixed"><parent link="head"/>'
+        '<child link="hokuyo_link"/></joint><link name="hokuyo_link"/></robot>'))
+    with pytest.raises(urdf.UrdfError, match="link 'hokuyo_link' is described twice"):
+        urdf.matching_urdf(variant, mjcf)
