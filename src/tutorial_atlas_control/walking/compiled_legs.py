@@ -91,15 +91,15 @@ class CompiledLegs:
         self._scratch = (model, data)
         self._foot = None  # the leg's dofs set again, from these
 
-    def swing_tick(self, state: BalanceState, contacts: tuple[ContactConstraint,
-                                                              ContactConstraint],
-                   joints: tuple[np.ndarray, np.ndarray],
-                   joint_gains: tuple[np.ndarray, np.ndarray], reference: StandReference,
-                   moved: MovedReference, cop: np.ndarray,
-                   swing: tuple[int, SwingPath, float]) -> tuple[np.ndarray, np.ndarray]:
-        """LegTasks.torque then LegTasks.finish with `swing` (the foot, its path, the time
-        into it): the torques (joints,) within the effort limits and the pressure centre as
-        kept, new arrays. `joints`: their positions and velocities."""
+    def load_swing_tick(self, state: BalanceState,
+                        contacts: tuple[ContactConstraint, ContactConstraint],
+                        joints: tuple[np.ndarray, np.ndarray],
+                        joint_gains: tuple[np.ndarray, np.ndarray], reference: StandReference,
+                        moved: MovedReference, swing: tuple[int, SwingPath, float]) -> None:
+        """A swinging tick's input but the pressure centre (tick_at sets it, or the walk's
+        swing tick, compiled_walk_swing): the state, the stance sole's `contacts`, the joints'
+        positions and velocities, their gains, the legs' reference (`moved`: its heading,
+        height and rate) and `swing` (the foot, its path, the time into it)."""
         source = state.mass_matrix_source
         if source is None or self._scratch != source[0:2]:
             self._bind(state)
@@ -108,12 +108,26 @@ class CompiledLegs:
             self._set_foot(foot)
         self._whole_body.load(state, contacts, joints[0], joints[1], joint_gains, reference,
                               moved)
-        self._whole_body.set_cop(cop)
         self._swing.set_path(path)
         self._swing.prepare_swing(elapsed_s)
-        self._library.atlas_legs_swing_tick(self._pointer)
+
+    def results(self) -> tuple[np.ndarray, np.ndarray]:
+        """The last tick's torques (joints,) and pressure centre as kept, new arrays."""
         out = self._out
         return out[:self._joints].copy(), out[self._joints:].copy()
+
+    def tick_at(self, cop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """LegTasks.torque then LegTasks.finish on the input load_swing_tick loaded, at the
+        pressure centre `cop`: the torques (joints,) within the effort limits and the
+        pressure centre as kept, new arrays."""
+        self._whole_body.set_cop(cop)
+        self._library.atlas_legs_swing_tick(self._pointer)
+        return self.results()
+
+    @property
+    def address(self) -> int:
+        """The call's struct, for a call that runs the tick itself (compiled_walk_swing)."""
+        return ctypes.addressof(self._call)
 
     def support_clamp(self, state: BalanceState, carrying: tuple[bool, bool],
                       cop: np.ndarray) -> np.ndarray:

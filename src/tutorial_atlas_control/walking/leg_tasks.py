@@ -163,6 +163,11 @@ class LegTasks:
         """Whether swing_tick runs the one C call (on a compiled estimate's state)."""
         return self._legs_kernel is not None
 
+    @property
+    def legs_kernel(self) -> CompiledLegs | None:
+        """swing_tick's one C call (None: it computes in pieces)."""
+        return self._legs_kernel
+
     def move_height(self, height_m: float, time_s: float, duration_s: float) -> None:
         """Take the CoM's reference height from where it is now to `height_m` over
         `duration_s` (a smoothstep)."""
@@ -297,6 +302,21 @@ class LegTasks:
                                   moved).torque_nm
         return torque, cop, contact
 
+    def load_swing_tick(self, state: BalanceState, joint_positions: np.ndarray,
+                        joint_velocities: np.ndarray, time_s: float,
+                        swing: tuple[int, SwingPath, float]) -> CompiledLegs | None:
+        """The one call of swing_tick with its input loaded but the pressure centre, or None
+        where swing_tick computes in pieces (no library, or a Python estimate's state)."""
+        legs = self._legs_kernel
+        if legs is None or state.row_address is None:
+            return None
+        foot = swing[0]
+        legs.load_swing_tick(state, self.stand.contacts_for((foot != 0, foot != 1),
+                                                            self.gains.torsion_m),
+                             (joint_positions, joint_velocities), self._joint_gains,
+                             self.reference, self._moved_reference(time_s), swing)
+        return legs
+
     def swing_tick(self, state: BalanceState, joint_positions: np.ndarray,
                    joint_velocities: np.ndarray, time_s: float, cop: np.ndarray,
                    swing: tuple[int, SwingPath, float]) -> tuple[np.ndarray, np.ndarray,
@@ -304,18 +324,13 @@ class LegTasks:
         """torque() then finish() with `swing` (the foot, its path and the time into it):
         the torques within the effort limits, the pressure centre as kept, which soles
         carry."""
-        legs = self._legs_kernel
-        if legs is None or state.row_address is None:
+        legs = self.load_swing_tick(state, joint_positions, joint_velocities, time_s, swing)
+        if legs is None:
             torque, cop, contact = self.torque(state, joint_positions, joint_velocities,
                                                time_s, cop, swing[0])
             return self.finish(state, joint_velocities, torque, contact, swing, ()), cop, contact
-        foot = swing[0]
-        contact = (foot != 0, foot != 1)
-        torque, cop = legs.swing_tick(
-            state, self.stand.contacts_for(contact, self.gains.torsion_m),
-            (joint_positions, joint_velocities), self._joint_gains, self.reference,
-            self._moved_reference(time_s), cop, swing)
-        return torque, cop, contact
+        torque, cop = legs.tick_at(cop)
+        return torque, cop, (swing[0] != 0, swing[0] != 1)
 
     def _support_clamp(self, state: BalanceState, contact: tuple[bool, bool],
                        cop: np.ndarray) -> np.ndarray:

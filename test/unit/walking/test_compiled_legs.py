@@ -20,6 +20,7 @@ from tutorial_atlas_control.balance.stand_behaviour import StandBehaviour
 from tutorial_atlas_control.balance.stand_pose import place_in_stand_pose
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.walking import straight_steps
+from tutorial_atlas_control.walking.compiled_walk_swing import WALK_SWING_ENV
 from tutorial_atlas_control.walking.leg_tasks import LEGS_ENV, SWING_ENV, LegGains, LegTasks
 from tutorial_atlas_control.walking.swing import SwingPath
 from tutorial_atlas_control.walking.walk_trial import SETTLE_S, walk_trial
@@ -91,6 +92,7 @@ def test_the_one_call_agrees_with_the_pieces_and_python_through_a_walk(
         library, monkeypatch: pytest.MonkeyPatch) -> None:
     for name in (LEGS_ENV, SWING_ENV):
         monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv(WALK_SWING_ENV, 'python')  # the walk's swinging tick calls swing_tick
     walked: list[float] = []
     tried: list[float] = []
     largest: list[float] = []
