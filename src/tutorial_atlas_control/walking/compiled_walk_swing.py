@@ -55,7 +55,7 @@ class CompiledWalkSwing:
         call.tolerance_m = tolerance_m
         self._pointer = ctypes.byref(call)
         self._tick = library.atlas_walk_swing_tick
-        #: What the call's step numbers were set from (plan, planned, step, stance).
+        #: What the call's step numbers were set from (plan, planned, step, stance, limits).
         self._bound: tuple[object, ...] = ()
 
     def bind(self, plan: DcmPlan, planned: Footstep, step: Footstep, stance: Footstep,
@@ -63,9 +63,9 @@ class CompiledWalkSwing:
         """The step's numbers, unless they were set from these very objects: its plan's
         first stage, the landing as planned and as adjusted so far (`step`), the stance
         foot as the queue holds it, and the step limits."""
-        bound = (plan, planned, step, stance, limits)
-        if len(self._bound) == len(bound) and all(
-                a is b for a, b in zip(self._bound, bound, strict=True)):
+        last = self._bound
+        if last and last[0] is plan and last[1] is planned and last[2] is step \
+                and last[3] is stance and last[4] is limits:  # every tick of the step
             return
         call = self._call
         (cop_x, cop_y), (end_x, end_y) = plan.cops[0].tolist(), plan.ends[0].tolist()
@@ -81,7 +81,7 @@ class CompiledWalkSwing:
                           limits.max_width_m)
         call.side = side_sign(step.foot_index)
         call.step_xy[:] = (step.x_m, step.y_m)
-        self._bound = bound
+        self._bound = (plan, planned, step, stance, limits)
 
     def tick(self, elapsed_s: float) -> tuple[np.ndarray, np.ndarray, np.ndarray,
                                               tuple[float, float] | None]:
