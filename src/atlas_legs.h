@@ -32,6 +32,25 @@ typedef struct {
   long carrying[2];                 /* which soles carry (1) */
 } AtlasLegs;
 
+/* A foot's pose for a tick with both feet meant down (LegTasks.finish): the put-down servo's
+ * target (x, y, its step's height less the press, yaw, the surface's tilt x, y), then what
+ * the flat test reads (the surface's height, its normal). */
+enum { FOOT_X = 0, FOOT_Y, FOOT_Z_PRESSED, FOOT_YAW, FOOT_TILT_X, FOOT_TILT_Y, FOOT_Z,
+       FOOT_NORMAL, FOOT_SIZE = FOOT_NORMAL + 3 };
+
+/* Laid out once by walking/compiled_legs.py, mirrored in native.py (same fields, same
+ * order; tac_sizeof_AtlasLegsSupport lets the loader check). */
+typedef struct {
+  AtlasLegs *legs;           /* loaded for this tick: its whole body, row, carrying soles and
+                              * the law's pressure centre (out); its leg set here per foot */
+  long leg_starts[2];        /* each leg's first joint (tutorial order) */
+  long leg_dofs[2][LEG];     /* each leg's dof addresses in qvel */
+  double feet[2][FOOT_SIZE]; /* each foot's pose: FOOT_* */
+  double flat_height_m;      /* a sole is flat within this height over its surface (m) */
+  double flat_cos;           /* and its normal within acos(flat_cos) of the surface's */
+} AtlasLegsSupport;
+
 void atlas_legs_swing_tick(const AtlasLegs *legs);
+void atlas_legs_support_clamp(const AtlasLegs *legs);
 
 #endif

@@ -34,7 +34,8 @@ import numpy as np
 from tutorial_atlas_control.command import LAW_FIELDS
 
 __all__ = ['LIBRARY_ENV', 'LIBRARY_NAME', 'MIRRORED_STRUCTS', 'AtlasCopy', 'AtlasEstimator',
-           'AtlasLawStep', 'AtlasLegs', 'AtlasStatics', 'AtlasSwing', 'AtlasWalkSwing',
+           'AtlasLawStep', 'AtlasLegs', 'AtlasLegsSupport', 'AtlasStatics', 'AtlasSwing',
+           'AtlasWalkSwing',
            'AtlasWholeBody', 'address',
            'chosen_library', 'find_library', 'load_library', 'size_mismatches']
 
@@ -136,6 +137,14 @@ class AtlasLegs(ctypes.Structure):
                 ('carrying', ctypes.c_long * 2)]
 
 
+class AtlasLegsSupport(ctypes.Structure):
+    """AtlasLegsSupport in src/atlas_legs.h (same fields, same order)."""
+
+    _fields_ = [('legs', ctypes.c_void_p), ('leg_starts', ctypes.c_long * 2),
+                ('leg_dofs', (ctypes.c_long * 6) * 2), ('feet', (ctypes.c_double * 10) * 2),
+                ('flat_height_m', ctypes.c_double), ('flat_cos', ctypes.c_double)]
+
+
 class AtlasWalkSwing(ctypes.Structure):
     """AtlasWalkSwing in src/atlas_walk_swing.c (same fields, same order)."""
 
@@ -159,6 +168,7 @@ MIRRORED_STRUCTS: dict[str, type[ctypes.Structure]] = {
     'AtlasSwing': AtlasSwing,
     'AtlasWholeBody': AtlasWholeBody,
     'AtlasLegs': AtlasLegs,
+    'AtlasLegsSupport': AtlasLegsSupport,
     'AtlasWalkSwing': AtlasWalkSwing,
 }
 
@@ -242,6 +252,8 @@ def _declare(library: ctypes.CDLL) -> None:
         function = getattr(library, name)
         function.argtypes = [ctypes.POINTER(AtlasLegs)]
         function.restype = None
+    library.atlas_legs_support_tick.argtypes = [ctypes.POINTER(AtlasLegsSupport)]
+    library.atlas_legs_support_tick.restype = None
     library.atlas_walk_swing_tick.argtypes = [ctypes.POINTER(AtlasWalkSwing)]
     library.atlas_walk_swing_tick.restype = None
 

@@ -42,7 +42,8 @@ def test_every_struct_of_the_c_sources_is_mirrored() -> None:
     assert c_structs == set(native.MIRRORED_STRUCTS) == {'AtlasLawStep', 'AtlasCopy',
                                                          'AtlasEstimator', 'AtlasStatics',
                                                          'AtlasSwing', 'AtlasWholeBody',
-                                                         'AtlasLegs', 'AtlasWalkSwing'}
+                                                         'AtlasLegs', 'AtlasLegsSupport',
+                                                         'AtlasWalkSwing'}
     for name, mirror in native.MIRRORED_STRUCTS.items():
         assert mirror.__name__ == name
 
@@ -99,6 +100,7 @@ def test_a_library_without_size_functions_is_refused(
                                             r'tac_sizeof_AtlasSwing\(\); no '
                                             r'tac_sizeof_AtlasWholeBody\(\); no '
                                             r'tac_sizeof_AtlasLegs\(\); no '
+                                            r'tac_sizeof_AtlasLegsSupport\(\); no '
                                             r'tac_sizeof_AtlasWalkSwing\(\)\); rebuild'):
         assert native.load_library() is None
 

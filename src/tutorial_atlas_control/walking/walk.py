@@ -396,8 +396,7 @@ class WalkController:
             torque, cop, _ = legs.swing_tick(state, joint_positions, joint_velocities, time_s,
                                              cop, swing)
         else:
-            torque, cop, contact = legs.torque(state, joint_positions, joint_velocities,
-                                               time_s, cop, None)
-            legs.finish(state, joint_velocities, torque, contact, None, feet)
+            torque, cop, _ = legs.support_torque(state, joint_positions, joint_velocities,
+                                                 time_s, cop, feet)
         self._last_cop = cop
         return WalkOutput(torque, cop, xi_ref, self.phase, swing_foot)
