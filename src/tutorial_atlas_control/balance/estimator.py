@@ -299,6 +299,7 @@ class BalanceEstimator:
         #: an index array.
         self._inertia_index: dict[tuple[int, int], tuple[slice, slice] | tuple] = {}
         self._sized_data: mujoco.MjData | None = None  # the last found _sized_as the copy
+        self._sized_address = 0  # its address, for the compiled estimate
         self._mass_matrix_source = (self.model._address, self.scratch._address,
                                     int(self.model.nv), np.asarray(self._dof_adr, dtype=np.intp))
         self._ground_m = 0.0
@@ -435,8 +436,8 @@ class BalanceEstimator:
         if data is not self._sized_data:
             if not _sized_as(self.model, data):
                 return self.estimate(data.qpos, data.qvel)
-            self._sized_data = data
-        return self._state_of(kernel.run_stepped(data._address))
+            self._sized_data, self._sized_address = data, data._address
+        return self._state_of(kernel.run_stepped(self._sized_address))
 
     def _state_of(self, raw: RawEstimate) -> BalanceState:
         """The BalanceState of a compiled estimate's row (its arrays made on first read)."""

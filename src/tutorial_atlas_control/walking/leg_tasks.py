@@ -133,6 +133,9 @@ class LegTasks:
         joint_kd[LEG_JOINTS] = gains.leg_kd
         self._joint_gains = (joint_kp, joint_kd)
         self._ik_damping = gains.ik_damping_m ** 2 * np.eye(6)
+        #: The soles' contacts while each foot swings (the stance sole's yaw moment limited).
+        self._swing_contacts = tuple(stand.contacts_for((foot != 0, foot != 1), gains.torsion_m)
+                                     for foot in (0, 1))
         #: How far a lone stance sole's pressure centre may go from the sole's centre (m),
         #: along it and across it: the sole's half size less the Stand's margin.
         half_length, half_width = stand.sole_half_size_m
@@ -290,9 +293,7 @@ class LegTasks:
         legs = self._legs_kernel
         if legs is None or state.row_address is None:
             return None
-        foot = swing[0]
-        legs.load_swing_tick(state, self.stand.contacts_for((foot != 0, foot != 1),
-                                                            self.gains.torsion_m),
+        legs.load_swing_tick(state, self._swing_contacts[swing[0]],
                              (joint_positions, joint_velocities), self._joint_gains,
                              self.reference, self._moved_reference(time_s), swing)
         return legs

@@ -111,6 +111,20 @@ class WalkOutput:
     swing_foot: int | None
 
 
+_new_object = object.__new__
+
+
+def _output(torque_nm: np.ndarray, desired_cop: np.ndarray, capture_point_ref: np.ndarray,
+            phase: int, swing_foot: int | None) -> WalkOutput:
+    """WalkOutput(...) without the frozen dataclass's __init__ (an object.__setattr__ a
+    field): every swinging tick's."""
+    output = _new_object(WalkOutput)
+    output.__dict__.update(torque_nm=torque_nm, desired_cop=desired_cop,
+                           capture_point_ref=capture_point_ref, phase=phase,
+                           swing_foot=swing_foot)
+    return output
+
+
 def _phase_over(phase: Phase, step: Footstep | None, state: BalanceState,
                 at_rest_m: float) -> bool:
     """What ends the phase under way once its time allows: nothing for the sway, the swing
@@ -362,7 +376,7 @@ class WalkController:
             self.swing = replace(swing, end=np.array([moved[0], moved[1], planned.z_m]))
             self.queue.adjust(self.step)
         self._last_cop = cop
-        return WalkOutput(torque, cop, xi_ref, self.phase, step.foot_index)
+        return _output(torque, cop, xi_ref, self.phases.status, step.foot_index)
 
     def tick_torque(self, state: BalanceState, joint_positions: np.ndarray,
                     joint_velocities: np.ndarray, time_s: float) -> WalkOutput:
