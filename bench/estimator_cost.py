@@ -8,9 +8,10 @@ in one process, each figure (process time) beside a bare mj_step timed in the sa
 
 The estimator is chosen at its construction by TAC_ESTIMATOR, inverse statics by
 TAC_STATICS, Walk's swing servo by TAC_SWING, the whole-body tick around the statics by
-TAC_WHOLE_BODY, Walk's one call around the last two by TAC_LEGS (`python`, else compiled);
-the runs compare all in Python, the estimator compiled, the estimator and statics compiled,
-all but the whole-body tick compiled, all but the one call, and all compiled (--kinds picks
+TAC_WHOLE_BODY, Walk's one call around the last two by TAC_LEGS, the walk's swinging tick
+around that by TAC_WALK_SWING (`python`, else compiled); the runs compare all in Python, the
+estimator compiled, the estimator and statics compiled, all but the whole-body tick compiled,
+all but the legs' one call, all but the walk's swinging tick, and all compiled (--kinds picks
 some); with --ticks, StandController.tick alone on a Stand
 run's recorded inputs too. Each round alternates which goes first. Prints the
 medians, their ratios to mj_step and to Python's in each pair, and the load (`uptime`)
@@ -41,15 +42,17 @@ from tutorial_atlas_control.sim import model as atlas_model
 KINDS = ('python', 'compiled')
 #: The variables that switch the estimator, inverse statics, the swing servo, the
 #: whole-body tick and Walk's one call around the last two to Python.
-SWITCHES = ESTIMATOR, STATICS, SWING, WHOLE_BODY, LEGS = python_reference_switches()
+SWITCHES = ESTIMATOR, STATICS, SWING, WHOLE_BODY, LEGS, WALK_SWING = python_reference_switches()
 #: The runs' kinds: the parts each runs in Python (all; all but the estimator; the swing
 #: servo and the whole-body tick; the whole-body tick; Walk's one call around the pieces;
 #: none).
 RUN_KINDS = {'python': dict.fromkeys(SWITCHES, 'python'),
-             'estimator': dict.fromkeys((STATICS, SWING, WHOLE_BODY, LEGS), 'python'),
-             'statics': dict.fromkeys((SWING, WHOLE_BODY, LEGS), 'python'),
-             'swing': dict.fromkeys((WHOLE_BODY, LEGS), 'python'),
-             'legs': {LEGS: 'python'}, 'compiled': {}}
+             'estimator': dict.fromkeys((STATICS, SWING, WHOLE_BODY, LEGS, WALK_SWING),
+                                        'python'),
+             'statics': dict.fromkeys((SWING, WHOLE_BODY, LEGS, WALK_SWING), 'python'),
+             'swing': dict.fromkeys((WHOLE_BODY, LEGS, WALK_SWING), 'python'),
+             'legs': dict.fromkeys((LEGS, WALK_SWING), 'python'),
+             'walk_swing': {WALK_SWING: 'python'}, 'compiled': {}}
 
 
 class BareStep:

@@ -58,9 +58,9 @@ def python_reference_switches() -> tuple[str, ...]:
     """The environment variables that switch each compiled part of the controller to its
     pure Python reference: the bench's "before" of the compiled core."""
     from tutorial_atlas_control.balance import ESTIMATOR_ENV, STATICS_ENV, WHOLE_BODY_ENV
-    from tutorial_atlas_control.walking import LEGS_ENV, SWING_ENV
+    from tutorial_atlas_control.walking import LEGS_ENV, SWING_ENV, WALK_SWING_ENV
 
-    return ESTIMATOR_ENV, STATICS_ENV, SWING_ENV, WHOLE_BODY_ENV, LEGS_ENV
+    return ESTIMATOR_ENV, STATICS_ENV, SWING_ENV, WHOLE_BODY_ENV, LEGS_ENV, WALK_SWING_ENV
 
 
 def own_passes_switches() -> tuple[str, ...]:

@@ -22,32 +22,10 @@
 
 #include <mujoco/mujoco.h>
 
-#include "atlas_swing.h"
-#include "atlas_whole_body.h"
-
-/* Laid out once by walking/compiled_legs.py, mirrored in native.py (same fields, same
- * order; tac_sizeof_AtlasLegs lets the loader check). */
-typedef struct {
-  const AtlasWholeBody *whole_body; /* loaded for this tick, its row set: the stance sole's
-                                     * contacts, the legs' reference and joint gains, the
-                                     * joints; its pressure centre is the law's, unclamped */
-  const AtlasSwing *swing;          /* its path's numbers in its input; the rest filled here */
-  const mjModel *model;             /* the estimator's model and the scratch data the */
-  mjData *data;                     /* estimate ran in: the mass matrix of its state */
-  double *mass_matrix;              /* (nv, nv) scratch */
-  double *out;                      /* LEGS_OUT_*: the torques (n), the pressure centre */
-  double reach[2];                  /* the stance sole's reach along and across it (m) */
-  long stance;                      /* the stance foot: 0 left, 1 right */
-  long leg_start;                   /* the swing leg's first joint (tutorial order) */
-  long leg_dofs[LEG];               /* the swing leg's dof addresses in qvel */
-  long sole_velocities_at;          /* where the row holds the soles' velocities (2, 6) */
-  const double *row;                /* atlas_legs_support_clamp's state: the estimate's row */
-  double half_size[2];              /* a sole's half length and half width (m) */
-  double margin_m;                  /* the support region's margin (m) */
-  long carrying[2];                 /* which soles carry (1) */
-} AtlasLegs;
+#include "atlas_legs.h"
 
 size_t tac_sizeof_AtlasLegs(void) { return sizeof(AtlasLegs); }
+size_t tac_sizeof_AtlasLegsSupport(void) { return sizeof(AtlasLegsSupport); }
 
 /* _clamp_to_sole: `p` moved to the nearest point of the stance sole's rectangle. */
 static void clamp_to_sole(const AtlasLegs *legs, const double *centre, const double *r,
@@ -86,6 +64,15 @@ static void load_swing(const AtlasLegs *legs) {
       in[IN_INERTIA + LEG * i + j] = legs->mass_matrix[nv * legs->leg_dofs[i] + legs->leg_dofs[j]];
 }
 
+/* WholeBodyLayer.limit on the legs' torques: np.maximum then np.minimum. */
+static void limit_efforts(const AtlasWholeBody *w, double *torque) {
+  const double *limit = w->effort_limit;
+  for (long j = 0; j < w->statics->n; ++j) {
+    double low = -limit[j], raised = low > torque[j] ? low : torque[j];
+    torque[j] = limit[j] < raised ? limit[j] : raised;
+  }
+}
+
 /* LegTasks.torque then LegTasks.finish, one foot swinging. */
 void atlas_legs_swing_tick(const AtlasLegs *legs) {
   const AtlasWholeBody *w = legs->whole_body;
@@ -101,11 +88,7 @@ void atlas_legs_swing_tick(const AtlasLegs *legs) {
   memcpy(torque, w->statics->torque, (size_t)n * sizeof(double));
   for (long j = 0; j < LEG; ++j)
     torque[legs->leg_start + j] = torque[legs->leg_start + j] + legs->swing->torque[j];
-  const double *limit = w->effort_limit;
-  for (long j = 0; j < n; ++j) { /* WholeBodyLayer.limit: np.maximum then np.minimum */
-    double low = -limit[j], raised = low > torque[j] ? low : torque[j];
-    torque[j] = limit[j] < raised ? limit[j] : raised;
-  }
+  limit_efforts(w, torque);
   torque[n] = cop[0];
   torque[n + 1] = cop[1];
 }
@@ -246,4 +229,62 @@ void atlas_legs_support_clamp(const AtlasLegs *legs) {
   }
   long rows = shrunk_region(hull, size, legs->margin_m, region);
   atlas_clamp_into_rows(&region[0][0], rows, legs->out + w->statics->n);
+}
+
+/* LegTasks.flat_down: the sole's centre within flat_height_m over its surface and its normal
+ * within acos(flat_cos) of the surface's. */
+static int flat_down(const AtlasLegsSupport *s, const double *row, const long *at, int foot) {
+  const double *centre = row + at[WB_ROW_SOLE_CENTRES] + 3 * foot;
+  const double *r = row + at[WB_ROW_SOLE_ROTATIONS] + 9 * foot;
+  const double *pose = s->feet[foot];
+  if (!(centre[2] - pose[FOOT_Z] < s->flat_height_m)) return 0;
+  const double *normal = pose + FOOT_NORMAL;
+  return r[2] * normal[0] + r[5] * normal[1] + r[8] * normal[2] > s->flat_cos;
+}
+
+/* LegTasks.put_down_torque added to `torque` (LegTasks.finish's sum: every joint, the leg's
+ * the servo's, the others + 0.0): the foot's sole servoed onto its pose, pressed down. */
+static void add_put_down(const AtlasLegsSupport *s, int foot, double *torque) {
+  AtlasLegs *legs = s->legs;
+  AtlasSwing *swing = (AtlasSwing *)legs->swing;
+  legs->stance = 1 - foot;
+  legs->leg_start = s->leg_starts[foot];
+  memcpy(legs->leg_dofs, s->leg_dofs[foot], sizeof(legs->leg_dofs));
+  load_swing(legs);
+  const double *pose = s->feet[foot];
+  double *in = swing->in;
+  in[IN_POSITION] = pose[FOOT_X];
+  in[IN_POSITION + 1] = pose[FOOT_Y];
+  in[IN_POSITION + 2] = pose[FOOT_Z_PRESSED];
+  for (int k = 0; k < 3; ++k) in[IN_VELOCITY + k] = in[IN_ACCELERATION + k] = 0.0;
+  in[IN_YAW] = pose[FOOT_YAW];
+  in[IN_YAW_RATE] = in[IN_YAW_ACCELERATION] = 0.0;
+  in[IN_TILT] = pose[FOOT_TILT_X];
+  in[IN_TILT + 1] = pose[FOOT_TILT_Y];
+  swing->world = 0;
+  swing->feedforward = 0;
+  atlas_foot_servo(swing);
+  long n = legs->whole_body->statics->n, start = legs->leg_start;
+  for (long j = 0; j < n; ++j)
+    torque[j] = torque[j] + (j >= start && j < start + LEG ? swing->torque[j - start] : 0.0);
+}
+
+/* LegTasks.torque then LegTasks.finish with no foot swinging: the law's pressure centre kept
+ * in the carrying soles' hull shrunk by the margin, the whole body there, each foot that
+ * should carry but is not flat down put back on its pose, the sum within the effort limits. */
+void atlas_legs_support_tick(const AtlasLegsSupport *s) {
+  AtlasLegs *legs = s->legs;
+  const AtlasWholeBody *w = legs->whole_body;
+  long n = w->statics->n;
+  double *torque = legs->out;
+  atlas_legs_support_clamp(legs);
+  double *cop = (double *)w->in + WB_IN_COP;
+  cop[0] = torque[n];
+  cop[1] = torque[n + 1];
+  atlas_whole_body(w);
+  memcpy(torque, w->statics->torque, (size_t)n * sizeof(double));
+  for (int foot = 0; foot < 2; ++foot)
+    if (!legs->carrying[foot] || !flat_down(s, w->row, w->row_at, foot))
+      add_put_down(s, foot, torque);
+  limit_efforts(w, torque);
 }

@@ -1,6 +1,6 @@
 """The package's compiled library (src/atlas_law.c, src/atlas_gather.c,
 src/atlas_estimator.c, src/atlas_statics.c, src/atlas_whole_body.c, src/atlas_swing.c,
-src/atlas_legs.c): found, loaded, checked.
+src/atlas_legs.c, src/atlas_walk_swing.c): found, loaded, checked.
 
 One place knows the library's binary interface: the ctypes mirrors of its structs, the
 signatures of its functions, and where catkin puts it (a devel space's lib/ and an
@@ -9,8 +9,9 @@ Its users, the compiled law (sim/law_kernel.py), the messages' copies
 (sim/copy_plan.py), the balance estimator (balance/compiled_estimator.py), the
 whole-body layer's inverse statics (balance/compiled_statics.py), Stand's whole-body tick
 around them (balance/compiled_whole_body.py), the swing foot's
-servo (walking/compiled_swing.py) and Walk's single-support tick of the legs around both
-(walking/compiled_legs.py), ask here.
+servo (walking/compiled_swing.py), Walk's single-support tick of the legs around both
+(walking/compiled_legs.py) and the walk's swing tick around that (walking/compiled_walk_swing.py),
+ask here.
 The estimator's part calls MuJoCo: the library is linked against the Python wheel's
 libmujoco, the one `import mujoco` loads, so that one MuJoCo runs in the process.
 
@@ -33,7 +34,9 @@ import numpy as np
 from tutorial_atlas_control.command import LAW_FIELDS
 
 __all__ = ['LIBRARY_ENV', 'LIBRARY_NAME', 'MIRRORED_STRUCTS', 'AtlasCopy', 'AtlasEstimator',
-           'AtlasLawStep', 'AtlasLegs', 'AtlasStatics', 'AtlasSwing', 'AtlasWholeBody', 'address',
+           'AtlasLawStep', 'AtlasLegs', 'AtlasLegsSupport', 'AtlasStatics', 'AtlasSwing',
+           'AtlasWalkSwing',
+           'AtlasWholeBody', 'address',
            'chosen_library', 'find_library', 'load_library', 'size_mismatches']
 
 #: The shared library CMakeLists.txt builds (devel/lib, installed to the prefix's lib/).
@@ -134,6 +137,27 @@ class AtlasLegs(ctypes.Structure):
                 ('carrying', ctypes.c_long * 2)]
 
 
+class AtlasLegsSupport(ctypes.Structure):
+    """AtlasLegsSupport in src/atlas_legs.h (same fields, same order)."""
+
+    _fields_ = [('legs', ctypes.c_void_p), ('leg_starts', ctypes.c_long * 2),
+                ('leg_dofs', (ctypes.c_long * 6) * 2), ('feet', (ctypes.c_double * 10) * 2),
+                ('flat_height_m', ctypes.c_double), ('flat_cos', ctypes.c_double)]
+
+
+class AtlasWalkSwing(ctypes.Structure):
+    """AtlasWalkSwing in src/atlas_walk_swing.c (same fields, same order)."""
+
+    _fields_ = [('legs', ctypes.c_void_p), ('out', ctypes.c_void_p),
+                ('plan', ctypes.c_double * 5), ('plan_omega', ctypes.c_double),
+                ('next_duration_s', ctypes.c_double), ('has_next', ctypes.c_long),
+                ('step_duration_s', ctypes.c_double), ('dcm_gain', ctypes.c_double),
+                ('tolerance_m', ctypes.c_double), ('planned', ctypes.c_double * 3),
+                ('stance', ctypes.c_double * 3), ('limits', ctypes.c_double * 4),
+                ('side', ctypes.c_double), ('step_xy', ctypes.c_double * 2),
+                ('adjust', ctypes.c_long), ('elapsed_s', ctypes.c_double)]
+
+
 #: Every struct Python lays out for the library, by its C name: the library must export
 #: SIZEOF_PREFIX + name, returning the same size as the mirror's.
 MIRRORED_STRUCTS: dict[str, type[ctypes.Structure]] = {
@@ -144,6 +168,8 @@ MIRRORED_STRUCTS: dict[str, type[ctypes.Structure]] = {
     'AtlasSwing': AtlasSwing,
     'AtlasWholeBody': AtlasWholeBody,
     'AtlasLegs': AtlasLegs,
+    'AtlasLegsSupport': AtlasLegsSupport,
+    'AtlasWalkSwing': AtlasWalkSwing,
 }
 
 
@@ -226,6 +252,10 @@ def _declare(library: ctypes.CDLL) -> None:
         function = getattr(library, name)
         function.argtypes = [ctypes.POINTER(AtlasLegs)]
         function.restype = None
+    library.atlas_legs_support_tick.argtypes = [ctypes.POINTER(AtlasLegsSupport)]
+    library.atlas_legs_support_tick.restype = None
+    library.atlas_walk_swing_tick.argtypes = [ctypes.POINTER(AtlasWalkSwing)]
+    library.atlas_walk_swing_tick.restype = None
 
 
 _library: ctypes.CDLL | None = None

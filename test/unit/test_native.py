@@ -22,7 +22,8 @@ C_SOURCES = (REPO / 'src' / 'atlas_law.c', REPO / 'src' / 'atlas_gather.c',
              REPO / 'src' / 'atlas_estimator.c', REPO / 'src' / 'atlas_statics.h',
              REPO / 'src' / 'atlas_statics.c', REPO / 'src' / 'atlas_swing.h',
              REPO / 'src' / 'atlas_swing.c', REPO / 'src' / 'atlas_whole_body.h',
-             REPO / 'src' / 'atlas_whole_body.c', REPO / 'src' / 'atlas_legs.c')
+             REPO / 'src' / 'atlas_whole_body.c', REPO / 'src' / 'atlas_legs.h',
+             REPO / 'src' / 'atlas_legs.c', REPO / 'src' / 'atlas_walk_swing.c')
 CONFIG = REPO / 'config' / 'atlas_controller.yaml'
 #: A C struct Python may lay out: `typedef struct { ... } Name;`.
 C_TYPEDEF_STRUCT = re.compile(r'typedef struct \{.*?\} (\w+);', re.S)
@@ -41,7 +42,8 @@ def test_every_struct_of_the_c_sources_is_mirrored() -> None:
     assert c_structs == set(native.MIRRORED_STRUCTS) == {'AtlasLawStep', 'AtlasCopy',
                                                          'AtlasEstimator', 'AtlasStatics',
                                                          'AtlasSwing', 'AtlasWholeBody',
-                                                         'AtlasLegs'}
+                                                         'AtlasLegs', 'AtlasLegsSupport',
+                                                         'AtlasWalkSwing'}
     for name, mirror in native.MIRRORED_STRUCTS.items():
         assert mirror.__name__ == name
 
@@ -97,7 +99,9 @@ def test_a_library_without_size_functions_is_refused(
                                             r'tac_sizeof_AtlasStatics\(\); no '
                                             r'tac_sizeof_AtlasSwing\(\); no '
                                             r'tac_sizeof_AtlasWholeBody\(\); no '
-                                            r'tac_sizeof_AtlasLegs\(\)\); rebuild'):
+                                            r'tac_sizeof_AtlasLegs\(\); no '
+                                            r'tac_sizeof_AtlasLegsSupport\(\); no '
+                                            r'tac_sizeof_AtlasWalkSwing\(\)\); rebuild'):
         assert native.load_library() is None
 
 

@@ -47,6 +47,7 @@ from tutorial_atlas_control.balance import lipm, support
 from tutorial_atlas_control.balance.compiled_estimator import (
     POLYGON_KEPT,
     SCALARS_AT,
+    STATE_ARRAYS,
     CompiledEstimate,
     EstimatorGeometry,
     RawEstimate,
@@ -182,6 +183,32 @@ class BalanceState:
 
 
 _new_object = object.__new__
+#: Where each of a compiled estimate's arrays is among its block's views.
+_ROW_VIEWS = {name: index for index, name in enumerate(STATE_ARRAYS)}
+
+
+class _RowState(BalanceState):
+    """A compiled estimate's BalanceState: its arrays, views of its row, made on first read
+    and kept (a walking tick with a foot in the air reads none of them: its C calls read the
+    row in place). Its scalars, callables and addresses are set at the estimate."""
+
+    def __getattr__(self, name: str) -> Any:
+        values = self.__dict__
+        raw = values.get('_raw')
+        index = _ROW_VIEWS.get(name)
+        if raw is None:
+            raise AttributeError(name)
+        block, tick = raw.block, raw.tick
+        if index is not None:
+            view = block.fields[index][tick]
+        elif name == 'bias_nm':
+            view = block.bias[tick]
+        elif name == 'sole_jacobians':
+            view = block.jacobians[tick]
+        else:
+            raise AttributeError(name)
+        values[name] = view
+        return view
 
 
 def _within(difference: np.ndarray, tolerance: float) -> bool:
@@ -272,6 +299,7 @@ class BalanceEstimator:
         #: an index array.
         self._inertia_index: dict[tuple[int, int], tuple[slice, slice] | tuple] = {}
         self._sized_data: mujoco.MjData | None = None  # the last found _sized_as the copy
+        self._sized_address = 0  # its address, for the compiled estimate
         self._mass_matrix_source = (self.model._address, self.scratch._address,
                                     int(self.model.nv), np.asarray(self._dof_adr, dtype=np.intp))
         self._ground_m = 0.0
@@ -408,19 +436,16 @@ class BalanceEstimator:
         if data is not self._sized_data:
             if not _sized_as(self.model, data):
                 return self.estimate(data.qpos, data.qvel)
-            self._sized_data = data
-        return self._state_of(kernel.run_stepped(data._address))
+            self._sized_data, self._sized_address = data, data._address
+        return self._state_of(kernel.run_stepped(self._sized_address))
 
     def _state_of(self, raw: RawEstimate) -> BalanceState:
-        """The BalanceState of a compiled estimate's row."""
+        """The BalanceState of a compiled estimate's row (its arrays made on first read)."""
         self._inertia_current = False
         block, tick = raw.block, raw.tick
-        (com, com_velocity, pelvis_position, pelvis_rotation, pelvis_angular_velocity,
-         centres, rotations, capture_point, sole_velocities) = [
-            view[tick] for view in block.fields]  # compiled_estimator.STATE_ARRAYS
         scalars = block.array[tick, SCALARS_AT:POLYGON_KEPT + 1].tolist()
         contact = (scalars[0] != 0.0, scalars[1] != 0.0)
-        state = _new_object(BalanceState)
+        state = _new_object(_RowState)
         values = state.__dict__
         if scalars[-1] != 0.0:  # the polygon last handed over holds: this state's too
             values['support_polygon'] = self._last_polygon[3]
@@ -429,17 +454,13 @@ class BalanceEstimator:
             held = self._polygons_held
 
             def polygon_of() -> np.ndarray:
+                rotations = block.fields[_ROW_VIEWS['sole_rotations']][tick]
                 return self._compiled_polygon(raw, contact, rotations, held)
-        # The dataclass's fields without its frozen __init__ (an object.__setattr__ a field).
+        # The scalar fields without the frozen __init__ (an object.__setattr__ a field).
         values.update(
-            com=com, com_velocity=com_velocity, pelvis_position=pelvis_position,
-            pelvis_rotation=pelvis_rotation, pelvis_angular_velocity=pelvis_angular_velocity,
-            sole_centres=centres, sole_rotations=rotations, in_contact=contact,
-            omega=scalars[2], capture_point=capture_point, bias_nm=block.bias[tick],
-            sole_jacobians=block.jacobians[tick], sole_velocities=sole_velocities,
-            joint_inertia=self._inertia_of, polygon_of=polygon_of,
-            contacts_of=lambda: _contacts_of_raw(raw), row_address=raw.address,
-            mass_matrix_source=self._mass_matrix_source)
+            in_contact=contact, omega=scalars[2], joint_inertia=self._inertia_of,
+            polygon_of=polygon_of, contacts_of=lambda: _contacts_of_raw(raw),
+            row_address=raw.address, mass_matrix_source=self._mass_matrix_source, _raw=raw)
         return state
 
     def _estimate_in_python(self, qpos: np.ndarray, qvel: np.ndarray) -> BalanceState:

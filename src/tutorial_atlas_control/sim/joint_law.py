@@ -53,6 +53,8 @@ class JointLaw:
             self._hold = CompiledLaw(library, joints, self.pid, self._hold_torque_nm)
             self._blend = CompiledLaw(library, joints, self.blend_pid, self.torque_nm,
                                       self._ctrl, self._hold_torque_nm)
+        #: The effort limits' negatives (N m): a behaviour's torque's lower bound.
+        self._lowest_nm = -self.joints.effort_limit
         #: The velocity gain of the command in force, as the joints' damping (DRCSim 2.7).
         self.velocity_damping = VelocityDamping(atlas.model.dof_damping, atlas.dof_adr,
                                                 atlas.effort_limit_nm, atlas.velocity_limit_rad_s)
@@ -96,7 +98,9 @@ class JointLaw:
         self.velocity_damping.apply(blended)
         f_out = self._hold_torque_nm
         limit = self.joints.effort_limit
-        np.clip(f_out_nm, -limit, limit, out=f_out)
+        # np.clip's own arithmetic (max, then min) without its Python wrappers: every step
+        np.maximum(f_out_nm, self._lowest_nm, out=f_out)
+        np.minimum(f_out, limit, out=f_out)
         if blended is None:
             self.torque_nm[:] = f_out
             self._ctrl[:] = f_out

@@ -12,8 +12,10 @@ Walk and Step run (their phases in order, each one's end rule, the transition);
 leg_tasks: what Walk and Step do alike each tick (the whole-body law on the carrying soles,
 the swing foot, the pelvis's heading); compiled_swing: the swing foot's path and servo as
 one C call (src/atlas_swing.c); compiled_legs: a swinging tick of the legs (sole clamp,
-whole body, swing servo, effort limits) as one C call (src/atlas_legs.c); walk: the walk's
-phases; walk_behaviour: Walk as the simulator's behaviour;
+whole body, swing servo, effort limits) as one C call (src/atlas_legs.c); compiled_walk_swing:
+a walking tick with the foot in the air (reference, step adjustment, the law, the legs) as one
+C call (src/atlas_walk_swing.c); walk: the walk's phases; walk_behaviour: Walk as the
+simulator's behaviour;
 route: footsteps through a route of waypoints (a course walker's plan) from where the
 feet are; ground_strides: a straight run's strides fitted to the ground (no sole across a
 bend, short slow steps on steep ground);
@@ -36,6 +38,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'feet_surfaces': ['FeetSurfaces', 'support_height_m'],
     'compiled_swing': ['CompiledSwing'],
     'compiled_legs': ['CompiledLegs'],
+    'compiled_walk_swing': ['WALK_SWING_ENV', 'CompiledWalkSwing'],
     'leg_tasks': ['LEGS_ENV', 'SWING_ENV'],
     'walk': ['WalkGains'],
     'walk_behaviour': ['WalkBehaviour', 'WalkStatus'],

@@ -19,7 +19,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from tutorial_atlas_control.balance import row_offsets
-from tutorial_atlas_control.native import AtlasLegs, address
+from tutorial_atlas_control.native import AtlasLegs, AtlasLegsSupport, address
+from tutorial_atlas_control.walking.swing import surface_tilt
 
 if TYPE_CHECKING:
     from tutorial_atlas_control.balance import (
@@ -30,6 +31,7 @@ if TYPE_CHECKING:
         StandReference,
     )
     from tutorial_atlas_control.walking.compiled_swing import CompiledSwing
+    from tutorial_atlas_control.walking.footsteps import Footstep
     from tutorial_atlas_control.walking.swing import SwingPath
 
 #: The swing leg's joints.
@@ -39,12 +41,13 @@ LEG = 6
 class CompiledLegs:
     """atlas_legs_swing_tick over a whole-body call and a swing servo, with the stance sole's
     `reach_m` (along, across) and the legs' first joints; atlas_legs_support_clamp with the
-    soles' half size and the support region's margin (m); its buffers its own."""
+    `region`'s soles' half size (length, width) and margin (m); atlas_legs_support_tick with
+    `put_down` (LegGains' press_m, flat_height_m, flat_cos); its buffers its own."""
 
     def __init__(self, library: ctypes.CDLL, whole_body: CompiledWholeBody,
                  swing: CompiledSwing, reach_m: tuple[float, float],
-                 leg_starts: tuple[int, int], sole_half_size_m: tuple[float, float],
-                 margin_m: float) -> None:
+                 leg_starts: tuple[int, int], region: tuple[float, float, float],
+                 put_down: tuple[float, float, float]) -> None:
         self._library = library
         self._whole_body = whole_body
         self._swing = swing
@@ -58,9 +61,15 @@ class CompiledLegs:
         call.out = address(self._out, np.float64)
         call.reach[:] = reach_m
         call.sole_velocities_at = row_offsets(joints)['sole_velocities']
-        call.half_size[:] = sole_half_size_m
-        call.margin_m = margin_m
+        call.half_size[0], call.half_size[1], call.margin_m = region
         self._pointer = ctypes.byref(call)
+        support = self._support = AtlasLegsSupport()
+        support.legs = ctypes.addressof(call)
+        support.leg_starts[:] = leg_starts
+        self._press_m, support.flat_height_m, support.flat_cos = put_down
+        self._support_pointer = ctypes.byref(support)
+        #: The poses the support call's feet were set from (none yet).
+        self._feet: tuple[Footstep | None, Footstep | None] = (None, None)
         #: The scratch data whose mass matrix was last read (None: not yet), its dofs.
         self._scratch: tuple[int, int] | None = None
         self._mass_matrix = np.zeros(0)
@@ -88,18 +97,20 @@ class CompiledLegs:
         call.model, call.data = model, data
         call.mass_matrix = address(self._mass_matrix, np.float64)
         self._dof_adr = dof_adr
+        for foot, start in enumerate(self._leg_starts):
+            self._support.leg_dofs[foot][:] = dof_adr[start:start + LEG].tolist()
         self._scratch = (model, data)
         self._foot = None  # the leg's dofs set again, from these
 
-    def swing_tick(self, state: BalanceState, contacts: tuple[ContactConstraint,
-                                                              ContactConstraint],
-                   joints: tuple[np.ndarray, np.ndarray],
-                   joint_gains: tuple[np.ndarray, np.ndarray], reference: StandReference,
-                   moved: MovedReference, cop: np.ndarray,
-                   swing: tuple[int, SwingPath, float]) -> tuple[np.ndarray, np.ndarray]:
-        """LegTasks.torque then LegTasks.finish with `swing` (the foot, its path, the time
-        into it): the torques (joints,) within the effort limits and the pressure centre as
-        kept, new arrays. `joints`: their positions and velocities."""
+    def load_swing_tick(self, state: BalanceState,
+                        contacts: tuple[ContactConstraint, ContactConstraint],
+                        joints: tuple[np.ndarray, np.ndarray],
+                        joint_gains: tuple[np.ndarray, np.ndarray], reference: StandReference,
+                        moved: MovedReference, swing: tuple[int, SwingPath, float]) -> None:
+        """A swinging tick's input but the pressure centre (tick_at sets it, or the walk's
+        swing tick, compiled_walk_swing): the state, the stance sole's `contacts`, the joints'
+        positions and velocities, their gains, the legs' reference (`moved`: its heading,
+        height and rate) and `swing` (the foot, its path, the time into it)."""
         source = state.mass_matrix_source
         if source is None or self._scratch != source[0:2]:
             self._bind(state)
@@ -108,12 +119,60 @@ class CompiledLegs:
             self._set_foot(foot)
         self._whole_body.load(state, contacts, joints[0], joints[1], joint_gains, reference,
                               moved)
-        self._whole_body.set_cop(cop)
         self._swing.set_path(path)
         self._swing.prepare_swing(elapsed_s)
-        self._library.atlas_legs_swing_tick(self._pointer)
+
+    def results(self) -> tuple[np.ndarray, np.ndarray]:
+        """The last tick's torques (joints,) and pressure centre as kept, new arrays."""
         out = self._out
         return out[:self._joints].copy(), out[self._joints:].copy()
+
+    def tick_at(self, cop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """LegTasks.torque then LegTasks.finish on the input load_swing_tick loaded, at the
+        pressure centre `cop`: the torques (joints,) within the effort limits and the
+        pressure centre as kept, new arrays."""
+        self._whole_body.set_cop(cop)
+        self._library.atlas_legs_swing_tick(self._pointer)
+        return self.results()
+
+    @property
+    def address(self) -> int:
+        """The call's struct, for a call that runs the tick itself (compiled_walk_swing)."""
+        return ctypes.addressof(self._call)
+
+    def _set_feet(self, feet: tuple[Footstep, Footstep]) -> None:
+        """Each foot's pose for the put-down servo and the flat test (atlas_legs.h's FOOT_*)."""
+        for foot, pose in enumerate(feet):
+            normal = tuple(pose.normal)
+            self._support.feet[foot][:] = (pose.x_m, pose.y_m, pose.z_m - self._press_m,
+                                           pose.yaw_rad, *surface_tilt(normal), pose.z_m,
+                                           *normal)
+        self._feet = (feet[0], feet[1])
+
+    def support_tick(self, state: BalanceState, contacts: tuple[ContactConstraint,
+                                                                ContactConstraint],
+                     joints: tuple[np.ndarray, np.ndarray],
+                     joint_gains: tuple[np.ndarray, np.ndarray], reference: StandReference,
+                     moved: MovedReference, cop: np.ndarray, carrying: tuple[bool, bool],
+                     feet: tuple[Footstep, Footstep]) -> tuple[np.ndarray, np.ndarray]:
+        """LegTasks.torque then LegTasks.finish with no foot swinging: the soles `carrying`
+        (their `contacts`), each foot not flat down put back on its pose in `feet`; the
+        torques (joints,) within the effort limits and the pressure centre as kept, new
+        arrays. A compiled estimate's state only."""
+        source = state.mass_matrix_source
+        if source is None or self._scratch != source[0:2]:
+            self._bind(state)
+        self._whole_body.load(state, contacts, joints[0], joints[1], joint_gains, reference,
+                              moved)
+        call = self._call
+        call.row = state.row_address
+        call.carrying[:] = carrying
+        self._out[self._joints:] = cop
+        if feet[0] is not self._feet[0] or feet[1] is not self._feet[1]:
+            self._set_feet(feet)
+        self._library.atlas_legs_support_tick(self._support_pointer)
+        self._foot = None  # the call sets the legs' foot for each foot it puts down
+        return self.results()
 
     def support_clamp(self, state: BalanceState, carrying: tuple[bool, bool],
                       cop: np.ndarray) -> np.ndarray:

@@ -133,6 +133,9 @@ class LegTasks:
         joint_kd[LEG_JOINTS] = gains.leg_kd
         self._joint_gains = (joint_kp, joint_kd)
         self._ik_damping = gains.ik_damping_m ** 2 * np.eye(6)
+        #: The soles' contacts while each foot swings (the stance sole's yaw moment limited).
+        self._swing_contacts = tuple(stand.contacts_for((foot != 0, foot != 1), gains.torsion_m)
+                                     for foot in (0, 1))
         #: How far a lone stance sole's pressure centre may go from the sole's centre (m),
         #: along it and across it: the sole's half size less the Stand's margin.
         half_length, half_width = stand.sole_half_size_m
@@ -151,7 +154,8 @@ class LegTasks:
             None if legs_library is None or whole_body is None or self._kernel is None
             else CompiledLegs(legs_library, whole_body, self._kernel, self.sole_reach_m,
                               (LEG_OF_FOOT[0].start, LEG_OF_FOOT[1].start),
-                              stand.sole_half_size_m, stand.gains.cop_margin_m))
+                              (*stand.sole_half_size_m, stand.gains.cop_margin_m),
+                              (gains.press_m, gains.flat_height_m, gains.flat_cos)))
 
     @property
     def compiled(self) -> bool:
@@ -162,6 +166,11 @@ class LegTasks:
     def compiled_swing_tick(self) -> bool:
         """Whether swing_tick runs the one C call (on a compiled estimate's state)."""
         return self._legs_kernel is not None
+
+    @property
+    def legs_kernel(self) -> CompiledLegs | None:
+        """swing_tick's one C call (None: it computes in pieces)."""
+        return self._legs_kernel
 
     def move_height(self, height_m: float, time_s: float, duration_s: float) -> None:
         """Take the CoM's reference height from where it is now to `height_m` over
@@ -237,30 +246,9 @@ class LegTasks:
                 state, joint_velocities, leg, foot,
                 (position, velocity, yaw, yaw_rate, acceleration, yaw_acceleration), world,
                 tilt)
-        gains = self.gains
-        jacobian = state.sole_jacobians[foot][:, leg]
-        columns = 2 if acceleration is None else 3
-        targets = np.zeros((6, columns))  # the pose's error, the velocity asked for, ...
-        targets[0:3, 0] = position - state.sole_centres[foot]
-        targets[3:6, 0] = orientation_error(state.sole_rotations[foot], sole_frame(yaw, tilt))
-        targets[0:3, 1] = velocity
-        targets[5, 1] = yaw_rate
-        if world:
-            targets[:, 1] -= state.sole_velocities[foot]
-        if acceleration is not None:  # ... and the acceleration
-            targets[0:3, 2] = acceleration
-            targets[5, 2] = yaw_acceleration
-        damped = jacobian @ jacobian.T + self._ik_damping
-        joint_targets = (jacobian.T @ np.linalg.solve(damped, targets)).T
-        joint_error, joint_rate = joint_targets[0], joint_targets[1]
-        if not world:
-            joint_rate = joint_rate - joint_velocities[leg]
-        accel = gains.swing_kp * joint_error + gains.swing_kd * joint_rate
-        if acceleration is not None:
-            accel += joint_targets[2]
-        torque = np.zeros(len(joint_velocities))
-        torque[leg] = state.joint_inertia(leg) @ accel
-        return torque
+        return _python_foot_servo(self.gains, self._ik_damping, state, joint_velocities, foot,
+                                  (position, velocity, yaw, yaw_rate, acceleration,
+                                   yaw_acceleration), world, tilt)
 
     def flat_down(self, state: BalanceState, foot: int, pose: Footstep) -> bool:
         """Whether a sole lies flat on the surface of `pose` (not up, not on an edge)."""
@@ -297,6 +285,19 @@ class LegTasks:
                                   moved).torque_nm
         return torque, cop, contact
 
+    def load_swing_tick(self, state: BalanceState, joint_positions: np.ndarray,
+                        joint_velocities: np.ndarray, time_s: float,
+                        swing: tuple[int, SwingPath, float]) -> CompiledLegs | None:
+        """The one call of swing_tick with its input loaded but the pressure centre, or None
+        where swing_tick computes in pieces (no library, or a Python estimate's state)."""
+        legs = self._legs_kernel
+        if legs is None or state.row_address is None:
+            return None
+        legs.load_swing_tick(state, self._swing_contacts[swing[0]],
+                             (joint_positions, joint_velocities), self._joint_gains,
+                             self.reference, self._moved_reference(time_s), swing)
+        return legs
+
     def swing_tick(self, state: BalanceState, joint_positions: np.ndarray,
                    joint_velocities: np.ndarray, time_s: float, cop: np.ndarray,
                    swing: tuple[int, SwingPath, float]) -> tuple[np.ndarray, np.ndarray,
@@ -304,17 +305,30 @@ class LegTasks:
         """torque() then finish() with `swing` (the foot, its path and the time into it):
         the torques within the effort limits, the pressure centre as kept, which soles
         carry."""
-        legs = self._legs_kernel
-        if legs is None or state.row_address is None:
+        legs = self.load_swing_tick(state, joint_positions, joint_velocities, time_s, swing)
+        if legs is None:
             torque, cop, contact = self.torque(state, joint_positions, joint_velocities,
                                                time_s, cop, swing[0])
             return self.finish(state, joint_velocities, torque, contact, swing, ()), cop, contact
-        foot = swing[0]
-        contact = (foot != 0, foot != 1)
-        torque, cop = legs.swing_tick(
-            state, self.stand.contacts_for(contact, self.gains.torsion_m),
-            (joint_positions, joint_velocities), self._joint_gains, self.reference,
-            self._moved_reference(time_s), cop, swing)
+        torque, cop = legs.tick_at(cop)
+        return torque, cop, (swing[0] != 0, swing[0] != 1)
+
+    def support_torque(self, state: BalanceState, joint_positions: np.ndarray,
+                       joint_velocities: np.ndarray, time_s: float, cop: np.ndarray,
+                       feet: Sequence[Footstep]) -> tuple[np.ndarray, np.ndarray,
+                                                          tuple[bool, bool]]:
+        """torque() then finish() with no foot swinging (`feet`: the poses a foot not flat
+        down is put back on): one C call on a compiled estimate's state."""
+        legs = self._legs_kernel
+        if legs is None or state.row_address is None:
+            torque, cop, contact = self.torque(state, joint_positions, joint_velocities,
+                                               time_s, cop, None)
+            return self.finish(state, joint_velocities, torque, contact, None, feet), cop, contact
+        contact = state.in_contact if any(state.in_contact) else (True, True)
+        torque, cop = legs.support_tick(
+            state, self.stand.contacts_for(contact, None), (joint_positions, joint_velocities),
+            self._joint_gains, self.reference, self._moved_reference(time_s), cop, contact,
+            (feet[0], feet[1]))
         return torque, cop, contact
 
     def _support_clamp(self, state: BalanceState, contact: tuple[bool, bool],
@@ -346,6 +360,40 @@ class LegTasks:
                 if not contact[foot] or not self.flat_down(state, foot, feet[foot]):
                     torque += self.put_down_torque(state, joint_velocities, foot, feet[foot])
         return self.stand.layer.limit(torque)
+
+
+def _python_foot_servo(gains: LegGains, ik_damping: np.ndarray, state: BalanceState,
+                       joint_velocities: np.ndarray, foot: int,
+                       target: tuple[np.ndarray, np.ndarray, float, float, np.ndarray | None,
+                                     float],
+                       world: bool, tilt: tuple[float, float]) -> np.ndarray:
+    """LegTasks.foot_servo in Python: `target` its position, velocity, yaw, yaw rate,
+    acceleration (None: none fed forward) and yaw acceleration."""
+    position, velocity, yaw, yaw_rate, acceleration, yaw_acceleration = target
+    leg = LEG_OF_FOOT[foot]
+    jacobian = state.sole_jacobians[foot][:, leg]
+    columns = 2 if acceleration is None else 3
+    targets = np.zeros((6, columns))  # the pose's error, the velocity asked for, ...
+    targets[0:3, 0] = position - state.sole_centres[foot]
+    targets[3:6, 0] = orientation_error(state.sole_rotations[foot], sole_frame(yaw, tilt))
+    targets[0:3, 1] = velocity
+    targets[5, 1] = yaw_rate
+    if world:
+        targets[:, 1] -= state.sole_velocities[foot]
+    if acceleration is not None:  # ... and the acceleration
+        targets[0:3, 2] = acceleration
+        targets[5, 2] = yaw_acceleration
+    damped = jacobian @ jacobian.T + ik_damping
+    joint_targets = (jacobian.T @ np.linalg.solve(damped, targets)).T
+    joint_error, joint_rate = joint_targets[0], joint_targets[1]
+    if not world:
+        joint_rate = joint_rate - joint_velocities[leg]
+    accel = gains.swing_kp * joint_error + gains.swing_kd * joint_rate
+    if acceleration is not None:
+        accel += joint_targets[2]
+    torque = np.zeros(len(joint_velocities))
+    torque[leg] = state.joint_inertia(leg) @ accel
+    return torque
 
 
 def _clamp_to_sole(state: BalanceState, foot: int, reach_m: tuple[float, float],

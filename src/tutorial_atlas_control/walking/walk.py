@@ -40,6 +40,10 @@ from tutorial_atlas_control.balance import (
     cop_reaching,
     dcm_feedback_cop,
 )
+from tutorial_atlas_control.walking.compiled_walk_swing import (
+    CompiledWalkSwing,
+    walk_swing_kernel,
+)
 from tutorial_atlas_control.walking.dcm_plan import DcmPlan
 from tutorial_atlas_control.walking.feet_surfaces import FeetSurfaces
 from tutorial_atlas_control.walking.footsteps import Footstep
@@ -107,6 +111,60 @@ class WalkOutput:
     swing_foot: int | None
 
 
+_new_object = object.__new__
+
+
+def _output(torque_nm: np.ndarray, desired_cop: np.ndarray, capture_point_ref: np.ndarray,
+            phase: int, swing_foot: int | None) -> WalkOutput:
+    """WalkOutput(...) without the frozen dataclass's __init__ (an object.__setattr__ a
+    field): every swinging tick's."""
+    output = _new_object(WalkOutput)
+    output.__dict__.update(torque_nm=torque_nm, desired_cop=desired_cop,
+                           capture_point_ref=capture_point_ref, phase=phase,
+                           swing_foot=swing_foot)
+    return output
+
+
+def _phase_over(phase: Phase, step: Footstep | None, state: BalanceState,
+                at_rest_m: float) -> bool:
+    """What ends the phase under way once its time allows: nothing for the sway, the swing
+    foot (`step`'s) touching, the capture point at rest (within `at_rest_m`) between the feet
+    for the catch."""
+    if phase is _SWING and step is not None:
+        return bool(state.in_contact[step.foot_index])
+    if phase is _CATCH:
+        middle = state.sole_centres[:, :2].mean(axis=0)
+        return float(np.linalg.norm(state.capture_point - middle)) < at_rest_m
+    return True
+
+
+def _walk_height_m(stand_height_m: float, gains: WalkGains,
+                   standing_height_m: float | None) -> float:
+    """The CoM height the walk walks at (m): walk_lowering_m below the Stand's, unless that
+    is more than LOWEST_WALK_MARGIN_M below what the Stand pose stands at here."""
+    height = stand_height_m - gains.walk_lowering_m
+    if standing_height_m is not None:
+        lowest = standing_height_m - gains.walk_lowering_m - LOWEST_WALK_MARGIN_M
+        height = max(height, min(stand_height_m, lowest))
+    return height
+
+
+def _plan_steps(feet_now: list[Footstep], preview: list[Footstep],
+                omega: float) -> DcmPlan | None:
+    """The capture point's plan over the queue's `preview`, from the feet as they are."""
+    if not preview:
+        return None
+    feet = [feet_now[0], feet_now[1]]
+    cops, durations = [], []
+    for step in preview:
+        stance = feet[1 - step.foot_index]
+        cops.append((stance.x_m, stance.y_m))
+        durations.append(step.duration_s)
+        feet[step.foot_index] = step
+    final = 0.5 * np.array([feet[0].x_m + feet[1].x_m, feet[0].y_m + feet[1].y_m])
+    return DcmPlan.plan(np.array(cops), np.array(durations), final, omega)
+
+
 class WalkController:
     """Walks the queue's steps from a standing start; `done` once it stands again."""
 
@@ -121,6 +179,8 @@ class WalkController:
         self.queue = queue
         self.gains = gains or WalkGains()
         self.legs = LegTasks(stand, self.gains.legs, time_s)
+        #: A tick with the foot in the air as one C call (None: in Python).
+        self._kernel = walk_swing_kernel(self.legs, self.gains)
         #: The phase (sway, swing or catch) and when it began.
         self.phases = PhaseSequence(WALK_PHASES, time_s,
                                     PhaseEnd(self.gains.sway_s, self.gains.sway_s))
@@ -143,10 +203,7 @@ class WalkController:
         #: The CoM height the walk starts from and returns to (m, where it began).
         self.stand_height_m = stand.reference.com_height_m
         #: The CoM height the walk walks at (m).
-        self.walk_height_m = self.stand_height_m - self.gains.walk_lowering_m
-        if standing_height_m is not None:
-            lowest = standing_height_m - self.gains.walk_lowering_m - LOWEST_WALK_MARGIN_M
-            self.walk_height_m = max(self.walk_height_m, min(self.stand_height_m, lowest))
+        self.walk_height_m = _walk_height_m(self.stand_height_m, self.gains, standing_height_m)
         self._begin_sway(state, time_s)
 
     @property
@@ -166,23 +223,9 @@ class WalkController:
 
     # -- the phases ---------------------------------------------------------------------------
 
-    def _plan_steps(self, preview: list[Footstep], omega: float) -> DcmPlan | None:
-        """The capture point's plan over the queue's `preview`, from the feet as they are."""
-        if not preview:
-            return None
-        feet = [self.queue.feet[0], self.queue.feet[1]]
-        cops, durations = [], []
-        for step in preview:
-            stance = feet[1 - step.foot_index]
-            cops.append((stance.x_m, stance.y_m))
-            durations.append(step.duration_s)
-            feet[step.foot_index] = step
-        final = 0.5 * np.array([feet[0].x_m + feet[1].x_m, feet[0].y_m + feet[1].y_m])
-        return DcmPlan.plan(np.array(cops), np.array(durations), final, omega)
-
     def _begin_sway(self, state: BalanceState, time_s: float) -> None:
         self.legs.move_height(self.walk_height_m, time_s, self.gains.sway_s)
-        self._plan = self._plan_steps(self.queue.preview(), state.omega)
+        self._plan = _plan_steps(self.queue.feet, self.queue.preview(), state.omega)
         target = (self._plan.start if self._plan is not None
                   else state.sole_centres[:, :2].mean(axis=0))
         self._sway_cop = cop_reaching(state.capture_point, target, state.omega,
@@ -191,7 +234,7 @@ class WalkController:
 
     def _begin_step(self, phase: Phase, state: BalanceState, time_s: float) -> None:
         preview = self.queue.preview()
-        self._plan = self._plan_steps(preview, state.omega)
+        self._plan = _plan_steps(self.queue.feet, preview, state.omega)
         assert self._plan is not None  # entered with steps to take only
         step = preview[0]
         self.step = self._planned_step = step
@@ -213,22 +256,12 @@ class WalkController:
         self.step, self.swing, self._plan = None, None, None
         self.phases.enter(phase, time_s, PhaseEnd(self.gains.catch_s, self.gains.longest_catch_s))
 
-    def _condition(self, state: BalanceState) -> bool:
-        """What ends the phase under way once its time allows: nothing for the sway, the
-        swing foot touching, the capture point at rest between the feet for the catch."""
-        phase, step = self.phases.phase, self.step
-        if phase is _SWING and step is not None:
-            return bool(state.in_contact[step.foot_index])
-        if phase is _CATCH:
-            middle = state.sole_centres[:, :2].mean(axis=0)
-            return float(np.linalg.norm(state.capture_point - middle)) < self.gains.at_rest_m
-        return True
-
     def _advance(self, state: BalanceState, time_s: float) -> None:
         """Move on to the next phase when this one ends: a swing's touchdown taken into the
         queue, then another swing while the queue has steps, else the catch."""
         phases, step = self.phases, self.step
-        if not phases.ended(time_s, self._condition(state)):
+        if not phases.ended(time_s, _phase_over(phases.phase, step, state,
+                                                 self.gains.at_rest_m)):
             return
         if phases.phase is _SWING and step is not None:
             landed = replace(foot_pose(state, step.foot_index, step.step_index),
@@ -324,11 +357,38 @@ class WalkController:
 
     # -- one tick -----------------------------------------------------------------------------
 
+    def _compiled_swing(self, kernel: CompiledWalkSwing, state: BalanceState,
+                        joint_positions: np.ndarray, joint_velocities: np.ndarray,
+                        time_s: float) -> WalkOutput | None:
+        """tick_torque with the foot in the air as one C call (the reference, _adjust, the
+        law, the legs), or None where that call does not run (a Python estimate's state)."""
+        step, swing, plan, planned = self.step, self.swing, self._plan, self._planned_step
+        assert step is not None and swing is not None and plan is not None \
+            and planned is not None and self._lift_off_s is not None  # swinging
+        elapsed = self.phases.elapsed_s(time_s)
+        if self.legs.load_swing_tick(state, joint_positions, joint_velocities, time_s,
+                                     (step.foot_index, swing, elapsed - self._lift_off_s)) is None:
+            return None
+        kernel.bind(plan, planned, step, self.queue.feet[1 - step.foot_index], self.queue.limits)
+        torque, cop, xi_ref, moved = kernel.tick(elapsed)
+        if moved is not None:  # _adjust's new landing, the call's path already ending there
+            self.step = replace(planned, x_m=moved[0], y_m=moved[1])
+            self.swing = replace(swing, end=np.array([moved[0], moved[1], planned.z_m]))
+            self.queue.adjust(self.step)
+        self._last_cop = cop
+        return _output(torque, cop, xi_ref, self.phases.status, step.foot_index)
+
     def tick_torque(self, state: BalanceState, joint_positions: np.ndarray,
                     joint_velocities: np.ndarray, time_s: float) -> WalkOutput:
         """The 28 joint torques (N m) for this 1 ms tick, within the effort limits."""
         self._advance(state, time_s)
         self._lift_off(state, time_s)
+        if self._kernel is not None and self._lift_off_s is not None \
+                and self.phases.phase is _SWING:
+            output = self._compiled_swing(self._kernel, state, joint_positions,
+                                          joint_velocities, time_s)
+            if output is not None:
+                return output
         xi_ref, cop_ref = self._capture_reference(state, time_s)
         if self.phase == STEPPING and self.gains.adjust_steps:
             self._adjust(state, xi_ref, cop_ref, time_s)
@@ -350,8 +410,7 @@ class WalkController:
             torque, cop, _ = legs.swing_tick(state, joint_positions, joint_velocities, time_s,
                                              cop, swing)
         else:
-            torque, cop, contact = legs.torque(state, joint_positions, joint_velocities,
-                                               time_s, cop, None)
-            legs.finish(state, joint_velocities, torque, contact, None, feet)
+            torque, cop, _ = legs.support_torque(state, joint_positions, joint_velocities,
+                                                 time_s, cop, feet)
         self._last_cop = cop
         return WalkOutput(torque, cop, xi_ref, self.phase, swing_foot)

@@ -66,6 +66,8 @@ class WalkBehaviour:
         self.next_steps: list[Footstep] | None = None
         #: The state the last tick estimated (None before the first).
         self.last_state: BalanceState | None = None
+        #: The MjData ticked last and its qpos and qvel views (None: none yet).
+        self._vectors: tuple[mujoco.MjData, np.ndarray, np.ndarray] | None = None
 
     @property
     def done(self) -> bool:
@@ -117,7 +119,10 @@ class WalkBehaviour:
             stand.estimator.ground_m = ground
         state = stand.estimator.estimate_stepped(data)
         self.last_state = state
-        return walk.tick_torque(state, data.qpos[atlas.qpos_adr], data.qvel[atlas.dof_adr],
+        vectors = self._vectors  # the binding makes a new view at each read of data.qpos
+        if vectors is None or vectors[0] is not data:
+            vectors = self._vectors = (data, data.qpos, data.qvel)
+        return walk.tick_torque(state, vectors[1][atlas.qpos_adr], vectors[2][atlas.dof_adr],
                                 float(data.time)).torque_nm
 
     def status(self, time_s: float) -> WalkStatus:

@@ -55,6 +55,8 @@ from tutorial_atlas_control.walking.walk_behaviour import WalkBehaviour
 
 #: Stand before the walk begins (s).
 SETTLE_S = 1.0
+#: Walking ticks whose leg torques are kept before their changes are summed.
+JUMP_BLOCK_TICKS = 4096
 
 
 @dataclass(frozen=True)
@@ -123,12 +125,11 @@ class WalkingStand:
         self.walk_at_s = walk_at_s
         self.trial = WalkTrial()
         self._phase = 'stand'  # then 'walk', then 'stand again'
-        #: The legs' last walking torques (None before the first), their |changes| summed,
-        #: with their count, and this tick's change (arrays reused: a walk's every tick).
-        legs = LEG_JOINTS.stop - LEG_JOINTS.start
-        self._last_legs: np.ndarray | None = None
-        self._jumps = np.zeros(legs)
-        self._jump = np.zeros(legs)
+        #: The legs' walking torques, a block of ticks at a time (row 0: the last of the
+        #: block before), and their |changes| summed over the blocks before, with their count.
+        self._legs_block = np.empty((JUMP_BLOCK_TICKS + 1, LEG_JOINTS.stop - LEG_JOINTS.start))
+        self._legs_rows = 0
+        self._jump_sums = np.zeros(self._legs_block.shape[1])
         self._jump_count = 0
 
     @property
@@ -178,24 +179,33 @@ class WalkingStand:
         return torque
 
     def _note_jump(self, torque: np.ndarray) -> None:
-        """Add this walking step's leg torque changes to the sums (in place: the offline
-        walk's every tick; note_jumps makes the trial's figure of them once)."""
-        legs = torque[LEG_JOINTS]
-        last = self._last_legs
-        if last is None:
-            self._last_legs = legs.copy()
+        """Keep this walking step's leg torques (a row a tick: the offline walk's every tick;
+        their changes are summed a block at a time)."""
+        rows = self._legs_rows
+        self._legs_block[rows] = torque[LEG_JOINTS]
+        self._legs_rows = rows + 1
+        if rows + 1 == len(self._legs_block):
+            self._sum_jumps()
+
+    def _sum_jumps(self) -> None:
+        """The block's |changes| added to the sums, tick after tick (cumsum's order, from the
+        sums so far: what adding each tick's in place gave, bit for bit)."""
+        rows = self._legs_rows
+        if rows < 2:
             return
-        jump = self._jump
-        np.subtract(legs, last, out=jump)
-        np.abs(jump, out=jump)
-        np.add(self._jumps, jump, out=self._jumps)
-        self._jump_count += 1
-        last[:] = legs
+        block = self._legs_block[:rows]
+        jumps = np.abs(np.diff(block, axis=0))
+        self._jump_sums = np.cumsum(np.vstack([self._jump_sums[None], jumps]), axis=0)[-1]
+        self._jump_count += rows - 1
+        self._legs_block[0] = block[-1]
+        self._legs_rows = 1
 
     def note_jumps(self) -> None:
-        """The trial's leg_torque_jump_nm from the changes summed so far."""
+        """The trial's leg_torque_jump_nm from the changes so far: the largest over the leg
+        joints of a joint's summed |changes|, per change."""
+        self._sum_jumps()
         if self._jump_count:
-            self.trial.leg_torque_jump_nm = float(np.max(self._jumps)) / self._jump_count
+            self.trial.leg_torque_jump_nm = float(np.max(self._jump_sums)) / self._jump_count
 
     def _landed(self, walk: WalkController, state: BalanceState, taken: Footstep) -> None:
         """Note the step just down against its target and against `taken`, the step as

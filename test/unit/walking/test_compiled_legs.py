@@ -9,7 +9,7 @@ such tick of the walk, and random pressure centres on one sole or both."""
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import mujoco
 import numpy as np
@@ -20,6 +20,8 @@ from tutorial_atlas_control.balance.stand_behaviour import StandBehaviour
 from tutorial_atlas_control.balance.stand_pose import place_in_stand_pose
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.walking import straight_steps
+from tutorial_atlas_control.walking.compiled_walk_swing import WALK_SWING_ENV
+from tutorial_atlas_control.walking.footsteps import Footstep
 from tutorial_atlas_control.walking.leg_tasks import LEGS_ENV, SWING_ENV, LegGains, LegTasks
 from tutorial_atlas_control.walking.swing import SwingPath
 from tutorial_atlas_control.walking.walk_trial import SETTLE_S, walk_trial
@@ -91,6 +93,7 @@ def test_the_one_call_agrees_with_the_pieces_and_python_through_a_walk(
         library, monkeypatch: pytest.MonkeyPatch) -> None:
     for name in (LEGS_ENV, SWING_ENV):
         monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv(WALK_SWING_ENV, 'python')  # the walk's swinging tick calls swing_tick
     walked: list[float] = []
     tried: list[float] = []
     largest: list[float] = []
@@ -131,9 +134,16 @@ def test_the_one_call_agrees_with_the_pieces_and_python_through_a_walk(
                 restore()
         return ours
 
+    def support_by_pieces(self: LegTasks, state: BalanceState, positions: np.ndarray,
+                          velocities: np.ndarray, time_s: float, cop: np.ndarray,
+                          feet: Sequence[Footstep]) -> Tick:
+        torque, kept, contact = self.torque(state, positions, velocities, time_s, cop, None)
+        return self.finish(state, velocities, torque, contact, None, feet), kept, contact
+
     supported: list[float] = []
     monkeypatch.setattr(LegTasks, 'swing_tick', both)
     monkeypatch.setattr(LegTasks, 'torque', both_feet)
+    monkeypatch.setattr(LegTasks, 'support_torque', support_by_pieces)  # its own test's
     trial = walk_trial(straight_steps(2, 0.25), SETTLE_S + 0.6 + 2 * 0.63 + 0.2)
     assert not trial.fell and trial.steps == 2
     assert len(walked) > 1500 and len(tried) > 200 and len(supported) > 1000
