@@ -4,7 +4,7 @@ frames: the head's fixed frames as multisense_sl.urdf gives them (the laser's sp
 frame, the stereo cameras, the head's IMU); spindle: `hokuyo_joint`, simulated beside the
 model as DRCSim's plugin drove it (its PID, its limits); laser: the Hokuyo's scans by
 MuJoCo's ray queries, with seeded noise; head: their messages as wire bytes, for the
-stepping loop and offline runs.
+stepping loop and offline runs; height_map: the ground's heights from the laser's scans.
 """
 
 from tutorial_atlas_control.exports import lazy_exports
@@ -17,4 +17,5 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                 'spindle_command'],
     'laser': ['COLLISION_GROUPS', 'HOKUYO', 'HokuyoLaser', 'LaserSpec'],
     'head': ['HeadSensors'],
+    'height_map': ['GroundGrid', 'HeightMap', 'HeightMapSpec', 'ground_grid', 'scan_points'],
 })
