@@ -12,10 +12,16 @@ so each cell's height is a robust statistic of every point in it:
 - a cell's height is the median (`percentile`) of its points' heights, given `min_hits`
   of them: the noise averages (a low percentile biased it 4 mm low on the course's floor);
 - a cell whose top (`top_percentile` of its points) stands more than `step_reach_m` over
-  the lowest cell within `obstacle_window_m` is an obstacle (a block, a wall, a gate post,
-  or ground beside one with its side's points in it), not ground: neither known nor used;
+  the lowest cell within `obstacle_window_m`, a step (a rise of that much from one cell to
+  the next) within that window too, is an obstacle (a block, a wall, a gate post, or
+  ground beside one with its side's points in it), not ground: neither known nor used; a
+  ramp, however long, has no step (without that test the pit's 22-degree ramps were
+  obstacles);
 - a ground cell without enough points, next to known ones (up to `fill_cells` away), takes
-  their mean: the laser's lines lie a few cells apart a few metres out.
+  their mean: the laser's lines lie a few cells apart a few metres out;
+- the known cells are smoothed by a Gaussian of `smooth_m` over known ground: a footstep
+  planner's flatness test under a sole (1 cm: walking/ground_strides.py) read the cells'
+  noise as bends and broke the pen's even strides up.
 `height_m(x, y)` is bilinear between the four cell centres around the point when all four
 are known ground, NaN otherwise; `nearest_m` the nearest known cell's height (a planner's
 fallback for ground it has not seen). No ROS, no MuJoCo.
@@ -39,7 +45,7 @@ _NEIGHBOURS = np.ones((3, 3))
 class HeightMapSpec:
     """How scans become ground heights (ours; measured on the VRC course: docs/sensors.md)."""
 
-    cell_m: float = 0.05
+    cell_m: float = 0.1
     percentile: float = 50.0
     top_percentile: float = 90.0
     min_hits: int = 2
@@ -48,13 +54,15 @@ class HeightMapSpec:
     step_reach_m: float = 0.1
     obstacle_window_m: float = 0.6
     fill_cells: int = 2
+    smooth_m: float = 0.1
 
     def __post_init__(self) -> None:
         positive = (self.cell_m, self.max_distance_m, self.step_reach_m, self.obstacle_window_m)
         if not all(math.isfinite(v) and v > 0.0 for v in positive) \
                 or not 0.0 <= self.percentile <= self.top_percentile <= 100.0 \
                 or self.min_hits < 1 \
-                or self.self_radius_m < 0.0 or self.fill_cells < 0:
+                or self.self_radius_m < 0.0 or self.fill_cells < 0 \
+                or not (math.isfinite(self.smooth_m) and self.smooth_m >= 0.0):
             raise ValueError(f'a height map needs positive cells, reach and ranges: {self}')
 
 
@@ -200,17 +208,36 @@ def _cell_statistics(points: np.ndarray, spec: HeightMapSpec
 def ground_grid(points: np.ndarray, spec: HeightMapSpec) -> GroundGrid:
     """The grid of `points`: cells' heights, obstacles taken out, small holes filled."""
     if not len(points):
-        empty = np.full((1, 1), np.nan)
-        return GroundGrid(0.0, 0.0, spec.cell_m, empty, np.zeros((1, 1), dtype=np.int64),
-                          np.zeros((1, 1), dtype=bool))
+        empty = np.full((2, 2), np.nan)  # bilinear reads a cell and the next
+        return GroundGrid(0.0, 0.0, spec.cell_m, empty, np.zeros((2, 2), dtype=np.int64),
+                          np.zeros((2, 2), dtype=bool))
     x0, y0, low, top, hits = _cell_statistics(points, spec)
     seen = np.isfinite(low)
     window = 2 * round(spec.obstacle_window_m / spec.cell_m / 2) + 1
-    lowest = ndimage.minimum_filter(np.where(seen, low, np.inf), size=window, mode='nearest')
-    obstacle = seen & (top - lowest > spec.step_reach_m)
+    floor = np.where(seen, low, np.inf)
+    lowest = ndimage.minimum_filter(floor, size=window, mode='nearest')
+    # A step: the top over a neighbour's ground by more than a step's reach within one cell
+    # (45 degrees at 5 cm cells; the pit's 22-degree ramps rise 4 cm over two cells).
+    rise = np.where(seen, top, -np.inf) - ndimage.minimum_filter(floor, size=3, mode='nearest')
+    near_step = ndimage.maximum_filter(rise > spec.step_reach_m, size=window, mode='nearest')
+    obstacle = seen & (top - lowest > spec.step_reach_m) & near_step
     ground = np.where(seen & ~obstacle, low, np.nan)
-    return GroundGrid(x0, y0, spec.cell_m, _filled(ground, obstacle, spec.fill_cells),
-                      hits, obstacle)
+    heights = _smoothed(_filled(ground, obstacle, spec.fill_cells), spec.smooth_m / spec.cell_m)
+    return GroundGrid(x0, y0, spec.cell_m, heights, hits, obstacle)
+
+
+def _smoothed(heights: np.ndarray, sigma_cells: float) -> np.ndarray:
+    """The known cells' heights averaged with their known neighbours' by a Gaussian of
+    `sigma_cells` (0: as they are): a planner's flatness test under a sole reads the ground,
+    not the cells' noise."""
+    if sigma_cells <= 0.0:
+        return heights
+    known = np.isfinite(heights)
+    total = ndimage.gaussian_filter(np.where(known, heights, 0.0), sigma_cells,
+                                    mode='constant', truncate=2.0)
+    weight = ndimage.gaussian_filter(known.astype(float), sigma_cells, mode='constant',
+                                     truncate=2.0)
+    return np.where(known, total / np.where(known, weight, 1.0), np.nan)
 
 
 def _filled(heights: np.ndarray, obstacle: np.ndarray, cells: int) -> np.ndarray:

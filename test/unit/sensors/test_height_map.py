@@ -83,8 +83,8 @@ def test_height_map_leaves_out_the_robots_own_cylinder() -> None:
     height_map, _, _ = _spun_map(FLOOR_WORLD)
     points = height_map.points
     assert np.hypot(points[:, 0], points[:, 1]).min() > HeightMapSpec().self_radius_m
-    assert math.isnan(height_map.height_m(0.2, 0.0))
-    height, distance = height_map.nearest_m(0.2, 0.0)
+    assert math.isnan(height_map.height_m(0.05, 0.0))
+    height, distance = height_map.nearest_m(0.05, 0.0)
     assert abs(height) < 0.015 and 0.1 < distance < 0.5, 'the nearest seen floor'
 
 
