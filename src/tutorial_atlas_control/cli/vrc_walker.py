@@ -173,8 +173,9 @@ def _walk_leg(link: AsiLink, leg: Leg, gait: RouteGait, timeout_s: float,
         if listener is None:
             plan = leg_plan(leg, origin, heading, gait, BLOCKS, course_height_m)
         else:
-            ground = PlanningGround(listener.snapshot())
-            plan = leg_plan(leg, origin, heading, gait, BLOCKS, ground)
+            seen = listener.snapshot()
+            ground = PlanningGround(seen)
+            plan = leg_plan(leg, origin, heading, gait, (), ground, seen.grid.obstacle_xy())
             _print_map_figures(leg, plan, ground)
     except (WalkingError, CourseError, ValueError) as err:
         raise Refused(f'no route to {leg.gate} from ({origin[0]:.2f}, {origin[1]:.2f}): '

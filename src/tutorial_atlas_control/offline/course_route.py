@@ -315,9 +315,11 @@ def _course_simulator(world_name: str, variant: CourseVariant | None) -> AtlasSi
 
 
 def leg_plan(leg: Leg, origin: tuple[float, float], heading_rad: float, gait: RouteGait,
-             blocks: Sequence[Block], ground: HeightField) -> list[Footstep]:
+             blocks: Sequence[Block], ground: HeightField,
+             obstacles: np.ndarray | None = None) -> list[Footstep]:
     """A leg's steps from feet side by side at `origin` facing `heading_rad`: its waypoints
-    (around `blocks` across the rubble, on gentle ground over the hills: leg_waypoints), the
+    (around `blocks` and the points of `obstacles` (n, 2) across the rubble, on gentle
+    ground over the hills: leg_waypoints), the
     corners among the blocks turned on the spot, the straight runs fitted to `ground` when
     the gait says so (the offline walker's world, the live one's course description).
 
@@ -327,8 +329,8 @@ def leg_plan(leg: Leg, origin: tuple[float, float], heading_rad: float, gait: Ro
     """
     if leg.clear_of_blocks:  # around blocks: the corners turned on the spot
         gait = gait.turning_in_place()
-    return route_steps(origin, heading_rad, leg_waypoints(leg, *origin, blocks), gait,
-                       ground=ground if gait.fit_ground else None)
+    return route_steps(origin, heading_rad, leg_waypoints(leg, *origin, blocks, obstacles),
+                       gait, ground=ground if gait.fit_ground else None)
 
 
 def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,
@@ -343,7 +345,8 @@ def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,
         plan = leg_plan(leg, origin, heading, gait, blocks, streamer.ground.ground.height_m)
     else:
         ground = PlanningGround(streamer.laser.map)
-        plan = leg_plan(leg, origin, heading, gait, blocks, ground)
+        plan = leg_plan(leg, origin, heading, gait, (), ground,
+                        streamer.laser.map.grid.obstacle_xy())
         laser_legs.append(streamer.laser.leg_figures(
             leg.gate, plan, leg_plan(leg, origin, heading, gait, blocks, course_height_m),
             ground))

@@ -8,7 +8,9 @@ again from all of them when it is next asked for after new scans (a walker asks 
 so each cell's height is a robust statistic of every point in it:
 - points near the robot are dropped (a cylinder of `self_radius_m` around the pelvis: its
   legs, arms and feet are not ground; the ground there was seen from behind before);
-- points farther than `max_distance_m` from the laser are dropped (few, grazing, noisy);
+- points farther than `max_distance_m` from the laser are dropped (few, grazing, noisy),
+  and those more than `overhead_m` over it: overhead, what the robot walks under (the
+  gates' bars were walls across the rubble's way);
 - a cell's height is the median (`percentile`) of its points' heights, given `min_hits`
   of them: the noise averages (a low percentile biased it 4 mm low on the course's floor);
 - a cell whose top (`top_percentile` of its points) stands more than `step_reach_m` over
@@ -51,6 +53,7 @@ class HeightMapSpec:
     min_hits: int = 2
     self_radius_m: float = 0.5
     max_distance_m: float = 12.0
+    overhead_m: float = 0.3
     step_reach_m: float = 0.1
     obstacle_window_m: float = 0.6
     fill_cells: int = 2
@@ -91,6 +94,11 @@ class GroundGrid:
     @property
     def known(self) -> np.ndarray:
         return np.isfinite(self.heights)
+
+    def obstacle_xy(self) -> np.ndarray:
+        """The obstacle cells' centres (n, 2; world x, y)."""
+        rows, cols = np.nonzero(self.obstacle)
+        return np.stack((self.x0_m + cols * self.cell_m, self.y0_m + rows * self.cell_m), 1)
 
     def index(self, x_m: np.ndarray, y_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The fractional (row, col) of world points."""
@@ -136,6 +144,7 @@ class HeightMap:
         (None: no self filter); how many of its points were kept."""
         points = scan_points(origin, rotation, angles, ranges)
         near = np.linalg.norm(points - np.asarray(origin), axis=1) <= self.spec.max_distance_m
+        near &= points[:, 2] <= origin[2] + self.spec.overhead_m
         if robot_xy is not None:
             away = np.hypot(points[:, 0] - robot_xy[0], points[:, 1] - robot_xy[1])
             near &= away > self.spec.self_radius_m

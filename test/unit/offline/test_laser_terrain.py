@@ -11,7 +11,13 @@ import mujoco
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.course import BLOCKS, COURSE_LEGS, course_height_m
+from tutorial_atlas_control.course import (
+    BLOCKS,
+    COURSE_LEGS,
+    block_footprint,
+    course_height_m,
+    distance_to_polygon,
+)
 from tutorial_atlas_control.offline import PlanningGround, footstep_errors, leg_plan
 from tutorial_atlas_control.offline.course_route import _course_simulator
 from tutorial_atlas_control.sensors import HeightMap, HokuyoLaser
@@ -69,6 +75,25 @@ def test_the_pit_leg_planned_on_the_laser_map_takes_slow_strides_on_its_ramps() 
     assert known >= 0.75 * len(laser)
     assert np.median(np.abs(errors)) < 0.01
     assert np.percentile(np.abs(errors), 95) < 0.05
+
+
+def test_the_rubble_leg_planned_around_the_laser_maps_obstacles_keeps_off_the_blocks() -> None:
+    """From the rubble's start the map takes the blocks for obstacles (not the gates' bars
+    overhead, which closed the way), and the way planned around them alone, without the
+    world's blocks, keeps every footstep off every block as the world's plan does."""
+    height_map, origin, heading = _seen_from_start('vrc_task_2_rubble_start')
+    grid = height_map.grid
+    seen = 0
+    for block in BLOCKS:
+        row, col = (int(round(float(v))) for v in grid.index(block.x_m, block.y_m))
+        seen += bool(grid.obstacle[row - 1:row + 2, col - 1:col + 2].any())
+    assert seen >= 28
+    plan = leg_plan(LEGS['gate_4'], origin, heading, RouteGait(), (),
+                    PlanningGround(height_map), grid.obstacle_xy())
+    xs, ys = np.array([s.x_m for s in plan]), np.array([s.y_m for s in plan])
+    nearest = min(float(distance_to_polygon(block_footprint(b), xs, ys).min()) for b in BLOCKS)
+    assert nearest > 0.3
+    assert math.hypot(plan[-1].x_m - 6.0, plan[-1].y_m - 18.5) < 0.2
 
 
 def test_planning_ground_falls_back_on_the_nearest_seen_ground_and_counts_it() -> None:
