@@ -16,7 +16,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
                    'block_step_trial'],
     'course_route': ['PLANNING_GROUNDS', 'CourseWalk', 'LegFigures', 'course_walk', 'leg_plan'],
     'laser_terrain': ['SPIN_RAD_S', 'LaserLegFigures', 'LaserTerrain', 'PlanningGround',
-                      'footstep_errors'],
+                      'footstep_errors', 'unlike_plan'],
     'course_variant': ['BLOCK_CLEARANCE_M', 'MUD_FLOOR_GEOM', 'block_placement',
                        'highest_ground_m', 'variant_model'],
     'player': ['CommandLatency', 'DEFAULT_SETTLE_S', 'DEFAULT_START_AFTER_S', 'OfflineRunError',

@@ -29,7 +29,7 @@ from tutorial_atlas_control.stepping import steps_between
 from tutorial_atlas_control.walking import Footstep
 
 __all__ = ['SPIN_RAD_S', 'LaserLegFigures', 'LaserTerrain', 'PlanningGround',
-           'footstep_errors']
+           'footstep_errors', 'unlike_plan']
 
 #: The spindle's speed (rad/s): half a turn (every direction once) in 3.1 s, the scans
 #: 25 mrad apart, 7.5 cm at 3 m.
@@ -66,7 +66,9 @@ class LaserLegFigures:
     """One leg planned on the laser's map: its steps and the world's plan's, how many of its
     footsteps stood on known ground, the map's error there against course_height_m (m;
     p50, p95, max of the absolute error, and the signed median), the planner's fallbacks
-    (asked, fallen back, the farthest, m) and the map's points then."""
+    (asked, fallen back, the farthest, m), the map's points then, and how many of its steps
+    are not the world's plan's (index by index: another foot, 1 cm away or another
+    duration; the steps one plan has beyond the other count too)."""
 
     gate: str
     steps: int
@@ -80,6 +82,7 @@ class LaserLegFigures:
     fallbacks: int
     farthest_fallback_m: float
     points: int
+    steps_unlike_world: int = 0
 
 
 def footstep_errors(steps: Sequence[Footstep], ground: PlanningGround
@@ -136,4 +139,16 @@ class LaserTerrain:
             gate, len(plan), len(world_plan), known,
             round(float(np.percentile(size, 50)), 4), round(float(np.percentile(size, 95)), 4),
             round(float(size.max()), 4), round(float(np.median(errors)) if len(errors) else 0.0, 4),
-            asked, fallbacks, round(farthest, 3), len(self.map.points))
+            asked, fallbacks, round(farthest, 3), len(self.map.points),
+            unlike_plan(plan, world_plan))
+
+
+def unlike_plan(plan: Sequence[Footstep], other: Sequence[Footstep]) -> int:
+    """How many of `plan`'s steps are not `other`'s, index by index (another foot, 1 cm
+    away or another duration), and the steps one has beyond the other."""
+    unlike = abs(len(plan) - len(other))
+    for ours, theirs in zip(plan, other):
+        unlike += (ours.foot_index != theirs.foot_index
+                   or math.hypot(ours.x_m - theirs.x_m, ours.y_m - theirs.y_m) > 0.01
+                   or abs(ours.duration_s - theirs.duration_s) > 1e-6)
+    return unlike
