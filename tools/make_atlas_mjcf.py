@@ -26,6 +26,11 @@ import numpy as np
 REPO_ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO_ROOT / 'src'))
 from tutorial_atlas_control.joints import JOINT_NAMES  # noqa: E402
+from tutorial_atlas_control.sensors.frames import (  # noqa: E402
+    HEAD_FRAMES,
+    HOKUYO_AXIS,
+    HOKUYO_JOINT,
+)
 
 DEFAULT_OUTPUT = REPO_ROOT / 'sim' / 'atlas_v1.xml'
 
@@ -631,6 +636,29 @@ def _tree_order(link: str) -> list[tuple[str, str | None]]:
     return order
 
 
+def sensor_frames_urdf() -> list[str]:
+    """The head's sensor frames (sensors/frames.py, multisense_sl.urdf's numbers): the laser's
+    spindle (continuous hokuyo_joint) and the fixed frames the scan, the cameras and the IMU
+    are stamped in. Frames only, no bodies: the model turns the spindle without a body, so
+    these links have no inertia and the simulator publishes them from the URDF (/tf_static)
+    and from /multisense_sl/joint_states."""
+    lines = [f'  <joint name="{HOKUYO_JOINT.joint}" type="continuous">',
+             f'    <parent link="{HOKUYO_JOINT.parent}"/>',
+             f'    <child link="{HOKUYO_JOINT.child}"/>',
+             f'    <origin xyz="{fmt(HOKUYO_JOINT.xyz_m)}" rpy="{fmt(HOKUYO_JOINT.rpy_rad)}"/>',
+             f'    <axis xyz="{fmt(HOKUYO_AXIS)}"/>',
+             '  </joint>',
+             f'  <link name="{HOKUYO_JOINT.child}"/>']
+    for frame in HEAD_FRAMES:
+        lines += [f'  <joint name="{frame.joint}" type="fixed">',
+                  f'    <parent link="{frame.parent}"/>',
+                  f'    <child link="{frame.child}"/>',
+                  f'    <origin xyz="{fmt(frame.xyz_m)}" rpy="{fmt(frame.rpy_rad)}"/>',
+                  '  </joint>',
+                  f'  <link name="{frame.child}"/>']
+    return lines
+
+
 def build_urdf() -> str:
     """Return the URDF text: the MJCF's robot, for robot_state_publisher and rviz."""
     lines = ['<?xml version="1.0"?>',
@@ -642,6 +670,8 @@ def build_urdf() -> str:
              '  edit the table, then run:  python3 tools/make_atlas_mjcf.py',
              '  The root link is pelvis; the simulator broadcasts world -> pelvis on /tf.',
              '  Capsules (no URDF primitive) are drawn as a cylinder with a sphere at each end.',
+             '  Below `head`, the MultiSense SL head\'s sensor frames (sensors/frames.py): frames',
+             '  only, not bodies of the model.',
              '-->',
              '<robot name="atlas">']
     for name, (rgba, _specular) in MATERIALS.items():
@@ -650,6 +680,7 @@ def build_urdf() -> str:
         if joint_name is not None:
             lines += joint_urdf(joint_name)
         lines += link_urdf(link)
+    lines += sensor_frames_urdf()
     lines.append('</robot>')
     return '\n'.join(lines) + '\n'
 

@@ -14,7 +14,15 @@ import pytest
 from matplotlib.colors import to_rgb
 
 from tutorial_atlas_control.asi import Behavior
-from tutorial_atlas_control.bags import plot_course_map, read_bag, read_course_run, read_scores
+from tutorial_atlas_control.bags import (
+    footprints,
+    plot_course_map,
+    read_bag,
+    read_course_run,
+    read_scores,
+    summarise_walk,
+    terrain_heights,
+)
 from tutorial_atlas_control.bags.course_map import FOOT_COLOURS, map_pixel
 from tutorial_atlas_control.msgs.atlas_sim_interface import (
     AsiCommand,
@@ -94,3 +102,19 @@ def test_the_course_map_draws_the_landings(course_walk: Path, tmp_path: Path) ->
         column, row = map_pixel(*sole_centre)
         drawn = np.array(to_rgb(FOOT_COLOURS[foot])) * 255.0
         assert np.abs(image[row, column] - drawn).max() <= 40, (foot, image[row, column])
+
+
+def test_the_walk_summary_takes_the_pelvis_over_the_course_s_ground(
+        course_walk: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The lowest pelvis (and so a fall) is taken over the terrain under it: in the mud pit,
+    0.6 m down, a walking pelvis at z 0.26 m is no fall (a live course demo's summary said
+    FELL there). The same walk over ground raised 0.5 m has fallen."""
+    data = read_bag(course_walk)
+    walked = summarise_walk(data)
+    assert walked is not None and not walked.fell
+    assert 0.75 < walked.lowest_pelvis_m < 0.95
+    raised = terrain_heights() + 0.5
+    monkeypatch.setattr(footprints, 'terrain_heights', lambda: raised)
+    sunk = summarise_walk(data)
+    assert sunk is not None and sunk.fell
+    assert sunk.lowest_pelvis_m == pytest.approx(walked.lowest_pelvis_m - 0.5, abs=1e-9)

@@ -39,6 +39,10 @@ FOOT_HEIGHT_TOLERANCE_M = 0.03
 STANDING_AT_S = 3.0
 #: Sim time (s) the test watches /tf and /ground_truth_odom for.
 WATCH_S = 3.5
+#: The head's sensor frames robot_description carries beside the robot's links.
+SENSOR_FRAMES = {'hokuyo_link', 'head_hokuyo_frame', 'left_camera_frame',
+                 'left_camera_optical_frame', 'right_camera_frame', 'right_camera_optical_frame',
+                 'head_imu_link'}
 #: Longest wall-clock wait (s).
 WALL_TIMEOUT_S = 120.0
 
@@ -55,13 +59,16 @@ class TfTest(unittest.TestCase):
         rospy.init_node('test_tf')
         cls.lock = threading.Lock()
         cls.first_stamp_s, cls.pelvis_tf, cls.pelvis_odom = {}, {}, {}
+        cls.static_children: set[str] = set()
         cls.clock_s = 0.0
         cls.buffer = tf2_ros.Buffer(cache_time=rospy.Duration(60))
         cls.listener = tf2_ros.TransformListener(cls.buffer)
         tf_sub = rospy.Subscriber('/tf', TFMessage, cls._on_tf, queue_size=1000)
+        rospy.Subscriber('/tf_static', TFMessage, cls._on_tf_static, queue_size=100)
         rospy.Subscriber('/ground_truth_odom', Odometry, cls._on_odom, queue_size=1000)
         rospy.Subscriber('/clock', Clock, cls._on_clock, queue_size=10)
-        publishers = 2 if rospy.get_param('/atlas_sim/tf_publisher') != 'sim' else 1
+        # robot_state_publisher: one for the links, one for the laser's spindle (DRCSim's).
+        publishers = 3 if rospy.get_param('/atlas_sim/tf_publisher') != 'sim' else 1
         # The listener's /tf subscription is tf_sub's (one per topic in a rospy node); its
         # /tf_static one connects on its own, to every publisher the master lists.
         cls._wait(lambda: tf_sub.get_num_connections() >= publishers
@@ -114,6 +121,11 @@ class TfTest(unittest.TestCase):
                         [t.x, t.y, t.z, r.x, r.y, r.z, r.w])
 
     @classmethod
+    def _on_tf_static(cls, msg: TFMessage) -> None:
+        with cls.lock:
+            cls.static_children.update(t.child_frame_id for t in msg.transforms)
+
+    @classmethod
     def _on_odom(cls, msg: Odometry) -> None:
         p, q = msg.pose.pose.position, msg.pose.pose.orientation
         with cls.lock:
@@ -121,17 +133,25 @@ class TfTest(unittest.TestCase):
                 [p.x, p.y, p.z, q.x, q.y, q.z, q.w])
 
     def test_every_link_of_robot_description_is_on_tf_within_2_s(self) -> None:
+        """The robot's 29 links and the head's sensor frames: the moving ones on /tf within
+        2 s of sim time (the laser's hokuyo_link among them), the fixed frames (the scan's
+        head_hokuyo_frame, the cameras', the IMU's) on /tf_static."""
         root = ET.fromstring(rospy.get_param('/robot_description'))
         links = {link.get('name') for link in root.findall('link')}
-        self.assertEqual(len(links), 29)
+        fixed = {joint.find('child').get('link') for joint in root.findall('joint')
+                 if joint.get('type') == 'fixed'}
+        self.assertEqual(len(links), 29 + len(SENSOR_FRAMES))
+        self.assertEqual(fixed, SENSOR_FRAMES - {'hokuyo_link'})
         with self.lock:
-            first = dict(self.first_stamp_s)
-        missing = sorted(links - set(first))
+            first, static = dict(self.first_stamp_s), set(self.static_children)
+        self.assertEqual(sorted(fixed - static), [], 'fixed frames never seen on /tf_static')
+        moving = links - fixed
+        missing = sorted(moving - set(first))
         self.assertEqual(missing, [], 'links never seen on /tf')
-        late = {link: first[link] for link in links if first[link] > ALL_LINKS_WITHIN_S}
+        late = {link: first[link] for link in moving if first[link] > ALL_LINKS_WITHIN_S}
         self.assertEqual(late, {}, f'links first on /tf after {ALL_LINKS_WITHIN_S} s of sim time')
         rospy.loginfo(
-            f'every link on /tf by {max(first[link] for link in links):.3f} s of sim time')
+            f'every link on /tf by {max(first[link] for link in moving):.3f} s of sim time')
 
     def test_world_to_pelvis_is_the_ground_truth(self) -> None:
         with self.lock:

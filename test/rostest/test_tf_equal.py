@@ -186,11 +186,27 @@ class TfEqualTest(unittest.TestCase):
         self.assertGreater(moved, 1e-4)
 
     def test_tf_static_is_robot_state_publishers(self) -> None:
-        """Atlas v1 has no fixed joint: both latch one empty message."""
+        """The URDF's fixed joints (the head's six sensor frames): each latches one message
+        with the same transforms, in the same order, within EQUAL_WITHIN."""
         self._wait(lambda: self.static['sim'] and self.static['rsp'], 'both /tf_static')
-        self.assertEqual([m.transforms for m in self.static['sim']], [[]])
-        self.assertEqual([m.transforms for m in self.static['rsp']], [[]])
+        self.assertEqual(len(self.static['sim']), 1)
+        self.assertEqual(len(self.static['rsp']), 1)
+        sim, rsp = (self._static_rows(self.static[side][0]) for side in ('sim', 'rsp'))
+        self.assertEqual([frames for frames, _ in sim], [frames for frames, _ in rsp])
+        self.assertEqual(len(sim), 6)
+        self.assertIn(('hokuyo_link', 'head_hokuyo_frame'), [frames for frames, _ in sim])
+        for (frames, mine), (_, theirs) in zip(sim, rsp, strict=True):
+            np.testing.assert_allclose(mine, theirs, atol=EQUAL_WITHIN, err_msg=str(frames))
 
+    @staticmethod
+    def _static_rows(msg: TFMessage) -> list[tuple[tuple[str, str], np.ndarray]]:
+        rows = []
+        for transform in msg.transforms:
+            t, r = transform.transform.translation, transform.transform.rotation
+            quaternion = np.array([r.x, r.y, r.z, r.w])
+            rows.append(((transform.header.frame_id, transform.child_frame_id),
+                         np.r_[t.x, t.y, t.z, quaternion if quaternion[3] >= 0 else -quaternion]))
+        return rows
 
 if __name__ == '__main__':
     rostest.rosrun(PKG, 'tf_equal', TfEqualTest)

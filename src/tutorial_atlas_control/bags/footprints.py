@@ -282,7 +282,8 @@ def summarise_walk(data: BagData, window_s: tuple[float, float] | None = None
     walking = (pelvis.t_s >= first_walk_s) & (pelvis.t_s <= until_s)
     path = pelvis.position_m[walking]
     distance = float(np.hypot(*(path[-1, :2] - path[0, :2]))) if len(path) else None
-    lowest = float(path[:, 2].min()) if len(path) else None
+    # Over the ground under it: walking in the course's mud pit, 0.6 m down, is no fall.
+    lowest = float(above_ground(path, heights)[:, 2].min()) if len(path) else None
     travel = [_travel(positions[foot][0, :2] if len(t_s) else None, by_foot[foot])
               for foot in (0, 1)]
     return WalkSummary(placements, distance, lowest is not None and fallen(lowest),

@@ -8,13 +8,10 @@ Gazebo's laser saw the robot, except the head's, which the frame sits on. Only c
 geoms count (group 0: the robot's and the world's solids; visuals are group 1, the VRC mud's
 volume group 3), as Gazebo's ray sensor hit collision shapes.
 
-A heightfield (the VRC course's terrain) is not left to `mj_multiRay`: MuJoCo's ray test of
-a heightfield visits every cell of the rectangle the ray spans seen from above, and 720 rays
-of 30 m over the course's 513 x 513 terrain took 480 ms a scan (0.2 ms in the flat world),
-which starved the course's real time whenever a recorder listened. The rays are cast on a
-copy of the model without its heightfields, and each heightfield is met by marching the rays
-in MARCH_STEP_M steps over its heights, bilinear between its vertices (MuJoCo's triangles lie
-within millimetres of that), the crossing then bisected to BISECT_TOL_M.
+A heightfield (the VRC course's terrain) is not left to `mj_multiRay`, whose heightfield test
+took 480 ms a scan on the course (0.2 ms in the flat world) and starved the course's real
+time whenever a recorder listened: the rays are cast on a copy of the model without its
+heightfields, and each heightfield is met by heightfield_march.py's march over its heights.
 
 What a ray reports follows REP 117 (sensor_msgs/LaserScan's convention): its true distance
 plus noise; +inf when nothing is within range_max (no return; Gazebo 1.9 reported range_max
@@ -36,15 +33,12 @@ from tutorial_atlas_control.sensors.frames import (
     HEAD_LINK,
     frame_in_head,
 )
+from tutorial_atlas_control.sensors.heightfield_march import Heightfield
 
 __all__ = ['COLLISION_GROUPS', 'HOKUYO', 'HokuyoLaser', 'LaserSpec']
 
 #: The geom groups rays see: the collision geoms.
 COLLISION_GROUPS = np.array([1, 0, 0, 0, 0, 0], dtype=np.uint8)
-#: A heightfield is marched in steps of this length (m; the course's cells are 0.195 m),
-#: and its crossing bisected to this (m).
-MARCH_STEP_M = 0.2
-BISECT_TOL_M = 1e-4
 #: A group no ray sees: the heightfields' in the rays' copy of the model.
 _UNSEEN_GROUP = 5
 
@@ -145,73 +139,3 @@ class HokuyoLaser:
              out: np.ndarray) -> None:
         """The scan of `data` with the spindle at `spindle_rad`, stamped `stamp_ns`."""
         self.ranges(self.cast(data, spindle_rad), stamp_ns, out)
-
-
-class Heightfield:
-    """One heightfield geom (unturned) as heights over a grid: where rays first meet it."""
-
-    def __init__(self, model: mujoco.MjModel, geom: int) -> None:
-        if not np.allclose(model.geom_quat[geom], (1.0, 0.0, 0.0, 0.0)):
-            raise ValueError(f'heightfield geom {geom} is turned: the laser takes it upright')
-        field = int(model.geom_dataid[geom])
-        rows, cols = int(model.hfield_nrow[field]), int(model.hfield_ncol[field])
-        start = int(model.hfield_adr[field])
-        self.geom = geom
-        self.half_x, self.half_y, top, _ = (float(v) for v in model.hfield_size[field])
-        self.centre = np.array(model.geom_pos[geom], dtype=float)
-        #: Heights (m, world z) of the vertices, row 0 at -y, column 0 at -x.
-        self.heights = (self.centre[2] + top * np.asarray(
-            model.hfield_data[start:start + rows * cols]).reshape(rows, cols))
-        self.lowest, self.highest = float(self.heights.min()), float(self.heights.max())
-
-    def height_m(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        """The surface's height under world points (bilinear); -inf outside it."""
-        rows, cols = self.heights.shape
-        col = (x - self.centre[0] + self.half_x) / (2.0 * self.half_x) * (cols - 1)
-        row = (y - self.centre[1] + self.half_y) / (2.0 * self.half_y) * (rows - 1)
-        inside = (col >= 0.0) & (col <= cols - 1) & (row >= 0.0) & (row <= rows - 1)
-        col, row = np.clip(col, 0.0, cols - 1.0), np.clip(row, 0.0, rows - 1.0)
-        c0 = np.minimum(col.astype(int), cols - 2)
-        r0 = np.minimum(row.astype(int), rows - 2)
-        fc, fr = col - c0, row - r0
-        h = self.heights
-        surface = ((h[r0, c0] * (1.0 - fc) + h[r0, c0 + 1] * fc) * (1.0 - fr)
-                   + (h[r0 + 1, c0] * (1.0 - fc) + h[r0 + 1, c0 + 1] * fc) * fr)
-        return np.where(inside, surface, -np.inf)
-
-    def distances(self, origin: np.ndarray, rays: np.ndarray, range_m: float) -> np.ndarray:
-        """Each ray's distance (m) to where it first goes below the surface, within
-        `range_m`; -1 where it does not (0 for every ray from under the surface)."""
-        result = np.full(len(rays), -1.0)
-        if self.height_m(origin[:1], origin[1:2])[0] >= origin[2]:
-            return np.zeros(len(rays))
-        # How far a ray can meet the surface: not past its lowest point going down, never
-        # going up or level from above its highest.
-        reach = np.full(len(rays), float(range_m))
-        falling = rays[:, 2] < 0.0
-        reach[falling] = np.minimum(reach[falling],
-                                    (origin[2] - self.lowest) / -rays[falling, 2])
-        if origin[2] > self.highest:
-            reach[~falling] = 0.0
-        live = np.flatnonzero(reach > 0.0)
-        if not len(live):
-            return result
-        steps = np.arange(MARCH_STEP_M, float(reach[live].max()) + MARCH_STEP_M, MARCH_STEP_M)
-        points = origin + steps[:, None, None] * rays[live]  # (steps, rays, 3)
-        below = ((points[..., 2] <= self.height_m(points[..., 0], points[..., 1]))
-                 & (steps[:, None] <= reach[live] + MARCH_STEP_M))
-        met = below.any(axis=0)
-        first = np.argmax(below, axis=0)[met]
-        near = np.where(first > 0, steps[np.maximum(first - 1, 0)], 0.0)
-        far = steps[first]
-        rays_met = rays[live[met]]
-        while far.size and float((far - near).max()) > BISECT_TOL_M:
-            middle = 0.5 * (near + far)
-            at = origin + middle[:, None] * rays_met
-            under = at[:, 2] <= self.height_m(at[:, 0], at[:, 1])
-            far = np.where(under, middle, far)
-            near = np.where(under, near, middle)
-        distance = 0.5 * (near + far)
-        within = distance <= range_m
-        result[live[met][within]] = distance[within]
-        return result

@@ -83,12 +83,39 @@ def read_joints(text: str, source: str = 'URDF') -> tuple[list[str], list[UrdfJo
     return links, joints
 
 
+#: Joints that may carry a URDF link that is not a body of the model: a fixed frame (a
+#: sensor's), or a spindle the model turns without a body (the laser's hokuyo_joint).
+FRAME_JOINTS = ('fixed', 'continuous')
+
+
+def _check_frames(extra_links: list[str], bodies: set[str], joints: list[UrdfJoint],
+                  mismatch: str) -> None:
+    """Every URDF link that is not a body hangs below one through FRAME_JOINTS only: a frame
+    on the robot (the head's sensors), which robot_state_publisher publishes and the
+    physics has no use for. Anything else is a link the model lacks.
+
+    Raises:
+        UrdfError: such a link has no body above it through frame joints (`mismatch`: the
+            message's start).
+    """
+    into = {joint.child: joint for joint in joints}
+    for link in extra_links:
+        name = link
+        while name not in bodies:
+            joint = into.get(name)
+            if joint is None or joint.kind not in FRAME_JOINTS:
+                raise UrdfError(f'{mismatch}: links and bodies differ ({link} is neither a body '
+                                'nor a frame fixed or spun on one)')
+            name = joint.parent
+
+
 def matching_urdf(model_path: Path | str, model: mujoco.MjModel) -> tuple[Path, str]:
     """The URDF beside `model_path` and its text, if it describes `model`'s kinematics.
 
     Every hinge joint of the model must be a URDF revolute joint of the same name between
     the same two links, with the same origin and axis; the URDF's links are the robot's
-    bodies (the pelvis's tree: a world's loose bodies are not in the URDF).
+    bodies (the pelvis's tree: a world's loose bodies are not in the URDF) and frames
+    fixed or spun on them (FRAME_JOINTS: the head's sensor frames).
 
     Raises:
         UrdfError: no such file, or it describes a different robot (the message says what).
@@ -98,15 +125,20 @@ def matching_urdf(model_path: Path | str, model: mujoco.MjModel) -> tuple[Path, 
         raise UrdfError(f'the model {model_path} has no URDF beside it ({path} does not exist)')
     text = path.read_text()
     links, joints = read_joints(text, str(path))
+    twice = sorted({link for link in links if links.count(link) > 1})
+    if twice:  # rviz's RobotModel refuses such a robot ("link ... is not unique")
+        raise UrdfError(f'{path}: link {twice[0]!r} is described twice')
     by_name = {joint.name: joint for joint in joints}
     # The robot's bodies: the pelvis's tree (a course's loose blocks are not the robot).
     robot_root = model.body_rootid[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, PELVIS_BODY)]
     bodies = {mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) for b in range(1, model.nbody)
               if model.body_rootid[b] == robot_root}
-    if set(links) != bodies:
-        differ = sorted(set(links) ^ bodies)
+    missing = sorted(bodies - set(links))
+    if missing:
         raise UrdfError(f'{path} does not match the model {model_path}: links and bodies differ '
-                        f'({", ".join(differ[:5])})')
+                        f'({", ".join(missing[:5])})')
+    _check_frames([link for link in links if link not in bodies], bodies, joints,
+                  f'{path} does not match the model {model_path}')
     for joint_id in range(model.njnt):
         if model.jnt_type[joint_id] != mujoco.mjtJoint.mjJNT_HINGE:
             continue

@@ -66,13 +66,16 @@ def test_world_file_is_what_the_generator_writes() -> None:
 
 
 def test_urdf_matches_the_robot_not_the_blocks(atlas: model.AtlasModel) -> None:
-    """/tf and rviz get the VRC robot: its hands' and Hokuyo's links on fixed joints, the
-    course's loose blocks (bodies of the world, not of the robot) left out."""
+    """/tf and rviz get the VRC robot: its hands' links on fixed joints, the Hokuyo's
+    (a body welded to the head in the model) on the spun hokuyo_joint as the simulator
+    publishes it, each link once, the course's loose blocks (bodies of the world, not of
+    the robot) left out."""
     path, text = matching_urdf(WORLD_PATH, atlas.model)
     links, joints = read_joints(text, str(path))
     assert {'l_palm', 'r_f3', 'hokuyo_link'} <= set(links)
     assert not any(link.startswith('cinder_block') for link in links)
-    assert {joint.name: joint.kind for joint in joints}['hokuyo_joint'] == 'fixed'
+    assert {joint.name: joint.kind for joint in joints}['hokuyo_joint'] == 'continuous'
+    assert len(links) == len(set(links))
 
 
 def test_terrain_heights_are_the_heightmap_scaled_as_gazebo_did(

@@ -322,7 +322,12 @@ def test_tf_publisher_parameter_chooses_who_publishes_the_links(
     sim_node.build_node()
     tf, links = built[-1][3], built[-1][1].links  # SimNode(sim, settings, gui, tf, ...)
     assert tf and links.frames[:2] == (('pelvis', 'ltorso'), ('ltorso', 'mtorso'))
-    assert len(links) == 28 and links.static == ()
+    # The 28 joints of /atlas/joint_states (not the spindle: the head's part publishes it);
+    # the head's six fixed sensor frames on /tf_static.
+    assert len(links) == 28 and 'hokuyo_joint' not in links.joint_names
+    assert [(fixed.parent, fixed.child) for fixed in links.static][:2] == [
+        ('hokuyo_link', 'head_hokuyo_frame'), ('head', 'head_imu_link')]
+    assert len(links.static) == 6
     assert params[topics.ROBOT_DESCRIPTION_PARAM].startswith('<?xml')
     del params[topics.ROBOT_DESCRIPTION_PARAM]
     params['~tf_publisher'] = 'robot_state_publisher'
