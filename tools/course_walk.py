@@ -3,14 +3,16 @@
 measurement behind docs/vrc.md's figures for the walk to gate_1.
 
     python3 tools/course_walk.py [--to GATE | --waypoints 'X,Y X,Y ...'] [--stride M]
-                                 [--no-fit-ground] [--world NAME] [--variant NAME] SEED ...
+                                 [--no-fit-ground] [--world NAME] [--variant NAME]
+                                 [--terrain world|laser] SEED ...
 
 The walk is vrc_walker.py's, offline: the course's legs (course/legs.py) from the world's
 start to --to (default gate_1), each planned from where the feet are as it begins; or one
 leg through --waypoints. A straight run over a bend or steep ground (the pit's ramps) is
 planned on the world's ground (walking/ground_strides.py); --no-fit-ground: equal strides.
 --variant: one of the finals' changes to the course (course/variants.py; default the world
-as shipped).
+as shipped). --terrain laser: each leg planned on the head laser's height map of what it
+has seen so far, the spindle spinning (offline/laser_terrain.py; docs/sensors.md).
 SEED is an integer (walking/start_noise.py's perturbed start) or `none` (the start as the
 world gives it). Each walk prints one JSON line (offline/course_route.py's CourseWalk) as it
 ends; a run costs about 300-500 s of CPU on this host (the course's physics). Run it under
@@ -28,7 +30,7 @@ import sys
 from tutorial_atlas_control.cli.convention import seed_or_none
 from tutorial_atlas_control.course import COURSE_VARIANTS, GATES, Leg, course_variant
 from tutorial_atlas_control.errors import AtlasControlError
-from tutorial_atlas_control.offline import course_walk
+from tutorial_atlas_control.offline import PLANNING_GROUNDS, course_walk
 from tutorial_atlas_control.walking import RouteGait
 
 PROG = 'course_walk.py'
@@ -58,6 +60,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--fit-ground', action=argparse.BooleanOptionalAction, default=True,
                         help='plan straight runs over a bend or steep ground on the world\'s '
                         'ground (walking/ground_strides.py: the pit\'s ramps; default: on)')
+    parser.add_argument('--terrain', choices=PLANNING_GROUNDS, default='world',
+                        help="the ground each leg is planned on: the world's, or the head "
+                        "laser's height map of what it has seen (offline/laser_terrain.py)")
     parser.add_argument('--world', default='vrc_task_2', help='a VRC Task 2 world name')
     parser.add_argument('--variant', choices=[v.name for v in COURSE_VARIANTS], default=None,
                         help="one of the VRC finals' changes to the course")
@@ -71,7 +76,8 @@ def main(argv: list[str] | None = None) -> int:
         try:
             legs = None if args.waypoints is None else [Leg('route', args.waypoints)]
             walk = course_walk(seed, legs, args.to, args.world, gait,
-                               variant=args.variant and course_variant(args.variant))
+                               variant=args.variant and course_variant(args.variant),
+                               terrain=args.terrain)
         except AtlasControlError as err:
             print(f'{PROG}: {err}', file=sys.stderr)
             return 2

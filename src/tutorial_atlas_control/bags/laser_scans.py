@@ -14,6 +14,7 @@ lag by a few steps' turn, a few mrad at 50 RPM).
 from __future__ import annotations
 
 import struct
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,20 +24,26 @@ from tutorial_atlas_control import topics
 from tutorial_atlas_control.bags.feet import RecordedKinematics
 from tutorial_atlas_control.bags.reader import BagData
 from tutorial_atlas_control.bags.records import open_bag
+from tutorial_atlas_control.course import course_height_m
 from tutorial_atlas_control.sensors import (
     HEAD_HOKUYO_FRAME,
     HEAD_LINK,
+    HeightMap,
     Spindle,
     frame_in_head,
+    scan_points,
     spindle_command,
 )
 from tutorial_atlas_control.units import NS_PER_S
 
-__all__ = ['LaserScans', 'read_laser_scans', 'scan_cloud', 'spindle_angles']
+__all__ = ['LaserScans', 'laser_height_map', 'map_error_lines', 'placed_scans',
+           'read_laser_scans', 'scan_cloud', 'spindle_angles']
 
 _HEADER = struct.Struct('<III')
 _U32 = struct.Struct('<I')
 _FIGURES = struct.Struct('<7f')
+#: The robot's body whose (x, y) centres the height map's self filter.
+PELVIS_LINK = 'pelvis'
 #: The physics step the spindle is simulated at (s): the simulator's.
 SPINDLE_STEP_S = 0.001
 
@@ -115,27 +122,57 @@ def spindle_angles(scans: LaserScans) -> np.ndarray:
     return angles
 
 
-def scan_cloud(data: BagData, scans: LaserScans, every: int = 1) -> np.ndarray:
-    """The points (x, y, z in the world, m) of every `every`-th scan's finite ranges."""
+def placed_scans(data: BagData, scans: LaserScans, every: int = 1
+                 ) -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray, tuple[float, float]]]:
+    """Every `every`-th scan with a return, placed: (the laser frame's origin and rotation
+    in the world, the ranges, the pelvis's (x, y) then)."""
     if scans.frame_id != HEAD_HOKUYO_FRAME:
-        return np.empty((0, 3))
+        return
     kinematics = RecordedKinematics(data)
     head = kinematics.body_id(HEAD_LINK)
+    pelvis = kinematics.body_id(PELVIS_LINK)
     spindle = spindle_angles(scans)
-    angles = scans.angles()
-    rays = np.stack((np.cos(angles), np.sin(angles), np.zeros_like(angles)), 1)
-    points = []
     for row in range(0, len(scans.stamp_ns), max(1, every)):
         ranges = scans.ranges[row].astype(float)
-        hit = np.isfinite(ranges)
-        if not hit.any():
+        if not np.isfinite(ranges).any():
             continue
         # Sim time on the run's timeline; a run whose sim time went back (a
         # reset_simulation) is placed in its first epoch's.
         placed = kinematics.place(data.run_time_s(scans.stamp_ns[row] / NS_PER_S, 0))
         offset, rotation = frame_in_head(HEAD_HOKUYO_FRAME, float(spindle[row]))
         head_rotation = placed.xmat[head].reshape(3, 3)
-        origin = placed.xpos[head] + head_rotation @ offset
-        world = rays[hit] @ (head_rotation @ rotation).T
-        points.append(origin + world * ranges[hit, None])
+        yield (placed.xpos[head] + head_rotation @ offset, head_rotation @ rotation, ranges,
+               (float(placed.xpos[pelvis][0]), float(placed.xpos[pelvis][1])))
+
+
+def scan_cloud(data: BagData, scans: LaserScans, every: int = 1) -> np.ndarray:
+    """The points (x, y, z in the world, m) of every `every`-th scan's finite ranges."""
+    angles = scans.angles()
+    points = [scan_points(origin, rotation, angles, ranges)
+              for origin, rotation, ranges, _ in placed_scans(data, scans, every)]
     return np.concatenate(points) if points else np.empty((0, 3))
+
+
+def laser_height_map(data: BagData, scans: LaserScans) -> HeightMap:
+    """The height map (sensors/height_map.py) of every scan of the run, each with the
+    pelvis's (x, y) then for its self filter."""
+    height_map = HeightMap()
+    angles = scans.angles()
+    for origin, rotation, ranges, pelvis_xy in placed_scans(data, scans):
+        height_map.add_scan(origin, rotation, angles, ranges, pelvis_xy)
+    return height_map
+
+
+def map_error_lines(height_map: HeightMap, footsteps: list[tuple[float, float]]) -> list[str]:
+    """The map's figures at the `footsteps` (x, y) a walk asked for: how many it saw, its
+    heights there against the course's description (course_height_m)."""
+    errors = np.array([height_map.height_m(x, y) - course_height_m(x, y) for x, y in footsteps])
+    seen = errors[np.isfinite(errors)]
+    lines = [f'laser map: {len(height_map.points)} points of {height_map.scans} scans; '
+             f'{len(seen)} of {len(footsteps)} footsteps asked for on seen ground']
+    if len(seen):
+        size = np.abs(seen)
+        lines.append(f'  its height there against the course\'s: p50 {np.median(size) * 100:.1f} '
+                     f'cm, p95 {np.percentile(size, 95) * 100:.1f} cm, max '
+                     f'{size.max() * 100:.1f} cm (signed median {np.median(seen) * 100:+.1f} cm)')
+    return lines

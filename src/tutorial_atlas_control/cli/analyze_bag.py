@@ -29,6 +29,8 @@ from tutorial_atlas_control.bags import (
     format_comparison,
     format_summary,
     is_course_run,
+    laser_height_map,
+    map_error_lines,
     parse_fps,
     parse_size,
     plot_behaviours,
@@ -42,6 +44,7 @@ from tutorial_atlas_control.bags import (
     read_behaviours,
     read_laser_scans,
     read_scores,
+    read_step_targets,
     recorded_course_run,
     render_bag_video,
     scan_cloud,
@@ -174,6 +177,11 @@ def build_parser() -> argparse.ArgumentParser:
                         help='with --course-map: the head laser\'s recorded scans over it, each '
                              'range a point in the world (the head\'s recorded pose, the spindle '
                              'simulated from set_spindle_speed), coloured by height')
+    parser.add_argument('--laser-map', action='store_true',
+                        help='the head laser\'s height map of the run\'s scans (as a course '
+                             'walker builds it: sensors/height_map.py) at the footsteps its WALK '
+                             'commands asked for: how many it saw, its error against the '
+                             'course\'s description')
     parser.add_argument('--plot-joints', metavar='FILE.png',
                         help='write commanded vs measured positions of every joint that moved '
                              '(one panel each) and the pelvis height to this image')
@@ -236,7 +244,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         scores = read_scores(analysis.data)
         extra = (behaviour_lines(changes) if changes is not None else []) + [
             line for title, each in walks for line in [title, *walk_lines(each)]] + (
-            score_lines(scores) if scores is not None else [])
+            score_lines(scores) if scores is not None else []) + (
+            _laser_map_lines(analysis) if args.laser_map else [])
         print(analysis_to_json(analysis, {
             'trajectory': _played_dict(played), 'walk': _walk_dict(walk),
             'walks': [_walk_dict(each) for _, each in walks],
@@ -288,9 +297,19 @@ def _check_course_map(analysis: Analysis, args: argparse.Namespace) -> None:
                                '/atlas/sim_config names no vrc_task_2.xml and it has no '
                                '/vrc_score): --course-map draws course runs only')
     scans = analysis.data.topics.get(topics.LASER_SCAN)
-    if args.scan_cloud and not getattr(scans, 'count', 0):
+    if (args.scan_cloud or args.laser_map) and not getattr(scans, 'count', 0):
         raise BagAnalysisError(f'{analysis.data.path} has no {topics.LASER_SCAN}: no scan to '
-                               'draw')
+                               'draw or map')
+
+
+def _laser_map_lines(analysis: Analysis) -> list[str]:
+    """--laser-map's lines: the run's scans as a height map, at its WALK footsteps."""
+    scans = read_laser_scans(analysis.data.path)
+    if scans is None:
+        return []
+    targets, _ = read_step_targets(analysis.data)
+    return map_error_lines(laser_height_map(analysis.data, scans),
+                           [(target.x_m, target.y_m) for target in targets])
 
 
 def _course_maps(analysis: Analysis, args: argparse.Namespace) -> list[Path]:

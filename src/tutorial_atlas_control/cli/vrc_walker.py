@@ -8,7 +8,9 @@ commands (the window from next_step_index_needed on every state). Steps land whe
 course's ground is (the simulator puts each on the surface under it). It prints each gate
 passed and every other event of /vrc_score, then the score. It ends with exit 0 once
 --to is passed with no fall, 1 on a fall, a refused walk, a walk that did not end or a gate
-not passed, 130 on Ctrl-C.
+not passed, 130 on Ctrl-C. With --terrain laser each leg is planned on the head laser's
+height map of what it has seen (the spindle spinning; cli/laser_listener.py) instead of the
+course's description, and the map's figures at the chosen footsteps are printed.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ import threading
 import time
 from collections.abc import Sequence
 
+import numpy as np
 import rospy
 from atlas_msgs.msg import VRCScore
 
@@ -31,6 +34,7 @@ from tutorial_atlas_control.cli.convention import (
     positive_number,
     print_error,
 )
+from tutorial_atlas_control.cli.laser_listener import LaserListener, half_turn_scans
 from tutorial_atlas_control.course import (
     BLOCKS,
     GATES,
@@ -40,12 +44,20 @@ from tutorial_atlas_control.course import (
     course_height_m,
     legs_ahead,
 )
-from tutorial_atlas_control.offline import leg_plan
+from tutorial_atlas_control.offline import (
+    PLANNING_GROUNDS,
+    SPIN_RAD_S,
+    PlanningGround,
+    footstep_errors,
+    leg_plan,
+)
 from tutorial_atlas_control.walking import RouteGait, WalkingError
 
 PROG = 'vrc_walker.py'
 #: How long (s, wall time) /vrc_score may take to report a gate the walk has passed.
 SCORE_WAIT_S = 5.0
+#: How long (s, wall time) the first look around (half a spindle turn) may take.
+LOOK_TIMEOUT_S = 60.0
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -59,6 +71,9 @@ def _parser() -> argparse.ArgumentParser:
                              '%(default)s: the whole course)')
     parser.add_argument('--stride', type=positive_number, default=RouteGait.stride_m,
                         metavar='M', help='longest stride (m, default %(default)g)')
+    parser.add_argument('--terrain', choices=PLANNING_GROUNDS, default='world',
+                        help="the ground each leg is planned on: the course's description, or "
+                        "the head laser's height map of what it has seen (default %(default)s)")
     parser.add_argument('--timeout', type=positive_number, default=900.0, metavar='S',
                         help='give up after this long (s, wall time; default %(default)g)')
     return parser
@@ -74,7 +89,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.error(str(err))
     link = AsiLink(PROG)
     try:
-        return _walk_course(link, args.to, gait, args.timeout)
+        return _walk_course(link, args.to, gait, args.timeout, args.terrain == 'laser')
     except KeyboardInterrupt:
         print(f'{PROG}: interrupted', file=sys.stderr)
         return EXIT_INTERRUPTED
@@ -111,9 +126,11 @@ class _ScoreWatch:
             return self._changed.wait_for(lambda: self.passed(gate), timeout_s)
 
 
-def _walk_course(link: AsiLink, to_gate: str, gait: RouteGait, timeout_s: float) -> int:
+def _walk_course(link: AsiLink, to_gate: str, gait: RouteGait, timeout_s: float,
+                 laser: bool) -> int:
     score = _ScoreWatch()
     first = link.connect('vrc_walker')
+    listener = LaserListener(SPIN_RAD_S) if laser else None
     rospy.Subscriber(topics.VRC_SCORE, VRCScore, score.on_score, queue_size=100)
     pelvis = first.pos_est.position
     legs = legs_ahead(pelvis.x, pelvis.y, to_gate)
@@ -123,11 +140,15 @@ def _walk_course(link: AsiLink, to_gate: str, gait: RouteGait, timeout_s: float)
           f'{", ".join(leg.gate for leg in legs)}', flush=True)
     if first.current_behavior == Behavior.USER:
         link.stand_first()
+    if listener is not None and not listener.wait_for_scans(half_turn_scans(SPIN_RAD_S),
+                                                            LOOK_TIMEOUT_S):
+        raise Refused(f'no half turn of laser scans within {LOOK_TIMEOUT_S:g} s '
+                      f'({listener.scans} placed, {listener.dropped} without /tf)')
     deadline = time.monotonic() + timeout_s
     for number, leg in enumerate(legs):
         if number > 0:
             link.hold(LEG_PAUSE_S)
-        _walk_leg(link, leg, gait, deadline - time.monotonic())
+        _walk_leg(link, leg, gait, deadline - time.monotonic(), listener)
     passed = score.wait_for(to_gate, SCORE_WAIT_S)
     last = score.last
     if last is not None:
@@ -141,14 +162,22 @@ def _walk_course(link: AsiLink, to_gate: str, gait: RouteGait, timeout_s: float)
     return 0
 
 
-def _walk_leg(link: AsiLink, leg: Leg, gait: RouteGait, timeout_s: float) -> None:
-    """One leg, planned from where the feet are now, streamed to its end."""
+def _walk_leg(link: AsiLink, leg: Leg, gait: RouteGait, timeout_s: float,
+              listener: LaserListener | None) -> None:
+    """One leg, planned from where the feet are now (on the course's description or the
+    laser's map), streamed to its end."""
     if timeout_s <= 0.0:
         raise Refused(f'no time left for the leg to {leg.gate}')
     origin, heading = link.feet()
     try:
-        plan = leg_plan(leg, origin, heading, gait, BLOCKS, course_height_m)
-    except (WalkingError, CourseError) as err:
+        if listener is None:
+            plan = leg_plan(leg, origin, heading, gait, BLOCKS, course_height_m)
+        else:
+            seen = listener.snapshot()
+            ground = PlanningGround(seen)
+            plan = leg_plan(leg, origin, heading, gait, (), ground, seen.grid.obstacle_xy())
+            _print_map_figures(leg, plan, ground)
+    except (WalkingError, CourseError, ValueError) as err:
         raise Refused(f'no route to {leg.gate} from ({origin[0]:.2f}, {origin[1]:.2f}): '
                       f'{err}') from None
     print(f'{PROG}: to {leg.gate} from ({origin[0]:.2f}, {origin[1]:.2f}): {len(plan)} steps',
@@ -161,3 +190,17 @@ def _walk_leg(link: AsiLink, leg: Leg, gait: RouteGait, timeout_s: float) -> Non
         hint = refusal_hint(state.behavior_feedback.status_flags, state.current_behavior)
         raise Refused(f'the walk to {leg.gate} {client.outcome.value} after '
                       f'{client.steps_taken} of {len(plan)} steps ({hint})')
+
+
+def _print_map_figures(leg: Leg, plan: list, ground: PlanningGround) -> None:
+    """The laser map's figures for a leg planned on it: its points, the planner's fallbacks
+    to the nearest seen ground, and its error at the chosen footsteps against the course's
+    description (a measurement: the plan does not read the description)."""
+    asked, fallbacks, farthest = ground.asked, ground.fallbacks, ground.farthest_m
+    known, errors = footstep_errors(plan, ground)
+    size = np.abs(errors) if len(errors) else np.zeros(1)
+    print(f'{PROG}: laser map for {leg.gate}: {len(ground.map.points)} points; '
+          f'{known} of {len(plan)} footsteps on seen ground, {fallbacks} of {asked} heights '
+          f'the nearest seen (up to {farthest:.2f} m away); error at the footsteps '
+          f'p50 {np.percentile(size, 50) * 100:.1f} cm, p95 {np.percentile(size, 95) * 100:.1f} '
+          f'cm, max {size.max() * 100:.1f} cm', flush=True)

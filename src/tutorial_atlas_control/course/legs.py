@@ -19,6 +19,8 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
+import numpy as np
+
 from tutorial_atlas_control.course.errors import CourseError
 from tutorial_atlas_control.course.hill_way import gentle_path
 from tutorial_atlas_control.course.rubble_way import clear_path
@@ -89,17 +91,17 @@ def legs_ahead(x_m: float, y_m: float, to_gate: str = GATES[-1].name) -> tuple[L
     return tuple(legs)
 
 
-def leg_waypoints(leg: Leg, x_m: float, y_m: float, blocks: Sequence[Block]
-                  ) -> tuple[tuple[float, float], ...]:
+def leg_waypoints(leg: Leg, x_m: float, y_m: float, blocks: Sequence[Block],
+                  obstacles: np.ndarray | None = None) -> tuple[tuple[float, float], ...]:
     """The waypoints a walker at (x, y) walks for `leg`: its own, across the rubble a way
-    around `blocks` to its last one (clear_path), or over the hills a way on their gentle
-    ground (gentle_path).
+    around `blocks` and the points of `obstacles` (clear_path) to its last one, or over the
+    hills a way on their gentle ground (gentle_path).
 
     Raises:
         CourseError: no way around the blocks, or none over gentle ground.
     """
     if leg.clear_of_blocks:
-        return clear_path(blocks, (x_m, y_m), leg.waypoints[-1])
+        return clear_path(blocks, (x_m, y_m), leg.waypoints[-1], obstacles=obstacles)
     if leg.over_hills:
         return gentle_path((x_m, y_m), leg.waypoints[-1])
     return leg.waypoints

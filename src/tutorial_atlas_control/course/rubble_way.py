@@ -17,6 +17,7 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from tutorial_atlas_control.course.errors import CourseError
 from tutorial_atlas_control.course.grid_path import a_star, cells_on_line, shortened
@@ -116,9 +117,11 @@ def gate_posts() -> list[np.ndarray]:
 
 
 def clear_path(blocks: Sequence[Block], start: Point, goal: Point,
-               clearance_m: float = CLEARANCE_M) -> tuple[Point, ...]:
+               clearance_m: float = CLEARANCE_M, obstacles: np.ndarray | None = None
+               ) -> tuple[Point, ...]:
     """Waypoints from `start` (excluded) to `goal` (the last one) whose straight lines keep
-    `clearance_m` from every block and gate post (from a start nearer one than that, the
+    `clearance_m` from every block, gate post and point of `obstacles` ((n, 2) world x, y:
+    what a walker's sensors took for obstacles) (from a start nearer one than that, the
     first goes straight to the nearest place that is not).
 
     Raises:
@@ -132,6 +135,10 @@ def clear_path(blocks: Sequence[Block], start: Point, goal: Point,
     nearest_m = np.full(grid_x.shape, np.inf)
     for polygon in [block_footprint(block) for block in blocks] + gate_posts():
         nearest_m = np.minimum(nearest_m, distance_to_polygon(polygon, grid_x, grid_y))
+    if obstacles is not None and len(obstacles):
+        distance, _ = cKDTree(np.asarray(obstacles)[:, :2]).query(
+            np.stack((grid_x.ravel(), grid_y.ravel()), 1))
+        nearest_m = np.minimum(nearest_m, distance.reshape(grid_x.shape))
     free = nearest_m > clearance_m
 
     def cell(point: Point) -> tuple[int, int]:

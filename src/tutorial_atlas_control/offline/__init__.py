@@ -2,9 +2,10 @@
 and the replay of a recorded run (replay_score: a scored run's /vrc_score computed again on
 the replayed steps); world: the model and start they simulate (a VRC world by name, or the
 recorded run's); course_route: a course walker's streamed walk, leg by leg, on a VRC world,
-scored; course_variant: a finals' variant of the course's world (course/variants.py) compiled
-in memory; terrain_trial: straight walks on the course's kinds of ground one at a time (mud,
-slopes), over seeds; block_step: static steps onto a cinder block and off again, from a
+scored (planned on the world's ground or its laser's map: laser_terrain); course_variant: a
+finals' variant of the course's world (course/variants.py) compiled in memory;
+terrain_trial: straight walks on the course's kinds of ground one at a time (mud, slopes),
+over seeds; block_step: static steps onto a cinder block and off again, from a
 seeded start."""
 
 from tutorial_atlas_control.exports import lazy_exports
@@ -13,7 +14,9 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'asi_playback': ['AsiStream', 'read_asi_stream', 'run_asi_offline'],
     'block_step': ['PLANS', 'BlockRun', 'BlockStep', 'CinderBlock', 'block_model', 'block_plan',
                    'block_step_trial'],
-    'course_route': ['CourseWalk', 'LegFigures', 'course_walk', 'leg_plan'],
+    'course_route': ['PLANNING_GROUNDS', 'CourseWalk', 'LegFigures', 'course_walk', 'leg_plan'],
+    'laser_terrain': ['SPIN_RAD_S', 'LaserLegFigures', 'LaserTerrain', 'PlanningGround',
+                      'footstep_errors', 'unlike_plan'],
     'course_variant': ['BLOCK_CLEARANCE_M', 'MUD_FLOOR_GEOM', 'block_placement',
                        'highest_ground_m', 'variant_model'],
     'player': ['CommandLatency', 'DEFAULT_SETTLE_S', 'DEFAULT_START_AFTER_S', 'OfflineRunError',

@@ -44,11 +44,17 @@ from tutorial_atlas_control.course import (
     CourseVariant,
     Leg,
     ScoreRow,
+    course_height_m,
     leg_waypoints,
     legs_ahead,
 )
 from tutorial_atlas_control.msgs import AsiCommand, ManipulateParams, StepData
 from tutorial_atlas_control.offline.course_variant import variant_model
+from tutorial_atlas_control.offline.laser_terrain import (
+    LaserLegFigures,
+    LaserTerrain,
+    PlanningGround,
+)
 from tutorial_atlas_control.offline.world import named_world
 from tutorial_atlas_control.sim import (
     DEFAULT_GAINS_FILE,
@@ -71,7 +77,11 @@ from tutorial_atlas_control.walking import (
     route_steps,
 )
 
-__all__ = ['CourseWalk', 'LegFigures', 'course_walk', 'leg_plan']
+__all__ = ['PLANNING_GROUNDS', 'CourseWalk', 'LegFigures', 'course_walk', 'leg_plan']
+
+#: The grounds a walker plans on: the world's (offline: MuJoCo's rays on the world) or its
+#: head laser's height map (laser_terrain.py).
+PLANNING_GROUNDS = ('world', 'laser')
 
 #: The fall criterion is asked this often (ticks).
 FALL_CHECK_TICKS = 10
@@ -124,6 +134,9 @@ class CourseWalk:
     legs: tuple[LegFigures, ...] = ()
     #: The scorer's clock: sim time (s) from gate_0 to the last gate passed (0 before gate_0).
     course_clock_s: float = 0.0
+    terrain: str = 'world'
+    #: Each leg planned on the laser's map: its figures (terrain 'laser').
+    laser_legs: tuple[LaserLegFigures, ...] = ()
 
 
 class _Closest:
@@ -187,8 +200,9 @@ def _distance_to_segment(point: np.ndarray, start: np.ndarray, end: np.ndarray) 
 class _Streamer:
     """The client's side of each tick: the newest WALK before the step, the state after."""
 
-    def __init__(self, sim: AtlasSimulator, interface: AtlasSimInterface) -> None:
-        self.sim, self.interface = sim, interface
+    def __init__(self, sim: AtlasSimulator, interface: AtlasSimInterface,
+                 laser: LaserTerrain | None = None) -> None:
+        self.sim, self.interface, self.laser = sim, interface, laser
         self.client: WalkClient | None = None
         self.pending: list[Footstep] | None = None
         self.ground = GroundUnderFeet(sim.atlas, sim.data)
@@ -206,6 +220,8 @@ class _Streamer:
 
     def after_step(self) -> None:
         self.ticks += 1
+        if self.laser is not None:
+            self.laser.after_step()
         if self.client is not None:
             state = self.interface.state()
             steps = self.client.on_state(state.current_behavior,
@@ -230,20 +246,24 @@ def _feet(interface: AtlasSimInterface) -> tuple[tuple[float, float], float]:
 def course_walk(seed: int | None, legs: Sequence[Leg] | None = None, to_gate: str = 'gate_1',
                 world_name: str = 'vrc_task_2', gait: RouteGait | None = None,
                 walk_at_s: float = 3.0, stand_after_s: float = 3.0,
-                score_dir: Path | None = None, variant: CourseVariant | None = None
-                ) -> CourseWalk:
+                score_dir: Path | None = None, variant: CourseVariant | None = None,
+                terrain: str = 'world') -> CourseWalk:
     """Walk `legs` (None: the course's legs from the start to `to_gate`) on the world
     `world_name` (its start) changed as `variant` says (None: the world as shipped) from its
-    start perturbed by `seed` (None: unperturbed); score.log goes to `score_dir` (None: a
-    temporary directory)."""
+    start perturbed by `seed` (None: unperturbed), each leg planned on the `terrain` (one of
+    PLANNING_GROUNDS); score.log goes to `score_dir` (None: a temporary directory)."""
+    if terrain not in PLANNING_GROUNDS:
+        raise ValueError(f'terrain {terrain!r} is not one of {", ".join(PLANNING_GROUNDS)}')
     sim = _course_simulator(world_name, variant)
     if legs is None:
         pelvis = sim.data.xpos[sim.atlas.pelvis_body_id]
         legs = legs_ahead(float(pelvis[0]), float(pelvis[1]), to_gate)
     perturb_start(sim.atlas, sim.data, seed, on_ground=False)
     interface = AtlasSimInterface(sim, hold_at_start=True)
-    streamer = _Streamer(sim, interface)
+    laser = LaserTerrain(sim, seed or 0) if terrain == 'laser' else None
+    streamer = _Streamer(sim, interface, laser)
     rows: list[ScoreRow] = []
+    laser_legs: list[LaserLegFigures] = []
     figures: list[LegFigures] = []
     started = time.process_time()
     planned = taken = walked = 0
@@ -258,7 +278,7 @@ def course_walk(seed: int | None, legs: Sequence[Leg] | None = None, to_gate: st
                 break
             figures += [done] if (done := streamer.closest.start(leg.gate)) else []
             client = _walk_leg(tick, sim, interface, streamer, leg, gait,
-                               (variant or COURSE_VARIANTS[0]).blocks)
+                               (variant or COURSE_VARIANTS[0]).blocks, laser_legs)
             planned, taken = planned + len(client.plan), taken + client.steps_taken
             if client.outcome is not Outcome.WALKED:
                 break
@@ -280,7 +300,8 @@ def course_walk(seed: int | None, legs: Sequence[Leg] | None = None, to_gate: st
         pelvis_xy=(float(pelvis[0]), float(pelvis[1])), sim_s=sim.sim_time_ns / NS_PER_S,
         cpu_s=time.process_time() - started,
         variant=(variant or COURSE_VARIANTS[0]).name, legs=tuple(figures),
-        course_clock_s=0.0 if last is None else last.sim_since_gate0_ns / NS_PER_S)
+        course_clock_s=0.0 if last is None else last.sim_since_gate0_ns / NS_PER_S,
+        terrain=terrain, laser_legs=tuple(laser_legs))
 
 
 def _course_simulator(world_name: str, variant: CourseVariant | None) -> AtlasSimulator:
@@ -294,9 +315,11 @@ def _course_simulator(world_name: str, variant: CourseVariant | None) -> AtlasSi
 
 
 def leg_plan(leg: Leg, origin: tuple[float, float], heading_rad: float, gait: RouteGait,
-             blocks: Sequence[Block], ground: HeightField) -> list[Footstep]:
+             blocks: Sequence[Block], ground: HeightField,
+             obstacles: np.ndarray | None = None) -> list[Footstep]:
     """A leg's steps from feet side by side at `origin` facing `heading_rad`: its waypoints
-    (around `blocks` across the rubble, on gentle ground over the hills: leg_waypoints), the
+    (around `blocks` and the points of `obstacles` (n, 2) across the rubble, on gentle
+    ground over the hills: leg_waypoints), the
     corners among the blocks turned on the spot, the straight runs fitted to `ground` when
     the gait says so (the offline walker's world, the live one's course description).
 
@@ -306,19 +329,27 @@ def leg_plan(leg: Leg, origin: tuple[float, float], heading_rad: float, gait: Ro
     """
     if leg.clear_of_blocks:  # around blocks: the corners turned on the spot
         gait = gait.turning_in_place()
-    return route_steps(origin, heading_rad, leg_waypoints(leg, *origin, blocks), gait,
-                       ground=ground if gait.fit_ground else None)
+    return route_steps(origin, heading_rad, leg_waypoints(leg, *origin, blocks, obstacles),
+                       gait, ground=ground if gait.fit_ground else None)
 
 
 def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,
               streamer: _Streamer, leg: Leg, gait: RouteGait | None,
-              blocks: Sequence[Block]) -> WalkClient:
-    """One leg planned from where the feet are now (around `blocks` across the rubble),
-    streamed until it ends, the robot falls or the leg's time (SECONDS_PER_STEP a step)
-    runs out."""
+              blocks: Sequence[Block], laser_legs: list[LaserLegFigures]) -> WalkClient:
+    """One leg planned from where the feet are now (around `blocks` across the rubble) on
+    the world's ground or the laser's map (its figures appended to `laser_legs`), streamed
+    until it ends, the robot falls or the leg's time (SECONDS_PER_STEP a step) runs out."""
     origin, heading = _feet(interface)
-    plan = leg_plan(leg, origin, heading, gait or RouteGait(), blocks,
-                    streamer.ground.ground.height_m)
+    gait = gait or RouteGait()
+    if streamer.laser is None:
+        plan = leg_plan(leg, origin, heading, gait, blocks, streamer.ground.ground.height_m)
+    else:
+        ground = PlanningGround(streamer.laser.map)
+        plan = leg_plan(leg, origin, heading, gait, (), ground,
+                        streamer.laser.map.grid.obstacle_xy())
+        laser_legs.append(streamer.laser.leg_figures(
+            leg.gate, plan, leg_plan(leg, origin, heading, gait, blocks, course_height_m),
+            ground))
     client = streamer.client = WalkClient(plan, streaming=True)
     limit_ns = sim.sim_time_ns + math.floor(len(plan) * SECONDS_PER_STEP * NS_PER_S)
     while client.outcome is None and streamer.fell_at_s is None \

@@ -5,7 +5,7 @@ frame, the stereo cameras, the head's IMU); spindle: `hokuyo_joint`, simulated b
 model as DRCSim's plugin drove it (its PID, its limits); laser: the Hokuyo's scans by
 MuJoCo's ray queries, with seeded noise (heightfield_march: where rays meet a
 heightfield, cheaper than MuJoCo's test); head: their messages as wire bytes, for the
-stepping loop and offline runs.
+stepping loop and offline runs; height_map: the ground's heights from the laser's scans.
 """
 
 from tutorial_atlas_control.exports import lazy_exports
@@ -19,4 +19,5 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'heightfield_march': ['BISECT_TOL_M', 'MARCH_STEP_M', 'TILE_CELLS', 'Heightfield'],
     'laser': ['COLLISION_GROUPS', 'HOKUYO', 'HokuyoLaser', 'LaserSpec'],
     'head': ['HeadSensors'],
+    'height_map': ['GroundGrid', 'HeightMap', 'HeightMapSpec', 'ground_grid', 'scan_points'],
 })

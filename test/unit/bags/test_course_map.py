@@ -205,3 +205,19 @@ def test_scan_cloud_needs_the_course_map_and_scans(course_bag: Path, tmp_path: P
     out, err = capsys.readouterr()
     assert out == '' and f'has no {topics.LASER_SCAN}' in err
     assert not (tmp_path / 'none.png').exists()
+
+
+def test_laser_map_option_maps_the_scans_and_needs_them(course_bag: Path, tmp_path: Path,
+                                                        capsys: pytest.CaptureFixture[str]
+                                                        ) -> None:
+    """--laser-map prints the run's scans as a height map at its WALK footsteps (this run
+    teleports: none asked for); a bag without scans is one line, no summary."""
+    capsys.readouterr()
+    assert main([str(course_bag), '--laser-map']) == 0
+    out, _ = capsys.readouterr()
+    assert 'laser map: ' in out and '0 of 0 footsteps asked for on seen ground' in out
+    bare = write_bag(tmp_path / 'no_scans.bag', [_course_config(0.0)] + [
+        odometry(t_s, 0.3, x_m=-3.0, y_m=-38.0) for t_s in np.arange(0.0, 1.0, 0.01)])
+    assert main([str(bare), '--laser-map']) == 1
+    out, err = capsys.readouterr()
+    assert out == '' and f'has no {topics.LASER_SCAN}' in err
