@@ -127,7 +127,13 @@ class SimControls:
                       f'for {self.sim.time_to_unpin_s} s)')
 
     def reset_simulation(self) -> None:
+        """/gazebo/reset_simulation. The commands received before it are applied first, as
+        DRCSim applied each on arrival, so that their stamps (of the rewound timeline) are
+        forgotten with the rest: a controller's answer to the state published before the
+        first step (stamped 0, "now" by DRCSim's rule) that waited, paused, for the first
+        step after a reset made that step's command age 0 instead of one step."""
         with self.lock:
+            self.inbox.apply_pending()
             self.sim.reset_simulation()
             self.inbox.forget_stamp()
             self.watch.rearm()

@@ -248,6 +248,23 @@ def test_with_the_window_every_step_obeys_the_answer_to_the_state_before(
     assert delays[-1][1] == pytest.approx(49 * 0.0002)  # all in the same window
 
 
+def test_an_answer_received_before_a_reset_is_not_the_first_steps(
+        sim: AtlasSimulator) -> None:
+    """A controller's answer to the state published before the first step (stamped 0) that
+    arrived while paused, then /gazebo/reset_simulation: the steps after the reset are
+    answered each by the state before, the first's age one step (not 0, the stamp-0
+    command's "when applied": the rostest sync_lockstep once saw that)."""
+    loop, outbox, _, clock = make_sync_loop(sim)
+    loop.receive_command(atlas_bytes(0, 1, k_effort=full(255),
+                                     position=list(sim.joint_positions())),
+                         topics.ATLAS_COMMAND)
+    loop.reset_simulation()
+    echo = EchoController(loop, outbox, clock)
+    loop.gate.wait_for_command = echo.answer
+    loop.run(stops_after(20))
+    assert command_ages_ns(outbox) == [STEP_NS] * 20
+
+
 def test_the_state_is_sent_before_the_wait(sim: AtlasSimulator) -> None:
     # At real_time_factor 0 the loop batches sends (pacing.FLUSH_PERIOD_S); a wait with
     # the state still queued would wait for an answer to a state nobody received.
