@@ -115,18 +115,22 @@ class Heightfield:
         met = first_step >= 0
         first = first_step[met]
         near = np.where(first > 0, steps[np.maximum(first - 1, 0)], 0.0)
-        far = steps[first]
-        rays_met = rays[live[met]]
-        while far.size and float((far - near).max()) > BISECT_TOL_M:
-            middle = 0.5 * (near + far)
-            at = origin + middle[:, None] * rays_met
-            under = at[:, 2] <= self.height_m(at[:, 0], at[:, 1])
-            far = np.where(under, middle, far)
-            near = np.where(under, near, middle)
-        distance = 0.5 * (near + far)
+        distance = self.crossing_m(origin, rays[live[met]], near, steps[first])
         within = distance <= range_m
         result[live[met][within]] = distance[within]
         return result
+
+    def crossing_m(self, origin: np.ndarray, rays: np.ndarray, near: np.ndarray,
+                   far: np.ndarray) -> np.ndarray:
+        """Where each ray crosses under the surface (m along it), bisected to BISECT_TOL_M
+        between a distance above it (`near`) and one under it (`far`)."""
+        while far.size and float((far - near).max()) > BISECT_TOL_M:
+            middle = 0.5 * (near + far)
+            at = origin + middle[:, None] * rays
+            under = at[:, 2] <= self.height_m(at[:, 0], at[:, 1])
+            far = np.where(under, middle, far)
+            near = np.where(under, near, middle)
+        return 0.5 * (near + far)
 
     def _first_steps_under(self, origin: np.ndarray, rays: np.ndarray, reach: np.ndarray,
                            steps: np.ndarray) -> np.ndarray:
