@@ -1,8 +1,9 @@
 """A live walker's height map from the head laser: the spindle set spinning, every scan
-placed in the world by /tf (world -> hokuyo_link at the scan's stamp, then the URDF's
-head_hokuyo_frame) and added to a sensors/height_map.HeightMap with the pelvis's (x, y) of
-that stamp (its self filter). A planner reads a copy of the map taken under the lock, not
-the map the scans are still going into.
+placed in the world by /tf (world -> the scan's frame, head_hokuyo_frame, at its stamp: the
+spindle's hokuyo_link on /tf, the URDF's laser frame on /tf_static) and added to a
+sensors/height_map.HeightMap with the pelvis's (x, y) of that stamp (its self filter). A
+planner reads a copy of the map taken under the lock, not the map the scans are still going
+into.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ from sensor_msgs.msg import LaserScan
 from std_msgs.msg import Float64
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.sensors import HOKUYO_FRAME, HOKUYO_LINK, HeightMap
+from tutorial_atlas_control.sensors import HeightMap
 
 __all__ = ['LaserListener']
 
@@ -47,8 +48,6 @@ class LaserListener:
         self.dropped = 0
         self.buffer = tf2_ros.Buffer(cache_time=rospy.Duration(30))
         self._listener = tf2_ros.TransformListener(self.buffer)
-        self._offset = np.array(HOKUYO_FRAME.xyz_m)
-        self._frame_rotation = HOKUYO_FRAME.rotation()
         self._spindle = rospy.Publisher(topics.SET_SPINDLE_SPEED, Float64, queue_size=1,
                                         latch=True)
         self._spindle.publish(Float64(spin_rad_s))
@@ -56,8 +55,8 @@ class LaserListener:
 
     def _on_scan(self, scan: LaserScan) -> None:
         try:
-            laser = self.buffer.lookup_transform(WORLD_FRAME, HOKUYO_LINK, scan.header.stamp,
-                                                 rospy.Duration(TF_WAIT_S))
+            laser = self.buffer.lookup_transform(WORLD_FRAME, scan.header.frame_id,
+                                                 scan.header.stamp, rospy.Duration(TF_WAIT_S))
             pelvis = self.buffer.lookup_transform(WORLD_FRAME, PELVIS_FRAME, scan.header.stamp,
                                                   rospy.Duration(TF_WAIT_S))
         except (tf2_ros.LookupException, tf2_ros.ExtrapolationException,
@@ -65,12 +64,10 @@ class LaserListener:
             self.dropped += 1
             return
         t, q = laser.transform.translation, laser.transform.rotation
-        rotation = _matrix(q.x, q.y, q.z, q.w)
-        origin = np.array([t.x, t.y, t.z]) + rotation @ self._offset
         angles = scan.angle_min + scan.angle_increment * np.arange(len(scan.ranges))
         where = pelvis.transform.translation
         with self.lock:
-            self.map.add_scan(origin, rotation @ self._frame_rotation, angles,
+            self.map.add_scan(np.array([t.x, t.y, t.z]), _matrix(q.x, q.y, q.z, q.w), angles,
                               np.asarray(scan.ranges, dtype=float), (where.x, where.y))
             self.scans += 1
 
