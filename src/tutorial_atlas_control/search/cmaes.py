@@ -24,15 +24,17 @@ import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import cma
 import numpy as np
 
 from tutorial_atlas_control.joints import JOINT_INDEX, JOINT_NAMES
 from tutorial_atlas_control.search.objectives import Objective
 from tutorial_atlas_control.search.runs import RunSpec, SweepError
 from tutorial_atlas_control.search.sweep import SweepOutcome, atomic_write
+
+if TYPE_CHECKING:
+    import cma
 
 __all__ = ['Parameter', 'SearchProblem', 'SearchResult', 'parse_parameter', 'run_search',
            'runs_per_candidate']
@@ -222,6 +224,8 @@ class SearchProblem:
         # cma takes seed 0 as "from the clock": the user's seed is shifted by one.
         options = {'seed': self.seed + 1, 'popsize': self.popsize, 'CMA_stds': self.steps(),
                    'verbose': -9, 'verb_log': 0, 'verb_disp': 0}
+        import cma  # noqa: PLC0415 - scipy.stats behind it: --help and bad input skip it
+
         return cma.CMAEvolutionStrategy(np.zeros(len(self.parameters)), 1.0, options)
 
 

@@ -25,7 +25,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from distributed import Client, LocalCluster, as_completed
 from tqdm import tqdm
 
 from tutorial_atlas_control.search.runs import (
@@ -138,6 +137,9 @@ class SweepOutcome:
 
 def _client(scheduler: str | None, workers: int) -> Any:
     """A Dask client: on `scheduler`, or on a new local cluster of `workers` processes."""
+    # distributed imported here: half a second (matplotlib among it) --help need not pay.
+    from distributed import Client, LocalCluster  # noqa: PLC0415
+
     if scheduler is not None:
         try:
             return Client(scheduler, timeout=CONNECT_TIMEOUT_S)
@@ -211,6 +213,8 @@ class SweepEngine:
         client = self.client
         futures = [] if client is None else [client.submit(run, spec, pure=False)
                                              for spec in specs]
+        if client is not None:
+            from distributed import as_completed  # noqa: PLC0415
         finished = ((run(spec) for spec in specs) if client is None
                     else (future.result() for future in as_completed(futures)))
         bar = _bar(len(specs), progress)
