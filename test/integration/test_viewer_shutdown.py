@@ -31,7 +31,7 @@ NODE = '/atlas_sim'
 STOP_AT_S = 2.0
 #: Fresh launches stopped per way: the segfault is a race between two threads at the
 #: node's exit, which a single stop often misses.
-ROUNDS = 3
+ROUNDS = 2
 #: roslaunch's report of the node's end, on its screen (the required node ended by itself;
 #: no exit code: "finished cleanly") ...
 DIED = re.compile(r'REQUIRED process \[atlas_sim-\d+\] has died!\s*process has '
