@@ -21,6 +21,8 @@ import math
 import mujoco
 import numpy as np
 
+from tutorial_atlas_control.grids import grid_bilinear
+
 __all__ = ['BISECT_TOL_M', 'MARCH_STEP_M', 'TILE_CELLS', 'Heightfield']
 
 #: A heightfield is marched in steps of this length (m; the course's cells are 0.195 m),
@@ -73,13 +75,8 @@ class Heightfield:
         col = (x - self.centre[0] + self.half_x) / (2.0 * self.half_x) * (cols - 1)
         row = (y - self.centre[1] + self.half_y) / (2.0 * self.half_y) * (rows - 1)
         inside = (col >= 0.0) & (col <= cols - 1) & (row >= 0.0) & (row <= rows - 1)
-        col, row = np.clip(col, 0.0, cols - 1.0), np.clip(row, 0.0, rows - 1.0)
-        c0 = np.minimum(col.astype(int), cols - 2)
-        r0 = np.minimum(row.astype(int), rows - 2)
-        fc, fr = col - c0, row - r0
-        h = self.heights
-        surface = ((h[r0, c0] * (1.0 - fc) + h[r0, c0 + 1] * fc) * (1.0 - fr)
-                   + (h[r0 + 1, c0] * (1.0 - fc) + h[r0 + 1, c0 + 1] * fc) * fr)
+        surface = grid_bilinear(self.heights, np.clip(row, 0.0, rows - 1.0),
+                                np.clip(col, 0.0, cols - 1.0))
         return np.where(inside, surface, -np.inf)
 
     def tile_highest_m(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
