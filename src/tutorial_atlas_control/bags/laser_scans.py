@@ -17,6 +17,8 @@ at the footsteps p95 2.0 cm, against 2 mm from /tf).
 
 from __future__ import annotations
 
+import copy
+import math
 import struct
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -42,7 +44,8 @@ from tutorial_atlas_control.sensors import (
 from tutorial_atlas_control.units import NS_PER_S
 
 __all__ = ['LaserScans', 'hokuyo_angles', 'laser_height_map', 'map_error_lines',
-           'placed_scans', 'read_laser_scans', 'scan_cloud', 'spindle_angles']
+           'placed_scans', 'read_laser_scans', 'scan_cloud', 'spindle_angles',
+           'spindle_command_steps']
 
 _HEADER = struct.Struct('<III')
 _U32 = struct.Struct('<I')
@@ -52,6 +55,14 @@ _QUATERNION = struct.Struct('<4d')
 PELVIS_LINK = 'pelvis'
 #: The physics step the spindle is simulated at (s): the simulator's.
 SPINDLE_STEP_S = 0.001
+#: How far (s) from its record time a spindle command may have first acted: the record
+#: time is the recorder's receipt on its clock (94 ms off on a live bag).
+COMMAND_SEARCH_S = 1.0
+#: The samples after a candidate step that must match the spindle it would give (s).
+COMMAND_CHECK_S = 0.06
+#: A recorded angle and the one simulated are the same within this (rad): /tf holds the
+#: angle as a quaternion's half angle, float64.
+SAME_ANGLE_RAD = 1e-9
 
 
 @dataclass(frozen=True)
@@ -164,6 +175,70 @@ def spindle_angles(scans: LaserScans) -> np.ndarray:
             now_ns += step_ns
         angles[row] = spindle.angle
     return angles
+
+
+def spindle_command_steps(scans: LaserScans) -> list[tuple[int, float]] | None:
+    """When each recorded spindle command first acted: (the sim time (ns) at the end of the
+    first spindle step that had its speed, the speed), in order, found where the spindle
+    simulated from rest at sim time 0 gives the recorded /tf's angles; None when the bag
+    has no /tf samples of the spindle or no step within COMMAND_SEARCH_S of a command's
+    record time gives them. Ignored commands (NaN) are left out."""
+    if scans.spindle_samples is None:
+        return None
+    stamps, angles = scans.spindle_samples
+    step_ns = round(SPINDLE_STEP_S * NS_PER_S)
+    search_ns = round(COMMAND_SEARCH_S * NS_PER_S)
+    spindle, now_ns = Spindle(SPINDLE_STEP_S), 0  # the base: the commands found so far
+    found: list[tuple[int, float]] = []
+    for record_ns, value in sorted(scans.spindle_commands):
+        speed = spindle_command(value).speed
+        if speed is None:
+            continue
+        first_ns = max(now_ns + step_ns, (record_ns - search_ns) // step_ns * step_ns)
+        acted = None
+        for end_ns in range(first_ns, record_ns + search_ns + 1, step_ns):
+            while now_ns < end_ns - step_ns:  # the base up to the candidate step's start
+                spindle.step()
+                now_ns += step_ns
+                if not _matches(stamps, angles, now_ns, spindle.angle):
+                    return None  # the recorded angle left the base before any candidate
+            trial = copy.copy(spindle)
+            trial.command(speed)
+            if _follows(trial, end_ns, stamps, angles, step_ns):
+                acted = end_ns
+                break
+        if acted is None:
+            return None
+        spindle.command(speed)
+        found.append((acted, speed))
+    return found
+
+
+def _matches(stamps: np.ndarray, angles: np.ndarray, at_ns: int, angle_rad: float) -> bool:
+    """Whether a recorded sample at `at_ns`, if there is one, holds `angle_rad`."""
+    row = int(np.searchsorted(stamps, at_ns))
+    if row == len(stamps) or stamps[row] != at_ns:
+        return True
+    return abs(math.remainder(float(angles[row]) - angle_rad, 2.0 * math.pi)) < SAME_ANGLE_RAD
+
+
+def _follows(trial: Spindle, end_ns: int, stamps: np.ndarray, angles: np.ndarray,
+             step_ns: int) -> bool:
+    """Whether `trial`, stepped from the step ending at `end_ns`, gives every recorded
+    sample over the next COMMAND_CHECK_S (at least one)."""
+    until_ns = end_ns + round(COMMAND_CHECK_S * NS_PER_S)
+    checked = 0
+    at_ns = end_ns
+    while at_ns <= until_ns:
+        trial.step()
+        row = int(np.searchsorted(stamps, at_ns))
+        if row < len(stamps) and stamps[row] == at_ns:
+            if abs(math.remainder(float(angles[row]) - trial.angle, 2.0 * math.pi)) \
+                    >= SAME_ANGLE_RAD:
+                return False
+            checked += 1
+        at_ns += step_ns
+    return checked > 0
 
 
 def _between(samples: tuple[np.ndarray, np.ndarray], stamp_ns: np.ndarray) -> np.ndarray:

@@ -621,7 +621,12 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
     steps, effort = all_steps[rows], recording.effort_nm[rows]
     probe = _OdomProbe(odom_steps, reset_step, int(steps[-1]))
     probe.score = _score_replay(recording, sim, reset_step, warnings)
-    probe.scans = ScanReplay.of(sim, recording.scans, config.sensor_seed)
+    scans = recording.scans
+    if scans is not None and scans.spindle_commands and reset_step != 0:
+        warnings.append(f'{topics.LASER_SCAN} is not compared: the spindle was commanded and '
+                        'the replayed try begins at a reset, where its speed is not recorded.')
+        scans = None
+    probe.scans = ScanReplay.of(sim, scans, config.sensor_seed)
     inputs = _InputQueue(recording.inputs)
     prefix = _recreate_prefix(sim, config, reset_step, int(steps[0]), effort[0], probe, warnings,
                               inputs)
