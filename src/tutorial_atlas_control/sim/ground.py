@@ -192,6 +192,7 @@ class Ground:
         self._loose_ids = np.array([c.geom for c in self._loose], dtype=int)
         self._loose_r2 = np.array([c.rbound for c in self._loose]) ** 2
         self._loose_aabb = np.array([c.aabb for c in self._loose]).reshape(-1, 6)
+        self._loose_bodies = np.unique(model.geom_bodyid[self._loose_ids])
         self._static_xy = np.array([c.pos[:2] for c in self._static]).reshape(-1, 2)
         self._static_r2 = np.array([c.rbound for c in self._static]) ** 2
         self._static_disc = [(*self._static_xy[i].tolist(), self._static_r2[i].item())
@@ -340,10 +341,11 @@ class Ground:
         return self._last_height_m
 
     def _loose_poses(self) -> bytes:
-        """The loose geoms' world poses now, as bytes (what a height depends on besides the
-        point: the welded geoms never move)."""
-        ids, data = self._loose_ids, self._loose_data
-        return data.geom_xpos[ids].tobytes() + data.geom_xmat[ids].tobytes()
+        """The loose geoms' bodies' world poses now (xpos, xquat), as bytes: what a height
+        depends on besides the point (the welded geoms never move; a geom's pose is its
+        body's composed with a fixed offset). Bodies: 30 on the course, not 150 geoms."""
+        bodies, data = self._loose_bodies, self._loose_data
+        return data.xpos[bodies].tobytes() + data.xquat[bodies].tobytes()
 
     def normal(self, x: float, y: float) -> np.ndarray:
         """The ground's unit normal (3,) under world (x, y); NaN over no ground."""

@@ -212,3 +212,20 @@ def test_clear_above_is_the_bound_on_all_ground() -> None:
     data.qpos[2] = 6.0  # a block lifted over the bar: the bound follows it
     mujoco.mj_forward(model, data)
     assert ground.top_m() > 6.0 and not ground.clear_above(4.7, 0.5)
+
+
+def test_a_block_turned_in_place_is_seen_turned() -> None:
+    """The ground keeps its last answer with the question: a block turned about its
+    centre (the same position) is a new question, whose answer is the turned block's."""
+    model = world('<geom type="plane" size="0 0 1"/>'
+                  '<body name="block" pos="0 0 0.1"><freejoint/>'
+                  '<geom type="box" size="0.2 0.05 0.1" mass="5"/></body>')
+    data = mujoco.MjData(model)
+    data.qpos[:3] = (0.0, 0.0, 0.1)
+    mujoco.mj_forward(model, data)
+    ground = Ground(model, data)
+    assert ground.height_m(0.15, 0.0) == pytest.approx(0.2, abs=1e-9)
+    data.qpos[3:7] = (math.cos(math.pi / 4), 0.0, 0.0, math.sin(math.pi / 4))  # 90 deg about z
+    mujoco.mj_forward(model, data)
+    assert ground.height_m(0.15, 0.0) == pytest.approx(0.0, abs=1e-9)
+    assert ground.height_m(0.0, 0.15) == pytest.approx(0.2, abs=1e-9)
