@@ -43,9 +43,9 @@ LIBRARY_NAME = 'libtutorial_atlas_control_law.so'
 #: Set to a library path to use that one (or to a missing path to force numpy).
 LIBRARY_ENV = 'TAC_LAW_LIBRARY'
 #: What the callers do without the library (the end of the one warning).
-FALLBACK = ('using the numpy controller law (same torques, slower), the Python swing-foot '
-            'servo and the Python balance estimator, statics and whole-body tick, and the '
-            "laser's Python heightfield march")
+FALLBACK = ("using the numpy controller law (same torques, slower), the laser's numpy "
+            'heightfield march, the Python swing-foot servo and the Python balance estimator, '
+            'statics and whole-body tick')
 #: How the library names the function that returns sizeof(Struct).
 SIZEOF_PREFIX = 'tac_sizeof_'
 

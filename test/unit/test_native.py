@@ -73,9 +73,9 @@ def test_a_library_whose_sizes_differ_is_refused_with_one_warning(
     expected = (rf'^{re.escape(str(path))} does not match this code \(sizeof\(AtlasCopy\) is '
                 rf'{ctypes.sizeof(native.AtlasCopy)} bytes there, {ctypes.sizeof(_LongerCopy)}'
                 r' in tutorial_atlas_control.native\); rebuild it \(`make setup`\); '
-                r'using the numpy controller law \(same torques, slower\), the Python '
-                r'swing-foot servo and the Python balance estimator, statics and '
-                r"whole-body tick, and the laser's Python heightfield march$")
+                r"using the numpy controller law \(same torques, slower\), the laser's "
+                r'numpy heightfield march, the Python swing-foot servo and the Python '
+                r'balance estimator, statics and whole-body tick$')
     with pytest.warns(RuntimeWarning, match=expected) as caught:
         assert native.load_library() is None
         sim = AtlasSimulator(atlas_model.load_model(), load_gains_yaml(CONFIG))
