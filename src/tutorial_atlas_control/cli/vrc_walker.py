@@ -45,13 +45,16 @@ from tutorial_atlas_control.course import (
     legs_ahead,
 )
 from tutorial_atlas_control.offline import (
+    MAX_LOOKS,
     PLANNING_GROUNDS,
     SPIN_RAD_S,
     PlanningGround,
     footstep_errors,
     leg_plan,
+    level_footstep,
+    seen_prefix,
 )
-from tutorial_atlas_control.walking import RouteGait, WalkingError
+from tutorial_atlas_control.walking import Footstep, RouteGait, WalkingError
 
 PROG = 'vrc_walker.py'
 #: How long (s, wall time) /vrc_score may take to report a gate the walk has passed.
@@ -165,31 +168,48 @@ def _walk_course(link: AsiLink, to_gate: str, gait: RouteGait, timeout_s: float,
 def _walk_leg(link: AsiLink, leg: Leg, gait: RouteGait, timeout_s: float,
               listener: LaserListener | None) -> None:
     """One leg, planned from where the feet are now (on the course's description or the
-    laser's map), streamed to its end."""
-    if timeout_s <= 0.0:
-        raise Refused(f'no time left for the leg to {leg.gate}')
+    laser's map), streamed to its end; on the map, only as far as it has seen, then,
+    having stood LEG_PAUSE_S looking, the rest planned again (offline.seen_prefix)."""
+    deadline = time.monotonic() + timeout_s
+    for look in range(MAX_LOOKS):
+        if look:
+            link.hold(LEG_PAUSE_S)
+        if deadline <= time.monotonic():
+            raise Refused(f'no time left for the leg to {leg.gate}')
+        plan, walked = _plan_leg(link, leg, gait, listener)
+        client = WalkClient(plan[:walked], streaming=True)
+        link.walk(client, deadline - time.monotonic())
+        if client.outcome is not Outcome.WALKED:
+            state = link.last
+            assert state is not None  # connected
+            hint = refusal_hint(state.behavior_feedback.status_flags, state.current_behavior)
+            raise Refused(f'the walk to {leg.gate} {client.outcome.value} after '
+                          f'{client.steps_taken} of {walked} steps ({hint})')
+        if walked == len(plan):
+            return
+
+
+def _plan_leg(link: AsiLink, leg: Leg, gait: RouteGait,
+              listener: LaserListener | None) -> tuple[list[Footstep], int]:
+    """The leg's steps from where the feet are, and how many to walk before looking again."""
     origin, heading = link.feet()
     try:
         if listener is None:
             plan = leg_plan(leg, origin, heading, gait, BLOCKS, course_height_m)
+            walked = len(plan)
         else:
             seen = listener.snapshot()
             ground = PlanningGround(seen)
             plan = leg_plan(leg, origin, heading, gait, (), ground, seen.grid.obstacle_xy())
             _print_map_figures(leg, plan, ground)
+            walked = seen_prefix(plan, seen, level_footstep(ground))
     except (WalkingError, CourseError, ValueError) as err:
         raise Refused(f'no route to {leg.gate} from ({origin[0]:.2f}, {origin[1]:.2f}): '
                       f'{err}') from None
-    print(f'{PROG}: to {leg.gate} from ({origin[0]:.2f}, {origin[1]:.2f}): {len(plan)} steps',
-          flush=True)
-    client = WalkClient(plan, streaming=True)
-    link.walk(client, timeout_s)
-    if client.outcome is not Outcome.WALKED:
-        state = link.last
-        assert state is not None  # connected
-        hint = refusal_hint(state.behavior_feedback.status_flags, state.current_behavior)
-        raise Refused(f'the walk to {leg.gate} {client.outcome.value} after '
-                      f'{client.steps_taken} of {len(plan)} steps ({hint})')
+    then = '' if walked == len(plan) else f', walking {walked} before looking again'
+    print(f'{PROG}: to {leg.gate} from ({origin[0]:.2f}, {origin[1]:.2f}): {len(plan)} steps'
+          f'{then}', flush=True)
+    return plan, walked
 
 
 def _print_map_figures(leg: Leg, plan: list, ground: PlanningGround) -> None:

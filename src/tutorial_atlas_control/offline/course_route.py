@@ -54,6 +54,8 @@ from tutorial_atlas_control.offline.laser_terrain import (
     LaserLegFigures,
     LaserTerrain,
     PlanningGround,
+    level_footstep,
+    seen_prefix,
 )
 from tutorial_atlas_control.offline.world import named_world
 from tutorial_atlas_control.sim import (
@@ -83,6 +85,8 @@ __all__ = ['PLANNING_GROUNDS', 'CourseWalk', 'LegFigures', 'course_walk', 'leg_p
 #: head laser's height map (laser_terrain.py).
 PLANNING_GROUNDS = ('world', 'laser')
 
+#: A leg planned on the laser's map stops to look again at most this many times.
+MAX_LOOKS = 12
 #: The fall criterion is asked this often (ticks).
 FALL_CHECK_TICKS = 10
 #: A route's steps may take this long each, on average, before the run gives up (s).
@@ -277,9 +281,9 @@ def course_walk(seed: int | None, legs: Sequence[Leg] | None = None, to_gate: st
             if streamer.fell_at_s is not None:
                 break
             figures += [done] if (done := streamer.closest.start(leg.gate)) else []
-            client = _walk_leg(tick, sim, interface, streamer, leg, gait,
-                               (variant or COURSE_VARIANTS[0]).blocks, laser_legs)
-            planned, taken = planned + len(client.plan), taken + client.steps_taken
+            client, sent, stepped = _walk_leg(tick, sim, interface, streamer, leg, gait,
+                                              (variant or COURSE_VARIANTS[0]).blocks, laser_legs)
+            planned, taken = planned + sent, taken + stepped
             if client.outcome is not Outcome.WALKED:
                 break
             walked += 1
@@ -335,27 +339,40 @@ def leg_plan(leg: Leg, origin: tuple[float, float], heading_rad: float, gait: Ro
 
 def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,
               streamer: _Streamer, leg: Leg, gait: RouteGait | None,
-              blocks: Sequence[Block], laser_legs: list[LaserLegFigures]) -> WalkClient:
+              blocks: Sequence[Block], laser_legs: list[LaserLegFigures]
+              ) -> tuple[WalkClient, int, int]:
     """One leg planned from where the feet are now (around `blocks` across the rubble) on
     the world's ground or the laser's map (its figures appended to `laser_legs`), streamed
-    until it ends, the robot falls or the leg's time (SECONDS_PER_STEP a step) runs out."""
-    origin, heading = _feet(interface)
+    until it ends, the robot falls or the leg's time (SECONDS_PER_STEP a step) runs out. On
+    the map, only as far as it has seen (seen_prefix): there the robot stands LEG_PAUSE_S,
+    looking, and the rest is planned again. Returns the last walk's client and the steps
+    sent and taken over the leg."""
     gait = gait or RouteGait()
-    if streamer.laser is None:
-        plan = leg_plan(leg, origin, heading, gait, blocks, streamer.ground.ground.height_m)
-    else:
-        ground = PlanningGround(streamer.laser.map)
-        plan = leg_plan(leg, origin, heading, gait, (), ground,
-                        streamer.laser.map.grid.obstacle_xy())
-        laser_legs.append(streamer.laser.leg_figures(
-            leg.gate, plan, leg_plan(leg, origin, heading, gait, blocks, course_height_m),
-            ground))
-    client = streamer.client = WalkClient(plan, streaming=True)
-    limit_ns = sim.sim_time_ns + math.floor(len(plan) * SECONDS_PER_STEP * NS_PER_S)
-    while client.outcome is None and streamer.fell_at_s is None \
-            and sim.sim_time_ns < limit_ns:
-        tick()
-    return client
+    sent = taken = 0
+    for look in range(MAX_LOOKS):
+        if look:  # stand and look at what the last part walked towards
+            _run_until(tick, sim, sim.sim_time_ns / NS_PER_S + LEG_PAUSE_S, streamer)
+        origin, heading = _feet(interface)
+        if streamer.laser is None:
+            plan = leg_plan(leg, origin, heading, gait, blocks, streamer.ground.ground.height_m)
+            walked = len(plan)
+        else:
+            ground = PlanningGround(streamer.laser.map)
+            plan = leg_plan(leg, origin, heading, gait, (), ground,
+                            streamer.laser.map.grid.obstacle_xy())
+            laser_legs.append(streamer.laser.leg_figures(
+                leg.gate, plan, leg_plan(leg, origin, heading, gait, blocks, course_height_m),
+                ground))
+            walked = seen_prefix(plan, streamer.laser.map, level_footstep(ground))
+        client = streamer.client = WalkClient(plan[:walked], streaming=True)
+        limit_ns = sim.sim_time_ns + math.floor(walked * SECONDS_PER_STEP * NS_PER_S)
+        while client.outcome is None and streamer.fell_at_s is None \
+                and sim.sim_time_ns < limit_ns:
+            tick()
+        sent, taken = sent + walked, taken + client.steps_taken
+        if walked == len(plan) or client.outcome is not Outcome.WALKED:
+            break
+    return client, sent, taken
 
 
 def _run_until(tick: Tick, sim: AtlasSimulator, until_s: float, streamer: _Streamer) -> None:

@@ -16,7 +16,7 @@ description (course_height_m), beside the plan the world's ground would have giv
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,16 +26,24 @@ from tutorial_atlas_control.course import course_height_m
 from tutorial_atlas_control.sensors import HeightMap, HeightMapSpec, HokuyoLaser, Spindle
 from tutorial_atlas_control.sim import AtlasSimulator
 from tutorial_atlas_control.stepping import steps_between
-from tutorial_atlas_control.walking import Footstep
+from tutorial_atlas_control.walking import Footstep, GroundGait, sole_fit
 
-__all__ = ['SPIN_RAD_S', 'LaserLegFigures', 'LaserTerrain', 'PlanningGround',
-           'footstep_errors', 'unlike_plan']
+__all__ = ['LOOK_AGAIN_AFTER_STEPS', 'LOOK_AGAIN_SLOPE_RAD', 'SPIN_RAD_S', 'LaserLegFigures',
+           'LaserTerrain', 'PlanningGround', 'footstep_errors', 'level_footstep',
+           'seen_prefix', 'unlike_plan']
 
 #: The spindle's speed (rad/s): half a turn (every direction once) in 3.1 s, the scans
 #: 25 mrad apart, 7.5 cm at 3 m.
 SPIN_RAD_S = 1.0
 #: A fallback farther than this (m) from the nearest known cell is warned about.
 FAR_FALLBACK_M = 0.5
+#: A leg planned on the map is walked at least this many steps before it may stop to look
+#: again: the map never sees the ground under and beside the robot (its self filter).
+LOOK_AGAIN_AFTER_STEPS = 8
+#: It stops to look again only where both feet stand on ground this level (rad) or less,
+#: one plane within 1 cm under each sole (the course's curved ground: walking/route.py).
+LOOK_AGAIN_SLOPE_RAD = math.radians(6.0)
+_STANDING_FIT = GroundGait(flat_m=0.01)
 
 
 class PlanningGround:
@@ -83,6 +91,36 @@ class LaserLegFigures:
     farthest_fallback_m: float
     points: int
     steps_unlike_world: int = 0
+
+
+def seen_prefix(plan: Sequence[Footstep], height_map: HeightMap,
+                level: Callable[[Footstep], bool] | None = None) -> int:
+    """How many of `plan`'s steps to walk before stopping to look again and plan the rest:
+    all when every footstep from the LOOK_AGAIN_AFTER_STEPS'th on stands on ground the map
+    has seen; else up to the last step before the first that does not, going back to where
+    the last two footsteps are both `level` (None: anywhere), never fewer than
+    LOOK_AGAIN_AFTER_STEPS (then, with no level place, up to the unseen step anyway). The
+    map's fallback (the nearest seen cell's height) is fine near what it saw and off by
+    decimetres metres away: live, the hills leg planned at gate_2 had 65 of 183 footsteps
+    on unseen ground, up to 6.7 m from it, 25 cm off, and fell after 86 steps."""
+    unseen = next((k for k in range(LOOK_AGAIN_AFTER_STEPS, len(plan))
+                   if not math.isfinite(height_map.height_m(plan[k].x_m, plan[k].y_m))), None)
+    if unseen is None:
+        return len(plan)
+    if level is None:
+        return unseen
+    stop = next((k for k in range(unseen, LOOK_AGAIN_AFTER_STEPS, -1)
+                 if level(plan[k - 1]) and level(plan[k - 2])), None)
+    return unseen if stop is None else stop
+
+
+def level_footstep(ground: Callable[[float, float], float]) -> Callable[[Footstep], bool]:
+    """Whether a footstep's sole stands on one plane of `ground` within
+    LOOK_AGAIN_SLOPE_RAD of level (walking/ground_strides.sole_fit)."""
+    def level(step: Footstep) -> bool:
+        fit = sole_fit(ground, step.x_m, step.y_m, step.yaw_rad, _STANDING_FIT)
+        return fit.flat and fit.slope_rad <= LOOK_AGAIN_SLOPE_RAD
+    return level
 
 
 def footstep_errors(steps: Sequence[Footstep], ground: PlanningGround
