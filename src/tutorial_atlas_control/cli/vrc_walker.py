@@ -43,6 +43,7 @@ from tutorial_atlas_control.course import (
     Leg,
     course_height_m,
     legs_ahead,
+    rest_of_leg,
 )
 from tutorial_atlas_control.offline import (
     MAX_LOOKS,
@@ -171,12 +172,14 @@ def _walk_leg(link: AsiLink, leg: Leg, gait: RouteGait, timeout_s: float,
     laser's map), streamed to its end; on the map, only as far as it has seen, then,
     having stood LEG_PAUSE_S looking, the rest planned again (offline.seen_prefix)."""
     deadline = time.monotonic() + timeout_s
+    began, _ = link.feet()
     for look in range(MAX_LOOKS):
         if look:
             link.hold(LEG_PAUSE_S)
         if deadline <= time.monotonic():
             raise Refused(f'no time left for the leg to {leg.gate}')
-        plan, walked = _plan_leg(link, leg, gait, listener)
+        rest = rest_of_leg(leg, began, link.feet()[0]) if look else leg
+        plan, walked = _plan_leg(link, rest, gait, listener)
         client = WalkClient(plan[:walked], streaming=True)
         link.walk(client, deadline - time.monotonic())
         if client.outcome is not Outcome.WALKED:

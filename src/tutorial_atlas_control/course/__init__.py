@@ -24,7 +24,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'errors': ['CourseError'],
     'rubble_way': ['CLEARANCE_M', 'GRID_M', 'block_corners', 'block_footprint', 'clear_path',
                    'distance_to_polygon', 'gate_posts'],
-    'legs': ['COURSE_LEGS', 'LEG_PAUSE_S', 'Leg', 'leg_waypoints', 'legs_ahead'],
+    'legs': ['COURSE_LEGS', 'LEG_PAUSE_S', 'Leg', 'leg_waypoints', 'legs_ahead', 'rest_of_leg'],
     'markers': ['COURSE_AREA', 'MAX_TRIANGLES', 'Area', 'BoxShape', 'CourseShapes',
                 'TerrainMesh', 'course_shapes', 'height_colours', 'terrain_mesh'],
     'mud': ['MAX_MUD_DAMPING', 'check_mud_damping', 'drag_at_point', 'drag_wrench',

@@ -91,6 +91,20 @@ def legs_ahead(x_m: float, y_m: float, to_gate: str = GATES[-1].name) -> tuple[L
     return tuple(legs)
 
 
+def rest_of_leg(leg: Leg, start_xy: tuple[float, float], now_xy: tuple[float, float]) -> Leg:
+    """The leg as still to walk from `now_xy`, having begun at `start_xy`: the waypoints
+    after the line of its route (start, waypoint, ...) nearest `now_xy` (a walker stopping
+    partway, to look again, would otherwise plan from its first waypoint again)."""
+    route = np.array([start_xy, *leg.waypoints])
+    here = np.asarray(now_xy, dtype=float)
+    starts, ends = route[:-1], route[1:]
+    along = ends - starts
+    length2 = np.maximum(np.sum(along * along, axis=1), 1e-12)
+    t = np.clip(np.sum((here - starts) * along, axis=1) / length2, 0.0, 1.0)
+    distance = np.hypot(*(starts + t[:, None] * along - here).T)
+    return replace(leg, waypoints=leg.waypoints[int(np.argmin(distance)):])
+
+
 def leg_waypoints(leg: Leg, x_m: float, y_m: float, blocks: Sequence[Block],
                   obstacles: np.ndarray | None = None) -> tuple[tuple[float, float], ...]:
     """The waypoints a walker at (x, y) walks for `leg`: its own, across the rubble a way

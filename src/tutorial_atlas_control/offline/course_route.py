@@ -47,6 +47,7 @@ from tutorial_atlas_control.course import (
     course_height_m,
     leg_waypoints,
     legs_ahead,
+    rest_of_leg,
 )
 from tutorial_atlas_control.msgs import AsiCommand, ManipulateParams, StepData
 from tutorial_atlas_control.offline.course_variant import variant_model
@@ -349,19 +350,21 @@ def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,
     sent and taken over the leg."""
     gait = gait or RouteGait()
     sent = taken = 0
+    began, _ = _feet(interface)
     for look in range(MAX_LOOKS):
         if look:  # stand and look at what the last part walked towards
             _run_until(tick, sim, sim.sim_time_ns / NS_PER_S + LEG_PAUSE_S, streamer)
         origin, heading = _feet(interface)
+        rest = rest_of_leg(leg, began, origin) if look else leg
         if streamer.laser is None:
-            plan = leg_plan(leg, origin, heading, gait, blocks, streamer.ground.ground.height_m)
+            plan = leg_plan(rest, origin, heading, gait, blocks, streamer.ground.ground.height_m)
             walked = len(plan)
         else:
             ground = PlanningGround(streamer.laser.map)
-            plan = leg_plan(leg, origin, heading, gait, (), ground,
+            plan = leg_plan(rest, origin, heading, gait, (), ground,
                             streamer.laser.map.grid.obstacle_xy())
             laser_legs.append(streamer.laser.leg_figures(
-                leg.gate, plan, leg_plan(leg, origin, heading, gait, blocks, course_height_m),
+                leg.gate, plan, leg_plan(rest, origin, heading, gait, blocks, course_height_m),
                 ground))
             walked = seen_prefix(plan, streamer.laser.map, level_footstep(ground))
         client = streamer.client = WalkClient(plan[:walked], streaming=True)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+from tutorial_atlas_control.course import COURSE_LEGS, rest_of_leg
 from tutorial_atlas_control.offline import (
     LOOK_AGAIN_AFTER_STEPS,
     level_footstep,
@@ -60,3 +61,13 @@ def test_level_is_a_plane_within_six_degrees() -> None:
         assert level_footstep(lambda x, _y, s=slope: s * x)(step) is expected, degrees
     crease = level_footstep(lambda x, _y: 0.2 * max(0.0, x - step.x_m))  # bent, 5.7 deg
     assert crease(step) is False
+
+
+def test_the_rest_of_a_leg_begins_after_the_line_the_walker_is_on() -> None:
+    """The gate_1 leg (four waypoints) stopped partway up its second line: planned again, it
+    goes on from there, not back to its first waypoint."""
+    gate_1 = COURSE_LEGS[1]
+    assert gate_1.waypoints[0] == (3.2, -38.0)
+    assert rest_of_leg(gate_1, (1.6, -38.0), (1.6, -38.0)) == gate_1
+    assert rest_of_leg(gate_1, (1.6, -38.0), (3.25, -31.97)).waypoints == gate_1.waypoints[1:]
+    assert rest_of_leg(gate_1, (1.6, -38.0), (0.6, -23.0)).waypoints == gate_1.waypoints[3:]
