@@ -203,7 +203,8 @@ def _plan_leg(link: AsiLink, leg: Leg, gait: RouteGait,
         else:
             seen = listener.snapshot()
             ground = PlanningGround(seen)
-            plan = leg_plan(leg, origin, heading, gait, (), ground, seen.grid.obstacle_xy())
+            plan = leg_plan(leg, origin, heading, gait, (), ground, seen.grid.obstacle_xy(),
+                            seen.heights_or_nearest)
             _print_map_figures(leg, plan, ground)
             walked = seen_prefix(plan, seen, level_footstep(ground))
     except (WalkingError, CourseError, ValueError) as err:

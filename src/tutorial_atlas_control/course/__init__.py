@@ -34,7 +34,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'variants': ['COURSE_VARIANTS', 'RUBBLE_SEED', 'CourseVariant', 'course_variant',
                  'rearranged_blocks'],
     'terrain': ['course_height_m', 'ground_under', 'terrain_heights'],
-    'hill_way': ['STEEPEST_DEG', 'gentle_path', 'slope_deg'],
+    'hill_way': ['STEEPEST_DEG', 'Heights', 'course_heights', 'gentle_path', 'slope_deg'],
     'starts': ['TERRAIN_FILE', 'WORLD_MODEL_FILE', 'parse_start', 'start_text', 'world_start'],
     'vrc_task_2': ['BLOCKS', 'BLOCK_ENVELOPE_M', 'BLOCK_INERTIA', 'BLOCK_MASS_KG', 'BLOCK_WALLS',
                    'GATES', 'HEIGHTMAP', 'MUD_BOX', 'MUD_DAMPING',

@@ -21,6 +21,7 @@ the corner moves back along the way to it until the next one lies outside).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 from scipy import ndimage
@@ -30,7 +31,8 @@ from tutorial_atlas_control.course.grid_path import Cell, a_star, shortened, tur
 from tutorial_atlas_control.course.rubble_way import distance_to_polygon, gate_posts
 from tutorial_atlas_control.course.terrain import ground_under, terrain_heights
 
-__all__ = ['GRID_M', 'REACH_M', 'STEEPEST_DEG', 'gentle_path', 'slope_deg']
+__all__ = ['GRID_M', 'REACH_M', 'STEEPEST_DEG', 'Heights', 'course_heights', 'gentle_path',
+           'slope_deg']
 
 #: Grid cell (m).
 GRID_M = 0.05
@@ -59,22 +61,33 @@ MARGIN_M = 3.0
 Point = tuple[float, float]
 
 
-def slope_deg(x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
-    """The course's slope (degrees) under a sole at each of the world points (any shape):
-    the gradient by central differences SOLE_SPAN_M apart."""
-    heights, half = terrain_heights(), SOLE_SPAN_M / 2.0
-    grade_x = (ground_under(heights, x_m + half, y_m)
-               - ground_under(heights, x_m - half, y_m)) / SOLE_SPAN_M
-    grade_y = (ground_under(heights, x_m, y_m + half)
-               - ground_under(heights, x_m, y_m - half)) / SOLE_SPAN_M
+#: The ground's heights (m) under world points (arrays of any shape).
+Heights = Callable[[np.ndarray, np.ndarray], np.ndarray]
+
+
+def course_heights(x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
+    """The course's terrain (its image) under world points."""
+    return ground_under(terrain_heights(), x_m, y_m)
+
+
+def slope_deg(x_m: np.ndarray, y_m: np.ndarray,
+              heights: Heights = course_heights) -> np.ndarray:
+    """The slope (degrees) of `heights` (the course's terrain by default) under a sole at
+    each of the world points (any shape): the gradient by central differences SOLE_SPAN_M
+    apart."""
+    half = SOLE_SPAN_M / 2.0
+    grade_x = (heights(x_m + half, y_m) - heights(x_m - half, y_m)) / SOLE_SPAN_M
+    grade_y = (heights(x_m, y_m + half) - heights(x_m, y_m - half)) / SOLE_SPAN_M
     return np.degrees(np.arctan(np.hypot(grade_x, grade_y)))
 
 
 def gentle_path(start: Point, goal: Point, steepest_deg: float = STEEPEST_DEG,
-                reach_m: float = REACH_M) -> tuple[Point, ...]:
-    """Waypoints from `start` (excluded) to `goal` (the last one) over ground no steeper than
-    `steepest_deg` within `reach_m` of the way (its straight lines SLACK_DEG more), clear of
-    the gate posts. The start and the goal count as free.
+                reach_m: float = REACH_M, heights: Heights = course_heights
+                ) -> tuple[Point, ...]:
+    """Waypoints from `start` (excluded) to `goal` (the last one) over ground (`heights`: the
+    course's terrain, or a walker's map of it) no steeper than `steepest_deg` within
+    `reach_m` of the way (its straight lines SLACK_DEG more), clear of the gate posts. The
+    start and the goal count as free.
 
     Raises:
         CourseError: no such way joins them.
@@ -90,7 +103,7 @@ def gentle_path(start: Point, goal: Point, steepest_deg: float = STEEPEST_DEG,
     grid_x, grid_y = np.meshgrid(xs, ys, indexing='ij')
     radius = max(1, round(reach_m / GRID_M))
     di, dj = np.mgrid[-radius:radius + 1, -radius:radius + 1]
-    steepest = ndimage.maximum_filter(slope_deg(grid_x, grid_y),
+    steepest = ndimage.maximum_filter(slope_deg(grid_x, grid_y, heights),
                                       footprint=di ** 2 + dj ** 2 <= radius ** 2)
     clear = np.ones(grid_x.shape, dtype=bool)
     for post in gate_posts():

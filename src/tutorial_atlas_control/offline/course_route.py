@@ -42,9 +42,11 @@ from tutorial_atlas_control.course import (
     LEG_PAUSE_S,
     Block,
     CourseVariant,
+    Heights,
     Leg,
     ScoreRow,
     course_height_m,
+    course_heights,
     leg_waypoints,
     legs_ahead,
     rest_of_leg,
@@ -321,7 +323,8 @@ def _course_simulator(world_name: str, variant: CourseVariant | None) -> AtlasSi
 
 def leg_plan(leg: Leg, origin: tuple[float, float], heading_rad: float, gait: RouteGait,
              blocks: Sequence[Block], ground: HeightField,
-             obstacles: np.ndarray | None = None) -> list[Footstep]:
+             obstacles: np.ndarray | None = None,
+             heights: Heights = course_heights) -> list[Footstep]:
     """A leg's steps from feet side by side at `origin` facing `heading_rad`: its waypoints
     (around `blocks` and the points of `obstacles` (n, 2) across the rubble, on gentle
     ground over the hills: leg_waypoints), the
@@ -334,8 +337,9 @@ def leg_plan(leg: Leg, origin: tuple[float, float], heading_rad: float, gait: Ro
     """
     if leg.clear_of_blocks:  # around blocks: the corners turned on the spot
         gait = gait.turning_in_place()
-    return route_steps(origin, heading_rad, leg_waypoints(leg, *origin, blocks, obstacles),
-                       gait, ground=ground if gait.fit_ground else None)
+    return route_steps(origin, heading_rad,
+                       leg_waypoints(leg, *origin, blocks, obstacles, heights), gait,
+                       ground=ground if gait.fit_ground else None)
 
 
 def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,
@@ -362,7 +366,8 @@ def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,
         else:
             ground = PlanningGround(streamer.laser.map)
             plan = leg_plan(rest, origin, heading, gait, (), ground,
-                            streamer.laser.map.grid.obstacle_xy())
+                            streamer.laser.map.grid.obstacle_xy(),
+                            streamer.laser.map.heights_or_nearest)
             laser_legs.append(streamer.laser.leg_figures(
                 leg.gate, plan, leg_plan(rest, origin, heading, gait, blocks, course_height_m),
                 ground))

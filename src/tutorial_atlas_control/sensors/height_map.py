@@ -167,21 +167,44 @@ class HeightMap:
         """The ground's height under (x, y): bilinear over known ground, NaN where unknown."""
         return float(self.grid.bilinear(np.asarray(x_m), np.asarray(y_m)))
 
+    def heights_or_nearest(self, x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
+        """Heights under world points (any shape): bilinear over known ground, else the
+        nearest known cell's (nearest_m's, for arrays); NaN when nothing is known."""
+        x_m, y_m = np.asarray(x_m, dtype=float), np.asarray(y_m, dtype=float)
+        heights = self.grid.bilinear(x_m, y_m)
+        missing = ~np.isfinite(heights)
+        if missing.any():
+            rows, cols = self._nearest_cells()
+            if rows is None:
+                return heights
+            row, col = self.grid.index(x_m[missing], y_m[missing])
+            r = np.clip(np.round(row).astype(int), 0, rows.shape[0] - 1)
+            c = np.clip(np.round(col).astype(int), 0, rows.shape[1] - 1)
+            heights[missing] = self.grid.heights[rows[r, c], cols[r, c]]
+        return heights
+
+    def _nearest_cells(self) -> tuple[np.ndarray | None, np.ndarray | None]:
+        """Each cell's nearest known cell (row and column index grids), or (None, None)."""
+        known = self.grid.known
+        if not known.any():
+            return None, None
+        if self._nearest is None:
+            _, index = ndimage.distance_transform_edt(~known, return_indices=True)
+            self._nearest = (index[0], index[1])
+        return self._nearest
+
     def nearest_m(self, x_m: float, y_m: float) -> tuple[float, float]:
         """The height of the known ground cell nearest (x, y), and how far it is (m); (NaN,
         inf) when nothing is known."""
         grid = self.grid
-        known = grid.known
-        if not known.any():
+        nearest_rows, nearest_cols = self._nearest_cells()
+        if nearest_rows is None or nearest_cols is None:
             return math.nan, math.inf
-        if self._nearest is None:
-            _, index = ndimage.distance_transform_edt(~known, return_indices=True)
-            self._nearest = (index[0], index[1])
-        rows, cols = known.shape
+        rows, cols = nearest_rows.shape
         row, col = grid.index(x_m, y_m)
         r = min(max(round(float(row)), 0), rows - 1)
         c = min(max(round(float(col)), 0), cols - 1)
-        nr, nc = int(self._nearest[0][r, c]), int(self._nearest[1][r, c])
+        nr, nc = int(nearest_rows[r, c]), int(nearest_cols[r, c])
         distance = math.hypot(x_m - (grid.x0_m + nc * grid.cell_m),
                               y_m - (grid.y0_m + nr * grid.cell_m))
         return float(grid.heights[nr, nc]), distance

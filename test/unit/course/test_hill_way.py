@@ -105,3 +105,21 @@ def test_starts_a_few_centimetres_apart_share_the_way_beyond_its_first_corners()
     assert all(len(way) >= 5 for way in ways)
     spread = max(math.dist(a, b) for way in ways for a, b in zip(way[-5:], ways[0][-5:]))
     assert spread <= 0.1  # a grid cell or two of the shortening's choice
+
+
+def test_the_way_is_planned_on_the_ground_it_is_given() -> None:
+    """A walker's map instead of the course's terrain (the laser's, offline.course_route):
+    on level ground the way is the straight line; a steep ridge across it (0.4 m high, 0.4 m
+    wide, y within 2 m) is walked round, past its end."""
+    start, goal = (20.0, 0.0), (26.0, 0.0)
+
+    def level(x: np.ndarray, _y: np.ndarray) -> np.ndarray:
+        return np.zeros_like(x)
+
+    def ridge(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        return np.where((np.abs(x - 23.0) < 0.2) & (np.abs(y) < 2.0), 0.4, 0.0)
+
+    assert gentle_path(start, goal, heights=level) == (goal,)
+    way = gentle_path(start, goal, heights=ridge)
+    assert len(way) > 1 and max(abs(y) for _, y in way) > 2.0
+    assert slope_deg(np.array([23.2]), np.array([0.0]), ridge)[0] > 45.0  # its side
