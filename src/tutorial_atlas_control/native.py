@@ -155,7 +155,9 @@ class AtlasWalkSwing(ctypes.Structure):
                 ('tolerance_m', ctypes.c_double), ('planned', ctypes.c_double * 3),
                 ('stance', ctypes.c_double * 3), ('limits', ctypes.c_double * 4),
                 ('side', ctypes.c_double), ('step_xy', ctypes.c_double * 2),
-                ('adjust', ctypes.c_long), ('elapsed_s', ctypes.c_double)]
+                ('adjust', ctypes.c_long), ('elapsed_s', ctypes.c_double),
+                ('time_s', ctypes.c_double), ('height', ctypes.c_double * 4),
+                ('facing', ctypes.c_double * 4)]
 
 
 #: Every struct Python lays out for the library, by its C name: the library must export

@@ -47,6 +47,7 @@ from tutorial_atlas_control.balance import (
     smoothstep_rate,
     yaw_of,
 )
+from tutorial_atlas_control.balance.compiled_whole_body import MOVED_IN_CALL
 from tutorial_atlas_control.walking.compiled_legs import CompiledLegs
 from tutorial_atlas_control.walking.compiled_swing import CompiledSwing
 from tutorial_atlas_control.walking.footsteps import Footstep, wrap_angle
@@ -62,6 +63,8 @@ LEGS_ENV = 'TAC_LEGS'
 
 #: The leg joints (tutorial order): their Stand posture PD is off while stepping.
 LEG_JOINTS = slice(4, 16)
+#: A timed move of the legs' reference: began (s), duration (s), from, change.
+Move = tuple[float, float, float, float]
 #: Each foot's leg joints, uhz to lax (tutorial order).
 LEG_OF_FOOT = (slice(4, 10), slice(10, 16))
 
@@ -171,6 +174,12 @@ class LegTasks:
     def legs_kernel(self) -> CompiledLegs | None:
         """swing_tick's one C call (None: it computes in pieces)."""
         return self._legs_kernel
+
+    @property
+    def moves(self) -> tuple[Move, Move]:
+        """The CoM height's move and the heading's (began (s), duration (s), from, change):
+        what _moved_reference reads, for a call that computes it (compiled_walk_swing)."""
+        return self._height, self._facing
 
     def move_height(self, height_m: float, time_s: float, duration_s: float) -> None:
         """Take the CoM's reference height from where it is now to `height_m` over
@@ -287,15 +296,20 @@ class LegTasks:
 
     def load_swing_tick(self, state: BalanceState, joint_positions: np.ndarray,
                         joint_velocities: np.ndarray, time_s: float,
-                        swing: tuple[int, SwingPath, float]) -> CompiledLegs | None:
+                        swing: tuple[int, SwingPath, float],
+                        moved_in_call: bool = False) -> CompiledLegs | None:
         """The one call of swing_tick with its input loaded but the pressure centre, or None
-        where swing_tick computes in pieces (no library, or a Python estimate's state)."""
+        where swing_tick computes in pieces (no library, or a Python estimate's state);
+        `moved_in_call`: the reference's heading, height and rate left to the caller's call
+        (compiled_walk_swing, from `moves`)."""
         legs = self._legs_kernel
         if legs is None or state.row_address is None:
             return None
         legs.load_swing_tick(state, self._swing_contacts[swing[0]],
                              (joint_positions, joint_velocities), self._joint_gains,
-                             self.reference, self._moved_reference(time_s), swing)
+                             self.reference,
+                             MOVED_IN_CALL if moved_in_call else self._moved_reference(time_s),
+                             swing)
         return legs
 
     def swing_tick(self, state: BalanceState, joint_positions: np.ndarray,
