@@ -62,6 +62,8 @@ class AtlasLawStep(ctypes.Structure):
         ('torque', ctypes.c_void_p), ('ctrl', ctypes.c_void_p), ('f_out', ctypes.c_void_p),
         ('dt_s', ctypes.c_double), ('n', ctypes.c_long), ('initialized', ctypes.c_long),
         ('nq', ctypes.c_long), ('nv', ctypes.c_long),
+        ('warnings', ctypes.c_void_p), ('warning_stride', ctypes.c_long),
+        ('warning_count', ctypes.c_long), ('warning_which', ctypes.c_long * 4),
     ]
 
 
@@ -230,6 +232,8 @@ def _declare(library: ctypes.CDLL) -> None:
     library.atlas_law_step.restype = None
     library.atlas_state_is_finite.argtypes = [ctypes.POINTER(AtlasLawStep)]
     library.atlas_state_is_finite.restype = ctypes.c_int
+    library.atlas_step_unsound.argtypes = [ctypes.POINTER(AtlasLawStep)]
+    library.atlas_step_unsound.restype = ctypes.c_long
     library.atlas_copy_all.argtypes = [ctypes.POINTER(AtlasCopy), ctypes.c_long]
     library.atlas_copy_all.restype = None
     estimator = ctypes.POINTER(AtlasEstimator)
