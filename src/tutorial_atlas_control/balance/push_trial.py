@@ -25,13 +25,13 @@ from tutorial_atlas_control.sim import (
     DEFAULT_GAINS_FILE,
     AtlasModel,
     AtlasSimulator,
+    Gains,
     GroundUnderFeet,
     load_gains_yaml,
     load_model,
     standing,
     wrench_input,
 )
-from tutorial_atlas_control.sim.controller import Gains
 
 Vector = tuple[float, float, float]
 

@@ -27,7 +27,7 @@ if TYPE_CHECKING:
     from tutorial_atlas_control.walking.compiled_legs import CompiledLegs
     from tutorial_atlas_control.walking.dcm_plan import DcmPlan
     from tutorial_atlas_control.walking.footsteps import Footstep
-    from tutorial_atlas_control.walking.leg_tasks import LegTasks, Move
+    from tutorial_atlas_control.walking.leg_tasks import LegTasks
     from tutorial_atlas_control.walking.step_queue import StepLimits
     from tutorial_atlas_control.walking.walk import WalkGains
 
@@ -43,9 +43,10 @@ class CompiledWalkSwing:
     """atlas_walk_swing_tick around one CompiledLegs, with the walk's gain, whether and from
     what change (m) the landing is adjusted; its buffers its own."""
 
-    def __init__(self, library: ctypes.CDLL, legs: CompiledLegs, dcm_gain: float,
-                 adjust: bool, tolerance_m: float) -> None:
+    def __init__(self, library: ctypes.CDLL, tasks: LegTasks, legs: CompiledLegs,
+                 dcm_gain: float, adjust: bool, tolerance_m: float) -> None:
         self._library = library
+        self._tasks = tasks  # its timed moves of the legs' reference
         self._legs = legs
         self._out = np.zeros(OUT_SIZE)
         call = self._call = AtlasWalkSwing()
@@ -60,11 +61,12 @@ class CompiledWalkSwing:
         self._bound: tuple[object, ...] = ()
 
     def bind(self, plan: DcmPlan, planned: Footstep, step: Footstep, stance: Footstep,
-             limits: StepLimits, moves: tuple[Move, Move]) -> None:
+             limits: StepLimits) -> None:
         """The step's numbers, unless they were set from these very objects: its plan's
         first stage, the landing as planned and as adjusted so far (`step`), the stance
-        foot as the queue holds it, the step limits, and the legs' reference's `moves`
+        foot as the queue holds it, the step limits, and the legs' reference's timed moves
         (LegTasks.moves: the CoM height's, the heading's)."""
+        moves = self._tasks.moves
         last = self._bound
         if last and last[0] is plan and last[1] is planned and last[2] is step \
                 and last[3] is stance and last[4] is limits and last[5] is moves[0] \
@@ -116,5 +118,5 @@ def walk_swing_kernel(legs: LegTasks, gains: WalkGains,
     kernel = legs.legs_kernel
     if library is None or kernel is None:
         return None
-    return CompiledWalkSwing(library, kernel, gains.dcm_gain, gains.adjust_steps,
+    return CompiledWalkSwing(library, legs, kernel, gains.dcm_gain, gains.adjust_steps,
                              gains.adjust_tolerance_m)

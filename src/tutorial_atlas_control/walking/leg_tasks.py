@@ -47,7 +47,6 @@ from tutorial_atlas_control.balance import (
     smoothstep_rate,
     yaw_of,
 )
-from tutorial_atlas_control.balance.compiled_whole_body import MOVED_IN_CALL
 from tutorial_atlas_control.walking.compiled_legs import CompiledLegs
 from tutorial_atlas_control.walking.compiled_swing import CompiledSwing
 from tutorial_atlas_control.walking.footsteps import Footstep, wrap_angle
@@ -177,8 +176,7 @@ class LegTasks:
 
     @property
     def moves(self) -> tuple[Move, Move]:
-        """The CoM height's move and the heading's (began (s), duration (s), from, change):
-        what _moved_reference reads, for a call that computes it (compiled_walk_swing)."""
+        """The CoM height's and heading's timed moves, for a call computing the reference."""
         return self._height, self._facing
 
     def move_height(self, height_m: float, time_s: float, duration_s: float) -> None:
@@ -219,8 +217,7 @@ class LegTasks:
     def swing_torque(self, state: BalanceState, joint_velocities: np.ndarray, foot: int,
                      swing: SwingPath, elapsed_s: float) -> np.ndarray:
         """The swing leg's torques (28,) along `swing`, `elapsed_s` into it, the path's
-        acceleration fed forward; past its end the foot goes on down at
-        touchdown_speed_m_s."""
+        acceleration fed forward; past its end the foot goes on down at touchdown_speed_m_s."""
         if self._kernel is not None:
             return self._kernel.swing_torque(state, joint_velocities, LEG_OF_FOOT[foot], foot,
                                              swing, elapsed_s)
@@ -295,21 +292,16 @@ class LegTasks:
         return torque, cop, contact
 
     def load_swing_tick(self, state: BalanceState, joint_positions: np.ndarray,
-                        joint_velocities: np.ndarray, time_s: float,
-                        swing: tuple[int, SwingPath, float],
-                        moved_in_call: bool = False) -> CompiledLegs | None:
-        """The one call of swing_tick with its input loaded but the pressure centre, or None
-        where swing_tick computes in pieces (no library, or a Python estimate's state);
-        `moved_in_call`: the reference's heading, height and rate left to the caller's call
-        (compiled_walk_swing, from `moves`)."""
+                        joint_velocities: np.ndarray, moved: MovedReference,
+                        swing: tuple[int, SwingPath, float]) -> CompiledLegs | None:
+        """swing_tick's one call loaded but the pressure centre (`moved`: MOVED_IN_CALL for the
+        caller's call's), or None: in pieces (no library, or a Python estimate's state)."""
         legs = self._legs_kernel
         if legs is None or state.row_address is None:
             return None
         legs.load_swing_tick(state, self._swing_contacts[swing[0]],
                              (joint_positions, joint_velocities), self._joint_gains,
-                             self.reference,
-                             MOVED_IN_CALL if moved_in_call else self._moved_reference(time_s),
-                             swing)
+                             self.reference, moved, swing)
         return legs
 
     def swing_tick(self, state: BalanceState, joint_positions: np.ndarray,
@@ -319,7 +311,8 @@ class LegTasks:
         """torque() then finish() with `swing` (the foot, its path and the time into it):
         the torques within the effort limits, the pressure centre as kept, which soles
         carry."""
-        legs = self.load_swing_tick(state, joint_positions, joint_velocities, time_s, swing)
+        legs = self.load_swing_tick(state, joint_positions, joint_velocities,
+                                    self._moved_reference(time_s), swing)
         if legs is None:
             torque, cop, contact = self.torque(state, joint_positions, joint_velocities,
                                                time_s, cop, swing[0])

@@ -34,6 +34,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from tutorial_atlas_control.balance import (
+    MOVED_IN_CALL,
     BalanceState,
     StandController,
     capture_point_after,
@@ -366,13 +367,10 @@ class WalkController:
         assert step is not None and swing is not None and plan is not None \
             and planned is not None and self._lift_off_s is not None  # swinging
         elapsed = self.phases.elapsed_s(time_s)
-        legs = self.legs
-        if legs.load_swing_tick(state, joint_positions, joint_velocities, time_s,
-                                (step.foot_index, swing, elapsed - self._lift_off_s),
-                                moved_in_call=True) is None:
+        if self.legs.load_swing_tick(state, joint_positions, joint_velocities, MOVED_IN_CALL,
+                                     (step.foot_index, swing, elapsed - self._lift_off_s)) is None:
             return None
-        kernel.bind(plan, planned, step, self.queue.feet[1 - step.foot_index], self.queue.limits,
-                    legs.moves)
+        kernel.bind(plan, planned, step, self.queue.feet[1 - step.foot_index], self.queue.limits)
         torque, cop, xi_ref, moved = kernel.tick(elapsed, time_s)
         if moved is not None:  # _adjust's new landing, the call's path already ending there
             self.step = replace(planned, x_m=moved[0], y_m=moved[1])
