@@ -261,8 +261,8 @@ class WalkController:
         """Move on to the next phase when this one ends: a swing's touchdown taken into the
         queue, then another swing while the queue has steps, else the catch."""
         phases, step = self.phases, self.step
-        if not phases.ended(time_s, _phase_over(phases.phase, step, state,
-                                                 self.gains.at_rest_m)):
+        if not (phases.may_end(time_s) and phases.ended(
+                time_s, _phase_over(phases.phase, step, state, self.gains.at_rest_m))):
             return
         if phases.phase is _SWING and step is not None:
             landed = replace(foot_pose(state, step.foot_index, step.step_index),
