@@ -34,9 +34,8 @@ import numpy as np
 from tutorial_atlas_control.command import LAW_FIELDS
 
 __all__ = ['LIBRARY_ENV', 'LIBRARY_NAME', 'MIRRORED_STRUCTS', 'AtlasCopy', 'AtlasEstimator',
-           'AtlasLawStep', 'AtlasLegs', 'AtlasLegsSupport', 'AtlasStatics', 'AtlasSwing',
-           'AtlasWalkSwing',
-           'AtlasWholeBody', 'address',
+           'AtlasHeightfield', 'AtlasLawStep', 'AtlasLegs', 'AtlasLegsSupport',
+           'AtlasStatics', 'AtlasSwing', 'AtlasWalkSwing', 'AtlasWholeBody', 'address',
            'chosen_library', 'find_library', 'load_library', 'size_mismatches']
 
 #: The shared library CMakeLists.txt builds (devel/lib, installed to the prefix's lib/).
@@ -44,8 +43,9 @@ LIBRARY_NAME = 'libtutorial_atlas_control_law.so'
 #: Set to a library path to use that one (or to a missing path to force numpy).
 LIBRARY_ENV = 'TAC_LAW_LIBRARY'
 #: What the callers do without the library (the end of the one warning).
-FALLBACK = ('using the numpy controller law (same torques, slower), the Python swing-foot '
-            'servo and the Python balance estimator, statics and whole-body tick')
+FALLBACK = ("using the numpy controller law (same torques, slower), the laser's numpy "
+            'heightfield march, the Python swing-foot servo and the Python balance estimator, '
+            'statics and whole-body tick')
 #: How the library names the function that returns sizeof(Struct).
 SIZEOF_PREFIX = 'tac_sizeof_'
 
@@ -162,6 +162,17 @@ class AtlasWalkSwing(ctypes.Structure):
                 ('facing', ctypes.c_double * 4)]
 
 
+class AtlasHeightfield(ctypes.Structure):
+    """AtlasHeightfield in src/atlas_heightfield.c (same fields, same order)."""
+
+    _fields_ = [('heights', ctypes.c_void_p), ('tile_highest', ctypes.c_void_p),
+                *((name, ctypes.c_long) for name in ('rows', 'cols', 'tile_rows', 'tile_cols',
+                                                     'tile_cells', 'segment_steps')),
+                *((name, ctypes.c_double) for name in ('centre_x', 'centre_y', 'half_x',
+                                                       'half_y', 'lowest', 'highest', 'step_m',
+                                                       'tol_m'))]
+
+
 #: Every struct Python lays out for the library, by its C name: the library must export
 #: SIZEOF_PREFIX + name, returning the same size as the mirror's.
 MIRRORED_STRUCTS: dict[str, type[ctypes.Structure]] = {
@@ -174,6 +185,7 @@ MIRRORED_STRUCTS: dict[str, type[ctypes.Structure]] = {
     'AtlasLegs': AtlasLegs,
     'AtlasLegsSupport': AtlasLegsSupport,
     'AtlasWalkSwing': AtlasWalkSwing,
+    'AtlasHeightfield': AtlasHeightfield,
 }
 
 
@@ -262,6 +274,10 @@ def _declare(library: ctypes.CDLL) -> None:
     library.atlas_legs_support_tick.restype = None
     library.atlas_walk_swing_tick.argtypes = [ctypes.POINTER(AtlasWalkSwing)]
     library.atlas_walk_swing_tick.restype = None
+    library.atlas_heightfield_distances.argtypes = [
+        ctypes.POINTER(AtlasHeightfield), ctypes.c_void_p, ctypes.c_void_p, ctypes.c_long,
+        ctypes.c_double, ctypes.c_void_p]
+    library.atlas_heightfield_distances.restype = ctypes.c_long
 
 
 _library: ctypes.CDLL | None = None

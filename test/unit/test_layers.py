@@ -191,7 +191,7 @@ def test_the_import_check_catches_a_module_that_needs_rospy(tmp_path: Path) -> N
 #: the tutorial and reads its bag; search sweeps offline runs; node is the simulator node
 #: over all of these; cli, each script's command line, over everything.
 LAYERS: tuple[tuple[str, ...], ...] = (
-    ('', 'control_modes', 'errors', 'exports', 'fall_report', 'joints', 'launch_args',
+    ('', 'control_modes', 'errors', 'exports', 'fall_report', 'grids', 'joints', 'launch_args',
      'processes', 'resources', 'topics', 'units', 'yaml_errors'),
     ('command',),
     ('native',),

@@ -23,7 +23,8 @@ C_SOURCES = (REPO / 'src' / 'atlas_law.c', REPO / 'src' / 'atlas_gather.c',
              REPO / 'src' / 'atlas_statics.c', REPO / 'src' / 'atlas_swing.h',
              REPO / 'src' / 'atlas_swing.c', REPO / 'src' / 'atlas_whole_body.h',
              REPO / 'src' / 'atlas_whole_body.c', REPO / 'src' / 'atlas_legs.h',
-             REPO / 'src' / 'atlas_legs.c', REPO / 'src' / 'atlas_walk_swing.c')
+             REPO / 'src' / 'atlas_legs.c', REPO / 'src' / 'atlas_walk_swing.c',
+             REPO / 'src' / 'atlas_heightfield.c')
 CONFIG = REPO / 'config' / 'atlas_controller.yaml'
 #: A C struct Python may lay out: `typedef struct { ... } Name;`.
 C_TYPEDEF_STRUCT = re.compile(r'typedef struct \{.*?\} (\w+);', re.S)
@@ -43,7 +44,7 @@ def test_every_struct_of_the_c_sources_is_mirrored() -> None:
                                                          'AtlasEstimator', 'AtlasStatics',
                                                          'AtlasSwing', 'AtlasWholeBody',
                                                          'AtlasLegs', 'AtlasLegsSupport',
-                                                         'AtlasWalkSwing'}
+                                                         'AtlasWalkSwing', 'AtlasHeightfield'}
     for name, mirror in native.MIRRORED_STRUCTS.items():
         assert mirror.__name__ == name
 
@@ -72,9 +73,9 @@ def test_a_library_whose_sizes_differ_is_refused_with_one_warning(
     expected = (rf'^{re.escape(str(path))} does not match this code \(sizeof\(AtlasCopy\) is '
                 rf'{ctypes.sizeof(native.AtlasCopy)} bytes there, {ctypes.sizeof(_LongerCopy)}'
                 r' in tutorial_atlas_control.native\); rebuild it \(`make setup`\); '
-                r'using the numpy controller law \(same torques, slower\), the Python '
-                r'swing-foot servo and the Python balance estimator, statics and '
-                r'whole-body tick$')
+                r"using the numpy controller law \(same torques, slower\), the laser's "
+                r'numpy heightfield march, the Python swing-foot servo and the Python '
+                r'balance estimator, statics and whole-body tick$')
     with pytest.warns(RuntimeWarning, match=expected) as caught:
         assert native.load_library() is None
         sim = AtlasSimulator(atlas_model.load_model(), load_gains_yaml(CONFIG))
@@ -101,7 +102,8 @@ def test_a_library_without_size_functions_is_refused(
                                             r'tac_sizeof_AtlasWholeBody\(\); no '
                                             r'tac_sizeof_AtlasLegs\(\); no '
                                             r'tac_sizeof_AtlasLegsSupport\(\); no '
-                                            r'tac_sizeof_AtlasWalkSwing\(\)\); rebuild'):
+                                            r'tac_sizeof_AtlasWalkSwing\(\); no '
+                                            r'tac_sizeof_AtlasHeightfield\(\)\); rebuild'):
         assert native.load_library() is None
 
 

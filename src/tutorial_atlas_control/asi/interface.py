@@ -99,7 +99,7 @@ class AtlasSimInterface:
                  user_behaviour: LibraryBehaviour | None = None) -> None:
         self.sim = sim
         self.user_behaviour = user_behaviour
-        self._ground = GroundUnderFeet(sim.atlas, sim.data)  # falling and fallen: fall.py
+        self._ground = GroundUnderFeet(sim.atlas, sim.data, sim.ground)  # the watch's ground
         if balance and hold_at_start:
             sim.behaviours.hold_stand_at_start = True
             if sim.mode is ControlMode.STAND:

@@ -14,6 +14,7 @@ import numpy as np
 
 from tutorial_atlas_control.course.starts import TERRAIN_FILE
 from tutorial_atlas_control.course.vrc_task_2 import HEIGHTMAP, MUD_FLOOR_Z_M, PEN
+from tutorial_atlas_control.grids import grid_bilinear
 from tutorial_atlas_control.resources import package_path
 
 __all__ = ['course_height_m', 'ground_under', 'terrain_heights']
@@ -40,11 +41,7 @@ def ground_under(heights: np.ndarray, x_m: np.ndarray, y_m: np.ndarray) -> np.nd
     last = heights.shape[0] - 1
     col = np.clip((np.asarray(x_m) + half) / cell, 0.0, last)
     row = np.clip((half - np.asarray(y_m)) / cell, 0.0, last)
-    c0, r0 = np.minimum(col.astype(int), last - 1), np.minimum(row.astype(int), last - 1)
-    fc, fr = col - c0, row - r0
-    top = heights[r0, c0] * (1 - fc) + heights[r0, c0 + 1] * fc
-    bottom = heights[r0 + 1, c0] * (1 - fc) + heights[r0 + 1, c0 + 1] * fc
-    return top * (1 - fr) + bottom * fr
+    return grid_bilinear(heights, row, col)
 
 
 def course_height_m(x_m: float, y_m: float) -> float:

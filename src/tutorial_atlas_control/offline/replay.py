@@ -276,6 +276,27 @@ def load_recording(path: Path | str, data: BagData | None = None,
                      scores=read_scores(data), scans=_comparable_scans(data, warnings))
 
 
+def _probe(recording: Recording, sim: AtlasSimulator, odom_steps: np.ndarray,
+           reset_step: int, last_step: int, warnings: list[str]) -> _OdomProbe:
+    """What watches each replayed step: the odometry's poses, the score, the laser's scans."""
+    probe = _OdomProbe(odom_steps, reset_step, last_step)
+    probe.score = _score_replay(recording, sim, reset_step, warnings)
+    probe.scans = ScanReplay.of(sim, _scans_from(recording.scans, reset_step, warnings),
+                                recording.config.sensor_seed)
+    return probe
+
+
+def _scans_from(scans: LaserScans | None, reset_step: int,
+                warnings: list[str]) -> LaserScans | None:
+    """The scans a replay from `reset_step` can compare: a commanded spindle's only from sim
+    time 0 (its speed at a later reset is not recorded)."""
+    if scans is not None and scans.spindle_commands and reset_step != 0:
+        warnings.append(f'{topics.LASER_SCAN} is not compared: the spindle was commanded and '
+                        'the replayed try begins at a reset, where its speed is not recorded.')
+        return None
+    return scans
+
+
 def _comparable_scans(data: BagData, warnings: list[str]) -> LaserScans | None:
     """The bag's laser scans, if it has any that replay can compare (a bag without any is
     not opened again)."""
@@ -619,9 +640,7 @@ def replay(recording: Recording, tolerance: float = DEFAULT_TOLERANCE,
     odom_steps = _to_steps(recording.odom_stamp_ns, step_ns, ODOM_TOPIC)
     rows = _segment(recording, all_steps, reset_step, sim.dt_s, warnings)
     steps, effort = all_steps[rows], recording.effort_nm[rows]
-    probe = _OdomProbe(odom_steps, reset_step, int(steps[-1]))
-    probe.score = _score_replay(recording, sim, reset_step, warnings)
-    probe.scans = ScanReplay.of(sim, recording.scans, config.sensor_seed)
+    probe = _probe(recording, sim, odom_steps, reset_step, int(steps[-1]), warnings)
     inputs = _InputQueue(recording.inputs)
     prefix = _recreate_prefix(sim, config, reset_step, int(steps[0]), effort[0], probe, warnings,
                               inputs)

@@ -3,9 +3,11 @@
 A scan is a function of the state at its stamp (the head's pose, which replay reproduces
 bit for bit), the spindle's angle and the noise of (the run's sensor_seed, the stamp): cast
 again on the replayed state it is the recorded one, range for range, as float32 bytes. The
-spindle is simulated from the replay's start at rest, as a run starts it; a run whose
-spindle was commanded is not compared (the bag has its commands, not the step each first
-acted in), and the report says so.
+spindle is simulated from the replay's start at rest, as a run starts it, each recorded
+set_spindle_speed taken in the step it first acted in: not recorded as such (the command's
+record time is the recorder's receipt), but found from the recorded /tf's spindle angles
+(bags/laser_scans.spindle_command_steps). A run whose commands cannot be placed so (no
+/tf, or a reset before the replayed try) is not compared, and the report says so.
 """
 
 from __future__ import annotations
@@ -14,7 +16,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.bags import LaserScans
+from tutorial_atlas_control.bags import LaserScans, spindle_command_steps
 from tutorial_atlas_control.sensors import HeadSensors
 from tutorial_atlas_control.sim import AtlasSimulator
 from tutorial_atlas_control.units import NS_PER_S
@@ -53,6 +55,7 @@ class ScanReplay:
         self.sim = sim
         self.head = HeadSensors(sim.model, sim.data, sim.dt_s, seed)
         self.recorded = scans.ranges
+        self.commands = (spindle_command_steps(scans) or []) if scans.spindle_commands else []
         self.row_at = {stamp: row for row, stamp in enumerate(scans.stamp_ns.tolist())}
         self.compared = 0
         self.differing = 0
@@ -68,15 +71,17 @@ class ScanReplay:
         """Whether a recording's scans can be compared (else a warning says why not)."""
         if scans is None:
             return False
-        if scans.spindle_commands:
+        if scans.spindle_commands and spindle_command_steps(scans) is None:
             warnings.append(f'{topics.LASER_SCAN} is not compared: the spindle was commanded '
-                            f'({topics.SET_SPINDLE_SPEED}), and the step each command first '
-                            'acted in is not recorded.')
+                            f'({topics.SET_SPINDLE_SPEED}), and the recorded /tf does not '
+                            'say the step each command first acted in.')
             return False
         return True
 
     def __call__(self) -> None:
         head, stamp_ns = self.head, self.sim.state_time_ns
+        while self.commands and self.commands[0][0] <= self.sim.sim_time_ns:
+            head.spindle.command(self.commands.pop(0)[1])  # before the step it acted in
         head.step()
         row = self.row_at.get(stamp_ns)
         if row is None:

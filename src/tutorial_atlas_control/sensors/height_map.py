@@ -37,6 +37,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
+from tutorial_atlas_control.grids import grid_bilinear
+
 __all__ = ['GroundGrid', 'HeightMap', 'HeightMapSpec', 'ground_grid', 'scan_points']
 
 #: A cell and its eight neighbours (sums by correlation are exact: no running sums).
@@ -109,13 +111,9 @@ class GroundGrid:
         """Heights under world points, bilinear between known cells; NaN elsewhere."""
         row, col = self.index(x_m, y_m)
         rows, cols = self.heights.shape
-        r0, c0 = np.floor(row).astype(int), np.floor(col).astype(int)
-        inside = (r0 >= 0) & (c0 >= 0) & (r0 < rows - 1) & (c0 < cols - 1)
-        r0, c0 = np.where(inside, r0, 0), np.where(inside, c0, 0)
-        fr, fc = row - r0, col - c0
-        h = self.heights
-        value = ((h[r0, c0] * (1 - fc) + h[r0, c0 + 1] * fc) * (1 - fr)
-                 + (h[r0 + 1, c0] * (1 - fc) + h[r0 + 1, c0 + 1] * fc) * fr)
+        inside = (row >= 0.0) & (col >= 0.0) & (row < rows - 1) & (col < cols - 1)
+        value = grid_bilinear(self.heights, np.where(inside, row, 0.0),
+                              np.where(inside, col, 0.0))
         return np.where(inside, value, np.nan)
 
 

@@ -12,14 +12,21 @@ whose lower end is above the highest vertex of the tiles around its start cannot
 step under the surface, and its steps are not evaluated. The steps that are evaluated are
 the same as a full march's, so the distances are a full march's bit for bit, only cheaper
 (7 ms to about 2 ms a scan on the course; `test_heightfield_march.py`).
+
+Compiled (src/atlas_heightfield.c, loaded by tutorial_atlas_control.native) the same march is
+one call, its distances this numpy's bit for bit; `TAC_HEIGHTFIELD=python` for the numpy.
 """
 
 from __future__ import annotations
 
+import ctypes
 import math
 
 import mujoco
 import numpy as np
+
+from tutorial_atlas_control.grids import grid_bilinear
+from tutorial_atlas_control.native import AtlasHeightfield, address, chosen_library
 
 __all__ = ['BISECT_TOL_M', 'MARCH_STEP_M', 'TILE_CELLS', 'Heightfield']
 
@@ -29,6 +36,8 @@ MARCH_STEP_M = 0.2
 BISECT_TOL_M = 1e-4
 #: Cells a side of the tiles whose highest vertices let the march skip a segment.
 TILE_CELLS = 8
+#: Set to `python` to march with numpy instead of the compiled library.
+SWITCH_ENV = 'TAC_HEIGHTFIELD'
 
 
 def _tile_maxima(heights: np.ndarray, tile: int) -> np.ndarray:
@@ -46,9 +55,11 @@ def _tile_maxima(heights: np.ndarray, tile: int) -> np.ndarray:
 
 
 class Heightfield:
-    """One heightfield geom (unturned) as heights over a grid: where rays first meet it."""
+    """One heightfield geom (unturned) as heights over a grid: where rays first meet it.
 
-    def __init__(self, model: mujoco.MjModel, geom: int) -> None:
+    `compiled`: None as SWITCH_ENV says (compiled unless `python`), False numpy's march."""
+
+    def __init__(self, model: mujoco.MjModel, geom: int, compiled: bool | None = None) -> None:
         if not np.allclose(model.geom_quat[geom], (1.0, 0.0, 0.0, 0.0)):
             raise ValueError(f'heightfield geom {geom} is turned: the laser takes it upright')
         field = int(model.geom_dataid[geom])
@@ -66,6 +77,25 @@ class Heightfield:
                                         2.0 * self.half_y / (rows - 1))
         #: Steps a segment: its horizontal length within a tile's width.
         self.segment_steps = max(1, int(tile_width_m / MARCH_STEP_M))
+        library = chosen_library(SWITCH_ENV, compiled)
+        self._call = None if library is None else library.atlas_heightfield_distances
+        self._struct = self._compiled_struct() if self._call is not None else None
+
+    @property
+    def compiled(self) -> bool:
+        return self._call is not None
+
+    def _compiled_struct(self) -> AtlasHeightfield:
+        """The library's view of this field (its arrays are this object's, never replaced)."""
+        self.heights = np.ascontiguousarray(self.heights)
+        self._tile_highest = np.ascontiguousarray(self._tile_highest)
+        rows, cols = self.heights.shape
+        tile_rows, tile_cols = self._tile_highest.shape
+        return AtlasHeightfield(
+            address(self.heights, np.float64), address(self._tile_highest, np.float64),
+            rows, cols, tile_rows, tile_cols, TILE_CELLS, self.segment_steps,
+            float(self.centre[0]), float(self.centre[1]), self.half_x, self.half_y,
+            self.lowest, self.highest, MARCH_STEP_M, BISECT_TOL_M)
 
     def height_m(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """The surface's height under world points (bilinear); -inf outside it."""
@@ -73,13 +103,8 @@ class Heightfield:
         col = (x - self.centre[0] + self.half_x) / (2.0 * self.half_x) * (cols - 1)
         row = (y - self.centre[1] + self.half_y) / (2.0 * self.half_y) * (rows - 1)
         inside = (col >= 0.0) & (col <= cols - 1) & (row >= 0.0) & (row <= rows - 1)
-        col, row = np.clip(col, 0.0, cols - 1.0), np.clip(row, 0.0, rows - 1.0)
-        c0 = np.minimum(col.astype(int), cols - 2)
-        r0 = np.minimum(row.astype(int), rows - 2)
-        fc, fr = col - c0, row - r0
-        h = self.heights
-        surface = ((h[r0, c0] * (1.0 - fc) + h[r0, c0 + 1] * fc) * (1.0 - fr)
-                   + (h[r0 + 1, c0] * (1.0 - fc) + h[r0 + 1, c0 + 1] * fc) * fr)
+        surface = grid_bilinear(self.heights, np.clip(row, 0.0, rows - 1.0),
+                                np.clip(col, 0.0, cols - 1.0))
         return np.where(inside, surface, -np.inf)
 
     def tile_highest_m(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -96,6 +121,8 @@ class Heightfield:
     def distances(self, origin: np.ndarray, rays: np.ndarray, range_m: float) -> np.ndarray:
         """Each ray's distance (m) to where it first goes below the surface, within
         `range_m`; -1 where it does not (0 for every ray from under the surface)."""
+        if self._call is not None:
+            return self._compiled_distances(origin, rays, range_m)
         result = np.full(len(rays), -1.0)
         if self.height_m(origin[:1], origin[1:2])[0] >= origin[2]:
             return np.zeros(len(rays))
@@ -118,6 +145,18 @@ class Heightfield:
         distance = self.crossing_m(origin, rays[live[met]], near, steps[first])
         within = distance <= range_m
         result[live[met][within]] = distance[within]
+        return result
+
+    def _compiled_distances(self, origin: np.ndarray, rays: np.ndarray, range_m: float
+                            ) -> np.ndarray:
+        """distances() as one call into the library."""
+        origin = np.ascontiguousarray(origin, dtype=np.float64)
+        rays = np.ascontiguousarray(rays, dtype=np.float64).reshape(-1, 3)
+        result = np.empty(len(rays))
+        if self._call(ctypes.byref(self._struct), address(origin, np.float64),
+                      address(rays, np.float64), len(rays), float(range_m),
+                      address(result, np.float64)) != 0:
+            raise MemoryError('the heightfield march ran out of memory')
         return result
 
     def crossing_m(self, origin: np.ndarray, rays: np.ndarray, near: np.ndarray,

@@ -113,7 +113,7 @@ class GroundUnderFeet:
         the pelvis is FALL_HEIGHT_M above the world's highest ground."""
         if pelvis_z_m is None:
             pelvis_z_m = self.pelvis_z_m()
-        if self.ground.level_m is None and pelvis_z_m - self.ground.top_m() >= FALL_HEIGHT_M:
+        if self.ground.level_m is None and self.ground.clear_above(pelvis_z_m, FALL_HEIGHT_M):
             return False
         return fallen(pelvis_z_m, self.height_m())
 

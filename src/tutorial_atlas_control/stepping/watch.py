@@ -37,7 +37,7 @@ class RunWatch:
         self.sim = sim
         self.log = log
         self.pelvis_z_index = sim.atlas.free_qpos_adr + 2  # the pelvis height in qpos
-        self.ground = GroundUnderFeet(sim.atlas, sim.data)
+        self.ground = GroundUnderFeet(sim.atlas, sim.data, sim.ground)  # the interface's too
         self.fall_armed = True  # one line per fall: disarmed by it, re-armed by a reset
         self.first_command_ns: int | None = None  # since the start or last reset
         self.not_user_warned_ns: int | None = None

@@ -46,8 +46,7 @@ def full_march(field: Heightfield, origin: np.ndarray, rays: np.ndarray,
     return result
 
 
-@pytest.fixture(scope='module')
-def spiky() -> Heightfield:
+def spiky_model() -> mujoco.MjModel:
     """A 20 m field of 0.2 m cells, gentle waves with single-vertex spikes 2 m high: a
     spike a tile away from a segment's start is what an undilated tile test would miss."""
     rng = np.random.default_rng(4)
@@ -55,11 +54,16 @@ def spiky() -> Heightfield:
     heights = 0.2 + 0.1 * np.sin(9.0 * xs)[None, :] * np.cos(7.0 * xs)[:, None]
     heights[rng.integers(0, 101, 60), rng.integers(0, 101, 60)] = 1.0
     elevation = ' '.join(f'{z:.6f}' for z in heights.ravel())
-    model = mujoco.MjModel.from_xml_string(f'''<mujoco><asset>
+    return mujoco.MjModel.from_xml_string(f'''<mujoco><asset>
       <hfield name="spikes" nrow="101" ncol="101" size="10 10 2 0.1" elevation="{elevation}"/>
       </asset><worldbody><geom type="hfield" hfield="spikes" pos="1 -1 -0.3"/></worldbody>
       </mujoco>''')
-    return Heightfield(model, 0)
+
+
+@pytest.fixture(scope='module')
+def spiky() -> Heightfield:
+    """spiky_model's field, marched as the laser marches it (compiled when built)."""
+    return Heightfield(spiky_model(), 0)
 
 
 def test_skipping_the_tiles_keeps_a_full_marchs_distances(spiky: Heightfield) -> None:
@@ -79,3 +83,21 @@ def test_skipping_the_tiles_keeps_a_full_marchs_distances(spiky: Heightfield) ->
 def test_a_segment_is_shorter_than_a_tile(spiky: Heightfield) -> None:
     assert spiky.segment_steps * MARCH_STEP_M <= 8 * 0.2 + 1e-12
     assert spiky.segment_steps == 8
+
+
+def test_compiled_march_is_numpys_bit_for_bit(spiky: Heightfield) -> None:
+    """The library's march (src/atlas_heightfield.c) against this module's numpy, on the
+    spikes from above, from under the surface, and with rays going up over the top."""
+    numpy_field = Heightfield(spiky_model(), 0, compiled=False)
+    assert spiky.compiled and not numpy_field.compiled
+    rng = np.random.default_rng(12)
+    hits = 0
+    for case in range(CASES):
+        z = (-0.5, 3.5, rng.uniform(-0.2, 2.5))[case % 3]  # under, over the top, between
+        origin = np.array([rng.uniform(-14, 16), rng.uniform(-16, 14), z])
+        rays = rng.normal(size=(RAYS, 3)) * (1.0, 1.0, 0.3)
+        rays /= np.linalg.norm(rays, axis=1, keepdims=True)
+        ours = spiky.distances(origin, rays, RANGE_M)
+        np.testing.assert_array_equal(ours, numpy_field.distances(origin, rays, RANGE_M))
+        hits += int((ours > 0.0).sum())
+    assert hits > 0.1 * CASES * RAYS

@@ -160,3 +160,72 @@ def test_atlas_world_is_the_floor() -> None:
         hit = ground.hit(float(x), float(y))
         assert hit.height_m == 0.0 and hit.geom_id == floor
         np.testing.assert_array_equal(hit.normal, [0.0, 0.0, 1.0])
+
+
+def scattered_blocks(bar: bool, count: int = 20, seed: int = 4
+                     ) -> tuple[mujoco.MjModel, mujoco.MjData]:
+    """A plane under `count` loose boxes placed and turned at random (the course's kind of
+    world: more loose geoms than the Python loop takes), with `bar` a gate bar welded
+    overhead."""
+    rng = np.random.default_rng(seed)
+    bodies = ''.join(f'<body name="b{i}"><freejoint/><geom type="box" size="0.2 0.1 0.1" '
+                     'mass="5"/></body>' for i in range(count))
+    overhead = '<geom type="box" size="2 0.1 0.1" pos="0 0 4"/>' if bar else ''
+    model = world(f'<geom type="plane" size="0 0 1"/>{overhead}{bodies}')
+    data = mujoco.MjData(model)
+    for i in range(count):
+        quat = rng.normal(size=4)
+        data.qpos[7 * i:7 * i + 7] = (*rng.uniform(-1.5, 1.5, 2), rng.uniform(0.0, 0.6),
+                                      *(quat / np.linalg.norm(quat)))
+    mujoco.mj_forward(model, data)
+    return model, data
+
+
+def test_many_loose_blocks_culled_by_numpy_as_by_the_loop(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    model, data = scattered_blocks(bar=False)
+    ground = Ground(model, data)
+    points = np.random.default_rng(5).uniform(-1.8, 1.8, (300, 2)).tolist()
+    fast = [ground.hit(x, y) for x, y in points]
+    fast_top = ground.top_m()
+    monkeypatch.setattr('tutorial_atlas_control.sim.ground._NUMPY_CULL_FROM', 10 ** 6)
+    looped = [ground.hit(x, y) for x, y in points]
+    assert ground.top_m() == fast_top
+    for one, other in zip(fast, looped):
+        assert (one.height_m, one.geom_id) == (other.height_m, other.geom_id)
+        np.testing.assert_array_equal(one.normal, other.normal)
+    assert sum(hit.geom_id > 0 for hit in fast) > 30  # many points on blocks, not the plane
+    corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+    highest = max(float(data.geom_xpos[g][2] + (data.geom_xmat[g].reshape(3, 3)
+                                                 @ (corners * model.geom_size[g]).T)[2].max())
+                  for g in range(1, model.ngeom))
+    assert highest <= fast_top <= highest + 0.25  # a bound, within a box's diagonal
+
+
+def test_clear_above_is_the_bound_on_all_ground() -> None:
+    model, data = scattered_blocks(bar=True)
+    ground = Ground(model, data)
+    top = ground.top_m()
+    assert top == pytest.approx(4.1, abs=1e-9)  # the bar
+    for z in (top - 0.6, top + 0.49, top + 0.5, top + 0.51, 9.0):
+        assert ground.clear_above(z, 0.5) == (z - top >= 0.5)
+    data.qpos[2] = 6.0  # a block lifted over the bar: the bound follows it
+    mujoco.mj_forward(model, data)
+    assert ground.top_m() > 6.0 and not ground.clear_above(4.7, 0.5)
+
+
+def test_a_block_turned_in_place_is_seen_turned() -> None:
+    """The ground keeps its last answer with the question: a block turned about its
+    centre (the same position) is a new question, whose answer is the turned block's."""
+    model = world('<geom type="plane" size="0 0 1"/>'
+                  '<body name="block" pos="0 0 0.1"><freejoint/>'
+                  '<geom type="box" size="0.2 0.05 0.1" mass="5"/></body>')
+    data = mujoco.MjData(model)
+    data.qpos[:3] = (0.0, 0.0, 0.1)
+    mujoco.mj_forward(model, data)
+    ground = Ground(model, data)
+    assert ground.height_m(0.15, 0.0) == pytest.approx(0.2, abs=1e-9)
+    data.qpos[3:7] = (math.cos(math.pi / 4), 0.0, 0.0, math.sin(math.pi / 4))  # 90 deg about z
+    mujoco.mj_forward(model, data)
+    assert ground.height_m(0.15, 0.0) == pytest.approx(0.0, abs=1e-9)
+    assert ground.height_m(0.0, 0.15) == pytest.approx(0.2, abs=1e-9)
