@@ -41,6 +41,11 @@ typedef struct {
   long n;
   long initialized;                  /* PidState.initialized; set to 1 */
   long nq, nv;                       /* lengths of qpos and qvel (atlas_state_is_finite) */
+  const int *warnings;               /* MjData.warning's number fields, every warning_stride-th
+                                      * int (atlas_step_unsound; NULL: not set) */
+  long warning_stride;
+  long warning_count;                /* how many of warning_which it tests, in order */
+  long warning_which[4];
 } AtlasLawStep;
 
 /* numpy.minimum / numpy.maximum for one pair: a NaN wins, and of two equal values (0.0 and
@@ -106,4 +111,15 @@ int atlas_state_is_finite(const AtlasLawStep *s) {
     if (!isfinite(s->qvel[i])) return 0;
   }
   return 1;
+}
+
+/* The simulator's divergence check after each step in one call (sim/divergence.py's, in its
+ * order): MuJoCo's warning counters at each of warning_which, then every qpos and qvel finite.
+ * 0: sound; 1 + the index in warning_which of the first counter above 0; warning_count + 1:
+ * a value not finite. */
+long atlas_step_unsound(const AtlasLawStep *s) {
+  for (long k = 0; k < s->warning_count; ++k) {
+    if (s->warnings[s->warning_stride * s->warning_which[k]] > 0) return k + 1;
+  }
+  return atlas_state_is_finite(s) ? 0 : s->warning_count + 1;
 }

@@ -1,7 +1,8 @@
 /*
  * A walking tick with a foot swinging, in one call: the compiled twin of what
  * WalkController.tick_torque does between its phase logic and its output
- * (src/tutorial_atlas_control/walking/walk.py, whose docstrings give the rules): the capture
+ * (src/tutorial_atlas_control/walking/walk.py, whose docstrings give the rules): the legs'
+ * reference turned and lowered by its timed moves (LegTasks._moved_reference), the capture
  * point's reference from the step's plan (DcmPlan.reference), the swing foot's landing moved
  * by the capture point's predicted error (step_adjustment.foothold_shift, then
  * step_queue.clamp_pose, kept unless it moves by the tolerance: _adjust), the law's pressure
@@ -13,6 +14,7 @@
  */
 #include <math.h>
 #include <stddef.h>
+#include <string.h>
 
 #include "atlas_legs.h"
 
@@ -35,6 +37,9 @@ typedef struct {
   double step_xy[2];      /* the landing as adjusted so far (m) */
   long adjust;            /* 0: the landing is not adjusted */
   double elapsed_s;       /* the time into the step (s) */
+  double time_s;          /* the tick's time (s) */
+  double height[4];       /* the CoM height's move: began (s), duration (s), from, change (m) */
+  double facing[4];       /* the heading's move: began (s), duration (s), from, turn (rad) */
 } AtlasWalkSwing;
 
 enum { WALK_OUT_XI_REF = 0, WALK_OUT_MOVED = 2, WALK_OUT_STEP = 3, WALK_OUT_SIZE = 5 };
@@ -106,11 +111,33 @@ static void adjust(AtlasWalkSwing *w, const double *row, const long *at, const d
   end[2] = w->planned[2];
 }
 
-/* The tick: reference, adjustment, the law's pressure centre, the legs' swing tick. */
+/* balance.blend.smoothstep (min(max(f, 0), 1) as Python's, then the same products). */
+static double smoothstep(double fraction) {
+  double s = clamp(fraction, 0.0, 1.0);
+  return s * s * (3.0 - 2.0 * s);
+}
+
+/* LegTasks._moved_reference then CompiledWholeBody._move_reference: the legs' heading, CoM
+ * height and its rate at time_s written over the whole body's reference (upright pelvis
+ * frame turned by the heading), as the Python writes them. */
+static void move_reference(const AtlasWalkSwing *w, double *reference) {
+  const double *h = w->height, *f = w->facing;
+  double fraction = (w->time_s - h[0]) / h[1];
+  double rate = (0.0 < fraction && fraction < 1.0) ? 6.0 * fraction * (1.0 - fraction) / h[1]
+                                                   : 0.0;
+  double yaw = f[2] + smoothstep((w->time_s - f[0]) / f[1]) * f[3];
+  double c = cos(yaw), s = sin(yaw);
+  double values[11] = {h[2] + smoothstep(fraction) * h[3], rate * h[3], c, -s, 0.0, s, c,
+                       0.0, 0.0, 0.0, 1.0};
+  memcpy(reference + WB_REF_HEIGHT, values, sizeof values);
+}
+
+/* The tick: the legs' moved reference, reference, adjustment, the law's pressure centre, the legs' swing tick. */
 void atlas_walk_swing_tick(AtlasWalkSwing *w) {
   const AtlasWholeBody *body = w->legs->whole_body;
   const double *row = body->row;
   const long *at = body->row_at;
+  move_reference(w, (double *)body->reference);
   /* DcmPlan.reference(0, elapsed) */
   const double *plan = w->plan;
   double t = clamp(w->elapsed_s, 0.0, plan[4]);

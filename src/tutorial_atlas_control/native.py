@@ -62,6 +62,8 @@ class AtlasLawStep(ctypes.Structure):
         ('torque', ctypes.c_void_p), ('ctrl', ctypes.c_void_p), ('f_out', ctypes.c_void_p),
         ('dt_s', ctypes.c_double), ('n', ctypes.c_long), ('initialized', ctypes.c_long),
         ('nq', ctypes.c_long), ('nv', ctypes.c_long),
+        ('warnings', ctypes.c_void_p), ('warning_stride', ctypes.c_long),
+        ('warning_count', ctypes.c_long), ('warning_which', ctypes.c_long * 4),
     ]
 
 
@@ -155,7 +157,9 @@ class AtlasWalkSwing(ctypes.Structure):
                 ('tolerance_m', ctypes.c_double), ('planned', ctypes.c_double * 3),
                 ('stance', ctypes.c_double * 3), ('limits', ctypes.c_double * 4),
                 ('side', ctypes.c_double), ('step_xy', ctypes.c_double * 2),
-                ('adjust', ctypes.c_long), ('elapsed_s', ctypes.c_double)]
+                ('adjust', ctypes.c_long), ('elapsed_s', ctypes.c_double),
+                ('time_s', ctypes.c_double), ('height', ctypes.c_double * 4),
+                ('facing', ctypes.c_double * 4)]
 
 
 class AtlasHeightfield(ctypes.Structure):
@@ -240,6 +244,8 @@ def _declare(library: ctypes.CDLL) -> None:
     library.atlas_law_step.restype = None
     library.atlas_state_is_finite.argtypes = [ctypes.POINTER(AtlasLawStep)]
     library.atlas_state_is_finite.restype = ctypes.c_int
+    library.atlas_step_unsound.argtypes = [ctypes.POINTER(AtlasLawStep)]
+    library.atlas_step_unsound.restype = ctypes.c_long
     library.atlas_copy_all.argtypes = [ctypes.POINTER(AtlasCopy), ctypes.c_long]
     library.atlas_copy_all.restype = None
     estimator = ctypes.POINTER(AtlasEstimator)

@@ -25,7 +25,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'compiled_estimator': ['CompiledEstimate', 'EstimatorGeometry', 'RawEstimate',
                            'row_offsets'],
     'compiled_statics': ['CompiledStatics'],
-    'compiled_whole_body': ['CompiledWholeBody'],
+    'compiled_whole_body': ['MOVED_IN_CALL', 'CompiledWholeBody'],
     'estimator': ['CONTACT_HEIGHT_M', 'ESTIMATOR_ENV', 'MIN_COM_HEIGHT_M', 'BalanceEstimator',
                   'BalanceState'],
     'manipulate': ['PelvisServo'],

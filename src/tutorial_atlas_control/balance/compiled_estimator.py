@@ -168,6 +168,7 @@ class CompiledEstimate:
         self._count = count
         self._size = FIXED_SIZE + 13 * count + 2 + ROW * CONTACT_CAPACITY
         self._block = OutputBlock(self._size, count)
+        self._row_bytes = 8 * self._size
 
     def hold_polygon(self, contact: tuple[bool, bool], positions: np.ndarray,
                      rotations: np.ndarray) -> None:
@@ -197,9 +198,20 @@ class CompiledEstimate:
         """The estimate at the state of an MjData (its address) whose position and velocity
         stages mj_step1 has just computed, for a model of the same sizes: those passes read,
         not run again (atlas_estimate_stepped)."""
-        block, tick, row = self._next_row()
-        return self._raw(block, tick, row,
-                         self._estimate_stepped(self._pointer, stepped_address))
+        block = self._block
+        tick = block.next
+        if tick == BLOCK_TICKS:  # a new block: _next_row's
+            block, tick, row = self._next_row()
+            return self._raw(block, tick, row,
+                             self._estimate_stepped(self._pointer, stepped_address))
+        # _next_row and _raw inline: every tick of a walk, their calls cost as much as the
+        # arithmetic
+        block.next = tick + 1
+        row = self._kernel.out = block.base + self._row_bytes * tick
+        total = self._estimate_stepped(self._pointer, stepped_address)
+        if total > CONTACT_CAPACITY:
+            return self._raw(block, tick, row, total)
+        return RawEstimate(block, tick, row, total, None)
 
     def _next_row(self) -> tuple[OutputBlock, int, int]:
         """The next tick's block, row index and row address (set as the kernel's output)."""
@@ -208,7 +220,7 @@ class CompiledEstimate:
             block = self._block = OutputBlock(self._size, self._count)
         tick = block.next
         block.next = tick + 1
-        row = self._kernel.out = block.base + 8 * self._size * tick
+        row = self._kernel.out = block.base + self._row_bytes * tick
         return block, tick, row
 
     def _raw(self, block: OutputBlock, tick: int, row: int, total: int) -> RawEstimate:

@@ -48,6 +48,10 @@ ROW_FIELDS = ('com', 'com_velocity', 'pelvis_rotation', 'pelvis_angular_velocity
               'sole_centres', 'sole_rotations', 'omega', 'capture_point', 'bias_nm',
               'sole_jacobians')
 
+#: load's `moved` when the caller's own C call writes the heading, height and rate over the
+#: reference (Walk's swinging tick, compiled_walk_swing): compared by identity only.
+MOVED_IN_CALL: MovedReference = (math.nan, math.nan, math.nan)
+
 #: One tick's results: torque (n,), pressure centre (2,), force (3,), moment (3,) and the
 #: soles' wrenches (2, 6), new arrays.
 Tick = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
@@ -160,7 +164,8 @@ class CompiledWholeBody:
               moved: MovedReference | None = None) -> None:
         """This tick's input: the state (read in place from a compiled estimate's row, else
         copied), the contacts, the reference (`moved`: its heading, height and rate
-        replaced) and joint gains when they changed, the joints."""
+        replaced; MOVED_IN_CALL: the caller's call replaces them) and joint gains when they
+        changed, the joints."""
         row = state.row_address
         self._call.row = row
         if row is None:
@@ -170,7 +175,9 @@ class CompiledWholeBody:
         if reference is not self._last_reference or (moved is None
                                                      and self._last_moved is not None):
             self._set_reference(reference)
-        if moved is not None and moved != self._last_moved:
+        if moved is MOVED_IN_CALL:
+            self._last_moved = moved  # not equal to any heading, height and rate again
+        elif moved is not None and moved != self._last_moved:
             self._move_reference(moved)
         if joint_gains is not self._last_gains:
             joints = len(self._effort_limit)

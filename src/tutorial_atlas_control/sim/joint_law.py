@@ -71,6 +71,11 @@ class JointLaw:
         return view
 
     @property
+    def kernel(self) -> CompiledLaw | None:
+        """The compiled law's plain call (None: numpy's law)."""
+        return self._plain
+
+    @property
     def compiled(self) -> bool:
         return self._plain is not None
 

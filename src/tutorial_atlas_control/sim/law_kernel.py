@@ -12,6 +12,8 @@ its bag and its offline replay do not depend on which one ran.
 from __future__ import annotations
 
 import ctypes
+import functools
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -85,6 +87,7 @@ class CompiledLaw:
         step.dt_s = joints.dt_s
         step.n = count
         step.nq, step.nv = joints.qpos.size, joints.qvel.size
+        self._library = library
         self._call = library.atlas_law_step
         self._finite = library.atlas_state_is_finite
         self._pointer = ctypes.byref(step)
@@ -104,6 +107,23 @@ class CompiledLaw:
     def state_is_finite(self) -> bool:
         """Every entry of qpos and qvel (the MjData arrays given) finite?"""
         return bool(self._finite(self._pointer))
+
+    def unsound_call(self, numbers: np.ndarray, which: Sequence[int]) -> Callable[[], int]:
+        """The divergence check's one call over this kernel's qpos and qvel and MuJoCo's
+        warning counters `numbers` (MjData.warning.number, a view) at `which` (at most 4):
+        0 when sound, 1 + the index in `which` of the first counter above 0, len(which) + 1
+        when a value is not finite (atlas_step_unsound)."""
+        item = numbers.itemsize
+        if numbers.dtype != np.int32 or numbers.strides[0] % item or len(which) > 4:
+            raise ValueError(f'warning counters of {numbers.dtype}, stride {numbers.strides}, '
+                             f'{len(which)} tested')
+        step = self._step
+        step.warnings = numbers.ctypes.data
+        step.warning_stride = numbers.strides[0] // item
+        step.warning_count = len(which)
+        step.warning_which[:len(which)] = which
+        self._keep_unsound = numbers
+        return functools.partial(self._library.atlas_step_unsound, self._pointer)
 
     def _bind(self, command: JointCommandArrays) -> None:
         """Point the kernel at another command's arrays (a new command arrived)."""

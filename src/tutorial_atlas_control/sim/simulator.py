@@ -134,7 +134,8 @@ class AtlasSimulator:
         self.torque_nm = self.law.torque_nm  # the law's output array, applied each step
         self.commands = ModeCommands(gains, self.joint_positions, self.torque_nm)
         self.behaviours = ModeBehaviours()  # install_stand
-        self._check_divergence = DivergenceCheck(self.data, self.law.state_is_finite).check
+        self._check_divergence = DivergenceCheck(self.data, self.law.state_is_finite,
+                                                 self.law.kernel).check
         self.sim_time_ns = 0
         self.start = start
         # VRCPlugin's cheats, pinning at reset_world's pelvis qpos; the world's ground.

@@ -74,6 +74,8 @@ class CompiledLegs:
         self._scratch: tuple[int, int] | None = None
         self._mass_matrix = np.zeros(0)
         self._dof_adr: np.ndarray | None = None
+        #: The state's mass_matrix_source last seen by load_swing_tick (compared by identity).
+        self._source: object = None
         #: The swinging foot the call's leg is set for (None: none yet).
         self._foot: int | None = None
 
@@ -112,8 +114,10 @@ class CompiledLegs:
         positions and velocities, their gains, the legs' reference (`moved`: its heading,
         height and rate) and `swing` (the foot, its path, the time into it)."""
         source = state.mass_matrix_source
-        if source is None or self._scratch != source[0:2]:
-            self._bind(state)
+        if source is not self._source or source is None:  # the estimator's one tuple: once
+            if source is None or self._scratch != source[0:2]:
+                self._bind(state)
+            self._source = source
         foot, path, elapsed_s = swing
         if foot != self._foot:
             self._set_foot(foot)
@@ -124,8 +128,8 @@ class CompiledLegs:
 
     def results(self) -> tuple[np.ndarray, np.ndarray]:
         """The last tick's torques (joints,) and pressure centre as kept, new arrays."""
-        out = self._out
-        return out[:self._joints].copy(), out[self._joints:].copy()
+        out = self._out.copy()  # one copy, two views of it
+        return out[:self._joints], out[self._joints:]
 
     def tick_at(self, cop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """LegTasks.torque then LegTasks.finish on the input load_swing_tick loaded, at the

@@ -6,7 +6,8 @@ limits' clamp), made the law's pressure centre, then ran the legs' one call
 (compiled_legs): a hundred float operations and a dozen Python calls a tick around a C call
 of about the same cost. Here the legs' input is loaded as before and one call does the rest;
 the step's numbers (its plan's first stage, the landing as planned, the stance foot, the
-limits) are set once a step. Python makes the moved Footstep and SwingPath only in the ticks
+limits, the legs' reference's timed moves, whose heading, height and rate the call computes
+each tick) are set once a step. Python makes the moved Footstep and SwingPath only in the ticks
 where the landing moves. Used for a compiled estimate's state with the legs' one call; equal
 to the Python bit for bit (test/unit/walking/test_compiled_walk_swing.py).
 """
@@ -42,9 +43,10 @@ class CompiledWalkSwing:
     """atlas_walk_swing_tick around one CompiledLegs, with the walk's gain, whether and from
     what change (m) the landing is adjusted; its buffers its own."""
 
-    def __init__(self, library: ctypes.CDLL, legs: CompiledLegs, dcm_gain: float,
-                 adjust: bool, tolerance_m: float) -> None:
+    def __init__(self, library: ctypes.CDLL, tasks: LegTasks, legs: CompiledLegs,
+                 dcm_gain: float, adjust: bool, tolerance_m: float) -> None:
         self._library = library
+        self._tasks = tasks  # its timed moves of the legs' reference
         self._legs = legs
         self._out = np.zeros(OUT_SIZE)
         call = self._call = AtlasWalkSwing()
@@ -62,12 +64,16 @@ class CompiledWalkSwing:
              limits: StepLimits) -> None:
         """The step's numbers, unless they were set from these very objects: its plan's
         first stage, the landing as planned and as adjusted so far (`step`), the stance
-        foot as the queue holds it, and the step limits."""
+        foot as the queue holds it, the step limits, and the legs' reference's timed moves
+        (LegTasks.moves: the CoM height's, the heading's)."""
+        moves = self._tasks.moves
         last = self._bound
         if last and last[0] is plan and last[1] is planned and last[2] is step \
-                and last[3] is stance and last[4] is limits:  # every tick of the step
+                and last[3] is stance and last[4] is limits and last[5] is moves[0] \
+                and last[6] is moves[1]:  # every tick of the step
             return
         call = self._call
+        call.height[:], call.facing[:] = moves
         (cop_x, cop_y), (end_x, end_y) = plan.cops[0].tolist(), plan.ends[0].tolist()
         durations = plan.durations_s.tolist()
         call.plan[:] = (cop_x, cop_y, end_x, end_y, durations[0])
@@ -81,14 +87,19 @@ class CompiledWalkSwing:
                           limits.max_width_m)
         call.side = side_sign(step.foot_index)
         call.step_xy[:] = (step.x_m, step.y_m)
-        self._bound = (plan, planned, step, stance, limits)
+        self._bound = (plan, planned, step, stance, limits, *moves)
 
-    def tick(self, elapsed_s: float) -> tuple[np.ndarray, np.ndarray, np.ndarray,
-                                              tuple[float, float] | None]:
-        """The tick `elapsed_s` (s) into the step, the legs' input loaded but the pressure
-        centre: the torques, the pressure centre as kept, the capture point's reference (new
-        arrays), and the landing (x, y) where it moved this tick (None: it did not)."""
-        self._call.elapsed_s = elapsed_s
+    def tick(self, elapsed_s: float, time_s: float) -> tuple[np.ndarray, np.ndarray,
+                                                             np.ndarray,
+                                                             tuple[float, float] | None]:
+        """The tick at `time_s` (s), `elapsed_s` (s) into the step, the legs' input loaded
+        but the pressure centre and the reference's heading, height and rate (the call's, from
+        the moves bound): the torques, the pressure centre as kept, the capture point's
+        reference (new arrays), and the landing (x, y) where it moved this tick (None: it
+        did not)."""
+        call = self._call
+        call.elapsed_s = elapsed_s
+        call.time_s = time_s
         self._tick(self._pointer)
         out = self._out
         moved = None
@@ -107,5 +118,5 @@ def walk_swing_kernel(legs: LegTasks, gains: WalkGains,
     kernel = legs.legs_kernel
     if library is None or kernel is None:
         return None
-    return CompiledWalkSwing(library, kernel, gains.dcm_gain, gains.adjust_steps,
+    return CompiledWalkSwing(library, legs, kernel, gains.dcm_gain, gains.adjust_steps,
                              gains.adjust_tolerance_m)

@@ -62,6 +62,8 @@ LEGS_ENV = 'TAC_LEGS'
 
 #: The leg joints (tutorial order): their Stand posture PD is off while stepping.
 LEG_JOINTS = slice(4, 16)
+#: A timed move of the legs' reference: began (s), duration (s), from, change.
+Move = tuple[float, float, float, float]
 #: Each foot's leg joints, uhz to lax (tutorial order).
 LEG_OF_FOOT = (slice(4, 10), slice(10, 16))
 
@@ -172,6 +174,11 @@ class LegTasks:
         """swing_tick's one C call (None: it computes in pieces)."""
         return self._legs_kernel
 
+    @property
+    def moves(self) -> tuple[Move, Move]:
+        """The CoM height's and heading's timed moves, for a call computing the reference."""
+        return self._height, self._facing
+
     def move_height(self, height_m: float, time_s: float, duration_s: float) -> None:
         """Take the CoM's reference height from where it is now to `height_m` over
         `duration_s` (a smoothstep)."""
@@ -210,8 +217,7 @@ class LegTasks:
     def swing_torque(self, state: BalanceState, joint_velocities: np.ndarray, foot: int,
                      swing: SwingPath, elapsed_s: float) -> np.ndarray:
         """The swing leg's torques (28,) along `swing`, `elapsed_s` into it, the path's
-        acceleration fed forward; past its end the foot goes on down at
-        touchdown_speed_m_s."""
+        acceleration fed forward; past its end the foot goes on down at touchdown_speed_m_s."""
         if self._kernel is not None:
             return self._kernel.swing_torque(state, joint_velocities, LEG_OF_FOOT[foot], foot,
                                              swing, elapsed_s)
@@ -286,16 +292,16 @@ class LegTasks:
         return torque, cop, contact
 
     def load_swing_tick(self, state: BalanceState, joint_positions: np.ndarray,
-                        joint_velocities: np.ndarray, time_s: float,
+                        joint_velocities: np.ndarray, moved: MovedReference,
                         swing: tuple[int, SwingPath, float]) -> CompiledLegs | None:
-        """The one call of swing_tick with its input loaded but the pressure centre, or None
-        where swing_tick computes in pieces (no library, or a Python estimate's state)."""
+        """swing_tick's one call loaded but the pressure centre (`moved`: MOVED_IN_CALL for the
+        caller's call's), or None: in pieces (no library, or a Python estimate's state)."""
         legs = self._legs_kernel
         if legs is None or state.row_address is None:
             return None
         legs.load_swing_tick(state, self._swing_contacts[swing[0]],
                              (joint_positions, joint_velocities), self._joint_gains,
-                             self.reference, self._moved_reference(time_s), swing)
+                             self.reference, moved, swing)
         return legs
 
     def swing_tick(self, state: BalanceState, joint_positions: np.ndarray,
@@ -305,7 +311,8 @@ class LegTasks:
         """torque() then finish() with `swing` (the foot, its path and the time into it):
         the torques within the effort limits, the pressure centre as kept, which soles
         carry."""
-        legs = self.load_swing_tick(state, joint_positions, joint_velocities, time_s, swing)
+        legs = self.load_swing_tick(state, joint_positions, joint_velocities,
+                                    self._moved_reference(time_s), swing)
         if legs is None:
             torque, cop, contact = self.torque(state, joint_positions, joint_velocities,
                                                time_s, cop, swing[0])

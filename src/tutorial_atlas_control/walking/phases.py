@@ -147,6 +147,12 @@ class PhaseSequence:
         """How long the phase has run at `time_s` (s)."""
         return time_s - self.started_s
 
+    def may_end(self, time_s: float) -> bool:
+        """Whether the phase under way can end at `time_s` whatever its condition: past its
+        shortest time (settled's first test), not done. Most ticks are not: their condition
+        need not be observed."""
+        return not self.done and time_s - self.started_s >= self.end.shortest_s
+
     def ended(self, time_s: float, condition: bool) -> bool:
         """Whether the phase under way ends at `time_s` with its condition as observed
         (never once done)."""

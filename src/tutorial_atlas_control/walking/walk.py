@@ -34,6 +34,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from tutorial_atlas_control.balance import (
+    MOVED_IN_CALL,
     BalanceState,
     StandController,
     capture_point_after,
@@ -260,8 +261,8 @@ class WalkController:
         """Move on to the next phase when this one ends: a swing's touchdown taken into the
         queue, then another swing while the queue has steps, else the catch."""
         phases, step = self.phases, self.step
-        if not phases.ended(time_s, _phase_over(phases.phase, step, state,
-                                                 self.gains.at_rest_m)):
+        if not (phases.may_end(time_s) and phases.ended(
+                time_s, _phase_over(phases.phase, step, state, self.gains.at_rest_m))):
             return
         if phases.phase is _SWING and step is not None:
             landed = replace(foot_pose(state, step.foot_index, step.step_index),
@@ -366,11 +367,11 @@ class WalkController:
         assert step is not None and swing is not None and plan is not None \
             and planned is not None and self._lift_off_s is not None  # swinging
         elapsed = self.phases.elapsed_s(time_s)
-        if self.legs.load_swing_tick(state, joint_positions, joint_velocities, time_s,
+        if self.legs.load_swing_tick(state, joint_positions, joint_velocities, MOVED_IN_CALL,
                                      (step.foot_index, swing, elapsed - self._lift_off_s)) is None:
             return None
         kernel.bind(plan, planned, step, self.queue.feet[1 - step.foot_index], self.queue.limits)
-        torque, cop, xi_ref, moved = kernel.tick(elapsed)
+        torque, cop, xi_ref, moved = kernel.tick(elapsed, time_s)
         if moved is not None:  # _adjust's new landing, the call's path already ending there
             self.step = replace(planned, x_m=moved[0], y_m=moved[1])
             self.swing = replace(swing, end=np.array([moved[0], moved[1], planned.z_m]))

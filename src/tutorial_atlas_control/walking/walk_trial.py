@@ -32,10 +32,10 @@ from tutorial_atlas_control.balance import (
     standing_simulator,
 )
 from tutorial_atlas_control.sim import (
+    STANDING_PELVIS_M,
     AtlasModel,
     AtlasSimulator,
     GroundUnderFeet,
-    pelvis_height_m,
 )
 from tutorial_atlas_control.walking.footsteps import (
     STEP_DURATION_S,
@@ -248,18 +248,26 @@ def run_walking_stand(sim: AtlasSimulator, behaviour: WalkingStand, ground: Grou
     not None) that long after the walk ended; the behaviour's trial, its lowest pelvis
     measured over the ground."""
     trial = behaviour.trial
+    data = sim.data
+    # Per tick in plain floats (the pelvis's height from a view kept, a level world's ground
+    # read once): GroundUnderFeet's clearance and standing test, the same subtraction.
+    pelvis_z = data.qpos[sim.atlas.free_qpos_adr + 2:sim.atlas.free_qpos_adr + 3]
+    level = ground.ground.level_m
+    lowest = trial.lowest_pelvis_m
     for tick in range(round(duration_s / sim.dt_s)):
         if stand_after_s is not None and trial.walk_ended_s is not None \
-                and sim.data.time >= trial.walk_ended_s + stand_after_s:
+                and data.time >= trial.walk_ended_s + stand_after_s:
             break
-        apply_pushes(sim, events, tick)
+        if events and events[0][0] == tick:
+            apply_pushes(sim, events, tick)
         sim.step()
-        height = pelvis_height_m(sim.atlas, sim.data)
-        trial.lowest_pelvis_m = min(trial.lowest_pelvis_m, ground.clearance_m(height))
-        if not ground.standing(height):
+        clearance = pelvis_z.item() - (ground.height_m() if level is None else level)
+        lowest = min(lowest, clearance)
+        if clearance < STANDING_PELVIS_M:  # fall.standing's test
             trial.fell = True
             break
-    trial.pelvis_end = sim.data.xpos[sim.atlas.pelvis_body_id].copy()
+    trial.lowest_pelvis_m = lowest
+    trial.pelvis_end = data.xpos[sim.atlas.pelvis_body_id].copy()
     behaviour.note_jumps()
     return trial
 

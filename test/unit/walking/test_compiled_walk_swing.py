@@ -43,8 +43,8 @@ def _recorded_walk(monkeypatch: pytest.MonkeyPatch, python: bool) -> tuple[np.nd
         torques.append(result.copy())
         return result
 
-    def counted(self: CompiledWalkSwing, elapsed_s: float) -> tuple:
-        result = tick(self, elapsed_s)
+    def counted(self: CompiledWalkSwing, elapsed_s: float, time_s: float) -> tuple:
+        result = tick(self, elapsed_s, time_s)
         moved[0] += result[3] is not None
         return result
 
