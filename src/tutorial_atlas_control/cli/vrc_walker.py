@@ -204,7 +204,7 @@ def _plan_leg(link: AsiLink, leg: Leg, gait: RouteGait,
             seen = listener.snapshot()
             ground = PlanningGround(seen)
             plan = leg_plan(leg, origin, heading, gait, (), ground, seen.grid.obstacle_xy(),
-                            seen.heights_or_nearest)
+                            seen.grid.bilinear)
             _print_map_figures(leg, plan, ground)
             walked = seen_prefix(plan, seen, level_footstep(ground))
     except (WalkingError, CourseError, ValueError) as err:

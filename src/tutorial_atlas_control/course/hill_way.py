@@ -74,11 +74,14 @@ def slope_deg(x_m: np.ndarray, y_m: np.ndarray,
               heights: Heights = course_heights) -> np.ndarray:
     """The slope (degrees) of `heights` (the course's terrain by default) under a sole at
     each of the world points (any shape): the gradient by central differences SOLE_SPAN_M
-    apart."""
+    apart. Where `heights` does not know the ground (NaN: a map's unseen ground) that
+    gradient counts as level: the way may go there, and a walker looks before it does
+    (the nearest seen cell's height instead made cliffs between seen places and blocked
+    every way over the hills)."""
     half = SOLE_SPAN_M / 2.0
     grade_x = (heights(x_m + half, y_m) - heights(x_m - half, y_m)) / SOLE_SPAN_M
     grade_y = (heights(x_m, y_m + half) - heights(x_m, y_m - half)) / SOLE_SPAN_M
-    return np.degrees(np.arctan(np.hypot(grade_x, grade_y)))
+    return np.degrees(np.arctan(np.hypot(np.nan_to_num(grade_x), np.nan_to_num(grade_y))))
 
 
 def gentle_path(start: Point, goal: Point, steepest_deg: float = STEEPEST_DEG,

@@ -167,22 +167,6 @@ class HeightMap:
         """The ground's height under (x, y): bilinear over known ground, NaN where unknown."""
         return float(self.grid.bilinear(np.asarray(x_m), np.asarray(y_m)))
 
-    def heights_or_nearest(self, x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
-        """Heights under world points (any shape): bilinear over known ground, else the
-        nearest known cell's (nearest_m's, for arrays); NaN when nothing is known."""
-        x_m, y_m = np.asarray(x_m, dtype=float), np.asarray(y_m, dtype=float)
-        heights = self.grid.bilinear(x_m, y_m)
-        missing = ~np.isfinite(heights)
-        if missing.any():
-            rows, cols = self._nearest_cells()
-            if rows is None:
-                return heights
-            row, col = self.grid.index(x_m[missing], y_m[missing])
-            r = np.clip(np.round(row).astype(int), 0, rows.shape[0] - 1)
-            c = np.clip(np.round(col).astype(int), 0, rows.shape[1] - 1)
-            heights[missing] = self.grid.heights[rows[r, c], cols[r, c]]
-        return heights
-
     def _nearest_cells(self) -> tuple[np.ndarray | None, np.ndarray | None]:
         """Each cell's nearest known cell (row and column index grids), or (None, None)."""
         known = self.grid.known

@@ -123,3 +123,15 @@ def test_the_way_is_planned_on_the_ground_it_is_given() -> None:
     way = gentle_path(start, goal, heights=ridge)
     assert len(way) > 1 and max(abs(y) for _, y in way) > 2.0
     assert slope_deg(np.array([23.2]), np.array([0.0]), ridge)[0] > 45.0  # its side
+
+
+def test_ground_a_map_has_not_seen_counts_as_level() -> None:
+    """A map's unseen ground (NaN) is no obstacle: the way goes on into it (the walker looks
+    before it gets there and plans again)."""
+    start, goal = (20.0, 0.0), (26.0, 0.0)
+
+    def seen_to_22(x: np.ndarray, _y: np.ndarray) -> np.ndarray:
+        return np.where(x < 22.0, 0.0, np.nan)
+
+    assert gentle_path(start, goal, heights=seen_to_22) == (goal,)
+    assert slope_deg(np.array([23.0]), np.array([0.0]), seen_to_22)[0] == 0.0

@@ -125,21 +125,3 @@ def test_height_map_spec_refuses_nonsense() -> None:
     with pytest.raises(ValueError, match='height map'):
         HeightMapSpec(percentile=120.0)
 
-
-def test_heights_or_nearest_is_the_scalar_height_or_nearest_for_arrays() -> None:
-    """The planner's grid of heights (the hills' way on the map) is the scalar planner's
-    ground: bilinear over known ground, else the nearest known cell's, point for point."""
-    height_map = HeightMap()
-    rng = np.random.default_rng(8)
-    x, y = rng.uniform(0.5, 3.0, 5000), rng.uniform(-1.0, 1.0, 5000)
-    points = np.column_stack([x, y, 0.1 * x + 0.02 * np.sin(3.0 * y)])
-    height_map.add_points(points[points[:, 0] < 2.0])
-    qx, qy = rng.uniform(-1.0, 5.0, 300), rng.uniform(-3.0, 3.0, 300)
-    scalar = [height_map.height_m(a, b) for a, b in zip(qx, qy)]
-    scalar = [h if math.isfinite(h) else height_map.nearest_m(a, b)[0]
-              for h, a, b in zip(scalar, qx, qy)]
-    both = height_map.heights_or_nearest(qx, qy)
-    assert np.array_equal(both, scalar)
-    assert np.isfinite(both).all() and (~np.isfinite([height_map.height_m(a, b) for a, b
-                                                       in zip(qx, qy)])).sum() > 100
-    assert np.isnan(HeightMap().heights_or_nearest(qx, qy)).all()
