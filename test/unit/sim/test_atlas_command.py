@@ -496,3 +496,60 @@ def test_the_gain_memo_decodes_a_stream_as_each_message_alone() -> None:
         assert streamed.update.indices.tobytes() == alone.update.indices.tobytes(), index
         assert (streamed.stamp_ns, streamed.desired_controller_period_ms, streamed.ignored) == (
             alone.stamp_ns, alone.desired_controller_period_ms, alone.ignored), index
+
+
+def test_the_bare_header_path_decodes_and_refuses_as_each_message_alone() -> None:
+    """A controller's full commands with an empty frame_id and remembered gains take the
+    decoder's one-struct path: targets, stamp and period as decode_atlas_command makes them,
+    and the same refusals (NaN, +-Inf where no bound is set, beyond a bound; a bound itself
+    accepted); a frame_id, a short array or a byte too many leave that path, same results."""
+    from tutorial_atlas_control.msgs.atlas_command import AtlasCommandDecoder
+
+    rng = np.random.default_rng(61)
+    gains = {'kp_position': full(100.0), 'ki_position': full(0.0), 'kd_position': full(1.0),
+             'kp_velocity': full(0.0), 'k_effort': [255] * N, 'i_effort_min': full(-1.0),
+             'i_effort_max': full(1.0)}
+
+    def message(field: str = 'position', value: float | None = None) -> bytes:
+        arrays = {name: rng.uniform(-3.0, 3.0, N) for name in ('position', 'velocity', 'effort')}
+        if value is not None:
+            arrays[field][int(rng.integers(N))] = value
+        return encode_atlas_command(int(rng.integers(0, 10**12)), {**arrays, **gains},
+                                    int(rng.integers(256)))
+
+    def framed(raw: bytes) -> bytes:  # the same message with frame_id 'pelvis'
+        return raw[:12] + (6).to_bytes(4, 'little') + b'pelvis' + raw[16:]
+
+    decoder = AtlasCommandDecoder()
+    decoder.decode(message())  # the gains remembered
+    bare = [message() for _ in range(5)] + [message('position', 1e300),
+                                            message('velocity', -1e3), message('effort', 1e5)]
+    refused = [message('position', np.nan), message('position', np.inf),
+               message('velocity', -np.inf), message('velocity', 1000.5),
+               message('effort', -2e5), message('effort', np.nan)]
+    other = [framed(message()), framed(message('effort', 3e5)), message()[:-1] + b'\0\0',
+             encode_atlas_command(7, {'position': full(0.25)[:27], **gains})]
+    for raw in bare:
+        assert decoder._known_gains(raw) is not None
+    for index, raw in enumerate(bare + refused + other):
+        try:
+            alone = decode_atlas_command(raw)
+        except CommandError as err:
+            with pytest.raises(CommandError, match=f'^{re.escape(str(err))}$'):
+                decoder.decode(raw)
+            assert index >= len(bare), index
+            continue
+        streamed = decoder.decode(raw)
+        assert streamed.update.rows == alone.update.rows, index
+        assert streamed.update.values.tobytes() == alone.update.values.tobytes(), index
+        assert (streamed.stamp_ns, streamed.desired_controller_period_ms, streamed.ignored) == (
+            alone.stamp_ns, alone.desired_controller_period_ms, alone.ignored), index
+    assert sum(1 for raw in refused + other[1:3] if _refused(raw)) == len(refused) + 2
+
+
+def _refused(raw: bytes) -> bool:
+    try:
+        decode_atlas_command(raw)
+    except CommandError:
+        return True
+    return False
