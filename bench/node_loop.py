@@ -130,33 +130,40 @@ def controller_phases_run(steps: int = 3000, answered: bool = True) -> dict[str,
         sim.step()
     raw = controller_command(sim)
     with fake_rospy.fake_ros_node(sim, 0, tcp=True, heard=CONTROLLER_RUN_TOPICS) as node:
-        loop = node.loop
-        tick, outbox, lock, clock = loop.tick, loop.outbox, loop.lock, time.thread_time
-        receive = loop.receive_command if answered else (lambda *_args: None)
-        before, step, publish, end = (tick.controller.before_step, sim.step,
-                                      loop._publish_step, tick.end_step)
-        spent = [0.0] * len(PHASES)
         cpu_start = time.process_time()
-        for _ in range(steps):
-            t0 = clock()
-            receive(raw, '/atlas/atlas_command')
-            with lock:
-                t1 = clock()
-                before()
-                t2 = clock()
-                step()
-                t3 = clock()
-                publish()
-                t4 = clock()
-                end()
-                t5 = clock()
-            outbox.flush()
-            for index, elapsed in enumerate((t1 - t0, t2 - t1, t3 - t2, t4 - t3, t5 - t4,
-                                             clock() - t5)):
-                spent[index] += elapsed
+        spent = _timed_steps(node.loop, raw if answered else None, steps)
         figures = {'cpu': (time.process_time() - cpu_start) / steps * 1e6}
     figures.update({name: value / steps * 1e6 for name, value in zip(PHASES, spent)})
     return figures
+
+
+def _timed_steps(loop: Any, raw: bytes | None, steps: int) -> list[float]:
+    """The thread CPU (s) of each of PHASES over `steps` turns of `loop`; `raw` (an
+    AtlasCommand) received before each step, or None: no command."""
+    tick, outbox, lock, clock = loop.tick, loop.outbox, loop.lock, time.thread_time
+    sim = loop.sim
+    receive = loop.receive_command if raw is not None else (lambda *_args: None)
+    before, step, publish, end = (tick.controller.before_step, sim.step,
+                                  loop._publish_step, tick.end_step)
+    spent = [0.0] * len(PHASES)
+    for _ in range(steps):
+        t0 = clock()
+        receive(raw, '/atlas/atlas_command')
+        with lock:
+            t1 = clock()
+            before()
+            t2 = clock()
+            step()
+            t3 = clock()
+            publish()
+            t4 = clock()
+            end()
+            t5 = clock()
+        outbox.flush()
+        for index, elapsed in enumerate((t1 - t0, t2 - t1, t3 - t2, t4 - t3, t5 - t4,
+                                         clock() - t5)):
+            spent[index] += elapsed
+    return spent
 
 
 def unheard_topic_run(calls: int = 20000, rounds: int = 5) -> float:

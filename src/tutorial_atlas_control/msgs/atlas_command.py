@@ -23,6 +23,7 @@ from tutorial_atlas_control.command import (
     ALL_JOINTS,
     K_EFFORT_ROW,
     LAW_FIELDS,
+    MAX_MAGNITUDE,
     CommandError,
     CommandUpdate,
     check_values,
@@ -228,24 +229,66 @@ class GainMemo:
         self.gains = np.zeros((len(_FULL_ROWS) - _GAIN_ROWS, NUM_JOINTS))
 
 
+#: A full AtlasCommand whose header has an empty frame_id (what controllers send): its size,
+#: and its header (seq skipped) and counts as one pre-parsed struct: (secs, nsecs, the
+#: frame_id's length, the ten counts), which must end in _BARE_FULL.
+_HEADER_BYTES = 16
+_BARE_SIZE = _HEADER_BYTES + _FULL_BODY.itemsize
+_BARE_HEAD = struct.Struct('<4xIII' + _FULL_COUNTS.format[1:])
+_BARE_FULL = (0, *_ALL_FULL)
+#: Where its gains' bytes start, and its targets' float64 rows (start, stride).
+_BARE_GAINS_FROM = _HEADER_BYTES + _GAINS_FROM
+_BARE_TARGETS = (_HEADER_BYTES + _FULL_GROUPS[0][3], 4 + _F8.itemsize * NUM_JOINTS)
+
+
 class AtlasCommandDecoder:
     """decode_atlas_command for one stream of messages.
 
     A controller sends the same gains in every message and changes only its targets: the
     decoder remembers the last gains' bytes and values (GainMemo), so such a message costs
-    the conversion and checks of its three target arrays, not of all ten. Not for
-    concurrent calls (the loop's lock serializes the inbox's).
+    the conversion and checks of its three target arrays, not of all ten; with an empty
+    frame_id its header and counts are one struct call and its targets' check two ufuncs
+    into buffers kept here. Not for concurrent calls (the loop's lock serializes the inbox's).
     """
 
     def __init__(self) -> None:
         self.memo = GainMemo()
+        # check_values' bounds (MAX_MAGNITUDE; the largest float for none): NaN/Inf fail.
+        bounds = [min(MAX_MAGNITUDE.get(LAW_FIELDS[row], np.inf), np.finfo(np.float64).max)
+                  for row in _TARGET_ROWS]
+        self._bounds = np.repeat(np.array(bounds)[:, np.newaxis], NUM_JOINTS, axis=1)
+        self._magnitude = np.empty((_GAIN_ROWS, NUM_JOINTS))
+        self._within = np.empty((_GAIN_ROWS, NUM_JOINTS), dtype=bool)
 
     def decode(self, raw: bytes) -> AtlasUpdate:
         """Raises CommandError as decode_atlas_command does."""
+        known = self._known_gains(raw)
+        if known is not None:
+            return known
         full = _decode_full(raw, self.memo)
         if full is not None:
             return full
         return _decode(raw, ATLAS_COMMAND_FIELDS, with_period=True)
+
+    def _known_gains(self, raw: bytes) -> AtlasUpdate | None:
+        """A full message with an empty frame_id and the remembered gains; None otherwise
+        (the same update _decode_full makes of it, the same refusal)."""
+        memo = self.memo
+        if len(raw) != _BARE_SIZE or not memo.gain_bytes:
+            return None
+        head = _BARE_HEAD.unpack_from(raw)
+        if head[2:] != _BARE_FULL or not raw.startswith(memo.gain_bytes, _BARE_GAINS_FROM):
+            return None
+        block = np.empty((len(_FULL_ROWS), NUM_JOINTS))
+        targets = block[:_GAIN_ROWS]
+        start, stride = _BARE_TARGETS
+        targets[:] = np.ndarray((_GAIN_ROWS, NUM_JOINTS), _F8, raw, start, (stride, _F8.itemsize))
+        np.abs(targets, out=self._magnitude)
+        if not np.less_equal(self._magnitude, self._bounds, out=self._within).all():
+            check_values(_TARGET_ROWS, targets)  # raises, naming the first bad entry
+        block[_GAIN_ROWS:] = memo.gains
+        return AtlasUpdate(CommandUpdate(ALL_JOINTS, _FULL_ROWS, block), (),
+                           head[0] * NS_PER_S + head[1], raw[-1])
 
 
 def decode_atlas_command(raw: bytes) -> AtlasUpdate:

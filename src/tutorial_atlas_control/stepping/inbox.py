@@ -114,9 +114,18 @@ class CommandInbox:
         not one per message.
         """
         pending = self.pending
-        received = []
+        if not pending:
+            return
+        received = [pending.popleft()]
+        if not pending and received[0][0] == topics.ATLAS_COMMAND:
+            self._apply_atlas_command(received[0][1])  # a 1 kHz controller's every step
+            return
         while pending:
             received.append(pending.popleft())
+        self._apply_received(received)
+
+    def _apply_received(self, received: list[tuple[str, bytes]]) -> None:
+        """apply_pending's general path: `received` oldest first, the newest decoded first."""
         hidden: set[int] = set()
         decoded: list[tuple[str, CommandUpdate | AtlasUpdate | AsiCommand]] = []
         stamped = asi_seen = False
@@ -149,6 +158,26 @@ class CommandInbox:
 
     #: The default StepController: what users sent, for the simulator's law.
     before_step = apply_pending
+
+    def _apply_atlas_command(self, raw: bytes) -> None:
+        """apply_pending of one AtlasCommand alone (what a controller sends before each
+        step): the same decode, refusal, stamp and merge, without the general path's
+        bookkeeping of what hides what."""
+        topic = topics.ATLAS_COMMAND
+        try:
+            result = self.atlas_decoder.decode(raw)
+        except CommandError as err:
+            self.log.refused_command(f'refused {topic}: {err}; previous command kept', topic)
+            return
+        self._note_command_stamp(result.stamp_ns)
+        first = self.watch.first_command_ns is None  # since the start or last reset
+        if result.ignored:
+            self.log.kept_fields(f'{topic}: {result.ignored_text()}', topic)
+        if result.desired_controller_period_ms is not None:
+            self.store_period(result.desired_controller_period_ms)
+        self.sim.receive_updates((result.update,))
+        if first:
+            self.watch.first_command(topic)
 
     def _apply(self, decoded: list[tuple[str, CommandUpdate | AtlasUpdate | AsiCommand]]
                ) -> None:

@@ -13,7 +13,7 @@ from test_controller import DT_S, LIMIT, LOWER, UPPER, one_joint
 
 from support.stepping_fakes import atlas_bytes, command_bytes, complete_command, full, make_loop
 from tutorial_atlas_control import topics
-from tutorial_atlas_control.command.arrays import CommandError
+from tutorial_atlas_control.command.arrays import LAW_FIELDS, CommandError
 from tutorial_atlas_control.joints import JOINT_INDEX, NUM_JOINTS
 from tutorial_atlas_control.msgs.atlas_command import (
     decode_atlas_command,
@@ -496,3 +496,105 @@ def test_the_gain_memo_decodes_a_stream_as_each_message_alone() -> None:
         assert streamed.update.indices.tobytes() == alone.update.indices.tobytes(), index
         assert (streamed.stamp_ns, streamed.desired_controller_period_ms, streamed.ignored) == (
             alone.stamp_ns, alone.desired_controller_period_ms, alone.ignored), index
+
+
+def test_the_bare_header_path_decodes_and_refuses_as_each_message_alone() -> None:
+    """A controller's full commands with an empty frame_id and remembered gains take the
+    decoder's one-struct path: targets, stamp and period as decode_atlas_command makes them,
+    and the same refusals (NaN, +-Inf where no bound is set, beyond a bound; a bound itself
+    accepted); a frame_id, a short array or a byte too many leave that path, same results."""
+    from tutorial_atlas_control.msgs.atlas_command import AtlasCommandDecoder
+
+    rng = np.random.default_rng(61)
+    gains = {'kp_position': full(100.0), 'ki_position': full(0.0), 'kd_position': full(1.0),
+             'kp_velocity': full(0.0), 'k_effort': [255] * N, 'i_effort_min': full(-1.0),
+             'i_effort_max': full(1.0)}
+
+    def message(field: str = 'position', value: float | None = None) -> bytes:
+        arrays = {name: rng.uniform(-3.0, 3.0, N) for name in ('position', 'velocity', 'effort')}
+        if value is not None:
+            arrays[field][int(rng.integers(N))] = value
+        return encode_atlas_command(int(rng.integers(0, 10**12)), {**arrays, **gains},
+                                    int(rng.integers(256)))
+
+    def framed(raw: bytes) -> bytes:  # the same message with frame_id 'pelvis'
+        return raw[:12] + (6).to_bytes(4, 'little') + b'pelvis' + raw[16:]
+
+    decoder = AtlasCommandDecoder()
+    decoder.decode(message())  # the gains remembered
+    bare = [message() for _ in range(5)] + [message('position', 1e300),
+                                            message('velocity', -1e3), message('effort', 1e5)]
+    refused = [message('position', np.nan), message('position', np.inf),
+               message('velocity', -np.inf), message('velocity', 1000.5),
+               message('effort', -2e5), message('effort', np.nan)]
+    other = [framed(message()), framed(message('effort', 3e5)), message()[:-1] + b'\0\0',
+             encode_atlas_command(7, {'position': full(0.25)[:27], **gains})]
+    for raw in bare:
+        assert decoder._known_gains(raw) is not None
+    for index, raw in enumerate(bare + refused + other):
+        try:
+            alone = decode_atlas_command(raw)
+        except CommandError as err:
+            with pytest.raises(CommandError, match=f'^{re.escape(str(err))}$'):
+                decoder.decode(raw)
+            assert index >= len(bare), index
+            continue
+        streamed = decoder.decode(raw)
+        assert streamed.update.rows == alone.update.rows, index
+        assert streamed.update.values.tobytes() == alone.update.values.tobytes(), index
+        assert (streamed.stamp_ns, streamed.desired_controller_period_ms, streamed.ignored) == (
+            alone.stamp_ns, alone.desired_controller_period_ms, alone.ignored), index
+    assert sum(1 for raw in refused + other[1:3] if _refused(raw)) == len(refused) + 2
+
+
+def _refused(raw: bytes) -> bool:
+    try:
+        decode_atlas_command(raw)
+    except CommandError:
+        return True
+    return False
+
+
+def test_one_atlas_command_alone_is_merged_as_by_the_general_path(
+        atlas: atlas_model.AtlasModel, sim: AtlasSimulator) -> None:
+    """The inbox's path for a step's lone AtlasCommand (a 1 kHz controller's) leaves the
+    simulator, the stamp, the window's period, the watch and the log as the general path
+    does with the same message: full and partial commands, a short array kept, the window
+    on and off, refusals, in user mode and out of it."""
+    twin = AtlasSimulator(atlas, load_gains_yaml(CONFIG), time_to_unpin_s=0.0)
+    fast, _, fast_log, _ = make_loop(sim)
+    general, _, general_log, _ = make_loop(twin)
+    gains = {'kp_position': full(90.0), 'kd_position': full(2.0), 'k_effort': [200] * N}
+    stream = [
+        atlas_bytes(3 * NS_PER_S, 0, position=full(0.1), velocity=full(0.0), **gains),
+        atlas_bytes(4 * NS_PER_S, 5, position=full(0.2), effort=full(1.0), **gains),
+        atlas_bytes(5 * NS_PER_S, 5, position=full(0.3)[:20], velocity=full(0.5)),
+        atlas_bytes(6 * NS_PER_S, 0, position=full(float('nan')), **gains),
+        atlas_bytes(7 * NS_PER_S, 0, effort=full(3e5)),
+        atlas_bytes(0, 0, position=full(-0.2), **gains),
+        atlas_bytes(8 * NS_PER_S, 2, k_effort=[0] * N)]
+    for index, raw in enumerate(stream):
+        if index == 4:
+            sim.set_mode(ControlMode.USER)
+            twin.set_mode(ControlMode.USER)
+        fast.receive_command(raw, topics.ATLAS_COMMAND)
+        fast.apply_pending_commands()
+        general.inbox._apply_received([(topics.ATLAS_COMMAND, raw)])
+        for name in ('user_command', 'law_command', 'blend_command'):
+            ours, theirs = getattr(sim.commands, name), getattr(twin.commands, name)
+            assert (ours is None) == (theirs is None), (index, name)
+            if ours is not None:
+                assert _fields_bytes(ours) == _fields_bytes(theirs), (index, name)
+        assert (fast.statistics.command_stamp_ns, fast.inbox.period_ms,
+                fast.watch.first_command_ns) == (
+            general.statistics.command_stamp_ns, general.inbox.period_ms,
+            general.watch.first_command_ns), index
+        assert fast_log.lines == general_log.lines, index
+        sim.step()
+        twin.step()
+    assert len(fast_log.of('refused')) == 2 and len(fast_log.of('kept')) == 1
+    assert any('synchronization window on' in line for line in fast_log.of('info'))
+
+
+def _fields_bytes(command: object) -> bytes:
+    return b''.join(np.asarray(getattr(command, name)).tobytes() for name in LAW_FIELDS)
