@@ -20,7 +20,13 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from tutorial_atlas_control.course.errors import CourseError
-from tutorial_atlas_control.course.grid_path import a_star, cells_on_line, shortened
+from tutorial_atlas_control.course.grid_path import (
+    TURN_RADIUS_M,
+    a_star,
+    cells_on_line,
+    shortened,
+    turnable,
+)
 from tutorial_atlas_control.course.vrc_task_2 import (
     BLOCK_ENVELOPE_M,
     GATE_POST_M,
@@ -29,8 +35,8 @@ from tutorial_atlas_control.course.vrc_task_2 import (
     Block,
 )
 
-__all__ = ['CLEARANCE_M', 'GRID_M', 'block_corners', 'block_footprint', 'clear_path',
-           'distance_to_polygon', 'gate_posts']
+__all__ = ['CLEARANCE_M', 'GRID_M', 'SOLE_CLEARANCE_M', 'block_corners', 'block_footprint',
+           'clear_path', 'distance_to_polygon', 'gate_posts', 'sole_clearances_m']
 
 #: Grid cell (m).
 GRID_M = 0.05
@@ -41,6 +47,11 @@ CLEARANCE_M = 0.55
 #: A shortened path's straight lines may pass this much (m) nearer than the clearance: the
 #: grid path hugs the clearance's edge, and lines between its cells cut it by a cell or two.
 SHORTCUT_SLACK_M = 0.1
+#: A planned sole's edge to a block's footprint (m): what the way's straight lines leave a
+#: sole (the clearance less the shortcut's slack and the centre line's 0.18 m reach to a
+#: sole's outer edge: 0.27) less a grid cell and a little turn of the sole. A walk fell
+#: beside a block 0.18 m from its sole's edge.
+SOLE_CLEARANCE_M = 0.2
 #: The grid reaches this far (m) beyond the start, the goal and the blocks between them.
 MARGIN_M = 1.5
 
@@ -161,6 +172,46 @@ def clear_path(blocks: Sequence[Block], start: Point, goal: Point,
     if cells is None:
         raise CourseError(f'no way from ({start[0]:.2f}, {start[1]:.2f}) to '
                           f'({goal[0]:.2f}, {goal[1]:.2f}) keeps {clearance_m} m from the blocks')
-    kept = shortened(free | (nearest_m > clearance_m - SHORTCUT_SLACK_M), cells)
+    looser = free | (nearest_m > clearance_m - SHORTCUT_SLACK_M)
+    kept = turnable(looser, shortened(looser, cells), TURN_RADIUS_M / GRID_M)
     return tuple((round(float(xs[i]), 3), round(float(ys[j]), 3)) for i, j in kept[1:-1]) \
         + (goal,)
+
+
+def _rectangle(x_m: float, y_m: float, yaw_rad: float,
+               half_size_m: tuple[float, float]) -> np.ndarray:
+    """A sole's corners (4, 2), counter-clockwise: its centre, heading and half sizes."""
+    c, s = math.cos(yaw_rad), math.sin(yaw_rad)
+    local = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * half_size_m
+    return local @ np.array([[c, s], [-s, c]]) + (x_m, y_m)
+
+
+def _polygon_distance(a: np.ndarray, b: np.ndarray) -> float:
+    """The distance (m) between two convex counter-clockwise polygons (0 when they overlap:
+    no edge's normal separates them)."""
+    for polygon, other in ((a, b), (b, a)):
+        for start, end in zip(polygon, np.roll(polygon, -1, axis=0)):
+            normal = np.array([end[1] - start[1], start[0] - end[0]])  # outward
+            if np.all((other - start) @ normal > 0.0):
+                return min(float(distance_to_polygon(b, a[:, 0], a[:, 1]).min()),
+                           float(distance_to_polygon(a, b[:, 0], b[:, 1]).min()))
+    return 0.0
+
+
+def sole_clearances_m(soles: Sequence[tuple[float, float, float]], blocks: Sequence[Block],
+                      half_size_m: tuple[float, float], obstacles: np.ndarray | None = None
+                      ) -> np.ndarray:
+    """How near (m) each sole ((x, y, yaw) of its centre; `half_size_m` its half length and
+    width) comes to any block's footprint or point of `obstacles` ((n, 2) world x, y) (0: on
+    one): a planned footstep's clearance."""
+    footprints = [block_footprint(block) for block in blocks]
+    points = np.empty((0, 2)) if obstacles is None else np.asarray(obstacles)[:, :2]
+    nearest = []
+    for sole in soles:
+        rectangle = _rectangle(*sole, half_size_m)
+        distances = [_polygon_distance(rectangle, footprint) for footprint in footprints]
+        if len(points):
+            distances.append(float(distance_to_polygon(rectangle, points[:, 0],
+                                                       points[:, 1]).min()))
+        nearest.append(min(distances, default=math.inf))
+    return np.array(nearest)
