@@ -77,6 +77,10 @@ class RouteGait:
     #: Whether a waypoint the turning strides cannot face (it lies inside their circle) is
     #: faced on the spot instead of refused.
     inside_in_place: bool = False
+    #: The most (m) a stride shortens from one step to the next into a turn (0: at once,
+    #: from full strides to the turning steps): the straight run before a corner ends in
+    #: strides stepping down to the turning steps' length.
+    turn_slowdown_m: float = 0.0
 
     def turning_in_place(self) -> RouteGait:
         """This gait with its turns in place: among obstacles, where a corner must be
@@ -87,7 +91,8 @@ class RouteGait:
         numbers = (self.stride_m, self.turn_step_rad, self.width_m, self.duration_s,
                    self.ground_flat_m)
         if not all(math.isfinite(value) and value > 0.0 for value in numbers) \
-                or not (math.isfinite(self.turn_stride_m) and self.turn_stride_m >= 0.0):
+                or not all(math.isfinite(value) and value >= 0.0
+                           for value in (self.turn_stride_m, self.turn_slowdown_m)):
             raise WalkingError(f'a route gait needs positive finite numbers (a turning '
                                f'stride of 0 turns in place): {self}')
 
@@ -135,6 +140,24 @@ def _straight(start_xy: tuple[float, float], heading_rad: float, distance_m: flo
     return moves
 
 
+def _slowed(run: list[Move], end_m: float, gait: RouteGait) -> list[Move]:
+    """A straight run of equal strides ending in strides that step down by at most the
+    gait's turn_slowdown_m to `end_m` (the turning step's length after it); the same run
+    when it is not one of equal strides or is too short to step down."""
+    if not run or len({move[1:] for move in run}) > 1:
+        return run
+    heading, stride, duration = run[0]
+    slowing: list[float] = []
+    while (length := end_m + gait.turn_slowdown_m * (len(slowing) + 1)) < stride - 1e-9:
+        slowing.insert(0, length)
+    rest = sum(move[1] for move in run) - sum(slowing)
+    if not slowing or rest <= 0.0:
+        return run
+    count = math.ceil(rest / gait.stride_m - 1e-9)
+    return [(heading, rest / count, duration)] * count \
+        + [(heading, length, duration) for length in slowing]
+
+
 def _facing(start_xy: tuple[float, float], heading_rad: float, goal: tuple[float, float],
             stride_m: float, gait: RouteGait) -> list[Move] | None:
     """The turning steps (each `stride_m` long) until `goal`'s bearing is within a step's
@@ -163,6 +186,7 @@ def _moves(start_xy: tuple[float, float], start_yaw_rad: float,
     x, y = start_xy
     heading = start_yaw_rad
     moves: list[Move] = []
+    run = 0  # where the last straight run's moves begin
     for number, goal in enumerate(waypoints):
         if not (math.isfinite(goal[0]) and math.isfinite(goal[1])):
             raise WalkingError(f'waypoint ({goal[0]}, {goal[1]}) is not finite')
@@ -176,7 +200,10 @@ def _moves(start_xy: tuple[float, float], start_yaw_rad: float,
         for heading, length, _ in turns:
             x += length * math.cos(heading)
             y += length * math.sin(heading)
+        if turns and gait.turn_slowdown_m > 0.0:
+            moves[run:] = _slowed(moves[run:], turns[0][1], gait)
         moves += turns
+        run = len(moves)
         goal_x, goal_y = goal
         distance = math.hypot(goal_x - x, goal_y - y)
         if distance < REACHED_M:

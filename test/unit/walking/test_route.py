@@ -93,6 +93,21 @@ def test_a_gait_may_face_the_first_waypoint_and_any_inside_its_circle_on_the_spo
         route_steps((0.0, 0.0), 0.0, waypoints, RouteGait(start_in_place=True))
 
 
+def test_a_gait_may_slow_its_strides_into_a_corner() -> None:
+    waypoints = [(2.0, 0.0), (2.0, 2.0)]  # 2 m east, then a quarter turn left
+    for slowdown in (0.0, 0.035):
+        steps = route_steps((0.0, 0.0), 0.0, waypoints, RouteGait(turn_slowdown_m=slowdown))
+        centres = [(0.0, 0.0)] + [centre_of(step)[:2] for step in steps]
+        moves = [math.dist(a, b) for a, b in zip(centres, centres[1:])]
+        first_turn = next(k for k, step in enumerate(steps) if step.yaw_rad > 0.05)
+        into = moves[:first_turn + 1]
+        drop = max(a - b for a, b in zip(into, into[1:]))
+        assert drop <= 0.035 + 1e-9 if slowdown else drop > 0.06  # 0.143 -> 0.08 at once
+        assert into[-1] == pytest.approx(0.08)  # the first turning step
+        assert sum(into[:-1]) == pytest.approx(2.0)  # the corner where it was
+        assert centre_after(steps) == pytest.approx(waypoints[-1], abs=1e-9)
+
+
 def test_waypoints_in_turn_and_a_final_heading() -> None:
     steps = route_steps((-3.0, -38.0), 0.0, [(2.5, -38.0), (0.5, -24.5)],
                         final_heading_rad=math.pi / 2)
