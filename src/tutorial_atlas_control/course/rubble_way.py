@@ -8,7 +8,10 @@ its centre is more than `clearance_m` from every block's footprint (its 0.435 x 
 0.203 m envelope turned as it lies, seen from above) and every post. A* over the free cells
 (8-connected, the straight-line distance as its estimate) finds the shortest grid path;
 it is shortened to the few waypoints between which a straight line keeps the clearance less
-SHORTCUT_SLACK_M, the ones a route of straight strides (walking/route.py) walks.
+SHORTCUT_SLACK_M, the ones a route of straight strides (walking/route.py) walks, and a corner
+inside the turning circle at the one before is dropped or moved back (grid_path.turnable):
+the walker turns its corners in strides. Whether its planned soles keep clear of the blocks
+is sole_clearances_m's to say (offline/course_route.py's around_blocks asks it).
 """
 
 from __future__ import annotations
