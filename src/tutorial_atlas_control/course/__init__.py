@@ -24,7 +24,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'errors': ['CourseError'],
     'rubble_way': ['CLEARANCE_M', 'GRID_M', 'SOLE_CLEARANCE_M', 'block_corners',
                    'block_footprint', 'clear_path', 'distance_to_polygon', 'gate_posts',
-                   'sole_clearances_m'],
+                   'point_clearances_m', 'sole_clearances_m'],
     'legs': ['COURSE_LEGS', 'LEG_PAUSE_S', 'Leg', 'leg_waypoints', 'legs_ahead'],
     'markers': ['COURSE_AREA', 'MAX_TRIANGLES', 'Area', 'BoxShape', 'CourseShapes',
                 'TerrainMesh', 'course_shapes', 'height_colours', 'terrain_mesh'],

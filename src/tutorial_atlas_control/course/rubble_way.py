@@ -39,7 +39,8 @@ from tutorial_atlas_control.course.vrc_task_2 import (
 )
 
 __all__ = ['CLEARANCE_M', 'GRID_M', 'SOLE_CLEARANCE_M', 'block_corners', 'block_footprint',
-           'clear_path', 'distance_to_polygon', 'gate_posts', 'sole_clearances_m']
+           'clear_path', 'distance_to_polygon', 'gate_posts', 'point_clearances_m',
+           'sole_clearances_m']
 
 #: Grid cell (m).
 GRID_M = 0.05
@@ -218,3 +219,17 @@ def sole_clearances_m(soles: Sequence[tuple[float, float, float]], blocks: Seque
                                                        points[:, 1]).min()))
         nearest.append(min(distances, default=math.inf))
     return np.array(nearest)
+
+
+def point_clearances_m(points: np.ndarray, blocks: Sequence[Block],
+                       obstacles: np.ndarray | None = None) -> np.ndarray:
+    """How near (m) each point ((n, 2) world x, y) comes to any block's footprint or point of
+    `obstacles` (0: on a block)."""
+    points = np.asarray(points, dtype=float).reshape(-1, 2)
+    nearest = np.full(len(points), np.inf)
+    for footprint in (block_footprint(block) for block in blocks):
+        nearest = np.minimum(nearest, distance_to_polygon(footprint, points[:, 0], points[:, 1]))
+    if obstacles is not None and len(obstacles):
+        distance, _ = cKDTree(np.asarray(obstacles)[:, :2]).query(points)
+        nearest = np.minimum(nearest, distance)
+    return nearest

@@ -38,6 +38,7 @@ from tutorial_atlas_control.asi import (
     yaw_of_quaternion,
 )
 from tutorial_atlas_control.course import (
+    CLEARANCE_M,
     COURSE_VARIANTS,
     LEG_PAUSE_S,
     SOLE_CLEARANCE_M,
@@ -48,8 +49,10 @@ from tutorial_atlas_control.course import (
     course_height_m,
     leg_waypoints,
     legs_ahead,
+    point_clearances_m,
     sole_clearances_m,
 )
+from tutorial_atlas_control.course.rubble_way import SHORTCUT_SLACK_M as SLACK_M
 from tutorial_atlas_control.msgs import AsiCommand, ManipulateParams, StepData
 from tutorial_atlas_control.offline.course_variant import variant_model
 from tutorial_atlas_control.offline.laser_terrain import (
@@ -80,6 +83,7 @@ from tutorial_atlas_control.walking import (
     perturb_start,
     route_steps,
 )
+from tutorial_atlas_control.walking.footsteps import side_sign
 
 __all__ = ['PLANNING_GROUNDS', 'CourseWalk', 'LegFigures', 'around_blocks', 'course_walk',
            'leg_plan']
@@ -350,13 +354,17 @@ def around_blocks(origin: tuple[float, float], heading_rad: float,
     """The way around the blocks with its corners turned in strides, slowing into each
     (an on-the-spot turn after full strides tipped the stance foot onto its toe:
     docs/vrc.md), the first one and any the strides cannot face on the spot, when every
-    sole past the first waypoint keeps
-    SOLE_CLEARANCE_M from the blocks and obstacles (before it a walker beside a block steps
-    out); else every corner turned on the spot."""
+    sole keeps SOLE_CLEARANCE_M from the blocks and obstacles from the first step whose
+    centre keeps the way's clearance (before it a walker beside a block steps out); else
+    every corner turned on the spot."""
     strides = replace(gait, start_in_place=True, inside_in_place=True,
                       turn_slowdown_m=CORNER_SLOWDOWN_M)
     plan = route_steps(origin, heading_rad, waypoints, strides, ground=ground)
-    out = len(route_steps(origin, heading_rad, waypoints[:1], strides, ground=ground)) - 1
+    centres = [(step.x_m + side_sign(step.foot_index) * gait.width_m / 2 * math.sin(step.yaw_rad),
+                step.y_m - side_sign(step.foot_index) * gait.width_m / 2 * math.cos(step.yaw_rad))
+               for step in plan]
+    clear = point_clearances_m(np.array(centres), blocks, obstacles) >= CLEARANCE_M - SLACK_M
+    out = int(np.argmax(clear)) if clear.any() else len(plan)
     nearest = sole_clearances_m([(step.x_m, step.y_m, step.yaw_rad) for step in plan[out:]],
                                 blocks, (SOLE_HALF_LENGTH_M, SOLE_HALF_WIDTH_M), obstacles)
     if nearest.min(initial=np.inf) >= SOLE_CLEARANCE_M:

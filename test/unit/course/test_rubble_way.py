@@ -19,6 +19,7 @@ from tutorial_atlas_control.course import (
     clear_path,
     distance_to_polygon,
     leg_waypoints,
+    point_clearances_m,
     rearranged_blocks,
     sole_clearances_m,
 )
@@ -140,3 +141,7 @@ def test_a_sole_s_clearance_is_the_gap_between_its_edge_and_a_block_s() -> None:
     # A point of a sensor's obstacles counts as a block does.
     near = sole_clearances_m(soles[:1], (), half, np.array([[6.0, 8.3]]))
     assert near[0] == pytest.approx(0.5 - 0.3 - 0.0624)
+    # The centre line's points alike (around_blocks: where a walker beside a block is out).
+    points = point_clearances_m(np.array([[6.0, 8.5], [6.0, 8.0]]), (block,),
+                                np.array([[6.0, 8.3]]))
+    assert points == pytest.approx([0.2, 0.0])
