@@ -38,7 +38,8 @@ from tutorial_atlas_control.course.vrc_task_2 import (
     Block,
 )
 
-__all__ = ['CLEARANCE_M', 'GRID_M', 'SOLE_CLEARANCE_M', 'block_corners', 'block_footprint',
+__all__ = ['CLEARANCE_M', 'GRID_M', 'SHORTCUT_SLACK_M', 'SOLE_CLEARANCE_M', 'block_corners',
+           'block_footprint',
            'clear_path', 'distance_to_polygon', 'gate_posts', 'point_clearances_m',
            'sole_clearances_m']
 

@@ -41,6 +41,7 @@ from tutorial_atlas_control.course import (
     CLEARANCE_M,
     COURSE_VARIANTS,
     LEG_PAUSE_S,
+    SHORTCUT_SLACK_M,
     SOLE_CLEARANCE_M,
     Block,
     CourseVariant,
@@ -52,7 +53,6 @@ from tutorial_atlas_control.course import (
     point_clearances_m,
     sole_clearances_m,
 )
-from tutorial_atlas_control.course.rubble_way import SHORTCUT_SLACK_M as SLACK_M
 from tutorial_atlas_control.msgs import AsiCommand, ManipulateParams, StepData
 from tutorial_atlas_control.offline.course_variant import variant_model
 from tutorial_atlas_control.offline.laser_terrain import (
@@ -82,8 +82,8 @@ from tutorial_atlas_control.walking import (
     feet_origin,
     perturb_start,
     route_steps,
+    side_sign,
 )
-from tutorial_atlas_control.walking.footsteps import side_sign
 
 __all__ = ['PLANNING_GROUNDS', 'CourseWalk', 'LegFigures', 'around_blocks', 'course_walk',
            'leg_plan']
@@ -363,7 +363,8 @@ def around_blocks(origin: tuple[float, float], heading_rad: float,
     centres = [(step.x_m + side_sign(step.foot_index) * gait.width_m / 2 * math.sin(step.yaw_rad),
                 step.y_m - side_sign(step.foot_index) * gait.width_m / 2 * math.cos(step.yaw_rad))
                for step in plan]
-    clear = point_clearances_m(np.array(centres), blocks, obstacles) >= CLEARANCE_M - SLACK_M
+    way_m = CLEARANCE_M - SHORTCUT_SLACK_M  # what the way's straight lines keep
+    clear = point_clearances_m(np.array(centres), blocks, obstacles) >= way_m
     out = int(np.argmax(clear)) if clear.any() else len(plan)
     nearest = sole_clearances_m([(step.x_m, step.y_m, step.yaw_rad) for step in plan[out:]],
                                 blocks, (SOLE_HALF_LENGTH_M, SOLE_HALF_WIDTH_M), obstacles)

@@ -30,7 +30,8 @@ from tutorial_atlas_control.exports import lazy_exports
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'errors': ['WalkingError'],
     'footsteps': ['DRCSIM_WALK_QUEUE', 'LEFT', 'QUEUE_LENGTH', 'RIGHT', 'STEP_DURATION_S',
-                  'Footstep', 'circle_steps', 'placed', 'straight_steps', 'window', 'wrap_angle'],
+                  'Footstep', 'circle_steps', 'placed', 'side_sign', 'straight_steps', 'window',
+                  'wrap_angle'],
     'status_flags': ['CATCHING', 'ERROR_INCONSISTENT_STEPS', 'OKAY', 'STEPPING', 'SWAYING',
                      'WARNING_INSUFFICIENT_STEP_DATA'],
     'swing': ['END_CLEARANCE_M', 'SWING_HEIGHT_M', 'sole_frame', 'surface_tilt',
