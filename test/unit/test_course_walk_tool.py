@@ -24,7 +24,7 @@ TOOL = Path(__file__).resolve().parents[2] / 'tools' / 'course_walk.py'
     (['--stride', '-1', '1'], 'course_walk.py: error: a route gait needs positive finite '
      'numbers (a turning stride of 0 turns in place): RouteGait(stride_m=-1.0, '
      'turn_step_rad=0.2, turn_stride_m=0.08, width_m=0.24, duration_s=0.63, fit_ground=True, '
-     'ground_flat_m=0.01)')])
+     'ground_flat_m=0.01, start_in_place=False, inside_in_place=False, turn_slowdown_m=0.0)')])
 def test_bad_arguments_are_one_line_and_exit_2(args: list[str], line: str) -> None:
     done = subprocess.run([sys.executable, str(TOOL), *args], capture_output=True, text=True,
                           timeout=60, check=False)

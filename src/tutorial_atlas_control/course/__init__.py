@@ -22,8 +22,9 @@ from tutorial_atlas_control.exports import lazy_exports
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'errors': ['CourseError'],
-    'rubble_way': ['CLEARANCE_M', 'GRID_M', 'block_corners', 'block_footprint', 'clear_path',
-                   'distance_to_polygon', 'gate_posts'],
+    'rubble_way': ['CLEARANCE_M', 'GRID_M', 'SHORTCUT_SLACK_M', 'SOLE_CLEARANCE_M', 'block_corners',
+                   'block_footprint', 'clear_path', 'distance_to_polygon', 'gate_posts',
+                   'point_clearances_m', 'sole_clearances_m'],
     'legs': ['COURSE_LEGS', 'LEG_PAUSE_S', 'Leg', 'leg_waypoints', 'legs_ahead', 'rest_of_leg'],
     'markers': ['COURSE_AREA', 'MAX_TRIANGLES', 'Area', 'BoxShape', 'CourseShapes',
                 'TerrainMesh', 'course_shapes', 'height_colours', 'terrain_mesh'],

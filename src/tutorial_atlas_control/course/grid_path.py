@@ -11,10 +11,15 @@ import math
 
 import numpy as np
 
-__all__ = ['Cell', 'a_star', 'cells_on_line', 'inside_turn', 'shortened', 'turnable',
-           'turned_earlier', 'visible']
+__all__ = ['TURN_RADIUS_M', 'Cell', 'a_star', 'cells_on_line', 'inside_turn', 'shortened',
+           'turnable', 'turned_earlier', 'visible']
 
 Cell = tuple[int, int]
+
+#: A walker turning in strides turns on a circle of about this radius (m; route.py's turning
+#: steps: 0.08 m each turning 0.2 rad make 0.4): a corner inside the circle from the one
+#: before (as the walker arrives there) cannot be faced (turnable).
+TURN_RADIUS_M = 0.45
 
 _MOVES = [(di, dj, math.hypot(di, dj)) for di in (-1, 0, 1) for dj in (-1, 0, 1)
           if (di, dj) != (0, 0)]

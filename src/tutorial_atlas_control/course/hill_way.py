@@ -27,7 +27,13 @@ import numpy as np
 from scipy import ndimage
 
 from tutorial_atlas_control.course.errors import CourseError
-from tutorial_atlas_control.course.grid_path import Cell, a_star, shortened, turnable
+from tutorial_atlas_control.course.grid_path import (
+    TURN_RADIUS_M,
+    Cell,
+    a_star,
+    shortened,
+    turnable,
+)
 from tutorial_atlas_control.course.rubble_way import distance_to_polygon, gate_posts
 from tutorial_atlas_control.course.terrain import ground_under, terrain_heights
 
@@ -46,12 +52,9 @@ STEEPEST_DEG = 11.0
 REACH_M = 0.15
 #: The shortened way's straight lines may cross ground this much steeper (degrees).
 SLACK_DEG = 1.0
-#: A walker turning in strides turns on a circle of about this radius (m; route.py's turning
-#: steps: 0.08 m each turning 0.2 rad make 0.4): a corner inside the circle from the one
-#: before (as the walker arrives there) cannot be faced. Such a corner is dropped where the
-#: line past it (or, else, the line past the one before to it) crosses ground at most
-#: DROP_SLACK_DEG steeper than the way.
-TURN_RADIUS_M = 0.45
+#: A corner inside the turning circle (grid_path.TURN_RADIUS_M) at the one before is dropped
+#: where the line past it (or, else, the line past the one before to it) crosses ground at
+#: most DROP_SLACK_DEG steeper than the way.
 DROP_SLACK_DEG = 3.0
 #: The centre line keeps this far (m) from a gate post's side.
 POST_CLEARANCE_M = 0.6

@@ -8,7 +8,10 @@ its centre is more than `clearance_m` from every block's footprint (its 0.435 x 
 0.203 m envelope turned as it lies, seen from above) and every post. A* over the free cells
 (8-connected, the straight-line distance as its estimate) finds the shortest grid path;
 it is shortened to the few waypoints between which a straight line keeps the clearance less
-SHORTCUT_SLACK_M, the ones a route of straight strides (walking/route.py) walks.
+SHORTCUT_SLACK_M, the ones a route of straight strides (walking/route.py) walks, and a corner
+inside the turning circle at the one before is dropped or moved back (grid_path.turnable):
+the walker turns its corners in strides. Whether its planned soles keep clear of the blocks
+is sole_clearances_m's to say (offline/course_route.py's around_blocks asks it).
 """
 
 from __future__ import annotations
@@ -20,7 +23,13 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from tutorial_atlas_control.course.errors import CourseError
-from tutorial_atlas_control.course.grid_path import a_star, cells_on_line, shortened
+from tutorial_atlas_control.course.grid_path import (
+    TURN_RADIUS_M,
+    a_star,
+    cells_on_line,
+    shortened,
+    turnable,
+)
 from tutorial_atlas_control.course.vrc_task_2 import (
     BLOCK_ENVELOPE_M,
     GATE_POST_M,
@@ -29,8 +38,10 @@ from tutorial_atlas_control.course.vrc_task_2 import (
     Block,
 )
 
-__all__ = ['CLEARANCE_M', 'GRID_M', 'block_corners', 'block_footprint', 'clear_path',
-           'distance_to_polygon', 'gate_posts']
+__all__ = ['CLEARANCE_M', 'GRID_M', 'SHORTCUT_SLACK_M', 'SOLE_CLEARANCE_M', 'block_corners',
+           'block_footprint',
+           'clear_path', 'distance_to_polygon', 'gate_posts', 'point_clearances_m',
+           'sole_clearances_m']
 
 #: Grid cell (m).
 GRID_M = 0.05
@@ -41,6 +52,11 @@ CLEARANCE_M = 0.55
 #: A shortened path's straight lines may pass this much (m) nearer than the clearance: the
 #: grid path hugs the clearance's edge, and lines between its cells cut it by a cell or two.
 SHORTCUT_SLACK_M = 0.1
+#: A planned sole's edge to a block's footprint (m): what the way's straight lines leave a
+#: sole (the clearance less the shortcut's slack and the centre line's 0.18 m reach to a
+#: sole's outer edge: 0.27) less a grid cell and a little turn of the sole. A walk fell
+#: beside a block 0.18 m from its sole's edge.
+SOLE_CLEARANCE_M = 0.2
 #: The grid reaches this far (m) beyond the start, the goal and the blocks between them.
 MARGIN_M = 1.5
 
@@ -161,6 +177,60 @@ def clear_path(blocks: Sequence[Block], start: Point, goal: Point,
     if cells is None:
         raise CourseError(f'no way from ({start[0]:.2f}, {start[1]:.2f}) to '
                           f'({goal[0]:.2f}, {goal[1]:.2f}) keeps {clearance_m} m from the blocks')
-    kept = shortened(free | (nearest_m > clearance_m - SHORTCUT_SLACK_M), cells)
+    looser = free | (nearest_m > clearance_m - SHORTCUT_SLACK_M)
+    kept = turnable(looser, shortened(looser, cells), TURN_RADIUS_M / GRID_M)
     return tuple((round(float(xs[i]), 3), round(float(ys[j]), 3)) for i, j in kept[1:-1]) \
         + (goal,)
+
+
+def _rectangle(x_m: float, y_m: float, yaw_rad: float,
+               half_size_m: tuple[float, float]) -> np.ndarray:
+    """A sole's corners (4, 2), counter-clockwise: its centre, heading and half sizes."""
+    c, s = math.cos(yaw_rad), math.sin(yaw_rad)
+    local = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * half_size_m
+    return local @ np.array([[c, s], [-s, c]]) + (x_m, y_m)
+
+
+def _polygon_distance(a: np.ndarray, b: np.ndarray) -> float:
+    """The distance (m) between two convex counter-clockwise polygons (0 when they overlap:
+    no edge's normal separates them)."""
+    for polygon, other in ((a, b), (b, a)):
+        for start, end in zip(polygon, np.roll(polygon, -1, axis=0)):
+            normal = np.array([end[1] - start[1], start[0] - end[0]])  # outward
+            if np.all((other - start) @ normal > 0.0):
+                return min(float(distance_to_polygon(b, a[:, 0], a[:, 1]).min()),
+                           float(distance_to_polygon(a, b[:, 0], b[:, 1]).min()))
+    return 0.0
+
+
+def sole_clearances_m(soles: Sequence[tuple[float, float, float]], blocks: Sequence[Block],
+                      half_size_m: tuple[float, float], obstacles: np.ndarray | None = None
+                      ) -> np.ndarray:
+    """How near (m) each sole ((x, y, yaw) of its centre; `half_size_m` its half length and
+    width) comes to any block's footprint or point of `obstacles` ((n, 2) world x, y) (0: on
+    one): a planned footstep's clearance."""
+    footprints = [block_footprint(block) for block in blocks]
+    points = np.empty((0, 2)) if obstacles is None else np.asarray(obstacles)[:, :2]
+    nearest = []
+    for sole in soles:
+        rectangle = _rectangle(*sole, half_size_m)
+        distances = [_polygon_distance(rectangle, footprint) for footprint in footprints]
+        if len(points):
+            distances.append(float(distance_to_polygon(rectangle, points[:, 0],
+                                                       points[:, 1]).min()))
+        nearest.append(min(distances, default=math.inf))
+    return np.array(nearest)
+
+
+def point_clearances_m(points: np.ndarray, blocks: Sequence[Block],
+                       obstacles: np.ndarray | None = None) -> np.ndarray:
+    """How near (m) each point ((n, 2) world x, y) comes to any block's footprint or point of
+    `obstacles` (0: on a block)."""
+    points = np.asarray(points, dtype=float).reshape(-1, 2)
+    nearest = np.full(len(points), np.inf)
+    for footprint in (block_footprint(block) for block in blocks):
+        nearest = np.minimum(nearest, distance_to_polygon(footprint, points[:, 0], points[:, 1]))
+    if obstacles is not None and len(obstacles):
+        distance, _ = cKDTree(np.asarray(obstacles)[:, :2]).query(points)
+        nearest = np.minimum(nearest, distance)
+    return nearest

@@ -24,7 +24,7 @@ import math
 import tempfile
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -38,8 +38,11 @@ from tutorial_atlas_control.asi import (
     yaw_of_quaternion,
 )
 from tutorial_atlas_control.course import (
+    CLEARANCE_M,
     COURSE_VARIANTS,
     LEG_PAUSE_S,
+    SHORTCUT_SLACK_M,
+    SOLE_CLEARANCE_M,
     Block,
     CourseVariant,
     Heights,
@@ -49,7 +52,9 @@ from tutorial_atlas_control.course import (
     course_heights,
     leg_waypoints,
     legs_ahead,
+    point_clearances_m,
     rest_of_leg,
+    sole_clearances_m,
 )
 from tutorial_atlas_control.msgs import AsiCommand, ManipulateParams, StepData
 from tutorial_atlas_control.offline.course_variant import variant_model
@@ -74,15 +79,19 @@ from tutorial_atlas_control.stepping import CourseScoring, Tick
 from tutorial_atlas_control.units import NS_PER_S
 from tutorial_atlas_control.walking import (
     QUEUE_LENGTH,
+    SOLE_HALF_LENGTH_M,
+    SOLE_HALF_WIDTH_M,
     Footstep,
     HeightField,
     RouteGait,
     feet_origin,
     perturb_start,
     route_steps,
+    side_sign,
 )
 
-__all__ = ['PLANNING_GROUNDS', 'CourseWalk', 'LegFigures', 'course_walk', 'leg_plan']
+__all__ = ['PLANNING_GROUNDS', 'CourseWalk', 'LegFigures', 'around_blocks', 'course_walk',
+           'leg_plan']
 
 #: The grounds a walker plans on: the world's (offline: MuJoCo's rays on the world) or its
 #: head laser's height map (laser_terrain.py).
@@ -97,6 +106,10 @@ SECONDS_PER_STEP = 0.9
 #: The lowest CoM height (m over the ground) the capture point's LIPM frequency is taken at.
 LOWEST_LIPM_HEIGHT_M = 0.3
 GRAVITY_M_S2 = 9.81
+#: Among the blocks the strides step down by at most this much (m) a step into a corner's
+#: turning steps (0.15 -> 0.115 -> 0.08): turned at once from full strides, the stance foot
+#: tipped onto its toe as the first turning step began (docs/vrc.md).
+CORNER_SLOWDOWN_M = 0.035
 #: A sole whose centre is this close (m) to the ground under it carries the robot.
 SOLE_ON_GROUND_M = 0.03
 
@@ -327,19 +340,45 @@ def leg_plan(leg: Leg, origin: tuple[float, float], heading_rad: float, gait: Ro
              heights: Heights = course_heights) -> list[Footstep]:
     """A leg's steps from feet side by side at `origin` facing `heading_rad`: its waypoints
     (around `blocks` and the points of `obstacles` (n, 2) across the rubble, on gentle
-    ground over the hills: leg_waypoints), the
-    corners among the blocks turned on the spot, the straight runs fitted to `ground` when
-    the gait says so (the offline walker's world, the live one's course description).
+    ground over the hills: leg_waypoints), the straight runs fitted to `ground` when the gait
+    says so (the offline walker's world, the live one's course description); among the
+    blocks as around_blocks turns its corners.
 
     Raises:
         CourseError: no way around the blocks or over the hills.
         WalkingError: a waypoint the route cannot reach.
     """
-    if leg.clear_of_blocks:  # around blocks: the corners turned on the spot
-        gait = gait.turning_in_place()
-    return route_steps(origin, heading_rad,
-                       leg_waypoints(leg, *origin, blocks, obstacles, heights), gait,
-                       ground=ground if gait.fit_ground else None)
+    waypoints = leg_waypoints(leg, *origin, blocks, obstacles, heights)
+    fitted = ground if gait.fit_ground else None
+    if leg.clear_of_blocks:
+        return around_blocks(origin, heading_rad, waypoints, gait, blocks, fitted, obstacles)
+    return route_steps(origin, heading_rad, waypoints, gait, ground=fitted)
+
+
+def around_blocks(origin: tuple[float, float], heading_rad: float,
+                   waypoints: Sequence[tuple[float, float]], gait: RouteGait,
+                   blocks: Sequence[Block], ground: HeightField | None,
+                   obstacles: np.ndarray | None) -> list[Footstep]:
+    """The way around the blocks with its corners turned in strides, slowing into each
+    (an on-the-spot turn after full strides tipped the stance foot onto its toe:
+    docs/vrc.md), the first one and any the strides cannot face on the spot, when every
+    sole keeps SOLE_CLEARANCE_M from the blocks and obstacles from the first step whose
+    centre keeps the way's clearance (before it a walker beside a block steps out); else
+    every corner turned on the spot."""
+    strides = replace(gait, start_in_place=True, inside_in_place=True,
+                      turn_slowdown_m=CORNER_SLOWDOWN_M)
+    plan = route_steps(origin, heading_rad, waypoints, strides, ground=ground)
+    centres = [(step.x_m + side_sign(step.foot_index) * gait.width_m / 2 * math.sin(step.yaw_rad),
+                step.y_m - side_sign(step.foot_index) * gait.width_m / 2 * math.cos(step.yaw_rad))
+               for step in plan]
+    way_m = CLEARANCE_M - SHORTCUT_SLACK_M  # what the way's straight lines keep
+    clear = point_clearances_m(np.array(centres), blocks, obstacles) >= way_m
+    out = int(np.argmax(clear)) if clear.any() else len(plan)
+    nearest = sole_clearances_m([(step.x_m, step.y_m, step.yaw_rad) for step in plan[out:]],
+                                blocks, (SOLE_HALF_LENGTH_M, SOLE_HALF_WIDTH_M), obstacles)
+    if nearest.min(initial=np.inf) >= SOLE_CLEARANCE_M:
+        return plan
+    return route_steps(origin, heading_rad, waypoints, gait.turning_in_place(), ground=ground)
 
 
 def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,

@@ -43,7 +43,8 @@ from tutorial_atlas_control.walking.footsteps import (
     wrap_angle,
 )
 
-__all__ = ['GroundGait', 'HeightField', 'SoleFit', 'ground_steps', 'sole_fit']
+__all__ = ['SOLE_HALF_LENGTH_M', 'SOLE_HALF_WIDTH_M', 'GroundGait', 'HeightField', 'SoleFit',
+           'ground_steps', 'sole_fit']
 
 #: The ground's height (m) under a world (x, y).
 HeightField = Callable[[float, float], float]

@@ -70,6 +70,17 @@ class RouteGait:
     #: pulled footholds back and swung up to 0.33 m; at 1 cm the strides there are even
     #: (docs/vrc.md).
     ground_flat_m: float = 0.01
+    #: Whether the turn towards the first waypoint is made on the spot whatever
+    #: `turn_stride_m`: from rest, as a leg begins, there are no strides to stop from, and a
+    #: walker beside an obstacle faces its way out without sweeping a circle.
+    start_in_place: bool = False
+    #: Whether a waypoint the turning strides cannot face (it lies inside their circle) is
+    #: faced on the spot instead of refused.
+    inside_in_place: bool = False
+    #: The most (m) a stride shortens from one step to the next into a turn (0: at once,
+    #: from full strides to the turning steps): the straight run before a corner ends in
+    #: strides stepping down to the turning steps' length.
+    turn_slowdown_m: float = 0.0
 
     def turning_in_place(self) -> RouteGait:
         """This gait with its turns in place: among obstacles, where a corner must be
@@ -80,7 +91,8 @@ class RouteGait:
         numbers = (self.stride_m, self.turn_step_rad, self.width_m, self.duration_s,
                    self.ground_flat_m)
         if not all(math.isfinite(value) and value > 0.0 for value in numbers) \
-                or not (math.isfinite(self.turn_stride_m) and self.turn_stride_m >= 0.0):
+                or not all(math.isfinite(value) and value >= 0.0
+                           for value in (self.turn_stride_m, self.turn_slowdown_m)):
             raise WalkingError(f'a route gait needs positive finite numbers (a turning '
                                f'stride of 0 turns in place): {self}')
 
@@ -128,31 +140,71 @@ def _straight(start_xy: tuple[float, float], heading_rad: float, distance_m: flo
     return moves
 
 
+def _slowed(run: list[Move], end_m: float, gait: RouteGait) -> list[Move]:
+    """A straight run of equal strides ending in strides that step down by at most the
+    gait's turn_slowdown_m to `end_m` (the turning step's length after it); the same run
+    when it is not one of equal strides or is too short to step down."""
+    if not run or len({move[1:] for move in run}) > 1:
+        return run
+    heading, stride, duration = run[0]
+    slowing: list[float] = []
+    while (length := end_m + gait.turn_slowdown_m * (len(slowing) + 1)) < stride - 1e-9:
+        slowing.insert(0, length)
+    rest = sum(move[1] for move in run) - sum(slowing)
+    if not slowing or rest <= 0.0:
+        return run
+    count = math.ceil(rest / gait.stride_m - 1e-9)
+    return [(heading, rest / count, duration)] * count \
+        + [(heading, length, duration) for length in slowing]
+
+
+def _facing(start_xy: tuple[float, float], heading_rad: float, goal: tuple[float, float],
+            stride_m: float, gait: RouteGait) -> list[Move] | None:
+    """The turning steps (each `stride_m` long) until `goal`'s bearing is within a step's
+    turn (each moves the centre, so the bearing is taken again); None when no step faces it
+    (it lies inside their turning circle)."""
+    (x, y), heading = start_xy, heading_rad
+    moves: list[Move] = []
+    for _ in range(MAX_TURNING_STEPS):
+        turn = wrap_angle(math.atan2(goal[1] - y, goal[0] - x) - heading)
+        if math.hypot(goal[0] - x, goal[1] - y) < REACHED_M or abs(turn) <= gait.turn_step_rad:
+            return moves
+        heading += math.copysign(gait.turn_step_rad, turn)
+        x += stride_m * math.cos(heading)
+        y += stride_m * math.sin(heading)
+        moves.append((heading, stride_m, gait.duration_s))
+    return None
+
+
 def _moves(start_xy: tuple[float, float], start_yaw_rad: float,
            waypoints: Sequence[tuple[float, float]], final_heading_rad: float | None,
            gait: RouteGait, ground: HeightField | None = None, first_foot: int = LEFT
            ) -> list[Move]:
-    """The centre line's moves through every waypoint: turning steps while the waypoint's
-    bearing is more than a step's turn away (each moves the centre, so the bearing is taken
-    again), then strides straight to it (_straight; step k moves `first_foot` for odd k)."""
+    """The centre line's moves through every waypoint: turning steps to face it (_facing; on
+    the spot as the gait says), then strides straight to it (_straight; step k moves
+    `first_foot` for odd k)."""
     x, y = start_xy
     heading = start_yaw_rad
     moves: list[Move] = []
-    for goal_x, goal_y in waypoints:
-        if not (math.isfinite(goal_x) and math.isfinite(goal_y)):
-            raise WalkingError(f'waypoint ({goal_x}, {goal_y}) is not finite')
-        for _ in range(MAX_TURNING_STEPS):
-            distance = math.hypot(goal_x - x, goal_y - y)
-            turn = wrap_angle(math.atan2(goal_y - y, goal_x - x) - heading)
-            if distance < REACHED_M or abs(turn) <= gait.turn_step_rad:
-                break
-            heading += math.copysign(gait.turn_step_rad, turn)
-            x += gait.turn_stride_m * math.cos(heading)
-            y += gait.turn_stride_m * math.sin(heading)
-            moves.append((heading, gait.turn_stride_m, gait.duration_s))
-        else:
-            raise WalkingError(f'waypoint ({goal_x}, {goal_y}) lies inside the turning circle '
+    run = 0  # where the last straight run's moves begin
+    for number, goal in enumerate(waypoints):
+        if not (math.isfinite(goal[0]) and math.isfinite(goal[1])):
+            raise WalkingError(f'waypoint ({goal[0]}, {goal[1]}) is not finite')
+        stride = 0.0 if number == 0 and gait.start_in_place else gait.turn_stride_m
+        turns = _facing((x, y), heading, goal, stride, gait)
+        if turns is None and stride > 0.0 and gait.inside_in_place:
+            turns = _facing((x, y), heading, goal, 0.0, gait)
+        if turns is None:
+            raise WalkingError(f'waypoint ({goal[0]}, {goal[1]}) lies inside the turning circle '
                                f'from ({x:.3f}, {y:.3f}): no step faces it')
+        for heading, length, _ in turns:
+            x += length * math.cos(heading)
+            y += length * math.sin(heading)
+        if turns and gait.turn_slowdown_m > 0.0:
+            moves[run:] = _slowed(moves[run:], turns[0][1], gait)
+        moves += turns
+        run = len(moves)
+        goal_x, goal_y = goal
         distance = math.hypot(goal_x - x, goal_y - y)
         if distance < REACHED_M:
             continue

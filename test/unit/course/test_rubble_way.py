@@ -19,8 +19,11 @@ from tutorial_atlas_control.course import (
     clear_path,
     distance_to_polygon,
     leg_waypoints,
+    point_clearances_m,
     rearranged_blocks,
+    sole_clearances_m,
 )
+from tutorial_atlas_control.course.grid_path import TURN_RADIUS_M, inside_turn
 from tutorial_atlas_control.course.rubble_way import GRID_M, SHORTCUT_SLACK_M
 
 #: The least a planned line keeps from a block: the clearance less the shortcut's slack, to
@@ -101,3 +104,44 @@ def test_only_the_rubble_s_leg_is_planned_around_blocks() -> None:
     assert leg_waypoints(gate_2, 0.5, -21.0, BLOCKS) == gate_2.waypoints
     across = leg_waypoints(COURSE_LEGS[4], *FROM, BLOCKS)
     assert across[-1] == TO and len(across) > 1
+
+
+#: Three blocks whose shortest way's third corner lies inside the turning circle at the second.
+SLALOM = (Block('a', 20.19, 2.28, 0.0, 0.0, 0.0, 2.11),
+          Block('b', 19.28, 4.59, 0.0, 0.0, 0.0, 1.15),
+          Block('c', 19.05, 3.46, 0.0, 0.0, 0.0, 2.91))
+
+
+@pytest.mark.parametrize('blocks, starts', [
+    (BLOCKS, ((6.0, 6.6), (5.49, 6.02), (6.3, 6.7))),
+    (rearranged_blocks(BLOCKS, 2013), ((6.0, 6.6), (5.49, 6.02), (6.3, 6.7))),
+    (SLALOM, ((20.0, 0.0),))], ids=['shipped', 'finals', 'slalom'])
+def test_every_corner_of_the_way_can_be_faced_by_a_walker_turning_in_strides(
+        blocks: tuple[Block, ...], starts: tuple[tuple[float, float], ...]) -> None:
+    for start in starts:
+        points = [start, *clear_path(blocks, start, TO if blocks != SLALOM else (20.0, 6.0))]
+        for before, corner, after in zip(points, points[1:], points[2:]):
+            assert not inside_turn(before, corner, after, TURN_RADIUS_M - GRID_M)
+        assert nearest_block_m(blocks, start, tuple(points[1:])) >= KEPT_M
+
+
+def test_a_sole_s_clearance_is_the_gap_between_its_edge_and_a_block_s() -> None:
+    block = Block('b', 6.0, 8.0, 0.0, 0.0, 0.0, 0.0)  # 0.435 m along x, 0.203 across
+    half = (0.13, 0.0624)
+    soles = [(6.0, 8.5, 0.0),                  # beside it: 0.5 - 0.1015 - 0.0624
+             (6.0, 8.5, math.pi / 2),          # turned a quarter: 0.5 - 0.1015 - 0.13
+             (6.5, 8.0, 0.0),                  # ahead: 0.5 - 0.2175 - 0.13
+             (6.2, 8.05, 0.3),                 # on it
+             (6.0, 8.0, math.pi / 2),          # across it, no corner on the other
+             (6.0 + 0.2175 + 0.3, 8.1015 + 0.4, 0.0)]  # off its corner, diagonally
+    clear = sole_clearances_m(soles, (block,), half)
+    assert clear == pytest.approx([0.3361, 0.2685, 0.1525, 0.0, 0.0,
+                                   math.hypot(0.3 - 0.13, 0.4 - 0.0624)], abs=1e-4)
+    assert sole_clearances_m(soles[:1], (), half)[0] == math.inf
+    # A point of a sensor's obstacles counts as a block does.
+    near = sole_clearances_m(soles[:1], (), half, np.array([[6.0, 8.3]]))
+    assert near[0] == pytest.approx(0.5 - 0.3 - 0.0624)
+    # The centre line's points alike (around_blocks: where a walker beside a block is out).
+    points = point_clearances_m(np.array([[6.0, 8.5], [6.0, 8.0]]), (block,),
+                                np.array([[6.0, 8.3]]))
+    assert points == pytest.approx([0.2, 0.0])

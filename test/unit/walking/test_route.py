@@ -20,6 +20,13 @@ def centre_after(steps: list[Footstep]) -> tuple[float, float]:
     return (a.x_m + b.x_m) / 2, (a.y_m + b.y_m) / 2
 
 
+def centre_of(step: Footstep) -> tuple[float, float, float]:
+    """The centre line's point and heading a step was placed from (half the width aside)."""
+    half = (0.12 if step.foot_index == LEFT else -0.12)
+    return (step.x_m + half * math.sin(step.yaw_rad), step.y_m - half * math.cos(step.yaw_rad),
+            step.yaw_rad)
+
+
 def test_a_straight_route_strides_equally_and_ends_with_the_feet_side_by_side() -> None:
     steps = route_steps((1.0, 2.0), 0.0, [(1.6, 2.0)])
     assert [s.step_index for s in steps] == [1, 2, 3, 4, 5]
@@ -64,6 +71,41 @@ def test_a_waypoint_inside_the_turning_circle_is_refused() -> None:
     assert gait == RouteGait(turn_stride_m=0.0)
     assert centre_after(route_steps((0.0, 0.0), 0.0, [(0.0, 0.3)], gait)) == \
         pytest.approx((0.0, 0.3), abs=1e-9)
+
+
+def test_a_gait_may_face_the_first_waypoint_and_any_inside_its_circle_on_the_spot() -> None:
+    gait = RouteGait(start_in_place=True, inside_in_place=True)
+    # Behind the walker, then 0.3 m to its left (inside the strides' turning circle), then
+    # 2 m on: the first two faced on the spot, the third in turning strides.
+    waypoints = [(-0.6, 0.0), (-0.6, -0.3), (-2.6, -2.3)]
+    steps = route_steps((0.0, 0.0), 0.0, waypoints, gait)
+    centres = [(0.0, 0.0, 0.0)] + [centre_of(step) for step in steps]
+    moved = [math.dist(a[:2], b[:2]) for a, b in zip(centres, centres[1:])]
+    turned = [abs(wrap_angle(b[2] - a[2])) for a, b in zip(centres, centres[1:])]
+    assert max(turned) <= 0.2 + 1e-9
+    spots = [k for k, (m, t) in enumerate(zip(moved, turned)) if m < 1e-9 and t > 0.05]
+    assert len(spots) == 15 + 7  # 0.2 rad a step: half a turn to face the first, a quarter
+    in_strides = [k for k, (m, t) in enumerate(zip(moved, turned))
+                  if m == pytest.approx(gait.turn_stride_m) and t > 0.05]
+    assert in_strides and min(in_strides) > max(spots)
+    assert centre_after(steps) == pytest.approx(waypoints[-1], abs=1e-9)
+    with pytest.raises(WalkingError, match='inside the turning circle'):
+        route_steps((0.0, 0.0), 0.0, waypoints, RouteGait(start_in_place=True))
+
+
+def test_a_gait_may_slow_its_strides_into_a_corner() -> None:
+    waypoints = [(2.0, 0.0), (2.0, 2.0)]  # 2 m east, then a quarter turn left
+    for slowdown in (0.0, 0.035):
+        steps = route_steps((0.0, 0.0), 0.0, waypoints, RouteGait(turn_slowdown_m=slowdown))
+        centres = [(0.0, 0.0)] + [centre_of(step)[:2] for step in steps]
+        moves = [math.dist(a, b) for a, b in zip(centres, centres[1:])]
+        first_turn = next(k for k, step in enumerate(steps) if step.yaw_rad > 0.05)
+        into = moves[:first_turn + 1]
+        drop = max(a - b for a, b in zip(into, into[1:]))
+        assert drop <= 0.035 + 1e-9 if slowdown else drop > 0.06  # 0.143 -> 0.08 at once
+        assert into[-1] == pytest.approx(0.08)  # the first turning step
+        assert sum(into[:-1]) == pytest.approx(2.0)  # the corner where it was
+        assert centre_after(steps) == pytest.approx(waypoints[-1], abs=1e-9)
 
 
 def test_waypoints_in_turn_and_a_final_heading() -> None:
