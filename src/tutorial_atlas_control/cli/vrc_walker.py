@@ -20,6 +20,7 @@ import sys
 import threading
 import time
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 import rospy
@@ -179,7 +180,9 @@ def _walk_leg(link: AsiLink, leg: Leg, gait: RouteGait, timeout_s: float,
         if deadline <= time.monotonic():
             raise Refused(f'no time left for the leg to {leg.gate}')
         rest = rest_of_leg(leg, began, link.feet()[0]) if look else leg
-        plan, walked = _plan_leg(link, rest, gait, listener)
+        # From rest, the next waypoint may lie inside the turning strides' circle.
+        again = replace(gait, start_in_place=True, inside_in_place=True) if look else gait
+        plan, walked = _plan_leg(link, rest, again, listener)
         client = WalkClient(plan[:walked], streaming=True)
         link.walk(client, deadline - time.monotonic())
         if client.outcome is not Outcome.WALKED:

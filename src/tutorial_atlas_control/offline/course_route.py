@@ -399,6 +399,8 @@ def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,
             _run_until(tick, sim, sim.sim_time_ns / NS_PER_S + LEG_PAUSE_S, streamer)
         origin, heading = _feet(interface)
         rest = rest_of_leg(leg, began, origin) if look else leg
+        if look:  # from rest, the next waypoint may lie inside the turning strides' circle
+            gait = replace(gait, start_in_place=True, inside_in_place=True)
         if streamer.laser is None:
             plan = leg_plan(rest, origin, heading, gait, blocks, streamer.ground.ground.height_m)
             walked = len(plan)
