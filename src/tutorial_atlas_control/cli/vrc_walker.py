@@ -206,8 +206,7 @@ def _plan_leg(link: AsiLink, leg: Leg, gait: RouteGait,
         else:
             seen = listener.snapshot()
             ground = PlanningGround(seen)
-            plan = leg_plan(leg, origin, heading, gait, (), ground, seen.grid.obstacle_xy(),
-                            seen.grid.bilinear)
+            plan = leg_plan(leg, origin, heading, gait, (), ground, seen.grid.obstacle_xy())
             _print_map_figures(leg, plan, ground)
             walked = seen_prefix(plan, seen, level_footstep(ground))
     except (WalkingError, CourseError, ValueError) as err:

@@ -407,8 +407,7 @@ def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,
         else:
             ground = PlanningGround(streamer.laser.map)
             plan = leg_plan(rest, origin, heading, gait, (), ground,
-                            streamer.laser.map.grid.obstacle_xy(),
-                            streamer.laser.map.grid.bilinear)
+                            streamer.laser.map.grid.obstacle_xy())
             laser_legs.append(streamer.laser.leg_figures(
                 leg.gate, plan, leg_plan(rest, origin, heading, gait, blocks, course_height_m),
                 ground))
