@@ -117,13 +117,19 @@ def test_what_cannot_collide_is_not_ground() -> None:
     assert ground.height_m(2.0, 0.0) == pytest.approx(0.4, abs=1e-9)  # invisible, solid
 
 
-def test_loose_block_follows_the_data() -> None:
+def _loose_block(half_size: str, x_m: float) -> tuple[mujoco.MjModel, mujoco.MjData]:
+    """A plane and a free 0.2 m high box of half sizes `half_size` resting at x `x_m`."""
     model = world('<geom type="plane" size="0 0 1"/>'
                   '<body name="block" pos="0 0 0.1"><freejoint/>'
-                  '<geom type="box" size="0.2 0.1 0.1" mass="5"/></body>')
+                  f'<geom type="box" size="{half_size}" mass="5"/></body>')
     data = mujoco.MjData(model)
-    data.qpos[:3] = (1.0, 0.0, 0.1)
+    data.qpos[:3] = (x_m, 0.0, 0.1)
     mujoco.mj_forward(model, data)
+    return model, data
+
+
+def test_loose_block_follows_the_data() -> None:
+    model, data = _loose_block('0.2 0.1 0.1', 1.0)
     ground = Ground(model, data)
     assert ground.height_m(1.0, 0.0) == pytest.approx(0.2, abs=1e-9)
     assert ground.height_m(0.0, 0.0) == pytest.approx(0.0, abs=1e-9)
@@ -217,12 +223,7 @@ def test_clear_above_is_the_bound_on_all_ground() -> None:
 def test_a_block_turned_in_place_is_seen_turned() -> None:
     """The ground keeps its last answer with the question: a block turned about its
     centre (the same position) is a new question, whose answer is the turned block's."""
-    model = world('<geom type="plane" size="0 0 1"/>'
-                  '<body name="block" pos="0 0 0.1"><freejoint/>'
-                  '<geom type="box" size="0.2 0.05 0.1" mass="5"/></body>')
-    data = mujoco.MjData(model)
-    data.qpos[:3] = (0.0, 0.0, 0.1)
-    mujoco.mj_forward(model, data)
+    model, data = _loose_block('0.2 0.05 0.1', 0.0)
     ground = Ground(model, data)
     assert ground.height_m(0.15, 0.0) == pytest.approx(0.2, abs=1e-9)
     data.qpos[3:7] = (math.cos(math.pi / 4), 0.0, 0.0, math.sin(math.pi / 4))  # 90 deg about z
