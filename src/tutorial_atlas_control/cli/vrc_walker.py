@@ -20,7 +20,6 @@ import sys
 import threading
 import time
 from collections.abc import Sequence
-from dataclasses import replace
 
 import numpy as np
 import rospy
@@ -44,7 +43,6 @@ from tutorial_atlas_control.course import (
     Leg,
     course_height_m,
     legs_ahead,
-    rest_of_leg,
 )
 from tutorial_atlas_control.offline import (
     MAX_LOOKS,
@@ -54,6 +52,7 @@ from tutorial_atlas_control.offline import (
     footstep_errors,
     leg_plan,
     level_footstep,
+    resumed_leg,
     seen_prefix,
 )
 from tutorial_atlas_control.walking import Footstep, RouteGait, WalkingError
@@ -179,9 +178,7 @@ def _walk_leg(link: AsiLink, leg: Leg, gait: RouteGait, timeout_s: float,
             link.hold(LEG_PAUSE_S)
         if deadline <= time.monotonic():
             raise Refused(f'no time left for the leg to {leg.gate}')
-        rest = rest_of_leg(leg, began, link.feet()[0]) if look else leg
-        # From rest, the next waypoint may lie inside the turning strides' circle.
-        again = replace(gait, start_in_place=True, inside_in_place=True) if look else gait
+        rest, again = resumed_leg(leg, gait, began, link.feet()[0]) if look else (leg, gait)
         plan, walked = _plan_leg(link, rest, again, listener)
         client = WalkClient(plan[:walked], streaming=True)
         link.walk(client, deadline - time.monotonic())

@@ -22,7 +22,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from tutorial_atlas_control.course.errors import CourseError
-from tutorial_atlas_control.course.hill_way import Heights, course_heights, gentle_path
+from tutorial_atlas_control.course.hill_way import gentle_path
 from tutorial_atlas_control.course.rubble_way import clear_path
 from tutorial_atlas_control.course.vrc_task_2 import GATES, Block, Gate
 
@@ -106,12 +106,10 @@ def rest_of_leg(leg: Leg, start_xy: tuple[float, float], now_xy: tuple[float, fl
 
 
 def leg_waypoints(leg: Leg, x_m: float, y_m: float, blocks: Sequence[Block],
-                  obstacles: np.ndarray | None = None, heights: Heights = course_heights
-                  ) -> tuple[tuple[float, float], ...]:
+                  obstacles: np.ndarray | None = None) -> tuple[tuple[float, float], ...]:
     """The waypoints a walker at (x, y) walks for `leg`: its own, across the rubble a way
     around `blocks` and the points of `obstacles` (clear_path) to its last one, or over the
-    hills a way on their gentle ground (gentle_path) of `heights` (the course's terrain, or
-    the walker's map of it).
+    hills a way on their gentle ground (gentle_path, on the course's terrain).
 
     Raises:
         CourseError: no way around the blocks, or none over gentle ground.
@@ -119,5 +117,5 @@ def leg_waypoints(leg: Leg, x_m: float, y_m: float, blocks: Sequence[Block],
     if leg.clear_of_blocks:
         return clear_path(blocks, (x_m, y_m), leg.waypoints[-1], obstacles=obstacles)
     if leg.over_hills:
-        return gentle_path((x_m, y_m), leg.waypoints[-1], heights=heights)
+        return gentle_path((x_m, y_m), leg.waypoints[-1])
     return leg.waypoints

@@ -15,7 +15,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'block_step': ['PLANS', 'BlockRun', 'BlockStep', 'CinderBlock', 'block_model', 'block_plan',
                    'block_step_trial'],
     'course_route': ['MAX_LOOKS', 'PLANNING_GROUNDS', 'CourseWalk', 'LegFigures', 'around_blocks',
-                     'course_walk', 'leg_plan'],
+                     'course_walk', 'leg_plan', 'resumed_leg'],
     'laser_terrain': ['LOOK_AGAIN_AFTER_STEPS', 'LOOK_AGAIN_SLOPE_RAD', 'SPIN_RAD_S',
                       'LaserLegFigures', 'LaserTerrain', 'PlanningGround', 'footstep_errors',
                       'level_footstep', 'seen_prefix', 'unlike_plan'],

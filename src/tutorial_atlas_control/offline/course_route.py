@@ -45,11 +45,9 @@ from tutorial_atlas_control.course import (
     SOLE_CLEARANCE_M,
     Block,
     CourseVariant,
-    Heights,
     Leg,
     ScoreRow,
     course_height_m,
-    course_heights,
     leg_waypoints,
     legs_ahead,
     point_clearances_m,
@@ -91,7 +89,7 @@ from tutorial_atlas_control.walking import (
 )
 
 __all__ = ['PLANNING_GROUNDS', 'CourseWalk', 'LegFigures', 'around_blocks', 'course_walk',
-           'leg_plan']
+           'leg_plan', 'resumed_leg']
 
 #: The grounds a walker plans on: the world's (offline: MuJoCo's rays on the world) or its
 #: head laser's height map (laser_terrain.py).
@@ -336,8 +334,7 @@ def _course_simulator(world_name: str, variant: CourseVariant | None) -> AtlasSi
 
 def leg_plan(leg: Leg, origin: tuple[float, float], heading_rad: float, gait: RouteGait,
              blocks: Sequence[Block], ground: HeightField,
-             obstacles: np.ndarray | None = None,
-             heights: Heights = course_heights) -> list[Footstep]:
+             obstacles: np.ndarray | None = None) -> list[Footstep]:
     """A leg's steps from feet side by side at `origin` facing `heading_rad`: its waypoints
     (around `blocks` and the points of `obstacles` (n, 2) across the rubble, on gentle
     ground over the hills: leg_waypoints), the straight runs fitted to `ground` when the gait
@@ -348,7 +345,7 @@ def leg_plan(leg: Leg, origin: tuple[float, float], heading_rad: float, gait: Ro
         CourseError: no way around the blocks or over the hills.
         WalkingError: a waypoint the route cannot reach.
     """
-    waypoints = leg_waypoints(leg, *origin, blocks, obstacles, heights)
+    waypoints = leg_waypoints(leg, *origin, blocks, obstacles)
     fitted = ground if gait.fit_ground else None
     if leg.clear_of_blocks:
         return around_blocks(origin, heading_rad, waypoints, gait, blocks, fitted, obstacles)
@@ -381,6 +378,15 @@ def around_blocks(origin: tuple[float, float], heading_rad: float,
     return route_steps(origin, heading_rad, waypoints, gait.turning_in_place(), ground=ground)
 
 
+def resumed_leg(leg: Leg, gait: RouteGait, began: tuple[float, float],
+                here: tuple[float, float]) -> tuple[Leg, RouteGait]:
+    """What a walker that began `leg` at `began` and stopped at `here` (to look again) plans
+    next: the rest of the leg (rest_of_leg), with `gait` facing the next waypoint from rest
+    on the spot, or one inside its turning strides' circle."""
+    return (rest_of_leg(leg, began, here),
+            replace(gait, start_in_place=True, inside_in_place=True))
+
+
 def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,
               streamer: _Streamer, leg: Leg, gait: RouteGait | None,
               blocks: Sequence[Block], laser_legs: list[LaserLegFigures]
@@ -398,9 +404,7 @@ def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,
         if look:  # stand and look at what the last part walked towards
             _run_until(tick, sim, sim.sim_time_ns / NS_PER_S + LEG_PAUSE_S, streamer)
         origin, heading = _feet(interface)
-        rest = rest_of_leg(leg, began, origin) if look else leg
-        if look:  # from rest, the next waypoint may lie inside the turning strides' circle
-            gait = replace(gait, start_in_place=True, inside_in_place=True)
+        rest, gait = resumed_leg(leg, gait, began, origin) if look else (leg, gait)
         if streamer.laser is None:
             plan = leg_plan(rest, origin, heading, gait, blocks, streamer.ground.ground.height_m)
             walked = len(plan)

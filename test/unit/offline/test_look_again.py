@@ -9,9 +9,10 @@ from tutorial_atlas_control.course import COURSE_LEGS, rest_of_leg
 from tutorial_atlas_control.offline import (
     LOOK_AGAIN_AFTER_STEPS,
     level_footstep,
+    resumed_leg,
     seen_prefix,
 )
-from tutorial_atlas_control.walking import Footstep, straight_steps
+from tutorial_atlas_control.walking import Footstep, RouteGait, straight_steps
 
 PLAN = straight_steps(20, 0.15)  # x 0.15 k, alternate feet
 
@@ -71,3 +72,11 @@ def test_the_rest_of_a_leg_begins_after_the_line_the_walker_is_on() -> None:
     assert rest_of_leg(gate_1, (1.6, -38.0), (1.6, -38.0)) == gate_1
     assert rest_of_leg(gate_1, (1.6, -38.0), (3.25, -31.97)).waypoints == gate_1.waypoints[1:]
     assert rest_of_leg(gate_1, (1.6, -38.0), (0.6, -23.0)).waypoints == gate_1.waypoints[3:]
+
+
+def test_a_resumed_leg_is_planned_from_rest() -> None:
+    """After a look the rest of the leg is planned facing its next waypoint from rest."""
+    rest, gait = resumed_leg(COURSE_LEGS[1], RouteGait(), (1.6, -38.0), (3.25, -31.97))
+    assert rest.waypoints == COURSE_LEGS[1].waypoints[1:]
+    assert gait.start_in_place and gait.inside_in_place
+    assert gait.stride_m == RouteGait().stride_m
