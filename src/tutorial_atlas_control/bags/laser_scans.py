@@ -200,7 +200,7 @@ def spindle_command_steps(scans: LaserScans) -> list[tuple[int, float]] | None:
             while now_ns < end_ns - step_ns:  # the base up to the candidate step's start
                 spindle.step()
                 now_ns += step_ns
-                if not _matches(stamps, angles, now_ns, spindle.angle):
+                if not _same(_recorded_at(stamps, angles, now_ns), spindle.angle):
                     return None  # the recorded angle left the base before any candidate
             trial = copy.copy(spindle)
             trial.command(speed)
@@ -214,30 +214,29 @@ def spindle_command_steps(scans: LaserScans) -> list[tuple[int, float]] | None:
     return found
 
 
-def _matches(stamps: np.ndarray, angles: np.ndarray, at_ns: int, angle_rad: float) -> bool:
-    """Whether a recorded sample at `at_ns`, if there is one, holds `angle_rad`."""
+def _recorded_at(stamps: np.ndarray, angles: np.ndarray, at_ns: int) -> float | None:
+    """The recorded angle stamped `at_ns`, or None when no sample is."""
     row = int(np.searchsorted(stamps, at_ns))
-    if row == len(stamps) or stamps[row] != at_ns:
-        return True
-    return abs(math.remainder(float(angles[row]) - angle_rad, 2.0 * math.pi)) < SAME_ANGLE_RAD
+    return float(angles[row]) if row < len(stamps) and stamps[row] == at_ns else None
+
+
+def _same(recorded: float | None, angle_rad: float) -> bool:
+    """Whether `angle_rad` is the recorded angle (no sample: nothing says otherwise)."""
+    return recorded is None or \
+        abs(math.remainder(recorded - angle_rad, 2.0 * math.pi)) < SAME_ANGLE_RAD
 
 
 def _follows(trial: Spindle, end_ns: int, stamps: np.ndarray, angles: np.ndarray,
              step_ns: int) -> bool:
     """Whether `trial`, stepped from the step ending at `end_ns`, gives every recorded
     sample over the next COMMAND_CHECK_S (at least one)."""
-    until_ns = end_ns + round(COMMAND_CHECK_S * NS_PER_S)
     checked = 0
-    at_ns = end_ns
-    while at_ns <= until_ns:
+    for at_ns in range(end_ns, end_ns + round(COMMAND_CHECK_S * NS_PER_S) + 1, step_ns):
         trial.step()
-        row = int(np.searchsorted(stamps, at_ns))
-        if row < len(stamps) and stamps[row] == at_ns:
-            if abs(math.remainder(float(angles[row]) - trial.angle, 2.0 * math.pi)) \
-                    >= SAME_ANGLE_RAD:
-                return False
-            checked += 1
-        at_ns += step_ns
+        recorded = _recorded_at(stamps, angles, at_ns)
+        if not _same(recorded, trial.angle):
+            return False
+        checked += recorded is not None
     return checked > 0
 
 
