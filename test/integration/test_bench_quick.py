@@ -24,7 +24,7 @@ pytestmark = pytest.mark.offline
 
 RUN_BENCH = Path(run_bench.__file__)
 SECTIONS = ('physics', 'offline', 'analysis', 'walking')
-#: About 90 CPU s at load 1 (physics 40 with the Python reference's runs, walking 37).
+#: About 15 CPU s beside two offline walks (physics 6 with the Python reference's runs, walking 6).
 TIMEOUT_S = 1200.0
 
 
