@@ -41,6 +41,44 @@ static void clamp_to_sole(const AtlasLegs *legs, const double *centre, const dou
   p[1] = centre[1] + (r[3] * along + r[4] * across);
 }
 
+/* sole_support.near_asked: the stance sole's constraint `foot` (FOOT numbers) kept to the
+ * rectangle within near_m of the pressure centre `p` along and across the sole, and on it. */
+static void near_asked(const AtlasLegs *legs, const double *centre, const double *r,
+                       const double p[2], double *foot) {
+  double dx = p[0] - centre[0], dy = p[1] - centre[1], near = legs->near_m;
+  double asked[2] = {r[0] * dx + r[3] * dy, r[1] * dx + r[4] * dy};
+  double halves[2] = {foot[HALF_LENGTH], foot[HALF_WIDTH]}, low[2], high[2];
+  for (int k = 0; k < 2; ++k) { /* Python's max(a - near, -h), min(a + near, h) */
+    double a = asked[k] - near, b = asked[k] + near;
+    low[k] = a >= -halves[k] ? a : -halves[k];
+    high[k] = b <= halves[k] ? b : halves[k];
+    high[k] = high[k] >= low[k] ? high[k] : low[k]; /* a point at worst */
+  }
+  foot[HALF_LENGTH] = 0.5 * (high[0] - low[0]);
+  foot[HALF_WIDTH] = 0.5 * (high[1] - low[1]);
+  foot[CENTRE_ALONG] = 0.5 * (low[0] + high[0]);
+  foot[CENTRE_ACROSS] = 0.5 * (low[1] + high[1]);
+}
+
+/* The whole body at the kept pressure centre: across facets (near_m > 0) on a copy of the
+ * soles' constraints with the stance sole's kept near it (the loaded ones left as they are). */
+static void stance_whole_body(const AtlasLegs *legs, const double *centre, const double *r,
+                              const double cop[2]) {
+  const AtlasWholeBody *w = legs->whole_body;
+  if (!(legs->near_m > 0.0)) {
+    atlas_whole_body(w);
+    return;
+  }
+  AtlasStatics *statics = w->statics;
+  const double *loaded = statics->feet;
+  double feet[2 * FOOT];
+  memcpy(feet, loaded, sizeof feet);
+  near_asked(legs, centre, r, cop, feet + FOOT * legs->stance);
+  statics->feet = feet;
+  atlas_whole_body(w);
+  statics->feet = loaded;
+}
+
 /* CompiledSwing._load from the row: the swing sole's jacobian (its leg's columns), pose and
  * velocity, the leg's joint rates, and its inertia block (mj_crb, mj_fullM). */
 static void load_swing(const AtlasLegs *legs) {
@@ -79,9 +117,10 @@ void atlas_legs_swing_tick(const AtlasLegs *legs) {
   const double *row = w->row;
   long n = w->statics->n, stance = legs->stance;
   double *cop = (double *)w->in + WB_IN_COP;
-  clamp_to_sole(legs, row + w->row_at[WB_ROW_SOLE_CENTRES] + 3 * stance,
-                row + w->row_at[WB_ROW_SOLE_ROTATIONS] + 9 * stance, cop);
-  atlas_whole_body(w);
+  const double *centre = row + w->row_at[WB_ROW_SOLE_CENTRES] + 3 * stance;
+  const double *r = row + w->row_at[WB_ROW_SOLE_ROTATIONS] + 9 * stance;
+  clamp_to_sole(legs, centre, r, cop);
+  stance_whole_body(legs, centre, r, cop);
   load_swing(legs);
   atlas_swing_torque(legs->swing);
   double *torque = legs->out;

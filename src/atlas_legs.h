@@ -30,6 +30,9 @@ typedef struct {
   double half_size[2];              /* a sole's half length and half width (m) */
   double margin_m;                  /* the support region's margin (m) */
   long carrying[2];                 /* which soles carry (1) */
+  double near_m;                    /* > 0: the stance sole is across facets, its wrench's
+                                     * pressure centre within this of the kept one (m;
+                                     * walking/sole_support.py); else the whole sole */
 } AtlasLegs;
 
 /* A foot's pose for a tick with both feet meant down (LegTasks.finish): the put-down servo's

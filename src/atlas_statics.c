@@ -105,8 +105,11 @@ static void make_feasible(double w[6], const double r[9], const double *foot) {
   double lx = r[0] * mx + r[3] * my + r[6] * mz;
   double ly = r[1] * mx + r[4] * my + r[7] * mz;
   double lz = r[2] * mx + r[5] * my + r[8] * mz;
-  lx = clamp(lx, -fz * foot[HALF_WIDTH], fz * foot[HALF_WIDTH]);
-  ly = clamp(ly, -fz * foot[HALF_LENGTH], fz * foot[HALF_LENGTH]);
+  /* the pressure centre (-ly / fz, lx / fz) within the region about its centre */
+  lx = clamp(lx, fz * (foot[CENTRE_ACROSS] - foot[HALF_WIDTH]),
+             fz * (foot[CENTRE_ACROSS] + foot[HALF_WIDTH]));
+  ly = clamp(ly, -fz * (foot[CENTRE_ALONG] + foot[HALF_LENGTH]),
+             -fz * (foot[CENTRE_ALONG] - foot[HALF_LENGTH]));
   if (!isnan(foot[TORSION])) lz = clamp(lz, -fz * foot[TORSION], fz * foot[TORSION]);
   w[0] = f[0];
   w[1] = f[1];

@@ -24,8 +24,9 @@ if TYPE_CHECKING:
     from tutorial_atlas_control.balance.estimator import BalanceState
     from tutorial_atlas_control.balance.whole_body import ContactConstraint
 
-#: A sole's constraint as C reads it: carries, half length, half width, torsion, friction.
-FOOT = 5
+#: A sole's constraint as C reads it: carries, half length, half width, torsion, friction,
+#: the centre of its pressure centre's region (along, across).
+FOOT = 7
 #: The input's fixed part (src/atlas_statics.c's enum): force, moment, com, sole centres
 #: (2, 3), sole rotations (2, 3, 3).
 FIXED_SIZE = 33
@@ -61,7 +62,8 @@ class CompiledStatics:
             self._feet[foot] = (
                 float(contact.carries), contact.half_length_m, contact.half_width_m,
                 math.nan if contact.torsion_m is None else contact.torsion_m,
-                math.nan if contact.friction is None else contact.friction)
+                math.nan if contact.friction is None else contact.friction,
+                *contact.centre_m)
         self._contacts = contacts
 
     @property

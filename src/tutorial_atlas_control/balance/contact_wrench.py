@@ -95,9 +95,12 @@ def _within_friction(force: Vector, normal: Vector, friction: float) -> Vector:
 
 def make_feasible(wrench: np.ndarray, sole_rotation: np.ndarray,
                   half_length_m: float, half_width_m: float,
-                  torsion_m: float | None = None, friction: float | None = None) -> np.ndarray:
+                  torsion_m: float | None = None, friction: float | None = None,
+                  centre_m: tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
     """`wrench` [f, m] (world) with f_z >= 0 and its pressure centre kept inside a sole of
-    half sizes (half_length_m, half_width_m) (along the sole's x and y); with `torsion_m`,
+    half sizes (half_length_m, half_width_m) (along the sole's x and y), or inside the
+    rectangle of those half sizes about `centre_m` (along, across; sole frame) where only a
+    part of the sole bears on the ground (walking/sole_support.py); with `torsion_m`,
     its moment about the sole's normal within torsion_m * f_z too (MuJoCo's torsional
     friction: more turns the foot on the ground); with `friction`, its force's part along
     the sole within friction times the part pressing on it (a cone about the sole's
@@ -111,8 +114,9 @@ def make_feasible(wrench: np.ndarray, sole_rotation: np.ndarray,
     lx = r00 * mx + r10 * my + r20 * mz
     ly = r01 * mx + r11 * my + r21 * mz
     lz = r02 * mx + r12 * my + r22 * mz
-    lx = min(max(lx, -fz * half_width_m), fz * half_width_m)
-    ly = min(max(ly, -fz * half_length_m), fz * half_length_m)
+    along, across = centre_m  # the pressure centre (-ly / fz, lx / fz) in the region
+    lx = min(max(lx, fz * (across - half_width_m)), fz * (across + half_width_m))
+    ly = min(max(ly, -fz * (along + half_length_m)), -fz * (along - half_length_m))
     if torsion_m is not None:
         lz = min(max(lz, -fz * torsion_m), fz * torsion_m)
     return np.array([fx, fy, fz, r00 * lx + r01 * ly + r02 * lz,

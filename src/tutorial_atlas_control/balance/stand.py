@@ -273,15 +273,17 @@ class StandController:
                    joint_gains: tuple[np.ndarray, np.ndarray] | None = None,
                    torsion_m: float | None = None,
                    reference: StandReference | None = None,
-                   moved: MovedReference | None = None) -> StandOutput:
+                   moved: MovedReference | None = None,
+                   contacts: tuple[ContactConstraint, ContactConstraint] | None = None
+                   ) -> StandOutput:
         """The whole-body layer's torques for `reference` (else the Stand's own; `moved`:
         its pelvis heading, CoM height and rate replaced) with the
         pressure centre at `cop`, pressed by the soles in `contact` (`torsion_m`: their yaw
         moment limited too), plus the joint PD to the reference's posture (`joint_gains`
         (kp, kd), else the Stand's); not yet clamped to the effort limits (Walk adds its
-        swing leg's first)."""
+        swing leg's first). `contacts`: the soles' constraints, if not contacts_for's."""
         reference = reference or self.reference
-        contacts = self.contacts_for(contact, torsion_m)
+        contacts = contacts or self.contacts_for(contact, torsion_m)
         if self._kernel is not None:
             return StandOutput(*self._kernel.whole_body(
                 state, cop, contacts, joint_positions, joint_velocities,

@@ -142,18 +142,22 @@ class ContactConstraint:
     """What one sole's contact wrench may be: none if it does not carry (`carries` False);
     else no pull, the pressure centre inside the sole's half sizes (m), with `torsion_m` the
     yaw moment within torsion_m f_n, and with `friction` the tangential force within
-    friction f_n (a cone about the sole's normal)."""
+    friction f_n (a cone about the sole's normal). `centre_m`: the centre (along, across;
+    sole frame, m) of the rectangle of those half sizes the pressure centre stays in: the
+    sole's own (0, 0), or the part of it bearing on the ground (walking/sole_support.py)."""
 
     carries: bool
     half_length_m: float
     half_width_m: float
     torsion_m: float | None = None
     friction: float | None = None
+    centre_m: tuple[float, float] = (0.0, 0.0)
 
     def feasible(self, wrench: np.ndarray, sole_rotation: np.ndarray) -> np.ndarray:
         """`wrench` [f, m] (world, at the sole's centre) made feasible."""
         return contact_wrench.make_feasible(wrench, sole_rotation, self.half_length_m,
-                                            self.half_width_m, self.torsion_m, self.friction)
+                                            self.half_width_m, self.torsion_m, self.friction,
+                                            self.centre_m)
 
 
 @dataclass(slots=True)

@@ -108,11 +108,14 @@ class CompiledLegs:
                         contacts: tuple[ContactConstraint, ContactConstraint],
                         joints: tuple[np.ndarray, np.ndarray],
                         joint_gains: tuple[np.ndarray, np.ndarray], reference: StandReference,
-                        moved: MovedReference, swing: tuple[int, SwingPath, float]) -> None:
+                        moved: MovedReference, swing: tuple[int, SwingPath, float],
+                        near_m: float = 0.0) -> None:
         """A swinging tick's input but the pressure centre (tick_at sets it, or the walk's
         swing tick, compiled_walk_swing): the state, the stance sole's `contacts`, the joints'
         positions and velocities, their gains, the legs' reference (`moved`: its heading,
-        height and rate) and `swing` (the foot, its path, the time into it)."""
+        height and rate), `swing` (the foot, its path, the time into it) and `near_m` (> 0:
+        the stance sole across facets, its wrench's pressure centre kept within near_m of
+        the kept one: LegTasks.stance_near_m)."""
         source = state.mass_matrix_source
         if source is not self._source or source is None:  # the estimator's one tuple: once
             if source is None or self._scratch != source[0:2]:
@@ -125,6 +128,7 @@ class CompiledLegs:
                               moved)
         self._swing.set_path(path)
         self._swing.prepare_swing(elapsed_s)
+        self._call.near_m = near_m
 
     def results(self) -> tuple[np.ndarray, np.ndarray]:
         """The last tick's torques (joints,) and pressure centre as kept, new arrays."""

@@ -47,9 +47,11 @@ from tutorial_atlas_control.balance import (
     smoothstep_rate,
     yaw_of,
 )
+from tutorial_atlas_control.walking import sole_support
 from tutorial_atlas_control.walking.compiled_legs import CompiledLegs
 from tutorial_atlas_control.walking.compiled_swing import CompiledSwing
 from tutorial_atlas_control.walking.footsteps import Footstep, wrap_angle
+from tutorial_atlas_control.walking.sole_support import SHIFT_M
 from tutorial_atlas_control.walking.swing import SwingPath, quintic, sole_frame, surface_tilt
 
 __all__ = ['LEGS_ENV', 'LEG_JOINTS', 'SWING_ENV', 'LegGains', 'LegTasks', 'foot_pose']
@@ -108,6 +110,11 @@ class LegGains:
     #: within acos(flat_cos) of vertical (0.05 rad).
     flat_height_m: float = 0.005
     flat_cos: float = 0.99875
+    #: A lone stance sole across facets keeps its wrench's pressure centre within this (m)
+    #: of the one asked (sole_support: the pelvis task's moment took it to the sole's edge,
+    #: where on the course's hills nothing bore, and the sole rolled over); None: the whole
+    #: sole, as on a plane.
+    near_cop_m: float | None = SHIFT_M
 
 
 def foot_pose(state: BalanceState, foot: int, step_index: int = 0) -> Footstep:
@@ -140,9 +147,7 @@ class LegTasks:
                                      for foot in (0, 1))
         #: How far a lone stance sole's pressure centre may go from the sole's centre (m),
         #: along it and across it: the sole's half size less the Stand's margin.
-        half_length, half_width = stand.sole_half_size_m
-        margin = stand.gains.cop_margin_m
-        self.sole_reach_m = (max(half_length - margin, 0.0), max(half_width - margin, 0.0))
+        self.sole_reach_m = _sole_reach_m(stand)
         #: The pelvis's heading moving on: (start time, duration, from, turn) (s, rad).
         self._facing = (time_s, 1.0, yaw_of(stand.reference.pelvis_rotation), 0.0)
         #: The CoM height moving on: (start time, duration, from, change) (s, m).
@@ -180,8 +185,7 @@ class LegTasks:
         return self._height, self._facing
 
     def move_height(self, height_m: float, time_s: float, duration_s: float) -> None:
-        """Take the CoM's reference height from where it is now to `height_m` over
-        `duration_s` (a smoothstep)."""
+        """Take the CoM's reference height from where it is to `height_m` (a smoothstep)."""
         now, _ = self.height(time_s)
         self._height = (time_s, duration_s, now, height_m - now)
 
@@ -286,9 +290,11 @@ class LegTasks:
             contact = state.in_contact if any(state.in_contact) else (True, True)
             cop = self._support_clamp(state, contact, cop)
         torsion = self.gains.torsion_m if swing_foot is not None else None
+        contacts = None if swing_foot is None else sole_support.stance_contacts(
+            state, 1 - swing_foot, self._swing_contacts[swing_foot], cop, self.gains.near_cop_m)
         torque = stand.whole_body(state, cop, contact, joint_positions, joint_velocities,
                                   self._joint_gains, torsion, self.reference,
-                                  moved).torque_nm
+                                  moved, contacts).torque_nm
         return torque, cop, contact
 
     def load_swing_tick(self, state: BalanceState, joint_positions: np.ndarray,
@@ -299,9 +305,10 @@ class LegTasks:
         legs = self._legs_kernel
         if legs is None or state.row_address is None:
             return None
+        near = sole_support.stance_near_m(state, 1 - swing[0], self.gains.near_cop_m)
         legs.load_swing_tick(state, self._swing_contacts[swing[0]],
                              (joint_positions, joint_velocities), self._joint_gains,
-                             self.reference, moved, swing)
+                             self.reference, moved, swing, near)
         return legs
 
     def swing_tick(self, state: BalanceState, joint_positions: np.ndarray,
@@ -401,6 +408,13 @@ def _python_foot_servo(gains: LegGains, ik_damping: np.ndarray, state: BalanceSt
     torque = np.zeros(len(joint_velocities))
     torque[leg] = state.joint_inertia(leg) @ accel
     return torque
+
+
+def _sole_reach_m(stand: StandController) -> tuple[float, float]:
+    """A sole's half length and width less the Stand's margin (m; at least 0)."""
+    half_length, half_width = stand.sole_half_size_m
+    margin = stand.gains.cop_margin_m
+    return max(half_length - margin, 0.0), max(half_width - margin, 0.0)
 
 
 def _clamp_to_sole(state: BalanceState, foot: int, reach_m: tuple[float, float],

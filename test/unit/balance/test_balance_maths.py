@@ -161,3 +161,17 @@ def test_feasibility_keeps_the_pressure_centre_on_the_sole_and_no_pull() -> None
     pulled = contact_wrench.make_feasible(np.array([5.0, 0, -10.0, 1.0, 1.0, 0.0]),
                                           rotation, 0.13, 0.06)
     np.testing.assert_allclose(pulled, [5.0, 0, 0, 0, 0, 0])
+
+
+def test_feasibility_keeps_the_pressure_centre_on_a_rectangle_off_the_soles_centre() -> None:
+    """A rectangle 4 cm by 1 cm about (0.09, 0.05) of a sole heading +y: a pressure
+    centre asked at the sole's centre comes to its nearest corner; one inside it stays."""
+    turned = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])  # heading +y
+    centred = contact_wrench.make_feasible(np.array([0, 0, 500.0, 0, 0, 0]), turned, 0.02,
+                                           0.005, centre_m=(0.09, 0.05))
+    # the sole's (along, across) (0.07, 0.045) is the world's (-0.045, 0.07): m = r x f
+    np.testing.assert_allclose(centred, [0, 0, 500.0, 0.07 * 500.0, 0.045 * 500.0, 0],
+                               atol=1e-9)
+    inside = np.array([0, 0, 500.0, 0.1 * 500.0, 0.05 * 500.0, 0])  # at (0.1, 0.05)
+    np.testing.assert_allclose(contact_wrench.make_feasible(
+        inside, turned, 0.02, 0.005, centre_m=(0.09, 0.05)), inside, atol=1e-9)

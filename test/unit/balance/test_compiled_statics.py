@@ -1,7 +1,8 @@
 """The compiled inverse statics (src/atlas_statics.c) agrees with the Python solver to 1e-9:
 the contact wrenches and torques of every tick of a two-step walk, and of random states,
 wrenches and constraints (either sole carrying, both, none; with and without torsion and
-friction; pulling and pushing wrenches)."""
+friction; the pressure centre on the whole sole or on a rectangle of it off its centre;
+pulling and pushing wrenches)."""
 
 from __future__ import annotations
 
@@ -71,7 +72,10 @@ def test_compiled_statics_agrees_with_python_on_random_cases(library) -> None:
         torsion = None if case % 3 == 0 else 0.01
         friction = None if case % 5 == 0 else float(rng.uniform(0.2, 1.0))
         carries = ((True, True), (True, False), (False, True), (False, False))[case % 4]
-        contacts = tuple(ContactConstraint(c, 0.1, 0.05, torsion, friction) for c in carries)
+        centre = ((0.0, 0.0) if case % 2 == 0  # the sole's own, or a rectangle of it
+                  else (float(rng.uniform(-0.08, 0.08)), float(rng.uniform(-0.04, 0.04))))
+        contacts = tuple(ContactConstraint(c, 0.1, 0.05, torsion, friction, centre)
+                         for c in carries)
         force = tuple(rng.normal(0.0, 200.0, 3) + [0.0, 0.0, 600.0 * (case % 7 != 0)])
         task = FixedWrench(force, tuple(rng.normal(0.0, 40.0, 3)))
         ours = compiled.solve(state, [task], contacts, (), np.zeros(JOINTS), np.zeros(JOINTS))

@@ -2,7 +2,9 @@
 with the same tick by LegTasks.torque and finish in Python (every part's Python: whole body,
 statics, swing servo) and by the compiled pieces called from Python: every swing tick of a
 two-step walk, and at states of that walk, random pressure centres, paths and times (before,
-inside and after a path, either foot swinging, far outside the stance sole). So does the
+inside and after a path, either foot swinging, far outside the stance sole); every such tick
+again with the stance sole taken as across facets (its wrench's pressure centre kept near the
+one asked: walking/sole_support.py), where the torques differ from the plane's. So does the
 pressure centre kept in the carrying soles' hull with no foot swinging (one C call): every
 such tick of the walk, and random pressure centres on one sole or both."""
 
@@ -19,10 +21,11 @@ from tutorial_atlas_control.balance import BalanceState
 from tutorial_atlas_control.balance.stand_behaviour import StandBehaviour
 from tutorial_atlas_control.balance.stand_pose import place_in_stand_pose
 from tutorial_atlas_control.sim import model as atlas_model
-from tutorial_atlas_control.walking import straight_steps
+from tutorial_atlas_control.walking import sole_support, straight_steps
 from tutorial_atlas_control.walking.compiled_walk_swing import WALK_SWING_ENV
 from tutorial_atlas_control.walking.footsteps import Footstep
 from tutorial_atlas_control.walking.leg_tasks import LEGS_ENV, SWING_ENV, LegGains, LegTasks
+from tutorial_atlas_control.walking.sole_support import SHIFT_M
 from tutorial_atlas_control.walking.swing import SwingPath
 from tutorial_atlas_control.walking.walk_trial import SETTLE_S, walk_trial
 
@@ -31,6 +34,7 @@ TOLERANCE = 1e-9
 EVERY_TICKS = 40
 SWING_TICK = LegTasks.swing_tick
 TORQUE = LegTasks.torque
+STANCE_NEAR = sole_support.stance_near_m
 Tick = tuple[np.ndarray, np.ndarray, tuple[bool, bool]]
 
 
@@ -98,12 +102,26 @@ def test_the_one_call_agrees_with_the_pieces_and_python_through_a_walk(
     tried: list[float] = []
     largest: list[float] = []
     rng = np.random.default_rng(63)
+    across: list[float] = []  # the ticks again across facets: their differences
+    moved_by_rule: list[float] = []  # how much the rule changed those ticks' torques
+    facets = [False]
+
+    def stance_near(state: BalanceState, stance: int, near_cop_m: float | None) -> float:
+        return SHIFT_M if facets[0] else STANCE_NEAR(state, stance, near_cop_m)
 
     def both(self: LegTasks, state: BalanceState, positions: np.ndarray,
              velocities: np.ndarray, time_s: float, cop: np.ndarray,
              swing: tuple[int, SwingPath, float]) -> Tick:
         ours, pieces, python = _compare(self, state, positions, velocities, time_s, cop, swing)
         walked.extend((pieces, python))
+        facets[0] = True
+        try:
+            on_facets, *differences = _compare(self, state, positions, velocities, time_s,
+                                               cop, swing)
+        finally:
+            facets[0] = False
+        across.extend(differences)
+        moved_by_rule.append(float(np.max(np.abs(on_facets[0] - ours[0]))))
         largest.append(float(np.max(np.abs(ours[0][4:16]))))
         if len(walked) % (2 * EVERY_TICKS) == 0:
             tried.extend(_random_cases(self, state, positions, velocities, time_s, rng))
@@ -142,6 +160,7 @@ def test_the_one_call_agrees_with_the_pieces_and_python_through_a_walk(
 
     supported: list[float] = []
     monkeypatch.setattr(LegTasks, 'swing_tick', both)
+    monkeypatch.setattr(sole_support, 'stance_near_m', stance_near)
     monkeypatch.setattr(LegTasks, 'torque', both_feet)
     monkeypatch.setattr(LegTasks, 'support_torque', support_by_pieces)  # its own test's
     trial = walk_trial(straight_steps(2, 0.25), SETTLE_S + 0.6 + 2 * 0.63 + 0.2)
@@ -150,6 +169,8 @@ def test_the_one_call_agrees_with_the_pieces_and_python_through_a_walk(
     assert max(supported) < TOLERANCE
     assert max(largest) > 20.0  # the legs' torques, not zeros compared
     assert max(walked) < TOLERANCE
+    assert max(across) < TOLERANCE
+    assert max(moved_by_rule) > 20.0  # across facets, other torques: the rule compared
     assert max(tried) < TOLERANCE
 
 

@@ -1,0 +1,88 @@
+"""A lone stance sole across facets: its wrench's pressure centre kept near the one asked.
+
+The whole-body layer keeps each sole's pressure centre inside the sole's rectangle, and the
+pelvis task's moment moves it there from where the capture point's law asks (on the floor
+by up to 7 cm: 60 N m of pitch on 900 N). The whole sole bears on a plane (the floor, a
+ramp, one facet), and a pressure centre at its edge is one it can hold. The course's hills
+are a heightfield of 0.195 m cells in 14 mm height steps, facets 4 to 13 degrees apart: a
+sole on them rests on two or three points, near one end or one edge. There the pelvis's
+moment took the stance sole's pressure centre to its edge (6 cm ahead and 3 cm across of the
+asked one, 50 to 100 N m) where nothing bore: the sole rolled over about its points, 10 to 30
+degrees within 0.1 s of taking the weight (30 of 178 steps), and the walker fell.
+
+So a stance sole whose contacts are not on one plane (their normals more than 2 degrees
+apart) keeps its wrench's pressure centre within SHIFT_M of the one asked (which the walk
+keeps on the sole less the Stand's margin): the pelvis task gets what moment that leaves.
+A sole on one plane is left as it was (any flat walk: the same torques).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from tutorial_atlas_control.balance import BalanceState, ContactConstraint
+
+__all__ = ['ONE_SURFACE_COS', 'PRESSED_M', 'SHIFT_M', 'across_facets', 'near_asked',
+           'stance_contacts', 'stance_near_m']
+
+#: A contact within this of its surface (m) bears on it: the estimator's reach 1 cm out, and
+#: a sole on a ramp beside its bend (steps are planned clear of bends) has the other plane's
+#: within that (up the pit's 22 degree ramp, counting them, the walk fell at its 8th step).
+PRESSED_M = 0.002
+#: Contact normals all within acos(ONE_SURFACE_COS) (2 degrees) of each other: one plane.
+ONE_SURFACE_COS = 0.99939
+#: How far (m) along and across the sole the wrench's pressure centre may be from the one
+#: asked, across facets.
+SHIFT_M = 0.02
+
+
+def across_facets(state: BalanceState, foot: int) -> bool:
+    """Whether the sole `foot` bears on more than one plane (the normals of its contacts
+    within PRESSED_M of their surface apart)."""
+    contacts = state.sole_contacts[foot]
+    normals = contacts.normals[contacts.distances_m <= PRESSED_M]
+    if len(normals) < 2:
+        return False
+    return float(np.min(normals @ normals[0])) < ONE_SURFACE_COS
+
+
+def near_asked(state: BalanceState, foot: int, contact: ContactConstraint,
+               cop: np.ndarray, shift_m: float = SHIFT_M) -> ContactConstraint:
+    """`contact` (the sole `foot`'s) with its pressure centre kept within `shift_m` of `cop`
+    ((2,) m, world; on the sole) along and across the sole, and on the sole."""
+    rotation, centre = state.sole_rotations[foot], state.sole_centres[foot]
+    (r00, r01, _), (r10, r11, _), _ = rotation.tolist()
+    dx, dy = float(cop[0] - centre[0]), float(cop[1] - centre[1])
+    asked = (r00 * dx + r10 * dy, r01 * dx + r11 * dy)
+    halves = (contact.half_length_m, contact.half_width_m)
+    low = [max(a - shift_m, -h) for a, h in zip(asked, halves)]
+    high = [min(a + shift_m, h) for a, h in zip(asked, halves)]
+    high = [max(hi, lo) for lo, hi in zip(low, high)]  # a point at worst
+    return replace(contact, half_length_m=0.5 * (high[0] - low[0]),
+                   half_width_m=0.5 * (high[1] - low[1]),
+                   centre_m=(0.5 * (low[0] + high[0]), 0.5 * (low[1] + high[1])))
+
+
+def stance_near_m(state: BalanceState, stance: int, near_cop_m: float | None) -> float:
+    """How near (m) the lone stance sole `stance`'s wrench's pressure centre stays to the one
+    asked: `near_cop_m` (LegGains') across facets; 0.0, the whole sole, on one plane or with
+    the rule off (None). The one decision both the compiled tick and the Python read."""
+    if near_cop_m is None or not across_facets(state, stance):
+        return 0.0
+    return near_cop_m
+
+
+def stance_contacts(state: BalanceState, stance: int,
+                    contacts: tuple[ContactConstraint, ContactConstraint], cop: np.ndarray,
+                    near_cop_m: float | None
+                    ) -> tuple[ContactConstraint, ContactConstraint] | None:
+    """`contacts` (the soles' while the other foot swings) with the stance sole's kept
+    within stance_near_m of `cop` across facets; None (`contacts` as they are) else."""
+    near = stance_near_m(state, stance, near_cop_m)
+    if near <= 0.0:
+        return None
+    kept = list(contacts)
+    kept[stance] = near_asked(state, stance, kept[stance], cop, near)
+    return kept[0], kept[1]
