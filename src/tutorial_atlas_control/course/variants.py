@@ -6,8 +6,9 @@ world); the mud's damping 70 N s/m (40); the rubble rearranged; another heightma
 world files are not in DRCSim 2.x, so the changes that matter to a walker are made here from
 the qualification's world: the mud floor's friction, the mud's damping, and the rubble
 rearranged by a seed (the 30 blocks' places shuffled among themselves, each block turned
-to a new heading drawn uniformly, each lying as it lay: flat, on a side or on end). The
-moved pen and the other heightmap are not made (their files are unknown).
+to a new heading drawn uniformly, drawn again while it would overlap a block placed before
+it, each lying as it lay: flat, on a side or on end). The moved pen and the other heightmap
+are not made (their files are unknown).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from tutorial_atlas_control.course.errors import CourseError
+from tutorial_atlas_control.course.rubble_way import footprints_within
 from tutorial_atlas_control.course.vrc_task_2 import (
     BLOCKS,
     MUD_DAMPING,
@@ -27,11 +29,18 @@ from tutorial_atlas_control.course.vrc_task_2 import (
     Block,
 )
 
-__all__ = ['COURSE_VARIANTS', 'RUBBLE_SEED', 'CourseVariant', 'course_variant',
+__all__ = ['BLOCK_GAP_M', 'COURSE_VARIANTS', 'RUBBLE_SEED', 'CourseVariant', 'course_variant',
            'rearranged_blocks']
 
 #: The finals' rubble as this package rearranges it (rearranged_blocks' seed).
 RUBBLE_SEED = 2013
+#: The least gap (m) between two rearranged blocks' footprints. Blocks drawn overlapping are
+#: pushed apart by the physics as the world starts: two of the rubble of seed 2013 (before
+#: headings were drawn again) lay 1 m from their described places, one on the planned way,
+#: and a walk's step landed on its top (0.23 m) where the plan had the ground.
+BLOCK_GAP_M = 0.02
+#: Headings drawn for one block before its place is given up as too tight.
+MAX_HEADING_DRAWS = 200
 
 
 @dataclass(frozen=True)
@@ -79,11 +88,28 @@ def course_variant(name: str) -> CourseVariant:
 
 def rearranged_blocks(blocks: tuple[Block, ...], seed: int) -> tuple[Block, ...]:
     """`blocks` with their places (x, y) shuffled among them and each a new heading drawn
-    uniformly from default_rng(seed); each keeps its name, its height in the world file
-    and the way it lies (roll, pitch). The same seed gives the same rubble."""
+    uniformly from default_rng(seed), drawn again (from a stream of its own, so that the
+    other blocks keep theirs) while its footprint comes within BLOCK_GAP_M of a block placed
+    before it; each keeps its name, its height in the world file and the way it lies (roll,
+    pitch). The same seed gives the same rubble.
+
+    Raises:
+        CourseError: a place where no heading drawn leaves the gap.
+    """
     rng = np.random.default_rng(seed)
     order = rng.permutation(len(blocks))
     yaws = rng.uniform(-math.pi, math.pi, len(blocks))
-    return tuple(replace(block, x_m=blocks[k].x_m, y_m=blocks[k].y_m,
-                         yaw_rad=round(float(yaw), 6))
-                 for block, k, yaw in zip(blocks, order, yaws))
+    redraws = np.random.default_rng([seed, 1])
+    placed: list[Block] = []
+    for block, k, yaw in zip(blocks, order, yaws):
+        moved = replace(block, x_m=blocks[k].x_m, y_m=blocks[k].y_m, yaw_rad=round(float(yaw), 6))
+        for _ in range(MAX_HEADING_DRAWS):
+            if not any(footprints_within(moved, other, BLOCK_GAP_M) for other in placed):
+                break
+            moved = replace(moved, yaw_rad=round(float(redraws.uniform(-math.pi, math.pi)), 6))
+        else:
+            raise CourseError(f'rubble seed {seed}: no heading of {block.name} at '
+                              f'({moved.x_m}, {moved.y_m}) keeps {BLOCK_GAP_M} m from the '
+                              'blocks placed before it')
+        placed.append(moved)
+    return tuple(placed)
