@@ -51,7 +51,6 @@ from tutorial_atlas_control.walking import sole_support
 from tutorial_atlas_control.walking.compiled_legs import CompiledLegs
 from tutorial_atlas_control.walking.compiled_swing import CompiledSwing
 from tutorial_atlas_control.walking.footsteps import Footstep, wrap_angle
-from tutorial_atlas_control.walking.sole_support import SHIFT_M
 from tutorial_atlas_control.walking.swing import SwingPath, quintic, sole_frame, surface_tilt
 
 __all__ = ['LEGS_ENV', 'LEG_JOINTS', 'SWING_ENV', 'LegGains', 'LegTasks', 'foot_pose']
@@ -112,9 +111,11 @@ class LegGains:
     flat_cos: float = 0.99875
     #: A lone stance sole across facets keeps its wrench's pressure centre within this (m)
     #: of the one asked (sole_support: the pelvis task's moment took it to the sole's edge,
-    #: where on the course's hills nothing bore, and the sole rolled over); None: the whole
-    #: sole, as on a plane.
-    near_cop_m: float | None = SHIFT_M
+    #: where on the course's hills nothing bore, and the sole rolled over; SHIFT_M); None:
+    #: the whole sole, as on a plane. Off by default: on the pit's entry ramp (the
+    #: heightfield's, facets 2-18 degrees apart under a sole) every walk from the mud start
+    #: fell at step 31 of 109 with it (docs/controllers.md).
+    near_cop_m: float | None = None
 
 
 def foot_pose(state: BalanceState, foot: int, step_index: int = 0) -> Footstep:

@@ -59,7 +59,7 @@ def _stance_shift(behaviour: StandBehaviour, state: BalanceState) -> np.ndarray:
     """How far (m; along, across the sole) the right stance sole's wrench's pressure centre
     is from the one asked (its centre) while the left foot swings."""
     assert behaviour.controller is not None
-    legs = LegTasks(behaviour.controller, LegGains(), 0.0)
+    legs = LegTasks(behaviour.controller, LegGains(near_cop_m=SHIFT_M), 0.0)
     centre, rotation = state.sole_centres[RIGHT], state.sole_rotations[RIGHT]
     captured = {}
     whole_body = behaviour.controller.whole_body
