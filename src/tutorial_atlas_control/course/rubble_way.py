@@ -90,19 +90,8 @@ def block_footprint(block: Block) -> np.ndarray:
 
 def footprints_within(a: Block, b: Block, gap_m: float) -> bool:
     """Whether the footprints of blocks `a` and `b` (block_footprint) overlap or come within
-    `gap_m` of each other along some axis of their edges (the separating axis test on the
-    convex hulls: apart only if some edge's normal separates them by `gap_m`)."""
-    first, second = block_footprint(a), block_footprint(b)
-    for polygon in (first, second):
-        edges = np.roll(polygon, -1, axis=0) - polygon
-        normals = np.column_stack([-edges[:, 1], edges[:, 0]])
-        normals /= np.linalg.norm(normals, axis=1)[:, None]
-        for normal in normals:
-            along_a, along_b = first @ normal, second @ normal
-            if (along_a.max() + gap_m <= along_b.min()
-                    or along_b.max() + gap_m <= along_a.min()):
-                return False
-    return True
+    `gap_m` of each other."""
+    return _polygon_distance(block_footprint(a), block_footprint(b)) < gap_m
 
 
 def _hull(points: np.ndarray) -> np.ndarray:
