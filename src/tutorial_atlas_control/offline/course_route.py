@@ -82,10 +82,10 @@ from tutorial_atlas_control.walking import (
     Footstep,
     HeightField,
     RouteGait,
+    centre_line_xy,
     feet_origin,
     perturb_start,
     route_steps,
-    side_sign,
 )
 
 __all__ = ['PLANNING_GROUNDS', 'CourseWalk', 'LegFigures', 'around_blocks', 'course_walk',
@@ -365,9 +365,7 @@ def around_blocks(origin: tuple[float, float], heading_rad: float,
     strides = replace(gait, start_in_place=True, inside_in_place=True,
                       turn_slowdown_m=CORNER_SLOWDOWN_M)
     plan = route_steps(origin, heading_rad, waypoints, strides, ground=ground)
-    centres = [(step.x_m + side_sign(step.foot_index) * gait.width_m / 2 * math.sin(step.yaw_rad),
-                step.y_m - side_sign(step.foot_index) * gait.width_m / 2 * math.cos(step.yaw_rad))
-               for step in plan]
+    centres = [centre_line_xy(step, gait.width_m) for step in plan]
     way_m = CLEARANCE_M - SHORTCUT_SLACK_M  # what the way's straight lines keep
     clear = point_clearances_m(np.array(centres), blocks, obstacles) >= way_m
     out = int(np.argmax(clear)) if clear.any() else len(plan)

@@ -45,7 +45,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'leg_tasks': ['LEGS_ENV', 'SWING_ENV'],
     'walk': ['WalkGains'],
     'walk_behaviour': ['WalkBehaviour', 'WalkStatus'],
-    'route': ['RouteGait', 'feet_origin', 'route_steps'],
+    'route': ['RouteGait', 'centre_line_xy', 'feet_origin', 'route_steps'],
     'ground_strides': ['SOLE_HALF_LENGTH_M', 'SOLE_HALF_WIDTH_M', 'GroundGait', 'HeightField',
                        'SoleFit', 'ground_steps', 'sole_fit'],
     'start_noise': ['perturb_start'],

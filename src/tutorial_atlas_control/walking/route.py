@@ -39,7 +39,7 @@ from tutorial_atlas_control.walking.ground_strides import (
     sole_fit,
 )
 
-__all__ = ['RouteGait', 'feet_origin', 'route_steps']
+__all__ = ['RouteGait', 'centre_line_xy', 'feet_origin', 'route_steps']
 
 #: A waypoint this near the centre line's point (m) is reached: no move towards it.
 REACHED_M = 1e-6
@@ -261,6 +261,13 @@ def _foot_at(index: int, foot: int, x_m: float, y_m: float, heading_rad: float,
     half = side_sign(foot) * gait.width_m / 2
     return Footstep(index, foot, x_m - half * math.sin(heading_rad),
                     y_m + half * math.cos(heading_rad), wrap_angle(heading_rad), duration_s)
+
+
+def centre_line_xy(step: Footstep, width_m: float) -> tuple[float, float]:
+    """The centre line's point `step` stands beside, `width_m` the stance (_foot_at's
+    inverse)."""
+    half = side_sign(step.foot_index) * width_m / 2
+    return step.x_m + half * math.sin(step.yaw_rad), step.y_m - half * math.cos(step.yaw_rad)
 
 
 def feet_origin(left: tuple[float, float, float],

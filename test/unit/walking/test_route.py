@@ -10,7 +10,12 @@ import pytest
 from tutorial_atlas_control.walking import WalkingError
 from tutorial_atlas_control.walking.footsteps import LEFT, RIGHT, Footstep, wrap_angle
 from tutorial_atlas_control.walking.ground_strides import GroundGait, sole_fit
-from tutorial_atlas_control.walking.route import RouteGait, feet_origin, route_steps
+from tutorial_atlas_control.walking.route import (
+    RouteGait,
+    centre_line_xy,
+    feet_origin,
+    route_steps,
+)
 from tutorial_atlas_control.walking.step_queue import clamp_step
 
 
@@ -207,3 +212,16 @@ def test_a_route_up_a_curved_ramp_strides_evenly_and_slowly_where_it_is_steep() 
         if 1.55 < step.y_m < 2.75:  # the ramp steeper than 15 degrees
             assert step.duration_s == 0.9, step
     assert centre_after(steps) == pytest.approx((0.0, 4.5))
+
+
+def test_a_step_s_centre_line_point_is_the_one_its_foot_was_put_beside() -> None:
+    gait = RouteGait()
+    steps = route_steps((1.0, 2.0), 0.3, [(3.0, 2.5), (3.5, 4.0)], gait)
+    # the last two steps put the feet side by side about the route's end
+    last, before = (centre_line_xy(step, gait.width_m) for step in steps[-2:])
+    assert last == pytest.approx(before, abs=1e-12)
+    assert last == pytest.approx((3.5, 4.0), abs=0.15)
+    # and the first stands beside the start, half the stance to its side
+    x, y = centre_line_xy(steps[0], gait.width_m)
+    assert math.hypot(x - 1.0, y - 2.0) < gait.stride_m
+    assert math.hypot(steps[0].x_m - x, steps[0].y_m - y) == pytest.approx(gait.width_m / 2)
