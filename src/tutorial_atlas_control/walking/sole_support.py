@@ -13,7 +13,9 @@ degrees within 0.1 s of taking the weight (30 of 178 steps), and the walker fell
 So a stance sole whose contacts are not on one plane (their normals more than 2 degrees
 apart) keeps its wrench's pressure centre within SHIFT_M of the one asked (which the walk
 keeps on the sole less the Stand's margin): the pelvis task gets what moment that leaves.
-A sole on one plane is left as it was (any flat walk: the same torques).
+A sole on one plane is left as it was (any flat walk: the same torques). The rule acts only
+with LegGains.near_cop_m set, and is off by default: the pit's ramps are curved heightfield
+too, and with it every walk from the mud start fell on the entry ramp (docs/controllers.md).
 """
 
 from __future__ import annotations
