@@ -11,13 +11,13 @@ CoM height over them (a slope's steps up or down); phases: the one phase machine
 Walk and Step run (their phases in order, each one's end rule, the transition);
 leg_tasks: what Walk and Step do alike each tick (the whole-body law on the carrying soles,
 the swing foot, the pelvis's heading); sole_support: a lone stance sole across facets (the
-course's hills) keeps its wrench's pressure centre near the one asked; compiled_swing: the
-swing foot's path and servo as one C call (src/atlas_swing.c); compiled_legs: a swinging
-tick of the legs (sole clamp, whole body, swing servo, effort limits) as one C call
-(src/atlas_legs.c); compiled_walk_swing:
-a walking tick with the foot in the air (reference, step adjustment, the law, the legs) as one
-C call (src/atlas_walk_swing.c); walk: the walk's phases; walk_behaviour: Walk as the
-simulator's behaviour;
+course's hills) keeps its wrench's pressure centre near the one asked (off by default);
+compiled_swing: the swing foot's path and servo as one C call (src/atlas_swing.c);
+compiled_legs: a swinging tick of the legs (sole clamp, whole body, swing servo, effort
+limits) as one C call (src/atlas_legs.c); compiled_walk_swing: a walking tick with the foot
+in the air (reference, step adjustment, the law, the legs) as one C call
+(src/atlas_walk_swing.c); walk: the walk's phases; walk_behaviour: Walk as the simulator's
+behaviour;
 route: footsteps through a route of waypoints (a course walker's plan) from where the
 feet are; ground_strides: a straight run's strides fitted to the ground (no sole across a
 bend, short slow steps on steep ground);
