@@ -42,14 +42,17 @@ static void clamp_to_sole(const AtlasLegs *legs, const double *centre, const dou
 }
 
 /* sole_support.near_asked: the stance sole's constraint `foot` (FOOT numbers) kept to the
- * rectangle within near_m of the pressure centre `p` along and across the sole, and on it. */
+ * rectangle within near_m of the pressure centre `p` or of the bearing box, along and across
+ * the sole, and on it. */
 static void near_asked(const AtlasLegs *legs, const double *centre, const double *r,
                        const double p[2], double *foot) {
   double dx = p[0] - centre[0], dy = p[1] - centre[1], near = legs->near_m;
   double asked[2] = {r[0] * dx + r[3] * dy, r[1] * dx + r[4] * dy};
   double halves[2] = {foot[HALF_LENGTH], foot[HALF_WIDTH]}, low[2], high[2];
-  for (int k = 0; k < 2; ++k) { /* Python's max(a - near, -h), min(a + near, h) */
-    double a = asked[k] - near, b = asked[k] + near;
+  for (int k = 0; k < 2; ++k) { /* Python's max(min(a, s) - near, -h), min(max(a, s) + near, h) */
+    double lowest = legs->bearing[2 * k], highest = legs->bearing[2 * k + 1];
+    double a = (asked[k] <= lowest ? asked[k] : lowest) - near;
+    double b = (asked[k] >= highest ? asked[k] : highest) + near;
     low[k] = a >= -halves[k] ? a : -halves[k];
     high[k] = b <= halves[k] ? b : halves[k];
     high[k] = high[k] >= low[k] ? high[k] : low[k]; /* a point at worst */

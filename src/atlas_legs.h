@@ -31,8 +31,11 @@ typedef struct {
   double margin_m;                  /* the support region's margin (m) */
   long carrying[2];                 /* which soles carry (1) */
   double near_m;                    /* > 0: the stance sole is across facets, its wrench's
-                                     * pressure centre within this of the kept one (m;
-                                     * walking/sole_support.py); else the whole sole */
+                                     * pressure centre within this of the kept one or of
+                                     * `bearing` (m; walking/sole_support.py); else the
+                                     * whole sole */
+  double bearing[4];                /* the box the stance sole bears on (sole frame, m):
+                                     * along lowest, highest, across lowest, highest */
 } AtlasLegs;
 
 /* A foot's pose for a tick with both feet meant down (LegTasks.finish): the put-down servo's

@@ -136,7 +136,8 @@ class AtlasLegs(ctypes.Structure):
                 ('leg_start', ctypes.c_long), ('leg_dofs', ctypes.c_long * 6),
                 ('sole_velocities_at', ctypes.c_long), ('row', ctypes.c_void_p),
                 ('half_size', ctypes.c_double * 2), ('margin_m', ctypes.c_double),
-                ('carrying', ctypes.c_long * 2), ('near_m', ctypes.c_double)]
+                ('carrying', ctypes.c_long * 2), ('near_m', ctypes.c_double),
+                ('bearing', ctypes.c_double * 4)]
 
 
 class AtlasLegsSupport(ctypes.Structure):

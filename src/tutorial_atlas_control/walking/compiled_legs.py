@@ -20,6 +20,7 @@ import numpy as np
 
 from tutorial_atlas_control.balance import row_offsets
 from tutorial_atlas_control.native import AtlasLegs, AtlasLegsSupport, address
+from tutorial_atlas_control.walking.sole_support import NO_SPAN
 from tutorial_atlas_control.walking.swing import surface_tilt
 
 if TYPE_CHECKING:
@@ -32,6 +33,7 @@ if TYPE_CHECKING:
     )
     from tutorial_atlas_control.walking.compiled_swing import CompiledSwing
     from tutorial_atlas_control.walking.footsteps import Footstep
+    from tutorial_atlas_control.walking.sole_support import Span
     from tutorial_atlas_control.walking.swing import SwingPath
 
 #: The swing leg's joints.
@@ -109,13 +111,14 @@ class CompiledLegs:
                         joints: tuple[np.ndarray, np.ndarray],
                         joint_gains: tuple[np.ndarray, np.ndarray], reference: StandReference,
                         moved: MovedReference, swing: tuple[int, SwingPath, float],
-                        near_m: float = 0.0) -> None:
+                        near: tuple[float, Span] = (0.0, NO_SPAN)) -> None:
         """A swinging tick's input but the pressure centre (tick_at sets it, or the walk's
         swing tick, compiled_walk_swing): the state, the stance sole's `contacts`, the joints'
         positions and velocities, their gains, the legs' reference (`moved`: its heading,
-        height and rate), `swing` (the foot, its path, the time into it) and `near_m` (> 0:
-        the stance sole across facets, its wrench's pressure centre kept within near_m of
-        the kept one: LegTasks.stance_near_m)."""
+        height and rate), `swing` (the foot, its path, the time into it) and `near` (how near
+        and the stance sole's bearing box: > 0 across facets, its wrench's pressure centre
+        kept within that of the kept one or of the box: sole_support.stance_near_m and
+        bearing_span)."""
         source = state.mass_matrix_source
         if source is not self._source or source is None:  # the estimator's one tuple: once
             if source is None or self._scratch != source[0:2]:
@@ -128,7 +131,8 @@ class CompiledLegs:
                               moved)
         self._swing.set_path(path)
         self._swing.prepare_swing(elapsed_s)
-        self._call.near_m = near_m
+        self._call.near_m = near[0]
+        self._call.bearing[:] = near[1]
 
     def results(self) -> tuple[np.ndarray, np.ndarray]:
         """The last tick's torques (joints,) and pressure centre as kept, new arrays."""

@@ -110,12 +110,10 @@ class LegGains:
     flat_height_m: float = 0.005
     flat_cos: float = 0.99875
     #: A lone stance sole across facets keeps its wrench's pressure centre within this (m)
-    #: of the one asked (sole_support: the pelvis task's moment took it to the sole's edge,
-    #: where on the course's hills nothing bore, and the sole rolled over; SHIFT_M); None:
-    #: the whole sole, as on a plane. Off by default: on the pit's entry ramp (the
-    #: heightfield's, facets 2-18 degrees apart under a sole) every walk from the mud start
-    #: fell at step 31 of 109 with it (docs/controllers.md).
-    near_cop_m: float | None = None
+    #: of the one asked or of the points it bears on (sole_support: the pelvis task's
+    #: moment took it to the sole's edge, where on the course's hills nothing bore, and the
+    #: sole rolled over); None: the whole sole, as on a plane.
+    near_cop_m: float | None = sole_support.SHIFT_M
 
 
 def foot_pose(state: BalanceState, foot: int, step_index: int = 0) -> Footstep:
@@ -306,10 +304,12 @@ class LegTasks:
         legs = self._legs_kernel
         if legs is None or state.row_address is None:
             return None
-        near = sole_support.stance_near_m(state, 1 - swing[0], self.gains.near_cop_m)
+        stance = 1 - swing[0]
+        near = sole_support.stance_near_m(state, stance, self.gains.near_cop_m)
+        span = sole_support.bearing_span(state, stance) if near > 0.0 else sole_support.NO_SPAN
         legs.load_swing_tick(state, self._swing_contacts[swing[0]],
                              (joint_positions, joint_velocities), self._joint_gains,
-                             self.reference, moved, swing, near)
+                             self.reference, moved, swing, (near, span))
         return legs
 
     def swing_tick(self, state: BalanceState, joint_positions: np.ndarray,

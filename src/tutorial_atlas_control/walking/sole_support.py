@@ -1,4 +1,5 @@
-"""A lone stance sole across facets: its wrench's pressure centre kept near the one asked.
+"""A lone stance sole across facets: its wrench's pressure centre kept near the one asked
+or where the sole bears.
 
 The whole-body layer keeps each sole's pressure centre inside the sole's rectangle, and the
 pelvis task's moment moves it there from where the capture point's law asks (on the floor
@@ -11,11 +12,14 @@ asked one, 50 to 100 N m) where nothing bore: the sole rolled over about its poi
 degrees within 0.1 s of taking the weight (30 of 178 steps), and the walker fell.
 
 So a stance sole whose contacts are not on one plane (their normals more than 2 degrees
-apart) keeps its wrench's pressure centre within SHIFT_M of the one asked (which the walk
-keeps on the sole less the Stand's margin): the pelvis task gets what moment that leaves.
-A sole on one plane is left as it was (any flat walk: the same torques). The rule acts only
-with LegGains.near_cop_m set, and is off by default: the pit's ramps are curved heightfield
-too, and with it every walk from the mud start fell on the entry ramp (docs/controllers.md).
+apart) keeps its wrench's pressure centre within SHIFT_M of the one asked or of the points
+it bears on, whichever reaches further (`bearing_span`: the box of its contacts within
+PRESSED_M of their surface, along and across it): the pelvis task gets what moment that
+leaves. A sole on one plane is left as it was (any flat walk: the same torques). Near the
+asked one alone was too little on the pit's ramps (heightfield too, curved: a sole on them
+is across facets nearly all the way down, bearing at both ends), and every walk from the mud
+start fell on the entry ramp; with the bearing points the ramp's soles keep most of their
+length. The rule acts with LegGains.near_cop_m set (SHIFT_M by default; None: off).
 """
 
 from __future__ import annotations
@@ -25,9 +29,10 @@ from dataclasses import replace
 import numpy as np
 
 from tutorial_atlas_control.balance import BalanceState, ContactConstraint
+from tutorial_atlas_control.balance.estimator import SoleContacts
 
-__all__ = ['ONE_SURFACE_COS', 'PRESSED_M', 'SHIFT_M', 'across_facets', 'near_asked',
-           'stance_contacts', 'stance_near_m']
+__all__ = ['NO_SPAN', 'ONE_SURFACE_COS', 'PRESSED_M', 'SHIFT_M', 'Span', 'UPRIGHT_COS',
+           'across_facets', 'bearing_span', 'near_asked', 'stance_contacts', 'stance_near_m']
 
 #: A contact within this of its surface (m) bears on it: the estimator's reach 1 cm out, and
 #: a sole on a ramp beside its bend (steps are planned clear of bends) has the other plane's
@@ -35,32 +40,63 @@ __all__ = ['ONE_SURFACE_COS', 'PRESSED_M', 'SHIFT_M', 'across_facets', 'near_ask
 PRESSED_M = 0.002
 #: Contact normals all within acos(ONE_SURFACE_COS) (2 degrees) of each other: one plane.
 ONE_SURFACE_COS = 0.99939
+#: A contact bears only with its normal within acos(UPRIGHT_COS) (60 degrees) of up: the
+#: side of a heightfield's prism or of a block beside a sole flat on the ground (normals
+#: 87-90 degrees from up, under a millimetre away) carries none of its weight, and counted,
+#: made a sole on the pen's flat floor "across facets".
+UPRIGHT_COS = 0.5
 #: How far (m) along and across the sole the wrench's pressure centre may be from the one
-#: asked, across facets.
+#: asked or from the points the sole bears on, across facets.
 SHIFT_M = 0.02
+
+#: The box of a sole's bearing points in its own frame (m, from its centre): lowest and
+#: highest along it, lowest and highest across it.
+Span = tuple[float, float, float, float]
+#: No bearing point: the box of the asked pressure centre alone (the sole's centre's).
+NO_SPAN: Span = (np.inf, -np.inf, np.inf, -np.inf)
+
+
+def _bearing(contacts: SoleContacts) -> np.ndarray:
+    """Which of a sole's contacts bear: within PRESSED_M of their surface, facing up."""
+    return (contacts.distances_m <= PRESSED_M) & (contacts.normals[:, 2] >= UPRIGHT_COS)
 
 
 def across_facets(state: BalanceState, foot: int) -> bool:
-    """Whether the sole `foot` bears on more than one plane (the normals of its contacts
-    within PRESSED_M of their surface apart)."""
+    """Whether the sole `foot` bears on more than one plane (the normals of its bearing
+    contacts apart)."""
     contacts = state.sole_contacts[foot]
-    normals = contacts.normals[contacts.distances_m <= PRESSED_M]
+    normals = contacts.normals[_bearing(contacts)]
     if len(normals) < 2:
         return False
     return float(np.min(normals @ normals[0])) < ONE_SURFACE_COS
 
 
+def bearing_span(state: BalanceState, foot: int) -> Span:
+    """The box (sole frame, m) of the bearing contacts of the sole `foot` (within PRESSED_M
+    of their surface, facing up): where it bears; NO_SPAN when none does."""
+    contacts = state.sole_contacts[foot]
+    points = contacts.points[_bearing(contacts)]
+    if not len(points):
+        return NO_SPAN
+    rotation = state.sole_rotations[foot]
+    offsets = points - state.sole_centres[foot]
+    along, across = offsets @ rotation[:, 0], offsets @ rotation[:, 1]
+    return (float(along.min()), float(along.max()), float(across.min()), float(across.max()))
+
+
 def near_asked(state: BalanceState, foot: int, contact: ContactConstraint,
-               cop: np.ndarray, shift_m: float = SHIFT_M) -> ContactConstraint:
+               cop: np.ndarray, shift_m: float = SHIFT_M, span: Span = NO_SPAN
+               ) -> ContactConstraint:
     """`contact` (the sole `foot`'s) with its pressure centre kept within `shift_m` of `cop`
-    ((2,) m, world; on the sole) along and across the sole, and on the sole."""
+    ((2,) m, world; on the sole) or of the box `span` (bearing_span's), along and across the
+    sole, and on the sole."""
     rotation, centre = state.sole_rotations[foot], state.sole_centres[foot]
     (r00, r01, _), (r10, r11, _), _ = rotation.tolist()
     dx, dy = float(cop[0] - centre[0]), float(cop[1] - centre[1])
     asked = (r00 * dx + r10 * dy, r01 * dx + r11 * dy)
     halves = (contact.half_length_m, contact.half_width_m)
-    low = [max(a - shift_m, -h) for a, h in zip(asked, halves)]
-    high = [min(a + shift_m, h) for a, h in zip(asked, halves)]
+    low = [max(min(a, s) - shift_m, -h) for a, s, h in zip(asked, span[0::2], halves)]
+    high = [min(max(a, s) + shift_m, h) for a, s, h in zip(asked, span[1::2], halves)]
     high = [max(hi, lo) for lo, hi in zip(low, high)]  # a point at worst
     return replace(contact, half_length_m=0.5 * (high[0] - low[0]),
                    half_width_m=0.5 * (high[1] - low[1]),
@@ -69,8 +105,9 @@ def near_asked(state: BalanceState, foot: int, contact: ContactConstraint,
 
 def stance_near_m(state: BalanceState, stance: int, near_cop_m: float | None) -> float:
     """How near (m) the lone stance sole `stance`'s wrench's pressure centre stays to the one
-    asked: `near_cop_m` (LegGains') across facets; 0.0, the whole sole, on one plane or with
-    the rule off (None). The one decision both the compiled tick and the Python read."""
+    asked or its bearing points: `near_cop_m` (LegGains') across facets; 0.0, the whole sole,
+    on one plane or with the rule off (None). The one decision both the compiled tick and
+    the Python read (with bearing_span's box)."""
     if near_cop_m is None or not across_facets(state, stance):
         return 0.0
     return near_cop_m
@@ -81,10 +118,12 @@ def stance_contacts(state: BalanceState, stance: int,
                     near_cop_m: float | None
                     ) -> tuple[ContactConstraint, ContactConstraint] | None:
     """`contacts` (the soles' while the other foot swings) with the stance sole's kept
-    within stance_near_m of `cop` across facets; None (`contacts` as they are) else."""
+    within stance_near_m of `cop` or its bearing points across facets; None (`contacts` as
+    they are) else."""
     near = stance_near_m(state, stance, near_cop_m)
     if near <= 0.0:
         return None
     kept = list(contacts)
-    kept[stance] = near_asked(state, stance, kept[stance], cop, near)
+    kept[stance] = near_asked(state, stance, kept[stance], cop, near,
+                              bearing_span(state, stance))
     return kept[0], kept[1]

@@ -1,9 +1,9 @@
 """A lone stance sole across facets (walking/sole_support.py), on the Atlas model placed in
 DRCSim's Stand pose with its contacts given: on one plane (the floor, or up on one edge of
 it, or beside a bend with the other plane a few millimetres off) the Stand's constraint as
-it was; across two facets the wrench's pressure centre stays
-within SHIFT_M of the one asked, however much moment the pelvis task asks for, where on a
-plane that moment takes it to the sole's edge."""
+it was; across two facets the wrench's pressure centre stays within SHIFT_M of the one
+asked or of the corners the sole bears on, however much moment the pelvis task asks for,
+where on a plane that moment takes it to the sole's edge."""
 
 from __future__ import annotations
 
@@ -19,12 +19,19 @@ from tutorial_atlas_control.balance.stand_behaviour import StandBehaviour
 from tutorial_atlas_control.balance.stand_pose import place_in_stand_pose
 from tutorial_atlas_control.sim import model as atlas_model
 from tutorial_atlas_control.walking.leg_tasks import LegGains, LegTasks
-from tutorial_atlas_control.walking.sole_support import SHIFT_M, across_facets
+from tutorial_atlas_control.walking.sole_support import (
+    NO_SPAN,
+    SHIFT_M,
+    across_facets,
+    bearing_span,
+)
 
 LEFT, RIGHT = 0, 1
 UP = (0.0, 0.0, 1.0)
 #: A facet 8 degrees off the floor, falling to the sole's right.
 FACET = (0.0, -math.sin(math.radians(8.0)), math.cos(math.radians(8.0)))
+#: A wall's side, 89 degrees from up, facing the sole's left.
+SIDE = (0.0, -math.sin(math.radians(89.0)), math.cos(math.radians(89.0)))
 CORNERS = [(x, y) for x in (-0.13, 0.13) for y in (-0.0624, 0.0624)]
 
 
@@ -88,17 +95,50 @@ def test_a_sole_on_one_plane_is_on_one_plane(
     # beside a bend: the other plane within the estimator's reach, 5 mm off, bears nothing
     assert not across_facets(_touching(state, [UP, FACET, UP, FACET],
                                        gaps=(-0.0005, 0.005, -0.0005, 0.005)), RIGHT)
+    # beside a wall (a heightfield prism's side, a block's): it bears nothing either
+    assert not across_facets(_touching(state, [UP, UP, UP, SIDE]), RIGHT)
+
+
+#: The corners' gaps (m; CORNERS' order: heel right, heel left, toe right, toe left) of a
+#: sole bearing on its heel (the toe 5 mm up), on its toe, and on all four.
+ON_HEEL = (-0.0005, -0.0005, 0.005, 0.005)
+ON_TOE = (0.005, 0.005, -0.0005, -0.0005)
+ON_ALL = (-0.0005,) * 4
 
 
 def test_the_pelvis_moment_moves_a_stance_pressure_centre_across_facets_little(
         standing: tuple[StandBehaviour, BalanceState]) -> None:
-    """The pelvis pitched 2 degrees (the pelvis task asks for about 100 N m): on the floor
-    the stance sole's pressure centre goes 10 cm from the one asked; across facets it
-    stays within SHIFT_M."""
+    """The pelvis pitched 2 degrees (the pelvis task asks for about 100 N m, the pressure
+    centre toward the toe): on the floor the stance sole's pressure centre goes 10 cm from
+    the one asked; across facets bearing on its heel it stays within SHIFT_M of it."""
     behaviour, state = standing
     pitch = math.radians(2.0)
     on_floor = _stance_shift(behaviour, _touching(state, [UP] * 4, pitch))
-    assert float(np.max(np.abs(on_floor))) > 0.05
-    across = _stance_shift(behaviour, _touching(state, [UP, FACET, UP, FACET], pitch))
+    assert float(on_floor[0]) > 0.05
+    across = _stance_shift(behaviour, _touching(state, [UP, FACET, UP, FACET], pitch,
+                                                ON_HEEL))
     assert float(np.max(np.abs(across))) <= SHIFT_M + 1e-6
     assert float(np.max(np.abs(across))) > 0.5 * SHIFT_M  # still moved, as far as it may
+
+
+def test_a_stance_sole_across_facets_keeps_where_it_bears(
+        standing: tuple[StandBehaviour, BalanceState]) -> None:
+    """Bearing on its toe, or on all four corners across a bend (the pit's curved ramps),
+    the same moment takes the pressure centre as far toward the toe as on the floor."""
+    behaviour, state = standing
+    pitch = math.radians(2.0)
+    on_floor = _stance_shift(behaviour, _touching(state, [UP] * 4, pitch))
+    for gaps in (ON_TOE, ON_ALL):
+        across = _stance_shift(behaviour, _touching(state, [UP, FACET, UP, FACET], pitch,
+                                                    gaps))
+        assert float(across[0]) == pytest.approx(float(on_floor[0]), abs=0.005)
+
+
+def test_the_bearing_span_is_the_box_of_the_pressed_corners(
+        standing: tuple[StandBehaviour, BalanceState]) -> None:
+    _, state = standing
+    heel = bearing_span(_touching(state, [UP, FACET, UP, FACET], gaps=ON_HEEL), RIGHT)
+    assert heel == pytest.approx((-0.13, -0.13, -0.0624, 0.0624), abs=1e-9)
+    assert bearing_span(_touching(state, [UP] * 4, gaps=(0.005,) * 4), RIGHT) == NO_SPAN
+    beside_wall = bearing_span(_touching(state, [UP, UP, SIDE, SIDE]), RIGHT)
+    assert beside_wall == pytest.approx((-0.13, -0.13, -0.0624, 0.0624), abs=1e-9)
