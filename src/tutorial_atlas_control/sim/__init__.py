@@ -29,7 +29,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
               'body_position_in_pose', 'index_model', 'load_model', 'pelvis_height_m',
               'reset_to_initial'],
     'shared_passes': ['SHARED_PASSES_ENV', 'behaviour_between', 'passes_current',
-                      'shares_passes'],
+                      'shares_passes', 'step_behaviour'],
     'sim_config': ['SimConfig', 'SimConfigError', 'parse_sim_config'],
     'sim_messages': ['SimMessages', 'TCPROS_PREFIX_BYTES'],
     'simulator': ['AtlasSimulator', 'DEFAULT_TIME_TO_UNPIN_S'],

@@ -45,8 +45,9 @@ class DivergenceCheck:
         self._warning_counts = data.warning.number  # a view: MuJoCo's counters
         self._state_is_finite = state_is_finite
         #: What finds the first sign of divergence: 0 none, 1 + a DIVERGENCE_WARNINGS index,
-        #: or NON_FINITE.
-        self._unsound: Callable[[], int] = (
+        #: or NON_FINITE (the compiled one a C call with no Python frame: a caller that
+        #: calls check only when it is not 0 spares a call a step).
+        self.unsound: Callable[[], int] = (
             self._python_unsound if kernel is None
             else kernel.unsound_call(self._warning_counts, [w for w, _ in DIVERGENCE_WARNINGS]))
 
@@ -64,7 +65,7 @@ class DivergenceCheck:
             PhysicsDivergenceError: MuJoCo warned of an unstable step (its counter is
                 cleared), or the state is not finite; the message gives the sim time.
         """
-        found = self._unsound()
+        found = self.unsound()
         if not found:
             return
         if found == NON_FINITE:

@@ -29,7 +29,8 @@ from tutorial_atlas_control.command import JointCommandArrays
 from tutorial_atlas_control.sim.behaviour import Behaviour
 from tutorial_atlas_control.sim.joint_law import JointLaw
 
-__all__ = ['SHARED_PASSES_ENV', 'behaviour_between', 'passes_current', 'shares_passes']
+__all__ = ['SHARED_PASSES_ENV', 'behaviour_between', 'passes_current', 'shares_passes',
+           'step_behaviour']
 
 #: `own` or `python`: mj_step whole, the estimate's own passes; unset: shared.
 SHARED_PASSES_ENV = 'TAC_SHARED_PASSES'
@@ -65,3 +66,20 @@ def behaviour_between(law: JointLaw, behaviour: Behaviour, data: mujoco.MjData,
         law.apply_behaviour(f_out_nm, blended)
 
     return torque_between
+
+
+def step_behaviour(model: mujoco.MjModel, data: mujoco.MjData, law: JointLaw,
+                   behaviour: Behaviour) -> None:
+    """One step under `behaviour` with nothing else acting (no command blended with it, no
+    cheat's or mud's body forces): behaviour_between's step, mj_step1, the torque applied,
+    mj_step2, in one call, without the closure and the three calls around it (every step of
+    an offline walk)."""
+    law.velocity_damping.apply(None)
+    mujoco.mj_step1(model, data)
+    _stepping.data = data
+    try:
+        f_out_nm = behaviour.torque(data)
+    finally:
+        _stepping.data = None
+    law.apply_behaviour(f_out_nm, None)
+    mujoco.mj_step2(model, data)

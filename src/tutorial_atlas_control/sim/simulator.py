@@ -42,7 +42,11 @@ from tutorial_atlas_control.sim.mode_commands import (
     parse_mode,
 )
 from tutorial_atlas_control.sim.mud import MudDrag
-from tutorial_atlas_control.sim.shared_passes import behaviour_between, shares_passes
+from tutorial_atlas_control.sim.shared_passes import (
+    behaviour_between,
+    shares_passes,
+    step_behaviour,
+)
 from tutorial_atlas_control.sim.sim_config import SimConfig
 from tutorial_atlas_control.sim.start_pose import home_qpos
 from tutorial_atlas_control.sim.startup_pin import StartupEvent, StartupPin
@@ -134,8 +138,8 @@ class AtlasSimulator:
         self.torque_nm = self.law.torque_nm  # the law's output array, applied each step
         self.commands = ModeCommands(gains, self.joint_positions, self.torque_nm)
         self.behaviours = ModeBehaviours()  # install_stand
-        self._check_divergence = DivergenceCheck(self.data, self.law.state_is_finite,
-                                                 self.law.kernel).check
+        divergence = DivergenceCheck(self.data, self.law.state_is_finite, self.law.kernel)
+        self._unsound, self._check_divergence = divergence.unsound, divergence.check
         self.sim_time_ns = 0
         self.start = start
         # VRCPlugin's cheats, pinning at reset_world's pelvis qpos; the world's ground.
@@ -326,13 +330,22 @@ class AtlasSimulator:
                 self._playback_step()
                 return
             vrc.warp_step(self.dt_s)
-        step_with_body_forces(self.model, self.data, vrc.xfrc if vrc.active else None,
-                              self.mud, _apply_torque(self, torque_nm))
+            step_with_body_forces(self.model, self.data, vrc.xfrc if vrc.active else None,
+                                  self.mud,
+                                  _apply_torque(self, torque_nm))
+        elif (behaviour := self.behaviours.acting) is not None and torque_nm is None \
+                and self.mud is None and self.shares_passes \
+                and self.commands.blend_command is None:  # a behaviour alone: every walk's
+            step_behaviour(self.model, self.data, self.law, behaviour)
+        else:
+            step_with_body_forces(self.model, self.data, None, self.mud,
+                                  _apply_torque(self, torque_nm))
         # mj_step integrates last: joint positions/velocities are at the new time, while body
         # poses and sensor readings were computed before integrating, at the step's start.
         self.state_time_ns = self.sim_time_ns
         self.sim_time_ns += self.step_ns
-        self._check_divergence(self.sim_time_ns)
+        if self._unsound():
+            self._check_divergence(self.sim_time_ns)
 
     def _playback_step(self) -> None:
         """step() during kinematic playback: physics off, no torque, time advances."""
