@@ -80,6 +80,8 @@ class CompiledLegs:
         self._source: object = None
         #: The swinging foot the call's leg is set for (None: none yet).
         self._foot: int | None = None
+        #: The soles the call's carrying flags say carry (None: not set yet).
+        self._carrying: tuple[bool, bool] | None = None
 
     def _set_foot(self, foot: int) -> None:
         """The swinging foot: its leg's joints and dofs, the other sole the stance."""
@@ -152,6 +154,13 @@ class CompiledLegs:
         """The call's struct, for a call that runs the tick itself (compiled_walk_swing)."""
         return ctypes.addressof(self._call)
 
+    def _set_carrying(self, carrying: tuple[bool, bool]) -> None:
+        """The soles that carry, into the call unless they are there already (a ctypes array's
+        slice assignment costs more than the support tick's other input)."""
+        if carrying != self._carrying:
+            self._call.carrying[:] = carrying
+            self._carrying = carrying
+
     def _set_feet(self, feet: tuple[Footstep, Footstep]) -> None:
         """Each foot's pose for the put-down servo and the flat test (atlas_legs.h's FOOT_*)."""
         for foot, pose in enumerate(feet):
@@ -172,13 +181,15 @@ class CompiledLegs:
         torques (joints,) within the effort limits and the pressure centre as kept, new
         arrays. A compiled estimate's state only."""
         source = state.mass_matrix_source
-        if source is None or self._scratch != source[0:2]:
-            self._bind(state)
+        if source is not self._source or source is None:  # as load_swing_tick's
+            if source is None or self._scratch != source[0:2]:
+                self._bind(state)
+            self._source = source
         self._whole_body.load(state, contacts, joints[0], joints[1], joint_gains, reference,
                               moved)
         call = self._call
         call.row = state.row_address
-        call.carrying[:] = carrying
+        self._set_carrying(carrying)
         self._out[self._joints:] = cop
         if feet[0] is not self._feet[0] or feet[1] is not self._feet[1]:
             self._set_feet(feet)
@@ -193,7 +204,7 @@ class CompiledLegs:
         estimate's state only."""
         call = self._call
         call.row = state.row_address
-        call.carrying[:] = carrying
+        self._set_carrying(carrying)
         out = self._out
         out[self._joints:] = cop
         self._library.atlas_legs_support_clamp(self._pointer)

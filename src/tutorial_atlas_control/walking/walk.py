@@ -37,7 +37,6 @@ from tutorial_atlas_control.balance import (
     MOVED_IN_CALL,
     BalanceState,
     StandController,
-    capture_point_after,
     cop_reaching,
     dcm_feedback_cop,
 )
@@ -126,6 +125,14 @@ def _output(torque_nm: np.ndarray, desired_cop: np.ndarray, capture_point_ref: n
     return output
 
 
+def _feet_middle(state: BalanceState) -> np.ndarray:
+    """The soles' centres' midpoint (x, y): state.sole_centres[:, :2].mean(axis=0)'s sum and
+    division in plain floats (the same bits; numpy's mean is some ten Python calls, every
+    tick of the catch)."""
+    (left_x, left_y, _), (right_x, right_y, _) = state.sole_centres.tolist()
+    return np.array([(left_x + right_x) / 2.0, (left_y + right_y) / 2.0])
+
+
 def _phase_over(phase: Phase, step: Footstep | None, state: BalanceState,
                 at_rest_m: float) -> bool:
     """What ends the phase under way once its time allows: nothing for the sway, the swing
@@ -134,7 +141,7 @@ def _phase_over(phase: Phase, step: Footstep | None, state: BalanceState,
     if phase is _SWING and step is not None:
         return bool(state.in_contact[step.foot_index])
     if phase is _CATCH:
-        middle = state.sole_centres[:, :2].mean(axis=0)
+        middle = _feet_middle(state)
         return float(np.linalg.norm(state.capture_point - middle)) < at_rest_m
     return True
 
@@ -232,6 +239,8 @@ class WalkController:
         self._sway_cop = cop_reaching(state.capture_point, target, state.omega,
                                      self.gains.sway_s)
         self._sway_from = state.capture_point.copy()
+        #: The sway's start and pressure centre as floats (x, y each): every sway tick's.
+        self._sway_xy = (*self._sway_from.tolist(), *self._sway_cop.tolist())
 
     def _begin_step(self, phase: Phase, state: BalanceState, time_s: float) -> None:
         preview = self.queue.preview()
@@ -321,12 +330,14 @@ class WalkController:
         """(xi_ref, p_ref) now."""
         elapsed = self.phases.elapsed_s(time_s)
         if self.phases.phase is _SWAY:
-            xi = capture_point_after(self._sway_from, self._sway_cop, state.omega,
-                                     min(elapsed, self.gains.sway_s))
-            return xi, self._sway_cop
+            # capture_point_after's elementwise arithmetic in plain floats (the same bits)
+            growth = math.exp(state.omega * min(elapsed, self.gains.sway_s))
+            from_x, from_y, cop_x, cop_y = self._sway_xy
+            return (np.array([cop_x + (from_x - cop_x) * growth,
+                              cop_y + (from_y - cop_y) * growth]), self._sway_cop)
         if self.phase == STEPPING and self._plan is not None:
             return self._plan.reference(0, elapsed)
-        middle = state.sole_centres[:, :2].mean(axis=0)
+        middle = _feet_middle(state)
         return middle, middle
 
     def _adjust(self, state: BalanceState, xi_ref: np.ndarray, cop_ref: np.ndarray,
