@@ -394,9 +394,10 @@ class WalkController:
                     joint_velocities: np.ndarray, time_s: float) -> WalkOutput:
         """The 28 joint torques (N m) for this 1 ms tick, within the effort limits."""
         self._advance(state, time_s)
-        self._lift_off(state, time_s)
-        if self._kernel is not None and self._lift_off_s is not None \
-                and self.phases.phase is _SWING:
+        swinging = self.phases.phase is _SWING
+        if swinging and self._lift_off_s is None:  # transferring: no call on other ticks
+            self._lift_off(state, time_s)
+        if swinging and self._lift_off_s is not None and self._kernel is not None:
             output = self._compiled_swing(self._kernel, state, joint_positions,
                                           joint_velocities, time_s)
             if output is not None:
