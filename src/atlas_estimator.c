@@ -49,6 +49,9 @@ typedef struct {
   double polygon_tolerance_m;        /* estimator.POLYGON_TOLERANCE_M */
   double rotation_tolerance;         /* the rotation entries' change that moves a corner so */
   double corner_offsets[2][4][3];    /* each sole's bottom corners in its own frame */
+  long mass_current;          /* 1: the scratch data's mass matrix (d->M) is the last estimate's
+                               * state's, copied from the step (atlas_estimate_stepped); 0: not
+                               * computed (atlas_estimate). Walk's legs run mj_crb only then. */
 } AtlasEstimator;
 
 /* The output, flat doubles (compiled_estimator.py's FIXED_FIELDS and POLYGON_* say the same). */
@@ -247,9 +250,10 @@ static long estimate_from_passes(const AtlasEstimator *e) {
 
 /* The estimate at (qpos, qvel) (full MuJoCo vectors) into out; returns the sole contacts'
  * row count (rows beyond contact_capacity are not written: atlas_estimator_contacts then). */
-long atlas_estimate(const AtlasEstimator *e) {
+long atlas_estimate(AtlasEstimator *e) {
   const mjModel *m = e->model;
   mjData *d = e->data;
+  e->mass_current = 0;
   memcpy(d->qpos, e->qpos, m->nq * sizeof(double));
   memcpy(d->qvel, e->qvel, m->nv * sizeof(double));
   mj_kinematics(m, d);
@@ -268,8 +272,10 @@ long atlas_estimate(const AtlasEstimator *e) {
  * position and velocity stages (mj_kinematics, mj_comPos, mj_comVel, and mj_rne's bias
  * forces: the same functions on the same numbers) copied into the scratch data instead of
  * computed again; only the soles' collision within their wider margin and the subtree
- * velocity, which mj_step1 does not compute, run here. `stepped` is read, never written. */
-long atlas_estimate_stepped(const AtlasEstimator *e, const mjData *s) {
+ * velocity, which mj_step1 does not compute, run here. The step's mass matrix (mj_makeM's,
+ * mj_crb's numbers on a robot without tendons) is copied too, for Walk's legs
+ * (mass_current). `stepped` is read, never written. */
+long atlas_estimate_stepped(AtlasEstimator *e, const mjData *s) {
   const mjModel *m = e->model;
   mjData *d = e->data;
   long nbody = m->nbody, nv = m->nv;
@@ -291,6 +297,8 @@ long atlas_estimate_stepped(const AtlasEstimator *e, const mjData *s) {
   COPY(cdof, 6 * nv);
   COPY(cvel, 6 * nbody);
   COPY(cdof_dot, 6 * nv);
+  COPY(M, m->nC);
+  e->mass_current = 1;
   memcpy(e->bias, s->qfrc_bias, (size_t)nv * sizeof(mjtNum));
   mj_collision(m, d);
   mj_subtreeVel(m, d);

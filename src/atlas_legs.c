@@ -83,7 +83,8 @@ static void stance_whole_body(const AtlasLegs *legs, const double *centre, const
 }
 
 /* CompiledSwing._load from the row: the swing sole's jacobian (its leg's columns), pose and
- * velocity, the leg's joint rates, and its inertia block (mj_crb, mj_fullM). */
+ * velocity, the leg's joint rates, and its inertia block (mj_fullM; mj_crb first unless the
+ * estimate copied the step's mass matrix: the same numbers). */
 static void load_swing(const AtlasLegs *legs) {
   const AtlasWholeBody *w = legs->whole_body;
   const double *row = w->row;
@@ -97,7 +98,7 @@ static void load_swing(const AtlasLegs *legs) {
   memcpy(in + IN_ROTATION, row + at[WB_ROW_SOLE_ROTATIONS] + 9 * foot, 9 * sizeof(double));
   memcpy(in + IN_SOLE_VELOCITY, row + legs->sole_velocities_at + 6 * foot, 6 * sizeof(double));
   memcpy(in + IN_JOINT_VELOCITY, w->in + WB_IN_JOINTS + n + start, LEG * sizeof(double));
-  mj_crb(legs->model, legs->data);
+  if (legs->mass_current == NULL || !*legs->mass_current) mj_crb(legs->model, legs->data);
   mj_fullM(legs->model, legs->data, legs->mass_matrix);
   long nv = legs->model->nv;
   for (int i = 0; i < LEG; ++i)

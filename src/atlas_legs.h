@@ -36,6 +36,8 @@ typedef struct {
                                      * whole sole */
   double bearing[4];                /* the box the stance sole bears on (sole frame, m):
                                      * along lowest, highest, across lowest, highest */
+  const long *mass_current;         /* the estimator's flag: not 0 when the data's mass
+                                     * matrix is its state's already (NULL: never) */
 } AtlasLegs;
 
 /* A foot's pose for a tick with both feet meant down (LegTasks.finish): the put-down servo's

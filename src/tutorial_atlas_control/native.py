@@ -90,7 +90,7 @@ class AtlasEstimator(ctypes.Structure):
                 ('polygon_positions', ctypes.c_void_p), ('polygon_rotations', ctypes.c_void_p),
                 ('polygon_contact', ctypes.c_long * 2), ('polygon_tolerance_m', ctypes.c_double),
                 ('rotation_tolerance', ctypes.c_double),
-                ('corner_offsets', ctypes.c_double * 24)]
+                ('corner_offsets', ctypes.c_double * 24), ('mass_current', ctypes.c_long)]
 
 
 class AtlasStatics(ctypes.Structure):
@@ -137,7 +137,7 @@ class AtlasLegs(ctypes.Structure):
                 ('sole_velocities_at', ctypes.c_long), ('row', ctypes.c_void_p),
                 ('half_size', ctypes.c_double * 2), ('margin_m', ctypes.c_double),
                 ('carrying', ctypes.c_long * 2), ('near_m', ctypes.c_double),
-                ('bearing', ctypes.c_double * 4)]
+                ('bearing', ctypes.c_double * 4), ('mass_current', ctypes.c_void_p)]
 
 
 class AtlasLegsSupport(ctypes.Structure):

@@ -180,6 +180,12 @@ class CompiledEstimate:
         kernel.polygon_contact[:] = contact
         self._polygon_reference = (positions, rotations)
 
+    @property
+    def mass_current_address(self) -> int:
+        """The address of the call's flag saying its scratch data's mass matrix is the last
+        estimate's state's (a stepped estimate copies the step's): Walk's legs read it."""
+        return ctypes.addressof(self._kernel) + AtlasEstimator.mass_current.offset
+
     def set_ground(self, height_m: float) -> None:
         """The pendulum's ground (m, world z): omega is the CoM's height over it."""
         self._kernel.ground_m = height_m

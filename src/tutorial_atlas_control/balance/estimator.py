@@ -166,10 +166,12 @@ class BalanceState:
     #: whole-body tick reads in place: set in the instance by the compiled estimate only, not
     #: a field (so a state from __init__ or dataclasses.replace has None: its fields copied).
     row_address: ClassVar[int | None] = None
-    #: The compiled estimate's model and scratch data (their addresses), nv and each joint's
-    #: dof (tutorial order): the mass matrix of this state, which Walk's compiled legs read
-    #: (mj_crb) before the next estimate; set as row_address is (None: not compiled).
-    mass_matrix_source: ClassVar[tuple[int, int, int, np.ndarray] | None] = None
+    #: The compiled estimate's model and scratch data (their addresses), nv, each joint's
+    #: dof (tutorial order) and the address of its flag saying the scratch's mass matrix is
+    #: the state's already (copied from the step; else mj_crb): the mass matrix of this
+    #: state, which Walk's compiled legs read before the next estimate; set as row_address
+    #: is (None: not compiled).
+    mass_matrix_source: ClassVar[tuple[int, int, int, np.ndarray, int] | None] = None
 
     @_Cached
     def sole_contacts(self) -> tuple[SoleContacts, SoleContacts]:
@@ -223,8 +225,9 @@ def _sized_as(model: mujoco.MjModel, data: mujoco.MjData) -> bool:
     """Whether `data` is of a model sized as `model` in every array the compiled estimate
     copies from a simulator's MjData (atlas_estimate_stepped)."""
     sizes = (data.qpos.shape[0], data.qvel.shape[0], data.xpos.shape[0], data.xanchor.shape[0],
-             data.geom_xpos.shape[0], data.site_xpos.shape[0])
-    return sizes == (model.nq, model.nv, model.nbody, model.njnt, model.ngeom, model.nsite)
+             data.geom_xpos.shape[0], data.site_xpos.shape[0], data.M.shape[0])
+    return sizes == (model.nq, model.nv, model.nbody, model.njnt, model.ngeom, model.nsite,
+                     model.nC)
 
 
 def _bodies_collide_as_their_geoms(model: mujoco.MjModel) -> None:
@@ -300,8 +303,6 @@ class BalanceEstimator:
         self._inertia_index: dict[tuple[int, int], tuple[slice, slice] | tuple] = {}
         self._sized_data: mujoco.MjData | None = None  # the last found _sized_as the copy
         self._sized_address = 0  # its address, for the compiled estimate
-        self._mass_matrix_source = (self.model._address, self.scratch._address,
-                                    int(self.model.nv), np.asarray(self._dof_adr, dtype=np.intp))
         self._ground_m = 0.0
         library = native.chosen_library(ESTIMATOR_ENV, compiled)
         self._kernel = None if library is None else CompiledEstimate(
@@ -311,6 +312,10 @@ class BalanceEstimator:
                 self._pelvis, self._free_dof, np.asarray(self._dof_adr, dtype=np.intp),
                 lipm.GRAVITY_M_S2, MIN_COM_HEIGHT_M, self._corner_offsets,
                 POLYGON_TOLERANCE_M, self._rotation_tolerance))
+        self._mass_matrix_source = (
+            self.model._address, self.scratch._address, int(self.model.nv),
+            np.asarray(self._dof_adr, dtype=np.intp),
+            0 if self._kernel is None else self._kernel.mass_current_address)
 
     @property
     def compiled(self) -> bool:

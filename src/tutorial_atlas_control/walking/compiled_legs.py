@@ -96,11 +96,12 @@ class CompiledLegs:
         """The estimator's model and scratch data the state came from (its mass matrix)."""
         source = state.mass_matrix_source
         assert source is not None  # a compiled estimate's state only
-        model, data, nv, dof_adr = source
+        model, data, nv, dof_adr, mass_current = source
         if self._mass_matrix.size != nv * nv:
             self._mass_matrix = np.zeros(nv * nv)
         call = self._call
         call.model, call.data = model, data
+        call.mass_current = mass_current or None  # the step's mass matrix copied: no mj_crb
         call.mass_matrix = address(self._mass_matrix, np.float64)
         self._dof_adr = dof_adr
         for foot, start in enumerate(self._leg_starts):
