@@ -123,3 +123,18 @@ long atlas_step_unsound(const AtlasLawStep *s) {
   }
   return atlas_state_is_finite(s) ? 0 : s->warning_count + 1;
 }
+
+/* A behaviour's torque within the effort limits (JointLaw.apply_behaviour with no command
+ * blended): f_out, the behaviour's torque copied in, clamped in place as numpy's maximum
+ * with -limit then minimum with limit, and written to torque and ctrl. One call for the
+ * two ufuncs and two copies a step. */
+void atlas_behaviour_torque(const AtlasLawStep *s) {
+  double *f_out = (double *)s->f_out;
+  for (long j = 0; j < s->n; ++j) {
+    const double limit = s->effort_limit[j];
+    const double torque = np_minimum(np_maximum(f_out[j], -limit), limit);
+    f_out[j] = torque;
+    s->torque[j] = torque;
+    if (s->ctrl != NULL) s->ctrl[j] = torque;
+  }
+}

@@ -247,6 +247,8 @@ def _declare(library: ctypes.CDLL) -> None:
     library.atlas_state_is_finite.restype = ctypes.c_int
     library.atlas_step_unsound.argtypes = [ctypes.POINTER(AtlasLawStep)]
     library.atlas_step_unsound.restype = ctypes.c_long
+    library.atlas_behaviour_torque.argtypes = [ctypes.POINTER(AtlasLawStep)]
+    library.atlas_behaviour_torque.restype = None
     library.atlas_copy_all.argtypes = [ctypes.POINTER(AtlasCopy), ctypes.c_long]
     library.atlas_copy_all.restype = None
     estimator = ctypes.POINTER(AtlasEstimator)

@@ -55,6 +55,9 @@ class JointLaw:
                                       self._ctrl, self._hold_torque_nm)
         #: The effort limits' negatives (N m): a behaviour's torque's lower bound.
         self._lowest_nm = -self.joints.effort_limit
+        #: A lone behaviour's torque, copied into _hold_torque_nm, limited into it, torque_nm
+        #: and ctrl by one C call (None: numpy's).
+        self._limit_behaviour = None if self._blend is None else self._blend.behaviour_call()
         #: The velocity gain of the command in force, as the joints' damping (DRCSim 2.7).
         self.velocity_damping = VelocityDamping(atlas.model.dof_damping, atlas.dof_adr,
                                                 atlas.effort_limit_nm, atlas.velocity_limit_rad_s)
@@ -102,6 +105,10 @@ class JointLaw:
         `blended`'s velocity gain into the joints' damping."""
         self.velocity_damping.apply(blended)
         f_out = self._hold_torque_nm
+        if blended is None and self._limit_behaviour is not None:  # every walk's step
+            f_out[:] = f_out_nm
+            self._limit_behaviour()
+            return
         limit = self.joints.effort_limit
         # np.clip's own arithmetic (max, then min) without its Python wrappers: every step
         np.maximum(f_out_nm, self._lowest_nm, out=f_out)

@@ -125,6 +125,14 @@ class CompiledLaw:
         self._keep_unsound = numbers
         return functools.partial(self._library.atlas_step_unsound, self._pointer)
 
+    def behaviour_call(self) -> Callable[[], None]:
+        """A behaviour's torque, copied into this kernel's f_out, clamped there to the effort
+        limits (numpy's maximum with their negatives, then minimum) and written to its torque
+        and ctrl, in one call (atlas_behaviour_torque); the kernel must have an f_out."""
+        if not self._step.f_out:
+            raise ValueError('behaviour_call: this kernel has no f_out')
+        return functools.partial(self._library.atlas_behaviour_torque, self._pointer)
+
     def _bind(self, command: JointCommandArrays) -> None:
         """Point the kernel at another command's arrays (a new command arrived)."""
         count = self._step.n
