@@ -117,7 +117,7 @@ _new_object = object.__new__
 def _output(torque_nm: np.ndarray, desired_cop: np.ndarray, capture_point_ref: np.ndarray,
             phase: int, swing_foot: int | None) -> WalkOutput:
     """WalkOutput(...) without the frozen dataclass's __init__ (an object.__setattr__ a
-    field): every swinging tick's."""
+    field): every tick's."""
     output = _new_object(WalkOutput)
     output.__dict__.update(torque_nm=torque_nm, desired_cop=desired_cop,
                            capture_point_ref=capture_point_ref, phase=phase,
@@ -377,7 +377,7 @@ class WalkController:
         step, swing, plan, planned = self.step, self.swing, self._plan, self._planned_step
         assert step is not None and swing is not None and plan is not None \
             and planned is not None and self._lift_off_s is not None  # swinging
-        elapsed = self.phases.elapsed_s(time_s)
+        elapsed = time_s - self.phases.started_s  # phases.elapsed_s
         if self.legs.load_swing_tick(state, joint_positions, joint_velocities, MOVED_IN_CALL,
                                      (step.foot_index, swing, elapsed - self._lift_off_s)) is None:
             return None
@@ -388,7 +388,7 @@ class WalkController:
             self.swing = replace(swing, end=np.array([moved[0], moved[1], planned.z_m]))
             self.queue.adjust(self.step)
         self._last_cop = cop
-        return _output(torque, cop, xi_ref, self.phases.status, step.foot_index)
+        return _output(torque, cop, xi_ref, STEPPING, step.foot_index)  # the swing's status
 
     def tick_torque(self, state: BalanceState, joint_positions: np.ndarray,
                     joint_velocities: np.ndarray, time_s: float) -> WalkOutput:
@@ -403,17 +403,17 @@ class WalkController:
             if output is not None:
                 return output
         xi_ref, cop_ref = self._capture_reference(state, time_s)
-        if self.phase == STEPPING and self.gains.adjust_steps:
+        if swinging and self.gains.adjust_steps:  # self.phase == STEPPING: the swing's status
             self._adjust(state, xi_ref, cop_ref, time_s)
         cop = dcm_feedback_cop(state.capture_point, xi_ref, self.gains.dcm_gain, cop_ref)
-        transferring = self.transferring
+        transferring = swinging and self._lift_off_s is None  # self.transferring
         feet = self.queue.feet
         if transferring:  # both feet carry, the landed one pressed onto its surface
             cop = self._transfer_cop(cop, time_s)
             feet = list(feet)
             stance = self._stance_pose()
             feet[stance.foot_index] = stance
-        step = self.step if self.phase == STEPPING and not transferring else None
+        step = self.step if swinging and not transferring else None
         swing_foot = None if step is None else step.foot_index
         legs = self.legs
         if step is not None:
@@ -426,4 +426,4 @@ class WalkController:
             torque, cop, _ = legs.support_torque(state, joint_positions, joint_velocities,
                                                  time_s, cop, feet)
         self._last_cop = cop
-        return WalkOutput(torque, cop, xi_ref, self.phase, swing_foot)
+        return _output(torque, cop, xi_ref, self.phases.status, swing_foot)

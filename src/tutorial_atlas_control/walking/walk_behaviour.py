@@ -113,8 +113,8 @@ class WalkBehaviour:
         walk = self.walk
         if walk is None:
             raise WalkingError('WalkBehaviour.torque before start()')
-        stand, atlas = self.stand, self.stand.atlas
-        ground = walk.surfaces.support_at(float(data.time)) + self.pendulum_offset_m
+        stand, atlas, time_s = self.stand, self.stand.atlas, float(data.time)
+        ground = walk.surfaces.support_at(time_s) + self.pendulum_offset_m
         if ground != stand.estimator.ground_m:  # on level ground never: no C field written
             stand.estimator.ground_m = ground
         state = stand.estimator.estimate_stepped(data)
@@ -123,7 +123,7 @@ class WalkBehaviour:
         if vectors is None or vectors[0] is not data:
             vectors = self._vectors = (data, data.qpos, data.qvel)
         return walk.tick_torque(state, vectors[1][atlas.qpos_adr], vectors[2][atlas.dof_adr],
-                                float(data.time)).torque_nm
+                                time_s).torque_nm
 
     def status(self, time_s: float) -> WalkStatus:
         """walk_feedback's values now."""
