@@ -98,11 +98,33 @@ class _Transition:
         return _as_vector(self.start), _as_vector(self.goal)
 
     @functools.cached_property
+    def capture_points(self) -> tuple[float, float, float, float]:
+        """The start's and the goal's capture points (x, y each) as floats."""
+        return (*self.start.capture_point.tolist(), *self.goal.capture_point.tolist())
+
+    @functools.cached_property
     def yaws(self) -> tuple[float, float]:
         """(the start's yaw, the shorter turn to the goal's) (rad)."""
         start_yaw = yaw_of(self.start.pelvis_rotation)
         turn = (yaw_of(self.goal.pelvis_rotation) - start_yaw + np.pi) % (2 * np.pi) - np.pi
         return start_yaw, turn
+
+
+_new_object = object.__new__
+
+
+def _reference_without_rates(capture_point: np.ndarray, com_height_m: float,
+                             pelvis_rotation: np.ndarray,
+                             posture_rad: np.ndarray) -> StandReference:
+    """StandReference(capture_point, com_height_m, pelvis_rotation, posture_rad) without the
+    frozen dataclass's __init__ (an object.__setattr__ a field, its defaults' factories
+    called through it): every tick of a take-over."""
+    reference = _new_object(StandReference)
+    reference.__dict__.update(
+        capture_point=capture_point, com_height_m=com_height_m,
+        pelvis_rotation=pelvis_rotation, posture_rad=posture_rad, com_height_rate_m_s=0.0,
+        pelvis_angular_velocity=np.zeros(3), posture_rate_rad_s=np.zeros(len(posture_rad)))
+    return reference
 
 
 class StandBehaviour:
@@ -261,7 +283,7 @@ class StandBehaviour:
         s = smoothstep(fraction)
         start, goal = transition.vectors
         vector = (1.0 - s) * start + s * goal
-        per_s = goal - start  # d(vector)/ds
+        per_s = None  # d(vector)/ds: goal - start, made where it is read
         self._table_height_m = None
         if transition.table is not None:
             # Along the squat table rather than straight across it, so that the posture,
@@ -270,17 +292,20 @@ class StandBehaviour:
             height = (1.0 - s) * low + s * high
             row, slope = self.squats.row(height)
             vector += row - ((1.0 - s) * low_row + s * high_row)
+            per_s = goal - start
             per_s += slope * (high - low) - (high_row - low_row)
             self._table_height_m = height
         start_yaw, turn = transition.yaws
         yaw, pitch = start_yaw + s * turn, float(vector[28])
-        capture_point = ((1.0 - s) * transition.start.capture_point
-                         + s * transition.goal.capture_point)
-        if not transition.with_rates:
-            return StandReference(capture_point, float(vector[29]), pelvis_frame(yaw, pitch),
-                                  vector[:28])
+        # the capture points' elementwise blend in plain floats (the same bits)
+        start_x, start_y, goal_x, goal_y = transition.capture_points
+        capture_point = np.array([(1.0 - s) * start_x + s * goal_x,
+                                  (1.0 - s) * start_y + s * goal_y])
+        if not transition.with_rates:  # start()'s, every tick of its take-over
+            return _reference_without_rates(capture_point, float(vector[29]),
+                                            pelvis_frame(yaw, pitch), vector[:28])
         s_rate = smoothstep_rate(fraction, duration)  # ds/dt
-        rate = per_s * s_rate
+        rate = (goal - start if per_s is None else per_s) * s_rate
         return StandReference(
             capture_point, float(vector[29]), pelvis_frame(yaw, pitch), vector[:28],
             com_height_rate_m_s=float(rate[29]),
