@@ -107,6 +107,16 @@ def _apply_torque(sim: AtlasSimulator, torque_nm: np.ndarray | None
     return None
 
 
+def _playback_step(sim: AtlasSimulator) -> None:
+    """AtlasSimulator.step() during kinematic playback: physics off, no torque, time
+    advances."""
+    sim.vrc.playback_step(sim.sim_time_ns)
+    sim.law.set_torque(0.0)
+    sim.state_time_ns = sim.sim_time_ns
+    sim.sim_time_ns += sim.step_ns
+    sim.data.time = sim.sim_time_ns / NS_PER_S
+
+
 class AtlasSimulator:
     """One Atlas in MuJoCo, driven by DRCSim's per-joint controller law. Not thread-safe:
     the ROS node calls every method under its own lock."""
@@ -327,33 +337,22 @@ class AtlasSimulator:
         vrc = self.vrc
         if vrc.active:
             if vrc.playback is not None:
-                self._playback_step()
+                _playback_step(self)
                 return
             vrc.warp_step(self.dt_s)
+        behaviour = self.behaviours.acting
+        if vrc.active or behaviour is None or torque_nm is not None or self.mud is not None \
+                or not self.shares_passes or self.commands.blend_command is not None:
             step_with_body_forces(self.model, self.data, vrc.xfrc if vrc.active else None,
-                                  self.mud,
-                                  _apply_torque(self, torque_nm))
-        elif (behaviour := self.behaviours.acting) is not None and torque_nm is None \
-                and self.mud is None and self.shares_passes \
-                and self.commands.blend_command is None:  # a behaviour alone: every walk's
+                                  self.mud, _apply_torque(self, torque_nm))
+        else:  # a behaviour acting alone (every offline walk's step): one call
             step_behaviour(self.model, self.data, self.law, behaviour)
-        else:
-            step_with_body_forces(self.model, self.data, None, self.mud,
-                                  _apply_torque(self, torque_nm))
         # mj_step integrates last: joint positions/velocities are at the new time, while body
         # poses and sensor readings were computed before integrating, at the step's start.
         self.state_time_ns = self.sim_time_ns
         self.sim_time_ns += self.step_ns
         if self._unsound():
             self._check_divergence(self.sim_time_ns)
-
-    def _playback_step(self) -> None:
-        """step() during kinematic playback: physics off, no torque, time advances."""
-        self.vrc.playback_step(self.sim_time_ns)
-        self.law.set_torque(0.0)
-        self.state_time_ns = self.sim_time_ns
-        self.sim_time_ns += self.step_ns
-        self.data.time = self.sim_time_ns / NS_PER_S
 
     def next_law_torque(self) -> np.ndarray:
         """The torque (N m) the law would apply at the next step; the law's memory is kept."""

@@ -133,6 +133,15 @@ def _feet_middle(state: BalanceState) -> np.ndarray:
     return np.array([(left_x + right_x) / 2.0, (left_y + right_y) / 2.0])
 
 
+def _sway_capture_point(sway_xy: tuple[float, float, float, float], omega: float,
+                        t_s: float) -> np.ndarray:
+    """capture_point_after(start, cop, omega, t_s) for the sway's start and pressure centre
+    (`sway_xy`: x, y each), its elementwise arithmetic in plain floats (the same bits)."""
+    growth = math.exp(omega * t_s)
+    from_x, from_y, cop_x, cop_y = sway_xy
+    return np.array([cop_x + (from_x - cop_x) * growth, cop_y + (from_y - cop_y) * growth])
+
+
 def _phase_over(phase: Phase, step: Footstep | None, state: BalanceState,
                 at_rest_m: float) -> bool:
     """What ends the phase under way once its time allows: nothing for the sway, the swing
@@ -238,9 +247,8 @@ class WalkController:
                   else state.sole_centres[:, :2].mean(axis=0))
         self._sway_cop = cop_reaching(state.capture_point, target, state.omega,
                                      self.gains.sway_s)
-        self._sway_from = state.capture_point.copy()
         #: The sway's start and pressure centre as floats (x, y each): every sway tick's.
-        self._sway_xy = (*self._sway_from.tolist(), *self._sway_cop.tolist())
+        self._sway_xy = (*state.capture_point.tolist(), *self._sway_cop.tolist())
 
     def _begin_step(self, phase: Phase, state: BalanceState, time_s: float) -> None:
         preview = self.queue.preview()
@@ -330,11 +338,8 @@ class WalkController:
         """(xi_ref, p_ref) now."""
         elapsed = self.phases.elapsed_s(time_s)
         if self.phases.phase is _SWAY:
-            # capture_point_after's elementwise arithmetic in plain floats (the same bits)
-            growth = math.exp(state.omega * min(elapsed, self.gains.sway_s))
-            from_x, from_y, cop_x, cop_y = self._sway_xy
-            return (np.array([cop_x + (from_x - cop_x) * growth,
-                              cop_y + (from_y - cop_y) * growth]), self._sway_cop)
+            return (_sway_capture_point(self._sway_xy, state.omega,
+                                        min(elapsed, self.gains.sway_s)), self._sway_cop)
         if self.phase == STEPPING and self._plan is not None:
             return self._plan.reference(0, elapsed)
         middle = _feet_middle(state)

@@ -23,7 +23,8 @@ def _numpy_reference(walk: WalkController, state: BalanceState,
     """_capture_reference as it was computed on arrays."""
     elapsed = walk.phases.elapsed_s(time_s)
     if walk.phases.phase is walk_module.WALK_PHASES[0]:
-        return (capture_point_after(walk._sway_from, walk._sway_cop, state.omega,
+        start = np.array(walk._sway_xy[0:2])  # the capture point as the sway began
+        return (capture_point_after(start, walk._sway_cop, state.omega,
                                     min(elapsed, walk.gains.sway_s)), walk._sway_cop)
     if walk._plan is not None and walk.phases.phase is walk_module.WALK_PHASES[1]:
         return walk._plan.reference(0, elapsed)
