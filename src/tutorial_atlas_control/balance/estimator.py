@@ -129,10 +129,14 @@ class _Cached:
 
 def _contacts_of_rows(rows: np.ndarray) -> SoleContacts:
     """One sole's contacts from the compiled estimate's rows (point, normal into the sole,
-    distance, surface geom)."""
+    distance, surface geom), made without the frozen dataclass's __init__ (an
+    object.__setattr__ a field): a walking tick's stance sole asks for them (sole_support)."""
     if len(rows) == 0:
         return _no_contacts()
-    return SoleContacts(rows[:, 0:3], rows[:, 3:6], rows[:, 6], rows[:, 7].astype(np.int64))
+    contacts = _new_object(SoleContacts)
+    contacts.__dict__.update(points=rows[:, 0:3], normals=rows[:, 3:6], distances_m=rows[:, 6],
+                             surface_geoms=rows[:, 7].astype(np.int64))
+    return contacts
 
 
 @dataclass(frozen=True)
