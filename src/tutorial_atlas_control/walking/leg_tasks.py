@@ -304,12 +304,10 @@ class LegTasks:
         legs = self._legs_kernel
         if legs is None or state.row_address is None:
             return None
-        stance = 1 - swing[0]
-        near = sole_support.stance_near_m(state, stance, self.gains.near_cop_m)
-        span = sole_support.bearing_span(state, stance) if near > 0.0 else sole_support.NO_SPAN
+        near = sole_support.stance_rule(state, 1 - swing[0], self.gains.near_cop_m)
         legs.load_swing_tick(state, self._swing_contacts[swing[0]],
                              (joint_positions, joint_velocities), self._joint_gains,
-                             self.reference, moved, swing, (near, span))
+                             self.reference, moved, swing, near)
         return legs
 
     def swing_tick(self, state: BalanceState, joint_positions: np.ndarray,

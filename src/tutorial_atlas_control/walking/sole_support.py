@@ -29,10 +29,10 @@ from dataclasses import replace
 import numpy as np
 
 from tutorial_atlas_control.balance import BalanceState, ContactConstraint
-from tutorial_atlas_control.balance.estimator import SoleContacts
 
 __all__ = ['NO_SPAN', 'ONE_SURFACE_COS', 'PRESSED_M', 'SHIFT_M', 'Span', 'UPRIGHT_COS',
-           'across_facets', 'bearing_span', 'near_asked', 'stance_contacts', 'stance_near_m']
+           'across_facets', 'bearing_span', 'near_asked', 'stance_contacts', 'stance_near_m',
+           'stance_rule']
 
 #: A contact within this of its surface (m) bears on it: the estimator's reach 1 cm out, and
 #: a sole on a ramp beside its bend (steps are planned clear of bends) has the other plane's
@@ -56,32 +56,51 @@ Span = tuple[float, float, float, float]
 NO_SPAN: Span = (np.inf, -np.inf, np.inf, -np.inf)
 
 
-def _bearing(contacts: SoleContacts) -> np.ndarray:
-    """Which of a sole's contacts bear: within PRESSED_M of their surface, facing up."""
-    return (contacts.distances_m <= PRESSED_M) & (contacts.normals[:, 2] >= UPRIGHT_COS)
+def _bearing(state: BalanceState, foot: int) -> tuple[list[list[float]], list[list[float]]]:
+    """The points and normals (world, as lists: a sole has a few, and a Python loop over them
+    costs less than numpy's calls, every swinging tick) of the sole `foot`'s bearing
+    contacts: within PRESSED_M of their surface, facing within acos(UPRIGHT_COS) of up."""
+    contacts = state.sole_contacts[foot]
+    if not len(contacts.distances_m):
+        return [], []
+    points, normals = contacts.points.tolist(), contacts.normals.tolist()
+    kept = [k for k, (gap, normal) in enumerate(zip(contacts.distances_m.tolist(), normals))
+            if gap <= PRESSED_M and normal[2] >= UPRIGHT_COS]
+    return [points[k] for k in kept], [normals[k] for k in kept]
+
+
+def _apart(normals: list[list[float]]) -> bool:
+    """Whether some of `normals` lie more than acos(ONE_SURFACE_COS) from the first."""
+    if len(normals) < 2:
+        return False
+    x, y, z = normals[0]
+    return any(x * a + y * b + z * c < ONE_SURFACE_COS for a, b, c in normals[1:])
 
 
 def across_facets(state: BalanceState, foot: int) -> bool:
     """Whether the sole `foot` bears on more than one plane (the normals of its bearing
     contacts apart)."""
-    contacts = state.sole_contacts[foot]
-    normals = contacts.normals[_bearing(contacts)]
-    if len(normals) < 2:
-        return False
-    return float(np.min(normals @ normals[0])) < ONE_SURFACE_COS
+    return _apart(_bearing(state, foot)[1])
+
+
+def _span_of(state: BalanceState, foot: int, points: list[list[float]]) -> Span:
+    """The box (sole frame, m) of `points` (world) on the sole `foot`; NO_SPAN for none."""
+    if not points:
+        return NO_SPAN
+    (r00, r01, _), (r10, r11, _), (r20, r21, _) = state.sole_rotations[foot].tolist()
+    cx, cy, cz = state.sole_centres[foot].tolist()
+    along, across = [], []
+    for x, y, z in points:
+        dx, dy, dz = x - cx, y - cy, z - cz
+        along.append(dx * r00 + dy * r10 + dz * r20)
+        across.append(dx * r01 + dy * r11 + dz * r21)
+    return min(along), max(along), min(across), max(across)
 
 
 def bearing_span(state: BalanceState, foot: int) -> Span:
     """The box (sole frame, m) of the bearing contacts of the sole `foot` (within PRESSED_M
     of their surface, facing up): where it bears; NO_SPAN when none does."""
-    contacts = state.sole_contacts[foot]
-    points = contacts.points[_bearing(contacts)]
-    if not len(points):
-        return NO_SPAN
-    rotation = state.sole_rotations[foot]
-    offsets = points - state.sole_centres[foot]
-    along, across = offsets @ rotation[:, 0], offsets @ rotation[:, 1]
-    return (float(along.min()), float(along.max()), float(across.min()), float(across.max()))
+    return _span_of(state, foot, _bearing(state, foot)[0])
 
 
 def near_asked(state: BalanceState, foot: int, contact: ContactConstraint,
@@ -111,6 +130,13 @@ def stance_near_m(state: BalanceState, stance: int, near_cop_m: float | None) ->
     if near_cop_m is None or not across_facets(state, stance):
         return 0.0
     return near_cop_m
+
+
+def stance_rule(state: BalanceState, stance: int, near_cop_m: float | None
+                ) -> tuple[float, Span]:
+    """stance_near_m and, across facets, bearing_span: what the compiled tick is given."""
+    near = stance_near_m(state, stance, near_cop_m)
+    return (near, bearing_span(state, stance)) if near > 0.0 else (0.0, NO_SPAN)
 
 
 def stance_contacts(state: BalanceState, stance: int,
