@@ -24,6 +24,7 @@ import threading
 from collections.abc import Callable
 
 import mujoco
+import numpy as np
 
 from tutorial_atlas_control.command import JointCommandArrays
 from tutorial_atlas_control.sim.behaviour import Behaviour
@@ -58,14 +59,18 @@ def behaviour_between(law: JointLaw, behaviour: Behaviour, data: mujoco.MjData,
     law.velocity_damping.apply(blended)
 
     def torque_between() -> None:
-        _stepping.data = data
-        try:
-            f_out_nm = behaviour.torque(data)
-        finally:
-            _stepping.data = None
-        law.apply_behaviour(f_out_nm, blended)
+        law.apply_behaviour(_torque_of(behaviour, data), blended)
 
     return torque_between
+
+
+def _torque_of(behaviour: Behaviour, data: mujoco.MjData) -> np.ndarray:
+    """`behaviour`'s torque at `data`, its passes marked current while it reads them."""
+    _stepping.data = data
+    try:
+        return behaviour.torque(data)
+    finally:
+        _stepping.data = None
 
 
 def step_behaviour(model: mujoco.MjModel, data: mujoco.MjData, law: JointLaw,
@@ -76,10 +81,5 @@ def step_behaviour(model: mujoco.MjModel, data: mujoco.MjData, law: JointLaw,
     an offline walk)."""
     law.velocity_damping.apply(None)
     mujoco.mj_step1(model, data)
-    _stepping.data = data
-    try:
-        f_out_nm = behaviour.torque(data)
-    finally:
-        _stepping.data = None
-    law.apply_behaviour(f_out_nm, None)
+    law.apply_behaviour(_torque_of(behaviour, data), None)
     mujoco.mj_step2(model, data)
