@@ -120,8 +120,7 @@ class CompiledLegs:
         positions and velocities, their gains, the legs' reference (`moved`: its heading,
         height and rate), `swing` (the foot, its path, the time into it) and `near` (how near
         and the stance sole's bearing box: > 0 across facets, its wrench's pressure centre
-        kept within that of the kept one or of the box: sole_support.stance_near_m and
-        bearing_span)."""
+        kept within that of the kept one or of the box: sole_support.stance_rule)."""
         source = state.mass_matrix_source
         if source is not self._source or source is None:  # the estimator's one tuple: once
             if source is None or self._scratch != source[0:2]:

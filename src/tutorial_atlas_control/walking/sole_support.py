@@ -31,8 +31,7 @@ import numpy as np
 from tutorial_atlas_control.balance import BalanceState, ContactConstraint
 
 __all__ = ['NO_SPAN', 'ONE_SURFACE_COS', 'PRESSED_M', 'SHIFT_M', 'Span', 'UPRIGHT_COS',
-           'across_facets', 'bearing_span', 'near_asked', 'stance_contacts', 'stance_near_m',
-           'stance_rule']
+           'across_facets', 'bearing_span', 'near_asked', 'stance_contacts', 'stance_rule']
 
 #: A contact within this of its surface (m) bears on it: the estimator's reach 1 cm out, and
 #: a sole on a ramp beside its bend (steps are planned clear of bends) has the other plane's
@@ -122,21 +121,18 @@ def near_asked(state: BalanceState, foot: int, contact: ContactConstraint,
                    centre_m=(0.5 * (low[0] + high[0]), 0.5 * (low[1] + high[1])))
 
 
-def stance_near_m(state: BalanceState, stance: int, near_cop_m: float | None) -> float:
-    """How near (m) the lone stance sole `stance`'s wrench's pressure centre stays to the one
-    asked or its bearing points: `near_cop_m` (LegGains') across facets; 0.0, the whole sole,
-    on one plane or with the rule off (None). The one decision both the compiled tick and
-    the Python read (with bearing_span's box)."""
-    if near_cop_m is None or not across_facets(state, stance):
-        return 0.0
-    return near_cop_m
-
-
 def stance_rule(state: BalanceState, stance: int, near_cop_m: float | None
                 ) -> tuple[float, Span]:
-    """stance_near_m and, across facets, bearing_span: what the compiled tick is given."""
-    near = stance_near_m(state, stance, near_cop_m)
-    return (near, bearing_span(state, stance)) if near > 0.0 else (0.0, NO_SPAN)
+    """How near (m) the lone stance sole `stance`'s wrench's pressure centre stays to the one
+    asked or its bearing points, and their box: (`near_cop_m`, bearing_span's box) across
+    facets; (0.0, NO_SPAN), the whole sole, on one plane or with the rule off (None). The
+    one decision both the compiled tick and the Python read; the contacts read once."""
+    if near_cop_m is None:
+        return 0.0, NO_SPAN
+    points, normals = _bearing(state, stance)
+    if not _apart(normals):
+        return 0.0, NO_SPAN
+    return near_cop_m, _span_of(state, stance, points)
 
 
 def stance_contacts(state: BalanceState, stance: int,
@@ -144,12 +140,11 @@ def stance_contacts(state: BalanceState, stance: int,
                     near_cop_m: float | None
                     ) -> tuple[ContactConstraint, ContactConstraint] | None:
     """`contacts` (the soles' while the other foot swings) with the stance sole's kept
-    within stance_near_m of `cop` or its bearing points across facets; None (`contacts` as
-    they are) else."""
-    near = stance_near_m(state, stance, near_cop_m)
+    within stance_rule's distance of `cop` or its bearing points across facets; None
+    (`contacts` as they are) else."""
+    near, span = stance_rule(state, stance, near_cop_m)
     if near <= 0.0:
         return None
     kept = list(contacts)
-    kept[stance] = near_asked(state, stance, kept[stance], cop, near,
-                              bearing_span(state, stance))
+    kept[stance] = near_asked(state, stance, kept[stance], cop, near, span)
     return kept[0], kept[1]

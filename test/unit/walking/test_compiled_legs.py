@@ -34,8 +34,7 @@ TOLERANCE = 1e-9
 EVERY_TICKS = 40
 SWING_TICK = LegTasks.swing_tick
 TORQUE = LegTasks.torque
-STANCE_NEAR = sole_support.stance_near_m
-BEARING_SPAN = sole_support.bearing_span
+STANCE_RULE = sole_support.stance_rule
 #: Across facets (faked): the stance sole bears on its heel's rear 3 cm, across its width.
 HEEL_SPAN = (-0.13, -0.10, -0.06, 0.06)
 Tick = tuple[np.ndarray, np.ndarray, tuple[bool, bool]]
@@ -109,11 +108,9 @@ def test_the_one_call_agrees_with_the_pieces_and_python_through_a_walk(
     moved_by_rule: list[float] = []  # how much the rule changed those ticks' torques
     facets = [False]
 
-    def stance_near(state: BalanceState, stance: int, near_cop_m: float | None) -> float:
-        return SHIFT_M if facets[0] else STANCE_NEAR(state, stance, near_cop_m)
-
-    def bearing_span(state: BalanceState, foot: int) -> sole_support.Span:
-        return HEEL_SPAN if facets[0] else BEARING_SPAN(state, foot)
+    def stance_rule(state: BalanceState, stance: int, near_cop_m: float | None
+                    ) -> tuple[float, sole_support.Span]:
+        return (SHIFT_M, HEEL_SPAN) if facets[0] else STANCE_RULE(state, stance, near_cop_m)
 
     def both(self: LegTasks, state: BalanceState, positions: np.ndarray,
              velocities: np.ndarray, time_s: float, cop: np.ndarray,
@@ -166,8 +163,7 @@ def test_the_one_call_agrees_with_the_pieces_and_python_through_a_walk(
 
     supported: list[float] = []
     monkeypatch.setattr(LegTasks, 'swing_tick', both)
-    monkeypatch.setattr(sole_support, 'stance_near_m', stance_near)
-    monkeypatch.setattr(sole_support, 'bearing_span', bearing_span)
+    monkeypatch.setattr(sole_support, 'stance_rule', stance_rule)
     monkeypatch.setattr(LegTasks, 'torque', both_feet)
     monkeypatch.setattr(LegTasks, 'support_torque', support_by_pieces)  # its own test's
     trial = walk_trial(straight_steps(2, 0.25), SETTLE_S + 0.6 + 2 * 0.63 + 0.2)
