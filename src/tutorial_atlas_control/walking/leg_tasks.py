@@ -53,7 +53,7 @@ from tutorial_atlas_control.walking.compiled_swing import CompiledSwing
 from tutorial_atlas_control.walking.footsteps import Footstep, wrap_angle
 from tutorial_atlas_control.walking.swing import SwingPath, quintic, sole_frame, surface_tilt
 
-__all__ = ['LEGS_ENV', 'LEG_JOINTS', 'SWING_ENV', 'LegGains', 'LegTasks', 'foot_pose']
+__all__ = ['LEGS_ENV', 'LEG_JOINTS', 'SWING_ENV', 'LegGains', 'LegTasks', 'foot_pose', 'sole_flat']
 
 #: Set to `python` for the swing servo in Python even where the compiled library is built.
 SWING_ENV = 'TAC_SWING'
@@ -121,6 +121,15 @@ def foot_pose(state: BalanceState, foot: int, step_index: int = 0) -> Footstep:
     centre = state.sole_centres[foot]
     return Footstep(step_index, foot, float(centre[0]), float(centre[1]),
                     yaw_of(state.sole_rotations[foot]), z_m=float(centre[2]))
+
+
+def sole_flat(state: BalanceState, foot: int, pose: Footstep, height_m: float,
+              flat_cos: float) -> bool:
+    """Whether the sole `foot` lies flat on the surface of `pose`: its centre less than
+    `height_m` over it, its normal within acos(`flat_cos`) of the surface's."""
+    sole_normal = state.sole_rotations[foot][:, 2]
+    return (float(state.sole_centres[foot][2]) - pose.z_m < height_m
+            and float(sole_normal @ np.asarray(pose.normal)) > flat_cos)
 
 
 class LegTasks:
@@ -261,9 +270,7 @@ class LegTasks:
 
     def flat_down(self, state: BalanceState, foot: int, pose: Footstep) -> bool:
         """Whether a sole lies flat on the surface of `pose` (not up, not on an edge)."""
-        sole_normal = state.sole_rotations[foot][:, 2]
-        return (float(state.sole_centres[foot][2]) - pose.z_m < self.gains.flat_height_m
-                and float(sole_normal @ np.asarray(pose.normal)) > self.gains.flat_cos)
+        return sole_flat(state, foot, pose, self.gains.flat_height_m, self.gains.flat_cos)
 
     def put_down_torque(self, state: BalanceState, joint_velocities: np.ndarray, foot: int,
                         pose: Footstep) -> np.ndarray:

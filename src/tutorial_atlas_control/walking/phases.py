@@ -21,6 +21,7 @@ MuJoCo.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -78,12 +79,23 @@ class WeightTransfer:
     Without it a landing sole touching by its heel's edge took the whole weight in 4 ms and
     its toes slammed down. The blend is short: the capture point is ahead of the landed
     foot at touchdown, and every millisecond the pressure centre stays back on the other
-    sole moves it further (a 0.1 s blend: 3 cm, and the stance foot rolled)."""
+    sole moves it further (a 0.1 s blend: 3 cm, and the stance foot rolled).
+
+    Flat here is stricter than for a sole put down (LegGains.flat_cos, 2.9 degrees): the
+    landed sole within acos(`level_cos`) of its surface. A sole still rolling onto the
+    ground passes 2.9 degrees on its way: at the VRC course's mud leg's end a left sole
+    whose heel grazed the ground rising ahead (4.6 degrees) counted as flat 17 ms after
+    touchdown, rolling onto its toes; the other foot lifted, the weight came onto the toes,
+    the heel rose to 44 degrees and the robot fell. Within 1 degree the other foot lifts
+    about 24 ms after a touchdown on flat ground rather than 18."""
 
     longest_s: float
     share: float
     blend_s: float
     most_of_step: float = 0.25
+    #: The cosine of how far (1 degree) the landed sole may lie off its surface for the
+    #: other foot to lift before the longest time.
+    level_cos: float = math.cos(math.radians(1.0))
 
     def longest_for(self, step_s: float) -> float:
         """The transfer's longest time in a step of `step_s` (s)."""

@@ -47,7 +47,7 @@ from tutorial_atlas_control.walking.compiled_walk_swing import (
 from tutorial_atlas_control.walking.dcm_plan import DcmPlan
 from tutorial_atlas_control.walking.feet_surfaces import FeetSurfaces
 from tutorial_atlas_control.walking.footsteps import Footstep
-from tutorial_atlas_control.walking.leg_tasks import LegGains, LegTasks, foot_pose
+from tutorial_atlas_control.walking.leg_tasks import LegGains, LegTasks, foot_pose, sole_flat
 from tutorial_atlas_control.walking.phases import (
     WALK_PHASES,
     Phase,
@@ -93,7 +93,7 @@ class WalkGains:
     adjust_tolerance_m: float = 0.001
     #: The weight transfer at each step's start: the pressure centre over in 0.03 s, the
     #: other foot down at most 0.1 s (and a quarter of the step), until the landed sole is
-    #: flat and carries half the weight.
+    #: flat (within 1 degree of its surface) and carries half the weight.
     transfer: WeightTransfer = field(
         default_factory=lambda: WeightTransfer(0.1, 0.5, blend_s=0.03))
     #: The legs' gains and limits (leg_tasks).
@@ -314,9 +314,9 @@ class WalkController:
         step = self.step
         if not self.transferring or step is None:
             return
-        elapsed = self.phases.elapsed_s(time_s)
-        stance = 1 - step.foot_index
-        flat = self.legs.flat_down(state, stance, self._stance_pose())
+        elapsed, stance = self.phases.elapsed_s(time_s), 1 - step.foot_index
+        flat = sole_flat(state, stance, self._stance_pose(), self.gains.legs.flat_height_m,
+                         self.gains.transfer.level_cos)
         share = carried_share(self._last_cop, state.sole_centres[step.foot_index][0:2],
                               state.sole_centres[stance][0:2])
         if self.gains.transfer.lifts(elapsed, step.duration_s, flat, share):
