@@ -20,6 +20,10 @@ asked one alone was too little on the pit's ramps (heightfield too, curved: a so
 is across facets nearly all the way down, bearing at both ends), and every walk from the mud
 start fell on the entry ramp; with the bearing points the ramp's soles keep most of their
 length. The rule acts with LegGains.near_cop_m set (SHIFT_M by default; None: off).
+
+A compiled estimate sums each sole's contacts up as it copies them (BalanceState.sole_bearing:
+the flag and the box, src/atlas_estimator.c), and stance_rule reads that; the functions below
+are the reference, for a state without a row (a Python estimate's, or one made from fields).
 """
 
 from __future__ import annotations
