@@ -126,8 +126,8 @@ def stance_rule(state: BalanceState, stance: int, near_cop_m: float | None
     asked or its bearing points, and their box: (`near_cop_m`, bearing_span's box) across
     facets; (0.0, NO_SPAN), the whole sole, on one plane or with the rule off (None). The
     one decision both the compiled tick and the Python read; from the compiled estimate's
-    summary of the sole's contacts where the state has one (BalanceState.sole_bearing: a
-    float or two a tick on one plane), else from its contacts (the reference)."""
+    summary of the sole's contacts where the state has one (BalanceState.sole_bearing: five
+    floats, about 0.5 us), else from its contacts (the reference)."""
     if near_cop_m is None:
         return 0.0, NO_SPAN
     summed = state.sole_bearing(stance)
