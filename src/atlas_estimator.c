@@ -52,6 +52,11 @@ typedef struct {
   long mass_current;          /* 1: the scratch data's mass matrix (d->M) is the last estimate's
                                * state's, copied from the step (atlas_estimate_stepped); 0: not
                                * computed (atlas_estimate). Walk's legs run mj_crb only then. */
+  /* Which contacts bear and when a sole is across facets (balance/sole.py's PRESSED_M,
+   * UPRIGHT_COS, ONE_SURFACE_COS): each sole's bearing summary (OUT_BEARING). */
+  double pressed_m;
+  double upright_cos;
+  double one_surface_cos;
 } AtlasEstimator;
 
 /* The output, flat doubles (compiled_estimator.py's FIXED_FIELDS and POLYGON_* say the same). */
@@ -60,9 +65,10 @@ enum {
   OUT_PELVIS_ANGULAR_VELOCITY = 18, OUT_SOLE_POSITIONS = 21, OUT_SOLE_CENTRES = 27,
   OUT_SOLE_ROTATIONS = 33, OUT_IN_CONTACT = 51, OUT_OMEGA = 53, OUT_CAPTURE_POINT = 54,
   OUT_SOLE_VELOCITIES = 56, OUT_POLYGON_KEPT = 68, OUT_POLYGON_COUNT = 69, OUT_POLYGON = 70,
-  OUT_FIXED = 86
+  OUT_BEARING = 86, OUT_FIXED = 96
   /* OUT_POLYGON_KEPT: 1 when the cached polygon still holds, else the hull of the touching
-   * soles' corners is at OUT_POLYGON (OUT_POLYGON_COUNT vertices, x y each); then bias (n),
+   * soles' corners is at OUT_POLYGON (OUT_POLYGON_COUNT vertices, x y each); OUT_BEARING:
+   * each sole's bearing summary (bearings()); then bias (n),
    * sole jacobians (2, 6, n), contact counts (2), contact rows (capacity, ROW): point (3),
    * normal into the sole (3), distance, surface geom */
 };
@@ -212,6 +218,48 @@ static int support_polygon(const AtlasEstimator *e, double *out) {
   return vertices;
 }
 
+/* Each sole's bearing summary into out[OUT_BEARING + 5 * foot]: 1.0 when the normals of its
+ * bearing contacts (within pressed_m of their surface, normal z >= upright_cos) are apart
+ * (some more than acos(one_surface_cos) from the first's), else 0.0; then the box of those
+ * contacts in the sole's frame from its bottom-face centre: lowest and highest along, lowest
+ * and highest across (+inf, -inf, +inf, -inf with none). walking/sole_support.py's _bearing,
+ * _apart and _span_of, the same arithmetic in the same order, over every contact of the
+ * list (the rows beyond contact_capacity too). Needs the sole centres and rotations out. */
+static void bearings(const AtlasEstimator *e, double *out) {
+  const mjData *d = e->data;
+  for (int foot = 0; foot < 2; ++foot) {
+    long sole = e->soles[foot];
+    const double *c = out + OUT_SOLE_CENTRES + 3 * foot;
+    const double *r = out + OUT_SOLE_ROTATIONS + 9 * foot;
+    double *summary = out + OUT_BEARING + 5 * foot;
+    double first[3] = {0.0, 0.0, 0.0};
+    int bearing = 0, apart = 0;
+    summary[1] = summary[3] = INFINITY;
+    summary[2] = summary[4] = -INFINITY;
+    for (int k = 0; k < d->ncon; ++k) {
+      const mjContact *con = &d->contact[k];
+      if (con->geom[0] != sole && con->geom[1] != sole) continue;
+      double sign = con->geom[1] == sole ? 1.0 : -1.0;
+      double normal[3] = {sign * con->frame[0], sign * con->frame[1], sign * con->frame[2]};
+      if (!(con->dist <= e->pressed_m && normal[2] >= e->upright_cos)) continue;
+      if (bearing++ == 0) {
+        memcpy(first, normal, sizeof first);
+      } else if (first[0] * normal[0] + first[1] * normal[1] + first[2] * normal[2] <
+                 e->one_surface_cos) {
+        apart = 1;
+      }
+      double dx = con->pos[0] - c[0], dy = con->pos[1] - c[1], dz = con->pos[2] - c[2];
+      double along = dx * r[0] + dy * r[3] + dz * r[6];
+      double across = dx * r[1] + dy * r[4] + dz * r[7];
+      if (along < summary[1]) summary[1] = along;
+      if (along > summary[2]) summary[2] = along;
+      if (across < summary[3]) summary[3] = across;
+      if (across > summary[4]) summary[4] = across;
+    }
+    summary[0] = apart ? 1.0 : 0.0;
+  }
+}
+
 /* The estimate from the scratch data's passes (the state's kinematics, collision, centre of
  * mass and its velocity, subtree velocity) and the bias forces in e->bias, into out;
  * returns the sole contacts' row count. */
@@ -242,6 +290,7 @@ static long estimate_from_passes(const AtlasEstimator *e) {
   long total = atlas_estimator_contacts(e, counts, counts + 2, e->contact_capacity);
   out[OUT_IN_CONTACT] = counts[0] > 0 ? 1.0 : 0.0;
   out[OUT_IN_CONTACT + 1] = counts[1] > 0 ? 1.0 : 0.0;
+  bearings(e, out);
   int kept = polygon_kept(e, out);
   out[OUT_POLYGON_KEPT] = kept ? 1.0 : 0.0;
   out[OUT_POLYGON_COUNT] = kept ? 0.0 : (double)support_polygon(e, out);

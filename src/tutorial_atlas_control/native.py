@@ -90,7 +90,9 @@ class AtlasEstimator(ctypes.Structure):
                 ('polygon_positions', ctypes.c_void_p), ('polygon_rotations', ctypes.c_void_p),
                 ('polygon_contact', ctypes.c_long * 2), ('polygon_tolerance_m', ctypes.c_double),
                 ('rotation_tolerance', ctypes.c_double),
-                ('corner_offsets', ctypes.c_double * 24), ('mass_current', ctypes.c_long)]
+                ('corner_offsets', ctypes.c_double * 24), ('mass_current', ctypes.c_long),
+                ('pressed_m', ctypes.c_double), ('upright_cos', ctypes.c_double),
+                ('one_surface_cos', ctypes.c_double)]
 
 
 class AtlasStatics(ctypes.Structure):

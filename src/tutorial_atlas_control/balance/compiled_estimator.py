@@ -21,6 +21,7 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control.balance.errors import BalanceError
+from tutorial_atlas_control.balance.sole import ONE_SURFACE_COS, PRESSED_M, UPRIGHT_COS
 from tutorial_atlas_control.native import AtlasEstimator, address
 
 #: Sole contact rows the flat output holds (a box on a plane makes four a sole); more are
@@ -42,7 +43,13 @@ SCALARS_AT = 51
 POLYGON_KEPT, POLYGON_COUNT, POLYGON_AT = 68, 69, 70
 #: Two soles' four corners.
 POLYGON_CAPACITY = 8
-FIXED_SIZE = POLYGON_AT + 2 * POLYGON_CAPACITY
+#: Each sole's bearing summary (src/atlas_estimator.c's bearings, BEARING_SIZE doubles a
+#: sole): 1.0 across facets, else 0.0; the box of its bearing contacts in its frame (m:
+#: lowest, highest along; lowest, highest across; infinities with none). What
+#: walking/sole_support.py's rule computes from the sole's contacts, made here with them.
+BEARING_AT = POLYGON_AT + 2 * POLYGON_CAPACITY
+BEARING_SIZE = 5
+FIXED_SIZE = BEARING_AT + 2 * BEARING_SIZE
 #: The FIXED_FIELDS a BalanceState holds as arrays, in the order of OutputBlock.fields (the
 #: sole boxes' positions are read only for a new polygon; the scalars as one list).
 STATE_ARRAYS = ('com', 'com_velocity', 'pelvis_position', 'pelvis_rotation',
@@ -96,6 +103,10 @@ class RawEstimate:
         left = int(block.counts[tick, 0])
         return rows[:left], rows[left:]
 
+    def bearing(self, foot: int) -> list[float]:
+        """The sole `foot`'s bearing summary (BEARING_AT's), as floats."""
+        return self.block.bearings[self.tick, foot].tolist()
+
     def polygon(self) -> np.ndarray:
         """The new support polygon's vertices (a view: valid when not kept)."""
         return self.block.polygons[self.tick, :int(self.block.array[self.tick, POLYGON_COUNT])]
@@ -116,7 +127,8 @@ class OutputBlock:
         #: STATE_ARRAYS' views, in their order.
         self.fields = tuple(views[name] for name in STATE_ARRAYS)
         self.sole_positions = views['sole_positions']
-        self.polygons = array[:, POLYGON_AT:FIXED_SIZE].reshape(BLOCK_TICKS, POLYGON_CAPACITY, 2)
+        self.polygons = array[:, POLYGON_AT:BEARING_AT].reshape(BLOCK_TICKS, POLYGON_CAPACITY, 2)
+        self.bearings = array[:, BEARING_AT:FIXED_SIZE].reshape(BLOCK_TICKS, 2, BEARING_SIZE)
         jac_at, counts_at = FIXED_SIZE + joints, FIXED_SIZE + 13 * joints
         self.bias = array[:, FIXED_SIZE:jac_at]
         self.jacobians = array[:, jac_at:counts_at].reshape(BLOCK_TICKS, 2, 6, joints)
@@ -161,6 +173,8 @@ class CompiledEstimate:
         kernel.corner_offsets[:] = np.asarray(geometry.corner_offsets, dtype=np.float64).ravel()
         kernel.polygon_tolerance_m = geometry.polygon_tolerance_m
         kernel.rotation_tolerance = geometry.rotation_tolerance
+        kernel.pressed_m, kernel.upright_cos = PRESSED_M, UPRIGHT_COS
+        kernel.one_surface_cos = ONE_SURFACE_COS
         self._polygon_reference: tuple[np.ndarray, np.ndarray] | None = None
         self._pointer = ctypes.byref(kernel)
         self._estimate = library.atlas_estimate

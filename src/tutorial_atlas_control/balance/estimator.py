@@ -177,6 +177,13 @@ class BalanceState:
     #: is (None: not compiled).
     mass_matrix_source: ClassVar[tuple[int, int, int, np.ndarray, int] | None] = None
 
+    def sole_bearing(self, foot: int) -> list[float] | None:
+        """Where the sole `foot` bears as the compiled estimate summed it up with its
+        contacts (compiled_estimator.BEARING_AT's five numbers: across facets 1.0 or 0.0,
+        the box of its bearing contacts); None: not summed up (a Python estimate's state,
+        or one made from fields), walking/sole_support then reads sole_contacts."""
+        return None
+
     @_Cached
     def sole_contacts(self) -> tuple[SoleContacts, SoleContacts]:
         """Each sole's contacts (left, right), from MuJoCo's contact list."""
@@ -215,6 +222,11 @@ class _RowState(BalanceState):
             raise AttributeError(name)
         values[name] = view
         return view
+
+    def sole_bearing(self, foot: int) -> list[float] | None:
+        """BalanceState.sole_bearing: the row's, when this state is the estimate's own."""
+        raw = self.__dict__.get('_raw')
+        return None if raw is None else raw.bearing(foot)
 
 
 def _within(difference: np.ndarray, tolerance: float) -> bool:

@@ -15,8 +15,23 @@ import numpy as np
 
 from tutorial_atlas_control.sim import SOLE_GEOMS
 
-__all__ = ['BOTTOM_CORNER_SIGNS', 'SOLE_GEOMS', 'SoleBox', 'box_corners',
-           'lowest_sole_corner_m', 'sole_corners', 'sole_geom_ids']
+__all__ = ['BOTTOM_CORNER_SIGNS', 'ONE_SURFACE_COS', 'PRESSED_M', 'SOLE_GEOMS', 'SoleBox',
+           'UPRIGHT_COS', 'box_corners', 'lowest_sole_corner_m', 'sole_corners',
+           'sole_geom_ids']
+
+# Where a sole bears (walking/sole_support.py's rule; the compiled estimate sums each sole's
+# bearing contacts up with them, src/atlas_estimator.c's bearings):
+#: A contact within this of its surface (m) bears on it: the estimator's reach 1 cm out, and
+#: a sole on a ramp beside its bend (steps are planned clear of bends) has the other plane's
+#: within that (up the pit's 22 degree ramp, counting them, the walk fell at its 8th step).
+PRESSED_M = 0.002
+#: Contact normals all within acos(ONE_SURFACE_COS) (2 degrees) of each other: one plane.
+ONE_SURFACE_COS = 0.99939
+#: A contact bears only with its normal within acos(UPRIGHT_COS) (60 degrees) of up: the
+#: side of a heightfield's prism or of a block beside a sole flat on the ground (normals
+#: 87-90 degrees from up, under a millimetre away) carries none of its weight, and counted,
+#: made a sole on the pen's flat floor "across facets".
+UPRIGHT_COS = 0.5
 
 #: The sole boxes of the model, left then right.
 #: A box's bottom-face corners as signs on its half sizes (x ahead, y left, z up): front

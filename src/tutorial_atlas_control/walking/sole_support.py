@@ -20,6 +20,10 @@ asked one alone was too little on the pit's ramps (heightfield too, curved: a so
 is across facets nearly all the way down, bearing at both ends), and every walk from the mud
 start fell on the entry ramp; with the bearing points the ramp's soles keep most of their
 length. The rule acts with LegGains.near_cop_m set (SHIFT_M by default; None: off).
+
+A compiled estimate sums each sole's contacts up as it copies them (BalanceState.sole_bearing:
+the flag and the box, src/atlas_estimator.c), and stance_rule reads that; the functions below
+are the reference, for a state without a row (a Python estimate's, or one made from fields).
 """
 
 from __future__ import annotations
@@ -28,22 +32,17 @@ from dataclasses import replace
 
 import numpy as np
 
-from tutorial_atlas_control.balance import BalanceState, ContactConstraint
+from tutorial_atlas_control.balance import (
+    ONE_SURFACE_COS,
+    PRESSED_M,
+    UPRIGHT_COS,
+    BalanceState,
+    ContactConstraint,
+)
 
 __all__ = ['NO_SPAN', 'ONE_SURFACE_COS', 'PRESSED_M', 'SHIFT_M', 'Span', 'UPRIGHT_COS',
            'across_facets', 'bearing_span', 'near_asked', 'stance_contacts', 'stance_rule']
 
-#: A contact within this of its surface (m) bears on it: the estimator's reach 1 cm out, and
-#: a sole on a ramp beside its bend (steps are planned clear of bends) has the other plane's
-#: within that (up the pit's 22 degree ramp, counting them, the walk fell at its 8th step).
-PRESSED_M = 0.002
-#: Contact normals all within acos(ONE_SURFACE_COS) (2 degrees) of each other: one plane.
-ONE_SURFACE_COS = 0.99939
-#: A contact bears only with its normal within acos(UPRIGHT_COS) (60 degrees) of up: the
-#: side of a heightfield's prism or of a block beside a sole flat on the ground (normals
-#: 87-90 degrees from up, under a millimetre away) carries none of its weight, and counted,
-#: made a sole on the pen's flat floor "across facets".
-UPRIGHT_COS = 0.5
 #: How far (m) along and across the sole the wrench's pressure centre may be from the one
 #: asked or from the points the sole bears on, across facets.
 SHIFT_M = 0.02
@@ -126,9 +125,15 @@ def stance_rule(state: BalanceState, stance: int, near_cop_m: float | None
     """How near (m) the lone stance sole `stance`'s wrench's pressure centre stays to the one
     asked or its bearing points, and their box: (`near_cop_m`, bearing_span's box) across
     facets; (0.0, NO_SPAN), the whole sole, on one plane or with the rule off (None). The
-    one decision both the compiled tick and the Python read; the contacts read once."""
+    one decision both the compiled tick and the Python read; from the compiled estimate's
+    summary of the sole's contacts where the state has one (BalanceState.sole_bearing: five
+    floats, about 0.5 us), else from its contacts (the reference)."""
     if near_cop_m is None:
         return 0.0, NO_SPAN
+    summed = state.sole_bearing(stance)
+    if summed is not None:
+        across, *box = summed
+        return (near_cop_m, (box[0], box[1], box[2], box[3])) if across else (0.0, NO_SPAN)
     points, normals = _bearing(state, stance)
     if not _apart(normals):
         return 0.0, NO_SPAN
