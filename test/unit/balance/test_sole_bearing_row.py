@@ -53,14 +53,13 @@ def test_the_rows_bearing_summary_is_the_python_rules_on_the_course(course: Atla
         for foot in (0, 1):
             summary = state.sole_bearing(foot)
             assert summary is not None
-            points, normals = sole_support._bearing(python, foot)
-            facets = sole_support._apart(normals)
+            facets = sole_support.across_facets(python, foot)
             assert (summary[0] == 1.0) == facets
-            box = sole_support._span_of(python, foot, points)
-            if points:
-                np.testing.assert_allclose(summary[1:], box, rtol=0.0, atol=TOLERANCE)
+            box = sole_support.bearing_span(python, foot)
+            if box == sole_support.NO_SPAN:
+                assert tuple(summary[1:]) == box
             else:
-                assert tuple(summary[1:]) == box == sole_support.NO_SPAN
+                np.testing.assert_allclose(summary[1:], box, rtol=0.0, atol=TOLERANCE)
             near, span = sole_support.stance_rule(state, foot, sole_support.SHIFT_M)
             near_python, span_python = sole_support.stance_rule(python, foot,
                                                                 sole_support.SHIFT_M)

@@ -1,8 +1,8 @@
 """A walking step's weight transfer, on one frozen estimate of the Stand pose (no physics):
 both feet carry until the landed sole is flat and carries half the weight, or at most 0.1 s
-(a sole touching heel first, 5 degrees, as the course's landings were, or 2, still
-rolling onto the ground); only then does the
-other foot lift, and its swing takes the rest of the step, so the step ends on time."""
+(a sole touching heel first, 5 degrees, as the course's landings were, or 2, still rolling
+onto the ground); only then does the other foot lift, and its swing takes the rest of the
+step, so the step ends on time."""
 
 from __future__ import annotations
 
