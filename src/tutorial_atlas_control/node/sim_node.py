@@ -42,6 +42,9 @@ Parameters (private unless noted):
         robot_state_publisher: atlas.launch's state_publisher.py does both.
     ~bag_dir (str, unset): where the launch's recorder writes; if set and no file can be
         written there, the node refuses to start (one line).
+    ~recorder_send_period (s of wall time, 0.01): what the launch's recorder (/recorder)
+        subscribes to is sent to it this often, in one send per topic, instead of after
+        every step as to any other subscriber (node/held_sends.py); 0: after every step.
     ~stand (str, balance): what Stand does. balance: the open AtlasSimInterface's balancing
         Stand (balance/, docs/controllers.md) whenever Stand is asked for (an ASI STAND,
         /atlas/control_mode Stand, bdi_stand's sequence); a (re)start in Stand holds the robot
@@ -122,9 +125,11 @@ from tutorial_atlas_control.course import (
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.joints import JOINT_NAMES
 from tutorial_atlas_control.node.cheats import WARN_THROTTLE_S, subscribe_cheats
+from tutorial_atlas_control.node.held_sends import RECORDER_SEND_PERIOD_S, HeldSends
 from tutorial_atlas_control.node.master_watch import start_master_watch
-from tutorial_atlas_control.node.recorder_watch import start_recorder_watch
+from tutorial_atlas_control.node.recorder_watch import RECORDER_NODE, start_recorder_watch
 from tutorial_atlas_control.node.transport import (
+    ConnectionWriter,
     WireBatch,
     flush_queued,
     flush_rosout,
@@ -300,17 +305,20 @@ class SimNode:
         settings: the loop's rates, pace and pause, and the links' transforms to publish
             (with `tf` only).
         tf: publish /tf (and, with settings.links, the links and /tf_static).
+        recorder_send_period_s: how often the recorder's bytes go out (held_sends.py).
     """
 
     def __init__(self, sim: AtlasSimulator, settings: LoopSettings, gui: bool,
-                 tf: bool = False, sync_budgets: DelayBudgets | None = None) -> None:
+                 tf: bool = False, sync_budgets: DelayBudgets | None = None,
+                 recorder_send_period_s: float = RECORDER_SEND_PERIOD_S) -> None:
         self.sim = sim
         self.gui = gui
         # UDPROS for roscpp's unreliable() subscribers, before the master announces a topic.
         self.udpros = serve_udpros()
         widen_accept_queue()  # a dozen subscribers connect at once when it advertises
         self._advertise(tf, settings.score_dir is not None)
-        outbox = WireBatch()
+        outbox = WireBatch(ConnectionWriter(held=HeldSends({RECORDER_NODE},
+                                                           recorder_send_period_s)))
         # Before rospy closes the connections: what a stalled-then-live subscriber (the
         # recorder) has not taken yet (transport.ConnectionWriter.drain).
         rospy.on_shutdown(outbox.drain)
@@ -587,7 +595,8 @@ def build_node() -> SimNode:
                             hold_at_start=stand == 'balance',
                             user_behaviour=user_behaviour, score_dir=_score_dir())
     return SimNode(sim, settings, bool(rospy.get_param('~gui', False)),
-                   description is not None, DelayBudgets.from_params(rospy.get_param))
+                   description is not None, DelayBudgets.from_params(rospy.get_param),
+                   _float_param('~recorder_send_period', RECORDER_SEND_PERIOD_S))
 
 
 def _sensor_seed_param() -> int:

@@ -20,11 +20,13 @@ import select
 import socket
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 
 import rospy
 from rospy.impl import rosout, tcpros_base
 from rospy.impl.tcpros_base import TransportTerminated
+
+from tutorial_atlas_control.node.held_sends import HeldSends
 
 __all__ = ['MAX_BACKLOG_BYTES', 'SEND_TIMEOUT_S', 'STALL_PROBE_S', 'ConnectionWriter',
            'WireBatch', 'flush_queued', 'flush_rosout', 'subscriber_names', 'widen_accept_queue']
@@ -122,9 +124,12 @@ class ConnectionWriter:
     """
 
     def __init__(self, clock: Callable[[], float] = time.monotonic,
-                 wait: Callable[[socket.socket, float], bool] = wait_writable) -> None:
+                 wait: Callable[[socket.socket, float], bool] = wait_writable,
+                 held: HeldSends | None = None) -> None:
         self.clock = clock
         self.wait = wait
+        #: The bag recorder's bytes, sent every few ms rather than at each flush (held_sends.py).
+        self.held = held if held is not None else HeldSends(())
         #: TCP connections with bytes not taken yet (only those: the hot path is a miss).
         self.backlogs: dict[object, Backlog] = {}
         #: Held by write() and drain(): drain() runs in rospy's SIGINT handler, which runs
@@ -145,66 +150,106 @@ class ConnectionWriter:
             finally:
                 self._holder = None
 
-    def _write(self, pub: rospy.Publisher, data: bytes | bytearray) -> None:
-        impl, backlogs = pub.impl, self.backlogs
-        if backlogs:
-            self._forget_closed()
-        for connection in list(impl.connections):
-            sock = getattr(connection, 'socket', None)
-            try:
-                if sock is None or connection.done:
-                    raise TransportTerminated('connection closed')
-                if getattr(connection, 'transport_type', None) != 'TCPROS':
-                    if sock.gettimeout() is None:
-                        sock.settimeout(SEND_TIMEOUT_S)
-                    sock.sendall(data)  # UDPROS: datagrams, never held by the subscriber
-                    continue
-                backlog = backlogs.get(connection)
-                if backlog is None:
-                    if sock.gettimeout() != 0.0:
-                        sock.setblocking(False)
-                    try:
-                        sent = sock.send(data)
-                    except BlockingIOError:
-                        sent = 0
-                    if sent == len(data):
-                        continue  # the hot path: everything taken at once
-                    backlog = backlogs[connection] = Backlog(memoryview(data)[sent:],
-                                                             self.clock())
-                    patient = True  # a live subscriber whose buffer is full: wait a slice
-                else:
-                    backlog.data += data
-                    patient = False  # stalled so far: wait only if it takes bytes again
-                self._send_backlog(sock, backlog, patient)
-                if not backlog.data:
-                    backlogs.pop(connection, None)  # back to normal
-                elif len(backlog.data) > MAX_BACKLOG_BYTES:
-                    raise BacklogFull(f'more than {MAX_BACKLOG_BYTES} bytes not taken')
-                elif self.clock() - backlog.progress_s >= SEND_TIMEOUT_S:
-                    raise TimeoutError(f'timed out: nothing taken for {SEND_TIMEOUT_S:g} s')
-            except (TransportTerminated, OSError) as err:  # socket.timeout is an OSError
-                backlogs.pop(connection, None)
-                if impl.closed:  # rospy closed every connection and cannot remove one any more
-                    return
-                if isinstance(err, (BrokenPipeError, ConnectionResetError,
-                                    ConnectionRefusedError)):
-                    # The subscriber exited (traj_yaml.py at its end): routine, as in rospy.
-                    # Refused: a UDPROS subscriber's port is closed (node/udpros.py).
-                    rospy.logdebug(f'{pub.resolved_name}: subscriber {connection.endpoint_id} '
-                                   'left')
-                elif not isinstance(err, TransportTerminated):
-                    rospy.logwarn(f'{pub.resolved_name}: dropping subscriber '
-                                  f'{connection.endpoint_id}: {err}')
+    def begin_flush(self) -> None:
+        """A flush starts (WireBatch.flush): it may release what is held."""
+        self.held.begin_flush()
+
+    def release_held(self, written_next: Collection[rospy.Publisher] = ()) -> None:
+        """In a releasing flush, send what is held for publishers with nothing new in it
+        (but those in `written_next`, whose bytes follow: /clock)."""
+        rest = self.held.release_rest(written_next)
+        if rest:
+            with self.lock:
+                self._holder = threading.get_ident()
                 try:
-                    impl.remove_connection(connection)
-                except (TypeError, AttributeError):
-                    # rospy closed the publisher after the check above (another thread: a
-                    # shutdown, such as a second atlas_sim registering): its listener list
-                    # is gone, and with it every connection. Nothing left to send to.
-                    if impl.closed:
-                        return
-                    raise
-                connection.close()
+                    for pub, connection, data in rest:
+                        if connection in pub.impl.connections:
+                            self._send(pub, connection, data)
+                finally:
+                    self._holder = None
+
+    def end_flush(self) -> None:
+        self.held.end_flush()
+
+    def _write(self, pub: rospy.Publisher, data: bytes | bytearray) -> None:
+        if self.backlogs:
+            self._forget_closed()
+        held = self.held
+        for connection in list(pub.impl.connections):
+            out = data
+            if held.subscribers and held.holds(connection):
+                out = held.take(pub, connection, data)
+                if out is None:
+                    continue
+            if not self._send(pub, connection, out):
+                return
+
+    def _send(self, pub: rospy.Publisher, connection: object,
+              data: bytes | bytearray) -> bool:
+        """Send `data` to one of `pub`'s connections, or drop it (it left or stalled);
+        False once rospy has closed `pub` (nothing more to send to)."""
+        backlogs = self.backlogs
+        sock = getattr(connection, 'socket', None)
+        try:
+            if sock is None or connection.done:
+                raise TransportTerminated('connection closed')
+            if getattr(connection, 'transport_type', None) != 'TCPROS':
+                if sock.gettimeout() is None:
+                    sock.settimeout(SEND_TIMEOUT_S)
+                sock.sendall(data)  # UDPROS: datagrams, never held by the subscriber
+                return True
+            backlog = backlogs.get(connection)
+            if backlog is None:
+                if sock.gettimeout() != 0.0:
+                    sock.setblocking(False)
+                try:
+                    sent = sock.send(data)
+                except BlockingIOError:
+                    sent = 0
+                if sent == len(data):
+                    return True  # the hot path: everything taken at once
+                backlog = backlogs[connection] = Backlog(memoryview(data)[sent:],
+                                                         self.clock())
+                patient = True  # a live subscriber whose buffer is full: wait a slice
+            else:
+                backlog.data += data
+                patient = False  # stalled so far: wait only if it takes bytes again
+            self._send_backlog(sock, backlog, patient)
+            if not backlog.data:
+                backlogs.pop(connection, None)  # back to normal
+            elif len(backlog.data) > MAX_BACKLOG_BYTES:
+                raise BacklogFull(f'more than {MAX_BACKLOG_BYTES} bytes not taken')
+            elif self.clock() - backlog.progress_s >= SEND_TIMEOUT_S:
+                raise TimeoutError(f'timed out: nothing taken for {SEND_TIMEOUT_S:g} s')
+        except (TransportTerminated, OSError) as err:  # socket.timeout is an OSError
+            return self._drop(pub, connection, err)
+        return True
+
+    def _drop(self, pub: rospy.Publisher, connection: object, err: Exception) -> bool:
+        """Forget a connection that left or stalled; False once rospy has closed `pub`."""
+        impl = pub.impl
+        self.backlogs.pop(connection, None)
+        self.held.forget(connection)
+        if impl.closed:  # rospy closed every connection and cannot remove one any more
+            return False
+        if isinstance(err, (BrokenPipeError, ConnectionResetError, ConnectionRefusedError)):
+            # The subscriber exited (traj_yaml.py at its end): routine, as in rospy.
+            # Refused: a UDPROS subscriber's port is closed (node/udpros.py).
+            rospy.logdebug(f'{pub.resolved_name}: subscriber {connection.endpoint_id} left')
+        elif not isinstance(err, TransportTerminated):
+            rospy.logwarn(f'{pub.resolved_name}: dropping subscriber '
+                          f'{connection.endpoint_id}: {err}')
+        try:
+            impl.remove_connection(connection)
+        except (TypeError, AttributeError):
+            # rospy closed the publisher after the check above (another thread: a
+            # shutdown, such as a second atlas_sim registering): its listener list
+            # is gone, and with it every connection. Nothing left to send to.
+            if impl.closed:
+                return False
+            raise
+        connection.close()
+        return True
 
     def _send_backlog(self, sock: socket.socket, backlog: Backlog, patient: bool) -> None:
         """Send what `backlog` holds, in order. Without `patient`, give up at once unless
@@ -267,6 +312,12 @@ class ConnectionWriter:
 
     def _drain(self, timeout_s: float) -> None:
         deadline_s = self.clock() + timeout_s
+        for _pub, connection, data in self.held.pop_all():  # after any older backlog
+            backlog = self.backlogs.get(connection)
+            if backlog is None:
+                self.backlogs[connection] = Backlog(data, self.clock())
+            else:
+                backlog.data += data
         for connection, backlog in list(self.backlogs.items()):
             sock, data = getattr(connection, 'socket', None), backlog.data
             try:
@@ -341,7 +392,9 @@ class WireBatch:
     def flush(self) -> None:
         pending, self.pending = self.pending, {}
         latest, self.latest = self.latest, {}
-        write, watchers = self.writer.write, self.watchers
+        writer, watchers = self.writer, self.watchers
+        write = writer.write
+        writer.begin_flush()
         for batches in (pending, latest):
             for pub, data in batches.items():
                 write(pub, data)
@@ -349,6 +402,9 @@ class WireBatch:
                     sent = watchers.get(pub)
                     if sent is not None:
                         sent(data)
+            if batches is pending:  # what is held goes out before the time (held_sends.py)
+                writer.release_held(latest)
+        writer.end_flush()
 
     def drain(self) -> None:
         """Send what stalled connections still hold (rospy.on_shutdown: see ConnectionWriter)."""

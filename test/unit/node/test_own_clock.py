@@ -8,7 +8,7 @@ from rospy.impl import simtime
 
 from tutorial_atlas_control.msgs.wire import clock_bytes
 from tutorial_atlas_control.node import own_clock
-from tutorial_atlas_control.node.transport import WireBatch
+from tutorial_atlas_control.node.transport import ConnectionWriter, WireBatch
 
 
 class Subscription:
@@ -19,8 +19,9 @@ class Subscription:
         self.unregistered = True
 
 
-class Writer:
+class Writer(ConnectionWriter):
     def __init__(self) -> None:
+        super().__init__()
         self.sent: list[tuple[str, bytes]] = []
 
     def write(self, pub: str, data: bytearray) -> None:

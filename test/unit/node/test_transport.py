@@ -139,7 +139,7 @@ def test_clock_goes_out_after_the_messages_stamped_with_it(
     bag held a time no joint state was stamped with. The latest /clock is now sent last."""
     sent: list[tuple[str, bytes]] = []
 
-    class Writer:
+    class Writer(transport.ConnectionWriter):
         def write(self, pub, data):
             sent.append((pub, bytes(data)))
 
@@ -159,7 +159,7 @@ def test_clock_goes_out_after_the_messages_stamped_with_it(
 def test_a_watcher_sees_what_each_flush_sent_after_it_was_written() -> None:
     events: list[tuple[str, str, bytes]] = []
 
-    class Writer:
+    class Writer(transport.ConnectionWriter):
         def write(self, pub, data):
             events.append(('write', pub, bytes(data)))
 
