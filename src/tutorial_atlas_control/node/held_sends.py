@@ -7,8 +7,8 @@ simulator's loop that also runs the recorder's side of loopback TCP and wakes it
 bytes for the subscribers named here (the launch's recorder) are held and sent together once
 `period_s` of wall time has passed since the first one held; every other subscriber still
 gets each flush. Measured on a standing launch at real time with its recorder (20 s, two
-runs each): the node 0.37-0.39 -> 0.31-0.33 of a core, the recorder 0.15 -> 0.08-0.09,
-with a period of 10 ms.
+runs each, alternated): the node 0.39-0.43 -> 0.30-0.36 of a core, the recorder 0.15-0.16 ->
+0.09, with a period of 10 ms.
 
 What is held goes out in one flush, in that flush's order (transport.WireBatch.flush): the
 batches, then what was held for publishers with nothing new, then /clock; so the recorder
