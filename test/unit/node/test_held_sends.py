@@ -4,11 +4,10 @@ every other subscriber's at each flush, nothing lost at shutdown."""
 from __future__ import annotations
 
 import pytest
+from test_transport import Clock, FakePublisher, TcpConnection, Waits
 
 from tutorial_atlas_control.node import transport
 from tutorial_atlas_control.node.held_sends import HeldSends
-
-from test_transport import Clock, FakePublisher, TcpConnection, Waits
 
 PERIOD_S = 0.01
 
@@ -61,8 +60,9 @@ def test_the_recorder_gets_one_send_per_topic_a_period_a_client_one_each_flush()
     # The recorder: held from step 1; the flush 10 ms later (step 11) releases steps 1-11,
     # the next hold starts at step 12 and goes out at step 22; 23-30 are still held.
     assert recorder['state'].socket.send_calls == 2
-    assert bytes(recorder['state'].socket.in_buffer) == every['state'][:every['state'].index(b'S23;')]
-    assert bytes(recorder['clock'].socket.in_buffer) == every['clock'][:every['clock'].index(b'C23;')]
+    for name, first_held in (('state', b'S23;'), ('clock', b'C23;')):
+        sent = every[name][:every[name].index(first_held)]
+        assert bytes(recorder[name].socket.in_buffer) == sent
     # odom had nothing new at step 11: its held bytes went out in that flush all the same.
     assert bytes(recorder['odom'].socket.in_buffer) == b'O5;O10;O15;O20;'
     assert recorder['odom'].socket.send_calls == 2
