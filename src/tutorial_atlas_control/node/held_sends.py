@@ -6,14 +6,20 @@ receives to a file and wakes every 5 ms anyway, while every send is a syscall of
 simulator's loop that also runs the recorder's side of loopback TCP and wakes it. So the
 bytes for the subscribers named here (the launch's recorder) are held and sent together once
 `period_s` of wall time has passed since the first one held; every other subscriber still
-gets each flush. Measured on a standing launch at real time with its recorder (20 s, two
-runs each, alternated): the node 0.39-0.43 -> 0.30-0.36 of a core, the recorder 0.15-0.16 ->
-0.09, with a period of 10 ms.
+gets each flush. Measured on a standing launch at real time with its recorder (20 s a run,
+alternated, nothing else running): every step, the node 0.29-0.32 of a core and the recorder
+0.12-0.13; held 4 ms, 0.24-0.25 and 0.07 (2 ms: 0.26 and 0.08; 10 ms: 0.22-0.24 and 0.06-0.07;
+/clock alone sent every step and the rest held 10 ms: 0.28 and 0.10, most of the cost is the
+per-step wake).
 
-What is held goes out in one flush, in that flush's order (transport.WireBatch.flush): the
-batches, then what was held for publishers with nothing new, then /clock; so the recorder
-still never receives a time before the messages stamped with it. At shutdown, what is held
-joins the backlogs that ConnectionWriter.drain sends.
+/clock is held too, so the recorder's clock, from which it takes each message's bag time,
+runs up to `period_s` behind: a command it receives straight from a client (an unstamped
+one is placed by its bag time) is recorded up to that much early, as at real_time_factor 0,
+where every subscriber gets a flush only every 4 ms (stepping/pacing.py's FLUSH_PERIOD_S):
+the period is that 4 ms. What is held goes out in one flush, in that flush's order
+(transport.WireBatch.flush): the batches, then what was held for publishers with nothing new,
+then /clock; so the recorder still never receives a time before the messages stamped with
+it. At shutdown, what is held joins the backlogs that ConnectionWriter.drain sends.
 """
 
 from __future__ import annotations
@@ -23,8 +29,9 @@ from collections.abc import Callable, Collection
 
 __all__ = ['RECORDER_SEND_PERIOD_S', 'HeldSends']
 
-#: Default hold (wall s) for the recorder's bytes: two of atlas_recorder's 5 ms wakes.
-RECORDER_SEND_PERIOD_S = 0.01
+#: Default hold (wall s) for the recorder's bytes: its clock at most this far behind, as
+#: every subscriber's at real_time_factor 0 (pacing.FLUSH_PERIOD_S).
+RECORDER_SEND_PERIOD_S = 0.004
 
 
 class HeldSends:

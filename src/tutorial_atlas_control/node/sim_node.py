@@ -42,7 +42,7 @@ Parameters (private unless noted):
         robot_state_publisher: atlas.launch's state_publisher.py does both.
     ~bag_dir (str, unset): where the launch's recorder writes; if set and no file can be
         written there, the node refuses to start (one line).
-    ~recorder_send_period (s of wall time, 0.01): what the launch's recorder (/recorder)
+    ~recorder_send_period (s of wall time, 0.004): what the launch's recorder (/recorder)
         subscribes to is sent to it this often, in one send per topic, instead of after
         every step as to any other subscriber (node/held_sends.py); 0: after every step.
     ~stand (str, balance): what Stand does. balance: the open AtlasSimInterface's balancing

@@ -9,7 +9,7 @@ from test_transport import Clock, FakePublisher, TcpConnection, Waits
 from tutorial_atlas_control.node import transport
 from tutorial_atlas_control.node.held_sends import HeldSends
 
-PERIOD_S = 0.01
+PERIOD_S = 0.01  # a test's own, not the default
 
 
 class Named:
