@@ -114,6 +114,26 @@ class BacklogFull(OSError):
     """A backlog past MAX_BACKLOG_BYTES (dropped like a send timeout, with its reason)."""
 
 
+class _Holding:
+    """`with` it: a ConnectionWriter's lock taken by this thread, noted as its holder (what
+    drain() reads when a SIGINT lands in the middle of a send)."""
+
+    __slots__ = ('writer',)
+
+    def __init__(self, writer: ConnectionWriter) -> None:
+        self.writer = writer
+
+    def __enter__(self) -> None:
+        writer = self.writer
+        writer.lock.acquire()
+        writer._holder = threading.get_ident()
+
+    def __exit__(self, *exc_info: object) -> None:
+        writer = self.writer
+        writer._holder = None
+        writer.lock.release()
+
+
 class ConnectionWriter:
     """Writes already-serialized TCPROS bytes to every subscriber of a publisher.
 
@@ -136,6 +156,7 @@ class ConnectionWriter:
         #: in the loop's thread, possibly in the middle of a write (see drain()).
         self.lock = threading.Lock()
         self._holder: int | None = None
+        self._holding = _Holding(self)
         #: True only while write() waits for a socket with every backlog committed.
         self._waiting = False
 
@@ -143,12 +164,8 @@ class ConnectionWriter:
         """Send `data` to every subscriber of `pub`; drop those that left or stalled. Once
         rospy has shut the publisher down (node shutdown, from another thread), nothing
         is sent."""
-        with self.lock:
-            self._holder = threading.get_ident()
-            try:
-                self._write(pub, data)
-            finally:
-                self._holder = None
+        with self._holding:
+            self._write(pub, data)
 
     def begin_flush(self) -> None:
         """A flush starts (WireBatch.flush): it may release what is held."""
@@ -159,16 +176,13 @@ class ConnectionWriter:
         (but those in `written_next`, whose bytes follow: /clock)."""
         rest = self.held.release_rest(written_next)
         if rest:
-            with self.lock:
-                self._holder = threading.get_ident()
-                try:
-                    for pub, connection, data in rest:
-                        if connection in pub.impl.connections:
-                            self._send(pub, connection, data)
-                finally:
-                    self._holder = None
+            with self._holding:
+                for pub, connection, data in rest:
+                    if connection in pub.impl.connections:
+                        self._send(pub, connection, data)
 
     def end_flush(self) -> None:
+        """A flush has ended: the next byte held starts a new period."""
         self.held.end_flush()
 
     def _write(self, pub: rospy.Publisher, data: bytes | bytearray) -> None:

@@ -392,8 +392,10 @@ def test_the_shutdown_hook_in_a_write_drains_only_while_it_waits(
     writer.write(pub, b'abcd')  # waits one slice: the hook runs there
     conn.socket.reads_per_slice = 4
     conn.socket.read_some()
-    waits.during.append(writer.drain)
+    left_by_hook: list[dict] = []
+    waits.during.append(lambda: (writer.drain(), left_by_hook.append(dict(writer.backlogs))))
     writer.write(pub, b'efgh')  # reads again: waited for, the hook drains from the wait
+    assert left_by_hook == [{}], 'the hook itself drained (the writer noted as holder)'
     assert waits.during == [] and writer.backlogs == {}
     while conn.socket.in_buffer:
         conn.socket.read_some()
