@@ -19,7 +19,11 @@ A mirror that disagrees with the C struct would let C read or write past the fie
 Python laid out, so the library exports `size_t tac_sizeof_<Struct>(void)` for each
 mirrored struct, and a library whose sizes differ from the mirrors' (built from other
 sources) is refused. Refused or missing, the callers fall back to numpy after one
-warning: the same numbers, bit for bit, only slower.
+warning, only slower: the law's torques bit for bit, the balance and walking ticks to
+rounding (sums in another order, within 1e-9: test_compiled_*). A long walk on the course
+feels that rounding: the deterministic finals_rubble walk from the rubble start walks
+through with the library and falls at step 66 without it (their torques part by 3e-14 N m
+at Stand's first tick), so a course figure is a fraction over seeds on one path.
 """
 
 from __future__ import annotations
