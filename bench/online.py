@@ -303,28 +303,31 @@ def _bdi_stand_pace(master: Master, launch_file: str, probes: Probes, work_dir: 
     """atlas.launch as DRCSim 2.7 started (startup_mode:=bdi_stand: the balancing Stand from
     2 s of sim time) at real_time_factor:=1 with the recorder, and from STAND_STARTED_S on,
     while `during` runs: the pace kept (`<prefix>_realtime_rtf`), the step lateness p99
-    (`<prefix>_lateness_p99_ms`) and the node's CPU per step (`<prefix>_node_us_per_step`);
-    and what `during` returned."""
+    (`<prefix>_lateness_p99_ms`), and the CPU per step of the node and of the recorder
+    (`<prefix>_node_us_per_step`, `<prefix>_recorder_us_per_step`: the recorder's is the
+    cost of what the node sends it); and what `during` returned."""
     with _launch(master, launch_file, work_dir, name, 1.0,
                  extra_args={'startup_mode': 'bdi_stand'}) as launch:
         _wait_ready(master, launch, probes)
         time.sleep(STAND_STARTED_S)
-        node = launch.node_pid('atlas_sim')
-        cpu0 = cpu_seconds(node) if node else 0.0
+        pids = {'node': launch.node_pid('atlas_sim'), 'recorder': launch.node_pid('recorder')}
+        cpu0 = {role: cpu_seconds(pid) if pid else 0.0 for role, pid in pids.items()}
         probes.clock.start()
         try:
             outcome = during()
         finally:
             samples = probes.clock.stop()
-        cpu1 = cpu_seconds(node) if node else 0.0
+        cpu1 = {role: cpu_seconds(pid) if pid else 0.0 for role, pid in pids.items()}
         launch.check_running()
     _drop_bags(launch)
     wall, sim = _clock_series(samples)
     steps = (sim[-1] - sim[0]) * 1000.0
     result = {f'{prefix}_realtime_rtf': float((sim[-1] - sim[0]) / (wall[-1] - wall[0])),
               f'{prefix}_lateness_p99_ms': float(np.percentile(_lateness(wall, sim), 99))}
-    if node:
-        result[f'{prefix}_node_us_per_step'] = (cpu1 - cpu0) / max(steps, 1.0) * 1e6
+    for role, pid in pids.items():
+        if pid:
+            result[f'{prefix}_{role}_us_per_step'] = \
+                (cpu1[role] - cpu0[role]) / max(steps, 1.0) * 1e6
     return result, outcome
 
 
