@@ -57,6 +57,12 @@ MOVED_IN_CALL: MovedReference = (math.nan, math.nan, math.nan)
 Tick = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 
+def _kept_if_read_only(array: np.ndarray) -> np.ndarray | None:
+    """`array` if nothing can write into it, not even through a base (its values then stay
+    those copied), else None."""
+    return None if array.flags.writeable or array.base is not None else array
+
+
 class CompiledWholeBody:
     """atlas_stand_tick and atlas_whole_body over `statics`, with Stand's `gains` for a robot
     of `mass_kg` and its `effort_limit_nm`; its buffers its own."""
@@ -81,6 +87,8 @@ class CompiledWholeBody:
         self._pelvis_angular = buffer[17:20]
         self._joints = buffer[IN_FIXED:].reshape(2, joints)
         self._last_reference: StandReference | None = None
+        #: The read-only rate arrays the buffer holds (None: a writable one, copied each time).
+        self._rates: tuple[np.ndarray | None, np.ndarray | None] = (None, None)
         #: The heading, height and rate written over the last reference's (None: its own).
         self._last_moved: MovedReference | None = None
         self._last_gains: tuple[np.ndarray, np.ndarray] | None = None
@@ -99,14 +107,20 @@ class CompiledWholeBody:
         self._pointer = ctypes.byref(call)
 
     def _set_reference(self, reference: StandReference) -> None:
+        """The reference into the buffer; a rate array only when it is not the read-only
+        one copied last (a take-over's every tick: its zeros are such arrays)."""
         joints = len(self._effort_limit)
         buffer = self._reference
         buffer[0:2] = reference.capture_point
         buffer[2:4] = (reference.com_height_m, reference.com_height_rate_m_s)
         buffer[4:13] = reference.pelvis_rotation.reshape(9)
-        buffer[13:16] = reference.pelvis_angular_velocity
         buffer[REFERENCE_FIXED:REFERENCE_FIXED + joints] = reference.posture_rad
-        buffer[REFERENCE_FIXED + joints:] = reference.posture_rate_rad_s
+        turn, posture = reference.pelvis_angular_velocity, reference.posture_rate_rad_s
+        if turn is not self._rates[0]:
+            buffer[13:16] = turn
+        if posture is not self._rates[1]:
+            buffer[REFERENCE_FIXED + joints:] = posture
+        self._rates = (_kept_if_read_only(turn), _kept_if_read_only(posture))
         self._last_reference = reference
         self._last_moved = None
 
