@@ -162,7 +162,8 @@ class AtlasWalkSwing(ctypes.Structure):
                 ('side', ctypes.c_double), ('step_xy', ctypes.c_double * 2),
                 ('adjust', ctypes.c_long), ('elapsed_s', ctypes.c_double),
                 ('time_s', ctypes.c_double), ('height', ctypes.c_double * 4),
-                ('facing', ctypes.c_double * 4)]
+                ('facing', ctypes.c_double * 4), ('rule_in_call', ctypes.c_long),
+                ('near_cop_m', ctypes.c_double), ('bearing_at', ctypes.c_long)]
 
 
 class AtlasHeightfield(ctypes.Structure):
