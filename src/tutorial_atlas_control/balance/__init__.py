@@ -22,8 +22,8 @@ from tutorial_atlas_control.exports import lazy_exports
 __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'blend': ['smoothstep', 'smoothstep_rate'],
     'errors': ['BalanceError'],
-    'compiled_estimator': ['CompiledEstimate', 'EstimatorGeometry', 'RawEstimate',
-                           'row_offsets'],
+    'compiled_estimator': ['BEARING_AT', 'CompiledEstimate', 'EstimatorGeometry',
+                           'RawEstimate', 'row_offsets'],
     'compiled_statics': ['CompiledStatics'],
     'compiled_whole_body': ['MOVED_IN_CALL', 'CompiledWholeBody'],
     'estimator': ['CONTACT_HEIGHT_M', 'ESTIMATOR_ENV', 'MIN_COM_HEIGHT_M', 'BalanceEstimator',

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from tutorial_atlas_control import native
-from tutorial_atlas_control.balance.compiled_estimator import BEARING_AT
+from tutorial_atlas_control.balance import BEARING_AT
 from tutorial_atlas_control.native import AtlasWalkSwing, address
 from tutorial_atlas_control.walking.footsteps import side_sign
 
