@@ -115,7 +115,9 @@ class AtlasWholeBody(ctypes.Structure):
                 ('joint_gains', ctypes.c_void_p), ('effort_limit', ctypes.c_void_p),
                 ('region', ctypes.c_void_p), ('out', ctypes.c_void_p),
                 ('region_count', ctypes.c_long), ('row', ctypes.c_void_p),
-                ('row_at', ctypes.c_long * WHOLE_BODY_ROW_FIELDS)]
+                ('row_at', ctypes.c_long * WHOLE_BODY_ROW_FIELDS),
+                ('joint_qpos', ctypes.c_void_p), ('joint_qvel', ctypes.c_void_p),
+                ('qpos_adr', ctypes.c_void_p), ('dof_adr', ctypes.c_void_p)]
 
 
 class AtlasSwing(ctypes.Structure):

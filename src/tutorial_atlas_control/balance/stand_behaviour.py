@@ -26,6 +26,7 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control.balance.blend import smoothstep, smoothstep_rate
+from tutorial_atlas_control.balance.compiled_whole_body import JOINTS_IN_CALL
 from tutorial_atlas_control.balance.errors import BalanceError
 from tutorial_atlas_control.balance.estimator import BalanceEstimator, BalanceState
 from tutorial_atlas_control.balance.manipulate import (
@@ -333,11 +334,14 @@ class StandBehaviour:
             raise BalanceError('StandBehaviour.torque before start()')
         if self._transition is not None:
             controller.reference = self._reference_at(float(data.time))
-        atlas, vectors = self.atlas, self._vectors
-        if vectors is None or vectors[0] is not data:
-            vectors = self._vectors = (data, data.qpos, data.qvel)
-        qpos, qvel = vectors[1], vectors[2]
         state = self.estimator.estimate_stepped(data)
-        output = controller.tick(state, qpos[atlas.qpos_adr], qvel[atlas.dof_adr])
+        if state.row_address is not None and controller.compiled:  # the call reads the joints
+            output = controller.tick(state, JOINTS_IN_CALL, JOINTS_IN_CALL)
+        else:
+            atlas, vectors = self.atlas, self._vectors
+            if vectors is None or vectors[0] is not data:
+                vectors = self._vectors = (data, data.qpos, data.qvel)
+            output = controller.tick(state, vectors[1][atlas.qpos_adr],
+                                     vectors[2][atlas.dof_adr])
         self.last_state, self.last_output = state, output
         return output.torque_nm
