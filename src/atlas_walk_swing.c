@@ -21,7 +21,8 @@
 /* Laid out once a step by walking/compiled_walk_swing.py, mirrored in native.py (same
  * fields, same order; tac_sizeof_AtlasWalkSwing lets the loader check). */
 typedef struct {
-  const AtlasLegs *legs;  /* its whole body loaded for this tick (row set), its path set */
+  AtlasLegs *legs;        /* its whole body loaded for this tick (row set), its path set;
+                           * with rule_in_call its near_m and bearing set here */
   double *out;            /* WALK_OUT_*: the capture point's reference, moved?, the landing */
   double plan[5];         /* the step's plan: pressure centre x, y; end x, y; duration (s) */
   double plan_omega;      /* the omega the plan was made with (1/s) */
@@ -40,6 +41,10 @@ typedef struct {
   double time_s;          /* the tick's time (s) */
   double height[4];       /* the CoM height's move: began (s), duration (s), from, change (m) */
   double facing[4];       /* the heading's move: began (s), duration (s), from, turn (rad) */
+  long rule_in_call;      /* 1: the stance sole's rule read here from the estimate's row
+                           * (sole_support.stance_rule); 0: the caller set it in legs */
+  double near_cop_m;      /* the rule's distance across facets (m) */
+  long bearing_at;        /* where the row holds each sole's bearing summary (5 doubles) */
 } AtlasWalkSwing;
 
 enum { WALK_OUT_XI_REF = 0, WALK_OUT_MOVED = 2, WALK_OUT_STEP = 3, WALK_OUT_SIZE = 5 };
@@ -133,10 +138,27 @@ static void move_reference(const AtlasWalkSwing *w, double *reference) {
 }
 
 /* The tick: the legs' moved reference, reference, adjustment, the law's pressure centre, the legs' swing tick. */
+/* sole_support.stance_rule from the row's summary of the stance sole's contacts: across
+ * facets (its first number not 0.0, NaN too, as Python's truth), near_cop_m and the box of
+ * its bearing points; else 0.0 and no box (NO_SPAN: inf, -inf, inf, -inf). */
+static void stance_rule(const AtlasWalkSwing *w, const double *row) {
+  AtlasLegs *legs = w->legs;
+  const double *summary = row + w->bearing_at + 5 * legs->stance;
+  if (summary[0] != 0.0) {
+    legs->near_m = w->near_cop_m;
+    memcpy(legs->bearing, summary + 1, 4 * sizeof(double));
+  } else {
+    legs->near_m = 0.0;
+    legs->bearing[0] = INFINITY, legs->bearing[1] = -INFINITY;
+    legs->bearing[2] = INFINITY, legs->bearing[3] = -INFINITY;
+  }
+}
+
 void atlas_walk_swing_tick(AtlasWalkSwing *w) {
   const AtlasWholeBody *body = w->legs->whole_body;
   const double *row = body->row;
   const long *at = body->row_at;
+  if (w->rule_in_call) stance_rule(w, row);
   move_reference(w, (double *)body->reference);
   /* DcmPlan.reference(0, elapsed) */
   const double *plan = w->plan;

@@ -19,7 +19,8 @@
 size_t tac_sizeof_AtlasWholeBody(void) { return sizeof(AtlasWholeBody); }
 
 /* The state's fields from the estimate's row into the inputs (the same numbers the Python
- * copies would put there). */
+ * copies would put there), and its joints from the estimate's scratch data where the caller
+ * gave none (the fancy-indexed copies of qpos and qvel it would have made). */
 static void load_row(const AtlasWholeBody *w) {
   const double *row = w->row;
   const long *at = w->row_at;
@@ -36,6 +37,12 @@ static void load_row(const AtlasWholeBody *w) {
   memcpy(in + WB_IN_COM_VELOCITY, row + at[WB_ROW_COM_VELOCITY], 3 * sizeof(double));
   memcpy(in + WB_IN_PELVIS_ROTATION, row + at[WB_ROW_PELVIS_ROTATION], 9 * sizeof(double));
   memcpy(in + WB_IN_PELVIS_ANGULAR, row + at[WB_ROW_PELVIS_ANGULAR], 3 * sizeof(double));
+  if (w->joint_qpos == NULL) return;
+  double *q = in + WB_IN_JOINTS, *qd = q + n;
+  for (long j = 0; j < n; ++j) {
+    q[j] = w->joint_qpos[w->qpos_adr[j]];
+    qd[j] = w->joint_qvel[w->dof_adr[j]];
+  }
 }
 
 /* support.Region.clamp: `p` if inside the region, else the region's nearest point. */

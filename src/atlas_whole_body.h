@@ -30,6 +30,10 @@ typedef struct {
   const double *row;          /* NULL: the state's fields were copied into `in` and the
                                * statics' input; else the estimate's row, read at row_at */
   long row_at[WB_ROW_FIELDS]; /* each field's offset in the row (doubles) */
+  const double *joint_qpos;   /* NULL: the joints copied into `in` by the caller; else, with a */
+  const double *joint_qvel;   /* row, the estimate's scratch qpos and qvel (the row's state), */
+  const long *qpos_adr;       /* its joints read at these qpos and dof addresses (tutorial */
+  const long *dof_adr;        /* order) into `in` by the call itself */
 } AtlasWholeBody;
 
 enum { WB_IN_COP = 0, WB_IN_CAPTURE = 2, WB_IN_OMEGA = 4, WB_IN_COM_VELOCITY = 5,

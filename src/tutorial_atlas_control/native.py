@@ -119,7 +119,9 @@ class AtlasWholeBody(ctypes.Structure):
                 ('joint_gains', ctypes.c_void_p), ('effort_limit', ctypes.c_void_p),
                 ('region', ctypes.c_void_p), ('out', ctypes.c_void_p),
                 ('region_count', ctypes.c_long), ('row', ctypes.c_void_p),
-                ('row_at', ctypes.c_long * WHOLE_BODY_ROW_FIELDS)]
+                ('row_at', ctypes.c_long * WHOLE_BODY_ROW_FIELDS),
+                ('joint_qpos', ctypes.c_void_p), ('joint_qvel', ctypes.c_void_p),
+                ('qpos_adr', ctypes.c_void_p), ('dof_adr', ctypes.c_void_p)]
 
 
 class AtlasSwing(ctypes.Structure):
@@ -166,7 +168,8 @@ class AtlasWalkSwing(ctypes.Structure):
                 ('side', ctypes.c_double), ('step_xy', ctypes.c_double * 2),
                 ('adjust', ctypes.c_long), ('elapsed_s', ctypes.c_double),
                 ('time_s', ctypes.c_double), ('height', ctypes.c_double * 4),
-                ('facing', ctypes.c_double * 4)]
+                ('facing', ctypes.c_double * 4), ('rule_in_call', ctypes.c_long),
+                ('near_cop_m', ctypes.c_double), ('bearing_at', ctypes.c_long)]
 
 
 class AtlasHeightfield(ctypes.Structure):

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from tutorial_atlas_control.balance.compiled_estimator import row_offsets
+from tutorial_atlas_control.balance.errors import BalanceError
 from tutorial_atlas_control.balance.lipm import GRAVITY_M_S2
 from tutorial_atlas_control.native import AtlasWholeBody, address
 
@@ -52,9 +53,34 @@ ROW_FIELDS = ('com', 'com_velocity', 'pelvis_rotation', 'pelvis_angular_velocity
 #: reference (Walk's swinging tick, compiled_walk_swing): compared by identity only.
 MOVED_IN_CALL: MovedReference = (math.nan, math.nan, math.nan)
 
+#: load's joint positions and velocities when the call reads them itself from the compiled
+#: estimate's scratch data (the state's, at the joints' addresses): compared by identity only.
+JOINTS_IN_CALL = np.empty(0)
+JOINTS_IN_CALL.setflags(write=False)
+#: BalanceState.joint_source: the estimate's scratch qpos, qvel, the joints' addresses in each.
+JointSource = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+def joints_of(state: BalanceState) -> tuple[np.ndarray, np.ndarray]:
+    """The joint positions and velocities (tutorial order, new arrays) JOINTS_IN_CALL stands
+    for: the compiled estimate's state's, as its callers' copies of the simulator's qpos and
+    qvel were (the estimate copies those into its scratch data); for a Python path."""
+    source = state.joint_source
+    if source is None:
+        raise BalanceError('JOINTS_IN_CALL for a state not of the compiled estimate: pass '
+                           'its joint positions and velocities')
+    qpos, qvel, qpos_adr, dof_adr = source
+    return qpos[qpos_adr], qvel[dof_adr]
+
 #: One tick's results: torque (n,), pressure centre (2,), force (3,), moment (3,) and the
 #: soles' wrenches (2, 6), new arrays.
 Tick = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+def _kept_if_read_only(array: np.ndarray) -> np.ndarray | None:
+    """`array` if nothing can write into it, not even through a base (its values then stay
+    those copied), else None."""
+    return None if array.flags.writeable or array.base is not None else array
 
 
 class CompiledWholeBody:
@@ -71,6 +97,8 @@ class CompiledWholeBody:
         self._gains = np.array([mass_kg, gains.capture_gain, gains.height_kp, gains.height_kd,
                                 gains.orientation_kp, gains.orientation_kd, GRAVITY_M_S2])
         self._joint_gains = np.zeros(2 * joints)
+        #: The joint_source the call reads the joints from (None: they are copied into _in).
+        self._gathering: JointSource | None = None
         self._effort_limit = np.array(effort_limit_nm, dtype=np.float64)
         self._out = np.zeros(8)
         self._region = np.zeros((1, REGION_ROW))
@@ -81,6 +109,8 @@ class CompiledWholeBody:
         self._pelvis_angular = buffer[17:20]
         self._joints = buffer[IN_FIXED:].reshape(2, joints)
         self._last_reference: StandReference | None = None
+        #: The read-only rate arrays the buffer holds (None: a writable one, copied each time).
+        self._rates: tuple[np.ndarray | None, np.ndarray | None] = (None, None)
         #: The heading, height and rate written over the last reference's (None: its own).
         self._last_moved: MovedReference | None = None
         self._last_gains: tuple[np.ndarray, np.ndarray] | None = None
@@ -99,14 +129,20 @@ class CompiledWholeBody:
         self._pointer = ctypes.byref(call)
 
     def _set_reference(self, reference: StandReference) -> None:
+        """The reference into the buffer; a rate array only when it is not the read-only
+        one copied last (a take-over's every tick: its zeros are such arrays)."""
         joints = len(self._effort_limit)
         buffer = self._reference
         buffer[0:2] = reference.capture_point
         buffer[2:4] = (reference.com_height_m, reference.com_height_rate_m_s)
         buffer[4:13] = reference.pelvis_rotation.reshape(9)
-        buffer[13:16] = reference.pelvis_angular_velocity
         buffer[REFERENCE_FIXED:REFERENCE_FIXED + joints] = reference.posture_rad
-        buffer[REFERENCE_FIXED + joints:] = reference.posture_rate_rad_s
+        turn, posture = reference.pelvis_angular_velocity, reference.posture_rate_rad_s
+        if turn is not self._rates[0]:
+            buffer[13:16] = turn
+        if posture is not self._rates[1]:
+            buffer[REFERENCE_FIXED + joints:] = posture
+        self._rates = (_kept_if_read_only(turn), _kept_if_read_only(posture))
         self._last_reference = reference
         self._last_moved = None
 
@@ -165,7 +201,8 @@ class CompiledWholeBody:
         """This tick's input: the state (read in place from a compiled estimate's row, else
         copied), the contacts, the reference (`moved`: its heading, height and rate
         replaced; MOVED_IN_CALL: the caller's call replaces them) and joint gains when they
-        changed, the joints."""
+        changed, the joints (JOINTS_IN_CALL: the compiled estimate's state's, read by the call
+        from its scratch data; the state must then be the estimator's last)."""
         row = state.row_address
         self._call.row = row
         if row is None:
@@ -184,8 +221,31 @@ class CompiledWholeBody:
             self._joint_gains[:joints] = joint_gains[0]
             self._joint_gains[joints:] = joint_gains[1]
             self._last_gains = joint_gains
+        if joint_positions is JOINTS_IN_CALL:  # the call reads the state's own
+            if row is None or state.joint_source is None:
+                raise BalanceError('JOINTS_IN_CALL for a state not of the compiled estimate: '
+                                   'pass its joint positions and velocities')
+            if state.joint_source is not self._gathering:
+                self._gather(state.joint_source)
+            return
+        if self._gathering is not None:
+            self._gather(None)
         self._joints[0] = joint_positions
         self._joints[1] = joint_velocities
+
+    def _gather(self, source: JointSource | None) -> None:
+        """Where the call reads the joints: an estimator's scratch qpos and qvel at the joints'
+        addresses (its joint_source, kept here: C holds its pointers), or None: from _in."""
+        call = self._call
+        if source is None:
+            call.joint_qpos = call.joint_qvel = call.qpos_adr = call.dof_adr = None
+        else:
+            qpos, qvel, qpos_adr, dof_adr = source
+            call.joint_qpos = address(qpos, np.float64)
+            call.joint_qvel = address(qvel, np.float64)
+            call.qpos_adr = address(qpos_adr, np.intp)
+            call.dof_adr = address(dof_adr, np.intp)
+        self._gathering = source
 
     def _results(self) -> Tick:
         wrenches, torque = self._statics.outputs

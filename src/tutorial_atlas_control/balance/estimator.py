@@ -176,6 +176,10 @@ class BalanceState:
     #: state, which Walk's compiled legs read before the next estimate; set as row_address
     #: is (None: not compiled).
     mass_matrix_source: ClassVar[tuple[int, int, int, np.ndarray, int] | None] = None
+    #: The compiled estimate's scratch qpos and qvel (the state's, until the next estimate)
+    #: and each joint's qpos and dof address (tutorial order): the compiled whole body reads
+    #: the joints there for JOINTS_IN_CALL; set as row_address is.
+    joint_source: ClassVar[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None] = None
 
     def sole_bearing(self, foot: int) -> list[float] | None:
         """Where the sole `foot` bears as the compiled estimate summed it up with its
@@ -328,6 +332,9 @@ class BalanceEstimator:
                 self._pelvis, self._free_dof, np.asarray(self._dof_adr, dtype=np.intp),
                 lipm.GRAVITY_M_S2, MIN_COM_HEIGHT_M, self._corner_offsets,
                 POLYGON_TOLERANCE_M, self._rotation_tolerance))
+        self._joint_source = (self.scratch.qpos, self.scratch.qvel,
+                              np.asarray(atlas.qpos_adr, dtype=np.intp),
+                              np.asarray(self._dof_adr, dtype=np.intp))
         self._mass_matrix_source = (
             self.model._address, self.scratch._address, int(self.model.nv),
             np.asarray(self._dof_adr, dtype=np.intp),
@@ -481,7 +488,8 @@ class BalanceEstimator:
         values.update(
             in_contact=contact, omega=scalars[2], joint_inertia=self._inertia_of,
             polygon_of=polygon_of, contacts_of=lambda: _contacts_of_raw(raw),
-            row_address=raw.address, mass_matrix_source=self._mass_matrix_source, _raw=raw)
+            row_address=raw.address, mass_matrix_source=self._mass_matrix_source,
+            joint_source=self._joint_source, _raw=raw)
         return state
 
     def _estimate_in_python(self, qpos: np.ndarray, qvel: np.ndarray) -> BalanceState:

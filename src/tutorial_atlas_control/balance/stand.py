@@ -156,9 +156,17 @@ def pitch_of(rotation: np.ndarray) -> float:
 
 
 def pelvis_frame(yaw_rad: float, pitch_rad: float = 0.0) -> np.ndarray:
-    """A frame turned by `yaw_rad` about z, then pitched by `pitch_rad` about its own y."""
-    c, s = np.cos(pitch_rad), np.sin(pitch_rad)
-    return yaw_rotation(yaw_rad) @ np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+    """A frame turned by `yaw_rad` about z, then pitched by `pitch_rad` about its own y.
+
+    yaw_rotation(yaw) @ [[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]] written out in floats (every
+    tick of a Stand's take-over; the product's three calls cost twice the arithmetic): each
+    entry is one rounded product or a factor, the same bits; the `+ 0.0` gives the entries
+    the product sums with a +0 term its sign of zero."""
+    c, s = math.cos(yaw_rad), math.sin(yaw_rad)
+    cp, sp = math.cos(pitch_rad), math.sin(pitch_rad)
+    return np.array([[c * cp, -s + 0.0, c * sp + 0.0],
+                     [s * cp + 0.0, c, s * sp + 0.0],
+                     [-sp + 0.0, 0.0, cp]])
 
 
 @dataclass(frozen=True)

@@ -26,6 +26,7 @@ import mujoco
 import numpy as np
 
 from tutorial_atlas_control.balance.blend import smoothstep, smoothstep_rate
+from tutorial_atlas_control.balance.compiled_whole_body import JOINTS_IN_CALL
 from tutorial_atlas_control.balance.errors import BalanceError
 from tutorial_atlas_control.balance.estimator import BalanceEstimator, BalanceState
 from tutorial_atlas_control.balance.manipulate import (
@@ -68,6 +69,18 @@ def stand_pose_com_height_m(atlas: AtlasModel) -> float:
 
 
 _UP = np.array([0.0, 0.0, 1.0])
+
+
+def _still(size: int) -> np.ndarray:
+    """Zeros that cannot be written: a reference's rates while it moves without them."""
+    zeros = np.zeros(size)
+    zeros.setflags(write=False)
+    return zeros
+
+
+#: A take-over's reference's pelvis angular velocity and posture rates: the same read-only
+#: zeros every tick (the whole-body call copies a rate only when it is another array).
+_STILL_TURN, _STILL_POSTURE = _still(3), _still(len(JOINT_NAMES))
 
 
 def _as_vector(reference: StandReference) -> np.ndarray:
@@ -118,12 +131,14 @@ def _reference_without_rates(capture_point: np.ndarray, com_height_m: float,
                              posture_rad: np.ndarray) -> StandReference:
     """StandReference(capture_point, com_height_m, pelvis_rotation, posture_rad) without the
     frozen dataclass's __init__ (an object.__setattr__ a field, its defaults' factories
-    called through it): every tick of a take-over."""
+    called through it), its zero rates shared read-only arrays: every tick of a take-over."""
     reference = _new_object(StandReference)
     reference.__dict__.update(
         capture_point=capture_point, com_height_m=com_height_m,
         pelvis_rotation=pelvis_rotation, posture_rad=posture_rad, com_height_rate_m_s=0.0,
-        pelvis_angular_velocity=np.zeros(3), posture_rate_rad_s=np.zeros(len(posture_rad)))
+        pelvis_angular_velocity=_STILL_TURN,
+        posture_rate_rad_s=(_STILL_POSTURE if len(posture_rad) == len(_STILL_POSTURE)
+                            else np.zeros(len(posture_rad))))
     return reference
 
 
@@ -319,11 +334,14 @@ class StandBehaviour:
             raise BalanceError('StandBehaviour.torque before start()')
         if self._transition is not None:
             controller.reference = self._reference_at(float(data.time))
-        atlas, vectors = self.atlas, self._vectors
-        if vectors is None or vectors[0] is not data:
-            vectors = self._vectors = (data, data.qpos, data.qvel)
-        qpos, qvel = vectors[1], vectors[2]
         state = self.estimator.estimate_stepped(data)
-        output = controller.tick(state, qpos[atlas.qpos_adr], qvel[atlas.dof_adr])
+        if state.row_address is not None and controller.compiled:  # the call reads the joints
+            output = controller.tick(state, JOINTS_IN_CALL, JOINTS_IN_CALL)
+        else:
+            atlas, vectors = self.atlas, self._vectors
+            if vectors is None or vectors[0] is not data:
+                vectors = self._vectors = (data, data.qpos, data.qvel)
+            output = controller.tick(state, vectors[1][atlas.qpos_adr],
+                                     vectors[2][atlas.dof_adr])
         self.last_state, self.last_output = state, output
         return output.torque_nm

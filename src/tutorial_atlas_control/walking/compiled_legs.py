@@ -114,13 +114,14 @@ class CompiledLegs:
                         joints: tuple[np.ndarray, np.ndarray],
                         joint_gains: tuple[np.ndarray, np.ndarray], reference: StandReference,
                         moved: MovedReference, swing: tuple[int, SwingPath, float],
-                        near: tuple[float, Span] = (0.0, NO_SPAN)) -> None:
+                        near: tuple[float, Span] | None = (0.0, NO_SPAN)) -> None:
         """A swinging tick's input but the pressure centre (tick_at sets it, or the walk's
         swing tick, compiled_walk_swing): the state, the stance sole's `contacts`, the joints'
         positions and velocities, their gains, the legs' reference (`moved`: its heading,
         height and rate), `swing` (the foot, its path, the time into it) and `near` (how near
         and the stance sole's bearing box: > 0 across facets, its wrench's pressure centre
-        kept within that of the kept one or of the box: sole_support.stance_rule)."""
+        kept within that of the kept one or of the box: sole_support.stance_rule; None: left
+        to the walk's swing call, which reads the rule from the row)."""
         source = state.mass_matrix_source
         if source is not self._source or source is None:  # the estimator's one tuple: once
             if source is None or self._scratch != source[0:2]:
@@ -133,8 +134,9 @@ class CompiledLegs:
                               moved)
         self._swing.set_path(path)
         self._swing.prepare_swing(elapsed_s)
-        self._call.near_m = near[0]
-        self._call.bearing[:] = near[1]
+        if near is not None:
+            self._call.near_m = near[0]
+            self._call.bearing[:] = near[1]
 
     def results(self) -> tuple[np.ndarray, np.ndarray]:
         """The last tick's torques (joints,) and pressure centre as kept, new arrays."""

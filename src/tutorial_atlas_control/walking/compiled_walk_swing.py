@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from tutorial_atlas_control import native
+from tutorial_atlas_control.balance import BEARING_AT
 from tutorial_atlas_control.native import AtlasWalkSwing, address
 from tutorial_atlas_control.walking.footsteps import side_sign
 
@@ -44,7 +45,11 @@ class CompiledWalkSwing:
     what change (m) the landing is adjusted; its buffers its own."""
 
     def __init__(self, library: ctypes.CDLL, tasks: LegTasks, legs: CompiledLegs,
-                 dcm_gain: float, adjust: bool, tolerance_m: float) -> None:
+                 dcm_gain: float, adjust: bool, tolerance_m: float,
+                 near_cop_m: float | None = None) -> None:
+        """`near_cop_m`: the stance-sole rule's distance (sole_support.stance_rule), read by
+        the call from the estimate's row each tick; None: the rule off, the legs' input as
+        their caller loads it."""
         self._library = library
         self._tasks = tasks  # its timed moves of the legs' reference
         self._legs = legs
@@ -55,6 +60,11 @@ class CompiledWalkSwing:
         call.dcm_gain = dcm_gain
         call.adjust = int(adjust)
         call.tolerance_m = tolerance_m
+        #: Whether the call applies the stance-sole rule itself (the legs' load skips it).
+        self.rule_in_call = near_cop_m is not None
+        call.rule_in_call = int(self.rule_in_call)
+        call.near_cop_m = 0.0 if near_cop_m is None else near_cop_m
+        call.bearing_at = BEARING_AT
         self._pointer = ctypes.byref(call)
         self._tick = library.atlas_walk_swing_tick
         #: What the call's step numbers were set from (plan, planned, step, stance, limits).
@@ -119,4 +129,4 @@ def walk_swing_kernel(legs: LegTasks, gains: WalkGains,
     if library is None or kernel is None:
         return None
     return CompiledWalkSwing(library, legs, kernel, gains.dcm_gain, gains.adjust_steps,
-                             gains.adjust_tolerance_m)
+                             gains.adjust_tolerance_m, gains.legs.near_cop_m)

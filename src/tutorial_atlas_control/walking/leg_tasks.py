@@ -305,13 +305,15 @@ class LegTasks:
 
     def load_swing_tick(self, state: BalanceState, joint_positions: np.ndarray,
                         joint_velocities: np.ndarray, moved: MovedReference,
-                        swing: tuple[int, SwingPath, float]) -> CompiledLegs | None:
-        """swing_tick's one call loaded but the pressure centre (`moved`: MOVED_IN_CALL for the
-        caller's call's), or None: in pieces (no library, or a Python estimate's state)."""
+                        swing: tuple[int, SwingPath, float],
+                        rule_in_call: bool = False) -> CompiledLegs | None:
+        """swing_tick's call loaded but the pressure centre, the caller's call's (MOVED_IN_CALL
+        `moved`, the stance rule if `rule_in_call`), or None: no library, a Python state."""
         legs = self._legs_kernel
         if legs is None or state.row_address is None:
             return None
-        near = sole_support.stance_rule(state, 1 - swing[0], self.gains.near_cop_m)
+        near = None if rule_in_call else sole_support.stance_rule(state, 1 - swing[0],
+                                                                  self.gains.near_cop_m)
         legs.load_swing_tick(state, self._swing_contacts[swing[0]],
                              (joint_positions, joint_velocities), self._joint_gains,
                              self.reference, moved, swing, near)

@@ -377,14 +377,14 @@ class WalkController:
     def _compiled_swing(self, kernel: CompiledWalkSwing, state: BalanceState,
                         joint_positions: np.ndarray, joint_velocities: np.ndarray,
                         time_s: float) -> WalkOutput | None:
-        """tick_torque with the foot in the air as one C call (the reference, _adjust, the
-        law, the legs), or None where that call does not run (a Python estimate's state)."""
+        """tick_torque's swinging tick as one C call (None: not run, a Python estimate's state)."""
         step, swing, plan, planned = self.step, self.swing, self._plan, self._planned_step
         assert step is not None and swing is not None and plan is not None \
             and planned is not None and self._lift_off_s is not None  # swinging
         elapsed = time_s - self.phases.started_s  # phases.elapsed_s
         if self.legs.load_swing_tick(state, joint_positions, joint_velocities, MOVED_IN_CALL,
-                                     (step.foot_index, swing, elapsed - self._lift_off_s)) is None:
+                                     (step.foot_index, swing, elapsed - self._lift_off_s),
+                                     kernel.rule_in_call) is None:
             return None
         kernel.bind(plan, planned, step, self.queue.feet[1 - step.foot_index], self.queue.limits)
         torque, cop, xi_ref, moved = kernel.tick(elapsed, time_s)

@@ -23,7 +23,7 @@ from dataclasses import dataclass, replace
 import mujoco
 import numpy as np
 
-from tutorial_atlas_control.balance import BalanceState, StandBehaviour
+from tutorial_atlas_control.balance import JOINTS_IN_CALL, BalanceState, StandBehaviour
 from tutorial_atlas_control.walking.errors import WalkingError
 from tutorial_atlas_control.walking.feet_surfaces import support_height_m
 from tutorial_atlas_control.walking.footsteps import DRCSIM_WALK_QUEUE, Footstep
@@ -119,6 +119,9 @@ class WalkBehaviour:
             stand.estimator.ground_m = ground
         state = stand.estimator.estimate_stepped(data)
         self.last_state = state
+        if state.row_address is not None and walk.legs.legs_kernel is not None:
+            # every call of the tick compiled: they read the joints from the estimate's data
+            return walk.tick_torque(state, JOINTS_IN_CALL, JOINTS_IN_CALL, time_s).torque_nm
         vectors = self._vectors  # the binding makes a new view at each read of data.qpos
         if vectors is None or vectors[0] is not data:
             vectors = self._vectors = (data, data.qpos, data.qvel)

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from tutorial_atlas_control import native
-from tutorial_atlas_control.balance import support
+from tutorial_atlas_control.balance import JOINTS_IN_CALL, joints_of, support
 from tutorial_atlas_control.balance.estimator import BalanceEstimator, BalanceState, _within
 from tutorial_atlas_control.balance.push_trial import (
     Push,
@@ -85,8 +85,8 @@ def test_compiled_stand_tick_agrees_with_python_through_a_push(
              velocities: np.ndarray) -> StandOutput:
         nonlocal clamped
         assert self.compiled
-        ours = TICK(self, state, positions, velocities)
-        theirs = _in_python(self, TICK, state, positions, velocities)
+        ours = TICK(self, state, positions, velocities)  # JOINTS_IN_CALL: read by C
+        theirs = _in_python(self, TICK, state, *_joints(state, positions, velocities))
         differences.append(_difference(ours, theirs))
         clamped += _outside(state, self)
         return ours
@@ -99,6 +99,12 @@ def test_compiled_stand_tick_agrees_with_python_through_a_push(
     assert clamped > 20
 
 
+def _joints(state: BalanceState, positions: np.ndarray,
+            velocities: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The joints a Python path needs: JOINTS_IN_CALL's (the state's, as Python reads them)."""
+    return joints_of(state) if positions is JOINTS_IN_CALL else (positions, velocities)
+
+
 def test_compiled_whole_body_agrees_with_python_through_a_walk(
         library, monkeypatch: pytest.MonkeyPatch) -> None:
     """Walk's whole-body solves (one sole with its yaw moment limited, Walk's joint gains,
@@ -109,7 +115,9 @@ def test_compiled_whole_body_agrees_with_python_through_a_walk(
     def both(self: StandController, *args: object) -> StandOutput:
         assert self.compiled
         ours = WHOLE_BODY(self, *args)
-        theirs = _in_python(self, WHOLE_BODY, *args)
+        state, cop, contact, positions, velocities, *rest = args
+        theirs = _in_python(self, WHOLE_BODY, state, cop, contact,
+                            *_joints(state, positions, velocities), *rest)  # type: ignore[arg-type]
         differences.append(_difference(ours, theirs))
         torsions.add(args[6] if len(args) > 6 else None)
         return ours

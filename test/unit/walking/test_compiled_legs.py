@@ -17,7 +17,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.balance import BalanceState
+from tutorial_atlas_control.balance import JOINTS_IN_CALL, BalanceState, joints_of
 from tutorial_atlas_control.balance.stand_behaviour import StandBehaviour
 from tutorial_atlas_control.balance.stand_pose import place_in_stand_pose
 from tutorial_atlas_control.sim import model as atlas_model
@@ -115,6 +115,8 @@ def test_the_one_call_agrees_with_the_pieces_and_python_through_a_walk(
     def both(self: LegTasks, state: BalanceState, positions: np.ndarray,
              velocities: np.ndarray, time_s: float, cop: np.ndarray,
              swing: tuple[int, SwingPath, float]) -> Tick:
+        if positions is JOINTS_IN_CALL:  # the pieces and the Python need them as arrays
+            positions, velocities = joints_of(state)
         ours, pieces, python = _compare(self, state, positions, velocities, time_s, cop, swing)
         walked.extend((pieces, python))
         facets[0] = True
@@ -133,6 +135,8 @@ def test_the_one_call_agrees_with_the_pieces_and_python_through_a_walk(
     def both_feet(self: LegTasks, state: BalanceState, positions: np.ndarray,
                   velocities: np.ndarray, time_s: float, cop: np.ndarray,
                   swing_foot: int | None) -> Tick:
+        if positions is JOINTS_IN_CALL:
+            positions, velocities = joints_of(state)
         ours = TORQUE(self, state, positions, velocities, time_s, cop, swing_foot)
         if swing_foot is not None:  # the pieces of a swinging tick, compared above
             return ours
@@ -158,6 +162,8 @@ def test_the_one_call_agrees_with_the_pieces_and_python_through_a_walk(
     def support_by_pieces(self: LegTasks, state: BalanceState, positions: np.ndarray,
                           velocities: np.ndarray, time_s: float, cop: np.ndarray,
                           feet: Sequence[Footstep]) -> Tick:
+        if positions is JOINTS_IN_CALL:
+            positions, velocities = joints_of(state)
         torque, kept, contact = self.torque(state, positions, velocities, time_s, cop, None)
         return self.finish(state, velocities, torque, contact, None, feet), kept, contact
 

@@ -13,7 +13,7 @@ from collections.abc import Sequence
 import numpy as np
 import pytest
 
-from tutorial_atlas_control.balance import BalanceState
+from tutorial_atlas_control.balance import JOINTS_IN_CALL, BalanceState, joints_of
 from tutorial_atlas_control.walking.footsteps import Footstep
 from tutorial_atlas_control.walking.leg_tasks import LEGS_ENV, LegTasks
 from tutorial_atlas_control.walking.walk_behaviour import WalkBehaviour
@@ -97,7 +97,9 @@ def test_the_support_call_agrees_with_the_pieces_on_random_feet(
     def both(self: LegTasks, state: BalanceState, positions: np.ndarray,
              velocities: np.ndarray, time_s: float, cop: np.ndarray,
              feet: Sequence[Footstep]) -> Tick:
-        ours = SUPPORT(self, state, positions, velocities, time_s, cop, feet)
+        ours = SUPPORT(self, state, positions, velocities, time_s, cop, feet)  # C reads them
+        if positions is JOINTS_IN_CALL:  # the pieces need them as arrays
+            positions, velocities = joints_of(state)
         assert ours[2] == _by_pieces(self, state, positions, velocities, time_s, cop, feet)[2]
         walked.append(_difference(ours, _by_pieces(self, state, positions, velocities,
                                                    time_s, cop, feet)))
