@@ -61,15 +61,21 @@ JOINTS_IN_CALL.setflags(write=False)
 JointSource = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 
+def _joint_source(state: BalanceState, row: int | None) -> JointSource:
+    """Where JOINTS_IN_CALL's joints are for `state` (the estimate's `row`, None for a
+    Python estimate's); refused for a state not of the compiled estimate."""
+    source = state.joint_source
+    if row is None or source is None:
+        raise BalanceError('JOINTS_IN_CALL for a state not of the compiled estimate: pass '
+                           'its joint positions and velocities')
+    return source
+
+
 def joints_of(state: BalanceState) -> tuple[np.ndarray, np.ndarray]:
     """The joint positions and velocities (tutorial order, new arrays) JOINTS_IN_CALL stands
     for: the compiled estimate's state's, as its callers' copies of the simulator's qpos and
     qvel were (the estimate copies those into its scratch data); for a Python path."""
-    source = state.joint_source
-    if source is None:
-        raise BalanceError('JOINTS_IN_CALL for a state not of the compiled estimate: pass '
-                           'its joint positions and velocities')
-    qpos, qvel, qpos_adr, dof_adr = source
+    qpos, qvel, qpos_adr, dof_adr = _joint_source(state, state.row_address)
     return qpos[qpos_adr], qvel[dof_adr]
 
 #: One tick's results: torque (n,), pressure centre (2,), force (3,), moment (3,) and the
@@ -222,11 +228,9 @@ class CompiledWholeBody:
             self._joint_gains[joints:] = joint_gains[1]
             self._last_gains = joint_gains
         if joint_positions is JOINTS_IN_CALL:  # the call reads the state's own
-            if row is None or state.joint_source is None:
-                raise BalanceError('JOINTS_IN_CALL for a state not of the compiled estimate: '
-                                   'pass its joint positions and velocities')
-            if state.joint_source is not self._gathering:
-                self._gather(state.joint_source)
+            source = _joint_source(state, row)
+            if source is not self._gathering:
+                self._gather(source)
             return
         if self._gathering is not None:
             self._gather(None)
