@@ -43,6 +43,10 @@ LANDING_BIAS_BELOW_M = 0.005
 #: The README's "every landing within about 3 cm" (m), the issue's 0.1 rad.
 LANDING_WITHIN_M = 0.03
 LANDING_YAW_WITHIN_RAD = 0.1
+#: A landed sole lies within this of its surface when Walk takes the next step (rad; 2
+#: degrees; 0.015 here). Its swing leg damped by the stance's leg damping as well as by its
+#: servo, the ankle lagged and every sole was still 0.13-0.16 rad heel first then.
+LANDING_TILT_BELOW_RAD = 0.035
 #: The issue's bound on a pushed step, from where Walk moved it (m).
 TAKEN_WITHIN_M = 0.05
 #: A walking pelvis stays above this (m; the walk lowers it 5 cm, Stand holds 0.91).
@@ -70,7 +74,9 @@ def fraction_text(trials: dict[int, WalkTrial], bad: list[int], what: str) -> st
 
 def describe(trial: WalkTrial) -> str:
     return (f'fell={trial.fell}, {trial.steps} steps, worst landing '
-            f'{trial.worst_landing_m:.3f} m, lowest pelvis {trial.lowest_pelvis_m:.3f} m')
+            f'{trial.worst_landing_m:.3f} m, worst tilt '
+            f'{max((x.tilt_rad for x in trial.landings), default=0.0):.3f} rad, lowest pelvis '
+            f'{trial.lowest_pelvis_m:.3f} m')
 
 
 def summary(name: str, trials: dict[int, WalkTrial]) -> str:
@@ -121,6 +127,16 @@ def test_eight_of_eight_seeds_land_without_bias(straight: dict[int, WalkTrial]) 
     servo without the path's acceleration and blind to the pelvis's speed: 2.4 cm ahead)."""
     bad = failed(straight, lambda trial: abs(trial.mean_ahead_m) < LANDING_BIAS_BELOW_M)
     assert len(straight) - len(bad) == 8, fraction_text(straight, bad, 'landed without bias')
+
+
+def test_eight_of_eight_seeds_land_flat(straight: dict[int, WalkTrial]) -> None:
+    """Every sole comes down flat, not heel first (planted, the swinging leg damped by
+    LegGains.leg_kd as the stance leg is: 0.13 rad at every landing)."""
+    def ok(trial: WalkTrial) -> bool:
+        return walked(trial) and all(landing.tilt_rad < LANDING_TILT_BELOW_RAD
+                                     for landing in trial.landings)
+    bad = failed(straight, ok)
+    assert len(straight) - len(bad) == 8, fraction_text(straight, bad, 'landed flat')
 
 
 def test_the_seeds_perturb_the_walk(straight: dict[int, WalkTrial]) -> None:

@@ -3,8 +3,8 @@ walks the issue's two turns of a 2 m circle, streamed (walking/walk.py on the St
 whole-body balance), then stands again. The issue's bounds: every landing within 5 cm and
 0.1 rad of its target, no fall, back within 0.3 m of the start after each turn; the legs'
 torques without chatter; and the exact figures of this run. Defects kept as tests: pushed
-sideways by the issue's 15 N s four times during 20 straight steps, at phases chosen so,
-a walk without step adjustment falls at the eighth step (with it, seeded pushed walks walk
+sideways by 20 N s four times during 20 straight steps, at phases chosen so, a walk without
+step adjustment falls at its sixth step and with it walks the 20 (seeded pushed walks walk
 on: test_walk_seeds.py; the moved step's landing and step_queue_saturated:
 test_asi_walk.py); the walk at the Stand's height (the trailing leg cannot lift) falls
 within its first three steps. Planted once: a swing servo
@@ -43,8 +43,11 @@ CIRCLE_TURNS = 1
 CIRCLE_WIDTH_M = 0.3
 BACK_WITHIN_M = 0.3
 PELVIS_ABOVE_M = 0.7
-#: The issue's push while walking: 150 N sideways on the pelvis for 0.1 s (15 N s).
-PUSH_N = 150.0
+#: The push while walking: 200 N sideways on the pelvis for 0.1 s (20 N s). At the issue's
+#: 150 N the walk without step adjustment fell at its eighth step while its swinging leg was
+#: damped as the stance leg is (LegGains.swing_leg_kd); with the ankle following its path
+#: it walks the 20, and falls at its sixth step from 175 N.
+PUSH_N = 200.0
 PUSH_S = 0.1
 #: The legs' torques change by at most this much per 1 ms step, on average (N m): the
 #: chattering servo's was 107, the smooth one's is 1.4.
@@ -71,7 +74,7 @@ def test_a_turn_of_a_two_metre_circle_streamed() -> None:
         assert np.linalg.norm(np.array(after.pelvis_xy) - start) < BACK_WITHIN_M
     assert trial.leg_torque_jump_nm < TORQUE_JUMP_BELOW_NM
     # This run's figures (deterministic).
-    assert round(trial.worst_landing_m, 3) == 0.007
+    assert round(trial.worst_landing_m, 3) == 0.005
 
 
 def _pushed_walk(adjust_steps: bool) -> WalkTrial:
@@ -81,8 +84,8 @@ def _pushed_walk(adjust_steps: bool) -> WalkTrial:
     towards the stance foot: without step adjustment, each of these fell. (Pushed at the
     lift-off of steps 4 and 9, as before the walk's weight transfer, or a twentieth or a
     quarter into them, the walk without step adjustment walks on: the transfer's two feet
-    and the capture point it leaves over the stance sole take those pushes. Halfway, it
-    falls at the eighth step (7 taken), and with step adjustment walks the 20.)"""
+    and the capture point it leaves over the stance sole take those pushes. Halfway, at
+    PUSH_N, it falls at the sixth step (5 taken), and with step adjustment walks the 20.)"""
     def during(step: int, fraction: float) -> float:
         return SETTLE_S + WalkGains().sway_s + (step - 1 + fraction) * STEP_DURATION_S
 
@@ -96,7 +99,13 @@ def _pushed_walk(adjust_steps: bool) -> WalkTrial:
 def test_pushed_while_walking_without_step_adjustment_it_falls() -> None:
     trial = _pushed_walk(adjust_steps=False)
     assert trial.fell
-    assert trial.steps == 7
+    assert trial.steps == 5
+
+
+def test_pushed_so_while_walking_with_step_adjustment_it_walks_on() -> None:
+    trial = _pushed_walk(adjust_steps=True)
+    assert not trial.fell
+    assert trial.steps == STRAIGHT_STEPS
 
 
 def test_at_the_stands_height_the_trailing_leg_cannot_lift_and_it_falls() -> None:

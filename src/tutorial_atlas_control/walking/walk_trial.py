@@ -75,6 +75,9 @@ class Landing:
     #: How far ahead of its target it came down, along the target's heading (m; negative:
     #: short of it): a bias here is the swing servo's, not scatter.
     ahead_m: float = 0.0
+    #: How far its sole lay off its step's surface as Walk took the next step (rad): a
+    #: swing foot lagging in the ankle comes down heel first.
+    tilt_rad: float = 0.0
 
 
 @dataclass
@@ -222,7 +225,14 @@ class WalkingStand:
             abs(wrap_angle(down.yaw_rad - target.yaw_rad)),
             (float(state.pelvis_position[0]), float(state.pelvis_position[1])),
             math.hypot(down.x_m - taken.x_m, down.y_m - taken.y_m),
-            math.cos(target.yaw_rad) * dx + math.sin(target.yaw_rad) * dy))
+            math.cos(target.yaw_rad) * dx + math.sin(target.yaw_rad) * dy,
+            _tilt_rad(state.sole_rotations[target.foot_index], target.normal)))
+
+
+def _tilt_rad(sole_rotation: np.ndarray, normal: Sequence[float]) -> float:
+    """The angle (rad) between a sole's normal and a surface's unit `normal`."""
+    cosine = float(sole_rotation[:, 2] @ np.asarray(normal, dtype=float))
+    return math.acos(min(max(cosine, -1.0), 1.0))
 
 
 def walk_trial(plan: Sequence[Footstep], duration_s: float, gains: WalkGains | None = None,
