@@ -5,10 +5,10 @@ own reference is not touched), a swing foot servoed along its path, a foot that 
 down put back flat on its last pose.
 
 The Stand's joint PD keeps the arms and the back; the legs' posture gains are off (leg_kd
-of damping instead, a tenth of it on the swinging leg): in single support the stance leg's joints
-follow from the pelvis and the foot, the swing leg's from its task. While a foot swings, the stance sole's yaw moment
-is held within torsion_m times its load (beyond the model's torsional friction the foot
-turns).
+of damping instead, a tenth of it on the swinging leg): in single support the stance leg's
+joints follow from the pelvis and the foot, the swing leg's from its task. While a foot
+swings, the stance sole's yaw moment is held within torsion_m times its load (beyond the
+model's torsional friction the foot turns).
 
 A foot is servoed in the leg's joint space: its pose error turned into joint errors by
 the leg's damped least-squares inverse, then a joint PD scaled by the leg's inertia, so
