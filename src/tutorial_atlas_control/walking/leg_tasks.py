@@ -153,14 +153,8 @@ class LegTasks:
         #: The legs' own reference for the whole-body layer: the Stand's as the walk or
         #: step begins, its heading and height moved on (the Stand's is left as it is).
         self.reference = stand.reference
-        #: The Stand's joint PD with the legs' posture gains off (damping leg_kd instead).
-        joint_kp, joint_kd = stand.gains.joint_kp.copy(), stand.gains.joint_kd.copy()
-        joint_kp[LEG_JOINTS] = 0.0
-        joint_kd[LEG_JOINTS] = gains.leg_kd
-        self._joint_gains = (joint_kp, joint_kd)
-        #: The same while each foot swings: its leg damped by swing_leg_kd.
-        self._swing_joint_gains = tuple(
-            (joint_kp, _with_leg_kd(joint_kd, foot, gains.swing_leg_kd)) for foot in (0, 1))
+        #: The legs' joint PD, standing and while each foot swings (_stepping_joint_gains).
+        self._joint_gains, self._swing_joint_gains = _stepping_joint_gains(stand, gains)
         self._ik_damping = gains.ik_damping_m ** 2 * np.eye(6)
         #: The soles' contacts while each foot swings (the stance sole's yaw moment limited).
         self._swing_contacts = tuple(stand.contacts_for((foot != 0, foot != 1), gains.torsion_m)
@@ -399,11 +393,23 @@ class LegTasks:
         return self.stand.layer.limit(torque)
 
 
-def _with_leg_kd(joint_kd: np.ndarray, foot: int, leg_kd: float) -> np.ndarray:
-    """`joint_kd` with the leg of `foot` damped by `leg_kd` instead (a copy)."""
-    damped = joint_kd.copy()
-    damped[LEG_OF_FOOT[foot]] = leg_kd
-    return damped
+JointGains = tuple[np.ndarray, np.ndarray]
+
+
+def _stepping_joint_gains(stand: StandController, gains: LegGains
+                          ) -> tuple[JointGains, tuple[JointGains, JointGains]]:
+    """The Stand's joint PD (kp, kd) with the legs' posture gains off, damping leg_kd
+    instead; and the same while the left, then the right foot swings, its leg damped by
+    swing_leg_kd."""
+    joint_kp, joint_kd = stand.gains.joint_kp.copy(), stand.gains.joint_kd.copy()
+    joint_kp[LEG_JOINTS] = 0.0
+    joint_kd[LEG_JOINTS] = gains.leg_kd
+    swinging = []
+    for foot in (0, 1):
+        damped = joint_kd.copy()
+        damped[LEG_OF_FOOT[foot]] = gains.swing_leg_kd
+        swinging.append((joint_kp, damped))
+    return (joint_kp, joint_kd), (swinging[0], swinging[1])
 
 
 def _python_foot_servo(gains: LegGains, ik_damping: np.ndarray, state: BalanceState,
