@@ -22,7 +22,7 @@ import numpy as np
 
 from tutorial_atlas_control.asi.behaviors import BEHAVIOR_OF_MODE, Behavior
 from tutorial_atlas_control.asi.walk_params import footsteps_of, step_feedback, walk_feedback
-from tutorial_atlas_control.balance import PelvisServo, StandBehaviour
+from tutorial_atlas_control.balance import PelvisServo, SoleBox, StandBehaviour
 from tutorial_atlas_control.control_modes import ControlMode
 from tutorial_atlas_control.msgs import AsiCommand, ManipulateFeedback, ManipulateParams
 from tutorial_atlas_control.sim import Ground
@@ -31,6 +31,7 @@ from tutorial_atlas_control.walking import (
     Footstep,
     StepBehaviour,
     WalkBehaviour,
+    footprint_surface,
 )
 
 __all__ = ['BehaviourBase', 'Handover', 'LibraryBehaviour', 'ManipulateEntry', 'NestedBehaviour',
@@ -148,19 +149,29 @@ class BehaviourBase:
 
 
 def on_ground(steps: list[Footstep], ground: Ground | None) -> list[Footstep]:
-    """`steps` placed on the world's surface under each sole's centre (its height and
-    normal): a DRC-era client's z is the foot link's, or none (ASI.md: it may be ignored),
-    so the world says where a sole lands. Nothing below (off the world): as asked."""
+    """`steps` placed on the world's surface under each sole (its height and normal): on a
+    heightfield the plane its footprint rests on (walking/sole_footprint.py), elsewhere the
+    surface under its centre. A DRC-era client's z is the foot link's, or none (ASI.md: it
+    may be ignored), so the world says where a sole lands. Nothing below (off the world):
+    as asked."""
     if ground is None or ground.level_m == 0.0:
         return steps  # the ground the robot starts on: every step's default
+    model = ground.model
+    hfields = frozenset(geom for geom in ground.geom_ids
+                        if model.geom_type[geom] == mujoco.mjtGeom.mjGEOM_HFIELD)
+    half_size = SoleBox.of(model).half_size_m if hfields else (0.0, 0.0)
     placed = []
     for step in steps:
         hit = ground.hit(step.x_m, step.y_m)
         if hit.geom_id < 0:
             placed.append(step)
             continue
-        normal = (float(hit.normal[0]), float(hit.normal[1]), float(hit.normal[2]))
-        placed.append(dataclasses.replace(step, z_m=hit.height_m, normal=normal))
+        surface = None if hit.geom_id not in hfields else footprint_surface(
+            ground, step.x_m, step.y_m, step.yaw_rad, half_size, hfields)
+        if surface is None:
+            surface = (hit.height_m, (float(hit.normal[0]), float(hit.normal[1]),
+                                      float(hit.normal[2])))
+        placed.append(dataclasses.replace(step, z_m=surface[0], normal=surface[1]))
     return placed
 
 

@@ -12,6 +12,7 @@ Walk and Step run (their phases in order, each one's end rule, the transition);
 leg_tasks: what Walk and Step do alike each tick (the whole-body law on the carrying soles,
 the swing foot, the pelvis's heading); sole_support: a lone stance sole across facets (the
 course's hills) keeps its wrench's pressure centre near the one asked (off by default);
+sole_footprint: the plane a step's sole rests on over a heightfield;
 compiled_swing: the swing foot's path and servo as one C call (src/atlas_swing.c);
 compiled_legs: a swinging tick of the legs (sole clamp, whole body, swing servo, effort
 limits) as one C call (src/atlas_legs.c); compiled_walk_swing: a walking tick with the foot
@@ -48,6 +49,7 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'route': ['RouteGait', 'centre_line_xy', 'feet_origin', 'route_steps'],
     'ground_strides': ['SOLE_HALF_LENGTH_M', 'SOLE_HALF_WIDTH_M', 'GroundGait', 'HeightField',
                        'SoleFit', 'ground_steps', 'sole_fit'],
+    'sole_footprint': ['footprint_surface'],
     'start_noise': ['perturb_start'],
     'walk_trial': ['SETTLE_S', 'WalkTrial', 'WalkingStand', 'pushed_walk_trial',
                    'random_pushes', 'run_walking_stand', 'straight_walk_trial', 'walk_trial'],
