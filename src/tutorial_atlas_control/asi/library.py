@@ -156,10 +156,8 @@ def on_ground(steps: list[Footstep], ground: Ground | None) -> list[Footstep]:
     as asked."""
     if ground is None or ground.level_m == 0.0:
         return steps  # the ground the robot starts on: every step's default
-    model = ground.model
-    hfields = frozenset(geom for geom in ground.geom_ids
-                        if model.geom_type[geom] == mujoco.mjtGeom.mjGEOM_HFIELD)
-    half_size = SoleBox.of(model).half_size_m if hfields else (0.0, 0.0)
+    hfields = ground.hfield_geoms
+    half_size = SoleBox.of(ground.model).half_size_m if hfields else (0.0, 0.0)
     placed = []
     for step in steps:
         hit = ground.hit(step.x_m, step.y_m)
@@ -167,7 +165,7 @@ def on_ground(steps: list[Footstep], ground: Ground | None) -> list[Footstep]:
             placed.append(step)
             continue
         surface = None if hit.geom_id not in hfields else footprint_surface(
-            ground, step.x_m, step.y_m, step.yaw_rad, half_size, hfields)
+            ground, step.x_m, step.y_m, step.yaw_rad, half_size, hit.height_m)
         if surface is None:
             surface = (hit.height_m, (float(hit.normal[0]), float(hit.normal[1]),
                                       float(hit.normal[2])))

@@ -185,6 +185,8 @@ class Ground:
         casts = [self._prepare(geom, fixed if welded[geom] else loose_data)
                  for geom in self.geom_ids]
         self._planes = [c for c in casts if c.kind == _PLANE]
+        #: The heightfields among them (the course's terrain).
+        self.hfield_geoms = frozenset(c.geom for c in casts if c.kind == _HFIELD)
         self._static = [c for c in casts if c.kind != _PLANE and welded[c.geom]]
         self._loose = [c for c in casts if c.kind != _PLANE and not welded[c.geom]]
         # The loose geoms as arrays, for numpy (the course's 30 blocks are 150 boxes).

@@ -17,28 +17,32 @@ import math
 
 import numpy as np
 
+from tutorial_atlas_control.balance import BOTTOM_CORNER_SIGNS
 from tutorial_atlas_control.sim import Ground
 
 __all__ = ['footprint_surface']
 
-#: The sole's bottom face sampled: its corners (along, across, in half sizes) and centre.
-_SAMPLES = np.array([[1.0, 1.0], [1.0, -1.0], [-1.0, -1.0], [-1.0, 1.0], [0.0, 0.0]])
+#: The sole's bottom face sampled: its corners (along, across, in half sizes; sole.py's
+#: order) and, last, its centre.
+_SAMPLES = np.vstack([BOTTOM_CORNER_SIGNS[:, :2], np.zeros((1, 2))])
 
 
 def footprint_surface(ground: Ground, x_m: float, y_m: float, yaw_rad: float,
-                      half_size_m: tuple[float, float], hfield_geoms: frozenset[int]
+                      half_size_m: tuple[float, float], centre_height_m: float
                       ) -> tuple[float, tuple[float, float, float]] | None:
     """The height (m) at (`x_m`, `y_m`) and the unit normal of the plane a sole of
     `half_size_m` (along, across) heading `yaw_rad` rests on there, when the ground under
-    its corners and centre is all one of `hfield_geoms`; else None."""
+    its corners is all one of `ground`'s heightfields (the caller has found its centre on
+    one, at `centre_height_m`); else None."""
     cos, sin = math.cos(yaw_rad), math.sin(yaw_rad)
     offsets = _SAMPLES * np.asarray(half_size_m, dtype=float)
     dx = offsets[:, 0] * cos - offsets[:, 1] * sin
     dy = offsets[:, 0] * sin + offsets[:, 1] * cos
     heights = np.empty(len(offsets))
-    for row in range(len(offsets)):
+    heights[-1] = centre_height_m
+    for row in range(len(offsets) - 1):
         hit = ground.hit(x_m + float(dx[row]), y_m + float(dy[row]))
-        if hit.geom_id not in hfield_geoms:
+        if hit.geom_id not in ground.hfield_geoms:
             return None
         heights[row] = hit.height_m
     design = np.column_stack([np.ones(len(offsets)), dx, dy])
