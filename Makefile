@@ -7,6 +7,7 @@
 #                or a step that stands: make demo TRAJ=step_and_stand (Stepping.yaml, its gains)
 #                or Atlas walking: make demo TRAJ=walk_straight (or walk_circle; run_demo.py --help)
 #                or the VRC walking course, scored: make demo TRAJ=vrc_task_2 (vrc_walker.py)
+#                (TRAJ=vrc_task_2_laser: each leg planned on what the head's laser has seen)
 #                RTF=0.5 runs the simulator at half real time (a busy machine's late commands
 #                matter half as much in sim time); TABLE=1 lists every joint's tracking error
 #   make bench   the performance benchmark

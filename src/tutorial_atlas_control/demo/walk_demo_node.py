@@ -40,6 +40,9 @@ WALKS: dict[str, tuple[str, tuple[str, ...]]] = {
 COURSE_WALKS: dict[str, tuple[str, tuple[str, ...]]] = {
     'vrc_task_2': ("the VRC Task 2 course from the pen, gate to gate with vrc_walker.py, "
                    'scored', ('--to', 'gate_4')),
+    'vrc_task_2_laser': ("the same course walked on what the head's laser sees (vrc_walker.py "
+                         '--terrain laser: each leg planned on its height map)',
+                         ('--to', 'gate_4', '--terrain', 'laser')),
 }
 #: Wall-clock bound (s) of the course walker (the course's physics runs slower than real
 #: time on two cores: docs/vrc.md).

@@ -12,9 +12,10 @@ import pytest
 
 from tutorial_atlas_control.bags.feet import foot_displacement, foot_line
 from tutorial_atlas_control.bags.reader import BagData, JointStateSeries, PelvisSeries
-from tutorial_atlas_control.cli import run_demo
+from tutorial_atlas_control.cli import run_demo, vrc_walker
 from tutorial_atlas_control.cli.convention import EXIT_REFUSED
 from tutorial_atlas_control.demo import demo_node as demo
+from tutorial_atlas_control.demo import walk_demo_node as walk_demo
 from tutorial_atlas_control.joints import JOINT_NAMES, NUM_JOINTS
 from tutorial_atlas_control.sim.controller import DEFAULT_GAINS_FILE, GainsError, load_gains_yaml
 from tutorial_atlas_control.sim.model import load_model
@@ -185,8 +186,8 @@ def test_main_runs_the_name_with_its_gains(launched: Launched, argv: list[str], 
     (['--gains-file', '{tmp}/bad.yaml'],
      "{tmp}/bad.yaml: atlas_controller/gains/back_lbz/p is 'x', not a finite number"),
     (['jump'], "no trajectory or walk named jump in the package's trajectory files: (walks: "
-               'walk_straight, walk_twenty, walk_circle, vrc_task_2; valid names: '
-               'Traj_data2.yaml: step_and_fall, touchdown, touchdown_exhausted; '
+               'walk_straight, walk_twenty, walk_circle, vrc_task_2, vrc_task_2_laser; valid '
+               'names: Traj_data2.yaml: step_and_fall, touchdown, touchdown_exhausted; '
                f'{QUICK_STEP.name}: {", ".join(load_trajectory_file(QUICK_STEP))}; Stepping.yaml: '
                f'{", ".join(load_trajectory_file(STEPPING))}); give its file with --file'),
     (['step_and_stand', '--file', str(TUTORIAL)],
@@ -333,3 +334,10 @@ def test_atlas_launch_bag_dir_default_is_tac_bag_dir(env: dict[str, str], expect
     for name, value in env.items():
         monkeypatch.setenv(name, value)
     assert resolve_args(default, context={'arg': {}}) == expected
+
+
+@pytest.mark.parametrize('walk', sorted(walk_demo.COURSE_WALKS))
+def test_each_course_walk_is_a_command_line_vrc_walker_takes(walk: str) -> None:
+    args = vrc_walker._parser().parse_args(list(walk_demo.COURSE_WALKS[walk][1]))
+    assert args.to == 'gate_4'
+    assert args.terrain == ('laser' if walk.endswith('_laser') else 'world')
