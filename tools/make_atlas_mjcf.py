@@ -168,6 +168,13 @@ def _mirror(shapes: list[tuple]) -> list[tuple]:
 #: Foot sole: 0.26 x 0.124887 x 0.01 m box, centre 0.048 0 -0.076119 in the foot frame.
 SOLE_SIZE_M = (0.26, 0.124887, 0.01)
 SOLE_POS_M = (0.048, 0.0, -0.076119)
+#: A sphere inside each corner of a sole's bottom face, flush with it, touching heightfields
+#: only (a heightfield geom's contype holds HEIGHTFIELD_CONTACT_BIT; the spheres' conaffinity
+#: is that bit alone, their contype 0). MuJoCo collides a box with a heightfield prism by
+#: prism, one contact each where its penetration search ends: on the VRC course's flat
+#: ground a sole bore on 2-4 points near its middle and tipped about them onto its toes.
+SOLE_CORNER_RADIUS_M = 0.005
+HEIGHTFIELD_CONTACT_BIT = 4
 
 _LEFT_SHAPES: dict[str, list[tuple]] = {
     'l_uglut': [('cylinder', (0.019096, 0.078396), (0, 0, 0), (0, HALF_PI, 0)),
@@ -390,10 +397,27 @@ def body_xml(name: str, joint_name: str | None, depth: int) -> list[str]:
         quat = '' if not any(rpy) else f' quat="{fmt(np.round(rpy_to_quat(rpy), 9))}"'
         lines.append(f'{inner}<geom name="{geom_name}"{extra} type="{kind}" size="{size_text}" '
                      f'pos="{fmt(pos)}"{quat} material="{LINK_MATERIAL[name]}"/>')
+    if name.endswith('_foot'):
+        lines.extend(sole_corner_geoms(name, inner))
     lines.extend(visual_geoms(name, inner))
     for child_joint, joint in children_of(name):
         lines.extend(body_xml(joint.child, child_joint, depth + 1))
     lines.append(f'{ind}</body>')
+    return lines
+
+
+def sole_corner_geoms(foot: str, indent: str) -> list[str]:
+    """The sole's four corner spheres (SOLE_CORNER_RADIUS_M), each inside its corner of the
+    box and flush with its bottom face: front left, front right, back left, back right."""
+    half_x, half_y, half_z = (size / 2 for size in SOLE_SIZE_M)
+    radius = SOLE_CORNER_RADIUS_M
+    z = SOLE_POS_M[2] - half_z + radius
+    lines = []
+    for index, (along, across) in enumerate(((1, 1), (1, -1), (-1, 1), (-1, -1))):
+        pos = (round(SOLE_POS_M[0] + along * (half_x - radius), 9),
+               round(SOLE_POS_M[1] + across * (half_y - radius), 9), round(z, 9))
+        lines.append(f'{indent}<geom name="{foot}_sole_corner{index}" class="sole_corner" '
+                     f'type="sphere" size="{fmt((radius,))}" pos="{fmt(pos)}"/>')
     return lines
 
 
@@ -490,6 +514,16 @@ def build() -> str:
              spin freely about the weakly held hip yaw (p = 5). Standing drift
              is the same with condim 3; pyramidal cones doubled the slide. -->
         <geom condim="{FOOT_CONDIM}" friction="{fmt(FOOT_FRICTION)}" priority="1"/>
+      </default>
+      <default class="sole_corner">
+        <!-- A sphere in each corner of a sole, flush with its bottom face, touching
+             heightfields only (their contype holds bit {HEIGHTFIELD_CONTACT_BIT}): MuJoCo
+             collides a box with a heightfield one contact a prism, wherever its
+             penetration search ends, and a flat sole on the VRC course bore on a few
+             points near its middle. Massless, in a group nothing draws and no ray
+             sees (inside the box); on planes and boxes the box alone touches. -->
+        <geom contype="0" conaffinity="{HEIGHTFIELD_CONTACT_BIT}" condim="{FOOT_CONDIM}"
+              friction="{fmt(FOOT_FRICTION)}" priority="1" mass="0" group="4"/>
       </default>
       <default class="visual">
         <geom contype="0" conaffinity="0" group="1" mass="0"/>

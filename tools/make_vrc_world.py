@@ -315,8 +315,10 @@ def _box(parent: ET.Element, name: str, box: course.Box, **attributes: str) -> E
 def add_course(world: ET.Element, grey: np.ndarray) -> None:
     """The course's geoms and loose bodies in the worldbody (after the robot)."""
     hm = course.HEIGHTMAP
+    # The soles' corner spheres touch it (make_atlas_mjcf.py's HEIGHTFIELD_CONTACT_BIT).
     _sub(world, 'geom', name='terrain', type_='hfield', hfield='terrain', class_='course',
-         pos=fmt((0, 0, hm.z0_m)), material='terrain')
+         contype=str(1 | ATLAS.HEIGHTFIELD_CONTACT_BIT), pos=fmt((0, 0, hm.z0_m)),
+         material='terrain')
     _sub(world, 'geom', name='mud_ground_plane', type_='plane', class_='mud_floor',
          size=fmt((hm.size_m / 2, hm.size_m / 2, 0.1)), pos=fmt((0, 0, course.MUD_FLOOR_Z_M)),
          material='mud')

@@ -163,13 +163,14 @@ _POSE_FIELDS = ('xpos', 'xmat', 'xipos', 'ximat', 'geom_xpos', 'geom_xmat')
 
 
 def _mud_link_geoms(model: mujoco.MjModel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The mud links present (body ids), their collision geoms, and each geom's link (an
-    index into the first)."""
+    """The mud links present (body ids), their collision geoms (contype set: the soles'
+    corner spheres, which touch heightfields only, are not the links' shapes), and each
+    geom's link (an index into the first)."""
     found = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name) for name in MUD_LINKS]
     bodies = np.array([body for body in found if body >= 0], dtype=int)
     pairs = [(link, geom) for link, body in enumerate(bodies.tolist())
              for geom in range(model.ngeom) if model.geom_bodyid[geom] == body
-             and (model.geom_contype[geom] or model.geom_conaffinity[geom])]
+             and model.geom_contype[geom]]
     return (bodies, np.array([geom for _, geom in pairs], dtype=int),
             np.array([link for link, _ in pairs], dtype=int))
 
