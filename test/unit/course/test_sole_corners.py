@@ -16,6 +16,7 @@ import pytest
 from support.vrc_world import WORLD_PATH
 from tutorial_atlas_control.course import course_height_m
 from tutorial_atlas_control.sim import model
+from tutorial_atlas_control.walking import SOLE_HALF_LENGTH_M
 
 #: Where a flat left sole bore on two points 5 cm apart (finals_rubble, seed 11, at 65.1 s):
 #: its centre (m) and heading (rad).
@@ -23,8 +24,6 @@ RUBBLE_SOLE_XY = (6.344, 13.714)
 RUBBLE_YAW_RAD = 1.629
 #: How far the soles are pressed into the ground (m): a standing sole's sinking.
 PRESS_M = 0.0004
-#: The sole box's half length (m): a bearing spread over the sole reaches near both ends.
-SOLE_HALF_LENGTH_M = 0.13
 
 
 def _corner_geoms(m: mujoco.MjModel) -> list[int]:
