@@ -30,7 +30,7 @@ sole clamp, the whole body, the swing servo, the effort limits) are one C call a
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -53,7 +53,8 @@ from tutorial_atlas_control.walking.compiled_swing import CompiledSwing
 from tutorial_atlas_control.walking.footsteps import Footstep, wrap_angle
 from tutorial_atlas_control.walking.swing import SwingPath, quintic, sole_frame, surface_tilt
 
-__all__ = ['LEGS_ENV', 'LEG_JOINTS', 'SWING_ENV', 'LegGains', 'LegTasks', 'foot_pose', 'sole_flat']
+__all__ = ['LEGS_ENV', 'LEG_JOINTS', 'SWING_ENV', 'LegGains', 'LegTasks', 'foot_pose', 'sole_flat',
+           'standing_pose']
 
 #: Set to `python` for the swing servo in Python even where the compiled library is built.
 SWING_ENV = 'TAC_SWING'
@@ -130,6 +131,21 @@ def foot_pose(state: BalanceState, foot: int, step_index: int = 0) -> Footstep:
     centre = state.sole_centres[foot]
     return Footstep(step_index, foot, float(centre[0]), float(centre[1]),
                     yaw_of(state.sole_rotations[foot]), z_m=float(centre[2]))
+
+
+def standing_pose(state: BalanceState, foot: int,
+                  ground_normal: tuple[float, float, float] = (0.0, 0.0, 1.0)) -> Footstep:
+    """Where a foot stands as a walk or a step begins, as a step on the surface it rests on:
+    a sole that carries lies on that surface, so its own plane is the surface (the ground's
+    normal under the sole's centre is one facet of a heightfield, on the course's hills 6
+    degrees off the plane a planted sole rested on: the put-down servo then pressed the sole
+    onto the facet, its pressure centre went astray and the robot fell in its first sway);
+    a sole that does not carry, the ground's `ground_normal` under it."""
+    normal = ground_normal
+    if state.in_contact[foot]:
+        x, y, z = state.sole_rotations[foot][:, 2].tolist()
+        normal = (x, y, z) if z > 0.0 else ground_normal
+    return replace(foot_pose(state, foot), normal=normal)
 
 
 def sole_flat(state: BalanceState, foot: int, pose: Footstep, height_m: float,

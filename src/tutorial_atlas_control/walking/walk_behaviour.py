@@ -7,18 +7,19 @@ before the start from an AtlasSimInterfaceCommand's queue) or, without them, its
 steps (DRCSim's fixed queue: /atlas/control_mode Walk). Steps offered while it walks
 join the queue by index. Once the walk has caught itself after its last step it is
 `done`: the interface then hands the robot back to Stand. The feet stand on the ground
-under their soles (its height and normal, from the Stand's ground), and each tick the
-estimator's pendulum ground moves with the walk's support height (feet_surfaces) from where
-it was as the walk began: on a slope omega follows the CoM's height over the feet as they
-rise or fall, not over z 0; it stays there for the Stand after. (Set to the support's own
-height instead, a walk begun on the course's level ground at z 0.03 landed its steps 13 cm
-ahead on average: the walk's gains were found with omega over z 0.)
+under their soles (its height from the Stand's ground; a carrying sole on its own plane,
+leg_tasks.standing_pose), and each tick the estimator's pendulum ground moves with the
+walk's support height (feet_surfaces) from where it was as the walk began: on a slope omega
+follows the CoM's height over the feet as they rise or fall, not over z 0; it stays there
+for the Stand after. (Set to the support's own height instead, a walk begun on the
+course's level ground at z 0.03 landed its steps 13 cm ahead on average: the walk's gains
+were found with omega over z 0.)
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import mujoco
 import numpy as np
@@ -27,7 +28,7 @@ from tutorial_atlas_control.balance import JOINTS_IN_CALL, BalanceState, StandBe
 from tutorial_atlas_control.walking.errors import WalkingError
 from tutorial_atlas_control.walking.feet_surfaces import support_height_m
 from tutorial_atlas_control.walking.footsteps import DRCSIM_WALK_QUEUE, Footstep
-from tutorial_atlas_control.walking.leg_tasks import foot_pose
+from tutorial_atlas_control.walking.leg_tasks import standing_pose
 from tutorial_atlas_control.walking.status_flags import STEPPING
 from tutorial_atlas_control.walking.step_queue import DEFAULT_LIMITS, StepLimits, StepQueue
 from tutorial_atlas_control.walking.walk import WalkController, WalkGains
@@ -100,8 +101,8 @@ class WalkBehaviour:
         # The pendulum's ground moves with the feet's support from where it is now.
         self.pendulum_offset_m = (stand.estimator.ground_m
                                   - support_height_m(under[0][0], under[1][0]))
-        queue = StepQueue(*(replace(foot_pose(state, foot), normal=under[foot][1])
-                            for foot in (0, 1)), self.limits)
+        queue = StepQueue(*(standing_pose(state, foot, under[foot][1]) for foot in (0, 1)),
+                          self.limits)
         queue.offer(self.default_steps if self.next_steps is None else self.next_steps)
         self.next_steps = None
         self.walk = WalkController(controller, queue, state, float(data.time), self.gains,
