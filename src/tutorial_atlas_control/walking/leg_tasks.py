@@ -134,18 +134,20 @@ def foot_pose(state: BalanceState, foot: int, step_index: int = 0) -> Footstep:
 
 
 def standing_pose(state: BalanceState, foot: int,
-                  ground_normal: tuple[float, float, float] = (0.0, 0.0, 1.0)) -> Footstep:
-    """Where a foot stands as a walk or a step begins, as a step on the surface it rests on:
-    a sole that carries lies on that surface, so its own plane is the surface (the ground's
-    normal under the sole's centre is one facet of a heightfield, on the course's hills 6
-    degrees off the plane a planted sole rested on: the put-down servo then pressed the sole
-    onto the facet, its pressure centre went astray and the robot fell in its first sway);
-    a sole that does not carry, the ground's `ground_normal` under it."""
+                  ground_normal: tuple[float, float, float] = (0.0, 0.0, 1.0),
+                  step_index: int = 0) -> Footstep:
+    """Where a foot stands as a walk begins or a swing lands, as a step on the surface it
+    rests on: a sole that carries lies on that surface, so its own plane is the surface (the
+    ground's normal under the sole's centre is one facet of a heightfield, on the course's
+    hills 6 degrees off the plane a planted sole rested on, and a step's planned plane was 4
+    degrees off the one its sole came to rest on: the put-down servo then pressed the sole
+    onto the wrong plane, its pressure centre went astray or its toe slammed, and the robot
+    fell); a sole that does not carry, the ground's `ground_normal` under it."""
     normal = ground_normal
     if state.in_contact[foot]:
         x, y, z = state.sole_rotations[foot][:, 2].tolist()
         normal = (x, y, z) if z > 0.0 else ground_normal
-    return replace(foot_pose(state, foot), normal=normal)
+    return replace(foot_pose(state, foot, step_index), normal=normal)
 
 
 def sole_flat(state: BalanceState, foot: int, pose: Footstep, height_m: float,

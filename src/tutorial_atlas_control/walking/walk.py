@@ -6,7 +6,8 @@ the whole wrench, the other foot swings to its target along swing.SwingPath), th
 catch (both feet down, the capture point brought to rest between them), after which
 Stand takes over. Each step begins with a weight transfer (phases.WeightTransfer): both
 feet carry, the pressure centre moves over to the sole that has just landed in 0.03 s (a
-foot servo pressing that sole flat on its step's surface), and the other foot lifts once
+foot servo pressing that sole flat on the surface it landed on: the plane it rests on once
+it carries, else its step's), and the other foot lifts once
 that sole is flat and carries half the weight, or after at most 0.1 s; the swing then
 takes the rest of the step's duration, so the step ends when planned and the capture
 point's plan, made at the step's start over the step's whole duration, stays the reference
@@ -47,7 +48,12 @@ from tutorial_atlas_control.walking.compiled_walk_swing import (
 from tutorial_atlas_control.walking.dcm_plan import DcmPlan
 from tutorial_atlas_control.walking.feet_surfaces import FeetSurfaces
 from tutorial_atlas_control.walking.footsteps import Footstep
-from tutorial_atlas_control.walking.leg_tasks import LegGains, LegTasks, foot_pose, sole_flat
+from tutorial_atlas_control.walking.leg_tasks import (
+    LegGains,
+    LegTasks,
+    sole_flat,
+    standing_pose,
+)
 from tutorial_atlas_control.walking.phases import (
     WALK_PHASES,
     Phase,
@@ -282,8 +288,7 @@ class WalkController:
                 time_s, _phase_over(phases.phase, step, state, self.gains.at_rest_m))):
             return
         if phases.phase is _SWING and step is not None:
-            landed = replace(foot_pose(state, step.foot_index, step.step_index),
-                             normal=step.normal)  # on its step's surface
+            landed = standing_pose(state, step.foot_index, step.normal, step.step_index)
             self.queue.touchdown(landed)
             self._landed = replace(landed, z_m=step.z_m)
         following = phases.following(more_steps=bool(self.queue.preview()))
