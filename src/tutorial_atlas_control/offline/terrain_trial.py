@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 import tempfile
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import mujoco
@@ -121,6 +121,10 @@ class Terrain:
     #: Stairs (m, each riser; negative: down from a landing; stairs_model): STAIR_COUNT
     #: steps of STAIR_TREAD_M from RAMP_START_M ahead.
     stair_rise_m: float = 0.0
+    #: How much steeper along +x than the ground the steps' surfaces are planned (rad;
+    #: negative: shallower): a height map's plane a few degrees off the ground's, as the
+    #: course's footprint planes were on its hills.
+    surface_error_rad: float = 0.0
 
 
 #: The cases by name: 10 m through the mud at DRCSim's and the finals' damping, in strides
@@ -258,7 +262,19 @@ def terrain_plan(terrain: Terrain, ground: Ground) -> list[Footstep]:
                              GroundGait(stride_m=terrain.stride_m))
     else:
         steps = straight_steps(terrain.steps, terrain.stride_m)
-    return on_ground(steps, ground)
+    placed = on_ground(steps, ground)
+    if terrain.surface_error_rad == 0.0:
+        return placed
+    return [replace(step, normal=_pitched(step.normal, terrain.surface_error_rad))
+            for step in placed]
+
+
+def _pitched(normal: tuple[float, float, float],
+             steeper_rad: float) -> tuple[float, float, float]:
+    """`normal` turned about y so that its surface rises `steeper_rad` more along +x."""
+    x, y, z = normal
+    cos, sin = math.cos(steeper_rad), math.sin(steeper_rad)
+    return (cos * x - sin * z, y, sin * x + cos * z)
 
 
 def planned_steps(terrain: Terrain) -> int:
