@@ -20,6 +20,6 @@ __all__, __getattr__, __dir__ = lazy_exports(__name__, {
     'teleop': ['Settings', 'ego_steps', 'key_action'],
     'user_behaviour': ['UserBehaviourError', 'load_user_behaviour'],
     'walk_client': ['Outcome', 'WalkClient', 'refusal_hint'],
-    'walk_params': ['step_data_of'],
+    'walk_params': ['step_data_of', 'walk_command'],
     'walk_demo': ['Decision', 'WalkDemoServer', 'yaw_of_quaternion'],
 })

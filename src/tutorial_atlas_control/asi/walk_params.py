@@ -13,13 +13,22 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import replace
 
-from tutorial_atlas_control.msgs import STEP_QUEUE_LENGTH, StepData, StepFeedback, WalkFeedback
+from tutorial_atlas_control.asi.behaviors import Behavior
+from tutorial_atlas_control.msgs import (
+    STEP_QUEUE_LENGTH,
+    AsiCommand,
+    ManipulateParams,
+    StepData,
+    StepFeedback,
+    WalkFeedback,
+)
 from tutorial_atlas_control.walking import SWING_HEIGHT_M, Footstep, StepStatus, WalkStatus
 
-__all__ = ['footsteps_of', 'sole_step', 'step_data_of', 'step_feedback', 'walk_feedback']
+__all__ = ['footsteps_of', 'sole_step', 'step_data_of', 'step_feedback', 'walk_command',
+           'walk_feedback']
 
 
 def _ahead(x_m: float, y_m: float, yaw_rad: float, ahead_m: float) -> tuple[float, float]:
@@ -55,6 +64,18 @@ def step_data_of(step: Footstep, sole_ahead_m: float) -> StepData:
     half = 0.5 * step.yaw_rad
     return StepData(step.step_index, step.foot_index, step.duration_s, (link.x_m, link.y_m, 0.0),
                     (0.0, 0.0, math.sin(half), math.cos(half)), SWING_HEIGHT_M)
+
+
+def walk_command(link_steps: Sequence[Footstep]) -> AsiCommand:
+    """A WALK of up to four steps, each at its foot link's pose (as WalkClient gives them),
+    the rest of the queue empty: what an offline client applies to the interface."""
+    if len(link_steps) > STEP_QUEUE_LENGTH:
+        raise ValueError(f'a WALK carries at most {STEP_QUEUE_LENGTH} steps, '
+                         f'not {len(link_steps)}')
+    queue = [step_data_of(step, 0.0) for step in link_steps]
+    queue += [StepData()] * (STEP_QUEUE_LENGTH - len(queue))
+    return AsiCommand(0, Behavior.WALK, tuple(queue), False, StepData(), False,
+                      ManipulateParams(), None, 0)
 
 
 def walk_feedback(status: WalkStatus, sole_ahead_m: float) -> WalkFeedback:

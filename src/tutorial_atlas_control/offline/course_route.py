@@ -31,10 +31,9 @@ import numpy as np
 
 from tutorial_atlas_control.asi import (
     AtlasSimInterface,
-    Behavior,
     Outcome,
     WalkClient,
-    step_data_of,
+    walk_command,
     yaw_of_quaternion,
 )
 from tutorial_atlas_control.course import (
@@ -54,7 +53,6 @@ from tutorial_atlas_control.course import (
     rest_of_leg,
     sole_clearances_m,
 )
-from tutorial_atlas_control.msgs import AsiCommand, ManipulateParams, StepData
 from tutorial_atlas_control.offline.course_variant import variant_model
 from tutorial_atlas_control.offline.laser_terrain import (
     LaserLegFigures,
@@ -76,7 +74,6 @@ from tutorial_atlas_control.sim import (
 from tutorial_atlas_control.stepping import CourseScoring, Tick
 from tutorial_atlas_control.units import NS_PER_S
 from tutorial_atlas_control.walking import (
-    QUEUE_LENGTH,
     SOLE_HALF_LENGTH_M,
     SOLE_HALF_WIDTH_M,
     Footstep,
@@ -230,10 +227,7 @@ class _Streamer:
 
     def before_step(self) -> None:
         if self.pending is not None:
-            queue = [step_data_of(step, 0.0) for step in self.pending]  # the links' poses
-            queue += [StepData()] * (QUEUE_LENGTH - len(queue))
-            self.interface.apply(AsiCommand(0, Behavior.WALK, tuple(queue), False, StepData(),
-                                            False, ManipulateParams(), None, 0))
+            self.interface.apply(walk_command(self.pending))  # the links' poses
             self.pending = None
 
     def after_step(self) -> None:

@@ -1,6 +1,6 @@
 """A WALK's queue as the soles' footsteps and walk_feedback back as the foot links' poses:
 unused slots skipped, the sole's offset along each step's heading, four slots reported;
-step_feedback alike, empty before the first step."""
+step_feedback alike, empty before the first step; an offline client's WALK of link poses."""
 
 from __future__ import annotations
 
@@ -8,10 +8,12 @@ import math
 
 import pytest
 
+from tutorial_atlas_control.asi import Behavior
 from tutorial_atlas_control.asi.walk_params import (
     footsteps_of,
     step_data_of,
     step_feedback,
+    walk_command,
     walk_feedback,
 )
 from tutorial_atlas_control.msgs.atlas_sim_interface import StepData
@@ -53,3 +55,18 @@ def test_step_feedback_gives_the_step_as_clamped_as_its_foot_link() -> None:
     assert feedback.desired_step_saturated.position_m == pytest.approx((0.3, -0.12, 0.0))
     assert step_feedback(StepStatus(1, 0.0, 0, 1, None), AHEAD_M).desired_step_saturated \
         == StepData()
+
+
+def test_a_walk_command_carries_the_links_poses_in_four_slots() -> None:
+    steps = [Footstep(7, 1, 1.0, -0.1, 0.0, 0.5), Footstep(8, 0, 1.2, 0.1, 0.0, 0.5)]
+    command = walk_command(steps)
+    assert command.behavior == Behavior.WALK
+    assert [slot.step_index for slot in command.step_queue] == [7, 8, 0, 0]
+    assert command.step_queue[1].position_m == (1.2, 0.1, 0.0)  # the link's, not moved
+    assert footsteps_of(command.step_queue, 0.0) == steps
+
+
+def test_a_walk_command_takes_at_most_four_steps() -> None:
+    steps = [Footstep(k, k % 2, 0.1 * k, 0.0, 0.0) for k in range(1, 6)]
+    with pytest.raises(ValueError, match='at most 4 steps, not 5'):
+        walk_command(steps)

@@ -19,10 +19,9 @@ import numpy as np
 import pytest
 
 from support.vrc_world import WORLD_PATH
-from tutorial_atlas_control.asi import AtlasSimInterface, Behavior, step_data_of
+from tutorial_atlas_control.asi import AtlasSimInterface, Behavior, walk_command
 from tutorial_atlas_control.asi.walk_client import Outcome, WalkClient
 from tutorial_atlas_control.balance import sole_geom_ids
-from tutorial_atlas_control.msgs import AsiCommand, ManipulateParams, StepData
 from tutorial_atlas_control.sim import (
     DEFAULT_GAINS_FILE,
     AtlasSimulator,
@@ -30,7 +29,7 @@ from tutorial_atlas_control.sim import (
     load_gains_yaml,
     model,
 )
-from tutorial_atlas_control.walking import QUEUE_LENGTH, SWAYING, Footstep
+from tutorial_atlas_control.walking import SWAYING, Footstep
 from tutorial_atlas_control.walking.leg_tasks import standing_pose
 
 #: The pelvis's free joint (x y z, quaternion w x y z) and the 28 joints (rad, JOINT_NAMES'
@@ -46,13 +45,6 @@ STEPS = ((0, 6.115, -0.843), (1, 6.389, -0.903), (0, 6.314, -0.633), (1, 6.588, 
          (0, 6.513, -0.422), (1, 6.787, -0.483))
 STAND_FIRST_S = 0.8
 LONGEST_WALK_S = 10.0
-
-
-def _walk_command(steps: list[Footstep]) -> AsiCommand:
-    queue = [step_data_of(step, 0.0) for step in steps]  # the foot links' poses
-    queue += [StepData()] * (QUEUE_LENGTH - len(queue))
-    return AsiCommand(0, Behavior.WALK, tuple(queue), False, StepData(), False,
-                      ManipulateParams(), None, 0)
 
 
 @dataclass(frozen=True)
@@ -98,7 +90,7 @@ def walk_on_the_hill() -> HillWalk:
         if client.outcome is not None:
             break
         if steps:
-            interface.apply(_walk_command(steps))
+            interface.apply(walk_command(steps))
         if state.current_behavior == Behavior.WALK and state.walk_feedback.status_flags == SWAYING:
             slide = np.maximum(slide, np.hypot(*(_soles_xy(sim, soles) - before).T))
         sim.step()
