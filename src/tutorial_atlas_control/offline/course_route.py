@@ -79,14 +79,15 @@ from tutorial_atlas_control.walking import (
     Footstep,
     HeightField,
     RouteGait,
+    WalkGains,
     centre_line_xy,
     feet_origin,
     perturb_start,
     route_steps,
 )
 
-__all__ = ['PLANNING_GROUNDS', 'CourseWalk', 'LegFigures', 'around_blocks', 'course_walk',
-           'leg_plan', 'resumed_leg']
+__all__ = ['PLANNING_GROUNDS', 'WALK_OVERHEAD_S', 'CourseWalk', 'LegFigures', 'around_blocks',
+           'course_walk', 'leg_plan', 'resumed_leg', 'walk_time_limit_s']
 
 #: The grounds a walker plans on: the world's (offline: MuJoCo's rays on the world) or its
 #: head laser's height map (laser_terrain.py).
@@ -98,6 +99,10 @@ MAX_LOOKS = 12
 FALL_CHECK_TICKS = 10
 #: A route's steps may take this long each, on average, before the run gives up (s).
 SECONDS_PER_STEP = 0.9
+#: A walk's own time besides its steps (s): the sway onto the first stance foot and the
+#: longest catch after the last. Without it a look of four steep steps (0.9 s each) ran out
+#: of time while the robot caught itself, and the run stopped at that leg's end, standing.
+WALK_OVERHEAD_S = WalkGains().sway_s + WalkGains().longest_catch_s
 #: The lowest CoM height (m over the ground) the capture point's LIPM frequency is taken at.
 LOWEST_LIPM_HEIGHT_M = 0.3
 GRAVITY_M_S2 = 9.81
@@ -385,8 +390,8 @@ def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,
               ) -> tuple[WalkClient, int, int]:
     """One leg planned from where the feet are now (around `blocks` across the rubble) on
     the world's ground or the laser's map (its figures appended to `laser_legs`), streamed
-    until it ends, the robot falls or the leg's time (SECONDS_PER_STEP a step) runs out. On
-    the map, only as far as it has seen (seen_prefix): there the robot stands LEG_PAUSE_S,
+    until it ends, the robot falls or a walk's time (walk_time_limit_s) runs out. On the
+    map, only as far as it has seen (seen_prefix): there the robot stands LEG_PAUSE_S,
     looking, and the rest is planned again. Returns the last walk's client and the steps
     sent and taken over the leg."""
     gait = gait or RouteGait()
@@ -409,7 +414,7 @@ def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,
                 ground))
             walked = seen_prefix(plan, streamer.laser.map, level_footstep(ground))
         client = streamer.client = WalkClient(plan[:walked], streaming=True)
-        limit_ns = sim.sim_time_ns + math.floor(walked * SECONDS_PER_STEP * NS_PER_S)
+        limit_ns = sim.sim_time_ns + math.floor(walk_time_limit_s(walked) * NS_PER_S)
         while client.outcome is None and streamer.fell_at_s is None \
                 and sim.sim_time_ns < limit_ns:
             tick()
@@ -417,6 +422,12 @@ def _walk_leg(tick: Tick, sim: AtlasSimulator, interface: AtlasSimInterface,
         if walked == len(plan) or client.outcome is not Outcome.WALKED:
             break
     return client, sent, taken
+
+
+def walk_time_limit_s(steps: int) -> float:
+    """How long (s of sim time) a walk of `steps` steps may take before the run gives up
+    on it: SECONDS_PER_STEP a step and the walk's sway and catch (WALK_OVERHEAD_S)."""
+    return steps * SECONDS_PER_STEP + WALK_OVERHEAD_S
 
 
 def _run_until(tick: Tick, sim: AtlasSimulator, until_s: float, streamer: _Streamer) -> None:
