@@ -4,7 +4,7 @@ measurement behind docs/vrc.md's figures for the walk to gate_1.
 
     python3 tools/course_walk.py [--to GATE | --waypoints 'X,Y X,Y ...'] [--stride M]
                                  [--no-fit-ground] [--world NAME] [--variant NAME]
-                                 [--terrain world|laser] SEED ...
+                                 [--terrain world|laser] [--mud-damping C] SEED ...
 
 The walk is vrc_walker.py's, offline: the course's legs (course/legs.py) from the world's
 start to --to (default gate_1), each planned from where the feet are as it begins; or one
@@ -13,6 +13,8 @@ planned on the world's ground (walking/ground_strides.py); --no-fit-ground: equa
 --variant: one of the finals' changes to the course (course/variants.py; default the world
 as shipped). --terrain laser: each leg planned on the head laser's height map of what it
 has seen so far, the spindle spinning (offline/laser_terrain.py; docs/sensors.md).
+--mud-damping C: the mud's damping (N s/m) instead of the world's or the variant's: the
+margin of a walk through the pit, between the qualification's 40 and the finals' 70.
 SEED is an integer (walking/start_noise.py's perturbed start) or `none` (the start as the
 world gives it). Each walk prints one JSON line (offline/course_route.py's CourseWalk) as it
 ends; a run costs about 300-500 s of CPU on this host (the course's physics). Run it under
@@ -28,7 +30,14 @@ import json
 import sys
 
 from tutorial_atlas_control.cli.convention import seed_or_none
-from tutorial_atlas_control.course import COURSE_VARIANTS, GATES, Leg, course_variant
+from tutorial_atlas_control.course import (
+    COURSE_VARIANTS,
+    GATES,
+    CourseVariant,
+    Leg,
+    check_mud_damping,
+    course_variant,
+)
 from tutorial_atlas_control.errors import AtlasControlError
 from tutorial_atlas_control.offline import PLANNING_GROUNDS, course_walk
 from tutorial_atlas_control.walking import RouteGait
@@ -49,6 +58,25 @@ def _waypoints(text: str) -> tuple[tuple[float, float], ...]:
     return tuple(points)
 
 
+def _mud_damping(text: str) -> float:
+    try:
+        return check_mud_damping(float(text))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'mud damping must be a finite number >= 0 (N s/m), '
+                                         f'got {text!r}') from None
+    except AtlasControlError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+
+
+def _variant(name: str | None, mud_damping: float | None) -> CourseVariant | None:
+    """The variant named (None: the world as shipped), its mud's damping `mud_damping` if
+    given."""
+    variant = None if name is None else course_variant(name)
+    if mud_damping is None:
+        return variant
+    return (variant or COURSE_VARIANTS[0]).with_mud_damping(mud_damping)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog=PROG, description=__doc__.split('\n\n')[0])
     parser.add_argument('seeds', type=seed_or_none, nargs='+', metavar='SEED')
@@ -66,6 +94,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--world', default='vrc_task_2', help='a VRC Task 2 world name')
     parser.add_argument('--variant', choices=[v.name for v in COURSE_VARIANTS], default=None,
                         help="one of the VRC finals' changes to the course")
+    parser.add_argument('--mud-damping', type=_mud_damping, default=None, metavar='C',
+                        help="the mud's damping (N s/m and N m s/rad) instead of the world's "
+                        "or the variant's (the qualification's 40, the finals' 70)")
     args = parser.parse_args(argv)
     try:
         gait = RouteGait(stride_m=args.stride, fit_ground=args.fit_ground)
@@ -76,7 +107,7 @@ def main(argv: list[str] | None = None) -> int:
         try:
             legs = None if args.waypoints is None else [Leg('route', args.waypoints)]
             walk = course_walk(seed, legs, args.to, args.world, gait,
-                               variant=args.variant and course_variant(args.variant),
+                               variant=_variant(args.variant, args.mud_damping),
                                terrain=args.terrain)
         except AtlasControlError as err:
             print(f'{PROG}: {err}', file=sys.stderr)

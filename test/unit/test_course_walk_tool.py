@@ -1,5 +1,5 @@
-"""tools/course_walk.py's arguments: a bad seed, waypoint, gate, stride or world is one line
-and exit status 2, before any physics runs."""
+"""tools/course_walk.py's arguments: a bad seed, waypoint, gate, stride, world or mud damping
+is one line and exit status 2, before any physics runs."""
 
 from __future__ import annotations
 
@@ -21,6 +21,10 @@ TOOL = Path(__file__).resolve().parents[2] / 'tools' / 'course_walk.py'
     (['--world', 'nowhere', 'none'],
      "course_walk.py: unknown world 'nowhere'; the VRC Task 2 worlds are vrc_task_2, "
      'vrc_task_2_mud_start, vrc_task_2_uneven_start, vrc_task_2_rubble_start'),
+    (['--mud-damping', 'forty', '1'], "course_walk.py: error: argument --mud-damping: mud "
+     "damping must be a finite number >= 0 (N s/m), got 'forty'"),
+    (['--mud-damping=-1', '1'], "course_walk.py: error: argument --mud-damping: mud damping "
+     "must be a finite number >= 0 (N s/m), got '-1'"),
     (['--stride', '-1', '1'], 'course_walk.py: error: a route gait needs positive finite '
      'numbers (a turning stride of 0 turns in place): RouteGait(stride_m=-1.0, '
      'turn_step_rad=0.2, turn_stride_m=0.08, width_m=0.24, duration_s=0.63, fit_ground=True, '

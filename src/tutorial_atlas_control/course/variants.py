@@ -19,6 +19,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from tutorial_atlas_control.course.errors import CourseError
+from tutorial_atlas_control.course.mud import check_mud_damping
 from tutorial_atlas_control.course.rubble_way import footprints_within
 from tutorial_atlas_control.course.vrc_task_2 import (
     BLOCKS,
@@ -59,6 +60,19 @@ class CourseVariant:
         """The rubble's 30 blocks in this variant."""
         return BLOCKS if self.rubble_seed is None else rearranged_blocks(BLOCKS,
                                                                          self.rubble_seed)
+
+    def with_mud_damping(self, damping: object) -> CourseVariant:
+        """This variant with the mud's damping `damping` (N s/m) instead, named so
+        (`<name>+mud_damping=<c>`): how far a walk is from falling in the mud is found by
+        walking it at dampings between the qualification's and the finals'.
+
+        Raises:
+            CourseError: not a finite number, negative or absurd (course.check_mud_damping).
+        """
+        value = check_mud_damping(damping)
+        return replace(self, name=f'{self.name}+mud_damping={value:g}',
+                       description=f'{self.description}; the mud\'s damping {value:g} N s/m',
+                       mud_damping=value)
 
 
 #: The qualification's course and the finals' three changes a walker meets, one each.

@@ -37,6 +37,22 @@ def test_each_finals_variant_changes_one_thing() -> None:
     assert course_variant('finals_mud_damping').mud_damping == MUD_DAMPING_FINALS
 
 
+def test_a_variant_with_another_mud_damping_changes_only_that_and_says_so() -> None:
+    rubble = course_variant('finals_rubble')
+    muddier = rubble.with_mud_damping(55)
+    assert muddier.name == 'finals_rubble+mud_damping=55'
+    assert muddier.mud_damping == 55.0
+    assert (muddier.mud_floor_friction, muddier.rubble_seed, muddier.blocks) == (
+        rubble.mud_floor_friction, rubble.rubble_seed, rubble.blocks)
+    assert rubble.mud_damping == MUD_DAMPING  # the variant itself is unchanged
+
+
+@pytest.mark.parametrize('damping', [-1.0, math.nan, math.inf, 'forty', True])
+def test_a_variant_refuses_a_mud_damping_that_is_not_one(damping: object) -> None:
+    with pytest.raises(CourseError, match=r'^mud damping must be a finite number >= 0'):
+        course_variant('qualification').with_mud_damping(damping)
+
+
 def test_the_rubble_is_rearranged_the_same_way_by_the_same_seed() -> None:
     again = rearranged_blocks(BLOCKS, 7)
     assert again == rearranged_blocks(BLOCKS, 7)
